@@ -1,0 +1,192 @@
+# proxima - plain GNU make.  `make help` lists targets and variables.
+
+# ---- overridable ---------------------------------------------------------
+CC       ?= cc
+PREFIX   ?= /usr/local
+DESTDIR  ?=
+LIBDIR   ?= $(PREFIX)/lib
+INCLUDEDIR ?= $(PREFIX)/include
+BINDIR   ?= $(PREFIX)/bin
+BUILD    ?= build
+OPTFLAGS ?= -O2 -g
+CFLAGS   ?=
+LDFLAGS  ?=
+SAN      ?=
+# Per-test time limit (seconds) used by the test runner.
+TEST_TIMEOUT ?= 900
+
+# ---- fixed ---------------------------------------------------------------
+NAME    := proxima
+VERSION := $(shell sed -n 's/^\#define PX_VERSION_STRING "\(.*\)"/\1/p' core/px_base.h)
+SOMAJOR := $(firstword $(subst ., ,$(VERSION)))
+
+MODULE_DIRS := core geom rt devices config
+WARN    := -Wall -Wextra -Wshadow -Wstrict-prototypes -Werror
+INCS    := $(addprefix -I,$(MODULE_DIRS))
+BASE_CFLAGS := -std=c11 -D_GNU_SOURCE $(WARN) $(INCS) -fvisibility=hidden -MMD -MP
+
+ifeq ($(SAN),1)
+OPTFLAGS := -O1 -g -fno-omit-frame-pointer
+SANFLAGS := -fsanitize=address,undefined -fno-sanitize-recover=all
+# The sanitizer runtime owns malloc; the test allocation counter wraps it.
+WRAP     := -Wl,--wrap=malloc,--wrap=calloc,--wrap=realloc,--wrap=free \
+            -Wl,--wrap=posix_memalign,--wrap=aligned_alloc,--wrap=memalign
+TEST_DEFS := -DPX_ALLOC_WRAP
+# Setup paths must see allocation failure as NULL (PX_E_NOMEM), not abort.
+export ASAN_OPTIONS ?= allocator_may_return_null=1:detect_leaks=1
+export UBSAN_OPTIONS ?= print_stacktrace=1:halt_on_error=1
+endif
+
+ALL_CFLAGS := $(BASE_CFLAGS) $(OPTFLAGS) $(SANFLAGS) $(CFLAGS)
+ALL_LDFLAGS := $(SANFLAGS) $(LDFLAGS)
+
+# Optional libraries found with pkg-config (device back ends, config).
+PKGS     :=
+PKG_CFLAGS := $(if $(PKGS),$(shell pkg-config --cflags $(PKGS)))
+PKG_LIBS   := $(if $(PKGS),$(shell pkg-config --libs $(PKGS)))
+LIBS    := $(PKG_LIBS) -lm -lpthread
+
+# ---- sources -------------------------------------------------------------
+LIB_SRC  := $(foreach d,$(MODULE_DIRS),$(wildcard $(d)/*.c))
+LIB_OBJ  := $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC))
+PUB_HDRS := $(filter-out %/internal.h,$(foreach d,$(MODULE_DIRS),$(wildcard $(d)/px*.h)))
+
+TEST_SUPPORT_SRC := $(wildcard tests/px_*.c)
+TEST_SUPPORT_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(TEST_SUPPORT_SRC))
+TEST_SRC := $(wildcard tests/test_*.c)
+TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
+TEST_SH  := $(wildcard tests/test_*.sh)
+
+TOOL_SUPPORT_SRC := $(wildcard tools/tool_*.c)
+TOOL_SUPPORT_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(TOOL_SUPPORT_SRC))
+TOOL_SRC := $(wildcard tools/proxima-*.c)
+TOOL_BIN := $(patsubst tools/%.c,$(BUILD)/bin/%,$(TOOL_SRC))
+
+BENCH_SRC := $(wildcard bench/bench_*.c)
+BENCH_BIN := $(patsubst bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
+
+STATIC_LIB := $(BUILD)/lib/lib$(NAME).a
+SHARED_LIB := $(BUILD)/lib/lib$(NAME).so.$(VERSION)
+PC_FILE    := $(BUILD)/lib/pkgconfig/$(NAME).pc
+
+# Debian packages that building and testing need (see `make deps`).
+DEB_PACKAGES := gcc make libc6-dev pkg-config
+
+FORCE:
+
+.PHONY: FORCE all lib tools tests benches test bench sanitize install uninstall \
+        clean help deps check-deps
+
+all: lib tools
+
+# Keep objects made by chained pattern rules.
+.SECONDARY:
+
+# Keep objects made by chained pattern rules.
+.SECONDARY:
+
+lib: $(STATIC_LIB) $(SHARED_LIB) $(PC_FILE)
+
+tools: $(TOOL_BIN)
+
+tests: $(TEST_BIN)
+
+benches: $(BENCH_BIN)
+
+# ---- rules ---------------------------------------------------------------
+$(BUILD)/obj/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) $(PKG_CFLAGS) -fPIC $(TEST_DEFS) -c $< -o $@
+
+$(STATIC_LIB): $(LIB_OBJ)
+	@mkdir -p $(dir $@)
+	rm -f $@
+	ar rcs $@ $^
+
+$(SHARED_LIB): $(LIB_OBJ)
+	@mkdir -p $(dir $@)
+	$(CC) -shared -Wl,-soname,lib$(NAME).so.$(SOMAJOR) $(ALL_LDFLAGS) -o $@ $^ $(LIBS)
+	ln -sf lib$(NAME).so.$(VERSION) $(BUILD)/lib/lib$(NAME).so.$(SOMAJOR)
+	ln -sf lib$(NAME).so.$(SOMAJOR) $(BUILD)/lib/lib$(NAME).so
+
+# Regenerated every time: it records PREFIX/LIBDIR, which may change per call.
+$(PC_FILE): FORCE
+	@mkdir -p $(dir $@)
+	printf '%s\n' 'prefix=$(PREFIX)' 'libdir=$(LIBDIR)' 'includedir=$(INCLUDEDIR)' '' \
+	  'Name: $(NAME)' \
+	  'Description: real-time distance queries and control loops for haptics and robotics' \
+	  'Version: $(VERSION)' \
+	  'Requires.private: $(PKGS)' \
+	  'Cflags: -I$${includedir}/$(NAME)' \
+	  'Libs: -L$${libdir} -l$(NAME)' \
+	  'Libs.private: -lm -lpthread' > $@
+
+$(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT_OBJ) $(STATIC_LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_LDFLAGS) $(WRAP) -o $@ $< $(TEST_SUPPORT_OBJ) $(STATIC_LIB) $(LIBS)
+
+$(BUILD)/bin/%: $(BUILD)/obj/tools/%.o $(TOOL_SUPPORT_OBJ) $(STATIC_LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_LDFLAGS) -o $@ $< $(TOOL_SUPPORT_OBJ) $(STATIC_LIB) $(LIBS)
+
+$(BUILD)/bench/%: $(BUILD)/obj/bench/%.o $(STATIC_LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_LDFLAGS) -o $@ $< $(STATIC_LIB) $(LIBS)
+
+# Test and bench sources also see the test harness headers.
+$(BUILD)/obj/tests/%.o $(BUILD)/obj/bench/%.o $(BUILD)/obj/tools/%.o: ALL_CFLAGS += -Itests -Itools
+
+# ---- top-level actions ---------------------------------------------------
+test: deps all tests
+	@BUILD=$(BUILD) SAN=$(SAN) CC="$(CC)" MAKE="$(MAKE)" TEST_TIMEOUT=$(TEST_TIMEOUT) \
+	  sh tests/run.sh $(TEST_BIN) $(TEST_SH)
+
+bench: all benches
+	@set -e; for b in $(BENCH_BIN); do echo "== $$b"; $$b; done
+
+sanitize:
+	$(MAKE) BUILD=$(BUILD)/san SAN=1 test
+
+deps:
+	@sh tools/install-deps.sh $(DEB_PACKAGES)
+
+install: lib tools
+	install -d $(DESTDIR)$(LIBDIR)/pkgconfig $(DESTDIR)$(INCLUDEDIR)/$(NAME) $(DESTDIR)$(BINDIR)
+	install -m 644 $(STATIC_LIB) $(DESTDIR)$(LIBDIR)/
+	install -m 755 $(SHARED_LIB) $(DESTDIR)$(LIBDIR)/
+	ln -sf lib$(NAME).so.$(VERSION) $(DESTDIR)$(LIBDIR)/lib$(NAME).so.$(SOMAJOR)
+	ln -sf lib$(NAME).so.$(SOMAJOR) $(DESTDIR)$(LIBDIR)/lib$(NAME).so
+	install -m 644 $(PUB_HDRS) $(DESTDIR)$(INCLUDEDIR)/$(NAME)/
+	install -m 644 $(PC_FILE) $(DESTDIR)$(LIBDIR)/pkgconfig/
+	$(if $(TOOL_BIN),install -m 755 $(TOOL_BIN) $(DESTDIR)$(BINDIR)/)
+
+uninstall:
+	rm -f $(DESTDIR)$(LIBDIR)/lib$(NAME).a $(DESTDIR)$(LIBDIR)/lib$(NAME).so*
+	rm -f $(DESTDIR)$(LIBDIR)/pkgconfig/$(NAME).pc
+	rm -rf $(DESTDIR)$(INCLUDEDIR)/$(NAME)
+	rm -f $(addprefix $(DESTDIR)$(BINDIR)/,$(notdir $(TOOL_BIN)))
+
+clean:
+	rm -rf $(BUILD)
+
+help:
+	@echo 'Targets:'
+	@echo '  all        static and shared library (build/lib), tools (build/bin)'
+	@echo '  test       install missing packages, build, run the whole test suite'
+	@echo '  bench      build and run the benchmarks'
+	@echo '  sanitize   the test suite built with AddressSanitizer + UBSan'
+	@echo '  install    library, headers, tools and proxima.pc under DESTDIR/PREFIX'
+	@echo '  uninstall  remove what install put there'
+	@echo '  deps       install the Debian packages building and testing need'
+	@echo '  clean      remove the build directory'
+	@echo '  help       this text'
+	@echo 'Variables (make VAR=value):'
+	@echo '  CC=$(CC) PREFIX=$(PREFIX) DESTDIR=$(DESTDIR) LIBDIR=$(LIBDIR)'
+	@echo '  INCLUDEDIR=$(INCLUDEDIR) BINDIR=$(BINDIR) BUILD=$(BUILD)'
+	@echo '  OPTFLAGS=$(OPTFLAGS) CFLAGS=$(CFLAGS) LDFLAGS=$(LDFLAGS)'
+	@echo '  TEST_TIMEOUT=$(TEST_TIMEOUT) (seconds per test binary)'
+	@echo 'Environment for tests: PX_TEST_SEED=<n> replays a seed,'
+	@echo '  PX_TEST_ONLY=<name> runs one test of a binary.'
+
+-include $(LIB_OBJ:.o=.d) $(TEST_SUPPORT_OBJ:.o=.d) $(TOOL_SUPPORT_OBJ:.o=.d)
+-include $(patsubst %.c,$(BUILD)/obj/%.d,$(TEST_SRC) $(TOOL_SRC) $(BENCH_SRC))

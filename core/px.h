@@ -1,0 +1,11 @@
+/*
+ * px.h - umbrella header: include this to get all of proxima's public API.
+ * Each module also has its own header (px_<module>.h) for finer use.
+ */
+#ifndef PX_H
+#define PX_H
+
+#include "px_base.h"
+#include "px_arena.h"
+
+#endif

@@ -1,0 +1,33 @@
+#!/bin/sh
+# Run test binaries and scripts, add up their summary lines and print the
+# final "N passed, N failed, N skipped". A binary that dies or prints no
+# summary counts as one failure.
+set -u
+timeout_s=${TEST_TIMEOUT:-900}
+tp=0 tf=0 ts=0
+log=$(mktemp)
+trap 'rm -f "$log"' EXIT
+for t in "$@"; do
+	echo "== $t"
+	case "$t" in
+	*.sh) timeout "$timeout_s" sh "$t" >"$log" 2>&1 ;;
+	*) timeout "$timeout_s" "$t" >"$log" 2>&1 ;;
+	esac
+	rc=$?
+	cat "$log"
+	line=$(grep -E '^[A-Za-z0-9_.-]+: [0-9]+ passed, [0-9]+ failed, [0-9]+ skipped$' "$log" | tail -n 1)
+	if [ -z "$line" ]; then
+		echo "   $t: no summary (exit status $rc): counted as 1 failed"
+		tf=$((tf + 1))
+		continue
+	fi
+	counts=$(echo "$line" | sed -E 's/^[^:]*: ([0-9]+) passed, ([0-9]+) failed, ([0-9]+) skipped$/\1 \2 \3/')
+	p=${counts%% *} s=${counts##* } f=${counts#* } f=${f%% *}
+	if [ "$rc" -ne 0 ] && [ "$f" -eq 0 ]; then
+		echo "   $t: exit status $rc with no failed test: counted as 1 failed"
+		f=1
+	fi
+	tp=$((tp + p)) tf=$((tf + f)) ts=$((ts + s))
+done
+echo "$tp passed, $tf failed, $ts skipped"
+[ "$tf" -eq 0 ]

@@ -1,0 +1,60 @@
+#!/bin/sh
+# Install into a scratch DESTDIR with PREFIX=/usr, then build a tiny
+# consumer through `pkg-config --cflags --libs proxima`, shared and static,
+# and run it. Prints a harness-style summary line.
+set -u
+name=test_install
+if [ "${SAN:-}" = 1 ]; then
+	echo "skip install: sanitizer libraries cannot be linked into a plain consumer"
+	echo "$name: 0 passed, 0 failed, 1 skipped"
+	exit 0
+fi
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+pass=0 fail=0
+check() { # description, command...
+	d=$1; shift
+	if "$@" >"$tmp/out" 2>&1; then
+		echo "ok   $d"; pass=$((pass + 1))
+	else
+		echo "FAIL $d"; sed 's/^/    /' "$tmp/out"; fail=$((fail + 1))
+	fi
+}
+check "make install DESTDIR PREFIX=/usr" \
+	${MAKE:-make} -s install DESTDIR="$tmp/root" PREFIX=/usr BUILD="${BUILD:-build}"
+cat >"$tmp/consumer.c" <<'C'
+#include <px.h>
+#include <stdio.h>
+#include <string.h>
+int main(void)
+{
+	static unsigned char buf[256];
+	struct px_arena a;
+	if (strcmp(px_version(), PX_VERSION_STRING) != 0)
+		return 1;
+	if (px_arena_init(&a, buf, sizeof(buf)) != PX_OK)
+		return 2;
+	if (!px_arena_alloc(&a, 100, 0) || px_arena_alloc(&a, 1000, 0))
+		return 3;
+	printf("%s %s\n", px_version(), px_strerror(PX_E_NOSPC));
+	return 0;
+}
+C
+export PKG_CONFIG_SYSROOT_DIR="$tmp/root"
+export PKG_CONFIG_PATH="$tmp/root/usr/lib/pkgconfig"
+export PKG_CONFIG_LIBDIR="$tmp/root/usr/lib/pkgconfig"
+check "pkg-config knows proxima" pkg-config --exists proxima
+cflags=$(pkg-config --cflags proxima) libs=$(pkg-config --libs proxima)
+slibs=$(pkg-config --static --libs proxima)
+check "consumer compiles against the shared library" \
+	${CC:-cc} -std=c11 -Wall -Werror $cflags "$tmp/consumer.c" -o "$tmp/consumer" $libs
+check "shared consumer runs" env LD_LIBRARY_PATH="$tmp/root/usr/lib" "$tmp/consumer"
+check "consumer links statically" \
+	${CC:-cc} -std=c11 -Wall -Werror $cflags "$tmp/consumer.c" -o "$tmp/consumer_static" \
+	"$tmp/root/usr/lib/libproxima.a" $slibs
+check "static consumer runs" "$tmp/consumer_static"
+check "uninstall removes everything" \
+	sh -c "${MAKE:-make} -s uninstall DESTDIR='$tmp/root' PREFIX=/usr BUILD='${BUILD:-build}' &&
+	       test -z \"\$(find '$tmp/root' -type f -o -type l)\""
+echo "$name: $pass passed, $fail failed, 0 skipped"
+[ "$fail" -eq 0 ]
