@@ -7,5 +7,6 @@
 
 #include "px_base.h"
 #include "px_arena.h"
+#include "px_math.h"
 
 #endif
