@@ -1,0 +1,312 @@
+#include "px_cpiece.h"
+
+#include <math.h>
+#include <string.h>
+
+int px_cpiece_init(struct px_cpiece *pc, int degree, const double (*hw)[4],
+		   double u0, double u1)
+{
+	double hd[4][PX_CPIECE_MAX_DEGREE + 1];
+	double k[3][2 * PX_CPIECE_MAX_DEGREE];
+	double t1[PX_BERN_MAX_DEGREE + 1], t2[PX_BERN_MAX_DEGREE + 1];
+	int p = degree, i, c, j;
+
+	if (!pc || !hw)
+		return PX_E_INVAL;
+	if (p < 1 || p > PX_CPIECE_MAX_DEGREE)
+		return PX_E_RANGE;
+	if (!isfinite(u0) || !isfinite(u1))
+		return PX_E_NAN;
+	if (!(u0 < u1))
+		return PX_E_INVAL;
+	memset(pc, 0, sizeof(*pc));
+	pc->degree_ = p;
+	pc->u0_ = u0;
+	pc->u1_ = u1;
+	pc->box_ = px_aabb_empty();
+	for (i = 0; i <= p; i++) {
+		for (c = 0; c < 4; c++) {
+			if (!isfinite(hw[i][c]))
+				return PX_E_NAN;
+			pc->h_[c][i] = hw[i][c];
+		}
+		if (!(hw[i][3] > 0.0))
+			return PX_E_INVAL;
+		px_aabb_extend(&pc->box_,
+			       px_v3(hw[i][0] / hw[i][3], hw[i][1] / hw[i][3],
+				     hw[i][2] / hw[i][3]));
+	}
+	for (c = 0; c < 4; c++) {
+		px_bern_deriv(pc->h_[c], p, hd[c]);
+		px_bern_scale(pc->h_[c], p, pc->hb_[c]);
+		px_bern_scale(hd[c], p - 1, pc->hd_[c]);
+	}
+	pc->center_ = px_aabb_center(&pc->box_);
+	pc->radius_ = 0.5 * px_aabb_diagonal(&pc->box_);
+	pc->end_[0] = px_v3(hw[0][0] / hw[0][3], hw[0][1] / hw[0][3],
+			    hw[0][2] / hw[0][3]);
+	pc->end_[1] = px_v3(hw[p][0] / hw[p][3], hw[p][1] / hw[p][3],
+			    hw[p][2] / hw[p][3]);
+	/* K = H' w - H w' (degree 2p - 1; its top term cancels in exact
+	 * arithmetic but keeping the full degree costs nothing). */
+	for (c = 0; c < 3; c++) {
+		px_bern_mul(hd[c], p - 1, pc->h_[3], p, t1);
+		px_bern_mul(pc->h_[c], p, hd[3], p - 1, t2);
+		for (j = 0; j < 2 * p; j++)
+			k[c][j] = t1[j] - t2[j];
+	}
+	/* a = H . K and b = w K, degree 3p - 1. */
+	for (c = 0; c < 3; c++) {
+		px_bern_mul(pc->h_[c], p, k[c], 2 * p - 1, t1);
+		for (j = 0; j < 3 * p; j++)
+			pc->ga_[j] += t1[j];
+		px_bern_mul(pc->h_[3], p, k[c], 2 * p - 1, pc->gb_[c]);
+	}
+	/* w^2 f = |H|^2 - 2 P . (w H) + |P|^2 w^2, degree 2p. */
+	for (c = 0; c < 3; c++) {
+		px_bern_mul(pc->h_[c], p, pc->h_[c], p, t1);
+		for (j = 0; j <= 2 * p; j++)
+			pc->fa_[j] += t1[j];
+		px_bern_mul(pc->h_[3], p, pc->h_[c], p, pc->fb_[c]);
+	}
+	px_bern_mul(pc->h_[3], p, pc->h_[3], p, pc->fw_);
+	return PX_OK;
+}
+
+px_aabb px_cpiece_box(const struct px_cpiece *pc)
+{
+	return pc->box_;
+}
+
+px_vec3 px_cpiece_eval(const struct px_cpiece *pc, double t, px_vec3 *d1)
+{
+	double v[4], d[4];
+	int c;
+
+	for (c = 0; c < 4; c++)
+		v[c] = px_bern_eval_scaled(pc->hb_[c], pc->degree_, t);
+	if (d1) {
+		for (c = 0; c < 4; c++)
+			d[c] = px_bern_eval_scaled(pc->hd_[c], pc->degree_ - 1, t);
+		/* Quotient rule, then the chain rule to the global parameter. */
+		double s = 1.0 / (v[3] * v[3] * (pc->u1_ - pc->u0_));
+		*d1 = px_v3((d[0] * v[3] - v[0] * d[3]) * s,
+			    (d[1] * v[3] - v[1] * d[3]) * s,
+			    (d[2] * v[3] - v[2] * d[3]) * s);
+	}
+	return px_v3(v[0] / v[3], v[1] / v[3], v[2] / v[3]);
+}
+
+/*
+ * Lower bound of f = |C - P|^2 on [s, t]: with F = w^2 f and W = w^2 in
+ * Bernstein form, F / W is a convex combination of F_i / W_i (W_i > 0).
+ */
+static double lower_bound(const double *f, const double *w, int n, double s,
+			  double t)
+{
+	double fr[PX_CPIECE_NF], wr[PX_CPIECE_NF], lb = INFINITY;
+	int i;
+
+	px_bern_restrict(f, n, s, t, fr);
+	px_bern_restrict(w, n, s, t, wr);
+	for (i = 0; i <= n; i++) {
+		double r = fr[i] / wr[i];
+		lb = r < lb ? r : lb;
+	}
+	return lb;
+}
+
+/*
+ * Root of a Bernstein polynomial with one sign change from - to + on
+ * [0, 1]: Newton steps kept inside a shrinking bracket, bisection when a
+ * step would leave it. Always converges; the bracket halves at worst.
+ */
+static double refine_root(const double *c, int n, int *iters)
+{
+	double lo = 0.0, hi = 1.0, x, c0 = c[0], cn = c[n];
+	double cb[PX_CPIECE_NG], db[PX_CPIECE_NG];
+	int it, i;
+
+	/* Scale once: every iteration then costs O(n). */
+	for (i = 0; i < n; i++)
+		db[i] = n * (c[i + 1] - c[i]);
+	px_bern_scale(c, n, cb);
+	px_bern_scale(db, n - 1, db);
+	/* Start where the control polygon crosses zero: with a single sign
+	 * change it crosses once, and it hugs the polynomial, so Newton
+	 * starts within a few percent of the root. */
+	x = 0.5;
+	for (i = 0; i < n; i++) {
+		if ((c[i] < 0.0 && c[i + 1] >= 0.0) ||
+		    (c[i] <= 0.0 && c[i + 1] > 0.0)) {
+			x = (i + c[i] / (c[i] - c[i + 1])) / n;
+			break;
+		}
+	}
+	(void)c0;
+	(void)cn;
+	for (it = 0; it < PX_CPIECE_MAX_ITERS; it++) {
+		double v = px_bern_eval_scaled(cb, n, x), dv, xn;
+		if (v == 0.0)
+			break;
+		if (v < 0.0)
+			lo = x;
+		else
+			hi = x;
+		dv = px_bern_eval_scaled(db, n - 1, x);
+		xn = (dv != 0.0) ? x - v / dv : lo - 1.0;
+		if (!(xn > lo && xn < hi))
+			xn = 0.5 * (lo + hi);
+		/* 1e-13 of the interval is far below what the distance
+		 * (quadratic in the parameter error) or the foot point can
+		 * resolve at the required 1e-9 of the model size. */
+		if (fabs(xn - x) <= 1e-13 || hi - lo <= 1e-13) {
+			x = xn;
+			it++;
+			break;
+		}
+		x = xn;
+	}
+	*iters += it;
+	return x;
+}
+
+struct span {
+	double s, t;
+	int depth;
+};
+
+static void consider(const struct px_cpiece *pc, px_vec3 p, double t,
+		     double *best, struct px_cpiece_hit *hit, int *improved)
+{
+	px_vec3 q = t <= 0.0 ? pc->end_[0]
+			     : (t >= 1.0 ? pc->end_[1] : px_cpiece_eval(pc, t, NULL));
+	double d2 = px_v3_dist2(q, p);
+	if (d2 < *best) {
+		*best = d2;
+		hit->d2 = d2;
+		hit->point = q;
+		hit->u = t >= 1.0 ? pc->u1_
+				  : pc->u0_ + t * (pc->u1_ - pc->u0_);
+		*improved = 1;
+	}
+}
+
+int px_cpiece_closest(const struct px_cpiece *pc, px_vec3 p, double *best_d2,
+		      struct px_cpiece_hit *hit)
+{
+	double g[PX_CPIECE_NG], c[PX_CPIECE_NG], f[PX_CPIECE_NF];
+	struct span stack[2 * PX_CPIECE_MAX_DEPTH + 4];
+	int n = 3 * pc->degree_ - 1, nf = 2 * pc->degree_, sp = 0, i;
+	int improved = 0;
+	double best = *best_d2, pp = px_v3_dot(p, p), slack, lb_root = 0.0;
+	double lb_unresolved = INFINITY;
+
+	hit->iters = 0;
+	hit->nodes = 0;
+	hit->certified = 1;
+	hit->gap = 0.0;
+	/* Cheapest rejection first: a sphere around the box. */
+	{
+		double dc = px_v3_dist(p, pc->center_) - pc->radius_;
+		if (dc > 0.0 && dc * dc >= best)
+			goto out;
+	}
+	for (i = 0; i <= nf; i++)
+		f[i] = pc->fa_[i] -
+		       2.0 * (p.x * pc->fb_[0][i] + p.y * pc->fb_[1][i] +
+			      p.z * pc->fb_[2][i]) +
+		       pp * pc->fw_[i];
+	/* Rounding in F is about 1e-16 of |H|^2 + |P|^2 w^2; an interval
+	 * whose bound is within a few hundred times that of the best can
+	 * only improve it by rounding noise, so it is settled. This is what
+	 * stops endless subdivision where every point is equally near (a
+	 * circle seen from its centre). */
+	{
+		double r = px_v3_dist(pc->center_, p) + 2.0 * pc->radius_;
+		slack = 1e-13 * (r * r + px_v3_dot(pc->center_, pc->center_));
+	}
+	{
+		double lb = INFINITY;
+		for (i = 0; i <= nf; i++) {
+			double r = f[i] / pc->fw_[i];
+			lb = r < lb ? r : lb;
+		}
+		if (lb >= best - slack)
+			goto out;
+		lb_root = lb;
+	}
+	/* End points: candidates in their own right (open ends, corners
+	 * at knots) and a bound that prunes early. */
+	consider(pc, p, 0.0, &best, hit, &improved);
+	consider(pc, p, 1.0, &best, hit, &improved);
+	for (i = 0; i <= n; i++)
+		g[i] = pc->ga_[i] - (p.x * pc->gb_[0][i] + p.y * pc->gb_[1][i] +
+				     p.z * pc->gb_[2][i]);
+	stack[sp].s = 0.0;
+	stack[sp].t = 1.0;
+	stack[sp].depth = 0;
+	sp++;
+	while (sp > 0) {
+		struct span e = stack[--sp];
+		double lb;
+		int sc, k;
+
+		if (hit->nodes >= PX_CPIECE_MAX_NODES) {
+			sp++; /* account for it below */
+			break;
+		}
+		hit->nodes++;
+		/* The root interval's bound was computed above. */
+		lb = e.depth ? lower_bound(f, pc->fw_, nf, e.s, e.t) : lb_root;
+		if (lb >= best - slack)
+			continue;
+		px_bern_restrict(g, n, e.s, e.t, c);
+		sc = px_bern_sign_changes(c, n, 0.0);
+		if (sc == 0)
+			continue; /* f monotone here: no interior minimum */
+		if (sc == 1) {
+			for (k = 0; k <= n && c[k] == 0.0; k++)
+				;
+			if (k > n || c[k] > 0.0)
+				continue; /* the one critical point is a maximum */
+			consider(pc, p,
+				 e.s + refine_root(c, n, &hit->iters) * (e.t - e.s),
+				 &best, hit, &improved);
+			continue;
+		}
+		if (e.depth >= PX_CPIECE_MAX_DEPTH) {
+			consider(pc, p, 0.5 * (e.s + e.t), &best, hit, &improved);
+			lb_unresolved = fmin(lb_unresolved, lb);
+			continue;
+		}
+		{
+			double m = 0.5 * (e.s + e.t);
+			/* A root exactly at the split point would be hidden
+			 * from both halves' sign counts. */
+			if (px_bern_eval(c, n, 0.5) == 0.0)
+				consider(pc, p, m, &best, hit, &improved);
+			stack[sp].s = m;
+			stack[sp].t = e.t;
+			stack[sp].depth = e.depth + 1;
+			sp++;
+			stack[sp].s = e.s;
+			stack[sp].t = m;
+			stack[sp].depth = e.depth + 1;
+			sp++;
+		}
+	}
+	/* Intervals left by the node bound: their boxes bound what we may
+	 * have missed. */
+	for (i = 0; i < sp; i++)
+		lb_unresolved = fmin(lb_unresolved,
+				     lower_bound(f, pc->fw_, nf, stack[i].s,
+						 stack[i].t));
+	if (lb_unresolved < best - slack) {
+		hit->certified = 0;
+		hit->gap = sqrt(best) - sqrt(fmax(lb_unresolved, 0.0));
+	}
+out:
+	*best_d2 = best;
+	return improved;
+}
