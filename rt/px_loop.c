@@ -603,8 +603,11 @@ int px_loop_run(struct px_loop *l, uint64_t max_cycles)
 	}
 	atomic_store(&l->stop_req, 0);
 	if (l->cfg.rt_enable) {
+		/* The status keeps what was in force during the run. */
+		struct px_rt_report undo = l->rt;
+		px_rt_restore(&undo);
 		atomic_store(&l->rt_valid, 0);
-		px_rt_restore(&l->rt);
+		l->rt.dma_latency_fd = -1;
 		atomic_store_explicit(&l->rt_valid, 1, memory_order_release);
 	}
 	atomic_store(&l->running, 0);

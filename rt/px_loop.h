@@ -255,7 +255,8 @@ struct px_loop_status {
 	uint64_t faults;        /* faults recorded */
 	uint64_t faults_dropped;/* faults lost because the ring was full */
 	int64_t period_ns;
-	/* Real-time setup of the last px_loop_run() (all zero before). */
+	/* Real-time setup as in force during the last (or current)
+	 * px_loop_run(); all zero before the first. */
 	int rt_applied;         /* cfg.rt_enable was set */
 	int realtime;           /* SCHED_FIFO actually in force */
 	struct px_rt_report rt;

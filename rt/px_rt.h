@@ -65,8 +65,8 @@ struct px_rt_config {
 };
 
 /*
- * What is in force after px_rt_apply(). Plain data, may be copied (the
- * copy must not be passed to px_rt_restore()).
+ * What is in force after px_rt_apply(). Plain data, may be copied; pass
+ * exactly one of the copies to px_rt_restore().
  */
 struct px_rt_report {
 	unsigned requested; /* steps asked for */
