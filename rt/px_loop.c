@@ -67,7 +67,8 @@ struct px_loop {
 	_Atomic int32_t safe_cause, safe_source;
 	_Atomic uint64_t safe_cycle, cycles, overruns, missed, budget_exceeded,
 		safe_entries, nfaults;
-	_Atomic int rt_valid;
+	/* Even when rt is stable; odd while the loop thread rewrites it. */
+	_Atomic unsigned rt_gen;
 	int rt_applied;
 	struct px_rt_report rt;
 
@@ -174,7 +175,7 @@ int px_loop_create(const struct px_loop_config *cfg, struct px_loop **out)
 	atomic_init(&l->budget_exceeded, 0);
 	atomic_init(&l->safe_entries, 0);
 	atomic_init(&l->nfaults, 0);
-	atomic_init(&l->rt_valid, 0);
+	atomic_init(&l->rt_gen, 0);
 	*out = l;
 	return PX_OK;
 }
@@ -575,6 +576,18 @@ int px_loop_step(struct px_loop *l)
 	return cycle(l);
 }
 
+/* Status readers copy l->rt while the generation is even and unchanged
+ * (a seqlock: the report is written at most twice per run). */
+static void publish_rt(struct px_loop *l, const struct px_rt_report *rep)
+{
+	unsigned g = atomic_load_explicit(&l->rt_gen, memory_order_relaxed);
+	atomic_store_explicit(&l->rt_gen, g + 1, memory_order_relaxed);
+	atomic_thread_fence(memory_order_release);
+	l->rt = *rep;
+	l->rt_applied = 1;
+	atomic_store_explicit(&l->rt_gen, g + 2, memory_order_release);
+}
+
 int px_loop_run(struct px_loop *l, uint64_t max_cycles)
 {
 	uint64_t n = 0;
@@ -585,12 +598,11 @@ int px_loop_run(struct px_loop *l, uint64_t max_cycles)
 	if (!atomic_compare_exchange_strong(&l->running, &expected, 1))
 		return PX_E_STATE;
 	if (l->cfg.rt_enable) {
-		atomic_store(&l->rt_valid, 0);
+		struct px_rt_report rep;
 		/* Refusal is not an error here: the warning went out once,
 		 * the report shows it, and the loop runs degraded. */
-		(void)px_rt_apply(&l->cfg.rt, &l->rt);
-		l->rt_applied = 1;
-		atomic_store_explicit(&l->rt_valid, 1, memory_order_release);
+		(void)px_rt_apply(&l->cfg.rt, &rep);
+		publish_rt(l, &rep);
 	}
 	/* Fresh deadlines: a run never tries to catch up on the time
 	 * between runs. */
@@ -604,11 +616,10 @@ int px_loop_run(struct px_loop *l, uint64_t max_cycles)
 	atomic_store(&l->stop_req, 0);
 	if (l->cfg.rt_enable) {
 		/* The status keeps what was in force during the run. */
-		struct px_rt_report undo = l->rt;
+		struct px_rt_report undo = l->rt, kept = l->rt;
 		px_rt_restore(&undo);
-		atomic_store(&l->rt_valid, 0);
-		l->rt.dma_latency_fd = -1;
-		atomic_store_explicit(&l->rt_valid, 1, memory_order_release);
+		kept.dma_latency_fd = -1;
+		publish_rt(l, &kept);
 	}
 	atomic_store(&l->running, 0);
 	return PX_OK;
@@ -676,6 +687,7 @@ int px_loop_is_safe(const struct px_loop *l)
 int px_loop_status(const struct px_loop *l_, struct px_loop_status *s)
 {
 	struct px_loop *l = (struct px_loop *)l_;
+	int tries;
 
 	if (!l || !s)
 		return PX_E_INVAL;
@@ -693,11 +705,20 @@ int px_loop_status(const struct px_loop *l_, struct px_loop_status *s)
 	s->faults = LD(l->nfaults);
 	s->faults_dropped = px_ring_dropped(l->faults);
 	s->period_ns = l->cfg.period_ns;
-	if (atomic_load_explicit(&l->rt_valid, memory_order_acquire)) {
+	for (tries = 0; tries < 1000; tries++) {
+		unsigned g = atomic_load_explicit(&l->rt_gen,
+						  memory_order_acquire);
+		if (g & 1u) {
+			px__cpu_relax();
+			continue;
+		}
 		s->rt_applied = l->rt_applied;
 		s->rt = l->rt;
-		s->realtime = (l->rt.granted & PX_RT_SCHED) != 0;
+		atomic_thread_fence(memory_order_acquire);
+		if (atomic_load_explicit(&l->rt_gen, memory_order_relaxed) == g)
+			break;
 	}
+	s->realtime = s->rt_applied && (s->rt.granted & PX_RT_SCHED) != 0;
 	return PX_OK;
 }
 

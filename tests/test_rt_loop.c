@@ -201,6 +201,44 @@ static void test_phase_order_real_clock(void)
 	}
 }
 
+/* Real clock, slow compute by sleeping: behaviour only (at least the
+ * periods slept through are missed, the phase is kept), no timing. */
+static int sleepy_compute(struct px_loop *l, const struct px_loop_cycle *c,
+			  void *u)
+{
+	(void)l;
+	(void)u;
+	if (c->index == 3) {
+		struct timespec ts = {0, 2500000};
+		nanosleep(&ts, NULL);
+	}
+	return PX_OK;
+}
+
+static void test_overrun_real_clock(void)
+{
+	struct px_loop_config cfg;
+	struct fx f;
+	struct px_loop_status st;
+	int64_t d;
+
+	fx_init(&f, &cfg);
+	cfg.clock = PX_LOOP_CLOCK_MONOTONIC;
+	cfg.compute = sleepy_compute;
+	cfg.overrun_limit = 0;
+	cfg.budget_limit = 0;
+	fx_create(&f, &cfg);
+	PX_CHECK_INT_EQ(px_loop_run(f.l, 8), PX_OK);
+	PX_CHECK_INT_EQ(px_loop_status(f.l, &st), PX_OK);
+	PX_CHECK(st.overruns >= 1);
+	PX_CHECK(st.missed_periods >= 2);
+	d = f.cy[4].deadline_ns - f.cy[3].deadline_ns;
+	PX_CHECK(d >= 3 * P_NS && d % P_NS == 0);
+	PX_CHECK(f.cy[4].missed >= 2);
+	PX_CHECK_INT_EQ(st.cycles, 8);
+	px_loop_free(f.l);
+}
+
 static int pop_cause(struct px_loop *l, int cause, struct px_fault *out)
 {
 	struct px_fault f;
@@ -745,6 +783,7 @@ static const struct px_test tests[] = {
 	PX_T(test_phase_order_real_clock),
 	PX_T(test_overrun_skip),
 	PX_T(test_overrun_catch_up),
+	PX_T(test_overrun_real_clock),
 	PX_T(test_overrun_limit_trips),
 	PX_T(test_watchdog_stale_input),
 	PX_T(test_watchdog_never_stamped_input),
