@@ -131,6 +131,15 @@ static int run_cyclictest(const char *prog, int prio, long loops,
 
 /* ---- proxima's loop -------------------------------------------------------- */
 
+/* Each chunk sets the loop up again; show a refusal warning only once. */
+static void warn_once(void *ctx, const char *msg)
+{
+	static int shown;
+	(void)ctx;
+	if (!shown++)
+		fprintf(stderr, "%s\n", msg);
+}
+
 static int run_loop(int prio, long loops, struct hist *h,
 		    struct px_loop_status *st_out)
 {
@@ -151,6 +160,7 @@ static int run_loop(int prio, long loops, struct hist *h,
 	cfg.rt.priority = prio;
 	cfg.rt.lock_memory = 1;
 	cfg.rt.dma_latency = 1;
+	cfg.rt.warn = warn_once;
 	rc = px_loop_create(&cfg, &l);
 	if (rc)
 		return rc;
