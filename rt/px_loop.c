@@ -184,8 +184,10 @@ void px_loop_free(struct px_loop *l)
 {
 	if (!l)
 		return;
-	if (l->thread_live)
+	if (l->thread_live) {
+		px_loop_stop(l);
 		px_loop_join(l);
+	}
 	px_arena_fini(&l->arena);
 	free(l);
 }

@@ -148,7 +148,9 @@ PX_API void px_loop_config_default(struct px_loop_config *cfg);
 PX_API int px_loop_create(const struct px_loop_config *cfg,
 			  struct px_loop **out);
 
-/* Free a loop that is not running (join it first). NULL is a no-op. */
+/* Free a loop. A loop started with px_loop_start() is stopped and joined
+ * first; one running in px_loop_run() elsewhere must have returned.
+ * NULL is a no-op. */
 PX_API void px_loop_free(struct px_loop *loop);
 
 /*
