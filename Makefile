@@ -71,6 +71,9 @@ PC_FILE    := $(BUILD)/lib/pkgconfig/$(NAME).pc
 
 # Debian packages that building and testing need (see `make deps`).
 DEB_PACKAGES := gcc make libc6-dev pkg-config
+# Debian packages the benchmarks compare against (installed by `make bench`;
+# a benchmark whose reference is missing says so and still runs).
+BENCH_DEB_PACKAGES := rt-tests
 
 FORCE:
 
@@ -142,6 +145,7 @@ test: deps all tests
 	  sh tests/run.sh $(TEST_BIN) $(TEST_SH)
 
 bench: all benches
+	@sh tools/install-deps.sh $(BENCH_DEB_PACKAGES) || echo "make bench: continuing without $(BENCH_DEB_PACKAGES)"
 	@set -e; for b in $(BENCH_BIN); do echo "== $$b"; $$b; done
 
 sanitize:

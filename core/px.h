@@ -8,5 +8,11 @@
 #include "px_base.h"
 #include "px_arena.h"
 #include "px_math.h"
+#include "px_fault.h"
+#include "px_loop.h"
+#include "px_param.h"
+#include "px_ring.h"
+#include "px_rt.h"
+#include "px_stats.h"
 
 #endif
