@@ -1,0 +1,112 @@
+/*
+ * px_spiece.h - certified interior closest point on one rational Bezier
+ * patch.
+ *
+ * The surface counterpart of px_cpiece.h. With S = H / w on the patch's
+ * local square (s, t) in [0, 1]^2, the critical points of f = |S - P|^2
+ * are the common zeros of
+ *
+ *     gu = (H - w P) . (H_s w - H w_s) = (w^3 / 2) df/ds
+ *     gv = (H - w P) . (H_t w - H w_t) = (w^3 / 2) df/dt
+ *
+ * tensor-product polynomials whose Bernstein coefficients are
+ * a - P . b with a and b computed once here. A query subdivides the
+ * square and settles each rectangle by a proof:
+ *  - F / W bound: w^2 f and w^2 in Bernstein form give f >= min F_ij /
+ *    W_ij; a rectangle that cannot beat the best distance is dropped;
+ *  - no critical point: all coefficients of gu (or of gv) of one strict
+ *    sign mean df/ds (or df/dt) never vanishes on the closed rectangle;
+ *  - at most one, and it is a minimum: Bernstein bounds of the Jacobian
+ *    of (gu, gv) make its symmetric part positive definite, so (gu, gv)
+ *    is strictly monotone on the rectangle; Newton started inside finds
+ *    that single zero. Negative definite means a single maximum: dropped.
+ * Anything else is split in four, down to a depth and node bound; what
+ * the bound cuts short is reported as uncertified with a gap.
+ *
+ * Only interior critical points are searched here. Minima on the
+ * boundary of a surface (and on C0 creases) are minima of the boundary
+ * curves, which the distance core handles as curve pieces.
+ *
+ * Memory and real-time rules: a piece lives in caller memory: a small
+ * struct plus px_spiece_doubles(p, q) doubles filled by px_spiece_init()
+ * at setup. px_spiece_closest() uses fixed stack arrays (about 64 KiB,
+ * see PX_SPIECE_MAX_DEGREE) and no heap; all loops are bounded.
+ */
+#ifndef PX_SPIECE_H
+#define PX_SPIECE_H
+
+#include <stddef.h>
+
+#include "px_base.h"
+#include "px_math.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Same limit as the NURBS kernel. A query's stack arrays are sized for
+ * it: about 64 KiB, whatever the actual degree (only the used part is
+ * touched); real-time threads must have that much prefaulted stack. */
+#define PX_SPIECE_MAX_DEGREE 10
+#define PX_SPIECE_MAX_DEPTH 24
+#define PX_SPIECE_MAX_NODES 1024
+#define PX_SPIECE_MAX_ITERS 40
+
+struct px_spiece {
+	int p_, q_;
+	double u0_, u1_, v0_, v1_; /* global parameter rectangle */
+	px_aabb box_;
+	px_vec3 center_;
+	double radius_;
+	/* Arrays inside the caller block (see px_spiece_doubles()):
+	 * homogeneous control net h_[c][i][j] (c = x w, y w, z w, w; i along
+	 * s, j along t), and the coefficient tensors of F, W, gu, gv. */
+	double *h_;
+	double *fa_, *fb_, *fw_;
+	double *gua_, *gub_;
+	double *gva_, *gvb_;
+};
+
+struct px_spiece_hit {
+	double d2;
+	double u, v;   /* global parameters */
+	px_vec3 point;
+	int iters, nodes;
+	int certified; /* as px_cpiece_hit */
+	double gap;
+};
+
+/* Doubles of caller memory a piece of degrees (p, q) needs; 0 when a
+ * degree is outside 1..PX_SPIECE_MAX_DEGREE. */
+PX_API size_t px_spiece_doubles(int p, int q);
+
+/*
+ * Fill a piece from (p + 1) * (q + 1) homogeneous control points
+ * hw[i * (q + 1) + j] = (x w, y w, z w, w), i along u, over the global
+ * rectangle [u0, u1] x [v0, v1]. mem holds px_spiece_doubles(p, q)
+ * doubles and must outlive the piece. Returns PX_OK, PX_E_RANGE, PX_E_NAN
+ * or PX_E_INVAL (weights <= 0, empty rectangle).
+ */
+PX_API int px_spiece_init(struct px_spiece *sp, int p, int q,
+			  const double (*hw)[4], double u0, double u1,
+			  double v0, double v1, double *mem);
+
+/* Point and first/second partial derivatives (global parameters; any
+ * pointer may be NULL) at local (s, t). @note RT-safe. */
+PX_API px_vec3 px_spiece_eval(const struct px_spiece *sp, double s, double t,
+			      px_vec3 *su, px_vec3 *sv, px_vec3 *suu,
+			      px_vec3 *suv, px_vec3 *svv);
+
+/*
+ * Interior critical minimum of the patch closer than *best_d2 (in/out,
+ * as px_cpiece_closest()). Returns 1 and fills hit when it lowers the
+ * bound. @note RT-safe.
+ */
+PX_API int px_spiece_closest(const struct px_spiece *sp, px_vec3 p,
+			     double *best_d2, struct px_spiece_hit *hit);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

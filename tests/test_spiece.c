@@ -1,0 +1,286 @@
+/* Certified interior closest point on rational Bezier patches, completed
+ * by the boundary curves, against a brute-force oracle. */
+#include <math.h>
+#include <stdio.h>
+
+#include "px_alloc_count.h"
+#include "px_bern.h"
+#include "px_cpiece.h"
+#include "px_spiece.h"
+#include "px_test.h"
+
+#define MAXD 5
+
+static double mem[200000];
+
+/* Independent evaluation by the explicit tensor Bernstein sum. */
+static px_vec3 eval_ref(const double (*hw)[4], int p, int q, double s, double t)
+{
+	double acc[4] = {0, 0, 0, 0};
+	int i, j, c;
+	for (i = 0; i <= p; i++)
+		for (j = 0; j <= q; j++) {
+			double b = px_bern_binom(p, i) * pow(s, i) * pow(1 - s, p - i) *
+				   px_bern_binom(q, j) * pow(t, j) * pow(1 - t, q - j);
+			for (c = 0; c < 4; c++)
+				acc[c] += b * hw[i * (q + 1) + j][c];
+		}
+	return px_v3(acc[0] / acc[3], acc[1] / acc[3], acc[2] / acc[3]);
+}
+
+/* Oracle: 120 x 120 samples, then every sampled local minimum refined by
+ * repeated zooming 5 x 5 grids; the whole closed patch, boundary included. */
+static double oracle(const double (*hw)[4], int p, int q, px_vec3 x)
+{
+	enum { N = 120 };
+	static double d2[N + 1][N + 1];
+	double best = INFINITY;
+	int i, j;
+	for (i = 0; i <= N; i++)
+		for (j = 0; j <= N; j++)
+			d2[i][j] = px_v3_dist2(eval_ref(hw, p, q, (double)i / N, (double)j / N), x);
+	for (i = 0; i <= N; i++)
+		for (j = 0; j <= N; j++) {
+			int a, b, ok = 1, it;
+			double cs = (double)i / N, ct = (double)j / N, h = 1.0 / N;
+			for (a = -1; a <= 1 && ok; a++)
+				for (b = -1; b <= 1; b++)
+					if (i + a >= 0 && i + a <= N && j + b >= 0 && j + b <= N &&
+					    d2[i + a][j + b] < d2[i][j])
+						ok = 0;
+			if (!ok)
+				continue;
+			for (it = 0; it < 400 && h > 1e-15; it++) {
+				double bs = cs, bt = ct, bd = INFINITY;
+				for (a = -2; a <= 2; a++)
+					for (b = -2; b <= 2; b++) {
+						double s = fmin(1, fmax(0, cs + a * h / 2));
+						double t = fmin(1, fmax(0, ct + b * h / 2));
+						double d = px_v3_dist2(eval_ref(hw, p, q, s, t), x);
+						if (d < bd) {
+							bd = d;
+							bs = s;
+							bt = t;
+						}
+					}
+				/* Shrink only when the centre stays best: walk
+				 * otherwise, so long valleys are followed. */
+				if (bs == cs && bt == ct)
+					h *= 0.6;
+				cs = bs;
+				ct = bt;
+				best = fmin(best, bd);
+			}
+		}
+	return sqrt(best);
+}
+
+static void random_patch(double (*hw)[4], int p, int q, int rational)
+{
+	int i, j;
+	for (i = 0; i <= p; i++)
+		for (j = 0; j <= q; j++) {
+			double w = rational ? exp(px_rand_range(log(0.2), log(5.0))) : 1.0;
+			double *h = hw[i * (q + 1) + j];
+			/* A gently curved sheet over the unit square. */
+			h[0] = ((double)i / p + 0.15 * px_rand_normal()) * w;
+			h[1] = ((double)j / q + 0.15 * px_rand_normal()) * w;
+			h[2] = 0.4 * px_rand_normal() * w;
+			h[3] = w;
+		}
+}
+
+/* Interior by the patch solver, boundary by four curve pieces. */
+static double solve(const double (*hw)[4], int p, int q, px_vec3 x, int *unc,
+		    struct px_spiece_hit *out)
+{
+	struct px_spiece sp;
+	struct px_spiece_hit hit;
+	double best = INFINITY, edge[MAXD + 1][4];
+	int e, k, c;
+
+	PX_CHECK(px_spiece_doubles(p, q) <= sizeof(mem) / sizeof(mem[0]));
+	PX_CHECK_INT_EQ(px_spiece_init(&sp, p, q, hw, 0, 1, 0, 1, mem), PX_OK);
+	out->d2 = INFINITY;
+	for (e = 0; e < 4; e++) {
+		struct px_cpiece cp;
+		struct px_cpiece_hit ch;
+		int n = e < 2 ? q : p;
+		for (k = 0; k <= n; k++) {
+			int i = e == 0 ? 0 : (e == 1 ? p : k);
+			int j = e < 2 ? k : (e == 2 ? 0 : q);
+			for (c = 0; c < 4; c++)
+				edge[k][c] = hw[i * (q + 1) + j][c];
+		}
+		PX_CHECK_INT_EQ(px_cpiece_init(&cp, n, (const double(*)[4])edge, 0, 1), PX_OK);
+		px_cpiece_closest(&cp, x, &best, &ch);
+	}
+	if (px_spiece_closest(&sp, x, &best, &hit)) {
+		*out = hit;
+		if (!hit.certified)
+			(*unc)++;
+	}
+	return sqrt(best);
+}
+
+static void test_eval_matches_reference(void)
+{
+	double hw[(MAXD + 1) * (MAXD + 1)][4];
+	int trial;
+	for (trial = 0; trial < 100; trial++) {
+		int p = px_rand_int(1, MAXD), q = px_rand_int(1, MAXD);
+		struct px_spiece sp;
+		double s = px_rand_unit(), t = px_rand_unit(), h = 1e-6;
+		px_vec3 su, sv, suu, suv, svv, S;
+		random_patch(hw, p, q, 1);
+		PX_CHECK_INT_EQ(px_spiece_init(&sp, p, q, (const double(*)[4])hw, 2, 4, -1, 0, mem), PX_OK);
+		S = px_spiece_eval(&sp, s, t, &su, &sv, &suu, &suv, &svv);
+		PX_CHECK(px_v3_dist(S, eval_ref((const double(*)[4])hw, p, q, s, t)) < 1e-12);
+		/* Global parameters: u = 2 + 2 s, v = -1 + t. */
+		{
+			px_vec3 a = px_spiece_eval(&sp, s + h, t, NULL, NULL, NULL, NULL, NULL);
+			px_vec3 b = px_spiece_eval(&sp, s - h, t, NULL, NULL, NULL, NULL, NULL);
+			px_vec3 fd = px_v3_scale(px_v3_sub(a, b), 1.0 / (2 * h * 2.0));
+			PX_CHECK(px_v3_dist(fd, su) < 1e-5 * (1 + px_v3_norm(su)));
+			a = px_spiece_eval(&sp, s, t + h, NULL, NULL, NULL, NULL, NULL);
+			b = px_spiece_eval(&sp, s, t - h, NULL, NULL, NULL, NULL, NULL);
+			fd = px_v3_scale(px_v3_sub(a, b), 1.0 / (2 * h));
+			PX_CHECK(px_v3_dist(fd, sv) < 1e-5 * (1 + px_v3_norm(sv)));
+		}
+		{
+			px_vec3 a, b, fd;
+			px_spiece_eval(&sp, s, t + h, NULL, &a, NULL, NULL, NULL);
+			px_spiece_eval(&sp, s, t - h, NULL, &b, NULL, NULL, NULL);
+			fd = px_v3_scale(px_v3_sub(a, b), 1.0 / (2 * h));
+			PX_CHECK(px_v3_dist(fd, svv) < 1e-4 * (1 + px_v3_norm(svv)));
+			px_spiece_eval(&sp, s + h, t, NULL, &a, NULL, NULL, NULL);
+			px_spiece_eval(&sp, s - h, t, NULL, &b, NULL, NULL, NULL);
+			fd = px_v3_scale(px_v3_sub(a, b), 1.0 / (2 * h * 2.0));
+			PX_CHECK(px_v3_dist(fd, suv) < 1e-4 * (1 + px_v3_norm(suv)));
+			px_spiece_eval(&sp, s + h, t, &a, NULL, NULL, NULL, NULL);
+			px_spiece_eval(&sp, s - h, t, &b, NULL, NULL, NULL, NULL);
+			fd = px_v3_scale(px_v3_sub(a, b), 1.0 / (2 * h * 2.0));
+			PX_CHECK(px_v3_dist(fd, suu) < 1e-4 * (1 + px_v3_norm(suu)));
+		}
+	}
+}
+
+static void test_random_patches_vs_oracle(void)
+{
+	double hw[(MAXD + 1) * (MAXD + 1)][4];
+	int trial, unc = 0, interior = 0;
+	for (trial = 0; trial < 150; trial++) {
+		int p = px_rand_int(1, 4), q = px_rand_int(1, 4);
+		struct px_spiece_hit hit;
+		px_vec3 x;
+		double got, ref;
+		random_patch(hw, p, q, trial % 2);
+		switch (trial % 3) {
+		case 0: /* above/below the sheet: interior minima */
+			x = px_v3(px_rand_range(0.1, 0.9), px_rand_range(0.1, 0.9),
+				  px_rand_range(-1, 1));
+			break;
+		case 1: /* anywhere near */
+			x = px_v3(px_rand_range(-0.5, 1.5), px_rand_range(-0.5, 1.5),
+				  px_rand_range(-1, 1));
+			break;
+		default: /* on the surface */
+			x = eval_ref((const double(*)[4])hw, p, q, px_rand_unit(), px_rand_unit());
+		}
+		got = solve((const double(*)[4])hw, p, q, x, &unc, &hit);
+		ref = oracle((const double(*)[4])hw, p, q, x);
+		interior += hit.d2 < INFINITY;
+		PX_CHECK_MSG(got <= ref + 1e-9, "wrong branch: %.17g vs oracle %.17g (p %d q %d, "
+			     "query kind %d, interior hit %d at %g %g, nodes %d)",
+			     got, ref, p, q, trial % 3, hit.d2 < INFINITY, hit.u, hit.v, hit.nodes);
+		PX_CHECK_MSG(got >= ref - 1e-7, "below oracle: %.17g vs %.17g", got, ref);
+		if (hit.d2 < INFINITY)
+			PX_CHECK(px_v3_dist(hit.point, eval_ref((const double(*)[4])hw, p, q, hit.u, hit.v)) < 1e-12);
+	}
+	printf("    interior answers %d of 150, uncertified %d\n", interior, unc);
+	PX_CHECK(interior > 30);
+}
+
+static void test_sphere_octant_focal_point(void)
+{
+	/* Rational biquadratic octant of the unit sphere (a degenerate patch:
+	 * the t = 1 edge collapses to the pole). From the centre every point
+	 * is at distance 1: the focal point of a sphere. */
+	const double r2 = sqrt(0.5);
+	double hw[9][4];
+	static const double pts[3][3][3] = {
+		{{1, 0, 0}, {1, 0, 1}, {0, 0, 1}},
+		{{1, 1, 0}, {1, 1, 1}, {0, 0, 1}},
+		{{0, 1, 0}, {0, 1, 1}, {0, 0, 1}}};
+	struct px_spiece sp;
+	struct px_spiece_hit hit;
+	double best;
+	int i, j, k, unc = 0;
+
+	for (i = 0; i < 3; i++)
+		for (j = 0; j < 3; j++) {
+			double w = (i == 1 ? r2 : 1.0) * (j == 1 ? r2 : 1.0);
+			for (k = 0; k < 3; k++)
+				hw[i * 3 + j][k] = pts[i][j][k] * w;
+			hw[i * 3 + j][3] = w;
+		}
+	PX_CHECK_INT_EQ(px_spiece_init(&sp, 2, 2, (const double(*)[4])hw, 0, 1, 0, 1, mem), PX_OK);
+	/* All evaluated points on the unit sphere. */
+	for (i = 0; i < 50; i++) {
+		px_vec3 s = px_spiece_eval(&sp, px_rand_unit(), px_rand_unit(), NULL, NULL, NULL, NULL, NULL);
+		PX_CHECK_CLOSE(px_v3_norm(s), 1.0, 1e-12, 0);
+	}
+	best = INFINITY;
+	px_spiece_closest(&sp, px_v3(0, 0, 0), &best, &hit);
+	PX_CHECK_CLOSE(sqrt(best), 1.0, 1e-12, 0);
+	PX_CHECK_MSG(hit.nodes < 20, "nodes %d", hit.nodes);
+	for (i = 0; i < 200; i++) {
+		px_vec3 dir = px_v3(px_rand_range(0.05, 1), px_rand_range(0.05, 1), px_rand_range(0.05, 1));
+		double rad = px_rand_range(0.0, 3.0), got;
+		px_vec3 x = px_v3_scale(dir, rad / px_v3_norm(dir));
+		got = solve((const double(*)[4])hw, 2, 2, x, &unc, &hit);
+		PX_CHECK_CLOSE(got, fabs(rad - 1.0), 1e-10, 1e-10);
+	}
+	PX_CHECK_INT_EQ(unc, 0);
+}
+
+static void test_query_allocates_nothing(void)
+{
+	double hw[16][4];
+	struct px_spiece sp;
+	struct px_spiece_hit hit;
+	uint64_t a;
+	int i;
+	random_patch(hw, 3, 3, 1);
+	PX_CHECK_INT_EQ(px_spiece_init(&sp, 3, 3, (const double(*)[4])hw, 0, 1, 0, 1, mem), PX_OK);
+	a = px_alloc_region_begin();
+	for (i = 0; i < 500; i++) {
+		double best = INFINITY;
+		px_spiece_closest(&sp, px_v3(px_rand_unit(), px_rand_unit(), px_rand_normal()), &best, &hit);
+	}
+	PX_CHECK_INT_EQ(px_alloc_region_end(a), 0);
+}
+
+static void test_bad_input(void)
+{
+	double hw[4][4] = {{0, 0, 0, 1}, {1, 0, 0, 1}, {0, 1, 0, 1}, {1, 1, 0, 1}};
+	struct px_spiece sp;
+	PX_CHECK_INT_EQ(px_spiece_doubles(0, 2), 0);
+	PX_CHECK_INT_EQ(px_spiece_init(&sp, 11, 1, (const double(*)[4])hw, 0, 1, 0, 1, mem), PX_E_RANGE);
+	PX_CHECK_INT_EQ(px_spiece_init(&sp, 1, 1, (const double(*)[4])hw, 0, 1, 1, 1, mem), PX_E_INVAL);
+	hw[2][3] = -1;
+	PX_CHECK_INT_EQ(px_spiece_init(&sp, 1, 1, (const double(*)[4])hw, 0, 1, 0, 1, mem), PX_E_INVAL);
+	hw[2][3] = 1;
+	hw[1][0] = NAN;
+	PX_CHECK_INT_EQ(px_spiece_init(&sp, 1, 1, (const double(*)[4])hw, 0, 1, 0, 1, mem), PX_E_NAN);
+}
+
+static const struct px_test tests[] = {
+	PX_T(test_eval_matches_reference),
+	PX_T(test_random_patches_vs_oracle),
+	PX_T(test_sphere_octant_focal_point),
+	PX_T(test_query_allocates_nothing),
+	PX_T(test_bad_input),
+};
+
+PX_TEST_MAIN(tests)
