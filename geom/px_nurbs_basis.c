@@ -103,65 +103,64 @@ static inline double ratio(double a, double b)
 void px_nurbs_basis_ders(const double *U, int p, int k, double u, int nder,
 			 double *out)
 {
-	/* N[q][r]: degree-q function number k-q+r on span k. */
+	/* N[q][r]: degree-q function number k-q+r on span k.
+	 * inv[q][r] = 1 / (U[k+r+1] - U[k+1-q+r]), r < q: the knot
+	 * differences of the degree-q step. On a non-empty span
+	 * (U[k] < U[k+1]) every one of them is positive, so no 0/0 guard is
+	 * needed, and they are also the denominators of the derivative
+	 * recursion, which therefore needs no division at all. */
 	double N[PX_NURBS_MAX_DEGREE + 1][PX_NURBS_MAX_DEGREE + 1];
-	/* D[q][r]: derivative of the current order of the same functions;
-	 * E the previous order. */
-	double D[PX_NURBS_MAX_DEGREE + 1][PX_NURBS_MAX_DEGREE + 1];
-	double E[PX_NURBS_MAX_DEGREE + 1][PX_NURBS_MAX_DEGREE + 1];
+	double inv[PX_NURBS_MAX_DEGREE + 1][PX_NURBS_MAX_DEGREE + 1];
+	double left[PX_NURBS_MAX_DEGREE + 1], right[PX_NURBS_MAX_DEGREE + 1];
+	double D[2][PX_NURBS_MAX_DEGREE + 1][PX_NURBS_MAX_DEGREE + 1];
 	int q, r, kd;
 
 	N[0][0] = 1.0;
 	for (q = 1; q <= p; q++) {
-		for (r = 0; r <= q; r++) {
-			int j = k - q + r;
-			double v = 0.0;
-			if (r >= 1)
-				v += N[q - 1][r - 1] *
-				     ratio(u - U[j], U[j + q] - U[j]);
-			if (r <= q - 1)
-				v += N[q - 1][r] *
-				     ratio(U[j + q + 1] - u,
-					   U[j + q + 1] - U[j + 1]);
-			N[q][r] = v;
+		double saved = 0.0;
+		left[q] = u - U[k + 1 - q];
+		right[q] = U[k + q] - u;
+		for (r = 0; r < q; r++) {
+			double iv = 1.0 / (right[r + 1] + left[q - r]);
+			double t = N[q - 1][r] * iv;
+			inv[q][r] = iv;
+			N[q][r] = saved + right[r + 1] * t;
+			saved = left[q - r] * t;
 		}
+		N[q][q] = saved;
 	}
 	for (r = 0; r <= p; r++)
 		out[r] = N[p][r];
 	if (nder <= 0)
 		return;
+	if (nder > p) {
+		for (kd = p + 1; kd <= nder; kd++)
+			for (r = 0; r <= p; r++)
+				out[kd * (p + 1) + r] = 0.0;
+		nder = p;
+	}
 	/* d/du N_{j,q} = q (N_{j,q-1} / (U[j+q]-U[j])
 	 *                   - N_{j+1,q-1} / (U[j+q+1]-U[j+1])),
-	 * applied order by order on the lower-degree tables. */
-	for (q = 0; q <= p; q++)
-		for (r = 0; r <= q; r++)
-			E[q][r] = N[q][r];
-	for (kd = 1; kd <= nder; kd++) {
-		int qmin = p - nder + kd;
-		if (qmin < 0)
-			qmin = 0;
-		for (q = qmin; q <= p; q++) {
-			for (r = 0; r <= q; r++) {
-				int j = k - q + r;
-				double v = 0.0;
-				if (q == 0) {
-					D[q][r] = 0.0;
-					continue;
+	 * applied order by order on the lower-degree tables; with
+	 * j = k-q+r both differences are inv[q][r-1] and inv[q][r]. */
+	{
+		const double(*E)[PX_NURBS_MAX_DEGREE + 1] = N;
+		for (kd = 1; kd <= nder; kd++) {
+			double(*C)[PX_NURBS_MAX_DEGREE + 1] = D[kd & 1];
+			int qmin = p - nder + kd;
+			for (q = qmin; q <= p; q++) {
+				double prev = 0.0;
+				for (r = 0; r < q; r++) {
+					double t = E[q - 1][r] * inv[q][r];
+					C[q][r] = q * (prev - t);
+					prev = t;
 				}
-				if (r >= 1)
-					v += ratio(E[q - 1][r - 1],
-						   U[j + q] - U[j]);
-				if (r <= q - 1)
-					v -= ratio(E[q - 1][r],
-						   U[j + q + 1] - U[j + 1]);
-				D[q][r] = q * v;
+				C[q][q] = q * prev;
 			}
+			for (r = 0; r <= p; r++)
+				out[kd * (p + 1) + r] = C[p][r];
+			E = (const double(*)[PX_NURBS_MAX_DEGREE + 1])C;
 		}
-		for (r = 0; r <= p; r++)
-			out[kd * (p + 1) + r] = D[p][r];
-		for (q = qmin; q <= p; q++)
-			for (r = 0; r <= q; r++)
-				E[q][r] = D[q][r];
 	}
 }
 
