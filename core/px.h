@@ -9,5 +9,6 @@
 #include "px_arena.h"
 #include "px_math.h"
 #include "px_nurbs.h"
+#include "px_obj.h"
 
 #endif
