@@ -92,14 +92,6 @@ int px_nurbs_curve_find_span(const struct px_nurbs_curve *c, double u,
 	return px__nurbs_span(c->knots, c->degree, c->n_ctrl, u, side);
 }
 
-/* a / b with the convention 0/0 = 0 of the Cox-de Boor recursion: b is a
- * knot difference, zero only where the basis function it divides is
- * identically zero. */
-static inline double ratio(double a, double b)
-{
-	return b > 0.0 ? a / b : 0.0;
-}
-
 void px_nurbs_basis_ders(const double *U, int p, int k, double u, int nder,
 			 double *out)
 {

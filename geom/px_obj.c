@@ -592,17 +592,22 @@ static int nurbs_fail(struct ctx *c, const struct ent_rec *e,
 		       ne->msg);
 }
 
+static const double no_knots = 0.0;
+
 static int st_end(struct ctx *c, const struct tok *tk, size_t n)
 {
 	struct ent_rec *e = cur_ent(c);
 	struct px_nurbs_error ne;
-	const double *K = (const double *)c->knots.p;
-	const double *X = (const double *)c->xyz.p + 3 * (e ? e->ctrl_off : 0);
-	const double *W = (const double *)c->wts.p + (e ? e->ctrl_off : 0);
+	const double *K, *X, *W;
 	int d, rc, nd;
 	if (!e)
 		return fail(c, &tk[0], PX_E_PARSE,
 			    "'end' without an open curv/surf");
+	/* Pools are non-empty here: an entity has >= 2 control points, and
+	 * every knot vector was checked to exist below before use. */
+	K = c->knots.p ? (const double *)c->knots.p : &no_knots;
+	X = (const double *)c->xyz.p + 3 * e->ctrl_off;
+	W = (const double *)c->wts.p + e->ctrl_off;
 	if (n != 1)
 		return fail(c, &tk[1], PX_E_PARSE, "'end' takes no arguments");
 	nd = e->kind == PX_OBJ_SURF ? 2 : 1;
