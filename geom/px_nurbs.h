@@ -369,6 +369,20 @@ PX_API int px_nurbs_surf_closed(const struct px_nurbs_surf *s, int dir,
 				double tol);
 
 /*
+ * Seam across direction dir, as px_nurbs_curve_seam() for the boundary
+ * curves at the two ends of dir: -1 when they are not within tol at the
+ * sample parameters of px_nurbs_surf_closed(); otherwise the largest k in
+ * 0..min(degree[dir]-1, PX_NURBS_MAX_DERIV) such that the partial
+ * derivatives along dir of orders 1..k agree there within tol_rel times
+ * the largest magnitude of that order along the seam (so vanishing
+ * derivatives at a pole do not count as a break); k >= 1: smooth closed
+ * or periodic. The derivative test is made at those samples only.
+ * @note RT-safe.
+ */
+PX_API int px_nurbs_surf_seam(const struct px_nurbs_surf *s, int dir,
+			      double tol, double tol_rel);
+
+/*
  * Collapsed boundary (a pole): 1 when every control point of the edge
  * lies within tol of the edge's first control point, so the boundary
  * curve is a single point. edge: 0 u = u0, 1 u = u1, 2 v = v0, 3 v = v1.

@@ -385,6 +385,66 @@ int px_nurbs_surf_closed(const struct px_nurbs_surf *s, int dir, double tol)
 	return boundary_test(s, dir, 0, 1, tol, 0);
 }
 
+int px_nurbs_surf_seam(const struct px_nurbs_surf *s, int dir, double tol,
+		       double tol_rel)
+{
+	px_vec3 A[PX_NURBS_MAX_DERIV + 1][PX_NURBS_MAX_DERIV + 1];
+	px_vec3 B[PX_NURBS_MAX_DERIV + 1][PX_NURBS_MAX_DERIV + 1];
+	double scale[PX_NURBS_MAX_DERIV + 1] = {0};
+	int o, po, no, kmax, best, k, i, j, pass;
+	const double *T, *D;
+	double t0, t1;
+
+	if (!s || dir < 0 || dir > 1)
+		return -1;
+	o = 1 - dir;
+	po = s->degree[o];
+	no = s->n_ctrl[o];
+	T = s->knots[o];
+	D = s->knots[dir];
+	t0 = D[s->degree[dir]];
+	t1 = D[s->n_ctrl[dir]];
+	kmax = s->degree[dir] - 1;
+	if (kmax > PX_NURBS_MAX_DERIV)
+		kmax = PX_NURBS_MAX_DERIV;
+	best = kmax;
+	/* Pass 0 finds the largest derivative of each order along the seam,
+	 * pass 1 compares against tol_rel times it: at a pole the
+	 * derivatives vanish and their directions are rounding noise. */
+	for (pass = 0; pass < 2; pass++) {
+		for (k = po; k < no; k++) {
+			if (!(T[k] < T[k + 1]))
+				continue;
+			for (i = 0; i <= 2 * po; i++) {
+				double t = T[k] + (T[k + 1] - T[k]) * i / (2.0 * po);
+				if (dir == 0) {
+					surf_eval_core(s, t0, t, 1, 1, kmax, A);
+					surf_eval_core(s, t1, t, -1, 1, kmax, B);
+				} else {
+					surf_eval_core(s, t, t0, 1, 1, kmax, A);
+					surf_eval_core(s, t, t1, 1, -1, kmax, B);
+				}
+				if (!(px_v3_dist(A[0][0], B[0][0]) <= tol))
+					return -1;
+				for (j = 1; j <= best; j++) {
+					px_vec3 a = dir == 0 ? A[j][0] : A[0][j];
+					px_vec3 b = dir == 0 ? B[j][0] : B[0][j];
+					if (pass == 0) {
+						scale[j] = fmax(scale[j],
+								fmax(px_v3_norm(a),
+								     px_v3_norm(b)));
+					} else if (!(px_v3_dist(a, b) <=
+						     tol_rel * scale[j])) {
+						best = j - 1;
+						break;
+					}
+				}
+			}
+		}
+	}
+	return best;
+}
+
 int px_nurbs_surf_edge_collapsed(const struct px_nurbs_surf *s, int edge,
 				 double tol)
 {

@@ -997,6 +997,8 @@ static void test_rational_sphere(void)
 		}
 	PX_CHECK(px_nurbs_surf_closed(&s, 0, 1e-12));
 	PX_CHECK(!px_nurbs_surf_closed(&s, 1, 1e-12));
+	PX_CHECK_INT_EQ(px_nurbs_surf_seam(&s, 0, 1e-12, 1e-9), 1);
+	PX_CHECK_INT_EQ(px_nurbs_surf_seam(&s, 1, 1e-12, 1e-9), -1);
 	PX_CHECK(px_nurbs_surf_edge_collapsed(&s, 2, 1e-12));
 	PX_CHECK(px_nurbs_surf_edge_collapsed(&s, 3, 1e-12));
 	PX_CHECK(!px_nurbs_surf_edge_collapsed(&s, 0, 1e-12));
@@ -1010,6 +1012,40 @@ static void test_rational_sphere(void)
 	}
 	PX_CHECK_INT_EQ(px_nurbs_surf_breaks(&s, 0, NULL, 0), 3);
 	PX_CHECK_INT_EQ(px_nurbs_surf_breaks(&s, 1, NULL, 0), 1);
+}
+
+/* A periodic tube: uniform cubic closed curve (control polygon wrapped
+ * by 3 points) swept linearly along z. */
+static void test_periodic_tube_seam(void)
+{
+	double K[14], V[4] = {0, 0, 1, 1}, P[3 * 20];
+	struct px_arena a;
+	struct px_nurbs_surf s;
+	int i, j;
+	px_arena_init(&a, arena_buf, sizeof(arena_buf));
+	for (i = 0; i < 14; i++)
+		K[i] = i;
+	for (j = 0; j < 2; j++)
+		for (i = 0; i < 10; i++) {
+			double t = 2 * M_PI * (i % 7) / 7.0;
+			double r = 1 + 0.3 * ((i % 7) % 2);
+			P[3 * (j * 10 + i)] = r * cos(t);
+			P[3 * (j * 10 + i) + 1] = r * sin(t);
+			P[3 * (j * 10 + i) + 2] = 2.0 * j + 0.1 * (i % 7);
+		}
+	PX_CHECK_INT_EQ(px_nurbs_surf_init(&s, &a, 3, 1, 10, 2, K, 14, V, 4, P,
+					   NULL, NULL),
+			PX_OK);
+	PX_CHECK_INT_EQ(px_nurbs_surf_seam(&s, 0, 1e-12, 1e-9), 2);
+	PX_CHECK(px_nurbs_surf_closed(&s, 0, 1e-12));
+	PX_CHECK_INT_EQ(px_nurbs_surf_seam(&s, 1, 1e-12, 1e-9), -1);
+	/* open the tube at the top only: no longer closed */
+	P[3 * 19 + 2] += 0.25;
+	PX_CHECK_INT_EQ(px_nurbs_surf_init(&s, &a, 3, 1, 10, 2, K, 14, V, 4, P,
+					   NULL, NULL),
+			PX_OK);
+	PX_CHECK_INT_EQ(px_nurbs_surf_seam(&s, 0, 1e-9, 1e-9), -1);
+	PX_CHECK(!px_nurbs_surf_closed(&s, 0, 1e-9));
 }
 
 static void test_surf_validation(void)
@@ -1252,6 +1288,7 @@ static const struct px_test tests[] = {
 	PX_T(test_curve_extraction_and_boxes),
 	PX_T(test_surf_eval_vs_reference),
 	PX_T(test_rational_sphere),
+	PX_T(test_periodic_tube_seam),
 	PX_T(test_surf_validation),
 	PX_T(test_surf_insertion_and_extraction),
 	PX_T(test_sub_patch_boxes_cover_sphere),
