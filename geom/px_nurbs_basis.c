@@ -107,22 +107,25 @@ void px_nurbs_basis_ders(const double *U, int p, int k, double u, int nder,
 	double D[2][PX_NURBS_MAX_DEGREE + 1][PX_NURBS_MAX_DEGREE + 1];
 	int q, r, kd;
 
+	/* The degree-p rows are written straight into out (a copy loop here
+	 * would be turned into a memcpy call, a quarter of the cost). */
 	N[0][0] = 1.0;
+	if (p == 0)
+		out[0] = 1.0;
 	for (q = 1; q <= p; q++) {
 		double saved = 0.0;
+		double *Nq = q == p ? out : N[q];
 		left[q] = u - U[k + 1 - q];
 		right[q] = U[k + q] - u;
 		for (r = 0; r < q; r++) {
 			double iv = 1.0 / (right[r + 1] + left[q - r]);
 			double t = N[q - 1][r] * iv;
 			inv[q][r] = iv;
-			N[q][r] = saved + right[r + 1] * t;
+			Nq[r] = saved + right[r + 1] * t;
 			saved = left[q - r] * t;
 		}
-		N[q][q] = saved;
+		Nq[q] = saved;
 	}
-	for (r = 0; r <= p; r++)
-		out[r] = N[p][r];
 	if (nder <= 0)
 		return;
 	if (nder > p) {
@@ -134,23 +137,23 @@ void px_nurbs_basis_ders(const double *U, int p, int k, double u, int nder,
 	/* d/du N_{j,q} = q (N_{j,q-1} / (U[j+q]-U[j])
 	 *                   - N_{j+1,q-1} / (U[j+q+1]-U[j+1])),
 	 * applied order by order on the lower-degree tables; with
-	 * j = k-q+r both differences are inv[q][r-1] and inv[q][r]. */
+	 * j = k-q+r both differences are inv[q][r-1] and inv[q][r]. Rows of
+	 * degree < p are all the next order needs. */
 	{
 		const double(*E)[PX_NURBS_MAX_DEGREE + 1] = N;
 		for (kd = 1; kd <= nder; kd++) {
 			double(*C)[PX_NURBS_MAX_DEGREE + 1] = D[kd & 1];
 			int qmin = p - nder + kd;
 			for (q = qmin; q <= p; q++) {
+				double *Cq = q == p ? out + kd * (p + 1) : C[q];
 				double prev = 0.0;
 				for (r = 0; r < q; r++) {
 					double t = E[q - 1][r] * inv[q][r];
-					C[q][r] = q * (prev - t);
+					Cq[r] = q * (prev - t);
 					prev = t;
 				}
-				C[q][q] = q * prev;
+				Cq[q] = q * prev;
 			}
-			for (r = 0; r <= p; r++)
-				out[kd * (p + 1) + r] = C[p][r];
 			E = (const double(*)[PX_NURBS_MAX_DEGREE + 1])C;
 		}
 	}

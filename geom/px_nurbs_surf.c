@@ -199,7 +199,7 @@ static void surf_eval_core(const struct px_nurbs_surf *s, double u, double v,
 	const int pu = s->degree[0], pv = s->degree[1];
 	const int nu = s->n_ctrl[0], nv = s->n_ctrl[1];
 	const double *U = s->knots[0], *V = s->knots[1];
-	int ku, kv, du, dv, k, l, r, q, i, j, c;
+	int ku, kv, du, dv, k, l, r, q, i, j;
 
 	u = px__nurbs_clamp(U, pu, nu, u);
 	v = px__nurbs_clamp(V, pv, nv, v);
@@ -232,14 +232,22 @@ static void surf_eval_core(const struct px_nurbs_surf *s, double u, double v,
 	}
 	for (k = 0; k <= order; k++) {
 		for (l = 0; k + l <= order; l++) {
-			for (c = 0; c < 4; c++)
-				A[k][l][c] = 0.0;
-			if (k > du || l > dv)
-				continue;
-			const double *b = Bv + l * (pv + 1);
-			for (q = 0; q <= pv; q++)
-				for (c = 0; c < 4; c++)
-					A[k][l][c] += b[q] * T[k][q][c];
+			/* local sums: accumulating in A itself stalls on
+			 * store-to-load forwarding */
+			double a0 = 0, a1 = 0, a2 = 0, a3 = 0;
+			if (k <= du && l <= dv) {
+				const double *b = Bv + l * (pv + 1);
+				for (q = 0; q <= pv; q++) {
+					a0 += b[q] * T[k][q][0];
+					a1 += b[q] * T[k][q][1];
+					a2 += b[q] * T[k][q][2];
+					a3 += b[q] * T[k][q][3];
+				}
+			}
+			A[k][l][0] = a0;
+			A[k][l][1] = a1;
+			A[k][l][2] = a2;
+			A[k][l][3] = a3;
 		}
 	}
 	if (!s->rational) {
