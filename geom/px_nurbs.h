@@ -47,7 +47,8 @@
  * never lock, and have loop counts bounded by the entity size; they use
  * fixed stack arrays sized by PX_NURBS_MAX_DEGREE (a few kilobytes). They
  * are marked @note RT-safe. Validation formats its message with
- * snprintf() and is meant for setup.
+ * snprintf() and is meant for setup. Nothing keeps hidden state: a
+ * curve or surface may be evaluated from several threads at once.
  */
 #ifndef PX_NURBS_H
 #define PX_NURBS_H
@@ -279,7 +280,12 @@ PX_API int px_nurbs_curve_extract(const struct px_nurbs_curve *c, double a,
 /*
  * Guaranteed box of the curve on [a, b]: the box of the extracted
  * sub-curve's control points (every curve point with a <= u <= b lies in
- * it). work as for px_nurbs_curve_extract_work(). @note RT-safe.
+ * it, by the convex hull property; knot insertion only takes convex
+ * combinations). Floating point: evaluated points may stray outside by
+ * rounding, a few ulps of the coordinates (the tests allow 1e-13 of the
+ * entity's box diagonal); inflate by such a margin where the box is used
+ * as an exact bound. work as for px_nurbs_curve_extract_work().
+ * @note RT-safe.
  */
 PX_API int px_nurbs_curve_sub_aabb(const struct px_nurbs_curve *c, double a,
 				   double b, double *work, size_t work_len,
