@@ -173,7 +173,7 @@ static void test_basis_vs_cox_de_boor(void)
 		struct tcurve t;
 		struct px_nurbs_curve c = {0};
 		double B[(PX_NURBS_MAX_DERIV + 1) * (PX_NURBS_MAX_DEGREE + 1)];
-		int p = 1 + trial % 9, k, r, kd, i;
+		int p = 1 + trial % PX_NURBS_MAX_DEGREE, k, r, kd, i;
 		double u0, u1, u;
 		gen_curve(&t, p, trial % 3 != 0, 0);
 		c.degree = p;
@@ -258,7 +258,7 @@ static void test_curve_eval_vs_reference(void)
 		struct px_arena a;
 		struct tcurve t;
 		struct px_nurbs_curve c;
-		int p = 1 + trial % 9, j;
+		int p = 1 + trial % PX_NURBS_MAX_DEGREE, j;
 		px_arena_init(&a, arena_buf, sizeof(arena_buf));
 		gen_curve(&t, p, trial % 4 != 0, trial % 5 != 0);
 		make_curve(&a, &t, &c);

@@ -107,6 +107,44 @@ static void test_bicubic_file(void)
 	px_obj_free(m);
 }
 
+/* A surf range narrower than the knot domain selects that sub-patch. */
+static void test_sub_patch_range(void)
+{
+	size_t len;
+	char *buf = slurp("bicubic.obj", &len), *text;
+	struct px_obj_model *m;
+	struct px_obj_error e;
+	const struct px_nurbs_surf *s;
+	double u0, u1, v0, v1;
+	int i;
+	char *at = strstr(buf, "surf 0 1 0 1 ");
+	PX_CHECK(at != NULL);
+	text = malloc(len + 32);
+	PX_CHECK(text != NULL);
+	/* same length replacement keeps the rest of the file */
+	memcpy(text, buf, (size_t)(at - buf));
+	len = (size_t)(at - buf) +
+	      (size_t)sprintf(text + (at - buf), "surf 0.25 0.75 0.5 1 %s",
+			      at + strlen("surf 0 1 0 1 "));
+	PX_CHECK_INT_EQ(px_obj_load_mem("sub", text, len, &m, &e), PX_OK);
+	s = &m->entities[0].surf;
+	px_nurbs_surf_domain(s, &u0, &u1, &v0, &v1);
+	PX_CHECK(u0 == 0.25 && u1 == 0.75 && v0 == 0.5 && v1 == 1);
+	for (i = 0; i < 100; i++) {
+		double u = px_rand_range(0.25, 0.75), v = px_rand_range(0.5, 1);
+		PX_CHECK(px_v3_dist(px_nurbs_surf_point(s, u, v),
+				    px_v3(u, v, u * u + 0.5 * v)) < 1e-14);
+	}
+	{
+		px_aabb b = px_nurbs_surf_aabb(s);
+		PX_CHECK(b.min.x >= 0.25 - 1e-15 && b.max.x <= 0.75 + 1e-15);
+		PX_CHECK(b.min.y >= 0.5 - 1e-15);
+	}
+	px_obj_free(m);
+	free(text);
+	free(buf);
+}
+
 static void test_sphere_file(void)
 {
 	struct px_obj_model *m = load("sphere.obj");
@@ -473,6 +511,7 @@ static void test_random_garbage_never_crashes(void)
 static const struct px_test tests[] = {
 	PX_T(test_circle_file),
 	PX_T(test_bicubic_file),
+	PX_T(test_sub_patch_range),
 	PX_T(test_sphere_file),
 	PX_T(test_multi_entity_file),
 	PX_T(test_continuation_file),
