@@ -365,6 +365,20 @@ PX_API px_vec3 px_nurbs_surf_ctrl(const struct px_nurbs_surf *s, int i, int j,
 				  double *w);
 
 /*
+ * Iso-parametric curve running along direction dir with the other
+ * parameter fixed at t (clamped to its domain): dir 0 gives
+ * C(u) = S(u, t), dir 1 gives C(v) = S(t, v) - boundary curves at the
+ * domain ends, the "longest iso-curves" of a decomposition inside. The
+ * curve views the surface's knot vector of dir and gets its homogeneous
+ * control points in pw_out (pw_len >= 4 * n_ctrl[dir] doubles; keep both
+ * alive while using *out). Returns PX_OK, PX_E_INVAL, PX_E_NAN,
+ * PX_E_NOSPC. @note RT-safe.
+ */
+PX_API int px_nurbs_surf_iso_curve(const struct px_nurbs_surf *s, int dir,
+				   double t, double *pw_out, size_t pw_len,
+				   struct px_nurbs_curve *out);
+
+/*
  * Closed in direction dir: 1 when the boundary curves at the two ends of
  * dir coincide within tol. Checked at 2*p+1 parameters per span of the
  * other direction (p its degree), which decides equality of two rational

@@ -386,6 +386,49 @@ static int boundary_test(const struct px_nurbs_surf *s, int dir, int end_a,
 	return 1;
 }
 
+int px_nurbs_surf_iso_curve(const struct px_nurbs_surf *s, int dir, double t,
+			    double *pw_out, size_t pw_len,
+			    struct px_nurbs_curve *out)
+{
+	double N[PX_NURBS_MAX_DEGREE + 1];
+	int o, po, k, n, i, r, c;
+	size_t st_dir, st_o;
+
+	if (!s || !s->pw || !out || dir < 0 || dir > 1)
+		return PX_E_INVAL;
+	if (isnan(t))
+		return PX_E_NAN;
+	n = s->n_ctrl[dir];
+	if (!pw_out || pw_len < 4 * (size_t)n)
+		return PX_E_NOSPC;
+	o = 1 - dir;
+	po = s->degree[o];
+	t = px__nurbs_clamp(s->knots[o], po, s->n_ctrl[o], t);
+	k = px__nurbs_span(s->knots[o], po, s->n_ctrl[o], t, 1);
+	px_nurbs_basis_ders(s->knots[o], po, k, t, 0, N);
+	/* point (a along dir, b along o) is at pw + 4 * (a*st_dir + b*st_o) */
+	st_dir = dir == 0 ? 1 : (size_t)s->n_ctrl[0];
+	st_o = dir == 0 ? (size_t)s->n_ctrl[0] : 1;
+	for (i = 0; i < n; i++) {
+		double q[4] = {0, 0, 0, 0};
+		for (r = 0; r <= po; r++) {
+			const double *P = s->pw + 4 * ((size_t)i * st_dir +
+						       (size_t)(k - po + r) * st_o);
+			for (c = 0; c < 4; c++)
+				q[c] += N[r] * P[c];
+		}
+		for (c = 0; c < 4; c++)
+			pw_out[4 * (size_t)i + c] = q[c];
+	}
+	out->degree = s->degree[dir];
+	out->n_ctrl = n;
+	out->n_knots = s->n_knots[dir];
+	out->knots = s->knots[dir];
+	out->pw = pw_out;
+	out->rational = s->rational;
+	return PX_OK;
+}
+
 int px_nurbs_surf_closed(const struct px_nurbs_surf *s, int dir, double tol)
 {
 	if (!s || dir < 0 || dir > 1)

@@ -1199,6 +1199,52 @@ static void test_surf_insertion_and_extraction(void)
 	}
 }
 
+static void test_surf_iso_curves(void)
+{
+	int trial;
+	for (trial = 0; trial < 100; trial++) {
+		static struct tsurf t;
+		static double pw[4 * MAXN];
+		struct px_arena a;
+		struct px_nurbs_surf s;
+		struct px_nurbs_curve c;
+		int dir, j;
+		double dom[4], diag;
+		px_aabb b;
+		px_arena_init(&a, arena_buf, sizeof(arena_buf));
+		gen_surf(&t, 1 + trial % 5, 1 + (trial / 5) % 4, trial % 3 != 0,
+			 trial % 2);
+		make_surf(&a, &t, &s);
+		px_nurbs_surf_domain(&s, &dom[0], &dom[1], &dom[2], &dom[3]);
+		b = px_nurbs_surf_aabb(&s);
+		diag = px_v3_dist(b.min, b.max);
+		for (dir = 0; dir < 2; dir++) {
+			int o = 1 - dir;
+			double x = px_rand_range(dom[2 * o], dom[2 * o + 1]);
+			if (trial % 4 == 1)
+				x = dom[2 * o + (trial & 1)]; /* a boundary */
+			PX_CHECK_INT_EQ(px_nurbs_surf_iso_curve(&s, dir, x, pw,
+								4 * s.n_ctrl[dir] - 1,
+								&c),
+					PX_E_NOSPC);
+			PX_CHECK_INT_EQ(px_nurbs_surf_iso_curve(&s, dir, x, pw,
+								sizeof(pw) / sizeof(pw[0]),
+								&c),
+					PX_OK);
+			for (j = 0; j < 30; j++) {
+				double y = px_rand_range(dom[2 * dir], dom[2 * dir + 1]);
+				struct px_nurbs_surf_derivs d;
+				px_vec3 cd[2];
+				px_nurbs_surf_eval(&s, dir ? x : y, dir ? y : x, 1, &d);
+				px_nurbs_curve_eval(&c, y, 1, cd);
+				PX_CHECK(px_v3_dist(cd[0], d.s) <= 1e-12 * diag);
+				PX_CHECK(px_v3_dist(cd[1], dir ? d.sv : d.su) <=
+					 1e-9 * (diag + px_v3_norm(cd[1])));
+			}
+		}
+	}
+}
+
 /* Decomposition-style use: a grid of sub-patches whose boxes cover every
  * sampled point of the patch. */
 static void test_sub_patch_boxes_cover_sphere(void)
@@ -1272,6 +1318,12 @@ static void test_evaluation_allocates_nothing(void)
 				      &ss);
 		(void)px_nurbs_curve_aabb(&c);
 		(void)px_nurbs_surf_aabb(&s);
+		px_nurbs_surf_iso_curve(&s, i & 1, v, work_buf,
+					sizeof(work_buf) / sizeof(double), &cs);
+		(void)px_nurbs_curve_point(&cs, u);
+		(void)px_nurbs_curve_seam(&c, 1e-9, 1e-9);
+		(void)px_nurbs_curve_breaks(&c, NULL, 0);
+		(void)px_nurbs_curve_find_span(&c, u, -1);
 	}
 	PX_CHECK_INT_EQ(px_alloc_region_end(r), 0);
 }
@@ -1291,6 +1343,7 @@ static const struct px_test tests[] = {
 	PX_T(test_periodic_tube_seam),
 	PX_T(test_surf_validation),
 	PX_T(test_surf_insertion_and_extraction),
+	PX_T(test_surf_iso_curves),
 	PX_T(test_sub_patch_boxes_cover_sphere),
 	PX_T(test_evaluation_allocates_nothing),
 };
