@@ -179,6 +179,7 @@ help:
 	@echo '  test       install missing packages, build, run the whole test suite'
 	@echo '  bench      build and run the benchmarks'
 	@echo '  sanitize   the test suite built with AddressSanitizer + UBSan'
+	@echo '  fuzz       build fuzz/fuzz_*.c with libFuzzer, run each FUZZ_SECONDS=$(FUZZ_SECONDS) s'
 	@echo '  install    library, headers, tools and proxima.pc under DESTDIR/PREFIX'
 	@echo '  uninstall  remove what install put there'
 	@echo '  deps       install the Debian packages building and testing need'
@@ -191,6 +192,39 @@ help:
 	@echo '  TEST_TIMEOUT=$(TEST_TIMEOUT) (seconds per test binary)'
 	@echo 'Environment for tests: PX_TEST_SEED=<n> replays a seed,'
 	@echo '  PX_TEST_ONLY=<name> runs one test of a binary.'
+
+# ---- fuzzing (clang + libFuzzer) -----------------------------------------
+# Every fuzz/fuzz_<name>.c is built with the library sources into
+# $(BUILD)/fuzz/fuzz_<name> and run for FUZZ_SECONDS on a copy of its seed
+# corpus fuzz/corpus/<name>/ (new inputs and crash artifacts stay under
+# $(BUILD)/fuzz). Skipped, with a message, when FUZZ_CC cannot link
+# -fsanitize=fuzzer.
+FUZZ_CC      ?= clang
+FUZZ_SECONDS ?= 30
+FUZZ_SRC     := $(wildcard fuzz/fuzz_*.c)
+FUZZ_FLAGS   := -std=c11 -D_GNU_SOURCE $(WARN) $(INCS) -g -O1 \
+                -fno-omit-frame-pointer \
+                -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined
+
+.PHONY: fuzz
+fuzz:
+	@if ! printf 'int LLVMFuzzerTestOneInput(const char *d, unsigned long n);\nint LLVMFuzzerTestOneInput(const char *d, unsigned long n) { (void)d; (void)n; return 0; }\n' | \
+	    $(FUZZ_CC) -x c -fsanitize=fuzzer - -o /dev/null >/dev/null 2>&1; then \
+	  echo "fuzz: skipped: '$(FUZZ_CC)' cannot link -fsanitize=fuzzer (install clang with libFuzzer)"; \
+	  exit 0; \
+	fi; \
+	set -e; mkdir -p $(BUILD)/fuzz; \
+	for src in $(FUZZ_SRC); do \
+	  name=$$(basename $$src .c); short=$${name#fuzz_}; \
+	  echo "== $$name: build"; \
+	  $(FUZZ_CC) $(FUZZ_FLAGS) $(PKG_CFLAGS) $$src $(LIB_SRC) -o $(BUILD)/fuzz/$$name $(LIBS); \
+	  mkdir -p $(BUILD)/fuzz/corpus-$$short; \
+	  echo "== $$name: $(FUZZ_SECONDS) s"; \
+	  $(BUILD)/fuzz/$$name -max_total_time=$(FUZZ_SECONDS) -timeout=10 \
+	    -rss_limit_mb=2048 -artifact_prefix=$(BUILD)/fuzz/$$name- \
+	    -print_final_stats=1 $(BUILD)/fuzz/corpus-$$short \
+	    $$(test -d fuzz/corpus/$$short && echo fuzz/corpus/$$short); \
+	done
 
 -include $(LIB_OBJ:.o=.d) $(TEST_SUPPORT_OBJ:.o=.d) $(TOOL_SUPPORT_OBJ:.o=.d)
 -include $(patsubst %.c,$(BUILD)/obj/%.d,$(TEST_SRC) $(TOOL_SRC) $(BENCH_SRC))

@@ -8,6 +8,8 @@
 #include "px_base.h"
 #include "px_arena.h"
 #include "px_math.h"
+#include "px_nurbs.h"
+#include "px_obj.h"
 #include "px_fault.h"
 #include "px_loop.h"
 #include "px_param.h"
