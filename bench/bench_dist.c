@@ -1,0 +1,137 @@
+/*
+ * Distance core benchmark: per-query time (median, p99, max) for random
+ * points in the enlarged bounding box of representative curves, the
+ * root-iteration histogram, pieces solved per query, and model memory.
+ * Prints figures only; nothing here is a pass/fail test.
+ */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "px_arena.h"
+#include "px_dist.h"
+#include "px_nurbs.h"
+
+static uint64_t rng = 0x9e3779b97f4a7c15ull;
+static double urand(void)
+{
+	rng ^= rng << 13;
+	rng ^= rng >> 7;
+	rng ^= rng << 17;
+	return (double)(rng >> 11) * 0x1.0p-53;
+}
+
+static int64_t now_ns(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+
+static int cmp_i64(const void *a, const void *b)
+{
+	int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
+	return (x > y) - (x < y);
+}
+
+#define NQ 20000
+
+static void run(const char *name, const struct px_nurbs_curve *c, int nc,
+		const struct px_dist_opts *o)
+{
+	static int64_t t[NQ];
+	static px_vec3 q[NQ];
+	struct px_dist_model *m;
+	struct px_dist_info info;
+	struct px_dist_result r;
+	long hist[8] = {0};
+	long solved = 0, unc = 0;
+	int64_t t0;
+	int i, rc;
+
+	t0 = now_ns();
+	rc = px_dist_model_create(c, nc, o, &m);
+	if (rc) {
+		printf("%s: prepare failed: %s\n", name, px_strerror(rc));
+		return;
+	}
+	t0 = now_ns() - t0;
+	px_dist_model_info(m, &info);
+	{
+		px_vec3 lo = info.bounds.min, hi = info.bounds.max;
+		px_vec3 e = px_v3_scale(px_v3_sub(hi, lo), 0.25);
+		lo = px_v3_sub(lo, e);
+		hi = px_v3_add(hi, e);
+		for (i = 0; i < NQ; i++)
+			q[i] = px_v3(lo.x + (hi.x - lo.x) * urand(),
+				     lo.y + (hi.y - lo.y) * urand(),
+				     lo.z + (hi.z - lo.z) * urand());
+	}
+	for (i = 0; i < 1000; i++) /* warm the caches */
+		px_dist_query(m, q[i], &r);
+	for (i = 0; i < NQ; i++) {
+		int64_t a = now_ns();
+		px_dist_query(m, q[i], &r);
+		t[i] = now_ns() - a;
+		hist[r.iters < 7 ? r.iters : 7]++;
+		solved += r.pieces_solved;
+		unc += !r.certified;
+	}
+	qsort(t, NQ, sizeof(t[0]), cmp_i64);
+	printf("%-28s prepare %.2f ms, %d pieces, grid %dx%dx%d, %zu bytes\n",
+	       name, t0 / 1e6, info.n_pieces, info.grid[0], info.grid[1],
+	       info.grid[2], info.bytes);
+	printf("%-28s per query ns: median %lld  p99 %lld  max %lld; "
+	       "pieces solved %.2f/query; uncertified %ld\n",
+	       "", (long long)t[NQ / 2], (long long)t[NQ * 99 / 100],
+	       (long long)t[NQ - 1], (double)solved / NQ, unc);
+	printf("%-28s root iterations per query:", "");
+	for (i = 0; i < 8; i++)
+		printf(" %s%d:%.1f%%", i == 7 ? ">=" : "", i, 100.0 * hist[i] / NQ);
+	printf("\n");
+	px_dist_model_free(m);
+}
+
+int main(void)
+{
+	static unsigned char mem[1 << 20];
+	struct px_arena a;
+	struct px_nurbs_curve c[2];
+	struct px_dist_opts paper, coarse;
+	const double s = sqrt(0.5);
+	double k8[12] = {0, 0, 0, 0, 0.2, 0.4, 0.6, 0.8, 1, 1, 1, 1};
+	double xyz8[24], w8[8];
+	double kc[12] = {0, 0, 0, 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1, 1, 1};
+	double xyzc[27] = {1, 0, 0, 1, 1, 0, 0, 1, 0, -1, 1, 0, -1, 0, 0,
+			   -1, -1, 0, 0, -1, 0, 1, -1, 0, 1, 0, 0};
+	double wc[9] = {1, s, 1, s, 1, s, 1, s, 1};
+	int i;
+
+	px_arena_init(&a, mem, sizeof(mem));
+	for (i = 0; i < 8; i++) {
+		xyz8[3 * i] = i / 7.0;
+		xyz8[3 * i + 1] = urand() - 0.5;
+		xyz8[3 * i + 2] = 0.5 * (urand() - 0.5);
+		w8[i] = 1.0;
+	}
+	px_nurbs_curve_init(&c[0], &a, 3, 8, k8, 12, xyz8, w8, NULL);
+	px_dist_opts_default(&paper);
+	paper.decomp_tol = 0.05; /* the paper's recommended curve setting */
+	paper.jitter = 0.8;
+	px_dist_opts_default(&coarse);
+	coarse.decomp_tol = 0.25;
+	run("cubic B-spline (8 ctrl)", &c[0], 1, NULL);
+	run("  paper settings 5%/1%", &c[0], 1, &paper);
+	run("  coarse 25%/1%", &c[0], 1, &coarse);
+	for (i = 0; i < 8; i++)
+		w8[i] = 0.3 + 3.0 * urand();
+	px_nurbs_curve_init(&c[1], &a, 3, 8, k8, 12, xyz8, w8, NULL);
+	run("rational cubic (8 ctrl)", &c[1], 1, NULL);
+	run("  paper settings 5%/1%", &c[1], 1, &paper);
+	px_nurbs_curve_init(&c[0], &a, 2, 9, kc, 12, xyzc, wc, NULL);
+	run("NURBS circle (9 ctrl)", &c[0], 1, NULL);
+	return 0;
+}

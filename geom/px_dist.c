@@ -1,0 +1,950 @@
+#include "px_dist.h"
+
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "px_arena.h"
+#include "px_cpiece.h"
+
+/* Hot-path box distance: boxes here are never empty, and fmin/fmax
+ * would be library calls without -ffast-math. */
+static inline double gap1(double v, double lo, double hi)
+{
+	return v < lo ? lo - v : (v > hi ? v - hi : 0.0);
+}
+
+static inline double box_d2(const px_aabb *b, px_vec3 p)
+{
+	double dx = gap1(p.x, b->min.x, b->max.x);
+	double dy = gap1(p.y, b->min.y, b->max.y);
+	double dz = gap1(p.z, b->min.z, b->max.z);
+	return dx * dx + dy * dy + dz * dz;
+}
+
+struct cand {
+	double lb; /* squared lower bound */
+	int piece;
+};
+
+struct px_dist_model {
+	struct px_arena arena;
+	struct px_dist_opts opts;
+	int n_ent;
+	struct px_dist_entity_info *ent;
+	int n_pieces;
+	struct px_cpiece *pieces;
+	int *piece_ent;
+	int *sample_start; /* n_pieces + 1 */
+	px_vec3 *samples;
+	/* grid */
+	px_aabb bounds;
+	double h, inv_h;
+	int nx, ny, nz;
+	long n_cells, n_spill;
+	int cap;
+	int *cell_count;
+	/* Chebyshev distance (in cells) to the nearest non-empty cell: the
+	 * wave starts at that shell, all nearer ones being empty. */
+	uint16_t *cell_empty_r;
+	int *cell_slot;  /* n_cells * cap */
+	int *cell_spill; /* first spill index of each cell */
+	int *spill;
+	/* query workspace */
+	uint32_t epoch;
+	uint32_t *stamp;
+	struct cand *cand;
+};
+
+void px_dist_opts_default(struct px_dist_opts *o)
+{
+	memset(o, 0, sizeof(*o));
+	o->sample_tol = 0.01;
+	o->cell_cap = PX_DIST_CELL_CAP_DEFAULT;
+	o->max_cells = 1L << 18;
+	o->max_pieces_per_entity = 4096;
+}
+
+/* ---- knowledge step: parametrization factor ---------------------------- */
+
+/*
+ * Tolerance and jitter by parametrization factor (paper section 5): the
+ * further the speed |C'| varies, the finer the pieces, so that a start
+ * on a piece is close in parameter as well as in space.
+ */
+static void pf_table(double pf, double *tol, double *jit)
+{
+	if (pf <= 0.2) {
+		*tol = 0.2;
+		*jit = 0.5;
+	} else if (pf <= 0.4) {
+		*tol = 0.1;
+		*jit = 0.6;
+	} else if (pf <= 0.7) {
+		*tol = 0.05;
+		*jit = 0.7;
+	} else {
+		*tol = 0.01;
+		*jit = 0.8;
+	}
+}
+
+static double speed(const struct px_nurbs_curve *c, double u, int side)
+{
+	px_vec3 d[2];
+	px_nurbs_curve_eval_side(c, u, side, 1, d);
+	return px_v3_norm(d[1]);
+}
+
+/* Sorted distinct interior knots: the span boundaries. */
+static int interior_knots(const struct px_nurbs_curve *c, double a, double b,
+			  double *out)
+{
+	int i, n = 0;
+	for (i = 0; i < c->n_knots; i++) {
+		double k = c->knots[i];
+		if (k > a && k < b && (n == 0 || k > out[n - 1]))
+			out[n++] = k;
+	}
+	return n;
+}
+
+#define SPAN_SAMPLES 16
+
+struct decomp {
+	double *u;
+	int n, cap;
+};
+
+static int push(struct decomp *d, double u)
+{
+	if (d->n == d->cap) {
+		int nc = d->cap ? 2 * d->cap : 64;
+		double *nu = realloc(d->u, (size_t)nc * sizeof(double));
+		if (!nu)
+			return PX_E_NOMEM;
+		d->u = nu;
+		d->cap = nc;
+	}
+	d->u[d->n++] = u;
+	return PX_OK;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+	double x = *(const double *)a, y = *(const double *)b;
+	return (x > y) - (x < y);
+}
+
+/*
+ * Parameters that cut one curve into pieces: domain ends, every interior
+ * knot (so pieces are Bezier), cusps, and nearly uniform steps (paper
+ * section 5) with chord length in [jit * tol * L, tol * L].
+ */
+static int decompose(const struct px_nurbs_curve *c, const struct px_dist_opts *o,
+		     struct px_dist_entity_info *info, struct decomp *out)
+{
+	double a, b, *knots = NULL, dmin = INFINITY, dmax = 0.0, len = 0.0;
+	double tol, jit, eps_u, eps_l, u, du;
+	struct decomp cusps = {0}, steps = {0};
+	int nk, i, j, rc = PX_OK, guard;
+	px_vec3 prev;
+
+	px_nurbs_curve_domain(c, &a, &b);
+	knots = malloc((size_t)c->n_knots * sizeof(double));
+	if (!knots)
+		return PX_E_NOMEM;
+	nk = interior_knots(c, a, b, knots);
+	info->n_breaks = px_nurbs_curve_breaks(c, NULL, 0);
+	{
+		px_aabb hull = px_nurbs_curve_aabb(c);
+		info->closed = px_nurbs_curve_seam(
+				       c, 1e-12 * (1.0 + px_aabb_diagonal(&hull)),
+				       1e-9) >= 0;
+	}
+
+	/* Speed range and arc length from SPAN_SAMPLES per span; speeds at
+	 * knots from both sides (they differ at C0 breaks). */
+	prev = px_nurbs_curve_point(c, a);
+	for (i = 0; i <= nk; i++) {
+		double s0 = i == 0 ? a : knots[i - 1], s1 = i == nk ? b : knots[i];
+		double sp[SPAN_SAMPLES + 1];
+		for (j = 0; j <= SPAN_SAMPLES; j++) {
+			double t = s0 + (s1 - s0) * j / SPAN_SAMPLES;
+			px_vec3 q = px_nurbs_curve_point(c, t);
+			sp[j] = speed(c, t, j == SPAN_SAMPLES ? -1 : 1);
+			dmin = fmin(dmin, sp[j]);
+			dmax = fmax(dmax, sp[j]);
+			len += px_v3_dist(prev, q);
+			prev = q;
+		}
+		/* Cusp candidates: local minima of the sampled speed, refined
+		 * by golden section; a cusp is where the speed (almost)
+		 * vanishes inside the span. */
+		for (j = 1; j < SPAN_SAMPLES; j++) {
+			double lo, hi;
+			int k;
+			if (!(sp[j] <= sp[j - 1] && sp[j] <= sp[j + 1]))
+				continue;
+			lo = s0 + (s1 - s0) * (j - 1) / SPAN_SAMPLES;
+			hi = s0 + (s1 - s0) * (j + 1) / SPAN_SAMPLES;
+			for (k = 0; k < 80; k++) {
+				double x1 = hi - (hi - lo) * 0.6180339887498949;
+				double x2 = lo + (hi - lo) * 0.6180339887498949;
+				if (speed(c, x1, 1) < speed(c, x2, 1))
+					hi = x2;
+				else
+					lo = x1;
+			}
+			u = 0.5 * (lo + hi);
+			if (speed(c, u, 1) <= 1e-7 * dmax && u > s0 && u < s1) {
+				rc = push(&cusps, u);
+				if (rc)
+					goto out;
+			}
+		}
+	}
+	info->n_cusps = cusps.n;
+	info->arc_length = len;
+	info->pf = dmax > 0.0 ? (dmax - dmin) / dmax : 1.0;
+	pf_table(info->pf, &tol, &jit);
+	if (o->decomp_tol > 0.0)
+		tol = o->decomp_tol;
+	if (o->jitter > 0.0)
+		jit = o->jitter;
+	info->tol = tol;
+	info->jitter = jit;
+
+	/* Nearly uniform stepping: each step starts from the previous
+	 * increment (spatial coherence) and is brought into the chord band
+	 * by bisection. */
+	eps_u = tol * len;
+	eps_l = jit * eps_u;
+	u = a;
+	du = (b - a) * tol;
+	prev = px_nurbs_curve_point(c, a);
+	for (guard = 0; len > 0.0 && guard < o->max_pieces_per_entity; guard++) {
+		double lo = u, hi = b, x = fmin(u + du, b), d;
+		int k, overshot = 0;
+		for (k = 0; k < 60; k++) {
+			d = px_v3_dist(prev, px_nurbs_curve_point(c, x));
+			if (d > eps_u) {
+				hi = x;
+				overshot = 1;
+			} else if (d < eps_l && x < b) {
+				lo = x;
+			} else {
+				break;
+			}
+			/* Grow the step until the chord overshoots, then
+			 * bisect: growing from the last step rather than
+			 * bisecting towards the domain end keeps the step from
+			 * jumping across a loop to a far part of the curve. */
+			x = overshot ? 0.5 * (lo + hi) : fmin(b, u + 2 * (x - u));
+		}
+		if (x >= b || b - x < 1e-3 * (x - u))
+			break;
+		rc = push(&steps, x);
+		if (rc)
+			goto out;
+		du = x - u;
+		u = x;
+		prev = px_nurbs_curve_point(c, u);
+	}
+	if (guard >= o->max_pieces_per_entity) {
+		rc = PX_E_NOSPC;
+		goto out;
+	}
+
+	/* Merge: ends, knots, cusps, then steps not crowding a mandatory
+	 * cut (which would leave a sliver piece). */
+	rc = push(out, a);
+	for (i = 0; !rc && i < nk; i++)
+		rc = push(out, knots[i]);
+	for (i = 0; !rc && i < cusps.n; i++)
+		rc = push(out, cusps.u[i]);
+	if (!rc)
+		rc = push(out, b);
+	if (rc)
+		goto out;
+	qsort(out->u, (size_t)out->n, sizeof(double), cmp_double);
+	{
+		int mandatory = out->n;
+		double gap = (b - a) * tol * 0.25;
+		for (i = 0; i < steps.n; i++) {
+			double s = steps.u[i];
+			int ok = 1;
+			for (j = 0; j < mandatory; j++)
+				if (fabs(out->u[j] - s) < gap)
+					ok = 0;
+			if (ok && (rc = push(out, s)))
+				goto out;
+		}
+	}
+	qsort(out->u, (size_t)out->n, sizeof(double), cmp_double);
+	/* Drop exact duplicates. */
+	for (i = 1, j = 1; i < out->n; i++)
+		if (out->u[i] > out->u[j - 1])
+			out->u[j++] = out->u[i];
+	out->n = j;
+	if (out->n - 1 > o->max_pieces_per_entity)
+		rc = PX_E_NOSPC;
+out:
+	free(knots);
+	free(cusps.u);
+	free(steps.u);
+	return rc;
+}
+
+/* ---- setup ---------------------------------------------------------------- */
+
+struct tmp_piece {
+	struct px_cpiece pc;
+	int ent;
+	int n_samples;
+};
+
+static void cell_range(const struct px_dist_model *m, px_aabb b, int lo[3],
+		       int hi[3])
+{
+	const double mn[3] = {b.min.x, b.min.y, b.min.z};
+	const double mx[3] = {b.max.x, b.max.y, b.max.z};
+	const double g0[3] = {m->bounds.min.x, m->bounds.min.y, m->bounds.min.z};
+	const int n[3] = {m->nx, m->ny, m->nz};
+	int d;
+	for (d = 0; d < 3; d++) {
+		double l = floor((mn[d] - g0[d]) * m->inv_h);
+		double h = floor((mx[d] - g0[d]) * m->inv_h);
+		lo[d] = (int)fmax(0.0, fmin(l, n[d] - 1));
+		hi[d] = (int)fmax(0.0, fmin(h, n[d] - 1));
+	}
+}
+
+static long cell_index(const struct px_dist_model *m, int i, int j, int k)
+{
+	return ((long)k * m->ny + j) * m->nx + i;
+}
+
+static int piece_samples(const struct px_cpiece *pc, double total_len,
+			 double sample_tol)
+{
+	/* Control polygon length bounds the piece's length from above. */
+	double l = 0.0;
+	int i, n;
+	for (i = 0; i < pc->degree_; i++) {
+		px_vec3 a = px_v3(pc->h_[0][i] / pc->h_[3][i], pc->h_[1][i] / pc->h_[3][i],
+				  pc->h_[2][i] / pc->h_[3][i]);
+		px_vec3 b = px_v3(pc->h_[0][i + 1] / pc->h_[3][i + 1],
+				  pc->h_[1][i + 1] / pc->h_[3][i + 1],
+				  pc->h_[2][i + 1] / pc->h_[3][i + 1]);
+		l += px_v3_dist(a, b);
+	}
+	n = total_len > 0.0 ? (int)ceil(l / (sample_tol * total_len)) + 1 : 2;
+	return n < 2 ? 2 : (n > 64 ? 64 : n);
+}
+
+/*
+ * Chebyshev distance transform of the occupied cells by breadth-first
+ * search over the 26-neighbourhood (setup only).
+ */
+static int empty_radius(struct px_dist_model *m)
+{
+	long *queue = malloc((size_t)m->n_cells * sizeof(long)), head = 0,
+	     tail = 0, c;
+	if (!queue)
+		return PX_E_NOMEM;
+	for (c = 0; c < m->n_cells; c++) {
+		if (m->cell_count[c] > 0) {
+			m->cell_empty_r[c] = 0;
+			queue[tail++] = c;
+		} else {
+			m->cell_empty_r[c] = UINT16_MAX;
+		}
+	}
+	while (head < tail) {
+		long cur = queue[head++];
+		int x = (int)(cur % m->nx), y = (int)((cur / m->nx) % m->ny),
+		    z = (int)(cur / ((long)m->nx * m->ny)), dx, dy, dz;
+		uint16_t r = m->cell_empty_r[cur];
+		for (dz = -1; dz <= 1; dz++)
+			for (dy = -1; dy <= 1; dy++)
+				for (dx = -1; dx <= 1; dx++) {
+					long n;
+					if (x + dx < 0 || x + dx >= m->nx ||
+					    y + dy < 0 || y + dy >= m->ny ||
+					    z + dz < 0 || z + dz >= m->nz)
+						continue;
+					n = cell_index(m, x + dx, y + dy, z + dz);
+					if (m->cell_empty_r[n] != UINT16_MAX)
+						continue;
+					m->cell_empty_r[n] =
+						r < UINT16_MAX - 1 ? r + 1 : r;
+					queue[tail++] = n;
+				}
+	}
+	free(queue);
+	return PX_OK;
+}
+
+int px_dist_model_create(const struct px_nurbs_curve *curves, int n_curves,
+			 const struct px_dist_opts *opts,
+			 struct px_dist_model **out)
+{
+	struct px_dist_opts o;
+	struct px_dist_entity_info *ent = NULL;
+	struct tmp_piece *tp = NULL;
+	int n_tp = 0, cap_tp = 0, e, i, rc = PX_OK, n_samples = 0;
+	struct px_dist_model *m = NULL, hdr;
+	double *work = NULL;
+	size_t bytes;
+
+	if (!curves || n_curves < 1 || !out)
+		return PX_E_INVAL;
+	*out = NULL;
+	if (opts)
+		o = *opts;
+	else
+		px_dist_opts_default(&o);
+	if (o.sample_tol <= 0.0 || o.sample_tol > 1.0 || o.cell_cap < 1 ||
+	    o.max_cells < 1 || o.max_pieces_per_entity < 1 ||
+	    o.decomp_tol < 0.0 || o.decomp_tol > 1.0 || o.jitter < 0.0 ||
+	    o.jitter >= 1.0)
+		return PX_E_INVAL;
+	ent = calloc((size_t)n_curves, sizeof(*ent));
+	if (!ent)
+		return PX_E_NOMEM;
+
+	/* Pieces of every entity, in temporary memory. */
+	for (e = 0; e < n_curves; e++) {
+		const struct px_nurbs_curve *c = &curves[e];
+		struct decomp d = {0};
+		if (c->degree < 1 || c->degree > PX_CPIECE_MAX_DEGREE) {
+			rc = PX_E_RANGE;
+			goto fail;
+		}
+		rc = decompose(c, &o, &ent[e], &d);
+		if (rc) {
+			free(d.u);
+			goto fail;
+		}
+		free(work);
+		work = malloc(PX_NURBS_CURVE_WORK_LEN(c->degree, c->n_ctrl) *
+			      sizeof(double));
+		if (!work) {
+			free(d.u);
+			rc = PX_E_NOMEM;
+			goto fail;
+		}
+		ent[e].first_piece = n_tp;
+		for (i = 0; i + 1 < d.n; i++) {
+			struct px_nurbs_curve bz;
+			if (n_tp == cap_tp) {
+				int nc = cap_tp ? 2 * cap_tp : 64;
+				struct tmp_piece *nt =
+					realloc(tp, (size_t)nc * sizeof(*tp));
+				if (!nt) {
+					rc = PX_E_NOMEM;
+					break;
+				}
+				tp = nt;
+				cap_tp = nc;
+			}
+			rc = px_nurbs_curve_extract_work(
+				c, d.u[i], d.u[i + 1], work,
+				PX_NURBS_CURVE_WORK_LEN(c->degree, c->n_ctrl), &bz);
+			if (rc)
+				break;
+			if (bz.n_ctrl != c->degree + 1) {
+				rc = PX_E_STATE; /* a piece must be one span */
+				break;
+			}
+			rc = px_cpiece_init(&tp[n_tp].pc, c->degree,
+					    (const double(*)[4])bz.pw, d.u[i],
+					    d.u[i + 1]);
+			if (rc)
+				break;
+			tp[n_tp].ent = e;
+			tp[n_tp].n_samples = piece_samples(
+				&tp[n_tp].pc, ent[e].arc_length, o.sample_tol);
+			n_samples += tp[n_tp].n_samples;
+			n_tp++;
+		}
+		free(d.u);
+		if (rc)
+			goto fail;
+		ent[e].n_pieces = n_tp - ent[e].first_piece;
+	}
+
+	/* Grid geometry (paper section 6): cell size from the finest
+	 * entity's piece count along the longest extent. */
+	memset(&hdr, 0, sizeof(hdr));
+	hdr.bounds = px_aabb_empty();
+	for (i = 0; i < n_tp; i++) {
+		px_aabb b = px_cpiece_box(&tp[i].pc);
+		hdr.bounds = px_aabb_union(&hdr.bounds, &b);
+	}
+	{
+		px_vec3 ext = px_v3_sub(hdr.bounds.max, hdr.bounds.min);
+		double mx = fmax(ext.x, fmax(ext.y, ext.z));
+		int per = 1;
+		for (e = 0; e < n_curves; e++)
+			per = ent[e].n_pieces > per ? ent[e].n_pieces : per;
+		long cell_budget = 4L * n_tp;
+		if (!(mx > 0.0))
+			mx = 1.0;
+		hdr.h = mx / per;
+		/* The paper's cell size suits planar curves; a space curve
+		 * or a large model would get mostly empty cells that every
+		 * wave has to cross, so the cells also stay within a budget
+		 * proportional to the pieces (and the memory bound). */
+		if (cell_budget < 64)
+			cell_budget = 64;
+		if (cell_budget > o.max_cells)
+			cell_budget = o.max_cells;
+		for (;;) {
+			hdr.nx = (int)fmax(1.0, ceil(ext.x / hdr.h));
+			hdr.ny = (int)fmax(1.0, ceil(ext.y / hdr.h));
+			hdr.nz = (int)fmax(1.0, ceil(ext.z / hdr.h));
+			hdr.n_cells = (long)hdr.nx * hdr.ny * hdr.nz;
+			if (hdr.n_cells <= cell_budget)
+				break;
+			hdr.h *= 1.1;
+		}
+		hdr.inv_h = 1.0 / hdr.h;
+	}
+	hdr.cap = o.cell_cap;
+	/* Count references per cell to size the spill table exactly. */
+	{
+		long *cnt = calloc((size_t)hdr.n_cells, sizeof(long));
+		long c;
+		if (!cnt) {
+			rc = PX_E_NOMEM;
+			goto fail;
+		}
+		for (i = 0; i < n_tp; i++) {
+			int lo[3], hi[3], x, y, z;
+			cell_range(&hdr, px_cpiece_box(&tp[i].pc), lo, hi);
+			for (z = lo[2]; z <= hi[2]; z++)
+				for (y = lo[1]; y <= hi[1]; y++)
+					for (x = lo[0]; x <= hi[0]; x++)
+						cnt[cell_index(&hdr, x, y, z)]++;
+		}
+		hdr.n_spill = 0;
+		for (c = 0; c < hdr.n_cells; c++)
+			if (cnt[c] > hdr.cap)
+				hdr.n_spill += cnt[c] - hdr.cap;
+		free(cnt);
+	}
+
+	/* One block for everything the queries touch. */
+#define ALIGNED(x) (((x) + 63) & ~(size_t)63)
+	bytes = ALIGNED(sizeof(*m)) +
+		ALIGNED((size_t)n_curves * sizeof(*ent)) +
+		ALIGNED((size_t)n_tp * sizeof(struct px_cpiece)) +
+		ALIGNED((size_t)n_tp * sizeof(int)) +
+		ALIGNED((size_t)(n_tp + 1) * sizeof(int)) +
+		ALIGNED((size_t)n_samples * sizeof(px_vec3)) +
+		ALIGNED((size_t)hdr.n_cells * sizeof(int)) * 2 +
+		ALIGNED((size_t)hdr.n_cells * sizeof(uint16_t)) +
+		ALIGNED((size_t)hdr.n_cells * (size_t)hdr.cap * sizeof(int)) +
+		ALIGNED((size_t)(hdr.n_spill + 1) * sizeof(int)) +
+		ALIGNED((size_t)n_tp * sizeof(uint32_t)) +
+		ALIGNED((size_t)n_tp * sizeof(struct cand)) + 64 * 12;
+	{
+		struct px_arena ar;
+		rc = px_arena_init_alloc(&ar, bytes);
+		if (rc)
+			goto fail;
+		m = px_arena_alloc(&ar, sizeof(*m), 64);
+		*m = hdr;
+		m->arena = ar;
+	}
+#define TAKE(ptr, n) \
+	((ptr) = px_arena_calloc(&m->arena, (size_t)(n), sizeof(*(ptr)), 64))
+	m->opts = o;
+	m->n_ent = n_curves;
+	m->n_pieces = n_tp;
+	if (!TAKE(m->ent, n_curves) || !TAKE(m->pieces, n_tp) ||
+	    !TAKE(m->piece_ent, n_tp) || !TAKE(m->sample_start, n_tp + 1) ||
+	    !TAKE(m->samples, n_samples) || !TAKE(m->cell_count, m->n_cells) ||
+	    !TAKE(m->cell_spill, m->n_cells) ||
+	    !TAKE(m->cell_empty_r, m->n_cells) ||
+	    !TAKE(m->cell_slot, m->n_cells * m->cap) ||
+	    !TAKE(m->spill, m->n_spill + 1) || !TAKE(m->stamp, n_tp) ||
+	    !TAKE(m->cand, n_tp)) {
+		rc = PX_E_NOMEM; /* sizing above is wrong: a bug */
+		goto fail;
+	}
+#undef TAKE
+	memcpy(m->ent, ent, (size_t)n_curves * sizeof(*ent));
+	{
+		int s = 0;
+		for (i = 0; i < n_tp; i++) {
+			int k, ns = tp[i].n_samples;
+			m->pieces[i] = tp[i].pc;
+			m->piece_ent[i] = tp[i].ent;
+			m->sample_start[i] = s;
+			for (k = 0; k < ns; k++)
+				m->samples[s + k] = px_cpiece_eval(
+					&m->pieces[i], (double)k / (ns - 1), NULL);
+			s += ns;
+		}
+		m->sample_start[n_tp] = s;
+	}
+	/* Bin: first cap references in the cell, the rest in the spill
+	 * table, laid out cell by cell. */
+	{
+		long c, next = 0;
+		int *spill_count = calloc((size_t)m->n_cells, sizeof(int));
+		if (!spill_count) {
+			rc = PX_E_NOMEM;
+			goto fail;
+		}
+		for (i = 0; i < n_tp; i++) {
+			int lo[3], hi[3], x, y, z;
+			cell_range(m, px_cpiece_box(&m->pieces[i]), lo, hi);
+			for (z = lo[2]; z <= hi[2]; z++)
+				for (y = lo[1]; y <= hi[1]; y++)
+					for (x = lo[0]; x <= hi[0]; x++)
+						spill_count[cell_index(m, x, y, z)]++;
+		}
+		for (c = 0; c < m->n_cells; c++) {
+			m->cell_spill[c] = (int)next;
+			if (spill_count[c] > m->cap)
+				next += spill_count[c] - m->cap;
+		}
+		free(spill_count);
+		for (i = 0; i < n_tp; i++) {
+			int lo[3], hi[3], x, y, z;
+			cell_range(m, px_cpiece_box(&m->pieces[i]), lo, hi);
+			for (z = lo[2]; z <= hi[2]; z++)
+				for (y = lo[1]; y <= hi[1]; y++)
+					for (x = lo[0]; x <= hi[0]; x++) {
+						long ci = cell_index(m, x, y, z);
+						int k = m->cell_count[ci]++;
+						if (k < m->cap)
+							m->cell_slot[ci * m->cap + k] = i;
+						else
+							m->spill[m->cell_spill[ci] + k - m->cap] = i;
+					}
+		}
+	}
+	rc = empty_radius(m);
+	if (rc)
+		goto fail;
+	free(tp);
+	free(ent);
+	free(work);
+	*out = m;
+	return PX_OK;
+fail:
+	if (m)
+		px_arena_fini(&m->arena);
+	free(tp);
+	free(ent);
+	free(work);
+	return rc;
+}
+
+void px_dist_model_free(struct px_dist_model *m)
+{
+	struct px_arena a;
+	if (!m)
+		return;
+	/* The model lives inside its own arena. */
+	a = m->arena;
+	px_arena_fini(&a);
+}
+
+void px_dist_model_info(const struct px_dist_model *m, struct px_dist_info *info)
+{
+	memset(info, 0, sizeof(*info));
+	if (!m)
+		return;
+	info->n_entities = m->n_ent;
+	info->n_pieces = m->n_pieces;
+	info->n_samples = m->sample_start[m->n_pieces];
+	info->grid[0] = m->nx;
+	info->grid[1] = m->ny;
+	info->grid[2] = m->nz;
+	info->cell_size = m->h;
+	info->cells = m->n_cells;
+	info->spill = m->n_spill;
+	info->bytes = px_arena_capacity(&m->arena);
+	info->bounds = m->bounds;
+}
+
+int px_dist_entity_info(const struct px_dist_model *m, int entity,
+			struct px_dist_entity_info *info)
+{
+	if (!m || !info || entity < 0 || entity >= m->n_ent)
+		return PX_E_RANGE;
+	*info = m->ent[entity];
+	return PX_OK;
+}
+
+/* ---- query ---------------------------------------------------------------- */
+
+/*
+ * Squared distance from p to the part of the grid outside the cell block
+ * [lo, hi] (inclusive indices): the minimum over the six slabs beyond the
+ * block's faces, each clipped to the grid. INFINITY when the block covers
+ * the grid. Exact for p inside or outside the grid.
+ */
+static double outside_lb2(const struct px_dist_model *m, px_vec3 p,
+			  const int lo[3], const int hi[3])
+{
+	const int n[3] = {m->nx, m->ny, m->nz};
+	const double g0[3] = {m->bounds.min.x, m->bounds.min.y, m->bounds.min.z};
+	double best = INFINITY;
+	int d;
+	for (d = 0; d < 3; d++) {
+		px_aabb slab;
+		double *mn = d == 0 ? &slab.min.x : (d == 1 ? &slab.min.y : &slab.min.z);
+		double *mx = d == 0 ? &slab.max.x : (d == 1 ? &slab.max.y : &slab.max.z);
+		if (lo[d] > 0) {
+			slab = m->bounds;
+			*mx = g0[d] + lo[d] * m->h;
+			best = fmin(best, px_aabb_dist2(&slab, p));
+		}
+		if (hi[d] < n[d] - 1) {
+			slab = m->bounds;
+			*mn = g0[d] + (hi[d] + 1) * m->h;
+			best = fmin(best, px_aabb_dist2(&slab, p));
+		}
+	}
+	return best;
+}
+
+/* Cell index along one axis for a scaled coordinate, clamped to the
+ * grid; comparisons first so that far points never overflow the int. */
+static inline int clamp_cell(double v, int n)
+{
+	if (!(v >= 0.0))
+		return 0;
+	if (v >= (double)(n - 1))
+		return n - 1;
+	return (int)v;
+}
+
+struct qstate {
+	double best;  /* squared upper bound */
+	int best_piece, best_sample;
+	int n_cand;
+	int cells;
+};
+
+static void visit_piece(struct px_dist_model *m, px_vec3 p, int id,
+			struct qstate *q)
+{
+	px_aabb b;
+	double lb;
+	int s, e;
+
+	if (m->stamp[id] == m->epoch)
+		return;
+	m->stamp[id] = m->epoch;
+	b = m->pieces[id].box_;
+	lb = box_d2(&b, p);
+	if (lb >= q->best)
+		return;
+	for (s = m->sample_start[id], e = m->sample_start[id + 1]; s < e; s++) {
+		double d2 = px_v3_dist2(m->samples[s], p);
+		if (d2 < q->best) {
+			q->best = d2;
+			q->best_piece = id;
+			q->best_sample = s - m->sample_start[id];
+		}
+	}
+	m->cand[q->n_cand].lb = lb;
+	m->cand[q->n_cand].piece = id;
+	q->n_cand++;
+}
+
+static void visit_cell(struct px_dist_model *m, px_vec3 p, int x, int y, int z,
+		       struct qstate *q)
+{
+	long ci = cell_index(m, x, y, z);
+	int k, n = m->cell_count[ci];
+	double dx, dy, dz, lo;
+
+	if (n == 0)
+		return;
+	/* A cell farther than the best so far holds nothing useful: any
+	 * piece that could be nearer is also registered in a nearer cell
+	 * (the one holding its box's nearest point). */
+	lo = m->bounds.min.x + x * m->h;
+	dx = gap1(p.x, lo, lo + m->h);
+	lo = m->bounds.min.y + y * m->h;
+	dy = gap1(p.y, lo, lo + m->h);
+	lo = m->bounds.min.z + z * m->h;
+	dz = gap1(p.z, lo, lo + m->h);
+	if (dx * dx + dy * dy + dz * dz >= q->best)
+		return;
+	q->cells++;
+	for (k = 0; k < n && k < m->cap; k++)
+		visit_piece(m, p, m->cell_slot[ci * m->cap + k], q);
+	for (k = m->cap; k < n; k++)
+		visit_piece(m, p, m->spill[m->cell_spill[ci] + k - m->cap], q);
+}
+
+/* Heap sort by lower bound: bounded, in place, no allocation (the C
+ * library's qsort may allocate). */
+static void sift(struct cand *c, int i, int n)
+{
+	for (;;) {
+		int l = 2 * i + 1, big = i;
+		struct cand t;
+		if (l < n && c[l].lb > c[big].lb)
+			big = l;
+		if (l + 1 < n && c[l + 1].lb > c[big].lb)
+			big = l + 1;
+		if (big == i)
+			return;
+		t = c[i];
+		c[i] = c[big];
+		c[big] = t;
+		i = big;
+	}
+}
+
+static void sort_cand(struct cand *c, int n)
+{
+	int i;
+	for (i = n / 2 - 1; i >= 0; i--)
+		sift(c, i, n);
+	for (i = n - 1; i > 0; i--) {
+		struct cand t = c[0];
+		c[0] = c[i];
+		c[i] = t;
+		sift(c, 0, i);
+	}
+}
+
+int px_dist_query(struct px_dist_model *m, px_vec3 p, struct px_dist_result *r)
+{
+	struct qstate q;
+	int c[3], k, kmax, i;
+	double gap = 0.0;
+
+	if (!m || !r)
+		return PX_E_INVAL;
+	if (!px_v3_isfinite(p))
+		return PX_E_NAN;
+	if (++m->epoch == 0) {
+		/* Wrapped after 2^32 queries: clear once, then go on. */
+		memset(m->stamp, 0, (size_t)m->n_pieces * sizeof(uint32_t));
+		m->epoch = 1;
+	}
+	memset(r, 0, sizeof(*r));
+	r->certified = 1;
+	q.best = INFINITY;
+	q.best_piece = -1;
+	q.best_sample = 0;
+	q.n_cand = 0;
+	q.cells = 0;
+
+	/* The wave: shells of cells at Chebyshev distance k from the cell
+	 * nearest to p. */
+	c[0] = clamp_cell((p.x - m->bounds.min.x) * m->inv_h, m->nx);
+	c[1] = clamp_cell((p.y - m->bounds.min.y) * m->inv_h, m->ny);
+	c[2] = clamp_cell((p.z - m->bounds.min.z) * m->inv_h, m->nz);
+	kmax = m->nx > m->ny ? m->nx : m->ny;
+	kmax = kmax > m->nz ? kmax : m->nz;
+	/* Shells nearer than the nearest occupied cell hold nothing. */
+	k = m->cell_empty_r[cell_index(m, c[0], c[1], c[2])];
+	for (; k <= kmax; k++) {
+		int lo[3], hi[3], x, y, z;
+		/* Everything not yet reached lies outside block k - 1. */
+		if (k > 0) {
+			for (i = 0; i < 3; i++) {
+				lo[i] = c[i] - (k - 1);
+				hi[i] = c[i] + (k - 1);
+			}
+			if (q.best <= outside_lb2(m, p, lo, hi))
+				break;
+		} else if (q.best <= px_aabb_dist2(&m->bounds, p)) {
+			break;
+		}
+		for (z = c[2] - k; z <= c[2] + k; z++) {
+			if (z < 0 || z >= m->nz)
+				continue;
+			for (y = c[1] - k; y <= c[1] + k; y++) {
+				int rim;
+				if (y < 0 || y >= m->ny)
+					continue;
+				rim = abs(z - c[2]) == k || abs(y - c[1]) == k;
+				if (rim) {
+					for (x = c[0] - k; x <= c[0] + k; x++)
+						if (x >= 0 && x < m->nx)
+							visit_cell(m, p, x, y, z, &q);
+				} else {
+					if (c[0] - k >= 0)
+						visit_cell(m, p, c[0] - k, y, z, &q);
+					if (k > 0 && c[0] + k < m->nx)
+						visit_cell(m, p, c[0] + k, y, z, &q);
+				}
+			}
+		}
+	}
+	r->cells_visited = q.cells;
+
+	/* Exact solve of every piece that may still hold something closer,
+	 * nearest lower bound first. */
+	sort_cand(m->cand, q.n_cand);
+	if (q.best_piece < 0)
+		return PX_E_STATE; /* unreachable: the wave meets every piece */
+	{
+		/* Start from the best sample, a point on the model, so that
+		 * an answer exists even if no solve improves on it. */
+		const struct px_cpiece *bp = &m->pieces[q.best_piece];
+		int ns = m->sample_start[q.best_piece + 1] -
+			 m->sample_start[q.best_piece];
+		double t = (double)q.best_sample / (ns - 1), best = q.best;
+		r->point = m->samples[m->sample_start[q.best_piece] + q.best_sample];
+		r->u = bp->u0_ + t * (bp->u1_ - bp->u0_);
+		r->piece = q.best_piece;
+		for (i = 0; i < q.n_cand; i++) {
+			struct px_cpiece_hit hit;
+			const struct cand *cd = &m->cand[i];
+			if (cd->lb >= best)
+				break;
+			r->pieces_solved++;
+			if (px_cpiece_closest(&m->pieces[cd->piece], p, &best, &hit)) {
+				r->point = hit.point;
+				r->u = hit.u;
+				r->piece = cd->piece;
+			}
+			r->iters += hit.iters;
+			if (!hit.certified) {
+				r->certified = 0;
+				gap = fmax(gap, hit.gap);
+			}
+		}
+		r->dist = sqrt(best);
+	}
+	r->gap = gap;
+	r->v = 0.0;
+	r->entity = m->piece_ent[r->piece];
+	{
+		px_vec3 d = px_v3_sub(p, r->point);
+		r->dir = r->dist > 0.0 ? px_v3_scale(d, 1.0 / r->dist)
+				       : px_v3(0, 0, 0);
+	}
+	return PX_OK;
+}
+
+int px_dist_query_batch(struct px_dist_model *m, const px_vec3 *p, size_t n,
+			struct px_dist_result *r)
+{
+	size_t i;
+	if (!m || (!p && n) || (!r && n))
+		return PX_E_INVAL;
+	for (i = 0; i < n; i++) {
+		int rc = px_dist_query(m, p[i], &r[i]);
+		if (rc)
+			return rc;
+	}
+	return PX_OK;
+}
