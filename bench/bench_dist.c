@@ -40,7 +40,7 @@ static int cmp_i64(const void *a, const void *b)
 #define NQ 20000
 
 static void run(const char *name, const struct px_nurbs_curve *c, int nc,
-		const struct px_dist_opts *o)
+		const struct px_nurbs_surf *sf, int ns, const struct px_dist_opts *o)
 {
 	static int64_t t[NQ];
 	static px_vec3 q[NQ];
@@ -53,7 +53,7 @@ static void run(const char *name, const struct px_nurbs_curve *c, int nc,
 	int i, rc;
 
 	t0 = now_ns();
-	rc = px_dist_model_create(c, nc, o, &m);
+	rc = px_dist_model_create(c, nc, sf, ns, o, &m);
 	if (rc) {
 		printf("%s: prepare failed: %s\n", name, px_strerror(rc));
 		return;
@@ -100,7 +100,8 @@ int main(void)
 	static unsigned char mem[1 << 20];
 	struct px_arena a;
 	struct px_nurbs_curve c[2];
-	struct px_dist_opts paper, coarse;
+	struct px_dist_opts paper, coarse, surf_paper;
+	int k2;
 	const double s = sqrt(0.5);
 	double k8[12] = {0, 0, 0, 0, 0.2, 0.4, 0.6, 0.8, 1, 1, 1, 1};
 	double xyz8[24], w8[8];
@@ -121,17 +122,41 @@ int main(void)
 	px_dist_opts_default(&paper);
 	paper.decomp_tol = 0.05; /* the paper's recommended curve setting */
 	paper.jitter = 0.8;
+	px_dist_opts_default(&surf_paper);
+	surf_paper.decomp_tol = 0.1; /* the paper's surface setting */
+	surf_paper.jitter = 0.8;
 	px_dist_opts_default(&coarse);
 	coarse.decomp_tol = 0.25;
-	run("cubic B-spline (8 ctrl)", &c[0], 1, NULL);
-	run("  paper settings 5%/1%", &c[0], 1, &paper);
-	run("  coarse 25%/1%", &c[0], 1, &coarse);
+	run("cubic B-spline (8 ctrl)", &c[0], 1, NULL, 0, NULL);
+	run("  paper settings 5%/1%", &c[0], 1, NULL, 0, &paper);
+	run("  coarse 25%/1%", &c[0], 1, NULL, 0, &coarse);
 	for (i = 0; i < 8; i++)
 		w8[i] = 0.3 + 3.0 * urand();
 	px_nurbs_curve_init(&c[1], &a, 3, 8, k8, 12, xyz8, w8, NULL);
-	run("rational cubic (8 ctrl)", &c[1], 1, NULL);
-	run("  paper settings 5%/1%", &c[1], 1, &paper);
+	run("rational cubic (8 ctrl)", &c[1], 1, NULL, 0, NULL);
+	run("  paper settings 5%/1%", &c[1], 1, NULL, 0, &paper);
 	px_nurbs_curve_init(&c[0], &a, 2, 9, kc, 12, xyzc, wc, NULL);
-	run("NURBS circle (9 ctrl)", &c[0], 1, NULL);
+	run("NURBS circle (9 ctrl)", &c[0], 1, NULL, 0, NULL);
+	{
+		/* Bicubic Bezier patch: a gently curved sheet. */
+		double ku[8] = {0, 0, 0, 0, 1, 1, 1, 1}, xyz[48], w[16];
+		struct px_nurbs_surf sf;
+		int j;
+		for (j = 0; j < 4; j++)
+			for (i = 0; i < 4; i++) {
+				int k = j * 4 + i;
+				xyz[3 * k] = i / 3.0;
+				xyz[3 * k + 1] = j / 3.0;
+				xyz[3 * k + 2] = 0.4 * (urand() - 0.5);
+				w[k] = 1.0;
+			}
+		px_nurbs_surf_init(&sf, &a, 3, 3, 4, 4, ku, 8, ku, 8, xyz, w, NULL);
+		run("bicubic patch", NULL, 0, &sf, 1, NULL);
+		run("  paper settings 10%/1%", NULL, 0, &sf, 1, &surf_paper);
+		for (k2 = 0; k2 < 16; k2++)
+			w[k2] = 0.5 + 2.0 * urand();
+		px_nurbs_surf_init(&sf, &a, 3, 3, 4, 4, ku, 8, ku, 8, xyz, w, NULL);
+		run("rational bicubic patch", NULL, 0, &sf, 1, NULL);
+	}
 	return 0;
 }

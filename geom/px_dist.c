@@ -7,6 +7,7 @@
 
 #include "px_arena.h"
 #include "px_cpiece.h"
+#include "px_spiece.h"
 
 /* Hot-path box distance: boxes here are never empty, and fmin/fmax
  * would be library calls without -ffast-math. */
@@ -28,15 +29,34 @@ struct cand {
 	int piece;
 };
 
+enum { PK_CURVE = 0, PK_PATCH = 1 };
+
+/* One entry of the grid's index space: a curve piece or a patch. */
+struct piece {
+	px_aabb box;
+	int kind;    /* PK_CURVE or PK_PATCH */
+	int idx;     /* into cp or spc */
+	int ent;     /* entity */
+	/* Boundary curve of a surface: the curve runs along u (iso_dir 0,
+	 * v fixed at iso_t) or along v (iso_dir 1); -1 for an entity's own
+	 * curve pieces and patches. */
+	int iso_dir;
+	double iso_t;
+	int sample_start;
+	int ns, nt; /* samples: ns along the piece (curves) or ns x nt */
+};
+
 struct px_dist_model {
 	struct px_arena arena;
 	struct px_dist_opts opts;
 	int n_ent;
 	struct px_dist_entity_info *ent;
 	int n_pieces;
-	struct px_cpiece *pieces;
-	int *piece_ent;
-	int *sample_start; /* n_pieces + 1 */
+	struct piece *pieces;
+	int n_cp, n_sp;
+	struct px_cpiece *cp;
+	struct px_spiece *spc;
+	int n_samples;
 	px_vec3 *samples;
 	/* grid */
 	px_aabb bounds;
@@ -68,11 +88,6 @@ void px_dist_opts_default(struct px_dist_opts *o)
 
 /* ---- knowledge step: parametrization factor ---------------------------- */
 
-/*
- * Tolerance and jitter by parametrization factor (paper section 5): the
- * further the speed |C'| varies, the finer the pieces, so that a start
- * on a piece is close in parameter as well as in space.
- */
 static void pf_table(double pf, double *tol, double *jit)
 {
 	if (pf <= 0.2) {
@@ -297,13 +312,416 @@ out:
 	return rc;
 }
 
+/* ---- surfaces: decomposition ------------------------------------------ */
+
+/* Speed of a surface along one direction at (u, v). */
+static double surf_speed(const struct px_nurbs_surf *s, double u, double v,
+			 int dir)
+{
+	struct px_nurbs_surf_derivs d;
+	px_nurbs_surf_eval(s, u, v, 1, &d);
+	return px_v3_norm(dir == 0 ? d.su : d.sv);
+}
+
+/* Approximate length of a curve from SPAN_SAMPLES chords per span. */
+static double curve_length(const struct px_nurbs_curve *c)
+{
+	double a, b, len = 0.0;
+	int k, j;
+	px_vec3 prev;
+	px_nurbs_curve_domain(c, &a, &b);
+	prev = px_nurbs_curve_point(c, a);
+	for (k = c->degree; k < c->n_ctrl; k++) {
+		double s0 = c->knots[k], s1 = c->knots[k + 1];
+		if (!(s1 > s0) || s1 <= a || s0 >= b)
+			continue;
+		for (j = 1; j <= SPAN_SAMPLES; j++) {
+			px_vec3 q = px_nurbs_curve_point(c, s0 + (s1 - s0) * j / SPAN_SAMPLES);
+			len += px_v3_dist(prev, q);
+			prev = q;
+		}
+	}
+	return len;
+}
+
+/*
+ * Cut parameters of a surface in direction dir: the nearly uniform steps
+ * of its longest iso-curve in that direction (paper section 5), which
+ * include the direction's knots. The iso-curves compared are those at
+ * the other direction's knots and span middles.
+ */
+static int surf_cuts(const struct px_nurbs_surf *s, int dir,
+		     const struct px_dist_opts *o, double *len_out,
+		     struct decomp *out)
+{
+	int other = 1 - dir, nk = s->n_knots[other], k, rc;
+	const double *kn = s->knots[other];
+	size_t pwl = 4 * (size_t)s->n_ctrl[dir];
+	double *pw = malloc(pwl * sizeof(double)), best_len = -1.0, best_t = 0.0;
+	double a, b, c0, c1;
+	struct px_nurbs_curve iso;
+	struct px_dist_entity_info info;
+
+	if (!pw)
+		return PX_E_NOMEM;
+	px_nurbs_surf_domain(s, &a, &b, &c0, &c1);
+	if (other == 0) {
+		c0 = a;
+		c1 = b;
+	}
+	for (k = 0; k + 1 < nk; k++) {
+		double t0 = kn[k], t1 = kn[k + 1], ts[2];
+		int j;
+		if (!(t1 > t0) || t1 <= c0 || t0 >= c1)
+			continue;
+		ts[0] = t0 < c0 ? c0 : t0;
+		ts[1] = 0.5 * (t0 + t1);
+		for (j = 0; j < 2; j++) {
+			double l;
+			if (px_nurbs_surf_iso_curve(s, dir, ts[j], pw, pwl, &iso))
+				continue;
+			l = curve_length(&iso);
+			if (l > best_len) {
+				best_len = l;
+				best_t = ts[j];
+			}
+		}
+	}
+	{
+		double l;
+		if (!px_nurbs_surf_iso_curve(s, dir, c1, pw, pwl, &iso)) {
+			l = curve_length(&iso);
+			if (l > best_len) {
+				best_len = l;
+				best_t = c1;
+			}
+		}
+	}
+	rc = px_nurbs_surf_iso_curve(s, dir, best_t, pw, pwl, &iso);
+	if (!rc) {
+		memset(&info, 0, sizeof(info));
+		rc = decompose(&iso, o, &info, out);
+	}
+	*len_out = best_len > 0.0 ? best_len : 0.0;
+	free(pw);
+	return rc;
+}
+
+/* Parametrization factor of a surface: speed range in u and in v over
+ * SPAN_SAMPLES^2 samples per knot rectangle. */
+static double surf_pf(const struct px_nurbs_surf *s)
+{
+	double a, b, c, d, pf = 0.0;
+	int dir;
+	px_nurbs_surf_domain(s, &a, &b, &c, &d);
+	for (dir = 0; dir < 2; dir++) {
+		double mn = INFINITY, mx = 0.0;
+		int i, j, ku, kv;
+		for (ku = s->degree[0]; ku < s->n_ctrl[0]; ku++) {
+			double u0 = s->knots[0][ku], u1 = s->knots[0][ku + 1];
+			if (!(u1 > u0))
+				continue;
+			for (kv = s->degree[1]; kv < s->n_ctrl[1]; kv++) {
+				double v0 = s->knots[1][kv], v1 = s->knots[1][kv + 1];
+				if (!(v1 > v0))
+					continue;
+				for (i = 0; i <= 4; i++)
+					for (j = 0; j <= 4; j++) {
+						double sp = surf_speed(s, u0 + (u1 - u0) * i / 4,
+								       v0 + (v1 - v0) * j / 4, dir);
+						mn = sp < mn ? sp : mn;
+						mx = sp > mx ? sp : mx;
+					}
+			}
+		}
+		/* A collapsed edge (pole) has zero speed along it: that is a
+		 * property of the parametrization, and pf says so. */
+		if (mx > 0.0 && (mx - mn) / mx > pf)
+			pf = (mx - mn) / mx;
+	}
+	return pf;
+}
+
 /* ---- setup ---------------------------------------------------------------- */
 
+/* Pieces in temporary memory while the model is being built. */
 struct tmp_piece {
-	struct px_cpiece pc;
-	int ent;
-	int n_samples;
+	struct piece pc;
+	struct px_cpiece cp;  /* kind PK_CURVE */
+	double *hw;           /* kind PK_PATCH: (p+1)(q+1) x 4, i along u */
+	int p, q;
+	double r[4];          /* patch rectangle */
 };
+
+struct builder {
+	struct tmp_piece *tp;
+	int n, cap;
+	long n_samples;
+	double sample_tol;
+};
+
+static struct tmp_piece *new_piece(struct builder *bl)
+{
+	if (bl->n == bl->cap) {
+		int nc = bl->cap ? 2 * bl->cap : 64;
+		struct tmp_piece *nt = realloc(bl->tp, (size_t)nc * sizeof(*nt));
+		if (!nt)
+			return NULL;
+		bl->tp = nt;
+		bl->cap = nc;
+	}
+	memset(&bl->tp[bl->n], 0, sizeof(bl->tp[0]));
+	return &bl->tp[bl->n++];
+}
+
+static int clamp_count(double x, int lo, int hi)
+{
+	if (!(x >= lo))
+		return lo;
+	if (x > hi)
+		return hi;
+	return (int)ceil(x);
+}
+
+/*
+ * Curve pieces of one curve: the entity's own (iso_dir -1) or a boundary
+ * curve of a surface entity. len_scale is the arc length that the sample
+ * spacing refers to.
+ */
+static int add_curve_pieces(struct builder *bl, const struct px_nurbs_curve *c,
+			    const struct px_dist_opts *o,
+			    struct px_dist_entity_info *info, int ent,
+			    int iso_dir, double iso_t, double len_scale)
+{
+	struct decomp d = {0};
+	double *work;
+	size_t wl = PX_NURBS_CURVE_WORK_LEN(c->degree, c->n_ctrl);
+	int i, rc;
+
+	if (c->degree < 1 || c->degree > PX_CPIECE_MAX_DEGREE)
+		return PX_E_RANGE;
+	rc = decompose(c, o, info, &d);
+	if (rc) {
+		free(d.u);
+		return rc;
+	}
+	if (len_scale <= 0.0)
+		len_scale = info->arc_length;
+	work = malloc(wl * sizeof(double));
+	if (!work) {
+		free(d.u);
+		return PX_E_NOMEM;
+	}
+	for (i = 0; i + 1 < d.n; i++) {
+		struct px_nurbs_curve bz;
+		struct tmp_piece *t = new_piece(bl);
+		double l = 0.0;
+		int k;
+		if (!t) {
+			rc = PX_E_NOMEM;
+			break;
+		}
+		rc = px_nurbs_curve_extract_work(c, d.u[i], d.u[i + 1], work, wl, &bz);
+		if (rc)
+			break;
+		if (bz.n_ctrl != c->degree + 1) {
+			rc = PX_E_STATE; /* a piece must lie in one span */
+			break;
+		}
+		rc = px_cpiece_init(&t->cp, c->degree, (const double(*)[4])bz.pw,
+				    d.u[i], d.u[i + 1]);
+		if (rc)
+			break;
+		t->pc.kind = PK_CURVE;
+		t->pc.ent = ent;
+		t->pc.iso_dir = iso_dir;
+		t->pc.iso_t = iso_t;
+		t->pc.box = px_cpiece_box(&t->cp);
+		/* The control polygon is longer than the piece. */
+		for (k = 0; k < c->degree; k++)
+			l += px_v3_dist(px_v3(bz.pw[4 * k] / bz.pw[4 * k + 3],
+					      bz.pw[4 * k + 1] / bz.pw[4 * k + 3],
+					      bz.pw[4 * k + 2] / bz.pw[4 * k + 3]),
+					px_v3(bz.pw[4 * k + 4] / bz.pw[4 * k + 7],
+					      bz.pw[4 * k + 5] / bz.pw[4 * k + 7],
+					      bz.pw[4 * k + 6] / bz.pw[4 * k + 7]));
+		t->pc.ns = len_scale > 0.0
+				   ? clamp_count(l / (bl->sample_tol * len_scale) + 1.0, 2, 64)
+				   : 2;
+		t->pc.nt = 1;
+		bl->n_samples += t->pc.ns;
+	}
+	free(work);
+	free(d.u);
+	return rc;
+}
+
+static int add_surface(struct builder *bl, const struct px_nurbs_surf *s,
+		       const struct px_dist_opts *o,
+		       struct px_dist_entity_info *info, int ent)
+{
+	struct px_dist_opts so = *o;
+	struct decomp cu = {0}, cv = {0};
+	double len_u = 0.0, len_v = 0.0, tol, jit, a, b, c, d, len, diag;
+	double *work = NULL, *pw = NULL, brk[64];
+	size_t wl, pwl;
+	int i, j, rc, e, dir, first_boundary;
+	px_aabb hull = px_nurbs_surf_aabb(s);
+
+	if (s->degree[0] < 1 || s->degree[1] < 1 ||
+	    s->degree[0] > PX_SPIECE_MAX_DEGREE ||
+	    s->degree[1] > PX_SPIECE_MAX_DEGREE)
+		return PX_E_RANGE;
+	info->kind = PX_DIST_SURFACE;
+	info->pf = surf_pf(s);
+	pf_table(info->pf, &tol, &jit);
+	/* Patches carry their own proofs, so the decomposition only has to
+	 * make boxes tight; and memory grows with the square of the count:
+	 * surfaces stop at 5 %. */
+	if (tol < 0.05)
+		tol = 0.05;
+	if (o->decomp_tol > 0.0)
+		tol = o->decomp_tol;
+	if (o->jitter > 0.0)
+		jit = o->jitter;
+	info->tol = tol;
+	info->jitter = jit;
+	so.decomp_tol = tol;
+	so.jitter = jit;
+	rc = surf_cuts(s, 0, &so, &len_u, &cu);
+	if (!rc)
+		rc = surf_cuts(s, 1, &so, &len_v, &cv);
+	if (rc)
+		goto out;
+	if ((long)(cu.n - 1) * (cv.n - 1) > o->max_pieces_per_entity) {
+		rc = PX_E_NOSPC;
+		goto out;
+	}
+	len = len_u > len_v ? len_u : len_v;
+	info->arc_length = len;
+	diag = px_aabb_diagonal(&hull);
+	info->closed = (px_nurbs_surf_closed(s, 0, 1e-12 * (1.0 + diag)) ? 1 : 0) |
+		       (px_nurbs_surf_closed(s, 1, 1e-12 * (1.0 + diag)) ? 2 : 0);
+	info->n_breaks = px_nurbs_surf_breaks(s, 0, NULL, 0) +
+			 px_nurbs_surf_breaks(s, 1, NULL, 0);
+
+	/* Patches: every cell of the cut grid lies in one knot rectangle. */
+	wl = PX_NURBS_SURF_WORK_LEN(s->degree[0], s->degree[1], s->n_ctrl[0],
+				    s->n_ctrl[1]);
+	work = malloc(wl * sizeof(double));
+	if (!work) {
+		rc = PX_E_NOMEM;
+		goto out;
+	}
+	info->first_piece = bl->n;
+	for (i = 0; i + 1 < cu.n; i++)
+		for (j = 0; j + 1 < cv.n; j++) {
+			struct px_nurbs_surf bz;
+			struct tmp_piece *t;
+			int p = s->degree[0], q = s->degree[1], ii, jj, k;
+			double ext;
+			rc = px_nurbs_surf_extract_work(s, cu.u[i], cu.u[i + 1], cv.u[j],
+							cv.u[j + 1], work, wl, &bz);
+			if (rc)
+				goto out;
+			if (bz.n_ctrl[0] != p + 1 || bz.n_ctrl[1] != q + 1) {
+				rc = PX_E_STATE;
+				goto out;
+			}
+			t = new_piece(bl);
+			if (!t) {
+				rc = PX_E_NOMEM;
+				goto out;
+			}
+			t->hw = malloc((size_t)(p + 1) * (q + 1) * 4 * sizeof(double));
+			if (!t->hw) {
+				rc = PX_E_NOMEM;
+				goto out;
+			}
+			t->p = p;
+			t->q = q;
+			t->r[0] = cu.u[i];
+			t->r[1] = cu.u[i + 1];
+			t->r[2] = cv.u[j];
+			t->r[3] = cv.u[j + 1];
+			t->pc.kind = PK_PATCH;
+			t->pc.ent = ent;
+			t->pc.iso_dir = -1;
+			t->pc.box = px_aabb_empty();
+			/* The extracted net has u fastest; patches want i
+			 * (along u) as the slow index. */
+			for (ii = 0; ii <= p; ii++)
+				for (jj = 0; jj <= q; jj++) {
+					const double *src = bz.pw + 4 * (jj * (p + 1) + ii);
+					double *dst = t->hw + 4 * (ii * (q + 1) + jj);
+					for (k = 0; k < 4; k++)
+						dst[k] = src[k];
+					px_aabb_extend(&t->pc.box,
+						       px_v3(src[0] / src[3], src[1] / src[3],
+							     src[2] / src[3]));
+				}
+			ext = px_aabb_diagonal(&t->pc.box);
+			t->pc.ns = len > 0.0 ? clamp_count(ext / (so.sample_tol * len) + 1.0, 2, 12) : 2;
+			t->pc.nt = t->pc.ns;
+			bl->n_samples += (long)t->pc.ns * t->pc.nt;
+		}
+	info->n_pieces = bl->n - info->first_piece;
+
+	/* Boundary curves: domain edges that do not collapse to a point,
+	 * and interior C0 creases in both directions. */
+	px_nurbs_surf_domain(s, &a, &b, &c, &d);
+	pwl = 4 * (size_t)(s->n_ctrl[0] > s->n_ctrl[1] ? s->n_ctrl[0] : s->n_ctrl[1]);
+	pw = malloc(pwl * sizeof(double));
+	if (!pw) {
+		rc = PX_E_NOMEM;
+		goto out;
+	}
+	first_boundary = bl->n;
+	for (e = 0; e < 4; e++) {
+		/* edge: 0 u = a, 1 u = b, 2 v = c, 3 v = d */
+		struct px_nurbs_curve iso;
+		struct px_dist_entity_info ci;
+		double t = e == 0 ? a : (e == 1 ? b : (e == 2 ? c : d));
+		dir = e < 2 ? 1 : 0; /* the curve runs along the other direction */
+		if (px_nurbs_surf_edge_collapsed(s, e, 1e-12 * (1.0 + diag))) {
+			info->n_collapsed++;
+			continue;
+		}
+		rc = px_nurbs_surf_iso_curve(s, dir, t, pw, pwl, &iso);
+		if (rc)
+			goto out;
+		memset(&ci, 0, sizeof(ci));
+		rc = add_curve_pieces(bl, &iso, &so, &ci, ent, dir, t, len);
+		if (rc)
+			goto out;
+	}
+	for (dir = 0; dir < 2; dir++) {
+		int nb = px_nurbs_surf_breaks(s, dir, brk, 64), k;
+		if (nb > 64) {
+			rc = PX_E_NOSPC;
+			goto out;
+		}
+		for (k = 0; k < nb; k++) {
+			/* A crease at u = brk runs along v. */
+			struct px_nurbs_curve iso;
+			struct px_dist_entity_info ci;
+			rc = px_nurbs_surf_iso_curve(s, 1 - dir, brk[k], pw, pwl, &iso);
+			if (rc)
+				goto out;
+			memset(&ci, 0, sizeof(ci));
+			rc = add_curve_pieces(bl, &iso, &so, &ci, ent, 1 - dir, brk[k], len);
+			if (rc)
+				goto out;
+		}
+	}
+	info->n_boundary_pieces = bl->n - first_boundary;
+out:
+	free(work);
+	free(pw);
+	free(cu.u);
+	free(cv.u);
+	return rc;
+}
 
 static void cell_range(const struct px_dist_model *m, px_aabb b, int lo[3],
 		       int hi[3])
@@ -324,24 +742,6 @@ static void cell_range(const struct px_dist_model *m, px_aabb b, int lo[3],
 static long cell_index(const struct px_dist_model *m, int i, int j, int k)
 {
 	return ((long)k * m->ny + j) * m->nx + i;
-}
-
-static int piece_samples(const struct px_cpiece *pc, double total_len,
-			 double sample_tol)
-{
-	/* Control polygon length bounds the piece's length from above. */
-	double l = 0.0;
-	int i, n;
-	for (i = 0; i < pc->degree_; i++) {
-		px_vec3 a = px_v3(pc->h_[0][i] / pc->h_[3][i], pc->h_[1][i] / pc->h_[3][i],
-				  pc->h_[2][i] / pc->h_[3][i]);
-		px_vec3 b = px_v3(pc->h_[0][i + 1] / pc->h_[3][i + 1],
-				  pc->h_[1][i + 1] / pc->h_[3][i + 1],
-				  pc->h_[2][i + 1] / pc->h_[3][i + 1]);
-		l += px_v3_dist(a, b);
-	}
-	n = total_len > 0.0 ? (int)ceil(l / (sample_tol * total_len)) + 1 : 2;
-	return n < 2 ? 2 : (n > 64 ? 64 : n);
 }
 
 /*
@@ -387,21 +787,32 @@ static int empty_radius(struct px_dist_model *m)
 	return PX_OK;
 }
 
+static void free_builder(struct builder *bl)
+{
+	int i;
+	for (i = 0; i < bl->n; i++)
+		free(bl->tp[i].hw);
+	free(bl->tp);
+}
+
 int px_dist_model_create(const struct px_nurbs_curve *curves, int n_curves,
+			 const struct px_nurbs_surf *surfs, int n_surfs,
 			 const struct px_dist_opts *opts,
 			 struct px_dist_model **out)
 {
 	struct px_dist_opts o;
 	struct px_dist_entity_info *ent = NULL;
-	struct tmp_piece *tp = NULL;
-	int n_tp = 0, cap_tp = 0, e, i, rc = PX_OK, n_samples = 0;
+	struct builder bl;
 	struct px_dist_model *m = NULL, hdr;
-	double *work = NULL;
-	size_t bytes;
+	int e, i, rc = PX_OK, n_ent, n_cp = 0, n_sp = 0;
+	size_t bytes, sp_doubles = 0;
 
-	if (!curves || n_curves < 1 || !out)
+	if (!out)
 		return PX_E_INVAL;
 	*out = NULL;
+	if (n_curves < 0 || n_surfs < 0 || n_curves + n_surfs < 1 ||
+	    (n_curves && !curves) || (n_surfs && !surfs))
+		return PX_E_INVAL;
 	if (opts)
 		o = *opts;
 	else
@@ -411,93 +822,52 @@ int px_dist_model_create(const struct px_nurbs_curve *curves, int n_curves,
 	    o.decomp_tol < 0.0 || o.decomp_tol > 1.0 || o.jitter < 0.0 ||
 	    o.jitter >= 1.0)
 		return PX_E_INVAL;
-	ent = calloc((size_t)n_curves, sizeof(*ent));
+	n_ent = n_curves + n_surfs;
+	ent = calloc((size_t)n_ent, sizeof(*ent));
 	if (!ent)
 		return PX_E_NOMEM;
+	memset(&bl, 0, sizeof(bl));
+	bl.sample_tol = o.sample_tol;
 
-	/* Pieces of every entity, in temporary memory. */
-	for (e = 0; e < n_curves; e++) {
-		const struct px_nurbs_curve *c = &curves[e];
-		struct decomp d = {0};
-		if (c->degree < 1 || c->degree > PX_CPIECE_MAX_DEGREE) {
-			rc = PX_E_RANGE;
-			goto fail;
+	for (e = 0; e < n_curves && !rc; e++) {
+		ent[e].kind = PX_DIST_CURVE;
+		ent[e].first_piece = bl.n;
+		rc = add_curve_pieces(&bl, &curves[e], &o, &ent[e], e, -1, 0.0, 0.0);
+		ent[e].n_pieces = bl.n - ent[e].first_piece;
+	}
+	for (e = 0; e < n_surfs && !rc; e++)
+		rc = add_surface(&bl, &surfs[e], &o, &ent[n_curves + e], n_curves + e);
+	if (rc)
+		goto fail;
+	for (i = 0; i < bl.n; i++) {
+		if (bl.tp[i].pc.kind == PK_CURVE) {
+			n_cp++;
+		} else {
+			n_sp++;
+			sp_doubles += px_spiece_doubles(bl.tp[i].p, bl.tp[i].q);
 		}
-		rc = decompose(c, &o, &ent[e], &d);
-		if (rc) {
-			free(d.u);
-			goto fail;
-		}
-		free(work);
-		work = malloc(PX_NURBS_CURVE_WORK_LEN(c->degree, c->n_ctrl) *
-			      sizeof(double));
-		if (!work) {
-			free(d.u);
-			rc = PX_E_NOMEM;
-			goto fail;
-		}
-		ent[e].first_piece = n_tp;
-		for (i = 0; i + 1 < d.n; i++) {
-			struct px_nurbs_curve bz;
-			if (n_tp == cap_tp) {
-				int nc = cap_tp ? 2 * cap_tp : 64;
-				struct tmp_piece *nt =
-					realloc(tp, (size_t)nc * sizeof(*tp));
-				if (!nt) {
-					rc = PX_E_NOMEM;
-					break;
-				}
-				tp = nt;
-				cap_tp = nc;
-			}
-			rc = px_nurbs_curve_extract_work(
-				c, d.u[i], d.u[i + 1], work,
-				PX_NURBS_CURVE_WORK_LEN(c->degree, c->n_ctrl), &bz);
-			if (rc)
-				break;
-			if (bz.n_ctrl != c->degree + 1) {
-				rc = PX_E_STATE; /* a piece must be one span */
-				break;
-			}
-			rc = px_cpiece_init(&tp[n_tp].pc, c->degree,
-					    (const double(*)[4])bz.pw, d.u[i],
-					    d.u[i + 1]);
-			if (rc)
-				break;
-			tp[n_tp].ent = e;
-			tp[n_tp].n_samples = piece_samples(
-				&tp[n_tp].pc, ent[e].arc_length, o.sample_tol);
-			n_samples += tp[n_tp].n_samples;
-			n_tp++;
-		}
-		free(d.u);
-		if (rc)
-			goto fail;
-		ent[e].n_pieces = n_tp - ent[e].first_piece;
 	}
 
 	/* Grid geometry (paper section 6): cell size from the finest
 	 * entity's piece count along the longest extent. */
 	memset(&hdr, 0, sizeof(hdr));
 	hdr.bounds = px_aabb_empty();
-	for (i = 0; i < n_tp; i++) {
-		px_aabb b = px_cpiece_box(&tp[i].pc);
-		hdr.bounds = px_aabb_union(&hdr.bounds, &b);
-	}
+	for (i = 0; i < bl.n; i++)
+		hdr.bounds = px_aabb_union(&hdr.bounds, &bl.tp[i].pc.box);
 	{
 		px_vec3 ext = px_v3_sub(hdr.bounds.max, hdr.bounds.min);
 		double mx = fmax(ext.x, fmax(ext.y, ext.z));
 		int per = 1;
-		for (e = 0; e < n_curves; e++)
+		long cell_budget = 4L * bl.n;
+		for (e = 0; e < n_ent; e++)
 			per = ent[e].n_pieces > per ? ent[e].n_pieces : per;
-		long cell_budget = 4L * n_tp;
 		if (!(mx > 0.0))
 			mx = 1.0;
 		hdr.h = mx / per;
-		/* The paper's cell size suits planar curves; a space curve
-		 * or a large model would get mostly empty cells that every
-		 * wave has to cross, so the cells also stay within a budget
-		 * proportional to the pieces (and the memory bound). */
+		/* The paper's cell size suits planar curves; a space curve,
+		 * a surface or a large model would get mostly empty cells
+		 * that every wave has to cross, so the cells also stay within
+		 * a budget proportional to the pieces (and the memory bound). */
 		if (cell_budget < 64)
 			cell_budget = 64;
 		if (cell_budget > o.max_cells)
@@ -522,9 +892,9 @@ int px_dist_model_create(const struct px_nurbs_curve *curves, int n_curves,
 			rc = PX_E_NOMEM;
 			goto fail;
 		}
-		for (i = 0; i < n_tp; i++) {
+		for (i = 0; i < bl.n; i++) {
 			int lo[3], hi[3], x, y, z;
-			cell_range(&hdr, px_cpiece_box(&tp[i].pc), lo, hi);
+			cell_range(&hdr, bl.tp[i].pc.box, lo, hi);
 			for (z = lo[2]; z <= hi[2]; z++)
 				for (y = lo[1]; y <= hi[1]; y++)
 					for (x = lo[0]; x <= hi[0]; x++)
@@ -539,18 +909,18 @@ int px_dist_model_create(const struct px_nurbs_curve *curves, int n_curves,
 
 	/* One block for everything the queries touch. */
 #define ALIGNED(x) (((x) + 63) & ~(size_t)63)
-	bytes = ALIGNED(sizeof(*m)) +
-		ALIGNED((size_t)n_curves * sizeof(*ent)) +
-		ALIGNED((size_t)n_tp * sizeof(struct px_cpiece)) +
-		ALIGNED((size_t)n_tp * sizeof(int)) +
-		ALIGNED((size_t)(n_tp + 1) * sizeof(int)) +
-		ALIGNED((size_t)n_samples * sizeof(px_vec3)) +
+	bytes = ALIGNED(sizeof(*m)) + ALIGNED((size_t)n_ent * sizeof(*ent)) +
+		ALIGNED((size_t)bl.n * sizeof(struct piece)) +
+		ALIGNED((size_t)n_cp * sizeof(struct px_cpiece)) +
+		ALIGNED((size_t)n_sp * sizeof(struct px_spiece)) +
+		ALIGNED(sp_doubles * sizeof(double)) +
+		ALIGNED((size_t)bl.n_samples * sizeof(px_vec3)) +
 		ALIGNED((size_t)hdr.n_cells * sizeof(int)) * 2 +
 		ALIGNED((size_t)hdr.n_cells * sizeof(uint16_t)) +
 		ALIGNED((size_t)hdr.n_cells * (size_t)hdr.cap * sizeof(int)) +
 		ALIGNED((size_t)(hdr.n_spill + 1) * sizeof(int)) +
-		ALIGNED((size_t)n_tp * sizeof(uint32_t)) +
-		ALIGNED((size_t)n_tp * sizeof(struct cand)) + 64 * 12;
+		ALIGNED((size_t)bl.n * sizeof(uint32_t)) +
+		ALIGNED((size_t)bl.n * sizeof(struct cand)) + 64 * 16;
 	{
 		struct px_arena ar;
 		rc = px_arena_init_alloc(&ar, bytes);
@@ -563,34 +933,62 @@ int px_dist_model_create(const struct px_nurbs_curve *curves, int n_curves,
 #define TAKE(ptr, n) \
 	((ptr) = px_arena_calloc(&m->arena, (size_t)(n), sizeof(*(ptr)), 64))
 	m->opts = o;
-	m->n_ent = n_curves;
-	m->n_pieces = n_tp;
-	if (!TAKE(m->ent, n_curves) || !TAKE(m->pieces, n_tp) ||
-	    !TAKE(m->piece_ent, n_tp) || !TAKE(m->sample_start, n_tp + 1) ||
-	    !TAKE(m->samples, n_samples) || !TAKE(m->cell_count, m->n_cells) ||
-	    !TAKE(m->cell_spill, m->n_cells) ||
-	    !TAKE(m->cell_empty_r, m->n_cells) ||
-	    !TAKE(m->cell_slot, m->n_cells * m->cap) ||
-	    !TAKE(m->spill, m->n_spill + 1) || !TAKE(m->stamp, n_tp) ||
-	    !TAKE(m->cand, n_tp)) {
-		rc = PX_E_NOMEM; /* sizing above is wrong: a bug */
-		goto fail;
-	}
-#undef TAKE
-	memcpy(m->ent, ent, (size_t)n_curves * sizeof(*ent));
+	m->n_ent = n_ent;
+	m->n_pieces = bl.n;
+	m->n_cp = n_cp;
+	m->n_sp = n_sp;
+	m->n_samples = (int)bl.n_samples;
 	{
-		int s = 0;
-		for (i = 0; i < n_tp; i++) {
-			int k, ns = tp[i].n_samples;
-			m->pieces[i] = tp[i].pc;
-			m->piece_ent[i] = tp[i].ent;
-			m->sample_start[i] = s;
-			for (k = 0; k < ns; k++)
-				m->samples[s + k] = px_cpiece_eval(
-					&m->pieces[i], (double)k / (ns - 1), NULL);
-			s += ns;
+		double *spmem = NULL;
+		if (!TAKE(m->ent, n_ent) || !TAKE(m->pieces, bl.n) ||
+		    (n_cp && !TAKE(m->cp, n_cp)) || (n_sp && !TAKE(m->spc, n_sp)) ||
+		    (sp_doubles && !TAKE(spmem, sp_doubles)) ||
+		    !TAKE(m->samples, bl.n_samples) ||
+		    !TAKE(m->cell_count, m->n_cells) ||
+		    !TAKE(m->cell_spill, m->n_cells) ||
+		    !TAKE(m->cell_empty_r, m->n_cells) ||
+		    !TAKE(m->cell_slot, m->n_cells * m->cap) ||
+		    !TAKE(m->spill, m->n_spill + 1) || !TAKE(m->stamp, bl.n) ||
+		    !TAKE(m->cand, bl.n)) {
+			rc = PX_E_NOMEM; /* the sizing above is wrong: a bug */
+			goto fail;
 		}
-		m->sample_start[n_tp] = s;
+#undef TAKE
+		memcpy(m->ent, ent, (size_t)n_ent * sizeof(*ent));
+		{
+			int ic = 0, is = 0, smp = 0;
+			for (i = 0; i < bl.n; i++) {
+				struct tmp_piece *t = &bl.tp[i];
+				struct piece *pc = &m->pieces[i];
+				int a, b;
+				*pc = t->pc;
+				pc->sample_start = smp;
+				if (t->pc.kind == PK_CURVE) {
+					pc->idx = ic;
+					m->cp[ic] = t->cp;
+					for (a = 0; a < pc->ns; a++)
+						m->samples[smp++] = px_cpiece_eval(
+							&m->cp[ic], (double)a / (pc->ns - 1), NULL);
+					ic++;
+				} else {
+					pc->idx = is;
+					rc = px_spiece_init(&m->spc[is], t->p, t->q,
+							    (const double(*)[4])t->hw,
+							    t->r[0], t->r[1], t->r[2], t->r[3],
+							    spmem);
+					if (rc)
+						goto fail;
+					spmem += px_spiece_doubles(t->p, t->q);
+					for (a = 0; a < pc->ns; a++)
+						for (b = 0; b < pc->nt; b++)
+							m->samples[smp++] = px_spiece_eval(
+								&m->spc[is], (double)a / (pc->ns - 1),
+								(double)b / (pc->nt - 1), NULL, NULL,
+								NULL, NULL, NULL);
+					is++;
+				}
+			}
+		}
 	}
 	/* Bin: first cap references in the cell, the rest in the spill
 	 * table, laid out cell by cell. */
@@ -601,9 +999,9 @@ int px_dist_model_create(const struct px_nurbs_curve *curves, int n_curves,
 			rc = PX_E_NOMEM;
 			goto fail;
 		}
-		for (i = 0; i < n_tp; i++) {
+		for (i = 0; i < bl.n; i++) {
 			int lo[3], hi[3], x, y, z;
-			cell_range(m, px_cpiece_box(&m->pieces[i]), lo, hi);
+			cell_range(m, m->pieces[i].box, lo, hi);
 			for (z = lo[2]; z <= hi[2]; z++)
 				for (y = lo[1]; y <= hi[1]; y++)
 					for (x = lo[0]; x <= hi[0]; x++)
@@ -615,9 +1013,9 @@ int px_dist_model_create(const struct px_nurbs_curve *curves, int n_curves,
 				next += spill_count[c] - m->cap;
 		}
 		free(spill_count);
-		for (i = 0; i < n_tp; i++) {
+		for (i = 0; i < bl.n; i++) {
 			int lo[3], hi[3], x, y, z;
-			cell_range(m, px_cpiece_box(&m->pieces[i]), lo, hi);
+			cell_range(m, m->pieces[i].box, lo, hi);
 			for (z = lo[2]; z <= hi[2]; z++)
 				for (y = lo[1]; y <= hi[1]; y++)
 					for (x = lo[0]; x <= hi[0]; x++) {
@@ -633,17 +1031,15 @@ int px_dist_model_create(const struct px_nurbs_curve *curves, int n_curves,
 	rc = empty_radius(m);
 	if (rc)
 		goto fail;
-	free(tp);
+	free_builder(&bl);
 	free(ent);
-	free(work);
 	*out = m;
 	return PX_OK;
 fail:
 	if (m)
 		px_arena_fini(&m->arena);
-	free(tp);
+	free_builder(&bl);
 	free(ent);
-	free(work);
 	return rc;
 }
 
@@ -664,7 +1060,9 @@ void px_dist_model_info(const struct px_dist_model *m, struct px_dist_info *info
 		return;
 	info->n_entities = m->n_ent;
 	info->n_pieces = m->n_pieces;
-	info->n_samples = m->sample_start[m->n_pieces];
+	info->n_curve_pieces = m->n_cp;
+	info->n_patches = m->n_sp;
+	info->n_samples = m->n_samples;
 	info->grid[0] = m->nx;
 	info->grid[1] = m->ny;
 	info->grid[2] = m->nz;
@@ -730,7 +1128,8 @@ static inline int clamp_cell(double v, int n)
 
 struct qstate {
 	double best;  /* squared upper bound */
-	int best_piece, best_sample;
+	int best_sample; /* global sample index */
+	int best_piece;
 	int n_cand;
 	int cells;
 };
@@ -738,23 +1137,22 @@ struct qstate {
 static void visit_piece(struct px_dist_model *m, px_vec3 p, int id,
 			struct qstate *q)
 {
-	px_aabb b;
+	const struct piece *pc = &m->pieces[id];
 	double lb;
 	int s, e;
 
 	if (m->stamp[id] == m->epoch)
 		return;
 	m->stamp[id] = m->epoch;
-	b = m->pieces[id].box_;
-	lb = box_d2(&b, p);
+	lb = box_d2(&pc->box, p);
 	if (lb >= q->best)
 		return;
-	for (s = m->sample_start[id], e = m->sample_start[id + 1]; s < e; s++) {
+	for (s = pc->sample_start, e = s + pc->ns * pc->nt; s < e; s++) {
 		double d2 = px_v3_dist2(m->samples[s], p);
 		if (d2 < q->best) {
 			q->best = d2;
+			q->best_sample = s;
 			q->best_piece = id;
-			q->best_sample = s - m->sample_start[id];
 		}
 	}
 	m->cand[q->n_cand].lb = lb;
@@ -822,11 +1220,40 @@ static void sort_cand(struct cand *c, int n)
 	}
 }
 
+/* Global (u, v) of a sample: its piece's parameters at the sample's
+ * place in the piece's sample grid. */
+static void sample_params(const struct px_dist_model *m, int id, int s,
+			  double *u, double *v)
+{
+	const struct piece *pc = &m->pieces[id];
+	int k = s - pc->sample_start;
+	if (pc->kind == PK_PATCH) {
+		const struct px_spiece *sp = &m->spc[pc->idx];
+		double a = (double)(k / pc->nt) / (pc->ns - 1);
+		double b = (double)(k % pc->nt) / (pc->nt - 1);
+		*u = sp->u0_ + a * (sp->u1_ - sp->u0_);
+		*v = sp->v0_ + b * (sp->v1_ - sp->v0_);
+	} else {
+		const struct px_cpiece *cp = &m->cp[pc->idx];
+		double t = cp->u0_ + (double)k / (pc->ns - 1) * (cp->u1_ - cp->u0_);
+		if (pc->iso_dir == 1) {
+			*u = pc->iso_t;
+			*v = t;
+		} else if (pc->iso_dir == 0) {
+			*u = t;
+			*v = pc->iso_t;
+		} else {
+			*u = t;
+			*v = 0.0;
+		}
+	}
+}
+
 int px_dist_query(struct px_dist_model *m, px_vec3 p, struct px_dist_result *r)
 {
 	struct qstate q;
 	int c[3], k, kmax, i;
-	double gap = 0.0;
+	double gap = 0.0, best;
 
 	if (!m || !r)
 		return PX_E_INVAL;
@@ -864,8 +1291,6 @@ int px_dist_query(struct px_dist_model *m, px_vec3 p, struct px_dist_result *r)
 			}
 			if (q.best <= outside_lb2(m, p, lo, hi))
 				break;
-		} else if (q.best <= px_aabb_dist2(&m->bounds, p)) {
-			break;
 		}
 		for (z = c[2] - k; z <= c[2] + k; z++) {
 			if (z < 0 || z >= m->nz)
@@ -889,32 +1314,53 @@ int px_dist_query(struct px_dist_model *m, px_vec3 p, struct px_dist_result *r)
 		}
 	}
 	r->cells_visited = q.cells;
+	if (q.best_piece < 0)
+		return PX_E_STATE; /* unreachable: the wave meets every piece */
+
+	/* Start from the best sample, a point on the model, so that an
+	 * answer exists even if no solve improves on it. */
+	best = q.best;
+	r->point = m->samples[q.best_sample];
+	r->piece = q.best_piece;
+	sample_params(m, q.best_piece, q.best_sample, &r->u, &r->v);
 
 	/* Exact solve of every piece that may still hold something closer,
 	 * nearest lower bound first. */
 	sort_cand(m->cand, q.n_cand);
-	if (q.best_piece < 0)
-		return PX_E_STATE; /* unreachable: the wave meets every piece */
-	{
-		/* Start from the best sample, a point on the model, so that
-		 * an answer exists even if no solve improves on it. */
-		const struct px_cpiece *bp = &m->pieces[q.best_piece];
-		int ns = m->sample_start[q.best_piece + 1] -
-			 m->sample_start[q.best_piece];
-		double t = (double)q.best_sample / (ns - 1), best = q.best;
-		r->point = m->samples[m->sample_start[q.best_piece] + q.best_sample];
-		r->u = bp->u0_ + t * (bp->u1_ - bp->u0_);
-		r->piece = q.best_piece;
-		for (i = 0; i < q.n_cand; i++) {
+	for (i = 0; i < q.n_cand; i++) {
+		const struct cand *cd = &m->cand[i];
+		const struct piece *pc = &m->pieces[cd->piece];
+		if (cd->lb >= best)
+			break;
+		r->pieces_solved++;
+		if (pc->kind == PK_CURVE) {
 			struct px_cpiece_hit hit;
-			const struct cand *cd = &m->cand[i];
-			if (cd->lb >= best)
-				break;
-			r->pieces_solved++;
-			if (px_cpiece_closest(&m->pieces[cd->piece], p, &best, &hit)) {
+			if (px_cpiece_closest(&m->cp[pc->idx], p, &best, &hit)) {
 				r->point = hit.point;
-				r->u = hit.u;
 				r->piece = cd->piece;
+				if (pc->iso_dir == 1) {
+					r->u = pc->iso_t;
+					r->v = hit.u;
+				} else if (pc->iso_dir == 0) {
+					r->u = hit.u;
+					r->v = pc->iso_t;
+				} else {
+					r->u = hit.u;
+					r->v = 0.0;
+				}
+			}
+			r->iters += hit.iters;
+			if (!hit.certified) {
+				r->certified = 0;
+				gap = fmax(gap, hit.gap);
+			}
+		} else {
+			struct px_spiece_hit hit;
+			if (px_spiece_closest(&m->spc[pc->idx], p, &best, &hit)) {
+				r->point = hit.point;
+				r->piece = cd->piece;
+				r->u = hit.u;
+				r->v = hit.v;
 			}
 			r->iters += hit.iters;
 			if (!hit.certified) {
@@ -922,11 +1368,11 @@ int px_dist_query(struct px_dist_model *m, px_vec3 p, struct px_dist_result *r)
 				gap = fmax(gap, hit.gap);
 			}
 		}
-		r->dist = sqrt(best);
 	}
+	r->dist = sqrt(best);
 	r->gap = gap;
-	r->v = 0.0;
-	r->entity = m->piece_ent[r->piece];
+	r->entity = m->pieces[r->piece].ent;
+	r->kind = m->ent[r->entity].kind;
 	{
 		px_vec3 d = px_v3_sub(p, r->point);
 		r->dir = r->dist > 0.0 ? px_v3_scale(d, 1.0 / r->dist)

@@ -1,15 +1,16 @@
 /*
  * px_dist.h - global minimum distance from a point to a set of NURBS
- * curves (the distance core).
+ * curves and surfaces (the distance core).
  *
- * A model is prepared once from any number of curve entities; their union
- * is what a query measures against. Preparation follows the
+ * A model is prepared once from any number of curve and surface
+ * entities; their union is what a query measures against. Preparation follows the
  * knowledge-guided scheme: each entity's parametrization factor
  * pf = (Dmax - Dmin) / Dmax (from derivative magnitudes) picks the
  * decomposition tolerance and jitter from a table; the entity is cut by
  * nearly uniform parameter stepping, at every knot and at cusps (vanishing
  * derivative) into rational Bezier pieces whose control-net boxes are
- * guaranteed to contain them; every piece is pre-sampled (1 % of the arc
+ * guaranteed to contain them (surfaces: the same stepping along their
+ * longest iso-curves in u and in v gives a grid of Bezier patches); every piece is pre-sampled (1 % of the arc
  * length by default); and the pieces are binned by their boxes into a
  * uniform grid whose cells hold a fixed number of references (15 by
  * default) with overflow moved to a spill table at setup.
@@ -19,10 +20,15 @@
  * bounded below by their boxes and above by their samples, and the wave
  * stops once the best sample distance is no larger than the distance to
  * every cell not yet reached. Every piece whose lower bound is still below
- * the best is then solved exactly by px_cpiece_closest(), which proves
- * where the piece's minimum lies instead of trusting one Newton start.
+ * the best is then solved exactly
+ * by px_cpiece_closest() or px_spiece_closest(), which prove where the
+ * piece's minimum lies instead of trusting one Newton start.
  * Open ends, C0 corners, closed-curve seams and cusps are piece end points
- * and so always candidates; no parameter wraps across a seam.
+ * and so always candidates; no parameter wraps across a seam. A surface
+ * also contributes its boundary curves (the four domain edges that do not
+ * collapse to a point, and every interior C0 crease) as curve pieces, so
+ * minima on a patch boundary, at corners and on creases are found by the
+ * curve solver while the patch solver looks for interior minima only.
  *
  * Memory and real-time rules: px_dist_model_create() allocates once (one
  * block whose size px_dist_model_info() reports) and may take long; after
@@ -45,6 +51,8 @@ extern "C" {
 #endif
 
 #define PX_DIST_CELL_CAP_DEFAULT 15
+
+enum px_dist_kind { PX_DIST_CURVE = 0, PX_DIST_SURFACE = 1 };
 
 struct px_dist_opts {
 	/* Decomposition piece length as a fraction of the arc length and
@@ -70,7 +78,8 @@ struct px_dist_result {
 	double dist;     /* distance, metres (model units) */
 	px_vec3 point;   /* closest point on the model */
 	double u, v;     /* parameter(s) of the closest point (v = 0: curve) */
-	int entity;      /* index of the entity in the input order */
+	int entity;      /* index of the entity: curves first, then surfaces */
+	int kind;        /* PX_DIST_CURVE or PX_DIST_SURFACE */
 	int piece;       /* index of the piece within the model */
 	px_vec3 dir;     /* unit vector from point to the query; zero when
 			  * the query lies on the model */
@@ -85,17 +94,22 @@ struct px_dist_result {
 };
 
 struct px_dist_entity_info {
-	double pf;          /* parametrization factor */
+	int kind;           /* PX_DIST_CURVE or PX_DIST_SURFACE */
+	double pf;          /* parametrization factor (max over u and v) */
 	double tol, jitter; /* decomposition settings used */
 	double arc_length;  /* approximate */
-	int first_piece, n_pieces;
-	int closed;         /* end points coincide */
-	int n_breaks;       /* interior C0 knots */
+	int first_piece, n_pieces; /* own pieces: curve pieces or patches */
+	int n_boundary_pieces;     /* surfaces: curve pieces of edges/creases */
+	int closed;         /* curves: end points coincide; surfaces: bit 0
+			     * closed in u, bit 1 closed in v */
+	int n_breaks;       /* interior C0 knots (surfaces: both directions) */
 	int n_cusps;        /* interior points of vanishing derivative */
+	int n_collapsed;    /* surfaces: domain edges collapsed to a point */
 };
 
 struct px_dist_info {
 	int n_entities, n_pieces, n_samples;
+	int n_curve_pieces, n_patches;
 	int grid[3];
 	double cell_size;
 	long cells, spill;
@@ -106,16 +120,19 @@ struct px_dist_info {
 struct px_dist_model;
 
 /*
- * Prepare a model from n_curves curves (valid, e.g. from
- * px_nurbs_curve_init(); they are copied, the caller's arrays may go
- * away). opts may be NULL for defaults. Setup only: allocates.
- * Returns PX_OK, PX_E_INVAL (NULL, n_curves < 1, bad options),
- * PX_E_NOMEM, PX_E_NOSPC (an entity needs more than
- * max_pieces_per_entity pieces), PX_E_DEGENERATE (all geometry in one
- * point is still accepted; this is for NaN-free but unusable input).
+ * Prepare a model from n_curves curves and n_surfs surfaces (valid, e.g.
+ * from px_nurbs_curve_init() / px_nurbs_surf_init(); everything needed is
+ * copied, the caller's arrays may go away). Either array may be NULL when
+ * its count is 0, but not both counts. Entity indices in results are
+ * 0..n_curves-1 for the curves, then n_curves.. for the surfaces. opts
+ * may be NULL for defaults. Setup only: allocates.
+ * Returns PX_OK, PX_E_INVAL (NULL, no entity, bad options), PX_E_RANGE
+ * (degree above PX_NURBS_MAX_DEGREE), PX_E_NOMEM, PX_E_NOSPC (an entity
+ * needs more than max_pieces_per_entity pieces).
  */
 PX_API int px_dist_model_create(const struct px_nurbs_curve *curves,
-				int n_curves, const struct px_dist_opts *opts,
+				int n_curves, const struct px_nurbs_surf *surfs,
+				int n_surfs, const struct px_dist_opts *opts,
 				struct px_dist_model **out);
 
 /* NULL is a no-op. */

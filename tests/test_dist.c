@@ -235,7 +235,7 @@ static void run_random_family(int periodic, struct tally *t)
 			clamped_knots(&b, trial % 4);
 		}
 		PX_CHECK_INT_EQ(make_curve(&c, &b), PX_OK);
-		PX_CHECK_INT_EQ(px_dist_model_create(&c, 1, NULL, &m), PX_OK);
+		PX_CHECK_INT_EQ(px_dist_model_create(&c, 1, NULL, 0, NULL, &m), PX_OK);
 		px_dist_model_info(m, &info);
 		diag = px_aabb_diagonal(&info.bounds);
 		for (i = 0; i < 25; i++)
@@ -277,7 +277,7 @@ static void test_nurbs_circle_and_evolute(void)
 
 	arena_reset();
 	PX_CHECK_INT_EQ(make_curve(&c, &b), PX_OK);
-	PX_CHECK_INT_EQ(px_dist_model_create(&c, 1, NULL, &m), PX_OK);
+	PX_CHECK_INT_EQ(px_dist_model_create(&c, 1, NULL, 0, NULL, &m), PX_OK);
 	PX_CHECK_INT_EQ(px_dist_entity_info(m, 0, &ei), PX_OK);
 	PX_CHECK(ei.closed);
 	/* The centre and the axis are the evolute of a circle: every
@@ -325,7 +325,7 @@ static void test_cusp_curve(void)
 
 	arena_reset();
 	PX_CHECK_INT_EQ(make_curve(&c, &b), PX_OK);
-	PX_CHECK_INT_EQ(px_dist_model_create(&c, 1, NULL, &m), PX_OK);
+	PX_CHECK_INT_EQ(px_dist_model_create(&c, 1, NULL, 0, NULL, &m), PX_OK);
 	PX_CHECK_INT_EQ(px_dist_entity_info(m, 0, &ei), PX_OK);
 	PX_CHECK_INT_EQ(ei.n_cusps, 1);
 	px_dist_model_info(m, &info);
@@ -358,7 +358,7 @@ static void test_many_entities(void)
 		PX_CHECK_INT_EQ(make_curve(&c[e], &b[e]), PX_OK);
 		cs[e] = &c[e];
 	}
-	PX_CHECK_INT_EQ(px_dist_model_create(c, 6, NULL, &m), PX_OK);
+	PX_CHECK_INT_EQ(px_dist_model_create(c, 6, NULL, 0, NULL, &m), PX_OK);
 	px_dist_model_info(m, &info);
 	PX_CHECK_INT_EQ(info.n_entities, 6);
 	for (i = 0; i < 200; i++)
@@ -388,7 +388,7 @@ static void test_tiny_cells_spill(void)
 	px_dist_opts_default(&o);
 	o.cell_cap = 1;
 	o.decomp_tol = 0.01;
-	PX_CHECK_INT_EQ(px_dist_model_create(&c, 1, &o, &m), PX_OK);
+	PX_CHECK_INT_EQ(px_dist_model_create(&c, 1, NULL, 0, &o, &m), PX_OK);
 	px_dist_model_info(m, &info);
 	PX_CHECK(info.spill > 0);
 	for (i = 0; i < 100; i++)
@@ -414,12 +414,12 @@ static void test_bad_input_and_no_alloc(void)
 	random_points(&b, 1, 0);
 	clamped_knots(&b, 2);
 	PX_CHECK_INT_EQ(make_curve(&c, &b), PX_OK);
-	PX_CHECK_INT_EQ(px_dist_model_create(NULL, 1, NULL, &m), PX_E_INVAL);
-	PX_CHECK_INT_EQ(px_dist_model_create(&c, 0, NULL, &m), PX_E_INVAL);
+	PX_CHECK_INT_EQ(px_dist_model_create(NULL, 1, NULL, 0, NULL, &m), PX_E_INVAL);
+	PX_CHECK_INT_EQ(px_dist_model_create(&c, 0, NULL, 0, NULL, &m), PX_E_INVAL);
 	px_dist_opts_default(&o);
 	o.jitter = 1.5;
-	PX_CHECK_INT_EQ(px_dist_model_create(&c, 1, &o, &m), PX_E_INVAL);
-	PX_CHECK_INT_EQ(px_dist_model_create(&c, 1, NULL, &m), PX_OK);
+	PX_CHECK_INT_EQ(px_dist_model_create(&c, 1, NULL, 0, &o, &m), PX_E_INVAL);
+	PX_CHECK_INT_EQ(px_dist_model_create(&c, 1, NULL, 0, NULL, &m), PX_OK);
 	PX_CHECK_INT_EQ(px_dist_query(m, px_v3(NAN, 0, 0), &r[0]), PX_E_NAN);
 	PX_CHECK_INT_EQ(px_dist_query(m, px_v3(0, INFINITY, 0), &r[0]), PX_E_NAN);
 	for (i = 0; i < 64; i++)
