@@ -41,7 +41,7 @@ ALL_CFLAGS := $(BASE_CFLAGS) $(OPTFLAGS) $(SANFLAGS) $(CFLAGS)
 ALL_LDFLAGS := $(SANFLAGS) $(LDFLAGS)
 
 # Optional libraries found with pkg-config (device back ends, config).
-PKGS     :=
+PKGS     := yaml-0.1
 PKG_CFLAGS := $(if $(PKGS),$(shell pkg-config --cflags $(PKGS)))
 PKG_LIBS   := $(if $(PKGS),$(shell pkg-config --libs $(PKGS)))
 LIBS    := $(PKG_LIBS) -lm -lpthread
@@ -71,6 +71,8 @@ PC_FILE    := $(BUILD)/lib/pkgconfig/$(NAME).pc
 
 # Debian packages that building and testing need (see `make deps`).
 DEB_PACKAGES := gcc make libc6-dev pkg-config
+# config/: YAML loader.
+DEB_PACKAGES += libyaml-dev
 
 FORCE:
 
