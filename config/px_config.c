@@ -121,6 +121,12 @@ static void err_item(struct px_config_reader *r, const struct px_config_node *ma
 	px_config_reader_error(r, node_at(map, key, idx, sub), p, "%s", what);
 }
 
+/* Equal names; a name left NULL by an earlier error matches nothing. */
+static bool same(const char *a, const char *b)
+{
+	return a && b && strcmp(a, b) == 0;
+}
+
 static bool valid_name(const char *s)
 {
 	if (!s || !*s)
@@ -506,7 +512,7 @@ static void socketcan_check(struct px_config_reader *r,
 			err_item(r, map, "signals", i, "start_bit", what);
 		}
 		for (j = 0; j < i; j++)
-			if (strcmp(s->name, c->signals[j].name) == 0) {
+			if (same(s->name, c->signals[j].name)) {
 				snprintf(what, sizeof(what),
 					 "signal name '%s' is already used by "
 					 "signals[%zu]",
@@ -558,7 +564,7 @@ static void lines_check(struct px_config_reader *r,
 	char what[160];
 	for (i = 0; i < n; i++) {
 		for (j = 0; j < i; j++)
-			if (strcmp(l[i].name, l[j].name) == 0) {
+			if (same(l[i].name, l[j].name)) {
 				snprintf(what, sizeof(what),
 					 "line name '%s' is already used by "
 					 "lines[%zu]",
@@ -824,7 +830,7 @@ static void line_ref_check(struct px_config_reader *r,
 	}
 	snprintf(p, sizeof(p), "safety.%s.line", key);
 	for (i = 0; i < n; i++)
-		if (strcmp(lines[i].name, ref->line) == 0)
+		if (same(lines[i].name, ref->line))
 			break;
 	if (i == n) {
 		px_config_reader_error(r, px_config_node_get(rn, "line"), p,

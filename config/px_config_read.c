@@ -183,12 +183,13 @@ static int parse_i64(const char *s, size_t len, int64_t *out)
 	uint64_t v = 0, limit;
 	if (i < len && (s[i] == '+' || s[i] == '-'))
 		neg = s[i++] == '-';
-	if (len - i > 2 && s[i] == '0' && (s[i + 1] == 'x' || s[i + 1] == 'X')) {
+	if (len - i >= 2 && s[i] == '0' && (s[i + 1] == 'x' || s[i + 1] == 'X')) {
 		base = 16;
 		i += 2;
 	}
 	limit = neg ? (uint64_t)INT64_MAX + 1u : (uint64_t)INT64_MAX;
-	if (base == 10 && i + 1 < len && s[i] == '0')
+	if (base == 10 && i + 1 < len && s[i] == '0' &&
+	    ((s[i + 1] >= '0' && s[i + 1] <= '9') || s[i + 1] == '_'))
 		return NUM_LEADING0;
 	for (; i < len; i++) {
 		int d;
@@ -315,6 +316,8 @@ static bool looks_like_unit_suffix(const char *s, size_t len)
 		i++;
 	if (i >= len || !(s[i] >= '0' && s[i] <= '9'))
 		return false;
+	if (i + 1 < len && s[i] == '0' && (s[i + 1] == 'x' || s[i + 1] == 'X'))
+		return false; /* hex, not a unit */
 	while (i < len && ((s[i] >= '0' && s[i] <= '9') || s[i] == '.' ||
 			   s[i] == '_'))
 		i++;
