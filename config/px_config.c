@@ -121,6 +121,20 @@ static void err_item(struct px_config_reader *r, const struct px_config_node *ma
 	px_config_reader_error(r, node_at(map, key, idx, sub), p, "%s", what);
 }
 
+/* A config string made safe for a one-line message (control bytes
+ * escaped, long ones cut). Use as EX(s) inside one statement. */
+struct exbuf {
+	char s[112];
+};
+
+static const char *ex(struct exbuf *b, const char *s)
+{
+	px__cfg_excerpt(b->s, sizeof(b->s), s, strlen(s));
+	return b->s;
+}
+
+#define EX(s) ex(&(struct exbuf){{0}}, (s))
+
 /* Equal names; a name left NULL by an earlier error matches nothing. */
 static bool same(const char *a, const char *b)
 {
@@ -226,7 +240,7 @@ static void codec_check(struct px_config_reader *r,
 			const struct px_config_codec *c)
 {
 	size_t i, j;
-	char what[160];
+	char what[256];
 	for (i = 0; i < c->n_inputs; i++)
 		for (j = 0; j < i; j++)
 			if (c->inputs[i].axis == c->inputs[j].axis) {
@@ -311,7 +325,7 @@ static void libusb_check(struct px_config_reader *r,
 {
 	const struct px_config_libusb *u = obj;
 	size_t i;
-	char what[160];
+	char what[256];
 	if (!map)
 		return;
 	for (i = 0; i < u->codec.n_inputs; i++) {
@@ -444,7 +458,7 @@ static void canopen_check(struct px_config_reader *r,
 {
 	const struct px_config_canopen *c = obj;
 	size_t i, j;
-	char what[120];
+	char what[256];
 	if (!map)
 		return;
 	for (i = 0; i < c->n_drives; i++)
@@ -490,7 +504,7 @@ static void socketcan_check(struct px_config_reader *r,
 	const struct px_config_socketcan *c = obj;
 	int64_t frame_bits = c->fd ? 64 * 8 : 8 * 8;
 	size_t i, j;
-	char what[160];
+	char what[256];
 	if (!map)
 		return;
 	if (c->transport == PX_CONFIG_CAN_UNIX && !c->socket_path)
@@ -516,7 +530,7 @@ static void socketcan_check(struct px_config_reader *r,
 				snprintf(what, sizeof(what),
 					 "signal name '%s' is already used by "
 					 "signals[%zu]",
-					 s->name, j);
+					 EX(s->name), j);
 				err_item(r, map, "signals", i, "name", what);
 				break;
 			}
@@ -561,14 +575,14 @@ static void lines_check(struct px_config_reader *r,
 			bool real_chip)
 {
 	size_t i, j;
-	char what[160];
+	char what[256];
 	for (i = 0; i < n; i++) {
 		for (j = 0; j < i; j++)
 			if (same(l[i].name, l[j].name)) {
 				snprintf(what, sizeof(what),
 					 "line name '%s' is already used by "
 					 "lines[%zu]",
-					 l[i].name, j);
+					 EX(l[i].name), j);
 				err_item(r, map, "lines", i, "name", what);
 				break;
 			}
@@ -694,7 +708,7 @@ static void device_check(struct px_config_reader *r,
 		px_config_reader_error(r, px_config_node_get(map, "name"), "name",
 				       "'%s': use only letters, digits, '_', "
 				       "'-' and '.'",
-				       d->name);
+				       EX(d->name));
 	if (!px_config_node_get(map, "backend"))
 		return; /* already reported as missing */
 	for (b = 0; backend_names[b]; b++) {
@@ -810,7 +824,7 @@ static void line_ref_check(struct px_config_reader *r,
 	if (!d) {
 		px_config_reader_error(r, px_config_node_get(rn, "device"), p,
 				       "no device named '%s' in devices",
-				       ref->device);
+				       EX(ref->device));
 		return;
 	}
 	if (d->backend == PX_CONFIG_BACKEND_GPIOD) {
@@ -825,7 +839,7 @@ static void line_ref_check(struct px_config_reader *r,
 				       "device '%s' has no digital lines (the "
 				       "%s line needs a gpiod device or a sim "
 				       "device of kind gpio)",
-				       ref->device, role);
+				       EX(ref->device), role);
 		return;
 	}
 	snprintf(p, sizeof(p), "safety.%s.line", key);
@@ -835,14 +849,14 @@ static void line_ref_check(struct px_config_reader *r,
 	if (i == n) {
 		px_config_reader_error(r, px_config_node_get(rn, "line"), p,
 				       "device '%s' has no line named '%s'",
-				       ref->device, ref->line);
+				       EX(ref->device), EX(ref->line));
 		return;
 	}
 	if (lines[i].direction != want_dir)
 		px_config_reader_error(r, px_config_node_get(rn, "line"), p,
 				       "line '%s' of device '%s' is an %s; the "
 				       "%s line must be an %s",
-				       ref->line, ref->device,
+				       EX(ref->line), EX(ref->device),
 				       dir_names[lines[i].direction], role,
 				       dir_names[want_dir]);
 }
@@ -852,7 +866,7 @@ static void root_check(struct px_config_reader *r,
 {
 	struct px_config *cfg = obj;
 	size_t i, j;
-	char what[160];
+	char what[256];
 	if (!root || root->kind != PX_CONFIG_NODE_MAP)
 		return;
 	for (i = 0; i < cfg->n_devices; i++) {
@@ -867,7 +881,8 @@ static void root_check(struct px_config_reader *r,
 				snprintf(what, sizeof(what),
 					 "duplicate device name '%s' (first at "
 					 "line %d, column %d)",
-					 cfg->devices[i].name, f->line, f->column);
+					 EX(cfg->devices[i].name), f->line,
+					 f->column);
 				err_item(r, root, "devices", i, "name", what);
 				break;
 			}

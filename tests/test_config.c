@@ -270,6 +270,10 @@ static void test_device_errors(void)
 	expect_error("devices:\n  - {name: 'a b', backend: sim}\n",
 		     "t.yaml:2:12: devices[0].name: 'a b': use only letters, "
 		     "digits, '_', '-' and '.'");
+	/* Names are quoted back escaped: a message stays one line. */
+	expect_error("devices:\n  - {name: \"a\\nb\", backend: sim}\n",
+		     "t.yaml:2:12: devices[0].name: 'a\\x0ab': use only "
+		     "letters, digits, '_', '-' and '.'");
 	expect_error("devices:\n  - name: m\n    backend: hidapi\n",
 		     "t.yaml:2:5: devices[0].hidapi: missing required key "
 		     "(backend is 'hidapi')");
