@@ -130,8 +130,10 @@ struct px_config_pair {
 /* A node of the tree. Read-only; owned by its document. */
 struct px_config_node {
 	enum px_config_node_kind kind;
-	int line;          /* 1-based line of the node's first character */
-	int column;        /* 1-based column */
+	/* 1-based line and column of the node's first character: its anchor
+	 * or tag when it has one, the opening quote of a quoted scalar. */
+	int line;
+	int column;
 	const char *file;  /* file or buffer name, for messages */
 	size_t len;        /* scalar: bytes; seq: items; map: pairs */
 	/* Scalar text, NUL-terminated (len is exact; the text may contain NUL
@@ -148,9 +150,9 @@ struct px_config_node {
 struct px_config_doc;
 
 /*
- * Parse the YAML file at path. On success *out is the document (free with
- * px_config_doc_free()). On failure *out is NULL and diag (may be NULL)
- * says why: PX_E_IO (cannot open or read; the message carries strerror),
+ * Parse the YAML file at path. diag (may be NULL) is emptied first. On
+ * success *out is the document (free with px_config_doc_free()). On
+ * failure *out is NULL and diag says why: PX_E_IO (cannot open or read; the message carries strerror),
  * PX_E_PARSE (syntax, duplicate key, ...), PX_E_NOMEM, PX_E_INVAL (NULL
  * path or out).
  */
@@ -267,9 +269,14 @@ struct px_config_schema {
 
 /*
  * Fill obj from the mapping node map with schema. path names the section
- * in messages ("loop", "" for the root). Defaults are applied to every
+ * in messages ("loop", "" for the root). A later module reads its section
+ * of a loaded config with, for example,
+ *   px_config_read(cfg->doc, cfg->scene, "scene", &scene_schema, &scene, diag)
+ * and reports in the same format as the loader. Defaults are applied to every
  * key first, so obj is fully initialised even when errors are reported;
- * map NULL applies defaults only. Problems go to diag (may be NULL).
+ * map NULL applies defaults only; a null node
+ * ("scene:" with nothing under it) is an empty mapping. Problems are
+ * appended to diag (may be NULL).
  * Arrays for SEQ keys are allocated in doc.
  * Returns PX_OK, PX_E_PARSE (at least one problem), PX_E_NOMEM or
  * PX_E_INVAL (NULL doc, schema or obj).
@@ -632,9 +639,10 @@ PX_API const char *const *px_config_backend_names(void);
 PX_API const struct px_config_schema *px_config_schema_root(void);
 
 /*
- * Load and check a configuration file. On success *out is the config (free
- * with px_config_free()). On failure *out is NULL, diag (may be NULL)
- * holds every problem found, and the return is PX_E_IO, PX_E_PARSE,
+ * Load and check a configuration file. diag (may be NULL) is emptied
+ * first. On success *out is the config (free with px_config_free()). On
+ * failure *out is NULL, diag holds every problem found (sorted by line
+ * and column), and the return is PX_E_IO, PX_E_PARSE,
  * PX_E_NOMEM or PX_E_INVAL.
  */
 PX_API int px_config_load_file(const char *path, struct px_config **out,
@@ -646,7 +654,7 @@ PX_API int px_config_load_mem(const char *name, const void *buf, size_t len,
 			      struct px_config_diag *diag);
 
 /* Read an already loaded document into a config (takes ownership of doc
- * on success and on failure). */
+ * on success and on failure). Problems are appended to diag. */
 PX_API int px_config_from_doc(struct px_config_doc *doc, struct px_config **out,
 			      struct px_config_diag *diag);
 

@@ -126,20 +126,61 @@ void px__cfg_diag_sort(struct px_config_diag *d)
 	}
 }
 
+/* Length of a valid UTF-8 sequence at s that is safe to print (not a C1
+ * control, not U+2028/U+2029 which some viewers take as line breaks);
+ * 0 when the bytes must be escaped. */
+static size_t printable_utf8(const unsigned char *s, size_t left)
+{
+	size_t n, i;
+	unsigned cp;
+	if (s[0] >= 0xc2 && s[0] <= 0xdf) {
+		n = 2;
+		cp = s[0] & 0x1fu;
+	} else if (s[0] >= 0xe0 && s[0] <= 0xef) {
+		n = 3;
+		cp = s[0] & 0x0fu;
+	} else if (s[0] >= 0xf0 && s[0] <= 0xf4) {
+		n = 4;
+		cp = s[0] & 0x07u;
+	} else {
+		return 0;
+	}
+	if (n > left)
+		return 0;
+	for (i = 1; i < n; i++) {
+		if ((s[i] & 0xc0) != 0x80)
+			return 0;
+		cp = (cp << 6) | (s[i] & 0x3fu);
+	}
+	if ((n == 3 && cp < 0x800) || (n == 4 && (cp < 0x10000 || cp > 0x10ffff)) ||
+	    (cp >= 0xd800 && cp <= 0xdfff) || (cp >= 0x80 && cp <= 0x9f) ||
+	    cp == 0x2028 || cp == 0x2029)
+		return 0;
+	return n;
+}
+
 void px__cfg_excerpt(char *out, size_t cap, const char *s, size_t len)
 {
 	static const char hex[] = "0123456789abcdef";
-	size_t o = 0, i;
+	const unsigned char *u = (const unsigned char *)s;
+	size_t o = 0, i = 0;
 	if (cap == 0)
 		return;
-	for (i = 0; i < len; i++) {
-		unsigned char c = (unsigned char)s[i];
+	while (i < len) {
+		unsigned char c = u[i];
+		size_t n = c >= 0x80 ? printable_utf8(u + i, len - i) : 0;
 		if (o + 8 >= cap || i >= 48) {
 			if (o + 4 <= cap) {
 				memcpy(out + o, "...", 3);
 				o += 3;
 			}
 			break;
+		}
+		if (n) {
+			memcpy(out + o, u + i, n);
+			o += n;
+			i += n;
+			continue;
 		}
 		if (c < 0x20 || c >= 0x7f) {
 			out[o++] = '\\';
@@ -152,6 +193,7 @@ void px__cfg_excerpt(char *out, size_t cap, const char *s, size_t len)
 		} else {
 			out[o++] = (char)c;
 		}
+		i++;
 	}
 	out[o] = '\0';
 }

@@ -251,6 +251,11 @@ static void test_value_errors(void)
 		     "loop, safety, telemetry, devices, scene, control, sim)");
 	expect_error("version: 2\n",
 		     "t.yaml:1:10: version: 2 is out of range [1, 1]");
+	/* UTF-8 text is shown as text; line separators and C1 controls are
+	 * escaped. */
+	expect_error("loop: {priority: \"\xc3\xa9\\u2028\\x85\"}\n",
+		     "t.yaml:1:18: loop.priority: expected an integer, got the "
+		     "quoted string '\xc3\xa9\\xe2\\x80\\xa8\\xc2\\x85'");
 	/* Control characters never reach the message raw. */
 	expect_error("loop: {priority: \"a\\tb\\x01\"}\n",
 		     "t.yaml:1:18: loop.priority: expected an integer, got the "
