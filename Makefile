@@ -42,9 +42,11 @@ ALL_LDFLAGS := $(SANFLAGS) $(LDFLAGS)
 
 # Optional libraries found with pkg-config (device back ends, config).
 PKGS     := yaml-0.1
-PKG_CFLAGS := $(if $(PKGS),$(shell pkg-config --cflags $(PKGS)))
-PKG_LIBS   := $(if $(PKGS),$(shell pkg-config --libs $(PKGS)))
-LIBS    := $(PKG_LIBS) -lm -lpthread
+# Asked when a recipe runs, not when this file is read, so that packages
+# `make deps` has just installed are found by the same `make test`.
+PKG_CFLAGS = $(if $(PKGS),$(shell pkg-config --cflags $(PKGS)))
+PKG_LIBS   = $(if $(PKGS),$(shell pkg-config --libs $(PKGS)))
+LIBS    = $(PKG_LIBS) -lm -lpthread
 
 # ---- sources -------------------------------------------------------------
 LIB_SRC  := $(foreach d,$(MODULE_DIRS),$(wildcard $(d)/*.c))
@@ -99,6 +101,11 @@ benches: $(BENCH_BIN)
 $(BUILD)/obj/%.o: %.c
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) $(PKG_CFLAGS) -fPIC $(TEST_DEFS) -c $< -o $@
+
+# `make -j test` installs missing packages before compiling what needs them.
+ifneq ($(filter test run,$(MAKECMDGOALS)),)
+$(LIB_OBJ): | deps
+endif
 
 $(STATIC_LIB): $(LIB_OBJ)
 	@mkdir -p $(dir $@)
