@@ -230,7 +230,8 @@ struct px_config_schema;
  *    count_offset. Absent: NULL and 0.
  *  - SUB: a nested struct at offset, read with sub (defaults applied when
  *    the mapping is absent).
- *  - MAP: the raw mapping node kept for a later reader; absent: NULL.
+ *  - MAP: the raw mapping node kept for a later reader; absent or null:
+ *    NULL.
  */
 struct px_config_key {
 	const char *name;

@@ -724,6 +724,8 @@ static void read_key(struct px_config_reader *r, const struct px_config_key *k,
 		read_section(r, n, k->sub, obj + k->offset, depth + 1);
 		break;
 	case PX_CONFIG_T_MAP:
+		if (px_config_node_is_null(n))
+			break; /* "scene:" with nothing under it: absent */
 		if (n->kind != PX_CONFIG_NODE_MAP) {
 			wrong_type(r, n, PX_CONFIG_T_MAP, NULL);
 			break;

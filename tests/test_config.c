@@ -522,7 +522,7 @@ static void test_defaults(void)
 	px_config_free(c);
 
 	/* Sections written but emptied out are fine too. */
-	expect_ok("loop:\nsafety:\ntelemetry:\ndevices:\n");
+	expect_ok("loop:\nsafety:\ntelemetry:\ndevices:\nscene:\ncontrol: ~\n");
 	expect_ok("loop: {}\n");
 }
 
@@ -824,6 +824,111 @@ static void test_random_numbers(void)
 	px_config_doc_free(d);
 }
 
+/* ---- every range of every key ------------------------------------ */
+
+static union {
+	max_align_t align;
+	unsigned char bytes[1 << 16];
+} scratch;
+
+/* Read "name: val" with schema s alone; the key's range error is there or
+ * not. */
+static void range_case(const struct px_config_schema *s,
+		       const struct px_config_key *k, const char *val,
+		       bool want_err)
+{
+	char y[256], path[128], prefix[300];
+	struct px_config_doc *d = NULL;
+	const struct px_config_error *e;
+	snprintf(y, sizeof(y), "%s: %s\n", k->name, val);
+	px_config_diag_init(&g_diag);
+	PX_CHECK_INT_EQ(px_config_doc_load_mem("r", y, strlen(y), &d, &g_diag),
+			PX_OK);
+	px_config_read(d, px_config_doc_root(d), s->name, s, scratch.bytes,
+		       &g_diag);
+	snprintf(path, sizeof(path), "%s.%s", s->name, k->name);
+	e = px_config_diag_find(&g_diag, path);
+	if (want_err) {
+		snprintf(prefix, sizeof(prefix), "r:1:%d: %s: %s is out of range",
+			 (int)strlen(k->name) + 3, path, val);
+		PX_CHECK_MSG(e && strncmp(e->msg, prefix, strlen(prefix)) == 0,
+			     "%s: %s accepted or wrong message (%s)", path, val,
+			     e ? e->msg : "no error");
+	} else {
+		/* Relations checked elsewhere (a standard CAN id must fit in
+		 * 11 bits) may still complain; the range must not. */
+		int i;
+		for (i = 0; i < g_diag.count; i++) {
+			e = &g_diag.errors[i];
+			PX_CHECK_MSG(strcmp(e->path, path) != 0 ||
+					     !strstr(e->msg, "out of range"),
+				     "%s: %s refused: %s", path, val, e->msg);
+		}
+	}
+	px_config_doc_free(d);
+}
+
+static void walk_ranges(const struct px_config_schema *s, int depth, int *n)
+{
+	size_t i;
+	char v[64];
+	PX_CHECK(depth < 16);
+	PX_CHECK(sizeof(scratch) >= 4096);
+	for (i = 0; i < s->n_keys; i++) {
+		const struct px_config_key *k = &s->keys[i];
+		if (k->sub)
+			walk_ranges(k->sub, depth + 1, n);
+		if (k->fixed_count)
+			continue;
+		if (k->type == PX_CONFIG_T_INT64 ||
+		    k->type == PX_CONFIG_T_DURATION) {
+			if (k->flags & PX_CONFIG_HAS_MIN) {
+				snprintf(v, sizeof(v), "%lld", (long long)k->imin);
+				range_case(s, k, v, false);
+				if (k->imin > INT64_MIN) {
+					snprintf(v, sizeof(v), "%lld",
+						 (long long)k->imin - 1);
+					range_case(s, k, v, true);
+				}
+			}
+			if (k->flags & PX_CONFIG_HAS_MAX) {
+				snprintf(v, sizeof(v), "%lld", (long long)k->imax);
+				range_case(s, k, v, false);
+				if (k->imax < INT64_MAX) {
+					snprintf(v, sizeof(v), "%lld",
+						 (long long)k->imax + 1);
+					range_case(s, k, v, true);
+				}
+			}
+			++*n;
+		} else if (k->type == PX_CONFIG_T_DOUBLE) {
+			if (k->flags & PX_CONFIG_HAS_MIN) {
+				double below = k->dmin - (fabs(k->dmin) * 1e-9 + 1e-6);
+				snprintf(v, sizeof(v), "%.17g", k->dmin);
+				range_case(s, k, v, (k->flags & PX_CONFIG_MIN_EXCL) != 0);
+				snprintf(v, sizeof(v), "%.17g", below);
+				range_case(s, k, v, true);
+			}
+			if (k->flags & PX_CONFIG_HAS_MAX) {
+				double above = k->dmax + (fabs(k->dmax) * 1e-9 + 1e-6);
+				snprintf(v, sizeof(v), "%.17g", k->dmax);
+				range_case(s, k, v, (k->flags & PX_CONFIG_MAX_EXCL) != 0);
+				snprintf(v, sizeof(v), "%.17g", above);
+				range_case(s, k, v, true);
+			}
+			++*n;
+		}
+	}
+}
+
+static void test_every_range_enforced(void)
+{
+	int n = 0;
+	walk_ranges(px_config_schema_root(), 0, &n);
+	/* The walk reached the nested sections (devices, codecs, CAN). */
+	PX_CHECK_MSG(n >= 60, "only %d numeric keys walked", n);
+}
+
 /* ---- schemas and docs -------------------------------------------- */
 
 static void test_schema_validate(void)
@@ -1037,6 +1142,7 @@ static const struct px_test tests[] = {
 	PX_T(test_load_file_errors),
 	PX_T(test_generic_reader),
 	PX_T(test_random_numbers),
+	PX_T(test_every_range_enforced),
 	PX_T(test_schema_validate),
 	PX_T(test_docs_cover_every_key),
 	PX_T(test_examples_load),
