@@ -1,7 +1,11 @@
 /*
  * libFuzzer target: YAML loading and the whole config schema from memory.
- * Every input must either load or fail with at least one placed message;
- * nothing may crash, leak or read out of bounds. Seeds: fuzz/corpus/config.
+ * Every input must either load or fail with at least one one-line
+ * message; nothing may crash, leak or read out of bounds.
+ * Seeds: fuzz/corpus/config. By hand:
+ *   clang -g -O1 -fsanitize=fuzzer,address,undefined -std=c11 -D_GNU_SOURCE \
+ *     -Icore -Iconfig fuzz/fuzz_config.c config/px_config*.c core/px_*.c -lyaml -lm \
+ *     -lpthread -o fuzz_config && ./fuzz_config -max_len=4096 fuzz/corpus/config
  */
 #include <stddef.h>
 #include <stdint.h>
