@@ -8,5 +8,6 @@
 #include "px_base.h"
 #include "px_arena.h"
 #include "px_math.h"
+#include "px_config.h"
 
 #endif
