@@ -888,6 +888,41 @@ static void root_check(struct px_config_reader *r,
 			}
 		}
 	}
+	/* Timing relations: a budget beyond the period can never be kept, a
+	 * timeout shorter than the period trips on every cycle. */
+	if (cfg->safety.watchdog.compute_budget_ns > cfg->loop.period_ns)
+		px_config_reader_error(
+			r,
+			px_config_node_get(px_config_node_get(px_config_node_get(
+						   root, "safety"),
+						   "watchdog"),
+					   "compute_budget_ns"),
+			"safety.watchdog.compute_budget_ns",
+			"%lld is longer than loop.period_ns %lld",
+			(long long)cfg->safety.watchdog.compute_budget_ns,
+			(long long)cfg->loop.period_ns);
+	if (cfg->safety.watchdog.device_timeout_ns < cfg->loop.period_ns)
+		px_config_reader_error(
+			r,
+			px_config_node_get(px_config_node_get(px_config_node_get(
+						   root, "safety"),
+						   "watchdog"),
+					   "device_timeout_ns"),
+			"safety.watchdog.device_timeout_ns",
+			"%lld is shorter than loop.period_ns %lld: every cycle "
+			"would see stale data",
+			(long long)cfg->safety.watchdog.device_timeout_ns,
+			(long long)cfg->loop.period_ns);
+	for (i = 0; i < cfg->n_devices; i++) {
+		int64_t t = cfg->devices[i].stale_timeout_ns;
+		if (t && t < cfg->loop.period_ns) {
+			snprintf(what, sizeof(what),
+				 "%lld is shorter than loop.period_ns %lld: "
+				 "every cycle would see stale data",
+				 (long long)t, (long long)cfg->loop.period_ns);
+			err_item(r, root, "devices", i, "stale_timeout_ns", what);
+		}
+	}
 	line_ref_check(r, root, cfg, &cfg->safety.estop, "estop",
 		       PX_CONFIG_GPIO_INPUT);
 	line_ref_check(r, root, cfg, &cfg->safety.enable, "enable",

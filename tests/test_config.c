@@ -431,6 +431,31 @@ static void test_safety_line_refs(void)
 	expect_ok(buf);
 }
 
+static void test_timing_relations(void)
+{
+	expect_error("loop: {period_ns: 1000000}\n"
+		     "safety:\n"
+		     "  watchdog: {compute_budget_ns: 1000001}\n",
+		     "t.yaml:3:33: safety.watchdog.compute_budget_ns: 1000001 "
+		     "is longer than loop.period_ns 1000000");
+	expect_error("loop: {period_ns: 100_000_000}\n"
+		     "safety: {watchdog: {device_timeout_ns: 50_000_000}}\n",
+		     "t.yaml:2:40: safety.watchdog.device_timeout_ns: 50000000 "
+		     "is shorter than loop.period_ns 100000000: every cycle "
+		     "would see stale data");
+	expect_error("devices:\n"
+		     "  - {name: a, backend: sim, stale_timeout_ns: 999_999}\n",
+		     "t.yaml:2:47: devices[0].stale_timeout_ns: 999999 is "
+		     "shorter than loop.period_ns 1000000: every cycle would see "
+		     "stale data");
+	expect_ok("loop: {period_ns: 1000000}\n"
+		  "safety:\n"
+		  "  watchdog: {compute_budget_ns: 1000000, device_timeout_ns: "
+		  "1000000}\n"
+		  "devices:\n"
+		  "  - {name: a, backend: sim, stale_timeout_ns: 1000000}\n");
+}
+
 /* ---- many errors at once ----------------------------------------- */
 
 static void test_collects_all_errors(void)
@@ -1134,6 +1159,7 @@ static const struct px_test tests[] = {
 	PX_T(test_value_errors),
 	PX_T(test_device_errors),
 	PX_T(test_safety_line_refs),
+	PX_T(test_timing_relations),
 	PX_T(test_collects_all_errors),
 	PX_T(test_error_cap),
 	PX_T(test_defaults),
