@@ -41,10 +41,12 @@ ALL_CFLAGS := $(BASE_CFLAGS) $(OPTFLAGS) $(SANFLAGS) $(CFLAGS)
 ALL_LDFLAGS := $(SANFLAGS) $(LDFLAGS)
 
 # Optional libraries found with pkg-config (device back ends, config).
-PKGS     :=
-PKG_CFLAGS := $(if $(PKGS),$(shell pkg-config --cflags $(PKGS)))
-PKG_LIBS   := $(if $(PKGS),$(shell pkg-config --libs $(PKGS)))
-LIBS    := $(PKG_LIBS) -lm -lpthread
+PKGS     := yaml-0.1
+# Asked when a recipe runs, not when this file is read, so that packages
+# `make deps` has just installed are found by the same `make test`.
+PKG_CFLAGS = $(if $(PKGS),$(shell pkg-config --cflags $(PKGS)))
+PKG_LIBS   = $(if $(PKGS),$(shell pkg-config --libs $(PKGS)))
+LIBS    = $(PKG_LIBS) -lm -lpthread
 
 # ---- sources -------------------------------------------------------------
 LIB_SRC  := $(foreach d,$(MODULE_DIRS),$(wildcard $(d)/*.c))
@@ -74,6 +76,8 @@ DEB_PACKAGES := gcc make libc6-dev pkg-config
 # Debian packages the benchmarks compare against (installed by `make bench`;
 # a benchmark whose reference is missing says so and still runs).
 BENCH_DEB_PACKAGES := rt-tests
+# config/: YAML loader.
+DEB_PACKAGES += libyaml-dev
 
 FORCE:
 
@@ -100,6 +104,11 @@ benches: $(BENCH_BIN)
 $(BUILD)/obj/%.o: %.c
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) $(PKG_CFLAGS) -fPIC $(TEST_DEFS) -c $< -o $@
+
+# `make -j test` installs missing packages before compiling what needs them.
+ifneq ($(filter test run,$(MAKECMDGOALS)),)
+$(LIB_OBJ): | deps
+endif
 
 $(STATIC_LIB): $(LIB_OBJ)
 	@mkdir -p $(dir $@)

@@ -16,5 +16,6 @@
 #include "px_ring.h"
 #include "px_rt.h"
 #include "px_stats.h"
+#include "px_config.h"
 
 #endif

@@ -1,0 +1,923 @@
+/* YAML document loader on libyaml's event parser, and diagnostics. */
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+#include <yaml.h>
+
+#include "internal.h"
+
+/* A config file larger than this is certainly a mistake (wrong file). */
+#define MAX_FILE_BYTES (64u << 20)
+#define MAX_ANCHORS 10000
+#define BLOCK_BYTES 16384u
+
+/* ---- diagnostics ------------------------------------------------- */
+
+void px_config_diag_init(struct px_config_diag *d)
+{
+	if (!d)
+		return;
+	d->count = 0;
+	d->dropped = 0;
+}
+
+int px_config_diag_total(const struct px_config_diag *d)
+{
+	return d ? d->count + d->dropped : 0;
+}
+
+void px_config_diag_print(const struct px_config_diag *d, FILE *f)
+{
+	int i;
+	if (!d || !f)
+		return;
+	for (i = 0; i < d->count; i++)
+		fprintf(f, "%s\n", d->errors[i].msg);
+	if (d->dropped > 0)
+		fprintf(f, "... and %d more error%s\n", d->dropped,
+			d->dropped == 1 ? "" : "s");
+}
+
+const struct px_config_error *
+px_config_diag_find(const struct px_config_diag *d, const char *path)
+{
+	int i;
+	if (!d || !path)
+		return NULL;
+	for (i = 0; i < d->count; i++)
+		if (strcmp(d->errors[i].path, path) == 0)
+			return &d->errors[i];
+	return NULL;
+}
+
+static void append(char *dst, size_t cap, const char *src)
+{
+	size_t o = strlen(dst), n = strlen(src);
+	if (o + 1 >= cap)
+		return;
+	if (n > cap - 1 - o)
+		n = cap - 1 - o;
+	memcpy(dst + o, src, n);
+	dst[o + n] = '\0';
+}
+
+void px__cfg_diag_vadd(struct px_config_diag *d, const char *file, int line,
+		       int column, const char *path, const char *fmt,
+		       va_list ap)
+{
+	struct px_config_error *e;
+	char what[PX_CONFIG_MSG_LEN];
+	if (!d)
+		return;
+	if (d->count >= PX_CONFIG_MAX_ERRORS) {
+		d->dropped++;
+		return;
+	}
+	e = &d->errors[d->count++];
+	e->line = line;
+	e->column = column;
+	snprintf(e->path, sizeof(e->path), "%s", path ? path : "");
+	vsnprintf(what, sizeof(what), fmt, ap);
+	if (!file)
+		file = "<memory>";
+	/* Truncation of an over-long message is acceptable: it stays one
+	 * line and keeps the place, which comes first. */
+	if (line > 0)
+		snprintf(e->msg, sizeof(e->msg), "%s:%d:%d: ", file, line,
+			 column);
+	else
+		snprintf(e->msg, sizeof(e->msg), "%s: ", file);
+	if (path && *path) {
+		append(e->msg, sizeof(e->msg), path);
+		append(e->msg, sizeof(e->msg), ": ");
+	}
+	append(e->msg, sizeof(e->msg), what);
+}
+
+void px__cfg_diag_add(struct px_config_diag *d, const char *file, int line,
+		      int column, const char *path, const char *fmt, ...)
+{
+	va_list ap;
+	va_start(ap, fmt);
+	px__cfg_diag_vadd(d, file, line, column, path, fmt, ap);
+	va_end(ap);
+}
+
+void px__cfg_diag_sort(struct px_config_diag *d)
+{
+	int i, j;
+	struct px_config_error tmp;
+	if (!d)
+		return;
+	/* Insertion sort: stable, and the list holds at most a few dozen. */
+	for (i = 1; i < d->count; i++) {
+		if (d->errors[i - 1].line < d->errors[i].line ||
+		    (d->errors[i - 1].line == d->errors[i].line &&
+		     d->errors[i - 1].column <= d->errors[i].column))
+			continue;
+		tmp = d->errors[i];
+		for (j = i; j > 0 &&
+			    (d->errors[j - 1].line > tmp.line ||
+			     (d->errors[j - 1].line == tmp.line &&
+			      d->errors[j - 1].column > tmp.column));
+		     j--)
+			d->errors[j] = d->errors[j - 1];
+		d->errors[j] = tmp;
+	}
+}
+
+/* Length of a valid UTF-8 sequence at s that is safe to print (not a C1
+ * control, not U+2028/U+2029 which some viewers take as line breaks);
+ * 0 when the bytes must be escaped. */
+static size_t printable_utf8(const unsigned char *s, size_t left)
+{
+	size_t n, i;
+	unsigned cp;
+	if (s[0] >= 0xc2 && s[0] <= 0xdf) {
+		n = 2;
+		cp = s[0] & 0x1fu;
+	} else if (s[0] >= 0xe0 && s[0] <= 0xef) {
+		n = 3;
+		cp = s[0] & 0x0fu;
+	} else if (s[0] >= 0xf0 && s[0] <= 0xf4) {
+		n = 4;
+		cp = s[0] & 0x07u;
+	} else {
+		return 0;
+	}
+	if (n > left)
+		return 0;
+	for (i = 1; i < n; i++) {
+		if ((s[i] & 0xc0) != 0x80)
+			return 0;
+		cp = (cp << 6) | (s[i] & 0x3fu);
+	}
+	if ((n == 3 && cp < 0x800) || (n == 4 && (cp < 0x10000 || cp > 0x10ffff)) ||
+	    (cp >= 0xd800 && cp <= 0xdfff) || (cp >= 0x80 && cp <= 0x9f) ||
+	    cp == 0x2028 || cp == 0x2029)
+		return 0;
+	return n;
+}
+
+void px__cfg_excerpt(char *out, size_t cap, const char *s, size_t len)
+{
+	static const char hex[] = "0123456789abcdef";
+	const unsigned char *u = (const unsigned char *)s;
+	size_t o = 0, i = 0;
+	if (cap == 0)
+		return;
+	while (i < len) {
+		unsigned char c = u[i];
+		size_t n = c >= 0x80 ? printable_utf8(u + i, len - i) : 0;
+		if (o + 8 >= cap || i >= 48) {
+			if (o + 4 <= cap) {
+				memcpy(out + o, "...", 3);
+				o += 3;
+			}
+			break;
+		}
+		if (n) {
+			memcpy(out + o, u + i, n);
+			o += n;
+			i += n;
+			continue;
+		}
+		if (c < 0x20 || c >= 0x7f) {
+			out[o++] = '\\';
+			out[o++] = 'x';
+			out[o++] = hex[c >> 4];
+			out[o++] = hex[c & 15];
+		} else if (c == '\'' || c == '\\') {
+			out[o++] = '\\';
+			out[o++] = (char)c;
+		} else {
+			out[o++] = (char)c;
+		}
+		i++;
+	}
+	out[o] = '\0';
+}
+
+/* ---- document memory --------------------------------------------- */
+
+void *px__cfg_alloc(struct px_config_doc *doc, size_t size)
+{
+	struct px__cfg_block *b = doc->blocks;
+	size_t need = (size + 15u) & ~(size_t)15u;
+	void *p;
+	if (need < size)
+		return NULL;
+	if (!b || b->cap - b->used < need) {
+		size_t cap = need > BLOCK_BYTES ? need : BLOCK_BYTES;
+		if (cap > SIZE_MAX - sizeof(*b))
+			return NULL;
+		b = malloc(sizeof(*b) + cap);
+		if (!b)
+			return NULL;
+		b->cap = cap;
+		b->used = 0;
+		/* A big one-off block goes behind the current one so the
+		 * current block's free space is not abandoned. */
+		if (doc->blocks && need > BLOCK_BYTES / 2) {
+			b->next = doc->blocks->next;
+			doc->blocks->next = b;
+		} else {
+			b->next = doc->blocks;
+			doc->blocks = b;
+		}
+	}
+	p = b->data + b->used;
+	b->used += need;
+	memset(p, 0, size);
+	return p;
+}
+
+char *px__cfg_strndup(struct px_config_doc *doc, const char *s, size_t len)
+{
+	char *p;
+	if (len == SIZE_MAX)
+		return NULL;
+	p = px__cfg_alloc(doc, len + 1);
+	if (!p)
+		return NULL;
+	if (len)
+		memcpy(p, s, len);
+	p[len] = '\0';
+	return p;
+}
+
+void px_config_doc_free(struct px_config_doc *doc)
+{
+	struct px__cfg_block *b, *next;
+	if (!doc)
+		return;
+	for (b = doc->blocks; b; b = next) {
+		next = b->next;
+		free(b);
+	}
+	free(doc->name);
+	free(doc);
+}
+
+const struct px_config_node *px_config_doc_root(const struct px_config_doc *doc)
+{
+	return doc ? doc->root : NULL;
+}
+
+const char *px_config_doc_name(const struct px_config_doc *doc)
+{
+	return doc ? doc->name : NULL;
+}
+
+const struct px_config_node *px_config_node_get(const struct px_config_node *map,
+						const char *key)
+{
+	size_t i, n;
+	if (!map || !key || map->kind != PX_CONFIG_NODE_MAP)
+		return NULL;
+	n = strlen(key);
+	for (i = 0; i < map->len; i++) {
+		const struct px_config_node *k = map->pairs[i].key;
+		if (k->len == n && memcmp(k->str, key, n) == 0)
+			return map->pairs[i].value;
+	}
+	return NULL;
+}
+
+bool px_config_node_is_null(const struct px_config_node *n)
+{
+	if (!n || n->kind != PX_CONFIG_NODE_SCALAR || n->quoted)
+		return false;
+	return n->len == 0 || strcmp(n->str, "~") == 0 ||
+	       strcmp(n->str, "null") == 0 || strcmp(n->str, "Null") == 0 ||
+	       strcmp(n->str, "NULL") == 0;
+}
+
+/* ---- builder ----------------------------------------------------- */
+
+struct anchor {
+	const char *name;
+	const struct px_config_node *node;
+};
+
+struct builder {
+	struct px_config_doc *doc;
+	struct px_config_diag *diag;
+	yaml_parser_t parser;
+	const unsigned char *buf;
+	size_t buf_len;
+	int err; /* first fatal error; PX_E_PARSE also for soft errors */
+	struct anchor *anchors;
+	size_t n_anchors, cap_anchors;
+};
+
+static void berr(struct builder *b, int line, int column, const char *fmt,
+		 ...) __attribute__((format(printf, 4, 5)));
+
+static void berr(struct builder *b, int line, int column, const char *fmt, ...)
+{
+	va_list ap;
+	va_start(ap, fmt);
+	px__cfg_diag_vadd(b->diag, b->doc->name, line, column, "", fmt, ap);
+	va_end(ap);
+	if (!b->err)
+		b->err = PX_E_PARSE;
+}
+
+static int nomem(struct builder *b)
+{
+	b->err = PX_E_NOMEM;
+	px__cfg_diag_add(b->diag, b->doc->name, 0, 0, "",
+			 "out of memory while loading");
+	return PX_E_NOMEM;
+}
+
+/* Line and column (1-based) of a byte offset in the input. */
+static void offset_place(const struct builder *b, size_t off, int *line,
+			 int *col)
+{
+	size_t i, l = 1, c = 1;
+	if (off > b->buf_len)
+		off = b->buf_len;
+	for (i = 0; i < off; i++) {
+		if (b->buf[i] == '\n') {
+			l++;
+			c = 1;
+		} else if ((b->buf[i] & 0xc0) != 0x80) {
+			c++;
+		}
+	}
+	*line = l > INT32_MAX ? INT32_MAX : (int)l;
+	*col = c > INT32_MAX ? INT32_MAX : (int)c;
+}
+
+static int mark_line(const yaml_mark_t *m)
+{
+	return m->line >= INT32_MAX ? INT32_MAX : (int)m->line + 1;
+}
+
+static int mark_col(const yaml_mark_t *m)
+{
+	return m->column >= INT32_MAX ? INT32_MAX : (int)m->column + 1;
+}
+
+static int parser_error(struct builder *b)
+{
+	yaml_parser_t *p = &b->parser;
+	const char *problem = p->problem ? p->problem : "unknown problem";
+	int line, col;
+	if (p->error == YAML_MEMORY_ERROR)
+		return nomem(b);
+	if (p->error == YAML_READER_ERROR) {
+		offset_place(b, p->problem_offset, &line, &col);
+		if (p->problem_value != -1)
+			berr(b, line, col, "YAML error: %s (byte 0x%02x)",
+			     problem, (unsigned)p->problem_value & 0xffu);
+		else
+			berr(b, line, col, "YAML error: %s", problem);
+	} else if (p->context) {
+		berr(b, mark_line(&p->problem_mark), mark_col(&p->problem_mark),
+		     "YAML syntax error: %s (%s at line %d, column %d)",
+		     problem, p->context, mark_line(&p->context_mark),
+		     mark_col(&p->context_mark));
+	} else {
+		berr(b, mark_line(&p->problem_mark), mark_col(&p->problem_mark),
+		     "YAML syntax error: %s", problem);
+	}
+	b->err = PX_E_PARSE;
+	return PX_E_PARSE;
+}
+
+static int next_event(struct builder *b, yaml_event_t *ev)
+{
+	if (!yaml_parser_parse(&b->parser, ev))
+		return parser_error(b);
+	return PX_OK;
+}
+
+static struct px_config_node *new_node(struct builder *b,
+				       enum px_config_node_kind kind,
+				       const yaml_event_t *ev)
+{
+	struct px_config_node *n = px__cfg_alloc(b->doc, sizeof(*n));
+	if (!n) {
+		nomem(b);
+		return NULL;
+	}
+	n->kind = kind;
+	n->line = mark_line(&ev->start_mark);
+	n->column = mark_col(&ev->start_mark);
+	n->file = b->doc->name;
+	n->str = "";
+	n->expanded_ = 1;
+	return n;
+}
+
+static int add_anchor(struct builder *b, const yaml_char_t *name,
+		      const struct px_config_node *n)
+{
+	if (!name)
+		return PX_OK;
+	if (b->n_anchors == MAX_ANCHORS) {
+		berr(b, n->line, n->column, "more than %d anchors",
+		     MAX_ANCHORS);
+		return PX_E_PARSE;
+	}
+	if (b->n_anchors == b->cap_anchors) {
+		size_t cap = b->cap_anchors ? b->cap_anchors * 2 : 16;
+		struct anchor *a = realloc(b->anchors, cap * sizeof(*a));
+		if (!a)
+			return nomem(b);
+		b->anchors = a;
+		b->cap_anchors = cap;
+	}
+	b->anchors[b->n_anchors].name =
+		px__cfg_strndup(b->doc, (const char *)name,
+				strlen((const char *)name));
+	if (!b->anchors[b->n_anchors].name)
+		return nomem(b);
+	b->anchors[b->n_anchors].node = n;
+	b->n_anchors++;
+	return PX_OK;
+}
+
+static const struct px_config_node *find_anchor(const struct builder *b,
+						const char *name)
+{
+	size_t i = b->n_anchors;
+	/* A redefined anchor applies from its new definition on. */
+	while (i-- > 0)
+		if (strcmp(b->anchors[i].name, name) == 0)
+			return b->anchors[i].node;
+	return NULL;
+}
+
+/* Tags: the YAML core ones are accepted (!!str makes a string); anything
+ * else would need a meaning we do not have. */
+static int check_tag(struct builder *b, const yaml_char_t *tag,
+		     const yaml_event_t *ev, bool *is_str)
+{
+	static const char core[] = "tag:yaml.org,2002:";
+	const char *t = (const char *)tag;
+	char ex[80];
+	if (!t)
+		return PX_OK;
+	if (strncmp(t, core, sizeof(core) - 1) == 0) {
+		const char *s = t + sizeof(core) - 1;
+		if (strcmp(s, "str") == 0) {
+			*is_str = true;
+			return PX_OK;
+		}
+		if (!strcmp(s, "int") || !strcmp(s, "float") ||
+		    !strcmp(s, "bool") || !strcmp(s, "null") ||
+		    !strcmp(s, "seq") || !strcmp(s, "map"))
+			return PX_OK;
+	}
+	if (strcmp(t, "!") == 0) /* non-specific tag: a quoted-like string */
+		return PX_OK;
+	px__cfg_excerpt(ex, sizeof(ex), t, strlen(t));
+	berr(b, mark_line(&ev->start_mark), mark_col(&ev->start_mark),
+	     "unsupported YAML tag '%s'", ex);
+	return PX_E_PARSE;
+}
+
+static int build(struct builder *b, yaml_event_t *ev, int depth,
+		 const struct px_config_node **out);
+
+static int expand_add(struct builder *b, struct px_config_node *parent,
+		      const struct px_config_node *child)
+{
+	parent->expanded_ += child->expanded_;
+	if (parent->expanded_ > PX_CONFIG_MAX_EXPANDED) {
+		berr(b, parent->line, parent->column,
+		     "document too large with aliases expanded (more than %d "
+		     "nodes)",
+		     PX_CONFIG_MAX_EXPANDED);
+		return PX_E_PARSE;
+	}
+	return PX_OK;
+}
+
+/* Grow a temporary pointer array (freed by the caller). */
+static int grow(struct builder *b, void **arr, size_t *cap, size_t n,
+		size_t elem)
+{
+	size_t ncap;
+	void *p;
+	if (n < *cap)
+		return PX_OK;
+	ncap = *cap ? *cap * 2 : 8;
+	if (ncap > SIZE_MAX / elem)
+		return nomem(b);
+	p = realloc(*arr, ncap * elem);
+	if (!p)
+		return nomem(b);
+	*arr = p;
+	*cap = ncap;
+	return PX_OK;
+}
+
+static int build_seq(struct builder *b, const yaml_event_t *start, int depth,
+		     const struct px_config_node **out)
+{
+	struct px_config_node *n = new_node(b, PX_CONFIG_NODE_SEQ, start);
+	const struct px_config_node **tmp = NULL;
+	size_t count = 0, cap = 0;
+	int rc = PX_OK;
+	if (!n)
+		return PX_E_NOMEM;
+	for (;;) {
+		yaml_event_t ev;
+		const struct px_config_node *child;
+		rc = next_event(b, &ev);
+		if (rc)
+			break;
+		if (ev.type == YAML_SEQUENCE_END_EVENT) {
+			yaml_event_delete(&ev);
+			break;
+		}
+		rc = build(b, &ev, depth + 1, &child);
+		yaml_event_delete(&ev);
+		if (rc)
+			break;
+		rc = grow(b, (void **)&tmp, &cap, count, sizeof(*tmp));
+		if (rc)
+			break;
+		tmp[count++] = child;
+		rc = expand_add(b, n, child);
+		if (rc)
+			break;
+	}
+	if (!rc && count) {
+		const struct px_config_node **items =
+			px__cfg_alloc(b->doc, count * sizeof(*items));
+		if (!items) {
+			rc = nomem(b);
+		} else {
+			memcpy(items, tmp, count * sizeof(*items));
+			n->items = items;
+			n->len = count;
+		}
+	}
+	free(tmp);
+	if (!rc)
+		rc = add_anchor(b, start->data.sequence_start.anchor, n);
+	*out = n;
+	return rc;
+}
+
+struct keyref {
+	const struct px_config_node *key;
+	size_t idx;
+};
+
+static int keyref_cmp(const void *pa, const void *pb)
+{
+	const struct keyref *a = pa, *b = pb;
+	size_t n = a->key->len < b->key->len ? a->key->len : b->key->len;
+	int c = memcmp(a->key->str, b->key->str, n);
+	if (c)
+		return c;
+	if (a->key->len != b->key->len)
+		return a->key->len < b->key->len ? -1 : 1;
+	return a->idx < b->idx ? -1 : a->idx > b->idx;
+}
+
+/* Report every key that repeats an earlier one, in document order. */
+static int check_duplicates(struct builder *b, const struct px_config_pair *p,
+			    size_t n)
+{
+	struct keyref *refs;
+	size_t *first; /* per pair: index of its first occurrence */
+	size_t i;
+	if (n < 2)
+		return PX_OK;
+	refs = malloc(n * sizeof(*refs));
+	first = malloc(n * sizeof(*first));
+	if (!refs || !first) {
+		free(refs);
+		free(first);
+		return nomem(b);
+	}
+	for (i = 0; i < n; i++) {
+		refs[i].key = p[i].key;
+		refs[i].idx = i;
+		first[i] = i;
+	}
+	qsort(refs, n, sizeof(*refs), keyref_cmp);
+	for (i = 1; i < n; i++) {
+		const struct px_config_node *k0 = refs[i - 1].key, *k1 = refs[i].key;
+		if (k0->len == k1->len && memcmp(k0->str, k1->str, k0->len) == 0)
+			first[refs[i].idx] = first[refs[i - 1].idx];
+	}
+	for (i = 0; i < n; i++) {
+		if (first[i] != i) {
+			const struct px_config_node *k = p[i].key,
+						    *f = p[first[i]].key;
+			char ex[200];
+			px__cfg_excerpt(ex, sizeof(ex), k->str, k->len);
+			berr(b, k->line, k->column,
+			     "duplicate key '%s' (first at line %d, column %d)",
+			     ex, f->line, f->column);
+		}
+	}
+	free(refs);
+	free(first);
+	return PX_OK;
+}
+
+static int build_map(struct builder *b, const yaml_event_t *start, int depth,
+		     const struct px_config_node **out)
+{
+	struct px_config_node *n = new_node(b, PX_CONFIG_NODE_MAP, start);
+	struct px_config_pair *tmp = NULL;
+	size_t count = 0, cap = 0;
+	int rc = PX_OK;
+	if (!n)
+		return PX_E_NOMEM;
+	for (;;) {
+		yaml_event_t ev;
+		const struct px_config_node *key, *value;
+		rc = next_event(b, &ev);
+		if (rc)
+			break;
+		if (ev.type == YAML_MAPPING_END_EVENT) {
+			yaml_event_delete(&ev);
+			break;
+		}
+		rc = build(b, &ev, depth + 1, &key);
+		yaml_event_delete(&ev);
+		if (rc)
+			break;
+		if (key->kind != PX_CONFIG_NODE_SCALAR) {
+			berr(b, key->line, key->column,
+			     "mapping keys must be plain scalars, not a %s",
+			     key->kind == PX_CONFIG_NODE_MAP ? "mapping"
+							     : "sequence");
+			rc = PX_E_PARSE;
+			break;
+		}
+		if (!key->quoted && key->len == 2 && key->str[0] == '<' &&
+		    key->str[1] == '<') {
+			berr(b, key->line, key->column,
+			     "merge keys ('<<') are not supported; write the "
+			     "keys out");
+			rc = PX_E_PARSE;
+			break;
+		}
+		rc = next_event(b, &ev);
+		if (rc)
+			break;
+		rc = build(b, &ev, depth + 1, &value);
+		yaml_event_delete(&ev);
+		if (rc)
+			break;
+		rc = grow(b, (void **)&tmp, &cap, count, sizeof(*tmp));
+		if (rc)
+			break;
+		tmp[count].key = key;
+		tmp[count].value = value;
+		count++;
+		rc = expand_add(b, n, value);
+		if (rc)
+			break;
+	}
+	if (!rc && count) {
+		struct px_config_pair *pairs =
+			px__cfg_alloc(b->doc, count * sizeof(*pairs));
+		if (!pairs) {
+			rc = nomem(b);
+		} else {
+			memcpy(pairs, tmp, count * sizeof(*pairs));
+			n->pairs = pairs;
+			n->len = count;
+			rc = check_duplicates(b, pairs, count);
+		}
+	}
+	free(tmp);
+	if (!rc)
+		rc = add_anchor(b, start->data.mapping_start.anchor, n);
+	*out = n;
+	return rc;
+}
+
+static int build(struct builder *b, yaml_event_t *ev, int depth,
+		 const struct px_config_node **out)
+{
+	struct px_config_node *n;
+	bool is_str = false;
+	int rc;
+	*out = NULL;
+	if (depth > PX_CONFIG_MAX_DEPTH) {
+		berr(b, mark_line(&ev->start_mark), mark_col(&ev->start_mark),
+		     "nesting deeper than %d levels", PX_CONFIG_MAX_DEPTH);
+		return PX_E_PARSE;
+	}
+	switch (ev->type) {
+	case YAML_ALIAS_EVENT: {
+		const char *name = (const char *)ev->data.alias.anchor;
+		const struct px_config_node *t = find_anchor(b, name);
+		if (!t) {
+			char ex[80];
+			px__cfg_excerpt(ex, sizeof(ex), name, strlen(name));
+			berr(b, mark_line(&ev->start_mark),
+			     mark_col(&ev->start_mark),
+			     "alias '*%s' has no anchor before it", ex);
+			return PX_E_PARSE;
+		}
+		*out = t;
+		return PX_OK;
+	}
+	case YAML_SCALAR_EVENT:
+		rc = check_tag(b, ev->data.scalar.tag, ev, &is_str);
+		if (rc)
+			return rc;
+		n = new_node(b, PX_CONFIG_NODE_SCALAR, ev);
+		if (!n)
+			return PX_E_NOMEM;
+		n->str = px__cfg_strndup(b->doc, (const char *)ev->data.scalar.value,
+					 ev->data.scalar.length);
+		if (!n->str)
+			return nomem(b);
+		n->len = ev->data.scalar.length;
+		n->quoted = is_str || ev->data.scalar.style != YAML_PLAIN_SCALAR_STYLE;
+		*out = n;
+		return add_anchor(b, ev->data.scalar.anchor, n);
+	case YAML_SEQUENCE_START_EVENT:
+		rc = check_tag(b, ev->data.sequence_start.tag, ev, &is_str);
+		if (rc)
+			return rc;
+		return build_seq(b, ev, depth, out);
+	case YAML_MAPPING_START_EVENT:
+		rc = check_tag(b, ev->data.mapping_start.tag, ev, &is_str);
+		if (rc)
+			return rc;
+		return build_map(b, ev, depth, out);
+	default:
+		berr(b, mark_line(&ev->start_mark), mark_col(&ev->start_mark),
+		     "unexpected YAML event %d", (int)ev->type);
+		return PX_E_PARSE;
+	}
+}
+
+static int build_stream(struct builder *b)
+{
+	yaml_event_t ev;
+	int rc, docs = 0;
+	for (;;) {
+		rc = next_event(b, &ev);
+		if (rc)
+			return rc;
+		switch (ev.type) {
+		case YAML_STREAM_START_EVENT:
+		case YAML_DOCUMENT_END_EVENT:
+			break;
+		case YAML_STREAM_END_EVENT:
+			yaml_event_delete(&ev);
+			return b->err;
+		case YAML_DOCUMENT_START_EVENT:
+			if (docs++ > 0) {
+				berr(b, mark_line(&ev.start_mark),
+				     mark_col(&ev.start_mark),
+				     "more than one YAML document (a config "
+				     "file holds exactly one)");
+				yaml_event_delete(&ev);
+				return PX_E_PARSE;
+			}
+			break;
+		default: {
+			const struct px_config_node *root;
+			rc = build(b, &ev, 1, &root);
+			yaml_event_delete(&ev);
+			if (rc)
+				return rc;
+			b->doc->root = root;
+			continue;
+		}
+		}
+		yaml_event_delete(&ev);
+	}
+}
+
+static int set_name(struct px_config_doc *doc, const char *name)
+{
+	size_t n = strlen(name);
+	doc->name = malloc(n + 1);
+	if (!doc->name)
+		return PX_E_NOMEM;
+	memcpy(doc->name, name, n + 1);
+	return PX_OK;
+}
+
+int px_config_doc_load_mem(const char *name, const void *buf, size_t len,
+			   struct px_config_doc **out,
+			   struct px_config_diag *diag)
+{
+	struct builder b;
+	int rc;
+	px_config_diag_init(diag);
+	if (out)
+		*out = NULL;
+	if (!out || (!buf && len)) {
+		px__cfg_diag_add(diag, name, 0, 0, "",
+				 "invalid arguments to the loader");
+		return PX_E_INVAL;
+	}
+	memset(&b, 0, sizeof(b));
+	b.diag = diag;
+	b.buf = buf ? buf : (const void *)"";
+	b.buf_len = len;
+	b.doc = calloc(1, sizeof(*b.doc));
+	if (!b.doc || set_name(b.doc, name ? name : "<memory>") != PX_OK) {
+		px__cfg_diag_add(diag, name, 0, 0, "",
+				 "out of memory while loading");
+		px_config_doc_free(b.doc);
+		return PX_E_NOMEM;
+	}
+	if (!yaml_parser_initialize(&b.parser)) {
+		px__cfg_diag_add(diag, name, 0, 0, "",
+				 "out of memory while loading");
+		px_config_doc_free(b.doc);
+		return PX_E_NOMEM;
+	}
+	yaml_parser_set_input_string(&b.parser, b.buf, len);
+	yaml_parser_set_encoding(&b.parser, YAML_UTF8_ENCODING);
+	rc = build_stream(&b);
+	if (!rc && b.err)
+		rc = b.err;
+	yaml_parser_delete(&b.parser);
+	free(b.anchors);
+	if (rc) {
+		px_config_doc_free(b.doc);
+		return rc;
+	}
+	*out = b.doc;
+	return PX_OK;
+}
+
+int px_config_doc_load_file(const char *path, struct px_config_doc **out,
+			    struct px_config_diag *diag)
+{
+	FILE *f;
+	unsigned char *data = NULL;
+	size_t len = 0, cap = 0;
+	int rc;
+	px_config_diag_init(diag);
+	if (out)
+		*out = NULL;
+	if (!path || !out) {
+		px__cfg_diag_add(diag, path, 0, 0, "",
+				 "invalid arguments to the loader");
+		return PX_E_INVAL;
+	}
+	f = fopen(path, "rb");
+	if (!f) {
+		int e = errno;
+		px__cfg_diag_add(diag, path, 0, 0, "", "cannot open: %s",
+				 strerror(e));
+		return e == ENOMEM ? PX_E_NOMEM : PX_E_IO;
+	}
+	for (;;) {
+		size_t got;
+		if (len == cap) {
+			unsigned char *p;
+			if (cap >= MAX_FILE_BYTES) {
+				px__cfg_diag_add(diag, path, 0, 0, "",
+						 "larger than %u MiB; not a "
+						 "config file?",
+						 MAX_FILE_BYTES >> 20);
+				free(data);
+				fclose(f);
+				return PX_E_PARSE;
+			}
+			cap = cap ? cap * 2 : 8192;
+			p = realloc(data, cap);
+			if (!p) {
+				px__cfg_diag_add(diag, path, 0, 0, "",
+						 "out of memory while reading");
+				free(data);
+				fclose(f);
+				return PX_E_NOMEM;
+			}
+			data = p;
+		}
+		got = fread(data + len, 1, cap - len, f);
+		len += got;
+		if (got == 0) {
+			if (ferror(f)) {
+				int e = errno;
+				px__cfg_diag_add(diag, path, 0, 0, "",
+						 "cannot read: %s",
+						 strerror(e));
+				free(data);
+				fclose(f);
+				return PX_E_IO;
+			}
+			break;
+		}
+	}
+	fclose(f);
+	rc = px_config_doc_load_mem(path, data, len, out, diag);
+	free(data);
+	return rc;
+}
