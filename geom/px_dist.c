@@ -661,7 +661,7 @@ static int add_surface(struct builder *bl, const struct px_nurbs_surf *s,
 							     src[2] / src[3]));
 				}
 			ext = px_aabb_diagonal(&t->pc.box);
-			t->pc.ns = len > 0.0 ? clamp_count(ext / (so.sample_tol * len) + 1.0, 2, 12) : 2;
+			t->pc.ns = len > 0.0 ? clamp_count(ext / (so.sample_tol * len) + 1.0, 2, 4) : 2;
 			t->pc.nt = t->pc.ns;
 			bl->n_samples += (long)t->pc.ns * t->pc.nt;
 		}
@@ -1327,10 +1327,21 @@ int px_dist_query(struct px_dist_model *m, px_vec3 p, struct px_dist_result *r)
 	/* Exact solve of every piece that may still hold something closer,
 	 * nearest lower bound first. */
 	sort_cand(m->cand, q.n_cand);
+	/* The piece holding the best sample goes first: its solve usually
+	 * lands on the global minimum, after which most other candidates
+	 * fall to their first bound. */
+	for (i = 0; i < q.n_cand; i++)
+		if (m->cand[i].piece == q.best_piece) {
+			struct cand t = m->cand[i];
+			memmove(&m->cand[1], &m->cand[0], (size_t)i * sizeof(t));
+			m->cand[0] = t;
+			break;
+		}
 	for (i = 0; i < q.n_cand; i++) {
 		const struct cand *cd = &m->cand[i];
 		const struct piece *pc = &m->pieces[cd->piece];
-		if (cd->lb >= best)
+		/* Past the first, the list is sorted by lower bound. */
+		if (i > 0 && cd->lb >= best)
 			break;
 		r->pieces_solved++;
 		if (pc->kind == PK_CURVE) {
@@ -1356,7 +1367,15 @@ int px_dist_query(struct px_dist_model *m, px_vec3 p, struct px_dist_result *r)
 			}
 		} else {
 			struct px_spiece_hit hit;
-			if (px_spiece_closest(&m->spc[pc->idx], p, &best, &hit)) {
+			double hs = NAN, ht = NAN;
+			if (cd->piece == q.best_piece) {
+				/* Newton starts at the best pre-sample. */
+				int ks = q.best_sample - pc->sample_start;
+				hs = (double)(ks / pc->nt) / (pc->ns - 1);
+				ht = (double)(ks % pc->nt) / (pc->nt - 1);
+			}
+			if (px_spiece_closest_hint(&m->spc[pc->idx], p, hs, ht, &best,
+						   &hit)) {
 				r->point = hit.point;
 				r->piece = cd->piece;
 				r->u = hit.u;

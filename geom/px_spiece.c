@@ -31,31 +31,46 @@ size_t px_spiece_doubles(int p, int q)
 
 /* ---- tensor Bernstein helpers (row i along s, column j along t) ---------- */
 
-/* c (na, ma) times d (nb, mb) into out (na + nb, ma + mb). */
+static void binom_row(int n, double *row)
+{
+	int i;
+	for (i = 0; i <= n; i++)
+		row[i] = px_bern_binom(n, i);
+}
+
+/* a (na, ma) times b (nb, mb) into out (na + nb, ma + mb). */
 static void t_mul(const double *a, int na, int ma, const double *b, int nb,
 		  int mb, double *out)
 {
+	double ba[3 * MD + 2], bma[3 * MD + 2], bb[3 * MD + 2], bmb[3 * MD + 2];
+	double bn[3 * MD + 2], bm[3 * MD + 2];
 	int n = na + nb, m = ma + mb, i, j, k, l;
+
+	binom_row(na, ba);
+	binom_row(ma, bma);
+	binom_row(nb, bb);
+	binom_row(mb, bmb);
+	binom_row(n, bn);
+	binom_row(m, bm);
 	for (i = 0; i <= n; i++)
 		for (j = 0; j <= m; j++)
 			out[i * (m + 1) + j] = 0.0;
 	for (i = 0; i <= na; i++)
 		for (j = 0; j <= ma; j++) {
-			double av = a[i * (ma + 1) + j] * px_bern_binom(na, i) *
-				    px_bern_binom(ma, j);
+			double av = a[i * (ma + 1) + j] * ba[i] * bma[j];
 			if (av == 0.0)
 				continue;
-			for (k = 0; k <= nb; k++)
+			for (k = 0; k <= nb; k++) {
+				double avk = av * bb[k];
+				double *o = out + (i + k) * (m + 1) + j;
+				const double *br = b + k * (mb + 1);
 				for (l = 0; l <= mb; l++)
-					out[(i + k) * (m + 1) + j + l] +=
-						av * b[k * (mb + 1) + l] *
-						px_bern_binom(nb, k) *
-						px_bern_binom(mb, l);
+					o[l] += avk * br[l] * bmb[l];
+			}
 		}
 	for (i = 0; i <= n; i++)
 		for (j = 0; j <= m; j++)
-			out[i * (m + 1) + j] /=
-				px_bern_binom(n, i) * px_bern_binom(m, j);
+			out[i * (m + 1) + j] /= bn[i] * bm[j];
 }
 
 /* Derivative along s (degree n - 1, m) or along t (n, m - 1). */
@@ -86,6 +101,7 @@ static void t_restrict(const double *c, int n, int m, double s0, double s1,
 
 	if (out != c)
 		memcpy(out, c, tsize(n, m) * sizeof(double));
+	/* Restrict along s first, then along t; each only if needed. */
 	if (s0 > 0.0 || s1 < 1.0)
 		for (j = 0; j <= m; j++) {
 			for (i = 0; i <= n; i++)
@@ -224,37 +240,70 @@ int px_spiece_init(struct px_spiece *sp, int p, int q, const double (*hw)[4],
 
 /* ---- evaluation --------------------------------------------------------------- */
 
-#define NB (3 * MD + 1)
+/* Raise Bernstein basis values of degree k - 1 to degree k in place. */
+static inline void raise(double *b, int k, double t, double u)
+{
+	int i;
+	b[k] = t * b[k - 1];
+	for (i = k - 1; i > 0; i--)
+		b[i] = u * b[i] + t * b[i - 1];
+	b[0] = u * b[0];
+}
 
-/* Bernstein basis of degree n (<= 3 MD) at t with first and second
- * derivatives. */
+/* Bernstein basis of degree n (<= MD) at t, with first and second
+ * derivatives when b1 / b2 are not NULL (both need n >= 1). */
 static void basis(int n, double t, double *b0, double *b1, double *b2)
 {
-	double tri[NB][NB];
+	double lo[MD + 1], u = 1.0 - t;
 	int k, i;
 
-	tri[0][0] = 1.0;
-	for (k = 1; k <= n; k++) {
-		tri[k][0] = (1.0 - t) * tri[k - 1][0];
-		for (i = 1; i < k; i++)
-			tri[k][i] = (1.0 - t) * tri[k - 1][i] + t * tri[k - 1][i - 1];
-		tri[k][k] = t * tri[k - 1][k - 1];
+	b0[0] = 1.0;
+	if (!b1 && !b2) {
+		for (k = 1; k <= n; k++)
+			raise(b0, k, t, u);
+		return;
 	}
-	for (i = 0; i <= n; i++) {
-		double lo1 = n >= 1 ? (i >= 1 ? tri[n - 1][i - 1] : 0.0) -
-					      (i <= n - 1 ? tri[n - 1][i] : 0.0)
-				    : 0.0;
-		b0[i] = tri[n][i];
-		b1[i] = n * lo1;
-		if (n >= 2) {
-			double a = i >= 2 ? tri[n - 2][i - 2] : 0.0;
-			double b = (i >= 1 && i - 1 <= n - 2) ? tri[n - 2][i - 1] : 0.0;
-			double c = i <= n - 2 ? tri[n - 2][i] : 0.0;
-			b2[i] = n * (n - 1) * (a - 2.0 * b + c);
-		} else {
-			b2[i] = 0.0;
+	for (k = 1; k <= n - 2; k++)
+		raise(b0, k, t, u);
+	if (b2) {
+		/* Degree n - 2 values give the second derivative. */
+		for (i = 0; i <= n; i++) {
+			double a = (n >= 2 && i >= 2) ? b0[i - 2] : 0.0;
+			double m = (n >= 2 && i >= 1 && i - 1 <= n - 2) ? b0[i - 1] : 0.0;
+			double c = (n >= 2 && i <= n - 2) ? b0[i] : 0.0;
+			b2[i] = n * (n - 1) * (a - 2.0 * m + c);
 		}
 	}
+	if (n >= 2)
+		raise(b0, n - 1, t, u);
+	for (i = 0; i < n; i++)
+		lo[i] = b0[i];
+	raise(b0, n, t, u);
+	if (b1)
+		for (i = 0; i <= n; i++)
+			b1[i] = n * ((i >= 1 ? lo[i - 1] : 0.0) - (i < n ? lo[i] : 0.0));
+}
+
+/* Point only: the hot path of sampling and candidate checks. */
+static px_vec3 spiece_point(const struct px_spiece *sp, double s, double t)
+{
+	double bs[MD + 1], bt[MD + 1], acc[4] = {0, 0, 0, 0};
+	int p = sp->p_, q = sp->q_, i, j;
+	size_t np = tsize(p, q);
+	const double *h = sp->h_;
+
+	basis(p, s, bs, NULL, NULL);
+	basis(q, t, bt, NULL, NULL);
+	for (i = 0; i <= p; i++)
+		for (j = 0; j <= q; j++) {
+			size_t k = (size_t)i * (q + 1) + j;
+			double w = bs[i] * bt[j];
+			acc[0] += w * h[k];
+			acc[1] += w * h[np + k];
+			acc[2] += w * h[2 * np + k];
+			acc[3] += w * h[3 * np + k];
+		}
+	return px_v3(acc[0] / acc[3], acc[1] / acc[3], acc[2] / acc[3]);
 }
 
 px_vec3 px_spiece_eval(const struct px_spiece *sp, double s, double t,
@@ -264,26 +313,31 @@ px_vec3 px_spiece_eval(const struct px_spiece *sp, double s, double t,
 	double bs[3][MD + 1], bt[3][MD + 1];
 	/* d[a][b][c]: derivative a in s, b in t of homogeneous component c */
 	double d[3][3][4];
-	int p = sp->p_, q = sp->q_, i, j, c, a, b;
+	int p = sp->p_, q = sp->q_, i, j, c;
 	size_t np = tsize(p, q);
 	double ks = 1.0 / (sp->u1_ - sp->u0_), kt = 1.0 / (sp->v1_ - sp->v0_);
 	px_vec3 S;
 
+	if (!su && !sv && !suu && !suv && !svv)
+		return spiece_point(sp, s, t);
 	basis(p, s, bs[0], bs[1], bs[2]);
 	basis(q, t, bt[0], bt[1], bt[2]);
 	memset(d, 0, sizeof(d));
-	for (c = 0; c < 4; c++)
-		for (i = 0; i <= p; i++) {
-			double row[3] = {0, 0, 0};
-			for (j = 0; j <= q; j++) {
-				double h = sp->h_[c * np + (size_t)i * (q + 1) + j];
-				row[0] += bt[0][j] * h;
-				row[1] += bt[1][j] * h;
-				row[2] += bt[2][j] * h;
+	for (i = 0; i <= p; i++)
+		for (j = 0; j <= q; j++) {
+			size_t k = (size_t)i * (q + 1) + j;
+			double w00 = bs[0][i] * bt[0][j], w10 = bs[1][i] * bt[0][j];
+			double w01 = bs[0][i] * bt[1][j], w20 = bs[2][i] * bt[0][j];
+			double w11 = bs[1][i] * bt[1][j], w02 = bs[0][i] * bt[2][j];
+			for (c = 0; c < 4; c++) {
+				double h = sp->h_[c * np + k];
+				d[0][0][c] += w00 * h;
+				d[1][0][c] += w10 * h;
+				d[0][1][c] += w01 * h;
+				d[2][0][c] += w20 * h;
+				d[1][1][c] += w11 * h;
+				d[0][2][c] += w02 * h;
 			}
-			for (a = 0; a < 3; a++)
-				for (b = 0; a + b < 3; b++)
-					d[a][b][c] += bs[a][i] * row[b];
 		}
 	{
 		/* Quotient rule for S = H / w up to second order. */
@@ -325,6 +379,7 @@ struct rect {
 struct qctx {
 	const struct px_spiece *sp;
 	px_vec3 p;
+	double hint_s, hint_t; /* Newton start, or NaN */
 	double best, slack;
 	struct px_spiece_hit *hit;
 	int improved;
@@ -332,7 +387,7 @@ struct qctx {
 
 static void consider(struct qctx *x, double s, double t)
 {
-	px_vec3 q = px_spiece_eval(x->sp, s, t, NULL, NULL, NULL, NULL, NULL);
+	px_vec3 q = spiece_point(x->sp, s, t);
 	double d2 = px_v3_dist2(q, x->p);
 	if (d2 < x->best) {
 		x->best = d2;
@@ -344,101 +399,149 @@ static void consider(struct qctx *x, double s, double t)
 	}
 }
 
-/* Value and partial derivatives of a tensor polynomial at (s, t). */
-static void t_eval(const double *c, int n, int m, const double *bs0,
-		   const double *bs1, const double *bt0, const double *bt1,
-		   double *v, double *vs, double *vt)
-{
-	int i, j;
-	*v = *vs = *vt = 0.0;
-	for (i = 0; i <= n; i++) {
-		double r0 = 0.0, r1 = 0.0;
-		for (j = 0; j <= m; j++) {
-			r0 += bt0[j] * c[i * (m + 1) + j];
-			r1 += bt1[j] * c[i * (m + 1) + j];
-		}
-		*v += bs0[i] * r0;
-		*vs += bs1[i] * r0;
-		*vt += bs0[i] * r1;
-	}
-}
-
-struct gsys {
-	const double *gu, *gv;
-	int un, um, vn, vm;
-};
-
-static void g_eval(const struct gsys *g, double s, double t, double G[2],
-		   double J[2][2])
-{
-	double bs0[NB], bs1[NB], bs2[NB], bt0[NB], bt1[NB], bt2[NB];
-	basis(g->un, s, bs0, bs1, bs2);
-	basis(g->um, t, bt0, bt1, bt2);
-	t_eval(g->gu, g->un, g->um, bs0, bs1, bt0, bt1, &G[0], &J[0][0], &J[0][1]);
-	basis(g->vn, s, bs0, bs1, bs2);
-	basis(g->vm, t, bt0, bt1, bt2);
-	t_eval(g->gv, g->vn, g->vm, bs0, bs1, bt0, bt1, &G[1], &J[1][0], &J[1][1]);
-}
-
 /*
- * Zero of G = (gu, gv) inside the rectangle, where the caller proved
- * that G is strictly monotone (so there is at most one, and its Jacobian
- * is never singular): Newton steps with backtracking on |G|^2, each
- * clipped to the rectangle. Returns 1 with the zero when it converges
- * strictly inside; 0 otherwise (no zero here, or not yet reached: the
- * caller subdivides).
+ * The minimum of f inside a rectangle where the caller proved that there
+ * is at most one critical point, and that it is a minimum: Newton on
+ * grad f (gradient descent where the Hessian is not positive definite),
+ * with backtracking on f, every step clipped to the rectangle. Returns 1
+ * with the point when it converges to a vanishing gradient strictly
+ * inside; 0 otherwise (the minimum is not here, or not reached yet: the
+ * caller subdivides, so giving up is always safe).
  */
-static int newton_g(const struct gsys *g, const struct rect *r, int *iters,
+static int newton_f(struct qctx *x, const struct rect *r, int *iters,
 		    double *s_out, double *t_out)
 {
+	const struct px_spiece *sp = x->sp;
 	double s = 0.5 * (r->s0 + r->s1), t = 0.5 * (r->t0 + r->t1);
-	double G[2], J[2][2], n2;
+	double ks = sp->u1_ - sp->u0_, kt = sp->v1_ - sp->v0_;
+	double wmax = fmax(r->s1 - r->s0, r->t1 - r->t0), fcur;
 	int it;
 
-	g_eval(g, s, t, G, J);
-	n2 = G[0] * G[0] + G[1] * G[1];
+	if (x->hint_s >= r->s0 && x->hint_s <= r->s1 && x->hint_t >= r->t0 &&
+	    x->hint_t <= r->t1) {
+		s = x->hint_s;
+		t = x->hint_t;
+	}
+	fcur = px_v3_dist2(spiece_point(sp, s, t), x->p);
 	for (it = 0; it < PX_SPIECE_MAX_ITERS; it++) {
-		double det = J[0][0] * J[1][1] - J[0][1] * J[1][0], ds, dt, a;
+		px_vec3 su, sv, suu, suv, svv, d, S;
+		double gs, gt, a, b, c, det, ds, dt, al;
 		int k;
 
 		(*iters)++;
-		if (n2 == 0.0)
+		S = px_spiece_eval(sp, s, t, &su, &sv, &suu, &suv, &svv);
+		/* Derivatives with respect to the local (s, t). */
+		su = px_v3_scale(su, ks);
+		sv = px_v3_scale(sv, kt);
+		suu = px_v3_scale(suu, ks * ks);
+		suv = px_v3_scale(suv, ks * kt);
+		svv = px_v3_scale(svv, kt * kt);
+		d = px_v3_sub(S, x->p);
+		gs = px_v3_dot(d, su);
+		gt = px_v3_dot(d, sv);
+		a = px_v3_dot(su, su) + px_v3_dot(d, suu);
+		b = px_v3_dot(su, sv) + px_v3_dot(d, suv);
+		c = px_v3_dot(sv, sv) + px_v3_dot(d, svv);
+		det = a * c - b * b;
+		if (gs == 0.0 && gt == 0.0)
 			break;
-		if (det == 0.0)
-			return 0;
-		ds = -(J[1][1] * G[0] - J[0][1] * G[1]) / det;
-		dt = -(J[0][0] * G[1] - J[1][0] * G[0]) / det;
-		for (a = 1.0, k = 0; k < 30; k++, a *= 0.5) {
-			double ns = fmin(r->s1, fmax(r->s0, s + a * ds));
-			double nt = fmin(r->t1, fmax(r->t0, t + a * dt));
-			double NG[2], NJ[2][2], nn2;
-			g_eval(g, ns, nt, NG, NJ);
-			nn2 = NG[0] * NG[0] + NG[1] * NG[1];
-			if (nn2 < n2 || (fabs(ns - s) <= 1e-15 && fabs(nt - t) <= 1e-15)) {
-				double moved = fmax(fabs(ns - s), fabs(nt - t));
+		if (a > 0.0 && det > 0.0) {
+			ds = -(c * gs - b * gt) / det;
+			dt = -(a * gt - b * gs) / det;
+		} else {
+			double g = sqrt(gs * gs + gt * gt);
+			ds = -gs / g * wmax;
+			dt = -gt / g * wmax;
+		}
+		for (al = 1.0, k = 0; k < 40; k++, al *= 0.5) {
+			double ns = fmin(r->s1, fmax(r->s0, s + al * ds));
+			double nt = fmin(r->t1, fmax(r->t0, t + al * dt));
+			double fn = px_v3_dist2(spiece_point(sp, ns, nt), x->p);
+			double moved = fmax(fabs(ns - s), fabs(nt - t));
+			if (fn <= fcur || moved <= 1e-15) {
 				s = ns;
 				t = nt;
-				G[0] = NG[0];
-				G[1] = NG[1];
-				memcpy(J, NJ, sizeof(J));
-				n2 = nn2;
+				fcur = fn < fcur ? fn : fcur;
 				if (moved <= 1e-13)
 					goto done;
 				break;
 			}
 		}
-		if (k == 30)
-			return 0; /* no decrease possible: stalled on the border */
+		if (k == 40)
+			goto done;
 	}
 done:
-	/* A zero clipped onto the border is not this rectangle's. */
-	if (s <= r->s0 || s >= r->s1 || t <= r->t0 || t >= r->t1) {
-		if (!((s == 0.0 || s == 1.0 || t == 0.0 || t == 1.0) && n2 == 0.0))
-			return 0;
-	}
+	if (it >= PX_SPIECE_MAX_ITERS)
+		return 0;
+	/* Converged onto the rectangle's border: the minimum of this
+	 * rectangle, not a critical point of the patch (unless the border
+	 * is the patch's own, where boundary curves take over anyway). */
+	if (s <= r->s0 || s >= r->s1 || t <= r->t0 || t >= r->t1)
+		return 0;
 	*s_out = s;
 	*t_out = t;
-	return it < PX_SPIECE_MAX_ITERS;
+	return 1;
+}
+
+/* Split a tensor at s = 1/2 (rows) or t = 1/2 (columns). */
+static void t_half_s(const double *c, int n, int m, double *lo, double *hi)
+{
+	double col[3 * MD + 2], l[3 * MD + 2], h[3 * MD + 2];
+	int i, j;
+	for (j = 0; j <= m; j++) {
+		for (i = 0; i <= n; i++)
+			col[i] = c[i * (m + 1) + j];
+		px_bern_split(col, n, 0.5, l, h);
+		for (i = 0; i <= n; i++) {
+			lo[i * (m + 1) + j] = l[i];
+			hi[i * (m + 1) + j] = h[i];
+		}
+	}
+}
+
+static void t_half_t(const double *c, int n, int m, double *lo, double *hi)
+{
+	int i;
+	for (i = 0; i <= n; i++)
+		px_bern_split(c + i * (m + 1), m, 0.5, lo + i * (m + 1),
+			      hi + i * (m + 1));
+}
+
+static double ratio_min(const double *f, const double *w, size_t k)
+{
+	double lb = INFINITY;
+	size_t i;
+	for (i = 0; i < k; i++) {
+		double q = f[i] / w[i];
+		lb = q < lb ? q : lb;
+	}
+	return lb;
+}
+
+/*
+ * Lower bounds of the four quarters of r (order: s low/t low, s high/t
+ * low, s low/t high, s high/t high): restrict F and W to r once, then
+ * halve in s and in t, instead of restricting each quarter from scratch.
+ */
+static void children_lb(const double *F, const double *W, int fn, int fm,
+			const struct rect *r, struct rect ch[4])
+{
+	double pf[TMAX], pw[TMAX], fl[TMAX], fh[TMAX], wl[TMAX], wh[TMAX];
+	double a[TMAX], b[TMAX], c[TMAX], d[TMAX];
+	size_t k = tsize(fn, fm);
+
+	t_restrict(F, fn, fm, r->s0, r->s1, r->t0, r->t1, pf);
+	t_restrict(W, fn, fm, r->s0, r->s1, r->t0, r->t1, pw);
+	t_half_s(pf, fn, fm, fl, fh);
+	t_half_s(pw, fn, fm, wl, wh);
+	t_half_t(fl, fn, fm, a, b);
+	t_half_t(wl, fn, fm, c, d);
+	ch[0].lb = ratio_min(a, c, k);
+	ch[2].lb = ratio_min(b, d, k);
+	t_half_t(fh, fn, fm, a, b);
+	t_half_t(wh, fn, fm, c, d);
+	ch[1].lb = ratio_min(a, c, k);
+	ch[3].lb = ratio_min(b, d, k);
 }
 
 /* Min-heap of rectangles by lower bound: nearest first, so the best
@@ -493,6 +596,13 @@ static double rect_lb(const double *F, const double *W, int fn, int fm,
 int px_spiece_closest(const struct px_spiece *sp, px_vec3 p, double *best_d2,
 		      struct px_spiece_hit *hit)
 {
+	return px_spiece_closest_hint(sp, p, NAN, NAN, best_d2, hit);
+}
+
+int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
+			   double hint_s, double hint_t, double *best_d2,
+			   struct px_spiece_hit *hit)
+{
 	const int P = sp->p_, Q = sp->q_;
 	const int fn = nf_s(P), fm = nf_s(Q);
 	const int un = ngu_s(P), um = ngu_t(Q), vn = ngv_s(P), vm = ngv_t(Q);
@@ -502,14 +612,15 @@ int px_spiece_closest(const struct px_spiece *sp, px_vec3 p, double *best_d2,
 	/* Each split replaces one rectangle by four: the heap never holds
 	 * more than 3 * nodes + 1. */
 	struct rect heap[3 * PX_SPIECE_MAX_NODES + 4];
-	struct gsys gs;
 	struct qctx x;
 	double pp = px_v3_dot(p, p), lb_unresolved = INFINITY;
-	int hn = 0, k;
+	int hn = 0, k, have_gu = 0, have_gv = 0;
 	size_t i;
 
 	x.sp = sp;
 	x.p = p;
+	x.hint_s = hint_s;
+	x.hint_t = hint_t;
 	x.best = *best_d2;
 	x.hit = hit;
 	x.improved = 0;
@@ -538,18 +649,8 @@ int px_spiece_closest(const struct px_spiece *sp, px_vec3 p, double *best_d2,
 			goto out;
 		heap_push(heap, &hn, root);
 	}
-	for (i = 0; i < ngu; i++)
-		GU[i] = sp->gua_[i] - (p.x * sp->gub_[i] + p.y * sp->gub_[ngu + i] +
-				       p.z * sp->gub_[2 * ngu + i]);
-	for (i = 0; i < ngv; i++)
-		GV[i] = sp->gva_[i] - (p.x * sp->gvb_[i] + p.y * sp->gvb_[ngv + i] +
-				       p.z * sp->gvb_[2 * ngv + i]);
-	gs.gu = GU;
-	gs.gv = GV;
-	gs.un = un;
-	gs.um = um;
-	gs.vn = vn;
-	gs.vm = vm;
+	/* gu and gv are formed on first use: most candidate patches are
+	 * settled by the bound or by gu's sign alone. */
 	/* An upper bound before subdividing: without one, a patch whose
 	 * every point is equally near (a sphere seen from its centre) could
 	 * not be settled by the F / W bound. */
@@ -562,9 +663,23 @@ int px_spiece_closest(const struct px_spiece *sp, px_vec3 p, double *best_d2,
 		if (r.lb >= x.best - x.slack)
 			continue; /* the best dropped since it was queued */
 		hit->nodes++;
+		if (!have_gu) {
+			for (i = 0; i < ngu; i++)
+				GU[i] = sp->gua_[i] -
+					(p.x * sp->gub_[i] + p.y * sp->gub_[ngu + i] +
+					 p.z * sp->gub_[2 * ngu + i]);
+			have_gu = 1;
+		}
 		t_restrict(GU, un, um, r.s0, r.s1, r.t0, r.t1, rg);
 		if (strict_sign(rg, ngu))
 			continue; /* df/ds never vanishes here */
+		if (!have_gv) {
+			for (i = 0; i < ngv; i++)
+				GV[i] = sp->gva_[i] -
+					(p.x * sp->gvb_[i] + p.y * sp->gvb_[ngv + i] +
+					 p.z * sp->gvb_[2 * ngv + i]);
+			have_gv = 1;
+		}
 		t_restrict(GV, vn, vm, r.s0, r.s1, r.t0, r.t1, rv);
 		if (strict_sign(rv, ngv))
 			continue; /* df/dt never vanishes here */
@@ -596,7 +711,7 @@ int px_spiece_closest(const struct px_spiece *sp, px_vec3 p, double *best_d2,
 		}
 		if (certain) {
 			double s, t;
-			if (newton_g(&gs, &r, &hit->iters, &s, &t)) {
+			if (newton_f(&x, &r, &hit->iters, &s, &t)) {
 				consider(&x, s, t);
 				continue;
 			}
@@ -614,11 +729,10 @@ int px_spiece_closest(const struct px_spiece *sp, px_vec3 p, double *best_d2,
 					     {sm, r.s1, r.t0, tm, 0.0, r.depth + 1},
 					     {r.s0, sm, tm, r.t1, 0.0, r.depth + 1},
 					     {sm, r.s1, tm, r.t1, 0.0, r.depth + 1}};
-			for (k = 0; k < 4; k++) {
-				ch[k].lb = rect_lb(F, sp->fw_, fn, fm, &ch[k], rf, rw);
+			children_lb(F, sp->fw_, fn, fm, &r, ch);
+			for (k = 0; k < 4; k++)
 				if (ch[k].lb < x.best - x.slack)
 					heap_push(heap, &hn, ch[k]);
-			}
 		}
 	}
 	/* What the node bound left queued bounds what may have been missed. */

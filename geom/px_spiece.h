@@ -105,6 +105,14 @@ PX_API px_vec3 px_spiece_eval(const struct px_spiece *sp, double s, double t,
 PX_API int px_spiece_closest(const struct px_spiece *sp, px_vec3 p,
 			     double *best_d2, struct px_spiece_hit *hit);
 
+/* As px_spiece_closest(), with a guess (s, t) in local coordinates (for
+ * example the nearest pre-sample) that Newton starts from when it lies in
+ * the rectangle being solved. The guess changes speed, never the answer.
+ * @note RT-safe. */
+PX_API int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
+				  double hint_s, double hint_t,
+				  double *best_d2, struct px_spiece_hit *hit);
+
 #ifdef __cplusplus
 }
 #endif
