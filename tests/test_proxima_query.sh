@@ -1,0 +1,97 @@
+#!/bin/sh
+# proxima-query's contract (issue: distance core): output format, exact
+# distances on models with known geometry, header handling, and clear
+# errors with their place. Prints a harness-style summary line.
+set -u
+name=test_proxima_query
+bin="${BUILD:-build}/bin/proxima-query"
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+pass=0 fail=0
+ok() { echo "ok   $1"; pass=$((pass + 1)); }
+bad() { echo "FAIL $1"; sed 's/^/    /' "$tmp/out" "$tmp/err" 2>/dev/null | head -20; fail=$((fail + 1)); }
+expect() { # DESCRIPTION STATUS COMMAND...
+	d=$1 want=$2; shift 2
+	"$@" >"$tmp/out" 2>"$tmp/err"
+	got=$?
+	if [ "$got" -eq "$want" ]; then ok "$d (exit $got)"; else
+		echo "    exit status $got, expected $want"; bad "$d"; fi
+}
+err_has() { # DESCRIPTION EXTENDED-REGEX on stderr
+	if grep -qE -- "$2" "$tmp/err"; then ok "$1"; else
+		echo "    stderr lacks /$2/"; bad "$1"; fi
+}
+
+# Query points: a deterministic spread, including the centres (every
+# point of a circle or sphere is then a foot point), far points and
+# points exactly on the models.
+awk 'BEGIN { s = 12345; print "x,y,z";
+	for (i = 0; i < 300; i++) {
+		s = (s * 1103515245 + 12345) % 2147483648; x = s / 2147483648 * 12 - 5;
+		s = (s * 1103515245 + 12345) % 2147483648; y = s / 2147483648 * 12 - 7;
+		s = (s * 1103515245 + 12345) % 2147483648; z = s / 2147483648 * 6 - 3;
+		printf "%.17g,%.17g,%.17g\n", x, y, z }
+	print "1,-1,0.5"; print "0,0,0"; print "300,200,-100"; print "3,-1,0.5" }' >"$tmp/pts.csv"
+
+# Circle: radius 2, centre (1, -1, 0.5) in the plane z = 0.5.
+expect "circle model" 0 "$bin" tests/data/circle.obj "$tmp/pts.csv"
+if [ "$(wc -l <"$tmp/out")" -eq 304 ]; then ok "one output line per point (header skipped)"; else bad "one output line per point"; fi
+if awk -F, 'NF != 6 { exit 1 } $6 != 0 { exit 1 }' "$tmp/out"; then ok "six fields, v = 0 for curves"; else bad "six fields, v = 0 for curves"; fi
+tail -n +2 "$tmp/pts.csv" | paste -d, - "$tmp/out" >"$tmp/joined"
+if awk -F, 'function abs(a) { return a < 0 ? -a : a }
+	{ rho = sqrt(($1 - 1)^2 + ($2 + 1)^2); want = sqrt((rho - 2)^2 + ($3 - 0.5)^2);
+	  if (abs($4 - want) > 1e-9) { print "point " NR ": " $4 " vs " want; bad = 1 }
+	  # the reported point is on the circle and at the reported distance
+	  if (abs(sqrt(($5 - 1)^2 + ($6 + 1)^2) - 2) > 1e-9 || abs($7 - 0.5) > 1e-12) { print "point " NR " off the circle"; bad = 1 }
+	  d = sqrt(($1 - $5)^2 + ($2 - $6)^2 + ($3 - $7)^2); if (abs(d - $4) > 1e-9) { print "point " NR ": dist mismatch"; bad = 1 } }
+	END { exit bad }' "$tmp/joined" >"$tmp/err"; then ok "circle distances exact (1e-9)"; else bad "circle distances exact"; fi
+# %.17g: irrational distances show 16-17 significant digits.
+if grep -qE '^[0-9]\.[0-9]{15,16}(e[+-][0-9]+)?,' "$tmp/out"; then ok "numbers printed with %.17g"; else bad "numbers printed with %.17g"; fi
+
+# Sphere: radius 1.5 about the origin.
+expect "sphere model" 0 "$bin" tests/data/sphere.obj "$tmp/pts.csv"
+tail -n +2 "$tmp/pts.csv" | paste -d, - "$tmp/out" >"$tmp/joined"
+if awk -F, 'function abs(a) { return a < 0 ? -a : a }
+	{ r = sqrt($1^2 + $2^2 + $3^2); want = abs(r - 1.5);
+	  if (abs($4 - want) > 1e-9) { print "point " NR ": " $4 " vs " want; bad = 1 }
+	  if (abs(sqrt($5^2 + $6^2 + $7^2) - 1.5) > 1e-9) { print "point " NR " off the sphere"; bad = 1 } }
+	END { exit bad }' "$tmp/joined" >"$tmp/err"; then ok "sphere distances exact (1e-9)"; else bad "sphere distances exact"; fi
+
+# Bicubic: S(u, v) = (u, v, u^2 + v/2); the parameters of the answer
+# reproduce its point.
+expect "bicubic model" 0 "$bin" tests/data/bicubic.obj "$tmp/pts.csv"
+if awk -F, 'function abs(a) { return a < 0 ? -a : a }
+	{ if (abs($2 - $5) > 1e-9 || abs($3 - $6) > 1e-9 || abs($4 - ($5 * $5 + $6 / 2)) > 1e-9) { print "line " NR; bad = 1 }
+	  if ($5 < 0 || $5 > 1 || $6 < 0 || $6 > 1) { print "line " NR " outside the domain"; bad = 1 } }
+	END { exit bad }' "$tmp/out" >"$tmp/err"; then ok "bicubic points match their parameters"; else bad "bicubic points match their parameters"; fi
+
+# --stats goes to stderr with the documented fields.
+expect "--stats" 0 "$bin" --stats tests/data/circle.obj "$tmp/pts.csv"
+err_has "stats: setup time" '^setup_ms [0-9.]+$'
+err_has "stats: model memory" '^model_bytes [0-9]+$'
+err_has "stats: per-query ns" '^queries 304 query_ns min [0-9]+ median [0-9]+ p99 [0-9]+ max [0-9]+$'
+
+# Errors: clear message with the place, non-zero exit.
+expect "--track is refused, not ignored" 2 "$bin" --track tests/data/circle.obj "$tmp/pts.csv"
+err_has "--track says why" 'tracking is not available'
+printf '1,2,3\n4,nan,6\n' >"$tmp/nan.csv"
+expect "NaN point" 1 "$bin" tests/data/circle.obj "$tmp/nan.csv"
+err_has "NaN point: file:line" "nan.csv:2: field 2: not a finite number"
+printf '1,2\n' >"$tmp/short.csv"
+expect "two fields" 1 "$bin" tests/data/circle.obj "$tmp/short.csv"
+err_has "two fields: file:line" "short.csv:1: "
+expect "missing model" 1 "$bin" "$tmp/none.obj" "$tmp/pts.csv"
+err_has "missing model named" "none.obj"
+expect "missing points" 1 "$bin" tests/data/circle.obj "$tmp/none.csv"
+err_has "missing points named" "none.csv"
+printf 'v 0 0 0\nv 1 0 0\ncstype bspline\ndeg 3\ncurv 0 1 1 2\nparm u 0 0 0 0 1 1 1 1\nend\n' >"$tmp/bad.obj"
+expect "malformed OBJ" 1 "$bin" "$tmp/bad.obj" "$tmp/pts.csv"
+err_has "malformed OBJ: file:line:column" 'bad.obj:[0-9]+:[0-9]+: '
+printf 'solid x\nendsolid x\n' >"$tmp/m.stl"
+expect "mesh model not yet supported" 1 "$bin" "$tmp/m.stl" "$tmp/pts.csv"
+err_has "mesh model: says so" 'not supported'
+expect "unknown option" 2 "$bin" --frobnicate tests/data/circle.obj "$tmp/pts.csv"
+expect "missing arguments" 2 "$bin" tests/data/circle.obj
+
+echo "$name: $pass passed, $fail failed, 0 skipped"
+[ "$fail" -eq 0 ]

@@ -1,0 +1,325 @@
+/*
+ * proxima-query - global closest points from a file of query points to a
+ * model.
+ *
+ *   proxima-query [--track] [--stats] MODEL POINTS.csv
+ *
+ * MODEL: Wavefront OBJ with free-form curves and surfaces (all entities
+ * form one model). POINTS.csv: one "x,y,z" per line; a first line that
+ * starts with a letter is a header. Output, one line per point:
+ * "dist,cx,cy,cz,u,v" with %.17g (curves print v = 0). --stats writes
+ * setup time, model memory and per-query times to stderr.
+ */
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "px_dist.h"
+#include "px_obj.h"
+
+static const char *prog = "proxima-query";
+
+static void usage(FILE *f)
+{
+	fprintf(f, "usage: %s [--track] [--stats] MODEL POINTS.csv\n"
+		   "  MODEL       .obj with free-form curves/surfaces (cstype bspline)\n"
+		   "  POINTS.csv  one x,y,z per line (a first line starting with a\n"
+		   "              letter is a header)\n"
+		   "  --stats     setup time, model memory and per-query ns to stderr\n"
+		   "  --track     answer the points as one moving point by coherent\n"
+		   "              tracking (not available in this version)\n",
+		   prog);
+}
+
+static int64_t now_ns(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+
+static const char *ext_of(const char *path)
+{
+	const char *dot = strrchr(path, '.'), *slash = strrchr(path, '/');
+	if (!dot || (slash && dot < slash))
+		return "";
+	return dot + 1;
+}
+
+static int ieq(const char *a, const char *b)
+{
+	for (; *a && *b; a++, b++)
+		if (tolower((unsigned char)*a) != tolower((unsigned char)*b))
+			return 0;
+	return *a == *b;
+}
+
+struct points {
+	px_vec3 *p;
+	size_t n, cap;
+};
+
+/* Parse one number at *s up to a comma or the end of the field. */
+static int parse_num(const char **s, double *out)
+{
+	char *end;
+	while (**s == ' ' || **s == '\t')
+		(*s)++;
+	errno = 0;
+	*out = strtod(*s, &end);
+	if (end == *s || errno == ERANGE)
+		return -1;
+	*s = end;
+	while (**s == ' ' || **s == '\t')
+		(*s)++;
+	return 0;
+}
+
+static int read_points(const char *path, struct points *pts)
+{
+	FILE *f = fopen(path, "r");
+	char line[4096];
+	long lineno = 0;
+
+	if (!f) {
+		fprintf(stderr, "%s: %s: %s\n", prog, path, strerror(errno));
+		return -1;
+	}
+	while (fgets(line, sizeof(line), f)) {
+		const char *s = line;
+		double v[3];
+		size_t len = strlen(line);
+		int k;
+
+		lineno++;
+		if (len == sizeof(line) - 1 && line[len - 1] != '\n') {
+			fprintf(stderr, "%s: %s:%ld: line too long\n", prog, path, lineno);
+			fclose(f);
+			return -1;
+		}
+		while (*s == ' ' || *s == '\t')
+			s++;
+		if (*s == '\n' || *s == '\r' || *s == 0)
+			continue; /* blank line */
+		if (lineno == 1 && isalpha((unsigned char)*s) &&
+		    !ieq("nan", s) && strncmp(s, "nan", 3) && strncmp(s, "inf", 3))
+			continue; /* header */
+		for (k = 0; k < 3; k++) {
+			if (parse_num(&s, &v[k])) {
+				fprintf(stderr, "%s: %s:%ld: field %d: expected a number\n",
+					prog, path, lineno, k + 1);
+				fclose(f);
+				return -1;
+			}
+			if (!isfinite(v[k])) {
+				fprintf(stderr, "%s: %s:%ld: field %d: not a finite number\n",
+					prog, path, lineno, k + 1);
+				fclose(f);
+				return -1;
+			}
+			if (k < 2) {
+				if (*s != ',') {
+					fprintf(stderr, "%s: %s:%ld: expected 3 comma-separated "
+							"numbers x,y,z\n", prog, path, lineno);
+					fclose(f);
+					return -1;
+				}
+				s++;
+			}
+		}
+		if (*s && *s != '\n' && *s != '\r') {
+			fprintf(stderr, "%s: %s:%ld: unexpected text after z\n", prog,
+				path, lineno);
+			fclose(f);
+			return -1;
+		}
+		if (pts->n == pts->cap) {
+			size_t nc = pts->cap ? 2 * pts->cap : 1024;
+			px_vec3 *np = realloc(pts->p, nc * sizeof(*np));
+			if (!np) {
+				fprintf(stderr, "%s: out of memory\n", prog);
+				fclose(f);
+				return -1;
+			}
+			pts->p = np;
+			pts->cap = nc;
+		}
+		pts->p[pts->n++] = px_v3(v[0], v[1], v[2]);
+	}
+	if (ferror(f)) {
+		fprintf(stderr, "%s: %s: read error\n", prog, path);
+		fclose(f);
+		return -1;
+	}
+	fclose(f);
+	return 0;
+}
+
+static int cmp_i64(const void *a, const void *b)
+{
+	int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
+	return (x > y) - (x < y);
+}
+
+int main(int argc, char **argv)
+{
+	const char *model_path = NULL, *points_path = NULL;
+	int track = 0, stats = 0, i, rc, nc = 0, ns = 0;
+	struct px_obj_model *obj = NULL;
+	struct px_obj_error oerr;
+	struct px_nurbs_curve *curves = NULL;
+	struct px_nurbs_surf *surfs = NULL;
+	struct px_dist_model *m = NULL;
+	struct points pts = {0};
+	int64_t t_setup, *times = NULL;
+	const char *ext;
+
+	for (i = 1; i < argc; i++) {
+		if (!strcmp(argv[i], "--track"))
+			track = 1;
+		else if (!strcmp(argv[i], "--stats"))
+			stats = 1;
+		else if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
+			usage(stdout);
+			return 0;
+		} else if (argv[i][0] == '-' && argv[i][1]) {
+			fprintf(stderr, "%s: unknown option '%s'\n", prog, argv[i]);
+			usage(stderr);
+			return 2;
+		} else if (!model_path)
+			model_path = argv[i];
+		else if (!points_path)
+			points_path = argv[i];
+		else {
+			fprintf(stderr, "%s: unexpected argument '%s'\n", prog, argv[i]);
+			usage(stderr);
+			return 2;
+		}
+	}
+	if (!model_path || !points_path) {
+		usage(stderr);
+		return 2;
+	}
+	if (track) {
+		fprintf(stderr, "%s: --track: coherent tracking is not available in "
+				"this version; run without --track for independent "
+				"global queries\n", prog);
+		return 2;
+	}
+	ext = ext_of(model_path);
+	if (ieq(ext, "stl") || ieq(ext, "ply")) {
+		fprintf(stderr, "%s: %s: triangle-mesh and point-cloud models "
+				"(.%s) are not supported by this version\n",
+			prog, model_path, ext);
+		return 1;
+	}
+	if (!ieq(ext, "obj")) {
+		fprintf(stderr, "%s: %s: unknown model format '.%s' (expected .obj)\n",
+			prog, model_path, ext);
+		return 1;
+	}
+
+	t_setup = now_ns();
+	rc = px_obj_load_file(model_path, &obj, &oerr);
+	if (rc) {
+		if (oerr.line > 0)
+			fprintf(stderr, "%s: %s:%d:%d: %s\n", prog, oerr.file, oerr.line,
+				oerr.column, oerr.msg);
+		else
+			fprintf(stderr, "%s: %s: %s\n", prog, model_path,
+				oerr.msg[0] ? oerr.msg : px_strerror(rc));
+		return 1;
+	}
+	curves = calloc((size_t)obj->n_entities + 1, sizeof(*curves));
+	surfs = calloc((size_t)obj->n_entities + 1, sizeof(*surfs));
+	if (!curves || !surfs) {
+		fprintf(stderr, "%s: out of memory\n", prog);
+		rc = 1;
+		goto out;
+	}
+	for (i = 0; i < obj->n_entities; i++) {
+		if (obj->entities[i].kind == PX_OBJ_CURVE)
+			curves[nc++] = obj->entities[i].curve;
+		else
+			surfs[ns++] = obj->entities[i].surf;
+	}
+	if (nc + ns == 0) {
+		fprintf(stderr, "%s: %s: no free-form curve or surface in the file%s\n",
+			prog, model_path,
+			obj->n_triangles ? " (polygon faces are not supported by this "
+					   "version)" : "");
+		rc = 1;
+		goto out;
+	}
+	rc = px_dist_model_create(curves, nc, surfs, ns, NULL, &m);
+	if (rc) {
+		fprintf(stderr, "%s: %s: cannot prepare the model: %s\n", prog,
+			model_path, px_strerror(rc));
+		rc = 1;
+		goto out;
+	}
+	t_setup = now_ns() - t_setup;
+
+	if (read_points(points_path, &pts)) {
+		rc = 1;
+		goto out;
+	}
+	times = malloc((pts.n ? pts.n : 1) * sizeof(*times));
+	if (!times) {
+		fprintf(stderr, "%s: out of memory\n", prog);
+		rc = 1;
+		goto out;
+	}
+	for (size_t k = 0; k < pts.n; k++) {
+		struct px_dist_result r;
+		int64_t t0 = now_ns();
+		int qrc = px_dist_query(m, pts.p[k], &r);
+		times[k] = now_ns() - t0;
+		if (qrc) {
+			fprintf(stderr, "%s: %s: point %zu: %s\n", prog, points_path,
+				k + 1, px_strerror(qrc));
+			rc = 1;
+			goto out;
+		}
+		printf("%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", r.dist, r.point.x,
+		       r.point.y, r.point.z, r.u, r.v);
+	}
+	if (fflush(stdout) || ferror(stdout)) {
+		fprintf(stderr, "%s: write error on standard output\n", prog);
+		rc = 1;
+		goto out;
+	}
+	if (stats) {
+		struct px_dist_info info;
+		px_dist_model_info(m, &info);
+		fprintf(stderr, "setup_ms %.3f\n", t_setup / 1e6);
+		fprintf(stderr, "model_bytes %zu\n", info.bytes);
+		fprintf(stderr, "entities %d pieces %d (curve pieces %d, patches %d)\n",
+			info.n_entities, info.n_pieces, info.n_curve_pieces,
+			info.n_patches);
+		if (pts.n) {
+			qsort(times, pts.n, sizeof(*times), cmp_i64);
+			fprintf(stderr,
+				"queries %zu query_ns min %lld median %lld p99 %lld max %lld\n",
+				pts.n, (long long)times[0], (long long)times[pts.n / 2],
+				(long long)times[(pts.n * 99) / 100 < pts.n ? (pts.n * 99) / 100
+									  : pts.n - 1],
+				(long long)times[pts.n - 1]);
+		} else {
+			fprintf(stderr, "queries 0\n");
+		}
+	}
+	rc = 0;
+out:
+	px_dist_model_free(m);
+	px_obj_free(obj);
+	free(curves);
+	free(surfs);
+	free(pts.p);
+	free(times);
+	return rc;
+}
