@@ -66,6 +66,11 @@ TOOL_BIN := $(patsubst tools/%.c,$(BUILD)/bin/%,$(TOOL_SRC))
 
 BENCH_SRC := $(wildcard bench/bench_*.c)
 BENCH_BIN := $(patsubst bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
+# C++ comparisons against OpenCASCADE, built only where its headers are.
+OCCT_INC := /usr/include/opencascade
+OCCT_LIBS := -lTKGeomAlgo -lTKGeomBase -lTKG3d -lTKG2d -lTKMath -lTKernel
+CXX_BENCH_SRC := $(if $(wildcard $(OCCT_INC)/Standard.hxx),$(wildcard bench/bench_*_occt.cpp))
+CXX_BENCH_BIN := $(patsubst bench/%.cpp,$(BUILD)/bench/%,$(CXX_BENCH_SRC))
 
 STATIC_LIB := $(BUILD)/lib/lib$(NAME).a
 SHARED_LIB := $(BUILD)/lib/lib$(NAME).so.$(VERSION)
@@ -75,13 +80,13 @@ PC_FILE    := $(BUILD)/lib/pkgconfig/$(NAME).pc
 DEB_PACKAGES := gcc make libc6-dev pkg-config
 # Debian packages the benchmarks compare against (installed by `make bench`;
 # a benchmark whose reference is missing says so and still runs).
-BENCH_DEB_PACKAGES := rt-tests
+BENCH_DEB_PACKAGES := rt-tests g++ libocct-modeling-algorithms-dev
 # config/: YAML loader.
 DEB_PACKAGES += libyaml-dev
 
 FORCE:
 
-.PHONY: FORCE all lib tools tests benches test bench sanitize install uninstall \
+.PHONY: FORCE all lib tools tests benches run-benches test bench sanitize install uninstall \
         clean help deps check-deps
 
 all: lib tools
@@ -98,7 +103,7 @@ tools: $(TOOL_BIN)
 
 tests: $(TEST_BIN)
 
-benches: $(BENCH_BIN)
+benches: $(BENCH_BIN) $(CXX_BENCH_BIN)
 
 # ---- rules ---------------------------------------------------------------
 $(BUILD)/obj/%.o: %.c
@@ -141,6 +146,11 @@ $(BUILD)/bin/%: $(BUILD)/obj/tools/%.o $(TOOL_SUPPORT_OBJ) $(STATIC_LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_LDFLAGS) -o $@ $< $(TOOL_SUPPORT_OBJ) $(STATIC_LIB) $(LIBS)
 
+$(BUILD)/bench/%_occt: bench/%_occt.cpp $(STATIC_LIB)
+	@mkdir -p $(dir $@)
+	$(CXX) -std=c++17 -O2 -g -Wall -Wextra -Werror -Wno-deprecated-declarations \
+	  -isystem $(OCCT_INC) $(INCS) -o $@ $< $(STATIC_LIB) $(OCCT_LIBS) $(LIBS)
+
 $(BUILD)/bench/%: $(BUILD)/obj/bench/%.o $(STATIC_LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_LDFLAGS) -o $@ $< $(STATIC_LIB) $(LIBS)
@@ -153,9 +163,14 @@ test: deps all tests
 	@BUILD=$(BUILD) SAN=$(SAN) CC="$(CC)" MAKE="$(MAKE)" TEST_TIMEOUT=$(TEST_TIMEOUT) \
 	  sh tests/run.sh $(TEST_BIN) $(TEST_SH)
 
-bench: all benches
+bench: all
 	@sh tools/install-deps.sh $(BENCH_DEB_PACKAGES) || echo "make bench: continuing without $(BENCH_DEB_PACKAGES)"
-	@set -e; for b in $(BENCH_BIN); do echo "== $$b"; $$b; done
+	@# A second make sees the reference libraries just installed.
+	@$(MAKE) --no-print-directory benches
+	@$(MAKE) --no-print-directory run-benches
+
+run-benches:
+	@set -e; for b in $(BENCH_BIN) $(CXX_BENCH_BIN); do echo "== $$b"; $$b; done
 
 sanitize:
 	$(MAKE) BUILD=$(BUILD)/san SAN=1 test
