@@ -41,6 +41,11 @@ static void knots(double *k, int p, int n, int style)
 	}
 	for (i = 0; i < nin; i++)
 		k[p + 1 + i] = (i + 1.0) / (nin + 1.0);
+	if (style == 3) { /* clustered near both ends */
+		for (i = 0; i < nin; i++)
+			k[p + 1 + i] = i < nin / 2 ? 0.01 * (i + 1) : 1.0 - 0.01 * (nin - i);
+		return;
+	}
 	if (style == 1 && nin >= p) /* C0 crease in the middle */
 		for (i = 0; i < p; i++)
 			k[p + 1 + i] = 0.5;
@@ -54,12 +59,12 @@ static int random_surface(struct px_nurbs_surf *s, struct surf_buf *b,
 {
 	struct px_nurbs_error err;
 	int i, j, rc;
-	b->p = px_rand_int(1, 3);
-	b->q = px_rand_int(1, 3);
+	b->p = px_rand_int(1, 5);
+	b->q = px_rand_int(1, 5);
 	b->nu = b->p + 1 + px_rand_int(0, 3);
 	b->nv = b->q + 1 + px_rand_int(0, 3);
-	knots(b->ku, b->p, b->nu, px_rand_int(0, 2));
-	knots(b->kv, b->q, b->nv, px_rand_int(0, 2));
+	knots(b->ku, b->p, b->nu, px_rand_int(0, 3));
+	knots(b->kv, b->q, b->nv, px_rand_int(0, 3));
 	for (j = 0; j < b->nv; j++)
 		for (i = 0; i < b->nu; i++) {
 			int k = j * b->nu + i;
@@ -212,7 +217,7 @@ static void test_random_surfaces(void)
 {
 	struct tally t = {0, 0, 0};
 	int trial;
-	for (trial = 0; trial < 40; trial++) {
+	for (trial = 0; trial < 100; trial++) {
 		struct surf_buf b;
 		struct px_nurbs_surf s;
 		struct px_dist_model *m = NULL;
@@ -222,8 +227,8 @@ static void test_random_surfaces(void)
 		PX_CHECK_INT_EQ(random_surface(&s, &b, trial % 2), PX_OK);
 		PX_CHECK_INT_EQ(px_dist_model_create(NULL, 0, &s, 1, NULL, &m), PX_OK);
 		px_dist_model_info(m, &info);
-		for (i = 0; i < 10; i++)
-			check(m, &s, 0, query_point(&s, info.bounds, i),
+		for (i = 0; i < 5; i++)
+			check(m, &s, 0, query_point(&s, info.bounds, trial + i),
 			      px_aabb_diagonal(&info.bounds), &t);
 		px_dist_model_free(m);
 	}
@@ -336,6 +341,37 @@ static void test_mixed_model(void)
 	px_dist_model_free(m);
 }
 
+/* Two parallel sheets z = 0 and z = 1 (bilinear patches over the unit
+ * square): on the mid-plane both foot points are equally near, the
+ * medial axis where the closest point jumps. */
+static void test_medial_plane_of_two_sheets(void)
+{
+	double k[4] = {0, 0, 1, 1};
+	double a[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+	double b[12] = {0, 0, 1, 1, 0, 1, 0, 1, 1, 1, 1, 1};
+	struct px_nurbs_surf s[2];
+	struct px_dist_model *m;
+	struct px_dist_result r;
+	int i;
+
+	arena_reset();
+	PX_CHECK_INT_EQ(px_nurbs_surf_init(&s[0], &arena, 1, 1, 2, 2, k, 4, k, 4, a, NULL, NULL), PX_OK);
+	PX_CHECK_INT_EQ(px_nurbs_surf_init(&s[1], &arena, 1, 1, 2, 2, k, 4, k, 4, b, NULL, NULL), PX_OK);
+	PX_CHECK_INT_EQ(px_dist_model_create(NULL, 0, s, 2, NULL, &m), PX_OK);
+	for (i = 0; i < 300; i++) {
+		double x = px_rand_range(-0.5, 1.5), y = px_rand_range(-0.5, 1.5);
+		double z = i % 3 ? 0.5 : px_rand_range(-1, 2);
+		double dx = x < 0 ? -x : (x > 1 ? x - 1 : 0);
+		double dy = y < 0 ? -y : (y > 1 ? y - 1 : 0);
+		double dz = fmin(fabs(z), fabs(z - 1));
+		PX_CHECK_INT_EQ(px_dist_query(m, px_v3(x, y, z), &r), PX_OK);
+		PX_CHECK_CLOSE(r.dist, sqrt(dx * dx + dy * dy + dz * dz), 1e-12, 1e-12);
+		PX_CHECK(r.point.z == 0.0 || r.point.z == 1.0);
+		PX_CHECK(r.certified);
+	}
+	px_dist_model_free(m);
+}
+
 static void test_surface_queries_allocate_nothing(void)
 {
 	struct px_nurbs_surf s;
@@ -360,6 +396,7 @@ static const struct px_test tests[] = {
 	PX_T(test_random_surfaces),
 	PX_T(test_sphere_poles_seam_focal),
 	PX_T(test_mixed_model),
+	PX_T(test_medial_plane_of_two_sheets),
 	PX_T(test_surface_queries_allocate_nothing),
 };
 
