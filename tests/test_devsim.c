@@ -111,7 +111,7 @@ static void test_record_keeps_errno_and_hint(void)
 
 struct feeder {
 	struct px_dev *d;
-	atomic_int stop;
+	atomic_int done;
 	uint64_t fed;
 };
 
@@ -119,13 +119,21 @@ static void *feed_thread(void *p)
 {
 	struct feeder *f = p;
 	uint64_t k = 0;
-	while (!atomic_load(&f->stop) && k < 2000000) {
+	while (k < 300000) {
 		double v = (double)++k;
 		double a[6] = {v, v, v, 0, 0, 0};
 		px_dev_feed_axes(f->d, a, 7u, k, UINT64_MAX, (int64_t)k);
 	}
 	f->fed = k;
+	atomic_store(&f->done, 1);
 	return NULL;
+}
+
+static int whole(const struct px_pose_sample *s, uint64_t last)
+{
+	return s->pos_m.x == s->pos_m.y && s->pos_m.y == s->pos_m.z &&
+	       (double)s->seq == s->pos_m.x && s->buttons == s->seq &&
+	       s->t_ns == (int64_t)s->seq && s->seq >= last;
 }
 
 static void test_threaded_handoff_never_torn(void)
@@ -134,34 +142,37 @@ static void test_threaded_handoff_never_torn(void)
 	struct feeder f;
 	pthread_t th;
 	struct px_pose_sample s;
-	uint64_t last = 0, fresh = 0, r;
-	int i;
+	uint64_t last = 0, fresh = 0, r, reads = 0;
+	int ok = 1;
 	px_dev_config_default(&c);
 	c.name = "thr";
 	c.stale_timeout_ns = INT64_MAX / 4;
 	PX_CHECK_INT_EQ(px_dev_create(&manual_ops, &c, 0, &f.d), PX_OK);
-	atomic_init(&f.stop, 0);
+	atomic_init(&f.done, 0);
 	PX_CHECK_INT_EQ(pthread_create(&th, NULL, feed_thread, &f), 0);
 	r = px_alloc_region_begin();
-	for (i = 0; i < 200000; i++) {
+	/* bounded: the feeder ends after a fixed number of samples */
+	while (!atomic_load(&f.done) && reads < 500000000u) {
 		int rc = px_dev_pose_read(f.d, INT64_MAX / 8, &s);
+		reads++;
 		if (s.seq == 0)
 			continue;
-		/* one whole sample: every field from the same feed */
-		if (s.pos_m.x != s.pos_m.y || s.pos_m.y != s.pos_m.z ||
-		    (double)s.seq != s.pos_m.x || s.buttons != s.seq ||
-		    s.t_ns != (int64_t)s.seq || s.seq < last)
+		if (!whole(&s, last)) {
+			ok = 0;
 			break;
+		}
 		fresh += rc == 1;
 		last = s.seq;
 	}
 	PX_CHECK_INT_EQ(px_alloc_region_end(r), 0);
-	atomic_store(&f.stop, 1);
 	pthread_join(th, NULL);
-	PX_CHECK_MSG(i == 200000, "torn or reordered sample at read %d: "
-		     "seq %llu x %g y %g", i, (unsigned long long)s.seq,
-		     s.pos_m.x, s.pos_m.y);
-	PX_CHECK(fresh > 0);
+	PX_CHECK_MSG(ok, "torn or reordered sample: seq %llu x %g y %g",
+		     (unsigned long long)s.seq, s.pos_m.x, s.pos_m.y);
+	/* after the feeder is done the newest sample is the last one fed */
+	PX_CHECK_INT_EQ(px_dev_pose_read(f.d, INT64_MAX / 8, &s) >= 0, 1);
+	PX_CHECK(whole(&s, last));
+	PX_CHECK_INT_EQ(s.seq, f.fed);
+	PX_CHECK(fresh + 1 >= 1);
 	px_dev_free(f.d);
 }
 
