@@ -76,6 +76,8 @@ PC_FILE    := $(BUILD)/lib/pkgconfig/$(NAME).pc
 # Debian packages that building and testing need (see `make deps`).
 DEB_PACKAGES := gcc make libc6-dev pkg-config
 DEB_PACKAGES += libhidapi-dev libusb-1.0-0-dev libsocketcan-dev libgpiod-dev
+# static linking of hidapi and libusb needs libudev.so
+DEB_PACKAGES += libudev-dev
 # Debian packages the benchmarks compare against (installed by `make bench`;
 # a benchmark whose reference is missing says so and still runs).
 BENCH_DEB_PACKAGES := rt-tests
