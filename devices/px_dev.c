@@ -521,7 +521,8 @@ static void format_err(const struct px_dev *d, const struct errrec *e,
 	char detail[128] = "";
 	char frame[32] = "";
 	char sys[96] = "";
-	if (e->frame_id >= 0 && e->kind != PX_DEV_ERR_DECODE)
+	if (e->frame_id >= 0 &&
+	    !(e->kind == PX_DEV_ERR_DECODE && e->diag.what != PX_CODEC_OK))
 		snprintf(frame, sizeof frame, " [frame 0x%llx]",
 			 (unsigned long long)e->frame_id);
 	if (e->sys_errno) {
@@ -531,7 +532,16 @@ static void format_err(const struct px_dev *d, const struct errrec *e,
 	}
 	switch (e->kind) {
 	case PX_DEV_ERR_DECODE:
-		px_codec_diag_format(&e->diag, NULL, detail, sizeof detail);
+		if (e->diag.what != PX_CODEC_OK)
+			px_codec_diag_format(&e->diag, NULL, detail,
+					     sizeof detail);
+		else
+			snprintf(detail, sizeof detail, "frame rejected: %s",
+				 e->err == PX_E_RANGE
+					 ? "value outside its plausible range"
+					 : e->err == PX_E_PARSE
+						   ? "frame too short"
+						   : px_strerror_name(e->err));
 		break;
 	case PX_DEV_ERR_DUPLICATE:
 		snprintf(detail, sizeof detail,
@@ -549,6 +559,9 @@ static void format_err(const struct px_dev *d, const struct errrec *e,
 		break;
 	case PX_DEV_ERR_UNPLUG:
 		snprintf(detail, sizeof detail, "device unplugged");
+		break;
+	case PX_DEV_ERR_BUS:
+		snprintf(detail, sizeof detail, "bus error frame");
 		break;
 	default:
 		snprintf(detail, sizeof detail, "%s error %s",
