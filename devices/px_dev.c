@@ -12,6 +12,7 @@
 #include "px_dev.h"
 #include "px_loop.h"
 #include "px_param.h"
+#include "internal.h"
 
 enum {
 	C_REPORTS, C_SAMPLES, C_DECODE, C_NONFINITE, C_DUP, C_STUCK,
@@ -185,8 +186,14 @@ void px_dev_stop(struct px_dev *d)
 int px_dev_attach(struct px_dev *d, struct px_loop *l)
 {
 	int idx;
-	if (!d || !l || !(d->ops->caps & PX_DEV_CAP_POSE))
+	if (!d || !l)
 		return PX_E_INVAL;
+	if (!(d->ops->caps & PX_DEV_CAP_POSE)) {
+		if (!(d->ops->caps & PX_DEV_CAP_DIO))
+			return PX_E_INVAL;
+		d->loop = l; /* a pressed e-stop trips it */
+		return 0;
+	}
 	idx = px_loop_input_add(l, d->name, d->cfg.stale_timeout_ns);
 	if (idx < 0)
 		return idx;
@@ -644,4 +651,9 @@ const struct px_dev_config *px_dev_config(const struct px_dev *d)
 const struct px_dev_ops *px_dev_ops(const struct px_dev *d)
 {
 	return d ? d->ops : NULL;
+}
+
+struct px_loop *px__dev_loop(const struct px_dev *d)
+{
+	return d ? d->loop : NULL;
 }

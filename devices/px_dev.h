@@ -197,8 +197,10 @@ PX_API void px_dev_stop(struct px_dev *d);
 
 /*
  * Register the device's pose input with loop l's watchdog (timeout
- * stale_timeout_ns); px_dev_pose_read() stamps it from then on. Setup
- * only. Returns the input index or px_loop_input_add()'s error.
+ * stale_timeout_ns); px_dev_pose_read() stamps it from then on. For a
+ * digital I/O device without pose, remember l so that a pressed e-stop
+ * trips it (px_gpio.h) and return 0. Setup only. Returns the input
+ * index or px_loop_input_add()'s error.
  */
 PX_API int px_dev_attach(struct px_dev *d, struct px_loop *l);
 
