@@ -653,7 +653,69 @@ static void test_safe_state_sends_zero_force(void)
 	px_dev_free(d);
 }
 
+static int slow_read(struct px_loop *l, const struct px_loop_cycle *c,
+		     void *u)
+{
+	struct app *a = u;
+	int rc = px_dev_pose_read(a->dev, c->read_ns, &a->s);
+	(void)l;
+	a->fresh_cycles += rc == 1;
+	if (a->s.age_ns > a->k)
+		a->k = (double)a->s.age_ns; /* largest age seen */
+	a->nodev_cycles += a->s.stale;
+	return PX_OK;
+}
+
+static void test_slow_pose_device_age_is_visible(void)
+{
+	/* A 6-DoF pose device at 125 Hz (two reports per sample, like a
+	 * 3Dconnexion device) read by a 1 kHz loop: one fresh sample in
+	 * eight cycles, the age climbing to 7 ms in between, never stale
+	 * with a 50 ms timeout. */
+	struct px_sim_haptic_config hc = sines_cfg();
+	struct px_dev_config c;
+	struct px_dev *d;
+	struct px_loop_config lc;
+	struct px_loop *l;
+	struct px_loop_status ls;
+	struct app a;
+	char msg[200];
+	px_dev_config_default(&c);
+	c.name = "spacemouse";
+	c.codec = px_codec_builtin("spacemouse");
+	c.stale_timeout_ns = 50000000;
+	hc.follow_hand = 1;
+	hc.report_period_ns = 8000000;
+	hc.traj.sines = NULL; /* stay inside the +-50 mm range */
+	hc.traj.n_sines = 0;
+	hc.traj.center_m[0] = 0.01;
+	hc.traj.center_m[2] = -0.02;
+	PX_CHECK_INT_EQ(px_sim_haptic_create(&c, &hc, &d, msg, sizeof msg),
+			PX_OK);
+	px_loop_config_default(&lc);
+	lc.clock = PX_LOOP_CLOCK_VIRTUAL;
+	lc.read = slow_read;
+	lc.user = &a;
+	lc.hist_bins = 100;
+	PX_CHECK_INT_EQ(px_loop_create(&lc, &l), PX_OK);
+	memset(&a, 0, sizeof a);
+	a.dev = d;
+	PX_CHECK_INT_EQ(px_dev_attach(d, l), 0);
+	PX_CHECK_INT_EQ(px_loop_run(l, 800), PX_OK);
+	px_loop_status(l, &ls);
+	PX_CHECK_INT_EQ(ls.safe_entries, 0);
+	PX_CHECK_INT_EQ(a.fresh_cycles, 100);
+	PX_CHECK_INT_EQ((int64_t)a.k, 7000000);
+	PX_CHECK_INT_EQ(a.nodev_cycles, 0);
+	PX_CHECK_NEAR(a.s.pos_m.x, 0.01, 1.5e-4);  /* 1 count = 0.14 mm */
+	PX_CHECK_NEAR(a.s.pos_m.z, -0.02, 1.5e-4);
+	PX_CHECK_NEAR(a.s.q.w, 1.0, 0);
+	px_loop_free(l);
+	px_dev_free(d);
+}
+
 static const struct px_test tests[] = {
+	PX_T(test_slow_pose_device_age_is_visible),
 	PX_T(test_staleness_and_age),
 	PX_T(test_record_keeps_errno_and_hint),
 	PX_T(test_threaded_handoff_never_torn),
