@@ -42,6 +42,10 @@ ALL_LDFLAGS := $(SANFLAGS) $(LDFLAGS)
 
 # Optional libraries found with pkg-config (device back ends, config).
 PKGS     := yaml-0.1
+# Device back ends. hidapi comes as two builds with the same symbols:
+# HIDAPI=hidraw (default, /dev/hidraw*) or HIDAPI=libusb.
+HIDAPI   ?= hidraw
+PKGS     += hidapi-$(HIDAPI) libusb-1.0 libsocketcan libgpiod
 # Asked when a recipe runs, not when this file is read, so that packages
 # `make deps` has just installed are found by the same `make test`.
 PKG_CFLAGS = $(if $(PKGS),$(shell pkg-config --cflags $(PKGS)))
@@ -78,6 +82,9 @@ PC_FILE    := $(BUILD)/lib/pkgconfig/$(NAME).pc
 
 # Debian packages that building and testing need (see `make deps`).
 DEB_PACKAGES := gcc make libc6-dev pkg-config
+DEB_PACKAGES += libhidapi-dev libusb-1.0-0-dev libsocketcan-dev libgpiod-dev
+# static linking of hidapi and libusb needs libudev.so
+DEB_PACKAGES += libudev-dev
 # Debian packages the benchmarks compare against (installed by `make bench`;
 # a benchmark whose reference is missing says so and still runs).
 BENCH_DEB_PACKAGES := rt-tests g++ libocct-modeling-algorithms-dev
@@ -154,6 +161,9 @@ $(BUILD)/bench/%_occt: bench/%_occt.cpp $(STATIC_LIB)
 $(BUILD)/bench/%: $(BUILD)/obj/bench/%.o $(STATIC_LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_LDFLAGS) -o $@ $< $(STATIC_LIB) $(LIBS)
+
+# The HID back end reports which hidapi build it was linked with.
+$(BUILD)/obj/devices/px_hidapi.o: ALL_CFLAGS += -DPX_HIDAPI_DRIVER=\"$(HIDAPI)\"
 
 # Test and bench sources also see the test harness headers.
 $(BUILD)/obj/tests/%.o $(BUILD)/obj/bench/%.o $(BUILD)/obj/tools/%.o: ALL_CFLAGS += -Itests -Itools

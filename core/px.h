@@ -17,5 +17,12 @@
 #include "px_rt.h"
 #include "px_stats.h"
 #include "px_config.h"
+#include "px_codec.h"
+#include "px_dev.h"
+#include "px_sim.h"
+#include "px_hid.h"
+#include "px_usb.h"
+#include "px_can.h"
+#include "px_gpio.h"
 
 #endif

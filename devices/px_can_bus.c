@@ -1,0 +1,733 @@
+/* CAN buses: raw SocketCAN, in-process simulation, UNIX datagram
+ * simulation, candump replay; interface state through libsocketcan. */
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <net/if.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <libsocketcan.h>
+#include <linux/can/error.h>
+#include <linux/can/netlink.h>
+#include <linux/can/raw.h>
+
+#include "px_can.h"
+
+enum { K_SIM, K_UNIX, K_RAW, K_REPLAY };
+
+struct px_can_sim {
+	struct px_can_sim_config cfg;
+	struct px_sim_fault faults[PX_SIM_MAX_FAULTS];
+	struct px_can_bus **eps;
+	size_t n_eps;
+	uint64_t rng;
+	int busoff;
+};
+
+struct px_can_bus {
+	int kind;
+	struct px_can_bus_stats st;
+	int last_errno;
+	int sock;
+	int fd_frames;
+	/* sim */
+	struct px_can_sim *sim;
+	struct px_can_msg *q;
+	size_t qcap, qhead, qn;
+	/* unix */
+	struct sockaddr_un peer;
+	char local[sizeof(((struct sockaddr_un *)0)->sun_path)];
+	/* replay */
+	struct px_can_msg *recs;
+	int64_t *rec_t;
+	size_t n_recs, next;
+	int started;
+	int64_t t0_now;
+};
+
+static struct px_can_bus *bus_new(int kind)
+{
+	struct px_can_bus *b = calloc(1, sizeof *b);
+	if (!b)
+		return NULL;
+	b->kind = kind;
+	b->sock = -1;
+	b->st.state = PX_CAN_STATE_ACTIVE;
+	return b;
+}
+
+/* ---- in-process simulation ----------------------------------------------- */
+
+void px_can_sim_config_default(struct px_can_sim_config *c)
+{
+	if (!c)
+		return;
+	memset(c, 0, sizeof *c);
+	c->queue = 256;
+	c->max_endpoints = 8;
+	c->seed = 1;
+}
+
+int px_can_sim_create(const struct px_can_sim_config *c,
+		      struct px_can_sim **out)
+{
+	struct px_can_sim *s;
+	size_t i;
+	if (!c || !out || c->queue < 1 || c->max_endpoints < 2 ||
+	    c->max_endpoints > 64 || c->n_faults > PX_SIM_MAX_FAULTS ||
+	    (c->n_faults && !c->faults))
+		return PX_E_INVAL;
+	for (i = 0; i < c->n_faults; i++) {
+		int k = c->faults[i].kind;
+		if ((k != PX_SIM_FAULT_DROP && k != PX_SIM_FAULT_DUPLICATE &&
+		     k != PX_SIM_FAULT_CORRUPT && k != PX_SIM_FAULT_BUSOFF) ||
+		    c->faults[i].duration_ns <= 0)
+			return PX_E_INVAL;
+	}
+	s = calloc(1, sizeof *s);
+	if (!s)
+		return PX_E_NOMEM;
+	s->eps = calloc(c->max_endpoints, sizeof *s->eps);
+	if (!s->eps) {
+		free(s);
+		return PX_E_NOMEM;
+	}
+	s->cfg = *c;
+	if (c->n_faults)
+		memcpy(s->faults, c->faults, c->n_faults * sizeof *c->faults);
+	s->cfg.faults = s->faults;
+	s->rng = c->seed ? c->seed : 1;
+	*out = s;
+	return PX_OK;
+}
+
+int px_can_sim_endpoint(struct px_can_sim *s, struct px_can_bus **out)
+{
+	struct px_can_bus *b;
+	if (!s || !out)
+		return PX_E_INVAL;
+	if (s->n_eps >= s->cfg.max_endpoints)
+		return PX_E_NOSPC;
+	b = bus_new(K_SIM);
+	if (!b)
+		return PX_E_NOMEM;
+	b->q = calloc(s->cfg.queue, sizeof *b->q);
+	if (!b->q) {
+		free(b);
+		return PX_E_NOMEM;
+	}
+	b->qcap = s->cfg.queue;
+	b->sim = s;
+	b->fd_frames = 1;
+	s->eps[s->n_eps++] = b;
+	*out = b;
+	return PX_OK;
+}
+
+void px_can_sim_free(struct px_can_sim *s)
+{
+	size_t i;
+	if (!s)
+		return;
+	for (i = 0; i < s->n_eps; i++)
+		if (s->eps[i]) {
+			s->eps[i]->sim = NULL;
+			px_can_bus_close(s->eps[i]);
+		}
+	free(s->eps);
+	free(s);
+}
+
+static double sim_unit(struct px_can_sim *s)
+{
+	uint64_t x = s->rng;
+	x ^= x >> 12;
+	x ^= x << 25;
+	x ^= x >> 27;
+	s->rng = x;
+	return (double)((x * 2685821657736338717ull) >> 11) *
+	       (1.0 / 9007199254740992.0);
+}
+
+static int sim_fault(struct px_can_sim *s, int kind, int64_t now, int roll)
+{
+	size_t i;
+	for (i = 0; i < s->cfg.n_faults; i++) {
+		const struct px_sim_fault *f = &s->faults[i];
+		double p;
+		if (f->kind != kind || now < f->start_ns ||
+		    now >= f->start_ns + f->duration_ns)
+			continue;
+		p = f->probability > 0 ? f->probability : 1.0;
+		if (!roll || p >= 1.0 || sim_unit(s) < p)
+			return 1;
+	}
+	return 0;
+}
+
+static void q_push(struct px_can_bus *b, const struct px_can_msg *m)
+{
+	if (b->qn >= b->qcap) {
+		b->st.rx_dropped++;
+		return;
+	}
+	b->q[(b->qhead + b->qn) % b->qcap] = *m;
+	b->qn++;
+}
+
+static void sim_broadcast(struct px_can_sim *s, const struct px_can_bus *from,
+			  const struct px_can_msg *m)
+{
+	size_t i;
+	for (i = 0; i < s->n_eps; i++)
+		if (s->eps[i] && s->eps[i] != from)
+			q_push(s->eps[i], m);
+}
+
+/* Bus-off windows: an error frame to everyone on entry and on exit. */
+static void sim_tick(struct px_can_sim *s, int64_t now)
+{
+	int off = sim_fault(s, PX_SIM_FAULT_BUSOFF, now, 0);
+	struct px_can_msg e;
+	if (off == s->busoff)
+		return;
+	s->busoff = off;
+	memset(&e, 0, sizeof e);
+	e.f.can_id = CAN_ERR_FLAG | (off ? CAN_ERR_BUSOFF : CAN_ERR_RESTARTED);
+	e.f.len = CAN_ERR_DLC;
+	e.t_ns = now;
+	sim_broadcast(s, NULL, &e);
+}
+
+static int sim_send(struct px_can_bus *b, const struct px_can_msg *m,
+		    int64_t now)
+{
+	struct px_can_sim *s = b->sim;
+	struct px_can_msg c;
+	if (!s)
+		return PX_E_IO;
+	sim_tick(s, now);
+	if (s->busoff) {
+		b->last_errno = ENETDOWN;
+		return PX_E_IO;
+	}
+	if (sim_fault(s, PX_SIM_FAULT_DROP, now, 1))
+		return PX_OK; /* lost on the wire: the sender cannot know */
+	c = *m;
+	c.t_ns = now;
+	if (sim_fault(s, PX_SIM_FAULT_CORRUPT, now, 1))
+		c.f.len /= 2;
+	sim_broadcast(s, b, &c);
+	if (sim_fault(s, PX_SIM_FAULT_DUPLICATE, now, 1))
+		sim_broadcast(s, b, &c);
+	return PX_OK;
+}
+
+static int sim_recv(struct px_can_bus *b, int64_t now, struct px_can_msg *m)
+{
+	if (b->sim)
+		sim_tick(b->sim, now);
+	if (!b->qn)
+		return PX_E_AGAIN;
+	*m = b->q[b->qhead];
+	b->qhead = (b->qhead + 1) % b->qcap;
+	b->qn--;
+	return PX_OK;
+}
+
+/* ---- UNIX datagram simulation ------------------------------------------- */
+
+int px_can_unix_open(const char *local_path, const char *peer_path,
+		     struct px_can_bus **out, char *msg, size_t cap)
+{
+	struct px_can_bus *b;
+	struct sockaddr_un a;
+	int e;
+	if (msg && cap)
+		msg[0] = 0;
+	if (!local_path || !peer_path || !out)
+		return PX_E_INVAL;
+	*out = NULL;
+	if (strlen(local_path) >= sizeof a.sun_path ||
+	    strlen(peer_path) >= sizeof a.sun_path) {
+		if (msg)
+			snprintf(msg, cap, "UNIX socket path longer than %zu "
+				 "bytes", sizeof a.sun_path - 1);
+		return PX_E_INVAL;
+	}
+	b = bus_new(K_UNIX);
+	if (!b)
+		return PX_E_NOMEM;
+	b->fd_frames = 1;
+	b->sock = socket(AF_UNIX, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+	if (b->sock < 0) {
+		e = errno;
+		if (msg)
+			snprintf(msg, cap, "socket(AF_UNIX, SOCK_DGRAM): %s",
+				 strerror(e));
+		free(b);
+		return PX_E_IO;
+	}
+	memset(&a, 0, sizeof a);
+	a.sun_family = AF_UNIX;
+	snprintf(a.sun_path, sizeof a.sun_path, "%s", local_path);
+	unlink(local_path);
+	if (bind(b->sock, (struct sockaddr *)&a, sizeof a) != 0) {
+		e = errno;
+		if (msg)
+			snprintf(msg, cap, "bind(%s): %s", local_path,
+				 strerror(e));
+		close(b->sock);
+		free(b);
+		return e == EACCES ? PX_E_PERM : PX_E_IO;
+	}
+	snprintf(b->local, sizeof b->local, "%s", local_path);
+	memset(&b->peer, 0, sizeof b->peer);
+	b->peer.sun_family = AF_UNIX;
+	snprintf(b->peer.sun_path, sizeof b->peer.sun_path, "%s", peer_path);
+	*out = b;
+	return PX_OK;
+}
+
+static int unix_send(struct px_can_bus *b, const struct px_can_msg *m,
+		     int64_t now)
+{
+	size_t mtu = m->fd ? CANFD_MTU : CAN_MTU;
+	(void)now;
+	/* struct can_frame is the first CAN_MTU bytes of canfd_frame with
+	 * the same field offsets: the frame goes out as SocketCAN has it. */
+	if (sendto(b->sock, &m->f, mtu, MSG_DONTWAIT,
+		   (const struct sockaddr *)&b->peer, sizeof b->peer) ==
+	    (ssize_t)mtu)
+		return PX_OK;
+	b->last_errno = errno;
+	if (errno == EAGAIN || errno == ENOBUFS || errno == ECONNREFUSED ||
+	    errno == ENOENT) {
+		b->st.tx_dropped++; /* no peer yet, or it is not reading */
+		return PX_E_AGAIN;
+	}
+	return PX_E_IO;
+}
+
+static int unix_recv(struct px_can_bus *b, int64_t now, struct px_can_msg *m)
+{
+	ssize_t n;
+	memset(m, 0, sizeof *m);
+	for (;;) {
+		n = recv(b->sock, &m->f, sizeof m->f, MSG_DONTWAIT);
+		if (n < 0) {
+			if (errno == EAGAIN || errno == EWOULDBLOCK)
+				return PX_E_AGAIN;
+			b->last_errno = errno;
+			return PX_E_IO;
+		}
+		if (n == CAN_MTU || n == CANFD_MTU)
+			break;
+		b->st.rx_dropped++; /* not a SocketCAN frame */
+	}
+	m->fd = n == CANFD_MTU;
+	if (!m->fd && m->f.len > CAN_MAX_DLEN)
+		m->f.len = CAN_MAX_DLEN;
+	if (m->fd && m->f.len > CANFD_MAX_DLEN)
+		m->f.len = CANFD_MAX_DLEN;
+	m->t_ns = now;
+	return PX_OK;
+}
+
+/* ---- raw SocketCAN ------------------------------------------------------- */
+
+static int64_t clock_ns(clockid_t c)
+{
+	struct timespec ts;
+	clock_gettime(c, &ts);
+	return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+
+#define FAIL(code, ...)                                           \
+	do {                                                      \
+		if (msg)                                          \
+			snprintf(msg, cap, __VA_ARGS__);          \
+		rc = (code);                                      \
+		goto fail;                                        \
+	} while (0)
+
+int px_can_raw_open(const struct px_can_raw_config *c,
+		    struct px_can_bus **out, int *sys_errno, char *msg,
+		    size_t cap)
+{
+	struct px_can_bus *b;
+	struct sockaddr_can addr;
+	struct can_filter flt[64];
+	unsigned idx;
+	int one = 1, e = 0, rc, opt;
+	const char *nm;
+	if (msg && cap)
+		msg[0] = 0;
+	if (sys_errno)
+		*sys_errno = 0;
+	if (!c || !out || !c->interface || !*c->interface ||
+	    strlen(c->interface) >= IFNAMSIZ || c->n_filters > 64 ||
+	    (c->n_filters && !c->filters)) {
+		if (msg)
+			snprintf(msg, cap, "CAN: interface name (< %d bytes) "
+				 "and at most 64 filters", IFNAMSIZ);
+		return PX_E_INVAL;
+	}
+	*out = NULL;
+	b = bus_new(K_RAW);
+	if (!b)
+		return PX_E_NOMEM;
+	b->fd_frames = c->fd;
+	b->sock = socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC,
+			 CAN_RAW);
+	if (b->sock < 0) {
+		e = errno;
+		nm = strerrorname_np(e);
+		if (e == EAFNOSUPPORT || e == EPROTONOSUPPORT)
+			FAIL(PX_E_UNSUPPORTED,
+			     "%s: socket(PF_CAN, SOCK_RAW, CAN_RAW): errno %s "
+			     "(%d): %s: this kernel has no AF_CAN support "
+			     "(modprobe can can-raw; for a virtual bus modprobe "
+			     "vcan and ip link add dev vcan0 type vcan)",
+			     c->interface, nm ? nm : "?", e, strerror(e));
+		FAIL(e == EACCES || e == EPERM ? PX_E_PERM : PX_E_IO,
+		     "%s: socket(PF_CAN, SOCK_RAW, CAN_RAW): errno %s (%d): %s",
+		     c->interface, nm ? nm : "?", e, strerror(e));
+	}
+	idx = if_nametoindex(c->interface);
+	if (!idx) {
+		e = errno;
+		nm = strerrorname_np(e);
+		FAIL(PX_E_NODEV,
+		     "%s: no such network interface: errno %s (%d): %s "
+		     "(ip -details link show type can lists CAN interfaces; "
+		     "a virtual one: ip link add dev %s type vcan)",
+		     c->interface, nm ? nm : "?", e, strerror(e), c->interface);
+	}
+	if (c->fd && setsockopt(b->sock, SOL_CAN_RAW, CAN_RAW_FD_FRAMES, &one,
+				sizeof one) != 0) {
+		e = errno;
+		FAIL(PX_E_UNSUPPORTED, "%s: CAN FD frames refused "
+		     "(setsockopt CAN_RAW_FD_FRAMES): %s", c->interface,
+		     strerror(e));
+	}
+	if (c->n_filters) {
+		size_t i;
+		for (i = 0; i < c->n_filters; i++) {
+			flt[i].can_id = c->filters[i].id |
+					(c->filters[i].extended ? CAN_EFF_FLAG
+								: 0);
+			flt[i].can_mask = c->filters[i].mask | CAN_EFF_FLAG |
+					  CAN_RTR_FLAG;
+		}
+		if (setsockopt(b->sock, SOL_CAN_RAW, CAN_RAW_FILTER, flt,
+			       (socklen_t)(c->n_filters * sizeof flt[0])) != 0) {
+			e = errno;
+			FAIL(PX_E_IO, "%s: setsockopt CAN_RAW_FILTER: %s",
+			     c->interface, strerror(e));
+		}
+	}
+	opt = c->error_frames ? (int)CAN_ERR_MASK : 0;
+	if (setsockopt(b->sock, SOL_CAN_RAW, CAN_RAW_ERR_FILTER, &opt,
+		       sizeof opt) != 0) {
+		e = errno;
+		FAIL(PX_E_IO, "%s: setsockopt CAN_RAW_ERR_FILTER: %s",
+		     c->interface, strerror(e));
+	}
+	opt = c->loopback_own ? 1 : 0;
+	setsockopt(b->sock, SOL_CAN_RAW, CAN_RAW_RECV_OWN_MSGS, &opt,
+		   sizeof opt);
+	if (setsockopt(b->sock, SOL_SOCKET, SO_TIMESTAMPNS, &one,
+		       sizeof one) != 0) {
+		e = errno;
+		FAIL(PX_E_IO, "%s: setsockopt SO_TIMESTAMPNS: %s",
+		     c->interface, strerror(e));
+	}
+	memset(&addr, 0, sizeof addr);
+	addr.can_family = AF_CAN;
+	addr.can_ifindex = (int)idx;
+	if (bind(b->sock, (struct sockaddr *)&addr, sizeof addr) != 0) {
+		e = errno;
+		nm = strerrorname_np(e);
+		FAIL(e == ENETDOWN ? PX_E_NODEV : PX_E_IO,
+		     "%s: bind: errno %s (%d): %s%s", c->interface,
+		     nm ? nm : "?", e, strerror(e),
+		     e == ENETDOWN ? " (ip link set up the interface)" : "");
+	}
+	*out = b;
+	return PX_OK;
+fail:
+	if (sys_errno)
+		*sys_errno = e;
+	if (b->sock >= 0)
+		close(b->sock);
+	free(b);
+	return rc;
+}
+
+static int raw_send(struct px_can_bus *b, const struct px_can_msg *m,
+		    int64_t now)
+{
+	size_t mtu = m->fd ? CANFD_MTU : CAN_MTU;
+	(void)now;
+	if (m->fd && !b->fd_frames)
+		return PX_E_INVAL;
+	if (write(b->sock, &m->f, mtu) == (ssize_t)mtu)
+		return PX_OK;
+	b->last_errno = errno;
+	if (errno == EAGAIN || errno == ENOBUFS) {
+		b->st.tx_dropped++;
+		return PX_E_AGAIN;
+	}
+	return PX_E_IO;
+}
+
+static int raw_recv(struct px_can_bus *b, int64_t now, struct px_can_msg *m)
+{
+	struct iovec iov;
+	struct msghdr mh;
+	char ctrl[CMSG_SPACE(sizeof(struct timespec)) + 64];
+	struct cmsghdr *cm;
+	ssize_t n;
+	(void)now;
+	memset(m, 0, sizeof *m);
+	iov.iov_base = &m->f;
+	iov.iov_len = sizeof m->f;
+	memset(&mh, 0, sizeof mh);
+	mh.msg_iov = &iov;
+	mh.msg_iovlen = 1;
+	mh.msg_control = ctrl;
+	mh.msg_controllen = sizeof ctrl;
+	n = recvmsg(b->sock, &mh, MSG_DONTWAIT);
+	if (n < 0) {
+		if (errno == EAGAIN || errno == EWOULDBLOCK)
+			return PX_E_AGAIN;
+		b->last_errno = errno;
+		return PX_E_IO;
+	}
+	if (n != CAN_MTU && n != CANFD_MTU) {
+		b->st.rx_dropped++;
+		return PX_E_AGAIN;
+	}
+	m->fd = n == CANFD_MTU;
+	m->t_ns = clock_ns(CLOCK_MONOTONIC);
+	for (cm = CMSG_FIRSTHDR(&mh); cm; cm = CMSG_NXTHDR(&mh, cm)) {
+		if (cm->cmsg_level == SOL_SOCKET &&
+		    cm->cmsg_type == SCM_TIMESTAMPNS) {
+			struct timespec ts;
+			int64_t rt, off;
+			memcpy(&ts, CMSG_DATA(cm), sizeof ts);
+			rt = (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+			/* kernel stamps on CLOCK_REALTIME; move it onto the
+			 * loop's clock */
+			off = clock_ns(CLOCK_REALTIME) - m->t_ns;
+			m->t_ns = rt - off;
+		}
+	}
+	return PX_OK;
+}
+
+int px_can_iface_state(const char *iface, int *state)
+{
+	int s = 0;
+	if (!iface || !state)
+		return PX_E_INVAL;
+	if (if_nametoindex(iface) == 0)
+		return PX_E_NODEV;
+	if (can_get_state(iface, &s) != 0)
+		return PX_E_IO;
+	switch (s) {
+	case CAN_STATE_ERROR_ACTIVE: *state = PX_CAN_STATE_ACTIVE; break;
+	case CAN_STATE_ERROR_WARNING: *state = PX_CAN_STATE_WARNING; break;
+	case CAN_STATE_ERROR_PASSIVE: *state = PX_CAN_STATE_PASSIVE; break;
+	case CAN_STATE_BUS_OFF: *state = PX_CAN_STATE_BUS_OFF; break;
+	case CAN_STATE_STOPPED: *state = PX_CAN_STATE_STOPPED; break;
+	default: *state = PX_CAN_STATE_UNKNOWN; break;
+	}
+	return PX_OK;
+}
+
+int px_can_iface_restart(const char *iface)
+{
+	if (!iface)
+		return PX_E_INVAL;
+	if (if_nametoindex(iface) == 0)
+		return PX_E_NODEV;
+	return can_do_restart(iface) == 0 ? PX_OK : PX_E_IO;
+}
+
+/* ---- replay ---------------------------------------------------------------- */
+
+int px_can_replay_open(const char *path, const char *iface,
+		       struct px_can_bus **out, char *msg, size_t cap)
+{
+	FILE *f;
+	char line[512], ifn[IFNAMSIZ + 8];
+	struct px_can_bus *b;
+	size_t capn = 0;
+	int lineno = 0, rc = PX_OK;
+	if (msg && cap)
+		msg[0] = 0;
+	if (!path || !out)
+		return PX_E_INVAL;
+	*out = NULL;
+	f = fopen(path, "r");
+	if (!f) {
+		int e = errno;
+		if (msg)
+			snprintf(msg, cap, "%s: %s", path, strerror(e));
+		return e == ENOENT ? PX_E_NOTFOUND : PX_E_IO;
+	}
+	b = bus_new(K_REPLAY);
+	if (!b) {
+		fclose(f);
+		return PX_E_NOMEM;
+	}
+	b->fd_frames = 1;
+	while (fgets(line, sizeof line, f)) {
+		struct px_can_msg m;
+		int64_t t;
+		lineno++;
+		if (line[0] == '\n' || line[0] == '#' || line[0] == 0)
+			continue;
+		if (px_can_log_parse(line, &m, &t, ifn, sizeof ifn) != PX_OK) {
+			if (msg)
+				snprintf(msg, cap, "%s:%d: not a candump -l line "
+					 "\"(sec.usec) iface id#data\"", path,
+					 lineno);
+			rc = PX_E_PARSE;
+			break;
+		}
+		if (iface && strcmp(iface, ifn) != 0)
+			continue;
+		if (b->n_recs == capn) {
+			size_t nc = capn ? capn * 2 : 256;
+			struct px_can_msg *nr = realloc(b->recs, nc * sizeof *nr);
+			int64_t *nt;
+			if (!nr) {
+				rc = PX_E_NOMEM;
+				break;
+			}
+			b->recs = nr;
+			nt = realloc(b->rec_t, nc * sizeof *nt);
+			if (!nt) {
+				rc = PX_E_NOMEM;
+				break;
+			}
+			b->rec_t = nt;
+			capn = nc;
+		}
+		b->recs[b->n_recs] = m;
+		b->rec_t[b->n_recs] = t;
+		b->n_recs++;
+	}
+	fclose(f);
+	if (rc != PX_OK) {
+		px_can_bus_close(b);
+		return rc;
+	}
+	*out = b;
+	return PX_OK;
+}
+
+static int replay_recv(struct px_can_bus *b, int64_t now, struct px_can_msg *m)
+{
+	int64_t off;
+	if (!b->started) {
+		b->started = 1;
+		b->t0_now = now;
+	}
+	if (b->next >= b->n_recs)
+		return PX_E_AGAIN;
+	off = b->rec_t[b->next] - b->rec_t[0];
+	if (now - b->t0_now < off)
+		return PX_E_AGAIN;
+	*m = b->recs[b->next++];
+	m->t_ns = b->t0_now + off;
+	return PX_OK;
+}
+
+/* ---- common --------------------------------------------------------------- */
+
+int px_can_bus_send(struct px_can_bus *b, const struct px_can_msg *m,
+		    int64_t now_ns)
+{
+	int rc;
+	if (!b || !m || m->f.len > (m->fd ? CANFD_MAX_DLEN : CAN_MAX_DLEN))
+		return PX_E_INVAL;
+	switch (b->kind) {
+	case K_SIM: rc = sim_send(b, m, now_ns); break;
+	case K_UNIX: rc = unix_send(b, m, now_ns); break;
+	case K_RAW: rc = raw_send(b, m, now_ns); break;
+	default: rc = PX_OK; break; /* replay: sends go nowhere */
+	}
+	if (rc == PX_OK)
+		b->st.tx++;
+	return rc;
+}
+
+int px_can_bus_recv(struct px_can_bus *b, int64_t now_ns,
+		    struct px_can_msg *m)
+{
+	int rc;
+	if (!b || !m)
+		return PX_E_INVAL;
+	switch (b->kind) {
+	case K_SIM: rc = sim_recv(b, now_ns, m); break;
+	case K_UNIX: rc = unix_recv(b, now_ns, m); break;
+	case K_RAW: rc = raw_recv(b, now_ns, m); break;
+	default: rc = replay_recv(b, now_ns, m); break;
+	}
+	if (rc != PX_OK)
+		return rc;
+	b->st.rx++;
+	if (m->f.can_id & CAN_ERR_FLAG) {
+		struct px_can_err_info e;
+		b->st.err_frames++;
+		if (px_can_err_decode(&m->f, &e) == PX_OK &&
+		    e.state != PX_CAN_STATE_UNKNOWN)
+			b->st.state = e.state;
+	}
+	return PX_OK;
+}
+
+void px_can_bus_stats(const struct px_can_bus *b, struct px_can_bus_stats *st)
+{
+	if (!st)
+		return;
+	if (!b) {
+		memset(st, 0, sizeof *st);
+		return;
+	}
+	*st = b->st;
+}
+
+int px_can_bus_errno(const struct px_can_bus *b)
+{
+	return b ? b->last_errno : 0;
+}
+
+void px_can_bus_close(struct px_can_bus *b)
+{
+	size_t i;
+	if (!b)
+		return;
+	if (b->sim)
+		for (i = 0; i < b->sim->n_eps; i++)
+			if (b->sim->eps[i] == b)
+				b->sim->eps[i] = NULL;
+	if (b->sock >= 0)
+		close(b->sock);
+	if (b->kind == K_UNIX && b->local[0])
+		unlink(b->local);
+	free(b->q);
+	free(b->recs);
+	free(b->rec_t);
+	free(b);
+}

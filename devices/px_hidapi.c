@@ -1,0 +1,412 @@
+/* HID back end over hidapi. Every hidapi call of the library is in this
+ * file. */
+#include <errno.h>
+#include <pthread.h>
+#include <semaphore.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <wchar.h>
+
+#include <hidapi.h>
+
+#include "px_arena.h"
+#include "px_hid.h"
+#include "px_param.h"
+
+#ifndef PX_HIDAPI_DRIVER
+#define PX_HIDAPI_DRIVER "hidraw"
+#endif
+
+#define REP_MAX 256
+#define READ_TIMEOUT_MS 50
+#define REOPEN_NS 200000000
+
+struct outrep {
+	size_t len;
+	uint8_t b[REP_MAX];
+};
+
+struct hid {
+	struct px_hid_config cfg;
+	char serial[128];
+	char path[256];
+	hid_device *h;
+	pthread_mutex_t lock; /* h between reader (reopen) and writer */
+	pthread_t reader, writer;
+	int threads;
+	atomic_int stop;
+	sem_t wake;
+	struct px_arena arena;
+	uint8_t arena_buf[4 * sizeof(struct outrep) + 512];
+	struct px_param *out;
+};
+
+static pthread_once_t init_once = PTHREAD_ONCE_INIT;
+static int init_rc;
+
+static void do_init(void)
+{
+	init_rc = hid_init();
+}
+
+int px_hid_driver(void)
+{
+	return strcmp(PX_HIDAPI_DRIVER, "libusb") == 0 ? PX_HID_LIBUSB
+						       : PX_HID_HIDRAW;
+}
+
+const char *px_hid_driver_name(void)
+{
+	return PX_HIDAPI_DRIVER;
+}
+
+static int count_devices(void)
+{
+	struct hid_device_info *all = hid_enumerate(0, 0), *p;
+	int n = 0;
+	for (p = all; p; p = p->next)
+		n++;
+	hid_free_enumeration(all);
+	return n;
+}
+
+/* Find the path of the matching device, so that "not there" and "there
+ * but cannot be opened" give different answers. */
+static int find_path(const struct hid *x, char *path, size_t cap)
+{
+	struct hid_device_info *all, *p;
+	int found = 0;
+	wchar_t ws[128];
+	if (x->cfg.serial && mbstowcs(ws, x->cfg.serial, 127) == (size_t)-1)
+		return PX_E_INVAL;
+	ws[127] = 0;
+	all = hid_enumerate(x->cfg.vid, x->cfg.pid);
+	for (p = all; p && !found; p = p->next) {
+		if (x->cfg.serial &&
+		    (!p->serial_number || wcscmp(p->serial_number, ws) != 0))
+			continue;
+		snprintf(path, cap, "%s", p->path);
+		found = 1;
+	}
+	hid_free_enumeration(all);
+	return found ? PX_OK : PX_E_NOTFOUND;
+}
+
+/* Open (or reopen). Returns PX_OK or an error with msg filled. */
+static int hid_open_dev(struct hid *x, const char *nm, char *msg, size_t cap,
+			int *sys_errno)
+{
+	char path[256];
+	int rc, e;
+	*sys_errno = 0;
+	if (x->cfg.has_vid_pid) {
+		rc = find_path(x, path, sizeof path);
+		if (rc == PX_E_INVAL) {
+			if (msg)
+				snprintf(msg, cap, "%s: serial '%s' is not "
+					 "valid text", nm, x->cfg.serial);
+			return rc;
+		}
+		if (rc != PX_OK) {
+			if (msg)
+				snprintf(msg, cap,
+					 "%s: no HID device %04x:%04x%s%s found "
+					 "(%d HID devices present; "
+					 "proxima-probe lists them)",
+					 nm, x->cfg.vid, x->cfg.pid,
+					 x->cfg.serial ? " serial " : "",
+					 x->cfg.serial ? x->cfg.serial : "",
+					 count_devices());
+			return PX_E_NOTFOUND;
+		}
+	} else {
+		snprintf(path, sizeof path, "%s", x->path);
+	}
+	errno = 0;
+	x->h = hid_open_path(path);
+	e = errno;
+	if (x->h) {
+		snprintf(x->path, sizeof x->path, "%s", path);
+		return PX_OK;
+	}
+	*sys_errno = e;
+	if (msg) {
+		const wchar_t *he = hid_error(NULL);
+		snprintf(msg, cap, "%s: cannot open HID device %s (hidapi %s)%s%s"
+			 "%s%ls",
+			 nm, path, PX_HIDAPI_DRIVER,
+			 e ? ": " : "", e ? strerror(e) : "",
+			 he ? ": " : "", he ? he : L"");
+		if (e == EACCES || e == EPERM) {
+			size_t l = strlen(msg);
+			snprintf(msg + l, cap > l ? cap - l : 0,
+				 " (no permission: add a udev rule giving your "
+				 "user access to the hidraw node)");
+		}
+	}
+	if (e == EACCES || e == EPERM)
+		return PX_E_PERM;
+	if (e == ENOENT || e == ENODEV || e == ENXIO)
+		return PX_E_NOTFOUND;
+	return PX_E_IO;
+}
+
+static void sleep_ns(int64_t ns)
+{
+	struct timespec ts = {(time_t)(ns / 1000000000), (long)(ns % 1000000000)};
+	nanosleep(&ts, NULL);
+}
+
+static void *reader_main(void *p)
+{
+	struct px_dev *d = p;
+	struct hid *x = px_dev_impl(d);
+	uint8_t buf[REP_MAX];
+	while (!atomic_load(&x->stop)) {
+		int n, e;
+		if (!x->h) {
+			int se;
+			sleep_ns(REOPEN_NS);
+			pthread_mutex_lock(&x->lock);
+			if (hid_open_dev(x, px_dev_name(d), NULL, 0, &se) ==
+			    PX_OK)
+				px_dev_set_state(d, PX_DEV_STATE_RUNNING,
+						 px_dev_mono_ns());
+			pthread_mutex_unlock(&x->lock);
+			continue;
+		}
+		errno = 0;
+		n = hid_read_timeout(x->h, buf, sizeof buf, READ_TIMEOUT_MS);
+		e = errno;
+		if (n > 0) {
+			px_dev_feed_report(d, buf, (size_t)n, px_dev_mono_ns());
+			continue;
+		}
+		if (n == 0)
+			continue;
+		px_dev_record(d, PX_DEV_ERR_IO, PX_E_NODEV, e, -1, NULL,
+			      "hid_read failed", px_dev_mono_ns());
+		px_dev_set_state(d, PX_DEV_STATE_UNPLUGGED, px_dev_mono_ns());
+		pthread_mutex_lock(&x->lock);
+		hid_close(x->h);
+		x->h = NULL;
+		pthread_mutex_unlock(&x->lock);
+	}
+	return NULL;
+}
+
+static void *writer_main(void *p)
+{
+	struct px_dev *d = p;
+	struct hid *x = px_dev_impl(d);
+	while (!atomic_load(&x->stop)) {
+		const struct outrep *o;
+		int fresh = 0;
+		while (sem_wait(&x->wake) != 0 && errno == EINTR)
+			;
+		if (atomic_load(&x->stop))
+			break;
+		o = px_param_read(x->out, &fresh);
+		if (!fresh || o->len == 0)
+			continue;
+		pthread_mutex_lock(&x->lock);
+		if (x->h) {
+			int n, e;
+			errno = 0;
+			n = hid_write(x->h, o->b, o->len);
+			e = errno;
+			if (n < 0)
+				px_dev_record(d, PX_DEV_ERR_IO, PX_E_IO, e,
+					      o->b[0], NULL, "hid_write failed",
+					      px_dev_mono_ns());
+		}
+		pthread_mutex_unlock(&x->lock);
+	}
+	return NULL;
+}
+
+static int hid_start(struct px_dev *d)
+{
+	struct hid *x = px_dev_impl(d);
+	atomic_store(&x->stop, 0);
+	if (pthread_create(&x->reader, NULL, reader_main, d) != 0)
+		return PX_E_NOMEM;
+	if (pthread_create(&x->writer, NULL, writer_main, d) != 0) {
+		atomic_store(&x->stop, 1);
+		pthread_join(x->reader, NULL);
+		return PX_E_NOMEM;
+	}
+	x->threads = 1;
+	return PX_OK;
+}
+
+static void hid_stop(struct px_dev *d)
+{
+	struct hid *x = px_dev_impl(d);
+	if (!x->threads)
+		return;
+	atomic_store(&x->stop, 1);
+	sem_post(&x->wake);
+	pthread_join(x->writer, NULL);
+	pthread_join(x->reader, NULL);
+	x->threads = 0;
+}
+
+static int hid_force(struct px_dev *d, const struct px_force_cmd *c,
+		     int64_t now)
+{
+	struct hid *x = px_dev_impl(d);
+	const struct px_codec_map *m = px_dev_config(d)->codec;
+	double w[PX_WRENCH__COUNT] = {0};
+	struct px_codec_diag diag;
+	struct outrep o;
+	int n, k;
+	if (!m->n_outputs)
+		return PX_E_UNSUPPORTED;
+	if (c->enable)
+		for (k = 0; k < 3; k++) {
+			w[k] = c->force_n[k];
+			w[3 + k] = c->torque_n_m[k];
+		}
+	n = px_codec_encode(m, w, o.b, sizeof o.b, NULL, &diag);
+	if (n < 0) {
+		px_dev_record(d, PX_DEV_ERR_ENCODE, n, 0, diag.report_id,
+			      &diag, NULL, now);
+		return n;
+	}
+	o.len = (size_t)n;
+	px_param_write(x->out, &o);
+	sem_post(&x->wake);
+	return PX_OK;
+}
+
+static void hid_destroy(struct px_dev *d)
+{
+	struct hid *x = px_dev_impl(d);
+	if (x->h)
+		hid_close(x->h);
+	x->h = NULL;
+	sem_destroy(&x->wake);
+	pthread_mutex_destroy(&x->lock);
+}
+
+static const struct px_dev_ops hid_ops = {
+	.backend = "hidapi",
+	.caps = PX_DEV_CAP_POSE | PX_DEV_CAP_FORCE,
+	.start = hid_start,
+	.stop = hid_stop,
+	.force = hid_force,
+	.destroy = hid_destroy,
+};
+
+int px_hid_create(const struct px_dev_config *dcfg,
+		  const struct px_hid_config *hc, struct px_dev **out,
+		  char *msg, size_t cap)
+{
+	struct hid tmp, *x;
+	struct outrep zero;
+	const char *nm;
+	int rc, se = 0;
+	if (msg && cap)
+		msg[0] = 0;
+	if (out)
+		*out = NULL;
+	if (!dcfg || !hc || !out || !dcfg->codec ||
+	    (!hc->has_vid_pid && (!hc->path || !*hc->path))) {
+		if (msg)
+			snprintf(msg, cap, "%s: HID device needs a codec map "
+				 "and vid:pid or a path",
+				 dcfg && dcfg->name ? dcfg->name : "hid");
+		return PX_E_INVAL;
+	}
+	nm = dcfg->name ? dcfg->name : "hid";
+	if (hc->driver != px_hid_driver()) {
+		if (msg)
+			snprintf(msg, cap,
+				 "%s: driver %s asked for, but this build "
+				 "links hidapi-%s (rebuild with make HIDAPI=%s)",
+				 nm, hc->driver == PX_HID_LIBUSB ? "libusb"
+								 : "hidraw",
+				 PX_HIDAPI_DRIVER,
+				 hc->driver == PX_HID_LIBUSB ? "libusb"
+							     : "hidraw");
+		return PX_E_UNSUPPORTED;
+	}
+	if (px_codec_check(dcfg->codec, NULL) != PX_OK) {
+		if (msg)
+			snprintf(msg, cap, "%s: bad codec map (px_codec_check)",
+				 nm);
+		return PX_E_INVAL;
+	}
+	pthread_once(&init_once, do_init);
+	if (init_rc != 0) {
+		if (msg)
+			snprintf(msg, cap, "%s: hid_init failed: %ls", nm,
+				 hid_error(NULL) ? hid_error(NULL) : L"?");
+		return PX_E_IO;
+	}
+	memset(&tmp, 0, sizeof tmp);
+	tmp.cfg = *hc;
+	if (hc->serial) {
+		snprintf(tmp.serial, sizeof tmp.serial, "%s", hc->serial);
+		tmp.cfg.serial = tmp.serial;
+	}
+	if (hc->path)
+		snprintf(tmp.path, sizeof tmp.path, "%s", hc->path);
+	tmp.cfg.path = NULL;
+	rc = hid_open_dev(&tmp, nm, msg, cap, &se);
+	if (rc != PX_OK)
+		return rc;
+	rc = px_dev_create(&hid_ops, dcfg, sizeof *x, out);
+	if (rc != PX_OK) {
+		hid_close(tmp.h);
+		if (msg)
+			snprintf(msg, cap, "%s: %s", nm, px_strerror(rc));
+		return rc;
+	}
+	x = px_dev_impl(*out);
+	memcpy(x, &tmp, sizeof tmp);
+	if (x->cfg.serial)
+		x->cfg.serial = x->serial;
+	pthread_mutex_init(&x->lock, NULL);
+	sem_init(&x->wake, 0, 0);
+	atomic_init(&x->stop, 0);
+	px_arena_init(&x->arena, x->arena_buf, sizeof x->arena_buf);
+	memset(&zero, 0, sizeof zero);
+	rc = px_param_create(&x->arena, sizeof zero, &zero, &x->out);
+	if (rc != PX_OK) {
+		px_dev_free(*out);
+		*out = NULL;
+		return rc;
+	}
+	return PX_OK;
+}
+
+int px_hid_list(void (*fn)(void *user, const char *line), void *user)
+{
+	struct hid_device_info *all, *p;
+	int n = 0;
+	char line[512];
+	if (!fn)
+		return PX_E_INVAL;
+	pthread_once(&init_once, do_init);
+	if (init_rc != 0)
+		return PX_E_IO;
+	all = hid_enumerate(0, 0);
+	for (p = all; p; p = p->next) {
+		snprintf(line, sizeof line,
+			 "%04x:%04x usage %04x:%04x interface %d path %s "
+			 "\"%ls\" serial \"%ls\"",
+			 p->vendor_id, p->product_id, p->usage_page, p->usage,
+			 p->interface_number, p->path,
+			 p->product_string ? p->product_string : L"",
+			 p->serial_number ? p->serial_number : L"");
+		fn(user, line);
+		n++;
+	}
+	hid_free_enumeration(all);
+	return n;
+}

@@ -1,0 +1,244 @@
+/* HID back end over hidapi. Here (no HID devices) the open paths must give
+ * clear errors. Where /dev/uhid exists (the VM suite) a virtual HID
+ * device is created through it and the real back end reads its input
+ * reports, writes output reports, and sees it unplugged. */
+#include <errno.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <stdio.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <linux/uhid.h>
+
+#include "px_dev.h"
+#include "px_hid.h"
+#include "px_test.h"
+
+static void test_open_by_vid_pid_not_found(void)
+{
+	struct px_dev_config c;
+	struct px_hid_config h;
+	struct px_dev *d = (struct px_dev *)1;
+	char msg[300];
+	int rc;
+	px_dev_config_default(&c);
+	c.name = "spacemouse";
+	c.codec = px_codec_builtin("spacemouse");
+	memset(&h, 0, sizeof h);
+	h.has_vid_pid = 1;
+	h.vid = 0x256f;
+	h.pid = 0xc635;
+	h.driver = px_hid_driver();
+	rc = px_hid_create(&c, &h, &d, msg, sizeof msg);
+	if (rc == PX_OK) {
+		px_dev_free(d);
+		PX_SKIP("a real 256f:c635 device is attached");
+	}
+	PX_CHECK_INT_EQ(rc, PX_E_NOTFOUND);
+	PX_CHECK(d == NULL);
+	PX_CHECK_MSG(strstr(msg, "spacemouse: no HID device 256f:c635 found") &&
+			     strstr(msg, "proxima-probe"), "%s", msg);
+	h.serial = "SN123";
+	rc = px_hid_create(&c, &h, &d, msg, sizeof msg);
+	PX_CHECK_INT_EQ(rc, PX_E_NOTFOUND);
+	PX_CHECK_MSG(strstr(msg, "256f:c635 serial SN123") != NULL, "%s", msg);
+}
+
+static void test_open_by_path_gives_errno(void)
+{
+	struct px_dev_config c;
+	struct px_hid_config h;
+	struct px_dev *d;
+	char msg[300];
+	int rc;
+	px_dev_config_default(&c);
+	c.name = "haptic";
+	c.codec = px_codec_builtin("haptic");
+	memset(&h, 0, sizeof h);
+	h.path = "/dev/hidraw-proxima-absent";
+	h.driver = px_hid_driver();
+	rc = px_hid_create(&c, &h, &d, msg, sizeof msg);
+	PX_CHECK_MSG(rc == PX_E_NOTFOUND || rc == PX_E_IO, "rc %d: %s", rc,
+		     msg);
+	PX_CHECK_MSG(strstr(msg, "haptic: cannot open HID device "
+				 "/dev/hidraw-proxima-absent") != NULL,
+		     "%s", msg);
+	if (px_hid_driver() == PX_HID_HIDRAW)
+		PX_CHECK_MSG(strstr(msg, "No such file or directory") != NULL,
+			     "%s", msg);
+}
+
+static void test_config_errors(void)
+{
+	struct px_dev_config c;
+	struct px_hid_config h;
+	struct px_dev *d;
+	char msg[300];
+	px_dev_config_default(&c);
+	c.name = "x";
+	c.codec = px_codec_builtin("haptic");
+	memset(&h, 0, sizeof h);
+	h.has_vid_pid = 1;
+	h.driver = px_hid_driver() == PX_HID_HIDRAW ? PX_HID_LIBUSB
+						    : PX_HID_HIDRAW;
+	PX_CHECK_INT_EQ(px_hid_create(&c, &h, &d, msg, sizeof msg),
+			PX_E_UNSUPPORTED);
+	PX_CHECK_MSG(strstr(msg, "rebuild with make HIDAPI=") != NULL, "%s",
+		     msg);
+	h.driver = px_hid_driver();
+	h.has_vid_pid = 0;
+	PX_CHECK_INT_EQ(px_hid_create(&c, &h, &d, msg, sizeof msg),
+			PX_E_INVAL);
+	PX_CHECK(strstr(msg, "vid:pid or a path") != NULL);
+	c.codec = NULL;
+	h.has_vid_pid = 1;
+	PX_CHECK_INT_EQ(px_hid_create(&c, &h, &d, msg, sizeof msg),
+			PX_E_INVAL);
+	PX_CHECK(strcmp(px_hid_driver_name(), "hidraw") == 0 ||
+		 strcmp(px_hid_driver_name(), "libusb") == 0);
+}
+
+/* ---- through /dev/uhid ------------------------------------------------ */
+
+/* Report 1: x, y, z int32 + 4 buttons (+4 pad bits); output report 2:
+ * three int16: the built-in "haptic" map. */
+static const uint8_t haptic_rd[] = {
+	0x05, 0x01, 0x09, 0x08, 0xA1, 0x01,
+	0x85, 0x01, 0x09, 0x30, 0x09, 0x31, 0x09, 0x32,
+	0x17, 0x00, 0x00, 0x00, 0x80, 0x27, 0xFF, 0xFF, 0xFF, 0x7F,
+	0x75, 0x20, 0x95, 0x03, 0x81, 0x02,
+	0x05, 0x09, 0x19, 0x01, 0x29, 0x04, 0x15, 0x00, 0x25, 0x01,
+	0x75, 0x01, 0x95, 0x04, 0x81, 0x02, 0x75, 0x04, 0x95, 0x01,
+	0x81, 0x01,
+	0x85, 0x02, 0x06, 0x00, 0xFF, 0x09, 0x01,
+	0x16, 0x00, 0x80, 0x26, 0xFF, 0x7F, 0x75, 0x10, 0x95, 0x03,
+	0x91, 0x02,
+	0xC0,
+};
+
+/* Wait (bounded) for a uhid event of type want; returns 0 or -1. */
+static int uhid_wait(int fd, uint32_t want, struct uhid_event *ev, int ms)
+{
+	while (ms > 0) {
+		struct pollfd p = {fd, POLLIN, 0};
+		int r = poll(&p, 1, 100);
+		ms -= 100;
+		if (r <= 0)
+			continue;
+		if (read(fd, ev, sizeof *ev) <= 0)
+			return -1;
+		if (ev->type == want)
+			return 0;
+	}
+	return -1;
+}
+
+static void wait_ms(int ms)
+{
+	struct timespec ts = {ms / 1000, (ms % 1000) * 1000000L};
+	nanosleep(&ts, NULL);
+}
+
+static void test_uhid_device_roundtrip(void)
+{
+	struct uhid_event ev;
+	struct px_dev_config c;
+	struct px_hid_config h;
+	struct px_dev *d = NULL;
+	struct px_pose_sample s;
+	struct px_force_cmd cmd = {{1.5, -0.25, 7.0}, {0, 0, 0}, 1};
+	struct px_dev_status st;
+	const struct px_codec_map *m = px_codec_builtin("haptic");
+	char msg[300];
+	int fd, rc = PX_E_NOTFOUND, i, k;
+	fd = open("/dev/uhid", O_RDWR | O_CLOEXEC);
+	if (fd < 0)
+		PX_SKIP("no /dev/uhid (%s): the VM suite runs this",
+			strerror(errno));
+	memset(&ev, 0, sizeof ev);
+	ev.type = UHID_CREATE2;
+	snprintf((char *)ev.u.create2.name, sizeof ev.u.create2.name,
+		 "proxima test haptic");
+	memcpy(ev.u.create2.rd_data, haptic_rd, sizeof haptic_rd);
+	ev.u.create2.rd_size = sizeof haptic_rd;
+	ev.u.create2.bus = 0x03; /* BUS_USB */
+	ev.u.create2.vendor = 0x1234;
+	ev.u.create2.product = 0x0001;
+	PX_CHECK(write(fd, &ev, sizeof ev) == (ssize_t)sizeof ev);
+	PX_CHECK_INT_EQ(uhid_wait(fd, UHID_START, &ev, 5000), 0);
+	px_dev_config_default(&c);
+	c.name = "uhid-haptic";
+	c.codec = m;
+	c.stale_timeout_ns = 1000000000;
+	memset(&h, 0, sizeof h);
+	h.has_vid_pid = 1;
+	h.vid = 0x1234;
+	h.pid = 0x0001;
+	h.driver = px_hid_driver();
+	for (i = 0; i < 50 && rc != PX_OK; i++) { /* node appears async */
+		rc = px_hid_create(&c, &h, &d, msg, sizeof msg);
+		if (rc != PX_OK)
+			wait_ms(100);
+	}
+	PX_CHECK_MSG(rc == PX_OK, "%s", msg);
+	PX_CHECK_INT_EQ(px_dev_start(d), PX_OK);
+	/* input reports sent before UHID_OPEN are dropped */
+	PX_CHECK_INT_EQ(uhid_wait(fd, UHID_OPEN, &ev, 5000), 0);
+	for (k = 1; k <= 20; k++) {
+		double a[6] = {k * 1e-3, -k * 2e-3, 0.25, 0, 0, 0};
+		int n;
+		memset(&ev, 0, sizeof ev);
+		ev.type = UHID_INPUT2;
+		n = px_codec_encode_input(m, 1, a, (uint64_t)k & 15,
+					  ev.u.input2.data,
+					  sizeof ev.u.input2.data);
+		PX_CHECK(n == 14);
+		ev.u.input2.size = (uint16_t)n;
+		PX_CHECK(write(fd, &ev, sizeof ev) == (ssize_t)sizeof ev);
+	}
+	for (i = 0; i < 500; i++) {
+		px_dev_pose_read(d, px_dev_mono_ns(), &s);
+		if (s.seq >= 1 && s.pos_m.x > 0.0199)
+			break;
+		wait_ms(10);
+	}
+	PX_CHECK_NEAR(s.pos_m.x, 0.020, 1e-12);
+	PX_CHECK_NEAR(s.pos_m.y, -0.040, 1e-12);
+	PX_CHECK_NEAR(s.pos_m.z, 0.25, 1e-12);
+	PX_CHECK_INT_EQ(s.buttons, 20 & 15);
+	PX_CHECK(s.valid);
+	/* output report: 1.5 N, -0.25 N, 7 N clamped to 3 N, in mN */
+	PX_CHECK_INT_EQ(px_dev_force_write(d, &cmd, px_dev_mono_ns()), PX_OK);
+	PX_CHECK_INT_EQ(uhid_wait(fd, UHID_OUTPUT, &ev, 5000), 0);
+	PX_CHECK_INT_EQ(ev.u.output.size, 7);
+	PX_CHECK_INT_EQ(ev.u.output.data[0], 2);
+	PX_CHECK_INT_EQ(ev.u.output.data[1] | (ev.u.output.data[2] << 8), 1500);
+	PX_CHECK_INT_EQ(ev.u.output.data[5] | (ev.u.output.data[6] << 8), 3000);
+	/* unplug: the reader sees it, the cycle gets PX_E_NODEV */
+	memset(&ev, 0, sizeof ev);
+	ev.type = UHID_DESTROY;
+	PX_CHECK(write(fd, &ev, sizeof ev) == (ssize_t)sizeof ev);
+	for (i = 0; i < 300; i++) {
+		if (px_dev_pose_read(d, px_dev_mono_ns(), &s) == PX_E_NODEV)
+			break;
+		wait_ms(10);
+	}
+	PX_CHECK(!s.valid && s.stale);
+	px_dev_status(d, &st);
+	PX_CHECK_INT_EQ(st.unplugs, 1);
+	PX_CHECK_MSG(strstr(st.last_msg, "uhid-haptic (hidapi)") != NULL, "%s",
+		     st.last_msg);
+	px_dev_free(d);
+	close(fd);
+}
+
+static const struct px_test tests[] = {
+	PX_T(test_open_by_vid_pid_not_found),
+	PX_T(test_open_by_path_gives_errno),
+	PX_T(test_config_errors),
+	PX_T(test_uhid_device_roundtrip),
+};
+
+PX_TEST_MAIN(tests)
