@@ -42,6 +42,8 @@ ALL_LDFLAGS := $(SANFLAGS) $(LDFLAGS)
 
 # Optional libraries found with pkg-config (device back ends, config).
 PKGS     :=
+# Mesh and point-cloud file import (STL, OBJ, PLY).
+PKGS     += assimp
 PKG_CFLAGS := $(if $(PKGS),$(shell pkg-config --cflags $(PKGS)))
 PKG_LIBS   := $(if $(PKGS),$(shell pkg-config --libs $(PKGS)))
 LIBS    := $(PKG_LIBS) -lm -lpthread
@@ -71,6 +73,7 @@ PC_FILE    := $(BUILD)/lib/pkgconfig/$(NAME).pc
 
 # Debian packages that building and testing need (see `make deps`).
 DEB_PACKAGES := gcc make libc6-dev pkg-config
+DEB_PACKAGES += libassimp-dev
 # Debian packages the benchmarks compare against (installed by `make bench`;
 # a benchmark whose reference is missing says so and still runs).
 BENCH_DEB_PACKAGES := rt-tests

@@ -150,3 +150,8 @@ const void *px_model_impl(const struct px_model *m)
 {
 	return m ? m->impl : NULL;
 }
+
+const struct px_model_ops *px_model_get_ops(const struct px_model *m)
+{
+	return m ? m->ops : NULL;
+}

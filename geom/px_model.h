@@ -199,8 +199,11 @@ PX_API enum px_model_kind px_model_kind(const struct px_model *m);
 PX_API const char *px_model_name(const struct px_model *m);
 PX_API unsigned px_model_caps(const struct px_model *m);
 PX_API size_t px_model_memory_bytes(const struct px_model *m);
-/* The implementation pointer (for representation-specific accessors). */
+/* The implementation pointer and ops table (for representation-specific
+ * accessors, which check the ops to know the model is theirs).
+ * @note RT-safe. */
 PX_API const void *px_model_impl(const struct px_model *m);
+PX_API const struct px_model_ops *px_model_get_ops(const struct px_model *m);
 
 #ifdef __cplusplus
 }

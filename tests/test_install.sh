@@ -42,7 +42,9 @@ int main(void)
 C
 export PKG_CONFIG_SYSROOT_DIR="$tmp/root"
 export PKG_CONFIG_PATH="$tmp/root/usr/lib/pkgconfig"
-export PKG_CONFIG_LIBDIR="$tmp/root/usr/lib/pkgconfig"
+# The scratch tree first, then the system directories for the packages
+# proxima.pc requires (Requires.private, e.g. yaml-0.1).
+export PKG_CONFIG_LIBDIR="$tmp/root/usr/lib/pkgconfig:$(pkg-config --variable pc_path pkg-config)"
 check "pkg-config knows proxima" pkg-config --exists proxima
 cflags=$(pkg-config --cflags proxima) libs=$(pkg-config --libs proxima)
 slibs=$(pkg-config --static --libs proxima)

@@ -384,7 +384,7 @@ static void test_interface(void)
 	rc = px_model_query_ex(m, px_v3_add(P.t, px_v3(1.5, 0, 0)), 0.1, -1, 0, &r);
 	PX_CHECK_INT_EQ(rc, 0);
 	PX_CHECK(isinf(r.distance) && r.index == -1);
-	rc = px_model_query_ex(m, px_v3_add(P.t, px_v3(1.5, 0, 0)), 1.0, -1, 0, &r);
+	rc = px_model_query_ex(m, px_v3_add(P.t, px_v3(1.5, 0, 0)), 1.0 + 1e-9, -1, 0, &r);
 	PX_CHECK_INT_EQ(rc, 1);
 	PX_CHECK_NEAR(r.distance, 1.0, 1e-12);
 	rc = px_model_query_ex(m, P.t, INFINITY, -1, PX_QUERY_UNSIGNED, &r);
