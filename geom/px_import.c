@@ -10,6 +10,7 @@
  * arrive as the library's single-precision floats; they are widened to
  * double exactly.
  */
+#include <ctype.h>
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -141,6 +142,240 @@ static void walk(struct acc *A, const struct aiScene *s,
 		walk(A, s, n->mChildren[i], &T, seen, depth + 1);
 }
 
+/* ---- strict PLY structure check ---------------------------------------------
+ *
+ * The importer's PLY reader is lenient: a body shorter than its header
+ * promises is padded by repeating values, so a truncated scan would load
+ * as a wrong cloud without a word. Before importing, the header is read
+ * and the body walked element by element, property by property (list
+ * lengths included), for ASCII and both binary byte orders: every value
+ * must be present and numeric, and nothing may follow the last element.
+ */
+
+#define PLY_MAX_PROPS 64
+#define PLY_MAX_ELEMS 16
+
+struct ply_prop {
+	int list;   /* 0: scalar */
+	int csize;  /* byte size of the count (lists) */
+	int size;   /* byte size of the value / list item */
+};
+
+struct ply_elem {
+	char name[64];
+	unsigned long long count;
+	int n_props;
+	struct ply_prop props[PLY_MAX_PROPS];
+};
+
+static int ply_type_size(const char *t)
+{
+	static const struct {
+		const char *name;
+		int size;
+	} T[] = {{"char", 1},    {"uchar", 1},  {"int8", 1},    {"uint8", 1},
+		 {"short", 2},   {"ushort", 2}, {"int16", 2},   {"uint16", 2},
+		 {"int", 4},     {"uint", 4},   {"int32", 4},   {"uint32", 4},
+		 {"float", 4},   {"float32", 4}, {"double", 8}, {"float64", 8}};
+	size_t i;
+	for (i = 0; i < sizeof(T) / sizeof(T[0]); i++)
+		if (strcmp(t, T[i].name) == 0)
+			return T[i].size;
+	return 0;
+}
+
+static unsigned long long ply_uint(const unsigned char *b, int size, int big)
+{
+	unsigned long long v = 0;
+	int i;
+	for (i = 0; i < size; i++)
+		v |= (unsigned long long)b[big ? size - 1 - i : i] << (8 * i);
+	return v;
+}
+
+/* Next whitespace-separated token of an ASCII body; counts lines. */
+static int ply_token(FILE *f, char *tok, size_t cap, long *line)
+{
+	int c;
+	size_t n = 0;
+	while ((c = fgetc(f)) != EOF && isspace(c))
+		if (c == '\n')
+			(*line)++;
+	if (c == EOF)
+		return 0;
+	do {
+		if (n + 1 < cap)
+			tok[n++] = (char)c;
+	} while ((c = fgetc(f)) != EOF && !isspace(c));
+	if (c == '\n')
+		ungetc(c, f);
+	tok[n] = '\0';
+	return 1;
+}
+
+static int ply_validate(const char *path, char *msg, size_t msg_cap)
+{
+	struct ply_elem *E = NULL;
+	int ne = 0, fmt = -1, rc = PX_E_PARSE, k;
+	char line[512];
+	long lineno = 0;
+	FILE *f = fopen(path, "rb");
+	unsigned long long i;
+
+	if (!f) {
+		snprintf(msg, msg_cap, "%s: %s", path, strerror(errno));
+		return PX_E_IO;
+	}
+	E = calloc(PLY_MAX_ELEMS, sizeof(*E));
+	if (!E) {
+		fclose(f);
+		return PX_E_NOMEM;
+	}
+	/* header */
+	for (;;) {
+		char w[4][64];
+		int nw;
+		if (!fgets(line, sizeof(line), f)) {
+			snprintf(msg, msg_cap, "%s:%ld: PLY header without end_header", path, lineno);
+			goto out;
+		}
+		lineno++;
+		nw = sscanf(line, "%63s %63s %63s %63s", w[0], w[1], w[2], w[3]);
+		if (lineno == 1) {
+			if (nw < 1 || strcmp(w[0], "ply") != 0) {
+				snprintf(msg, msg_cap, "%s:1: not a PLY file", path);
+				goto out;
+			}
+			continue;
+		}
+		if (nw <= 0 || strcmp(w[0], "comment") == 0 || strcmp(w[0], "obj_info") == 0)
+			continue;
+		if (strcmp(w[0], "end_header") == 0)
+			break;
+		if (strcmp(w[0], "format") == 0 && nw >= 2) {
+			fmt = strcmp(w[1], "ascii") == 0 ? 0
+			      : strcmp(w[1], "binary_little_endian") == 0 ? 1
+			      : strcmp(w[1], "binary_big_endian") == 0 ? 2 : -2;
+			if (fmt == -2) {
+				snprintf(msg, msg_cap, "%s:%ld: unknown PLY format '%s'", path, lineno, w[1]);
+				goto out;
+			}
+		} else if (strcmp(w[0], "element") == 0 && nw >= 3) {
+			char *end;
+			if (ne == PLY_MAX_ELEMS) {
+				snprintf(msg, msg_cap, "%s:%ld: too many PLY elements", path, lineno);
+				goto out;
+			}
+			snprintf(E[ne].name, sizeof(E[ne].name), "%s", w[1]);
+			E[ne].count = strtoull(w[2], &end, 10);
+			if (*end || w[2][0] == '-') {
+				snprintf(msg, msg_cap, "%s:%ld: bad element count '%s'", path, lineno, w[2]);
+				goto out;
+			}
+			ne++;
+		} else if (strcmp(w[0], "property") == 0 && nw >= 3 && ne > 0) {
+			struct ply_elem *el = &E[ne - 1];
+			struct ply_prop *pp;
+			if (el->n_props == PLY_MAX_PROPS) {
+				snprintf(msg, msg_cap, "%s:%ld: too many PLY properties", path, lineno);
+				goto out;
+			}
+			pp = &el->props[el->n_props++];
+			if (strcmp(w[1], "list") == 0) {
+				pp->list = 1;
+				pp->csize = nw >= 4 ? ply_type_size(w[2]) : 0;
+				pp->size = nw >= 4 ? ply_type_size(w[3]) : 0;
+			} else {
+				pp->size = ply_type_size(w[1]);
+			}
+			if (!pp->size || (pp->list && !pp->csize)) {
+				snprintf(msg, msg_cap, "%s:%ld: bad PLY property type", path, lineno);
+				goto out;
+			}
+		} else {
+			snprintf(msg, msg_cap, "%s:%ld: unexpected PLY header line", path, lineno);
+			goto out;
+		}
+	}
+	if (fmt < 0) {
+		snprintf(msg, msg_cap, "%s: PLY header without format", path);
+		goto out;
+	}
+	/* body */
+	for (k = 0; k < ne; k++)
+		for (i = 0; i < E[k].count; i++) {
+			int j;
+			for (j = 0; j < E[k].n_props; j++) {
+				const struct ply_prop *pp = &E[k].props[j];
+				unsigned long long nitems = 1, t;
+				if (fmt == 0) {
+					char tok[64], *end;
+					if (pp->list) {
+						if (!ply_token(f, tok, sizeof(tok), &lineno))
+							goto truncated;
+						nitems = strtoull(tok, &end, 10);
+						if (*end || tok[0] == '-') {
+							snprintf(msg, msg_cap, "%s:%ld: bad list length '%s'",
+								 path, lineno, tok);
+							goto out;
+						}
+					}
+					for (t = 0; t < nitems; t++) {
+						if (!ply_token(f, tok, sizeof(tok), &lineno))
+							goto truncated;
+						strtod(tok, &end);
+						if (end == tok || *end) {
+							snprintf(msg, msg_cap, "%s:%ld: not a number '%s'",
+								 path, lineno, tok);
+							goto out;
+						}
+					}
+				} else {
+					unsigned char b[8];
+					if (pp->list) {
+						if (fread(b, 1, (size_t)pp->csize, f) != (size_t)pp->csize)
+							goto truncated;
+						nitems = ply_uint(b, pp->csize, fmt == 2);
+					}
+					for (t = 0; t < nitems; t++)
+						if (fread(b, 1, (size_t)pp->size, f) != (size_t)pp->size)
+							goto truncated;
+				}
+			}
+		}
+	if (fmt == 0) {
+		char tok[64];
+		if (ply_token(f, tok, sizeof(tok), &lineno)) {
+			snprintf(msg, msg_cap, "%s:%ld: data after the last PLY element", path, lineno);
+			goto out;
+		}
+	} else if (fgetc(f) != EOF) {
+		snprintf(msg, msg_cap, "%s: data after the last PLY element", path);
+		goto out;
+	}
+	rc = PX_OK;
+	goto out;
+truncated:
+	snprintf(msg, msg_cap, "%s: PLY data ends early (element '%s' %llu of %llu)", path,
+		 E[k].name, i, E[k].count);
+out:
+	free(E);
+	fclose(f);
+	return rc;
+}
+
+static int has_ply_magic(const char *path)
+{
+	char b[4] = {0};
+	FILE *f = fopen(path, "rb");
+	size_t n;
+	if (!f)
+		return 0;
+	n = fread(b, 1, 4, f);
+	fclose(f);
+	return n == 4 && memcmp(b, "ply", 3) == 0 && (b[3] == '\n' || b[3] == '\r');
+}
+
 int px__import_file(const char *path, int want_tri, double **xyz,
 		    size_t *nv, uint32_t **tri, size_t *nt, size_t *n_skipped,
 		    char *msg, size_t msg_cap)
@@ -182,6 +417,11 @@ int px__import_file(const char *path, int want_tri, double **xyz,
 		return PX_E_IO;
 	}
 	fclose(f);
+	if (has_ply_magic(path)) {
+		int rc = ply_validate(path, msg, msg_cap);
+		if (rc != PX_OK)
+			return rc;
+	}
 	s = aiImportFile(path, aiProcess_Triangulate);
 	if (!s) {
 		snprintf(msg, msg_cap, "%s: %s", path, aiGetErrorString());

@@ -104,9 +104,11 @@ PX_API int px_mesh_model(const double *xyz, size_t n_vertices,
  * transforms applied) and build it as px_mesh_model() does. Errors
  * name the file in rep->message: PX_E_NOTFOUND (no such file),
  * PX_E_IO (unreadable), PX_E_PARSE (the importer's message: malformed
- * or unknown format, or a file without triangles), PX_E_UNSUPPORTED
- * (built without a mesh importer), and px_mesh_model()'s errors.
- * Setup only.
+ * or unknown format, a PLY body shorter or longer than its header says,
+ * or a file without triangles), and px_mesh_model()'s errors.
+ * Files are read by the Open Asset Import Library, whose coordinates are
+ * single-precision floats (about 7 significant digits; exact for binary
+ * STL, which stores floats). Setup only.
  */
 PX_API int px_mesh_load(const char *path, const struct px_mesh_opts *opt,
 			struct px_mesh_report *rep, struct px_model **out);

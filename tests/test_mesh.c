@@ -608,6 +608,12 @@ static void write_files(const struct gen_mesh *g)
 	fprintf(f, "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n"
 		   "vertex 1 0 0\nvertex 0 1 nan\nendloop\nendfacet\nendsolid x\n");
 	fclose(f);
+	/* PLY whose last face lost its last index */
+	f = fopen(tpath("trunc.ply"), "w");
+	fprintf(f, "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+		   "property float y\nproperty float z\nelement face 1\n"
+		   "property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n");
+	fclose(f);
 	f = fopen(tpath("points.obj"), "w");
 	fprintf(f, "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\n");
 	fclose(f);
@@ -656,11 +662,13 @@ static void test_load_files(void)
 	PX_CHECK_INT_EQ(px_mesh_load(tpath("points.obj"), NULL, &rp, &m), PX_E_PARSE);
 	PX_CHECK_MSG(strstr(rp.message, "no triangles") != NULL, "%s", rp.message);
 	PX_CHECK_INT_EQ(px_mesh_load(tmpdir, NULL, &rp, &m), PX_E_IO);
+	PX_CHECK_INT_EQ(px_mesh_load(tpath("trunc.ply"), NULL, &rp, &m), PX_E_PARSE);
+	PX_CHECK_MSG(strstr(rp.message, "ends early") != NULL, "%s", rp.message);
 	px_model_free(ref);
 	gen_free(&g);
 	{
 		const char *all[] = {"box_a.stl", "box_b.stl", "box.obj", "box.ply",
-				     "garbage.stl", "nan.stl", "points.obj"};
+				     "garbage.stl", "nan.stl", "points.obj", "trunc.ply"};
 		for (k = 0; k < sizeof(all) / sizeof(all[0]); k++)
 			unlink(tpath(all[k]));
 		rmdir(tmpdir);
