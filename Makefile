@@ -77,11 +77,13 @@ DEB_PACKAGES += libassimp-dev
 # Debian packages the benchmarks compare against (installed by `make bench`;
 # a benchmark whose reference is missing says so and still runs).
 BENCH_DEB_PACKAGES := rt-tests
+# bench_models compares with FCL through a C++ program (bench/fcl_models.cpp).
+BENCH_DEB_PACKAGES += g++ libfcl-dev
 
 FORCE:
 
 .PHONY: FORCE all lib tools tests benches test bench sanitize install uninstall \
-        clean help deps check-deps
+        clean help deps check-deps fcl-bench
 
 all: lib tools
 
@@ -149,7 +151,19 @@ test: deps all tests
 
 bench: all benches
 	@sh tools/install-deps.sh $(BENCH_DEB_PACKAGES) || echo "make bench: continuing without $(BENCH_DEB_PACKAGES)"
+	@$(MAKE) --no-print-directory fcl-bench || echo "make bench: FCL reference not built"
 	@set -e; for b in $(BENCH_BIN); do echo "== $$b"; $$b; done
+
+# FCL reference program for bench_models, only where FCL is installed
+# (checked when it runs, after `make bench` installed the packages).
+fcl-bench:
+	@if pkg-config --exists fcl 2>/dev/null; then \
+	  $(MAKE) --no-print-directory $(BUILD)/bench/fcl_models; \
+	else echo "make bench: FCL not installed: bench_models runs without it"; fi
+
+$(BUILD)/bench/fcl_models: bench/fcl_models.cpp bench/models_common.h tests/mesh_gen.h
+	@mkdir -p $(dir $@)
+	$(CXX) -O2 -g -std=c++14 -Itests -Ibench $$(pkg-config --cflags fcl) $< -o $@ $$(pkg-config --libs fcl)
 
 sanitize:
 	$(MAKE) BUILD=$(BUILD)/san SAN=1 test

@@ -39,8 +39,8 @@ static inline int gen_sphere(double r, int nlat, int nlon, struct gen_mesh *g)
 	uint32_t S;
 	g->nv = (size_t)(nlat - 1) * nlon + 2;
 	g->nt = 0;
-	g->xyz = malloc(3 * g->nv * sizeof(double));
-	g->tri = malloc(6 * (size_t)nlat * nlon * sizeof(uint32_t));
+	g->xyz = (double *)malloc(3 * g->nv * sizeof(double));
+	g->tri = (uint32_t *)malloc(6 * (size_t)nlat * nlon * sizeof(uint32_t));
 	if (!g->xyz || !g->tri)
 		return -1;
 	g->xyz[0] = 0, g->xyz[1] = 0, g->xyz[2] = r;
@@ -80,8 +80,8 @@ static inline int gen_torus(double R, double r, int nu, int nv,
 	int i, j;
 	g->nv = (size_t)nu * nv;
 	g->nt = 0;
-	g->xyz = malloc(3 * g->nv * sizeof(double));
-	g->tri = malloc(6 * g->nv * sizeof(uint32_t));
+	g->xyz = (double *)malloc(3 * g->nv * sizeof(double));
+	g->tri = (uint32_t *)malloc(6 * g->nv * sizeof(uint32_t));
 	if (!g->xyz || !g->tri)
 		return -1;
 	for (i = 0; i < nu; i++)
@@ -110,8 +110,8 @@ static inline int gen_box(const double h[3], int n, struct gen_mesh *g)
 	size_t per = (size_t)(n + 1) * (n + 1);
 	g->nv = 6 * per;
 	g->nt = 0;
-	g->xyz = malloc(3 * g->nv * sizeof(double));
-	g->tri = malloc(6 * 2 * (size_t)n * n * 3 * sizeof(uint32_t));
+	g->xyz = (double *)malloc(3 * g->nv * sizeof(double));
+	g->tri = (uint32_t *)malloc(6 * 2 * (size_t)n * n * 3 * sizeof(uint32_t));
 	if (!g->xyz || !g->tri)
 		return -1;
 	for (k = 0; k < 3; k++)
@@ -148,8 +148,8 @@ static inline int gen_lprism(double s, double hz, struct gen_mesh *g)
 	int i;
 	g->nv = 12;
 	g->nt = 0;
-	g->xyz = malloc(3 * 12 * sizeof(double));
-	g->tri = malloc(3 * 20 * sizeof(uint32_t));
+	g->xyz = (double *)malloc(3 * 12 * sizeof(double));
+	g->tri = (uint32_t *)malloc(3 * 20 * sizeof(uint32_t));
 	if (!g->xyz || !g->tri)
 		return -1;
 	for (i = 0; i < 6; i++) {
