@@ -21,13 +21,29 @@
  * idx, and idx == EMPTY an absent child (only in a one-leaf root). */
 #define EMPTY 0xffffffffu
 struct node {
-	double lo[2][3], hi[2][3];
+	float lo[2][3], hi[2][3]; /* rounded outwards: still lower bounds */
 	uint32_t idx[2], cnt[2];
 };
 
+/* Triangle with its (unnormalized) normal n = (b - a) x (c - a) and
+ * 1 / |n|^2, for the plane-distance lower bound. */
 struct mtri {
 	px_vec3 a, b, c;
+	px_vec3 n;
+	double inv_nn;
 };
+
+static float f_down(double x)
+{
+	float f = (float)x;
+	return (double)f > x ? nextafterf(f, -INFINITY) : f;
+}
+
+static float f_up(double x)
+{
+	float f = (float)x;
+	return (double)f < x ? nextafterf(f, INFINITY) : f;
+}
 
 struct mesh {
 	size_t nt, nv;
@@ -104,35 +120,16 @@ static double tri_as_segments(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
  * projecting onto the plane along the cross-product normal rather than
  * from the barycentric ratios, which lose accuracy on thin triangles.
  */
-double px_tri_closest(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
-		      px_vec3 *q, int *feature, int *sub, double *u, double *v)
+/* n = (b - a) x (c - a), nn = |n|^2, needle: treat as segments. */
+static inline double tri_core(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
+			      px_vec3 n, double nn, int needle, px_vec3 *q,
+			      int *feature, int *sub, double *u, double *v)
 {
 	px_vec3 ab = px_v3_sub(b, a), ac = px_v3_sub(c, a), ap = px_v3_sub(p, a);
-	px_vec3 bp, cp, n, qq;
-	double d1, d2, d3, d4, d5, d6, va, vb, vc, t, nn, m;
-	int f_, s_;
-	double u_, v_;
+	px_vec3 bp, cp;
+	double d1, d2, d3, d4, d5, d6, va, vb, vc, t;
 
-	if (!feature)
-		feature = &f_;
-	if (!sub)
-		sub = &s_;
-	if (!u)
-		u = &u_;
-	if (!v)
-		v = &v_;
-	if (!q)
-		q = &qq;
-
-	n = px_v3_cross(ab, ac);
-	nn = px_v3_norm2(n);
-	{
-		px_vec3 bc = px_v3_sub(c, b);
-		double lab = px_v3_norm2(ab), lac = px_v3_norm2(ac),
-		       lbc = px_v3_norm2(bc);
-		m = fmax(lab * lac, fmax(lab * lbc, lac * lbc));
-	}
-	if (!(nn > NEEDLE_SIN2 * m))
+	if (needle)
 		return tri_as_segments(p, a, b, c, q, feature, sub, u, v);
 
 	d1 = px_v3_dot(ab, ap);
@@ -207,6 +204,36 @@ double px_tri_closest(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
 		*v = den != 0.0 ? vc / den : 0.0;
 		return s * s * nn;
 	}
+}
+
+/* The needle test shared by the public routine and mesh setup. */
+static int is_needle(px_vec3 a, px_vec3 b, px_vec3 c, px_vec3 n)
+{
+	px_vec3 ab = px_v3_sub(b, a), ac = px_v3_sub(c, a), bc = px_v3_sub(c, b);
+	double lab = px_v3_norm2(ab), lac = px_v3_norm2(ac), lbc = px_v3_norm2(bc);
+	double m = fmax(lab * lac, fmax(lab * lbc, lac * lbc));
+	return !(px_v3_norm2(n) > NEEDLE_SIN2 * m);
+}
+
+double px_tri_closest(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
+		      px_vec3 *q, int *feature, int *sub, double *u, double *v)
+{
+	px_vec3 n = px_v3_cross(px_v3_sub(b, a), px_v3_sub(c, a)), qq;
+	int f_, s_;
+	double u_, v_;
+
+	if (!feature)
+		feature = &f_;
+	if (!sub)
+		sub = &s_;
+	if (!u)
+		u = &u_;
+	if (!v)
+		v = &v_;
+	if (!q)
+		q = &qq;
+	return tri_core(p, a, b, c, n, px_v3_norm2(n), is_needle(a, b, c, n), q,
+			feature, sub, u, v);
 }
 
 /* ---- setup helpers ------------------------------------------------------ */
@@ -299,21 +326,23 @@ struct build {
 	int depth;
 };
 
-static void range_box(const struct build *B, size_t s, size_t n, double lo[3],
-		      double hi[3])
+static void range_box(const struct build *B, size_t s, size_t n, float lo[3],
+		      float hi[3])
 {
+	double l[3] = {INFINITY, INFINITY, INFINITY},
+	       h[3] = {-INFINITY, -INFINITY, -INFINITY};
 	size_t i;
 	int k;
-	for (k = 0; k < 3; k++) {
-		lo[k] = INFINITY;
-		hi[k] = -INFINITY;
-	}
 	for (i = s; i < s + n; i++) {
 		size_t t = B->perm[i];
 		for (k = 0; k < 3; k++) {
-			lo[k] = fmin(lo[k], B->tlo[3 * t + k]);
-			hi[k] = fmax(hi[k], B->thi[3 * t + k]);
+			l[k] = fmin(l[k], B->tlo[3 * t + k]);
+			h[k] = fmax(h[k], B->thi[3 * t + k]);
 		}
+	}
+	for (k = 0; k < 3; k++) {
+		lo[k] = f_down(l[k]);
+		hi[k] = f_up(h[k]);
 	}
 }
 
@@ -376,11 +405,19 @@ static void mesh_free(void *impl)
 
 /* ---- query --------------------------------------------------------------- */
 
+/* Plain compares rather than fmax(), which is an out-of-line libm call
+ * (NaN rules) and was a fifth of the query time; no NaN reaches here. */
+static inline double gap(double lo, double hi, double x)
+{
+	double d = lo - x > x - hi ? lo - x : x - hi;
+	return d > 0.0 ? d : 0.0;
+}
+
 static inline double box_d2(const struct node *nd, int c, px_vec3 p)
 {
-	double dx = fmax(fmax(nd->lo[c][0] - p.x, p.x - nd->hi[c][0]), 0.0);
-	double dy = fmax(fmax(nd->lo[c][1] - p.y, p.y - nd->hi[c][1]), 0.0);
-	double dz = fmax(fmax(nd->lo[c][2] - p.z, p.z - nd->hi[c][2]), 0.0);
+	double dx = gap(nd->lo[c][0], nd->hi[c][0], p.x);
+	double dy = gap(nd->lo[c][1], nd->hi[c][1], p.y);
+	double dz = gap(nd->lo[c][2], nd->hi[c][2], p.z);
 	return dx * dx + dy * dy + dz * dz;
 }
 
@@ -398,8 +435,16 @@ static inline void test_tri(const struct mesh *M, size_t li, px_vec3 p,
 	const struct mtri *t = &M->tri[li];
 	px_vec3 q;
 	int f, s;
-	double u, v;
-	double d2 = px_tri_closest(p, t->a, t->b, t->c, &q, &f, &s, &u, &v);
+	double u, v, d2;
+
+	if (!M->degen[li]) {
+		/* the distance to the plane is a lower bound */
+		double h = px_v3_dot(t->n, px_v3_sub(p, t->a));
+		if (h * h * t->inv_nn > b->d2)
+			return;
+	}
+	d2 = tri_core(p, t->a, t->b, t->c, t->n, 1.0 / t->inv_nn, M->degen[li], &q,
+		      &f, &s, &u, &v);
 	if (d2 < b->d2 ||
 	    (d2 == b->d2 && (b->li < 0 || (M->degen[b->li] && !M->degen[li])))) {
 		b->d2 = d2;
@@ -630,7 +675,8 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 		int collapsed = c0 == c1 || c1 == c2 || c0 == c2;
 
 		nb[3 * i] = nb[3 * i + 1] = nb[3 * i + 2] = -1;
-		if (collapsed || !(px_v3_norm2(nrm) > NEEDLE_SIN2 * m)) {
+		(void)m;
+		if (collapsed || is_needle(a, b, c, nrm)) {
 			deg[i] = 1;
 			if (rep->n_degenerate++ == 0)
 				rep->first_degenerate = (long)i;
@@ -784,6 +830,8 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 		M->tri[i].a = P[0];
 		M->tri[i].b = P[1];
 		M->tri[i].c = P[2];
+		M->tri[i].n = px_v3_cross(px_v3_sub(P[1], P[0]), px_v3_sub(P[2], P[0]));
+		M->tri[i].inv_nn = deg[t] ? 0.0 : 1.0 / px_v3_norm2(M->tri[i].n);
 		M->orig[i] = t;
 		M->leaf_of[t] = (uint32_t)i;
 		M->fn[i] = fn[t];
