@@ -46,6 +46,8 @@ PKGS     := yaml-0.1
 # HIDAPI=hidraw (default, /dev/hidraw*) or HIDAPI=libusb.
 HIDAPI   ?= hidraw
 PKGS     += hidapi-$(HIDAPI) libusb-1.0 libsocketcan libgpiod
+# Mesh and point-cloud file import (STL, OBJ, PLY).
+PKGS     += assimp
 # Asked when a recipe runs, not when this file is read, so that packages
 # `make deps` has just installed are found by the same `make test`.
 PKG_CFLAGS = $(if $(PKGS),$(shell pkg-config --cflags $(PKGS)))
@@ -88,13 +90,17 @@ DEB_PACKAGES += libudev-dev
 # Debian packages the benchmarks compare against (installed by `make bench`;
 # a benchmark whose reference is missing says so and still runs).
 BENCH_DEB_PACKAGES := rt-tests g++ libocct-modeling-algorithms-dev
+# bench_models compares with FCL through a C++ program (bench/fcl_models.cpp).
+BENCH_DEB_PACKAGES += libfcl-dev
 # config/: YAML loader.
 DEB_PACKAGES += libyaml-dev
+# geom/: mesh and point-cloud import.
+DEB_PACKAGES += libassimp-dev
 
 FORCE:
 
 .PHONY: FORCE all lib tools tests benches run-benches test bench sanitize install uninstall \
-        clean help deps check-deps
+        clean help deps check-deps fcl-bench
 
 all: lib tools
 
@@ -177,10 +183,22 @@ bench: all
 	@sh tools/install-deps.sh $(BENCH_DEB_PACKAGES) || echo "make bench: continuing without $(BENCH_DEB_PACKAGES)"
 	@# A second make sees the reference libraries just installed.
 	@$(MAKE) --no-print-directory benches
+	@$(MAKE) --no-print-directory fcl-bench || echo "make bench: FCL reference not built"
 	@$(MAKE) --no-print-directory run-benches
 
 run-benches:
 	@set -e; for b in $(BENCH_BIN) $(CXX_BENCH_BIN); do echo "== $$b"; $$b; done
+
+# FCL reference program for bench_models, only where FCL is installed
+# (checked when it runs, after `make bench` installed the packages).
+fcl-bench:
+	@if pkg-config --exists fcl 2>/dev/null; then \
+	  $(MAKE) --no-print-directory $(BUILD)/bench/fcl_models; \
+	else echo "make bench: FCL not installed: bench_models runs without it"; fi
+
+$(BUILD)/bench/fcl_models: bench/fcl_models.cpp bench/models_common.h tests/mesh_gen.h
+	@mkdir -p $(dir $@)
+	$(CXX) -O2 -g -std=c++14 -Itests -Ibench $$(pkg-config --cflags fcl) $< -o $@ $$(pkg-config --libs fcl)
 
 sanitize:
 	$(MAKE) BUILD=$(BUILD)/san SAN=1 test

@@ -1,0 +1,26 @@
+/*
+ * model_internal.h - private declarations shared by the model sources of
+ * geom/ (meshes, clouds, file import). Not installed, not API.
+ */
+#ifndef PX_MODEL_INTERNAL_H
+#define PX_MODEL_INTERNAL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+/*
+ * Read a mesh or point file with the Open Asset Import Library: all
+ * meshes of the scene with their node transforms applied (a mesh that no
+ * node references, as for a faceless PLY, is taken as it is), polygons
+ * triangulated. want_tri: collect triangles (other primitives are
+ * skipped and counted in *n_skipped); else only vertices. On success
+ * *xyz (3 doubles per vertex) and *tri (3 per triangle, NULL when
+ * !want_tri) are malloc'ed and owned by the caller. On failure msg holds
+ * "<path>: <reason>". Returns PX_OK, PX_E_INVAL, PX_E_NOTFOUND, PX_E_IO,
+ * PX_E_PARSE, PX_E_NOMEM, PX_E_OVERFLOW. Setup only.
+ */
+int px__import_file(const char *path, int want_tri, double **xyz,
+		    size_t *nv, uint32_t **tri, size_t *nt, size_t *n_skipped,
+		    char *msg, size_t msg_cap);
+
+#endif

@@ -1,0 +1,604 @@
+/*
+ * px_cloud.c - point cloud model: k-d tree with tight child boxes, text
+ * and PLY loading.
+ */
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+
+#include "model_internal.h"
+#include "px_cloud.h"
+
+#define LEAF 8
+#define EMPTY 0xffffffffu
+
+/* As in the mesh hierarchy: both children's boxes live in the parent;
+ * cnt > 0 marks a leaf range, idx == EMPTY an absent child. */
+struct node {
+	double lo[2][3], hi[2][3];
+	uint32_t idx[2], cnt[2];
+};
+
+struct cloud {
+	size_t n;
+	double radius;
+	px_vec3 *pt;       /* leaf order */
+	uint32_t *orig;    /* leaf -> input */
+	uint32_t *leaf_of; /* input -> leaf */
+	struct node *nodes;
+	size_t n_nodes;
+	int depth;
+	px_aabb box;
+	size_t bytes;
+};
+
+static void rep_msg(struct px_cloud_report *rep, const char *fmt, ...)
+	__attribute__((format(printf, 2, 3)));
+static void rep_msg(struct px_cloud_report *rep, const char *fmt, ...)
+{
+	va_list ap;
+	if (!rep || rep->message[0])
+		return;
+	va_start(ap, fmt);
+	vsnprintf(rep->message, sizeof(rep->message), fmt, ap);
+	va_end(ap);
+}
+
+static void cloud_free(void *impl)
+{
+	struct cloud *C = impl;
+	if (!C)
+		return;
+	free(C->pt);
+	free(C->orig);
+	free(C->leaf_of);
+	free(C->nodes);
+	free(C);
+}
+
+/* ---- build ------------------------------------------------------------------ */
+
+static void select_k(uint32_t *a, long n, long k, const double *xyz, int axis)
+{
+	long lo = 0, hi = n - 1;
+	while (lo < hi) {
+		double pv = xyz[3 * (size_t)a[lo + (hi - lo) / 2] + axis];
+		long i = lo, j = hi;
+		while (i <= j) {
+			while (xyz[3 * (size_t)a[i] + axis] < pv)
+				i++;
+			while (xyz[3 * (size_t)a[j] + axis] > pv)
+				j--;
+			if (i <= j) {
+				uint32_t t = a[i];
+				a[i] = a[j];
+				a[j] = t;
+				i++;
+				j--;
+			}
+		}
+		if (k <= j)
+			hi = j;
+		else if (k >= i)
+			lo = i;
+		else
+			break;
+	}
+}
+
+struct build {
+	uint32_t *perm;
+	const double *xyz;
+	struct node *nodes;
+	size_t n_nodes;
+	int depth;
+};
+
+static void range_box(const struct build *B, size_t s, size_t n, double lo[3],
+		      double hi[3])
+{
+	size_t i;
+	int k;
+	for (k = 0; k < 3; k++) {
+		lo[k] = INFINITY;
+		hi[k] = -INFINITY;
+	}
+	for (i = s; i < s + n; i++)
+		for (k = 0; k < 3; k++) {
+			double x = B->xyz[3 * (size_t)B->perm[i] + k];
+			lo[k] = fmin(lo[k], x);
+			hi[k] = fmax(hi[k], x);
+		}
+}
+
+static uint32_t build_node(struct build *B, size_t s, size_t n, int depth,
+			   const double lo[3], const double hi[3])
+{
+	uint32_t me = (uint32_t)B->n_nodes++;
+	size_t part[2][2], half = n / 2;
+	int k, axis = 0, c;
+
+	if (depth > B->depth)
+		B->depth = depth;
+	for (k = 1; k < 3; k++)
+		if (hi[k] - lo[k] > hi[axis] - lo[axis])
+			axis = k;
+	select_k(B->perm + s, (long)n, (long)half, B->xyz, axis);
+	part[0][0] = s;
+	part[0][1] = half;
+	part[1][0] = s + half;
+	part[1][1] = n - half;
+	for (c = 0; c < 2; c++) {
+		struct node *nd = &B->nodes[me];
+		range_box(B, part[c][0], part[c][1], nd->lo[c], nd->hi[c]);
+		if (part[c][1] <= LEAF) {
+			nd->idx[c] = (uint32_t)part[c][0];
+			nd->cnt[c] = (uint32_t)part[c][1];
+		} else {
+			double clo[3], chi[3];
+			uint32_t ch;
+			memcpy(clo, nd->lo[c], sizeof(clo));
+			memcpy(chi, nd->hi[c], sizeof(chi));
+			ch = build_node(B, part[c][0], part[c][1], depth + 1, clo, chi);
+			B->nodes[me].idx[c] = ch;
+			B->nodes[me].cnt[c] = 0;
+		}
+	}
+	return me;
+}
+
+/* ---- query ------------------------------------------------------------------ */
+
+/* Plain compares rather than fmax(), which is an out-of-line libm call
+ * (NaN rules) and was a fifth of the query time; no NaN reaches here. */
+static inline double gap(double lo, double hi, double x)
+{
+	double d = lo - x > x - hi ? lo - x : x - hi;
+	return d > 0.0 ? d : 0.0;
+}
+
+static inline double box_d2(const struct node *nd, int c, px_vec3 p)
+{
+	double dx = gap(nd->lo[c][0], nd->hi[c][0], p.x);
+	double dy = gap(nd->lo[c][1], nd->hi[c][1], p.y);
+	double dz = gap(nd->lo[c][2], nd->hi[c][2], p.z);
+	return dx * dx + dy * dy + dz * dz;
+}
+
+static int cloud_closest(const void *impl, const struct px_model_query *q,
+			 struct px_model_result *r)
+{
+	const struct cloud *C = impl;
+	struct {
+		uint32_t idx, cnt;
+		double d2;
+	} st[PX_CLOUD_MAX_DEPTH + 2];
+	int sp = 0, iters = 0, certified = 1;
+	px_vec3 p = q->p, v;
+	double best, d;
+	long bi = -1;
+
+	if (isinf(q->max_dist))
+		best = INFINITY;
+	else
+		best = (q->max_dist + C->radius) * (q->max_dist + C->radius);
+	if (q->hint >= 0 && (size_t)q->hint < C->n) {
+		uint32_t li = C->leaf_of[q->hint];
+		double d2 = px_v3_dist2(p, C->pt[li]);
+		if (d2 <= best) {
+			best = d2;
+			bi = (long)li;
+		}
+		iters++;
+	}
+	st[0].idx = 0;
+	st[0].cnt = 0;
+	st[0].d2 = 0.0;
+	sp = 1;
+	while (sp > 0) {
+		const struct node *nd;
+		double dc[2];
+		int near, c;
+
+		sp--;
+		if (st[sp].d2 > best || (st[sp].d2 == best && bi >= 0))
+			continue;
+		iters++;
+		if (st[sp].cnt > 0) {
+			uint32_t i;
+			for (i = st[sp].idx; i < st[sp].idx + st[sp].cnt; i++) {
+				double d2 = px_v3_dist2(p, C->pt[i]);
+				if (d2 < best || (d2 == best && bi < 0)) {
+					best = d2;
+					bi = (long)i;
+				}
+			}
+			continue;
+		}
+		nd = &C->nodes[st[sp].idx];
+		dc[0] = nd->idx[0] == EMPTY ? INFINITY : box_d2(nd, 0, p);
+		dc[1] = nd->idx[1] == EMPTY ? INFINITY : box_d2(nd, 1, p);
+		near = dc[1] < dc[0];
+		for (c = 0; c < 2; c++) {
+			int ch = c == 0 ? 1 - near : near;
+			if (dc[ch] > best)
+				continue;
+			if (sp >= PX_CLOUD_MAX_DEPTH + 2) {
+				certified = 0; /* cannot happen: depth checked at setup */
+				continue;
+			}
+			st[sp].idx = nd->idx[ch];
+			st[sp].cnt = nd->cnt[ch];
+			st[sp].d2 = dc[ch];
+			sp++;
+		}
+	}
+	if (bi < 0)
+		return 0;
+	v = px_v3_sub(p, C->pt[bi]);
+	d = sqrt(best);
+	if (d > 0.0)
+		r->direction = px_v3_scale(v, 1.0 / d);
+	else
+		r->direction = px_v3(0.0, 0.0, 1.0);
+	r->point = px_v3_madd(C->pt[bi], r->direction, C->radius);
+	r->distance = d - C->radius;
+	r->is_signed = C->radius > 0.0;
+	r->inside = 0;
+	if (r->distance < 0.0) {
+		if (q->flags & PX_QUERY_UNSIGNED) {
+			r->distance = -r->distance;
+			r->direction = px_v3_neg(r->direction);
+			r->is_signed = 0;
+		} else {
+			r->inside = 1;
+		}
+	} else if (q->flags & PX_QUERY_UNSIGNED) {
+		r->is_signed = 0;
+	}
+	if (r->distance == 0.0)
+		r->distance = 0.0;
+	if (fabs(r->distance) > q->max_dist)
+		return 0;
+	r->index = (int)C->orig[bi];
+	r->sub = -1;
+	r->feature = PX_FEATURE_POINT;
+	r->u = r->v = 0.0;
+	r->iterations = iters;
+	r->certified = certified;
+	r->gap = 0.0;
+	return 1;
+}
+
+static px_aabb cloud_aabb(const void *impl)
+{
+	const struct cloud *C = impl;
+	return px_aabb_inflate(&C->box, C->radius);
+}
+
+static size_t cloud_bytes(const void *impl)
+{
+	return ((const struct cloud *)impl)->bytes;
+}
+
+static const struct px_model_ops cloud_ops = {
+	"cloud", PX_MODEL_CLOUD, cloud_closest, cloud_aabb, cloud_bytes,
+	cloud_free};
+
+int px_cloud_model(const double *xyz, size_t n, double radius_m,
+		   struct px_cloud_report *rep, struct px_model **out)
+{
+	struct px_cloud_report lrep;
+	struct cloud *C = NULL;
+	uint32_t *perm = NULL;
+	struct build B;
+	size_t i;
+	int rc = PX_E_NOMEM, k;
+
+	if (!rep)
+		rep = &lrep;
+	memset(rep, 0, sizeof(*rep));
+	rep->line = -1;
+	rep->n_points = n;
+	if (out)
+		*out = NULL;
+	if (!out || !xyz || n == 0) {
+		rep_msg(rep, "%s", n == 0 ? "cloud has no points" : "invalid arguments");
+		return PX_E_INVAL;
+	}
+	if (!(radius_m >= 0.0) || !isfinite(radius_m)) {
+		rep_msg(rep, "point radius %g must be finite and >= 0", radius_m);
+		return PX_E_RANGE;
+	}
+	if (n > PX_CLOUD_MAX_POINTS) {
+		rep_msg(rep, "too many points (%zu)", n);
+		return PX_E_RANGE;
+	}
+	for (i = 0; i < n; i++)
+		if (!(isfinite(xyz[3 * i]) && isfinite(xyz[3 * i + 1]) &&
+		      isfinite(xyz[3 * i + 2]))) {
+			rep_msg(rep, "point %zu: non-finite coordinate (%g %g %g)", i,
+				xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+			return PX_E_NAN;
+		}
+	C = calloc(1, sizeof(*C));
+	if (!C)
+		goto fail;
+	C->n = n;
+	C->radius = radius_m;
+	perm = malloc(n * sizeof(*perm));
+	C->nodes = calloc(n / 2 + 2, sizeof(*C->nodes));
+	C->pt = malloc(n * sizeof(*C->pt));
+	C->orig = malloc(n * sizeof(*C->orig));
+	C->leaf_of = malloc(n * sizeof(*C->leaf_of));
+	if (!perm || !C->nodes || !C->pt || !C->orig || !C->leaf_of)
+		goto fail;
+	for (i = 0; i < n; i++)
+		perm[i] = (uint32_t)i;
+	B.perm = perm;
+	B.xyz = xyz;
+	B.nodes = C->nodes;
+	B.n_nodes = 0;
+	B.depth = 0;
+	if (n <= LEAF) {
+		struct node *nd = &C->nodes[0];
+		B.n_nodes = 1;
+		range_box(&B, 0, n, nd->lo[0], nd->hi[0]);
+		nd->idx[0] = 0;
+		nd->cnt[0] = (uint32_t)n;
+		for (k = 0; k < 3; k++) {
+			nd->lo[1][k] = INFINITY;
+			nd->hi[1][k] = -INFINITY;
+		}
+		nd->idx[1] = EMPTY;
+		nd->cnt[1] = 0;
+	} else {
+		double lo[3], hi[3];
+		range_box(&B, 0, n, lo, hi);
+		build_node(&B, 0, n, 0, lo, hi);
+	}
+	C->n_nodes = B.n_nodes;
+	C->depth = B.depth + 1;
+	if (C->depth > PX_CLOUD_MAX_DEPTH) {
+		rep_msg(rep, "tree too deep (%d)", C->depth);
+		rc = PX_E_RANGE;
+		goto fail;
+	}
+	C->box = px_aabb_empty();
+	for (i = 0; i < n; i++) {
+		uint32_t t = perm[i];
+		C->pt[i] = px_v3(xyz[3 * (size_t)t], xyz[3 * (size_t)t + 1],
+				 xyz[3 * (size_t)t + 2]);
+		px_aabb_extend(&C->box, C->pt[i]);
+		C->orig[i] = t;
+		C->leaf_of[t] = (uint32_t)i;
+	}
+	C->bytes = sizeof(*C) + n * (sizeof(px_vec3) + 2 * sizeof(uint32_t)) +
+		   C->n_nodes * sizeof(struct node);
+	free(perm);
+	rc = px_model_create(&cloud_ops, C,
+			     PX_MODEL_CAP_EXACT | PX_MODEL_CAP_COHERENT |
+				     (radius_m > 0.0 ? PX_MODEL_CAP_SIGNED : 0u),
+			     out);
+	if (rc != PX_OK)
+		rep_msg(rep, "out of memory");
+	return rc;
+fail:
+	if (rc == PX_E_NOMEM)
+		rep_msg(rep, "out of memory");
+	free(perm);
+	cloud_free(C);
+	return rc;
+}
+
+/* ---- text files -------------------------------------------------------------- */
+
+static int is_sep(int c)
+{
+	return c == ' ' || c == '\t' || c == ',' || c == ';' || c == '\r' ||
+	       c == '\n' || c == '\0';
+}
+
+/*
+ * Parse one line: up to 3 numbers (more columns ignored). Returns the
+ * count of numbers read at the start of the line (0..3), and in *bad_col
+ * the 1-based column of the first field that is not a number (0 if all
+ * of the first three parsed).
+ */
+static int parse_line(const char *s, double v[3], int *bad_col)
+{
+	const char *p = s;
+	int k = 0;
+	*bad_col = 0;
+	while (k < 3) {
+		char *end;
+		while (*p == ' ' || *p == '\t' || *p == ',' || *p == ';' || *p == '\r')
+			p++;
+		if (*p == '\0' || *p == '\n')
+			break;
+		errno = 0;
+		v[k] = strtod(p, &end);
+		if (end == p || !is_sep((unsigned char)*end)) {
+			*bad_col = (int)(p - s) + 1;
+			return k;
+		}
+		p = end;
+		k++;
+	}
+	return k;
+}
+
+static int load_text(const char *path, double **xyz_out, size_t *n_out,
+		     struct px_cloud_report *rep)
+{
+	FILE *f = fopen(path, "r");
+	char *line = NULL;
+	size_t cap = 0, n = 0, vcap = 0;
+	ssize_t len;
+	long lineno = 0;
+	double *xyz = NULL;
+	int seen_data = 0, rc = PX_OK;
+
+	if (!f) {
+		int e = errno;
+		rep_msg(rep, "%s: %s", path, strerror(e));
+		return e == ENOENT ? PX_E_NOTFOUND : PX_E_IO;
+	}
+	while ((len = getline(&line, &cap, f)) >= 0) {
+		const char *s = line;
+		double v[3];
+		int k, bad;
+		lineno++;
+		while (*s == ' ' || *s == '\t')
+			s++;
+		if (*s == '\0' || *s == '\n' || *s == '\r' || *s == '#' ||
+		    (s[0] == '/' && s[1] == '/'))
+			continue;
+		k = parse_line(line, v, &bad);
+		if (k < 3) {
+			/* a header of names before the first point is fine */
+			if (!seen_data && k == 0 && isalpha((unsigned char)*s)) {
+				seen_data = 1;
+				continue;
+			}
+			rep->line = lineno;
+			if (bad)
+				rep_msg(rep, "%s:%ld:%d: not a number", path, lineno, bad);
+			else
+				rep_msg(rep, "%s:%ld: %d numbers, a point needs 3", path,
+					lineno, k);
+			rc = PX_E_PARSE;
+			goto out;
+		}
+		if (!(isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]))) {
+			rep->line = lineno;
+			rep_msg(rep, "%s:%ld: non-finite coordinate", path, lineno);
+			rc = PX_E_NAN;
+			goto out;
+		}
+		seen_data = 1;
+		if (n == vcap) {
+			size_t nc = vcap ? 2 * vcap : 4096;
+			double *q = realloc(xyz, 3 * nc * sizeof(double));
+			if (!q) {
+				rc = PX_E_NOMEM;
+				goto out;
+			}
+			xyz = q;
+			vcap = nc;
+		}
+		memcpy(xyz + 3 * n, v, sizeof(v));
+		n++;
+	}
+	if (ferror(f)) {
+		rep_msg(rep, "%s: read error", path);
+		rc = PX_E_IO;
+	} else if (n == 0) {
+		rep_msg(rep, "%s: no points in the file", path);
+		rc = PX_E_PARSE;
+	}
+out:
+	free(line);
+	fclose(f);
+	if (rc != PX_OK) {
+		free(xyz);
+		return rc;
+	}
+	*xyz_out = xyz;
+	*n_out = n;
+	return PX_OK;
+}
+
+int px_cloud_load(const char *path, double radius_m,
+		  struct px_cloud_report *rep, struct px_model **out)
+{
+	struct px_cloud_report lrep;
+	double *xyz = NULL;
+	size_t n = 0, len;
+	struct stat st;
+	int rc;
+
+	if (!rep)
+		rep = &lrep;
+	memset(rep, 0, sizeof(*rep));
+	rep->line = -1;
+	if (out)
+		*out = NULL;
+	if (!path || !out) {
+		rep_msg(rep, "invalid arguments");
+		return PX_E_INVAL;
+	}
+	if (stat(path, &st) != 0) {
+		int e = errno;
+		rep_msg(rep, "%s: %s", path, strerror(e));
+		return e == ENOENT ? PX_E_NOTFOUND : PX_E_IO;
+	}
+	if (S_ISDIR(st.st_mode)) {
+		rep_msg(rep, "%s: is a directory", path);
+		return PX_E_IO;
+	}
+	len = strlen(path);
+	if (len >= 4 && strcasecmp(path + len - 4, ".ply") == 0) {
+		char msg[sizeof(rep->message)];
+		rc = px__import_file(path, 0, &xyz, &n, NULL, NULL, NULL, msg,
+				     sizeof(msg));
+		if (rc != PX_OK) {
+			snprintf(rep->message, sizeof(rep->message), "%s", msg);
+			return rc;
+		}
+	} else {
+		rc = load_text(path, &xyz, &n, rep);
+		if (rc != PX_OK)
+			return rc;
+	}
+	rc = px_cloud_model(xyz, n, radius_m, rep, out);
+	if (rc != PX_OK && rep->message[0]) {
+		char tmp[sizeof(rep->message)];
+		size_t lp = strlen(path);
+		memcpy(tmp, rep->message, sizeof(tmp));
+		if (lp > sizeof(rep->message) - 3)
+			lp = sizeof(rep->message) - 3;
+		memcpy(rep->message, path, lp);
+		memcpy(rep->message + lp, ": ", 2);
+		memcpy(rep->message + lp + 2, tmp, sizeof(rep->message) - lp - 3);
+		rep->message[sizeof(rep->message) - 1] = '\0';
+	}
+	free(xyz);
+	return rc;
+}
+
+/* ---- accessors ------------------------------------------------------------- */
+
+static const struct cloud *as_cloud(const struct px_model *m)
+{
+	if (px_model_get_ops(m) != &cloud_ops)
+		return NULL;
+	return px_model_impl(m);
+}
+
+size_t px_cloud_point_count(const struct px_model *m)
+{
+	const struct cloud *C = as_cloud(m);
+	return C ? C->n : 0;
+}
+
+int px_cloud_point(const struct px_model *m, size_t i, px_vec3 *p)
+{
+	const struct cloud *C = as_cloud(m);
+	if (!C || !p || i >= C->n)
+		return PX_E_INVAL;
+	*p = C->pt[C->leaf_of[i]];
+	return PX_OK;
+}
+
+double px_cloud_radius(const struct px_model *m)
+{
+	const struct cloud *C = as_cloud(m);
+	return C ? C->radius : 0.0;
+}

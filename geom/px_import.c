@@ -1,0 +1,468 @@
+/*
+ * px_import.c - mesh and point files through the Open Asset Import
+ * Library (Debian libassimp-dev): STL (ASCII and binary), OBJ, PLY and
+ * the other formats it reads.
+ *
+ * Only aiProcess_Triangulate is asked for. Vertex welding is done by the
+ * mesh module on exact positions instead of aiProcess_JoinIdenticalVertices,
+ * which merges a vertex with a NaN coordinate into another one and so
+ * hides exactly the corrupt data the validation must report. Coordinates
+ * arrive as the library's single-precision floats; they are widened to
+ * double exactly.
+ */
+#include <ctype.h>
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include <assimp/cimport.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include "model_internal.h"
+#include "px_base.h"
+
+struct acc {
+	double *xyz;
+	size_t nv, cap_v;
+	uint32_t *tri;
+	size_t nt, cap_t;
+	size_t skipped;
+	int want_tri;
+	int err;
+};
+
+static int grow(void **p, size_t *cap, size_t need, size_t elem)
+{
+	size_t nc;
+	void *q;
+	if (need <= *cap)
+		return 0;
+	nc = *cap ? *cap : 1024;
+	while (nc < need) {
+		if (nc > ((size_t)-1) / 2 / elem)
+			return PX_E_OVERFLOW;
+		nc *= 2;
+	}
+	q = realloc(*p, nc * elem);
+	if (!q)
+		return PX_E_NOMEM;
+	*p = q;
+	*cap = nc;
+	return 0;
+}
+
+/* row-major 4x4 (a1..d4), applied to a point */
+static void xform(const struct aiMatrix4x4 *T, const struct aiVector3D *v,
+		  double out[3])
+{
+	double x = v->x, y = v->y, z = v->z;
+	out[0] = (double)T->a1 * x + (double)T->a2 * y + (double)T->a3 * z + T->a4;
+	out[1] = (double)T->b1 * x + (double)T->b2 * y + (double)T->b3 * z + T->b4;
+	out[2] = (double)T->c1 * x + (double)T->c2 * y + (double)T->c3 * z + T->c4;
+}
+
+static void mul(const struct aiMatrix4x4 *A, const struct aiMatrix4x4 *B,
+		struct aiMatrix4x4 *C)
+{
+	const ai_real *a = &A->a1, *b = &B->a1;
+	ai_real *c = &C->a1;
+	int i, j, k;
+	for (i = 0; i < 4; i++)
+		for (j = 0; j < 4; j++) {
+			double s = 0.0;
+			for (k = 0; k < 4; k++)
+				s += (double)a[4 * i + k] * b[4 * k + j];
+			c[4 * i + j] = (ai_real)s;
+		}
+}
+
+static void add_mesh(struct acc *A, const struct aiMesh *m,
+		     const struct aiMatrix4x4 *T)
+{
+	size_t base = A->nv, i;
+	unsigned f;
+
+	if (A->err)
+		return;
+	if ((A->err = grow((void **)&A->xyz, &A->cap_v, A->nv + m->mNumVertices,
+			   3 * sizeof(double))))
+		return;
+	for (i = 0; i < m->mNumVertices; i++) {
+		if (T)
+			xform(T, &m->mVertices[i], A->xyz + 3 * (A->nv + i));
+		else {
+			A->xyz[3 * (A->nv + i)] = m->mVertices[i].x;
+			A->xyz[3 * (A->nv + i) + 1] = m->mVertices[i].y;
+			A->xyz[3 * (A->nv + i) + 2] = m->mVertices[i].z;
+		}
+	}
+	A->nv += m->mNumVertices;
+	if (!A->want_tri)
+		return;
+	for (f = 0; f < m->mNumFaces; f++) {
+		const struct aiFace *F = &m->mFaces[f];
+		if (F->mNumIndices != 3) {
+			A->skipped++;
+			continue;
+		}
+		if ((A->err = grow((void **)&A->tri, &A->cap_t, A->nt + 1,
+				   3 * sizeof(uint32_t))))
+			return;
+		for (i = 0; i < 3; i++) {
+			size_t vi = base + F->mIndices[i];
+			if (vi > 0xfffffffeu) {
+				A->err = PX_E_OVERFLOW;
+				return;
+			}
+			A->tri[3 * A->nt + i] = (uint32_t)vi;
+		}
+		A->nt++;
+	}
+}
+
+static void walk(struct acc *A, const struct aiScene *s,
+		 const struct aiNode *n, const struct aiMatrix4x4 *parent,
+		 unsigned char *seen, int depth)
+{
+	struct aiMatrix4x4 T;
+	unsigned i;
+
+	if (depth > 256)
+		return;
+	mul(parent, &n->mTransformation, &T);
+	for (i = 0; i < n->mNumMeshes; i++)
+		if (n->mMeshes[i] < s->mNumMeshes) {
+			seen[n->mMeshes[i]] = 1;
+			add_mesh(A, s->mMeshes[n->mMeshes[i]], &T);
+		}
+	for (i = 0; i < n->mNumChildren; i++)
+		walk(A, s, n->mChildren[i], &T, seen, depth + 1);
+}
+
+/* ---- strict PLY structure check ---------------------------------------------
+ *
+ * The importer's PLY reader is lenient: a body shorter than its header
+ * promises is padded by repeating values, so a truncated scan would load
+ * as a wrong cloud without a word. Before importing, the header is read
+ * and the body walked element by element, property by property (list
+ * lengths included), for ASCII and both binary byte orders: every value
+ * must be present and numeric, and nothing may follow the last element.
+ */
+
+#define PLY_MAX_PROPS 64
+#define PLY_MAX_ELEMS 16
+
+struct ply_prop {
+	int list;   /* 0: scalar */
+	int csize;  /* byte size of the count (lists) */
+	int size;   /* byte size of the value / list item */
+};
+
+struct ply_elem {
+	char name[64];
+	unsigned long long count;
+	int n_props;
+	struct ply_prop props[PLY_MAX_PROPS];
+};
+
+static int ply_type_size(const char *t)
+{
+	static const struct {
+		const char *name;
+		int size;
+	} T[] = {{"char", 1},    {"uchar", 1},  {"int8", 1},    {"uint8", 1},
+		 {"short", 2},   {"ushort", 2}, {"int16", 2},   {"uint16", 2},
+		 {"int", 4},     {"uint", 4},   {"int32", 4},   {"uint32", 4},
+		 {"float", 4},   {"float32", 4}, {"double", 8}, {"float64", 8}};
+	size_t i;
+	for (i = 0; i < sizeof(T) / sizeof(T[0]); i++)
+		if (strcmp(t, T[i].name) == 0)
+			return T[i].size;
+	return 0;
+}
+
+static unsigned long long ply_uint(const unsigned char *b, int size, int big)
+{
+	unsigned long long v = 0;
+	int i;
+	for (i = 0; i < size; i++)
+		v |= (unsigned long long)b[big ? size - 1 - i : i] << (8 * i);
+	return v;
+}
+
+/* Next whitespace-separated token of an ASCII body; counts lines. */
+static int ply_token(FILE *f, char *tok, size_t cap, long *line)
+{
+	int c;
+	size_t n = 0;
+	while ((c = fgetc(f)) != EOF && isspace(c))
+		if (c == '\n')
+			(*line)++;
+	if (c == EOF)
+		return 0;
+	do {
+		if (n + 1 < cap)
+			tok[n++] = (char)c;
+	} while ((c = fgetc(f)) != EOF && !isspace(c));
+	if (c == '\n')
+		ungetc(c, f);
+	tok[n] = '\0';
+	return 1;
+}
+
+static int ply_validate(const char *path, char *msg, size_t msg_cap)
+{
+	struct ply_elem *E = NULL;
+	int ne = 0, fmt = -1, rc = PX_E_PARSE, k;
+	char line[512];
+	long lineno = 0;
+	FILE *f = fopen(path, "rb");
+	unsigned long long i;
+
+	if (!f) {
+		snprintf(msg, msg_cap, "%s: %s", path, strerror(errno));
+		return PX_E_IO;
+	}
+	E = calloc(PLY_MAX_ELEMS, sizeof(*E));
+	if (!E) {
+		fclose(f);
+		return PX_E_NOMEM;
+	}
+	/* header */
+	for (;;) {
+		char w[4][64];
+		int nw;
+		if (!fgets(line, sizeof(line), f)) {
+			snprintf(msg, msg_cap, "%s:%ld: PLY header without end_header", path, lineno);
+			goto out;
+		}
+		lineno++;
+		nw = sscanf(line, "%63s %63s %63s %63s", w[0], w[1], w[2], w[3]);
+		if (lineno == 1) {
+			if (nw < 1 || strcmp(w[0], "ply") != 0) {
+				snprintf(msg, msg_cap, "%s:1: not a PLY file", path);
+				goto out;
+			}
+			continue;
+		}
+		if (nw <= 0 || strcmp(w[0], "comment") == 0 || strcmp(w[0], "obj_info") == 0)
+			continue;
+		if (strcmp(w[0], "end_header") == 0)
+			break;
+		if (strcmp(w[0], "format") == 0 && nw >= 2) {
+			fmt = strcmp(w[1], "ascii") == 0 ? 0
+			      : strcmp(w[1], "binary_little_endian") == 0 ? 1
+			      : strcmp(w[1], "binary_big_endian") == 0 ? 2 : -2;
+			if (fmt == -2) {
+				snprintf(msg, msg_cap, "%s:%ld: unknown PLY format '%s'", path, lineno, w[1]);
+				goto out;
+			}
+		} else if (strcmp(w[0], "element") == 0 && nw >= 3) {
+			char *end;
+			if (ne == PLY_MAX_ELEMS) {
+				snprintf(msg, msg_cap, "%s:%ld: too many PLY elements", path, lineno);
+				goto out;
+			}
+			snprintf(E[ne].name, sizeof(E[ne].name), "%s", w[1]);
+			E[ne].count = strtoull(w[2], &end, 10);
+			if (*end || w[2][0] == '-') {
+				snprintf(msg, msg_cap, "%s:%ld: bad element count '%s'", path, lineno, w[2]);
+				goto out;
+			}
+			ne++;
+		} else if (strcmp(w[0], "property") == 0 && nw >= 3 && ne > 0) {
+			struct ply_elem *el = &E[ne - 1];
+			struct ply_prop *pp;
+			if (el->n_props == PLY_MAX_PROPS) {
+				snprintf(msg, msg_cap, "%s:%ld: too many PLY properties", path, lineno);
+				goto out;
+			}
+			pp = &el->props[el->n_props++];
+			if (strcmp(w[1], "list") == 0) {
+				pp->list = 1;
+				pp->csize = nw >= 4 ? ply_type_size(w[2]) : 0;
+				pp->size = nw >= 4 ? ply_type_size(w[3]) : 0;
+			} else {
+				pp->size = ply_type_size(w[1]);
+			}
+			if (!pp->size || (pp->list && !pp->csize)) {
+				snprintf(msg, msg_cap, "%s:%ld: bad PLY property type", path, lineno);
+				goto out;
+			}
+		} else {
+			snprintf(msg, msg_cap, "%s:%ld: unexpected PLY header line", path, lineno);
+			goto out;
+		}
+	}
+	if (fmt < 0) {
+		snprintf(msg, msg_cap, "%s: PLY header without format", path);
+		goto out;
+	}
+	/* body */
+	for (k = 0; k < ne; k++)
+		for (i = 0; i < E[k].count; i++) {
+			int j;
+			for (j = 0; j < E[k].n_props; j++) {
+				const struct ply_prop *pp = &E[k].props[j];
+				unsigned long long nitems = 1, t;
+				if (fmt == 0) {
+					char tok[64], *end;
+					if (pp->list) {
+						if (!ply_token(f, tok, sizeof(tok), &lineno))
+							goto truncated;
+						nitems = strtoull(tok, &end, 10);
+						if (*end || tok[0] == '-') {
+							snprintf(msg, msg_cap, "%s:%ld: bad list length '%s'",
+								 path, lineno, tok);
+							goto out;
+						}
+					}
+					for (t = 0; t < nitems; t++) {
+						if (!ply_token(f, tok, sizeof(tok), &lineno))
+							goto truncated;
+						strtod(tok, &end);
+						if (end == tok || *end) {
+							snprintf(msg, msg_cap, "%s:%ld: not a number '%s'",
+								 path, lineno, tok);
+							goto out;
+						}
+					}
+				} else {
+					unsigned char b[8];
+					if (pp->list) {
+						if (fread(b, 1, (size_t)pp->csize, f) != (size_t)pp->csize)
+							goto truncated;
+						nitems = ply_uint(b, pp->csize, fmt == 2);
+					}
+					for (t = 0; t < nitems; t++)
+						if (fread(b, 1, (size_t)pp->size, f) != (size_t)pp->size)
+							goto truncated;
+				}
+			}
+		}
+	if (fmt == 0) {
+		char tok[64];
+		if (ply_token(f, tok, sizeof(tok), &lineno)) {
+			snprintf(msg, msg_cap, "%s:%ld: data after the last PLY element", path, lineno);
+			goto out;
+		}
+	} else if (fgetc(f) != EOF) {
+		snprintf(msg, msg_cap, "%s: data after the last PLY element", path);
+		goto out;
+	}
+	rc = PX_OK;
+	goto out;
+truncated:
+	snprintf(msg, msg_cap, "%s: PLY data ends early (element '%s' %llu of %llu)", path,
+		 E[k].name, i, E[k].count);
+out:
+	free(E);
+	fclose(f);
+	return rc;
+}
+
+static int has_ply_magic(const char *path)
+{
+	char b[4] = {0};
+	FILE *f = fopen(path, "rb");
+	size_t n;
+	if (!f)
+		return 0;
+	n = fread(b, 1, 4, f);
+	fclose(f);
+	return n == 4 && memcmp(b, "ply", 3) == 0 && (b[3] == '\n' || b[3] == '\r');
+}
+
+int px__import_file(const char *path, int want_tri, double **xyz,
+		    size_t *nv, uint32_t **tri, size_t *nt, size_t *n_skipped,
+		    char *msg, size_t msg_cap)
+{
+	const struct aiScene *s;
+	struct acc A;
+	struct stat st;
+	struct aiMatrix4x4 I;
+	unsigned char *seen;
+	unsigned i;
+	FILE *f;
+
+	memset(&A, 0, sizeof(A));
+	A.want_tri = want_tri;
+	if (msg_cap)
+		msg[0] = '\0';
+	if (!path || !xyz || !nv || (want_tri && (!tri || !nt))) {
+		snprintf(msg, msg_cap, "invalid arguments");
+		return PX_E_INVAL;
+	}
+	*xyz = NULL;
+	*nv = 0;
+	if (tri)
+		*tri = NULL;
+	if (nt)
+		*nt = 0;
+	if (stat(path, &st) != 0) {
+		int e = errno;
+		snprintf(msg, msg_cap, "%s: %s", path, strerror(e));
+		return e == ENOENT ? PX_E_NOTFOUND : PX_E_IO;
+	}
+	if (S_ISDIR(st.st_mode)) {
+		snprintf(msg, msg_cap, "%s: is a directory", path);
+		return PX_E_IO;
+	}
+	f = fopen(path, "rb");
+	if (!f) {
+		snprintf(msg, msg_cap, "%s: %s", path, strerror(errno));
+		return PX_E_IO;
+	}
+	fclose(f);
+	if (has_ply_magic(path)) {
+		int rc = ply_validate(path, msg, msg_cap);
+		if (rc != PX_OK)
+			return rc;
+	}
+	s = aiImportFile(path, aiProcess_Triangulate);
+	if (!s) {
+		snprintf(msg, msg_cap, "%s: %s", path, aiGetErrorString());
+		return PX_E_PARSE;
+	}
+	seen = calloc(s->mNumMeshes + 1, 1);
+	if (!seen) {
+		aiReleaseImport(s);
+		return PX_E_NOMEM;
+	}
+	memset(&I, 0, sizeof(I));
+	I.a1 = I.b2 = I.c3 = I.d4 = 1.0f;
+	if (s->mRootNode)
+		walk(&A, s, s->mRootNode, &I, seen, 0);
+	for (i = 0; i < s->mNumMeshes; i++)
+		if (!seen[i])
+			add_mesh(&A, s->mMeshes[i], NULL);
+	free(seen);
+	aiReleaseImport(s);
+	if (A.err) {
+		snprintf(msg, msg_cap, "%s: %s", path, px_strerror(A.err));
+		free(A.xyz);
+		free(A.tri);
+		return A.err;
+	}
+	if (A.nv == 0 || (want_tri && A.nt == 0)) {
+		snprintf(msg, msg_cap, "%s: no %s in the file", path,
+			 want_tri ? "triangles" : "points");
+		free(A.xyz);
+		free(A.tri);
+		return PX_E_PARSE;
+	}
+	*xyz = A.xyz;
+	*nv = A.nv;
+	if (want_tri) {
+		*tri = A.tri;
+		*nt = A.nt;
+	} else {
+		free(A.tri);
+	}
+	if (n_skipped)
+		*n_skipped = A.skipped;
+	return PX_OK;
+}

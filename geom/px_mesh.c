@@ -1,0 +1,950 @@
+/*
+ * px_mesh.c - triangle mesh model: validation, topology, pseudo-normals,
+ * AABB hierarchy, exact point-triangle distance.
+ */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "model_internal.h"
+#include "px_mesh.h"
+
+/* A triangle whose height over its longest edge is below this fraction
+ * of that edge is a needle: its distance is taken as that of its three
+ * edges (error at most this fraction of the edge length). */
+#define NEEDLE_SIN2 1e-20
+
+/* Two children per node, each with its box; cnt > 0 marks a leaf range
+ * [idx, idx + cnt) of the reordered triangles, cnt == 0 an inner node
+ * idx, and idx == EMPTY an absent child (only in a one-leaf root). */
+#define EMPTY 0xffffffffu
+struct node {
+	float lo[2][3], hi[2][3]; /* rounded outwards: still lower bounds */
+	uint32_t idx[2], cnt[2];
+};
+
+/* Triangle with its (unnormalized) normal n = (b - a) x (c - a) and
+ * 1 / |n|^2, for the plane-distance lower bound. */
+struct mtri {
+	px_vec3 a, b, c;
+	px_vec3 n;
+	double inv_nn;
+};
+
+static float f_down(double x)
+{
+	float f = (float)x;
+	return (double)f > x ? nextafterf(f, -INFINITY) : f;
+}
+
+static float f_up(double x)
+{
+	float f = (float)x;
+	return (double)f < x ? nextafterf(f, INFINITY) : f;
+}
+
+struct mesh {
+	size_t nt, nv;
+	struct mtri *tri;    /* leaf order */
+	uint32_t *orig;      /* leaf -> input triangle */
+	uint32_t *leaf_of;   /* input -> leaf */
+	px_vec3 *fn;         /* face normal per leaf triangle (0 if degenerate) */
+	px_vec3 *en;         /* 3 edge pseudo-normals per leaf triangle */
+	px_vec3 *vnt;        /* 3 vertex pseudo-normals per leaf triangle */
+	uint8_t *degen;      /* per leaf triangle */
+	struct node *nodes;
+	size_t n_nodes;
+	int closed;
+	int depth;
+	px_aabb box;
+	size_t bytes;
+};
+
+/* ---- point-triangle distance ------------------------------------------ */
+
+static double seg_closest(px_vec3 p, px_vec3 a, px_vec3 b, double *t,
+			  px_vec3 *q)
+{
+	px_vec3 ab = px_v3_sub(b, a);
+	double l2 = px_v3_norm2(ab), s = 0.0;
+	if (l2 > 0.0) {
+		s = px_v3_dot(px_v3_sub(p, a), ab) / l2;
+		s = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
+	}
+	*t = s;
+	*q = px_v3_madd(a, ab, s);
+	return px_v3_dist2(p, *q);
+}
+
+/* Needle or collapsed triangle: nearest of its three edges. */
+static double tri_as_segments(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
+			      px_vec3 *q, int *feature, int *sub, double *u,
+			      double *v)
+{
+	px_vec3 P[3] = {a, b, c}, qq;
+	double best = INFINITY, t, bt = 0.0;
+	int e, be = 0;
+	for (e = 0; e < 3; e++) {
+		double d2 = seg_closest(p, P[e], P[(e + 1) % 3], &t, &qq);
+		if (d2 < best) {
+			best = d2;
+			bt = t;
+			be = e;
+			*q = qq;
+		}
+	}
+	{
+		/* barycentrics of the point on edge be */
+		double w[3] = {0, 0, 0};
+		w[be] = 1.0 - bt;
+		w[(be + 1) % 3] = bt;
+		*u = w[1];
+		*v = w[2];
+	}
+	if (bt <= 0.0 || bt >= 1.0) {
+		*feature = PX_FEATURE_VERTEX;
+		*sub = bt <= 0.0 ? be : (be + 1) % 3;
+	} else {
+		*feature = PX_FEATURE_EDGE;
+		*sub = be;
+	}
+	return best;
+}
+
+/*
+ * Voronoi-region walk (the vertex, edge and face regions are decided by
+ * the signs of dot products of p - vertex with the edges, as in Ericson,
+ * Real-Time Collision Detection 5.1.5). The face point is taken by
+ * projecting onto the plane along the cross-product normal rather than
+ * from the barycentric ratios, which lose accuracy on thin triangles.
+ */
+/* n = (b - a) x (c - a), nn = |n|^2, needle: treat as segments. */
+static inline double tri_core(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
+			      px_vec3 n, double nn, int needle, px_vec3 *q,
+			      int *feature, int *sub, double *u, double *v)
+{
+	px_vec3 ab = px_v3_sub(b, a), ac = px_v3_sub(c, a), ap = px_v3_sub(p, a);
+	px_vec3 bp, cp;
+	double d1, d2, d3, d4, d5, d6, va, vb, vc, t;
+
+	if (needle)
+		return tri_as_segments(p, a, b, c, q, feature, sub, u, v);
+
+	d1 = px_v3_dot(ab, ap);
+	d2 = px_v3_dot(ac, ap);
+	if (d1 <= 0.0 && d2 <= 0.0) {
+		*q = a;
+		*feature = PX_FEATURE_VERTEX;
+		*sub = 0;
+		*u = *v = 0.0;
+		return px_v3_norm2(ap);
+	}
+	bp = px_v3_sub(p, b);
+	d3 = px_v3_dot(ab, bp);
+	d4 = px_v3_dot(ac, bp);
+	if (d3 >= 0.0 && d4 <= d3) {
+		*q = b;
+		*feature = PX_FEATURE_VERTEX;
+		*sub = 1;
+		*u = 1.0;
+		*v = 0.0;
+		return px_v3_norm2(bp);
+	}
+	vc = d1 * d4 - d3 * d2;
+	if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+		t = d1 / (d1 - d3);
+		*q = px_v3_madd(a, ab, t);
+		*feature = PX_FEATURE_EDGE;
+		*sub = 0;
+		*u = t;
+		*v = 0.0;
+		return px_v3_dist2(p, *q);
+	}
+	cp = px_v3_sub(p, c);
+	d5 = px_v3_dot(ab, cp);
+	d6 = px_v3_dot(ac, cp);
+	if (d6 >= 0.0 && d5 <= d6) {
+		*q = c;
+		*feature = PX_FEATURE_VERTEX;
+		*sub = 2;
+		*u = 0.0;
+		*v = 1.0;
+		return px_v3_norm2(cp);
+	}
+	vb = d5 * d2 - d1 * d6;
+	if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+		t = d2 / (d2 - d6);
+		*q = px_v3_madd(a, ac, t);
+		*feature = PX_FEATURE_EDGE;
+		*sub = 2;
+		*u = 0.0;
+		*v = t;
+		return px_v3_dist2(p, *q);
+	}
+	va = d3 * d6 - d5 * d4;
+	if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
+		t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+		*q = px_v3_madd(b, px_v3_sub(c, b), t);
+		*feature = PX_FEATURE_EDGE;
+		*sub = 1;
+		*u = 1.0 - t;
+		*v = t;
+		return px_v3_dist2(p, *q);
+	}
+	/* face region */
+	{
+		double s = px_v3_dot(n, ap) / nn;
+		double den = va + vb + vc;
+		*q = px_v3_madd(p, n, -s);
+		*feature = PX_FEATURE_FACE;
+		*sub = -1;
+		*u = den != 0.0 ? vb / den : 0.0;
+		*v = den != 0.0 ? vc / den : 0.0;
+		return s * s * nn;
+	}
+}
+
+/* The needle test shared by the public routine and mesh setup. */
+static int is_needle(px_vec3 a, px_vec3 b, px_vec3 c, px_vec3 n)
+{
+	px_vec3 ab = px_v3_sub(b, a), ac = px_v3_sub(c, a), bc = px_v3_sub(c, b);
+	double lab = px_v3_norm2(ab), lac = px_v3_norm2(ac), lbc = px_v3_norm2(bc);
+	double m = fmax(lab * lac, fmax(lab * lbc, lac * lbc));
+	return !(px_v3_norm2(n) > NEEDLE_SIN2 * m);
+}
+
+double px_tri_closest(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
+		      px_vec3 *q, int *feature, int *sub, double *u, double *v)
+{
+	px_vec3 n = px_v3_cross(px_v3_sub(b, a), px_v3_sub(c, a)), qq;
+	int f_, s_;
+	double u_, v_;
+
+	if (!feature)
+		feature = &f_;
+	if (!sub)
+		sub = &s_;
+	if (!u)
+		u = &u_;
+	if (!v)
+		v = &v_;
+	if (!q)
+		q = &qq;
+	return tri_core(p, a, b, c, n, px_v3_norm2(n), is_needle(a, b, c, n), q,
+			feature, sub, u, v);
+}
+
+/* ---- setup helpers ------------------------------------------------------ */
+
+static void rep_msg(struct px_mesh_report *rep, const char *fmt, ...)
+	__attribute__((format(printf, 2, 3)));
+static void rep_msg(struct px_mesh_report *rep, const char *fmt, ...)
+{
+	va_list ap;
+	if (!rep || rep->message[0])
+		return;
+	va_start(ap, fmt);
+	vsnprintf(rep->message, sizeof(rep->message), fmt, ap);
+	va_end(ap);
+}
+
+static int cmp_xyz(const void *x, const void *y, void *ctx)
+{
+	const double *P = ctx;
+	const double *a = P + 3 * (size_t)*(const uint32_t *)x;
+	const double *b = P + 3 * (size_t)*(const uint32_t *)y;
+	int k;
+	for (k = 0; k < 3; k++) {
+		if (a[k] < b[k])
+			return -1;
+		if (a[k] > b[k])
+			return 1;
+	}
+	return 0;
+}
+
+struct edge {
+	uint32_t lo, hi; /* canonical vertex ids */
+	uint32_t tri;
+	uint8_t e;       /* local edge 0..2 */
+	uint8_t fwd;     /* lo -> hi in the triangle's order */
+};
+
+static int cmp_edge(const void *x, const void *y)
+{
+	const struct edge *a = x, *b = y;
+	if (a->lo != b->lo)
+		return a->lo < b->lo ? -1 : 1;
+	if (a->hi != b->hi)
+		return a->hi < b->hi ? -1 : 1;
+	return a->tri < b->tri ? -1 : (a->tri > b->tri);
+}
+
+static double ang(px_vec3 u, px_vec3 w)
+{
+	return atan2(px_v3_norm(px_v3_cross(u, w)), px_v3_dot(u, w));
+}
+
+/* quickselect: put the k-th smallest centroid (on axis) at a[k] */
+static void select_k(uint32_t *a, long n, long k, const double *cen, int axis)
+{
+	long lo = 0, hi = n - 1;
+	while (lo < hi) {
+		double pv = cen[3 * (size_t)a[lo + (hi - lo) / 2] + axis];
+		long i = lo, j = hi;
+		while (i <= j) {
+			while (cen[3 * (size_t)a[i] + axis] < pv)
+				i++;
+			while (cen[3 * (size_t)a[j] + axis] > pv)
+				j--;
+			if (i <= j) {
+				uint32_t t = a[i];
+				a[i] = a[j];
+				a[j] = t;
+				i++;
+				j--;
+			}
+		}
+		if (k <= j)
+			hi = j;
+		else if (k >= i)
+			lo = i;
+		else
+			break;
+	}
+}
+
+struct build {
+	uint32_t *perm;
+	const double *cen;  /* 3 per input triangle */
+	const double *tlo, *thi; /* 3 each per input triangle */
+	struct node *nodes;
+	size_t n_nodes;
+	int leaf;
+	int depth;
+};
+
+static void range_box(const struct build *B, size_t s, size_t n, float lo[3],
+		      float hi[3])
+{
+	double l[3] = {INFINITY, INFINITY, INFINITY},
+	       h[3] = {-INFINITY, -INFINITY, -INFINITY};
+	size_t i;
+	int k;
+	for (i = s; i < s + n; i++) {
+		size_t t = B->perm[i];
+		for (k = 0; k < 3; k++) {
+			l[k] = fmin(l[k], B->tlo[3 * t + k]);
+			h[k] = fmax(h[k], B->thi[3 * t + k]);
+		}
+	}
+	for (k = 0; k < 3; k++) {
+		lo[k] = f_down(l[k]);
+		hi[k] = f_up(h[k]);
+	}
+}
+
+/* Build the node for range [s, s + n) (n > leaf); returns its index. */
+static uint32_t build_node(struct build *B, size_t s, size_t n, int depth)
+{
+	uint32_t me = (uint32_t)B->n_nodes++;
+	double clo[3] = {INFINITY, INFINITY, INFINITY},
+	       chi[3] = {-INFINITY, -INFINITY, -INFINITY};
+	size_t i, half = n / 2, part[2][2];
+	int k, axis = 0, c;
+
+	if (depth > B->depth)
+		B->depth = depth;
+	for (i = s; i < s + n; i++)
+		for (k = 0; k < 3; k++) {
+			double x = B->cen[3 * (size_t)B->perm[i] + k];
+			clo[k] = fmin(clo[k], x);
+			chi[k] = fmax(chi[k], x);
+		}
+	for (k = 1; k < 3; k++)
+		if (chi[k] - clo[k] > chi[axis] - clo[axis])
+			axis = k;
+	select_k(B->perm + s, (long)n, (long)half, B->cen, axis);
+	part[0][0] = s;
+	part[0][1] = half;
+	part[1][0] = s + half;
+	part[1][1] = n - half;
+	for (c = 0; c < 2; c++) {
+		struct node *nd = &B->nodes[me];
+		range_box(B, part[c][0], part[c][1], nd->lo[c], nd->hi[c]);
+		if (part[c][1] <= (size_t)B->leaf) {
+			nd->idx[c] = (uint32_t)part[c][0];
+			nd->cnt[c] = (uint32_t)part[c][1];
+		} else {
+			uint32_t ch = build_node(B, part[c][0], part[c][1],
+						 depth + 1);
+			B->nodes[me].idx[c] = ch;
+			B->nodes[me].cnt[c] = 0;
+		}
+	}
+	return me;
+}
+
+static void mesh_free(void *impl)
+{
+	struct mesh *M = impl;
+	if (!M)
+		return;
+	free(M->tri);
+	free(M->orig);
+	free(M->leaf_of);
+	free(M->fn);
+	free(M->en);
+	free(M->vnt);
+	free(M->degen);
+	free(M->nodes);
+	free(M);
+}
+
+/* ---- query --------------------------------------------------------------- */
+
+/* Plain compares rather than fmax(), which is an out-of-line libm call
+ * (NaN rules) and was a fifth of the query time; no NaN reaches here. */
+static inline double gap(double lo, double hi, double x)
+{
+	double d = lo - x > x - hi ? lo - x : x - hi;
+	return d > 0.0 ? d : 0.0;
+}
+
+static inline double box_d2(const struct node *nd, int c, px_vec3 p)
+{
+	double dx = gap(nd->lo[c][0], nd->hi[c][0], p.x);
+	double dy = gap(nd->lo[c][1], nd->hi[c][1], p.y);
+	double dz = gap(nd->lo[c][2], nd->hi[c][2], p.z);
+	return dx * dx + dy * dy + dz * dz;
+}
+
+struct best {
+	double d2;
+	long li;
+	px_vec3 q;
+	int feature, sub;
+	double u, v;
+};
+
+static inline void test_tri(const struct mesh *M, size_t li, px_vec3 p,
+			    struct best *b)
+{
+	const struct mtri *t = &M->tri[li];
+	px_vec3 q;
+	int f, s;
+	double u, v, d2;
+
+	if (!M->degen[li]) {
+		/* the distance to the plane is a lower bound */
+		double h = px_v3_dot(t->n, px_v3_sub(p, t->a));
+		if (h * h * t->inv_nn > b->d2)
+			return;
+	}
+	d2 = tri_core(p, t->a, t->b, t->c, t->n, 1.0 / t->inv_nn, M->degen[li], &q,
+		      &f, &s, &u, &v);
+	if (d2 < b->d2 ||
+	    (d2 == b->d2 && (b->li < 0 || (M->degen[b->li] && !M->degen[li])))) {
+		b->d2 = d2;
+		b->li = (long)li;
+		b->q = q;
+		b->feature = f;
+		b->sub = s;
+		b->u = u;
+		b->v = v;
+	}
+}
+
+static int mesh_closest(const void *impl, const struct px_model_query *qq,
+			struct px_model_result *r)
+{
+	const struct mesh *M = impl;
+	struct {
+		uint32_t idx, cnt;
+		double d2;
+	} st[PX_MESH_MAX_DEPTH + 2];
+	int sp = 0, iters = 0, certified = 1;
+	struct best b;
+	px_vec3 p = qq->p, n, dv;
+	double d;
+
+	b.d2 = isinf(qq->max_dist) ? INFINITY : qq->max_dist * qq->max_dist;
+	b.li = -1;
+	b.q = p;
+	b.feature = PX_FEATURE_NONE;
+	b.sub = 0;
+	b.u = b.v = 0.0;
+	if (qq->hint >= 0 && (size_t)qq->hint < M->nt) {
+		test_tri(M, M->leaf_of[qq->hint], p, &b);
+		iters++;
+	}
+	st[sp].idx = 0;
+	st[sp].cnt = 0;
+	st[sp].d2 = 0.0;
+	sp++;
+	while (sp > 0) {
+		const struct node *nd;
+		double dc[2];
+		int near, c;
+
+		sp--;
+		if (st[sp].d2 > b.d2 || (st[sp].d2 == b.d2 && b.li >= 0))
+			continue;
+		iters++;
+		if (st[sp].cnt > 0) {
+			uint32_t i;
+			for (i = st[sp].idx; i < st[sp].idx + st[sp].cnt; i++)
+				test_tri(M, i, p, &b);
+			continue;
+		}
+		nd = &M->nodes[st[sp].idx];
+		dc[0] = nd->idx[0] == EMPTY ? INFINITY : box_d2(nd, 0, p);
+		dc[1] = nd->idx[1] == EMPTY ? INFINITY : box_d2(nd, 1, p);
+		near = dc[1] < dc[0];
+		/* push the far child first so the near one is expanded first */
+		for (c = 0; c < 2; c++) {
+			int ch = c == 0 ? 1 - near : near;
+			if (dc[ch] > b.d2)
+				continue;
+			if (sp >= PX_MESH_MAX_DEPTH + 2) {
+				certified = 0; /* cannot happen: depth checked at setup */
+				continue;
+			}
+			st[sp].idx = nd->idx[ch];
+			st[sp].cnt = nd->cnt[ch];
+			st[sp].d2 = dc[ch];
+			sp++;
+		}
+	}
+	if (b.li < 0)
+		return 0;
+
+	r->point = b.q;
+	r->index = (int)M->orig[b.li];
+	r->sub = b.sub;
+	r->feature = b.feature;
+	r->u = b.u;
+	r->v = b.v;
+	r->iterations = iters;
+	r->certified = certified;
+	r->gap = 0.0;
+	if (b.feature == PX_FEATURE_FACE)
+		n = M->fn[b.li];
+	else if (b.feature == PX_FEATURE_EDGE)
+		n = M->en[3 * b.li + b.sub];
+	else
+		n = M->vnt[3 * b.li + b.sub];
+	d = sqrt(b.d2);
+	dv = px_v3_sub(p, b.q);
+	r->is_signed = M->closed && !(qq->flags & PX_QUERY_UNSIGNED);
+	r->inside = 0;
+	if (d > 0.0) {
+		r->direction = px_v3_scale(dv, 1.0 / d);
+		r->distance = d;
+		if (r->is_signed && px_v3_dot(dv, n) < 0.0) {
+			r->inside = 1;
+			r->distance = -d;
+			r->direction = px_v3_neg(r->direction);
+		}
+	} else {
+		px_vec3 f = M->fn[b.li];
+		r->distance = 0.0;
+		if (px_v3_normalize(n, f, &r->direction) != PX_OK)
+			px_v3_normalize(f, px_v3(0, 0, 1), &r->direction);
+	}
+	return 1;
+}
+
+static px_aabb mesh_aabb(const void *impl)
+{
+	return ((const struct mesh *)impl)->box;
+}
+
+static size_t mesh_bytes(const void *impl)
+{
+	return ((const struct mesh *)impl)->bytes;
+}
+
+static const struct px_model_ops mesh_ops = {
+	"mesh", PX_MODEL_MESH, mesh_closest, mesh_aabb, mesh_bytes, mesh_free};
+
+/* ---- build ----------------------------------------------------------------- */
+
+int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
+		  size_t nt, const struct px_mesh_opts *opt,
+		  struct px_mesh_report *rep, struct px_model **out)
+{
+	struct px_mesh_report lrep;
+	struct mesh *M = NULL;
+	uint32_t *order = NULL, *canon = NULL, *perm = NULL;
+	struct edge *E = NULL;
+	size_t ne = 0, i, j;
+	int32_t *nb = NULL;
+	px_vec3 *fn = NULL, *vn = NULL;
+	double *cen = NULL, *tlo = NULL, *thi = NULL;
+	uint8_t *deg = NULL, *used = NULL;
+	unsigned flags = opt ? opt->flags : 0u;
+	int leaf = (opt && opt->leaf_size) ? opt->leaf_size : 4;
+	int rc = PX_E_NOMEM, k;
+	struct build B;
+
+	if (!rep)
+		rep = &lrep;
+	memset(rep, 0, sizeof(*rep));
+	rep->first_degenerate = -1;
+	rep->first_bad_edge_triangle = -1;
+	rep->n_vertices = nv;
+	rep->n_triangles = nt;
+	if (out)
+		*out = NULL;
+	if (!out || !xyz || !tri || nt == 0 || nv == 0 || leaf < 1 || leaf > 16) {
+		rep_msg(rep, "%s", nt == 0 || nv == 0 ? "mesh has no triangles"
+						    : "invalid arguments");
+		return PX_E_INVAL;
+	}
+	if (nt > PX_MESH_MAX_TRIANGLES || nv > 0xfffffffeu) {
+		rep_msg(rep, "mesh too large (%zu triangles, %zu vertices)", nt, nv);
+		return PX_E_RANGE;
+	}
+	/* indices, then finiteness of the vertices actually used */
+	used = calloc(nv, 1);
+	if (!used)
+		goto fail;
+	for (i = 0; i < nt; i++)
+		for (k = 0; k < 3; k++) {
+			uint32_t vi = tri[3 * i + k];
+			if (vi >= nv) {
+				rep_msg(rep, "triangle %zu: vertex index %u out of range (%zu vertices)",
+					i, vi, nv);
+				rc = PX_E_RANGE;
+				goto fail;
+			}
+			used[vi] = 1;
+		}
+	for (i = 0; i < nv; i++)
+		if (used[i] && !(isfinite(xyz[3 * i]) && isfinite(xyz[3 * i + 1]) &&
+				 isfinite(xyz[3 * i + 2]))) {
+			rep_msg(rep, "vertex %zu: non-finite coordinate (%g %g %g)", i,
+				xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+			rc = PX_E_NAN;
+			goto fail;
+		}
+
+	/* weld identical positions */
+	order = malloc(nv * sizeof(*order));
+	canon = malloc(nv * sizeof(*canon));
+	if (!order || !canon)
+		goto fail;
+	for (i = 0; i < nv; i++)
+		order[i] = (uint32_t)i;
+	qsort_r(order, nv, sizeof(*order), cmp_xyz, (void *)xyz);
+	for (i = 0; i < nv; i++) {
+		if (i > 0 && cmp_xyz(&order[i - 1], &order[i], (void *)xyz) == 0)
+			canon[order[i]] = canon[order[i - 1]];
+		else {
+			canon[order[i]] = order[i];
+			if (used[order[i]])
+				rep->n_welded++;
+		}
+	}
+
+	/* per triangle: degeneracy, normal, boxes, centroid */
+	deg = calloc(nt, 1);
+	fn = calloc(nt, sizeof(*fn));
+	cen = malloc(nt * 3 * sizeof(double));
+	tlo = malloc(nt * 3 * sizeof(double));
+	thi = malloc(nt * 3 * sizeof(double));
+	E = malloc(nt * 3 * sizeof(*E));
+	nb = malloc(nt * 3 * sizeof(*nb));
+	vn = calloc(nv, sizeof(*vn));
+	if (!deg || !fn || !cen || !tlo || !thi || !E || !nb || !vn)
+		goto fail;
+	for (i = 0; i < nt; i++) {
+		uint32_t c0 = canon[tri[3 * i]], c1 = canon[tri[3 * i + 1]],
+			 c2 = canon[tri[3 * i + 2]];
+		const double *A = xyz + 3 * (size_t)c0, *Bv = xyz + 3 * (size_t)c1,
+			     *C = xyz + 3 * (size_t)c2;
+		px_vec3 a = px_v3(A[0], A[1], A[2]), b = px_v3(Bv[0], Bv[1], Bv[2]),
+			c = px_v3(C[0], C[1], C[2]);
+		px_vec3 ab = px_v3_sub(b, a), ac = px_v3_sub(c, a), bc = px_v3_sub(c, b);
+		px_vec3 nrm = px_v3_cross(ab, ac);
+		double lab = px_v3_norm2(ab), lac = px_v3_norm2(ac), lbc = px_v3_norm2(bc);
+		double m = fmax(lab * lac, fmax(lab * lbc, lac * lbc));
+		int collapsed = c0 == c1 || c1 == c2 || c0 == c2;
+
+		nb[3 * i] = nb[3 * i + 1] = nb[3 * i + 2] = -1;
+		(void)m;
+		if (collapsed || is_needle(a, b, c, nrm)) {
+			deg[i] = 1;
+			if (rep->n_degenerate++ == 0)
+				rep->first_degenerate = (long)i;
+		} else {
+			px_v3_normalize(nrm, px_v3(0, 0, 0), &fn[i]);
+			rep->volume += px_v3_dot(a, px_v3_cross(b, c)) / 6.0;
+			/* angle-weighted vertex pseudo-normals */
+			vn[c0] = px_v3_madd(vn[c0], fn[i], ang(ab, ac));
+			vn[c1] = px_v3_madd(vn[c1], fn[i], ang(px_v3_neg(ab), bc));
+			vn[c2] = px_v3_madd(vn[c2], fn[i], ang(px_v3_neg(ac), px_v3_neg(bc)));
+		}
+		for (k = 0; k < 3; k++) {
+			double lo = fmin(fmin(A[k], Bv[k]), C[k]);
+			double hi = fmax(fmax(A[k], Bv[k]), C[k]);
+			tlo[3 * i + k] = lo;
+			thi[3 * i + k] = hi;
+			cen[3 * i + k] = 0.5 * (lo + hi);
+		}
+		if (!collapsed) {
+			uint32_t cv[3] = {c0, c1, c2};
+			for (k = 0; k < 3; k++) {
+				uint32_t s = cv[k], e = cv[(k + 1) % 3];
+				struct edge *ed = &E[ne++];
+				ed->lo = s < e ? s : e;
+				ed->hi = s < e ? e : s;
+				ed->fwd = s < e;
+				ed->tri = (uint32_t)i;
+				ed->e = (uint8_t)k;
+			}
+		}
+	}
+	if (rep->n_degenerate)
+		rep_msg(rep, "triangle %ld is degenerate (zero area)%s",
+			rep->first_degenerate,
+			rep->n_degenerate > 1 ? ", and others" : "");
+	if ((flags & PX_MESH_REJECT_DEGENERATE) && rep->n_degenerate) {
+		rc = PX_E_DEGENERATE;
+		goto fail;
+	}
+
+	/* edge topology */
+	qsort(E, ne, sizeof(*E), cmp_edge);
+	for (i = 0; i < ne; i = j) {
+		for (j = i + 1; j < ne && E[j].lo == E[i].lo && E[j].hi == E[i].hi; j++)
+			;
+		if (j - i == 2 && E[i].fwd != E[i + 1].fwd) {
+			nb[3 * E[i].tri + E[i].e] = (int32_t)E[i + 1].tri;
+			nb[3 * E[i + 1].tri + E[i + 1].e] = (int32_t)E[i].tri;
+			continue;
+		}
+		if (j - i == 1)
+			rep->n_boundary_edges++;
+		else if (j - i == 2)
+			rep->n_misoriented_edges++;
+		else
+			rep->n_nonmanifold_edges++;
+		if (rep->first_bad_edge_triangle < 0) {
+			rep->first_bad_edge_triangle = (long)E[i].tri;
+			rep_msg(rep, "triangle %u edge %d: %s edge (shared by %zu triangles%s)",
+				E[i].tri, E[i].e,
+				j - i == 1 ? "boundary" : (j - i == 2 ? "inconsistently oriented" : "non-manifold"),
+				j - i, j - i == 2 ? " in the same direction" : "");
+		}
+	}
+	rep->closed = rep->n_boundary_edges == 0 && rep->n_nonmanifold_edges == 0 &&
+		      rep->n_misoriented_edges == 0 && ne > 0;
+	if ((flags & PX_MESH_REQUIRE_CLOSED) && !rep->closed) {
+		rc = PX_E_DEGENERATE;
+		goto fail;
+	}
+	if (!rep->closed)
+		rep->volume = 0.0;
+	if (rep->closed && rep->volume < 0.0 && !(flags & PX_MESH_NO_FLIP)) {
+		rep->flipped = 1;
+		rep->volume = -rep->volume;
+		for (i = 0; i < nt; i++)
+			fn[i] = px_v3_neg(fn[i]);
+		for (i = 0; i < nv; i++)
+			vn[i] = px_v3_neg(vn[i]);
+	}
+
+	/* hierarchy */
+	M = calloc(1, sizeof(*M));
+	if (!M)
+		goto fail;
+	M->nt = nt;
+	M->nv = nv;
+	M->closed = rep->closed;
+	perm = malloc(nt * sizeof(*perm));
+	M->nodes = calloc(nt + 1, sizeof(*M->nodes));
+	if (!perm || !M->nodes)
+		goto fail;
+	for (i = 0; i < nt; i++)
+		perm[i] = (uint32_t)i;
+	B.perm = perm;
+	B.cen = cen;
+	B.tlo = tlo;
+	B.thi = thi;
+	B.nodes = M->nodes;
+	B.n_nodes = 0;
+	B.leaf = leaf;
+	B.depth = 0;
+	if (nt <= (size_t)leaf) {
+		struct node *nd = &M->nodes[0];
+		B.n_nodes = 1;
+		range_box(&B, 0, nt, nd->lo[0], nd->hi[0]);
+		nd->idx[0] = 0;
+		nd->cnt[0] = (uint32_t)nt;
+		for (k = 0; k < 3; k++) {
+			nd->lo[1][k] = INFINITY;
+			nd->hi[1][k] = -INFINITY;
+		}
+		nd->idx[1] = EMPTY;
+		nd->cnt[1] = 0;
+	} else {
+		build_node(&B, 0, nt, 0);
+	}
+	M->n_nodes = B.n_nodes;
+	M->depth = B.depth + 1;
+	rep->depth = M->depth;
+	if (M->depth > PX_MESH_MAX_DEPTH) {
+		rep_msg(rep, "hierarchy too deep (%d)", M->depth);
+		rc = PX_E_RANGE;
+		goto fail;
+	}
+
+	/* reorder into leaf order */
+	M->tri = malloc(nt * sizeof(*M->tri));
+	M->orig = malloc(nt * sizeof(*M->orig));
+	M->leaf_of = malloc(nt * sizeof(*M->leaf_of));
+	M->fn = malloc(nt * sizeof(*M->fn));
+	M->en = malloc(3 * nt * sizeof(*M->en));
+	M->vnt = malloc(3 * nt * sizeof(*M->vnt));
+	M->degen = malloc(nt);
+	if (!M->tri || !M->orig || !M->leaf_of || !M->fn || !M->en || !M->vnt ||
+	    !M->degen)
+		goto fail;
+	M->box = px_aabb_empty();
+	for (i = 0; i < nt; i++) {
+		uint32_t t = perm[i];
+		px_vec3 P[3];
+		for (k = 0; k < 3; k++) {
+			const double *X = xyz + 3 * (size_t)canon[tri[3 * t + k]];
+			P[k] = px_v3(X[0], X[1], X[2]);
+			px_aabb_extend(&M->box, P[k]);
+			M->vnt[3 * i + k] = vn[canon[tri[3 * t + k]]];
+			M->en[3 * i + k] = nb[3 * t + k] >= 0
+						   ? px_v3_add(fn[t], fn[nb[3 * t + k]])
+						   : fn[t];
+		}
+		M->tri[i].a = P[0];
+		M->tri[i].b = P[1];
+		M->tri[i].c = P[2];
+		M->tri[i].n = px_v3_cross(px_v3_sub(P[1], P[0]), px_v3_sub(P[2], P[0]));
+		M->tri[i].inv_nn = deg[t] ? 0.0 : 1.0 / px_v3_norm2(M->tri[i].n);
+		M->orig[i] = t;
+		M->leaf_of[t] = (uint32_t)i;
+		M->fn[i] = fn[t];
+		M->degen[i] = deg[t];
+	}
+	M->bytes = sizeof(*M) + nt * (sizeof(struct mtri) + 2 * sizeof(uint32_t) +
+				      7 * sizeof(px_vec3) + 1) +
+		   M->n_nodes * sizeof(struct node);
+	rc = px_model_create(&mesh_ops, M,
+			     PX_MODEL_CAP_EXACT | PX_MODEL_CAP_COHERENT |
+				     (M->closed ? PX_MODEL_CAP_SIGNED : 0u),
+			     out);
+	M = NULL; /* owned by the model now, also on failure */
+	if (rc != PX_OK)
+		rep_msg(rep, "out of memory");
+	goto done;
+fail:
+	if (rc == PX_E_NOMEM)
+		rep_msg(rep, "out of memory");
+	mesh_free(M);
+done:
+	free(used);
+	free(order);
+	free(canon);
+	free(perm);
+	free(E);
+	free(nb);
+	free(fn);
+	free(vn);
+	free(cen);
+	free(tlo);
+	free(thi);
+	free(deg);
+	return rc;
+}
+
+/* ---- accessors ------------------------------------------------------------- */
+
+static const struct mesh *as_mesh(const struct px_model *m)
+{
+	if (px_model_get_ops(m) != &mesh_ops)
+		return NULL;
+	return px_model_impl(m);
+}
+
+size_t px_mesh_triangle_count(const struct px_model *m)
+{
+	const struct mesh *M = as_mesh(m);
+	return M ? M->nt : 0;
+}
+
+int px_mesh_triangle(const struct px_model *m, size_t i, px_vec3 v[3])
+{
+	const struct mesh *M = as_mesh(m);
+	const struct mtri *t;
+	if (!M || !v || i >= M->nt)
+		return PX_E_INVAL;
+	t = &M->tri[M->leaf_of[i]];
+	v[0] = t->a;
+	v[1] = t->b;
+	v[2] = t->c;
+	return PX_OK;
+}
+
+int px_mesh_is_closed(const struct px_model *m)
+{
+	const struct mesh *M = as_mesh(m);
+	return M ? M->closed : 0;
+}
+
+/* ---- files ------------------------------------------------------------------ */
+
+int px_mesh_load(const char *path, const struct px_mesh_opts *opt,
+		 struct px_mesh_report *rep, struct px_model **out)
+{
+	struct px_mesh_report lrep;
+	double *xyz = NULL;
+	uint32_t *tri = NULL;
+	size_t nv = 0, nt = 0, skipped = 0;
+	char msg[sizeof(rep->message)];
+	int rc;
+
+	if (!rep)
+		rep = &lrep;
+	memset(rep, 0, sizeof(*rep));
+	rep->first_degenerate = -1;
+	rep->first_bad_edge_triangle = -1;
+	if (out)
+		*out = NULL;
+	if (!out || !path) {
+		rep_msg(rep, "invalid arguments");
+		return PX_E_INVAL;
+	}
+	rc = px__import_file(path, 1, &xyz, &nv, &tri, &nt, &skipped, msg,
+			     sizeof(msg));
+	if (rc != PX_OK) {
+		snprintf(rep->message, sizeof(rep->message), "%s", msg);
+		return rc;
+	}
+	rc = px_mesh_model(xyz, nv, tri, nt, opt, rep, out);
+	if (rep->message[0]) {
+		char tmp[sizeof(rep->message)];
+		size_t lp = strlen(path);
+		memcpy(tmp, rep->message, sizeof(tmp));
+		/* "<path>: <message>", cut to fit */
+		if (lp > sizeof(rep->message) - 3)
+			lp = sizeof(rep->message) - 3;
+		memcpy(rep->message, path, lp);
+		memcpy(rep->message + lp, ": ", 2);
+		memcpy(rep->message + lp + 2, tmp, sizeof(rep->message) - lp - 3);
+		rep->message[sizeof(rep->message) - 1] = '\0';
+	}
+	free(xyz);
+	free(tri);
+	return rc;
+}

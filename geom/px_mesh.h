@@ -1,0 +1,140 @@
+/*
+ * px_mesh.h - triangle meshes: exact point-to-mesh distance with a
+ * bounding-volume hierarchy, signed distance for closed meshes, loading
+ * from STL, OBJ and PLY.
+ *
+ * Setup (px_mesh_model, px_mesh_load) validates the triangles, welds
+ * vertices at identical positions, builds the edge topology, decides
+ * whether the mesh is a closed, consistently oriented 2-manifold
+ * (watertight), computes angle-weighted pseudo-normals (Baerentzen and
+ * Aanaes 2005) and builds a binary AABB hierarchy over the triangles
+ * (median split on the longest axis, so its depth is at most
+ * PX_MESH_MAX_DEPTH). A query then needs no memory but a fixed array on
+ * the call stack: it descends nearer child first and prunes every box
+ * farther than the best triangle so far; the distance to a triangle is
+ * exact over all seven Voronoi regions (face, three edges, three
+ * vertices), also for collapsed or needle triangles, which are treated
+ * as the segments they are.
+ *
+ * Signed distance: on a watertight mesh the sign of (p - q) . n, with n
+ * the pseudo-normal of the feature (face, edge or vertex) holding the
+ * closest point q, is the inside/outside answer. A closed mesh whose
+ * triangles face inwards (negative volume) is flipped. Open,
+ * non-manifold or inconsistently oriented meshes answer with unsigned
+ * distances (result is_signed = 0) and say why in the report.
+ *
+ * Coherent queries (PX_QUERY_COHERENT with last cycle's triangle index as
+ * hint) start from that triangle's distance as an upper bound, which
+ * prunes most of the hierarchy at once when the point moved little.
+ *
+ * Results (px_model_result): index = triangle (input order), feature =
+ * FACE / EDGE (sub = 0: v0v1, 1: v1v2, 2: v2v0) / VERTEX (sub = 0..2),
+ * u, v = barycentric weights of v1 and v2 of the closest point,
+ * iterations = nodes and triangles visited, certified = 1 (exact).
+ *
+ * Memory and real-time rules: building allocates (setup only) about 300
+ * bytes per triangle; queries are RT-safe (no heap, bounded by the
+ * triangle count, fixed stack of PX_MESH_MAX_DEPTH + 2 entries).
+ */
+#ifndef PX_MESH_H
+#define PX_MESH_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "px_base.h"
+#include "px_math.h"
+#include "px_model.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Hierarchy depth bound (median splits give about log2(triangles / 2)). */
+#define PX_MESH_MAX_DEPTH 48
+/* Largest triangle count (indices are 32-bit inside). */
+#define PX_MESH_MAX_TRIANGLES ((size_t)1 << 30)
+
+/* Options (all zero = defaults). */
+#define PX_MESH_REJECT_DEGENERATE 0x1u /* zero-area triangles are errors */
+#define PX_MESH_REQUIRE_CLOSED 0x2u    /* open/non-manifold are errors */
+#define PX_MESH_NO_FLIP 0x4u           /* keep inward orientation (sign inverted) */
+
+struct px_mesh_opts {
+	unsigned flags;     /* PX_MESH_* */
+	int leaf_size;      /* triangles per leaf, 1..16; 0 = 4 */
+};
+
+/* What setup found. message names the first problem and where it is. */
+struct px_mesh_report {
+	size_t n_vertices, n_triangles;
+	size_t n_welded;              /* distinct vertex positions */
+	size_t n_degenerate;          /* zero-area or collapsed triangles */
+	size_t n_boundary_edges;      /* used by one triangle */
+	size_t n_nonmanifold_edges;   /* used by three or more */
+	size_t n_misoriented_edges;   /* two triangles, same direction */
+	long first_degenerate;        /* triangle index, -1 if none */
+	long first_bad_edge_triangle; /* a triangle on a bad edge, -1 if none */
+	int closed;                   /* watertight: signed distances */
+	int flipped;                  /* was inward, normals reversed */
+	double volume;                /* enclosed volume (closed meshes) */
+	int depth;                    /* hierarchy depth */
+	char message[256];            /* "" when everything is fine */
+};
+
+/*
+ * Build a mesh model from n_vertices points (xyz, 3 doubles each) and
+ * n_triangles index triples (tri, 3 each, 0-based). The data are copied.
+ * opt may be NULL; rep may be NULL (else always filled, also on error).
+ * Returns PX_OK; PX_E_INVAL (NULL pointers, no triangles, bad leaf
+ * size), PX_E_RANGE (an index >= n_vertices: rep->message names the
+ * triangle; or too many triangles), PX_E_NAN (a non-finite coordinate
+ * of a used vertex), PX_E_DEGENERATE (with PX_MESH_REJECT_DEGENERATE or
+ * PX_MESH_REQUIRE_CLOSED, when the mesh has what they reject),
+ * PX_E_NOMEM. Setup only.
+ */
+PX_API int px_mesh_model(const double *xyz, size_t n_vertices,
+			 const uint32_t *tri, size_t n_triangles,
+			 const struct px_mesh_opts *opt,
+			 struct px_mesh_report *rep, struct px_model **out);
+
+/*
+ * Load a mesh file (STL ASCII or binary, OBJ faces, PLY; polygons are
+ * triangulated, all meshes of the file merged with their node
+ * transforms applied) and build it as px_mesh_model() does. Errors
+ * name the file in rep->message: PX_E_NOTFOUND (no such file),
+ * PX_E_IO (unreadable), PX_E_PARSE (the importer's message: malformed
+ * or unknown format, a PLY body shorter or longer than its header says,
+ * or a file without triangles), and px_mesh_model()'s errors.
+ * Files are read by the Open Asset Import Library, whose coordinates are
+ * single-precision floats (about 7 significant digits; exact for binary
+ * STL, which stores floats). Setup only.
+ */
+PX_API int px_mesh_load(const char *path, const struct px_mesh_opts *opt,
+			struct px_mesh_report *rep, struct px_model **out);
+
+/*
+ * Exact closest point of triangle (a, b, c) to p: returns the squared
+ * distance, writes the point q, its feature (PX_FEATURE_FACE, _EDGE,
+ * _VERTEX), sub (edge 0: ab, 1: bc, 2: ca, or vertex 0..2) and the
+ * barycentric weights u (of b) and v (of c). Collapsed and needle
+ * triangles are handled as segments. Any output pointer but q may be
+ * NULL. @note RT-safe.
+ */
+PX_API double px_tri_closest(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
+			     px_vec3 *q, int *feature, int *sub, double *u,
+			     double *v);
+
+/* Mesh accessors for a model made by px_mesh_model/px_mesh_load (NULL or
+ * another kind of model gives 0 / PX_E_INVAL). @note RT-safe. */
+PX_API size_t px_mesh_triangle_count(const struct px_model *m);
+/* Vertices of triangle i (input order), model frame. */
+PX_API int px_mesh_triangle(const struct px_model *m, size_t i, px_vec3 v[3]);
+/* 1 when the mesh is watertight (signed distances), else 0. */
+PX_API int px_mesh_is_closed(const struct px_model *m);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,157 @@
+/*
+ * px_model.c - the model handle: pose, frame changes, dispatch.
+ */
+#include <math.h>
+#include <stdlib.h>
+
+#include "px_model.h"
+
+struct px_model {
+	const struct px_model_ops *ops;
+	void *impl;
+	unsigned caps;
+	px_pose pose;
+	px_aabb local_box; /* cached at creation: geometry never changes */
+};
+
+int px_model_create(const struct px_model_ops *ops, void *impl,
+		    unsigned caps, struct px_model **out)
+{
+	struct px_model *m;
+
+	if (out)
+		*out = NULL;
+	if (!ops || !ops->closest || !ops->aabb || !out) {
+		if (ops && ops->free && impl)
+			ops->free(impl);
+		return PX_E_INVAL;
+	}
+	m = calloc(1, sizeof(*m));
+	if (!m) {
+		if (ops->free && impl)
+			ops->free(impl);
+		return PX_E_NOMEM;
+	}
+	m->ops = ops;
+	m->impl = impl;
+	m->caps = caps;
+	m->pose = px_pose_identity();
+	m->local_box = ops->aabb(impl);
+	*out = m;
+	return PX_OK;
+}
+
+void px_model_free(struct px_model *m)
+{
+	if (!m)
+		return;
+	if (m->ops->free && m->impl)
+		m->ops->free(m->impl);
+	free(m);
+}
+
+int px_model_set_pose(struct px_model *m, px_pose pose)
+{
+	int rc;
+
+	if (!m)
+		return PX_E_INVAL;
+	rc = px_pose_sanitize(&pose);
+	if (rc != PX_OK)
+		return rc;
+	m->pose = pose;
+	return PX_OK;
+}
+
+px_pose px_model_pose(const struct px_model *m)
+{
+	return m ? m->pose : px_pose_identity();
+}
+
+int px_model_query_ex(const struct px_model *m, px_vec3 p, double max_dist,
+		      int hint, unsigned flags, struct px_model_result *out)
+{
+	struct px_model_query q;
+	int rc;
+
+	if (!m || !out || !(max_dist >= 0.0))
+		return PX_E_INVAL;
+	if (!px_v3_isfinite(p))
+		return PX_E_NAN;
+	q.p = px_pose_inverse_transform_point(m->pose, p);
+	q.max_dist = max_dist;
+	q.hint = (flags & PX_QUERY_COHERENT) ? hint : -1;
+	q.flags = flags;
+	rc = m->ops->closest(m->impl, &q, out);
+	if (rc <= 0) {
+		if (rc == 0) {
+			out->distance = INFINITY;
+			out->index = -1;
+			out->sub = -1;
+			out->feature = PX_FEATURE_NONE;
+		}
+		return rc;
+	}
+	out->point = px_pose_transform_point(m->pose, out->point);
+	out->direction = px_pose_transform_vector(m->pose, out->direction);
+	return 1;
+}
+
+int px_model_query(const struct px_model *m, px_vec3 p,
+		   struct px_model_result *out)
+{
+	return px_model_query_ex(m, p, INFINITY, -1, 0u, out);
+}
+
+px_aabb px_model_local_aabb(const struct px_model *m)
+{
+	return m ? m->local_box : px_aabb_empty();
+}
+
+px_aabb px_model_world_aabb(const struct px_model *m)
+{
+	if (!m)
+		return px_aabb_empty();
+	return px_aabb_transform(&m->local_box, m->pose);
+}
+
+px_obb px_model_world_obb(const struct px_model *m)
+{
+	px_aabb e = px_aabb_empty();
+	if (!m)
+		return px_obb_from_aabb(&e, px_pose_identity());
+	return px_obb_from_aabb(&m->local_box, m->pose);
+}
+
+enum px_model_kind px_model_kind(const struct px_model *m)
+{
+	return m ? m->ops->kind : PX_MODEL_CUSTOM;
+}
+
+const char *px_model_name(const struct px_model *m)
+{
+	return (m && m->ops->name) ? m->ops->name : "?";
+}
+
+unsigned px_model_caps(const struct px_model *m)
+{
+	return m ? m->caps : 0u;
+}
+
+size_t px_model_memory_bytes(const struct px_model *m)
+{
+	if (!m)
+		return 0;
+	return sizeof(*m) +
+	       (m->ops->memory_bytes ? m->ops->memory_bytes(m->impl) : 0);
+}
+
+const void *px_model_impl(const struct px_model *m)
+{
+	return m ? m->impl : NULL;
+}
+
+const struct px_model_ops *px_model_get_ops(const struct px_model *m)
+{
+	return m ? m->ops : NULL;
+}

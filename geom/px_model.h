@@ -1,0 +1,212 @@
+/*
+ * px_model.h - one point-to-model distance query for every representation.
+ *
+ * Users bring what they have: NURBS surfaces from CAD, STL meshes of robot
+ * links, scanned point clouds, simple primitives. Each representation
+ * implements a single operation, "closest point of the model to a point
+ * given in the model's own frame", behind a const table of function
+ * pointers (struct px_model_ops). Everything built on top (model-to-model
+ * distance by alternating projections, scenes) only talks to this table,
+ * so the number of distance routines grows linearly with the number of
+ * representations (Johnson and Cohen, "Unified distance queries in a
+ * heterogeneous model environment", 2004).
+ *
+ * A model handle carries a rigid pose (model frame to world frame) that
+ * may change every cycle: a query transforms the point into the model
+ * frame and the answer back to the world frame; the geometry and its
+ * acceleration structures are never touched after setup.
+ *
+ * Results (struct px_model_result) are in the world frame. The distance is
+ * signed for closed models (inside negative; penetration depth and
+ * direction come out of the same query) and unsigned otherwise, which
+ * is_signed says. direction is the unit gradient of that distance field:
+ * query = point + distance * direction. Outside it points from the model
+ * to the query point, inside it points outwards (the way to push the
+ * point out), and on the surface it is the outward normal where one is
+ * defined.
+ *
+ * Memory and real-time rules: creating a model (px_model_create and the
+ * per-representation constructors) is setup-time and allocates; the
+ * handle owns its implementation and px_model_free() releases both.
+ * px_model_set_pose() and all queries are RT-safe: no allocation, no
+ * locks, bounded work. Queries take a const model, so several threads
+ * may query one model at once; px_model_set_pose() must not race with
+ * queries of the same model (the owner of the cycle sets the pose, then
+ * queries).
+ */
+#ifndef PX_MODEL_H
+#define PX_MODEL_H
+
+#include <stddef.h>
+
+#include "px_base.h"
+#include "px_math.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* What a model is made of. */
+enum px_model_kind {
+	PX_MODEL_PRIMITIVE = 1,
+	PX_MODEL_MESH = 2,
+	PX_MODEL_CLOUD = 3,
+	PX_MODEL_NURBS = 4,
+	PX_MODEL_CUSTOM = 5
+};
+
+/* The kind of feature the closest point lies on. */
+enum px_feature {
+	PX_FEATURE_NONE = 0,
+	PX_FEATURE_FACE = 1,    /* triangle interior, primitive face/side */
+	PX_FEATURE_EDGE = 2,    /* triangle edge, box edge, cylinder rim */
+	PX_FEATURE_VERTEX = 3,  /* triangle vertex, box corner, cone apex */
+	PX_FEATURE_POINT = 4,   /* a point (or ball) of a cloud */
+	PX_FEATURE_CURVE = 5,   /* a NURBS curve */
+	PX_FEATURE_SURFACE = 6  /* a NURBS surface */
+};
+
+/* Query flags. */
+#define PX_QUERY_COHERENT 0x1u /* start from hint (last cycle's index) */
+#define PX_QUERY_UNSIGNED 0x2u /* skip the sign even on closed models */
+
+/* Model capability flags (px_model_caps()). */
+#define PX_MODEL_CAP_SIGNED 0x1u    /* closed: inside gets negative distance */
+#define PX_MODEL_CAP_EXACT 0x2u     /* every answer is the exact global one */
+#define PX_MODEL_CAP_COHERENT 0x4u  /* uses the hint of coherent queries */
+
+/* What a query asks, in the model frame (implementations see this). */
+struct px_model_query {
+	px_vec3 p;        /* query point, model frame */
+	double max_dist;  /* report nothing farther than this (INFINITY: no bound) */
+	int hint;         /* index from last cycle's result, or -1 */
+	unsigned flags;   /* PX_QUERY_* */
+};
+
+/*
+ * Answer of a point-to-model query. The model's ops fill it in the model
+ * frame; px_model_query() turns point and direction into the world frame.
+ */
+struct px_model_result {
+	double distance;   /* signed if is_signed (< 0 inside), else >= 0 */
+	px_vec3 point;     /* closest point on the model */
+	px_vec3 direction; /* unit: query = point + distance * direction */
+	/* Which part of the model: triangle index (mesh), point index
+	 * (cloud), face id (primitive, see px_prim.h), entity id (NURBS). */
+	int index;
+	/* Detail within index: the edge (0: v0v1, 1: v1v2, 2: v2v0) or the
+	 * vertex (0..2) of a triangle, the NURBS piece; -1 when none. */
+	int sub;
+	int feature;       /* enum px_feature */
+	/* Parameters where meaningful: barycentric weights of vertices 1
+	 * and 2 (mesh), (u, v) of a NURBS surface, u of a curve (v = 0),
+	 * primitive surface coordinates (px_prim.h); 0 otherwise. */
+	double u, v;
+	int is_signed;     /* distance carries a sign */
+	int inside;        /* is_signed and the point is strictly inside */
+	int iterations;    /* work spent: nodes visited, solver steps */
+	/* 1 when the answer is proven to be the global closest point (within
+	 * gap); 0 when a bound cut the search short. */
+	int certified;
+	double gap;        /* how much closer the true answer may be (>= 0) */
+};
+
+/*
+ * One representation's implementation. Every function receives the impl
+ * pointer given to px_model_create(). All but free must be RT-safe.
+ */
+struct px_model_ops {
+	const char *name;          /* "sphere", "mesh", "cloud", ... */
+	enum px_model_kind kind;
+	/*
+	 * Closest point of the model to q->p (model frame). Returns 1 and
+	 * fills r (model frame) when a point within q->max_dist exists, 0
+	 * when none does, a negative px_err on failure. Must honour
+	 * PX_QUERY_UNSIGNED, may use q->hint when PX_QUERY_COHERENT is set
+	 * (an out-of-range hint must be ignored, never trusted).
+	 */
+	int (*closest)(const void *impl, const struct px_model_query *q,
+		       struct px_model_result *r);
+	/* Bounding box of the model in its own frame (may be infinite, e.g.
+	 * a half-space). */
+	px_aabb (*aabb)(const void *impl);
+	/* Bytes owned by the implementation. */
+	size_t (*memory_bytes)(const void *impl);
+	/* Release the implementation (setup-time, may free). */
+	void (*free)(void *impl);
+};
+
+struct px_model; /* opaque handle */
+
+/*
+ * Wrap an implementation into a model handle with the identity pose.
+ * ops must outlive the model (normally a static const table); impl is
+ * owned by the model from now on, also on failure (ops->free(impl) is
+ * called then). caps: PX_MODEL_CAP_* bits. Setup only (allocates).
+ * Returns PX_OK, PX_E_INVAL (NULL ops/closest/aabb/out), PX_E_NOMEM.
+ */
+PX_API int px_model_create(const struct px_model_ops *ops, void *impl,
+			   unsigned caps, struct px_model **out);
+
+/* Release a model and its implementation. NULL is a no-op. */
+PX_API void px_model_free(struct px_model *m);
+
+/*
+ * Set the model-to-world pose. The pose is checked and its quaternion
+ * renormalized (px_pose_sanitize); on error the pose is left unchanged.
+ * Returns PX_OK, PX_E_INVAL, PX_E_NAN, PX_E_DEGENERATE, PX_E_RANGE.
+ * @note RT-safe.
+ */
+PX_API int px_model_set_pose(struct px_model *m, px_pose pose);
+
+/* Current pose (identity for NULL). @note RT-safe. */
+PX_API px_pose px_model_pose(const struct px_model *m);
+
+/*
+ * Closest point of the model to the world point p.
+ * Returns 1 with *out filled (world frame); PX_E_INVAL for NULL
+ * arguments, PX_E_NAN for a non-finite p. @note RT-safe.
+ */
+PX_API int px_model_query(const struct px_model *m, px_vec3 p,
+			  struct px_model_result *out);
+
+/*
+ * As px_model_query() with a distance bound, flags and a coherence hint.
+ * max_dist >= 0 (INFINITY for none) bounds |distance|: returns 0 with
+ * out->distance = INFINITY and out->index = -1 when nothing of the model
+ * is that close. With PX_QUERY_COHERENT, hint is the index of last
+ * cycle's result (the last closest triangle or point), which gives the
+ * search an immediate upper bound; any hint value is safe (a wrong one
+ * only costs time). Returns 1, 0, PX_E_INVAL (NULL, max_dist < 0 or NaN),
+ * PX_E_NAN (non-finite p), or an implementation's error. @note RT-safe.
+ */
+PX_API int px_model_query_ex(const struct px_model *m, px_vec3 p,
+			     double max_dist, int hint, unsigned flags,
+			     struct px_model_result *out);
+
+/* Bounding box in the model frame / in the world frame (the model-frame
+ * box transformed by the current pose). Empty box for NULL.
+ * @note RT-safe. */
+PX_API px_aabb px_model_local_aabb(const struct px_model *m);
+PX_API px_aabb px_model_world_aabb(const struct px_model *m);
+/* Oriented box in the world frame: the model-frame box under the pose.
+ * @note RT-safe. */
+PX_API px_obb px_model_world_obb(const struct px_model *m);
+
+/* Kind, name, PX_MODEL_CAP_* bits, bytes owned (handle + geometry).
+ * @note RT-safe. */
+PX_API enum px_model_kind px_model_kind(const struct px_model *m);
+PX_API const char *px_model_name(const struct px_model *m);
+PX_API unsigned px_model_caps(const struct px_model *m);
+PX_API size_t px_model_memory_bytes(const struct px_model *m);
+/* The implementation pointer and ops table (for representation-specific
+ * accessors, which check the ops to know the model is theirs).
+ * @note RT-safe. */
+PX_API const void *px_model_impl(const struct px_model *m);
+PX_API const struct px_model_ops *px_model_get_ops(const struct px_model *m);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
