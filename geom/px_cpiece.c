@@ -123,9 +123,9 @@ static double lower_bound(const double *f, const double *w, int n, double s,
  */
 static double refine_root(const double *c, int n, int *iters)
 {
-	double lo = 0.0, hi = 1.0, x, c0 = c[0], cn = c[n];
+	double lo = 0.0, hi = 1.0, flo = c[0], fhi = c[n], x;
 	double cb[PX_CPIECE_NG], db[PX_CPIECE_NG];
-	int it, i;
+	int it, i, side = 0;
 
 	/* Scale once: every iteration then costs O(n). */
 	for (i = 0; i < n; i++)
@@ -143,20 +143,36 @@ static double refine_root(const double *c, int n, int *iters)
 			break;
 		}
 	}
-	(void)c0;
-	(void)cn;
 	for (it = 0; it < PX_CPIECE_MAX_ITERS; it++) {
 		double v = px_bern_eval_scaled(cb, n, x), dv, xn;
 		if (v == 0.0)
 			break;
-		if (v < 0.0)
+		if (v < 0.0) {
 			lo = x;
-		else
+			flo = v;
+			/* Illinois: an end kept twice has its value halved so
+			 * false position keeps converging superlinearly. */
+			if (side == -1)
+				fhi *= 0.5;
+			side = -1;
+		} else {
 			hi = x;
+			fhi = v;
+			if (side == 1)
+				flo *= 0.5;
+			side = 1;
+		}
 		dv = px_bern_eval_scaled(db, n - 1, x);
 		xn = (dv != 0.0) ? x - v / dv : lo - 1.0;
-		if (!(xn > lo && xn < hi))
-			xn = 0.5 * (lo + hi);
+		/* A Newton step leaving the bracket is replaced by false
+		 * position inside it, which keeps the good start rather than
+		 * jumping to the middle of a wide bracket as bisection would. */
+		if (!(xn > lo && xn < hi)) {
+			xn = (fhi - flo) > 0.0 ? (lo * fhi - hi * flo) / (fhi - flo)
+					       : 0.5 * (lo + hi);
+			if (!(xn > lo && xn < hi))
+				xn = 0.5 * (lo + hi);
+		}
 		/* 1e-13 of the interval is far below what the distance
 		 * (quadratic in the parameter error) or the foot point can
 		 * resolve at the required 1e-9 of the model size. */

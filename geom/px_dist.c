@@ -88,6 +88,14 @@ void px_dist_opts_default(struct px_dist_opts *o)
 
 /* ---- knowledge step: parametrization factor ---------------------------- */
 
+/*
+ * Decomposition tolerance and jitter by parametrization factor (paper
+ * section 5 and its table): the further the speed |C'| varies, the finer
+ * the pieces and the more uniform their spacing. The table's finest row
+ * (1 %) serves Newton starts; pieces here carry their own proofs, so the
+ * callers floor it at the paper's recommended settings (5 % for curves,
+ * 10 % for surfaces), where boxes are tight and candidates few.
+ */
 static void pf_table(double pf, double *tol, double *jit)
 {
 	if (pf <= 0.2) {
@@ -224,6 +232,8 @@ static int decompose(const struct px_nurbs_curve *c, const struct px_dist_opts *
 	info->arc_length = len;
 	info->pf = dmax > 0.0 ? (dmax - dmin) / dmax : 1.0;
 	pf_table(info->pf, &tol, &jit);
+	if (tol < 0.05)
+		tol = 0.05;
 	if (o->decomp_tol > 0.0)
 		tol = o->decomp_tol;
 	if (o->jitter > 0.0)
@@ -575,11 +585,10 @@ static int add_surface(struct builder *bl, const struct px_nurbs_surf *s,
 	info->kind = PX_DIST_SURFACE;
 	info->pf = surf_pf(s);
 	pf_table(info->pf, &tol, &jit);
-	/* Patches carry their own proofs, so the decomposition only has to
-	 * make boxes tight; and memory grows with the square of the count:
-	 * surfaces stop at 5 %. */
-	if (tol < 0.05)
-		tol = 0.05;
+	/* Memory grows with the square of the count: surfaces stop at the
+	 * paper's 10 % (see pf_table()). */
+	if (tol < 0.1)
+		tol = 0.1;
 	if (o->decomp_tol > 0.0)
 		tol = o->decomp_tol;
 	if (o->jitter > 0.0)
