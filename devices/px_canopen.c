@@ -199,6 +199,8 @@ struct px_canopen {
 	struct px_can_bus *bus;
 	int started;
 	int64_t t0, last_hb;
+	/* a node announced boot-up or pre-operational: start it (again) */
+	int need_start[PX_CANOPEN_MAX_DRIVES];
 };
 
 void px_canopen_config_default(struct px_canopen_config *c)
@@ -320,6 +322,8 @@ int px_canopen_rx(struct px_canopen *co, int64_t now)
 		} else if (fn == 0x700 && m.f.len >= 1) {
 			s->heartbeat_ns = m.t_ns;
 			s->nmt_state = m.f.data[0] & 0x7F;
+			if (s->nmt_state != 0x05)
+				co->need_start[d] = 1;
 		} else if (fn == 0x080 && m.f.len >= 2) {
 			s->emcy_code = get16(m.f.data);
 			s->emcy_count++;
@@ -350,6 +354,14 @@ int px_canopen_tx(struct px_canopen *co, int64_t now, const double *targets,
 		if (!co->t0)
 			co->t0 = now;
 	}
+	for (i = 0; i < co->cfg.n_drives; i++)
+		if (co->need_start[i]) {
+			/* it missed the broadcast start (booted later) */
+			b[0] = 0x01;
+			b[1] = co->drv[i].node_id;
+			send_frame(co->bus, 0x000, b, 2, now);
+			co->need_start[i] = 0;
+		}
 	for (i = 0; i < co->cfg.n_drives; i++) {
 		const struct px_canopen_drive_cfg *c = &co->drv[i];
 		struct px_canopen_drive_status *s = &co->st[i];

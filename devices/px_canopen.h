@@ -4,7 +4,8 @@
  *
  * The subset ("lite": no SDO, no object dictionary, fixed PDO layouts):
  *  - NMT: the master sends "start remote node" (0x000: 01 00) at its
- *    first cycle;
+ *    first cycle, and again to a node whose heartbeat says boot-up or
+ *    pre-operational (it started after the master);
  *  - SYNC (0x080, no data) each cycle when enabled: drives act on it;
  *  - heartbeat producer (0x700 + own node id: one state byte, 0x05
  *    operational) every heartbeat_period_ns, and a consumer per drive:

@@ -5,7 +5,13 @@
  * fault and its reset, a silent drive (heartbeat timeout), no
  * allocations in cycles. */
 #include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
 
 #include "px_alloc_count.h"
 #include "px_canopen.h"
@@ -294,7 +300,72 @@ static void test_config_errors_name_the_drive(void)
 	px_can_sim_free(bus);
 }
 
+static int64_t mono(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+
+static void test_master_with_simarm_process(void)
+{
+	/* The arm as a second program (tools/proxima-simarm) on a UNIX
+	 * datagram bus; on vcan in the VM suite the same master code runs
+	 * over px_can_raw_open. Behaviour only: no timing asserted. */
+	const char *build = getenv("BUILD");
+	char tool[256], pa[64], pb[64], msg[200];
+	struct px_can_bus *bus;
+	struct px_canopen_config cc;
+	struct px_canopen *co;
+	struct px_canopen_drive_status ds;
+	struct px_canopen_drive_cfg d[2] = {
+		{1, PX_CIA402_CSV, 0, 100000.0, 1.0},
+		{2, PX_CIA402_CSV, 1, 100000.0, 1.0},
+	};
+	double targets[2] = {0.5, -0.2};
+	pid_t pid;
+	int i, ok = 0, st;
+	snprintf(tool, sizeof tool, "%s/bin/proxima-simarm",
+		 build && *build ? build : "build");
+	if (access(tool, X_OK) != 0)
+		PX_SKIP("%s not built", tool);
+	snprintf(pa, sizeof pa, "/tmp/pxarm-a-%d", (int)getpid());
+	snprintf(pb, sizeof pb, "/tmp/pxarm-b-%d", (int)getpid());
+	PX_CHECK_INT_EQ(px_can_unix_open(pb, pa, &bus, msg, sizeof msg), PX_OK);
+	pid = fork();
+	PX_CHECK(pid >= 0);
+	if (pid == 0) {
+		execl(tool, tool, "--unix", pa, pb, "--drives", "2",
+		      "--seconds", "20", (char *)NULL);
+		_exit(127);
+	}
+	px_canopen_config_default(&cc);
+	cc.drives = d;
+	cc.n_drives = 2;
+	cc.heartbeat_timeout_ns = 0; /* the child may start slowly */
+	PX_CHECK_INT_EQ(px_canopen_create(&cc, bus, &co, msg, sizeof msg),
+			PX_OK);
+	for (i = 0; i < 10000 && !ok; i++) {
+		struct timespec ts = {0, 1000000};
+		int64_t now = mono();
+		px_canopen_rx(co, now);
+		px_canopen_tx(co, now, targets, 2, 1);
+		px_canopen_drive_status(co, 1, &ds);
+		ok = px_canopen_all_enabled(co) && fabs(ds.velocity + 0.2) < 1e-9 &&
+		     ds.nmt_state == 5;
+		nanosleep(&ts, NULL);
+	}
+	kill(pid, SIGTERM);
+	waitpid(pid, &st, 0);
+	PX_CHECK_MSG(ok, "drive 2: %s, velocity %g, nmt %d",
+		     px_cia402_state_name(ds.state), ds.velocity, ds.nmt_state);
+	PX_CHECK(WIFEXITED(st) && WEXITSTATUS(st) == 0);
+	px_canopen_free(co);
+	px_can_bus_close(bus);
+}
+
 static const struct px_test tests[] = {
+	PX_T(test_master_with_simarm_process),
 	PX_T(test_statusword_table),
 	PX_T(test_drive_transitions),
 	PX_T(test_master_drives_simulated_arm),
