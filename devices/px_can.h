@@ -265,7 +265,8 @@ PX_API int px_can_record_flush(struct px_can_bus *rec, FILE *f,
  * failed until the bus comes back. px_dev_force_write encodes output
  * signals with a wrench axis and sends one frame per output id.
  * signals must outlive the device. Returns PX_OK, PX_E_INVAL (a bad
- * signal, named in msg), PX_E_NOMEM.
+ * signal, named in msg), PX_E_NOMEM; on failure the bus stays the
+ * caller's.
  */
 PX_API int px_can_dev_create(const struct px_dev_config *dcfg,
 			     struct px_can_bus *bus, int fd_frames,
