@@ -23,6 +23,7 @@
 #include "px_hid.h"
 #include "px_usb.h"
 #include "px_can.h"
+#include "px_canopen.h"
 #include "px_gpio.h"
 
 #endif

@@ -239,6 +239,22 @@ PX_API int px_can_replay_open(const char *path, const char *iface,
 			      struct px_can_bus **out, char *msg,
 			      size_t cap);
 
+/*
+ * Record a bus as candump -l lines: returns a bus that passes every call
+ * through to inner (which it then owns) and copies each frame received
+ * or sent into a ring of capacity frames (wait-free; when full, frames
+ * are dropped and counted). px_can_record_flush() writes what is in the
+ * ring to f as candump -l lines for interface iface (times moved from
+ * CLOCK_MONOTONIC to CLOCK_REALTIME as candump has them), from a non-RT
+ * thread. Returns PX_OK, PX_E_INVAL, PX_E_NOMEM.
+ */
+PX_API int px_can_record_open(struct px_can_bus *inner, size_t capacity,
+			      const char *iface, struct px_can_bus **out);
+/* Lines written, or PX_E_INVAL / PX_E_IO. *dropped (may be NULL): frames
+ * lost so far because the ring was full. One thread. */
+PX_API int px_can_record_flush(struct px_can_bus *rec, FILE *f,
+			       uint64_t *dropped);
+
 /* ---- CAN pose source / force sink --------------------------------------- */
 
 /*
@@ -249,7 +265,8 @@ PX_API int px_can_replay_open(const char *path, const char *iface,
  * failed until the bus comes back. px_dev_force_write encodes output
  * signals with a wrench axis and sends one frame per output id.
  * signals must outlive the device. Returns PX_OK, PX_E_INVAL (a bad
- * signal, named in msg), PX_E_NOMEM.
+ * signal, named in msg), PX_E_NOMEM; on failure the bus stays the
+ * caller's.
  */
 PX_API int px_can_dev_create(const struct px_dev_config *dcfg,
 			     struct px_can_bus *bus, int fd_frames,

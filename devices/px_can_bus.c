@@ -17,9 +17,11 @@
 #include <linux/can/netlink.h>
 #include <linux/can/raw.h>
 
+#include "px_arena.h"
 #include "px_can.h"
+#include "px_ring.h"
 
-enum { K_SIM, K_UNIX, K_RAW, K_REPLAY };
+enum { K_SIM, K_UNIX, K_RAW, K_REPLAY, K_REC };
 
 struct px_can_sim {
 	struct px_can_sim_config cfg;
@@ -49,6 +51,11 @@ struct px_can_bus {
 	size_t n_recs, next;
 	int started;
 	int64_t t0_now;
+	/* recorder */
+	struct px_can_bus *inner;
+	struct px_arena arena;
+	struct px_ring *ring;
+	char iface[IFNAMSIZ + 8];
 };
 
 static struct px_can_bus *bus_new(int kind)
@@ -665,6 +672,15 @@ int px_can_bus_send(struct px_can_bus *b, const struct px_can_msg *m,
 	case K_SIM: rc = sim_send(b, m, now_ns); break;
 	case K_UNIX: rc = unix_send(b, m, now_ns); break;
 	case K_RAW: rc = raw_send(b, m, now_ns); break;
+	case K_REC:
+		rc = px_can_bus_send(b->inner, m, now_ns);
+		b->last_errno = px_can_bus_errno(b->inner);
+		if (rc == PX_OK) {
+			struct px_can_msg c = *m;
+			c.t_ns = now_ns;
+			px_ring_push(b->ring, &c);
+		}
+		break;
 	default: rc = PX_OK; break; /* replay: sends go nowhere */
 	}
 	if (rc == PX_OK)
@@ -682,6 +698,12 @@ int px_can_bus_recv(struct px_can_bus *b, int64_t now_ns,
 	case K_SIM: rc = sim_recv(b, now_ns, m); break;
 	case K_UNIX: rc = unix_recv(b, now_ns, m); break;
 	case K_RAW: rc = raw_recv(b, now_ns, m); break;
+	case K_REC:
+		rc = px_can_bus_recv(b->inner, now_ns, m);
+		b->last_errno = px_can_bus_errno(b->inner);
+		if (rc == PX_OK)
+			px_ring_push(b->ring, m);
+		break;
 	default: rc = replay_recv(b, now_ns, m); break;
 	}
 	if (rc != PX_OK)
@@ -729,5 +751,57 @@ void px_can_bus_close(struct px_can_bus *b)
 	free(b->q);
 	free(b->recs);
 	free(b->rec_t);
+	if (b->kind == K_REC) {
+		px_can_bus_close(b->inner);
+		px_arena_fini(&b->arena);
+	}
 	free(b);
+}
+
+int px_can_record_open(struct px_can_bus *inner, size_t capacity,
+		       const char *iface, struct px_can_bus **out)
+{
+	struct px_can_bus *b;
+	if (!inner || !out || capacity < 2 || capacity > (1u << 20))
+		return PX_E_INVAL;
+	*out = NULL;
+	b = bus_new(K_REC);
+	if (!b)
+		return PX_E_NOMEM;
+	if (px_arena_init_alloc(&b->arena,
+				px_ring_size(capacity, sizeof(struct px_can_msg))) !=
+		    PX_OK ||
+	    px_ring_create(&b->arena, capacity, sizeof(struct px_can_msg),
+			   &b->ring) != PX_OK) {
+		px_arena_fini(&b->arena);
+		free(b);
+		return PX_E_NOMEM;
+	}
+	b->inner = inner;
+	b->fd_frames = inner->fd_frames;
+	snprintf(b->iface, sizeof b->iface, "%s", iface ? iface : "can0");
+	*out = b;
+	return PX_OK;
+}
+
+int px_can_record_flush(struct px_can_bus *b, FILE *f, uint64_t *dropped)
+{
+	struct px_can_msg m;
+	char line[256];
+	int n = 0;
+	int64_t off;
+	if (!b || b->kind != K_REC || !f)
+		return PX_E_INVAL;
+	off = clock_ns(CLOCK_REALTIME) - clock_ns(CLOCK_MONOTONIC);
+	while (px_ring_pop(b->ring, &m) == PX_OK) {
+		if (px_can_log_format(&m, m.t_ns + off, b->iface, line,
+				      sizeof line) < 0)
+			continue;
+		if (fprintf(f, "%s\n", line) < 0)
+			return PX_E_IO;
+		n++;
+	}
+	if (dropped)
+		*dropped = px_ring_dropped(b->ring);
+	return n;
 }

@@ -10,11 +10,14 @@
  * default, libusb with `make HIDAPI=libusb`; px_hid_driver() says which,
  * and asking for the other one is a clear PX_E_UNSUPPORTED.
  *
- * Threads: px_dev_start() starts a reader thread (hid_read_timeout with
- * 50 ms, stamping each report with CLOCK_MONOTONIC on arrival and feeding
- * it through the codec) and a writer thread: the cycle's
+ * Threads: px_dev_start() starts one I/O thread that makes every hidapi
+ * call for the device (hidapi's per-device error string makes concurrent
+ * read and write unsafe): hid_read_timeout with 1 ms, stamping each
+ * report with CLOCK_MONOTONIC on arrival and feeding it through the
+ * codec, then the newest output report if there is one. The cycle's
  * px_dev_force_write() only encodes the output report and hands it over
- * (triple buffer + semaphore post), because hidapi calls may allocate.
+ * (triple buffer), because hidapi calls may allocate; it goes out within
+ * about 1 ms.
  * A failed read marks the device unplugged (stale, PX_E_NODEV to the
  * cycle; the loop goes to safe state); the reader then tries to reopen
  * every 200 ms and marks it running again when it is back (the loop

@@ -2,7 +2,6 @@
  * file. */
 #include <errno.h>
 #include <pthread.h>
-#include <semaphore.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -21,7 +20,7 @@
 #endif
 
 #define REP_MAX 256
-#define READ_TIMEOUT_MS 50
+#define READ_TIMEOUT_MS 1
 #define REOPEN_NS 200000000
 
 struct outrep {
@@ -34,11 +33,9 @@ struct hid {
 	char serial[128];
 	char path[256];
 	hid_device *h;
-	pthread_mutex_t lock; /* h between reader (reopen) and writer */
-	pthread_t reader, writer;
+	pthread_t reader;
 	int threads;
 	atomic_int stop;
-	sem_t wake;
 	struct px_arena arena;
 	uint8_t arena_buf[4 * sizeof(struct outrep) + 512];
 	struct px_param *out;
@@ -160,70 +157,49 @@ static void sleep_ns(int64_t ns)
 	nanosleep(&ts, NULL);
 }
 
-static void *reader_main(void *p)
+/* One thread makes every hidapi call for a device: hidapi 0.13 keeps a
+ * per-device error string that hid_read_timeout and hid_write both
+ * replace, so reading and writing from two threads would race. Reads
+ * wait at most 1 ms, so an output command waits at most that long. */
+static void *io_main(void *p)
 {
 	struct px_dev *d = p;
 	struct hid *x = px_dev_impl(d);
 	uint8_t buf[REP_MAX];
 	while (!atomic_load(&x->stop)) {
-		int n, e;
+		const struct outrep *o;
+		int n, e, fresh = 0;
 		if (!x->h) {
 			int se;
 			sleep_ns(REOPEN_NS);
-			pthread_mutex_lock(&x->lock);
 			if (hid_open_dev(x, px_dev_name(d), NULL, 0, &se) ==
 			    PX_OK)
 				px_dev_set_state(d, PX_DEV_STATE_RUNNING,
 						 px_dev_mono_ns());
-			pthread_mutex_unlock(&x->lock);
 			continue;
 		}
 		errno = 0;
 		n = hid_read_timeout(x->h, buf, sizeof buf, READ_TIMEOUT_MS);
 		e = errno;
-		if (n > 0) {
+		if (n > 0)
 			px_dev_feed_report(d, buf, (size_t)n, px_dev_mono_ns());
+		if (n < 0) {
+			px_dev_record(d, PX_DEV_ERR_IO, PX_E_NODEV, e, -1, NULL,
+				      "hid_read failed", px_dev_mono_ns());
+			px_dev_set_state(d, PX_DEV_STATE_UNPLUGGED,
+					 px_dev_mono_ns());
+			hid_close(x->h);
+			x->h = NULL;
 			continue;
 		}
-		if (n == 0)
-			continue;
-		px_dev_record(d, PX_DEV_ERR_IO, PX_E_NODEV, e, -1, NULL,
-			      "hid_read failed", px_dev_mono_ns());
-		px_dev_set_state(d, PX_DEV_STATE_UNPLUGGED, px_dev_mono_ns());
-		pthread_mutex_lock(&x->lock);
-		hid_close(x->h);
-		x->h = NULL;
-		pthread_mutex_unlock(&x->lock);
-	}
-	return NULL;
-}
-
-static void *writer_main(void *p)
-{
-	struct px_dev *d = p;
-	struct hid *x = px_dev_impl(d);
-	while (!atomic_load(&x->stop)) {
-		const struct outrep *o;
-		int fresh = 0;
-		while (sem_wait(&x->wake) != 0 && errno == EINTR)
-			;
-		if (atomic_load(&x->stop))
-			break;
 		o = px_param_read(x->out, &fresh);
-		if (!fresh || o->len == 0)
-			continue;
-		pthread_mutex_lock(&x->lock);
-		if (x->h) {
-			int n, e;
+		if (fresh && o->len) {
 			errno = 0;
-			n = hid_write(x->h, o->b, o->len);
-			e = errno;
-			if (n < 0)
-				px_dev_record(d, PX_DEV_ERR_IO, PX_E_IO, e,
+			if (hid_write(x->h, o->b, o->len) < 0)
+				px_dev_record(d, PX_DEV_ERR_IO, PX_E_IO, errno,
 					      o->b[0], NULL, "hid_write failed",
 					      px_dev_mono_ns());
 		}
-		pthread_mutex_unlock(&x->lock);
 	}
 	return NULL;
 }
@@ -232,13 +208,8 @@ static int hid_start(struct px_dev *d)
 {
 	struct hid *x = px_dev_impl(d);
 	atomic_store(&x->stop, 0);
-	if (pthread_create(&x->reader, NULL, reader_main, d) != 0)
+	if (pthread_create(&x->reader, NULL, io_main, d) != 0)
 		return PX_E_NOMEM;
-	if (pthread_create(&x->writer, NULL, writer_main, d) != 0) {
-		atomic_store(&x->stop, 1);
-		pthread_join(x->reader, NULL);
-		return PX_E_NOMEM;
-	}
 	x->threads = 1;
 	return PX_OK;
 }
@@ -249,8 +220,6 @@ static void hid_stop(struct px_dev *d)
 	if (!x->threads)
 		return;
 	atomic_store(&x->stop, 1);
-	sem_post(&x->wake);
-	pthread_join(x->writer, NULL);
 	pthread_join(x->reader, NULL);
 	x->threads = 0;
 }
@@ -278,8 +247,7 @@ static int hid_force(struct px_dev *d, const struct px_force_cmd *c,
 		return n;
 	}
 	o.len = (size_t)n;
-	px_param_write(x->out, &o);
-	sem_post(&x->wake);
+	px_param_write(x->out, &o); /* the I/O thread sends it */
 	return PX_OK;
 }
 
@@ -289,8 +257,6 @@ static void hid_destroy(struct px_dev *d)
 	if (x->h)
 		hid_close(x->h);
 	x->h = NULL;
-	sem_destroy(&x->wake);
-	pthread_mutex_destroy(&x->lock);
 }
 
 static const struct px_dev_ops hid_ops = {
@@ -371,8 +337,6 @@ int px_hid_create(const struct px_dev_config *dcfg,
 	memcpy(x, &tmp, sizeof tmp);
 	if (x->cfg.serial)
 		x->cfg.serial = x->serial;
-	pthread_mutex_init(&x->lock, NULL);
-	sem_init(&x->wake, 0, 0);
 	atomic_init(&x->stop, 0);
 	px_arena_init(&x->arena, x->arena_buf, sizeof x->arena_buf);
 	memset(&zero, 0, sizeof zero);

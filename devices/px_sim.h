@@ -22,8 +22,11 @@
  *
  * Fault injection: windows [start_ns, start_ns + duration_ns) of the
  * simulation clock in which each report suffers the fault with a given
- * probability (seeded): drop, delay, duplicate, corrupt (truncated
- * report, then wrong report id, then a flipped high byte, in turn),
+ * probability (seeded): drop, delay (reports held back: a gap, then a
+ * burst, stamped on arrival as a reader thread would), duplicate,
+ * corrupt (truncated report, then a hit report id byte, then a flipped
+ * high bit of the report's first value, in turn: the last is caught only
+ * by a plausibility limit, max_abs),
  * stuck (the same bytes again), NaN (a non-finite sample, as a float
  * device would send), unplug (no reports, state unplugged; replug when
  * the window ends). Each reaches the device status and, through

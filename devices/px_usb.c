@@ -1,10 +1,466 @@
 /* USB through libusb-1.0. Every libusb call of the library is here. */
+#include <errno.h>
+#include <pthread.h>
+#include <semaphore.h>
+#include <stdatomic.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include <libusb.h>
 
+#include "px_arena.h"
+#include "px_param.h"
 #include "px_usb.h"
+
+#define MAX_XFER 16
+#define FRAME_MAX 1024
+#define REOPEN_NS 200000000
+
+struct outframe {
+	size_t len;
+	uint8_t b[FRAME_MAX];
+};
+
+struct usb {
+	struct px_usb_config cfg;
+	char serial[128];
+	libusb_context *ctx;
+	libusb_device_handle *h;
+	pthread_mutex_t lock; /* h between the event thread and the writer */
+	pthread_t events, writer;
+	int threads;
+	atomic_int stop;
+	sem_t wake;
+	struct px_dev *dev;
+	struct libusb_transfer *xfer[MAX_XFER];
+	uint8_t buf[MAX_XFER][FRAME_MAX];
+	atomic_int in_flight;
+	atomic_int gone;
+	struct px_arena arena;
+	uint8_t arena_buf[4 * sizeof(struct outframe) + 512];
+	struct px_param *out;
+};
+
+static int64_t mono_ns(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+
+static int map_err(int rc)
+{
+	switch (rc) {
+	case LIBUSB_ERROR_ACCESS: return PX_E_PERM;
+	case LIBUSB_ERROR_NO_DEVICE:
+	case LIBUSB_ERROR_NOT_FOUND: return PX_E_NOTFOUND;
+	case LIBUSB_ERROR_BUSY: return PX_E_BUSY;
+	case LIBUSB_ERROR_NO_MEM: return PX_E_NOMEM;
+	case LIBUSB_ERROR_NOT_SUPPORTED: return PX_E_UNSUPPORTED;
+	case LIBUSB_ERROR_TIMEOUT: return PX_E_TIMEOUT;
+	default: return PX_E_IO;
+	}
+}
+
+/* Find, open and claim. On failure msg says why (may be NULL). */
+static int usb_open(struct usb *u, const char *nm, char *msg, size_t cap)
+{
+	libusb_device **list = NULL;
+	ssize_t n, i;
+	int rc = LIBUSB_ERROR_NOT_FOUND, found = 0;
+	n = libusb_get_device_list(u->ctx, &list);
+	if (n < 0) {
+		if (msg)
+			snprintf(msg, cap, "%s: libusb_get_device_list: %s", nm,
+				 libusb_error_name((int)n));
+		return map_err((int)n);
+	}
+	for (i = 0; i < n && !u->h; i++) {
+		struct libusb_device_descriptor dd;
+		libusb_device_handle *h;
+		if (libusb_get_device_descriptor(list[i], &dd) != 0 ||
+		    dd.idVendor != u->cfg.vid || dd.idProduct != u->cfg.pid)
+			continue;
+		found = 1;
+		rc = libusb_open(list[i], &h);
+		if (rc != 0)
+			continue;
+		if (u->cfg.serial) {
+			unsigned char sn[128] = "";
+			if (!dd.iSerialNumber ||
+			    libusb_get_string_descriptor_ascii(
+				    h, dd.iSerialNumber, sn, sizeof sn) < 0 ||
+			    strcmp((const char *)sn, u->cfg.serial) != 0) {
+				libusb_close(h);
+				rc = LIBUSB_ERROR_NOT_FOUND;
+				continue;
+			}
+		}
+		u->h = h;
+	}
+	libusb_free_device_list(list, 1);
+	if (!u->h) {
+		if (msg) {
+			if (!found || rc == LIBUSB_ERROR_NOT_FOUND)
+				snprintf(msg, cap,
+					 "%s: no USB device %04x:%04x%s%s "
+					 "(%zd USB devices present; "
+					 "proxima-probe lists them)",
+					 nm, u->cfg.vid, u->cfg.pid,
+					 u->cfg.serial ? " serial " : "",
+					 u->cfg.serial ? u->cfg.serial : "", n);
+			else
+				snprintf(msg, cap,
+					 "%s: libusb_open %04x:%04x: %s%s", nm,
+					 u->cfg.vid, u->cfg.pid,
+					 libusb_error_name(rc),
+					 rc == LIBUSB_ERROR_ACCESS
+						 ? " (no permission: add a udev "
+						   "rule for the device)"
+						 : "");
+		}
+		return !found ? PX_E_NOTFOUND : map_err(rc);
+	}
+	if (u->cfg.detach_kernel_driver)
+		libusb_set_auto_detach_kernel_driver(u->h, 1);
+	rc = libusb_claim_interface(u->h, u->cfg.interface);
+	if (rc != 0) {
+		if (msg)
+			snprintf(msg, cap, "%s: libusb_claim_interface(%d): %s%s",
+				 nm, u->cfg.interface, libusb_error_name(rc),
+				 rc == LIBUSB_ERROR_BUSY
+					 ? " (a kernel driver holds it: set "
+					   "detach_kernel_driver)"
+					 : "");
+		libusb_close(u->h);
+		u->h = NULL;
+		return map_err(rc);
+	}
+	return PX_OK;
+}
+
+static void usb_close_handle(struct usb *u)
+{
+	if (!u->h)
+		return;
+	libusb_release_interface(u->h, u->cfg.interface);
+	libusb_close(u->h);
+	u->h = NULL;
+}
+
+static void LIBUSB_CALL on_in(struct libusb_transfer *t)
+{
+	struct usb *u = t->user_data;
+	int64_t now = mono_ns();
+	switch (t->status) {
+	case LIBUSB_TRANSFER_COMPLETED:
+		if (t->actual_length > 0)
+			px_dev_feed_report(u->dev, t->buffer,
+					   (size_t)t->actual_length, now);
+		break;
+	case LIBUSB_TRANSFER_NO_DEVICE:
+		atomic_store(&u->gone, 1);
+		atomic_fetch_sub(&u->in_flight, 1);
+		return;
+	case LIBUSB_TRANSFER_CANCELLED:
+		atomic_fetch_sub(&u->in_flight, 1);
+		return;
+	default: /* timed out, stall, overflow, error: count, go on */
+		px_dev_record(u->dev, PX_DEV_ERR_IO, PX_E_IO, 0,
+			      t->endpoint, NULL, "USB IN transfer failed", now);
+		break;
+	}
+	if (atomic_load(&u->stop) || libusb_submit_transfer(t) != 0)
+		atomic_fetch_sub(&u->in_flight, 1);
+}
+
+static int submit_all(struct usb *u)
+{
+	int i, rc;
+	for (i = 0; i < u->cfg.n_transfers; i++) {
+		struct libusb_transfer *t = u->xfer[i];
+		if (u->cfg.transfer == PX_USB_BULK)
+			libusb_fill_bulk_transfer(t, u->h, u->cfg.endpoint_in,
+						  u->buf[i],
+						  (int)u->cfg.frame_len, on_in,
+						  u, 0);
+		else
+			libusb_fill_interrupt_transfer(
+				t, u->h, u->cfg.endpoint_in, u->buf[i],
+				(int)u->cfg.frame_len, on_in, u, 0);
+		rc = libusb_submit_transfer(t);
+		if (rc != 0)
+			return rc;
+		atomic_fetch_add(&u->in_flight, 1);
+	}
+	return 0;
+}
+
+static void cancel_all(struct usb *u)
+{
+	int i, k;
+	struct timeval tv = {0, 20000};
+	for (i = 0; i < u->cfg.n_transfers; i++)
+		libusb_cancel_transfer(u->xfer[i]);
+	for (k = 0; k < 100 && atomic_load(&u->in_flight) > 0; k++)
+		libusb_handle_events_timeout_completed(u->ctx, &tv, NULL);
+}
+
+static void sleep_ns(int64_t ns)
+{
+	struct timespec ts = {(time_t)(ns / 1000000000), (long)(ns % 1000000000)};
+	nanosleep(&ts, NULL);
+}
+
+static void *events_main(void *p)
+{
+	struct usb *u = p;
+	struct timeval tv = {0, 50000};
+	while (!atomic_load(&u->stop)) {
+		if (atomic_load(&u->gone)) {
+			cancel_all(u);
+			pthread_mutex_lock(&u->lock);
+			usb_close_handle(u);
+			pthread_mutex_unlock(&u->lock);
+			px_dev_set_state(u->dev, PX_DEV_STATE_UNPLUGGED,
+					 mono_ns());
+			atomic_store(&u->gone, 0);
+		}
+		if (!u->h) {
+			sleep_ns(REOPEN_NS);
+			pthread_mutex_lock(&u->lock);
+			if (usb_open(u, px_dev_name(u->dev), NULL, 0) == PX_OK) {
+				if (submit_all(u) == 0)
+					px_dev_set_state(u->dev,
+							 PX_DEV_STATE_RUNNING,
+							 mono_ns());
+				else
+					atomic_store(&u->gone, 1);
+			}
+			pthread_mutex_unlock(&u->lock);
+			continue;
+		}
+		libusb_handle_events_timeout_completed(u->ctx, &tv, NULL);
+	}
+	return NULL;
+}
+
+static void *writer_main(void *p)
+{
+	struct usb *u = p;
+	while (!atomic_load(&u->stop)) {
+		const struct outframe *o;
+		int fresh = 0, rc, done = 0;
+		while (sem_wait(&u->wake) != 0 && errno == EINTR)
+			;
+		if (atomic_load(&u->stop))
+			break;
+		o = px_param_read(u->out, &fresh);
+		if (!fresh || !o->len || !u->cfg.endpoint_out)
+			continue;
+		pthread_mutex_lock(&u->lock);
+		if (u->h) {
+			if (u->cfg.transfer == PX_USB_BULK)
+				rc = libusb_bulk_transfer(u->h, u->cfg.endpoint_out,
+							  (unsigned char *)o->b,
+							  (int)o->len, &done, 100);
+			else
+				rc = libusb_interrupt_transfer(
+					u->h, u->cfg.endpoint_out,
+					(unsigned char *)o->b, (int)o->len,
+					&done, 100);
+			if (rc != 0)
+				px_dev_record(u->dev, PX_DEV_ERR_IO, map_err(rc),
+					      rc == LIBUSB_ERROR_NO_DEVICE ? ENODEV
+									   : 0,
+					      u->cfg.endpoint_out, NULL,
+					      "USB OUT transfer failed",
+					      mono_ns());
+		}
+		pthread_mutex_unlock(&u->lock);
+	}
+	return NULL;
+}
+
+static int usb_start(struct px_dev *d)
+{
+	struct usb *u = px_dev_impl(d);
+	int rc;
+	atomic_store(&u->stop, 0);
+	rc = submit_all(u);
+	if (rc != 0) {
+		px_dev_record(d, PX_DEV_ERR_IO, map_err(rc), 0,
+			      u->cfg.endpoint_in, NULL,
+			      "libusb_submit_transfer", mono_ns());
+		cancel_all(u);
+		return map_err(rc);
+	}
+	if (pthread_create(&u->events, NULL, events_main, u) != 0) {
+		cancel_all(u);
+		return PX_E_NOMEM;
+	}
+	if (pthread_create(&u->writer, NULL, writer_main, u) != 0) {
+		atomic_store(&u->stop, 1);
+		pthread_join(u->events, NULL);
+		cancel_all(u);
+		return PX_E_NOMEM;
+	}
+	u->threads = 1;
+	return PX_OK;
+}
+
+static void usb_stop(struct px_dev *d)
+{
+	struct usb *u = px_dev_impl(d);
+	if (!u->threads)
+		return;
+	atomic_store(&u->stop, 1);
+	sem_post(&u->wake);
+	pthread_join(u->writer, NULL);
+	pthread_join(u->events, NULL);
+	cancel_all(u);
+	u->threads = 0;
+}
+
+static int usb_force(struct px_dev *d, const struct px_force_cmd *c,
+		     int64_t now)
+{
+	struct usb *u = px_dev_impl(d);
+	const struct px_codec_map *m = px_dev_config(d)->codec;
+	double w[PX_WRENCH__COUNT] = {0};
+	struct px_codec_diag diag;
+	struct outframe o;
+	int n, k, off;
+	if (!m->n_outputs || !u->cfg.endpoint_out)
+		return PX_E_UNSUPPORTED;
+	if (c->enable)
+		for (k = 0; k < 3; k++) {
+			w[k] = c->force_n[k];
+			w[3 + k] = c->torque_n_m[k];
+		}
+	n = px_codec_encode(m, w, o.b, sizeof o.b, NULL, &diag);
+	if (n < 0) {
+		px_dev_record(d, PX_DEV_ERR_ENCODE, n, 0, diag.report_id,
+			      &diag, NULL, now);
+		return n;
+	}
+	/* a vendor frame has no report id byte unless the map numbers
+	 * its reports */
+	off = px_codec_numbered(m) ? 0 : 1;
+	o.len = (size_t)n - (size_t)off;
+	if (off)
+		memmove(o.b, o.b + 1, o.len);
+	px_param_write(u->out, &o);
+	sem_post(&u->wake);
+	return PX_OK;
+}
+
+static void usb_destroy(struct px_dev *d)
+{
+	struct usb *u = px_dev_impl(d);
+	int i;
+	for (i = 0; i < MAX_XFER; i++)
+		if (u->xfer[i])
+			libusb_free_transfer(u->xfer[i]);
+	usb_close_handle(u);
+	if (u->ctx)
+		libusb_exit(u->ctx);
+	sem_destroy(&u->wake);
+	pthread_mutex_destroy(&u->lock);
+}
+
+static const struct px_dev_ops usb_ops = {
+	.backend = "libusb",
+	.caps = PX_DEV_CAP_POSE | PX_DEV_CAP_FORCE,
+	.start = usb_start,
+	.stop = usb_stop,
+	.force = usb_force,
+	.destroy = usb_destroy,
+};
+
+int px_usb_create(const struct px_dev_config *dcfg,
+		  const struct px_usb_config *uc, struct px_dev **out,
+		  char *msg, size_t cap)
+{
+	struct usb *u;
+	struct outframe zero;
+	const char *nm = dcfg && dcfg->name ? dcfg->name : "usb";
+	libusb_context *ctx = NULL;
+	int rc, i;
+	if (msg && cap)
+		msg[0] = 0;
+	if (out)
+		*out = NULL;
+	if (!dcfg || !uc || !out || !dcfg->codec || uc->interface < 0 ||
+	    (uc->endpoint_in & 0x80) == 0 || (uc->endpoint_in & 0x70) ||
+	    (uc->endpoint_out & 0xF0) || uc->frame_len < 1 ||
+	    uc->frame_len > FRAME_MAX || uc->n_transfers < 0 ||
+	    uc->n_transfers > MAX_XFER ||
+	    (uc->transfer != PX_USB_INTERRUPT && uc->transfer != PX_USB_BULK)) {
+		if (msg)
+			snprintf(msg, cap, "%s: USB device needs a codec map, "
+				 "interface >= 0, endpoint_in 0x81..0x8f, "
+				 "endpoint_out 0x01..0x0f or 0, frame_len "
+				 "1..%d, at most %d transfers", nm, FRAME_MAX,
+				 MAX_XFER);
+		return PX_E_INVAL;
+	}
+	if (px_codec_check(dcfg->codec, NULL) != PX_OK) {
+		if (msg)
+			snprintf(msg, cap, "%s: bad codec map", nm);
+		return PX_E_INVAL;
+	}
+	rc = libusb_init(&ctx);
+	if (rc != 0) {
+		if (msg)
+			snprintf(msg, cap, "%s: libusb_init: %s (no USB in this "
+				 "machine or container?)", nm,
+				 libusb_error_name(rc));
+		return rc == LIBUSB_ERROR_NOT_SUPPORTED ? PX_E_UNSUPPORTED
+							: PX_E_IO;
+	}
+	rc = px_dev_create(&usb_ops, dcfg, sizeof *u, out);
+	if (rc != PX_OK) {
+		libusb_exit(ctx);
+		return rc;
+	}
+	u = px_dev_impl(*out);
+	u->cfg = *uc;
+	if (!u->cfg.n_transfers)
+		u->cfg.n_transfers = 4;
+	if (uc->serial) {
+		snprintf(u->serial, sizeof u->serial, "%s", uc->serial);
+		u->cfg.serial = u->serial;
+	}
+	u->ctx = ctx;
+	u->dev = *out;
+	pthread_mutex_init(&u->lock, NULL);
+	sem_init(&u->wake, 0, 0);
+	atomic_init(&u->stop, 0);
+	atomic_init(&u->in_flight, 0);
+	atomic_init(&u->gone, 0);
+	for (i = 0; i < u->cfg.n_transfers; i++) {
+		u->xfer[i] = libusb_alloc_transfer(0);
+		if (!u->xfer[i]) {
+			px_dev_free(*out);
+			*out = NULL;
+			return PX_E_NOMEM;
+		}
+	}
+	px_arena_init(&u->arena, u->arena_buf, sizeof u->arena_buf);
+	memset(&zero, 0, sizeof zero);
+	rc = px_param_create(&u->arena, sizeof zero, &zero, &u->out);
+	if (rc == PX_OK)
+		rc = usb_open(u, nm, msg, cap);
+	if (rc != PX_OK) {
+		px_dev_free(*out);
+		*out = NULL;
+		return rc;
+	}
+	return PX_OK;
+}
 
 int px_usb_list(void (*fn)(void *user, const char *line), void *user,
 		char *msg, size_t cap)

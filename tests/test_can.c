@@ -20,6 +20,7 @@
 
 #include "px_alloc_count.h"
 #include "px_can.h"
+#include "px_loop.h"
 #include "px_test.h"
 
 /* Reference: Motorola signals as a big-endian bit stream. DBC's start
@@ -667,7 +668,144 @@ static void test_can_device_on_sim_bus(void)
 	}
 }
 
+struct canapp {
+	struct px_can_bus *robot;
+	struct px_dev *dev;
+	struct px_pose_sample s;
+	int nodev;
+};
+
+static int can_read(struct px_loop *l, const struct px_loop_cycle *c, void *u)
+{
+	struct canapp *a = u;
+	struct px_can_msg m;
+	int rc;
+	(void)l;
+	memset(&m, 0, sizeof m);
+	m.f.can_id = 0x100;
+	m.f.len = 8;
+	px_can_signal_encode(&dev_sigs[0], 0.1, m.f.data, 8, NULL);
+	px_can_bus_send(a->robot, &m, c->read_ns);
+	rc = px_dev_pose_read(a->dev, c->read_ns, &a->s);
+	if (rc == PX_E_NODEV) {
+		a->nodev++;
+		return rc;
+	}
+	return PX_OK;
+}
+
+static void test_can_faults_reach_the_watchdog(void)
+{
+	struct px_sim_fault fl[2] = {
+		{PX_SIM_FAULT_DROP, 100000000, 100000000, 1.0, 0},
+		{PX_SIM_FAULT_BUSOFF, 400000000, 50000000, 1.0, 0},
+	};
+	struct px_can_sim_config c;
+	struct px_can_sim *s;
+	struct px_can_bus *ctl;
+	struct px_dev_config dc;
+	struct px_loop_config lc;
+	struct px_loop *l;
+	struct px_loop_status ls;
+	static struct canapp a;
+	char msg[200];
+	uint64_t r;
+	memset(&a, 0, sizeof a);
+	px_can_sim_config_default(&c);
+	c.faults = fl;
+	c.n_faults = 2;
+	PX_CHECK_INT_EQ(px_can_sim_create(&c, &s), PX_OK);
+	PX_CHECK_INT_EQ(px_can_sim_endpoint(s, &a.robot), PX_OK);
+	PX_CHECK_INT_EQ(px_can_sim_endpoint(s, &ctl), PX_OK);
+	px_dev_config_default(&dc);
+	dc.name = "arm";
+	PX_CHECK_INT_EQ(px_can_dev_create(&dc, ctl, 0, dev_sigs, 3, &a.dev,
+					  msg, sizeof msg),
+			PX_OK);
+	px_loop_config_default(&lc);
+	lc.clock = PX_LOOP_CLOCK_VIRTUAL;
+	lc.read = can_read;
+	lc.user = &a;
+	lc.hist_bins = 100;
+	PX_CHECK_INT_EQ(px_loop_create(&lc, &l), PX_OK);
+	PX_CHECK_INT_EQ(px_dev_attach(a.dev, l), 0);
+	PX_CHECK_INT_EQ(px_loop_run(l, 1), PX_OK);
+	r = px_alloc_region_begin();
+	PX_CHECK_INT_EQ(px_loop_run(l, 149), PX_OK);
+	PX_CHECK_INT_EQ(px_alloc_region_end(r), 0);
+	/* frames dropped from 100 ms: stale after 20 ms */
+	PX_CHECK(px_loop_is_safe(l));
+	px_loop_status(l, &ls);
+	PX_CHECK_INT_EQ(ls.safe_cause, PX_FAULT_INPUT_STALE);
+	PX_CHECK_INT_EQ(px_loop_run(l, 100), PX_OK);
+	px_loop_rearm(l);
+	PX_CHECK_INT_EQ(px_loop_run(l, 100), PX_OK);
+	PX_CHECK(!px_loop_is_safe(l));
+	/* bus-off at 400 ms: the read phase sees PX_E_NODEV at once */
+	PX_CHECK_INT_EQ(px_loop_run(l, 60), PX_OK);
+	PX_CHECK(px_loop_is_safe(l));
+	px_loop_status(l, &ls);
+	PX_CHECK_INT_EQ(ls.safe_cause, PX_FAULT_CALLBACK);
+	PX_CHECK(a.nodev >= 1);
+	px_loop_free(l);
+	px_dev_free(a.dev);
+	px_can_sim_free(s);
+}
+
+static void test_record_then_replay(void)
+{
+	struct px_can_sim_config c;
+	struct px_can_sim *s;
+	struct px_can_bus *a_raw, *a, *b, *rp;
+	struct px_can_msg m;
+	char path[] = "/tmp/px_rec_XXXXXX";
+	char msg[200];
+	int fd = mkstemp(path), i, n;
+	FILE *f;
+	uint64_t dropped, r;
+	PX_CHECK(fd >= 0);
+	px_can_sim_config_default(&c);
+	PX_CHECK_INT_EQ(px_can_sim_create(&c, &s), PX_OK);
+	PX_CHECK_INT_EQ(px_can_sim_endpoint(s, &a_raw), PX_OK);
+	PX_CHECK_INT_EQ(px_can_sim_endpoint(s, &b), PX_OK);
+	PX_CHECK_INT_EQ(px_can_record_open(a_raw, 8, "vcan0", &a), PX_OK);
+	r = px_alloc_region_begin();
+	for (i = 0; i < 6; i++) {
+		int64_t t = 1000000000LL + i * 2000000LL;
+		m = frame(0x300 + (uint32_t)i, 3, (uint8_t)i);
+		m.fd = i == 2;
+		PX_CHECK_INT_EQ(px_can_bus_send(b, &m, t), PX_OK);
+		PX_CHECK_INT_EQ(px_can_bus_recv(a, t, &m), PX_OK);
+		m.f.can_id = 0x400 + (uint32_t)i;
+		PX_CHECK_INT_EQ(px_can_bus_send(a, &m, t + 1000000), PX_OK);
+	}
+	PX_CHECK_INT_EQ(px_alloc_region_end(r), 0);
+	f = fdopen(fd, "w");
+	n = px_can_record_flush(a, f, &dropped);
+	fclose(f);
+	PX_CHECK_INT_EQ(n, 8);       /* the ring holds 8 */
+	PX_CHECK_INT_EQ(dropped, 4); /* 12 recorded, 4 lost and counted */
+	PX_CHECK_INT_EQ(px_can_replay_open(path, "vcan0", &rp, msg, sizeof msg),
+			PX_OK);
+	for (i = 0; i < 8; i++) {
+		int k = i / 2;
+		/* the first receive sets the replay's time origin */
+		PX_CHECK_INT_EQ(px_can_bus_recv(rp, i ? 1000000000000LL : 0, &m),
+				PX_OK);
+		PX_CHECK_INT_EQ(m.f.can_id, (i % 2 ? 0x400u : 0x300u) + (unsigned)k);
+		PX_CHECK_INT_EQ(m.f.data[0], k);
+		PX_CHECK_INT_EQ(m.fd, k == 2);
+	}
+	PX_CHECK_INT_EQ(px_can_bus_recv(rp, INT64_MAX / 4, &m), PX_E_AGAIN);
+	px_can_bus_close(rp);
+	px_can_bus_close(a); /* closes a_raw too */
+	px_can_sim_free(s);
+	unlink(path);
+}
+
 static const struct px_test tests[] = {
+	PX_T(test_record_then_replay),
+	PX_T(test_can_faults_reach_the_watchdog),
 	PX_T(test_signal_bits_match_dbc_reference),
 	PX_T(test_signal_known_layouts_and_roundtrip),
 	PX_T(test_error_frames_decoded),

@@ -5,6 +5,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <poll.h>
+#include <stdlib.h>
 #include <stdio.h>
 #include <string.h>
 #include <time.h>
@@ -153,6 +154,9 @@ static void test_uhid_device_roundtrip(void)
 	const struct px_codec_map *m = px_codec_builtin("haptic");
 	char msg[300];
 	int fd, rc = PX_E_NOTFOUND, i, k;
+	if (px_hid_driver() == PX_HID_LIBUSB)
+		PX_SKIP("uhid devices are not USB; hidapi-libusb is tested on "
+			"the USB gadget");
 	fd = open("/dev/uhid", O_RDWR | O_CLOEXEC);
 	if (fd < 0)
 		PX_SKIP("no /dev/uhid (%s): the VM suite runs this",
@@ -234,7 +238,62 @@ static void test_uhid_device_roundtrip(void)
 	close(fd);
 }
 
+static void test_usb_hid_gadget(void)
+{
+	/* A configfs USB HID gadget (PX_TEST_USB_VIDPID, PX_TEST_HIDG): seen
+	 * by hidraw through usbhid, or by hidapi-libusb directly. */
+	const char *vp = getenv("PX_TEST_USB_VIDPID");
+	const char *hidg = getenv("PX_TEST_HIDG");
+	const struct px_codec_map *m = px_codec_builtin("haptic");
+	struct px_dev_config c;
+	struct px_hid_config h;
+	struct px_dev *d = NULL;
+	struct px_pose_sample s;
+	double a[6] = {-0.004, 0.002, 0.5, 0, 0, 0};
+	uint8_t rep[64];
+	unsigned vid, pid;
+	char msg[300];
+	int fd, n, i, rc = PX_E_NOTFOUND;
+	if (!vp || !hidg || sscanf(vp, "%x:%x", &vid, &pid) != 2)
+		PX_SKIP("PX_TEST_USB_VIDPID/PX_TEST_HIDG not set: the VM suite "
+			"runs this on a USB HID gadget");
+	px_dev_config_default(&c);
+	c.name = "gadget-hid";
+	c.codec = m;
+	c.stale_timeout_ns = 1000000000;
+	memset(&h, 0, sizeof h);
+	h.has_vid_pid = 1;
+	h.vid = (uint16_t)vid;
+	h.pid = (uint16_t)pid;
+	h.driver = px_hid_driver();
+	for (i = 0; i < 50 && rc != PX_OK; i++) {
+		rc = px_hid_create(&c, &h, &d, msg, sizeof msg);
+		if (rc != PX_OK)
+			wait_ms(100);
+	}
+	PX_CHECK_MSG(rc == PX_OK, "%s", msg);
+	PX_CHECK_INT_EQ(px_dev_start(d), PX_OK);
+	fd = open(hidg, O_RDWR);
+	PX_CHECK_MSG(fd >= 0, "%s: %s", hidg, strerror(errno));
+	n = px_codec_encode_input(m, 1, a, 3, rep, sizeof rep);
+	for (i = 0; i < 300; i++) {
+		if (write(fd, rep, (size_t)n) != n)
+			wait_ms(5);
+		px_dev_pose_read(d, px_dev_mono_ns(), &s);
+		if (s.seq > 0)
+			break;
+		wait_ms(10);
+	}
+	PX_CHECK(s.valid);
+	PX_CHECK_NEAR(s.pos_m.x, -0.004, 1e-12);
+	PX_CHECK_NEAR(s.pos_m.z, 0.5, 1e-12);
+	PX_CHECK_INT_EQ(s.buttons, 3);
+	close(fd);
+	px_dev_free(d);
+}
+
 static const struct px_test tests[] = {
+	PX_T(test_usb_hid_gadget),
 	PX_T(test_open_by_vid_pid_not_found),
 	PX_T(test_open_by_path_gives_errno),
 	PX_T(test_config_errors),

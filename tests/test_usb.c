@@ -1,0 +1,155 @@
+/* libusb back end: clear errors here (no USB). With a USB HID gadget (the
+ * VM suite: PX_TEST_USB_VIDPID=vvvv:pppp, PX_TEST_HIDG=/dev/hidg0, and for
+ * unplug/replug PX_TEST_GADGET_DIR + PX_TEST_UDC) the real back end claims
+ * the interface, reads frames and sees an unplug and a replug. */
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "px_dev.h"
+#include "px_usb.h"
+#include "px_test.h"
+
+static struct px_usb_config base_cfg(void)
+{
+	struct px_usb_config u;
+	memset(&u, 0, sizeof u);
+	u.vid = 0x1234;
+	u.pid = 0x0001;
+	u.interface = 0;
+	u.endpoint_in = 0x81;
+	u.endpoint_out = 0x01;
+	u.transfer = PX_USB_INTERRUPT;
+	u.frame_len = 64;
+	u.detach_kernel_driver = 1;
+	return u;
+}
+
+static void test_open_errors(void)
+{
+	struct px_dev_config c;
+	struct px_usb_config u = base_cfg();
+	struct px_dev *d;
+	char msg[300];
+	int rc;
+	px_dev_config_default(&c);
+	c.name = "vendor";
+	c.codec = px_codec_builtin("haptic");
+	rc = px_usb_create(&c, &u, &d, msg, sizeof msg);
+	if (rc == PX_OK) {
+		px_dev_free(d);
+		PX_SKIP("a real 1234:0001 device is attached");
+	}
+	PX_CHECK_MSG(rc == PX_E_NOTFOUND || rc == PX_E_UNSUPPORTED ||
+			     rc == PX_E_IO, "rc %d: %s", rc, msg);
+	if (rc == PX_E_NOTFOUND)
+		PX_CHECK_MSG(strstr(msg, "vendor: no USB device 1234:0001 (") &&
+				     strstr(msg, "proxima-probe"), "%s", msg);
+	else
+		PX_CHECK_MSG(strstr(msg, "vendor: libusb_init") != NULL, "%s",
+			     msg);
+	u.endpoint_in = 0x01; /* an OUT address */
+	PX_CHECK_INT_EQ(px_usb_create(&c, &u, &d, msg, sizeof msg), PX_E_INVAL);
+	PX_CHECK(strstr(msg, "endpoint_in 0x81..0x8f") != NULL);
+	u = base_cfg();
+	c.codec = NULL;
+	PX_CHECK_INT_EQ(px_usb_create(&c, &u, &d, msg, sizeof msg), PX_E_INVAL);
+}
+
+static void wait_ms(int ms)
+{
+	struct timespec ts = {ms / 1000, (ms % 1000) * 1000000L};
+	nanosleep(&ts, NULL);
+}
+
+static int write_file(const char *dir, const char *name, const char *v)
+{
+	char p[512];
+	FILE *f;
+	snprintf(p, sizeof p, "%s/%s", dir, name);
+	f = fopen(p, "w");
+	if (!f)
+		return -1;
+	fputs(v, f);
+	return fclose(f);
+}
+
+static void test_hid_gadget_frames_unplug_replug(void)
+{
+	const char *vp = getenv("PX_TEST_USB_VIDPID");
+	const char *hidg = getenv("PX_TEST_HIDG");
+	const char *gdir = getenv("PX_TEST_GADGET_DIR");
+	const char *udc = getenv("PX_TEST_UDC");
+	const struct px_codec_map *m = px_codec_builtin("haptic");
+	struct px_dev_config c;
+	struct px_usb_config u = base_cfg();
+	struct px_dev *d;
+	struct px_pose_sample s;
+	struct px_dev_status st;
+	unsigned vid, pid;
+	char msg[300];
+	uint8_t rep[64];
+	double a[6] = {0.003, -0.002, 0.001, 0, 0, 0};
+	int fd, n, i, rc;
+	if (!vp || !hidg || sscanf(vp, "%x:%x", &vid, &pid) != 2)
+		PX_SKIP("PX_TEST_USB_VIDPID/PX_TEST_HIDG not set: the VM suite "
+			"runs this on a USB HID gadget");
+	u.vid = (uint16_t)vid;
+	u.pid = (uint16_t)pid;
+	u.endpoint_out = 0;
+	px_dev_config_default(&c);
+	c.name = "gadget";
+	c.codec = m;
+	c.stale_timeout_ns = 1000000000;
+	PX_CHECK_MSG((rc = px_usb_create(&c, &u, &d, msg, sizeof msg)) == PX_OK,
+		     "%s", msg);
+	PX_CHECK_INT_EQ(px_dev_start(d), PX_OK);
+	fd = open(hidg, O_RDWR);
+	PX_CHECK_MSG(fd >= 0, "%s: %s", hidg, strerror(errno));
+	n = px_codec_encode_input(m, 1, a, 5, rep, sizeof rep);
+	PX_CHECK_INT_EQ(n, 14);
+	for (i = 0; i < 300; i++) {
+		if (write(fd, rep, (size_t)n) != n)
+			wait_ms(5);
+		px_dev_pose_read(d, px_dev_mono_ns(), &s);
+		if (s.seq > 0)
+			break;
+		wait_ms(10);
+	}
+	PX_CHECK(s.valid);
+	PX_CHECK_NEAR(s.pos_m.x, 0.003, 1e-12);
+	PX_CHECK_INT_EQ(s.buttons, 5);
+	if (gdir && udc) {
+		PX_CHECK_INT_EQ(write_file(gdir, "UDC", "\n"), 0); /* unplug */
+		for (i = 0; i < 300; i++) {
+			if (px_dev_pose_read(d, px_dev_mono_ns(), &s) == PX_E_NODEV)
+				break;
+			wait_ms(10);
+		}
+		PX_CHECK(!s.valid && s.stale);
+		PX_CHECK_INT_EQ(write_file(gdir, "UDC", udc), 0); /* replug */
+		for (i = 0; i < 500; i++) {
+			px_dev_pose_read(d, px_dev_mono_ns(), &s);
+			if (px_dev_state(d) == PX_DEV_STATE_RUNNING)
+				break;
+			wait_ms(10);
+		}
+		PX_CHECK_INT_EQ(px_dev_state(d), PX_DEV_STATE_RUNNING);
+		px_dev_status(d, &st);
+		PX_CHECK_INT_EQ(st.unplugs, 1);
+		PX_CHECK_INT_EQ(st.replugs, 1);
+	}
+	close(fd);
+	px_dev_free(d);
+}
+
+static const struct px_test tests[] = {
+	PX_T(test_open_errors),
+	PX_T(test_hid_gadget_frames_unplug_replug),
+};
+
+PX_TEST_MAIN(tests)
