@@ -147,6 +147,7 @@ int px_spiece_init(struct px_spiece *sp, int p, int q, const double (*hw)[4],
 	double hs[4][(MD) * (MD + 1)], ht[4][(MD + 1) * (MD)];
 	double k1[TMAX], k2[TMAX], ku[3][TMAX], kv[3][TMAX], tmp[TMAX];
 	size_t np = tsize(p, q), i, nfs, ngu, ngv;
+	int wp, wq;
 	double *cur = mem;
 	int c;
 
@@ -198,43 +199,88 @@ int px_spiece_init(struct px_spiece *sp, int p, int q, const double (*hw)[4],
 	}
 	sp->center_ = px_aabb_center(&sp->box_);
 	sp->radius_ = 0.5 * px_aabb_diagonal(&sp->box_);
-	for (c = 0; c < 4; c++) {
-		t_deriv_s(sp->h_ + c * np, p, q, hs[c]);
-		t_deriv_t(sp->h_ + c * np, p, q, ht[c]);
+	/* Equal weights: divide them out, and w becomes the degree-0
+	 * constant 1. The critical-point tensors then drop from degree
+	 * 3p - 1 to 2p - 1, which is most of the query's work. */
+	sp->wconst_ = 1;
+	for (i = 1; i < np; i++)
+		if (sp->h_[3 * np + i] != sp->h_[3 * np])
+			sp->wconst_ = 0;
+	if (sp->wconst_) {
+		double w0 = sp->h_[3 * np];
+		for (i = 0; i < 4 * np; i++)
+			sp->h_[i] /= w0;
 	}
-	/* K_s = H_s w - H w_s (2p - 1, 2q) and K_t = H_t w - H w_t
-	 * (2p, 2q - 1). */
-	for (c = 0; c < 3; c++) {
-		const double *h = sp->h_ + c * np, *w = sp->h_ + 3 * np;
-		t_mul(hs[c], p - 1, q, w, p, q, k1);
-		t_mul(h, p, q, hs[3], p - 1, q, k2);
-		for (i = 0; i < tsize(2 * p - 1, 2 * q); i++)
-			ku[c][i] = k1[i] - k2[i];
-		t_mul(ht[c], p, q - 1, w, p, q, k1);
-		t_mul(h, p, q, ht[3], p, q - 1, k2);
-		for (i = 0; i < tsize(2 * p, 2 * q - 1); i++)
-			kv[c][i] = k1[i] - k2[i];
+	wp = sp->wconst_ ? 0 : p;
+	wq = sp->wconst_ ? 0 : q;
+	sp->gun_ = 2 * p + wp - 1;
+	sp->gum_ = 2 * q + wq;
+	sp->gvn_ = 2 * p + wp;
+	sp->gvm_ = 2 * q + wq - 1;
+	/* The coefficient blocks were laid out for the rational degrees;
+	 * within them the arrays are packed at the actual ones. */
+	ngu = tsize(sp->gun_, sp->gum_);
+	ngv = tsize(sp->gvn_, sp->gvm_);
+	{
+		const double *w = sp->h_ + 3 * np;
+		double one[TMAX];
+		size_t nk;
+
+		for (i = 0; i < TMAX; i++)
+			one[i] = 1.0; /* Bernstein coefficients of 1: elevation */
+		for (c = 0; c < 4; c++) {
+			t_deriv_s(sp->h_ + c * np, p, q, hs[c]);
+			t_deriv_t(sp->h_ + c * np, p, q, ht[c]);
+		}
+		/* K_s = H_s w - H w_s and K_t = H_t w - H w_t; with a constant
+		 * w they are H_s and H_t. */
+		for (c = 0; c < 3; c++) {
+			const double *h = sp->h_ + c * np;
+			if (sp->wconst_) {
+				memcpy(ku[c], hs[c], tsize(p - 1, q) * sizeof(double));
+				memcpy(kv[c], ht[c], tsize(p, q - 1) * sizeof(double));
+				continue;
+			}
+			t_mul(hs[c], p - 1, q, w, p, q, k1);
+			t_mul(h, p, q, hs[3], p - 1, q, k2);
+			for (i = 0; i < tsize(2 * p - 1, 2 * q); i++)
+				ku[c][i] = k1[i] - k2[i];
+			t_mul(ht[c], p, q - 1, w, p, q, k1);
+			t_mul(h, p, q, ht[3], p, q - 1, k2);
+			for (i = 0; i < tsize(2 * p, 2 * q - 1); i++)
+				kv[c][i] = k1[i] - k2[i];
+		}
+		memset(sp->gua_, 0, ngu * sizeof(double));
+		memset(sp->gva_, 0, ngv * sizeof(double));
+		memset(sp->fa_, 0, nfs * sizeof(double));
+		for (c = 0; c < 3; c++) {
+			const double *h = sp->h_ + c * np;
+			/* a = H . K (degree of gu), b = w K raised to it. */
+			t_mul(h, p, q, ku[c], p + wp - 1, q + wq, tmp);
+			nk = tsize(sp->gun_, sp->gum_);
+			for (i = 0; i < nk; i++)
+				sp->gua_[i] += tmp[i];
+			t_mul(w, wp, wq, ku[c], p + wp - 1, q + wq, k1);
+			t_mul(one, p - wp, q - wq, k1, p + 2 * wp - 1, q + 2 * wq,
+			      sp->gub_ + c * ngu);
+			t_mul(h, p, q, kv[c], p + wp, q + wq - 1, tmp);
+			nk = tsize(sp->gvn_, sp->gvm_);
+			for (i = 0; i < nk; i++)
+				sp->gva_[i] += tmp[i];
+			t_mul(w, wp, wq, kv[c], p + wp, q + wq - 1, k1);
+			t_mul(one, p - wp, q - wq, k1, p + 2 * wp, q + 2 * wq - 1,
+			      sp->gvb_ + c * ngv);
+			/* w^2 f = |H|^2 - 2 P . (w H) + |P|^2 w^2, all raised
+			 * to degree (2p, 2q). */
+			t_mul(h, p, q, h, p, q, tmp);
+			for (i = 0; i < nfs; i++)
+				sp->fa_[i] += tmp[i];
+			t_mul(w, wp, wq, h, p, q, k1);
+			t_mul(one, p - wp, q - wq, k1, p + wp, q + wq, sp->fb_ + c * nfs);
+		}
+		t_mul(w, wp, wq, w, wp, wq, k1);
+		t_mul(one, 2 * (p - wp), 2 * (q - wq), k1, 2 * wp, 2 * wq, sp->fw_);
 	}
-	memset(sp->gua_, 0, ngu * sizeof(double));
-	memset(sp->gva_, 0, ngv * sizeof(double));
-	memset(sp->fa_, 0, nfs * sizeof(double));
-	for (c = 0; c < 3; c++) {
-		const double *h = sp->h_ + c * np, *w = sp->h_ + 3 * np;
-		t_mul(h, p, q, ku[c], 2 * p - 1, 2 * q, tmp);
-		for (i = 0; i < ngu; i++)
-			sp->gua_[i] += tmp[i];
-		t_mul(w, p, q, ku[c], 2 * p - 1, 2 * q, sp->gub_ + c * ngu);
-		t_mul(h, p, q, kv[c], 2 * p, 2 * q - 1, tmp);
-		for (i = 0; i < ngv; i++)
-			sp->gva_[i] += tmp[i];
-		t_mul(w, p, q, kv[c], 2 * p, 2 * q - 1, sp->gvb_ + c * ngv);
-		/* w^2 f = |H|^2 - 2 P . (w H) + |P|^2 w^2 */
-		t_mul(h, p, q, h, p, q, tmp);
-		for (i = 0; i < nfs; i++)
-			sp->fa_[i] += tmp[i];
-		t_mul(w, p, q, h, p, q, sp->fb_ + c * nfs);
-	}
-	t_mul(sp->h_ + 3 * np, p, q, sp->h_ + 3 * np, p, q, sp->fw_);
 	return PX_OK;
 }
 
@@ -507,12 +553,13 @@ static void t_half_t(const double *c, int n, int m, double *lo, double *hi)
 			      hi + i * (m + 1));
 }
 
+/* min f_i / w_i, or min f_i when w is NULL (constant weight 1). */
 static double ratio_min(const double *f, const double *w, size_t k)
 {
 	double lb = INFINITY;
 	size_t i;
 	for (i = 0; i < k; i++) {
-		double q = f[i] / w[i];
+		double q = w ? f[i] / w[i] : f[i];
 		lb = q < lb ? q : lb;
 	}
 	return lb;
@@ -531,17 +578,20 @@ static void children_lb(const double *F, const double *W, int fn, int fm,
 	size_t k = tsize(fn, fm);
 
 	t_restrict(F, fn, fm, r->s0, r->s1, r->t0, r->t1, pf);
-	t_restrict(W, fn, fm, r->s0, r->s1, r->t0, r->t1, pw);
 	t_half_s(pf, fn, fm, fl, fh);
-	t_half_s(pw, fn, fm, wl, wh);
 	t_half_t(fl, fn, fm, a, b);
-	t_half_t(wl, fn, fm, c, d);
-	ch[0].lb = ratio_min(a, c, k);
-	ch[2].lb = ratio_min(b, d, k);
+	if (W) {
+		t_restrict(W, fn, fm, r->s0, r->s1, r->t0, r->t1, pw);
+		t_half_s(pw, fn, fm, wl, wh);
+		t_half_t(wl, fn, fm, c, d);
+	}
+	ch[0].lb = ratio_min(a, W ? c : NULL, k);
+	ch[2].lb = ratio_min(b, W ? d : NULL, k);
 	t_half_t(fh, fn, fm, a, b);
-	t_half_t(wh, fn, fm, c, d);
-	ch[1].lb = ratio_min(a, c, k);
-	ch[3].lb = ratio_min(b, d, k);
+	if (W)
+		t_half_t(wh, fn, fm, c, d);
+	ch[1].lb = ratio_min(a, W ? c : NULL, k);
+	ch[3].lb = ratio_min(b, W ? d : NULL, k);
 }
 
 /* Min-heap of rectangles by lower bound: nearest first, so the best
@@ -582,15 +632,10 @@ static struct rect heap_pop(struct rect *h, int *n)
 static double rect_lb(const double *F, const double *W, int fn, int fm,
 		      const struct rect *r, double *rf, double *rw)
 {
-	size_t i, k = tsize(fn, fm);
-	double lb = INFINITY;
 	t_restrict(F, fn, fm, r->s0, r->s1, r->t0, r->t1, rf);
-	t_restrict(W, fn, fm, r->s0, r->s1, r->t0, r->t1, rw);
-	for (i = 0; i < k; i++) {
-		double q = rf[i] / rw[i];
-		lb = q < lb ? q : lb;
-	}
-	return lb;
+	if (W)
+		t_restrict(W, fn, fm, r->s0, r->s1, r->t0, r->t1, rw);
+	return ratio_min(rf, W ? rw : NULL, tsize(fn, fm));
 }
 
 int px_spiece_closest(const struct px_spiece *sp, px_vec3 p, double *best_d2,
@@ -605,7 +650,7 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 {
 	const int P = sp->p_, Q = sp->q_;
 	const int fn = nf_s(P), fm = nf_s(Q);
-	const int un = ngu_s(P), um = ngu_t(Q), vn = ngv_s(P), vm = ngv_t(Q);
+	const int un = sp->gun_, um = sp->gum_, vn = sp->gvn_, vm = sp->gvm_;
 	const size_t nfs = tsize(fn, fm), ngu = tsize(un, um), ngv = tsize(vn, vm);
 	double F[TMAX], GU[TMAX], GV[TMAX];
 	double rf[TMAX], rw[TMAX], rg[TMAX], rv[TMAX], dg[TMAX];
@@ -644,7 +689,7 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 	}
 	{
 		struct rect root = {0.0, 1.0, 0.0, 1.0, 0.0, 0};
-		root.lb = rect_lb(F, sp->fw_, fn, fm, &root, rf, rw);
+		root.lb = rect_lb(F, sp->wconst_ ? NULL : sp->fw_, fn, fm, &root, rf, rw);
 		if (root.lb >= x.best - x.slack)
 			goto out;
 		heap_push(heap, &hn, root);
@@ -729,7 +774,7 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 					     {sm, r.s1, r.t0, tm, 0.0, r.depth + 1},
 					     {r.s0, sm, tm, r.t1, 0.0, r.depth + 1},
 					     {sm, r.s1, tm, r.t1, 0.0, r.depth + 1}};
-			children_lb(F, sp->fw_, fn, fm, &r, ch);
+			children_lb(F, sp->wconst_ ? NULL : sp->fw_, fn, fm, &r, ch);
 			for (k = 0; k < 4; k++)
 				if (ch[k].lb < x.best - x.slack)
 					heap_push(heap, &hn, ch[k]);

@@ -58,6 +58,12 @@ struct px_spiece {
 	px_aabb box_;
 	px_vec3 center_;
 	double radius_;
+	/* Degrees of the gu and gv tensors: (3p - 1, 3q) and (3p, 3q - 1)
+	 * for a rational patch, (2p - 1, 2q) and (2p, 2q - 1) when every
+	 * weight is equal (then w is the constant 1 and W = w^2 is not
+	 * needed: wconst_). */
+	int gun_, gum_, gvn_, gvm_;
+	int wconst_;
 	/* Arrays inside the caller block (see px_spiece_doubles()):
 	 * homogeneous control net h_[c][i][j] (c = x w, y w, z w, w; i along
 	 * s, j along t), and the coefficient tensors of F, W, gu, gv. */
