@@ -9,7 +9,8 @@ int px_cpiece_init(struct px_cpiece *pc, int degree, const double (*hw)[4],
 	double hd[4][PX_CPIECE_MAX_DEGREE + 1];
 	double k[3][2 * PX_CPIECE_MAX_DEGREE];
 	double t1[PX_BERN_MAX_DEGREE + 1], t2[PX_BERN_MAX_DEGREE + 1];
-	int p = degree, i, c, j;
+	double one[PX_CPIECE_MAX_DEGREE * 2 + 1];
+	int p = degree, i, c, j, wp;
 
 	if (!pc || !hw)
 		return PX_E_INVAL;
@@ -36,6 +37,20 @@ int px_cpiece_init(struct px_cpiece *pc, int degree, const double (*hw)[4],
 			       px_v3(hw[i][0] / hw[i][3], hw[i][1] / hw[i][3],
 				     hw[i][2] / hw[i][3]));
 	}
+	/* Equal weights: divide them out; w is then the constant 1 and g
+	 * drops from degree 3p - 1 to 2p - 1. */
+	pc->wconst_ = 1;
+	for (i = 1; i <= p; i++)
+		if (pc->h_[3][i] != pc->h_[3][0])
+			pc->wconst_ = 0;
+	if (pc->wconst_) {
+		double w0 = pc->h_[3][0];
+		for (c = 0; c < 4; c++)
+			for (i = 0; i <= p; i++)
+				pc->h_[c][i] /= w0;
+	}
+	wp = pc->wconst_ ? 0 : p;
+	pc->gdeg_ = 2 * p + wp - 1;
 	for (c = 0; c < 4; c++) {
 		px_bern_deriv(pc->h_[c], p, hd[c]);
 		px_bern_scale(pc->h_[c], p, pc->hb_[c]);
@@ -47,29 +62,39 @@ int px_cpiece_init(struct px_cpiece *pc, int degree, const double (*hw)[4],
 			    hw[0][2] / hw[0][3]);
 	pc->end_[1] = px_v3(hw[p][0] / hw[p][3], hw[p][1] / hw[p][3],
 			    hw[p][2] / hw[p][3]);
-	/* K = H' w - H w' (degree 2p - 1; its top term cancels in exact
-	 * arithmetic but keeping the full degree costs nothing). */
+	/* K = H' w - H w' (degree p + wp - 1; with a constant w, K = H'). */
 	for (c = 0; c < 3; c++) {
+		if (pc->wconst_) {
+			for (j = 0; j < p; j++)
+				k[c][j] = hd[c][j];
+			continue;
+		}
 		px_bern_mul(hd[c], p - 1, pc->h_[3], p, t1);
 		px_bern_mul(pc->h_[c], p, hd[3], p - 1, t2);
 		for (j = 0; j < 2 * p; j++)
 			k[c][j] = t1[j] - t2[j];
 	}
-	/* a = H . K and b = w K, degree 3p - 1. */
+	/* a = H . K and b = w K raised to the same degree 2p + wp - 1
+	 * (multiplying by the degree p - wp form of 1 raises the degree). */
+	for (i = 0; i <= PX_CPIECE_MAX_DEGREE; i++)
+		one[i] = 1.0;
 	for (c = 0; c < 3; c++) {
-		px_bern_mul(pc->h_[c], p, k[c], 2 * p - 1, t1);
-		for (j = 0; j < 3 * p; j++)
+		px_bern_mul(pc->h_[c], p, k[c], p + wp - 1, t1);
+		for (j = 0; j <= pc->gdeg_; j++)
 			pc->ga_[j] += t1[j];
-		px_bern_mul(pc->h_[3], p, k[c], 2 * p - 1, pc->gb_[c]);
+		px_bern_mul(pc->h_[3], wp, k[c], p + wp - 1, t2);
+		px_bern_mul(one, p - wp, t2, p + 2 * wp - 1, pc->gb_[c]);
 	}
 	/* w^2 f = |H|^2 - 2 P . (w H) + |P|^2 w^2, degree 2p. */
 	for (c = 0; c < 3; c++) {
 		px_bern_mul(pc->h_[c], p, pc->h_[c], p, t1);
 		for (j = 0; j <= 2 * p; j++)
 			pc->fa_[j] += t1[j];
-		px_bern_mul(pc->h_[3], p, pc->h_[c], p, pc->fb_[c]);
+		px_bern_mul(pc->h_[3], wp, pc->h_[c], p, t2);
+		px_bern_mul(one, p - wp, t2, p + wp, pc->fb_[c]);
 	}
-	px_bern_mul(pc->h_[3], p, pc->h_[3], p, pc->fw_);
+	px_bern_mul(pc->h_[3], wp, pc->h_[3], wp, t2);
+	px_bern_mul(one, 2 * (p - wp), t2, 2 * wp, pc->fw_);
 	return PX_OK;
 }
 
@@ -107,10 +132,12 @@ static double lower_bound(const double *f, const double *w, int n, double s,
 	double fr[PX_CPIECE_NF], wr[PX_CPIECE_NF], lb = INFINITY;
 	int i;
 
+	/* w NULL: constant weight 1, F is f itself. */
 	px_bern_restrict(f, n, s, t, fr);
-	px_bern_restrict(w, n, s, t, wr);
+	if (w)
+		px_bern_restrict(w, n, s, t, wr);
 	for (i = 0; i <= n; i++) {
-		double r = fr[i] / wr[i];
+		double r = w ? fr[i] / wr[i] : fr[i];
 		lb = r < lb ? r : lb;
 	}
 	return lb;
@@ -189,6 +216,10 @@ static double refine_root(const double *c, int n, int *iters)
 
 struct span {
 	double s, t;
+	/* g at s and at t, computed once where an interval was split and
+	 * shared by both halves, so that the two halves can never disagree
+	 * on the sign at their common end. */
+	double gs, gt;
 	int depth;
 };
 
@@ -211,9 +242,10 @@ static void consider(const struct px_cpiece *pc, px_vec3 p, double t,
 int px_cpiece_closest(const struct px_cpiece *pc, px_vec3 p, double *best_d2,
 		      struct px_cpiece_hit *hit)
 {
-	double g[PX_CPIECE_NG], c[PX_CPIECE_NG], f[PX_CPIECE_NF];
+	double g[PX_CPIECE_NG], c[PX_CPIECE_NG], f[PX_CPIECE_NF], cs[PX_CPIECE_NG];
+	double eps_g = 0.0;
 	struct span stack[2 * PX_CPIECE_MAX_DEPTH + 4];
-	int n = 3 * pc->degree_ - 1, nf = 2 * pc->degree_, sp = 0, i;
+	int n = pc->gdeg_, nf = 2 * pc->degree_, sp = 0, i;
 	int improved = 0;
 	double best = *best_d2, pp = px_v3_dot(p, p), slack, lb_root = 0.0;
 	double lb_unresolved = INFINITY;
@@ -245,7 +277,7 @@ int px_cpiece_closest(const struct px_cpiece *pc, px_vec3 p, double *best_d2,
 	{
 		double lb = INFINITY;
 		for (i = 0; i <= nf; i++) {
-			double r = f[i] / pc->fw_[i];
+			double r = pc->wconst_ ? f[i] : f[i] / pc->fw_[i];
 			lb = r < lb ? r : lb;
 		}
 		if (lb >= best - slack)
@@ -259,8 +291,18 @@ int px_cpiece_closest(const struct px_cpiece *pc, px_vec3 p, double *best_d2,
 	for (i = 0; i <= n; i++)
 		g[i] = pc->ga_[i] - (p.x * pc->gb_[0][i] + p.y * pc->gb_[1][i] +
 				     p.z * pc->gb_[2][i]);
+	/* Rounding in g is about 1e-16 of its largest coefficient per
+	 * operation; values within 1e-13 of it count as zero. */
+	{
+		double gmax = 0.0;
+		for (i = 0; i <= n; i++)
+			gmax = fabs(g[i]) > gmax ? fabs(g[i]) : gmax;
+		eps_g = 1e-13 * gmax;
+	}
 	stack[sp].s = 0.0;
 	stack[sp].t = 1.0;
+	stack[sp].gs = g[0];
+	stack[sp].gt = g[n];
 	stack[sp].depth = 0;
 	sp++;
 	while (sp > 0) {
@@ -274,10 +316,25 @@ int px_cpiece_closest(const struct px_cpiece *pc, px_vec3 p, double *best_d2,
 		}
 		hit->nodes++;
 		/* The root interval's bound was computed above. */
-		lb = e.depth ? lower_bound(f, pc->fw_, nf, e.s, e.t) : lb_root;
+		lb = e.depth ? lower_bound(f, pc->wconst_ ? NULL : pc->fw_, nf, e.s, e.t)
+			     : lb_root;
 		if (lb >= best - slack)
 			continue;
 		px_bern_restrict(g, n, e.s, e.t, c);
+		/* The end coefficients are the values at the ends: use the
+		 * shared ones. A root exactly at an end (within rounding) is
+		 * invisible to the sign count, which skips zeros: the end
+		 * itself is then the candidate. */
+		c[0] = e.gs;
+		c[n] = e.gt;
+		if (fabs(c[0]) <= eps_g) {
+			consider(pc, p, e.s, &best, hit, &improved);
+			c[0] = 0.0;
+		}
+		if (fabs(c[n]) <= eps_g) {
+			consider(pc, p, e.t, &best, hit, &improved);
+			c[n] = 0.0;
+		}
 		sc = px_bern_sign_changes(c, n, 0.0);
 		if (sc == 0)
 			continue; /* f monotone here: no interior minimum */
@@ -297,17 +354,19 @@ int px_cpiece_closest(const struct px_cpiece *pc, px_vec3 p, double *best_d2,
 			continue;
 		}
 		{
-			double m = 0.5 * (e.s + e.t);
-			/* A root exactly at the split point would be hidden
-			 * from both halves' sign counts. */
-			if (px_bern_eval(c, n, 0.5) == 0.0)
-				consider(pc, p, m, &best, hit, &improved);
+			double m = 0.5 * (e.s + e.t), gm;
+			px_bern_split(c, n, 0.5, NULL, cs);
+			gm = cs[0];
 			stack[sp].s = m;
 			stack[sp].t = e.t;
+			stack[sp].gs = gm;
+			stack[sp].gt = e.gt;
 			stack[sp].depth = e.depth + 1;
 			sp++;
 			stack[sp].s = e.s;
 			stack[sp].t = m;
+			stack[sp].gs = e.gs;
+			stack[sp].gt = gm;
 			stack[sp].depth = e.depth + 1;
 			sp++;
 		}
@@ -316,7 +375,7 @@ int px_cpiece_closest(const struct px_cpiece *pc, px_vec3 p, double *best_d2,
 	 * have missed. */
 	for (i = 0; i < sp; i++)
 		lb_unresolved = fmin(lb_unresolved,
-				     lower_bound(f, pc->fw_, nf, stack[i].s,
+				     lower_bound(f, pc->wconst_ ? NULL : pc->fw_, nf, stack[i].s,
 						 stack[i].t));
 	if (lb_unresolved < best - slack) {
 		hit->certified = 0;

@@ -54,6 +54,10 @@ extern "C" {
 /* A rational Bezier piece. Plain struct: members are private. */
 struct px_cpiece {
 	int degree_;
+	/* Degree of g: 3p - 1, or 2p - 1 when every weight is equal (w is
+	 * then divided out: wconst_, and w^2 = 1 needs no bound). */
+	int gdeg_;
+	int wconst_;
 	double u0_, u1_;                            /* global parameter range */
 	double h_[4][PX_CPIECE_MAX_DEGREE + 1];     /* x w, y w, z w, w */
 	double hb_[4][PX_CPIECE_MAX_DEGREE + 1];    /* h_ times binomials */

@@ -116,16 +116,32 @@ static void t_restrict(const double *c, int n, int m, double s0, double s1,
 					 out + i * (m + 1));
 }
 
-/* 1 when every coefficient is > 0, -1 when every one is < 0, else 0. */
-static int strict_sign(const double *c, size_t k)
+/*
+ * 1 when every coefficient is > eps, -1 when every one is < -eps, else 0.
+ * eps covers the rounding of restrictions: two rectangles sharing an edge
+ * restrict the same polynomial separately, and a zero lying exactly on
+ * that edge (a symmetry line, a split through the critical point) could
+ * otherwise come out slightly positive on one side and slightly negative
+ * on the other, and both sides would be pruned.
+ */
+static int strict_sign(const double *c, size_t k, double eps)
 {
 	size_t i;
 	int pos = 1, neg = 1;
 	for (i = 0; i < k; i++) {
-		pos &= c[i] > 0.0;
-		neg &= c[i] < 0.0;
+		pos &= c[i] > eps;
+		neg &= c[i] < -eps;
 	}
 	return pos ? 1 : (neg ? -1 : 0);
+}
+
+static double max_abs(const double *c, size_t k)
+{
+	double m = 0.0;
+	size_t i;
+	for (i = 0; i < k; i++)
+		m = fabs(c[i]) > m ? fabs(c[i]) : m;
+	return m;
 }
 
 static void t_range(const double *c, size_t k, double *lo, double *hi)
@@ -519,13 +535,19 @@ static int newton_f(struct qctx *x, const struct rect *r, int *iters,
 done:
 	if (it >= PX_SPIECE_MAX_ITERS)
 		return 0;
-	/* Converged onto the rectangle's border: the minimum of this
-	 * rectangle, not a critical point of the patch (unless the border
-	 * is the patch's own, where boundary curves take over anyway). */
-	if (s <= r->s0 || s >= r->s1 || t <= r->t0 || t >= r->t1)
-		return 0;
 	*s_out = s;
 	*t_out = t;
+	/* On the rectangle's border the point may be only this
+	 * rectangle's constrained minimum; it is the patch's critical
+	 * point (the one the certificate allows) only if the gradient
+	 * vanishes there too. */
+	if (s <= r->s0 || s >= r->s1 || t <= r->t0 || t >= r->t1) {
+		px_vec3 su, sv, S = px_spiece_eval(sp, s, t, &su, &sv, NULL, NULL, NULL);
+		px_vec3 d = px_v3_sub(S, x->p);
+		double gs = px_v3_dot(d, su) * ks, gt = px_v3_dot(d, sv) * kt;
+		double scale = px_v3_norm(d) * (px_v3_norm(su) * ks + px_v3_norm(sv) * kt);
+		return sqrt(gs * gs + gt * gt) <= 1e-10 * scale + 1e-300;
+	}
 	return 1;
 }
 
@@ -660,6 +682,7 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 	struct qctx x;
 	double pp = px_v3_dot(p, p), lb_unresolved = INFINITY;
 	int hn = 0, k, have_gu = 0, have_gv = 0;
+	double eps_gu = 0.0, eps_gv = 0.0;
 	size_t i;
 
 	x.sp = sp;
@@ -713,20 +736,22 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 				GU[i] = sp->gua_[i] -
 					(p.x * sp->gub_[i] + p.y * sp->gub_[ngu + i] +
 					 p.z * sp->gub_[2 * ngu + i]);
+			eps_gu = 1e-12 * max_abs(GU, ngu);
 			have_gu = 1;
 		}
 		t_restrict(GU, un, um, r.s0, r.s1, r.t0, r.t1, rg);
-		if (strict_sign(rg, ngu))
+		if (strict_sign(rg, ngu, eps_gu))
 			continue; /* df/ds never vanishes here */
 		if (!have_gv) {
 			for (i = 0; i < ngv; i++)
 				GV[i] = sp->gva_[i] -
 					(p.x * sp->gvb_[i] + p.y * sp->gvb_[ngv + i] +
 					 p.z * sp->gvb_[2 * ngv + i]);
+			eps_gv = 1e-12 * max_abs(GV, ngv);
 			have_gv = 1;
 		}
 		t_restrict(GV, vn, vm, r.s0, r.s1, r.t0, r.t1, rv);
-		if (strict_sign(rv, ngv))
+		if (strict_sign(rv, ngv, eps_gv))
 			continue; /* df/dt never vanishes here */
 		{
 			/* Bernstein bounds of the Jacobian of (gu, gv), in the
@@ -755,11 +780,12 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 				continue; /* at most one zero, and a maximum */
 		}
 		if (certain) {
-			double s, t;
-			if (newton_f(&x, &r, &hit->iters, &s, &t)) {
-				consider(&x, s, t);
+			double s = NAN, t = NAN;
+			int found = newton_f(&x, &r, &hit->iters, &s, &t);
+			if (s == s)
+				consider(&x, s, t); /* a real point: a valid bound */
+			if (found)
 				continue;
-			}
 		} else {
 			/* Keep the upper bound moving while we subdivide. */
 			consider(&x, 0.5 * (r.s0 + r.s1), 0.5 * (r.t0 + r.t1));

@@ -286,6 +286,28 @@ static void test_piece_cusp_and_circle(void)
 	PX_CHECK_INT_EQ(unc, 0);
 }
 
+/* Curves symmetric about t = 1/2 queried on their symmetry plane: the
+ * root of g lies exactly on the first split point. */
+static void test_piece_symmetric_split_point(void)
+{
+	double hw[6][4];
+	int trial, p, i, unc = 0;
+	for (trial = 0; trial < 300; trial++) {
+		p = px_rand_int(2, 5);
+		for (i = 0; i <= p; i++) {
+			int k = i <= p - i ? i : p - i;
+			double w = 1.0 + 0.3 * k;
+			hw[i][0] = (double)i / p * w;
+			hw[i][1] = (k == 0 ? 0.0 : (trial % 2 ? 1.0 : -1.0) * (0.3 + 0.2 * k)) * w;
+			hw[i][2] = 0.0;
+			hw[i][3] = trial % 3 ? w : 1.0;
+		}
+		check_against_brute((const double(*)[4])hw, p,
+				    px_v3(0.5, px_rand_range(-2, 2), px_rand_range(-0.5, 0.5)),
+				    &unc);
+	}
+}
+
 static void test_piece_bound_respected(void)
 {
 	double hw[4][4];
@@ -343,6 +365,7 @@ static const struct px_test tests[] = {
 	PX_T(test_bern_sign_changes_bound_roots),
 	PX_T(test_piece_random_vs_brute),
 	PX_T(test_piece_cusp_and_circle),
+	PX_T(test_piece_symmetric_split_point),
 	PX_T(test_piece_bound_respected),
 	PX_T(test_piece_bad_input),
 	PX_T(test_piece_query_allocates_nothing),

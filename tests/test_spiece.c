@@ -244,6 +244,38 @@ static void test_sphere_octant_focal_point(void)
 	PX_CHECK_INT_EQ(unc, 0);
 }
 
+/* A patch symmetric about s = 1/2 and t = 1/2, queried on its symmetry
+ * planes: the critical point lies exactly on the first split lines,
+ * where two sub-rectangles share coefficients computed separately. */
+static void test_symmetric_patch_split_lines(void)
+{
+	double hw[16][4];
+	int i, j, trial, unc = 0;
+	for (trial = 0; trial < 40; trial++) {
+		double z1 = px_rand_range(-0.5, 0.5), z2 = px_rand_range(-0.5, 0.5);
+		for (i = 0; i < 4; i++)
+			for (j = 0; j < 4; j++) {
+				double *h = hw[i * 4 + j];
+				int ci = i == 0 || i == 3, cj = j == 0 || j == 3;
+				h[0] = i / 3.0;
+				h[1] = j / 3.0;
+				h[2] = ci && cj ? 0.0 : (ci || cj ? z1 : z2);
+				h[3] = 1.0;
+			}
+		for (i = 0; i < 10; i++) {
+			struct px_spiece_hit hit;
+			double x = i % 3 == 0 ? 0.5 : px_rand_range(0, 1);
+			double y = i % 3 == 1 ? 0.5 : (i % 3 == 2 ? 0.5 : px_rand_range(0, 1));
+			px_vec3 q = px_v3(i % 3 == 2 ? 0.5 : x, y, px_rand_range(-1, 1));
+			double got = solve((const double(*)[4])hw, 3, 3, q, &unc, &hit);
+			double ref = oracle((const double(*)[4])hw, 3, 3, q);
+			PX_CHECK_MSG(got <= ref + 1e-9, "wrong branch on a symmetry plane: %.17g vs %.17g",
+				     got, ref);
+		}
+	}
+	PX_CHECK_INT_EQ(unc, 0);
+}
+
 static void test_query_allocates_nothing(void)
 {
 	double hw[16][4];
@@ -279,6 +311,7 @@ static const struct px_test tests[] = {
 	PX_T(test_eval_matches_reference),
 	PX_T(test_random_patches_vs_oracle),
 	PX_T(test_sphere_octant_focal_point),
+	PX_T(test_symmetric_patch_split_lines),
 	PX_T(test_query_allocates_nothing),
 	PX_T(test_bad_input),
 };
