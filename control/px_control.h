@@ -309,6 +309,10 @@ struct px_control_chain {
 	struct px_control_capsule capsules[PX_CONTROL_MAX_CAPSULES];
 };
 
+/* Pose from a URDF origin: translation xyz_m and fixed-axis roll,
+ * pitch, yaw (R = Rz(yaw) Ry(pitch) Rx(roll)). @note RT-safe. */
+PX_API px_pose px_control_pose_from_xyz_rpy(px_vec3 xyz_m, px_vec3 rpy_rad);
+
 /* Empty chain with the given base pose. */
 PX_API void px_control_chain_init(struct px_control_chain *c, px_pose base);
 

@@ -1059,6 +1059,464 @@ static void test_haptic_errors_ramp_down(void)
 			PX_E_INVAL);
 }
 
+/* ------------------------------------------------------------------ */
+/* Serial chains                                                       */
+/* ------------------------------------------------------------------ */
+
+static px_vec3 frame_x(px_pose f)
+{
+	return px_pose_transform_vector(f, px_v3(1, 0, 0));
+}
+
+static void test_fk_planar_and_elbow_by_hand(void)
+{
+	struct px_control_chain c;
+	px_pose f[PX_CONTROL_MAX_JOINTS + 1];
+	int it;
+	/* planar 2R, a1 = 0.4, a2 = 0.3 */
+	px_control_chain_init(&c, px_pose_identity());
+	PX_CHECK_INT_EQ(px_control_chain_add_dh(&c, PX_CONTROL_REVOLUTE, 0.4, 0, 0, 0),
+			PX_OK);
+	PX_CHECK_INT_EQ(px_control_chain_add_dh(&c, PX_CONTROL_REVOLUTE, 0.3, 0, 0, 0),
+			PX_OK);
+	for (it = 0; it < 100; it++) {
+		double q[2] = {px_rand_range(-3, 3), px_rand_range(-3, 3)};
+		px_vec3 x;
+		PX_CHECK_INT_EQ(px_control_chain_fk(&c, q, f, 3), PX_OK);
+		PX_CHECK_NEAR(f[1].t.x, 0.4 * cos(q[0]), 1e-14);
+		PX_CHECK_NEAR(f[1].t.y, 0.4 * sin(q[0]), 1e-14);
+		PX_CHECK_NEAR(f[2].t.x, 0.4 * cos(q[0]) + 0.3 * cos(q[0] + q[1]), 1e-14);
+		PX_CHECK_NEAR(f[2].t.y, 0.4 * sin(q[0]) + 0.3 * sin(q[0] + q[1]), 1e-14);
+		PX_CHECK_NEAR(f[2].t.z, 0, 1e-15);
+		x = frame_x(f[2]);
+		PX_CHECK_NEAR(x.x, cos(q[0] + q[1]), 1e-14);
+		PX_CHECK_NEAR(x.y, sin(q[0] + q[1]), 1e-14);
+	}
+	PX_CHECK_INT_EQ(px_control_chain_fk(&c, (double[]){0, 0}, f, 2), PX_E_NOSPC);
+	/* base rotation + shoulder + elbow + wrist pitch (alpha1 = pi/2):
+	 * r = a2 c2 + a3 c23 + a4 c234, z = d1 + a2 s2 + a3 s23 + a4 s234,
+	 * tip = (r cos q1, r sin q1, z), on a base at (1, 2, 3) */
+	px_control_chain_init(&c, px_control_pose_from_xyz_rpy(px_v3(1, 2, 3),
+								px_v3(0, 0, 0)));
+	PX_CHECK_INT_EQ(px_control_chain_add_dh(&c, PX_CONTROL_REVOLUTE, 0, M_PI / 2,
+						0.3, 0),
+			PX_OK);
+	PX_CHECK_INT_EQ(px_control_chain_add_dh(&c, PX_CONTROL_REVOLUTE, 0.4, 0, 0, 0),
+			PX_OK);
+	PX_CHECK_INT_EQ(px_control_chain_add_dh(&c, PX_CONTROL_REVOLUTE, 0.35, 0, 0, 0),
+			PX_OK);
+	PX_CHECK_INT_EQ(px_control_chain_add_dh(&c, PX_CONTROL_REVOLUTE, 0.1, 0, 0, 0),
+			PX_OK);
+	for (it = 0; it < 100; it++) {
+		double q[4], r, z;
+		int j;
+		for (j = 0; j < 4; j++)
+			q[j] = px_rand_range(-3, 3);
+		r = 0.4 * cos(q[1]) + 0.35 * cos(q[1] + q[2]) +
+		    0.1 * cos(q[1] + q[2] + q[3]);
+		z = 0.3 + 0.4 * sin(q[1]) + 0.35 * sin(q[1] + q[2]) +
+		    0.1 * sin(q[1] + q[2] + q[3]);
+		PX_CHECK_INT_EQ(px_control_chain_fk(&c, q, f, 5), PX_OK);
+		PX_CHECK_NEAR(f[4].t.x, 1 + r * cos(q[0]), 1e-13);
+		PX_CHECK_NEAR(f[4].t.y, 2 + r * sin(q[0]), 1e-13);
+		PX_CHECK_NEAR(f[4].t.z, 3 + z, 1e-13);
+		PX_CHECK_NEAR(f[1].t.z, 3.3, 1e-14);
+	}
+}
+
+/* The same arm written as URDF-style joints gives the same points; a
+ * prismatic DH joint moves along z. */
+static void test_fk_urdf_matches_dh(void)
+{
+	struct px_control_chain dh, ur;
+	px_pose fd[PX_CONTROL_MAX_JOINTS + 1], fu[PX_CONTROL_MAX_JOINTS + 1];
+	int it;
+	px_control_chain_init(&dh, px_pose_identity());
+	px_control_chain_add_dh(&dh, PX_CONTROL_REVOLUTE, 0, M_PI / 2, 0.3, 0);
+	px_control_chain_add_dh(&dh, PX_CONTROL_REVOLUTE, 0.4, 0, 0, 0);
+	px_control_chain_add_dh(&dh, PX_CONTROL_PRISMATIC, 0.2, 0, 0.05, 0.3);
+	/* URDF: joint i sits at the end of link i-1 */
+	px_control_chain_init(&ur, px_pose_identity());
+	PX_CHECK_INT_EQ(px_control_chain_add_joint(&ur, PX_CONTROL_REVOLUTE,
+						   px_pose_identity(), px_v3(0, 0, 2)),
+			PX_OK);
+	PX_CHECK_INT_EQ(px_control_chain_add_joint(
+				&ur, PX_CONTROL_REVOLUTE,
+				px_control_pose_from_xyz_rpy(px_v3(0, 0, 0.3),
+							     px_v3(M_PI / 2, 0, 0)),
+				px_v3(0, 0, 1)),
+			PX_OK);
+	PX_CHECK_INT_EQ(px_control_chain_add_joint(
+				&ur, PX_CONTROL_PRISMATIC,
+				px_control_pose_from_xyz_rpy(px_v3(0.4, 0, 0),
+							     px_v3(0, 0, 0.3)),
+				px_v3(0, 0, 1)),
+			PX_OK);
+	for (it = 0; it < 100; it++) {
+		double q[3] = {px_rand_range(-3, 3), px_rand_range(-3, 3),
+			       px_rand_range(-0.2, 0.2)};
+		px_vec3 tip_u;
+		PX_CHECK_INT_EQ(px_control_chain_fk(&dh, q, fd, 4), PX_OK);
+		PX_CHECK_INT_EQ(px_control_chain_fk(&ur, q, fu, 4), PX_OK);
+		/* DH frame 3 = URDF frame 3 moved by d = 0.05 along z... then
+		 * a = 0.2 along the rotated x */
+		tip_u = px_pose_transform_point(fu[3], px_v3(0.2, 0, 0.05));
+		PX_CHECK_NEAR(px_v3_dist(fd[3].t, tip_u), 0, 1e-13);
+		PX_CHECK_NEAR(px_v3_dist(fd[2].t, px_pose_transform_point(
+							  fu[2], px_v3(0.4, 0, 0))),
+			      0, 1e-13);
+		/* prismatic: the DH frame moves along joint 3's z by q */
+		PX_CHECK_NEAR(px_v3_dot(px_v3_sub(fd[3].t, fd[2].t),
+					px_pose_transform_vector(fd[2], px_v3(0, 0, 1))),
+			      0.05 + q[2], 1e-13);
+	}
+	PX_CHECK_INT_EQ(px_control_chain_add_joint(&ur, 5, px_pose_identity(),
+						   px_v3(0, 0, 1)),
+			PX_E_INVAL);
+	PX_CHECK_INT_EQ(px_control_chain_add_joint(&ur, 0, px_pose_identity(),
+						   px_v3(0, 0, 0)),
+			PX_E_INVAL);
+	PX_CHECK_INT_EQ(px_control_chain_add_dh(&ur, 0, NAN, 0, 0, 0), PX_E_NAN);
+	while (ur.n_joints < PX_CONTROL_MAX_JOINTS)
+		px_control_chain_add_dh(&ur, 0, 0.1, 0, 0, 0);
+	PX_CHECK_INT_EQ(px_control_chain_add_dh(&ur, 0, 0.1, 0, 0, 0), PX_E_NOSPC);
+}
+
+static void test_jacobian_finite_differences(void)
+{
+	struct px_control_chain c;
+	int it;
+	px_control_chain_init(&c, px_control_pose_from_xyz_rpy(px_v3(0.1, 0, 0.2),
+							       px_v3(0.1, 0.2, 0.3)));
+	px_control_chain_add_dh(&c, PX_CONTROL_REVOLUTE, 0, M_PI / 2, 0.3, 0);
+	px_control_chain_add_dh(&c, PX_CONTROL_REVOLUTE, 0.4, 0, 0, 0.2);
+	px_control_chain_add_dh(&c, PX_CONTROL_PRISMATIC, 0.1, -M_PI / 2, 0.0, 0);
+	px_control_chain_add_dh(&c, PX_CONTROL_REVOLUTE, 0.2, 0.3, 0.1, 0);
+	for (it = 0; it < 50; it++) {
+		double q[4];
+		px_vec3 jac[4], pl = rand_v3(-0.1, 0.1), p;
+		px_pose f[5];
+		int j, link = px_rand_int(0, 4);
+		for (j = 0; j < 4; j++)
+			q[j] = px_rand_range(-2, 2);
+		px_control_chain_fk(&c, q, f, 5);
+		p = px_pose_transform_point(f[link], pl);
+		PX_CHECK_INT_EQ(px_control_chain_jacobian(&c, q, link, p, jac), PX_OK);
+		for (j = 0; j < 4; j++) {
+			double qp[4], qm[4], h = 1e-6;
+			px_vec3 pp, pm, fd;
+			memcpy(qp, q, sizeof(q));
+			memcpy(qm, q, sizeof(q));
+			qp[j] += h;
+			qm[j] -= h;
+			px_control_chain_fk(&c, qp, f, 5);
+			pp = px_pose_transform_point(f[link], pl);
+			px_control_chain_fk(&c, qm, f, 5);
+			pm = px_pose_transform_point(f[link], pl);
+			fd = px_v3_scale(px_v3_sub(pp, pm), 0.5 / h);
+			PX_CHECK_NEAR(px_v3_dist(fd, jac[j]), 0, 1e-8);
+		}
+	}
+}
+
+/* ------------------------------------------------------------------ */
+/* Collision avoidance                                                 */
+/* ------------------------------------------------------------------ */
+
+/* Spatial arm: base yaw, shoulder, elbow, wrist; capsules on the three
+ * moving links (radius 4 cm). */
+static void make_arm(struct px_control_chain *c)
+{
+	static const double a[4] = {0, 0.4, 0.35, 0.15};
+	int i;
+	px_control_chain_init(c, px_pose_identity());
+	px_control_chain_add_dh(c, PX_CONTROL_REVOLUTE, 0, M_PI / 2, 0.3, 0);
+	for (i = 1; i < 4; i++)
+		px_control_chain_add_dh(c, PX_CONTROL_REVOLUTE, a[i], 0, 0, 0);
+	for (i = 1; i < 4; i++)
+		PX_CHECK_INT_EQ(px_control_chain_add_capsule(c, i + 1,
+							     px_v3(-a[i], 0, 0),
+							     px_v3(0, 0, 0), 0.04),
+				PX_OK);
+	PX_CHECK_INT_EQ(px_control_chain_add_capsule(c, 1, px_v3(0, 0, 0),
+						     px_v3(0, -0.2, 0), 0.05),
+			PX_OK);
+}
+
+/* Exact smallest clearance of the arm's capsules (reference). */
+static double arm_clearance(const struct px_control_chain *c,
+			    const struct scene *sc, const double *q)
+{
+	px_pose f[PX_CONTROL_MAX_JOINTS + 1];
+	double best = INFINITY;
+	int i;
+	px_control_chain_fk(c, q, f, PX_CONTROL_MAX_JOINTS + 1);
+	for (i = 0; i < c->n_capsules; i++) {
+		const struct px_control_capsule *cp = &c->capsules[i];
+		double d = ref_seg(sc, px_pose_transform_point(f[cp->link], cp->a_m),
+				   px_pose_transform_point(f[cp->link], cp->b_m)) -
+			   cp->radius_m;
+		best = fmin(best, d);
+	}
+	return best;
+}
+
+static void test_clearances_exact_and_searched(void)
+{
+	static struct scene sc;
+	struct px_control_chain c;
+	struct px_control_avoid_params p;
+	struct px_control_clearance cl[PX_CONTROL_MAX_CAPSULES];
+	px_pose f[PX_CONTROL_MAX_JOINTS + 1];
+	int it, i, nq;
+	make_arm(&c);
+	px_control_avoid_params_default(&p);
+	p.segment_point_queries = 40;
+	for (it = 0; it < 100; it++) {
+		struct px_control_query qe = query_of(&sc, 1), qs = query_of(&sc, 0);
+		double q[4];
+		for (i = 0; i < 4; i++)
+			q[i] = px_rand_range(-2, 2);
+		make_scene(&sc, it % 6);
+		for (i = 0; i < sc.n; i++)
+			sc.s[i].c = px_v3_add(sc.s[i].c, px_v3(0.4, 0.1, 0.3));
+		px_control_chain_fk(&c, q, f, 5);
+		PX_CHECK_INT_EQ(px_control_chain_clearances(&c, &p, &qe, q, 10, cl, &nq),
+				PX_OK);
+		PX_CHECK_INT_EQ(nq, c.n_capsules);
+		for (i = 0; i < c.n_capsules; i++) {
+			const struct px_control_capsule *cp = &c.capsules[i];
+			px_vec3 a = px_pose_transform_point(f[cp->link], cp->a_m);
+			px_vec3 b = px_pose_transform_point(f[cp->link], cp->b_m);
+			double ref = ref_seg(&sc, a, b) - cp->radius_m;
+			PX_CHECK_NEAR(cl[i].clearance_m, ref, 1e-12);
+			PX_CHECK_NEAR(cl[i].lower_bound_m, ref, 1e-12);
+			PX_CHECK_NEAR(ref_point(&sc, cl[i].point_m) - cp->radius_m, ref,
+				      1e-12);
+		}
+		PX_CHECK_INT_EQ(px_control_chain_clearances(&c, &p, &qs, q, 10, cl, &nq),
+				PX_OK);
+		PX_CHECK(nq <= c.n_capsules * p.segment_point_queries);
+		for (i = 0; i < c.n_capsules; i++) {
+			const struct px_control_capsule *cp = &c.capsules[i];
+			px_vec3 a = px_pose_transform_point(f[cp->link], cp->a_m);
+			px_vec3 b = px_pose_transform_point(f[cp->link], cp->b_m);
+			double ref = ref_seg(&sc, a, b) - cp->radius_m;
+			PX_CHECK(cl[i].lower_bound_m <= ref + 1e-12);
+			PX_CHECK(cl[i].clearance_m >= ref - 1e-12);
+		}
+	}
+}
+
+static void test_avoid_scaling_law(void)
+{
+	static struct scene sc;
+	struct px_control_query q = query_of(&sc, 1);
+	struct px_control_chain c;
+	struct px_control_avoid_params p;
+	struct px_control_avoid_out out;
+	int it;
+	/* one prismatic joint along x carrying a point capsule (r = 0) toward
+	 * a wall at x = 1 */
+	px_control_chain_init(&c, px_pose_identity());
+	px_control_chain_add_joint(&c, PX_CONTROL_PRISMATIC, px_pose_identity(),
+				   px_v3(1, 0, 0));
+	px_control_chain_add_capsule(&c, 1, px_v3(0, 0, 0), px_v3(0, 0, 0), 0);
+	memset(&sc, 0, sizeof(sc));
+	sc.n = 1;
+	sc.s[0] = halfspace(px_v3(1, 0, 0), px_v3(-1, 0, 0));
+	px_control_avoid_params_default(&p);
+	p.influence_distance_m = 0.3;
+	p.protective_distance_m = 0.1;
+	p.repulsive_speed_m_per_s = 0.05;
+	p.max_joint_velocity = 10;
+	p.max_margin_fraction = 1;
+	for (it = 0; it < 200; it++) {
+		double x = px_rand_range(0.5, 1.0), v = -px_rand_range(0.01, 0.5);
+		double c0 = 1 - x, s, w, want;
+		PX_CHECK_INT_EQ(px_control_avoid_step(&c, &p, &q, &x, &v, 1000000,
+						      &out),
+				PX_OK);
+		s = c0 >= 0.3 ? 1 : (c0 <= 0.1 ? 0 : (c0 - 0.1) / 0.2);
+		w = c0 >= 0.3 ? 0 : 1 - s;
+		/* moving away from the wall (v < 0): no margin limit */
+		want = s * v - w * 0.05;
+		PX_CHECK_NEAR(out.scale, s, 1e-12);
+		PX_CHECK_NEAR(out.qdot[0], want, 1e-12);
+		PX_CHECK_NEAR(out.min_clearance_m, fmin(c0, 0.3), 1e-12);
+		/* toward the wall: never more than the margin per period */
+		v = -v;
+		PX_CHECK_INT_EQ(px_control_avoid_step(&c, &p, &q, &x, &v, 1000000,
+						      &out),
+				PX_OK);
+		PX_CHECK(out.qdot[0] * 1e-3 <= fmax(c0 - 0.1, 0) + 1e-15);
+		if (c0 > 0.3 && v * 1e-3 < c0 - 0.1)
+			PX_CHECK_NEAR(out.qdot[0], v, 1e-12);
+		if (c0 <= 0.1)
+			PX_CHECK(out.qdot[0] <= 0);
+	}
+}
+
+/*
+ * Scripted approaches: the nominal command drives the arm (a joint-space
+ * P controller toward a goal inside or behind an obstacle); the arm
+ * integrates the commanded velocities at 1 kHz. Without avoidance the
+ * path collides; with it, the exact clearance never drops below the
+ * protective distance.
+ */
+static double run_arm(const struct px_control_chain *c, struct scene *sc,
+		      int with_segment, const double *q0, const double *goal,
+		      int avoid, double v_rep, double *min_clear)
+{
+	struct px_control_query qry = query_of(sc, with_segment);
+	struct px_control_avoid_params p;
+	struct px_control_avoid_out out;
+	double q[4], qn[4], mc = INFINITY;
+	int k, j;
+	px_control_avoid_params_default(&p);
+	p.influence_distance_m = 0.25;
+	p.protective_distance_m = 0.05;
+	p.repulsive_speed_m_per_s = v_rep;
+	p.max_joint_velocity = 1.5;
+	memcpy(q, q0, sizeof(q));
+	for (k = 0; k < 3000; k++) {
+		for (j = 0; j < 4; j++)
+			qn[j] = clampd(2.0 * (goal[j] - q[j]), -1.0, 1.0);
+		if (avoid) {
+			PX_CHECK_INT_EQ(px_control_avoid_step(c, &p, &qry, q, qn,
+							      1000000, &out),
+					PX_OK);
+			for (j = 0; j < 4; j++)
+				q[j] += out.qdot[j] * 1e-3;
+		} else {
+			for (j = 0; j < 4; j++)
+				q[j] += qn[j] * 1e-3;
+		}
+		mc = fmin(mc, arm_clearance(c, sc, q));
+	}
+	*min_clear = mc;
+	return p.protective_distance_m;
+}
+
+/* Joint goal that puts the wrist tip of make_arm() (wrist straight) at
+ * target: base yaw, then two-link inverse kinematics, elbow up. */
+static void arm_ik(px_vec3 target, double *goal)
+{
+	const double l1 = 0.4, l2 = 0.5;
+	double r = hypot(target.x, target.y), z = target.z - 0.3;
+	double d = clampd((r * r + z * z - l1 * l1 - l2 * l2) / (2 * l1 * l2), -1, 1);
+	goal[0] = atan2(target.y, target.x);
+	goal[2] = -acos(d);
+	goal[1] = atan2(z, r) - atan2(l2 * sin(goal[2]), l1 + l2 * cos(goal[2]));
+	goal[3] = 0;
+}
+
+static void test_avoid_scripted_approaches(void)
+{
+	static struct scene sc;
+	struct px_control_chain c;
+	int it, approached = 0;
+	make_arm(&c);
+	for (it = 0; it < 24; it++) {
+		double q0[4] = {0, 1.4, -2.2, 0}, goal[4], mc_free, mc, dp;
+		px_vec3 tgt;
+		int j;
+		memset(&sc, 0, sizeof(sc));
+		sc.n = 1;
+		switch (it % 4) {
+		case 0: /* reach through a table */
+			sc.s[0] = halfspace(px_v3(0, 0, -0.3), px_v3(0, 0, 1));
+			tgt = px_v3(px_rand_range(0.3, 0.6), px_rand_range(-0.3, 0.3),
+				    -0.4);
+			break;
+		case 1: /* reach into a sphere in front */
+			tgt = px_v3(px_rand_range(0.6, 0.8), px_rand_range(-0.3, 0.3),
+				    px_rand_range(0.0, 0.5));
+			sc.s[0] = sphere(tgt, 0.06);
+			break;
+		case 2: /* swing sideways into a post */
+			tgt = px_v3(px_rand_range(0.2, 0.5), px_rand_range(0.5, 0.7),
+				    px_rand_range(0.1, 0.5));
+			sc.s[0] = box(tgt, px_v3(0.05, 0.05, 0.15));
+			break;
+		default: /* reach through a 2 mm wall */
+			sc.s[0] = box(px_v3(0.7, 0, 0.3), px_v3(0.001, 0.4, 0.3));
+			tgt = px_v3(0.85, px_rand_range(-0.2, 0.2),
+				    px_rand_range(0.1, 0.5));
+			break;
+		}
+		arm_ik(tgt, goal);
+		for (j = 0; j < 4; j++)
+			q0[j] += px_rand_range(-0.05, 0.05);
+		if (arm_clearance(&c, &sc, q0) < 0.25)
+			continue; /* start outside the influence zone */
+		run_arm(&c, &sc, 1, q0, goal, 0, 0, &mc_free);
+		if (mc_free >= 0.0)
+			continue; /* this path does not collide */
+		approached++;
+		dp = run_arm(&c, &sc, it % 2, q0, goal, 1, 0.05, &mc);
+		PX_CHECK_MSG(mc >= dp - 1e-9,
+			     "case %d: clearance %.6g below protective %.3g "
+			     "(without avoidance %.4g)",
+			     it % 4, mc, dp, mc_free);
+		/* and it did come close: the command is not just "stop" */
+		PX_CHECK_MSG(mc < 0.15, "case %d: stayed %.3g away", it % 4, mc);
+		/* scaling alone (no repulsion) creeps up to the protective
+		 * distance without crossing it */
+		dp = run_arm(&c, &sc, it % 2, q0, goal, 1, 0.0, &mc);
+		PX_CHECK_MSG(mc >= dp - 1e-9,
+			     "case %d, no repulsion: clearance %.6g below "
+			     "protective %.3g",
+			     it % 4, mc, dp);
+		PX_CHECK_MSG(mc < dp + 0.03, "case %d: stayed %.3g away", it % 4, mc);
+	}
+	PX_CHECK_MSG(approached >= 12, "only %d scripted paths approached",
+		     approached);
+}
+
+/* ------------------------------------------------------------------ */
+/* Allocation                                                          */
+/* ------------------------------------------------------------------ */
+
+static void test_cycles_do_not_allocate(void)
+{
+	static struct scene sc;
+	struct px_control_query q = query_of(&sc, 0), qe = query_of(&sc, 1);
+	struct px_control_haptic hp, hq;
+	struct px_control_haptic_params pp;
+	struct px_control_haptic_out out;
+	struct px_control_chain c;
+	struct px_control_avoid_params ap;
+	struct px_control_avoid_out aout;
+	px_pose f[PX_CONTROL_MAX_JOINTS + 1];
+	px_vec3 jac[PX_CONTROL_MAX_JOINTS];
+	double qa[4] = {0.1, 0.5, -0.7, 0.2}, qd[4] = {0.3, -0.2, 0.1, 0.4};
+	uint64_t r;
+	int k;
+	make_scene(&sc, 5);
+	px_control_haptic_params_default(&pp);
+	pp.static_friction = 0.5;
+	pp.dynamic_friction = 0.3;
+	PX_CHECK_INT_EQ(px_control_haptic_init(&hq, &pp, 1000000), PX_OK);
+	pp.renderer = PX_CONTROL_PENALTY;
+	PX_CHECK_INT_EQ(px_control_haptic_init(&hp, &pp, 1000000), PX_OK);
+	make_arm(&c);
+	px_control_avoid_params_default(&ap);
+	r = px_alloc_region_begin();
+	for (k = 0; k < 500; k++) {
+		px_vec3 d = px_v3(0.06 * sin(k * 0.01), 0.05 * cos(k * 0.013),
+				  0.03 * sin(k * 0.02));
+		px_control_haptic_step(&hq, &q, d, NULL, &out);
+		px_control_haptic_step(&hp, &q, d, NULL, &out);
+		px_control_avoid_step(&c, &ap, k % 2 ? &q : &qe, qa, qd, 1000000,
+				      &aout);
+		px_control_chain_fk(&c, qa, f, 5);
+		px_control_chain_jacobian(&c, qa, 3, f[3].t, jac);
+		qa[k % 4] += 0.001;
+	}
+	PX_CHECK_INT_EQ(px_alloc_region_end(r), 0);
+}
+
 static const struct px_test tests[] = {
 	PX_T(test_segment_search_bounds),
 	PX_T(test_force_limit),
@@ -1072,5 +1530,12 @@ static const struct px_test tests[] = {
 	PX_T(test_penalty_solids),
 	PX_T(test_penalty_shell_side_tracking),
 	PX_T(test_haptic_errors_ramp_down),
+	PX_T(test_fk_planar_and_elbow_by_hand),
+	PX_T(test_fk_urdf_matches_dh),
+	PX_T(test_jacobian_finite_differences),
+	PX_T(test_clearances_exact_and_searched),
+	PX_T(test_avoid_scaling_law),
+	PX_T(test_avoid_scripted_approaches),
+	PX_T(test_cycles_do_not_allocate),
 };
 PX_TEST_MAIN(tests)
