@@ -437,6 +437,7 @@ PX_API int px_control_avoid_step(const struct px_control_chain *c,
 
 struct px_config;
 struct px_config_diag;
+struct px_config_schema;
 
 enum px_control_mode {
 	PX_CONTROL_MODE_NONE = 0,
@@ -450,22 +451,31 @@ struct px_control_config {
 	struct px_control_haptic_params haptic;
 	struct px_control_avoid_params avoid;
 	struct px_control_chain chain;
-	/* Haptic stability at the config's loop period. */
+	/* Haptic stability at the config's loop period (mode haptic). */
 	bool stable;
 	double stiffness_limit_n_per_m;
-	char warning[256];                     /* "" when stable */
+	/* "file:line:column: control.haptic.stiffness_n_per_m: warning: ..."
+	 * when not stable, else "". */
+	char warning[640];
 };
 
 /*
  * Read cfg->control (absent: mode none, defaults) into out, check it
- * against the rest of the config (device names, safety limits, loop
- * period) and compute the stability warning. Problems are appended to
- * diag as "file:line:column: control.key: what". Returns PX_OK,
- * PX_E_PARSE (problems found), PX_E_NOMEM, PX_E_INVAL.
+ * against the rest of the config (device names, safety limits, CANopen
+ * joint indices) and compute the stability warning at loop.period_ns.
+ * Problems are appended to diag as "file:line:column: control.key: what".
+ * Haptic max_force_n and max_force_rate_n_per_s default to the safety
+ * values and may not exceed them; device_damping_n_s_per_m defaults to
+ * the damping of a simulated haptic device, else 0. Strings in out point
+ * into cfg's document. Returns PX_OK, PX_E_PARSE (problems found),
+ * PX_E_NOMEM, PX_E_INVAL.
  */
 PX_API int px_control_config_read(const struct px_config *cfg,
 				  struct px_control_config *out,
 				  struct px_config_diag *diag);
+
+/* Schema of the control section (for tools and the docs check). */
+PX_API const struct px_config_schema *px_control_config_schema(void);
 
 #ifdef __cplusplus
 }

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "px_alloc_count.h"
+#include "px_config.h"
 #include "px_control.h"
 #include "px_test.h"
 
@@ -1517,6 +1518,324 @@ static void test_cycles_do_not_allocate(void)
 	PX_CHECK_INT_EQ(px_alloc_region_end(r), 0);
 }
 
+/* ------------------------------------------------------------------ */
+/* Configuration                                                       */
+/* ------------------------------------------------------------------ */
+
+static const char cfg_head[] =
+	"loop: {period_ns: 1000000}\n"                          /* 1 */
+	"safety: {max_force_n: 8.0, max_force_rate_n_per_s: 2000.0}\n"
+	"devices:\n"                                            /* 3 */
+	"  - name: pen\n"
+	"    backend: sim\n"                                    /* 5 */
+	"    sim: {kind: haptic, damping_n_s_per_m: 2.0}\n"
+	"  - name: arm\n"                                       /* 7 */
+	"    backend: socketcan\n"
+	"    socketcan:\n"                                      /* 9 */
+	"      interface: vcan0\n"
+	"      canopen:\n"                                      /* 11 */
+	"        drives:\n"
+	"          - {node_id: 1, mode: csv, joint: 0}\n"       /* 13 */
+	"          - {node_id: 2, mode: csv, joint: 1}\n";
+
+/* Load cfg_head + body and read its control section. */
+static int load_control(const char *body, struct px_control_config *out,
+			struct px_config_diag *diag)
+{
+	static char buf[8192];
+	struct px_config *cfg = NULL;
+	int rc;
+	snprintf(buf, sizeof(buf), "%s%s", cfg_head, body);
+	rc = px_config_load_mem("t.yaml", buf, strlen(buf), &cfg, diag);
+	PX_CHECK_MSG(rc == PX_OK, "base config failed: %s",
+		     diag->count ? diag->errors[0].msg : px_strerror(rc));
+	rc = px_control_config_read(cfg, out, diag);
+	px_config_free(cfg); /* out keeps no pointer used below but device */
+	return rc;
+}
+
+static void expect_control_error(const char *body, const char *path, int line,
+				 const char *what)
+{
+	static struct px_config_diag diag;
+	static struct px_control_config out;
+	const struct px_config_error *e;
+	int rc = load_control(body, &out, &diag);
+	PX_CHECK_MSG(rc == PX_E_PARSE, "expected an error at %s, got %d", path, rc);
+	e = px_config_diag_find(&diag, path);
+	PX_CHECK_MSG(e != NULL, "no error at %s (first: %s)", path,
+		     diag.count ? diag.errors[0].msg : "none");
+	PX_CHECK_MSG(e->line == line, "%s: line %d, expected %d", e->msg, e->line,
+		     line);
+	PX_CHECK_MSG(strstr(e->msg, what) != NULL, "'%s' lacks '%s'", e->msg, what);
+	PX_CHECK_MSG(strncmp(e->msg, "t.yaml:", 7) == 0, "%s", e->msg);
+}
+
+static void test_config_haptic_section(void)
+{
+	static struct px_config_diag diag;
+	static struct px_control_config c;
+	struct px_control_haptic h;
+	PX_CHECK_INT_EQ(load_control("control:\n"                  /* 15 */
+				     "  mode: haptic\n"
+				     "  device: pen\n"
+				     "  haptic:\n"
+				     "    renderer: penalty\n"
+				     "    stiffness_n_per_m: 1200\n"  /* 20 */
+				     "    damping_n_s_per_m: 0.25\n"
+				     "    static_friction: 0.4\n"
+				     "    dynamic_friction: 0.3\n"
+				     "    max_force_rate_n_per_s: 1000\n",
+				     &c, &diag),
+			PX_OK);
+	PX_CHECK_INT_EQ(c.mode, PX_CONTROL_MODE_HAPTIC);
+	PX_CHECK_INT_EQ(c.haptic.renderer, PX_CONTROL_PENALTY);
+	PX_CHECK_NEAR(c.haptic.stiffness_n_per_m, 1200, 0);
+	PX_CHECK_NEAR(c.haptic.damping_n_s_per_m, 0.25, 0);
+	PX_CHECK_NEAR(c.haptic.max_force_n, 8.0, 0);          /* from safety */
+	PX_CHECK_NEAR(c.haptic.max_force_rate_n_per_s, 1000, 0);
+	PX_CHECK_NEAR(c.haptic.device_damping_n_s_per_m, 2.0, 0); /* sim */
+	PX_CHECK_NEAR(c.haptic.proxy_radius_m, 0.0005, 0);
+	PX_CHECK(c.stable);
+	PX_CHECK(c.warning[0] == '\0');
+	PX_CHECK_INT_EQ(px_control_haptic_init(&h, &c.haptic, 1000000), PX_OK);
+	/* too stiff for 1 kHz and b = 2, B = 0.25: limit 3500 N/m */
+	PX_CHECK_INT_EQ(load_control("control:\n"
+				     "  mode: haptic\n"
+				     "  device: pen\n"
+				     "  haptic:\n"
+				     "    damping_n_s_per_m: 0.25\n"
+				     "    stiffness_n_per_m: 5000\n", /* 20 */
+				     &c, &diag),
+			PX_OK);
+	PX_CHECK(!c.stable);
+	PX_CHECK_NEAR(c.stiffness_limit_n_per_m, 3500, 1e-9);
+	PX_CHECK_MSG(strncmp(c.warning,
+			     "t.yaml:20:24: control.haptic.stiffness_n_per_m: "
+			     "warning: stiffness 5000 N/m",
+			     strlen("t.yaml:20:24: control.haptic.stiffness_n_per_m: "
+				    "warning: stiffness 5000 N/m")) == 0,
+		     "%s", c.warning);
+	PX_CHECK(strstr(c.warning, "K < 3500 N/m") != NULL);
+	/* a real device states its damping: none given = 0 = never passive */
+	PX_CHECK_INT_EQ(load_control("control: {mode: haptic, device: arm}\n", &c,
+				     &diag),
+			PX_OK);
+	PX_CHECK(!c.stable);
+	/* absent section: mode none */
+	PX_CHECK_INT_EQ(load_control("", &c, &diag), PX_OK);
+	PX_CHECK_INT_EQ(c.mode, PX_CONTROL_MODE_NONE);
+}
+
+static void test_config_errors(void)
+{
+	expect_control_error("control:\n  mode: haptic\n  device: pen\n"
+			     "  haptic:\n    stifness_n_per_m: 10\n",
+			     "control.haptic.stifness_n_per_m", 19,
+			     "did you mean 'stiffness_n_per_m'");
+	expect_control_error("control:\n  mode: haptic\n  device: pen\n"
+			     "  haptic:\n    stiffness_n_per_m: stiff\n",
+			     "control.haptic.stiffness_n_per_m", 19, "number");
+	expect_control_error("control:\n  mode: haptic\n  device: pen\n"
+			     "  haptic:\n    stiffness_n_per_m: -1\n",
+			     "control.haptic.stiffness_n_per_m", 19, "-1");
+	expect_control_error("control:\n  mode: haptic\n  device: pen\n"
+			     "  haptic:\n    static_friction: 0.2\n"
+			     "    dynamic_friction: 0.5\n",
+			     "control.haptic.dynamic_friction", 20,
+			     "larger than static_friction");
+	expect_control_error("control:\n  mode: haptic\n  device: pen\n"
+			     "  haptic:\n    max_force_n: 9\n",
+			     "control.haptic.max_force_n", 19,
+			     "above safety.max_force_n 8");
+	expect_control_error("control:\n  mode: haptic\n  device: pne\n",
+			     "control.device", 17, "no device named 'pne'");
+	expect_control_error("control:\n  mode: haptic\n", "control.device", 16,
+			     "missing required key");
+	expect_control_error("control:\n  mode: hapitc\n", "control.mode", 16,
+			     "hapitc");
+	expect_control_error("control:\n  mode: avoidance\n  device: arm\n"
+			     "  avoidance:\n"
+			     "    influence_distance_m: 0.1\n"
+			     "    protective_distance_m: 0.2\n"
+			     "    joints:\n"
+			     "      - {dh: {a_m: 0.3}, origin: {xyz_m: [0, 0, 1]}, axis: [0, 0, 1]}\n"
+			     "      - {type: prismatic}\n"
+			     "      - {origin: {xyz_m: [0, 0, 1]}}\n"
+			     "      - {origin: {xyz_m: [0, 0, 1]}, axis: [0, 0, 0]}\n"
+			     "    capsules:\n"
+			     "      - {link: 6, a_m: [0, 0, 0], b_m: [0, 0, 1], radius_m: 0.1}\n",
+			     "control.avoidance.protective_distance_m", 20,
+			     "smaller than influence_distance_m");
+	expect_control_error("control:\n  mode: avoidance\n  device: arm\n"
+			     "  avoidance:\n    joints:\n"
+			     "      - {dh: {a_m: 0.3}, origin: {xyz_m: [0, 0, 1]}, axis: [0, 0, 1]}\n",
+			     "control.avoidance.joints[0].origin", 20,
+			     "either dh or origin");
+	expect_control_error("control:\n  mode: avoidance\n  device: arm\n"
+			     "  avoidance:\n    joints:\n"
+			     "      - {dh: {a_m: 0.3}}\n"
+			     "      - {type: prismatic}\n",
+			     "control.avoidance.joints[1]", 21, "missing geometry");
+	expect_control_error("control:\n  mode: avoidance\n  device: arm\n"
+			     "  avoidance:\n    joints:\n"
+			     "      - {origin: {xyz_m: [0, 0, 1]}}\n",
+			     "control.avoidance.joints[0].axis", 20,
+			     "missing required key");
+	expect_control_error("control:\n  mode: avoidance\n  device: arm\n"
+			     "  avoidance:\n    joints:\n"
+			     "      - {dh: {a_m: 0.3}}\n"
+			     "      - {origin: {xyz_m: [0, 0, 1]}, axis: [0, 0, 0]}\n",
+			     "control.avoidance.joints[1].axis", 21, "zero vector");
+	expect_control_error("control:\n  mode: avoidance\n  device: arm\n"
+			     "  avoidance:\n    joints:\n"
+			     "      - {dh: {a_m: 0.3}}\n"
+			     "      - {dh: {a_m: 0.3}}\n"
+			     "    capsules:\n"
+			     "      - {link: 3, a_m: [0, 0, 0], b_m: [0, 0, 1], radius_m: 0.1}\n",
+			     "control.avoidance.capsules[0].link", 23,
+			     "beyond the last link");
+	/* the CAN drives feed joints 0 and 1: one joint is too few */
+	expect_control_error("control:\n  mode: avoidance\n  device: arm\n"
+			     "  avoidance:\n    joints:\n"
+			     "      - {dh: {a_m: 0.3}}\n"
+			     "    capsules:\n"
+			     "      - {link: 1, a_m: [0, 0, 0], b_m: [0, 0, 1], radius_m: 0.1}\n",
+			     "control.device", 17, "feeds joint 1");
+	expect_control_error("control:\n  mode: avoidance\n  device: arm\n"
+			     "  avoidance:\n    joints:\n"
+			     "      - {dh: {a_m: 0.3}}\n      - {dh: {a_m: 0.3}}\n",
+			     "control.avoidance.capsules", 19, "at least one capsule");
+}
+
+/* A chain read from the config equals the same chain built in code. */
+static void test_config_chain_matches_code(void)
+{
+	static struct px_config_diag diag;
+	static struct px_control_config c;
+	struct px_control_chain ref;
+	px_pose fa[PX_CONTROL_MAX_JOINTS + 1], fb[PX_CONTROL_MAX_JOINTS + 1];
+	int it, i;
+	PX_CHECK_INT_EQ(load_control(
+				"control:\n  mode: avoidance\n  device: arm\n"
+				"  avoidance:\n"
+				"    influence_distance_m: 0.4\n"
+				"    protective_distance_m: 0.1\n"
+				"    base: {xyz_m: [0.1, 0.2, 0.3], rpy_rad: [0, 0, 1.5]}\n"
+				"    joints:\n"
+				"      - {dh: {a_m: 0.0, alpha_rad: 1.5707963267948966, d_m: 0.3}}\n"
+				"      - {type: revolute, origin: {xyz_m: [0.4, 0, 0], rpy_rad: [0.1, 0.2, 0.3]}, axis: [0, 0, 2]}\n"
+				"      - {type: prismatic, origin: {xyz_m: [0, 0.1, 0]}, axis: [1, 0, 0]}\n"
+				"    capsules:\n"
+				"      - {link: 2, a_m: [-0.4, 0, 0], b_m: [0, 0, 0], radius_m: 0.05}\n"
+				"      - {link: 3, a_m: [0, 0, 0], b_m: [0.1, 0, 0], radius_m: 0.02}\n",
+				&c, &diag),
+			PX_OK);
+	PX_CHECK_INT_EQ(c.mode, PX_CONTROL_MODE_AVOIDANCE);
+	PX_CHECK_INT_EQ(c.chain.n_joints, 3);
+	PX_CHECK_INT_EQ(c.chain.n_capsules, 2);
+	PX_CHECK_NEAR(c.avoid.influence_distance_m, 0.4, 0);
+	PX_CHECK_NEAR(c.avoid.protective_distance_m, 0.1, 0);
+	PX_CHECK_INT_EQ(px_control_avoid_params_check(&c.avoid), PX_OK);
+	px_control_chain_init(&ref, px_control_pose_from_xyz_rpy(px_v3(0.1, 0.2, 0.3),
+								 px_v3(0, 0, 1.5)));
+	px_control_chain_add_dh(&ref, PX_CONTROL_REVOLUTE, 0, M_PI / 2, 0.3, 0);
+	px_control_chain_add_joint(&ref, PX_CONTROL_REVOLUTE,
+				   px_control_pose_from_xyz_rpy(px_v3(0.4, 0, 0),
+								px_v3(0.1, 0.2, 0.3)),
+				   px_v3(0, 0, 1));
+	px_control_chain_add_joint(&ref, PX_CONTROL_PRISMATIC,
+				   px_control_pose_from_xyz_rpy(px_v3(0, 0.1, 0),
+								px_v3(0, 0, 0)),
+				   px_v3(1, 0, 0));
+	for (it = 0; it < 20; it++) {
+		double q[3] = {px_rand_range(-2, 2), px_rand_range(-2, 2),
+			       px_rand_range(-0.1, 0.1)};
+		PX_CHECK_INT_EQ(px_control_chain_fk(&c.chain, q, fa, 4), PX_OK);
+		PX_CHECK_INT_EQ(px_control_chain_fk(&ref, q, fb, 4), PX_OK);
+		for (i = 0; i < 4; i++)
+			PX_CHECK_NEAR(px_v3_dist(fa[i].t, fb[i].t), 0, 1e-15);
+	}
+	/* rpy is roll about x, then pitch about y, then yaw about z */
+	{
+		px_pose p = px_control_pose_from_xyz_rpy(px_v3(0, 0, 0),
+							 px_v3(M_PI / 2, 0, M_PI / 2));
+		px_vec3 y = px_pose_transform_vector(p, px_v3(0, 1, 0));
+		/* roll takes y to z; yaw leaves z */
+		PX_CHECK_NEAR(px_v3_dist(y, px_v3(0, 0, 1)), 0, 1e-15);
+	}
+}
+
+static char *slurp(const char *path)
+{
+	FILE *f = fopen(path, "rb");
+	static char buf[1 << 16];
+	size_t n;
+	if (!f)
+		return NULL;
+	n = fread(buf, 1, sizeof(buf) - 1, f);
+	fclose(f);
+	buf[n] = '\0';
+	return buf;
+}
+
+static void check_doc_keys(const char *docs, const struct px_config_schema *s,
+			   int depth)
+{
+	size_t i;
+	char needle[96];
+	PX_CHECK(depth < 8);
+	for (i = 0; i < s->n_keys; i++) {
+		const struct px_config_key *k = &s->keys[i];
+		snprintf(needle, sizeof(needle), "`%s`", k->name);
+		PX_CHECK_MSG(strstr(docs, needle) != NULL,
+			     "docs/config.md does not document %s.%s", s->name,
+			     k->name);
+		if (k->names) {
+			int j;
+			for (j = 0; k->names[j]; j++) {
+				snprintf(needle, sizeof(needle), "`%s`", k->names[j]);
+				PX_CHECK_MSG(strstr(docs, needle) != NULL,
+					     "docs/config.md lacks value %s of %s.%s",
+					     k->names[j], s->name, k->name);
+			}
+		}
+		if (k->sub)
+			check_doc_keys(docs, k->sub, depth + 1);
+	}
+}
+
+static void test_config_docs_and_examples(void)
+{
+	static struct px_config_diag diag;
+	static struct px_control_config c;
+	struct px_config *cfg;
+	char why[200];
+	const char *docs = slurp("docs/config.md");
+	if (!docs)
+		PX_SKIP("docs/config.md not found (run from the source tree)");
+	PX_CHECK_INT_EQ(px_config_schema_validate(px_control_config_schema(), why,
+						  sizeof(why)),
+			PX_OK);
+	PX_CHECK(strstr(docs, "## control") != NULL);
+	check_doc_keys(docs, px_control_config_schema(), 0);
+	PX_CHECK_INT_EQ(px_config_load_file("config/examples/haptic_sim.yaml", &cfg,
+					    &diag),
+			PX_OK);
+	PX_CHECK_INT_EQ(px_control_config_read(cfg, &c, &diag), PX_OK);
+	PX_CHECK_INT_EQ(c.mode, PX_CONTROL_MODE_HAPTIC);
+	PX_CHECK(c.stable);
+	px_config_free(cfg);
+	PX_CHECK_INT_EQ(px_config_load_file("config/examples/can_arm.yaml", &cfg,
+					    &diag),
+			PX_OK);
+	PX_CHECK_INT_EQ(px_control_config_read(cfg, &c, &diag), PX_OK);
+	PX_CHECK_INT_EQ(c.mode, PX_CONTROL_MODE_AVOIDANCE);
+	PX_CHECK_INT_EQ(c.chain.n_joints, 6);
+	PX_CHECK_INT_EQ(c.chain.n_capsules, 3);
+	px_config_free(cfg);
+}
+
 static const struct px_test tests[] = {
 	PX_T(test_segment_search_bounds),
 	PX_T(test_force_limit),
@@ -1537,5 +1856,9 @@ static const struct px_test tests[] = {
 	PX_T(test_avoid_scaling_law),
 	PX_T(test_avoid_scripted_approaches),
 	PX_T(test_cycles_do_not_allocate),
+	PX_T(test_config_haptic_section),
+	PX_T(test_config_errors),
+	PX_T(test_config_chain_matches_code),
+	PX_T(test_config_docs_and_examples),
 };
 PX_TEST_MAIN(tests)
