@@ -256,8 +256,10 @@ PX_API int px_control_haptic_reset(struct px_control_haptic *h,
  * each step along its path is shorter than the distance to the scene
  * at its start, so it never crosses a surface, however fast the device
  * moves; at most p.max_point_queries queries are made (when they run
- * out the proxy stops where it is). On a query error the force ramps
- * toward zero at the rate limit and the error is returned.
+ * out the proxy stops where it is). A proxy found inside a closed
+ * solid (the scene moved onto it) is first put back on the nearest
+ * surface, proxy_radius_m out. On a query error the force ramps toward
+ * zero at the rate limit and the error is returned.
  * Returns PX_OK, PX_E_INVAL, PX_E_NAN (non-finite input) or the query's
  * error; out is always filled.
  * @note RT-safe.

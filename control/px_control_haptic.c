@@ -542,6 +542,17 @@ static int step_proxy(struct px_control_haptic *h,
 	rc = px__ctl_point(q, x, h->p.max_query_distance_m, &hit, &used);
 	if (rc < 0)
 		return fail_step(h, out, rc, used);
+	if (hit.valid && !hit.two_sided && hit.distance_m < 0) {
+		/* A moving solid swallowed the proxy: put it back on the
+		 * surface the short way out, r outside, and start over from
+		 * there (the force then pushes the device out too). */
+		x = px_v3_madd(hit.point_m, hit.normal, h->p.proxy_radius_m);
+		h->n_planes_ = 0;
+		h->sticking_ = false;
+		rc = px__ctl_point(q, x, h->p.max_query_distance_m, &hit, &used);
+		if (rc < 0)
+			return fail_step(h, out, rc, used);
+	}
 	goal = friction_goal(h, &hit, x, g);
 	rc = proxy_move(h, q, goal, &x, &hit, &used);
 	if (rc < 0)

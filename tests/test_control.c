@@ -844,6 +844,36 @@ static void test_proxy_faces_and_corners(void)
 	}
 }
 
+/* The scene moves: a sphere slides over the resting proxy. The proxy
+ * is never left inside it. */
+static void test_proxy_moving_solid(void)
+{
+	static struct scene sc;
+	struct px_control_query q = query_of(&sc, 0);
+	struct px_control_haptic h;
+	struct px_control_haptic_out out;
+	int it, k;
+	for (it = 0; it < 20; it++) {
+		px_vec3 dev = rand_v3(-0.01, 0.01);
+		px_vec3 from = px_v3_add(dev, px_v3(0.1, 0, 0));
+		px_vec3 dir = px_v3(-1, px_rand_range(-0.2, 0.2), px_rand_range(-0.2, 0.2));
+		memset(&sc, 0, sizeof(sc));
+		sc.n = 1;
+		sc.s[0] = sphere(from, 0.03);
+		init_proxy(&h, 1000, 0.0005);
+		PX_CHECK_INT_EQ(px_control_haptic_reset(&h, &q, dev), PX_OK);
+		for (k = 0; k < 200; k++) {
+			/* 1 mm per cycle: faster than the proxy can be pushed */
+			sc.s[0].c = px_v3_madd(from, dir, 0.001 * k);
+			PX_CHECK_INT_EQ(px_control_haptic_step(&h, &q, dev, NULL, &out),
+					PX_OK);
+			PX_CHECK_MSG(ref_point(&sc, out.proxy_m) > 0,
+				     "cycle %d: proxy %.3g inside", k,
+				     ref_point(&sc, out.proxy_m));
+		}
+	}
+}
+
 /* ------------------------------------------------------------------ */
 /* Friction                                                            */
 /* ------------------------------------------------------------------ */
@@ -1845,6 +1875,7 @@ static const struct px_test tests[] = {
 	PX_T(test_proxy_never_crosses_with_friction),
 	PX_T(test_proxy_plate_jump_through),
 	PX_T(test_proxy_faces_and_corners),
+	PX_T(test_proxy_moving_solid),
 	PX_T(test_friction_stick_and_slip),
 	PX_T(test_penalty_solids),
 	PX_T(test_penalty_shell_side_tracking),
