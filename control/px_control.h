@@ -205,8 +205,10 @@ struct px_control_haptic {
 struct px_control_haptic_out {
 	px_vec3 force_n;      /* on the device, after clamp and rate limit */
 	px_vec3 proxy_m;      /* proxy (penalty: the device point) */
-	double distance_m;    /* device point to the scene (signed; shells:
-				 negative when behind the tracked side) */
+	/* Penalty: signed distance of the device point (shells: negative
+	 * when behind the tracked side). Proxy: -penetration_m in contact,
+	 * else the proxy's clearance (the proxy is then at the device). */
+	double distance_m;
 	double penetration_m; /* >= 0: how far the device is inside */
 	bool contact;         /* the force comes from a surface */
 	bool sticking;        /* proxy held by static friction */

@@ -17,5 +17,6 @@
 #include "px_rt.h"
 #include "px_stats.h"
 #include "px_config.h"
+#include "px_control.h"
 
 #endif

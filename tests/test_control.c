@@ -480,6 +480,14 @@ static double wall_energy_min(double k, double bv, double b, const struct osc *o
 	p.max_force_rate_n_per_s = 1e15;
 	p.max_query_distance_m = 1.0;
 	PX_CHECK_INT_EQ(px_control_haptic_init(&h, &p, period_ns), PX_OK);
+	/* the setup-time warning agrees with the condition */
+	PX_CHECK(h.stable == (k < px_control_passive_stiffness_limit(b, bv,
+								      period_ns)));
+	{
+		char msg[400];
+		PX_CHECK((px_control_haptic_warning(&h, msg, sizeof(msg)) > 0) ==
+			 !h.stable);
+	}
 	for (k_i = 0; k_i < cycles; k_i++) {
 		struct px_control_haptic_out out;
 		double t0 = k_i * T, t1 = t0 + T, tm = 0.5 * (t0 + t1);
