@@ -86,8 +86,15 @@ struct px_control_seg_hit {
  * may be NULL (a bounded search with point() is used instead, see
  * px_control_query_segment()). Callbacks return PX_OK or a negative
  * px_err; max_distance_m is a hint: the callback may answer valid =
- * false when nothing lies within it (it must not answer valid with a
- * wrong distance). Both must be RT-safe when used from a cycle.
+ * false when nothing lies within it. A valid |distance_m| must never
+ * exceed the true distance (an answer known only within a gap reports
+ * distance - gap): the proxy's no-crossing guarantee and the certified
+ * clearances rest on it. Both must be RT-safe when used from a cycle.
+ *
+ * Backing it with a scene model (geom/px_model.h, px_model_query_ex):
+ * valid = (return 1), distance_m = distance (minus gap when not
+ * certified), point_m = point, normal = direction, two_sided =
+ * !is_signed.
  */
 struct px_control_query {
 	int (*point)(void *ctx, px_vec3 p_m, double max_distance_m,
