@@ -25,5 +25,6 @@
 #include "px_can.h"
 #include "px_canopen.h"
 #include "px_gpio.h"
+#include "px_control.h"
 
 #endif

@@ -86,5 +86,29 @@ expect "runner not built yet" 2 "$bin" "$good" --duration-s 1 --virtual-time
 if grep -q "runner .* is not built yet" "$tmp/err"; then ok "says the runner is not built"; else bad "says the runner is not built"; fi
 expect "runner on a bad config reports the config" 1 "$bin" "$tmp/bad.yaml"
 
+# control section: errors fail --check; a stiffness beyond the passive
+# limit is a warning on stderr with its place, and the file stays valid.
+cat >"$tmp/ctl.yaml" <<'Y'
+loop: {period_ns: 1000000}
+devices:
+  - {name: pen, backend: sim, sim: {kind: haptic, damping_n_s_per_m: 2.0}}
+control:
+  mode: haptic
+  device: pen
+  haptic:
+    stiffness_n_per_m: 5000
+    damping_n_s_per_m: 0.5
+Y
+expect "--check warns on a non-passive stiffness" 0 "$bin" --check "$tmp/ctl.yaml"
+if grep -q "^$tmp/ctl.yaml:8:24: control.haptic.stiffness_n_per_m: warning: stiffness 5000 N/m is not passive .* allows K < 3000 N/m$" "$tmp/err"; then
+	ok "stability warning placed"; else bad "stability warning placed"; fi
+sed 's/stiffness_n_per_m: 5000/stiffness_n_per_m: 2500/' "$tmp/ctl.yaml" >"$tmp/ctl2.yaml"
+expect "--check on a passive stiffness" 0 "$bin" --check "$tmp/ctl2.yaml"
+if [ -s "$tmp/err" ]; then bad "no warning when passive"; else ok "no warning when passive"; fi
+sed 's/device: pen$/device: pem/' "$tmp/ctl.yaml" >"$tmp/ctl3.yaml"
+expect "--check on a bad control section" 1 "$bin" --check "$tmp/ctl3.yaml"
+has "control error placed" "$tmp/err" \
+	"$tmp/ctl3.yaml:6:11: control.device: no device named 'pem' in devices"
+
 echo "$name: $pass passed, $fail failed, $skip skipped"
 [ "$fail" -eq 0 ]

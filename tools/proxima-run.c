@@ -16,6 +16,7 @@
 #include <string.h>
 
 #include "px_config.h"
+#include "px_control.h"
 
 static const char usage_text[] =
 	"usage: proxima-run CONFIG [--duration-s N] [--virtual-time] "
@@ -131,6 +132,23 @@ int main(int argc, char **argv)
 		fprintf(stderr, "%s: invalid configuration (%d error%s)\n",
 			o.config, n, n == 1 ? "" : "s");
 		return 1;
+	}
+	{
+		static struct px_control_config ctl;
+		rc = px_control_config_read(cfg, &ctl, &diag);
+		if (rc != PX_OK) {
+			int n = px_config_diag_total(&diag);
+			px_config_diag_print(&diag, stderr);
+			if (n == 0)
+				fprintf(stderr, "%s: %s\n", o.config,
+					px_strerror(rc));
+			fprintf(stderr, "%s: invalid configuration (%d error%s)\n",
+				o.config, n, n == 1 ? "" : "s");
+			px_config_free(cfg);
+			return 1;
+		}
+		if (ctl.warning[0])
+			fprintf(stderr, "%s\n", ctl.warning);
 	}
 	if (o.check) {
 		printf("%s: OK (%zu device%s, loop period %lld ns)\n", o.config,
