@@ -31,6 +31,17 @@ struct cand {
 
 enum { PK_CURVE = 0, PK_PATCH = 1 };
 
+/* What one query in flight needs besides the read-only model: per-piece
+ * visit stamps (an epoch, so nothing is cleared per query) and the
+ * candidate list. */
+struct px_dist_ws {
+	uint32_t epoch;
+	uint32_t *stamp;
+	struct cand *cand;
+	int n_pieces;
+	int owned; /* allocated by px_dist_ws_create() */
+};
+
 /* One entry of the grid's index space: a curve piece or a patch. */
 struct piece {
 	px_aabb box;
@@ -71,10 +82,8 @@ struct px_dist_model {
 	int *cell_slot;  /* n_cells * cap */
 	int *cell_spill; /* first spill index of each cell */
 	int *spill;
-	/* query workspace */
-	uint32_t epoch;
-	uint32_t *stamp;
-	struct cand *cand;
+	/* the workspace of px_dist_query() */
+	struct px_dist_ws ws;
 };
 
 void px_dist_opts_default(struct px_dist_opts *o)
@@ -947,6 +956,7 @@ int px_dist_model_create(const struct px_nurbs_curve *curves, int n_curves,
 	m->n_cp = n_cp;
 	m->n_sp = n_sp;
 	m->n_samples = (int)bl.n_samples;
+	m->ws.n_pieces = bl.n;
 	{
 		double *spmem = NULL;
 		if (!TAKE(m->ent, n_ent) || !TAKE(m->pieces, bl.n) ||
@@ -957,8 +967,8 @@ int px_dist_model_create(const struct px_nurbs_curve *curves, int n_curves,
 		    !TAKE(m->cell_spill, m->n_cells) ||
 		    !TAKE(m->cell_empty_r, m->n_cells) ||
 		    !TAKE(m->cell_slot, m->n_cells * m->cap) ||
-		    !TAKE(m->spill, m->n_spill + 1) || !TAKE(m->stamp, bl.n) ||
-		    !TAKE(m->cand, bl.n)) {
+		    !TAKE(m->spill, m->n_spill + 1) || !TAKE(m->ws.stamp, bl.n) ||
+		    !TAKE(m->ws.cand, bl.n)) {
 			rc = PX_E_NOMEM; /* the sizing above is wrong: a bug */
 			goto fail;
 		}
@@ -1143,16 +1153,16 @@ struct qstate {
 	int cells;
 };
 
-static void visit_piece(struct px_dist_model *m, px_vec3 p, int id,
-			struct qstate *q)
+static void visit_piece(const struct px_dist_model *m, struct px_dist_ws *ws,
+			px_vec3 p, int id, struct qstate *q)
 {
 	const struct piece *pc = &m->pieces[id];
 	double lb;
 	int s, e;
 
-	if (m->stamp[id] == m->epoch)
+	if (ws->stamp[id] == ws->epoch)
 		return;
-	m->stamp[id] = m->epoch;
+	ws->stamp[id] = ws->epoch;
 	lb = box_d2(&pc->box, p);
 	if (lb >= q->best)
 		return;
@@ -1164,13 +1174,13 @@ static void visit_piece(struct px_dist_model *m, px_vec3 p, int id,
 			q->best_piece = id;
 		}
 	}
-	m->cand[q->n_cand].lb = lb;
-	m->cand[q->n_cand].piece = id;
+	ws->cand[q->n_cand].lb = lb;
+	ws->cand[q->n_cand].piece = id;
 	q->n_cand++;
 }
 
-static void visit_cell(struct px_dist_model *m, px_vec3 p, int x, int y, int z,
-		       struct qstate *q)
+static void visit_cell(const struct px_dist_model *m, struct px_dist_ws *ws,
+		       px_vec3 p, int x, int y, int z, struct qstate *q)
 {
 	long ci = cell_index(m, x, y, z);
 	int k, n = m->cell_count[ci];
@@ -1191,9 +1201,9 @@ static void visit_cell(struct px_dist_model *m, px_vec3 p, int x, int y, int z,
 		return;
 	q->cells++;
 	for (k = 0; k < n && k < m->cap; k++)
-		visit_piece(m, p, m->cell_slot[ci * m->cap + k], q);
+		visit_piece(m, ws, p, m->cell_slot[ci * m->cap + k], q);
 	for (k = m->cap; k < n; k++)
-		visit_piece(m, p, m->spill[m->cell_spill[ci] + k - m->cap], q);
+		visit_piece(m, ws, p, m->spill[m->cell_spill[ci] + k - m->cap], q);
 }
 
 /* Heap sort by lower bound: bounded, in place, no allocation (the C
@@ -1260,18 +1270,52 @@ static void sample_params(const struct px_dist_model *m, int id, int s,
 
 int px_dist_query(struct px_dist_model *m, px_vec3 p, struct px_dist_result *r)
 {
+	if (!m)
+		return PX_E_INVAL;
+	return px_dist_query_ws(m, &m->ws, p, r);
+}
+
+int px_dist_ws_create(const struct px_dist_model *m, struct px_dist_ws **out)
+{
+	struct px_dist_ws *ws;
+	size_t n;
+
+	if (!m || !out)
+		return PX_E_INVAL;
+	n = (size_t)m->n_pieces;
+	ws = calloc(1, sizeof(*ws) + n * (sizeof(uint32_t) + sizeof(struct cand)) + 16);
+	if (!ws)
+		return PX_E_NOMEM;
+	/* One block: candidates first (8-byte aligned), then stamps. */
+	ws->cand = (struct cand *)(void *)(((uintptr_t)(ws + 1) + 15) & ~(uintptr_t)15);
+	ws->stamp = (uint32_t *)(void *)(ws->cand + n);
+	ws->n_pieces = m->n_pieces;
+	ws->owned = 1;
+	*out = ws;
+	return PX_OK;
+}
+
+void px_dist_ws_free(struct px_dist_ws *ws)
+{
+	if (ws && ws->owned)
+		free(ws);
+}
+
+int px_dist_query_ws(const struct px_dist_model *m, struct px_dist_ws *ws,
+		     px_vec3 p, struct px_dist_result *r)
+{
 	struct qstate q;
 	int c[3], k, kmax, i;
 	double gap = 0.0, best;
 
-	if (!m || !r)
+	if (!m || !ws || !r || ws->n_pieces != m->n_pieces)
 		return PX_E_INVAL;
 	if (!px_v3_isfinite(p))
 		return PX_E_NAN;
-	if (++m->epoch == 0) {
+	if (++ws->epoch == 0) {
 		/* Wrapped after 2^32 queries: clear once, then go on. */
-		memset(m->stamp, 0, (size_t)m->n_pieces * sizeof(uint32_t));
-		m->epoch = 1;
+		memset(ws->stamp, 0, (size_t)m->n_pieces * sizeof(uint32_t));
+		ws->epoch = 1;
 	}
 	memset(r, 0, sizeof(*r));
 	r->certified = 1;
@@ -1312,12 +1356,12 @@ int px_dist_query(struct px_dist_model *m, px_vec3 p, struct px_dist_result *r)
 				if (rim) {
 					for (x = c[0] - k; x <= c[0] + k; x++)
 						if (x >= 0 && x < m->nx)
-							visit_cell(m, p, x, y, z, &q);
+							visit_cell(m, ws, p, x, y, z, &q);
 				} else {
 					if (c[0] - k >= 0)
-						visit_cell(m, p, c[0] - k, y, z, &q);
+						visit_cell(m, ws, p, c[0] - k, y, z, &q);
 					if (k > 0 && c[0] + k < m->nx)
-						visit_cell(m, p, c[0] + k, y, z, &q);
+						visit_cell(m, ws, p, c[0] + k, y, z, &q);
 				}
 			}
 		}
@@ -1335,19 +1379,19 @@ int px_dist_query(struct px_dist_model *m, px_vec3 p, struct px_dist_result *r)
 
 	/* Exact solve of every piece that may still hold something closer,
 	 * nearest lower bound first. */
-	sort_cand(m->cand, q.n_cand);
+	sort_cand(ws->cand, q.n_cand);
 	/* The piece holding the best sample goes first: its solve usually
 	 * lands on the global minimum, after which most other candidates
 	 * fall to their first bound. */
 	for (i = 0; i < q.n_cand; i++)
-		if (m->cand[i].piece == q.best_piece) {
-			struct cand t = m->cand[i];
-			memmove(&m->cand[1], &m->cand[0], (size_t)i * sizeof(t));
-			m->cand[0] = t;
+		if (ws->cand[i].piece == q.best_piece) {
+			struct cand t = ws->cand[i];
+			memmove(&ws->cand[1], &ws->cand[0], (size_t)i * sizeof(t));
+			ws->cand[0] = t;
 			break;
 		}
 	for (i = 0; i < q.n_cand; i++) {
-		const struct cand *cd = &m->cand[i];
+		const struct cand *cd = &ws->cand[i];
 		const struct piece *pc = &m->pieces[cd->piece];
 		/* Past the first, the list is sorted by lower bound. */
 		if (i > 0 && cd->lb >= best)

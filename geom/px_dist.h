@@ -34,8 +34,10 @@
  * block whose size px_dist_model_info() reports) and may take long; after
  * it, px_dist_query() and px_dist_query_batch() use only that block, never
  * allocate, lock or print, and every loop in them has a bound. A model
- * holds one query workspace: queries on one model must not run
- * concurrently.
+ * holds one query workspace for px_dist_query(), so those calls on one
+ * model must not run concurrently; threads that query the same model at
+ * once each use their own workspace (px_dist_ws_create(),
+ * px_dist_query_ws()), the model itself is then only read.
  */
 #ifndef PX_DIST_H
 #define PX_DIST_H
@@ -151,6 +153,34 @@ PX_API int px_dist_entity_info(const struct px_dist_model *m, int entity,
  */
 PX_API int px_dist_query(struct px_dist_model *m, px_vec3 p,
 			 struct px_dist_result *r);
+
+/* A query workspace for another thread (setup: allocates once, about
+ * 16 bytes per piece). Returns PX_OK, PX_E_INVAL or PX_E_NOMEM. */
+struct px_dist_ws;
+PX_API int px_dist_ws_create(const struct px_dist_model *m,
+			     struct px_dist_ws **out);
+/* NULL is a no-op. */
+PX_API void px_dist_ws_free(struct px_dist_ws *ws);
+
+/* As px_dist_query() with the caller's workspace (made for this model);
+ * the model is only read. @note RT-safe. */
+PX_API int px_dist_query_ws(const struct px_dist_model *m,
+			    struct px_dist_ws *ws, px_vec3 p,
+			    struct px_dist_result *r);
+
+/*
+ * The same model behind the point-to-model interface (px_model.h), for
+ * scenes and model-to-model queries: unsigned distance, entity index and
+ * piece in index/sub, (u, v) of the foot point, certified flag and gap.
+ * Up to four threads may query it at once (each borrows a workspace
+ * without waiting; a fifth gets PX_E_BUSY). Setup only. Returns as
+ * px_dist_model_create().
+ */
+struct px_model;
+PX_API int px_nurbs_model_create(const struct px_nurbs_curve *curves,
+				 int n_curves, const struct px_nurbs_surf *surfs,
+				 int n_surfs, const struct px_dist_opts *opts,
+				 struct px_model **out);
 
 /* n queries; stops at the first error and returns it. @note RT-safe. */
 PX_API int px_dist_query_batch(struct px_dist_model *m, const px_vec3 *p,

@@ -8,6 +8,7 @@
 #include "px_alloc_count.h"
 #include "px_arena.h"
 #include "px_dist.h"
+#include "px_model.h"
 #include "px_nurbs.h"
 #include "px_test.h"
 
@@ -372,6 +373,36 @@ static void test_medial_plane_of_two_sheets(void)
 	px_dist_model_free(m);
 }
 
+/* The same sphere behind the point-to-model interface, posed. */
+static void test_as_posed_model(void)
+{
+	struct px_nurbs_surf s;
+	struct px_model *m;
+	struct px_model_result r;
+	px_pose pose;
+	uint64_t a;
+	int i;
+
+	arena_reset();
+	sphere(&s, 1.5, px_v3(0, 0, 0));
+	PX_CHECK_INT_EQ(px_nurbs_model_create(NULL, 0, &s, 1, NULL, &m), PX_OK);
+	PX_CHECK_INT_EQ(px_model_kind(m), PX_MODEL_NURBS);
+	PX_CHECK(px_quat_from_axis_angle(px_v3(1, 2, 3), 0.7, &pose.q) == PX_OK);
+	pose.t = px_v3(3, -1, 2);
+	PX_CHECK_INT_EQ(px_model_set_pose(m, pose), PX_OK);
+	a = px_alloc_region_begin();
+	for (i = 0; i < 200; i++) {
+		px_vec3 x = px_v3(px_rand_range(-2, 8), px_rand_range(-6, 4), px_rand_range(-3, 7));
+		PX_CHECK_INT_EQ(px_model_query(m, x, &r), 1);
+		PX_CHECK_CLOSE(r.distance, fabs(px_v3_dist(x, pose.t) - 1.5), 1e-10, 1e-10);
+		PX_CHECK_CLOSE(px_v3_dist(r.point, pose.t), 1.5, 1e-10, 0);
+		PX_CHECK_CLOSE(px_v3_dist(px_v3_madd(r.point, r.direction, r.distance), x), 0.0, 1e-9, 0);
+		PX_CHECK(r.certified && !r.is_signed);
+	}
+	PX_CHECK_INT_EQ(px_alloc_region_end(a), 0);
+	px_model_free(m);
+}
+
 static void test_surface_queries_allocate_nothing(void)
 {
 	struct px_nurbs_surf s;
@@ -397,6 +428,7 @@ static const struct px_test tests[] = {
 	PX_T(test_sphere_poles_seam_focal),
 	PX_T(test_mixed_model),
 	PX_T(test_medial_plane_of_two_sheets),
+	PX_T(test_as_posed_model),
 	PX_T(test_surface_queries_allocate_nothing),
 };
 
