@@ -515,7 +515,18 @@ static int newton_f(struct qctx *x, const struct rect *r, int *iters,
 			ds = -gs / g * wmax;
 			dt = -gt / g * wmax;
 		}
-		for (al = 1.0, k = 0; k < 40; k++, al *= 0.5) {
+		/* A step already below the resolution we need is the end:
+		 * near the minimum f changes only by rounding, and a line
+		 * search there would halve the step to nothing. */
+		if (fabs(ds) <= 1e-13 && fabs(dt) <= 1e-13)
+			goto done;
+		/* Sitting on the border and pushed out through it: the
+		 * minimum is not inside this rectangle (or not reachable from
+		 * here); give up, the caller subdivides, which is safe. */
+		if ((s <= r->s0 && ds < 0.0) || (s >= r->s1 && ds > 0.0) ||
+		    (t <= r->t0 && dt < 0.0) || (t >= r->t1 && dt > 0.0))
+			goto done;
+		for (al = 1.0, k = 0; k < 12; k++, al *= 0.5) {
 			double ns = fmin(r->s1, fmax(r->s0, s + al * ds));
 			double nt = fmin(r->t1, fmax(r->t0, t + al * dt));
 			double fn = px_v3_dist2(spiece_point(sp, ns, nt), x->p);
@@ -529,7 +540,7 @@ static int newton_f(struct qctx *x, const struct rect *r, int *iters,
 				break;
 			}
 		}
-		if (k == 40)
+		if (k == 12)
 			goto done;
 	}
 done:
