@@ -152,7 +152,7 @@ static double oracle(const struct px_nurbs_surf *s, px_vec3 x)
 }
 
 struct tally {
-	int queries, uncertified, boundary;
+	int queries, uncertified, boundary, oracle_missed;
 };
 
 static void check(struct px_dist_model *m, const struct px_nurbs_surf *s,
@@ -168,8 +168,11 @@ static void check(struct px_dist_model *m, const struct px_nurbs_surf *s,
 	PX_CHECK_MSG(r.dist <= ref + 1e-9 * diag,
 		     "wrong branch: %.17g vs oracle %.17g at (%.17g, %.17g, %.17g)",
 		     r.dist, ref, x.x, x.y, x.z);
-	PX_CHECK_MSG(r.dist >= ref - 1e-7 * diag, "below oracle: %.17g vs %.17g",
-		     r.dist, ref);
+	/* Below the oracle is fine when the answer is a real surface point
+	 * (checked next): then the sampling oracle missed a narrow minimum,
+	 * and the answer is its own witness. */
+	if (r.dist < ref - 1e-7 * diag)
+		t->oracle_missed++;
 	PX_CHECK_INT_EQ(r.entity, ent);
 	PX_CHECK_INT_EQ(r.kind, PX_DIST_SURFACE);
 	on = px_nurbs_surf_point(s, r.u, r.v);
@@ -216,7 +219,7 @@ static px_vec3 query_point(const struct px_nurbs_surf *s, px_aabb box, int kind)
 
 static void test_random_surfaces(void)
 {
-	struct tally t = {0, 0, 0};
+	struct tally t = {0, 0, 0, 0};
 	int trial;
 	for (trial = 0; trial < 100; trial++) {
 		struct surf_buf b;
@@ -233,8 +236,9 @@ static void test_random_surfaces(void)
 			      px_aabb_diagonal(&info.bounds), &t);
 		px_dist_model_free(m);
 	}
-	printf("    %d queries, %d on the boundary, %d uncertified\n", t.queries,
-	       t.boundary, t.uncertified);
+	printf("    %d queries, %d on the boundary, %d uncertified, %d below the "
+	       "sampling oracle (answer verified on the surface)\n",
+	       t.queries, t.boundary, t.uncertified, t.oracle_missed);
 	PX_CHECK(t.boundary > 20);
 }
 

@@ -193,7 +193,12 @@ static void test_random_patches_vs_oracle(void)
 		PX_CHECK_MSG(got <= ref + 1e-9, "wrong branch: %.17g vs oracle %.17g (p %d q %d, "
 			     "query kind %d, interior hit %d at %g %g, nodes %d)",
 			     got, ref, p, q, trial % 3, hit.d2 < INFINITY, hit.u, hit.v, hit.nodes);
-		PX_CHECK_MSG(got >= ref - 1e-7, "below oracle: %.17g vs %.17g", got, ref);
+		/* Below the oracle only with a witness on the patch (the
+		 * oracle sampled past a narrow minimum): checked below for
+		 * interior answers; boundary answers come from curve pieces
+		 * tested on their own. */
+		PX_CHECK_MSG(got >= ref - 1e-7 || hit.d2 < INFINITY,
+			     "below oracle without a witness: %.17g vs %.17g", got, ref);
 		if (hit.d2 < INFINITY)
 			PX_CHECK(px_v3_dist(hit.point, eval_ref((const double(*)[4])hw, p, q, hit.u, hit.v)) < 1e-12);
 	}
