@@ -48,6 +48,22 @@ static long long now_ns()
 	return (long long)ts.tv_sec * 1000000000LL + ts.tv_nsec;
 }
 
+/* A point in the box enlarged by a quarter of its size on every side. */
+static px_vec3 random_point(px_aabb b)
+{
+	px_vec3 e = px_v3_scale(px_v3_sub(b.max, b.min), 0.25);
+	px_vec3 lo = px_v3_sub(b.min, e), hi = px_v3_add(b.max, e);
+	return px_v3(lo.x + (hi.x - lo.x) * urand(), lo.y + (hi.y - lo.y) * urand(),
+		     lo.z + (hi.z - lo.z) * urand());
+}
+
+static long long timed_query(px_dist_model *m, px_vec3 q, px_dist_result *r)
+{
+	long long t0 = now_ns();
+	px_dist_query(m, q, r);
+	return now_ns() - t0;
+}
+
 struct timing {
 	long long med, p99, max;
 };
@@ -135,19 +151,13 @@ static void surface_case(const char *name, int rational)
 	double diag = px_aabb_diagonal(&info.bounds), tol = 1e-9 * diag;
 	int our_wrong_full = 0, occt_wrong_full = 0, occt_wrong_fast = 0, our_wrong_fast = 0;
 	for (int i = 0; i < N; i++) {
-		px_vec3 lo = info.bounds.min, hi = info.bounds.max;
-		px_vec3 e = px_v3_scale(px_v3_sub(hi, lo), 0.25);
-		px_vec3 q = px_v3(lo.x - e.x + (hi.x - lo.x + 2 * e.x) * urand(),
-				  lo.y - e.y + (hi.y - lo.y + 2 * e.y) * urand(),
-				  lo.z - e.z + (hi.z - lo.z + 2 * e.z) * urand());
+		px_vec3 q = random_point(info.bounds);
 		gp_Pnt P(q.x, q.y, q.z);
 		px_dist_result r;
-		long long t0 = now_ns();
-		px_dist_query(m, q, &r);
-		tp.push_back(now_ns() - t0);
+		tp.push_back(timed_query(m, q, &r));
 
 		double dfull = INFINITY, dfast = INFINITY;
-		t0 = now_ns();
+		long long t0 = now_ns();
 		try {
 			full.Perform(P);
 			if (full.NbPoints() > 0)
@@ -228,18 +238,12 @@ static void curve_case(const char *name, int rational)
 	double diag = px_aabb_diagonal(&info.bounds), tol = 1e-9 * diag;
 	int our_wrong = 0, occt_wrong = 0;
 	for (int i = 0; i < N; i++) {
-		px_vec3 lo = info.bounds.min, hi = info.bounds.max;
-		px_vec3 e = px_v3_scale(px_v3_sub(hi, lo), 0.25);
-		px_vec3 q = px_v3(lo.x - e.x + (hi.x - lo.x + 2 * e.x) * urand(),
-				  lo.y - e.y + (hi.y - lo.y + 2 * e.y) * urand(),
-				  lo.z - e.z + (hi.z - lo.z + 2 * e.z) * urand());
+		px_vec3 q = random_point(info.bounds);
 		gp_Pnt P(q.x, q.y, q.z);
 		px_dist_result r;
-		long long t0 = now_ns();
-		px_dist_query(m, q, &r);
-		tp.push_back(now_ns() - t0);
+		tp.push_back(timed_query(m, q, &r));
 		double d = std::min(P.Distance(e0), P.Distance(e1));
-		t0 = now_ns();
+		long long t0 = now_ns();
 		try {
 			pc.Perform(P);
 			if (pc.NbPoints() > 0)

@@ -122,6 +122,19 @@ static void pf_table(double pf, double *tol, double *jit)
 	}
 }
 
+/* Settings for an entity from its info->pf: the table, floored at
+ * floor_tol, unless the options fix tolerance or jitter. */
+static void decomp_settings(struct px_dist_entity_info *info, double floor_tol,
+			    const struct px_dist_opts *o)
+{
+	double tol, jit;
+	pf_table(info->pf, &tol, &jit);
+	if (tol < floor_tol)
+		tol = floor_tol;
+	info->tol = o->decomp_tol > 0.0 ? o->decomp_tol : tol;
+	info->jitter = o->jitter > 0.0 ? o->jitter : jit;
+}
+
 static double speed(const struct px_nurbs_curve *c, double u, int side)
 {
 	px_vec3 d[2];
@@ -240,15 +253,9 @@ static int decompose(const struct px_nurbs_curve *c, const struct px_dist_opts *
 	info->n_cusps = cusps.n;
 	info->arc_length = len;
 	info->pf = dmax > 0.0 ? (dmax - dmin) / dmax : 1.0;
-	pf_table(info->pf, &tol, &jit);
-	if (tol < 0.05)
-		tol = 0.05;
-	if (o->decomp_tol > 0.0)
-		tol = o->decomp_tol;
-	if (o->jitter > 0.0)
-		jit = o->jitter;
-	info->tol = tol;
-	info->jitter = jit;
+	decomp_settings(info, 0.05, o);
+	tol = info->tol;
+	jit = info->jitter;
 
 	/* Nearly uniform stepping: each step starts from the previous
 	 * increment (spatial coherence) and is brought into the chord band
@@ -581,7 +588,7 @@ static int add_surface(struct builder *bl, const struct px_nurbs_surf *s,
 {
 	struct px_dist_opts so = *o;
 	struct decomp cu = {0}, cv = {0};
-	double len_u = 0.0, len_v = 0.0, tol, jit, a, b, c, d, len, diag;
+	double len_u = 0.0, len_v = 0.0, a, b, c, d, len, diag;
 	double *work = NULL, *pw = NULL, brk[64];
 	size_t wl, pwl;
 	int i, j, rc, e, dir, first_boundary;
@@ -593,19 +600,11 @@ static int add_surface(struct builder *bl, const struct px_nurbs_surf *s,
 		return PX_E_RANGE;
 	info->kind = PX_DIST_SURFACE;
 	info->pf = surf_pf(s);
-	pf_table(info->pf, &tol, &jit);
 	/* Memory grows with the square of the count: surfaces stop at the
 	 * paper's 10 % (see pf_table()). */
-	if (tol < 0.1)
-		tol = 0.1;
-	if (o->decomp_tol > 0.0)
-		tol = o->decomp_tol;
-	if (o->jitter > 0.0)
-		jit = o->jitter;
-	info->tol = tol;
-	info->jitter = jit;
-	so.decomp_tol = tol;
-	so.jitter = jit;
+	decomp_settings(info, 0.1, o);
+	so.decomp_tol = info->tol;
+	so.jitter = info->jitter;
 	rc = surf_cuts(s, 0, &so, &len_u, &cu);
 	if (!rc)
 		rc = surf_cuts(s, 1, &so, &len_v, &cv);
