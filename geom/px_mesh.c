@@ -60,6 +60,8 @@ struct mesh {
 	int depth;
 	px_aabb box;
 	size_t bytes;
+	px_vec3 *hull;  /* distinct vertices, convex meshes only (support) */
+	size_t n_hull;
 };
 
 /* ---- point-triangle distance ------------------------------------------ */
@@ -400,6 +402,7 @@ static void mesh_free(void *impl)
 	free(M->vnt);
 	free(M->degen);
 	free(M->nodes);
+	free(M->hull);
 	free(M);
 }
 
@@ -567,8 +570,28 @@ static size_t mesh_bytes(const void *impl)
 	return ((const struct mesh *)impl)->bytes;
 }
 
+/* Convex meshes: the vertex farthest along d (a linear scan: convex
+ * meshes in this role are small, e.g. a tool or a hull). */
+static px_vec3 mesh_support(const void *impl, px_vec3 d)
+{
+	const struct mesh *M = impl;
+	size_t i, bi = 0;
+	double best = -INFINITY;
+	for (i = 0; i < M->n_hull; i++) {
+		double s = px_v3_dot(M->hull[i], d);
+		if (s > best) {
+			best = s;
+			bi = i;
+		}
+	}
+	return M->hull[bi];
+}
+
 static const struct px_model_ops mesh_ops = {
-	"mesh", PX_MODEL_MESH, mesh_closest, mesh_aabb, mesh_bytes, mesh_free};
+	"mesh", PX_MODEL_MESH, mesh_closest, mesh_aabb, mesh_bytes, mesh_free, NULL};
+static const struct px_model_ops mesh_ops_convex = {
+	"mesh", PX_MODEL_MESH, mesh_closest, mesh_aabb, mesh_bytes, mesh_free,
+	mesh_support};
 
 /* ---- build ----------------------------------------------------------------- */
 
@@ -758,6 +781,37 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 			vn[i] = px_v3_neg(vn[i]);
 	}
 
+	/* convexity: closed, and across every edge the neighbour's far
+	 * vertex lies on or below this triangle's plane */
+	if (rep->closed) {
+		double ext = 0.0;
+		rep->convex = 1;
+		for (i = 0; i < nv; i++)
+			if (used[i])
+				ext = fmax(ext, fmax(fabs(xyz[3 * i]),
+						     fmax(fabs(xyz[3 * i + 1]), fabs(xyz[3 * i + 2]))));
+		for (i = 0; i < nt && rep->convex; i++) {
+			const double *A = xyz + 3 * (size_t)canon[tri[3 * i]];
+			if (deg[i])
+				continue;
+			for (k = 0; k < 3; k++) {
+				int32_t o = nb[3 * i + k];
+				int w;
+				if (o < 0)
+					continue;
+				for (w = 0; w < 3; w++) {
+					const double *W = xyz + 3 * (size_t)canon[tri[3 * (size_t)o + w]];
+					double h = fn[i].x * (W[0] - A[0]) + fn[i].y * (W[1] - A[1]) +
+						   fn[i].z * (W[2] - A[2]);
+					if (h > 1e-12 * ext) {
+						rep->convex = 0;
+						break;
+					}
+				}
+			}
+		}
+	}
+
 	/* hierarchy */
 	M = calloc(1, sizeof(*M));
 	if (!M)
@@ -840,9 +894,21 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 	M->bytes = sizeof(*M) + nt * (sizeof(struct mtri) + 2 * sizeof(uint32_t) +
 				      7 * sizeof(px_vec3) + 1) +
 		   M->n_nodes * sizeof(struct node);
-	rc = px_model_create(&mesh_ops, M,
+	if (rep->convex) {
+		size_t h = 0;
+		M->hull = malloc(rep->n_welded * sizeof(*M->hull));
+		if (!M->hull)
+			goto fail;
+		for (i = 0; i < nv; i++)
+			if (used[i] && canon[i] == i && h < rep->n_welded)
+				M->hull[h++] = px_v3(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+		M->n_hull = h;
+		M->bytes += h * sizeof(*M->hull);
+	}
+	rc = px_model_create(rep->convex ? &mesh_ops_convex : &mesh_ops, M,
 			     PX_MODEL_CAP_EXACT | PX_MODEL_CAP_COHERENT |
-				     (M->closed ? PX_MODEL_CAP_SIGNED : 0u),
+				     (M->closed ? PX_MODEL_CAP_SIGNED : 0u) |
+				     (rep->convex ? PX_MODEL_CAP_CONVEX : 0u),
 			     out);
 	M = NULL; /* owned by the model now, also on failure */
 	if (rc != PX_OK)
@@ -872,7 +938,8 @@ done:
 
 static const struct mesh *as_mesh(const struct px_model *m)
 {
-	if (px_model_get_ops(m) != &mesh_ops)
+	const struct px_model_ops *o = px_model_get_ops(m);
+	if (o != &mesh_ops && o != &mesh_ops_convex)
 		return NULL;
 	return px_model_impl(m);
 }

@@ -77,6 +77,7 @@ struct px_mesh_report {
 	long first_bad_edge_triangle; /* a triangle on a bad edge, -1 if none */
 	int closed;                   /* watertight: signed distances */
 	int flipped;                  /* was inward, normals reversed */
+	int convex;                   /* closed, and no reflex edge */
 	double volume;                /* enclosed volume (closed meshes) */
 	int depth;                    /* hierarchy depth */
 	char message[256];            /* "" when everything is fine */

@@ -155,3 +155,14 @@ const struct px_model_ops *px_model_get_ops(const struct px_model *m)
 {
 	return m ? m->ops : NULL;
 }
+
+int px_model_support(const struct px_model *m, px_vec3 dir, px_vec3 *out)
+{
+	if (!m || !out)
+		return PX_E_INVAL;
+	if (!m->ops->support)
+		return PX_E_UNSUPPORTED;
+	*out = px_pose_transform_point(
+		m->pose, m->ops->support(m->impl, px_pose_inverse_transform_vector(m->pose, dir)));
+	return PX_OK;
+}

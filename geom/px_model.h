@@ -74,6 +74,7 @@ enum px_feature {
 #define PX_MODEL_CAP_SIGNED 0x1u    /* closed: inside gets negative distance */
 #define PX_MODEL_CAP_EXACT 0x2u     /* every answer is the exact global one */
 #define PX_MODEL_CAP_COHERENT 0x4u  /* uses the hint of coherent queries */
+#define PX_MODEL_CAP_CONVEX 0x8u    /* the solid is convex (closed models) */
 
 /* What a query asks, in the model frame (implementations see this). */
 struct px_model_query {
@@ -134,6 +135,11 @@ struct px_model_ops {
 	size_t (*memory_bytes)(const void *impl);
 	/* Release the implementation (setup-time, may free). */
 	void (*free)(void *impl);
+	/* Optional, for convex models (NULL otherwise): a point of the
+	 * model farthest along dir (model frame; dir need not be unit, and
+	 * a zero dir may give any point of the model). Used by the exact
+	 * convex-pair distance (GJK). Must be RT-safe. */
+	px_vec3 (*support)(const void *impl, px_vec3 dir);
 };
 
 struct px_model; /* opaque handle */
@@ -199,6 +205,13 @@ PX_API enum px_model_kind px_model_kind(const struct px_model *m);
 PX_API const char *px_model_name(const struct px_model *m);
 PX_API unsigned px_model_caps(const struct px_model *m);
 PX_API size_t px_model_memory_bytes(const struct px_model *m);
+/* Point of the model farthest along the world direction dir, in the
+ * world frame. Returns PX_OK, PX_E_INVAL (NULL), PX_E_UNSUPPORTED (the
+ * model has no support function: not convex or unbounded).
+ * @note RT-safe. */
+PX_API int px_model_support(const struct px_model *m, px_vec3 dir,
+			    px_vec3 *out);
+
 /* The implementation pointer and ops table (for representation-specific
  * accessors, which check the ops to know the model is theirs).
  * @note RT-safe. */
