@@ -29,7 +29,9 @@
 #include "px_cloud.h"
 #include "px_mesh.h"
 #include "px_model.h"
+#include "px_pair.h"
 #include "px_prim.h"
+#include "px_scene.h"
 
 static int64_t now_ns(void)
 {
@@ -257,6 +259,136 @@ int main(int argc, char **argv)
 			px_model_free(prim);
 		}
 	}
+	/* ---- model to model ---- */
+	{
+		struct gen_mesh g1, g2;
+		struct px_model *ma, *mb, *ca, *cb, *sp;
+		struct px_prim cyl = {PX_PRIM_CYLINDER, 0.05, 0.1, 0}, box = {PX_PRIM_BOX, 0.05, 0.08, 0.1};
+		struct px_prim sph = {PX_PRIM_SPHERE, 0.05, 0, 0};
+		struct px_pair_opts o1 = {1, 64, 1e-12, 1, 0}, o8 = {8, 64, 1e-12, 0, 0};
+		struct px_pair_result r;
+		const int NP = 2000;
+		gen_torus(0.1, 0.03, 64, 32, &g1);
+		gen_sphere(0.08, 32, 64, &g2);
+		px_mesh_model(g1.xyz, g1.nv, g1.tri, g1.nt, NULL, NULL, &ma);
+		px_mesh_model(g2.xyz, g2.nv, g2.tri, g2.nt, NULL, NULL, &mb);
+		px_prim_model(&cyl, &ca);
+		px_prim_model(&box, &cb);
+		px_prim_model(&sph, &sp);
+		printf("model to model (%d poses on a circle, 1 mm apart):\n", NP);
+		{
+			const struct {
+				const char *name;
+				struct px_model *a, *b;
+				const struct px_pair_opts *o;
+			} P[] = {{"mesh torus 4k tris / mesh sphere 4k, 8 starts", ma, mb, &o8},
+				 {"same, coherent, 1 start", ma, mb, &o1},
+				 {"sphere / mesh torus (exact)", sp, ma, &o8},
+				 {"cylinder / box (GJK)", ca, cb, &o8}};
+			size_t k;
+			for (k = 0; k < sizeof(P) / sizeof(P[0]); k++) {
+				int local = 0;
+				memset(&r, 0, sizeof(r));
+				for (i = 0; i < NP; i++) {
+					px_pose Pb = px_pose_identity();
+					int64_t a;
+					Pb.t = px_v3(0.25 * cos(4e-3 * i), 0.25 * sin(4e-3 * i), 0.02);
+					px_quat_from_axis_angle(px_v3(1, 1, 0), 2e-3 * i, &Pb.q);
+					px_model_set_pose(P[k].b, Pb);
+					a = now_ns();
+					px_pair_distance(P[k].a, P[k].b, P[k].o, &r);
+					times[i] = (double)(now_ns() - a);
+					local += r.local_only;
+				}
+				print_stats(P[k].name, summarize(times, NP, overhead));
+				printf("  %-34s %d of %d results flagged possibly local\n", "", local, NP);
+			}
+		}
+		px_model_free(ma);
+		px_model_free(mb);
+		px_model_free(ca);
+		px_model_free(cb);
+		px_model_free(sp);
+		gen_free(&g1);
+		gen_free(&g2);
+	}
+
+	/* ---- scenes ---- */
+	{
+		int sizes[2] = {20, 200}, si;
+		for (si = 0; si < 2; si++) {
+			int nm = sizes[si], k;
+			struct px_scene *scn;
+			struct px_model **ms = calloc((size_t)nm, sizeof(*ms));
+			struct px_model *tool;
+			struct px_prim cap = {PX_PRIM_CAPSULE, 0.02, 0.05, 0};
+			struct px_scene_hit hits[64];
+			struct gen_mesh gs;
+			struct stats su, stool, sn;
+			double *t2 = malloc(BM_NQ * sizeof(double)), *t3 = malloc(BM_NQ * sizeof(double));
+			uint64_t sd = 99;
+			const int NQ = 5000;
+			gen_sphere(0.05, 16, 32, &gs); /* 960 triangles */
+			px_scene_create((size_t)nm, &scn);
+			for (k = 0; k < nm; k++) {
+				px_pose P = px_pose_identity();
+				/* models spread in a cube whose volume grows with
+				 * their number (constant density) */
+				double e = 0.5 * cbrt(nm / 20.0);
+				if (k % 3 == 2) {
+					px_mesh_model(gs.xyz, gs.nv, gs.tri, gs.nt, NULL, NULL, &ms[k]);
+				} else {
+					struct px_prim pr = {k % 3 ? PX_PRIM_BOX : PX_PRIM_CYLINDER, 0.04, 0.06, 0.05};
+					px_prim_model(&pr, &ms[k]);
+				}
+				P.t = px_v3(e * (2 * bm_unit(&sd) - 1), e * (2 * bm_unit(&sd) - 1),
+					    e * (2 * bm_unit(&sd) - 1));
+				px_quat_from_axis_angle(px_v3(bm_unit(&sd), bm_unit(&sd), 1), 3 * bm_unit(&sd), &P.q);
+				px_model_set_pose(ms[k], P);
+				px_scene_add(scn, ms[k], NULL);
+			}
+			px_prim_model(&cap, &tool);
+			for (i = 0; i < NQ; i++) {
+				px_pose P = px_pose_identity();
+				double e = 0.5 * cbrt(nm / 20.0);
+				int64_t a;
+				/* every cycle: one model moves, the scene updates */
+				px_pose Q = px_model_pose(ms[i % nm]);
+				Q.t.x += 1e-4;
+				px_model_set_pose(ms[i % nm], Q);
+				a = now_ns();
+				px_scene_update(scn);
+				times[i] = (double)(now_ns() - a);
+				P.t = px_v3(e * cos(1e-3 * i), e * sin(1.3e-3 * i), 0.5 * e * sin(0.7e-3 * i));
+				px_model_set_pose(tool, P);
+				a = now_ns();
+				px_scene_tool(scn, tool, 0.05, NULL, hits, 64, NULL);
+				t2[i] = (double)(now_ns() - a);
+				a = now_ns();
+				px_scene_nearest(scn, P.t, INFINITY, hits);
+				t3[i] = (double)(now_ns() - a);
+			}
+			printf("scene of %d models (1/3 meshes of 960 triangles, boxes, cylinders):\n", nm);
+			su = summarize(times, NQ, overhead);
+			stool = summarize(t2, NQ, overhead);
+			sn = summarize(t3, NQ, overhead);
+			print_stats("update (poses -> hierarchy)", su);
+			print_stats("capsule tool, within 5 cm", stool);
+			print_stats("nearest model to a point", sn);
+			if (nm == 20)
+				printf("  target: tool against a 20-model scene <= 20 us: %s\n",
+				       stool.median + su.median <= 20000 ? "met (update + query)" : "NOT met");
+			px_scene_free(scn);
+			for (k = 0; k < nm; k++)
+				px_model_free(ms[k]);
+			px_model_free(tool);
+			free(ms);
+			free(t2);
+			free(t3);
+			gen_free(&gs);
+		}
+	}
+
 	free(times);
 	free(cold);
 	free(traj);

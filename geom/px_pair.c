@@ -213,7 +213,8 @@ struct run {
  * the point of B closest to it) or the reverse, real surface points.
  */
 static int run_start(const struct px_model *a, const struct px_model *b,
-		     px_vec3 seed, int max_iters, double tol, struct run *o)
+		     px_vec3 seed, int max_iters, double tol, double rel,
+		     struct run *o)
 {
 	struct px_model_result ra, rb;
 	double prev = INFINITY;
@@ -276,7 +277,7 @@ static int run_start(const struct px_model *a, const struct px_model *b,
 		}
 		/* each projection can only lower the distance; stop when it
 		 * no longer does by more than tol */
-		if (prev - o->d <= tol) {
+		if (prev - o->d <= tol + rel * o->d) {
 			o->converged = 1;
 			return 0;
 		}
@@ -360,6 +361,7 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 	int starts = opt && opt->starts ? opt->starts : 8;
 	int max_iters = opt && opt->max_iters ? opt->max_iters : 64;
 	double tol = opt && opt->tol > 0.0 ? opt->tol : 1e-12;
+	double rel = opt && opt->rel_tol > 0.0 ? opt->rel_tol : 1e-9;
 	int coherent = opt && opt->coherent && res && res->valid;
 	struct run best, r;
 	int k, n = 0, total = 0, rc, have = 0;
@@ -466,7 +468,7 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 		}
 		if (!px_v3_isfinite(seed))
 			continue;
-		rc = run_start(a, b, seed, max_iters, tol, &r);
+		rc = run_start(a, b, seed, max_iters, tol, rel, &r);
 		if (rc < 0)
 			return rc;
 		total += r.iters;

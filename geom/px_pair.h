@@ -56,8 +56,11 @@ extern "C" {
 struct px_pair_opts {
 	int starts;       /* 1..PX_PAIR_MAX_STARTS; 0 = 8 */
 	int max_iters;    /* projections per start (each = 2 queries); 0 = 64 */
-	double tol;       /* stop when the distance drops by <= tol; 0 = 1e-12 */
+	/* stop when one round of projections lowers the distance d by at
+	 * most tol + rel_tol * d (0 = 1e-12 and 1e-9) */
+	double tol;
 	int coherent;     /* start from the previous result's pair */
+	double rel_tol;
 };
 
 struct px_pair_result {

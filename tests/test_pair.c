@@ -148,7 +148,7 @@ static void check_pair_result(const struct px_model *a, const struct px_model *b
 static void test_mesh_pairs_hit_rate(void)
 {
 	int trial, hits = 0, misses = 0, flagged_hits = 0, n = 240;
-	struct px_pair_opts o = {8, 64, 1e-12, 0};
+	struct px_pair_opts o = {8, 64, 1e-12, 0, 0};
 	for (trial = 0; trial < n; trial++) {
 		double ra, rb, ref, sep;
 		struct px_model *a = make_mesh(trial % 4, &ra);
@@ -367,7 +367,7 @@ static void test_coherent_and_alloc(void)
 	double ra, rb;
 	struct px_model *a = make_mesh(0, &ra), *b = make_mesh(1, &rb);
 	struct px_pair_result rc, rf;
-	struct px_pair_opts co = {1, 64, 1e-12, 1}, fo = {8, 64, 1e-12, 0};
+	struct px_pair_opts co = {1, 64, 1e-12, 1, 0}, fo = {8, 64, 1e-12, 0, 0};
 	uint64_t al;
 	int i, agree = 0;
 	memset(&rc, 0, sizeof(rc));
