@@ -440,14 +440,14 @@ static inline void test_tri(const struct mesh *M, size_t li, px_vec3 p,
 	int f, s;
 	double u, v, d2;
 
-	if (!M->degen[li]) {
+	if (t->inv_nn != 0.0) {
 		/* the distance to the plane is a lower bound */
 		double h = px_v3_dot(t->n, px_v3_sub(p, t->a));
 		if (h * h * t->inv_nn > b->d2)
 			return;
 	}
-	d2 = tri_core(p, t->a, t->b, t->c, t->n, 1.0 / t->inv_nn, M->degen[li], &q,
-		      &f, &s, &u, &v);
+	d2 = tri_core(p, t->a, t->b, t->c, t->n, t->inv_nn != 0.0 ? 1.0 / t->inv_nn : 0.0,
+		      t->inv_nn == 0.0, &q, &f, &s, &u, &v);
 	if (d2 < b->d2 ||
 	    (d2 == b->d2 && (b->li < 0 || (M->degen[b->li] && !M->degen[li])))) {
 		b->d2 = d2;
@@ -518,6 +518,12 @@ static int mesh_closest(const void *impl, const struct px_model_query *qq,
 			st[sp].idx = nd->idx[ch];
 			st[sp].cnt = nd->cnt[ch];
 			st[sp].d2 = dc[ch];
+			/* start the memory fetch now: the node or the leaf's
+			 * triangles are needed within a few steps */
+			if (st[sp].cnt)
+				__builtin_prefetch(&M->tri[st[sp].idx]);
+			else
+				__builtin_prefetch(&M->nodes[st[sp].idx]);
 			sp++;
 		}
 	}
