@@ -26,7 +26,14 @@ struct px_scene {
 	uint32_t *perm;    /* leaf order -> model id */
 	struct snode *nodes;
 	size_t n_nodes;
+	size_t built_n;    /* model count when the hierarchy was built */
+	unsigned since;    /* updates since the last full build */
 };
+
+/* Every REBUILD-th update rebuilds the hierarchy; the others only refit
+ * its boxes (O(n)), which keeps it valid (boxes always enclose their
+ * models) while its shape slowly loosens as models move. */
+#define REBUILD 16
 
 int px_scene_create(size_t capacity, struct px_scene **out)
 {
@@ -190,8 +197,32 @@ int px_scene_update(struct px_scene *s)
 			double l = px_v3_comp(s->box[i].min, k), h = px_v3_comp(s->box[i].max, k);
 			s->cen[3 * i + k] = isfinite(l) && isfinite(h) ? 0.5 * (l + h) : 0.0;
 		}
-		s->perm[i] = (uint32_t)i;
 	}
+	if (!s->dirty && s->built_n == s->n && s->n > LEAF && ++s->since < REBUILD) {
+		/* refit: children come after their parent (preorder), so a
+		 * reverse sweep sees every child before its parent */
+		size_t j = s->n_nodes;
+		while (j-- > 0) {
+			struct snode *nd = &s->nodes[j];
+			int c;
+			for (c = 0; c < 2; c++) {
+				if (nd->cnt[c] > 0) {
+					range_box(s, nd->idx[c], nd->cnt[c], nd->lo[c], nd->hi[c]);
+				} else {
+					const struct snode *ch = &s->nodes[nd->idx[c]];
+					for (k = 0; k < 3; k++) {
+						nd->lo[c][k] = ch->lo[0][k] < ch->lo[1][k] ? ch->lo[0][k] : ch->lo[1][k];
+						nd->hi[c][k] = ch->hi[0][k] > ch->hi[1][k] ? ch->hi[0][k] : ch->hi[1][k];
+					}
+				}
+			}
+		}
+		return PX_OK;
+	}
+	s->since = 0;
+	s->built_n = s->n;
+	for (i = 0; i < s->n; i++)
+		s->perm[i] = (uint32_t)i;
 	s->n_nodes = 0;
 	if (s->n <= LEAF) {
 		struct snode *nd = &s->nodes[0];
