@@ -159,7 +159,7 @@ int main(int argc, char **argv)
 	struct px_model *mesh, *cloud, *prim;
 	struct px_mesh_report rp;
 	double overhead, *cold, *traj, *cpts, sum_cold = 0, sum_traj = 0;
-	struct stats sc, st, stc;
+	struct stats sc, st, stc, stcache;
 	uint64_t seed = 12345;
 	int64_t t0;
 	int i;
@@ -195,9 +195,27 @@ int main(int argc, char **argv)
 	stc = run_queries(mesh, traj, BM_NQ, 0, overhead, NULL);
 	print_stats("trajectory, cold", stc);
 	st = run_queries(mesh, traj, BM_NQ, 1, overhead, &sum_traj);
-	print_stats("trajectory, coherent", st);
+	print_stats("trajectory, coherent (hint)", st);
+	{
+		struct px_model_cache cache;
+		struct px_model_result r;
+		double s2 = 0;
+		px_model_cache_init(&cache, 0.0);
+		for (i = 0; i < BM_NQ; i++) {
+			px_vec3 p = px_v3(traj[3 * i], traj[3 * i + 1], traj[3 * i + 2]);
+			int64_t a = now_ns();
+			px_model_query_cached(mesh, p, &cache, &r);
+			times[i] = (double)(now_ns() - a);
+			s2 += fabs(r.distance);
+		}
+		stcache = summarize(times, BM_NQ, overhead);
+		print_stats("trajectory, coherent (cache)", stcache);
+		printf("  %-34s %lu refills in %d queries; sum of |distance| %.12g (hint path %.12g)\n",
+		       "", px_model_cache_refills(&cache), BM_NQ, s2, sum_traj);
+	}
 	printf("  targets: cold median <= 2 us: %s; coherent median <= 0.5 us: %s\n",
-	       sc.median <= 2000 ? "met" : "NOT met", st.median <= 500 ? "met" : "NOT met");
+	       sc.median <= 2000 ? "met" : "NOT met",
+	       fmin(st.median, stcache.median) <= 500 ? "met" : "NOT met");
 	{
 		struct fcl_out fo = run_fcl(argv[0]);
 		if (fo.ok) {
@@ -207,9 +225,11 @@ int main(int argc, char **argv)
 			printf("  same answers: sum of |distance| cold %.12g vs FCL %.12g, "
 			       "trajectory %.12g vs FCL %.12g\n",
 			       sum_cold, fo.cold_sum, sum_traj, fo.traj_sum);
-			printf("  speed-up over FCL: cold %.1fx, coherent %.1fx (target >= 5x)\n",
+			printf("  speed-up over FCL: cold %.1fx, coherent %.1fx (hint) %.1fx (cache) "
+			       "(target >= 5x)\n",
 			       fo.cold_median / fmax(sc.median, 1.0),
-			       fo.traj_median / fmax(st.median, 1.0));
+			       fo.traj_median / fmax(st.median, 1.0),
+			       fo.traj_median / fmax(stcache.median, 1.0));
 		}
 	}
 	px_model_free(mesh);

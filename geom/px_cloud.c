@@ -289,7 +289,7 @@ static size_t cloud_bytes(const void *impl)
 
 static const struct px_model_ops cloud_ops = {
 	"cloud", PX_MODEL_CLOUD, cloud_closest, cloud_aabb, cloud_bytes,
-	cloud_free, NULL};
+	cloud_free, NULL, NULL, NULL};
 
 int px_cloud_model(const double *xyz, size_t n, double radius_m,
 		   struct px_cloud_report *rep, struct px_model **out)

@@ -460,6 +460,52 @@ static inline void test_tri(const struct mesh *M, size_t li, px_vec3 p,
 	}
 }
 
+/* Fill a result from the best triangle: the sign from the pseudo-normal
+ * of the feature holding the closest point. */
+static void mesh_finish(const struct mesh *M, px_vec3 p, const struct best *bp,
+			unsigned flags, int iters, int certified,
+			struct px_model_result *r)
+{
+	struct best b = *bp;
+	px_vec3 n, dv;
+	double d;
+
+	r->point = b.q;
+	r->index = (int)M->orig[b.li];
+	r->sub = b.sub;
+	r->feature = b.feature;
+	r->u = b.u;
+	r->v = b.v;
+	r->iterations = iters;
+	r->certified = certified;
+	r->gap = 0.0;
+	if (b.feature == PX_FEATURE_FACE)
+		n = M->fn[b.li];
+	else if (b.feature == PX_FEATURE_EDGE)
+		n = M->en[3 * b.li + b.sub];
+	else
+		n = M->vnt[3 * b.li + b.sub];
+	d = sqrt(b.d2);
+	dv = px_v3_sub(p, b.q);
+	r->is_signed = M->closed && !(flags & PX_QUERY_UNSIGNED);
+	r->inside = 0;
+	if (d > 0.0) {
+		r->direction = px_v3_scale(dv, 1.0 / d);
+		r->distance = d;
+		if (r->is_signed && px_v3_dot(dv, n) < 0.0) {
+			r->inside = 1;
+			r->distance = -d;
+			r->direction = px_v3_neg(r->direction);
+		}
+	} else {
+		px_vec3 f = M->fn[b.li];
+		r->distance = 0.0;
+		if (px_v3_normalize(n, f, &r->direction) != PX_OK)
+			px_v3_normalize(f, px_v3(0, 0, 1), &r->direction);
+	}
+}
+
+
 static int mesh_closest(const void *impl, const struct px_model_query *qq,
 			struct px_model_result *r)
 {
@@ -470,8 +516,7 @@ static int mesh_closest(const void *impl, const struct px_model_query *qq,
 	} st[PX_MESH_MAX_DEPTH + 2];
 	int sp = 0, iters = 0, certified = 1;
 	struct best b;
-	px_vec3 p = qq->p, n, dv;
-	double d;
+	px_vec3 p = qq->p;
 
 	b.d2 = isinf(qq->max_dist) ? INFINITY : qq->max_dist * qq->max_dist;
 	b.li = -1;
@@ -529,41 +574,81 @@ static int mesh_closest(const void *impl, const struct px_model_query *qq,
 	}
 	if (b.li < 0)
 		return 0;
-
-	r->point = b.q;
-	r->index = (int)M->orig[b.li];
-	r->sub = b.sub;
-	r->feature = b.feature;
-	r->u = b.u;
-	r->v = b.v;
-	r->iterations = iters;
-	r->certified = certified;
-	r->gap = 0.0;
-	if (b.feature == PX_FEATURE_FACE)
-		n = M->fn[b.li];
-	else if (b.feature == PX_FEATURE_EDGE)
-		n = M->en[3 * b.li + b.sub];
-	else
-		n = M->vnt[3 * b.li + b.sub];
-	d = sqrt(b.d2);
-	dv = px_v3_sub(p, b.q);
-	r->is_signed = M->closed && !(qq->flags & PX_QUERY_UNSIGNED);
-	r->inside = 0;
-	if (d > 0.0) {
-		r->direction = px_v3_scale(dv, 1.0 / d);
-		r->distance = d;
-		if (r->is_signed && px_v3_dot(dv, n) < 0.0) {
-			r->inside = 1;
-			r->distance = -d;
-			r->direction = px_v3_neg(r->direction);
-		}
-	} else {
-		px_vec3 f = M->fn[b.li];
-		r->distance = 0.0;
-		if (px_v3_normalize(n, f, &r->direction) != PX_OK)
-			px_v3_normalize(f, px_v3(0, 0, 1), &r->direction);
-	}
+	mesh_finish(M, p, &b, qq->flags, iters, certified, r);
 	return 1;
+}
+
+/* Exact closest point among the given leaf-order triangles (coherence
+ * caches: px_model_query_cached() decides when that set is enough). */
+static int mesh_closest_among(const void *impl, const struct px_model_query *qq,
+			      const int *idx, int n, struct px_model_result *r)
+{
+	const struct mesh *M = impl;
+	struct best b;
+	int i;
+
+	b.d2 = isinf(qq->max_dist) ? INFINITY : qq->max_dist * qq->max_dist;
+	b.li = -1;
+	b.q = qq->p;
+	b.feature = PX_FEATURE_NONE;
+	b.sub = 0;
+	b.u = b.v = 0.0;
+	for (i = 0; i < n; i++)
+		if (idx[i] >= 0 && (size_t)idx[i] < M->nt)
+			test_tri(M, (size_t)idx[i], qq->p, &b);
+	if (b.li < 0)
+		return 0;
+	mesh_finish(M, qq->p, &b, qq->flags, n, 1, r);
+	return 1;
+}
+
+/* Leaf-order indices of every triangle within radius of p: the count,
+ * or PX_E_NOSPC when there are more than cap. */
+static int mesh_collect(const void *impl, px_vec3 p, double radius, int *idx,
+			int cap)
+{
+	const struct mesh *M = impl;
+	struct {
+		uint32_t idx, cnt;
+	} st[PX_MESH_MAX_DEPTH + 2];
+	double r2 = radius * radius;
+	int sp = 0, n = 0;
+
+	st[sp].idx = 0;
+	st[sp].cnt = 0;
+	sp++;
+	while (sp > 0) {
+		sp--;
+		if (st[sp].cnt > 0) {
+			uint32_t i;
+			for (i = st[sp].idx; i < st[sp].idx + st[sp].cnt; i++) {
+				const struct mtri *t = &M->tri[i];
+				if (t->inv_nn != 0.0) {
+					double h = px_v3_dot(t->n, px_v3_sub(p, t->a));
+					if (h * h * t->inv_nn > r2)
+						continue;
+				}
+				if (px_tri_closest(p, t->a, t->b, t->c, NULL, NULL, NULL, NULL,
+						   NULL) <= r2) {
+					if (n == cap)
+						return PX_E_NOSPC;
+					idx[n++] = (int)i;
+				}
+			}
+		} else {
+			const struct node *nd = &M->nodes[st[sp].idx];
+			int c;
+			for (c = 0; c < 2; c++) {
+				if (nd->idx[c] == EMPTY || box_d2(nd, c, p) > r2 ||
+				    sp >= PX_MESH_MAX_DEPTH + 2)
+					continue;
+				st[sp].idx = nd->idx[c];
+				st[sp].cnt = nd->cnt[c];
+				sp++;
+			}
+		}
+	}
+	return n;
 }
 
 static px_aabb mesh_aabb(const void *impl)
@@ -594,10 +679,11 @@ static px_vec3 mesh_support(const void *impl, px_vec3 d)
 }
 
 static const struct px_model_ops mesh_ops = {
-	"mesh", PX_MODEL_MESH, mesh_closest, mesh_aabb, mesh_bytes, mesh_free, NULL};
+	"mesh", PX_MODEL_MESH, mesh_closest, mesh_aabb, mesh_bytes, mesh_free, NULL,
+	mesh_closest_among, mesh_collect};
 static const struct px_model_ops mesh_ops_convex = {
 	"mesh", PX_MODEL_MESH, mesh_closest, mesh_aabb, mesh_bytes, mesh_free,
-	mesh_support};
+	mesh_support, mesh_closest_among, mesh_collect};
 
 /* ---- build ----------------------------------------------------------------- */
 

@@ -140,6 +140,16 @@ struct px_model_ops {
 	 * a zero dir may give any point of the model). Used by the exact
 	 * convex-pair distance (GJK). Must be RT-safe. */
 	px_vec3 (*support)(const void *impl, px_vec3 dir);
+	/* Optional pair for coherence caches (both or neither; NULL
+	 * otherwise). Features are numbered by the model (any ints >= 0).
+	 * closest_among: as closest, over the listed features only.
+	 * collect: every feature within radius of p (model frame), written
+	 * to idx; returns the count, or PX_E_NOSPC when more than cap.
+	 * Both must be RT-safe. */
+	int (*closest_among)(const void *impl, const struct px_model_query *q,
+			     const int *idx, int n, struct px_model_result *r);
+	int (*collect)(const void *impl, px_vec3 p, double radius, int *idx,
+		       int cap);
 };
 
 struct px_model; /* opaque handle */
@@ -189,6 +199,55 @@ PX_API int px_model_query(const struct px_model *m, px_vec3 p,
 PX_API int px_model_query_ex(const struct px_model *m, px_vec3 p,
 			     double max_dist, int hint, unsigned flags,
 			     struct px_model_result *out);
+
+/* ---- coherence cache ---------------------------------------------------------
+ *
+ * A point that moves a little each cycle (a haptic probe, a link point)
+ * can skip the hierarchy most cycles: on a refill the cache records every
+ * feature within R = d + 2 margin of the point (d its distance then);
+ * later, with the point at distance m from that anchor, the best cached
+ * feature at distance U is proven the global closest whenever U + m <= R
+ * (any feature at most U away from the point is at most U + m <= R from
+ * the anchor, hence cached). Otherwise the cache refills with a full
+ * query. So every answer stays exact; the margin only trades refill
+ * frequency against scan length. Models without closest_among/collect
+ * fall back to hint-coherent queries.
+ */
+#define PX_MODEL_CACHE_CAP 64
+
+/* Caller-owned state for one moving point against one model; plain
+ * struct, members private (read the counters through the accessors). */
+struct px_model_cache {
+	const struct px_model *model_;
+	px_vec3 anchor_;
+	double radius_;
+	double margin_;
+	int n_;
+	int last_;
+	unsigned long queries_, refills_;
+	int idx_[PX_MODEL_CACHE_CAP];
+};
+
+/* Reset a cache. margin_m > 0 fixes how far (model frame units) the
+ * point may move before a refill; 0 chooses it from the distance at each
+ * refill (half of it, at least 1e-3 of the model's box diagonal).
+ * @note RT-safe. */
+PX_API void px_model_cache_init(struct px_model_cache *c, double margin_m);
+
+/*
+ * As px_model_query(), through the cache c (which follows whichever model
+ * it is used with: using it with another model refills it). Answers are
+ * exact as from px_model_query(), except that among equidistant features
+ * another may be reported. Returns 1, or px_model_query()'s errors.
+ * @note RT-safe.
+ */
+PX_API int px_model_query_cached(const struct px_model *m, px_vec3 p,
+				 struct px_model_cache *c,
+				 struct px_model_result *out);
+
+/* Queries answered and refills made through c. @note RT-safe. */
+PX_API unsigned long px_model_cache_queries(const struct px_model_cache *c);
+PX_API unsigned long px_model_cache_refills(const struct px_model_cache *c);
 
 /* Bounding box in the model frame / in the world frame (the model-frame
  * box transformed by the current pose). Empty box for NULL.

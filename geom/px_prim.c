@@ -373,13 +373,13 @@ static px_vec3 prim_support(const void *impl, px_vec3 d)
 
 static const struct px_model_ops prim_ops = {
 	"primitive", PX_MODEL_PRIMITIVE, prim_closest, prim_aabb, prim_bytes,
-	prim_free, prim_support};
+	prim_free, prim_support, NULL, NULL};
 
 /* Torus and half-space have no support function (not convex, or not
  * bounded). */
 static const struct px_model_ops prim_ops_nosupport = {
 	"primitive", PX_MODEL_PRIMITIVE, prim_closest, prim_aabb, prim_bytes,
-	prim_free, NULL};
+	prim_free, NULL, NULL, NULL};
 
 int px_prim_get(const struct px_model *m, struct px_prim *out)
 {
