@@ -256,7 +256,19 @@ int main(int argc, char **argv)
 		p[0] *= rr / n, p[1] *= rr / n, p[2] *= rr / n;
 	}
 	print_stats("cold (independent points)", run_queries(cloud, cold, BM_NQ, 0, overhead, NULL));
-	print_stats("trajectory, coherent", run_queries(cloud, traj, BM_NQ, 1, overhead, NULL));
+	print_stats("trajectory, coherent (hint)", run_queries(cloud, traj, BM_NQ, 1, overhead, NULL));
+	{
+		struct px_model_cache cache;
+		struct px_model_result r;
+		px_model_cache_init(&cache, 0.0);
+		for (i = 0; i < BM_NQ; i++) {
+			px_vec3 p = px_v3(traj[3 * i], traj[3 * i + 1], traj[3 * i + 2]);
+			int64_t a = now_ns();
+			px_model_query_cached(cloud, p, &cache, &r);
+			times[i] = (double)(now_ns() - a);
+		}
+		print_stats("trajectory, coherent (cache)", summarize(times, BM_NQ, overhead));
+	}
 	px_model_free(cloud);
 
 	/* ---- primitives ---- */
