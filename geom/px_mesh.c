@@ -353,12 +353,122 @@ static void range_box(const struct build *B, size_t s, size_t n, float lo[3],
 }
 
 /* Build the node for range [s, s + n) (n > leaf); returns its index. */
+static int log2ceil(size_t n)
+{
+	int k = 0;
+	while (((size_t)1 << k) < n)
+		k++;
+	return k;
+}
+
+static double half_area(const double lo[3], const double hi[3])
+{
+	double x = hi[0] - lo[0], y = hi[1] - lo[1], z = hi[2] - lo[2];
+	return x * y + y * z + z * x;
+}
+
+#define SAH_BINS 16
+
+/*
+ * Binned surface-area split (the usual 16 bins per axis over the
+ * centroid bounds); returns the size of the left part after partitioning
+ * [s, s + n), or 0 when no split beats the others (then the caller takes
+ * the median).
+ */
+static size_t sah_split(struct build *B, size_t s, size_t n, const double clo[3],
+			const double chi[3])
+{
+	double best = INFINITY;
+	int bax = -1, bbin = 0, k, j;
+	size_t i, left;
+
+	for (k = 0; k < 3; k++) {
+		double ext = chi[k] - clo[k], blo[SAH_BINS][3], bhi[SAH_BINS][3];
+		size_t cnt[SAH_BINS] = {0};
+		double llo[3], lhi[3], rlo[3], rhi[3], la[SAH_BINS];
+		size_t lc[SAH_BINS], acc;
+		int m;
+		if (!(ext > 0.0))
+			continue;
+		for (j = 0; j < SAH_BINS; j++)
+			for (m = 0; m < 3; m++) {
+				blo[j][m] = INFINITY;
+				bhi[j][m] = -INFINITY;
+			}
+		for (i = s; i < s + n; i++) {
+			size_t t = B->perm[i];
+			int b = (int)(SAH_BINS * (B->cen[3 * t + k] - clo[k]) / ext);
+			b = b < 0 ? 0 : (b >= SAH_BINS ? SAH_BINS - 1 : b);
+			cnt[b]++;
+			for (m = 0; m < 3; m++) {
+				blo[b][m] = fmin(blo[b][m], B->tlo[3 * t + m]);
+				bhi[b][m] = fmax(bhi[b][m], B->thi[3 * t + m]);
+			}
+		}
+		for (m = 0; m < 3; m++) {
+			llo[m] = rlo[m] = INFINITY;
+			lhi[m] = rhi[m] = -INFINITY;
+		}
+		acc = 0;
+		for (j = 0; j < SAH_BINS - 1; j++) {
+			acc += cnt[j];
+			for (m = 0; m < 3; m++) {
+				llo[m] = fmin(llo[m], blo[j][m]);
+				lhi[m] = fmax(lhi[m], bhi[j][m]);
+			}
+			lc[j] = acc;
+			la[j] = acc ? half_area(llo, lhi) : 0.0;
+		}
+		acc = 0;
+		for (j = SAH_BINS - 1; j > 0; j--) {
+			double cost;
+			acc += cnt[j];
+			for (m = 0; m < 3; m++) {
+				rlo[m] = fmin(rlo[m], blo[j][m]);
+				rhi[m] = fmax(rhi[m], bhi[j][m]);
+			}
+			if (lc[j - 1] == 0 || acc == 0)
+				continue;
+			cost = la[j - 1] * (double)lc[j - 1] + half_area(rlo, rhi) * (double)acc;
+			if (cost < best) {
+				best = cost;
+				bax = k;
+				bbin = j; /* bins < j go left */
+			}
+		}
+	}
+	if (bax < 0)
+		return 0;
+	/* partition: bins < bbin to the left */
+	{
+		double ext = chi[bax] - clo[bax];
+		size_t a = s, b = s + n;
+		while (a < b) {
+			size_t t = B->perm[a];
+			int bin = (int)(SAH_BINS * (B->cen[3 * t + bax] - clo[bax]) / ext);
+			bin = bin < 0 ? 0 : (bin >= SAH_BINS ? SAH_BINS - 1 : bin);
+			if (bin < bbin) {
+				a++;
+			} else {
+				uint32_t x = B->perm[a];
+				B->perm[a] = B->perm[--b];
+				B->perm[b] = x;
+			}
+		}
+		left = a - s;
+	}
+	return (left > 0 && left < n) ? left : 0;
+}
+
+/* Build the node for range [s, s + n) (n > leaf); returns its index.
+ * Surface-area splits while the depth leaves room for the rest of the
+ * range to be finished by median splits within PX_MESH_MAX_DEPTH. */
 static uint32_t build_node(struct build *B, size_t s, size_t n, int depth)
 {
 	uint32_t me = (uint32_t)B->n_nodes++;
 	double clo[3] = {INFINITY, INFINITY, INFINITY},
 	       chi[3] = {-INFINITY, -INFINITY, -INFINITY};
-	size_t i, half = n / 2, part[2][2];
+	size_t i, half = 0, part[2][2];
 	int k, axis = 0, c;
 
 	if (depth > B->depth)
@@ -369,10 +479,15 @@ static uint32_t build_node(struct build *B, size_t s, size_t n, int depth)
 			clo[k] = fmin(clo[k], x);
 			chi[k] = fmax(chi[k], x);
 		}
-	for (k = 1; k < 3; k++)
-		if (chi[k] - clo[k] > chi[axis] - clo[axis])
-			axis = k;
-	select_k(B->perm + s, (long)n, (long)half, B->cen, axis);
+	if (depth + 2 + log2ceil(n) <= PX_MESH_MAX_DEPTH - 2)
+		half = sah_split(B, s, n, clo, chi);
+	if (half == 0) {
+		half = n / 2;
+		for (k = 1; k < 3; k++)
+			if (chi[k] - clo[k] > chi[axis] - clo[axis])
+				axis = k;
+		select_k(B->perm + s, (long)n, (long)half, B->cen, axis);
+	}
 	part[0][0] = s;
 	part[0][1] = half;
 	part[1][0] = s + half;

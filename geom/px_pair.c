@@ -286,6 +286,68 @@ static int run_start(const struct px_model *a, const struct px_model *b,
 	return 0;
 }
 
+#define REFINE_CAP 64
+
+/*
+ * Neighbourhood step on side x: every feature of x within the current
+ * distance of x's point (as many as REFINE_CAP allows, shrinking the
+ * radius otherwise), each taken at its point nearest y's point and
+ * projected onto y. Discrete models (clouds, fine meshes) have many
+ * shallow local minima next to the global one; this jumps over them.
+ * Every pair tried is a real pair, so the distance can only drop.
+ * Returns 1 when it improved, 0 when not, a negative error.
+ */
+static int refine_side(const struct px_model *x, const struct px_model *y,
+		       px_vec3 *px, px_vec3 *py, int *ix, int *iy, double *d,
+		       int *iters)
+{
+	const struct px_model_ops *o = px_model_get_ops(x);
+	const void *impl = px_model_impl(x);
+	px_pose P = px_model_pose(x);
+	struct px_model_query q;
+	int idx[REFINE_CAP], n = PX_E_NOSPC, k, tries, improved = 0;
+	double R = *d;
+	px_vec3 c;
+
+	if (!o->collect || !o->closest_among || !(R > 0.0))
+		return 0;
+	c = px_pose_inverse_transform_point(P, *px);
+	for (tries = 0; tries < 8 && n == PX_E_NOSPC; tries++) {
+		n = o->collect(impl, c, R, idx, REFINE_CAP);
+		if (n == PX_E_NOSPC)
+			R *= 0.5;
+	}
+	if (n < 0)
+		return n == PX_E_NOSPC ? 0 : n;
+	q.p = px_pose_inverse_transform_point(P, *py);
+	q.max_dist = INFINITY;
+	q.hint = -1;
+	q.flags = PX_QUERY_UNSIGNED;
+	for (k = 0; k < n; k++) {
+		struct px_model_result rx, ry;
+		px_vec3 xw;
+		int rc = o->closest_among(impl, &q, &idx[k], 1, &rx);
+		if (rc < 0)
+			return rc;
+		if (rc == 0)
+			continue;
+		xw = px_pose_transform_point(P, rx.point);
+		rc = px_model_query_ex(y, xw, INFINITY, -1, PX_QUERY_UNSIGNED, &ry);
+		if (rc < 0)
+			return rc;
+		(*iters)++;
+		if (ry.distance < *d) {
+			*d = ry.distance;
+			*px = xw;
+			*py = ry.point;
+			*ix = rx.index;
+			*iy = ry.index;
+			improved = 1;
+		}
+	}
+	return improved;
+}
+
 static int finite_box(const px_aabb *b)
 {
 	return !px_aabb_is_empty(b) && px_v3_isfinite(b->min) &&
@@ -482,6 +544,32 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 	}
 	if (!have)
 		return PX_E_DEGENERATE;
+	/* neighbourhood steps on both sides, each success polished by a
+	 * further round of projections */
+	for (k = 0; k < 4 && !best.intersecting && best.d > 0.0; k++) {
+		int ia = best.ia, ib = best.ib, ra, rb;
+		double d = best.d;
+		px_vec3 pa = best.pa, pb = best.pb;
+		ra = refine_side(a, b, &pa, &pb, &ia, &ib, &d, &total);
+		if (ra < 0)
+			return ra;
+		rb = refine_side(b, a, &pb, &pa, &ib, &ia, &d, &total);
+		if (rb < 0)
+			return rb;
+		if (!ra && !rb)
+			break;
+		best.d = d;
+		best.pa = pa;
+		best.pb = pb;
+		best.ia = ia;
+		best.ib = ib;
+		rc = run_start(a, b, pa, max_iters, tol, rel, &r);
+		if (rc < 0)
+			return rc;
+		total += r.iters;
+		if (r.d < best.d || r.intersecting)
+			best = r;
+	}
 	res->distance = best.d;
 	res->point_a = best.pa;
 	res->point_b = best.pb;

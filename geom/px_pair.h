@@ -13,7 +13,13 @@
  * points of the two oriented bounding boxes, and reports about 95 % global
  * hits on bunny pairs with that single start. Here several starts are
  * run (the box pair, then the corners and face centres of each box
- * projected onto the other model), the best pair wins, and the result
+ * projected onto the other model), the best pair wins. Discrete models
+ * (clouds, fine meshes) have many shallow local minima right next to the
+ * global one, so the best pair then gets neighbourhood steps: every
+ * feature of either model within the current distance of its point (up
+ * to 64, through the models' cache operations) is tried against the
+ * other model, and any improvement is polished by another round of
+ * projections. The result
  * says whether it is proven global: for two convex models alternating
  * projections converge to the global minimum (projections onto convex
  * sets), so convex pairs (px_model_caps() & PX_MODEL_CAP_CONVEX) that
