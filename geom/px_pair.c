@@ -286,7 +286,7 @@ static int run_start(const struct px_model *a, const struct px_model *b,
 	return 0;
 }
 
-#define REFINE_CAP 64
+#define REFINE_CAP 16
 
 /*
  * Neighbourhood step on side x: every feature of x within the current
@@ -546,7 +546,8 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 		return PX_E_DEGENERATE;
 	/* neighbourhood steps on both sides, each success polished by a
 	 * further round of projections */
-	for (k = 0; k < 4 && !best.intersecting && best.d > 0.0; k++) {
+	for (k = 0; k < (coherent && starts == 1 ? 0 : 2) && !best.intersecting &&
+		    best.d > 0.0; k++) {
 		int ia = best.ia, ib = best.ib, ra, rb;
 		double d = best.d;
 		px_vec3 pa = best.pa, pb = best.pb;

@@ -17,9 +17,10 @@
  * (clouds, fine meshes) have many shallow local minima right next to the
  * global one, so the best pair then gets neighbourhood steps: every
  * feature of either model within the current distance of its point (up
- * to 64, through the models' cache operations) is tried against the
+ * to 16, through the models' cache operations) is tried against the
  * other model, and any improvement is polished by another round of
- * projections. The result
+ * projections (two such rounds; none in coherent mode with one start,
+ * which is meant to be cheap). The result
  * says whether it is proven global: for two convex models alternating
  * projections converge to the global minimum (projections onto convex
  * sets), so convex pairs (px_model_caps() & PX_MODEL_CAP_CONVEX) that
