@@ -66,6 +66,9 @@ struct mesh {
 	size_t bytes;
 	px_vec3 *hull;  /* distinct vertices, convex meshes only (support) */
 	size_t n_hull;
+	uint32_t *adj_start; /* n_hull + 1 offsets into adj (vertex graph) */
+	uint32_t *adj;
+	uint32_t ext[6];     /* vertices extreme along -x, +x, -y, +y, -z, +z */
 };
 
 /* ---- point-triangle distance ------------------------------------------ */
@@ -522,6 +525,8 @@ static void mesh_free(void *impl)
 	free(M->degen);
 	free(M->nodes);
 	free(M->hull);
+	free(M->adj_start);
+	free(M->adj);
 	free(M);
 }
 
@@ -782,17 +787,54 @@ static size_t mesh_bytes(const void *impl)
 
 /* Convex meshes: the vertex farthest along d (a linear scan: convex
  * meshes in this role are small, e.g. a tool or a hull). */
+/*
+ * Convex meshes: the vertex farthest along d. Small meshes are scanned;
+ * larger ones are climbed along the vertex graph from the best of the
+ * six axis-extreme vertices, always to a strictly better neighbour. On a
+ * convex solid a vertex with no better neighbour is a global maximum:
+ * along a polytope edge or across a facet the objective rises wherever
+ * the vertex is not optimal, and the mesh edges follow those edges and
+ * fan across those facets. The one trap, a vertex inside a facet whose
+ * normal is -d, cannot be reached by strict climbing (that facet is the
+ * minimum) and is not a start unless all six extremes lie on one facet,
+ * which the volume required of convex meshes excludes. Each step
+ * strictly increases the objective, so at most n_hull steps.
+ */
 static px_vec3 mesh_support(const void *impl, px_vec3 d)
 {
 	const struct mesh *M = impl;
-	size_t i, bi = 0;
+	size_t i, bi = 0, steps;
 	double best = -INFINITY;
-	for (i = 0; i < M->n_hull; i++) {
-		double s = px_v3_dot(M->hull[i], d);
+	if (!M->adj_start) {
+		for (i = 0; i < M->n_hull; i++) {
+			double s = px_v3_dot(M->hull[i], d);
+			if (s > best) {
+				best = s;
+				bi = i;
+			}
+		}
+		return M->hull[bi];
+	}
+	for (i = 0; i < 6; i++) {
+		double s = px_v3_dot(M->hull[M->ext[i]], d);
 		if (s > best) {
 			best = s;
-			bi = i;
+			bi = M->ext[i];
 		}
+	}
+	for (steps = 0; steps < M->n_hull; steps++) {
+		size_t nb = bi;
+		uint32_t k;
+		for (k = M->adj_start[bi]; k < M->adj_start[bi + 1]; k++) {
+			double s = px_v3_dot(M->hull[M->adj[k]], d);
+			if (s > best) {
+				best = s;
+				nb = M->adj[k];
+			}
+		}
+		if (nb == bi)
+			break;
+		bi = nb;
 	}
 	return M->hull[bi];
 }
@@ -997,6 +1039,17 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 	if (rep->closed) {
 		double ext = 0.0;
 		rep->convex = 1;
+		{
+			/* a solid, not a flat double-sided sheet */
+			px_aabb bb = px_aabb_empty();
+			double dg;
+			for (i = 0; i < nv; i++)
+				if (used[i])
+					px_aabb_extend(&bb, px_v3(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]));
+			dg = px_aabb_diagonal(&bb);
+			if (!(rep->volume > 1e-9 * dg * dg * dg))
+				rep->convex = 0;
+		}
 		for (i = 0; i < nv; i++)
 			if (used[i])
 				ext = fmax(ext, fmax(fabs(xyz[3 * i]),
@@ -1114,10 +1167,51 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 		if (!M->hull)
 			goto fail;
 		for (i = 0; i < nv; i++)
-			if (used[i] && canon[i] == i && h < rep->n_welded)
+			if (used[i] && canon[i] == i && h < rep->n_welded) {
+				order[i] = (uint32_t)h; /* order[] reused: canon id -> hull index */
 				M->hull[h++] = px_v3(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+			}
 		M->n_hull = h;
 		M->bytes += h * sizeof(*M->hull);
+		if (h > 32) {
+			/* vertex graph (CSR) from the distinct edges, sorted in E */
+			size_t ne2 = 0, j2;
+			M->adj_start = calloc(h + 1, sizeof(uint32_t));
+			M->adj = malloc(2 * ne * sizeof(uint32_t));
+			if (!M->adj_start || !M->adj)
+				goto fail;
+			for (j2 = 0; j2 < ne; j2++)
+				if (j2 == 0 || E[j2].lo != E[j2 - 1].lo || E[j2].hi != E[j2 - 1].hi) {
+					M->adj_start[order[E[j2].lo] + 1]++;
+					M->adj_start[order[E[j2].hi] + 1]++;
+				}
+			for (j2 = 0; j2 < h; j2++)
+				M->adj_start[j2 + 1] += M->adj_start[j2];
+			{
+				uint32_t *fill = calloc(h, sizeof(uint32_t));
+				if (!fill)
+					goto fail;
+				for (j2 = 0; j2 < ne; j2++)
+					if (j2 == 0 || E[j2].lo != E[j2 - 1].lo || E[j2].hi != E[j2 - 1].hi) {
+						uint32_t a = order[E[j2].lo], b = order[E[j2].hi];
+						M->adj[M->adj_start[a] + fill[a]++] = b;
+						M->adj[M->adj_start[b] + fill[b]++] = a;
+						ne2 += 2;
+					}
+				free(fill);
+			}
+			for (k = 0; k < 6; k++) {
+				double bs = -INFINITY;
+				for (j2 = 0; j2 < h; j2++) {
+					double v = px_v3_comp(M->hull[j2], k / 2) * (k % 2 ? 1.0 : -1.0);
+					if (v > bs) {
+						bs = v;
+						M->ext[k] = (uint32_t)j2;
+					}
+				}
+			}
+			M->bytes += (h + 1 + ne2) * sizeof(uint32_t);
+		}
 	}
 	rc = px_model_create(rep->convex ? &mesh_ops_convex : &mesh_ops, M,
 			     PX_MODEL_CAP_EXACT | PX_MODEL_CAP_COHERENT |

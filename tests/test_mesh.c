@@ -315,6 +315,61 @@ static void test_cache(void)
 	gen_free(&g2);
 }
 
+static void test_convex_support(void)
+{
+	/* The support point of convex meshes (hill climbing on larger ones)
+	 * against a scan of all vertices, including axis directions, where a
+	 * subdivided box has whole faces of ties. */
+	struct gen_mesh g[3];
+	double h[3] = {0.3, 0.5, 0.2};
+	int k, i;
+	PX_CHECK_INT_EQ(gen_sphere(0.5, 20, 40, &g[0]), 0);
+	PX_CHECK_INT_EQ(gen_box(h, 6, &g[1]), 0);
+	PX_CHECK_INT_EQ(gen_sphere(0.5, 3, 4, &g[2]), 0); /* small: plain scan */
+	for (k = 0; k < 3; k++) {
+		struct px_model *m;
+		struct px_mesh_report rp;
+		PX_CHECK_INT_EQ(px_mesh_model(g[k].xyz, g[k].nv, g[k].tri, g[k].nt, NULL, &rp, &m), PX_OK);
+		PX_CHECK_MSG(rp.convex, "mesh %d not convex: %s", k, rp.message);
+		px_model_set_pose(m, rand_pose());
+		for (i = 0; i < 600; i++) {
+			px_vec3 d = i < 6 ? px_v3(i / 2 == 0 ? (i % 2 ? 1 : -1) : 0,
+						  i / 2 == 1 ? (i % 2 ? 1 : -1) : 0,
+						  i / 2 == 2 ? (i % 2 ? 1 : -1) : 0)
+				    : rand_v(1), s, dl;
+			double best = -INFINITY;
+			size_t t;
+			int c;
+			if (i < 6) /* axis directions of the mesh's own frame */
+				d = px_pose_transform_vector(px_model_pose(m), d);
+			PX_CHECK_INT_EQ(px_model_support(m, d, &s), PX_OK);
+			dl = px_pose_inverse_transform_vector(px_model_pose(m), d);
+			for (t = 0; t < px_mesh_triangle_count(m); t++) {
+				px_vec3 v[3];
+				px_mesh_triangle(m, t, v);
+				for (c = 0; c < 3; c++)
+					best = fmax(best, px_v3_dot(v[c], dl));
+			}
+			PX_CHECK_NEAR(px_v3_dot(px_pose_inverse_transform_point(px_model_pose(m), s), dl),
+				      best, 1e-12);
+		}
+		px_model_free(m);
+		gen_free(&g[k]);
+	}
+	{
+		/* a flat double-sided sheet is closed but not a convex solid */
+		double xyz[] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+		uint32_t t2[] = {0, 1, 2, 0, 2, 1};
+		struct px_model *m;
+		struct px_mesh_report rp;
+		px_vec3 out;
+		PX_CHECK_INT_EQ(px_mesh_model(xyz, 3, t2, 2, NULL, &rp, &m), PX_OK);
+		PX_CHECK(!rp.convex);
+		PX_CHECK_INT_EQ(px_model_support(m, px_v3(1, 0, 0), &out), PX_E_UNSUPPORTED);
+		px_model_free(m);
+	}
+}
+
 /* ---- sign -------------------------------------------------------------------- */
 
 static void test_sign_box_exact(void)
@@ -769,7 +824,7 @@ static void test_no_alloc(void)
 static const struct px_test tests[] = {
 	PX_T(test_tri_closest),      PX_T(test_tri_regions),
 	PX_T(test_soup_vs_brute),    PX_T(test_closed_vs_brute),
-	PX_T(test_coherent),         PX_T(test_cache),         PX_T(test_sign_box_exact),
+	PX_T(test_coherent),         PX_T(test_cache), PX_T(test_convex_support),         PX_T(test_sign_box_exact),
 	PX_T(test_sign_sphere_torus), PX_T(test_sign_concave), PX_T(test_sign_tetra),
 	PX_T(test_open_and_bad_topology),
 	PX_T(test_validation),       PX_T(test_load_files),
