@@ -48,7 +48,17 @@ static int cmp_d(const void *a, const void *b)
 
 struct stats {
 	double median, p90, p99, max, mean;
+	double cpu_mean; /* thread CPU time per query, < 0 when not measured */
 };
+
+/* Thread CPU time: on a shared machine the wall-clock figures include
+ * time the thread spent preempted; this one does not. */
+static int64_t cpu_ns(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+	return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
 
 static struct stats summarize(double *t, int n, double overhead)
 {
@@ -65,13 +75,17 @@ static struct stats summarize(double *t, int n, double overhead)
 	s.p99 = t[(int)(0.99 * n)];
 	s.max = t[n - 1];
 	s.mean = sum / n;
+	s.cpu_mean = -1.0;
 	return s;
 }
 
 static void print_stats(const char *what, struct stats s)
 {
-	printf("  %-34s median %8.3f us  p90 %8.3f  p99 %8.3f  max %8.3f  mean %8.3f\n",
+	printf("  %-34s median %8.3f us  p90 %8.3f  p99 %8.3f  max %8.3f  mean %8.3f",
 	       what, s.median / 1e3, s.p90 / 1e3, s.p99 / 1e3, s.max / 1e3, s.mean / 1e3);
+	if (s.cpu_mean >= 0.0)
+		printf("  cpu mean %.3f", s.cpu_mean / 1e3);
+	printf("\n");
 }
 
 static double timer_overhead(void)
@@ -95,8 +109,10 @@ static struct stats run_queries(const struct px_model *m, const double *pts,
 				double *sum_abs)
 {
 	struct px_model_result r;
+	struct stats st;
 	int i, hint = -1;
 	double s = 0;
+	int64_t c0 = cpu_ns(), c1;
 	for (i = 0; i < n; i++) {
 		px_vec3 p = px_v3(pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]);
 		int64_t a = now_ns();
@@ -108,9 +124,12 @@ static struct stats run_queries(const struct px_model *m, const double *pts,
 		hint = r.index;
 		s += fabs(r.distance);
 	}
+	c1 = cpu_ns();
 	if (sum_abs)
 		*sum_abs = s;
-	return summarize(times, n, overhead);
+	st = summarize(times, n, overhead);
+	st.cpu_mean = fmax(0.0, (double)(c1 - c0) / n - 2.0 * overhead);
+	return st;
 }
 
 struct fcl_out {
@@ -177,7 +196,9 @@ int main(int argc, char **argv)
 		bm_traj_point(i, traj + 3 * i);
 	}
 	overhead = timer_overhead();
-	printf("bench_models: timer overhead %.0f ns per query (subtracted)\n", overhead);
+	printf("bench_models: timer overhead %.0f ns per query (subtracted); 'cpu mean' is "
+	       "thread CPU time per query,\n  which leaves out time preempted by other "
+	       "processes on a shared machine\n", overhead);
 
 	/* ---- mesh ---- */
 	if (gen_torus(BM_R, BM_r, BM_NU, BM_NV, &g) != 0)
@@ -192,6 +213,20 @@ int main(int argc, char **argv)
 	       (now_ns() - t0) / 1e6);
 	sc = run_queries(mesh, cold, BM_NQ, 0, overhead, &sum_cold);
 	print_stats("cold (independent points)", sc);
+	{
+		/* the two halves of the cold set on their own */
+		double *half = malloc(3 * (BM_NQ / 2) * sizeof(double));
+		int h;
+		if (!half)
+			return 1;
+		for (h = 0; h < 2; h++) {
+			for (i = 0; i < BM_NQ / 2; i++)
+				memcpy(half + 3 * i, cold + 3 * (2 * i + h), 3 * sizeof(double));
+			print_stats(h ? "  of which free space" : "  of which near the surface",
+				    run_queries(mesh, half, BM_NQ / 2, 0, overhead, NULL));
+		}
+		free(half);
+	}
 	stc = run_queries(mesh, traj, BM_NQ, 0, overhead, NULL);
 	print_stats("trajectory, cold", stc);
 	st = run_queries(mesh, traj, BM_NQ, 1, overhead, &sum_traj);
