@@ -10,7 +10,8 @@
  * Aanaes 2005) and builds a binary AABB hierarchy over the triangles
  * (binned surface-area splits, switching to median splits where needed
  * to keep the depth within PX_MESH_MAX_DEPTH; child boxes are stored in
- * single precision rounded outwards, so they stay lower bounds). A query then needs no memory but a fixed array on
+ * single precision rounded outwards, so they stay lower bounds), then
+ * collapses it to four children per node for the queries. A query then needs no memory but a fixed array on
  * the call stack: it descends nearer child first and prunes every box
  * farther than the best triangle so far; the distance to a triangle is
  * exact over all seven Voronoi regions (face, three edges, three
@@ -38,7 +39,7 @@
  *
  * Memory and real-time rules: building allocates (setup only) about 330
  * bytes per triangle; queries are RT-safe (no heap, bounded by the
- * triangle count, fixed stack of PX_MESH_MAX_DEPTH + 2 entries).
+ * triangle count, fixed stack of 3 PX_MESH_MAX_DEPTH + 4 entries).
  */
 #ifndef PX_MESH_H
 #define PX_MESH_H
@@ -54,7 +55,9 @@
 extern "C" {
 #endif
 
-/* Hierarchy depth bound (median splits give about log2(triangles / 2)). */
+/* Depth bound of the binary build (median splits give about
+ * log2(triangles / 2); surface-area splits are used only while they leave
+ * room for that). */
 #define PX_MESH_MAX_DEPTH 48
 /* Largest triangle count (indices are 32-bit inside). */
 #define PX_MESH_MAX_TRIANGLES ((size_t)1 << 30)
