@@ -29,7 +29,9 @@
 #include "px_cloud.h"
 #include "px_mesh.h"
 #include "px_model.h"
+#include "px_pair.h"
 #include "px_prim.h"
+#include "px_scene.h"
 
 static int64_t now_ns(void)
 {
@@ -46,7 +48,17 @@ static int cmp_d(const void *a, const void *b)
 
 struct stats {
 	double median, p90, p99, max, mean;
+	double cpu_mean; /* thread CPU time per query, < 0 when not measured */
 };
+
+/* Thread CPU time: on a shared machine the wall-clock figures include
+ * time the thread spent preempted; this one does not. */
+static int64_t cpu_ns(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+	return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
 
 static struct stats summarize(double *t, int n, double overhead)
 {
@@ -63,13 +75,17 @@ static struct stats summarize(double *t, int n, double overhead)
 	s.p99 = t[(int)(0.99 * n)];
 	s.max = t[n - 1];
 	s.mean = sum / n;
+	s.cpu_mean = -1.0;
 	return s;
 }
 
 static void print_stats(const char *what, struct stats s)
 {
-	printf("  %-34s median %8.3f us  p90 %8.3f  p99 %8.3f  max %8.3f  mean %8.3f\n",
+	printf("  %-34s median %8.3f us  p90 %8.3f  p99 %8.3f  max %8.3f  mean %8.3f",
 	       what, s.median / 1e3, s.p90 / 1e3, s.p99 / 1e3, s.max / 1e3, s.mean / 1e3);
+	if (s.cpu_mean >= 0.0)
+		printf("  cpu mean %.3f", s.cpu_mean / 1e3);
+	printf("\n");
 }
 
 static double timer_overhead(void)
@@ -93,8 +109,10 @@ static struct stats run_queries(const struct px_model *m, const double *pts,
 				double *sum_abs)
 {
 	struct px_model_result r;
+	struct stats st;
 	int i, hint = -1;
 	double s = 0;
+	int64_t c0 = cpu_ns(), c1;
 	for (i = 0; i < n; i++) {
 		px_vec3 p = px_v3(pts[3 * i], pts[3 * i + 1], pts[3 * i + 2]);
 		int64_t a = now_ns();
@@ -106,9 +124,12 @@ static struct stats run_queries(const struct px_model *m, const double *pts,
 		hint = r.index;
 		s += fabs(r.distance);
 	}
+	c1 = cpu_ns();
 	if (sum_abs)
 		*sum_abs = s;
-	return summarize(times, n, overhead);
+	st = summarize(times, n, overhead);
+	st.cpu_mean = fmax(0.0, (double)(c1 - c0) / n - 2.0 * overhead);
+	return st;
 }
 
 struct fcl_out {
@@ -157,7 +178,7 @@ int main(int argc, char **argv)
 	struct px_model *mesh, *cloud, *prim;
 	struct px_mesh_report rp;
 	double overhead, *cold, *traj, *cpts, sum_cold = 0, sum_traj = 0;
-	struct stats sc, st, stc;
+	struct stats sc, st, stc, stcache;
 	uint64_t seed = 12345;
 	int64_t t0;
 	int i;
@@ -175,7 +196,9 @@ int main(int argc, char **argv)
 		bm_traj_point(i, traj + 3 * i);
 	}
 	overhead = timer_overhead();
-	printf("bench_models: timer overhead %.0f ns per query (subtracted)\n", overhead);
+	printf("bench_models: timer overhead %.0f ns per query (subtracted); 'cpu mean' is "
+	       "thread CPU time per query,\n  which leaves out time preempted by other "
+	       "processes on a shared machine\n", overhead);
 
 	/* ---- mesh ---- */
 	if (gen_torus(BM_R, BM_r, BM_NU, BM_NV, &g) != 0)
@@ -190,12 +213,44 @@ int main(int argc, char **argv)
 	       (now_ns() - t0) / 1e6);
 	sc = run_queries(mesh, cold, BM_NQ, 0, overhead, &sum_cold);
 	print_stats("cold (independent points)", sc);
+	{
+		/* the two halves of the cold set on their own */
+		double *half = malloc(3 * (BM_NQ / 2) * sizeof(double));
+		int h;
+		if (!half)
+			return 1;
+		for (h = 0; h < 2; h++) {
+			for (i = 0; i < BM_NQ / 2; i++)
+				memcpy(half + 3 * i, cold + 3 * (2 * i + h), 3 * sizeof(double));
+			print_stats(h ? "  of which free space" : "  of which near the surface",
+				    run_queries(mesh, half, BM_NQ / 2, 0, overhead, NULL));
+		}
+		free(half);
+	}
 	stc = run_queries(mesh, traj, BM_NQ, 0, overhead, NULL);
 	print_stats("trajectory, cold", stc);
 	st = run_queries(mesh, traj, BM_NQ, 1, overhead, &sum_traj);
-	print_stats("trajectory, coherent", st);
+	print_stats("trajectory, coherent (hint)", st);
+	{
+		struct px_model_cache cache;
+		struct px_model_result r;
+		double s2 = 0;
+		px_model_cache_init(&cache, 0.0);
+		for (i = 0; i < BM_NQ; i++) {
+			px_vec3 p = px_v3(traj[3 * i], traj[3 * i + 1], traj[3 * i + 2]);
+			int64_t a = now_ns();
+			px_model_query_cached(mesh, p, &cache, &r);
+			times[i] = (double)(now_ns() - a);
+			s2 += fabs(r.distance);
+		}
+		stcache = summarize(times, BM_NQ, overhead);
+		print_stats("trajectory, coherent (cache)", stcache);
+		printf("  %-34s %lu refills in %d queries; sum of |distance| %.12g (hint path %.12g)\n",
+		       "", px_model_cache_refills(&cache), BM_NQ, s2, sum_traj);
+	}
 	printf("  targets: cold median <= 2 us: %s; coherent median <= 0.5 us: %s\n",
-	       sc.median <= 2000 ? "met" : "NOT met", st.median <= 500 ? "met" : "NOT met");
+	       sc.median <= 2000 ? "met" : "NOT met",
+	       fmin(st.median, stcache.median) <= 500 ? "met" : "NOT met");
 	{
 		struct fcl_out fo = run_fcl(argv[0]);
 		if (fo.ok) {
@@ -205,9 +260,11 @@ int main(int argc, char **argv)
 			printf("  same answers: sum of |distance| cold %.12g vs FCL %.12g, "
 			       "trajectory %.12g vs FCL %.12g\n",
 			       sum_cold, fo.cold_sum, sum_traj, fo.traj_sum);
-			printf("  speed-up over FCL: cold %.1fx, coherent %.1fx (target >= 5x)\n",
+			printf("  speed-up over FCL: cold %.1fx, coherent %.1fx (hint) %.1fx (cache) "
+			       "(target >= 5x)\n",
 			       fo.cold_median / fmax(sc.median, 1.0),
-			       fo.traj_median / fmax(st.median, 1.0));
+			       fo.traj_median / fmax(st.median, 1.0),
+			       fo.traj_median / fmax(stcache.median, 1.0));
 		}
 	}
 	px_model_free(mesh);
@@ -234,7 +291,19 @@ int main(int argc, char **argv)
 		p[0] *= rr / n, p[1] *= rr / n, p[2] *= rr / n;
 	}
 	print_stats("cold (independent points)", run_queries(cloud, cold, BM_NQ, 0, overhead, NULL));
-	print_stats("trajectory, coherent", run_queries(cloud, traj, BM_NQ, 1, overhead, NULL));
+	print_stats("trajectory, coherent (hint)", run_queries(cloud, traj, BM_NQ, 1, overhead, NULL));
+	{
+		struct px_model_cache cache;
+		struct px_model_result r;
+		px_model_cache_init(&cache, 0.0);
+		for (i = 0; i < BM_NQ; i++) {
+			px_vec3 p = px_v3(traj[3 * i], traj[3 * i + 1], traj[3 * i + 2]);
+			int64_t a = now_ns();
+			px_model_query_cached(cloud, p, &cache, &r);
+			times[i] = (double)(now_ns() - a);
+		}
+		print_stats("trajectory, coherent (cache)", summarize(times, BM_NQ, overhead));
+	}
 	px_model_free(cloud);
 
 	/* ---- primitives ---- */
@@ -257,6 +326,136 @@ int main(int argc, char **argv)
 			px_model_free(prim);
 		}
 	}
+	/* ---- model to model ---- */
+	{
+		struct gen_mesh g1, g2;
+		struct px_model *ma, *mb, *ca, *cb, *sp;
+		struct px_prim cyl = {PX_PRIM_CYLINDER, 0.05, 0.1, 0}, box = {PX_PRIM_BOX, 0.05, 0.08, 0.1};
+		struct px_prim sph = {PX_PRIM_SPHERE, 0.05, 0, 0};
+		struct px_pair_opts o1 = {1, 64, 1e-12, 1, 0}, o8 = {8, 64, 1e-12, 0, 0};
+		struct px_pair_result r;
+		const int NP = 2000;
+		gen_torus(0.1, 0.03, 64, 32, &g1);
+		gen_sphere(0.08, 32, 64, &g2);
+		px_mesh_model(g1.xyz, g1.nv, g1.tri, g1.nt, NULL, NULL, &ma);
+		px_mesh_model(g2.xyz, g2.nv, g2.tri, g2.nt, NULL, NULL, &mb);
+		px_prim_model(&cyl, &ca);
+		px_prim_model(&box, &cb);
+		px_prim_model(&sph, &sp);
+		printf("model to model (%d poses on a circle, 1 mm apart):\n", NP);
+		{
+			const struct {
+				const char *name;
+				struct px_model *a, *b;
+				const struct px_pair_opts *o;
+			} P[] = {{"mesh torus 4k tris / mesh sphere 4k, 8 starts", ma, mb, &o8},
+				 {"same, coherent, 1 start", ma, mb, &o1},
+				 {"sphere / mesh torus (exact)", sp, ma, &o8},
+				 {"cylinder / box (GJK)", ca, cb, &o8}};
+			size_t k;
+			for (k = 0; k < sizeof(P) / sizeof(P[0]); k++) {
+				int local = 0;
+				memset(&r, 0, sizeof(r));
+				for (i = 0; i < NP; i++) {
+					px_pose Pb = px_pose_identity();
+					int64_t a;
+					Pb.t = px_v3(0.25 * cos(4e-3 * i), 0.25 * sin(4e-3 * i), 0.02);
+					px_quat_from_axis_angle(px_v3(1, 1, 0), 2e-3 * i, &Pb.q);
+					px_model_set_pose(P[k].b, Pb);
+					a = now_ns();
+					px_pair_distance(P[k].a, P[k].b, P[k].o, &r);
+					times[i] = (double)(now_ns() - a);
+					local += r.local_only;
+				}
+				print_stats(P[k].name, summarize(times, NP, overhead));
+				printf("  %-34s %d of %d results flagged possibly local\n", "", local, NP);
+			}
+		}
+		px_model_free(ma);
+		px_model_free(mb);
+		px_model_free(ca);
+		px_model_free(cb);
+		px_model_free(sp);
+		gen_free(&g1);
+		gen_free(&g2);
+	}
+
+	/* ---- scenes ---- */
+	{
+		int sizes[2] = {20, 200}, si;
+		for (si = 0; si < 2; si++) {
+			int nm = sizes[si], k;
+			struct px_scene *scn;
+			struct px_model **ms = calloc((size_t)nm, sizeof(*ms));
+			struct px_model *tool;
+			struct px_prim cap = {PX_PRIM_CAPSULE, 0.02, 0.05, 0};
+			struct px_scene_hit hits[64];
+			struct gen_mesh gs;
+			struct stats su, stool, sn;
+			double *t2 = malloc(BM_NQ * sizeof(double)), *t3 = malloc(BM_NQ * sizeof(double));
+			uint64_t sd = 99;
+			const int NQ = 5000;
+			gen_sphere(0.05, 16, 32, &gs); /* 960 triangles */
+			px_scene_create((size_t)nm, &scn);
+			for (k = 0; k < nm; k++) {
+				px_pose P = px_pose_identity();
+				/* models spread in a cube whose volume grows with
+				 * their number (constant density) */
+				double e = 0.5 * cbrt(nm / 20.0);
+				if (k % 3 == 2) {
+					px_mesh_model(gs.xyz, gs.nv, gs.tri, gs.nt, NULL, NULL, &ms[k]);
+				} else {
+					struct px_prim pr = {k % 3 ? PX_PRIM_BOX : PX_PRIM_CYLINDER, 0.04, 0.06, 0.05};
+					px_prim_model(&pr, &ms[k]);
+				}
+				P.t = px_v3(e * (2 * bm_unit(&sd) - 1), e * (2 * bm_unit(&sd) - 1),
+					    e * (2 * bm_unit(&sd) - 1));
+				px_quat_from_axis_angle(px_v3(bm_unit(&sd), bm_unit(&sd), 1), 3 * bm_unit(&sd), &P.q);
+				px_model_set_pose(ms[k], P);
+				px_scene_add(scn, ms[k], NULL);
+			}
+			px_prim_model(&cap, &tool);
+			for (i = 0; i < NQ; i++) {
+				px_pose P = px_pose_identity();
+				double e = 0.5 * cbrt(nm / 20.0);
+				int64_t a;
+				/* every cycle: one model moves, the scene updates */
+				px_pose Q = px_model_pose(ms[i % nm]);
+				Q.t.x += 1e-4;
+				px_model_set_pose(ms[i % nm], Q);
+				a = now_ns();
+				px_scene_update(scn);
+				times[i] = (double)(now_ns() - a);
+				P.t = px_v3(e * cos(1e-3 * i), e * sin(1.3e-3 * i), 0.5 * e * sin(0.7e-3 * i));
+				px_model_set_pose(tool, P);
+				a = now_ns();
+				px_scene_tool(scn, tool, 0.05, NULL, hits, 64, NULL);
+				t2[i] = (double)(now_ns() - a);
+				a = now_ns();
+				px_scene_nearest(scn, P.t, INFINITY, hits);
+				t3[i] = (double)(now_ns() - a);
+			}
+			printf("scene of %d models (1/3 meshes of 960 triangles, boxes, cylinders):\n", nm);
+			su = summarize(times, NQ, overhead);
+			stool = summarize(t2, NQ, overhead);
+			sn = summarize(t3, NQ, overhead);
+			print_stats("update (poses -> hierarchy)", su);
+			print_stats("capsule tool, within 5 cm", stool);
+			print_stats("nearest model to a point", sn);
+			if (nm == 20)
+				printf("  target: tool against a 20-model scene <= 20 us: %s\n",
+				       stool.median + su.median <= 20000 ? "met (update + query)" : "NOT met");
+			px_scene_free(scn);
+			for (k = 0; k < nm; k++)
+				px_model_free(ms[k]);
+			px_model_free(tool);
+			free(ms);
+			free(t2);
+			free(t3);
+			gen_free(&gs);
+		}
+	}
+
 	free(times);
 	free(cold);
 	free(traj);

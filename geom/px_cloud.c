@@ -171,6 +171,51 @@ static inline double box_d2(const struct node *nd, int c, px_vec3 p)
 	return dx * dx + dy * dy + dz * dz;
 }
 
+/* Fill a result from the nearest centre bi at squared distance best;
+ * returns 0 when it lies beyond max_dist. */
+static int cloud_finish(const struct cloud *C, const struct px_model_query *q,
+			long bi, double best, int iters, int certified,
+			struct px_model_result *r)
+{
+	px_vec3 p = q->p, v;
+	double d;
+
+	v = px_v3_sub(p, C->pt[bi]);
+	d = sqrt(best);
+	if (d > 0.0)
+		r->direction = px_v3_scale(v, 1.0 / d);
+	else
+		r->direction = px_v3(0.0, 0.0, 1.0);
+	r->point = px_v3_madd(C->pt[bi], r->direction, C->radius);
+	r->distance = d - C->radius;
+	r->is_signed = C->radius > 0.0;
+	r->inside = 0;
+	if (r->distance < 0.0) {
+		if (q->flags & PX_QUERY_UNSIGNED) {
+			r->distance = -r->distance;
+			r->direction = px_v3_neg(r->direction);
+			r->is_signed = 0;
+		} else {
+			r->inside = 1;
+		}
+	} else if (q->flags & PX_QUERY_UNSIGNED) {
+		r->is_signed = 0;
+	}
+	if (r->distance == 0.0)
+		r->distance = 0.0;
+	if (fabs(r->distance) > q->max_dist)
+		return 0;
+	r->index = (int)C->orig[bi];
+	r->sub = -1;
+	r->feature = PX_FEATURE_POINT;
+	r->u = r->v = 0.0;
+	r->iterations = iters;
+	r->certified = certified;
+	r->gap = 0.0;
+	return 1;
+}
+
+
 static int cloud_closest(const void *impl, const struct px_model_query *q,
 			 struct px_model_result *r)
 {
@@ -180,8 +225,8 @@ static int cloud_closest(const void *impl, const struct px_model_query *q,
 		double d2;
 	} st[PX_CLOUD_MAX_DEPTH + 2];
 	int sp = 0, iters = 0, certified = 1;
-	px_vec3 p = q->p, v;
-	double best, d;
+	px_vec3 p = q->p;
+	double best;
 	long bi = -1;
 
 	if (isinf(q->max_dist))
@@ -241,39 +286,70 @@ static int cloud_closest(const void *impl, const struct px_model_query *q,
 	}
 	if (bi < 0)
 		return 0;
-	v = px_v3_sub(p, C->pt[bi]);
-	d = sqrt(best);
-	if (d > 0.0)
-		r->direction = px_v3_scale(v, 1.0 / d);
-	else
-		r->direction = px_v3(0.0, 0.0, 1.0);
-	r->point = px_v3_madd(C->pt[bi], r->direction, C->radius);
-	r->distance = d - C->radius;
-	r->is_signed = C->radius > 0.0;
-	r->inside = 0;
-	if (r->distance < 0.0) {
-		if (q->flags & PX_QUERY_UNSIGNED) {
-			r->distance = -r->distance;
-			r->direction = px_v3_neg(r->direction);
-			r->is_signed = 0;
-		} else {
-			r->inside = 1;
+	return cloud_finish(C, q, bi, best, iters, certified, r);
+}
+
+/* Cache operations (clouds without a radius: the feature distance is
+ * then the point distance, which the cache's bound is about). */
+static int cloud_closest_among(const void *impl, const struct px_model_query *q,
+			       const int *idx, int n, struct px_model_result *r)
+{
+	const struct cloud *C = impl;
+	double best = isinf(q->max_dist) ? INFINITY : q->max_dist * q->max_dist;
+	long bi = -1;
+	int i;
+	for (i = 0; i < n; i++) {
+		double d2;
+		if (idx[i] < 0 || (size_t)idx[i] >= C->n)
+			continue;
+		d2 = px_v3_dist2(q->p, C->pt[idx[i]]);
+		if (d2 < best || (d2 == best && bi < 0)) {
+			best = d2;
+			bi = idx[i];
 		}
-	} else if (q->flags & PX_QUERY_UNSIGNED) {
-		r->is_signed = 0;
 	}
-	if (r->distance == 0.0)
-		r->distance = 0.0;
-	if (fabs(r->distance) > q->max_dist)
+	if (bi < 0)
 		return 0;
-	r->index = (int)C->orig[bi];
-	r->sub = -1;
-	r->feature = PX_FEATURE_POINT;
-	r->u = r->v = 0.0;
-	r->iterations = iters;
-	r->certified = certified;
-	r->gap = 0.0;
-	return 1;
+	return cloud_finish(C, q, bi, best, n, 1, r);
+}
+
+static int cloud_collect(const void *impl, px_vec3 p, double radius, int *idx,
+			 int cap)
+{
+	const struct cloud *C = impl;
+	struct {
+		uint32_t idx, cnt;
+	} st[PX_CLOUD_MAX_DEPTH + 2];
+	double r2 = radius * radius;
+	int sp = 0, n = 0;
+
+	st[sp].idx = 0;
+	st[sp].cnt = 0;
+	sp++;
+	while (sp > 0) {
+		sp--;
+		if (st[sp].cnt > 0) {
+			uint32_t i;
+			for (i = st[sp].idx; i < st[sp].idx + st[sp].cnt; i++)
+				if (px_v3_dist2(p, C->pt[i]) <= r2) {
+					if (n == cap)
+						return PX_E_NOSPC;
+					idx[n++] = (int)i;
+				}
+		} else {
+			const struct node *nd = &C->nodes[st[sp].idx];
+			int c;
+			for (c = 0; c < 2; c++) {
+				if (nd->idx[c] == EMPTY || box_d2(nd, c, p) > r2 ||
+				    sp >= PX_CLOUD_MAX_DEPTH + 2)
+					continue;
+				st[sp].idx = nd->idx[c];
+				st[sp].cnt = nd->cnt[c];
+				sp++;
+			}
+		}
+	}
+	return n;
 }
 
 static px_aabb cloud_aabb(const void *impl)
@@ -289,7 +365,10 @@ static size_t cloud_bytes(const void *impl)
 
 static const struct px_model_ops cloud_ops = {
 	"cloud", PX_MODEL_CLOUD, cloud_closest, cloud_aabb, cloud_bytes,
-	cloud_free};
+	cloud_free, NULL, NULL, NULL};
+static const struct px_model_ops cloud_ops_cache = {
+	"cloud", PX_MODEL_CLOUD, cloud_closest, cloud_aabb, cloud_bytes,
+	cloud_free, NULL, cloud_closest_among, cloud_collect};
 
 int px_cloud_model(const double *xyz, size_t n, double radius_m,
 		   struct px_cloud_report *rep, struct px_model **out)
@@ -382,7 +461,7 @@ int px_cloud_model(const double *xyz, size_t n, double radius_m,
 	C->bytes = sizeof(*C) + n * (sizeof(px_vec3) + 2 * sizeof(uint32_t)) +
 		   C->n_nodes * sizeof(struct node);
 	free(perm);
-	rc = px_model_create(&cloud_ops, C,
+	rc = px_model_create(radius_m > 0.0 ? &cloud_ops : &cloud_ops_cache, C,
 			     PX_MODEL_CAP_EXACT | PX_MODEL_CAP_COHERENT |
 				     (radius_m > 0.0 ? PX_MODEL_CAP_SIGNED : 0u),
 			     out);
@@ -577,7 +656,8 @@ int px_cloud_load(const char *path, double radius_m,
 
 static const struct cloud *as_cloud(const struct px_model *m)
 {
-	if (px_model_get_ops(m) != &cloud_ops)
+	const struct px_model_ops *o = px_model_get_ops(m);
+	if (o != &cloud_ops && o != &cloud_ops_cache)
 		return NULL;
 	return px_model_impl(m);
 }

@@ -16,6 +16,10 @@
  * into the nearest ball's centre, a conservative penetration value.
  * With r = 0 distances are unsigned.
  *
+ * Clouds without a radius support the coherence cache
+ * (px_model_query_cached); with a radius, cached queries fall back to
+ * hint-coherent ones.
+ *
  * Results (px_model_result): index = point (input order), feature =
  * PX_FEATURE_POINT, u = v = 0, iterations = nodes and points visited,
  * certified = 1 (exact).

@@ -23,15 +23,30 @@
 struct node {
 	float lo[2][3], hi[2][3]; /* rounded outwards: still lower bounds */
 	uint32_t idx[2], cnt[2];
-};
+} __attribute__((aligned(64)));
+
+/* The query hierarchy: the binary tree collapsed to four children per
+ * node (each node takes its children and grandchildren), which halves
+ * the number of dependent memory fetches on the way down. Boxes per axis
+ * and child, so the four distances are computed side by side. */
+struct node4 {
+	float lo[3][4], hi[3][4];
+	uint32_t idx[4], cnt[4];
+} __attribute__((aligned(64)));
+
+#define STACK4 (3 * PX_MESH_MAX_DEPTH + 4)
 
 /* Triangle with its (unnormalized) normal n = (b - a) x (c - a) and
  * 1 / |n|^2, for the plane-distance lower bound. */
 struct mtri {
-	px_vec3 a, b, c;
+	/* first cache line: what the plane lower bound reads */
+	px_vec3 a;
 	px_vec3 n;
 	double inv_nn;
-};
+	double pad_;
+	/* second line: only for triangles the bound does not reject */
+	px_vec3 b, c;
+} __attribute__((aligned(64)));
 
 static float f_down(double x)
 {
@@ -54,12 +69,19 @@ struct mesh {
 	px_vec3 *en;         /* 3 edge pseudo-normals per leaf triangle */
 	px_vec3 *vnt;        /* 3 vertex pseudo-normals per leaf triangle */
 	uint8_t *degen;      /* per leaf triangle */
-	struct node *nodes;
+	struct node *nodes;  /* binary tree: setup only, freed after collapsing */
 	size_t n_nodes;
+	struct node4 *n4;
+	size_t n_n4;
 	int closed;
 	int depth;
 	px_aabb box;
 	size_t bytes;
+	px_vec3 *hull;  /* distinct vertices, convex meshes only (support) */
+	size_t n_hull;
+	uint32_t *adj_start; /* n_hull + 1 offsets into adj (vertex graph) */
+	uint32_t *adj;
+	uint32_t ext[6];     /* vertices extreme along -x, +x, -y, +y, -z, +z */
 };
 
 /* ---- point-triangle distance ------------------------------------------ */
@@ -347,12 +369,122 @@ static void range_box(const struct build *B, size_t s, size_t n, float lo[3],
 }
 
 /* Build the node for range [s, s + n) (n > leaf); returns its index. */
+static int log2ceil(size_t n)
+{
+	int k = 0;
+	while (((size_t)1 << k) < n)
+		k++;
+	return k;
+}
+
+static double half_area(const double lo[3], const double hi[3])
+{
+	double x = hi[0] - lo[0], y = hi[1] - lo[1], z = hi[2] - lo[2];
+	return x * y + y * z + z * x;
+}
+
+#define SAH_BINS 16
+
+/*
+ * Binned surface-area split (the usual 16 bins per axis over the
+ * centroid bounds); returns the size of the left part after partitioning
+ * [s, s + n), or 0 when no split beats the others (then the caller takes
+ * the median).
+ */
+static size_t sah_split(struct build *B, size_t s, size_t n, const double clo[3],
+			const double chi[3])
+{
+	double best = INFINITY;
+	int bax = -1, bbin = 0, k, j;
+	size_t i, left;
+
+	for (k = 0; k < 3; k++) {
+		double ext = chi[k] - clo[k], blo[SAH_BINS][3], bhi[SAH_BINS][3];
+		size_t cnt[SAH_BINS] = {0};
+		double llo[3], lhi[3], rlo[3], rhi[3], la[SAH_BINS];
+		size_t lc[SAH_BINS], acc;
+		int m;
+		if (!(ext > 0.0))
+			continue;
+		for (j = 0; j < SAH_BINS; j++)
+			for (m = 0; m < 3; m++) {
+				blo[j][m] = INFINITY;
+				bhi[j][m] = -INFINITY;
+			}
+		for (i = s; i < s + n; i++) {
+			size_t t = B->perm[i];
+			int b = (int)(SAH_BINS * (B->cen[3 * t + k] - clo[k]) / ext);
+			b = b < 0 ? 0 : (b >= SAH_BINS ? SAH_BINS - 1 : b);
+			cnt[b]++;
+			for (m = 0; m < 3; m++) {
+				blo[b][m] = fmin(blo[b][m], B->tlo[3 * t + m]);
+				bhi[b][m] = fmax(bhi[b][m], B->thi[3 * t + m]);
+			}
+		}
+		for (m = 0; m < 3; m++) {
+			llo[m] = rlo[m] = INFINITY;
+			lhi[m] = rhi[m] = -INFINITY;
+		}
+		acc = 0;
+		for (j = 0; j < SAH_BINS - 1; j++) {
+			acc += cnt[j];
+			for (m = 0; m < 3; m++) {
+				llo[m] = fmin(llo[m], blo[j][m]);
+				lhi[m] = fmax(lhi[m], bhi[j][m]);
+			}
+			lc[j] = acc;
+			la[j] = acc ? half_area(llo, lhi) : 0.0;
+		}
+		acc = 0;
+		for (j = SAH_BINS - 1; j > 0; j--) {
+			double cost;
+			acc += cnt[j];
+			for (m = 0; m < 3; m++) {
+				rlo[m] = fmin(rlo[m], blo[j][m]);
+				rhi[m] = fmax(rhi[m], bhi[j][m]);
+			}
+			if (lc[j - 1] == 0 || acc == 0)
+				continue;
+			cost = la[j - 1] * (double)lc[j - 1] + half_area(rlo, rhi) * (double)acc;
+			if (cost < best) {
+				best = cost;
+				bax = k;
+				bbin = j; /* bins < j go left */
+			}
+		}
+	}
+	if (bax < 0)
+		return 0;
+	/* partition: bins < bbin to the left */
+	{
+		double ext = chi[bax] - clo[bax];
+		size_t a = s, b = s + n;
+		while (a < b) {
+			size_t t = B->perm[a];
+			int bin = (int)(SAH_BINS * (B->cen[3 * t + bax] - clo[bax]) / ext);
+			bin = bin < 0 ? 0 : (bin >= SAH_BINS ? SAH_BINS - 1 : bin);
+			if (bin < bbin) {
+				a++;
+			} else {
+				uint32_t x = B->perm[a];
+				B->perm[a] = B->perm[--b];
+				B->perm[b] = x;
+			}
+		}
+		left = a - s;
+	}
+	return (left > 0 && left < n) ? left : 0;
+}
+
+/* Build the node for range [s, s + n) (n > leaf); returns its index.
+ * Surface-area splits while the depth leaves room for the rest of the
+ * range to be finished by median splits within PX_MESH_MAX_DEPTH. */
 static uint32_t build_node(struct build *B, size_t s, size_t n, int depth)
 {
 	uint32_t me = (uint32_t)B->n_nodes++;
 	double clo[3] = {INFINITY, INFINITY, INFINITY},
 	       chi[3] = {-INFINITY, -INFINITY, -INFINITY};
-	size_t i, half = n / 2, part[2][2];
+	size_t i, half = 0, part[2][2];
 	int k, axis = 0, c;
 
 	if (depth > B->depth)
@@ -363,10 +495,15 @@ static uint32_t build_node(struct build *B, size_t s, size_t n, int depth)
 			clo[k] = fmin(clo[k], x);
 			chi[k] = fmax(chi[k], x);
 		}
-	for (k = 1; k < 3; k++)
-		if (chi[k] - clo[k] > chi[axis] - clo[axis])
-			axis = k;
-	select_k(B->perm + s, (long)n, (long)half, B->cen, axis);
+	if (depth + 2 + log2ceil(n) <= PX_MESH_MAX_DEPTH - 2)
+		half = sah_split(B, s, n, clo, chi);
+	if (half == 0) {
+		half = n / 2;
+		for (k = 1; k < 3; k++)
+			if (chi[k] - clo[k] > chi[axis] - clo[axis])
+				axis = k;
+		select_k(B->perm + s, (long)n, (long)half, B->cen, axis);
+	}
 	part[0][0] = s;
 	part[0][1] = half;
 	part[1][0] = s + half;
@@ -387,6 +524,75 @@ static uint32_t build_node(struct build *B, size_t s, size_t n, int depth)
 	return me;
 }
 
+static uint32_t collapse(const struct node *bn, struct node4 *n4, size_t *n_n4,
+			 uint32_t b)
+{
+	uint32_t me = (uint32_t)(*n_n4)++;
+	struct node4 *o = &n4[me];
+	int s = 0, c, g, j, k;
+	const struct node *nb = &bn[b];
+
+	for (j = 0; j < 4; j++) {
+		for (k = 0; k < 3; k++) {
+			o->lo[k][j] = INFINITY;
+			o->hi[k][j] = -INFINITY;
+		}
+		o->idx[j] = EMPTY;
+		o->cnt[j] = 0;
+	}
+	for (c = 0; c < 2; c++) {
+		if (nb->idx[c] == EMPTY)
+			continue;
+		if (nb->cnt[c] > 0) {
+			for (k = 0; k < 3; k++) {
+				o->lo[k][s] = nb->lo[c][k];
+				o->hi[k][s] = nb->hi[c][k];
+			}
+			o->idx[s] = nb->idx[c];
+			o->cnt[s] = nb->cnt[c];
+			s++;
+			continue;
+		}
+		for (g = 0; g < 2; g++) {
+			const struct node *gn = &bn[nb->idx[c]];
+			if (gn->idx[g] == EMPTY)
+				continue;
+			for (k = 0; k < 3; k++) {
+				o->lo[k][s] = gn->lo[g][k];
+				o->hi[k][s] = gn->hi[g][k];
+			}
+			o->idx[s] = gn->idx[g]; /* binary index until collapsed below */
+			o->cnt[s] = gn->cnt[g];
+			s++;
+		}
+	}
+	for (j = 0; j < s; j++)
+		if (n4[me].cnt[j] == 0) {
+			uint32_t ch = collapse(bn, n4, n_n4, n4[me].idx[j]);
+			n4[me].idx[j] = ch;
+		}
+	return me;
+}
+
+/* Squared distances from p to the four child boxes (+inf for absent
+ * children, whose boxes are empty). */
+static inline void box4_d2(const struct node4 *nd, px_vec3 p, double d2[4])
+{
+	int j;
+	for (j = 0; j < 4; j++) {
+		double dx = (double)nd->lo[0][j] - p.x, ex = p.x - (double)nd->hi[0][j];
+		double dy = (double)nd->lo[1][j] - p.y, ey = p.y - (double)nd->hi[1][j];
+		double dz = (double)nd->lo[2][j] - p.z, ez = p.z - (double)nd->hi[2][j];
+		dx = dx > ex ? dx : ex;
+		dy = dy > ey ? dy : ey;
+		dz = dz > ez ? dz : ez;
+		dx = dx > 0.0 ? dx : 0.0;
+		dy = dy > 0.0 ? dy : 0.0;
+		dz = dz > 0.0 ? dz : 0.0;
+		d2[j] = dx * dx + dy * dy + dz * dz;
+	}
+}
+
 static void mesh_free(void *impl)
 {
 	struct mesh *M = impl;
@@ -400,6 +606,10 @@ static void mesh_free(void *impl)
 	free(M->vnt);
 	free(M->degen);
 	free(M->nodes);
+	free(M->n4);
+	free(M->hull);
+	free(M->adj_start);
+	free(M->adj);
 	free(M);
 }
 
@@ -437,14 +647,14 @@ static inline void test_tri(const struct mesh *M, size_t li, px_vec3 p,
 	int f, s;
 	double u, v, d2;
 
-	if (!M->degen[li]) {
+	if (t->inv_nn != 0.0) {
 		/* the distance to the plane is a lower bound */
 		double h = px_v3_dot(t->n, px_v3_sub(p, t->a));
 		if (h * h * t->inv_nn > b->d2)
 			return;
 	}
-	d2 = tri_core(p, t->a, t->b, t->c, t->n, 1.0 / t->inv_nn, M->degen[li], &q,
-		      &f, &s, &u, &v);
+	d2 = tri_core(p, t->a, t->b, t->c, t->n, t->inv_nn != 0.0 ? 1.0 / t->inv_nn : 0.0,
+		      t->inv_nn == 0.0, &q, &f, &s, &u, &v);
 	if (d2 < b->d2 ||
 	    (d2 == b->d2 && (b->li < 0 || (M->degen[b->li] && !M->degen[li])))) {
 		b->d2 = d2;
@@ -457,69 +667,15 @@ static inline void test_tri(const struct mesh *M, size_t li, px_vec3 p,
 	}
 }
 
-static int mesh_closest(const void *impl, const struct px_model_query *qq,
+/* Fill a result from the best triangle: the sign from the pseudo-normal
+ * of the feature holding the closest point. */
+static void mesh_finish(const struct mesh *M, px_vec3 p, const struct best *bp,
+			unsigned flags, int iters, int certified,
 			struct px_model_result *r)
 {
-	const struct mesh *M = impl;
-	struct {
-		uint32_t idx, cnt;
-		double d2;
-	} st[PX_MESH_MAX_DEPTH + 2];
-	int sp = 0, iters = 0, certified = 1;
-	struct best b;
-	px_vec3 p = qq->p, n, dv;
+	struct best b = *bp;
+	px_vec3 n, dv;
 	double d;
-
-	b.d2 = isinf(qq->max_dist) ? INFINITY : qq->max_dist * qq->max_dist;
-	b.li = -1;
-	b.q = p;
-	b.feature = PX_FEATURE_NONE;
-	b.sub = 0;
-	b.u = b.v = 0.0;
-	if (qq->hint >= 0 && (size_t)qq->hint < M->nt) {
-		test_tri(M, M->leaf_of[qq->hint], p, &b);
-		iters++;
-	}
-	st[sp].idx = 0;
-	st[sp].cnt = 0;
-	st[sp].d2 = 0.0;
-	sp++;
-	while (sp > 0) {
-		const struct node *nd;
-		double dc[2];
-		int near, c;
-
-		sp--;
-		if (st[sp].d2 > b.d2 || (st[sp].d2 == b.d2 && b.li >= 0))
-			continue;
-		iters++;
-		if (st[sp].cnt > 0) {
-			uint32_t i;
-			for (i = st[sp].idx; i < st[sp].idx + st[sp].cnt; i++)
-				test_tri(M, i, p, &b);
-			continue;
-		}
-		nd = &M->nodes[st[sp].idx];
-		dc[0] = nd->idx[0] == EMPTY ? INFINITY : box_d2(nd, 0, p);
-		dc[1] = nd->idx[1] == EMPTY ? INFINITY : box_d2(nd, 1, p);
-		near = dc[1] < dc[0];
-		/* push the far child first so the near one is expanded first */
-		for (c = 0; c < 2; c++) {
-			int ch = c == 0 ? 1 - near : near;
-			if (dc[ch] > b.d2)
-				continue;
-			if (sp >= PX_MESH_MAX_DEPTH + 2) {
-				certified = 0; /* cannot happen: depth checked at setup */
-				continue;
-			}
-			st[sp].idx = nd->idx[ch];
-			st[sp].cnt = nd->cnt[ch];
-			st[sp].d2 = dc[ch];
-			sp++;
-		}
-	}
-	if (b.li < 0)
-		return 0;
 
 	r->point = b.q;
 	r->index = (int)M->orig[b.li];
@@ -538,7 +694,7 @@ static int mesh_closest(const void *impl, const struct px_model_query *qq,
 		n = M->vnt[3 * b.li + b.sub];
 	d = sqrt(b.d2);
 	dv = px_v3_sub(p, b.q);
-	r->is_signed = M->closed && !(qq->flags & PX_QUERY_UNSIGNED);
+	r->is_signed = M->closed && !(flags & PX_QUERY_UNSIGNED);
 	r->inside = 0;
 	if (d > 0.0) {
 		r->direction = px_v3_scale(dv, 1.0 / d);
@@ -554,7 +710,158 @@ static int mesh_closest(const void *impl, const struct px_model_query *qq,
 		if (px_v3_normalize(n, f, &r->direction) != PX_OK)
 			px_v3_normalize(f, px_v3(0, 0, 1), &r->direction);
 	}
+}
+
+
+static int mesh_closest(const void *impl, const struct px_model_query *qq,
+			struct px_model_result *r)
+{
+	const struct mesh *M = impl;
+	struct {
+		uint32_t idx, cnt;
+		double d2;
+	} st[STACK4];
+	int sp = 0, iters = 0, certified = 1;
+	struct best b;
+	px_vec3 p = qq->p;
+
+	b.d2 = isinf(qq->max_dist) ? INFINITY : qq->max_dist * qq->max_dist;
+	b.li = -1;
+	b.q = p;
+	b.feature = PX_FEATURE_NONE;
+	b.sub = 0;
+	b.u = b.v = 0.0;
+	if (qq->hint >= 0 && (size_t)qq->hint < M->nt) {
+		test_tri(M, M->leaf_of[qq->hint], p, &b);
+		iters++;
+	}
+	st[sp].idx = 0;
+	st[sp].cnt = 0;
+	st[sp].d2 = 0.0;
+	sp++;
+	while (sp > 0) {
+		const struct node4 *nd;
+		double dc[4];
+		int ord[4], no = 0, j, c;
+
+		sp--;
+		if (st[sp].d2 > b.d2 || (st[sp].d2 == b.d2 && b.li >= 0))
+			continue;
+		iters++;
+		if (st[sp].cnt > 0) {
+			uint32_t i;
+			for (i = st[sp].idx; i < st[sp].idx + st[sp].cnt; i++)
+				test_tri(M, i, p, &b);
+			continue;
+		}
+		nd = &M->n4[st[sp].idx];
+		box4_d2(nd, p, dc);
+		/* children that can still win, nearest first */
+		for (j = 0; j < 4; j++) {
+			if (nd->idx[j] == EMPTY || dc[j] > b.d2)
+				continue;
+			for (c = no; c > 0 && dc[ord[c - 1]] > dc[j]; c--)
+				ord[c] = ord[c - 1];
+			ord[c] = j;
+			no++;
+		}
+		/* push the farthest first so the nearest is expanded first */
+		for (c = no - 1; c >= 0; c--) {
+			j = ord[c];
+			if (sp >= STACK4) {
+				certified = 0; /* cannot happen: depth checked at setup */
+				continue;
+			}
+			st[sp].idx = nd->idx[j];
+			st[sp].cnt = nd->cnt[j];
+			st[sp].d2 = dc[j];
+			/* start the memory fetch now: the node or the leaf's
+			 * triangles are needed within a few steps */
+			if (st[sp].cnt)
+				__builtin_prefetch(&M->tri[st[sp].idx]);
+			else
+				__builtin_prefetch(&M->n4[st[sp].idx]);
+			sp++;
+		}
+	}
+	if (b.li < 0)
+		return 0;
+	mesh_finish(M, p, &b, qq->flags, iters, certified, r);
 	return 1;
+}
+
+/* Exact closest point among the given leaf-order triangles (coherence
+ * caches: px_model_query_cached() decides when that set is enough). */
+static int mesh_closest_among(const void *impl, const struct px_model_query *qq,
+			      const int *idx, int n, struct px_model_result *r)
+{
+	const struct mesh *M = impl;
+	struct best b;
+	int i;
+
+	b.d2 = isinf(qq->max_dist) ? INFINITY : qq->max_dist * qq->max_dist;
+	b.li = -1;
+	b.q = qq->p;
+	b.feature = PX_FEATURE_NONE;
+	b.sub = 0;
+	b.u = b.v = 0.0;
+	for (i = 0; i < n; i++)
+		if (idx[i] >= 0 && (size_t)idx[i] < M->nt)
+			test_tri(M, (size_t)idx[i], qq->p, &b);
+	if (b.li < 0)
+		return 0;
+	mesh_finish(M, qq->p, &b, qq->flags, n, 1, r);
+	return 1;
+}
+
+/* Leaf-order indices of every triangle within radius of p: the count,
+ * or PX_E_NOSPC when there are more than cap. */
+static int mesh_collect(const void *impl, px_vec3 p, double radius, int *idx,
+			int cap)
+{
+	const struct mesh *M = impl;
+	struct {
+		uint32_t idx, cnt;
+	} st[STACK4];
+	double r2 = radius * radius;
+	int sp = 0, n = 0;
+
+	st[sp].idx = 0;
+	st[sp].cnt = 0;
+	sp++;
+	while (sp > 0) {
+		sp--;
+		if (st[sp].cnt > 0) {
+			uint32_t i;
+			for (i = st[sp].idx; i < st[sp].idx + st[sp].cnt; i++) {
+				const struct mtri *t = &M->tri[i];
+				if (t->inv_nn != 0.0) {
+					double h = px_v3_dot(t->n, px_v3_sub(p, t->a));
+					if (h * h * t->inv_nn > r2)
+						continue;
+				}
+				if (px_tri_closest(p, t->a, t->b, t->c, NULL, NULL, NULL, NULL,
+						   NULL) <= r2) {
+					if (n == cap)
+						return PX_E_NOSPC;
+					idx[n++] = (int)i;
+				}
+			}
+		} else {
+			const struct node4 *nd = &M->n4[st[sp].idx];
+			double dc[4];
+			int c;
+			box4_d2(nd, p, dc);
+			for (c = 0; c < 4; c++) {
+				if (nd->idx[c] == EMPTY || dc[c] > r2 || sp >= STACK4)
+					continue;
+				st[sp].idx = nd->idx[c];
+				st[sp].cnt = nd->cnt[c];
+				sp++;
+			}
+		}
+	}
+	return n;
 }
 
 static px_aabb mesh_aabb(const void *impl)
@@ -567,8 +874,66 @@ static size_t mesh_bytes(const void *impl)
 	return ((const struct mesh *)impl)->bytes;
 }
 
+/* Convex meshes: the vertex farthest along d (a linear scan: convex
+ * meshes in this role are small, e.g. a tool or a hull). */
+/*
+ * Convex meshes: the vertex farthest along d. Small meshes are scanned;
+ * larger ones are climbed along the vertex graph from the best of the
+ * six axis-extreme vertices, always to a strictly better neighbour. On a
+ * convex solid a vertex with no better neighbour is a global maximum:
+ * along a polytope edge or across a facet the objective rises wherever
+ * the vertex is not optimal, and the mesh edges follow those edges and
+ * fan across those facets. The one trap, a vertex inside a facet whose
+ * normal is -d, cannot be reached by strict climbing (that facet is the
+ * minimum) and is not a start unless all six extremes lie on one facet,
+ * which the volume required of convex meshes excludes. Each step
+ * strictly increases the objective, so at most n_hull steps.
+ */
+static px_vec3 mesh_support(const void *impl, px_vec3 d)
+{
+	const struct mesh *M = impl;
+	size_t i, bi = 0, steps;
+	double best = -INFINITY;
+	if (!M->adj_start) {
+		for (i = 0; i < M->n_hull; i++) {
+			double s = px_v3_dot(M->hull[i], d);
+			if (s > best) {
+				best = s;
+				bi = i;
+			}
+		}
+		return M->hull[bi];
+	}
+	for (i = 0; i < 6; i++) {
+		double s = px_v3_dot(M->hull[M->ext[i]], d);
+		if (s > best) {
+			best = s;
+			bi = M->ext[i];
+		}
+	}
+	for (steps = 0; steps < M->n_hull; steps++) {
+		size_t nb = bi;
+		uint32_t k;
+		for (k = M->adj_start[bi]; k < M->adj_start[bi + 1]; k++) {
+			double s = px_v3_dot(M->hull[M->adj[k]], d);
+			if (s > best) {
+				best = s;
+				nb = M->adj[k];
+			}
+		}
+		if (nb == bi)
+			break;
+		bi = nb;
+	}
+	return M->hull[bi];
+}
+
 static const struct px_model_ops mesh_ops = {
-	"mesh", PX_MODEL_MESH, mesh_closest, mesh_aabb, mesh_bytes, mesh_free};
+	"mesh", PX_MODEL_MESH, mesh_closest, mesh_aabb, mesh_bytes, mesh_free, NULL,
+	mesh_closest_among, mesh_collect};
+static const struct px_model_ops mesh_ops_convex = {
+	"mesh", PX_MODEL_MESH, mesh_closest, mesh_aabb, mesh_bytes, mesh_free,
+	mesh_support, mesh_closest_among, mesh_collect};
 
 /* ---- build ----------------------------------------------------------------- */
 
@@ -758,6 +1123,48 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 			vn[i] = px_v3_neg(vn[i]);
 	}
 
+	/* convexity: closed, and across every edge the neighbour's far
+	 * vertex lies on or below this triangle's plane */
+	if (rep->closed) {
+		double ext = 0.0;
+		rep->convex = 1;
+		{
+			/* a solid, not a flat double-sided sheet */
+			px_aabb bb = px_aabb_empty();
+			double dg;
+			for (i = 0; i < nv; i++)
+				if (used[i])
+					px_aabb_extend(&bb, px_v3(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]));
+			dg = px_aabb_diagonal(&bb);
+			if (!(rep->volume > 1e-9 * dg * dg * dg))
+				rep->convex = 0;
+		}
+		for (i = 0; i < nv; i++)
+			if (used[i])
+				ext = fmax(ext, fmax(fabs(xyz[3 * i]),
+						     fmax(fabs(xyz[3 * i + 1]), fabs(xyz[3 * i + 2]))));
+		for (i = 0; i < nt && rep->convex; i++) {
+			const double *A = xyz + 3 * (size_t)canon[tri[3 * i]];
+			if (deg[i])
+				continue;
+			for (k = 0; k < 3; k++) {
+				int32_t o = nb[3 * i + k];
+				int w;
+				if (o < 0)
+					continue;
+				for (w = 0; w < 3; w++) {
+					const double *W = xyz + 3 * (size_t)canon[tri[3 * (size_t)o + w]];
+					double h = fn[i].x * (W[0] - A[0]) + fn[i].y * (W[1] - A[1]) +
+						   fn[i].z * (W[2] - A[2]);
+					if (h > 1e-12 * ext) {
+						rep->convex = 0;
+						break;
+					}
+				}
+			}
+		}
+	}
+
 	/* hierarchy */
 	M = calloc(1, sizeof(*M));
 	if (!M)
@@ -766,7 +1173,10 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 	M->nv = nv;
 	M->closed = rep->closed;
 	perm = malloc(nt * sizeof(*perm));
-	M->nodes = calloc(nt + 1, sizeof(*M->nodes));
+	/* cache-line aligned: a 64-byte node then costs one line, not two */
+	M->nodes = aligned_alloc(64, (nt + 1) * sizeof(*M->nodes));
+	if (M->nodes)
+		memset(M->nodes, 0, (nt + 1) * sizeof(*M->nodes));
 	if (!perm || !M->nodes)
 		goto fail;
 	for (i = 0; i < nt; i++)
@@ -802,9 +1212,16 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 		rc = PX_E_RANGE;
 		goto fail;
 	}
+	M->n4 = aligned_alloc(64, M->n_nodes * sizeof(*M->n4));
+	if (!M->n4)
+		goto fail;
+	M->n_n4 = 0;
+	collapse(M->nodes, M->n4, &M->n_n4, 0);
+	free(M->nodes);
+	M->nodes = NULL;
 
 	/* reorder into leaf order */
-	M->tri = malloc(nt * sizeof(*M->tri));
+	M->tri = aligned_alloc(64, nt * sizeof(*M->tri));
 	M->orig = malloc(nt * sizeof(*M->orig));
 	M->leaf_of = malloc(nt * sizeof(*M->leaf_of));
 	M->fn = malloc(nt * sizeof(*M->fn));
@@ -839,10 +1256,63 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 	}
 	M->bytes = sizeof(*M) + nt * (sizeof(struct mtri) + 2 * sizeof(uint32_t) +
 				      7 * sizeof(px_vec3) + 1) +
-		   M->n_nodes * sizeof(struct node);
-	rc = px_model_create(&mesh_ops, M,
+		   M->n_n4 * sizeof(struct node4);
+	if (rep->convex) {
+		size_t h = 0;
+		M->hull = malloc(rep->n_welded * sizeof(*M->hull));
+		if (!M->hull)
+			goto fail;
+		for (i = 0; i < nv; i++)
+			if (used[i] && canon[i] == i && h < rep->n_welded) {
+				order[i] = (uint32_t)h; /* order[] reused: canon id -> hull index */
+				M->hull[h++] = px_v3(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+			}
+		M->n_hull = h;
+		M->bytes += h * sizeof(*M->hull);
+		if (h > 32) {
+			/* vertex graph (CSR) from the distinct edges, sorted in E */
+			size_t ne2 = 0, j2;
+			M->adj_start = calloc(h + 1, sizeof(uint32_t));
+			M->adj = malloc(2 * ne * sizeof(uint32_t));
+			if (!M->adj_start || !M->adj)
+				goto fail;
+			for (j2 = 0; j2 < ne; j2++)
+				if (j2 == 0 || E[j2].lo != E[j2 - 1].lo || E[j2].hi != E[j2 - 1].hi) {
+					M->adj_start[order[E[j2].lo] + 1]++;
+					M->adj_start[order[E[j2].hi] + 1]++;
+				}
+			for (j2 = 0; j2 < h; j2++)
+				M->adj_start[j2 + 1] += M->adj_start[j2];
+			{
+				uint32_t *fill = calloc(h, sizeof(uint32_t));
+				if (!fill)
+					goto fail;
+				for (j2 = 0; j2 < ne; j2++)
+					if (j2 == 0 || E[j2].lo != E[j2 - 1].lo || E[j2].hi != E[j2 - 1].hi) {
+						uint32_t a = order[E[j2].lo], b = order[E[j2].hi];
+						M->adj[M->adj_start[a] + fill[a]++] = b;
+						M->adj[M->adj_start[b] + fill[b]++] = a;
+						ne2 += 2;
+					}
+				free(fill);
+			}
+			for (k = 0; k < 6; k++) {
+				double bs = -INFINITY;
+				for (j2 = 0; j2 < h; j2++) {
+					double v = px_v3_comp(M->hull[j2], k / 2) * (k % 2 ? 1.0 : -1.0);
+					if (v > bs) {
+						bs = v;
+						M->ext[k] = (uint32_t)j2;
+					}
+				}
+			}
+			M->bytes += (h + 1 + ne2) * sizeof(uint32_t);
+		}
+	}
+	rc = px_model_create(rep->convex ? &mesh_ops_convex : &mesh_ops, M,
 			     PX_MODEL_CAP_EXACT | PX_MODEL_CAP_COHERENT |
-				     (M->closed ? PX_MODEL_CAP_SIGNED : 0u),
+				     (M->closed ? PX_MODEL_CAP_SIGNED : 0u) |
+				     (rep->convex ? PX_MODEL_CAP_CONVEX : 0u),
 			     out);
 	M = NULL; /* owned by the model now, also on failure */
 	if (rc != PX_OK)
@@ -872,7 +1342,8 @@ done:
 
 static const struct mesh *as_mesh(const struct px_model *m)
 {
-	if (px_model_get_ops(m) != &mesh_ops)
+	const struct px_model_ops *o = px_model_get_ops(m);
+	if (o != &mesh_ops && o != &mesh_ops_convex)
 		return NULL;
 	return px_model_impl(m);
 }

@@ -8,8 +8,10 @@
  * whether the mesh is a closed, consistently oriented 2-manifold
  * (watertight), computes angle-weighted pseudo-normals (Baerentzen and
  * Aanaes 2005) and builds a binary AABB hierarchy over the triangles
- * (median split on the longest axis, so its depth is at most
- * PX_MESH_MAX_DEPTH). A query then needs no memory but a fixed array on
+ * (binned surface-area splits, switching to median splits where needed
+ * to keep the depth within PX_MESH_MAX_DEPTH; child boxes are stored in
+ * single precision rounded outwards, so they stay lower bounds), then
+ * collapses it to four children per node for the queries. A query then needs no memory but a fixed array on
  * the call stack: it descends nearer child first and prunes every box
  * farther than the best triangle so far; the distance to a triangle is
  * exact over all seven Voronoi regions (face, three edges, three
@@ -26,15 +28,18 @@
  * Coherent queries (PX_QUERY_COHERENT with last cycle's triangle index as
  * hint) start from that triangle's distance as an upper bound, which
  * prunes most of the hierarchy at once when the point moved little.
+ * Meshes also implement the coherence cache (px_model_query_cached):
+ * most cycles then scan a few nearby triangles with a proof that no
+ * other triangle can be closer.
  *
  * Results (px_model_result): index = triangle (input order), feature =
  * FACE / EDGE (sub = 0: v0v1, 1: v1v2, 2: v2v0) / VERTEX (sub = 0..2),
  * u, v = barycentric weights of v1 and v2 of the closest point,
  * iterations = nodes and triangles visited, certified = 1 (exact).
  *
- * Memory and real-time rules: building allocates (setup only) about 300
+ * Memory and real-time rules: building allocates (setup only) about 330
  * bytes per triangle; queries are RT-safe (no heap, bounded by the
- * triangle count, fixed stack of PX_MESH_MAX_DEPTH + 2 entries).
+ * triangle count, fixed stack of 3 PX_MESH_MAX_DEPTH + 4 entries).
  */
 #ifndef PX_MESH_H
 #define PX_MESH_H
@@ -50,7 +55,9 @@
 extern "C" {
 #endif
 
-/* Hierarchy depth bound (median splits give about log2(triangles / 2)). */
+/* Depth bound of the binary build (median splits give about
+ * log2(triangles / 2); surface-area splits are used only while they leave
+ * room for that). */
 #define PX_MESH_MAX_DEPTH 48
 /* Largest triangle count (indices are 32-bit inside). */
 #define PX_MESH_MAX_TRIANGLES ((size_t)1 << 30)
@@ -77,6 +84,7 @@ struct px_mesh_report {
 	long first_bad_edge_triangle; /* a triangle on a bad edge, -1 if none */
 	int closed;                   /* watertight: signed distances */
 	int flipped;                  /* was inward, normals reversed */
+	int convex;                   /* closed, and no reflex edge */
 	double volume;                /* enclosed volume (closed meshes) */
 	int depth;                    /* hierarchy depth */
 	char message[256];            /* "" when everything is fine */

@@ -3,6 +3,7 @@
  */
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "px_model.h"
 
@@ -154,4 +155,115 @@ const void *px_model_impl(const struct px_model *m)
 const struct px_model_ops *px_model_get_ops(const struct px_model *m)
 {
 	return m ? m->ops : NULL;
+}
+
+int px_model_support(const struct px_model *m, px_vec3 dir, px_vec3 *out)
+{
+	if (!m || !out)
+		return PX_E_INVAL;
+	if (!m->ops->support)
+		return PX_E_UNSUPPORTED;
+	*out = px_pose_transform_point(
+		m->pose, m->ops->support(m->impl, px_pose_inverse_transform_vector(m->pose, dir)));
+	return PX_OK;
+}
+
+/* ---- coherence cache ------------------------------------------------------- */
+
+void px_model_cache_init(struct px_model_cache *c, double margin_m)
+{
+	if (!c)
+		return;
+	memset(c, 0, sizeof(*c));
+	c->n_ = -1;
+	c->last_ = -1;
+	c->margin_ = margin_m > 0.0 && isfinite(margin_m) ? margin_m : 0.0;
+}
+
+static void to_world(const struct px_model *m, struct px_model_result *out)
+{
+	out->point = px_pose_transform_point(m->pose, out->point);
+	out->direction = px_pose_transform_vector(m->pose, out->direction);
+}
+
+int px_model_query_cached(const struct px_model *m, px_vec3 p,
+			  struct px_model_cache *c, struct px_model_result *out)
+{
+	struct px_model_query q;
+	const struct px_model_ops *o;
+	double d, margin, R;
+	int rc, n, tries;
+
+	if (!m || !c || !out)
+		return PX_E_INVAL;
+	if (!px_v3_isfinite(p))
+		return PX_E_NAN;
+	o = m->ops;
+	c->queries_++;
+	if (!o->closest_among || !o->collect) {
+		rc = px_model_query_ex(m, p, INFINITY, c->last_, PX_QUERY_COHERENT, out);
+		if (rc == 1)
+			c->last_ = out->index;
+		return rc;
+	}
+	if (c->model_ != m) {
+		c->model_ = m;
+		c->n_ = -1;
+		c->last_ = -1;
+	}
+	q.p = px_pose_inverse_transform_point(m->pose, p);
+	q.max_dist = INFINITY;
+	q.flags = 0u;
+	q.hint = -1;
+	if (c->n_ > 0) {
+		double moved = px_v3_dist(q.p, c->anchor_);
+		rc = o->closest_among(m->impl, &q, c->idx_, c->n_, out);
+		if (rc < 0)
+			return rc;
+		if (rc == 1 && fabs(out->distance) + moved <= c->radius_) {
+			to_world(m, out);
+			c->last_ = out->index;
+			return 1;
+		}
+	}
+	/* refill: one full query, then every feature near enough */
+	c->refills_++;
+	q.hint = c->last_;
+	q.flags = PX_QUERY_COHERENT;
+	rc = o->closest(m->impl, &q, out);
+	if (rc <= 0)
+		return rc < 0 ? rc : PX_E_DEGENERATE;
+	d = fabs(out->distance);
+	margin = c->margin_;
+	if (!(margin > 0.0))
+		margin = fmax(0.5 * d, 1e-3 * px_aabb_diagonal(&m->local_box));
+	R = d + 2.0 * margin;
+	n = PX_E_NOSPC;
+	for (tries = 0; tries < 4 && n < 0; tries++) {
+		n = o->collect(m->impl, q.p, R, c->idx_, PX_MODEL_CACHE_CAP);
+		if (n == PX_E_NOSPC)
+			R = d + 0.25 * (R - d);
+		else if (n < 0)
+			return n;
+	}
+	if (n > 0) {
+		c->anchor_ = q.p;
+		c->radius_ = R;
+		c->n_ = n;
+	} else {
+		c->n_ = -1; /* too crowded here: plain queries until it thins */
+	}
+	to_world(m, out);
+	c->last_ = out->index;
+	return 1;
+}
+
+unsigned long px_model_cache_queries(const struct px_model_cache *c)
+{
+	return c ? c->queries_ : 0;
+}
+
+unsigned long px_model_cache_refills(const struct px_model_cache *c)
+{
+	return c ? c->refills_ : 0;
 }

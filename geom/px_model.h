@@ -74,6 +74,7 @@ enum px_feature {
 #define PX_MODEL_CAP_SIGNED 0x1u    /* closed: inside gets negative distance */
 #define PX_MODEL_CAP_EXACT 0x2u     /* every answer is the exact global one */
 #define PX_MODEL_CAP_COHERENT 0x4u  /* uses the hint of coherent queries */
+#define PX_MODEL_CAP_CONVEX 0x8u    /* the solid is convex (closed models) */
 
 /* What a query asks, in the model frame (implementations see this). */
 struct px_model_query {
@@ -134,6 +135,21 @@ struct px_model_ops {
 	size_t (*memory_bytes)(const void *impl);
 	/* Release the implementation (setup-time, may free). */
 	void (*free)(void *impl);
+	/* Optional, for convex models (NULL otherwise): a point of the
+	 * model farthest along dir (model frame; dir need not be unit, and
+	 * a zero dir may give any point of the model). Used by the exact
+	 * convex-pair distance (GJK). Must be RT-safe. */
+	px_vec3 (*support)(const void *impl, px_vec3 dir);
+	/* Optional pair for coherence caches (both or neither; NULL
+	 * otherwise). Features are numbered by the model (any ints >= 0).
+	 * closest_among: as closest, over the listed features only.
+	 * collect: every feature within radius of p (model frame), written
+	 * to idx; returns the count, or PX_E_NOSPC when more than cap.
+	 * Both must be RT-safe. */
+	int (*closest_among)(const void *impl, const struct px_model_query *q,
+			     const int *idx, int n, struct px_model_result *r);
+	int (*collect)(const void *impl, px_vec3 p, double radius, int *idx,
+		       int cap);
 };
 
 struct px_model; /* opaque handle */
@@ -184,6 +200,55 @@ PX_API int px_model_query_ex(const struct px_model *m, px_vec3 p,
 			     double max_dist, int hint, unsigned flags,
 			     struct px_model_result *out);
 
+/* ---- coherence cache ---------------------------------------------------------
+ *
+ * A point that moves a little each cycle (a haptic probe, a link point)
+ * can skip the hierarchy most cycles: on a refill the cache records every
+ * feature within R = d + 2 margin of the point (d its distance then);
+ * later, with the point at distance m from that anchor, the best cached
+ * feature at distance U is proven the global closest whenever U + m <= R
+ * (any feature at most U away from the point is at most U + m <= R from
+ * the anchor, hence cached). Otherwise the cache refills with a full
+ * query. So every answer stays exact; the margin only trades refill
+ * frequency against scan length. Models without closest_among/collect
+ * fall back to hint-coherent queries.
+ */
+#define PX_MODEL_CACHE_CAP 64
+
+/* Caller-owned state for one moving point against one model; plain
+ * struct, members private (read the counters through the accessors). */
+struct px_model_cache {
+	const struct px_model *model_;
+	px_vec3 anchor_;
+	double radius_;
+	double margin_;
+	int n_;
+	int last_;
+	unsigned long queries_, refills_;
+	int idx_[PX_MODEL_CACHE_CAP];
+};
+
+/* Reset a cache. margin_m > 0 fixes how far (model frame units) the
+ * point may move before a refill; 0 chooses it from the distance at each
+ * refill (half of it, at least 1e-3 of the model's box diagonal).
+ * @note RT-safe. */
+PX_API void px_model_cache_init(struct px_model_cache *c, double margin_m);
+
+/*
+ * As px_model_query(), through the cache c (which follows whichever model
+ * it is used with: using it with another model refills it). Answers are
+ * exact as from px_model_query(), except that among equidistant features
+ * another may be reported. Returns 1, or px_model_query()'s errors.
+ * @note RT-safe.
+ */
+PX_API int px_model_query_cached(const struct px_model *m, px_vec3 p,
+				 struct px_model_cache *c,
+				 struct px_model_result *out);
+
+/* Queries answered and refills made through c. @note RT-safe. */
+PX_API unsigned long px_model_cache_queries(const struct px_model_cache *c);
+PX_API unsigned long px_model_cache_refills(const struct px_model_cache *c);
+
 /* Bounding box in the model frame / in the world frame (the model-frame
  * box transformed by the current pose). Empty box for NULL.
  * @note RT-safe. */
@@ -199,6 +264,13 @@ PX_API enum px_model_kind px_model_kind(const struct px_model *m);
 PX_API const char *px_model_name(const struct px_model *m);
 PX_API unsigned px_model_caps(const struct px_model *m);
 PX_API size_t px_model_memory_bytes(const struct px_model *m);
+/* Point of the model farthest along the world direction dir, in the
+ * world frame. Returns PX_OK, PX_E_INVAL (NULL), PX_E_UNSUPPORTED (the
+ * model has no support function: not convex or unbounded).
+ * @note RT-safe. */
+PX_API int px_model_support(const struct px_model *m, px_vec3 dir,
+			    px_vec3 *out);
+
 /* The implementation pointer and ops table (for representation-specific
  * accessors, which check the ops to know the model is theirs).
  * @note RT-safe. */

@@ -333,9 +333,62 @@ static void prim_free(void *impl)
 	free(impl);
 }
 
+static px_vec3 unit_or_x(double x, double y, double z)
+{
+	double n = sqrt(x * x + y * y + z * z);
+	return n > 0.0 ? px_v3(x / n, y / n, z / n) : px_v3(1.0, 0.0, 0.0);
+}
+
+static double sgn(double x)
+{
+	return x < 0.0 ? -1.0 : 1.0;
+}
+
+/* Support points of the convex primitives (GJK). */
+static px_vec3 prim_support(const void *impl, px_vec3 d)
+{
+	const struct px_prim *p = impl;
+	double rho = hypot(d.x, d.y), ux = rho > 0 ? d.x / rho : 1.0,
+	       uy = rho > 0 ? d.y / rho : 0.0;
+	switch (p->type) {
+	case PX_PRIM_SPHERE:
+		return px_v3_scale(unit_or_x(d.x, d.y, d.z), p->a);
+	case PX_PRIM_BOX:
+		return px_v3(sgn(d.x) * p->a, sgn(d.y) * p->b, sgn(d.z) * p->c);
+	case PX_PRIM_CAPSULE:
+		return px_v3_add(px_v3(0, 0, sgn(d.z) * p->b),
+				 px_v3_scale(unit_or_x(d.x, d.y, d.z), p->a));
+	case PX_PRIM_CYLINDER:
+		return px_v3(p->a * ux, p->a * uy, sgn(d.z) * p->b);
+	case PX_PRIM_CONE: {
+		/* the farther of the two rims (a rim of radius 0 is the apex) */
+		double s0 = p->a * rho - p->b * d.z, s1 = p->c * rho + p->b * d.z;
+		return s0 > s1 ? px_v3(p->a * ux, p->a * uy, -p->b)
+			       : px_v3(p->c * ux, p->c * uy, p->b);
+	}
+	default:
+		return px_v3(0, 0, 0);
+	}
+}
+
 static const struct px_model_ops prim_ops = {
 	"primitive", PX_MODEL_PRIMITIVE, prim_closest, prim_aabb, prim_bytes,
-	prim_free};
+	prim_free, prim_support, NULL, NULL};
+
+/* Torus and half-space have no support function (not convex, or not
+ * bounded). */
+static const struct px_model_ops prim_ops_nosupport = {
+	"primitive", PX_MODEL_PRIMITIVE, prim_closest, prim_aabb, prim_bytes,
+	prim_free, NULL, NULL, NULL};
+
+int px_prim_get(const struct px_model *m, struct px_prim *out)
+{
+	const struct px_model_ops *o = px_model_get_ops(m);
+	if (!out || (o != &prim_ops && o != &prim_ops_nosupport))
+		return PX_E_INVAL;
+	*out = *(const struct px_prim *)px_model_impl(m);
+	return PX_OK;
+}
 
 int px_prim_model(const struct px_prim *p, struct px_model **out)
 {
@@ -353,6 +406,10 @@ int px_prim_model(const struct px_prim *p, struct px_model **out)
 	if (!copy)
 		return PX_E_NOMEM;
 	*copy = *p;
-	return px_model_create(&prim_ops, copy,
-			       PX_MODEL_CAP_SIGNED | PX_MODEL_CAP_EXACT, out);
+	return px_model_create(p->type == PX_PRIM_TORUS || p->type == PX_PRIM_HALFSPACE
+				       ? &prim_ops_nosupport : &prim_ops,
+			       copy,
+			       PX_MODEL_CAP_SIGNED | PX_MODEL_CAP_EXACT |
+				       (p->type != PX_PRIM_TORUS ? PX_MODEL_CAP_CONVEX : 0u),
+			       out);
 }

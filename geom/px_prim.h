@@ -91,6 +91,10 @@ PX_API px_aabb px_prim_aabb(const struct px_prim *p);
  */
 PX_API int px_prim_model(const struct px_prim *p, struct px_model **out);
 
+/* The primitive of a model made by px_prim_model(). Returns PX_OK, or
+ * PX_E_INVAL when m is NULL or not a primitive. @note RT-safe. */
+PX_API int px_prim_get(const struct px_model *m, struct px_prim *out);
+
 #ifdef __cplusplus
 }
 #endif

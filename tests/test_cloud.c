@@ -139,6 +139,41 @@ static void test_coherent_and_bounded(void)
 	free(x);
 }
 
+static void test_cache(void)
+{
+	/* cached answers equal full ones, with a radius (fallback path) and
+	 * without (cache path), along a path with jumps */
+	size_t n = 4000;
+	double *x = make_cloud(n, 1);
+	int rad;
+	for (rad = 0; rad < 2; rad++) {
+		struct px_model *m;
+		struct px_model_cache c;
+		px_vec3 p = px_v3(0, 0, 0);
+		int i;
+		uint64_t a;
+		PX_CHECK_INT_EQ(px_cloud_model(x, n, rad ? 0.02 : 0.0, NULL, &m), PX_OK);
+		px_model_cache_init(&c, 0.0);
+		a = px_alloc_region_begin();
+		for (i = 0; i < 3000; i++) {
+			struct px_model_result rc, rf;
+			p = px_v3_add(p, px_v3(px_rand_range(-0.01, 0.01), px_rand_range(-0.01, 0.01),
+					       px_rand_range(-0.01, 0.01)));
+			if (i % 500 == 499)
+				p = px_v3(px_rand_range(-3, 3), px_rand_range(-1, 1), px_rand_range(-1, 1));
+			PX_CHECK_INT_EQ(px_model_query_cached(m, p, &c, &rc), 1);
+			PX_CHECK_INT_EQ(px_model_query(m, p, &rf), 1);
+			PX_CHECK_MSG(rc.distance == rf.distance, "step %d: %.17g vs %.17g", i,
+				     rc.distance, rf.distance);
+		}
+		PX_CHECK_INT_EQ(px_alloc_region_end(a), 0);
+		if (!rad)
+			PX_CHECK(px_model_cache_refills(&c) < 3000);
+		px_model_free(m);
+	}
+	free(x);
+}
+
 static void test_invalid(void)
 {
 	double x[] = {0, 0, 0, 1, INFINITY, 0};
@@ -295,6 +330,6 @@ static void test_no_alloc(void)
 }
 
 static const struct px_test tests[] = {
-	PX_T(test_vs_brute), PX_T(test_coherent_and_bounded), PX_T(test_invalid),
+	PX_T(test_vs_brute), PX_T(test_coherent_and_bounded), PX_T(test_cache), PX_T(test_invalid),
 	PX_T(test_files), PX_T(test_no_alloc)};
 PX_TEST_MAIN(tests)

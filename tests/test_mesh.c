@@ -249,6 +249,127 @@ static void test_coherent(void)
 	gen_free(&g);
 }
 
+static void test_cache(void)
+{
+	/* The cache must give exactly the distances of full queries, with
+	 * any margin (tiny: refills every cycle; huge: more triangles than it
+	 * holds, so it falls back), across jumps and model switches. */
+	struct gen_mesh g, g2;
+	struct px_model *m, *m2;
+	struct px_prim sp = {PX_PRIM_SPHERE, 0.5, 0, 0};
+	struct px_model *pm;
+	const double margins[4] = {0.0, 1e-6, 0.01, 10.0};
+	int k, i;
+	uint64_t a;
+
+	PX_CHECK_INT_EQ(gen_torus(1.0, 0.3, 60, 30, &g), 0);
+	PX_CHECK_INT_EQ(gen_sphere(0.7, 10, 16, &g2), 0);
+	PX_CHECK_INT_EQ(px_mesh_model(g.xyz, g.nv, g.tri, g.nt, NULL, NULL, &m), PX_OK);
+	PX_CHECK_INT_EQ(px_mesh_model(g2.xyz, g2.nv, g2.tri, g2.nt, NULL, NULL, &m2), PX_OK);
+	PX_CHECK_INT_EQ(px_prim_model(&sp, &pm), PX_OK);
+	for (k = 0; k < 4; k++) {
+		struct px_model_cache c;
+		px_vec3 p = px_v3(1.3, 0, 0.1);
+		px_model_cache_init(&c, margins[k]);
+		px_model_set_pose(m, rand_pose());
+		a = px_alloc_region_begin();
+		for (i = 0; i < 3000; i++) {
+			struct px_model_result rc, rf;
+			const struct px_model *mm = (i / 500) % 3 == 2 ? m2 : m;
+			p = px_v3_add(p, rand_v(0.003));
+			if (i % 700 == 699)
+				p = rand_v(2.0);
+			if (i % 100 == 50) /* the model moves too */
+				px_model_set_pose(m, rand_pose());
+			PX_CHECK_INT_EQ(px_model_query_cached(mm, p, &c, &rc), 1);
+			PX_CHECK_INT_EQ(px_model_query(mm, p, &rf), 1);
+			PX_CHECK_MSG(rc.distance == rf.distance,
+				     "margin %g, step %d: cached %.17g vs full %.17g", margins[k], i,
+				     rc.distance, rf.distance);
+			PX_CHECK(rc.inside == rf.inside);
+			PX_CHECK_NEAR(px_v3_dist(rc.point, rf.point), 0.0,
+				      1e-9 + (rc.index != rf.index ? INFINITY : 0));
+		}
+		PX_CHECK_INT_EQ(px_alloc_region_end(a), 0);
+		PX_CHECK_INT_EQ(px_model_cache_queries(&c), 3000);
+		if (k == 2)
+			PX_CHECK_MSG(px_model_cache_refills(&c) < 1500, "%lu refills",
+				     px_model_cache_refills(&c));
+		if (k == 1)
+			PX_CHECK(px_model_cache_refills(&c) > 2000);
+	}
+	{
+		/* a model without cache operations: coherent queries instead */
+		struct px_model_cache c;
+		struct px_model_result rc, rf;
+		px_model_cache_init(&c, 0.0);
+		PX_CHECK_INT_EQ(px_model_query_cached(pm, px_v3(1, 2, 3), &c, &rc), 1);
+		PX_CHECK_INT_EQ(px_model_query(pm, px_v3(1, 2, 3), &rf), 1);
+		PX_CHECK(rc.distance == rf.distance);
+		PX_CHECK_INT_EQ(px_model_query_cached(pm, px_v3(NAN, 2, 3), &c, &rc), PX_E_NAN);
+	}
+	px_model_free(m);
+	px_model_free(m2);
+	px_model_free(pm);
+	gen_free(&g);
+	gen_free(&g2);
+}
+
+static void test_convex_support(void)
+{
+	/* The support point of convex meshes (hill climbing on larger ones)
+	 * against a scan of all vertices, including axis directions, where a
+	 * subdivided box has whole faces of ties. */
+	struct gen_mesh g[3];
+	double h[3] = {0.3, 0.5, 0.2};
+	int k, i;
+	PX_CHECK_INT_EQ(gen_sphere(0.5, 20, 40, &g[0]), 0);
+	PX_CHECK_INT_EQ(gen_box(h, 6, &g[1]), 0);
+	PX_CHECK_INT_EQ(gen_sphere(0.5, 3, 4, &g[2]), 0); /* small: plain scan */
+	for (k = 0; k < 3; k++) {
+		struct px_model *m;
+		struct px_mesh_report rp;
+		PX_CHECK_INT_EQ(px_mesh_model(g[k].xyz, g[k].nv, g[k].tri, g[k].nt, NULL, &rp, &m), PX_OK);
+		PX_CHECK_MSG(rp.convex, "mesh %d not convex: %s", k, rp.message);
+		px_model_set_pose(m, rand_pose());
+		for (i = 0; i < 600; i++) {
+			px_vec3 d = i < 6 ? px_v3(i / 2 == 0 ? (i % 2 ? 1 : -1) : 0,
+						  i / 2 == 1 ? (i % 2 ? 1 : -1) : 0,
+						  i / 2 == 2 ? (i % 2 ? 1 : -1) : 0)
+				    : rand_v(1), s, dl;
+			double best = -INFINITY;
+			size_t t;
+			int c;
+			if (i < 6) /* axis directions of the mesh's own frame */
+				d = px_pose_transform_vector(px_model_pose(m), d);
+			PX_CHECK_INT_EQ(px_model_support(m, d, &s), PX_OK);
+			dl = px_pose_inverse_transform_vector(px_model_pose(m), d);
+			for (t = 0; t < px_mesh_triangle_count(m); t++) {
+				px_vec3 v[3];
+				px_mesh_triangle(m, t, v);
+				for (c = 0; c < 3; c++)
+					best = fmax(best, px_v3_dot(v[c], dl));
+			}
+			PX_CHECK_NEAR(px_v3_dot(px_pose_inverse_transform_point(px_model_pose(m), s), dl),
+				      best, 1e-12);
+		}
+		px_model_free(m);
+		gen_free(&g[k]);
+	}
+	{
+		/* a flat double-sided sheet is closed but not a convex solid */
+		double xyz[] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+		uint32_t t2[] = {0, 1, 2, 0, 2, 1};
+		struct px_model *m;
+		struct px_mesh_report rp;
+		px_vec3 out;
+		PX_CHECK_INT_EQ(px_mesh_model(xyz, 3, t2, 2, NULL, &rp, &m), PX_OK);
+		PX_CHECK(!rp.convex);
+		PX_CHECK_INT_EQ(px_model_support(m, px_v3(1, 0, 0), &out), PX_E_UNSUPPORTED);
+		px_model_free(m);
+	}
+}
+
 /* ---- sign -------------------------------------------------------------------- */
 
 static void test_sign_box_exact(void)
@@ -703,7 +824,7 @@ static void test_no_alloc(void)
 static const struct px_test tests[] = {
 	PX_T(test_tri_closest),      PX_T(test_tri_regions),
 	PX_T(test_soup_vs_brute),    PX_T(test_closed_vs_brute),
-	PX_T(test_coherent),         PX_T(test_sign_box_exact),
+	PX_T(test_coherent),         PX_T(test_cache), PX_T(test_convex_support),         PX_T(test_sign_box_exact),
 	PX_T(test_sign_sphere_torus), PX_T(test_sign_concave), PX_T(test_sign_tetra),
 	PX_T(test_open_and_bad_topology),
 	PX_T(test_validation),       PX_T(test_load_files),

@@ -1,0 +1,592 @@
+/*
+ * px_pair.c - model-to-model distance by alternating projections.
+ */
+#include <math.h>
+#include <string.h>
+
+#include "px_mesh.h"
+#include "px_pair.h"
+#include "px_prim.h"
+
+/* ---- exact convex distance: GJK ---------------------------------------------
+ *
+ * Gilbert, Johnson and Keerthi (1988) on the Minkowski difference A - B
+ * through the models' support functions. The simplex (at most 4
+ * points, each with the support points of A and B that made it) is
+ * reduced to the face, edge or vertex nearest the origin by the exact
+ * point-triangle routine of the mesh module, whose barycentric weights
+ * also give the witness points. Stops when the support point in the
+ * direction of the origin gains less than a relative 1e-10 of |v|^2 (the
+ * classic bound |v|^2 - v.w <= eps |v|^2: the true distance is within
+ * that of |v|; 1e-10 of |v|^2 is 5e-11 of the distance), or when the
+ * origin is inside (intersection).
+ */
+
+#define GJK_MAX_ITERS 128
+#define GJK_REL 1e-10
+
+struct gjk_vert {
+	px_vec3 w, a, b; /* w = a - b */
+};
+
+/* Closest point of the simplex to the origin; keeps only the vertices
+ * that carry it. Returns 1 when the origin is inside a full simplex. */
+static int gjk_reduce(struct gjk_vert *S, int *n, px_vec3 *v, px_vec3 *pa,
+		      px_vec3 *pb)
+{
+	px_vec3 o = px_v3(0, 0, 0), q;
+	double lam[4] = {1, 0, 0, 0};
+	int keep[4] = {1, 0, 0, 0}, i, m;
+
+	if (*n == 1) {
+		q = S[0].w;
+	} else if (*n == 2) {
+		px_vec3 d = px_v3_sub(S[1].w, S[0].w);
+		double l2 = px_v3_norm2(d), t = 0.0;
+		if (l2 > 0.0) {
+			t = -px_v3_dot(S[0].w, d) / l2;
+			t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+		}
+		lam[0] = 1.0 - t;
+		lam[1] = t;
+		keep[0] = t < 1.0;
+		keep[1] = t > 0.0;
+		q = px_v3_madd(S[0].w, d, t);
+	} else if (*n == 3) {
+		int f, sub;
+		double u, w;
+		px_tri_closest(o, S[0].w, S[1].w, S[2].w, &q, &f, &sub, &u, &w);
+		lam[0] = 1.0 - u - w;
+		lam[1] = u;
+		lam[2] = w;
+		keep[0] = keep[1] = keep[2] = 0;
+		if (f == PX_FEATURE_FACE) {
+			keep[0] = keep[1] = keep[2] = 1;
+		} else if (f == PX_FEATURE_EDGE) {
+			keep[sub] = keep[(sub + 1) % 3] = 1;
+		} else {
+			keep[sub] = 1;
+		}
+	} else {
+		/* tetrahedron: origin inside, or the nearest of its faces */
+		static const int F[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+		double vol = px_v3_dot(px_v3_sub(S[1].w, S[0].w),
+				       px_v3_cross(px_v3_sub(S[2].w, S[0].w),
+						   px_v3_sub(S[3].w, S[0].w)));
+		double best = INFINITY, L = 0.0;
+		int inside, k, j;
+		for (k = 0; k < 4; k++)
+			for (j = k + 1; j < 4; j++)
+				L = fmax(L, px_v3_dist(S[k].w, S[j].w));
+		/* a flat simplex (relative volume below 1e-9) never holds the
+		 * origin: its weights would be rounding noise */
+		inside = fabs(vol) > 1e-9 * L * L * L;
+		for (k = 0; k < 4 && inside; k++) {
+			const px_vec3 A = S[F[k][0]].w, B = S[F[k][1]].w, C = S[F[k][2]].w;
+			double s = px_v3_dot(px_v3_neg(A),
+					     px_v3_cross(px_v3_sub(B, A), px_v3_sub(C, A)));
+			/* origin on the inner side of every face (same sign as
+			 * the opposite vertex) */
+			double so = px_v3_dot(px_v3_sub(S[k].w, A),
+					      px_v3_cross(px_v3_sub(B, A), px_v3_sub(C, A)));
+			/* s / so is the origin's barycentric weight of vertex
+			 * k: inside only with every weight clearly positive,
+			 * so that a nearly flat simplex (common on smooth
+			 * shapes) never claims the origin by rounding; a
+			 * touching pair then ends through |v| -> 0 instead. */
+			if (!(so != 0.0 && s / so > 1e-9))
+				inside = 0;
+		}
+		if (inside)
+			return 1;
+		for (k = 0; k < 4; k++) {
+			int f, sub;
+			double u, w, d2;
+			px_vec3 qq;
+			const int *t = F[k];
+			d2 = px_tri_closest(o, S[t[0]].w, S[t[1]].w, S[t[2]].w, &qq, &f, &sub,
+					    &u, &w);
+			if (d2 < best) {
+				double l3[3] = {1.0 - u - w, u, w};
+				int k3[3] = {0, 0, 0};
+				best = d2;
+				q = qq;
+				if (f == PX_FEATURE_FACE)
+					k3[0] = k3[1] = k3[2] = 1;
+				else if (f == PX_FEATURE_EDGE)
+					k3[sub] = k3[(sub + 1) % 3] = 1;
+				else
+					k3[sub] = 1;
+				for (j = 0; j < 4; j++) {
+					lam[j] = 0.0;
+					keep[j] = 0;
+				}
+				for (j = 0; j < 3; j++) {
+					lam[t[j]] = l3[j];
+					keep[t[j]] = k3[j];
+				}
+			}
+		}
+	}
+	*pa = px_v3(0, 0, 0);
+	*pb = px_v3(0, 0, 0);
+	for (i = 0; i < *n; i++) {
+		*pa = px_v3_madd(*pa, S[i].a, lam[i]);
+		*pb = px_v3_madd(*pb, S[i].b, lam[i]);
+	}
+	for (i = 0, m = 0; i < *n; i++)
+		if (keep[i])
+			S[m++] = S[i];
+	if (m == 0) { /* cannot happen; keep the nearest vertex */
+		m = 1;
+	}
+	*n = m;
+	*v = q;
+	return 0;
+}
+
+/* Returns 1 with the distance and witness points, 0 when intersecting,
+ * negative when a model has no support function. */
+static int gjk(const struct px_model *a, const struct px_model *b, double *dist,
+	       px_vec3 *pa, px_vec3 *pb, int *iters)
+{
+	struct gjk_vert S[4];
+	px_vec3 v, sa, sb;
+	int n = 1, it, rc;
+
+	v = px_v3_sub(px_model_pose(a).t, px_model_pose(b).t);
+	if (px_v3_norm2(v) == 0.0)
+		v = px_v3(1, 0, 0);
+	if ((rc = px_model_support(a, px_v3_neg(v), &sa)) < 0 ||
+	    (rc = px_model_support(b, v, &sb)) < 0)
+		return rc;
+	S[0].a = sa;
+	S[0].b = sb;
+	S[0].w = px_v3_sub(sa, sb);
+	*pa = sa;
+	*pb = sb;
+	v = S[0].w;
+	for (it = 0; it < GJK_MAX_ITERS; it++) {
+		struct gjk_vert nw;
+		double vv = px_v3_norm2(v);
+		int k, dup = 0;
+		if (vv == 0.0)
+			break;
+		px_model_support(a, px_v3_neg(v), &nw.a);
+		px_model_support(b, v, &nw.b);
+		nw.w = px_v3_sub(nw.a, nw.b);
+		if (vv - px_v3_dot(v, nw.w) <= GJK_REL * vv)
+			break;
+		for (k = 0; k < n; k++)
+			if (S[k].w.x == nw.w.x && S[k].w.y == nw.w.y && S[k].w.z == nw.w.z)
+				dup = 1;
+		if (dup)
+			break;
+		S[n++] = nw;
+		if (gjk_reduce(S, &n, &v, pa, pb)) {
+			*iters = it + 1;
+			return 0;
+		}
+		/* no progress: rounding has taken over */
+		if (px_v3_norm2(v) >= vv)
+			break;
+	}
+	*iters = it;
+	*dist = px_v3_norm(v);
+	if (*dist <= 1e-15 * (1.0 + px_v3_norm(*pa)))
+		return 0;
+	return 1;
+}
+
+struct run {
+	double d;
+	px_vec3 pa, pb;
+	int ia, ib;
+	int iters;
+	int converged;
+	int intersecting;
+};
+
+/*
+ * One start. seed is a point to project onto A first (any point: a box
+ * corner, last cycle's pair), so every pair compared is (a point of A,
+ * the point of B closest to it) or the reverse, real surface points.
+ */
+static int run_start(const struct px_model *a, const struct px_model *b,
+		     px_vec3 seed, int max_iters, double tol, double rel,
+		     struct run *o)
+{
+	struct px_model_result ra, rb;
+	double prev = INFINITY;
+	int it, rc;
+
+	o->iters = 0;
+	o->converged = 0;
+	o->intersecting = 0;
+	o->d = INFINITY;
+	rc = px_model_query(a, seed, &ra);
+	if (rc < 0)
+		return rc;
+	o->iters++;
+	for (it = 0; it < max_iters; it++) {
+		double d;
+		rc = px_model_query(b, ra.point, &rb);
+		if (rc < 0)
+			return rc;
+		o->iters++;
+		d = fabs(rb.distance);
+		if (d < o->d) {
+			o->d = d;
+			o->pa = ra.point;
+			o->pb = rb.point;
+			o->ia = ra.index;
+			o->ib = rb.index;
+		}
+		if ((rb.is_signed && rb.distance <= 0.0) || d == 0.0) {
+			/* a point of A inside or on B */
+			o->d = 0.0;
+			o->pa = ra.point;
+			o->pb = rb.point;
+			o->ia = ra.index;
+			o->ib = rb.index;
+			o->intersecting = 1;
+			o->converged = 1;
+			return 0;
+		}
+		rc = px_model_query(a, rb.point, &ra);
+		if (rc < 0)
+			return rc;
+		o->iters++;
+		d = fabs(ra.distance);
+		if ((ra.is_signed && ra.distance <= 0.0) || d == 0.0) {
+			o->d = 0.0;
+			o->pa = ra.point;
+			o->pb = rb.point;
+			o->ia = ra.index;
+			o->ib = rb.index;
+			o->intersecting = 1;
+			o->converged = 1;
+			return 0;
+		}
+		if (d < o->d) {
+			o->d = d;
+			o->pa = ra.point;
+			o->pb = rb.point;
+			o->ia = ra.index;
+			o->ib = rb.index;
+		}
+		/* each projection can only lower the distance; stop when it
+		 * no longer does by more than tol */
+		if (prev - o->d <= tol + rel * o->d) {
+			o->converged = 1;
+			return 0;
+		}
+		prev = o->d;
+	}
+	return 0;
+}
+
+#define REFINE_CAP 16
+
+/*
+ * Neighbourhood step on side x: every feature of x within the current
+ * distance of x's point (as many as REFINE_CAP allows, shrinking the
+ * radius otherwise), each taken at its point nearest y's point and
+ * projected onto y. Discrete models (clouds, fine meshes) have many
+ * shallow local minima next to the global one; this jumps over them.
+ * Every pair tried is a real pair, so the distance can only drop.
+ * Returns 1 when it improved, 0 when not, a negative error.
+ */
+static int refine_side(const struct px_model *x, const struct px_model *y,
+		       px_vec3 *px, px_vec3 *py, int *ix, int *iy, double *d,
+		       int *iters)
+{
+	const struct px_model_ops *o = px_model_get_ops(x);
+	const void *impl = px_model_impl(x);
+	px_pose P = px_model_pose(x);
+	struct px_model_query q;
+	int idx[REFINE_CAP], n = PX_E_NOSPC, k, tries, improved = 0;
+	double R = *d;
+	px_vec3 c;
+
+	if (!o->collect || !o->closest_among || !(R > 0.0))
+		return 0;
+	c = px_pose_inverse_transform_point(P, *px);
+	for (tries = 0; tries < 8 && n == PX_E_NOSPC; tries++) {
+		n = o->collect(impl, c, R, idx, REFINE_CAP);
+		if (n == PX_E_NOSPC)
+			R *= 0.5;
+	}
+	if (n < 0)
+		return n == PX_E_NOSPC ? 0 : n;
+	q.p = px_pose_inverse_transform_point(P, *py);
+	q.max_dist = INFINITY;
+	q.hint = -1;
+	q.flags = PX_QUERY_UNSIGNED;
+	for (k = 0; k < n; k++) {
+		struct px_model_result rx, ry;
+		px_vec3 xw;
+		int rc = o->closest_among(impl, &q, &idx[k], 1, &rx);
+		if (rc < 0)
+			return rc;
+		if (rc == 0)
+			continue;
+		xw = px_pose_transform_point(P, rx.point);
+		rc = px_model_query_ex(y, xw, INFINITY, -1, PX_QUERY_UNSIGNED, &ry);
+		if (rc < 0)
+			return rc;
+		(*iters)++;
+		if (ry.distance < *d) {
+			*d = ry.distance;
+			*px = xw;
+			*py = ry.point;
+			*ix = rx.index;
+			*iy = ry.index;
+			improved = 1;
+		}
+	}
+	return improved;
+}
+
+static int finite_box(const px_aabb *b)
+{
+	return !px_aabb_is_empty(b) && px_v3_isfinite(b->min) &&
+	       px_v3_isfinite(b->max);
+}
+
+/* Seed k: 0 = closest point of A's box to B's box (alternating between
+ * the two convex boxes), then B's box corners and face centres, then
+ * A's (each later projected onto A by run_start). */
+static int seed_point(const struct px_model *a, const struct px_model *b,
+		      int k, px_vec3 *out)
+{
+	px_aabb la = px_model_local_aabb(a), lb = px_model_local_aabb(b);
+	int fa = finite_box(&la), fb = finite_box(&lb);
+	px_obb A, B;
+
+	if (fa)
+		A = px_model_world_obb(a);
+	if (fb)
+		B = px_model_world_obb(b);
+	if (k == 0) {
+		if (fa && fb) {
+			px_vec3 x = A.center, y;
+			int i;
+			for (i = 0; i < 16; i++) {
+				y = px_obb_closest_point(&B, x);
+				x = px_obb_closest_point(&A, y);
+			}
+			*out = x;
+		} else if (fb) {
+			*out = B.center;
+		} else if (fa) {
+			*out = A.center;
+		} else {
+			*out = px_model_pose(b).t;
+		}
+		return 1;
+	}
+	k--;
+	if (fb) {
+		if (k < 8) {
+			*out = px_obb_corner(&B, k);
+			return 1;
+		}
+		if (k < 14) {
+			int ax = (k - 8) / 2;
+			double s = (k - 8) % 2 ? 1.0 : -1.0;
+			*out = px_v3_madd(B.center, B.axis[ax],
+					  s * px_v3_comp(B.half, ax));
+			return 1;
+		}
+		k -= 14;
+	}
+	if (fa) {
+		if (k < 8) {
+			*out = px_obb_corner(&A, k);
+			return 1;
+		}
+		if (k < 14) {
+			int ax = (k - 8) / 2;
+			double s = (k - 8) % 2 ? 1.0 : -1.0;
+			*out = px_v3_madd(A.center, A.axis[ax],
+					  s * px_v3_comp(A.half, ax));
+			return 1;
+		}
+	}
+	return 0;
+}
+
+int px_pair_distance(const struct px_model *a, const struct px_model *b,
+		     const struct px_pair_opts *opt, struct px_pair_result *res)
+{
+	int starts = opt && opt->starts ? opt->starts : 8;
+	int max_iters = opt && opt->max_iters ? opt->max_iters : 64;
+	double tol = opt && opt->tol > 0.0 ? opt->tol : 1e-12;
+	double rel = opt && opt->rel_tol > 0.0 ? opt->rel_tol : 1e-9;
+	int coherent = opt && opt->coherent && res && res->valid;
+	struct run best, r;
+	int k, n = 0, total = 0, rc, have = 0;
+	px_vec3 seed;
+
+	if (!a || !b || !res || starts < 1 || starts > PX_PAIR_MAX_STARTS ||
+	    max_iters < 1 || !(tol >= 0.0))
+		return PX_E_INVAL;
+
+	/* Exact paths. A sphere against anything: one point query of its
+	 * centre. Two convex models with support functions: GJK. */
+	{
+		struct px_prim pr;
+		const struct px_model *sph = NULL, *oth = NULL;
+		int swap = 0;
+		if (px_prim_get(a, &pr) == PX_OK && pr.type == PX_PRIM_SPHERE) {
+			sph = a;
+			oth = b;
+		} else if (px_prim_get(b, &pr) == PX_OK && pr.type == PX_PRIM_SPHERE) {
+			sph = b;
+			oth = a;
+			swap = 1;
+		}
+		if (sph) {
+			struct px_model_result q;
+			px_vec3 c = px_model_pose(sph).t, ps, po;
+			double d;
+			rc = px_model_query(oth, c, &q);
+			if (rc < 0)
+				return rc;
+			d = q.distance - pr.a;
+			po = q.point;
+			/* the sphere's point towards the other model */
+			ps = px_v3_madd(c, q.direction, q.distance < 0.0 ? pr.a : -pr.a);
+			if (q.distance == 0.0)
+				ps = px_v3_madd(c, q.direction, -pr.a);
+			res->intersecting = d <= 0.0;
+			res->distance = d > 0.0 ? d : 0.0;
+			res->point_a = swap ? po : ps;
+			res->point_b = swap ? ps : po;
+			res->index_a = swap ? q.index : 0;
+			res->index_b = swap ? 0 : q.index;
+			res->iterations = 1;
+			res->starts = 0;
+			res->converged = 1;
+			res->local_only = !q.certified;
+			goto done;
+		}
+	}
+	if ((px_model_caps(a) & PX_MODEL_CAP_CONVEX) &&
+	    (px_model_caps(b) & PX_MODEL_CAP_CONVEX) &&
+	    px_model_get_ops(a)->support && px_model_get_ops(b)->support) {
+		double d = 0.0;
+		px_vec3 pa, pb;
+		int its = 0, g = gjk(a, b, &d, &pa, &pb, &its);
+		if (g > 0) {
+			/* GJK's witness points are convex combinations of
+			 * support points, whose weights lose accuracy on the thin
+			 * simplices of smooth shapes: two exact projections put
+			 * them on the surfaces (each step can only shorten the
+			 * pair, and both models are convex). */
+			struct px_model_result qa, qb;
+			int j;
+			for (j = 0; j < 2; j++) {
+				if ((rc = px_model_query(b, pa, &qb)) < 0 ||
+				    (rc = px_model_query(a, qb.point, &qa)) < 0)
+					return rc;
+				pa = qa.point;
+				pb = qb.point;
+			}
+			res->intersecting = qb.is_signed && qb.distance <= 0.0;
+			res->distance = res->intersecting ? 0.0 : px_v3_dist(pa, pb);
+			res->point_a = pa;
+			res->point_b = pb;
+			res->index_a = qa.index;
+			res->index_b = qb.index;
+			res->iterations = its + 4;
+			res->starts = 0;
+			res->converged = its < GJK_MAX_ITERS;
+			res->local_only = !res->converged;
+			goto done;
+		}
+		if (g == 0) {
+			res->intersecting = 1;
+			res->distance = 0.0;
+			res->point_a = pa;
+			res->point_b = pb;
+			res->index_a = res->index_b = -1;
+			res->iterations = its;
+			res->starts = 0;
+			res->converged = 1;
+			res->local_only = 0;
+			goto done;
+		}
+	}
+	memset(&best, 0, sizeof(best));
+	best.d = INFINITY;
+	for (k = coherent ? -1 : 0; n < starts; k++) {
+		if (k == -1) {
+			/* last pair, moved with the models */
+			seed = px_pose_transform_point(px_model_pose(a), res->local_a);
+		} else if (!seed_point(a, b, k, &seed)) {
+			break;
+		}
+		if (!px_v3_isfinite(seed))
+			continue;
+		rc = run_start(a, b, seed, max_iters, tol, rel, &r);
+		if (rc < 0)
+			return rc;
+		total += r.iters;
+		n++;
+		if (!have || r.d < best.d) {
+			best = r;
+			have = 1;
+		}
+		if (best.intersecting)
+			break;
+	}
+	if (!have)
+		return PX_E_DEGENERATE;
+	/* neighbourhood steps on both sides, each success polished by a
+	 * further round of projections */
+	for (k = 0; k < (coherent && starts == 1 ? 0 : 2) && !best.intersecting &&
+		    best.d > 0.0; k++) {
+		int ia = best.ia, ib = best.ib, ra, rb;
+		double d = best.d;
+		px_vec3 pa = best.pa, pb = best.pb;
+		ra = refine_side(a, b, &pa, &pb, &ia, &ib, &d, &total);
+		if (ra < 0)
+			return ra;
+		rb = refine_side(b, a, &pb, &pa, &ib, &ia, &d, &total);
+		if (rb < 0)
+			return rb;
+		if (!ra && !rb)
+			break;
+		best.d = d;
+		best.pa = pa;
+		best.pb = pb;
+		best.ia = ia;
+		best.ib = ib;
+		rc = run_start(a, b, pa, max_iters, tol, rel, &r);
+		if (rc < 0)
+			return rc;
+		total += r.iters;
+		if (r.d < best.d || r.intersecting)
+			best = r;
+	}
+	res->distance = best.d;
+	res->point_a = best.pa;
+	res->point_b = best.pb;
+	res->index_a = best.ia;
+	res->index_b = best.ib;
+	res->iterations = total;
+	res->starts = n;
+	res->converged = best.converged;
+	res->intersecting = best.intersecting;
+	res->local_only = !(best.intersecting ||
+			    (best.converged &&
+			     (px_model_caps(a) & PX_MODEL_CAP_CONVEX) &&
+			     (px_model_caps(b) & PX_MODEL_CAP_CONVEX)));
+done:
+	res->local_a = px_pose_inverse_transform_point(px_model_pose(a), res->point_a);
+	res->local_b = px_pose_inverse_transform_point(px_model_pose(b), res->point_b);
+	res->valid = 1;
+	return PX_OK;
+}

@@ -1,0 +1,415 @@
+/*
+ * Model-to-model distance by alternating projections.
+ *
+ * References: for mesh pairs, the exact minimum over all triangle pairs
+ * (for separated triangles, the minimum of the six vertex-triangle and
+ * nine edge-edge distances); for a cloud, the minimum over its points of
+ * the exact point distance; for sphere and capsule pairs, closed forms.
+ * The global-hit rate over random pairs is printed; every miss must be
+ * flagged local_only, and convex pairs must never miss.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mesh_gen.h"
+#include "px_alloc_count.h"
+#include "px_cloud.h"
+#include "px_mesh.h"
+#include "px_pair.h"
+#include "px_prim.h"
+#include "px_test.h"
+
+static px_pose rand_rot_pose(px_vec3 t)
+{
+	px_pose P;
+	px_quat q = {px_rand_normal(), px_rand_normal(), px_rand_normal(),
+		     px_rand_normal()};
+	double n = sqrt(px_quat_dot(q, q));
+	P.q.w = q.w / n;
+	P.q.x = q.x / n;
+	P.q.y = q.y / n;
+	P.q.z = q.z / n;
+	P.t = t;
+	return P;
+}
+
+static px_vec3 rand_dir(void)
+{
+	px_vec3 v = px_v3(px_rand_normal(), px_rand_normal(), px_rand_normal());
+	return px_v3_scale(v, 1.0 / px_v3_norm(v));
+}
+
+/* Closest points of segments p1q1 and p2q2 (Ericson 5.1.9); squared
+ * distance. */
+static double seg_seg(px_vec3 p1, px_vec3 q1, px_vec3 p2, px_vec3 q2)
+{
+	px_vec3 d1 = px_v3_sub(q1, p1), d2 = px_v3_sub(q2, p2), r = px_v3_sub(p1, p2);
+	double a = px_v3_dot(d1, d1), e = px_v3_dot(d2, d2), f = px_v3_dot(d2, r);
+	double s, t;
+	if (a <= 1e-30 && e <= 1e-30)
+		return px_v3_dist2(p1, p2);
+	if (a <= 1e-30) {
+		s = 0;
+		t = fmin(1, fmax(0, f / e));
+	} else {
+		double c = px_v3_dot(d1, r);
+		if (e <= 1e-30) {
+			t = 0;
+			s = fmin(1, fmax(0, -c / a));
+		} else {
+			double b = px_v3_dot(d1, d2), den = a * e - b * b;
+			s = den > 0 ? fmin(1, fmax(0, (b * f - c * e) / den)) : 0;
+			t = (b * s + f) / e;
+			if (t < 0) {
+				t = 0;
+				s = fmin(1, fmax(0, -c / a));
+			} else if (t > 1) {
+				t = 1;
+				s = fmin(1, fmax(0, (b - c) / a));
+			}
+		}
+	}
+	return px_v3_dist2(px_v3_madd(p1, d1, s), px_v3_madd(p2, d2, t));
+}
+
+/* Exact distance between two meshes in their poses (separated). */
+static double brute_mesh_mesh(const struct px_model *a, const struct px_model *b)
+{
+	size_t na = px_mesh_triangle_count(a), nb = px_mesh_triangle_count(b), i, j;
+	px_vec3 *A = malloc(3 * na * sizeof(px_vec3)), *B = malloc(3 * nb * sizeof(px_vec3));
+	double best = INFINITY;
+	int k, l;
+	for (i = 0; i < na; i++) {
+		px_mesh_triangle(a, i, A + 3 * i);
+		for (k = 0; k < 3; k++)
+			A[3 * i + k] = px_pose_transform_point(px_model_pose(a), A[3 * i + k]);
+	}
+	for (j = 0; j < nb; j++) {
+		px_mesh_triangle(b, j, B + 3 * j);
+		for (k = 0; k < 3; k++)
+			B[3 * j + k] = px_pose_transform_point(px_model_pose(b), B[3 * j + k]);
+	}
+	for (i = 0; i < na; i++)
+		for (j = 0; j < nb; j++) {
+			const px_vec3 *T = A + 3 * i, *U = B + 3 * j;
+			for (k = 0; k < 3; k++) {
+				best = fmin(best, px_tri_closest(T[k], U[0], U[1], U[2], NULL, NULL, NULL, NULL, NULL));
+				best = fmin(best, px_tri_closest(U[k], T[0], T[1], T[2], NULL, NULL, NULL, NULL, NULL));
+				for (l = 0; l < 3; l++)
+					best = fmin(best, seg_seg(T[k], T[(k + 1) % 3], U[l], U[(l + 1) % 3]));
+			}
+		}
+	free(A);
+	free(B);
+	return sqrt(best);
+}
+
+static struct px_model *make_mesh(int kind, double *radius)
+{
+	struct gen_mesh g;
+	struct px_model *m = NULL;
+	double h[3] = {0.3, 0.5, 0.2};
+	switch (kind) {
+	case 0:
+		gen_torus(0.6, 0.2, 16, 8, &g);
+		*radius = 0.8;
+		break;
+	case 1:
+		gen_sphere(0.5, 8, 12, &g);
+		*radius = 0.5;
+		break;
+	case 2:
+		gen_box(h, 1, &g);
+		*radius = sqrt(0.09 + 0.25 + 0.04);
+		break;
+	default:
+		gen_lprism(0.4, 0.3, &g);
+		*radius = sqrt(2 * 0.64 + 0.09);
+		break;
+	}
+	PX_CHECK_INT_EQ(px_mesh_model(g.xyz, g.nv, g.tri, g.nt, NULL, NULL, &m), PX_OK);
+	gen_free(&g);
+	return m;
+}
+
+static void check_pair_result(const struct px_model *a, const struct px_model *b,
+			      const struct px_pair_result *r)
+{
+	struct px_model_result qa, qb;
+	PX_CHECK_NEAR(px_v3_dist(r->point_a, r->point_b), r->distance, 1e-9);
+	px_model_query_ex(a, r->point_a, INFINITY, -1, PX_QUERY_UNSIGNED, &qa);
+	px_model_query_ex(b, r->point_b, INFINITY, -1, PX_QUERY_UNSIGNED, &qb);
+	PX_CHECK_NEAR(qa.distance, 0.0, 1e-9);
+	PX_CHECK_NEAR(qb.distance, 0.0, 1e-9);
+}
+
+static void test_mesh_pairs_hit_rate(void)
+{
+	int trial, hits = 0, misses = 0, flagged_hits = 0, n = 240;
+	struct px_pair_opts o = {8, 64, 1e-12, 0, 0};
+	for (trial = 0; trial < n; trial++) {
+		double ra, rb, ref, sep;
+		struct px_model *a = make_mesh(trial % 4, &ra);
+		struct px_model *b = make_mesh((trial / 4) % 4, &rb);
+		struct px_pair_result r;
+		px_vec3 dir = rand_dir();
+		memset(&r, 0, sizeof(r));
+		sep = ra + rb + px_rand_range(0.01, 0.8);
+		px_model_set_pose(a, rand_rot_pose(px_v3(0, 0, 0)));
+		px_model_set_pose(b, rand_rot_pose(px_v3_scale(dir, sep)));
+		PX_CHECK_INT_EQ(px_pair_distance(a, b, &o, &r), PX_OK);
+		ref = brute_mesh_mesh(a, b);
+		check_pair_result(a, b, &r);
+		PX_CHECK_MSG(r.distance >= ref - 1e-9, "below the true minimum: %.15g < %.15g",
+			     r.distance, ref);
+		PX_CHECK(!r.intersecting);
+		if (r.distance <= ref + 1e-6) {
+			hits++;
+			flagged_hits += r.local_only;
+		} else {
+			misses++;
+			PX_CHECK_MSG(r.local_only, "unflagged miss: %.9g vs %.9g", r.distance, ref);
+		}
+		if ((trial % 4) == 2 && ((trial / 4) % 4) == 2) /* box-box: convex */
+			PX_CHECK_MSG(r.distance <= ref + 1e-6, "convex pair missed: %.12g vs %.12g",
+				     r.distance, ref);
+		px_model_free(a);
+		px_model_free(b);
+	}
+	printf("    mesh pairs: %d of %d global (%.1f %%), %d local minima (all flagged); "
+	       "%d global hits flagged as possibly local\n",
+	       hits, n, 100.0 * hits / n, misses, flagged_hits);
+	PX_CHECK_MSG(hits >= 0.97 * n, "global-hit rate %.3f", (double)hits / n);
+}
+
+static double seg_pt_dist(px_vec3 a, px_vec3 b, px_vec3 p)
+{
+	return sqrt(seg_seg(a, b, p, p));
+}
+
+static void test_convex_primitive_pairs(void)
+{
+	int trial;
+	for (trial = 0; trial < 300; trial++) {
+		struct px_prim s1 = {PX_PRIM_SPHERE, px_rand_range(0.1, 1), 0, 0};
+		struct px_prim c1 = {PX_PRIM_CAPSULE, px_rand_range(0.05, 0.5), px_rand_range(0.1, 1), 0};
+		struct px_prim c2 = {PX_PRIM_CAPSULE, px_rand_range(0.05, 0.5), px_rand_range(0.1, 1), 0};
+		struct px_prim bx = {PX_PRIM_BOX, px_rand_range(0.1, 1), px_rand_range(0.1, 1), px_rand_range(0.1, 1)};
+		struct px_model *a, *b;
+		struct px_pair_result r;
+		px_pose Pa = rand_rot_pose(px_v3(0, 0, 0)), Pb;
+		double ref;
+		int kind = trial % 3;
+		memset(&r, 0, sizeof(r));
+		Pb = rand_rot_pose(px_v3_scale(rand_dir(), px_rand_range(0.2, 4)));
+		if (kind == 0) {
+			px_prim_model(&s1, &a);
+			px_prim_model(&bx, &b);
+		} else if (kind == 1) {
+			px_prim_model(&c1, &a);
+			px_prim_model(&c2, &b);
+		} else {
+			px_prim_model(&s1, &a);
+			px_prim_model(&c2, &b);
+		}
+		px_model_set_pose(a, Pa);
+		px_model_set_pose(b, Pb);
+		if (kind == 0) {
+			struct px_model_result q;
+			px_model_query(b, Pa.t, &q);
+			ref = q.distance - s1.a;
+		} else if (kind == 1) {
+			px_vec3 a0 = px_pose_transform_point(Pa, px_v3(0, 0, -c1.b));
+			px_vec3 a1 = px_pose_transform_point(Pa, px_v3(0, 0, c1.b));
+			px_vec3 b0 = px_pose_transform_point(Pb, px_v3(0, 0, -c2.b));
+			px_vec3 b1 = px_pose_transform_point(Pb, px_v3(0, 0, c2.b));
+			ref = sqrt(seg_seg(a0, a1, b0, b1)) - c1.a - c2.a;
+		} else {
+			px_vec3 b0 = px_pose_transform_point(Pb, px_v3(0, 0, -c2.b));
+			px_vec3 b1 = px_pose_transform_point(Pb, px_v3(0, 0, c2.b));
+			ref = seg_pt_dist(b0, b1, Pa.t) - s1.a - c2.a;
+		}
+		PX_CHECK_INT_EQ(px_pair_distance(a, b, NULL, &r), PX_OK);
+		if (ref <= 0) {
+			PX_CHECK_MSG(r.intersecting && r.distance == 0, "kind %d: overlap missed (%g)",
+				     kind, ref);
+			PX_CHECK(!r.local_only);
+		} else {
+			PX_CHECK_MSG(!r.intersecting, "kind %d: intersecting, reference %g", kind, ref);
+			check_pair_result(a, b, &r);
+			PX_CHECK_MSG(fabs(r.distance - ref) <= 1e-6, "kind %d: %.12g vs %.12g",
+				     kind, r.distance, ref);
+			if (r.converged)
+				PX_CHECK(!r.local_only);
+		}
+		px_model_free(a);
+		px_model_free(b);
+	}
+}
+
+/* Rings over the profile of a cylinder or cone, arc spacing <= h. */
+static int sample_frustum(const struct px_prim *p, double h, px_vec3 *out, int cap)
+{
+	double r0 = p->a, r1 = p->type == PX_PRIM_CONE ? p->c : p->a;
+	double P[4][2] = {{0, -p->b}, {r0, -p->b}, {r1, p->b}, {0, p->b}};
+	int e, n = 0;
+	for (e = 0; e < 3; e++) {
+		double L = hypot(P[e + 1][0] - P[e][0], P[e + 1][1] - P[e][1]);
+		int ns = (int)ceil(L / h), i;
+		for (i = 0; i <= ns; i++) {
+			double t = (double)i / ns, rr = P[e][0] + t * (P[e + 1][0] - P[e][0]);
+			double z = P[e][1] + t * (P[e + 1][1] - P[e][1]);
+			int na = rr > 0 ? (int)ceil(2 * M_PI * rr / h) : 1, j;
+			for (j = 0; j < na && n < cap; j++)
+				out[n++] = px_v3(rr * cos(2 * M_PI * j / na), rr * sin(2 * M_PI * j / na), z);
+		}
+	}
+	return n;
+}
+
+static void test_gjk_convex_primitives(void)
+{
+	/* GJK through support functions against the densest reference we
+	 * can afford: every sample of A's surface queried exactly on B. */
+	const double h = 0.01;
+	int cap = 200000, trial;
+	px_vec3 *S = malloc((size_t)cap * sizeof(px_vec3));
+	for (trial = 0; trial < 60; trial++) {
+		struct px_prim A = {trial % 2 ? PX_PRIM_CONE : PX_PRIM_CYLINDER,
+				    px_rand_range(0.1, 0.4), px_rand_range(0.1, 0.4), 0};
+		struct px_prim Bs[4] = {{PX_PRIM_BOX, px_rand_range(0.1, 0.4), px_rand_range(0.1, 0.4), px_rand_range(0.1, 0.4)},
+					{PX_PRIM_CAPSULE, px_rand_range(0.05, 0.3), px_rand_range(0.1, 0.4), 0},
+					{PX_PRIM_CYLINDER, px_rand_range(0.05, 0.3), px_rand_range(0.1, 0.4), 0},
+					{PX_PRIM_CONE, px_rand_range(0.05, 0.3), px_rand_range(0.1, 0.4), px_rand_range(0.0, 0.2)}};
+		struct px_prim B = Bs[(trial / 2) % 4];
+		struct px_model *ma, *mb;
+		struct px_pair_result r;
+		px_pose Pa = rand_rot_pose(px_v3(0, 0, 0));
+		double ref = INFINITY;
+		int n, i;
+		if (A.type == PX_PRIM_CONE)
+			A.c = trial % 4 == 1 ? 0.0 : px_rand_range(0.0, 0.3);
+		memset(&r, 0, sizeof(r));
+		PX_CHECK_INT_EQ(px_prim_model(&A, &ma), PX_OK);
+		PX_CHECK_INT_EQ(px_prim_model(&B, &mb), PX_OK);
+		px_model_set_pose(ma, Pa);
+		px_model_set_pose(mb, rand_rot_pose(px_v3_scale(rand_dir(), px_rand_range(0.3, 1.5))));
+		n = sample_frustum(&A, h, S, cap);
+		for (i = 0; i < n; i++) {
+			struct px_model_result q;
+			px_model_query(mb, px_pose_transform_point(Pa, S[i]), &q);
+			ref = fmin(ref, q.distance);
+		}
+		PX_CHECK_INT_EQ(px_pair_distance(ma, mb, NULL, &r), PX_OK);
+		if (ref <= -h) {
+			PX_CHECK_MSG(r.intersecting, "trial %d: overlap (%g) missed", trial, ref);
+		} else if (ref > h) {
+			PX_CHECK_MSG(!r.intersecting, "trial %d (%d vs %d): intersecting, sampled %g, %d iterations",
+				     trial, A.type, B.type, ref, r.iterations);
+			check_pair_result(ma, mb, &r);
+			PX_CHECK_MSG(r.distance <= ref + 1e-9 && r.distance >= ref - h,
+				     "trial %d (%d vs %d): %.12g vs sampled %.12g", trial, A.type,
+				     B.type, r.distance, ref);
+			PX_CHECK(!r.local_only);
+		}
+		px_model_free(ma);
+		px_model_free(mb);
+	}
+	free(S);
+}
+
+static void test_cloud_vs_box(void)
+{
+	/* heterogeneous: a scanned sphere against a box; exact reference is
+	 * the minimum over the points */
+	size_t n = 3000, i;
+	double *x = malloc(3 * n * sizeof(double));
+	struct px_prim bx = {PX_PRIM_BOX, 0.4, 0.3, 0.2};
+	struct px_model *c, *b;
+	int trial, hits = 0;
+	for (i = 0; i < n; i++) {
+		px_vec3 d = rand_dir();
+		x[3 * i] = 0.5 * d.x, x[3 * i + 1] = 0.5 * d.y, x[3 * i + 2] = 0.5 * d.z;
+	}
+	PX_CHECK_INT_EQ(px_cloud_model(x, n, 0.0, NULL, &c), PX_OK);
+	PX_CHECK_INT_EQ(px_prim_model(&bx, &b), PX_OK);
+	for (trial = 0; trial < 50; trial++) {
+		struct px_pair_result r;
+		double ref = INFINITY;
+		px_pose Pc = rand_rot_pose(px_v3(0, 0, 0));
+		memset(&r, 0, sizeof(r));
+		px_model_set_pose(c, Pc);
+		px_model_set_pose(b, rand_rot_pose(px_v3_scale(rand_dir(), px_rand_range(1.1, 2))));
+		for (i = 0; i < n; i++) {
+			struct px_model_result q;
+			px_model_query(b, px_pose_transform_point(Pc, px_v3(x[3 * i], x[3 * i + 1], x[3 * i + 2])), &q);
+			ref = fmin(ref, q.distance);
+		}
+		PX_CHECK_INT_EQ(px_pair_distance(c, b, NULL, &r), PX_OK);
+		check_pair_result(c, b, &r);
+		PX_CHECK(r.distance >= ref - 1e-12);
+		if (r.distance <= ref + 1e-12)
+			hits++;
+		else
+			PX_CHECK(r.local_only);
+	}
+	printf("    cloud-box pairs: %d of 50 global\n", hits);
+	PX_CHECK_MSG(hits >= 49, "cloud-box global-hit rate %d of 50", hits);
+	px_model_free(c);
+	px_model_free(b);
+	free(x);
+}
+
+static void test_coherent_and_alloc(void)
+{
+	double ra, rb;
+	struct px_model *a = make_mesh(0, &ra), *b = make_mesh(1, &rb);
+	struct px_pair_result rc, rf;
+	struct px_pair_opts co = {1, 64, 1e-12, 1, 0}, fo = {8, 64, 1e-12, 0, 0};
+	uint64_t al;
+	int i, agree = 0;
+	memset(&rc, 0, sizeof(rc));
+	memset(&rf, 0, sizeof(rf));
+	al = px_alloc_region_begin();
+	for (i = 0; i < 200; i++) {
+		px_pose Pb = px_pose_identity();
+		Pb.t = px_v3(1.6 * cos(0.01 * i), 1.6 * sin(0.01 * i), 0.3);
+		px_model_set_pose(b, Pb);
+		PX_CHECK_INT_EQ(px_pair_distance(a, b, &co, &rc), PX_OK);
+		PX_CHECK_INT_EQ(px_pair_distance(a, b, &fo, &rf), PX_OK);
+		PX_CHECK(rc.distance >= rf.distance - 1e-9 || rc.local_only);
+		agree += fabs(rc.distance - rf.distance) <= 1e-6;
+		PX_CHECK(rc.starts == 1);
+	}
+	PX_CHECK_INT_EQ(px_alloc_region_end(al), 0);
+	PX_CHECK_MSG(agree >= 190, "coherent agreed %d of 200", agree);
+	PX_CHECK_INT_EQ(px_pair_distance(NULL, b, NULL, &rc), PX_E_INVAL);
+	fo.starts = PX_PAIR_MAX_STARTS + 1;
+	PX_CHECK_INT_EQ(px_pair_distance(a, b, &fo, &rc), PX_E_INVAL);
+	px_model_free(a);
+	px_model_free(b);
+}
+
+static void test_convex_mesh_flag(void)
+{
+	double r;
+	struct px_model *t = make_mesh(0, &r), *s = make_mesh(1, &r), *bx = make_mesh(2, &r),
+			*l = make_mesh(3, &r);
+	PX_CHECK(!(px_model_caps(t) & PX_MODEL_CAP_CONVEX));
+	PX_CHECK(px_model_caps(s) & PX_MODEL_CAP_CONVEX);
+	PX_CHECK(px_model_caps(bx) & PX_MODEL_CAP_CONVEX);
+	PX_CHECK(!(px_model_caps(l) & PX_MODEL_CAP_CONVEX));
+	px_model_free(t);
+	px_model_free(s);
+	px_model_free(bx);
+	px_model_free(l);
+}
+
+static const struct px_test tests[] = {
+	PX_T(test_mesh_pairs_hit_rate), PX_T(test_convex_primitive_pairs),
+	PX_T(test_gjk_convex_primitives),
+	PX_T(test_cloud_vs_box), PX_T(test_coherent_and_alloc),
+	PX_T(test_convex_mesh_flag)};
+PX_TEST_MAIN(tests)
