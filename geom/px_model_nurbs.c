@@ -90,8 +90,13 @@ static void nurbs_free(void *impl)
 }
 
 static const struct px_model_ops nurbs_ops = {
-	"nurbs", PX_MODEL_NURBS, nurbs_closest, nurbs_aabb, nurbs_bytes,
-	nurbs_free};
+	.name = "nurbs",
+	.kind = PX_MODEL_NURBS,
+	.closest = nurbs_closest,
+	.aabb = nurbs_aabb,
+	.memory_bytes = nurbs_bytes,
+	.free = nurbs_free,
+};
 
 int px_nurbs_model_create(const struct px_nurbs_curve *curves, int n_curves,
 			  const struct px_nurbs_surf *surfs, int n_surfs,
