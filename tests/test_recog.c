@@ -1,0 +1,742 @@
+/* Recognition of exact primitives and closed-form closest points vs brute
+ * force over the entity's own parameter domain. */
+#include <math.h>
+#include <string.h>
+
+#include "px_alloc_count.h"
+#include "px_recog.h"
+#include "px_test.h"
+
+#define PI 3.14159265358979323846
+#define MAXC 96
+
+struct tcurve {
+	double U[MAXC + 16], pw[4 * MAXC];
+	struct px_nurbs_curve c;
+};
+
+struct tsurf {
+	double U[MAXC + 16], V[MAXC + 16], pw[4 * MAXC * MAXC / 4];
+	struct px_nurbs_surf s;
+};
+
+struct frame {
+	px_vec3 o, x, y, z;
+};
+
+static px_vec3 rand_unit(void)
+{
+	px_vec3 v;
+	do
+		v = px_v3(px_rand_normal(), px_rand_normal(), px_rand_normal());
+	while (px_v3_norm(v) < 1e-3);
+	return px_v3_scale(v, 1.0 / px_v3_norm(v));
+}
+
+static struct frame rand_frame(void)
+{
+	struct frame f;
+	px_vec3 t;
+	f.o = px_v3(px_rand_range(-3, 3), px_rand_range(-3, 3), px_rand_range(-3, 3));
+	f.x = rand_unit();
+	do {
+		t = rand_unit();
+		t = px_v3_madd(t, f.x, -px_v3_dot(t, f.x));
+	} while (px_v3_norm(t) < 1e-2);
+	f.y = px_v3_scale(t, 1.0 / px_v3_norm(t));
+	f.z = px_v3_cross(f.x, f.y);
+	return f;
+}
+
+static px_vec3 fr(const struct frame *f, double x, double y, double z)
+{
+	return px_v3_add(f->o, px_v3_add(px_v3_scale(f->x, x),
+					 px_v3_add(px_v3_scale(f->y, y),
+						   px_v3_scale(f->z, z))));
+}
+
+static void set_pw(double *pw, px_vec3 p, double w)
+{
+	pw[0] = p.x * w;
+	pw[1] = p.y * w;
+	pw[2] = p.z * w;
+	pw[3] = w;
+}
+
+/* 2D unit-circle arc from angle a0 over sweep in nseg rational quadratic
+ * spans: xy (2 per point), w, n points, knots U on [0, 1] (clamped). */
+static int arc2d(double a0, double sweep, int nseg, double *xy, double *w,
+		 double *U)
+{
+	int s, k = 0, n = 2 * nseg + 1, i;
+	double h = sweep / nseg;
+	for (s = 0; s < nseg; s++) {
+		double t0 = a0 + s * h, tm = t0 + h / 2;
+		if (s == 0) {
+			xy[0] = cos(t0), xy[1] = sin(t0), w[0] = 1;
+		}
+		xy[2 * (2 * s + 1)] = cos(tm) / cos(h / 2);
+		xy[2 * (2 * s + 1) + 1] = sin(tm) / cos(h / 2);
+		w[2 * s + 1] = cos(h / 2);
+		xy[2 * (2 * s + 2)] = cos(t0 + h);
+		xy[2 * (2 * s + 2) + 1] = sin(t0 + h);
+		w[2 * s + 2] = 1;
+	}
+	for (i = 0; i < 3; i++)
+		U[k++] = 0;
+	for (s = 1; s < nseg; s++)
+		U[k++] = (double)s / nseg, U[k++] = (double)s / nseg;
+	for (i = 0; i < 3; i++)
+		U[k++] = 1;
+	return n;
+}
+
+static int view_curve(struct tcurve *t, int p, int n)
+{
+	return px_nurbs_curve_view(&t->c, p, n, t->U, n + p + 1, t->pw, NULL);
+}
+
+/* Circle arc of radius r in frame f: sweep over nseg spans, degree
+ * elevated by elev (each span on its own, C0 joins). */
+static int make_arc(struct tcurve *t, const struct frame *f, double r,
+		    double sweep, int nseg, int elev)
+{
+	double xy[2 * MAXC], w[MAXC], U[MAXC];
+	double bz[12][4];
+	int s, i, k, q = 2 + elev, np = 0, nk = 0;
+	arc2d(0, sweep, nseg, xy, w, U);
+	for (s = 0; s < nseg; s++) {
+		int n = 2;
+		for (i = 0; i < 3; i++) {
+			px_vec3 p = fr(f, r * xy[2 * (2 * s + i)],
+				       r * xy[2 * (2 * s + i) + 1], 0);
+			set_pw(bz[i], p, w[2 * s + i]);
+		}
+		for (k = 0; k < elev; k++, n++) {
+			double nb[12][4];
+			int j, m;
+			for (m = 0; m < 4; m++)
+				nb[0][m] = bz[0][m], nb[n + 1][m] = bz[n][m];
+			for (j = 1; j <= n; j++)
+				for (m = 0; m < 4; m++)
+					nb[j][m] = (double)j / (n + 1) * bz[j - 1][m] +
+						   (1 - (double)j / (n + 1)) * bz[j][m];
+			memcpy(bz, nb, sizeof(nb));
+		}
+		for (i = (s == 0 ? 0 : 1); i <= q; i++)
+			memcpy(t->pw + 4 * np++, bz[i], 4 * sizeof(double));
+	}
+	for (i = 0; i <= q; i++)
+		t->U[nk++] = 0;
+	for (s = 1; s < nseg; s++)
+		for (i = 0; i < q; i++)
+			t->U[nk++] = (double)s / nseg;
+	for (i = 0; i <= q; i++)
+		t->U[nk++] = 1;
+	return view_curve(t, q, np);
+}
+
+/* Straight curve: collinear control points at sorted random stations,
+ * random weights and interior knots. */
+static int make_line(struct tcurve *t, const struct frame *f, int p, int n,
+		     double L, int rational, int uniform)
+{
+	int i, k = 0;
+	double st[MAXC];
+	for (i = 0; i < n; i++)
+		st[i] = px_rand_range(0, L);
+	for (i = 1; i < n; i++) { /* insertion sort */
+		double v = st[i];
+		int j = i - 1;
+		while (j >= 0 && st[j] > v)
+			st[j + 1] = st[j], j--;
+		st[j + 1] = v;
+	}
+	if (!uniform)
+		st[0] = 0, st[n - 1] = L;
+	for (i = 0; i < n; i++)
+		set_pw(t->pw + 4 * i, fr(f, st[i], 0, 0),
+		       rational ? px_rand_range(0.2, 5) : 1.0);
+	for (i = 0; i <= p; i++)
+		t->U[k++] = 0;
+	for (i = 1; i < n - p; i++)
+		t->U[k++] = uniform ? (double)i / (n - p) : px_rand_range(0.05, 0.95);
+	for (i = p + 1; i < n; i++) { /* sort interior knots */
+		double v = t->U[i];
+		int j = i - 1;
+		while (j > p && t->U[j] > v)
+			t->U[j + 1] = t->U[j], j--;
+		t->U[j + 1] = v;
+	}
+	for (i = 0; i <= p; i++)
+		t->U[k++] = 1;
+	if (uniform) /* stations at the Greville abscissae: linear in u */
+		for (i = 0; i < n; i++) {
+			double g = 0;
+			for (k = 1; k <= p; k++)
+				g += t->U[i + k];
+			st[i] = L * g / p;
+		}
+	for (i = 0; i < n; i++)
+		set_pw(t->pw + 4 * i, fr(f, st[i], 0, 0), t->pw[4 * i + 3]);
+	return view_curve(t, p, n);
+}
+
+/* ---- brute force references --------------------------------------------- */
+
+static double curve_brute(const struct px_nurbs_curve *c, px_vec3 p, double *ub)
+{
+	double u0, u1, best = INFINITY, bu = 0, lo, hi;
+	int i, N = 3000, it;
+	px_nurbs_curve_domain(c, &u0, &u1);
+	for (i = 0; i <= N; i++) {
+		double u = u0 + (u1 - u0) * i / N;
+		double d = px_v3_dist(p, px_nurbs_curve_point(c, u));
+		if (d < best)
+			best = d, bu = u;
+	}
+	lo = fmax(u0, bu - (u1 - u0) / N);
+	hi = fmin(u1, bu + (u1 - u0) / N);
+	for (it = 0; it < 200; it++) { /* golden-free ternary polish */
+		double a = lo + (hi - lo) / 3, b = hi - (hi - lo) / 3;
+		if (px_v3_dist(p, px_nurbs_curve_point(c, a)) <
+		    px_v3_dist(p, px_nurbs_curve_point(c, b)))
+			hi = b;
+		else
+			lo = a;
+	}
+	{
+		double d = px_v3_dist(p, px_nurbs_curve_point(c, 0.5 * (lo + hi)));
+		if (d < best)
+			best = d, bu = 0.5 * (lo + hi);
+	}
+	if (ub)
+		*ub = bu;
+	return best;
+}
+
+static double surf_brute(const struct px_nurbs_surf *s, px_vec3 p)
+{
+	double u0, u1, v0, v1, best = INFINITY;
+	double cu[3] = {0}, cv[3] = {0}, cd[3] = {INFINITY, INFINITY, INFINITY};
+	px_vec3 cx[3];
+	int i, j, N = 70, k;
+	px_nurbs_surf_domain(s, &u0, &u1, &v0, &v1);
+	for (i = 0; i <= N; i++)
+		for (j = 0; j <= N; j++) {
+			double u = u0 + (u1 - u0) * i / N, v = v0 + (v1 - v0) * j / N;
+			px_vec3 x = px_nurbs_surf_point(s, u, v);
+			double d = px_v3_dist(p, x);
+			int m, dup = 0;
+			/* Distinct points only: at a pole every sample of the
+			 * collapsed row is the same point. */
+			for (m = 0; m < 3; m++)
+				if (cd[m] < INFINITY && px_v3_dist(x, cx[m]) < 1e-9)
+					dup = 1;
+			for (m = 0; m < 3 && !dup; m++)
+				if (d < cd[m]) {
+					int q;
+					for (q = 2; q > m; q--)
+						cd[q] = cd[q - 1], cu[q] = cu[q - 1],
+						cv[q] = cv[q - 1], cx[q] = cx[q - 1];
+					cd[m] = d, cu[m] = u, cv[m] = v, cx[m] = x;
+					break;
+				}
+		}
+	for (k = 0; k < 3; k++) {
+		double hu = (u1 - u0) / N, hv = (v1 - v0) / N, bu = cu[k], bv = cv[k],
+		       bd = cd[k];
+		int it;
+		for (it = 0; it < 45; it++) {
+			double nu = bu, nv = bv;
+			int a, b;
+			for (a = -2; a <= 2; a++)
+				for (b = -2; b <= 2; b++) {
+					double u = fmin(u1, fmax(u0, bu + a * hu * 0.5));
+					double v = fmin(v1, fmax(v0, bv + b * hv * 0.5));
+					double d = px_v3_dist(p, px_nurbs_surf_point(s, u, v));
+					if (d < bd)
+						bd = d, nu = u, nv = v;
+				}
+			bu = nu, bv = nv;
+			hu *= 0.6, hv *= 0.6;
+		}
+		if (bd < best)
+			best = bd;
+	}
+	return best;
+}
+
+/* ---- curve tests ----------------------------------------------------------- */
+
+static void check_curve_queries(const struct px_prim *pr,
+				const struct px_nurbs_curve *c, int nq,
+				const px_vec3 *extra, int n_extra)
+{
+	int q;
+	double tol = 1e-9 * pr->size;
+	px_aabb b = px_nurbs_curve_aabb(c);
+	px_vec3 mid = px_v3_scale(px_v3_add(b.min, b.max), 0.5);
+	for (q = 0; q < nq + n_extra; q++) {
+		struct px_prim_hit h;
+		px_vec3 p;
+		double ref;
+		if (q < n_extra)
+			p = extra[q];
+		else if (q % 4 == 0) /* on the curve */
+			p = px_nurbs_curve_point(c, c->knots[c->degree] +
+							    px_rand_unit() *
+								    (c->knots[c->n_ctrl] -
+								     c->knots[c->degree]));
+		else
+			p = px_v3_madd(mid, rand_unit(),
+				       pr->size * px_rand_range(0, q % 4 == 1 ? 0.3 : 2));
+		PX_CHECK_INT_EQ(px_prim_closest(pr, p, PX_PRIM_WANT_PARAMS, &h), PX_OK);
+		ref = curve_brute(c, p, NULL);
+		PX_CHECK_MSG(h.dist <= ref + tol && ref <= h.dist + tol,
+			     "%s: closed form %.17g brute %.17g", px_prim_kind_name(pr->kind),
+			     h.dist, ref);
+		PX_CHECK_MSG(px_v3_dist(px_nurbs_curve_point(c, h.u), h.point) <= 1e-8 * pr->size,
+			     "parameter %.17g gives a point %.3g away", h.u,
+			     px_v3_dist(px_nurbs_curve_point(c, h.u), h.point));
+		PX_CHECK_NEAR(px_v3_dist(p, h.point), h.dist, 1e-12 * pr->size);
+	}
+}
+
+static void test_circle_full_and_arcs(void)
+{
+	int trial;
+	for (trial = 0; trial < 60; trial++) {
+		struct tcurve t;
+		struct px_prim pr;
+		struct frame f = rand_frame();
+		double r = px_rand_range(0.1, 10), sweep;
+		int nseg, elev = trial % 4 == 3 ? px_rand_int(1, 3) : 0;
+		px_vec3 extra[3];
+		if (trial % 3 == 0) {
+			sweep = 2 * PI, nseg = 4; /* 9-point circle */
+		} else if (trial % 3 == 1) {
+			sweep = px_rand_range(PI / 4, PI * 179.0 / 180), nseg = 1;
+		} else {
+			sweep = px_rand_range(0.5, 2 * PI);
+			nseg = (int)ceil(sweep / (PI / 2) - 1e-9);
+		}
+		PX_CHECK_INT_EQ(make_arc(&t, &f, r, sweep, nseg, elev), PX_OK);
+		PX_CHECK_INT_EQ(px_recog_curve(&t.c, 0, &pr), 1);
+		PX_CHECK_INT_EQ(pr.kind, PX_PRIM_ARC);
+		if (pr.kind != PX_PRIM_ARC)
+			continue;
+		PX_CHECK_NEAR(pr.arc.radius, r, 1e-12 * r);
+		PX_CHECK_NEAR(px_v3_dist(pr.arc.center, f.o), 0, 1e-12 * r);
+		PX_CHECK_NEAR(pr.arc.sweep, sweep, 1e-11);
+		PX_CHECK_NEAR(fabs(px_v3_dot(pr.arc.normal, f.z)), 1, 1e-12);
+		PX_CHECK(pr.hausdorff <= 1e-10 * pr.size);
+		extra[0] = f.o; /* centre: every point equally near */
+		extra[1] = fr(&f, 0, 0, r * px_rand_range(-2, 2)); /* on the axis */
+		extra[2] = fr(&f, -r * 0.7, r * 0.01, r * 0.3);
+		check_curve_queries(&pr, &t.c, 24, extra, 3);
+		{
+			struct px_prim_hit h;
+			px_prim_closest(&pr, f.o, 0, &h);
+			PX_CHECK(h.tie);
+			PX_CHECK_NEAR(h.dist, r, 1e-12 * r);
+		}
+	}
+}
+
+static void test_lines(void)
+{
+	int trial;
+	for (trial = 0; trial < 80; trial++) {
+		struct tcurve t;
+		struct px_prim pr;
+		struct frame f = rand_frame();
+		int p = 1 + trial % 5, n = p + 1 + px_rand_int(0, 4);
+		int uniform = trial % 4 == 0, rational = !uniform && trial % 2;
+		double L = px_rand_range(0.5, 20);
+		px_vec3 extra[2];
+		PX_CHECK_INT_EQ(make_line(&t, &f, p, n, L, rational, uniform), PX_OK);
+		PX_CHECK_INT_EQ(px_recog_curve(&t.c, 0, &pr), 1);
+		PX_CHECK_INT_EQ(pr.kind, PX_PRIM_SEGMENT);
+		if (pr.kind != PX_PRIM_SEGMENT)
+			continue;
+		PX_CHECK_NEAR(pr.seg.len, L, 1e-12 * L);
+		PX_CHECK_NEAR(px_v3_dot(pr.seg.dir, f.x), 1, 1e-12);
+		if (uniform)
+			PX_CHECK(pr.linear);
+		extra[0] = fr(&f, -L, 0.3, 0);
+		extra[1] = fr(&f, 0.5 * L, 0, 0);
+		check_curve_queries(&pr, &t.c, 20, extra, 2);
+	}
+}
+
+static void test_curve_near_misses(void)
+{
+	int trial;
+	for (trial = 0; trial < 60; trial++) {
+		struct tcurve t;
+		struct px_prim pr;
+		struct frame f = rand_frame();
+		double r = px_rand_range(0.5, 5);
+		int i, k;
+		switch (trial % 5) {
+		case 0: /* circle with one control point moved by 1e-6 size */
+			make_arc(&t, &f, r, px_rand_range(1, 2 * PI), 4, trial % 2);
+			k = px_rand_int(0, t.c.n_ctrl - 1);
+			{
+				px_vec3 d = px_v3_scale(rand_unit(), 2e-6 * r);
+				for (i = 0; i < 3; i++)
+					t.pw[4 * k + i] += px_v3_comp(d, i) * t.pw[4 * k + 3];
+			}
+			break;
+		case 1: /* ellipse: circle stretched by 1e-6 or more */
+			make_arc(&t, &f, r, px_rand_range(1, 2 * PI), 4, 0);
+			for (k = 0; k < t.c.n_ctrl; k++) {
+				px_vec3 q = px_v3_scale(px_v3(t.pw[4 * k], t.pw[4 * k + 1],
+							      t.pw[4 * k + 2]),
+							1.0 / t.pw[4 * k + 3]);
+				double e = px_v3_dot(px_v3_sub(q, f.o), f.x);
+				q = px_v3_madd(q, f.x, e * (trial % 2 ? 1e-6 : 0.3));
+				set_pw(t.pw + 4 * k, q, t.pw[4 * k + 3]);
+			}
+			break;
+		case 2: /* parabola (non-rational quadratic) */
+			set_pw(t.pw, fr(&f, r, 0, 0), 1);
+			set_pw(t.pw + 4, fr(&f, r, r, 0), 1);
+			set_pw(t.pw + 8, fr(&f, 0, r, 0), 1);
+			for (i = 0; i < 3; i++)
+				t.U[i] = 0, t.U[i + 3] = 1;
+			view_curve(&t, 2, 3);
+			break;
+		case 3: { /* line with a control point off by 1e-6 size */
+			int p = px_rand_int(1, 4);
+			make_line(&t, &f, p, p + 2, r, 1, 0);
+			k = px_rand_int(0, t.c.n_ctrl - 1);
+			for (i = 0; i < 3; i++)
+				t.pw[4 * k + i] += 1e-6 * r * px_v3_comp(f.y, i) * t.pw[4 * k + 3];
+			break;
+		}
+		default: { /* collinear but doubling back: not a monotone segment */
+			set_pw(t.pw, fr(&f, 0, 0, 0), 1);
+			set_pw(t.pw + 4, fr(&f, r, 0, 0), 1);
+			set_pw(t.pw + 8, fr(&f, 0.2 * r, 0, 0), 1);
+			set_pw(t.pw + 12, fr(&f, 0.5 * r, 0, 0), 1);
+			for (i = 0; i < 3; i++)
+				t.U[i] = 0, t.U[i + 4] = 1;
+			t.U[3] = 0.5;
+			view_curve(&t, 2, 4);
+			break;
+		}
+		}
+		PX_CHECK_MSG(px_recog_curve(&t.c, 0, &pr) == 0, "case %d recognised as %s",
+			     trial % 5, px_prim_kind_name(pr.kind));
+		PX_CHECK_INT_EQ(pr.kind, PX_PRIM_NONE);
+	}
+}
+
+/* ---- surfaces ---------------------------------------------------------------- */
+
+/* Surface of revolution: angular unit arc (xy, alpha, knots Ua, degree 2)
+ * times profile (h_j, rho_j, beta_j, knots Vp, degree pp) in frame f,
+ * axis f.z. transpose puts the angle along v. */
+static int make_rev(struct tsurf *t, const struct frame *f, double a0,
+		    double sweep, const double *hr, const double *beta, int np,
+		    const double *Vp, int pp, int transpose)
+{
+	double xy[2 * MAXC], al[MAXC], Ua[MAXC];
+	int nseg = (int)ceil(sweep / (PI / 2) - 1e-9), na, i, j;
+	na = arc2d(a0, sweep, nseg, xy, al, Ua);
+	for (i = 0; i < na; i++)
+		for (j = 0; j < np; j++) {
+			px_vec3 p = fr(f, hr[2 * j + 1] * xy[2 * i],
+				       hr[2 * j + 1] * xy[2 * i + 1], hr[2 * j]);
+			size_t idx = transpose ? (size_t)i * np + j : (size_t)j * na + i;
+			set_pw(t->pw + 4 * idx, p, al[i] * beta[j]);
+		}
+	memcpy(transpose ? t->V : t->U, Ua, (size_t)(na + 3) * sizeof(double));
+	memcpy(transpose ? t->U : t->V, Vp, (size_t)(np + pp + 1) * sizeof(double));
+	if (!transpose)
+		return px_nurbs_surf_view(&t->s, 2, pp, na, np, t->U, na + 3, t->V,
+					  np + pp + 1, t->pw, NULL);
+	return px_nurbs_surf_view(&t->s, pp, 2, np, na, t->U, np + pp + 1, t->V,
+				  na + 3, t->pw, NULL);
+}
+
+/* Profile arc in the (h, rho) plane: centre (hc, rc), radius r, angles
+ * [a0, a0 + sweep] measured from +h towards +rho. */
+static int profile_arc(double hc, double rc, double r, double a0, double sweep,
+		       double *hr, double *beta, double *V)
+{
+	double xy[2 * MAXC];
+	int nseg = (int)ceil(sweep / (PI / 2) - 1e-9), n, j;
+	n = arc2d(a0, sweep, nseg, xy, beta, V);
+	for (j = 0; j < n; j++) {
+		hr[2 * j] = hc + r * xy[2 * j];
+		hr[2 * j + 1] = rc + r * xy[2 * j + 1];
+	}
+	return n;
+}
+
+static int profile_seg(double h0, double r0, double h1, double r1, int deg,
+		       double *hr, double *beta, double *V)
+{
+	int j, n = deg + 1;
+	for (j = 0; j < n; j++) {
+		double s = (double)j / deg;
+		hr[2 * j] = h0 + (h1 - h0) * s;
+		hr[2 * j + 1] = r0 + (r1 - r0) * s;
+		beta[j] = 1;
+	}
+	for (j = 0; j <= deg; j++)
+		V[j] = 0, V[j + deg + 1] = 1;
+	return n;
+}
+
+static void check_surf_queries(const struct px_prim *pr,
+			       const struct px_nurbs_surf *s, int nq,
+			       const px_vec3 *extra, int n_extra)
+{
+	int q;
+	double tol = 1e-9 * pr->size, u0, u1, v0, v1;
+	px_aabb b = px_nurbs_surf_aabb(s);
+	px_vec3 mid = px_v3_scale(px_v3_add(b.min, b.max), 0.5);
+	px_nurbs_surf_domain(s, &u0, &u1, &v0, &v1);
+	for (q = 0; q < nq + n_extra; q++) {
+		struct px_prim_hit h;
+		px_vec3 p;
+		double ref;
+		if (q < n_extra)
+			p = extra[q];
+		else if (q % 4 == 0)
+			p = px_nurbs_surf_point(s, u0 + (u1 - u0) * px_rand_unit(),
+						v0 + (v1 - v0) * px_rand_unit());
+		else
+			p = px_v3_madd(mid, rand_unit(),
+				       pr->size * px_rand_range(0, q % 4 == 1 ? 0.4 : 1.5));
+		PX_CHECK_INT_EQ(px_prim_closest(pr, p, PX_PRIM_WANT_PARAMS, &h), PX_OK);
+		ref = surf_brute(s, p);
+		PX_CHECK_MSG(h.dist <= ref + tol && ref <= h.dist + tol,
+			     "%s: closed form %.17g brute %.17g (query %d) p=(%g %g %g) hit=(%g %g) deg %d %d",
+			     px_prim_kind_name(pr->kind), h.dist, ref, q, p.x, p.y, p.z, h.u, h.v, s->degree[0], s->degree[1]);
+		PX_CHECK_MSG(px_v3_dist(px_nurbs_surf_point(s, h.u, h.v), h.point) <=
+				     1e-8 * pr->size,
+			     "%s: parameters (%.17g, %.17g) give a point %.3g away",
+			     px_prim_kind_name(pr->kind), h.u, h.v,
+			     px_v3_dist(px_nurbs_surf_point(s, h.u, h.v), h.point));
+	}
+}
+
+static void test_revolutions(void)
+{
+	int trial;
+	for (trial = 0; trial < 30; trial++) {
+		struct tsurf t;
+		struct px_prim pr;
+		struct frame f = rand_frame();
+		double hr[2 * MAXC], beta[MAXC], V[MAXC + 8];
+		double R = px_rand_range(0.5, 3), a0 = px_rand_range(-PI, PI), sweep;
+		int np, want, kind = trial % 6, tr = (trial / 6) % 2;
+		px_vec3 extra[4];
+		int n_extra = 0;
+		sweep = trial % 3 == 0 ? 2 * PI : px_rand_range(0.3, 2 * PI);
+		switch (kind) {
+		case 0: /* full sphere or sphere zone */
+			np = trial % 2 ? profile_arc(0, 0, R, 0, PI, hr, beta, V)
+				       : profile_arc(0, 0, R, px_rand_range(0, 1),
+						     px_rand_range(0.5, 2), hr, beta, V);
+			want = PX_PRIM_SPHERE;
+			break;
+		case 1: /* octant */
+			np = profile_arc(0, 0, R, 0, PI / 2, hr, beta, V);
+			sweep = PI / 2;
+			want = PX_PRIM_SPHERE;
+			break;
+		case 2:
+			np = profile_seg(-1, R, px_rand_range(0, 2), R, 1 + trial % 3, hr,
+					 beta, V);
+			want = PX_PRIM_CYLINDER;
+			break;
+		case 3:
+			np = profile_seg(-1, R, 1.5, trial % 2 ? 0 : 0.3 * R, 1 + trial % 2,
+					 hr, beta, V);
+			want = PX_PRIM_CONE;
+			break;
+		case 4: /* torus: full tube or a partial one */
+			np = profile_arc(0, R, 0.4 * R, 0,
+					 trial % 2 ? 2 * PI : px_rand_range(1, 5), hr, beta,
+					 V);
+			want = PX_PRIM_TORUS;
+			break;
+		default:
+			np = profile_seg(0.5, 0.2 * R, 0.5, R, 1, hr, beta, V);
+			want = PX_PRIM_ANNULUS;
+			break;
+		}
+		PX_CHECK_INT_EQ(make_rev(&t, &f, a0, sweep, hr, beta, np, V,
+					 kind == 2 ? 1 + trial % 3
+						   : (kind == 3 ? 1 + trial % 2
+								: (kind == 5 ? 1 : 2)),
+					 tr),
+				PX_OK);
+		PX_CHECK_INT_EQ(px_recog_surf(&t.s, 0, &pr), 1);
+		PX_CHECK_MSG(pr.kind == (enum px_prim_kind)want, "trial %d: got %s want %s",
+			     trial, px_prim_kind_name(pr.kind),
+			     px_prim_kind_name((enum px_prim_kind)want));
+		if (pr.kind != (enum px_prim_kind)want)
+			continue;
+		PX_CHECK(pr.hausdorff <= 1e-10 * pr.size);
+		PX_CHECK_NEAR(fabs(px_v3_dot(pr.rev.axis, f.z)), 1, 1e-12);
+		PX_CHECK_NEAR(pr.rev.sweep, sweep, 1e-11);
+		if (want == PX_PRIM_SPHERE) {
+			PX_CHECK_NEAR(pr.radius, R, 1e-12 * R);
+			PX_CHECK_NEAR(px_v3_dist(pr.center, f.o), 0, 1e-12 * R);
+		} else if (want == PX_PRIM_CYLINDER) {
+			PX_CHECK_NEAR(pr.radius, R, 1e-12 * R);
+		} else if (want == PX_PRIM_TORUS) {
+			PX_CHECK_NEAR(pr.radius, R, 1e-12 * R);
+			PX_CHECK_NEAR(pr.radius2, 0.4 * R, 1e-12 * R);
+		} else if (want == PX_PRIM_CONE && trial % 2) {
+			PX_CHECK_NEAR(px_v3_dist(pr.center, fr(&f, 0, 0, 1.5)), 0, 1e-11);
+		}
+		/* On the axis (the evolute of every meridian circle), the
+		 * centre, and outside the angular range. */
+		extra[n_extra++] = fr(&f, 0, 0, px_rand_range(-2, 2));
+		extra[n_extra++] = f.o;
+		extra[n_extra++] = fr(&f, 2 * R * cos(a0 - 0.3), 2 * R * sin(a0 - 0.3), 0.2);
+		extra[n_extra++] = fr(&f, 0.5 * R * cos(a0 + sweep + 0.4),
+				      0.5 * R * sin(a0 + sweep + 0.4), -0.3);
+		check_surf_queries(&pr, &t.s, 14, extra, n_extra);
+	}
+}
+
+static void test_parallelograms(void)
+{
+	int trial;
+	for (trial = 0; trial < 12; trial++) {
+		struct tsurf t;
+		struct px_prim pr;
+		struct frame f = rand_frame();
+		int pu = 1 + trial % 3, pv = 1 + (trial / 3) % 3, nu = pu + 1 + trial % 2,
+		    nv = pv + 1, i, j;
+		double xs[MAXC], ys[MAXC], al[MAXC], be[MAXC], sk = px_rand_range(-0.5, 0.5);
+		int uniform = trial % 4 == 0, trap = trial % 6 == 5;
+		for (i = 0; i < nu; i++) {
+			xs[i] = uniform ? 2.0 * i / (nu - 1) : (i == 0 ? 0 : xs[i - 1] + px_rand_range(0.1, 1));
+			al[i] = uniform ? 1 : px_rand_range(0.3, 3);
+		}
+		for (j = 0; j < nv; j++) {
+			ys[j] = uniform ? 1.5 * j / (nv - 1) : (j == 0 ? 0 : ys[j - 1] + px_rand_range(0.1, 1));
+			be[j] = uniform ? 1 : px_rand_range(0.3, 3);
+		}
+		for (j = 0; j < nv; j++)
+			for (i = 0; i < nu; i++) {
+				double x = xs[i] + sk * ys[j];
+				if (trap) /* trapezoid: not a parallelogram */
+					x *= 1 + 0.3 * ys[j];
+				set_pw(t.pw + 4 * (j * nu + i), fr(&f, x, ys[j], 0),
+				       al[i] * be[j]);
+			}
+		for (i = 0; i <= pu; i++)
+			t.U[i] = 0, t.U[nu + i] = 1;
+		for (i = pu + 1; i < nu; i++)
+			t.U[i] = 0.5;
+		for (j = 0; j <= pv; j++)
+			t.V[j] = 0, t.V[nv + j] = 1;
+		PX_CHECK_INT_EQ(px_nurbs_surf_view(&t.s, pu, pv, nu, nv, t.U, nu + pu + 1,
+						   t.V, nv + pv + 1, t.pw, NULL),
+				PX_OK);
+		PX_CHECK_INT_EQ(px_recog_surf(&t.s, 0, &pr), 1);
+		if (trap) {
+			struct px_prim_hit h;
+			PX_CHECK_INT_EQ(pr.kind, PX_PRIM_PLANE);
+			PX_CHECK_INT_EQ(px_prim_closest(&pr, f.o, 0, &h), PX_E_UNSUPPORTED);
+			continue;
+		}
+		PX_CHECK_INT_EQ(pr.kind, PX_PRIM_PARALLELOGRAM);
+		if (pr.kind != PX_PRIM_PARALLELOGRAM)
+			continue;
+		if (uniform && pu == 1 && pv == 1)
+			PX_CHECK_INT_EQ(pr.linear, 3);
+		check_surf_queries(&pr, &t.s, 16, NULL, 0);
+	}
+}
+
+static void test_surface_near_misses(void)
+{
+	int trial;
+	for (trial = 0; trial < 18; trial++) {
+		struct tsurf t;
+		struct px_prim pr;
+		struct frame f = rand_frame();
+		double hr[2 * MAXC], beta[MAXC], V[MAXC + 8], R = px_rand_range(0.5, 2);
+		int np, k, i;
+		switch (trial % 3) {
+		case 0:
+			np = profile_arc(0, 0, R, 0, PI, hr, beta, V);
+			break;
+		case 1:
+			np = profile_arc(0, R, 0.3 * R, 0, 2 * PI, hr, beta, V);
+			break;
+		default:
+			np = profile_seg(-1, R, 1, 0.5 * R, 2, hr, beta, V);
+			break;
+		}
+		if (trial % 2 == 0) {
+			/* Profile slightly off: an ellipsoid / elliptic torus /
+			 * a parabolic-profile cone. */
+			for (k = 0; k < np; k++)
+				hr[2 * k] *= 1 + (trial % 3 == 2 ? 1e-6 * hr[2 * k] : 1e-6);
+			if (trial % 3 == 2)
+				hr[3] += 1e-6 * R;
+		}
+		make_rev(&t, &f, 0, px_rand_range(1, 2 * PI), hr, beta, np, V,
+			 trial % 3 == 2 ? 2 : 2, trial % 4 == 1);
+		if (trial % 2 == 1) { /* one control point moved by 2e-6 size */
+			px_vec3 d = px_v3_scale(rand_unit(), 2e-6 * R);
+			k = px_rand_int(0, t.s.n_ctrl[0] * t.s.n_ctrl[1] - 1);
+			for (i = 0; i < 3; i++)
+				t.pw[4 * k + i] += px_v3_comp(d, i) * t.pw[4 * k + 3];
+		}
+		PX_CHECK_MSG(px_recog_surf(&t.s, 0, &pr) == 0, "trial %d recognised as %s",
+			     trial, px_prim_kind_name(pr.kind));
+	}
+}
+
+static void test_no_alloc_and_errors(void)
+{
+	struct tcurve t;
+	struct tsurf ts;
+	struct px_prim pc, ps;
+	struct px_prim_hit h;
+	struct frame f = rand_frame();
+	double hr[2 * MAXC], beta[MAXC], V[MAXC + 8];
+	uint64_t reg;
+	int i, np;
+
+	make_arc(&t, &f, 2, 3, 2, 1);
+	PX_CHECK_INT_EQ(px_recog_curve(&t.c, 0, &pc), 1);
+	np = profile_arc(0, 1.5, 0.5, 0, 2 * PI, hr, beta, V);
+	make_rev(&ts, &f, 0, 4, hr, beta, np, V, 2, 0);
+	PX_CHECK_INT_EQ(px_recog_surf(&ts.s, 0, &ps), 1);
+	reg = px_alloc_region_begin();
+	for (i = 0; i < 200; i++) {
+		px_vec3 p = px_v3(px_rand_range(-5, 5), px_rand_range(-5, 5),
+				  px_rand_range(-5, 5));
+		px_prim_closest(&pc, p, PX_PRIM_WANT_PARAMS, &h);
+		px_prim_closest(&ps, p, PX_PRIM_WANT_PARAMS, &h);
+	}
+	PX_CHECK_INT_EQ(px_alloc_region_end(reg), 0);
+	PX_CHECK_INT_EQ(px_prim_closest(NULL, f.o, 0, &h), PX_E_INVAL);
+	PX_CHECK_INT_EQ(px_prim_closest(&pc, px_v3(NAN, 0, 0), 0, &h), PX_E_NAN);
+	PX_CHECK_INT_EQ(px_recog_curve(NULL, 0, &pc), PX_E_INVAL);
+	PX_CHECK_INT_EQ(px_recog_surf(&ts.s, 0, NULL), PX_E_INVAL);
+	memset(&pc, 0, sizeof(pc));
+	PX_CHECK_INT_EQ(px_prim_closest(&pc, f.o, 0, &h), PX_E_UNSUPPORTED);
+}
+
+static const struct px_test tests[] = {
+	PX_T(test_circle_full_and_arcs), PX_T(test_lines), PX_T(test_curve_near_misses),
+	PX_T(test_revolutions), PX_T(test_parallelograms),
+	PX_T(test_surface_near_misses), PX_T(test_no_alloc_and_errors),
+};
+PX_TEST_MAIN(tests)
