@@ -251,8 +251,9 @@ static int rec_arc(const struct px_nurbs_curve *c, double tol, double margin,
 		double W[PX_NURBS_MAX_DEGREE + 1], d1[PX_NURBS_MAX_DEGREE + 1],
 			d2[PX_NURBS_MAX_DEGREE + 1];
 		double F[PX_BERN_MAX_DEGREE + 1], Fa[PX_BERN_MAX_DEGREE + 1],
+			WW[PX_BERN_MAX_DEGREE + 1],
 			tmp[PX_BERN_MAX_DEGREE + 1], g[PX_BERN_MAX_DEGREE + 1];
-		double wmin = INFINITY, fmax = 0;
+		double fmax = 0;
 		struct px_nurbs_curve bz;
 		int j, m, pos = 0, neg = 0;
 
@@ -269,13 +270,11 @@ static int rec_arc(const struct px_nurbs_curve *c, double tol, double margin,
 			for (j = 0; j < 3; j++)
 				ya[j][i] = fabs(y[j][i]);
 			W[i] = q[3];
-			if (q[3] < wmin)
-				wmin = q[3];
 		}
 		/* F = |Y|^2 - r^2 W^2 (degree 2p); Fa bounds its rounding. */
-		px_bern_mul(W, p, W, p, F);
+		px_bern_mul(W, p, W, p, WW);
 		for (m = 0; m <= 2 * p; m++)
-			Fa[m] = rad * rad * F[m], F[m] = -Fa[m];
+			Fa[m] = rad * rad * WW[m], F[m] = -Fa[m];
 		for (j = 0; j < 3; j++) {
 			px_bern_mul(y[j], p, y[j], p, tmp);
 			for (m = 0; m <= 2 * p; m++)
@@ -284,13 +283,18 @@ static int rec_arc(const struct px_nurbs_curve *c, double tol, double margin,
 			for (m = 0; m <= 2 * p; m++)
 				Fa[m] += tmp[m];
 		}
+		/* |F| <= sum |F_m| B_m <= max_m (|F_m| / WW_m) W^2, WW the
+		 * (positive) coefficients of W^2: so |F| / W^2 is bounded
+		 * coefficient by coefficient, which stays tight when the
+		 * weights vary widely. */
 		for (m = 0; m <= 2 * p; m++) {
-			double e = fabs(F[m]) + 16.0 * (2 * p + 4) * DBL_EPSILON * Fa[m];
+			double e = (fabs(F[m]) + 16.0 * (2 * p + 4) * DBL_EPSILON * Fa[m]) /
+				   WW[m];
 			if (e > fmax)
 				fmax = e;
 		}
-		if (fmax / (wmin * wmin) > eF)
-			eF = fmax / (wmin * wmin);
+		if (fmax > eF)
+			eF = fmax;
 		/* g = y1 y2' - y2 y1' (degree 2p - 1): the angle's speed
 		 * times W^2 rho^2. One sign on every span => monotone. */
 		if (p >= 1) {

@@ -21,13 +21,14 @@
  *  - Arc (any degree, rational or not): control points within dz of the
  *    plane; on every Bezier span the polynomial F = |X - cW|^2 - r^2 W^2
  *    (X, W homogeneous numerator and weight) has Bernstein coefficients
- *    bounded by e (plus a rounding margin), so ||C - c| - r| <= e /
- *    (r min W^2) on the whole span; the angular speed polynomial
+ *    F_m with |F_m| <= e G_m (plus a rounding margin), G_m > 0 the
+ *    coefficients of W^2, so |F| <= e W^2 and ||C - c| - r| <= e / r on
+ *    the whole span; the angular speed polynomial
  *    n . (Y x Y') (Y = X - cW) has Bernstein coefficients of one sign on
  *    every span (the angle is monotone, so the image is exactly the arc
  *    between the end angles); the sweep is summed over sub-pieces whose
  *    control points lie in an open half-plane through the centre (each
- *    turns by less than pi, so no turn is lost). H = e/(r minW^2) + 2 dz.
+ *    turns by less than pi, so no turn is lost). H = e / r + 2 dz.
  *    Sweeps above a full turn are not recognised.
  *  - Surfaces: the homogeneous control net must factor as
  *    P_ij = c + h_j a + rho_j E_i with weights alpha_i beta_j, within a
@@ -135,7 +136,8 @@ struct px_prim_quad {
 struct px_prim {
 	enum px_prim_kind kind;
 	int is_surface;
-	double hausdorff;   /* proved bound H (model units) */
+	double hausdorff;   /* proved bound H (model units); for PLANE only
+			     * the distance of the patch from the plane */
 	double size;        /* entity size the tolerance was relative to */
 	/* Informational shape parameters: SPHERE center/radius; CYLINDER
 	 * radius; CONE apex (center) and half_angle; TORUS center, radius
