@@ -3,7 +3,10 @@
 #include <math.h>
 #include <string.h>
 
+#include <stdio.h>
+
 #include "px_alloc_count.h"
+#include "px_obj.h"
 #include "px_recog.h"
 #include "px_test.h"
 
@@ -378,7 +381,7 @@ static void test_circle_full_and_arcs(void)
 		struct px_prim pr;
 		struct frame f = rand_frame();
 		double r = px_rand_range(0.1, 10), sweep;
-		int nseg, elev = trial % 4 == 3 ? px_rand_int(1, 3) : 0;
+		int nseg, elev = trial % 4 == 3 ? px_rand_int(1, 8) : 0;
 		px_vec3 extra[3];
 		if (trial % 3 == 0) {
 			sweep = 2 * PI, nseg = 4; /* 9-point circle */
@@ -880,6 +883,50 @@ static void test_bound_holds_when_loose(void)
 	PX_CHECK_MSG(rec >= 12, "only %d of 24 perturbed entities recognised", rec);
 }
 
+/* The shipped example files: the NURBS circle and the rational sphere
+ * are recognised with their documented dimensions, the bicubic patch is
+ * not. */
+static void test_obj_files(void)
+{
+	const char *f = __FILE__, *slash = strrchr(f, '/');
+	const char *names[3] = {"circle.obj", "sphere.obj", "bicubic.obj"};
+	int k;
+	for (k = 0; k < 3; k++) {
+		char path[512];
+		struct px_obj_model *m = NULL;
+		struct px_obj_error e;
+		struct px_prim pr;
+		int rc;
+		if (slash)
+			snprintf(path, sizeof(path), "%.*s/data/%s", (int)(slash - f), f,
+				 names[k]);
+		else
+			snprintf(path, sizeof(path), "data/%s", names[k]);
+		rc = px_obj_load_file(path, &m, &e);
+		PX_CHECK_MSG(rc == PX_OK, "%s: %s", path, e.msg);
+		if (rc != PX_OK)
+			continue;
+		PX_CHECK(m->n_entities >= 1);
+		if (k == 0) {
+			PX_CHECK_INT_EQ(px_recog_curve(&m->entities[0].curve, 0, &pr), 1);
+			PX_CHECK_INT_EQ(pr.kind, PX_PRIM_ARC);
+			PX_CHECK_NEAR(pr.radius, 2, 1e-12);
+			PX_CHECK_NEAR(px_v3_dist(pr.center, px_v3(1, -1, 0.5)), 0, 1e-12);
+			PX_CHECK_NEAR(pr.arc.sweep, 2 * PI, 1e-12);
+		} else if (k == 1) {
+			PX_CHECK_INT_EQ(px_recog_surf(&m->entities[0].surf, 0, &pr), 1);
+			PX_CHECK_INT_EQ(pr.kind, PX_PRIM_SPHERE);
+			PX_CHECK_NEAR(pr.radius, 1.5, 1e-12);
+			PX_CHECK_NEAR(px_v3_norm(pr.center), 0, 1e-12);
+			check_surf_queries(&pr, &m->entities[0].surf, 10, NULL, 0);
+		} else {
+			PX_CHECK_INT_EQ(px_recog_surf(&m->entities[0].surf, 0, &pr), 0);
+			PX_CHECK_INT_EQ(pr.kind, PX_PRIM_NONE);
+		}
+		px_obj_free(m);
+	}
+}
+
 static void test_no_alloc_and_errors(void)
 {
 	struct tcurve t;
@@ -916,6 +963,7 @@ static const struct px_test tests[] = {
 	PX_T(test_circle_full_and_arcs), PX_T(test_lines), PX_T(test_curve_near_misses),
 	PX_T(test_revolutions), PX_T(test_parallelograms),
 	PX_T(test_surface_near_misses), PX_T(test_circle_rows_not_revolution),
-	PX_T(test_bound_holds_when_loose), PX_T(test_no_alloc_and_errors),
+	PX_T(test_bound_holds_when_loose), PX_T(test_obj_files),
+	PX_T(test_no_alloc_and_errors),
 };
 PX_TEST_MAIN(tests)
