@@ -29,6 +29,7 @@ struct crec {
 	struct px_prim_arc arc;
 	double hd;
 	int linear;
+	struct px_prim_qarc qa;
 };
 
 static px_vec3 hpt(const double *pw)
@@ -204,6 +205,51 @@ static int sweep_piece(const struct px_nurbs_curve *c, double a, double b,
 	       sweep_piece(c, 0.5 * (a + b), b, ar, depth + 1, work, sweep);
 }
 
+/* Angle -> parameter table of a degree-2 arc (struct px_prim_qarc);
+ * q->n = 0 when the curve is not quadratic, has too many spans, or a
+ * span's weights disagree with its turn (then parameters are solved). */
+static void qarc_table(const struct px_nurbs_curve *c,
+		       const struct px_prim_arc *ar, double *work,
+		       struct px_prim_qarc *q)
+{
+	int k, n = 0;
+	double acc = 0;
+	q->n = 0;
+	if (c->degree != 2)
+		return;
+	for (k = 2; k < c->n_ctrl; k++) {
+		struct px_nurbs_curve bz;
+		double w0, w1, w2, wn, turn, half;
+		px_vec3 pa, pb;
+		if (!(c->knots[k] < c->knots[k + 1]))
+			continue;
+		if (n >= PX_PRIM_QSPANS || !bezier_piece(c, c->knots[k],
+							 c->knots[k + 1], work, &bz))
+			return;
+		w0 = bz.pw[3], w1 = bz.pw[7], w2 = bz.pw[11];
+		wn = w1 / sqrt(w0 * w2);
+		if (!(wn > 0 && wn < 1))
+			return;
+		half = acos(wn);
+		pa = px_v3_sub(hpt(bz.pw), ar->center);
+		pb = px_v3_sub(hpt(bz.pw + 8), ar->center);
+		turn = atan2(px_v3_dot(ar->normal, px_v3_cross(pa, pb)),
+			     px_v3_dot(pa, pb));
+		if (!(fabs(turn - 2 * half) <= 1e-9))
+			return;
+		q->u[n] = c->knots[k];
+		q->a[n] = acc;
+		q->lam[n] = sqrt(w0 / w2);
+		q->half[n] = half;
+		acc += turn;
+		n++;
+		q->u[n] = c->knots[k + 1];
+	}
+	q->a[n] = acc;
+	if (n > 0 && fabs(acc - ar->sweep) <= 1e-9)
+		q->n = n;
+}
+
 static int rec_arc(const struct px_nurbs_curve *c, double tol, double margin,
 		   struct crec *r)
 {
@@ -349,6 +395,7 @@ static int rec_arc(const struct px_nurbs_curve *c, double tol, double margin,
 	r->kind = PX_PRIM_ARC;
 	r->arc = ar;
 	r->linear = 0;
+	qarc_table(c, &ar, work, &r->qa);
 	return 1;
 }
 
@@ -406,6 +453,8 @@ int px_recog_curve(const struct px_nurbs_curve *c, double rel_tol,
 	out->seg = r.seg;
 	out->arc = r.arc;
 	out->linear = r.linear;
+	if (r.kind == PX_PRIM_ARC)
+		out->qarc[0] = r.qa;
 	if (r.kind == PX_PRIM_ARC) {
 		out->center = r.arc.center;
 		out->normal = r.arc.normal;
@@ -606,6 +655,11 @@ static int rec_rev(const struct px_nurbs_surf *s, int d, double tol,
 	out->rev.parc = pr.arc;
 	out->rev.dir_angle = d;
 	out->normal = a;
+	out->qarc[0] = rr.qa;
+	if (pr.kind == PX_PRIM_ARC)
+		out->qarc[1] = pr.qa;
+	else if (pr.linear)
+		out->linear = 1 << (1 - d);
 	/* Fixed parameters for inversion: the angle is read where the
 	 * profile is farthest from the axis; the profile at the start of
 	 * the angular range. */
@@ -1093,6 +1147,23 @@ static double inv_solve(const struct px_prim *pr, int which, double lo,
 	return s;
 }
 
+/* Closed-form parameter of angle f on a degree-2 arc table. */
+static double qarc_param(const struct px_prim_qarc *q, double f)
+{
+	int k = 0;
+	double psi, sp, s, t, h;
+	while (k < q->n - 1 && f > q->a[k + 1])
+		k++;
+	h = q->half[k];
+	psi = f - q->a[k] - h;
+	psi = psi < -h ? -h : (psi > h ? h : psi);
+	sp = tan(0.5 * psi) / tan(0.5 * h);
+	sp = sp < -1 ? -1 : (sp > 1 ? 1 : sp);
+	s = 0.5 * (sp + 1);
+	t = q->lam[k] * s / ((1 - s) + q->lam[k] * s);
+	return q->u[k] + t * (q->u[k + 1] - q->u[k]);
+}
+
 static double lin_param(double lo, double hi, double x0, double x1, double x)
 {
 	double t = (x - x0) / (x1 - x0);
@@ -1131,7 +1202,10 @@ int px_prim_closest(const struct px_prim *pr, px_vec3 p, int flags,
 	case PX_PRIM_ARC: {
 		double f;
 		x = arc_closest(&pr->arc, p, &f, &hit->tie);
-		if (want) {
+		if (want && pr->qarc[0].n) {
+			hit->u = qarc_param(&pr->qarc[0], f);
+			hit->param = PX_PRIM_PARAM_EXACT;
+		} else if (want) {
 			hit->u = inv_solve(pr, INV_CURVE, pr->dom[0], pr->dom[1], 0,
 					   pr->arc.sweep, f, 1);
 			hit->param = PX_PRIM_PARAM_SOLVED;
@@ -1148,19 +1222,31 @@ int px_prim_closest(const struct px_prim *pr, px_vec3 p, int flags,
 		int da = rv->dir_angle;
 		x = rev_closest(rv, p, &th, &pt, &hit->tie);
 		if (want) {
-			pa = inv_solve(pr, INV_REV_ANG, pr->dom[2 * da],
-				       pr->dom[2 * da + 1], 0, rv->sweep, th, 1);
-			if (rv->profile_is_arc)
-				pp = inv_solve(pr, INV_REV_PROF, pr->dom[2 - 2 * da],
-					       pr->dom[3 - 2 * da], 0,
+			int exact = 1;
+			double lo = pr->dom[2 - 2 * da], hi = pr->dom[3 - 2 * da];
+			if (pr->qarc[0].n) {
+				pa = qarc_param(&pr->qarc[0], th);
+			} else {
+				pa = inv_solve(pr, INV_REV_ANG, pr->dom[2 * da],
+					       pr->dom[2 * da + 1], 0, rv->sweep, th, 1);
+				exact = 0;
+			}
+			if (rv->profile_is_arc && pr->qarc[1].n) {
+				pp = qarc_param(&pr->qarc[1], pt);
+			} else if (rv->profile_is_arc) {
+				pp = inv_solve(pr, INV_REV_PROF, lo, hi, 0,
 					       rv->parc.sweep, pt, 1);
-			else
-				pp = inv_solve(pr, INV_REV_PROF, pr->dom[2 - 2 * da],
-					       pr->dom[3 - 2 * da], 0,
+				exact = 0;
+			} else if (pr->linear & (1 << (1 - da))) {
+				pp = lin_param(lo, hi, 0, rv->pseg.len, pt);
+			} else {
+				pp = inv_solve(pr, INV_REV_PROF, lo, hi, 0,
 					       rv->pseg.len, pt, 0);
+				exact = 0;
+			}
 			hit->u = da == 0 ? pa : pp;
 			hit->v = da == 0 ? pp : pa;
-			hit->param = PX_PRIM_PARAM_SOLVED;
+			hit->param = exact ? PX_PRIM_PARAM_EXACT : PX_PRIM_PARAM_SOLVED;
 		}
 		break;
 	}

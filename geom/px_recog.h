@@ -48,9 +48,11 @@
  * reported as PX_PRIM_PLANE (its trimmed outline has no closed form here:
  * px_prim_closest() refuses it). Anything else is PX_PRIM_NONE.
  *
- * Parameters. The closest point's parameters are exact (affine formula)
- * for segments and parallelograms whose parametrization is linear (all
- * weights equal and control points at the Greville abscissae); otherwise
+ * Parameters. The closest point's parameters are exact (closed form)
+ * for segments, parallelograms and segment profiles whose
+ * parametrization is linear (all weights equal and control points at the
+ * Greville abscissae) and for degree-2 arcs (any weights: per-span
+ * Moebius map to the standard form, see struct px_prim_qarc); otherwise
  * the monotone map parameter -> position (projection or angle, proved
  * monotone at recognition) is inverted by safeguarded Newton/bisection in
  * at most PX_PRIM_INV_ITERS evaluations, to a few ulp of the domain.
@@ -125,6 +127,23 @@ struct px_prim_rev {
 	double ref_param[2]; /* fixed parameter used when inverting each dir */
 };
 
+/*
+ * Angle -> parameter table of a degree-2 arc (PX_PRIM_QSPANS spans at
+ * most; n = 0 when absent): span k covers parameters [u[k], u[k+1]] and
+ * angles [a[k], a[k+1]]; its Bezier weights (w0, w1, w2) give
+ * lam = sqrt(w0 / w2) and half = acos(w1 / sqrt(w0 w2)), half the span's
+ * turn. On the standard form (end weights equal, reached by the Moebius
+ * map t = lam s / (1 - s + lam s)) the angle from the span's bisector is
+ * f = 2 atan(tan(half / 2) (2 s - 1)), so parameters invert in closed
+ * form.
+ */
+#define PX_PRIM_QSPANS 16
+struct px_prim_qarc {
+	int n;
+	double u[PX_PRIM_QSPANS + 1], a[PX_PRIM_QSPANS + 1];
+	double lam[PX_PRIM_QSPANS], half[PX_PRIM_QSPANS];
+};
+
 /* Parallelogram origin + x e1 + y e2, x in [x0, x1], y in [y0, y1]
  * (x along u, y along v; x0 may exceed x1 when x falls with u). f1, f2
  * are the dual vectors (f1.e1 = 1, f1.e2 = 0, ...). */
@@ -153,6 +172,9 @@ struct px_prim {
 	/* Linear parametrization (parameters in closed form): bit 0 for the
 	 * curve / u, bit 1 for v. */
 	int linear;
+	/* Closed-form angle inversion of degree-2 arcs: [0] the curve (ARC)
+	 * or the angular direction of a revolution, [1] its profile arc. */
+	struct px_prim_qarc qarc[2];
 	/* Copy of the entity descriptor, for parameter inversion. */
 	struct px_nurbs_curve curve;
 	struct px_nurbs_surf surf;

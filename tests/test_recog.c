@@ -370,6 +370,10 @@ static void check_curve_queries(const struct px_prim *pr,
 			     "parameter %.17g gives a point %.3g away", h.u,
 			     px_v3_dist(px_nurbs_curve_point(c, h.u), h.point));
 		PX_CHECK_NEAR(px_v3_dist(p, h.point), h.dist, 1e-12 * pr->size);
+		PX_CHECK_INT_EQ(h.param, (pr->kind == PX_PRIM_ARC && pr->qarc[0].n) ||
+						 (pr->kind == PX_PRIM_SEGMENT && pr->linear)
+					 ? PX_PRIM_PARAM_EXACT
+					 : PX_PRIM_PARAM_SOLVED);
 	}
 }
 
@@ -412,6 +416,8 @@ static void test_circle_full_and_arcs(void)
 		PX_CHECK_NEAR(pr.arc.sweep, sweep, 1e-11);
 		PX_CHECK_NEAR(fabs(px_v3_dot(pr.arc.normal, f.z)), 1, 1e-12);
 		PX_CHECK(pr.hausdorff <= 1e-10 * pr.size);
+		/* Quadratic arcs invert in closed form, Moebius weights too. */
+		PX_CHECK_INT_EQ(pr.qarc[0].n > 0, elev == 0);
 		extra[0] = f.o; /* centre: every point equally near */
 		extra[1] = fr(&f, 0, 0, r * px_rand_range(-2, 2)); /* on the axis */
 		extra[2] = fr(&f, -r * 0.7, r * 0.01, r * 0.3);
@@ -678,6 +684,8 @@ static void test_revolutions(void)
 		if (pr.kind != (enum px_prim_kind)want)
 			continue;
 		PX_CHECK(pr.hausdorff <= 1e-10 * pr.size);
+		PX_CHECK(pr.qarc[0].n > 0);
+		PX_CHECK(!pr.rev.profile_is_arc || pr.qarc[1].n > 0);
 		PX_CHECK_NEAR(fabs(px_v3_dot(pr.rev.axis, f.z)), 1, 1e-12);
 		PX_CHECK_NEAR(pr.rev.sweep, sweep, 1e-11);
 		if (want == PX_PRIM_SPHERE) {
