@@ -40,10 +40,16 @@
  *    is then c + H(v) a + R(v) E(u): the profile swept over the proved
  *    angular range, so closest points reduce exactly to the meridian
  *    half-plane (or to the nearer end meridian when the query's angle is
- *    outside the range). The same factorisation with two straight,
+ *    outside the range). H = (control deviation) + 2 eps/(1 - eps) R_net
+ *    (eps the relative weight mismatch, R_net the net's half box
+ *    diagonal) + 2 H_profile + rho_max H_row / r* + 2 max(0, -rho_min of
+ *    the ideal profile). The same factorisation with two straight,
  *    monotone directions proves a parallelogram.
  * Floating point: every bound includes a margin of 64 ulp of the
- * entity's coordinates for the rounding of extraction and products. A
+ * entity's coordinates for the rounding of extraction and products; the
+ * sign tests (monotone projections, angular speed) are made on computed
+ * values and refuse exact zeros, so a wrong sign can only come from a
+ * quantity within rounding of zero (a backtrack of rounding size). A
  * planar patch that is neither a parallelogram nor a revolution is
  * reported as PX_PRIM_PLANE (its trimmed outline has no closed form here:
  * px_prim_closest() refuses it). Anything else is PX_PRIM_NONE.
@@ -56,9 +62,14 @@
  * the monotone map parameter -> position (projection or angle, proved
  * monotone at recognition) is inverted by safeguarded Newton/bisection in
  * at most PX_PRIM_INV_ITERS evaluations, to a few ulp of the domain.
+ * Either way the entity at (u, v) lies within about H of hit.point (the
+ * parameters map the primitive's point through the entity's own
+ * monotone angle / position functions). When the query is on an axis or
+ * centre (hit.tie), they are those of one of the equally near points.
  *
  * Memory and real-time rules. px_recog_curve()/px_recog_surf() are
- * setup-time: no heap, but tens of kilobytes of stack and O(n log) work;
+ * setup-time: no heap, but tens of kilobytes of stack, work linear in
+ * the number of spans (each extracted once or a few times);
  * entities with more than PX_RECOG_MAX_CTRL control points in a direction
  * are not recognised. A px_prim is a plain value holding a copy of the
  * entity descriptor (not of its arrays: they must outlive it).

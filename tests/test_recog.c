@@ -273,6 +273,50 @@ static double surf_edge_brute(const struct px_nurbs_surf *s, px_vec3 p, int edge
 	return best;
 }
 
+/* Damped Newton on |S - p|^2 / 2 from (*bu, *bv), clamped to the
+ * domain; keeps only steps that go down (halving them up to 20 times).
+ * The pattern search crawls in the curved valleys near a pole. */
+static void newton_polish(const struct px_nurbs_surf *s, px_vec3 p, double *bu,
+			  double *bv, double *bd)
+{
+	double u0, u1, v0, v1;
+	int it;
+	px_nurbs_surf_domain(s, &u0, &u1, &v0, &v1);
+	for (it = 0; it < 60; it++) {
+		struct px_nurbs_surf_derivs sd;
+		px_vec3 r;
+		double g1, g2, h11, h12, h22, det, du, dv, lam = 1;
+		int k, ok = 0;
+		px_nurbs_surf_eval(s, *bu, *bv, 2, &sd);
+		r = px_v3_sub(sd.s, p);
+		g1 = px_v3_dot(r, sd.su);
+		g2 = px_v3_dot(r, sd.sv);
+		h11 = px_v3_dot(sd.su, sd.su) + px_v3_dot(r, sd.suu);
+		h12 = px_v3_dot(sd.su, sd.sv) + px_v3_dot(r, sd.suv);
+		h22 = px_v3_dot(sd.sv, sd.sv) + px_v3_dot(r, sd.svv);
+		det = h11 * h22 - h12 * h12;
+		if (det > 0 && h11 > 0) {
+			du = -(h22 * g1 - h12 * g2) / det;
+			dv = -(h11 * g2 - h12 * g1) / det;
+		} else { /* not convex here: gradient direction */
+			double gn = hypot(g1, g2);
+			if (!(gn > 0))
+				return;
+			du = -g1 / gn * 1e-2 * (u1 - u0);
+			dv = -g2 / gn * 1e-2 * (v1 - v0);
+		}
+		for (k = 0; k < 20 && !ok; k++, lam *= 0.5) {
+			double u = fmin(u1, fmax(u0, *bu + lam * du));
+			double v = fmin(v1, fmax(v0, *bv + lam * dv));
+			double d = px_v3_dist(p, px_nurbs_surf_point(s, u, v));
+			if (d < *bd)
+				*bd = d, *bu = u, *bv = v, ok = 1;
+		}
+		if (!ok)
+			return;
+	}
+}
+
 static double surf_brute(const struct px_nurbs_surf *s, px_vec3 p)
 {
 	double u0, u1, v0, v1, best = INFINITY;
@@ -304,10 +348,39 @@ static double surf_brute(const struct px_nurbs_surf *s, px_vec3 p)
 					break;
 				}
 		}
-	for (k = 0; k < NC && cd[k] < INFINITY; k++) {
-		double hu = (u1 - u0) / N, hv = (v1 - v0) / N, bu = cu[k], bv = cv[k],
-		       bd = cd[k];
+	/* Strips just inside each edge: a minimum beside a pole is missed
+	 * by the coarse grid (the pole row is nearer than the next row)
+	 * and cannot be reached from the pole, where the parametrization
+	 * is singular. The best strip sample of each edge is polished too. */
+	double su[4], sv[4], sdist[4];
+	for (k = 0; k < 4; k++) {
+		int m, o;
+		sdist[k] = INFINITY;
+		for (o = 0; o < 3; o++)
+			for (m = 0; m <= 120; m++) {
+				double off = (o == 0 ? 0.002 : o == 1 ? 0.006 : 0.015);
+				double a = (double)m / 120, u, v, d;
+				u = k < 2 ? u0 + (u1 - u0) * a
+					  : (k == 2 ? u0 + off * (u1 - u0) : u1 - off * (u1 - u0));
+				v = k >= 2 ? v0 + (v1 - v0) * a
+					   : (k == 0 ? v0 + off * (v1 - v0) : v1 - off * (v1 - v0));
+				d = px_v3_dist(p, px_nurbs_surf_point(s, u, v));
+				if (d < sdist[k])
+					sdist[k] = d, su[k] = u, sv[k] = v;
+			}
+	}
+	for (k = 0; k < NC + 4; k++) {
+		double hu = (u1 - u0) / N, hv = (v1 - v0) / N, bu, bv, bd;
+		if (k < NC) {
+			if (!(cd[k] < INFINITY))
+				continue;
+			bu = cu[k], bv = cv[k], bd = cd[k];
+		} else {
+			bu = su[k - NC], bv = sv[k - NC], bd = sdist[k - NC];
+			hu *= 0.1, hv *= 0.1;
+		}
 		int it;
+		newton_polish(s, p, &bu, &bv, &bd);
 		/* Compass search: keep the step while it improves, halve it
 		 * when it does not. */
 		for (it = 0; it < 1500 && hu > 1e-13 * (u1 - u0); it++) {
@@ -325,6 +398,7 @@ static double surf_brute(const struct px_nurbs_surf *s, px_vec3 p)
 			if (!moved)
 				hu *= 0.5, hv *= 0.5;
 		}
+		newton_polish(s, p, &bu, &bv, &bd);
 		if (bd < best)
 			best = bd;
 	}
