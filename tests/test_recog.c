@@ -1009,6 +1009,56 @@ static void test_obj_files(void)
 	}
 }
 
+/* Extremes: a single-span arc of 179.9 degrees (middle weight ~9e-4),
+ * a semicircle in two spans, and a spindle torus (tube radius above the
+ * axis distance) whose profile arc ends on the axis. */
+static void test_extremes(void)
+{
+	int trial;
+	for (trial = 0; trial < 6; trial++) {
+		struct tcurve t;
+		struct px_prim pr;
+		struct frame f = rand_frame();
+		double r = px_rand_range(0.5, 3), sweep = trial % 2 ? PI : PI * 179.9 / 180;
+		px_vec3 extra[2];
+		PX_CHECK_INT_EQ(make_arc(&t, &f, r, sweep, trial % 2 ? 2 : 1, 0), PX_OK);
+		PX_CHECK_INT_EQ(px_recog_curve(&t.c, 0, &pr), 1);
+		PX_CHECK_INT_EQ(pr.kind, PX_PRIM_ARC);
+		if (pr.kind != PX_PRIM_ARC)
+			continue;
+		PX_CHECK_NEAR(pr.arc.sweep, sweep, 1e-10);
+		extra[0] = f.o;
+		extra[1] = fr(&f, 0, -0.5 * r, 0.1); /* in the gap of the arc */
+		check_curve_queries(&pr, &t.c, 16, extra, 2);
+	}
+	for (trial = 0; trial < 4; trial++) {
+		struct tsurf t;
+		struct px_prim pr;
+		struct frame f = rand_frame();
+		double hr[2 * MAXC], beta[MAXC], V[MAXC + 8];
+		double R = px_rand_range(0.3, 1), rt = R * px_rand_range(1.2, 2);
+		double a = asin(R / rt); /* rho = R + rt sin(psi) >= 0 */
+		int np = profile_arc(0, R, rt, -a, PI + 2 * a, hr, beta, V);
+		px_vec3 extra[2];
+		int k;
+		for (k = 0; k < np; k++) /* end points exactly on the axis */
+			if (fabs(hr[2 * k + 1]) < 1e-12)
+				hr[2 * k + 1] = 0;
+		PX_CHECK_INT_EQ(make_rev(&t, &f, 0, trial < 2 ? 2 * PI : 4, hr, beta, np,
+					 V, 2, trial % 2),
+				PX_OK);
+		PX_CHECK_INT_EQ(px_recog_surf(&t.s, 0, &pr), 1);
+		PX_CHECK_INT_EQ(pr.kind, PX_PRIM_TORUS);
+		if (pr.kind != PX_PRIM_TORUS)
+			continue;
+		PX_CHECK_NEAR(pr.radius, R, 1e-12);
+		PX_CHECK_NEAR(pr.radius2, rt, 1e-12);
+		extra[0] = f.o;
+		extra[1] = fr(&f, 0, 0, 0.5 * rt);
+		check_surf_queries(&pr, &t.s, 10, extra, 2);
+	}
+}
+
 static void test_no_alloc_and_errors(void)
 {
 	struct tcurve t;
@@ -1045,7 +1095,7 @@ static const struct px_test tests[] = {
 	PX_T(test_circle_full_and_arcs), PX_T(test_lines), PX_T(test_curve_near_misses),
 	PX_T(test_revolutions), PX_T(test_parallelograms),
 	PX_T(test_surface_near_misses), PX_T(test_circle_rows_not_revolution),
-	PX_T(test_bound_holds_when_loose), PX_T(test_obj_files),
+	PX_T(test_bound_holds_when_loose), PX_T(test_obj_files), PX_T(test_extremes),
 	PX_T(test_no_alloc_and_errors),
 };
 PX_TEST_MAIN(tests)
