@@ -496,6 +496,8 @@ static void test_circle_full_and_arcs(void)
 		extra[1] = fr(&f, 0, 0, r * px_rand_range(-2, 2)); /* on the axis */
 		extra[2] = fr(&f, -r * 0.7, r * 0.01, r * 0.3);
 		check_curve_queries(&pr, &t.c, 24, extra, 3);
+		pr.qarc[0].n = 0; /* the bounded inversion instead */
+		check_curve_queries(&pr, &t.c, 6, extra, 3);
 		{
 			struct px_prim_hit h;
 			px_prim_closest(&pr, f.o, 0, &h);
@@ -781,6 +783,11 @@ static void test_revolutions(void)
 		extra[n_extra++] = fr(&f, 0.5 * R * cos(a0 + sweep + 0.4),
 				      0.5 * R * sin(a0 + sweep + 0.4), -0.3);
 		check_surf_queries(&pr, &t.s, 10, extra, n_extra);
+		/* Without the closed-form tables the parameters come from the
+		 * bounded monotone inversion: same points. */
+		pr.qarc[0].n = pr.qarc[1].n = 0;
+		pr.linear = 0;
+		check_surf_queries(&pr, &t.s, 4, extra, n_extra);
 	}
 }
 
