@@ -37,24 +37,24 @@ static int cmp_i64(const void *a, const void *b)
 
 #define NQ 20000
 
-static void time_queries(const char *name, const struct px_prim *pr, int flags)
+static void time_queries(const char *name, const struct px_recog_shape *pr, int flags)
 {
 	static int64_t t[NQ];
-	struct px_prim_hit h;
+	struct px_recog_hit h;
 	double s = 2 * pr->size, sink = 0;
 	int i;
 	for (i = 0; i < NQ; i++) {
 		px_vec3 p = px_v3(s * (urand() - 0.5), s * (urand() - 0.5),
 				  s * (urand() - 0.5));
 		int64_t t0 = now_ns();
-		px_prim_closest(pr, p, flags, &h);
+		px_recog_closest(pr, p, flags, &h);
 		t[i] = now_ns() - t0;
 		sink += h.dist;
 	}
 	qsort(t, NQ, sizeof(t[0]), cmp_i64);
 	printf("%-8s %-13s %-10s ns/query median %5lld  p99 %6lld  max %7lld  (%g)\n",
-	       name, px_prim_kind_name(pr->kind),
-	       flags & PX_PRIM_WANT_PARAMS ? "+params" : "point", (long long)t[NQ / 2],
+	       name, px_recog_kind_name(pr->kind),
+	       flags & PX_RECOG_WANT_PARAMS ? "+params" : "point", (long long)t[NQ / 2],
 	       (long long)t[NQ * 99 / 100], (long long)t[NQ - 1], sink / NQ);
 }
 
@@ -90,7 +90,7 @@ static void bench_rev(const char *name, double hc, double rc, double r,
 	int na = arc2d(sweep, (int)ceil(sweep / (M_PI / 2) - 1e-9), axy, aw, AU);
 	int np = arc2d(psweep, (int)ceil(psweep / (M_PI / 2) - 1e-9), pxy, pwt, PU);
 	struct px_nurbs_surf s;
-	struct px_prim pr;
+	struct px_recog_shape pr;
 	int i, j, rc_;
 	int64_t t0;
 	for (j = 0; j < np; j++)
@@ -107,11 +107,11 @@ static void bench_rev(const char *name, double hc, double rc, double r,
 	t0 = now_ns();
 	rc_ = px_recog_surf(&s, 0, &pr);
 	printf("%-8s recognised %d as %s in %lld us, H = %.3g (size %.3g)\n", name,
-	       rc_, px_prim_kind_name(pr.kind), (long long)(now_ns() - t0) / 1000,
+	       rc_, px_recog_kind_name(pr.kind), (long long)(now_ns() - t0) / 1000,
 	       pr.hausdorff, pr.size);
 	if (rc_ == 1) {
 		time_queries(name, &pr, 0);
-		time_queries(name, &pr, PX_PRIM_WANT_PARAMS);
+		time_queries(name, &pr, PX_RECOG_WANT_PARAMS);
 	}
 }
 
@@ -119,7 +119,7 @@ int main(void)
 {
 	double xy[18], w[9], U[12], pw[36];
 	struct px_nurbs_curve c;
-	struct px_prim pr;
+	struct px_recog_shape pr;
 	int n = arc2d(2 * M_PI, 4, xy, w, U), i, rc;
 	int64_t t0;
 	for (i = 0; i < n; i++) {
@@ -133,11 +133,11 @@ int main(void)
 	t0 = now_ns();
 	rc = px_recog_curve(&c, 0, &pr);
 	printf("circle   recognised %d as %s in %lld us, H = %.3g\n", rc,
-	       px_prim_kind_name(pr.kind), (long long)(now_ns() - t0) / 1000,
+	       px_recog_kind_name(pr.kind), (long long)(now_ns() - t0) / 1000,
 	       pr.hausdorff);
 	if (rc == 1) {
 		time_queries("circle", &pr, 0);
-		time_queries("circle", &pr, PX_PRIM_WANT_PARAMS);
+		time_queries("circle", &pr, PX_RECOG_WANT_PARAMS);
 	}
 	bench_rev("sphere", 0, 0, 1, M_PI, 2 * M_PI);
 	bench_rev("torus", 0, 2, 0.5, 2 * M_PI, 1.5 * M_PI);

@@ -25,11 +25,11 @@ enum { INV_CURVE, INV_REV_ANG, INV_REV_PROF, INV_QUAD_X, INV_QUAD_Y };
  * the Hausdorff bound hd. */
 struct crec {
 	int kind;
-	struct px_prim_seg seg;
-	struct px_prim_arc arc;
+	struct px_recog_seg seg;
+	struct px_recog_arc arc;
 	double hd;
 	int linear;
-	struct px_prim_qarc qa;
+	struct px_recog_qarc qa;
 };
 
 static px_vec3 hpt(const double *pw)
@@ -146,7 +146,7 @@ static int rec_line(const struct px_nurbs_curve *c, double tol, double margin,
 	if (monotone(t, c->n_ctrl, 1) != 1)
 		return 0;
 	memset(r, 0, sizeof(*r));
-	r->kind = PX_PRIM_SEGMENT;
+	r->kind = PX_RECOG_SEGMENT;
 	r->seg.p0 = A;
 	r->seg.dir = d;
 	r->seg.len = L;
@@ -171,7 +171,7 @@ static int bezier_piece(const struct px_nurbs_curve *c, double a, double b,
  * holds the piece's control points; subdivides when needed. Adds to
  * *sweep; returns 0 when the proof fails within the depth bound. */
 static int sweep_piece(const struct px_nurbs_curve *c, double a, double b,
-		       const struct px_prim_arc *ar, int depth, double *work,
+		       const struct px_recog_arc *ar, int depth, double *work,
 		       double *sweep)
 {
 	struct px_nurbs_curve bz;
@@ -205,12 +205,12 @@ static int sweep_piece(const struct px_nurbs_curve *c, double a, double b,
 	       sweep_piece(c, 0.5 * (a + b), b, ar, depth + 1, work, sweep);
 }
 
-/* Angle -> parameter table of a degree-2 arc (struct px_prim_qarc);
+/* Angle -> parameter table of a degree-2 arc (struct px_recog_qarc);
  * q->n = 0 when the curve is not quadratic, has too many spans, or a
  * span's weights disagree with its turn (then parameters are solved). */
 static void qarc_table(const struct px_nurbs_curve *c,
-		       const struct px_prim_arc *ar, double *work,
-		       struct px_prim_qarc *q)
+		       const struct px_recog_arc *ar, double *work,
+		       struct px_recog_qarc *q)
 {
 	int k, n = 0;
 	double acc = 0;
@@ -223,7 +223,7 @@ static void qarc_table(const struct px_nurbs_curve *c,
 		px_vec3 pa, pb;
 		if (!(c->knots[k] < c->knots[k + 1]))
 			continue;
-		if (n >= PX_PRIM_QSPANS || !bezier_piece(c, c->knots[k],
+		if (n >= PX_RECOG_QSPANS || !bezier_piece(c, c->knots[k],
 							 c->knots[k + 1], work, &bz))
 			return;
 		w0 = bz.pw[3], w1 = bz.pw[7], w2 = bz.pw[11];
@@ -257,7 +257,7 @@ static int rec_arc(const struct px_nurbs_curve *c, double tol, double margin,
 	px_vec3 A, M1, M2, a, b, axb, cen, n, e0, e1;
 	double work[CWORK];
 	int p = c->degree, k, i, orient = 0;
-	struct px_prim_arc ar;
+	struct px_recog_arc ar;
 
 	if (2 * p > PX_BERN_MAX_DEGREE)
 		return 0;
@@ -392,7 +392,7 @@ static int rec_arc(const struct px_nurbs_curve *c, double tol, double margin,
 	if (!(sweep > 0) || sweep > TWO_PI + 1e-9)
 		return 0;
 	ar.sweep = sweep > TWO_PI ? TWO_PI : sweep;
-	r->kind = PX_PRIM_ARC;
+	r->kind = PX_RECOG_ARC;
 	r->arc = ar;
 	r->linear = 0;
 	qarc_table(c, &ar, work, &r->qa);
@@ -420,14 +420,14 @@ static int rec_curve_any(const struct px_nurbs_curve *c, double tol,
 	return rec_arc(c, tol, margin, r);
 }
 
-static void prim_clear(struct px_prim *out)
+static void prim_clear(struct px_recog_shape *out)
 {
 	memset(out, 0, sizeof(*out));
-	out->kind = PX_PRIM_NONE;
+	out->kind = PX_RECOG_NONE;
 }
 
 int px_recog_curve(const struct px_nurbs_curve *c, double rel_tol,
-		   struct px_prim *out)
+		   struct px_recog_shape *out)
 {
 	struct crec r;
 	double size, tol, margin;
@@ -446,16 +446,16 @@ int px_recog_curve(const struct px_nurbs_curve *c, double rel_tol,
 	margin = 64 * DBL_EPSILON * (coord_scale(c->pw, c->n_ctrl) + size);
 	if (!rec_curve_any(c, tol, margin, &r))
 		return 0;
-	out->kind = (enum px_prim_kind)r.kind;
+	out->kind = (enum px_recog_kind)r.kind;
 	out->is_surface = 0;
 	out->hausdorff = r.hd;
 	out->size = size;
 	out->seg = r.seg;
 	out->arc = r.arc;
 	out->linear = r.linear;
-	if (r.kind == PX_PRIM_ARC)
+	if (r.kind == PX_RECOG_ARC)
 		out->qarc[0] = r.qa;
-	if (r.kind == PX_PRIM_ARC) {
+	if (r.kind == PX_RECOG_ARC) {
 		out->center = r.arc.center;
 		out->normal = r.arc.normal;
 		out->radius = r.arc.radius;
@@ -530,7 +530,7 @@ static double weight_factor(const struct px_nurbs_surf *s, int d, int jref,
 }
 
 static int rec_rev(const struct px_nurbs_surf *s, int d, double tol,
-		   double margin, double size, struct px_prim *out)
+		   double margin, double size, struct px_recog_shape *out)
 {
 	int na = s->n_ctrl[d], nb = s->n_ctrl[1 - d], i, j, jstar = 0;
 	double rowpw[4 * PX_RECOG_MAX_CTRL], profpw[4 * PX_RECOG_MAX_CTRL];
@@ -616,7 +616,7 @@ static int rec_rev(const struct px_nurbs_surf *s, int d, double tol,
 		return 0;
 	/* Lowest rho of the ideal profile: below zero it would leave the
 	 * half-plane the reduction assumes; tiny dips are charged to H. */
-	if (pr.kind == PX_PRIM_SEGMENT) {
+	if (pr.kind == PX_RECOG_SEGMENT) {
 		px_vec3 q1 = px_v3_madd(pr.seg.p0, pr.seg.dir, pr.seg.len);
 		rhomin = fmin(pr.seg.p0.y, q1.y);
 	} else {
@@ -650,13 +650,13 @@ static int rec_rev(const struct px_nurbs_surf *s, int d, double tol,
 	out->rev.e0 = rr.arc.e0;
 	out->rev.e1 = rr.arc.e1;
 	out->rev.sweep = rr.arc.sweep;
-	out->rev.profile_is_arc = pr.kind == PX_PRIM_ARC;
+	out->rev.profile_is_arc = pr.kind == PX_RECOG_ARC;
 	out->rev.pseg = pr.seg;
 	out->rev.parc = pr.arc;
 	out->rev.dir_angle = d;
 	out->normal = a;
 	out->qarc[0] = rr.qa;
-	if (pr.kind == PX_PRIM_ARC)
+	if (pr.kind == PX_RECOG_ARC)
 		out->qarc[1] = pr.qa;
 	else if (pr.linear)
 		out->linear = 1 << (1 - d);
@@ -676,17 +676,17 @@ static int rec_rev(const struct px_nurbs_surf *s, int d, double tol,
 		out->rev.ref_param[d] = bestv;
 		out->rev.ref_param[1 - d] = u0;
 	}
-	if (pr.kind == PX_PRIM_SEGMENT) {
+	if (pr.kind == PX_RECOG_SEGMENT) {
 		double dh = pr.seg.dir.x, dr = pr.seg.dir.y, L = pr.seg.len;
 		if (fabs(dr) * L <= tol) {
-			out->kind = PX_PRIM_CYLINDER;
+			out->kind = PX_RECOG_CYLINDER;
 			out->radius = pr.seg.p0.y + 0.5 * dr * L;
 			out->center = px_v3_madd(c, a, pr.seg.p0.x);
 		} else if (fabs(dh) * L <= tol) {
-			out->kind = PX_PRIM_ANNULUS;
+			out->kind = PX_RECOG_ANNULUS;
 			out->center = px_v3_madd(c, a, pr.seg.p0.x);
 		} else {
-			out->kind = PX_PRIM_CONE;
+			out->kind = PX_RECOG_CONE;
 			out->center = px_v3_madd(c, a,
 						 pr.seg.p0.x - pr.seg.p0.y * dh / dr);
 			out->half_angle = atan2(fabs(dr), fabs(dh));
@@ -694,10 +694,10 @@ static int rec_rev(const struct px_nurbs_surf *s, int d, double tol,
 	} else {
 		out->center = px_v3_madd(c, a, pr.arc.center.x);
 		if (fabs(pr.arc.center.y) <= tol) {
-			out->kind = PX_PRIM_SPHERE;
+			out->kind = PX_RECOG_SPHERE;
 			out->radius = pr.arc.radius;
 		} else {
-			out->kind = PX_PRIM_TORUS;
+			out->kind = PX_RECOG_TORUS;
 			out->radius = pr.arc.center.y;
 			out->radius2 = pr.arc.radius;
 		}
@@ -727,7 +727,7 @@ static void fn_ends(const double *x, size_t stride, const double *wt, int n,
 }
 
 static int rec_plane(const struct px_nurbs_surf *s, double tol, double margin,
-		     double size, struct px_prim *out)
+		     double size, struct px_recog_shape *out)
 {
 	int nu = s->n_ctrl[0], nv = s->n_ctrl[1], i, j, eqa = 1, eqb = 1;
 	double u0, u1, v0, v1, dz = 0, dev = 0, weps, wterm;
@@ -754,7 +754,7 @@ static int rec_plane(const struct px_nurbs_surf *s, double tol, double margin,
 	if (dz + margin > tol)
 		return 0;
 	prim_clear(out);
-	out->kind = PX_PRIM_PLANE;
+	out->kind = PX_RECOG_PLANE;
 	out->is_surface = 1;
 	out->hausdorff = dz + margin; /* distance to the plane only */
 	out->size = size;
@@ -817,7 +817,7 @@ static int rec_plane(const struct px_nurbs_surf *s, double tol, double margin,
 	for (j = 1; j < nv; j++)
 		if (beta[j] != beta[0] || weps > 0)
 			eqb = 0;
-	out->kind = PX_PRIM_PARALLELOGRAM;
+	out->kind = PX_RECOG_PARALLELOGRAM;
 	out->hausdorff = dev + wterm + margin;
 	out->quad.origin = A0;
 	out->quad.e1 = e1;
@@ -838,11 +838,11 @@ static int rec_plane(const struct px_nurbs_surf *s, double tol, double margin,
 }
 
 int px_recog_surf(const struct px_nurbs_surf *s, double rel_tol,
-		  struct px_prim *out)
+		  struct px_recog_shape *out)
 {
 	double size, tol, margin;
 	int planar;
-	struct px_prim tmp;
+	struct px_recog_shape tmp;
 
 	if (!s || !out || !s->pw || !s->knots[0] || !s->knots[1])
 		return PX_E_INVAL;
@@ -858,7 +858,7 @@ int px_recog_surf(const struct px_nurbs_surf *s, double rel_tol,
 	margin = 64 * DBL_EPSILON *
 		 (coord_scale(s->pw, s->n_ctrl[0] * s->n_ctrl[1]) + size);
 	planar = rec_plane(s, tol, margin, size, &tmp);
-	if (planar && tmp.kind == PX_PRIM_PARALLELOGRAM)
+	if (planar && tmp.kind == PX_RECOG_PARALLELOGRAM)
 		goto done;
 	if (rec_rev(s, 0, tol, margin, size, out) ||
 	    rec_rev(s, 1, tol, margin, size, out))
@@ -878,7 +878,7 @@ found:
 
 /* ---- closed-form closest points ------------------------------------------- */
 
-static px_vec3 seg_closest(const struct px_prim_seg *sg, px_vec3 p, double *t)
+static px_vec3 seg_closest(const struct px_recog_seg *sg, px_vec3 p, double *t)
 {
 	double s = px_v3_dot(px_v3_sub(p, sg->p0), sg->dir);
 	s = s < 0 ? 0 : (s > sg->len ? sg->len : s);
@@ -886,7 +886,7 @@ static px_vec3 seg_closest(const struct px_prim_seg *sg, px_vec3 p, double *t)
 	return px_v3_madd(sg->p0, sg->dir, s);
 }
 
-static px_vec3 arc_point(const struct px_prim_arc *ar, double f)
+static px_vec3 arc_point(const struct px_recog_arc *ar, double f)
 {
 	return px_v3_add(ar->center,
 			 px_v3_add(px_v3_scale(ar->e0, ar->radius * cos(f)),
@@ -904,7 +904,7 @@ static double angle_near(double y, double x, double mid)
 	return f;
 }
 
-static px_vec3 arc_closest(const struct px_prim_arc *ar, px_vec3 p, double *f,
+static px_vec3 arc_closest(const struct px_recog_arc *ar, px_vec3 p, double *f,
 			   int *tie)
 {
 	px_vec3 w = px_v3_sub(p, ar->center);
@@ -940,7 +940,7 @@ static px_vec3 arc_closest(const struct px_prim_arc *ar, px_vec3 p, double *f,
 	return q1;
 }
 
-static px_vec3 rev_closest(const struct px_prim_rev *rv, px_vec3 p, double *theta,
+static px_vec3 rev_closest(const struct px_recog_rev *rv, px_vec3 p, double *theta,
 			   double *prof_t, int *tie)
 {
 	px_vec3 w = px_v3_sub(p, rv->origin), q2, m;
@@ -978,13 +978,13 @@ static px_vec3 rev_closest(const struct px_prim_rev *rv, px_vec3 p, double *thet
 				     m.y));
 }
 
-static px_vec3 quad_corner(const struct px_prim_quad *q, double x, double y)
+static px_vec3 quad_corner(const struct px_recog_quad *q, double x, double y)
 {
 	return px_v3_add(q->origin,
 			 px_v3_add(px_v3_scale(q->e1, x), px_v3_scale(q->e2, y)));
 }
 
-static px_vec3 quad_closest(const struct px_prim_quad *q, px_vec3 p, double *xs,
+static px_vec3 quad_closest(const struct px_recog_quad *q, px_vec3 p, double *xs,
 			    double *ys)
 {
 	px_vec3 w = px_v3_sub(p, q->origin), best = q->origin;
@@ -1005,7 +1005,7 @@ static px_vec3 quad_closest(const struct px_prim_quad *q, px_vec3 p, double *xs,
 	c[2] = quad_corner(q, xb, yb);
 	c[3] = quad_corner(q, xa, yb);
 	for (k = 0; k < 4; k++) {
-		struct px_prim_seg sg;
+		struct px_recog_seg sg;
 		px_vec3 d = px_v3_sub(c[(k + 1) & 3], c[k]), x;
 		double tt;
 		sg.p0 = c[k];
@@ -1025,7 +1025,7 @@ static px_vec3 quad_closest(const struct px_prim_quad *q, px_vec3 p, double *xs,
 
 /* Value (position along the segment, angle, coordinate) of the monotone
  * map being inverted at parameter s, and its derivative. */
-static void inv_eval(const struct px_prim *pr, int which, double s, double *f,
+static void inv_eval(const struct px_recog_shape *pr, int which, double s, double *f,
 		     double *df)
 {
 	px_vec3 P, D;
@@ -1034,7 +1034,7 @@ static void inv_eval(const struct px_prim *pr, int which, double s, double *f,
 		px_nurbs_curve_eval(&pr->curve, s, 1, ders);
 		P = ders[0];
 		D = ders[1];
-		if (pr->kind == PX_PRIM_SEGMENT) {
+		if (pr->kind == PX_RECOG_SEGMENT) {
 			*f = px_v3_dot(pr->seg.dir, px_v3_sub(P, pr->seg.p0));
 			*df = px_v3_dot(pr->seg.dir, D);
 			return;
@@ -1068,7 +1068,7 @@ static void inv_eval(const struct px_prim *pr, int which, double s, double *f,
 		return;
 	}
 	{
-		const struct px_prim_rev *rv = &pr->rev;
+		const struct px_recog_rev *rv = &pr->rev;
 		px_vec3 w = px_v3_sub(P, rv->origin);
 		if (which == INV_REV_ANG) {
 			double x = px_v3_dot(rv->e0, w), y = px_v3_dot(rv->e1, w);
@@ -1103,9 +1103,9 @@ static void inv_eval(const struct px_prim *pr, int which, double s, double *f,
  * fhi its values at the ends (the map is proved monotone at
  * recognition). Safeguarded Newton inside a shrinking bracket; angles
  * are unwrapped against the bracket's lower value (the map spans at most
- * 2 pi). At most PX_PRIM_INV_ITERS evaluations.
+ * 2 pi). At most PX_RECOG_INV_ITERS evaluations.
  */
-static double inv_solve(const struct px_prim *pr, int which, double lo,
+static double inv_solve(const struct px_recog_shape *pr, int which, double lo,
 			double hi, double flo, double fhi, double target,
 			int is_angle)
 {
@@ -1120,7 +1120,7 @@ static double inv_solve(const struct px_prim *pr, int which, double lo,
 	if (!(target < fb))
 		return hi;
 	s = a + (b - a) * (target - fa) / (fb - fa);
-	for (it = 0; it < PX_PRIM_INV_ITERS; it++) {
+	for (it = 0; it < PX_RECOG_INV_ITERS; it++) {
 		double f, df, r, sn;
 		inv_eval(pr, which, s, &f, &df);
 		f *= sgn;
@@ -1148,7 +1148,7 @@ static double inv_solve(const struct px_prim *pr, int which, double lo,
 }
 
 /* Closed-form parameter of angle f on a degree-2 arc table. */
-static double qarc_param(const struct px_prim_qarc *q, double f)
+static double qarc_param(const struct px_recog_qarc *q, double f)
 {
 	int k = 0;
 	double psi, sp, s, t, h;
@@ -1171,10 +1171,10 @@ static double lin_param(double lo, double hi, double x0, double x1, double x)
 	return lo + (hi - lo) * t;
 }
 
-int px_prim_closest(const struct px_prim *pr, px_vec3 p, int flags,
-		    struct px_prim_hit *hit)
+int px_recog_closest(const struct px_recog_shape *pr, px_vec3 p, int flags,
+		    struct px_recog_hit *hit)
 {
-	int want = flags & PX_PRIM_WANT_PARAMS;
+	int want = flags & PX_RECOG_WANT_PARAMS;
 	px_vec3 x;
 
 	if (!pr || !hit)
@@ -1183,41 +1183,41 @@ int px_prim_closest(const struct px_prim *pr, px_vec3 p, int flags,
 		return PX_E_NAN;
 	memset(hit, 0, sizeof(*hit));
 	switch (pr->kind) {
-	case PX_PRIM_SEGMENT: {
+	case PX_RECOG_SEGMENT: {
 		double t;
 		x = seg_closest(&pr->seg, p, &t);
 		if (want) {
 			if (pr->linear) {
 				hit->u = lin_param(pr->dom[0], pr->dom[1], 0,
 						   pr->seg.len, t);
-				hit->param = PX_PRIM_PARAM_EXACT;
+				hit->param = PX_RECOG_PARAM_EXACT;
 			} else {
 				hit->u = inv_solve(pr, INV_CURVE, pr->dom[0],
 						   pr->dom[1], 0, pr->seg.len, t, 0);
-				hit->param = PX_PRIM_PARAM_SOLVED;
+				hit->param = PX_RECOG_PARAM_SOLVED;
 			}
 		}
 		break;
 	}
-	case PX_PRIM_ARC: {
+	case PX_RECOG_ARC: {
 		double f;
 		x = arc_closest(&pr->arc, p, &f, &hit->tie);
 		if (want && pr->qarc[0].n) {
 			hit->u = qarc_param(&pr->qarc[0], f);
-			hit->param = PX_PRIM_PARAM_EXACT;
+			hit->param = PX_RECOG_PARAM_EXACT;
 		} else if (want) {
 			hit->u = inv_solve(pr, INV_CURVE, pr->dom[0], pr->dom[1], 0,
 					   pr->arc.sweep, f, 1);
-			hit->param = PX_PRIM_PARAM_SOLVED;
+			hit->param = PX_RECOG_PARAM_SOLVED;
 		}
 		break;
 	}
-	case PX_PRIM_CYLINDER:
-	case PX_PRIM_CONE:
-	case PX_PRIM_ANNULUS:
-	case PX_PRIM_SPHERE:
-	case PX_PRIM_TORUS: {
-		const struct px_prim_rev *rv = &pr->rev;
+	case PX_RECOG_CYLINDER:
+	case PX_RECOG_CONE:
+	case PX_RECOG_ANNULUS:
+	case PX_RECOG_SPHERE:
+	case PX_RECOG_TORUS: {
+		const struct px_recog_rev *rv = &pr->rev;
 		double th, pt, pa, pp;
 		int da = rv->dir_angle;
 		x = rev_closest(rv, p, &th, &pt, &hit->tie);
@@ -1246,12 +1246,12 @@ int px_prim_closest(const struct px_prim *pr, px_vec3 p, int flags,
 			}
 			hit->u = da == 0 ? pa : pp;
 			hit->v = da == 0 ? pp : pa;
-			hit->param = exact ? PX_PRIM_PARAM_EXACT : PX_PRIM_PARAM_SOLVED;
+			hit->param = exact ? PX_RECOG_PARAM_EXACT : PX_RECOG_PARAM_SOLVED;
 		}
 		break;
 	}
-	case PX_PRIM_PARALLELOGRAM: {
-		const struct px_prim_quad *q = &pr->quad;
+	case PX_RECOG_PARALLELOGRAM: {
+		const struct px_recog_quad *q = &pr->quad;
 		double xs, ys;
 		x = quad_closest(q, p, &xs, &ys);
 		if (want) {
@@ -1263,8 +1263,8 @@ int px_prim_closest(const struct px_prim *pr, px_vec3 p, int flags,
 					 ? lin_param(pr->dom[2], pr->dom[3], q->y0, q->y1, ys)
 					 : inv_solve(pr, INV_QUAD_Y, pr->dom[2], pr->dom[3],
 						     q->y0, q->y1, ys, 0);
-			hit->param = (pr->linear & 3) == 3 ? PX_PRIM_PARAM_EXACT
-							   : PX_PRIM_PARAM_SOLVED;
+			hit->param = (pr->linear & 3) == 3 ? PX_RECOG_PARAM_EXACT
+							   : PX_RECOG_PARAM_SOLVED;
 		}
 		break;
 	}
@@ -1278,18 +1278,18 @@ int px_prim_closest(const struct px_prim *pr, px_vec3 p, int flags,
 	return PX_OK;
 }
 
-const char *px_prim_kind_name(enum px_prim_kind k)
+const char *px_recog_kind_name(enum px_recog_kind k)
 {
 	switch (k) {
-	case PX_PRIM_SEGMENT: return "segment";
-	case PX_PRIM_ARC: return "arc";
-	case PX_PRIM_PLANE: return "plane";
-	case PX_PRIM_PARALLELOGRAM: return "parallelogram";
-	case PX_PRIM_CYLINDER: return "cylinder";
-	case PX_PRIM_CONE: return "cone";
-	case PX_PRIM_ANNULUS: return "annulus";
-	case PX_PRIM_SPHERE: return "sphere";
-	case PX_PRIM_TORUS: return "torus";
+	case PX_RECOG_SEGMENT: return "segment";
+	case PX_RECOG_ARC: return "arc";
+	case PX_RECOG_PLANE: return "plane";
+	case PX_RECOG_PARALLELOGRAM: return "parallelogram";
+	case PX_RECOG_CYLINDER: return "cylinder";
+	case PX_RECOG_CONE: return "cone";
+	case PX_RECOG_ANNULUS: return "annulus";
+	case PX_RECOG_SPHERE: return "sphere";
+	case PX_RECOG_TORUS: return "torus";
 	default: return "none";
 	}
 }

@@ -409,7 +409,7 @@ static double surf_brute(const struct px_nurbs_surf *s, px_vec3 p)
 
 /* ---- curve tests ----------------------------------------------------------- */
 
-static void check_curve_queries(const struct px_prim *pr,
+static void check_curve_queries(const struct px_recog_shape *pr,
 				const struct px_nurbs_curve *c, int nq,
 				const px_vec3 *extra, int n_extra)
 {
@@ -418,7 +418,7 @@ static void check_curve_queries(const struct px_prim *pr,
 	px_aabb b = px_nurbs_curve_aabb(c);
 	px_vec3 mid = px_v3_scale(px_v3_add(b.min, b.max), 0.5);
 	for (q = 0; q < nq + n_extra; q++) {
-		struct px_prim_hit h;
+		struct px_recog_hit h;
 		px_vec3 p;
 		double ref, ub;
 		if (q < n_extra)
@@ -433,21 +433,21 @@ static void check_curve_queries(const struct px_prim *pr,
 		else
 			p = px_v3_madd(mid, rand_unit(),
 				       pr->size * px_rand_range(0, q % 4 == 1 ? 0.3 : 2));
-		PX_CHECK_INT_EQ(px_prim_closest(pr, p, PX_PRIM_WANT_PARAMS, &h), PX_OK);
+		PX_CHECK_INT_EQ(px_recog_closest(pr, p, PX_RECOG_WANT_PARAMS, &h), PX_OK);
 		ref = curve_brute(c, p, &ub);
 		PX_CHECK_MSG(h.dist <= ref + tol && ref <= h.dist + tol,
 			     "%s: closed form %.17g brute %.17g (at u %.17g; hit u %.17g, "
 			     "entity there %.17g; query %d)",
-			     px_prim_kind_name(pr->kind), h.dist, ref, ub, h.u,
+			     px_recog_kind_name(pr->kind), h.dist, ref, ub, h.u,
 			     px_v3_dist(p, px_nurbs_curve_point(c, h.u)), q);
 		PX_CHECK_MSG(px_v3_dist(px_nurbs_curve_point(c, h.u), h.point) <= 1e-8 * pr->size,
 			     "parameter %.17g gives a point %.3g away", h.u,
 			     px_v3_dist(px_nurbs_curve_point(c, h.u), h.point));
 		PX_CHECK_NEAR(px_v3_dist(p, h.point), h.dist, 1e-12 * pr->size);
-		PX_CHECK_INT_EQ(h.param, (pr->kind == PX_PRIM_ARC && pr->qarc[0].n) ||
-						 (pr->kind == PX_PRIM_SEGMENT && pr->linear)
-					 ? PX_PRIM_PARAM_EXACT
-					 : PX_PRIM_PARAM_SOLVED);
+		PX_CHECK_INT_EQ(h.param, (pr->kind == PX_RECOG_ARC && pr->qarc[0].n) ||
+						 (pr->kind == PX_RECOG_SEGMENT && pr->linear)
+					 ? PX_RECOG_PARAM_EXACT
+					 : PX_RECOG_PARAM_SOLVED);
 	}
 }
 
@@ -456,7 +456,7 @@ static void test_circle_full_and_arcs(void)
 	int trial;
 	for (trial = 0; trial < 60; trial++) {
 		struct tcurve t;
-		struct px_prim pr;
+		struct px_recog_shape pr;
 		struct frame f = rand_frame();
 		double r = px_rand_range(0.1, 10), sweep;
 		int nseg, elev = trial % 4 == 3 ? px_rand_int(1, 8) : 0;
@@ -482,8 +482,8 @@ static void test_circle_full_and_arcs(void)
 					t.pw[4 * m + j] *= sc;
 		}
 		PX_CHECK_INT_EQ(px_recog_curve(&t.c, 0, &pr), 1);
-		PX_CHECK_INT_EQ(pr.kind, PX_PRIM_ARC);
-		if (pr.kind != PX_PRIM_ARC)
+		PX_CHECK_INT_EQ(pr.kind, PX_RECOG_ARC);
+		if (pr.kind != PX_RECOG_ARC)
 			continue;
 		PX_CHECK_NEAR(pr.arc.radius, r, 1e-12 * r);
 		PX_CHECK_NEAR(px_v3_dist(pr.arc.center, f.o), 0, 1e-12 * r);
@@ -499,8 +499,8 @@ static void test_circle_full_and_arcs(void)
 		pr.qarc[0].n = 0; /* the bounded inversion instead */
 		check_curve_queries(&pr, &t.c, 6, extra, 3);
 		{
-			struct px_prim_hit h;
-			px_prim_closest(&pr, f.o, 0, &h);
+			struct px_recog_hit h;
+			px_recog_closest(&pr, f.o, 0, &h);
 			PX_CHECK(h.tie);
 			PX_CHECK_NEAR(h.dist, r, 1e-12 * r);
 		}
@@ -512,7 +512,7 @@ static void test_lines(void)
 	int trial;
 	for (trial = 0; trial < 80; trial++) {
 		struct tcurve t;
-		struct px_prim pr;
+		struct px_recog_shape pr;
 		struct frame f = rand_frame();
 		int p = 1 + trial % 5, n = p + 1 + px_rand_int(0, 4);
 		int uniform = trial % 4 == 0, rational = !uniform && trial % 2;
@@ -530,8 +530,8 @@ static void test_lines(void)
 				       px_nurbs_curve_point(&t.c, u1));
 		}
 		PX_CHECK_INT_EQ(px_recog_curve(&t.c, 0, &pr), 1);
-		PX_CHECK_INT_EQ(pr.kind, PX_PRIM_SEGMENT);
-		if (pr.kind != PX_PRIM_SEGMENT)
+		PX_CHECK_INT_EQ(pr.kind, PX_RECOG_SEGMENT);
+		if (pr.kind != PX_RECOG_SEGMENT)
 			continue;
 		PX_CHECK_NEAR(pr.seg.len, L, 1e-12 * L);
 		PX_CHECK_NEAR(px_v3_dot(pr.seg.dir, f.x), 1, 1e-12);
@@ -548,7 +548,7 @@ static void test_curve_near_misses(void)
 	int trial;
 	for (trial = 0; trial < 60; trial++) {
 		struct tcurve t;
-		struct px_prim pr;
+		struct px_recog_shape pr;
 		struct frame f = rand_frame();
 		double r = px_rand_range(0.5, 5);
 		int i, k;
@@ -602,8 +602,8 @@ static void test_curve_near_misses(void)
 		}
 		}
 		PX_CHECK_MSG(px_recog_curve(&t.c, 0, &pr) == 0, "case %d recognised as %s",
-			     trial % 5, px_prim_kind_name(pr.kind));
-		PX_CHECK_INT_EQ(pr.kind, PX_PRIM_NONE);
+			     trial % 5, px_recog_kind_name(pr.kind));
+		PX_CHECK_INT_EQ(pr.kind, PX_RECOG_NONE);
 	}
 }
 
@@ -665,7 +665,7 @@ static int profile_seg(double h0, double r0, double h1, double r1, int deg,
 	return n;
 }
 
-static void check_surf_queries(const struct px_prim *pr,
+static void check_surf_queries(const struct px_recog_shape *pr,
 			       const struct px_nurbs_surf *s, int nq,
 			       const px_vec3 *extra, int n_extra)
 {
@@ -675,7 +675,7 @@ static void check_surf_queries(const struct px_prim *pr,
 	px_vec3 mid = px_v3_scale(px_v3_add(b.min, b.max), 0.5);
 	px_nurbs_surf_domain(s, &u0, &u1, &v0, &v1);
 	for (q = 0; q < nq + n_extra; q++) {
-		struct px_prim_hit h;
+		struct px_recog_hit h;
 		px_vec3 p;
 		double ref;
 		if (q < n_extra)
@@ -688,15 +688,15 @@ static void check_surf_queries(const struct px_prim *pr,
 		else
 			p = px_v3_madd(mid, rand_unit(),
 				       pr->size * px_rand_range(0, q % 4 == 1 ? 0.4 : 1.5));
-		PX_CHECK_INT_EQ(px_prim_closest(pr, p, PX_PRIM_WANT_PARAMS, &h), PX_OK);
+		PX_CHECK_INT_EQ(px_recog_closest(pr, p, PX_RECOG_WANT_PARAMS, &h), PX_OK);
 		ref = surf_brute(s, p);
 		PX_CHECK_MSG(h.dist <= ref + tol && ref <= h.dist + tol,
 			     "%s: closed form %.17g brute %.17g (query %d) p=(%g %g %g) hit=(%g %g) deg %d %d",
-			     px_prim_kind_name(pr->kind), h.dist, ref, q, p.x, p.y, p.z, h.u, h.v, s->degree[0], s->degree[1]);
+			     px_recog_kind_name(pr->kind), h.dist, ref, q, p.x, p.y, p.z, h.u, h.v, s->degree[0], s->degree[1]);
 		PX_CHECK_MSG(px_v3_dist(px_nurbs_surf_point(s, h.u, h.v), h.point) <=
 				     1e-8 * pr->size,
 			     "%s: parameters (%.17g, %.17g) give a point %.3g away",
-			     px_prim_kind_name(pr->kind), h.u, h.v,
+			     px_recog_kind_name(pr->kind), h.u, h.v,
 			     px_v3_dist(px_nurbs_surf_point(s, h.u, h.v), h.point));
 	}
 }
@@ -706,7 +706,7 @@ static void test_revolutions(void)
 	int trial;
 	for (trial = 0; trial < 30; trial++) {
 		struct tsurf t;
-		struct px_prim pr;
+		struct px_recog_shape pr;
 		struct frame f = rand_frame();
 		double hr[2 * MAXC], beta[MAXC], V[MAXC + 8];
 		double R = px_rand_range(0.5, 3), a0 = px_rand_range(-PI, PI), sweep;
@@ -719,32 +719,32 @@ static void test_revolutions(void)
 			np = trial % 2 ? profile_arc(0, 0, R, 0, PI, hr, beta, V)
 				       : profile_arc(0, 0, R, px_rand_range(0, 1),
 						     px_rand_range(0.5, 2), hr, beta, V);
-			want = PX_PRIM_SPHERE;
+			want = PX_RECOG_SPHERE;
 			break;
 		case 1: /* octant */
 			np = profile_arc(0, 0, R, 0, PI / 2, hr, beta, V);
 			sweep = PI / 2;
-			want = PX_PRIM_SPHERE;
+			want = PX_RECOG_SPHERE;
 			break;
 		case 2:
 			np = profile_seg(-1, R, px_rand_range(0, 2), R, 1 + trial % 3, hr,
 					 beta, V);
-			want = PX_PRIM_CYLINDER;
+			want = PX_RECOG_CYLINDER;
 			break;
 		case 3:
 			np = profile_seg(-1, R, 1.5, trial % 2 ? 0 : 0.3 * R, 1 + trial % 2,
 					 hr, beta, V);
-			want = PX_PRIM_CONE;
+			want = PX_RECOG_CONE;
 			break;
 		case 4: /* torus: full tube or a partial one */
 			np = profile_arc(0, R, 0.4 * R, 0,
 					 trial % 2 ? 2 * PI : px_rand_range(1, 5), hr, beta,
 					 V);
-			want = PX_PRIM_TORUS;
+			want = PX_RECOG_TORUS;
 			break;
 		default:
 			np = profile_seg(0.5, 0.2 * R, 0.5, R, 1, hr, beta, V);
-			want = PX_PRIM_ANNULUS;
+			want = PX_RECOG_ANNULUS;
 			break;
 		}
 		PX_CHECK_INT_EQ(make_rev(&t, &f, a0, sweep, hr, beta, np, V,
@@ -754,25 +754,25 @@ static void test_revolutions(void)
 					 tr),
 				PX_OK);
 		PX_CHECK_INT_EQ(px_recog_surf(&t.s, 0, &pr), 1);
-		PX_CHECK_MSG(pr.kind == (enum px_prim_kind)want, "trial %d: got %s want %s",
-			     trial, px_prim_kind_name(pr.kind),
-			     px_prim_kind_name((enum px_prim_kind)want));
-		if (pr.kind != (enum px_prim_kind)want)
+		PX_CHECK_MSG(pr.kind == (enum px_recog_kind)want, "trial %d: got %s want %s",
+			     trial, px_recog_kind_name(pr.kind),
+			     px_recog_kind_name((enum px_recog_kind)want));
+		if (pr.kind != (enum px_recog_kind)want)
 			continue;
 		PX_CHECK(pr.hausdorff <= 1e-10 * pr.size);
 		PX_CHECK(pr.qarc[0].n > 0);
 		PX_CHECK(!pr.rev.profile_is_arc || pr.qarc[1].n > 0);
 		PX_CHECK_NEAR(fabs(px_v3_dot(pr.rev.axis, f.z)), 1, 1e-12);
 		PX_CHECK_NEAR(pr.rev.sweep, sweep, 1e-11);
-		if (want == PX_PRIM_SPHERE) {
+		if (want == PX_RECOG_SPHERE) {
 			PX_CHECK_NEAR(pr.radius, R, 1e-12 * R);
 			PX_CHECK_NEAR(px_v3_dist(pr.center, f.o), 0, 1e-12 * R);
-		} else if (want == PX_PRIM_CYLINDER) {
+		} else if (want == PX_RECOG_CYLINDER) {
 			PX_CHECK_NEAR(pr.radius, R, 1e-12 * R);
-		} else if (want == PX_PRIM_TORUS) {
+		} else if (want == PX_RECOG_TORUS) {
 			PX_CHECK_NEAR(pr.radius, R, 1e-12 * R);
 			PX_CHECK_NEAR(pr.radius2, 0.4 * R, 1e-12 * R);
-		} else if (want == PX_PRIM_CONE && trial % 2) {
+		} else if (want == PX_RECOG_CONE && trial % 2) {
 			PX_CHECK_NEAR(px_v3_dist(pr.center, fr(&f, 0, 0, 1.5)), 0, 1e-11);
 		}
 		/* On the axis (the evolute of every meridian circle), the
@@ -796,7 +796,7 @@ static void test_parallelograms(void)
 	int trial;
 	for (trial = 0; trial < 12; trial++) {
 		struct tsurf t;
-		struct px_prim pr;
+		struct px_recog_shape pr;
 		struct frame f = rand_frame();
 		int pu = 1 + trial % 3, pv = 1 + (trial / 3) % 3, nu = pu + 1 + trial % 2,
 		    nv = pv + 1, i, j;
@@ -829,13 +829,13 @@ static void test_parallelograms(void)
 				PX_OK);
 		PX_CHECK_INT_EQ(px_recog_surf(&t.s, 0, &pr), 1);
 		if (trap) {
-			struct px_prim_hit h;
-			PX_CHECK_INT_EQ(pr.kind, PX_PRIM_PLANE);
-			PX_CHECK_INT_EQ(px_prim_closest(&pr, f.o, 0, &h), PX_E_UNSUPPORTED);
+			struct px_recog_hit h;
+			PX_CHECK_INT_EQ(pr.kind, PX_RECOG_PLANE);
+			PX_CHECK_INT_EQ(px_recog_closest(&pr, f.o, 0, &h), PX_E_UNSUPPORTED);
 			continue;
 		}
-		PX_CHECK_INT_EQ(pr.kind, PX_PRIM_PARALLELOGRAM);
-		if (pr.kind != PX_PRIM_PARALLELOGRAM)
+		PX_CHECK_INT_EQ(pr.kind, PX_RECOG_PARALLELOGRAM);
+		if (pr.kind != PX_RECOG_PARALLELOGRAM)
 			continue;
 		if (uniform && pu == 1 && pv == 1)
 			PX_CHECK_INT_EQ(pr.linear, 3);
@@ -848,7 +848,7 @@ static void test_surface_near_misses(void)
 	int trial;
 	for (trial = 0; trial < 18; trial++) {
 		struct tsurf t;
-		struct px_prim pr;
+		struct px_recog_shape pr;
 		struct frame f = rand_frame();
 		double hr[2 * MAXC], beta[MAXC], V[MAXC + 8], R = px_rand_range(0.5, 2);
 		int np, k, i;
@@ -880,7 +880,7 @@ static void test_surface_near_misses(void)
 				t.pw[4 * k + i] += px_v3_comp(d, i) * t.pw[4 * k + 3];
 		}
 		PX_CHECK_MSG(px_recog_surf(&t.s, 0, &pr) == 0, "trial %d recognised as %s",
-			     trial, px_prim_kind_name(pr.kind));
+			     trial, px_recog_kind_name(pr.kind));
 	}
 }
 
@@ -893,7 +893,7 @@ static void test_circle_rows_not_revolution(void)
 	int trial;
 	for (trial = 0; trial < 8; trial++) {
 		struct tsurf t;
-		struct px_prim pr;
+		struct px_recog_shape pr;
 		struct frame f = rand_frame();
 		double xy[2 * MAXC], al[MAXC], Ua[MAXC], R = px_rand_range(0.5, 2);
 		int na = arc2d(0, trial % 2 ? 2 * PI : 2.5, 4, xy, al, Ua), i, j;
@@ -912,7 +912,7 @@ static void test_circle_rows_not_revolution(void)
 						   t.pw, NULL),
 				PX_OK);
 		PX_CHECK_MSG(px_recog_surf(&t.s, 0, &pr) == 0, "trial %d recognised as %s",
-			     trial, px_prim_kind_name(pr.kind));
+			     trial, px_recog_kind_name(pr.kind));
 	}
 }
 
@@ -925,7 +925,7 @@ static void test_bound_holds_when_loose(void)
 	for (trial = 0; trial < 24; trial++) {
 		struct tcurve t;
 		struct tsurf ts;
-		struct px_prim pr;
+		struct px_recog_shape pr;
 		struct frame f = rand_frame();
 		double R = px_rand_range(0.5, 3), hr[2 * MAXC], beta[MAXC], V[MAXC + 8];
 		int k, i, surf = trial % 2, np;
@@ -954,17 +954,17 @@ static void test_bound_holds_when_loose(void)
 		rec++;
 		PX_CHECK(pr.hausdorff > 0 && pr.hausdorff <= 1e-2 * pr.size);
 		for (q = 0; q < 12; q++) {
-			struct px_prim_hit h;
+			struct px_recog_hit h;
 			px_aabb b = surf ? px_nurbs_surf_aabb(&ts.s) : px_nurbs_curve_aabb(&t.c);
 			px_vec3 p = px_v3_madd(px_v3_scale(px_v3_add(b.min, b.max), 0.5),
 					       rand_unit(), pr.size * px_rand_range(0, 1));
 			double ref = surf ? surf_brute(&ts.s, p) : curve_brute(&t.c, p, NULL);
-			PX_CHECK_INT_EQ(px_prim_closest(&pr, p, 0, &h), PX_OK);
-			PX_CHECK_INT_EQ(px_prim_closest(&pr, p, PX_PRIM_WANT_PARAMS, &h), PX_OK);
+			PX_CHECK_INT_EQ(px_recog_closest(&pr, p, 0, &h), PX_OK);
+			PX_CHECK_INT_EQ(px_recog_closest(&pr, p, PX_RECOG_WANT_PARAMS, &h), PX_OK);
 			PX_CHECK_MSG(fabs(h.dist - ref) <= pr.hausdorff + 1e-9 * pr.size,
 				     "%s: |%.17g - %.17g| above bound %.3g (entity at hit "
 				     "params %.17g)",
-				     px_prim_kind_name(pr.kind), h.dist, ref, pr.hausdorff,
+				     px_recog_kind_name(pr.kind), h.dist, ref, pr.hausdorff,
 				     surf ? px_v3_dist(p, px_nurbs_surf_point(&ts.s, h.u, h.v))
 					  : px_v3_dist(p, px_nurbs_curve_point(&t.c, h.u)));
 		}
@@ -984,7 +984,7 @@ static void test_obj_files(void)
 		char path[512];
 		struct px_obj_model *m = NULL;
 		struct px_obj_error e;
-		struct px_prim pr;
+		struct px_recog_shape pr;
 		int rc;
 		if (slash)
 			snprintf(path, sizeof(path), "%.*s/data/%s", (int)(slash - f), f,
@@ -998,19 +998,19 @@ static void test_obj_files(void)
 		PX_CHECK(m->n_entities >= 1);
 		if (k == 0) {
 			PX_CHECK_INT_EQ(px_recog_curve(&m->entities[0].curve, 0, &pr), 1);
-			PX_CHECK_INT_EQ(pr.kind, PX_PRIM_ARC);
+			PX_CHECK_INT_EQ(pr.kind, PX_RECOG_ARC);
 			PX_CHECK_NEAR(pr.radius, 2, 1e-12);
 			PX_CHECK_NEAR(px_v3_dist(pr.center, px_v3(1, -1, 0.5)), 0, 1e-12);
 			PX_CHECK_NEAR(pr.arc.sweep, 2 * PI, 1e-12);
 		} else if (k == 1) {
 			PX_CHECK_INT_EQ(px_recog_surf(&m->entities[0].surf, 0, &pr), 1);
-			PX_CHECK_INT_EQ(pr.kind, PX_PRIM_SPHERE);
+			PX_CHECK_INT_EQ(pr.kind, PX_RECOG_SPHERE);
 			PX_CHECK_NEAR(pr.radius, 1.5, 1e-12);
 			PX_CHECK_NEAR(px_v3_norm(pr.center), 0, 1e-12);
 			check_surf_queries(&pr, &m->entities[0].surf, 10, NULL, 0);
 		} else {
 			PX_CHECK_INT_EQ(px_recog_surf(&m->entities[0].surf, 0, &pr), 0);
-			PX_CHECK_INT_EQ(pr.kind, PX_PRIM_NONE);
+			PX_CHECK_INT_EQ(pr.kind, PX_RECOG_NONE);
 		}
 		px_obj_free(m);
 	}
@@ -1024,14 +1024,14 @@ static void test_extremes(void)
 	int trial;
 	for (trial = 0; trial < 6; trial++) {
 		struct tcurve t;
-		struct px_prim pr;
+		struct px_recog_shape pr;
 		struct frame f = rand_frame();
 		double r = px_rand_range(0.5, 3), sweep = trial % 2 ? PI : PI * 179.9 / 180;
 		px_vec3 extra[2];
 		PX_CHECK_INT_EQ(make_arc(&t, &f, r, sweep, trial % 2 ? 2 : 1, 0), PX_OK);
 		PX_CHECK_INT_EQ(px_recog_curve(&t.c, 0, &pr), 1);
-		PX_CHECK_INT_EQ(pr.kind, PX_PRIM_ARC);
-		if (pr.kind != PX_PRIM_ARC)
+		PX_CHECK_INT_EQ(pr.kind, PX_RECOG_ARC);
+		if (pr.kind != PX_RECOG_ARC)
 			continue;
 		PX_CHECK_NEAR(pr.arc.sweep, sweep, 1e-10);
 		extra[0] = f.o;
@@ -1040,7 +1040,7 @@ static void test_extremes(void)
 	}
 	for (trial = 0; trial < 4; trial++) {
 		struct tsurf t;
-		struct px_prim pr;
+		struct px_recog_shape pr;
 		struct frame f = rand_frame();
 		double hr[2 * MAXC], beta[MAXC], V[MAXC + 8];
 		double R = px_rand_range(0.3, 1), rt = R * px_rand_range(1.2, 2);
@@ -1055,8 +1055,8 @@ static void test_extremes(void)
 					 V, 2, trial % 2),
 				PX_OK);
 		PX_CHECK_INT_EQ(px_recog_surf(&t.s, 0, &pr), 1);
-		PX_CHECK_INT_EQ(pr.kind, PX_PRIM_TORUS);
-		if (pr.kind != PX_PRIM_TORUS)
+		PX_CHECK_INT_EQ(pr.kind, PX_RECOG_TORUS);
+		if (pr.kind != PX_RECOG_TORUS)
 			continue;
 		PX_CHECK_NEAR(pr.radius, R, 1e-12);
 		PX_CHECK_NEAR(pr.radius2, rt, 1e-12);
@@ -1070,8 +1070,8 @@ static void test_no_alloc_and_errors(void)
 {
 	struct tcurve t;
 	struct tsurf ts;
-	struct px_prim pc, ps;
-	struct px_prim_hit h;
+	struct px_recog_shape pc, ps;
+	struct px_recog_hit h;
 	struct frame f = rand_frame();
 	double hr[2 * MAXC], beta[MAXC], V[MAXC + 8];
 	uint64_t reg;
@@ -1086,16 +1086,16 @@ static void test_no_alloc_and_errors(void)
 	for (i = 0; i < 200; i++) {
 		px_vec3 p = px_v3(px_rand_range(-5, 5), px_rand_range(-5, 5),
 				  px_rand_range(-5, 5));
-		px_prim_closest(&pc, p, PX_PRIM_WANT_PARAMS, &h);
-		px_prim_closest(&ps, p, PX_PRIM_WANT_PARAMS, &h);
+		px_recog_closest(&pc, p, PX_RECOG_WANT_PARAMS, &h);
+		px_recog_closest(&ps, p, PX_RECOG_WANT_PARAMS, &h);
 	}
 	PX_CHECK_INT_EQ(px_alloc_region_end(reg), 0);
-	PX_CHECK_INT_EQ(px_prim_closest(NULL, f.o, 0, &h), PX_E_INVAL);
-	PX_CHECK_INT_EQ(px_prim_closest(&pc, px_v3(NAN, 0, 0), 0, &h), PX_E_NAN);
+	PX_CHECK_INT_EQ(px_recog_closest(NULL, f.o, 0, &h), PX_E_INVAL);
+	PX_CHECK_INT_EQ(px_recog_closest(&pc, px_v3(NAN, 0, 0), 0, &h), PX_E_NAN);
 	PX_CHECK_INT_EQ(px_recog_curve(NULL, 0, &pc), PX_E_INVAL);
 	PX_CHECK_INT_EQ(px_recog_surf(&ts.s, 0, NULL), PX_E_INVAL);
 	memset(&pc, 0, sizeof(pc));
-	PX_CHECK_INT_EQ(px_prim_closest(&pc, f.o, 0, &h), PX_E_UNSUPPORTED);
+	PX_CHECK_INT_EQ(px_recog_closest(&pc, f.o, 0, &h), PX_E_UNSUPPORTED);
 }
 
 static const struct px_test tests[] = {
