@@ -8,6 +8,7 @@
 #include "px_arena.h"
 #include "px_cpiece.h"
 #include "px_spiece.h"
+#include "px_recog.h"
 
 /* Hot-path box distance: boxes here are never empty, and fmin/fmax
  * would be library calls without -ffast-math. */
@@ -37,8 +38,9 @@ enum { PK_CURVE = 0, PK_PATCH = 1 };
 struct px_dist_ws {
 	uint32_t epoch;
 	uint32_t *stamp;
+	uint32_t *ent_stamp; /* entities answered in closed form */
 	struct cand *cand;
-	int n_pieces;
+	int n_pieces, n_ent;
 	int owned; /* allocated by px_dist_ws_create() */
 };
 
@@ -62,6 +64,9 @@ struct px_dist_model {
 	struct px_dist_opts opts;
 	int n_ent;
 	struct px_dist_entity_info *ent;
+	/* Knowledge step: entities that are exactly a primitive (with the
+	 * arrays their parameter inversion reads, copied here). */
+	struct px_recog_shape *shape;
 	int n_pieces;
 	struct piece *pieces;
 	int n_cp, n_sp;
@@ -821,8 +826,9 @@ int px_dist_model_create(const struct px_nurbs_curve *curves, int n_curves,
 	struct px_dist_entity_info *ent = NULL;
 	struct builder bl;
 	struct px_dist_model *m = NULL, hdr;
+	struct px_recog_shape *shapes = NULL;
 	int e, i, rc = PX_OK, n_ent, n_cp = 0, n_sp = 0;
-	size_t bytes, sp_doubles = 0;
+	size_t bytes, sp_doubles = 0, shape_doubles = 0;
 
 	if (!out)
 		return PX_E_INVAL;
@@ -856,6 +862,33 @@ int px_dist_model_create(const struct px_nurbs_curve *curves, int n_curves,
 		rc = add_surface(&bl, &surfs[e], &o, &ent[n_curves + e], n_curves + e);
 	if (rc)
 		goto fail;
+	/* Knowledge step (paper section 6, step 1): entities that are
+	 * exactly a primitive are answered in closed form; the bound on how
+	 * far the entity is from the primitive must be far inside the
+	 * accuracy promised (1e-9 of the model size). */
+	shapes = calloc((size_t)n_ent, sizeof(*shapes));
+	if (!shapes) {
+		rc = PX_E_NOMEM;
+		goto fail;
+	}
+	for (e = 0; e < n_ent; e++) {
+		struct px_recog_shape *sh = &shapes[e];
+		int got = e < n_curves ? px_recog_curve(&curves[e], 0.0, sh)
+				       : px_recog_surf(&surfs[e - n_curves], 0.0, sh);
+		if (got != 1 || sh->kind == PX_RECOG_PLANE ||
+		    !(sh->hausdorff <= 1e-11 * (sh->size > 0.0 ? sh->size : 1.0))) {
+			memset(sh, 0, sizeof(*sh));
+			continue;
+		}
+		ent[e].shape = sh->kind;
+		ent[e].hausdorff = sh->hausdorff;
+		shape_doubles += e < n_curves
+					 ? (size_t)curves[e].n_knots + 4 * (size_t)curves[e].n_ctrl
+					 : (size_t)surfs[e - n_curves].n_knots[0] +
+						   surfs[e - n_curves].n_knots[1] +
+						   4 * (size_t)surfs[e - n_curves].n_ctrl[0] *
+							   surfs[e - n_curves].n_ctrl[1];
+	}
 	for (i = 0; i < bl.n; i++) {
 		if (bl.tp[i].pc.kind == PK_CURVE) {
 			n_cp++;
@@ -927,6 +960,9 @@ int px_dist_model_create(const struct px_nurbs_curve *curves, int n_curves,
 	/* One block for everything the queries touch. */
 #define ALIGNED(x) (((x) + 63) & ~(size_t)63)
 	bytes = ALIGNED(sizeof(*m)) + ALIGNED((size_t)n_ent * sizeof(*ent)) +
+		ALIGNED((size_t)n_ent * sizeof(struct px_recog_shape)) +
+		ALIGNED(shape_doubles * sizeof(double)) +
+		ALIGNED((size_t)n_ent * sizeof(uint32_t)) +
 		ALIGNED((size_t)bl.n * sizeof(struct piece)) +
 		ALIGNED((size_t)n_cp * sizeof(struct px_cpiece)) +
 		ALIGNED((size_t)n_sp * sizeof(struct px_spiece)) +
@@ -956,8 +992,9 @@ int px_dist_model_create(const struct px_nurbs_curve *curves, int n_curves,
 	m->n_sp = n_sp;
 	m->n_samples = (int)bl.n_samples;
 	m->ws.n_pieces = bl.n;
+	m->ws.n_ent = n_ent;
 	{
-		double *spmem = NULL;
+		double *spmem = NULL, *shmem = NULL;
 		if (!TAKE(m->ent, n_ent) || !TAKE(m->pieces, bl.n) ||
 		    (n_cp && !TAKE(m->cp, n_cp)) || (n_sp && !TAKE(m->spc, n_sp)) ||
 		    (sp_doubles && !TAKE(spmem, sp_doubles)) ||
@@ -967,12 +1004,44 @@ int px_dist_model_create(const struct px_nurbs_curve *curves, int n_curves,
 		    !TAKE(m->cell_empty_r, m->n_cells) ||
 		    !TAKE(m->cell_slot, m->n_cells * m->cap) ||
 		    !TAKE(m->spill, m->n_spill + 1) || !TAKE(m->ws.stamp, bl.n) ||
-		    !TAKE(m->ws.cand, bl.n)) {
+		    !TAKE(m->ws.cand, bl.n) || !TAKE(m->shape, n_ent) ||
+		    !TAKE(m->ws.ent_stamp, n_ent) ||
+		    (shape_doubles && !TAKE(shmem, shape_doubles))) {
 			rc = PX_E_NOMEM; /* the sizing above is wrong: a bug */
 			goto fail;
 		}
 #undef TAKE
 		memcpy(m->ent, ent, (size_t)n_ent * sizeof(*ent));
+		memcpy(m->shape, shapes, (size_t)n_ent * sizeof(*shapes));
+		/* The shapes view the entity's arrays (for parameter
+		 * inversion): point them at copies the model owns. */
+		for (e = 0; e < n_ent; e++) {
+			struct px_recog_shape *sh = &m->shape[e];
+			if (sh->kind == PX_RECOG_NONE)
+				continue;
+			if (e < n_curves) {
+				const struct px_nurbs_curve *c = &curves[e];
+				memcpy(shmem, c->knots, (size_t)c->n_knots * sizeof(double));
+				sh->curve.knots = shmem;
+				shmem += c->n_knots;
+				memcpy(shmem, c->pw, 4 * (size_t)c->n_ctrl * sizeof(double));
+				sh->curve.pw = shmem;
+				shmem += 4 * (size_t)c->n_ctrl;
+			} else {
+				const struct px_nurbs_surf *sf = &surfs[e - n_curves];
+				size_t npw = 4 * (size_t)sf->n_ctrl[0] * sf->n_ctrl[1];
+				int d;
+				for (d = 0; d < 2; d++) {
+					memcpy(shmem, sf->knots[d],
+					       (size_t)sf->n_knots[d] * sizeof(double));
+					sh->surf.knots[d] = shmem;
+					shmem += sf->n_knots[d];
+				}
+				memcpy(shmem, sf->pw, npw * sizeof(double));
+				sh->surf.pw = shmem;
+				shmem += npw;
+			}
+		}
 		{
 			int ic = 0, is = 0, smp = 0;
 			for (i = 0; i < bl.n; i++) {
@@ -1051,6 +1120,7 @@ int px_dist_model_create(const struct px_nurbs_curve *curves, int n_curves,
 		goto fail;
 	free_builder(&bl);
 	free(ent);
+	free(shapes);
 	*out = m;
 	return PX_OK;
 fail:
@@ -1058,6 +1128,7 @@ fail:
 		px_arena_fini(&m->arena);
 	free_builder(&bl);
 	free(ent);
+	free(shapes);
 	return rc;
 }
 
@@ -1282,13 +1353,16 @@ int px_dist_ws_create(const struct px_dist_model *m, struct px_dist_ws **out)
 	if (!m || !out)
 		return PX_E_INVAL;
 	n = (size_t)m->n_pieces;
-	ws = calloc(1, sizeof(*ws) + n * (sizeof(uint32_t) + sizeof(struct cand)) + 16);
+	ws = calloc(1, sizeof(*ws) + n * (sizeof(uint32_t) + sizeof(struct cand)) +
+			       (size_t)m->n_ent * sizeof(uint32_t) + 16);
 	if (!ws)
 		return PX_E_NOMEM;
-	/* One block: candidates first (8-byte aligned), then stamps. */
+	/* One block: candidates first (16-byte aligned), then stamps. */
 	ws->cand = (struct cand *)(void *)(((uintptr_t)(ws + 1) + 15) & ~(uintptr_t)15);
 	ws->stamp = (uint32_t *)(void *)(ws->cand + n);
+	ws->ent_stamp = ws->stamp + n;
 	ws->n_pieces = m->n_pieces;
+	ws->n_ent = m->n_ent;
 	ws->owned = 1;
 	*out = ws;
 	return PX_OK;
@@ -1307,13 +1381,14 @@ int px_dist_query_ws(const struct px_dist_model *m, struct px_dist_ws *ws,
 	int c[3], k, kmax, i;
 	double gap = 0.0, best;
 
-	if (!m || !ws || !r || ws->n_pieces != m->n_pieces)
+	if (!m || !ws || !r || ws->n_pieces != m->n_pieces || ws->n_ent != m->n_ent)
 		return PX_E_INVAL;
 	if (!px_v3_isfinite(p))
 		return PX_E_NAN;
 	if (++ws->epoch == 0) {
 		/* Wrapped after 2^32 queries: clear once, then go on. */
 		memset(ws->stamp, 0, (size_t)m->n_pieces * sizeof(uint32_t));
+		memset(ws->ent_stamp, 0, (size_t)m->n_ent * sizeof(uint32_t));
 		ws->epoch = 1;
 	}
 	memset(r, 0, sizeof(*r));
@@ -1395,6 +1470,25 @@ int px_dist_query_ws(const struct px_dist_model *m, struct px_dist_ws *ws,
 		/* Past the first, the list is sorted by lower bound. */
 		if (i > 0 && cd->lb >= best)
 			break;
+		if (m->shape[pc->ent].kind != PX_RECOG_NONE) {
+			struct px_recog_hit h;
+			if (ws->ent_stamp[pc->ent] == ws->epoch)
+				continue; /* the whole entity is answered */
+			if (px_recog_closest(&m->shape[pc->ent], p, PX_RECOG_WANT_PARAMS,
+					     &h) == PX_OK) {
+				ws->ent_stamp[pc->ent] = ws->epoch;
+				r->pieces_solved++;
+				if (h.dist * h.dist < best) {
+					best = h.dist * h.dist;
+					r->point = h.point;
+					r->u = h.u;
+					r->v = h.v;
+					r->piece = cd->piece;
+				}
+				continue;
+			}
+			/* No closed form for this query: solve the pieces. */
+		}
 		r->pieces_solved++;
 		if (pc->kind == PK_CURVE) {
 			struct px_cpiece_hit hit;

@@ -107,6 +107,11 @@ struct px_dist_entity_info {
 	int n_breaks;       /* interior C0 knots (surfaces: both directions) */
 	int n_cusps;        /* interior points of vanishing derivative */
 	int n_collapsed;    /* surfaces: domain edges collapsed to a point */
+	/* Knowledge step: enum px_recog_kind (px_recog.h) when the entity is
+	 * exactly a primitive answered in closed form, 0 otherwise; then the
+	 * proved bound on the entity's distance from that primitive. */
+	int shape;
+	double hausdorff;
 };
 
 struct px_dist_info {

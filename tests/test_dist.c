@@ -7,6 +7,7 @@
 #include "px_arena.h"
 #include "px_dist.h"
 #include "px_nurbs.h"
+#include "px_recog.h"
 #include "px_test.h"
 
 #define MAXC 40
@@ -280,6 +281,9 @@ static void test_nurbs_circle_and_evolute(void)
 	PX_CHECK_INT_EQ(px_dist_model_create(&c, 1, NULL, 0, NULL, &m), PX_OK);
 	PX_CHECK_INT_EQ(px_dist_entity_info(m, 0, &ei), PX_OK);
 	PX_CHECK(ei.closed);
+	/* Knowledge step: answered in closed form. */
+	PX_CHECK_INT_EQ(ei.shape, PX_RECOG_ARC);
+	PX_CHECK(ei.hausdorff < 1e-12);
 	/* The centre and the axis are the evolute of a circle: every
 	 * point is a foot point, all at the same distance. */
 	PX_CHECK_INT_EQ(px_dist_query(m, px_v3(0, 0, 1), &r), PX_OK);

@@ -10,6 +10,7 @@
 #include "px_dist.h"
 #include "px_model.h"
 #include "px_nurbs.h"
+#include "px_recog.h"
 #include "px_test.h"
 
 #define MAXN 12
@@ -285,6 +286,7 @@ static void test_sphere_poles_seam_focal(void)
 	PX_CHECK_INT_EQ(px_dist_model_create(NULL, 0, &s, 1, NULL, &m), PX_OK);
 	PX_CHECK_INT_EQ(px_dist_entity_info(m, 0, &ei), PX_OK);
 	PX_CHECK_INT_EQ(ei.n_collapsed, 2);
+	PX_CHECK_INT_EQ(ei.shape, PX_RECOG_SPHERE); /* closed form */
 	PX_CHECK(ei.closed & 1);
 	/* The centre is the focal point of every patch. */
 	PX_CHECK_INT_EQ(px_dist_query(m, c, &r), PX_OK);
