@@ -87,9 +87,47 @@ err_has "missing points named" "none.csv"
 printf 'v 0 0 0\nv 1 0 0\ncstype bspline\ndeg 3\ncurv 0 1 1 2\nparm u 0 0 0 0 1 1 1 1\nend\n' >"$tmp/bad.obj"
 expect "malformed OBJ" 1 "$bin" "$tmp/bad.obj" "$tmp/pts.csv"
 err_has "malformed OBJ: file:line:column" 'bad.obj:[0-9]+:[0-9]+: '
-printf 'solid x\nendsolid x\n' >"$tmp/m.stl"
-expect "mesh model not yet supported" 1 "$bin" "$tmp/m.stl" "$tmp/pts.csv"
-err_has "mesh model: says so" 'not supported'
+# Meshes and clouds: the unit cube [0,1]^3 as an ASCII STL (12
+# triangles) and as OBJ faces, and its 8 corners as a point cloud.
+awk 'function v(x, y, z) { printf "    vertex %d %d %d\n", x, y, z }
+	function tri(a, b, c) { print "  facet normal 0 0 0"; print "   outer loop";
+		v(X[a], Y[a], Z[a]); v(X[b], Y[b], Z[b]); v(X[c], Y[c], Z[c]);
+		print "   endloop"; print "  endfacet" }
+	BEGIN { for (i = 0; i < 8; i++) { X[i] = i % 2; Y[i] = int(i / 2) % 2; Z[i] = int(i / 4) }
+		print "solid cube";
+		tri(0, 2, 1); tri(1, 2, 3); tri(4, 5, 6); tri(5, 7, 6);
+		tri(0, 1, 4); tri(1, 5, 4); tri(2, 6, 3); tri(3, 6, 7);
+		tri(0, 4, 2); tri(2, 4, 6); tri(1, 3, 5); tri(3, 7, 5);
+		print "endsolid cube" }' >"$tmp/cube.stl"
+awk 'BEGIN { for (i = 0; i < 8; i++) printf "v %d %d %d\n", i % 2, int(i / 2) % 2, int(i / 4);
+	print "f 1 3 2"; print "f 2 3 4"; print "f 5 6 7"; print "f 6 8 7";
+	print "f 1 2 5"; print "f 2 6 5"; print "f 3 7 4"; print "f 4 7 8";
+	print "f 1 5 3"; print "f 3 5 7"; print "f 2 4 6"; print "f 4 8 6" }' >"$tmp/cube.obj"
+awk 'BEGIN { for (i = 0; i < 8; i++) printf "%d,%d,%d\n", i % 2, int(i / 2) % 2, int(i / 4) }' >"$tmp/corners.xyz"
+boxcheck='function abs(a) { return a < 0 ? -a : a }
+	function gap(v) { return v < 0 ? -v : (v > 1 ? v - 1 : 0) }
+	{ dx = gap($1); dy = gap($2); dz = gap($3);
+	  if (dx + dy + dz > 0) want = sqrt(dx * dx + dy * dy + dz * dz);
+	  else { want = $1; if (1 - $1 < want) want = 1 - $1; if ($2 < want) want = $2;
+		 if (1 - $2 < want) want = 1 - $2; if ($3 < want) want = $3; if (1 - $3 < want) want = 1 - $3 }
+	  if (abs($4 - want) > 1e-6) { print "point " NR ": " $4 " vs " want; bad = 1 }
+	  if ($8 != int($8) || $8 < 0 || $8 > 11 || $9 != 0) { print "point " NR ": triangle index " $8; bad = 1 } }
+	END { exit bad }'
+for m in cube.stl cube.obj; do
+	expect "mesh model $m" 0 "$bin" "$tmp/$m" "$tmp/pts.csv"
+	tail -n +2 "$tmp/pts.csv" | paste -d, - "$tmp/out" >"$tmp/joined"
+	if awk -F, "$boxcheck" "$tmp/joined" >"$tmp/err"; then ok "$m: box distances, unsigned, triangle index as u"; else bad "$m: box distances"; fi
+done
+expect "point cloud" 0 "$bin" "$tmp/corners.xyz" "$tmp/pts.csv"
+tail -n +2 "$tmp/pts.csv" | paste -d, - "$tmp/out" >"$tmp/joined"
+if awk -F, 'function abs(a) { return a < 0 ? -a : a }
+	{ best = 1e300; for (i = 0; i < 8; i++) { d = sqrt(($1 - i % 2)^2 + ($2 - int(i / 2) % 2)^2 + ($3 - int(i / 4))^2); if (d < best) { best = d; bi = i } }
+	  if (abs($4 - best) > 1e-9) { print "point " NR ": " $4 " vs " best; bad = 1 }
+	  if ($8 != bi && abs(sqrt(($1 - $5)^2 + ($2 - $6)^2 + ($3 - $7)^2) - best) > 1e-9) { print "point " NR ": index " $9; bad = 1 } }
+	END { exit bad }' "$tmp/joined" >"$tmp/err"; then ok "cloud distances and point index"; else bad "cloud distances and point index"; fi
+printf 'solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n' >"$tmp/broken.stl"
+expect "truncated STL" 1 "$bin" "$tmp/broken.stl" "$tmp/pts.csv"
+err_has "truncated STL named" 'broken.stl'
 expect "unknown option" 2 "$bin" --frobnicate tests/data/circle.obj "$tmp/pts.csv"
 expect "missing arguments" 2 "$bin" tests/data/circle.obj
 

@@ -4,11 +4,15 @@
  *
  *   proxima-query [--track] [--stats] MODEL POINTS.csv
  *
- * MODEL: Wavefront OBJ with free-form curves and surfaces (all entities
- * form one model). POINTS.csv: one "x,y,z" per line; a first line that
- * starts with a letter is a header. Output, one line per point:
- * "dist,cx,cy,cz,u,v" with %.17g (curves print v = 0). --stats writes
- * setup time, model memory and per-query times to stderr.
+ * MODEL: Wavefront OBJ (free-form curves and surfaces, polygon faces, or
+ * both: all entities form one model), STL, PLY (mesh with faces, point
+ * cloud without), XYZ/CSV point clouds. POINTS.csv: one "x,y,z" per line;
+ * a first line that starts with a letter is a header. Output, one line
+ * per point: "dist,cx,cy,cz,u,v" with %.17g; curves print v = 0, meshes
+ * the triangle index as u and clouds the point index, with v = 0. The
+ * distance is unsigned (closed meshes know inside from outside, but the
+ * contract is the distance). --stats writes setup time, model memory and
+ * per-query times to stderr.
  */
 #include <ctype.h>
 #include <errno.h>
@@ -19,6 +23,9 @@
 #include <time.h>
 
 #include "px_dist.h"
+#include "px_load.h"
+#include "px_mesh.h"
+#include "px_model.h"
 #include "px_obj.h"
 
 static const char *prog = "proxima-query";
@@ -26,7 +33,8 @@ static const char *prog = "proxima-query";
 static void usage(FILE *f)
 {
 	fprintf(f, "usage: %s [--track] [--stats] MODEL POINTS.csv\n"
-		   "  MODEL       .obj with free-form curves/surfaces (cstype bspline)\n"
+		   "  MODEL       .obj (free-form curves/surfaces and/or faces), .stl,\n"
+		   "              .ply (mesh or point cloud), .xyz/.csv (point cloud)\n"
 		   "  POINTS.csv  one x,y,z per line (a first line starting with a\n"
 		   "              letter is a header)\n"
 		   "  --stats     setup time, model memory and per-query ns to stderr\n"
@@ -174,6 +182,7 @@ int main(int argc, char **argv)
 	struct px_nurbs_curve *curves = NULL;
 	struct px_nurbs_surf *surfs = NULL;
 	struct px_dist_model *m = NULL;
+	struct px_model *mesh = NULL;
 	struct points pts = {0};
 	int64_t t_setup, *times = NULL;
 	const char *ext;
@@ -211,56 +220,77 @@ int main(int argc, char **argv)
 		return 2;
 	}
 	ext = ext_of(model_path);
-	if (ieq(ext, "stl") || ieq(ext, "ply")) {
-		fprintf(stderr, "%s: %s: triangle-mesh and point-cloud models "
-				"(.%s) are not supported by this version\n",
-			prog, model_path, ext);
-		return 1;
-	}
-	if (!ieq(ext, "obj")) {
-		fprintf(stderr, "%s: %s: unknown model format '.%s' (expected .obj)\n",
-			prog, model_path, ext);
-		return 1;
-	}
-
 	t_setup = now_ns();
-	rc = px_obj_load_file(model_path, &obj, &oerr);
-	if (rc) {
-		if (oerr.line > 0)
-			fprintf(stderr, "%s: %s:%d:%d: %s\n", prog, oerr.file, oerr.line,
-				oerr.column, oerr.msg);
-		else
-			fprintf(stderr, "%s: %s: %s\n", prog, model_path,
-				oerr.msg[0] ? oerr.msg : px_strerror(rc));
-		return 1;
-	}
-	curves = calloc((size_t)obj->n_entities + 1, sizeof(*curves));
-	surfs = calloc((size_t)obj->n_entities + 1, sizeof(*surfs));
-	if (!curves || !surfs) {
-		fprintf(stderr, "%s: out of memory\n", prog);
-		rc = 1;
-		goto out;
-	}
-	for (i = 0; i < obj->n_entities; i++) {
-		if (obj->entities[i].kind == PX_OBJ_CURVE)
-			curves[nc++] = obj->entities[i].curve;
-		else
-			surfs[ns++] = obj->entities[i].surf;
-	}
-	if (nc + ns == 0) {
-		fprintf(stderr, "%s: %s: no free-form curve or surface in the file%s\n",
-			prog, model_path,
-			obj->n_triangles ? " (polygon faces are not supported by this "
-					   "version)" : "");
-		rc = 1;
-		goto out;
-	}
-	rc = px_dist_model_create(curves, nc, surfs, ns, NULL, &m);
-	if (rc) {
-		fprintf(stderr, "%s: %s: cannot prepare the model: %s\n", prog,
-			model_path, px_strerror(rc));
-		rc = 1;
-		goto out;
+	if (!ieq(ext, "obj")) {
+		/* Meshes and point clouds. */
+		char msg[512];
+		rc = px_model_load(model_path, 0.0, &mesh, msg, sizeof(msg));
+		if (rc) {
+			fprintf(stderr, "%s: %s\n", prog, msg[0] ? msg : px_strerror(rc));
+			return 1;
+		}
+		if (msg[0] && stats)
+			fprintf(stderr, "%s: %s\n", prog, msg);
+	} else {
+		rc = px_obj_load_file(model_path, &obj, &oerr);
+		if (rc) {
+			if (oerr.line > 0)
+				fprintf(stderr, "%s: %s:%d:%d: %s\n", prog, oerr.file,
+					oerr.line, oerr.column, oerr.msg);
+			else
+				fprintf(stderr, "%s: %s: %s\n", prog, model_path,
+					oerr.msg[0] ? oerr.msg : px_strerror(rc));
+			return 1;
+		}
+		curves = calloc((size_t)obj->n_entities + 1, sizeof(*curves));
+		surfs = calloc((size_t)obj->n_entities + 1, sizeof(*surfs));
+		if (!curves || !surfs) {
+			fprintf(stderr, "%s: out of memory\n", prog);
+			rc = 1;
+			goto out;
+		}
+		for (i = 0; i < obj->n_entities; i++) {
+			if (obj->entities[i].kind == PX_OBJ_CURVE)
+				curves[nc++] = obj->entities[i].curve;
+			else
+				surfs[ns++] = obj->entities[i].surf;
+		}
+		if (nc + ns == 0 && obj->n_triangles == 0) {
+			fprintf(stderr, "%s: %s: no free-form curve or surface and no "
+					"face in the file\n", prog, model_path);
+			rc = 1;
+			goto out;
+		}
+		if (nc + ns > 0) {
+			rc = px_dist_model_create(curves, nc, surfs, ns, NULL, &m);
+			if (rc) {
+				fprintf(stderr, "%s: %s: cannot prepare the model: %s\n",
+					prog, model_path, px_strerror(rc));
+				rc = 1;
+				goto out;
+			}
+		}
+		if (obj->n_triangles > 0) {
+			/* The file's faces are a mesh of the same model. */
+			struct px_mesh_report rep;
+			uint32_t *tri = malloc(3 * (size_t)obj->n_triangles * sizeof(*tri));
+			if (!tri) {
+				fprintf(stderr, "%s: out of memory\n", prog);
+				rc = 1;
+				goto out;
+			}
+			for (i = 0; i < 3 * obj->n_triangles; i++)
+				tri[i] = (uint32_t)obj->triangles[i];
+			rc = px_mesh_model(obj->vertices, (size_t)obj->n_vertices, tri,
+					   (size_t)obj->n_triangles, NULL, &rep, &mesh);
+			free(tri);
+			if (rc) {
+				fprintf(stderr, "%s: %s: faces: %s\n", prog, model_path,
+					rep.message[0] ? rep.message : px_strerror(rc));
+				rc = 1;
+				goto out;
+			}
+		}
 	}
 	t_setup = now_ns() - t_setup;
 
@@ -275,9 +305,32 @@ int main(int argc, char **argv)
 		goto out;
 	}
 	for (size_t k = 0; k < pts.n; k++) {
-		struct px_dist_result r;
+		double dist = INFINITY, u = 0.0, v = 0.0;
+		px_vec3 cp = px_v3(0, 0, 0);
 		int64_t t0 = now_ns();
-		int qrc = px_dist_query(m, pts.p[k], &r);
+		int qrc = 0;
+		if (m) {
+			struct px_dist_result r;
+			qrc = px_dist_query(m, pts.p[k], &r);
+			if (!qrc) {
+				dist = r.dist;
+				cp = r.point;
+				u = r.u;
+				v = r.v;
+			}
+		}
+		if (mesh && !qrc) {
+			struct px_model_result r;
+			qrc = px_model_query_ex(mesh, pts.p[k], INFINITY, -1,
+						PX_QUERY_UNSIGNED, &r);
+			if (qrc == 1 && r.distance < dist) {
+				dist = r.distance;
+				cp = r.point;
+				u = r.index; /* triangle or point index */
+				v = 0.0;
+			}
+			qrc = qrc < 0 ? qrc : 0;
+		}
 		times[k] = now_ns() - t0;
 		if (qrc) {
 			fprintf(stderr, "%s: %s: point %zu: %s\n", prog, points_path,
@@ -285,8 +338,8 @@ int main(int argc, char **argv)
 			rc = 1;
 			goto out;
 		}
-		printf("%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", r.dist, r.point.x,
-		       r.point.y, r.point.z, r.u, r.v);
+		printf("%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", dist, cp.x, cp.y,
+		       cp.z, u, v);
 	}
 	if (fflush(stdout) || ferror(stdout)) {
 		fprintf(stderr, "%s: write error on standard output\n", prog);
@@ -295,12 +348,22 @@ int main(int argc, char **argv)
 	}
 	if (stats) {
 		struct px_dist_info info;
-		px_dist_model_info(m, &info);
+		size_t bytes = 0;
+		if (m) {
+			px_dist_model_info(m, &info);
+			bytes += info.bytes;
+		}
+		if (mesh)
+			bytes += px_model_memory_bytes(mesh);
 		fprintf(stderr, "setup_ms %.3f\n", t_setup / 1e6);
-		fprintf(stderr, "model_bytes %zu\n", info.bytes);
-		fprintf(stderr, "entities %d pieces %d (curve pieces %d, patches %d)\n",
-			info.n_entities, info.n_pieces, info.n_curve_pieces,
-			info.n_patches);
+		fprintf(stderr, "model_bytes %zu\n", bytes);
+		if (m)
+			fprintf(stderr, "entities %d pieces %d (curve pieces %d, patches %d)\n",
+				info.n_entities, info.n_pieces, info.n_curve_pieces,
+				info.n_patches);
+		if (mesh)
+			fprintf(stderr, "%s model: %s\n", px_model_name(mesh),
+				px_model_kind(mesh) == PX_MODEL_CLOUD ? "point cloud" : "triangles");
 		if (pts.n) {
 			qsort(times, pts.n, sizeof(*times), cmp_i64);
 			fprintf(stderr,
@@ -316,6 +379,7 @@ int main(int argc, char **argv)
 	rc = 0;
 out:
 	px_dist_model_free(m);
+	px_model_free(mesh);
 	px_obj_free(obj);
 	free(curves);
 	free(surfs);
