@@ -9,6 +9,10 @@
  * starts with a letter is a header. Output, one line per point:
  * "dist,cx,cy,cz,u,v" with %.17g (curves print v = 0). --stats writes
  * setup time, model memory and per-query times to stderr.
+ * --track answers the points in file order as one moving point with the
+ * coherent tracker (px_track.h: every critical distance followed, pairs
+ * created and annihilated at transitions); curve-only models for now.
+ * With --stats it also prints the tracker's counters.
  */
 #include <ctype.h>
 #include <errno.h>
@@ -20,6 +24,7 @@
 
 #include "px_dist.h"
 #include "px_obj.h"
+#include "px_track.h"
 
 static const char *prog = "proxima-query";
 
@@ -30,8 +35,9 @@ static void usage(FILE *f)
 		   "  POINTS.csv  one x,y,z per line (a first line starting with a\n"
 		   "              letter is a header)\n"
 		   "  --stats     setup time, model memory and per-query ns to stderr\n"
-		   "  --track     answer the points as one moving point by coherent\n"
-		   "              tracking (not available in this version)\n",
+		   "  --track     answer the points in order as one moving point by\n"
+		   "              coherent tracking of all critical distances\n"
+		   "              (curve-only models)\n",
 		   prog);
 }
 
@@ -174,6 +180,7 @@ int main(int argc, char **argv)
 	struct px_nurbs_curve *curves = NULL;
 	struct px_nurbs_surf *surfs = NULL;
 	struct px_dist_model *m = NULL;
+	struct px_track *trk = NULL;
 	struct points pts = {0};
 	int64_t t_setup, *times = NULL;
 	const char *ext;
@@ -202,12 +209,6 @@ int main(int argc, char **argv)
 	}
 	if (!model_path || !points_path) {
 		usage(stderr);
-		return 2;
-	}
-	if (track) {
-		fprintf(stderr, "%s: --track: coherent tracking is not available in "
-				"this version; run without --track for independent "
-				"global queries\n", prog);
 		return 2;
 	}
 	ext = ext_of(model_path);
@@ -255,7 +256,25 @@ int main(int argc, char **argv)
 		rc = 1;
 		goto out;
 	}
-	rc = px_dist_model_create(curves, nc, surfs, ns, NULL, &m);
+	if (track && ns > 0) {
+		fprintf(stderr, "%s: %s: --track: coherent tracking supports curve-only "
+				"models in this version (the model has %d surface%s); "
+				"run without --track for independent global queries\n",
+			prog, model_path, ns, ns == 1 ? "" : "s");
+		rc = 2;
+		goto out;
+	}
+	if (track) {
+		rc = px_track_create(curves, nc, NULL, &trk);
+		if (rc) {
+			fprintf(stderr, "%s: %s: cannot prepare the tracker: %s\n", prog,
+				model_path, px_strerror(rc));
+			rc = 1;
+			goto out;
+		}
+	} else {
+		rc = px_dist_model_create(curves, nc, surfs, ns, NULL, &m);
+	}
 	if (rc) {
 		fprintf(stderr, "%s: %s: cannot prepare the model: %s\n", prog,
 			model_path, px_strerror(rc));
@@ -277,7 +296,17 @@ int main(int argc, char **argv)
 	for (size_t k = 0; k < pts.n; k++) {
 		struct px_dist_result r;
 		int64_t t0 = now_ns();
-		int qrc = px_dist_query(m, pts.p[k], &r);
+		int qrc;
+		if (trk) {
+			struct px_track_result tr;
+			qrc = px_track_update(trk, pts.p[k], &tr);
+			memset(&r, 0, sizeof(r));
+			r.dist = tr.dist;
+			r.point = tr.point;
+			r.u = tr.u;
+		} else {
+			qrc = px_dist_query(m, pts.p[k], &r);
+		}
 		times[k] = now_ns() - t0;
 		if (qrc) {
 			fprintf(stderr, "%s: %s: point %zu: %s\n", prog, points_path,
@@ -295,7 +324,7 @@ int main(int argc, char **argv)
 	}
 	if (stats) {
 		struct px_dist_info info;
-		px_dist_model_info(m, &info);
+		px_dist_model_info(trk ? px_track_dist_model(trk) : m, &info);
 		fprintf(stderr, "setup_ms %.3f\n", t_setup / 1e6);
 		fprintf(stderr, "model_bytes %zu\n", info.bytes);
 		fprintf(stderr, "entities %d pieces %d (curve pieces %d, patches %d)\n",
@@ -312,9 +341,28 @@ int main(int argc, char **argv)
 		} else {
 			fprintf(stderr, "queries 0\n");
 		}
+		if (trk) {
+			struct px_track_stats st;
+			struct px_track_info ti;
+			px_track_get_stats(trk, &st);
+			px_track_get_info(trk, &ti);
+			fprintf(stderr, "track_leaves %d boxed %d tracker_bytes %zu\n",
+				ti.n_leaves, ti.n_boxed_leaves, ti.bytes);
+			fprintf(stderr,
+				"track_updates %llu leaf_solves %llu created %llu "
+				"annihilated %llu reinits %llu outside %llu fallbacks %llu\n",
+				(unsigned long long)st.updates,
+				(unsigned long long)st.leaf_solves,
+				(unsigned long long)st.creations,
+				(unsigned long long)st.annihilations,
+				(unsigned long long)st.reinits,
+				(unsigned long long)st.outside,
+				(unsigned long long)st.fallbacks);
+		}
 	}
 	rc = 0;
 out:
+	px_track_free(trk);
 	px_dist_model_free(m);
 	px_obj_free(obj);
 	free(curves);
