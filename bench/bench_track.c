@@ -126,7 +126,7 @@ static int circle(struct px_nurbs_curve *c, double cx, double cy, double r)
 	return mk(c, 2, 9, U, xyz, w);
 }
 
-#define NSTEP 20000
+#define NSTEP 10000
 
 /* One trajectory of n points: kind 0 smooth random, 1 sinusoids. */
 static void make_path(px_vec3 *q, int n, int kind, px_aabb box, double step)
@@ -202,6 +202,7 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 	printf("%s: %d curves, %d spans, %d leaves (%d boxed), setup %.1f ms, "
 	       "%zu bytes\n", name, nc, ti.n_spans, ti.n_leaves,
 	       ti.n_boxed_leaves, t0 / 1e6, ti.bytes);
+	printf("  event cells %d\n", ti.n_cells);
 	printf("  %-8s %-7s %8s %8s %8s | %8s %8s | %6s | %5s %6s %6s %5s %5s\n",
 	       "path", "step", "med_ns", "p99_ns", "max_ns", "cold_med",
 	       "cold_p99", "ratio", "wrong", "trans", "solves", "reini", "fallb");

@@ -40,7 +40,7 @@
  * interior critical points, not only the minimum, would need a
  * root-isolating variant of it). Boundary curves and creases are tracked
  * as curve entities by this file, corners are candidates. The model
- * layout (entities -> cells -> event BVH -> stretches) stays as here.
+ * layout (entities -> cells -> event grid -> stretches) stays as here.
  */
 #include "px_track.h"
 
@@ -50,19 +50,10 @@
 
 #include "px_bern.h"
 
-#ifdef PX_TRACK_DEBUG
-#include <stdio.h>
-#define DBG_RET(k) do { fprintf(stderr, "evolve fail %d\n", k); return 1; } while (0)
-#else
-#define DBG_RET(k) return 1
-#endif
-
 #define TRK_MAXD PX_NURBS_MAX_DEGREE
 #define TRK_NG (3 * TRK_MAXD)          /* coefficients of g: degree 3p-1 */
 #define TRK_DEPTH 52                    /* root isolation depth */
 #define TRK_NEWTON 10
-#define TRK_STACK 64                    /* BVH traversal */
-#define TRK_LEAF_PER_NODE 2
 
 /* leaf flags */
 #define LF_EV0 0x1u   /* start is a break: a root crossing it is an event */
@@ -91,9 +82,17 @@ struct leaf {
 	size_t off;     /* pool: a[n+1], b[3][n+1], da[n], db[3][n] */
 	unsigned flags;
 	double tol_g, tol_d;
-	px_aabb box;
+	px_aabb box;    /* union of its event cells */
 	int boxed;
-	uint32_t mark;
+	uint32_t mark;  /* re-solved this update */
+	uint32_t tested; /* event test done this update */
+};
+
+/* An event cell of one leaf: an octree cell of the working volume where
+ * the leaf may have an event (setup only). */
+struct prim {
+	px_aabb box;
+	int leaf;
 };
 
 struct zero {
@@ -123,16 +122,10 @@ struct cand {
 	int ent, kind; /* PX_TRACK_END or PX_TRACK_BREAK */
 };
 
-struct node {
-	px_aabb box;
-	int left, right; /* children, -1 for a leaf node */
-	int first, count; /* into leaf order */
-};
-
 struct px_track {
 	struct px_track_opts opts;
 	struct px_dist_model *dist;
-	int n_ent, n_spans, n_leaves, n_cand, n_nodes, n_boxed;
+	int n_ent, n_spans, n_leaves, n_cand, n_boxed, n_prim;
 	int n_cusps, n_breaks;
 	struct ent *ent;
 	struct span *span;
@@ -140,8 +133,12 @@ struct px_track {
 	double *pool;
 	size_t pool_len;
 	struct cand *cand;
-	struct node *node;
-	int *order;          /* boxed leaves in BVH order */
+	/* event grid: the finest octree level over the working volume;
+	 * cell (i, j, k) lists the leaves with an event cell there */
+	int gn;              /* cells per axis */
+	px_vec3 ginv;        /* cells per unit length */
+	int *gstart;         /* gn^3 + 1 offsets into gleaf */
+	int *gleaf;
 	int *hits;           /* scratch: leaves of this update */
 	px_aabb work;
 	double scale;        /* model diagonal */
@@ -527,56 +524,92 @@ static int ent_reinit(struct px_track *t, struct ent *e, px_vec3 p)
 }
 
 /*
- * Evolve one root from the old point to p: predictor (dp . C') / D, then
- * Newton on (C - p) . C' with p fixed. Returns 0, or 1 for an anomaly
- * (no convergence, a stretch boundary crossed, type changed, landed in a
- * re-solved leaf).
+ * Newton on (C - p) . C' = 0 with p fixed from the unwrapped parameter
+ * *unw (updated); the root must keep its type. Returns 0 or 1.
  */
-static int evolve(struct px_track *t, struct ent *e, struct zero *z,
-		  px_vec3 dp, px_vec3 p)
+static int newton(const struct px_track *t, const struct ent *e, int type,
+		  double *unw, px_vec3 p, double lim, px_vec3 *c, px_vec3 *d1,
+		  double *D, double *u_out)
 {
-	double u = z->u, step, lim = e->len * 0.25, tol = 1e-10 * e->len;
-	double unw, u_old = z->u;
-	int k, li, guard;
-	px_vec3 c, d1, d2;
-	double f1 = 0.0, D = 0.0;
-
-	step = (z->D != 0.0) ? px_v3_dot(dp, z->d1) / z->D : 0.0;
-	if (!isfinite(step))
-		DBG_RET(1);
-	if (fabs(step) > lim)
-		step = step > 0 ? lim : -lim;
-	unw = u + step;
+	double u, step, tol = 1e-8 * e->len;
+	int k;
+	px_vec3 d2;
 	for (k = 0;; k++) {
-		u = unw;
+		double f1;
+		u = *unw;
 		if (e->cyclic) {
 			u = fmod(u - e->u0, e->len);
 			if (u < 0)
 				u += e->len;
 			u += e->u0;
 		} else if (u < e->u0 || u > e->u1) {
-			DBG_RET(2);
+			/* an iterate beyond an open end: come back to it */
+			u = u < e->u0 ? e->u0 : e->u1;
+			*unw = u;
 		}
-		span_eval(find_span(t, e, u), u, &c, &d1, &d2);
-		f1 = px_v3_dot(px_v3_sub(c, p), d1);
-		D = px_v3_dot(px_v3_sub(c, p), d2) + px_v3_dot(d1, d1);
-		if (!(D != 0.0))
-			DBG_RET(3);
-		step = -f1 / D;
+		span_eval(find_span(t, e, u), u, c, d1, &d2);
+		f1 = px_v3_dot(px_v3_sub(*c, p), *d1);
+		*D = px_v3_dot(px_v3_sub(*c, p), d2) + px_v3_dot(*d1, *d1);
+		if (!(*D != 0.0))
+			return 1;
+		step = -f1 / *D;
 		if (!isfinite(step))
-			DBG_RET(4);
+			return 1;
 		if (fabs(step) <= tol)
 			break;
 		if (k >= TRK_NEWTON)
-			DBG_RET(5);
+			return 1;
 		if (fabs(step) > lim)
 			step = step > 0 ? lim : -lim;
-		unw += step;
+		*unw += step;
 	}
-	if ((D > 0.0 ? 1 : -1) != z->type)
-		DBG_RET(6);
-	/* walk the leaves from the old one to the new parameter: no stretch
-	 * boundary may be crossed, no re-solved leaf entered */
+	if ((*D > 0.0 ? 1 : -1) != type)
+		return 1;
+	*u_out = u;
+	return 0;
+}
+
+/*
+ * Evolve one root from p0 to p0 + dp: predictor (dp . C') / D (Eq. 6),
+ * then Newton with the point held fixed. When that fails (a long step
+ * near a fold), the same in four sub-steps along the segment. Then the
+ * leaf walk: no stretch boundary may be crossed and no re-solved leaf
+ * entered. Returns 0, or 1 for an anomaly.
+ */
+static int evolve(struct px_track *t, struct ent *e, struct zero *z,
+		  px_vec3 p0, px_vec3 dp, px_vec3 p)
+{
+	double lim = e->len / (e->n_leaves > 0 ? e->n_leaves : 1);
+	double unw, u = z->u, step, D = 0.0;
+	int li, guard, k, ok;
+	px_vec3 c, d1;
+
+	step = (z->D != 0.0) ? px_v3_dot(dp, z->d1) / z->D : 0.0;
+	if (!isfinite(step))
+		step = 0.0;
+	if (fabs(step) > lim)
+		step = step > 0 ? lim : -lim;
+	unw = z->u + step;
+	ok = !newton(t, e, z->type, &unw, p, lim, &c, &d1, &D, &u);
+	if (!ok) {
+		/* continuation in sub-steps */
+		px_vec3 sd = px_v3_scale(dp, 0.25), dk = z->d1;
+		double Dk = z->D;
+		unw = z->u;
+		for (k = 1; k <= 4; k++) {
+			px_vec3 pk = k == 4 ? p : px_v3_add(p0, px_v3_scale(dp, 0.25 * k));
+			step = (Dk != 0.0) ? px_v3_dot(sd, dk) / Dk : 0.0;
+			if (!isfinite(step))
+				step = 0.0;
+			if (fabs(step) > lim)
+				step = step > 0 ? lim : -lim;
+			unw += step;
+			if (newton(t, e, z->type, &unw, pk, lim, &c, &d1, &D, &u))
+				return 1;
+			dk = d1;
+			Dk = D;
+		}
+	}
 	li = z->leaf - e->first_leaf;
 	{
 		double off = 0.0; /* unwrapped offset of the leaf walk */
@@ -586,31 +619,30 @@ static int evolve(struct px_track *t, struct ent *e, struct zero *z,
 				break;
 			if (unw > l->u1 + off) {
 				if (l->flags & LF_SB1)
-					DBG_RET(7);
+					return 1;
 				if (++li == e->n_leaves) {
 					if (!e->cyclic)
-						DBG_RET(8);
+						return 1;
 					li = 0;
 					off += e->len;
 				}
 			} else {
 				if (l->flags & LF_SB0)
-					DBG_RET(9);
+					return 1;
 				if (--li < 0) {
 					if (!e->cyclic)
-						DBG_RET(10);
+						return 1;
 					li = e->n_leaves - 1;
 					off -= e->len;
 				}
 			}
 		}
 		if (guard > e->n_leaves + 1)
-			DBG_RET(11);
+			return 1;
 	}
-	(void)u_old;
 	li += e->first_leaf;
 	if (t->leaf[li].mark == t->epoch)
-		DBG_RET(12);
+		return 1;
 	z->u = u;
 	z->leaf = li;
 	z->c = c;
@@ -669,34 +701,6 @@ static int leaf_event(const struct px_track *t, const struct leaf *l,
 	return !definite_seg(a + 4 * (n + 1), n, p0, p1, l->tol_d);
 }
 
-static int seg_box(const px_aabb *b, px_vec3 p0, px_vec3 d)
-{
-	double t0 = 0.0, t1 = 1.0;
-	const double *lo = &b->min.x, *hi = &b->max.x, *o = &p0.x, *v = &d.x;
-	int k;
-	for (k = 0; k < 3; k++) {
-		if (v[k] == 0.0) {
-			if (o[k] < lo[k] || o[k] > hi[k])
-				return 0;
-		} else {
-			double inv = 1.0 / v[k];
-			double a = (lo[k] - o[k]) * inv, c = (hi[k] - o[k]) * inv;
-			if (a > c) {
-				double s = a;
-				a = c;
-				c = s;
-			}
-			if (a > t0)
-				t0 = a;
-			if (c < t1)
-				t1 = c;
-			if (t0 > t1)
-				return 0;
-		}
-	}
-	return 1;
-}
-
 static void mark_leaf(struct px_track *t, int li, int *nh)
 {
 	if (t->leaf[li].mark == t->epoch)
@@ -709,31 +713,33 @@ static void mark_leaf(struct px_track *t, int li, int *nh)
  * crosses the outer boundary of the region. Returns their count. */
 static int collect_events(struct px_track *t, px_vec3 p0, px_vec3 p1)
 {
-	int stack[TRK_STACK], sp = 0, nh = 0, k;
-	px_vec3 d = px_v3_sub(p1, p0);
+	int nh = 0, k, lo[3], hi[3], i, j, ax;
+	const double *a0 = &p0.x, *a1 = &p1.x, *wl = &t->work.min.x,
+		     *gi = &t->ginv.x;
 
-	if (t->n_nodes > 0)
-		stack[sp++] = 0;
-	while (sp > 0) {
-		const struct node *nd = &t->node[stack[--sp]];
-		if (!seg_box(&nd->box, p0, d))
-			continue;
-		if (nd->left < 0) {
-			int i;
-			for (i = 0; i < nd->count; i++) {
-				int li = t->order[nd->first + i];
-				const struct leaf *l = &t->leaf[li];
-				if (l->mark == t->epoch || !seg_box(&l->box, p0, d))
-					continue;
-				t->st.box_hits++;
-				if (leaf_event(t, l, p0, p1))
-					mark_leaf(t, li, &nh);
-			}
-		} else if (sp + 2 <= TRK_STACK) {
-			stack[sp++] = nd->left;
-			stack[sp++] = nd->right;
-		}
+	/* grid cells of the segment's box (both ends are inside the working
+	 * volume, which the grid covers) */
+	for (ax = 0; ax < 3; ax++) {
+		double x0 = (fmin(a0[ax], a1[ax]) - wl[ax]) * gi[ax];
+		double x1 = (fmax(a0[ax], a1[ax]) - wl[ax]) * gi[ax];
+		lo[ax] = x0 <= 0.0 ? 0 : (x0 >= t->gn - 1 ? t->gn - 1 : (int)x0);
+		hi[ax] = x1 <= 0.0 ? 0 : (x1 >= t->gn - 1 ? t->gn - 1 : (int)x1);
 	}
+	for (k = lo[2]; k <= hi[2]; k++)
+		for (j = lo[1]; j <= hi[1]; j++)
+			for (i = lo[0]; i <= hi[0]; i++) {
+				int c = (k * t->gn + j) * t->gn + i, q;
+				for (q = t->gstart[c]; q < t->gstart[c + 1]; q++) {
+					int li = t->gleaf[q];
+					struct leaf *l = &t->leaf[li];
+					if (l->tested == t->epoch)
+						continue;
+					l->tested = t->epoch;
+					t->st.box_hits++;
+					if (leaf_event(t, l, p0, p1))
+						mark_leaf(t, li, &nh);
+				}
+			}
 	for (k = 0; k < nh; k++) {
 		int li = t->hits[k], side;
 		const struct leaf *l = &t->leaf[li];
@@ -974,7 +980,7 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 				e->touched = 1;
 				continue;
 			}
-			if (evolve(t, e, &z, dp, p)) {
+			if (evolve(t, e, &z, p0, dp, p)) {
 				e->stale = 1;
 				break;
 			}
@@ -1005,12 +1011,8 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 			struct ent *e = &t->ent[i];
 			if (!e->stale && e->touched) {
 				sort_zeros(e);
-				if (ent_check(t, e, p)) {
-#ifdef PX_TRACK_DEBUG
-					fprintf(stderr, "check fail\n");
-#endif
+				if (ent_check(t, e, p))
 					e->stale = 1;
-				}
 			}
 		}
 		for (i = 0; i < t->n_ent; i++) {
@@ -1100,7 +1102,7 @@ void px_track_get_info(const struct px_track *t, struct px_track_info *info)
 	info->n_spans = t->n_spans;
 	info->n_leaves = t->n_leaves;
 	info->n_boxed_leaves = t->n_boxed;
-	info->n_nodes = t->n_nodes;
+	info->n_cells = t->n_prim;
 	info->n_cusps = t->n_cusps;
 	info->n_breaks = t->n_breaks;
 	info->work = t->work;
@@ -1299,89 +1301,56 @@ static int cell_event(const struct px_track *t, const struct leaf *l,
 	return !cell_definite(a + 4 * (n + 1), n, c, r, l->tol_d);
 }
 
-static void leaf_box_rec(const struct px_track *t, const struct leaf *l,
-			 px_aabb cell, int depth, int max_depth, px_aabb *box,
-			 long *budget)
+struct cellbuf {
+	struct prim *p;
+	long n, cap;
+	int fail;
+};
+
+static void cell_push(struct cellbuf *cb, px_aabb box, int leaf)
 {
+	if (cb->n == cb->cap) {
+		long nc = cb->cap ? 2 * cb->cap : 1024;
+		struct prim *np = realloc(cb->p, (size_t)nc * sizeof(*np));
+		if (!np) {
+			cb->fail = 1;
+			return;
+		}
+		cb->p = np;
+		cb->cap = nc;
+	}
+	cb->p[cb->n].box = box;
+	cb->p[cb->n].leaf = leaf;
+	cb->n++;
+}
+
+/* Octree exclusion over the working volume: the cells at max_depth
+ * where leaf li may have an event (a cell is also kept whole when the
+ * budget runs out, which only makes the cover coarser). */
+static void leaf_cells_rec(const struct px_track *t, int li, px_aabb cell,
+			   int depth, int max_depth, struct cellbuf *cb,
+			   long *budget)
+{
+	const struct leaf *l = &t->leaf[li];
 	px_vec3 c = px_aabb_center(&cell);
 	px_vec3 r = px_v3_scale(px_v3_sub(cell.max, cell.min), 0.5);
 	int k;
-	if (*budget <= 0) {
-		px_aabb_extend(box, cell.min);
-		px_aabb_extend(box, cell.max);
-		return;
-	}
-	(*budget)--;
-	/* a cell inside the box so far cannot grow it */
-	if (box->min.x <= cell.min.x && box->min.y <= cell.min.y &&
-	    box->min.z <= cell.min.z && box->max.x >= cell.max.x &&
-	    box->max.y >= cell.max.y && box->max.z >= cell.max.z)
-		return;
 	if (!cell_event(t, l, c, r))
 		return;
-	if (depth >= max_depth) {
-		px_aabb_extend(box, cell.min);
-		px_aabb_extend(box, cell.max);
+	if (depth >= max_depth || --(*budget) <= 0) {
+		cell_push(cb, cell, li);
 		return;
 	}
 	for (k = 0; k < 8; k++) {
 		px_aabb ch;
 		ch.min = px_v3(k & 1 ? c.x : cell.min.x, k & 2 ? c.y : cell.min.y,
-			      k & 4 ? c.z : cell.min.z);
+			       k & 4 ? c.z : cell.min.z);
 		ch.max = px_v3(k & 1 ? cell.max.x : c.x, k & 2 ? cell.max.y : c.y,
-			      k & 4 ? cell.max.z : c.z);
-		leaf_box_rec(t, l, ch, depth + 1, max_depth, box, budget);
+			       k & 4 ? cell.max.z : c.z);
+		leaf_cells_rec(t, li, ch, depth + 1, max_depth, cb, budget);
 	}
 }
 
-static int build_bvh(struct px_track *t, int first, int count)
-{
-	int id = t->n_nodes++, i, axis = 0, mid;
-	struct node *nd = &t->node[id];
-	px_aabb cb = px_aabb_empty();
-	nd->box = px_aabb_empty();
-	for (i = 0; i < count; i++) {
-		const struct leaf *l = &t->leaf[t->order[first + i]];
-		px_aabb_extend(&nd->box, l->box.min);
-		px_aabb_extend(&nd->box, l->box.max);
-		px_aabb_extend(&cb, px_aabb_center(&l->box));
-	}
-	nd->first = first;
-	nd->count = count;
-	nd->left = nd->right = -1;
-	if (count <= TRK_LEAF_PER_NODE)
-		return id;
-	{
-		px_vec3 e = px_v3_sub(cb.max, cb.min);
-		if (e.y > e.x && e.y >= e.z)
-			axis = 1;
-		else if (e.z > e.x && e.z > e.y)
-			axis = 2;
-	}
-	/* sort by centre along the axis (insertion sort: setup only) */
-	for (i = 1; i < count; i++) {
-		int v = t->order[first + i], k = i;
-		px_vec3 cv = px_aabb_center(&t->leaf[v].box);
-		double key = axis == 0 ? cv.x : axis == 1 ? cv.y : cv.z;
-		while (k > 0) {
-			px_vec3 cu = px_aabb_center(&t->leaf[t->order[first + k - 1]].box);
-			double ku = axis == 0 ? cu.x : axis == 1 ? cu.y : cu.z;
-			if (ku <= key)
-				break;
-			t->order[first + k] = t->order[first + k - 1];
-			k--;
-		}
-		t->order[first + k] = v;
-	}
-	mid = count / 2;
-	{
-		int l = build_bvh(t, first, mid);
-		int r = build_bvh(t, first + mid, count - mid);
-		t->node[id].left = l;
-		t->node[id].right = r;
-	}
-	return id;
-}
 
 void px_track_free(struct px_track *t)
 {
@@ -1399,8 +1368,8 @@ void px_track_free(struct px_track *t)
 	free(t->leaf);
 	free(t->pool);
 	free(t->cand);
-	free(t->node);
-	free(t->order);
+	free(t->gstart);
+	free(t->gleaf);
 	free(t->hits);
 	free(t);
 }
@@ -1424,7 +1393,7 @@ int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
 	else
 		px_track_opts_default(&o);
 	if (o.max_crit < 2 || o.max_crit > 1 << 20 || o.leaves_per_span < 1 ||
-	    o.leaves_per_span > 64 || o.box_depth < 0 || o.box_depth > 8 ||
+	    o.leaves_per_span > 64 || o.box_depth < 0 || o.box_depth > 7 ||
 	    o.verify_every < 0 || !(o.work_margin >= 0.0))
 		return PX_E_INVAL;
 	for (i = 0; i < n_curves; i++) {
@@ -1544,9 +1513,7 @@ int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
 	t->pool = calloc(pool_cap ? pool_cap : 1, sizeof(double));
 	t->cand = calloc((size_t)cand_cap + 1, sizeof(*t->cand));
 	t->hits = calloc((size_t)leaf_cap + 1, sizeof(int));
-	t->order = calloc((size_t)leaf_cap + 1, sizeof(int));
-	t->node = calloc((size_t)2 * leaf_cap + 1, sizeof(*t->node));
-	if (!t->leaf || !t->pool || !t->cand || !t->hits || !t->order || !t->node) {
+	if (!t->leaf || !t->pool || !t->cand || !t->hits) {
 		rc = PX_E_NOMEM;
 		goto fail;
 	}
@@ -1721,22 +1688,90 @@ int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
 				e->n_sb++;
 	}
 
-	/* event boxes */
-	for (i = 0; i < t->n_leaves; i++) {
-		struct leaf *l = &t->leaf[i];
-		long budget = 20000;
-		l->box = px_aabb_empty();
-		leaf_box_rec(t, l, t->work, 0, o.box_depth, &l->box, &budget);
-		if (l->box.min.x <= l->box.max.x) {
-			double m = 1e-9 * t->scale;
-			l->box.min = px_v3_sub(l->box.min, px_v3(m, m, m));
-			l->box.max = px_v3_add(l->box.max, px_v3(m, m, m));
-			l->boxed = 1;
-			t->order[t->n_boxed++] = i;
+	/* event cells: octree exclusion per leaf down to the grid level */
+	{
+		struct cellbuf cb = {0};
+		long q, ncell;
+		int gn = 1 << o.box_depth, ax;
+		const double *wl = &t->work.min.x, *wh = &t->work.max.x;
+		double *gi = &t->ginv.x;
+		t->gn = gn;
+		for (ax = 0; ax < 3; ax++)
+			gi[ax] = wh[ax] > wl[ax] ? gn / (wh[ax] - wl[ax]) : 0.0;
+		for (i = 0; i < t->n_leaves; i++) {
+			long budget = 1L << 14, first = cb.n;
+			struct leaf *l = &t->leaf[i];
+			leaf_cells_rec(t, i, t->work, 0, o.box_depth, &cb, &budget);
+			if (cb.fail) {
+				free(cb.p);
+				rc = PX_E_NOMEM;
+				goto fail;
+			}
+			l->box = px_aabb_empty();
+			for (q = first; q < cb.n; q++) {
+				px_aabb_extend(&l->box, cb.p[q].box.min);
+				px_aabb_extend(&l->box, cb.p[q].box.max);
+			}
+			if (cb.n > first) {
+				l->boxed = 1;
+				t->n_boxed++;
+			}
 		}
+		ncell = (long)gn * gn * gn;
+		t->gstart = calloc((size_t)ncell + 1, sizeof(int));
+		if (!t->gstart) {
+			free(cb.p);
+			rc = PX_E_NOMEM;
+			goto fail;
+		}
+		/* two passes: count, then fill (a cell cut short by the budget
+		 * covers several grid cells) */
+		for (ax = 0; ax < 2; ax++) {
+			long total = 0;
+			if (ax == 1) {
+				for (q = 0; q < ncell; q++) {
+					int c = t->gstart[q];
+					t->gstart[q] = (int)total;
+					total += c;
+				}
+				t->gstart[ncell] = (int)total;
+				t->n_prim = (int)total;
+				t->gleaf = calloc((size_t)total + 1, sizeof(int));
+				if (!t->gleaf) {
+					free(cb.p);
+					rc = PX_E_NOMEM;
+					goto fail;
+				}
+				/* reuse gstart as fill cursors, restored below */
+			}
+			for (q = 0; q < cb.n; q++) {
+				int lo3[3], hi3[3], ii, jj, kk, d;
+				const double *bl = &cb.p[q].box.min.x, *bh = &cb.p[q].box.max.x;
+				for (d = 0; d < 3; d++) {
+					double x0 = (bl[d] - wl[d]) * gi[d] + 1e-6;
+					double x1 = (bh[d] - wl[d]) * gi[d] - 1e-6;
+					lo3[d] = x0 < 0 ? 0 : (x0 > gn - 1 ? gn - 1 : (int)x0);
+					hi3[d] = x1 < 0 ? 0 : (x1 > gn - 1 ? gn - 1 : (int)x1);
+				}
+				for (kk = lo3[2]; kk <= hi3[2]; kk++)
+					for (jj = lo3[1]; jj <= hi3[1]; jj++)
+						for (ii = lo3[0]; ii <= hi3[0]; ii++) {
+							int c = (kk * gn + jj) * gn + ii;
+							if (ax == 0)
+								t->gstart[c]++;
+							else
+								t->gleaf[t->gstart[c]++] = cb.p[q].leaf;
+						}
+			}
+			if (ax == 1) {
+				/* cursors ended at the next cell's start: shift back */
+				for (q = ncell; q > 0; q--)
+					t->gstart[q] = t->gstart[q - 1];
+				t->gstart[0] = 0;
+			}
+		}
+		free(cb.p);
 	}
-	if (t->n_boxed > 0)
-		build_bvh(t, 0, t->n_boxed);
 
 	t->bytes = sizeof(*t) + (size_t)t->n_ent * sizeof(*t->ent) +
 		   (size_t)t->n_ent * 2 * (size_t)o.max_crit * sizeof(struct zero) +
@@ -1744,7 +1779,8 @@ int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
 		   (size_t)leaf_cap * (sizeof(*t->leaf) + 2 * sizeof(int)) +
 		   pool_cap * sizeof(double) +
 		   (size_t)(cand_cap + 1) * sizeof(*t->cand) +
-		   (size_t)(2 * leaf_cap + 1) * sizeof(*t->node);
+		   ((size_t)t->gn * t->gn * t->gn + 1 + (size_t)t->n_prim) *
+			   sizeof(int);
 	t->epoch = 1;
 	free(spl);
 	free(work);

@@ -24,12 +24,17 @@
  *    cut into Bezier spans and those into parameter leaves; for every leaf
  *    the Bernstein coefficients of w^3 g (affine in p, as in px_cpiece.h)
  *    are precomputed, and the part of a working volume where the leaf can
- *    have an event is bounded by a box (octree exclusion with exact
- *    interval bounds of those affine coefficients). The boxes form a
- *    bounding-volume tree; an update tests the segment p_old -> p_new
- *    against it, then tests each hit leaf exactly along the segment (the
+ *    have an event is covered by octree cells (exclusion with exact
+ *    interval bounds of those affine coefficients: a cell where the
+ *    coefficients of g, or of dg/ds, keep one sign holds no event). The
+ *    cells of the finest level form a uniform grid whose cells list their
+ *    leaves (a segment of one cycle meets a few grid cells, so the lookup
+ *    is O(1), unlike a tree of the overlapping boxes, which measured
+ *    slower). An update looks up the grid cells of the segment p_old ->
+ *    p_new, then tests each listed leaf exactly along the segment (the
  *    coefficients are affine in the segment parameter, so sign-definite
- *    coefficients at both ends prove there is no event), and re-solves
+ *    coefficients at both ends prove there is no event - the exact
+ *    counterpart of the paper's line/box-diagonal stage), and re-solves
  *    the leaves that may hold one with a certified Bernstein/Descartes
  *    root isolation at the new point. A region is grown while a root
  *    crosses its outer boundary, so created pairs that drift away from the
@@ -51,7 +56,7 @@
  * the design note in px_track.c for how patches will fit).
  *
  * Memory and real-time rules: px_track_create() allocates everything
- * (spans, leaves, coefficient pool, box tree, per-entity critical-point
+ * (spans, leaves, coefficient pool, event grid, per-entity critical-point
  * arrays of fixed capacity, the global-query model) and may take long.
  * px_track_update() and the accessors never allocate, lock or print, and
  * every loop has a bound. One tracker follows one moving point; it must
@@ -82,8 +87,8 @@ struct px_track_opts {
 	int max_crit;
 	/* Parameter leaves per Bezier span (default 4, 1..64). */
 	int leaves_per_span;
-	/* Octree depth of the box of a leaf inside the working volume
-	 * (default 4, 0..8). */
+	/* Octree depth of the event cells of a leaf inside the working
+	 * volume (default 4, 0..7). */
 	int box_depth;
 	/* Compare with the global query every verify_every updates (0: off,
 	 * the default). */
@@ -145,7 +150,8 @@ struct px_track_stats {
 };
 
 struct px_track_info {
-	int n_entities, n_spans, n_leaves, n_boxed_leaves, n_nodes;
+	int n_entities, n_spans, n_leaves, n_boxed_leaves;
+	int n_cells;             /* (grid cell, leaf) event entries */
 	int n_cusps, n_breaks;   /* detected cusps, C0/C1 breaks (all) */
 	px_aabb work;
 	size_t bytes;            /* tracker memory without the global model */
