@@ -203,9 +203,11 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 	       "%zu bytes\n", name, nc, ti.n_spans, ti.n_leaves,
 	       ti.n_boxed_leaves, t0 / 1e6, ti.bytes);
 	printf("  event cells %d\n", ti.n_cells);
-	printf("  %-8s %-7s %8s %8s %8s | %8s %8s | %6s | %5s %6s %6s %5s %5s\n",
+	printf("  %-8s %-7s %8s %8s %8s | %8s %8s | %6s | %5s %6s %6s %5s %5s %6s\n",
 	       "path", "step", "med_ns", "p99_ns", "max_ns", "cold_med",
-	       "cold_p99", "ratio", "wrong", "trans", "solves", "reini", "fallb");
+	       "cold_p99", "ratio", "wrong", "trans", "solves", "reini", "fallb",
+	       "tests");
+	/* tests: leaves given the exact segment test per update */
 	for (kind = 0; kind < 2; kind++)
 		for (s = 0; s < 4; s++) {
 			struct px_track_result r;
@@ -229,7 +231,7 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 			qsort(tt, NSTEP, sizeof(tt[0]), cmp_i64);
 			qsort(tg, NSTEP, sizeof(tg[0]), cmp_i64);
 			printf("  %-8s %-7g %8lld %8lld %8lld | %8lld %8lld | %6.1f | %5ld "
-			       "%6llu %6llu %5llu %5llu\n",
+			       "%6llu %6llu %5llu %5llu %6.2f\n",
 			       kind ? "sines" : "random", steps[s] * 100.0,
 			       (long long)tt[NSTEP / 2], (long long)tt[NSTEP * 99 / 100],
 			       (long long)tt[NSTEP - 1], (long long)tg[NSTEP / 2],
@@ -240,7 +242,8 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 						    a.creations - a.annihilations),
 			       (unsigned long long)(b.leaf_solves - a.leaf_solves),
 			       (unsigned long long)(b.reinits - a.reinits),
-			       (unsigned long long)(b.fallbacks - a.fallbacks));
+			       (unsigned long long)(b.fallbacks - a.fallbacks),
+			       (double)(b.box_hits - a.box_hits) / NSTEP);
 		}
 	/* verification disagreements with the tracker's own check on */
 	{

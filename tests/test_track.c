@@ -556,7 +556,7 @@ static void test_planar_closed_c2(void)
 	struct tcurve tc;
 	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
 	PX_CHECK_INT_EQ(curve_blob(&tc, 0, 0), 0);
-	one_curve("blob", &tc, 1000, 10);
+	one_curve("blob", &tc, 800, 10);
 }
 
 static void test_planar_open_c1_c0(void)
@@ -564,7 +564,7 @@ static void test_planar_open_c1_c0(void)
 	struct tcurve tc;
 	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
 	PX_CHECK_INT_EQ(curve_breaks(&tc, 0, 0), 0);
-	one_curve("breaks", &tc, 1000, 10);
+	one_curve("breaks", &tc, 800, 10);
 }
 
 static void test_planar_cusp(void)
@@ -578,7 +578,7 @@ static void test_planar_cusp(void)
 	px_track_get_info(t, &info);
 	PX_CHECK_INT_EQ(info.n_cusps, 1);
 	px_track_free(t);
-	one_curve("cusp", &tc, 1000, 10);
+	one_curve("cusp", &tc, 800, 10);
 }
 
 static void test_rational_circle(void)
@@ -586,7 +586,7 @@ static void test_rational_circle(void)
 	struct tcurve tc;
 	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
 	PX_CHECK_INT_EQ(curve_circle(&tc, 0.3, -0.2, 1.5), 0);
-	one_curve("circle", &tc, 1000, 0);
+	one_curve("circle", &tc, 800, 0);
 }
 
 static void test_space_closed(void)
@@ -594,7 +594,7 @@ static void test_space_closed(void)
 	struct tcurve tc;
 	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
 	PX_CHECK_INT_EQ(curve_knot(&tc, 0, 0, 0), 0);
-	one_curve("knot", &tc, 1000, 10);
+	one_curve("knot", &tc, 800, 10);
 }
 
 static void test_space_open(void)
@@ -602,7 +602,7 @@ static void test_space_open(void)
 	struct tcurve tc;
 	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
 	PX_CHECK_INT_EQ(curve_space_open(&tc, 0, 0, 0), 0);
-	one_curve("space-open", &tc, 1000, 10);
+	one_curve("space-open", &tc, 800, 10);
 }
 
 static void test_polygon(void)
@@ -610,7 +610,7 @@ static void test_polygon(void)
 	struct tcurve tc;
 	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
 	PX_CHECK_INT_EQ(curve_square(&tc, 0, 0), 0);
-	one_curve("square", &tc, 1000, 10);
+	one_curve("square", &tc, 800, 10);
 }
 
 static void test_multi_entity(void)
@@ -644,6 +644,70 @@ static void test_no_verification(void)
 	run_model(tc, 3, 1500, 64, &rs, 0);
 	check_run("no-verify", &rs, 10);
 	PX_CHECK_INT_EQ((long)rs.ts.verifications, 0);
+}
+
+/* Random curves: degree 2..5, clamped knots with random interior values
+ * (sometimes a C1 or C0 multiplicity), random weights, planar or space. */
+static int curve_random(struct tcurve *tc)
+{
+	double U[MAXC + 12], xyz[3 * MAXC], w[MAXC];
+	int p = px_rand_int(2, 5), n = p + 1 + px_rand_int(0, 7), i, m, rat,
+	    planar = px_rand_int(0, 1);
+	m = n + p + 1;
+	rat = px_rand_int(0, 1);
+	for (i = 0; i <= p; i++) {
+		U[i] = 0.0;
+		U[m - 1 - i] = 1.0;
+	}
+	for (i = p + 1; i < n; i++)
+		U[i] = px_rand_range(0.05, 0.95);
+	for (i = p + 2; i < n; i++) { /* sort */
+		int j = i;
+		while (j > p + 1 && U[j - 1] > U[j]) {
+			double x = U[j];
+			U[j] = U[j - 1];
+			U[j - 1] = x;
+			j--;
+		}
+	}
+	tc->nbrk = 0;
+	if (n - p - 1 >= p && px_rand_int(0, 2) == 0) {
+		/* a C0 corner (multiplicity p) in the middle */
+		for (i = 0; i < p; i++)
+			U[p + 1 + i] = 0.5;
+		for (i = p + 1 + p; i < n; i++)
+			U[i] = 0.5 + 0.45 * (i - 2 * p) / (n - 2 * p);
+	}
+	for (i = 0; i < n; i++) {
+		xyz[3 * i] = px_rand_range(-1, 1);
+		xyz[3 * i + 1] = px_rand_range(-1, 1);
+		xyz[3 * i + 2] = planar ? 0.0 : px_rand_range(-1, 1);
+		w[i] = rat ? px_rand_range(0.3, 3.0) : 1.0;
+	}
+	if (mk(tc, p, n, U, xyz, w))
+		return -1;
+	tc->nbrk = px_nurbs_curve_breaks(&tc->c, tc->brk, 16);
+	return 0;
+}
+
+static void test_random_curves(void)
+{
+	int k;
+	for (k = 0; k < 4; k++) {
+		struct tcurve tc;
+		struct run_stats rs;
+		char name[32];
+		px_arena_init(&arena, arena_mem, sizeof(arena_mem));
+		if (curve_random(&tc)) {
+			PX_CHECK_MSG(0, "random curve rejected");
+			return;
+		}
+		snprintf(name, sizeof(name), "random-%d (p=%d n=%d)", k, tc.c.degree,
+			 tc.c.n_ctrl);
+		memset(&rs, 0, sizeof(rs));
+		run_model(&tc, 1, 400, 20, &rs, 1);
+		check_run(name, &rs, 0);
+	}
 }
 
 static void test_errors(void)
@@ -697,6 +761,7 @@ static const struct px_test tests[] = {
 	PX_T(test_planar_cusp),      PX_T(test_rational_circle),
 	PX_T(test_space_closed),     PX_T(test_space_open),
 	PX_T(test_polygon),          PX_T(test_multi_entity),
-	PX_T(test_no_verification),  PX_T(test_errors),
+	PX_T(test_no_verification),  PX_T(test_random_curves),
+	PX_T(test_errors),
 };
 PX_TEST_MAIN(tests)
