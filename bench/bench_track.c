@@ -7,6 +7,7 @@
  * global one (must be 0), transitions, leaf re-solves and
  * re-initialisations. Verification inside the tracker is off (the loop
  * configuration); the comparison is made outside the timed call.
+ * BENCH_TRACK_DEPTH=d overrides the event-grid depth (default 4).
  * Prints figures only; nothing here is a pass/fail test.
  */
 #include <math.h>
@@ -185,6 +186,8 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 	px_aabb box;
 
 	px_track_opts_default(&o);
+	if (getenv("BENCH_TRACK_DEPTH"))
+		o.box_depth = atoi(getenv("BENCH_TRACK_DEPTH"));
 	t0 = now_ns();
 	rc = px_track_create(cs, nc, &o, &t);
 	if (rc) {
