@@ -72,8 +72,31 @@ err_has "stats: model memory" '^model_bytes [0-9]+$'
 err_has "stats: per-query ns" '^queries 304 query_ns min [0-9]+ median [0-9]+ p99 [0-9]+ max [0-9]+$'
 
 # Errors: clear message with the place, non-zero exit.
-expect "--track is refused, not ignored" 2 "$bin" --track tests/data/circle.obj "$tmp/pts.csv"
-err_has "--track says why" 'tracking is not available'
+# --track: the points as one moving point, answered by the tracker. A
+# smooth path (small steps, crossing the circle's centre region and the
+# curves' evolutes) and the scattered points above (large jumps, far
+# points) must give the same distances as the global query.
+awk 'BEGIN { print "x,y,z"; for (i = 0; i < 3000; i++) { t = i / 3000;
+	printf "%.17g,%.17g,%.17g\n", 1 + 2.6 * sin(6.2832 * t * 3) * cos(6.2832 * t),
+		-1 + 2.2 * sin(6.2832 * t * 2), 0.5 + 0.8 * sin(6.2832 * t * 5) } }' >"$tmp/path.csv"
+for model in circle continuation; do
+	for pts in path pts; do
+		expect "--track $model ($pts)" 0 "$bin" --track tests/data/$model.obj "$tmp/$pts.csv"
+		cp "$tmp/out" "$tmp/track.out"
+		"$bin" tests/data/$model.obj "$tmp/$pts.csv" >"$tmp/global.out" 2>/dev/null
+		if paste -d, "$tmp/track.out" "$tmp/global.out" | awk -F, 'function abs(a) { return a < 0 ? -a : a }
+			NF != 12 { print "line " NR ": " NF " fields"; bad = 1; next }
+			abs($1 - $7) > 1e-9 * (1 + $7) { print "line " NR ": tracked " $1 " global " $7; bad = 1 }
+			$6 != 0 { print "line " NR ": v not 0"; bad = 1 }
+			END { exit bad }' >"$tmp/err"; then
+			ok "--track $model ($pts): same distances as the global query"
+		else bad "--track $model ($pts): same distances as the global query"; fi
+	done
+done
+expect "--track --stats" 0 "$bin" --track --stats tests/data/circle.obj "$tmp/path.csv"
+err_has "--track stats: tracker counters" '^track_updates 3000 leaf_solves [0-9]+ created [0-9]+ annihilated [0-9]+ reinits [0-9]+ outside [0-9]+ fallbacks 0$'
+expect "--track refuses surfaces clearly" 2 "$bin" --track tests/data/multi.obj "$tmp/pts.csv"
+err_has "--track with surfaces says why" 'curve-only models'
 printf '1,2,3\n4,nan,6\n' >"$tmp/nan.csv"
 expect "NaN point" 1 "$bin" tests/data/circle.obj "$tmp/nan.csv"
 err_has "NaN point: file:line" "nan.csv:2: field 2: not a finite number"

@@ -13,6 +13,10 @@
  * distance is unsigned (closed meshes know inside from outside, but the
  * contract is the distance). --stats writes setup time, model memory and
  * per-query times to stderr.
+ * --track answers the points in file order as one moving point with the
+ * coherent tracker (px_track.h: every critical distance followed, pairs
+ * created and annihilated at transitions); curve-only models for now.
+ * With --stats it also prints the tracker's counters.
  */
 #include <ctype.h>
 #include <errno.h>
@@ -27,6 +31,7 @@
 #include "px_mesh.h"
 #include "px_model.h"
 #include "px_obj.h"
+#include "px_track.h"
 
 static const char *prog = "proxima-query";
 
@@ -38,8 +43,9 @@ static void usage(FILE *f)
 		   "  POINTS.csv  one x,y,z per line (a first line starting with a\n"
 		   "              letter is a header)\n"
 		   "  --stats     setup time, model memory and per-query ns to stderr\n"
-		   "  --track     answer the points as one moving point by coherent\n"
-		   "              tracking (not available in this version)\n",
+		   "  --track     answer the points in order as one moving point by\n"
+		   "              coherent tracking of all critical distances\n"
+		   "              (curve-only models in this version)\n",
 		   prog);
 }
 
@@ -183,6 +189,7 @@ int main(int argc, char **argv)
 	struct px_nurbs_surf *surfs = NULL;
 	struct px_dist_model *m = NULL;
 	struct px_model *mesh = NULL;
+	struct px_track *trk = NULL;
 	struct points pts = {0};
 	int64_t t_setup, *times = NULL;
 	const char *ext;
@@ -213,14 +220,15 @@ int main(int argc, char **argv)
 		usage(stderr);
 		return 2;
 	}
-	if (track) {
-		fprintf(stderr, "%s: --track: coherent tracking is not available in "
-				"this version; run without --track for independent "
-				"global queries\n", prog);
-		return 2;
-	}
 	ext = ext_of(model_path);
 	t_setup = now_ns();
+	if (track && !ieq(ext, "obj")) {
+		fprintf(stderr, "%s: %s: --track: coherent tracking supports "
+				"curve-only models in this version; run without "
+				"--track for independent global queries\n",
+			prog, model_path);
+		return 2;
+	}
 	if (!ieq(ext, "obj")) {
 		/* Meshes and point clouds. */
 		char msg[512];
@@ -261,7 +269,24 @@ int main(int argc, char **argv)
 			rc = 1;
 			goto out;
 		}
-		if (nc + ns > 0) {
+		if (track && (ns > 0 || obj->n_triangles > 0)) {
+			fprintf(stderr, "%s: %s: --track: coherent tracking supports "
+					"curve-only models in this version (the model "
+					"has %s); run without --track for independent "
+					"global queries\n",
+				prog, model_path, ns > 0 ? "surfaces" : "faces");
+			rc = 2;
+			goto out;
+		}
+		if (track) {
+			rc = px_track_create(curves, nc, NULL, &trk);
+			if (rc) {
+				fprintf(stderr, "%s: %s: cannot prepare the tracker: %s\n",
+					prog, model_path, px_strerror(rc));
+				rc = 1;
+				goto out;
+			}
+		} else if (nc + ns > 0) {
 			rc = px_dist_model_create(curves, nc, surfs, ns, NULL, &m);
 			if (rc) {
 				fprintf(stderr, "%s: %s: cannot prepare the model: %s\n",
@@ -309,6 +334,16 @@ int main(int argc, char **argv)
 		px_vec3 cp = px_v3(0, 0, 0);
 		int64_t t0 = now_ns();
 		int qrc = 0;
+		if (trk) {
+			struct px_track_result tr;
+			qrc = px_track_update(trk, pts.p[k], &tr);
+			if (!qrc) {
+				dist = tr.dist;
+				cp = tr.point;
+				u = tr.u;
+				v = 0.0;
+			}
+		}
 		if (m) {
 			struct px_dist_result r;
 			qrc = px_dist_query(m, pts.p[k], &r);
@@ -349,15 +384,16 @@ int main(int argc, char **argv)
 	if (stats) {
 		struct px_dist_info info;
 		size_t bytes = 0;
-		if (m) {
-			px_dist_model_info(m, &info);
+		const struct px_dist_model *dm = trk ? px_track_dist_model(trk) : m;
+		if (dm) {
+			px_dist_model_info(dm, &info);
 			bytes += info.bytes;
 		}
 		if (mesh)
 			bytes += px_model_memory_bytes(mesh);
 		fprintf(stderr, "setup_ms %.3f\n", t_setup / 1e6);
 		fprintf(stderr, "model_bytes %zu\n", bytes);
-		if (m)
+		if (dm)
 			fprintf(stderr, "entities %d pieces %d (curve pieces %d, patches %d)\n",
 				info.n_entities, info.n_pieces, info.n_curve_pieces,
 				info.n_patches);
@@ -375,9 +411,28 @@ int main(int argc, char **argv)
 		} else {
 			fprintf(stderr, "queries 0\n");
 		}
+		if (trk) {
+			struct px_track_stats st;
+			struct px_track_info ti;
+			px_track_get_stats(trk, &st);
+			px_track_get_info(trk, &ti);
+			fprintf(stderr, "track_leaves %d boxed %d tracker_bytes %zu\n",
+				ti.n_leaves, ti.n_boxed_leaves, ti.bytes);
+			fprintf(stderr,
+				"track_updates %llu leaf_solves %llu created %llu "
+				"annihilated %llu reinits %llu outside %llu fallbacks %llu\n",
+				(unsigned long long)st.updates,
+				(unsigned long long)st.leaf_solves,
+				(unsigned long long)st.creations,
+				(unsigned long long)st.annihilations,
+				(unsigned long long)st.reinits,
+				(unsigned long long)st.outside,
+				(unsigned long long)st.fallbacks);
+		}
 	}
 	rc = 0;
 out:
+	px_track_free(trk);
 	px_dist_model_free(m);
 	px_model_free(mesh);
 	px_obj_free(obj);

@@ -1,0 +1,297 @@
+/*
+ * Tracking benchmark: per-update time (median, p99, max) of px_track on
+ * moving-point trajectories (smooth random paths and sums of sinusoids,
+ * steps of 0.01 %, 0.1 %, 1 % and 5 % of the model size), next to the
+ * cold global query px_dist_query() on the same points in the same run
+ * (ratio of medians), with the number of answers that differ from the
+ * global one (must be 0), transitions, leaf re-solves and
+ * re-initialisations. Verification inside the tracker is off (the loop
+ * configuration); the comparison is made outside the timed call.
+ * BENCH_TRACK_DEPTH=d overrides the event-grid depth (default 4).
+ * Prints figures only; nothing here is a pass/fail test.
+ */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "px_arena.h"
+#include "px_dist.h"
+#include "px_nurbs.h"
+#include "px_track.h"
+
+static uint64_t rng = 0x9e3779b97f4a7c15ull;
+static double urand(void)
+{
+	rng ^= rng << 13;
+	rng ^= rng >> 7;
+	rng ^= rng << 17;
+	return (double)(rng >> 11) * 0x1.0p-53;
+}
+
+static double nrand(void)
+{
+	double a = urand(), b = urand();
+	return sqrt(-2.0 * log(a + 1e-300)) * cos(2 * M_PI * b);
+}
+
+static int64_t now_ns(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+
+static int cmp_i64(const void *a, const void *b)
+{
+	int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
+	return (x > y) - (x < y);
+}
+
+static struct px_arena arena;
+static unsigned char arena_mem[1 << 20];
+
+static int mk(struct px_nurbs_curve *c, int p, int n, const double *U,
+	      const double *xyz, const double *w)
+{
+	return px_nurbs_curve_init(c, &arena, p, n, U, n + p + 1, xyz, w, NULL);
+}
+
+static int mk_periodic(struct px_nurbs_curve *c, int p, int m, const double *pts)
+{
+	double U[80], xyz[3 * 80];
+	int n = m + p, i;
+	for (i = 0; i < n + p + 1; i++)
+		U[i] = i;
+	for (i = 0; i < n; i++)
+		memcpy(&xyz[3 * i], &pts[3 * (i % m)], 3 * sizeof(double));
+	return mk(c, p, n, U, xyz, NULL);
+}
+
+static int blob(struct px_nurbs_curve *c, double cx, double cy)
+{
+	double pts[3 * 14];
+	int i;
+	for (i = 0; i < 14; i++) {
+		double a = 2 * M_PI * i / 14, r = 1.0 + 0.35 * sin(3 * a) + 0.1 * cos(5 * a);
+		pts[3 * i] = cx + r * cos(a);
+		pts[3 * i + 1] = cy + 0.8 * r * sin(a);
+		pts[3 * i + 2] = 0;
+	}
+	return mk_periodic(c, 3, 14, pts);
+}
+
+static int breaks(struct px_nurbs_curve *c, double cx, double cy)
+{
+	static const double U[] = {0, 0, 0, 0, 0.2, 0.35, 0.35, 0.5, 0.5, 0.5,
+				   0.7, 0.85, 1, 1, 1, 1};
+	double xyz[36];
+	int i;
+	for (i = 0; i < 12; i++) {
+		double a = 1.6 * M_PI * i / 11;
+		xyz[3 * i] = cx + 1.2 * cos(a) + 0.3 * ((i * 7) % 3 - 1);
+		xyz[3 * i + 1] = cy + 0.9 * sin(a) + 0.25 * ((i * 5) % 4 - 1.5);
+		xyz[3 * i + 2] = 0;
+	}
+	return mk(c, 3, 12, U, xyz, NULL);
+}
+
+static int knot(struct px_nurbs_curve *c, double cx, double cy, double cz)
+{
+	double pts[3 * 18];
+	int i;
+	for (i = 0; i < 18; i++) {
+		double a = 2 * M_PI * i / 18;
+		pts[3 * i] = cx + 0.5 * (sin(a) + 2 * sin(2 * a));
+		pts[3 * i + 1] = cy + 0.5 * (cos(a) - 2 * cos(2 * a));
+		pts[3 * i + 2] = cz - 0.5 * sin(3 * a);
+	}
+	return mk_periodic(c, 3, 18, pts);
+}
+
+static int circle(struct px_nurbs_curve *c, double cx, double cy, double r)
+{
+	static const double U[] = {0, 0, 0, 0.25, 0.25, 0.5, 0.5, 0.75, 0.75, 1, 1, 1};
+	static const double px[] = {1, 1, 0, -1, -1, -1, 0, 1, 1};
+	static const double py[] = {0, 1, 1, 1, 0, -1, -1, -1, 0};
+	double xyz[27], w[9];
+	int i;
+	for (i = 0; i < 9; i++) {
+		xyz[3 * i] = cx + r * px[i];
+		xyz[3 * i + 1] = cy + r * py[i];
+		xyz[3 * i + 2] = 0;
+		w[i] = (i & 1) ? sqrt(0.5) : 1.0;
+	}
+	return mk(c, 2, 9, U, xyz, w);
+}
+
+#define NSTEP 10000
+
+/* One trajectory of n points: kind 0 smooth random, 1 sinusoids. */
+static void make_path(px_vec3 *q, int n, int kind, px_aabb box, double step)
+{
+	px_vec3 c = px_aabb_center(&box);
+	px_vec3 h = px_v3_scale(px_v3_sub(box.max, box.min), 0.5);
+	px_vec3 pos = c, vel = px_v3(nrand(), nrand(), nrand());
+	double amp[3][3], frq[3][3], ph[3][3], tt = 0;
+	int i, j, k;
+	for (i = 0; i < 3; i++)
+		for (j = 0; j < 3; j++) {
+			amp[i][j] = 0.2 + 0.25 * urand();
+			frq[i][j] = 0.5 + 2.5 * urand();
+			ph[i][j] = 2 * M_PI * urand();
+		}
+	for (k = 0; k < n; k++) {
+		if (kind == 0) {
+			double nv, *pp = &pos.x, *vv = &vel.x;
+			const double *cc = &c.x, *hh = &h.x;
+			vel = px_v3_add(px_v3_scale(vel, 0.97),
+					px_v3(0.25 * nrand(), 0.25 * nrand(), 0.25 * nrand()));
+			nv = px_v3_norm(vel);
+			pos = px_v3_add(pos, px_v3_scale(vel, step / nv));
+			for (i = 0; i < 3; i++)
+				if (fabs(pp[i] - cc[i]) > hh[i]) {
+					pp[i] = cc[i] + (pp[i] > cc[i] ? hh[i] : -hh[i]);
+					vv[i] = -vv[i];
+				}
+		} else {
+			double v[3];
+			for (i = 0; i < 3; i++) {
+				v[i] = 0;
+				for (j = 0; j < 3; j++)
+					v[i] += amp[i][j] * sin(frq[i][j] * tt + ph[i][j]);
+			}
+			tt += step / (1.2 * fmax(h.x, h.y));
+			pos = px_v3_add(c, px_v3(v[0] * h.x, v[1] * h.y, v[2] * h.z));
+		}
+		q[k] = pos;
+	}
+}
+
+static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
+{
+	static px_vec3 q[NSTEP];
+	static int64_t tt[NSTEP], tg[NSTEP];
+	static const double steps[] = {1e-4, 1e-3, 1e-2, 5e-2};
+	struct px_track *t = NULL;
+	struct px_track_opts o;
+	struct px_dist_model *ref = NULL;
+	struct px_track_info ti;
+	struct px_dist_info di;
+	int64_t t0;
+	int kind, s, k, rc;
+	double size;
+	px_aabb box;
+
+	px_track_opts_default(&o);
+	if (getenv("BENCH_TRACK_DEPTH"))
+		o.box_depth = atoi(getenv("BENCH_TRACK_DEPTH"));
+	t0 = now_ns();
+	rc = px_track_create(cs, nc, &o, &t);
+	if (rc) {
+		printf("%s: tracker setup failed: %s\n", name, px_strerror(rc));
+		return;
+	}
+	t0 = now_ns() - t0;
+	px_dist_model_create(cs, nc, NULL, 0, NULL, &ref);
+	px_track_get_info(t, &ti);
+	px_dist_model_info(ref, &di);
+	box = di.bounds;
+	size = px_aabb_diagonal(&box);
+	box.min = px_v3_sub(box.min, px_v3(0.3 * size, 0.3 * size, 0.3 * size));
+	box.max = px_v3_add(box.max, px_v3(0.3 * size, 0.3 * size, 0.3 * size));
+	printf("%s: %d curves, %d spans, %d leaves (%d boxed), setup %.1f ms, "
+	       "%zu bytes\n", name, nc, ti.n_spans, ti.n_leaves,
+	       ti.n_boxed_leaves, t0 / 1e6, ti.bytes);
+	printf("  event cells %d\n", ti.n_cells);
+	printf("  %-8s %-7s %8s %8s %8s | %8s %8s | %6s | %5s %6s %6s %5s %5s %6s\n",
+	       "path", "step", "med_ns", "p99_ns", "max_ns", "cold_med",
+	       "cold_p99", "ratio", "wrong", "trans", "solves", "reini", "fallb",
+	       "tests");
+	/* tests: leaves given the exact segment test per update */
+	for (kind = 0; kind < 2; kind++)
+		for (s = 0; s < 4; s++) {
+			struct px_track_result r;
+			struct px_track_stats a, b;
+			struct px_dist_result g;
+			long wrong = 0;
+			make_path(q, NSTEP, kind, box, steps[s] * size);
+			px_track_reset(t, q[0], &r);
+			px_track_get_stats(t, &a);
+			for (k = 0; k < NSTEP; k++) {
+				int64_t x = now_ns();
+				px_track_update(t, q[k], &r);
+				tt[k] = now_ns() - x;
+				x = now_ns();
+				px_dist_query(ref, q[k], &g);
+				tg[k] = now_ns() - x;
+				if (fabs(r.dist - g.dist) > 1e-9 * (size + g.dist))
+					wrong++;
+			}
+			px_track_get_stats(t, &b);
+			qsort(tt, NSTEP, sizeof(tt[0]), cmp_i64);
+			qsort(tg, NSTEP, sizeof(tg[0]), cmp_i64);
+			printf("  %-8s %-7g %8lld %8lld %8lld | %8lld %8lld | %6.1f | %5ld "
+			       "%6llu %6llu %5llu %5llu %6.2f\n",
+			       kind ? "sines" : "random", steps[s] * 100.0,
+			       (long long)tt[NSTEP / 2], (long long)tt[NSTEP * 99 / 100],
+			       (long long)tt[NSTEP - 1], (long long)tg[NSTEP / 2],
+			       (long long)tg[NSTEP * 99 / 100],
+			       (double)tg[NSTEP / 2] / (double)(tt[NSTEP / 2] ? tt[NSTEP / 2] : 1),
+			       wrong,
+			       (unsigned long long)(b.creations + b.annihilations -
+						    a.creations - a.annihilations),
+			       (unsigned long long)(b.leaf_solves - a.leaf_solves),
+			       (unsigned long long)(b.reinits - a.reinits),
+			       (unsigned long long)(b.fallbacks - a.fallbacks),
+			       (double)(b.box_hits - a.box_hits) / NSTEP);
+		}
+	/* verification disagreements with the tracker's own check on */
+	{
+		struct px_track *tv = NULL;
+		struct px_track_stats st;
+		struct px_track_result r;
+		o.verify_every = 1;
+		if (px_track_create(cs, nc, &o, &tv) == PX_OK) {
+			make_path(q, NSTEP, 0, box, 1e-2 * size);
+			for (k = 0; k < NSTEP; k++)
+				px_track_update(tv, q[k], &r);
+			make_path(q, NSTEP, 1, box, 5e-2 * size);
+			for (k = 0; k < NSTEP; k++)
+				px_track_update(tv, q[k], &r);
+			px_track_get_stats(tv, &st);
+			printf("  verification (every update, %llu checks): %llu "
+			       "disagreements\n",
+			       (unsigned long long)st.verifications,
+			       (unsigned long long)st.disagreements);
+			px_track_free(tv);
+		}
+	}
+	px_track_free(t);
+	px_dist_model_free(ref);
+}
+
+int main(void)
+{
+	struct px_nurbs_curve c[6];
+	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
+	printf("px_track: per-update ns vs cold px_dist_query on the same points "
+	       "(step in %% of the model diagonal; ratio = cold median / tracked "
+	       "median; wrong = answers differing from the global query)\n");
+	if (blob(&c[0], 0, 0) == PX_OK)
+		run("planar C2 closed (blob)", c, 1);
+	if (breaks(&c[1], 0, 0) == PX_OK)
+		run("planar open, C1 + C0 breaks", &c[1], 1);
+	if (circle(&c[2], 0, 0, 1.5) == PX_OK)
+		run("rational circle", &c[2], 1);
+	if (knot(&c[3], 0, 0, 0) == PX_OK)
+		run("space closed (trefoil)", &c[3], 1);
+	blob(&c[0], 0, 0);
+	breaks(&c[1], 2.5, 0.5);
+	circle(&c[2], 0.5, -2.5, 1.0);
+	knot(&c[3], 1.0, 1.0, 1.0);
+	run("multi-entity (4 curves)", c, 4);
+	return 0;
+}

@@ -1,0 +1,1795 @@
+/*
+ * px_track.c - coherent tracking of point-curve critical distances.
+ *
+ * Notation: for a span with homogeneous Bezier form H = (xw, yw, zw, w) in
+ * the local parameter t, g(t; p) = (H - w p) . (H' w - H w') = w^3 (C - p)
+ * . C_t has the sign of f' and Bernstein coefficients a_i - p . b_i
+ * (px_cpiece.h). Its critical points are the simple roots of g; the
+ * transition set is where g has a double root (g = g_t = 0: with w > 0
+ * this is f' = f'' = 0, i.e. D = 0 on a critical point, the evolute of
+ * Chen-Cohen-Riesenfeld section 5). Because the coefficients are affine
+ * in p, three exact facts drive everything:
+ *  - over a box of points the range of each coefficient is exact, so a
+ *    box where the coefficients of g (or of g_t) keep one sign holds no
+ *    event (this builds the per-leaf event boxes at setup);
+ *  - along the segment p0 -> p1 each coefficient is affine in the segment
+ *    parameter, so one sign at both ends is one sign on the whole segment
+ *    (the exact second stage of the detection, replacing the paper's
+ *    box-diagonal interpolation by a proof);
+ *  - g at a leaf boundary is affine along the segment, so a root crosses
+ *    that boundary during the step iff the end values differ in sign.
+ * A cusp (C' = 0) is a root of g for every p; leaves ending at a cusp
+ * carry g divided by (t) or (1 - t) (exact in Bernstein form), and the
+ * cusp itself is a candidate like a C0 corner (the paper's zero-radius
+ * arc, section 8). C1 breaks (knots of multiplicity degree - 1, where D
+ * jumps) and C0 breaks flag their leaves so a root crossing them is an
+ * event: that is where the extended evolute lies (inside the normal
+ * planes at the break).
+ *
+ * Design note - surfaces (next step). A patch gets the same treatment
+ * over (u, v) cells instead of parameter leaves: the two lifted equations
+ * E1 = (S - p) . S_u, E2 = (S - p) . S_v (Seong-Johnson-Cohen section 4)
+ * have Bernstein coefficients affine in p over each Bezier cell, the
+ * transition set is {E1 = E2 = det J = 0} (the focal sheets S + N / k_i),
+ * and a cell's event box comes from the same octree exclusion (cell
+ * excluded when E1 or E2 or det J is sign-definite over the box; det J is
+ * quadratic in p, bounded by interval arithmetic), so umbilics and
+ * parabolic lines (focal points at infinity) only make boxes larger,
+ * never NaN. Evolution is Newton in (u, v) with the 2x2 Jacobian; a hit
+ * cell is re-solved by the certified patch solver of px_spiece (all
+ * interior critical points, not only the minimum, would need a
+ * root-isolating variant of it). Boundary curves and creases are tracked
+ * as curve entities by this file, corners are candidates. The model
+ * layout (entities -> cells -> event grid -> stretches) stays as here.
+ */
+#include "px_track.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "px_bern.h"
+
+#define TRK_MAXD PX_NURBS_MAX_DEGREE
+#define TRK_NG (3 * TRK_MAXD)          /* coefficients of g: degree 3p-1 */
+#define TRK_DEPTH 52                    /* root isolation depth */
+#define TRK_NEWTON 10
+
+/* leaf flags */
+#define LF_EV0 0x1u   /* start is a break: a root crossing it is an event */
+#define LF_EV1 0x2u
+#define LF_SB0 0x4u   /* start is a stretch boundary (C0, cusp, open end) */
+#define LF_SB1 0x8u
+#define LF_CUSP0 0x10u
+#define LF_CUSP1 0x20u
+
+/* split-point kinds */
+#define K_SMOOTH 0
+#define K_C1 1
+#define K_C0 2
+#define K_CUSP 3
+
+struct span {
+	double u0, u1, inv;
+	int deg;
+	double pc[4][TRK_MAXD + 1]; /* power basis in t of x w, y w, z w, w */
+};
+
+struct leaf {
+	double u0, u1;
+	int ent, span;
+	int n;          /* degree of the (divided) g */
+	size_t off;     /* pool: a[n+1], b[3][n+1], da[n], db[3][n] */
+	unsigned flags;
+	double tol_g, tol_d;
+	px_aabb box;    /* union of its event cells */
+	int boxed;
+	uint32_t mark;  /* re-solved this update */
+	uint32_t tested; /* event test done this update */
+};
+
+/* An event cell of one leaf: an octree cell of the working volume where
+ * the leaf may have an event (setup only). */
+struct prim {
+	px_aabb box;
+	int leaf;
+};
+
+struct zero {
+	double u;
+	int type;       /* +1 min, -1 max */
+	int leaf;       /* global leaf index */
+	uint32_t id;
+	px_vec3 c, d1;  /* point and C' at u (last evaluation) */
+	double D;       /* (C - p) . C'' + |C'|^2 there */
+};
+
+struct ent {
+	double u0, u1, len;
+	int cyclic;     /* closed with a smooth seam: parameters wrap */
+	int first_span, n_spans, first_leaf, n_leaves;
+	int n_sb;       /* stretch boundaries (leaf starts with LF_SB0) */
+	struct zero *z, *old;
+	int nz, nold, cap;
+	int first_cand, n_cand;
+	int stale;
+	int touched;
+};
+
+struct cand {
+	px_vec3 q;
+	double u;
+	int ent, kind; /* PX_TRACK_END or PX_TRACK_BREAK */
+};
+
+struct px_track {
+	struct px_track_opts opts;
+	struct px_dist_model *dist;
+	int n_ent, n_spans, n_leaves, n_cand, n_boxed, n_prim;
+	int n_cusps, n_breaks;
+	struct ent *ent;
+	struct span *span;
+	struct leaf *leaf;
+	double *pool;
+	size_t pool_len;
+	struct cand *cand;
+	/* event grid: the finest octree level over the working volume;
+	 * cell (i, j, k) lists the leaves with an event cell there */
+	int gn;              /* cells per axis */
+	px_vec3 ginv;        /* cells per unit length */
+	int *gstart;         /* gn^3 + 1 offsets into gleaf */
+	int *gleaf;
+	int *hits;           /* scratch: leaves of this update */
+	px_aabb work;
+	double scale;        /* model diagonal */
+	px_vec3 p;
+	int init;
+	uint32_t epoch, next_id, best_id;
+	struct px_track_stats st;
+	size_t bytes;
+};
+
+/* ------------------------------------------------------------------ */
+/* evaluation                                                          */
+
+static void span_eval(const struct span *s, double u, px_vec3 *c, px_vec3 *d1,
+		      px_vec3 *d2)
+{
+	double t = (u - s->u0) * s->inv, h[4][3];
+	int k, j, p = s->deg;
+
+	for (k = 0; k < 4; k++) {
+		double v = s->pc[k][p], v1 = 0.0, v2 = 0.0;
+		for (j = p - 1; j >= 0; j--) {
+			v2 = v2 * t + 2.0 * v1;
+			v1 = v1 * t + v;
+			v = v * t + s->pc[k][j];
+		}
+		h[k][0] = v;
+		h[k][1] = v1;
+		h[k][2] = v2;
+	}
+	{
+		double w = h[3][0], w1 = h[3][1], w2 = h[3][2], iw = 1.0 / w;
+		px_vec3 C = px_v3(h[0][0] * iw, h[1][0] * iw, h[2][0] * iw);
+		px_vec3 C1 = px_v3((h[0][1] - w1 * C.x) * iw,
+				   (h[1][1] - w1 * C.y) * iw,
+				   (h[2][1] - w1 * C.z) * iw);
+		px_vec3 C2 = px_v3((h[0][2] - 2.0 * w1 * C1.x - w2 * C.x) * iw,
+				   (h[1][2] - 2.0 * w1 * C1.y - w2 * C.y) * iw,
+				   (h[2][2] - 2.0 * w1 * C1.z - w2 * C.z) * iw);
+		*c = C;
+		*d1 = px_v3_scale(C1, s->inv);
+		*d2 = px_v3_scale(C2, s->inv * s->inv);
+	}
+}
+
+/* Span of entity e holding u (clamped to the entity's spans). */
+static const struct span *find_span(const struct px_track *t,
+				    const struct ent *e, double u)
+{
+	int lo = e->first_span, hi = e->first_span + e->n_spans - 1;
+	while (lo < hi) {
+		int mid = (lo + hi + 1) / 2;
+		if (t->span[mid].u0 <= u)
+			lo = mid;
+		else
+			hi = mid - 1;
+	}
+	return &t->span[lo];
+}
+
+static inline const double *leaf_a(const struct px_track *t,
+				   const struct leaf *l)
+{
+	return t->pool + l->off;
+}
+
+/* g coefficient i of a leaf at p. */
+static inline double gco(const double *a, int n, int i, px_vec3 p)
+{
+	const double *b = a + n + 1;
+	return a[i] - (p.x * b[i] + p.y * b[n + 1 + i] +
+		       p.z * b[2 * (n + 1) + i]);
+}
+
+/* ------------------------------------------------------------------ */
+/* root isolation on one leaf                                          */
+
+static double bern_root(const double *c, int n)
+{
+	double lo = 0.0, hi = 1.0, x = 0.5, flo = c[0];
+	int k;
+	for (k = 0; k < 100; k++) {
+		double d, f = px_bern_eval_d(c, n, x, &d), nx;
+		if (f == 0.0)
+			return x;
+		if ((f < 0.0) == (flo < 0.0)) {
+			lo = x;
+			flo = f;
+		} else {
+			hi = x;
+		}
+		nx = (d != 0.0) ? x - f / d : 0.5 * (lo + hi);
+		if (!(nx > lo && nx < hi))
+			nx = 0.5 * (lo + hi);
+		if (fabs(nx - x) <= 1e-16 || hi - lo <= 1e-16)
+			return nx;
+		x = nx;
+	}
+	return x;
+}
+
+/* Divide a Bernstein polynomial of degree n with a root at t = 0 (end 0)
+ * or t = 1 (end 1) by t or (1 - t): degree n - 1. */
+static void bern_divide(double *c, int n, int end)
+{
+	int i;
+	if (end == 0) {
+		for (i = 1; i <= n; i++)
+			c[i - 1] = c[i] * n / i;
+	} else {
+		for (i = 0; i < n; i++)
+			c[i] = c[i] * n / (n - i);
+	}
+}
+
+struct iso_item {
+	double c[TRK_NG + 1];
+	double min, max;
+	int depth;
+};
+
+/*
+ * All roots of the leaf's g at p, in increasing order, into u/type (cap).
+ * Returns the count, PX_E_NOSPC (more than cap) or PX_E_RANGE (a cluster
+ * not separated at the depth bound: not certified).
+ */
+static int leaf_roots(const struct px_track *t, const struct leaf *l,
+		      px_vec3 p, double *u, int *type, int cap)
+{
+	struct iso_item st[TRK_DEPTH + 3];
+	const double *a = leaf_a(t, l);
+	int n = l->n, sp = 1, nr = 0, i;
+
+	for (i = 0; i <= n; i++)
+		st[0].c[i] = gco(a, n, i, p);
+	/* A root on a leaf boundary (the point on a normal plane there, e.g.
+	 * exactly on the curve at a knot) belongs to the leaf it starts:
+	 * claimed here unless the start is a stretch boundary (a candidate
+	 * already), and divided out of both neighbours so the sign counts
+	 * below stay exact. */
+	if (n >= 1 && fabs(st[0].c[0]) <= l->tol_g) {
+		if (!(l->flags & LF_SB0)) {
+			for (i = 1; i <= n; i++)
+				if (fabs(st[0].c[i]) > l->tol_g)
+					break;
+			if (i <= n) {
+				if (nr >= cap)
+					return PX_E_NOSPC;
+				u[nr] = l->u0;
+				type[nr] = st[0].c[i] > 0.0 ? 1 : -1;
+				nr++;
+			}
+		}
+		st[0].c[0] = 0.0;
+		bern_divide(st[0].c, n, 0);
+		n--;
+	}
+	if (n >= 1 && fabs(st[0].c[n]) <= l->tol_g) {
+		st[0].c[n] = 0.0;
+		bern_divide(st[0].c, n, 1);
+		n--;
+	}
+	st[0].min = 0.0;
+	st[0].max = 1.0;
+	st[0].depth = 0;
+	while (sp > 0) {
+		struct iso_item it = st[--sp];
+		int v = px_bern_sign_changes(it.c, n, 0.0);
+		if (v == 0)
+			continue;
+		if (v == 1) {
+			double x = bern_root(it.c, n), first = 0.0;
+			for (i = 0; i <= n && first == 0.0; i++)
+				first = it.c[i];
+			if (nr >= cap)
+				return PX_E_NOSPC;
+			u[nr] = l->u0 + (l->u1 - l->u0) *
+					(it.min + x * (it.max - it.min));
+			type[nr] = first < 0.0 ? 1 : -1;
+			nr++;
+			continue;
+		}
+		if (it.depth >= TRK_DEPTH)
+			return PX_E_RANGE;
+		{
+			/* right half below the left one: roots come out sorted */
+			struct iso_item *r = &st[sp], *lf = &st[sp + 1];
+			double mid = 0.5 * (it.min + it.max);
+			px_bern_split(it.c, n, 0.5, lf->c, r->c);
+			r->min = mid;
+			r->max = it.max;
+			lf->min = it.min;
+			lf->max = mid;
+			r->depth = lf->depth = it.depth + 1;
+			sp += 2;
+		}
+	}
+	return nr;
+}
+
+/* ------------------------------------------------------------------ */
+/* entity state                                                        */
+
+static void zero_eval(const struct px_track *t, const struct ent *e,
+		      struct zero *z, px_vec3 p)
+{
+	px_vec3 c, d1, d2;
+	span_eval(find_span(t, e, z->u), z->u, &c, &d1, &d2);
+	z->c = c;
+	z->d1 = d1;
+	z->D = px_v3_dot(px_v3_sub(c, p), d2) + px_v3_dot(d1, d1);
+}
+
+static int cmp_zero(const struct zero *a, const struct zero *b)
+{
+	return a->u > b->u;
+}
+
+static void sort_zeros(struct ent *e)
+{
+	int i, j;
+	for (i = 1; i < e->nz; i++) {
+		struct zero z = e->z[i];
+		for (j = i; j > 0 && cmp_zero(&e->z[j - 1], &z); j--)
+			e->z[j] = e->z[j - 1];
+		e->z[j] = z;
+	}
+}
+
+/* Give a new root the id of the nearest dropped root of the same type. */
+static uint32_t inherit_id(struct px_track *t, struct ent *e, double u,
+			   int type)
+{
+	int i, best = -1;
+	double bd = 0.05 * e->len;
+	for (i = 0; i < e->nold; i++) {
+		double d;
+		if (e->old[i].type != type || e->old[i].id == 0)
+			continue;
+		d = fabs(e->old[i].u - u);
+		if (e->cyclic)
+			d = fmin(d, e->len - d);
+		if (d <= bd) {
+			bd = d;
+			best = i;
+		}
+	}
+	if (best >= 0) {
+		uint32_t id = e->old[best].id;
+		e->old[best].id = 0;
+		return id;
+	}
+	if (++t->next_id >= 0x7fffffffu)
+		t->next_id = 1;
+	return t->next_id;
+}
+
+/* Append the roots of leaf li at p. Returns the count or an error. */
+static int add_leaf_roots(struct px_track *t, struct ent *e, int li, px_vec3 p)
+{
+	double u[TRK_NG + 1];
+	int ty[TRK_NG + 1], n, i;
+	n = leaf_roots(t, &t->leaf[li], p, u, ty, TRK_NG + 1);
+	if (n < 0)
+		return n;
+	if (e->nz + n > e->cap)
+		return PX_E_NOSPC;
+	for (i = 0; i < n; i++) {
+		struct zero *z = &e->z[e->nz++];
+		z->u = u[i];
+		z->type = ty[i];
+		z->leaf = li;
+		z->id = inherit_id(t, e, u[i], ty[i]);
+		zero_eval(t, e, z, p);
+	}
+	return n;
+}
+
+/* Sign of g at the start (side 0) or end (side 1) of leaf li at p, with
+ * 0 for "too close to tell". */
+static int leaf_end_sign(const struct px_track *t, int li, int side, px_vec3 p)
+{
+	const struct leaf *l = &t->leaf[li];
+	double v = gco(leaf_a(t, l), l->n, side ? l->n : 0, p);
+	if (fabs(v) <= l->tol_g)
+		return 0;
+	return v > 0.0 ? 1 : -1;
+}
+
+static int ent_dups(const struct ent *e)
+{
+	int i;
+	double dtol = 1e-11 * e->len;
+	for (i = 1; i < e->nz; i++)
+		if (e->z[i].u - e->z[i - 1].u <= dtol)
+			return 1;
+	if (e->cyclic && e->nz >= 2 &&
+	    e->z[0].u + e->len - e->z[e->nz - 1].u <= dtol)
+		return 1;
+	return 0;
+}
+
+/*
+ * Structure check at p: sorted, no duplicates, types alternate inside
+ * every C1 stretch and agree with the sign of f' at the stretch ends.
+ * Returns 0 when consistent.
+ */
+static int ent_check(const struct px_track *t, const struct ent *e, px_vec3 p)
+{
+	int i, j, k0 = -1, zi, n = e->n_leaves;
+
+	if (ent_dups(e))
+		return 1;
+	if (e->n_sb == 0) {
+		/* one closed stretch: even count, alternating cyclically */
+		if (e->nz & 1)
+			return 1;
+		for (i = 0; i < e->nz; i++)
+			if (e->z[i].type == e->z[(i + 1) % e->nz].type)
+				return 1;
+		return 0;
+	}
+	for (j = 0; j < n; j++)
+		if (t->leaf[e->first_leaf + j].flags & LF_SB0) {
+			k0 = j;
+			break;
+		}
+	if (k0 < 0)
+		return 1;
+	/* first zero at or after leaf k0 (cyclic order) */
+	zi = 0;
+	while (zi < e->nz && e->z[zi].leaf - e->first_leaf < k0)
+		zi++;
+	{
+		int expect = 0, seen = 0;
+		for (j = 0; j < n; j++) {
+			int lj = (k0 + j) % n, li = e->first_leaf + lj;
+			const struct leaf *l = &t->leaf[li];
+			if (l->flags & LF_SB0) {
+				int s = leaf_end_sign(t, li, 0, p);
+				expect = s < 0 ? 1 : (s > 0 ? -1 : 0);
+			}
+			while (seen < e->nz) {
+				const struct zero *z = &e->z[zi % e->nz];
+				if (z->leaf != li)
+					break;
+				if (expect && z->type != expect)
+					return 1;
+				expect = -z->type;
+				zi++;
+				seen++;
+			}
+			if (l->flags & LF_SB1) {
+				int s = leaf_end_sign(t, li, 1, p);
+				/* after a minimum g > 0, after a maximum g < 0 */
+				if (s && expect && s != -expect)
+					return 1;
+			}
+		}
+		if (seen != e->nz)
+			return 1;
+	}
+	return 0;
+}
+
+/* Rebuild one entity at p. Returns 0, PX_E_NOSPC or PX_E_RANGE. */
+static int ent_reinit(struct px_track *t, struct ent *e, px_vec3 p)
+{
+	int i, rc;
+	memcpy(e->old, e->z, (size_t)e->nz * sizeof(*e->z));
+	e->nold = e->nz;
+	e->nz = 0;
+	for (i = 0; i < e->n_leaves; i++) {
+		rc = add_leaf_roots(t, e, e->first_leaf + i, p);
+		if (rc < 0) {
+			e->nz = 0;
+			e->stale = 1;
+			return rc;
+		}
+	}
+	e->stale = 0;
+	return 0;
+}
+
+/*
+ * Newton on (C - p) . C' = 0 with p fixed from the unwrapped parameter
+ * *unw (updated); the root must keep its type. Returns 0 or 1.
+ */
+static int newton(const struct px_track *t, const struct ent *e, int type,
+		  double *unw, px_vec3 p, double lim, px_vec3 *c, px_vec3 *d1,
+		  double *D, double *u_out)
+{
+	double u, step, tol = 1e-8 * e->len;
+	int k;
+	px_vec3 d2;
+	for (k = 0;; k++) {
+		double f1;
+		u = *unw;
+		if (e->cyclic) {
+			u = fmod(u - e->u0, e->len);
+			if (u < 0)
+				u += e->len;
+			u += e->u0;
+		} else if (u < e->u0 || u > e->u1) {
+			/* an iterate beyond an open end: come back to it */
+			u = u < e->u0 ? e->u0 : e->u1;
+			*unw = u;
+		}
+		span_eval(find_span(t, e, u), u, c, d1, &d2);
+		f1 = px_v3_dot(px_v3_sub(*c, p), *d1);
+		*D = px_v3_dot(px_v3_sub(*c, p), d2) + px_v3_dot(*d1, *d1);
+		if (!(*D != 0.0))
+			return 1;
+		step = -f1 / *D;
+		if (!isfinite(step))
+			return 1;
+		if (fabs(step) <= tol)
+			break;
+		if (k >= TRK_NEWTON)
+			return 1;
+		if (fabs(step) > lim)
+			step = step > 0 ? lim : -lim;
+		*unw += step;
+	}
+	if ((*D > 0.0 ? 1 : -1) != type)
+		return 1;
+	*u_out = u;
+	return 0;
+}
+
+/*
+ * Evolve one root from p0 to p0 + dp: predictor (dp . C') / D (Eq. 6),
+ * then Newton with the point held fixed. When that fails (a long step
+ * near a fold), the same in four sub-steps along the segment. Then the
+ * leaf walk: no stretch boundary may be crossed and no re-solved leaf
+ * entered. Returns 0, or 1 for an anomaly.
+ */
+static int evolve(struct px_track *t, struct ent *e, struct zero *z,
+		  px_vec3 p0, px_vec3 dp, px_vec3 p)
+{
+	double lim = e->len / (e->n_leaves > 0 ? e->n_leaves : 1);
+	double unw, u = z->u, step, D = 0.0;
+	int li, guard, k, ok;
+	px_vec3 c, d1;
+
+	step = (z->D != 0.0) ? px_v3_dot(dp, z->d1) / z->D : 0.0;
+	if (!isfinite(step))
+		step = 0.0;
+	if (fabs(step) > lim)
+		step = step > 0 ? lim : -lim;
+	unw = z->u + step;
+	ok = !newton(t, e, z->type, &unw, p, lim, &c, &d1, &D, &u);
+	if (!ok) {
+		/* continuation in sub-steps */
+		px_vec3 sd = px_v3_scale(dp, 0.25), dk = z->d1;
+		double Dk = z->D;
+		unw = z->u;
+		for (k = 1; k <= 4; k++) {
+			px_vec3 pk = k == 4 ? p : px_v3_add(p0, px_v3_scale(dp, 0.25 * k));
+			step = (Dk != 0.0) ? px_v3_dot(sd, dk) / Dk : 0.0;
+			if (!isfinite(step))
+				step = 0.0;
+			if (fabs(step) > lim)
+				step = step > 0 ? lim : -lim;
+			unw += step;
+			if (newton(t, e, z->type, &unw, pk, lim, &c, &d1, &D, &u))
+				return 1;
+			dk = d1;
+			Dk = D;
+		}
+	}
+	li = z->leaf - e->first_leaf;
+	{
+		double off = 0.0; /* unwrapped offset of the leaf walk */
+		for (guard = 0; guard <= e->n_leaves + 1; guard++) {
+			const struct leaf *l = &t->leaf[e->first_leaf + li];
+			if (unw >= l->u0 + off && unw <= l->u1 + off)
+				break;
+			if (unw > l->u1 + off) {
+				if (l->flags & LF_SB1)
+					return 1;
+				if (++li == e->n_leaves) {
+					if (!e->cyclic)
+						return 1;
+					li = 0;
+					off += e->len;
+				}
+			} else {
+				if (l->flags & LF_SB0)
+					return 1;
+				if (--li < 0) {
+					if (!e->cyclic)
+						return 1;
+					li = e->n_leaves - 1;
+					off -= e->len;
+				}
+			}
+		}
+		if (guard > e->n_leaves + 1)
+			return 1;
+	}
+	li += e->first_leaf;
+	if (t->leaf[li].mark == t->epoch)
+		return 1;
+	z->u = u;
+	z->leaf = li;
+	z->c = c;
+	z->d1 = d1;
+	z->D = D;
+	return 0;
+}
+
+/* ------------------------------------------------------------------ */
+/* event detection                                                     */
+
+/* Coefficients a - p.b (count m, stride m) sign-definite along p0 -> p1. */
+static int definite_seg(const double *a, int m, px_vec3 p0, px_vec3 p1,
+			double tol)
+{
+	const double *bx = a + m, *by = bx + m, *bz = by + m;
+	int i, pos = 0, neg = 0;
+	for (i = 0; i < m; i++) {
+		double v0 = a[i] - (p0.x * bx[i] + p0.y * by[i] + p0.z * bz[i]);
+		double v1 = a[i] - (p1.x * bx[i] + p1.y * by[i] + p1.z * bz[i]);
+		if (v0 > tol && v1 > tol)
+			pos++;
+		else if (v0 < -tol && v1 < -tol)
+			neg++;
+		else
+			return 0;
+		if (pos && neg)
+			return 0;
+	}
+	return 1;
+}
+
+/* May leaf l hold an event while the point runs p0 -> p1? */
+static int leaf_event(const struct px_track *t, const struct leaf *l,
+		      px_vec3 p0, px_vec3 p1)
+{
+	const double *a = leaf_a(t, l);
+	int n = l->n;
+	if (definite_seg(a, n + 1, p0, p1, l->tol_g))
+		return 0;
+	if (l->flags & (LF_EV0 | LF_EV1)) {
+		int i;
+		for (i = 0; i < 2; i++) {
+			double v0, v1;
+			if (!(l->flags & (i ? LF_EV1 : LF_EV0)))
+				continue;
+			v0 = gco(a, n, i ? n : 0, p0);
+			v1 = gco(a, n, i ? n : 0, p1);
+			if (!((v0 > l->tol_g && v1 > l->tol_g) ||
+			      (v0 < -l->tol_g && v1 < -l->tol_g)))
+				return 1;
+		}
+	}
+	if (n < 1)
+		return 0;
+	return !definite_seg(a + 4 * (n + 1), n, p0, p1, l->tol_d);
+}
+
+static void mark_leaf(struct px_track *t, int li, int *nh)
+{
+	if (t->leaf[li].mark == t->epoch)
+		return;
+	t->leaf[li].mark = t->epoch;
+	t->hits[(*nh)++] = li;
+}
+
+/* Leaves that may hold an event along p0 -> p1, grown while a root
+ * crosses the outer boundary of the region. Returns their count. */
+static int collect_events(struct px_track *t, px_vec3 p0, px_vec3 p1)
+{
+	int nh = 0, k, lo[3], hi[3], i, j, ax;
+	const double *a0 = &p0.x, *a1 = &p1.x, *wl = &t->work.min.x,
+		     *gi = &t->ginv.x;
+
+	/* grid cells of the segment's box (both ends are inside the working
+	 * volume, which the grid covers) */
+	for (ax = 0; ax < 3; ax++) {
+		double x0 = (fmin(a0[ax], a1[ax]) - wl[ax]) * gi[ax];
+		double x1 = (fmax(a0[ax], a1[ax]) - wl[ax]) * gi[ax];
+		lo[ax] = x0 <= 0.0 ? 0 : (x0 >= t->gn - 1 ? t->gn - 1 : (int)x0);
+		hi[ax] = x1 <= 0.0 ? 0 : (x1 >= t->gn - 1 ? t->gn - 1 : (int)x1);
+	}
+	for (k = lo[2]; k <= hi[2]; k++)
+		for (j = lo[1]; j <= hi[1]; j++)
+			for (i = lo[0]; i <= hi[0]; i++) {
+				int c = (k * t->gn + j) * t->gn + i, q;
+				for (q = t->gstart[c]; q < t->gstart[c + 1]; q++) {
+					int li = t->gleaf[q];
+					struct leaf *l = &t->leaf[li];
+					if (l->tested == t->epoch)
+						continue;
+					l->tested = t->epoch;
+					t->st.box_hits++;
+					if (leaf_event(t, l, p0, p1))
+						mark_leaf(t, li, &nh);
+				}
+			}
+	for (k = 0; k < nh; k++) {
+		int li = t->hits[k], side;
+		const struct leaf *l = &t->leaf[li];
+		const struct ent *e = &t->ent[l->ent];
+		for (side = 0; side < 2; side++) {
+			int nb;
+			double v0, v1;
+			if (l->flags & (side ? LF_SB1 : LF_SB0))
+				continue;
+			nb = li - e->first_leaf + (side ? 1 : -1);
+			if (nb < 0 || nb >= e->n_leaves) {
+				if (!e->cyclic)
+					continue;
+				nb = (nb + e->n_leaves) % e->n_leaves;
+			}
+			nb += e->first_leaf;
+			if (t->leaf[nb].mark == t->epoch)
+				continue;
+			v0 = gco(leaf_a(t, l), l->n, side ? l->n : 0, p0);
+			v1 = gco(leaf_a(t, l), l->n, side ? l->n : 0, p1);
+			if ((v0 > l->tol_g && v1 > l->tol_g) ||
+			    (v0 < -l->tol_g && v1 < -l->tol_g))
+				continue;
+			mark_leaf(t, nb, &nh);
+		}
+	}
+	return nh;
+}
+
+/* ------------------------------------------------------------------ */
+/* answer                                                              */
+
+static int in_work(const struct px_track *t, px_vec3 p)
+{
+	return p.x >= t->work.min.x && p.x <= t->work.max.x &&
+	       p.y >= t->work.min.y && p.y <= t->work.max.y &&
+	       p.z >= t->work.min.z && p.z <= t->work.max.z;
+}
+
+static void fill_dir(struct px_track_result *r, px_vec3 p)
+{
+	px_vec3 d = px_v3_sub(p, r->point);
+	double n = px_v3_norm(d);
+	r->dist = n;
+	r->dir = n > 0.0 ? px_v3_scale(d, 1.0 / n) : px_v3(0, 0, 0);
+}
+
+static void answer(struct px_track *t, px_vec3 p, struct px_track_result *r)
+{
+	double best = INFINITY;
+	uint32_t id = 0;
+	int i, j, nc = 0, nm = 0;
+
+	for (i = 0; i < t->n_ent; i++) {
+		const struct ent *e = &t->ent[i];
+		nc += e->nz;
+		for (j = 0; j < e->nz; j++) {
+			const struct zero *z = &e->z[j];
+			double d2;
+			if (z->type < 0)
+				continue;
+			nm++;
+			d2 = px_v3_dist2(z->c, p);
+			if (d2 < best) {
+				best = d2;
+				id = z->id;
+				r->point = z->c;
+				r->u = z->u;
+				r->entity = i;
+				r->feature = PX_TRACK_MIN;
+			}
+		}
+	}
+	for (i = 0; i < t->n_cand; i++) {
+		double d2 = px_v3_dist2(t->cand[i].q, p);
+		if (d2 < best) {
+			best = d2;
+			id = 0x80000000u | (uint32_t)i;
+			r->point = t->cand[i].q;
+			r->u = t->cand[i].u;
+			r->entity = t->cand[i].ent;
+			r->feature = t->cand[i].kind;
+		}
+	}
+	fill_dir(r, p);
+	r->n_crit = nc;
+	r->n_min = nm;
+	r->jumped = t->best_id != 0 && id != t->best_id;
+	t->best_id = id;
+}
+
+static void answer_global(struct px_track *t, px_vec3 p,
+			  struct px_track_result *r)
+{
+	struct px_dist_result g;
+	int i, nc = 0, nm = 0, j;
+	px_dist_query(t->dist, p, &g);
+	r->point = g.point;
+	r->u = g.u;
+	r->entity = g.entity;
+	r->feature = PX_TRACK_FROM_GLOBAL;
+	fill_dir(r, p);
+	for (i = 0; i < t->n_ent; i++) {
+		nc += t->ent[i].nz;
+		for (j = 0; j < t->ent[i].nz; j++)
+			nm += t->ent[i].z[j].type > 0;
+	}
+	r->n_crit = nc;
+	r->n_min = nm;
+	r->jumped = 1;
+	t->best_id = 0;
+	r->source = PX_TRACK_GLOBAL;
+	t->st.fallbacks++;
+}
+
+static void result_clear(struct px_track_result *r)
+{
+	memset(r, 0, sizeof(*r));
+	r->entity = -1;
+}
+
+/* Rebuild every entity; returns 0 or the first error. */
+static int reinit_all(struct px_track *t, px_vec3 p)
+{
+	int i, rc = 0;
+	for (i = 0; i < t->n_ent; i++) {
+		int r2 = ent_reinit(t, &t->ent[i], p);
+		if (r2 && !rc)
+			rc = r2;
+	}
+	return rc;
+}
+
+static void count_fail(struct px_track *t, int rc)
+{
+	if (rc == PX_E_NOSPC)
+		t->st.overflows++;
+	else
+		t->st.unresolved++;
+}
+
+static void verify(struct px_track *t, px_vec3 p, struct px_track_result *r)
+{
+	struct px_dist_result g;
+	if (t->opts.verify_every <= 0 ||
+	    t->st.updates % (uint64_t)t->opts.verify_every != 0)
+		return;
+	if (px_dist_query(t->dist, p, &g))
+		return;
+	t->st.verifications++;
+	r->verified = 1;
+	if (r->dist > g.dist + 1e-9 * (t->scale + g.dist)) {
+		int rc;
+		t->st.disagreements++;
+		rc = reinit_all(t, p);
+		if (rc)
+			count_fail(t, rc);
+		answer_global(t, p, r);
+		r->verified = 1;
+	}
+}
+
+int px_track_reset(struct px_track *t, px_vec3 p, struct px_track_result *r)
+{
+	int rc;
+	if (!t || !r)
+		return PX_E_INVAL;
+	if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
+		return PX_E_NAN;
+	result_clear(r);
+	t->st.updates++;
+	t->p = p;
+	t->init = 1;
+	t->best_id = 0;
+	rc = reinit_all(t, p);
+	r->source = PX_TRACK_REINIT;
+	if (rc) {
+		count_fail(t, rc);
+		answer_global(t, p, r);
+	} else {
+		answer(t, p, r);
+		r->jumped = 1;
+		verify(t, p, r);
+	}
+	return PX_OK;
+}
+
+int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
+{
+	int i, j, nh, rc = 0, fail = 0, added = 0;
+	px_vec3 p0, dp;
+
+	if (!t || !r)
+		return PX_E_INVAL;
+	if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
+		return PX_E_NAN;
+	if (!t->init)
+		return px_track_reset(t, p, r);
+	result_clear(r);
+	t->st.updates++;
+	p0 = t->p;
+	dp = px_v3_sub(p, p0);
+	t->p = p;
+	r->source = PX_TRACK_TRACKED;
+	if (++t->epoch == 0)
+		t->epoch = 1;
+
+	if (!in_work(t, p) || !in_work(t, p0)) {
+		t->st.outside++;
+		r->source = PX_TRACK_REINIT;
+		rc = reinit_all(t, p);
+		if (rc) {
+			count_fail(t, rc);
+			answer_global(t, p, r);
+			return PX_OK;
+		}
+		answer(t, p, r);
+		verify(t, p, r);
+		return PX_OK;
+	}
+
+	nh = collect_events(t, p0, p);
+	r->leaves_solved = nh;
+	t->st.leaf_solves += (uint64_t)nh;
+
+	/* evolve every root outside the re-solved leaves */
+	for (i = 0; i < t->n_ent; i++) {
+		struct ent *e = &t->ent[i];
+		int w = 0;
+		e->nold = 0;
+		e->touched = 0;
+		if (e->stale)
+			continue;
+		for (j = 0; j < e->nz; j++) {
+			struct zero z = e->z[j];
+			if (t->leaf[z.leaf].mark == t->epoch) {
+				e->old[e->nold++] = z;
+				e->touched = 1;
+				continue;
+			}
+			if (evolve(t, e, &z, p0, dp, p)) {
+				e->stale = 1;
+				break;
+			}
+			e->z[w++] = z;
+		}
+		if (!e->stale)
+			e->nz = w;
+	}
+	/* re-solve the event leaves at the new point */
+	for (i = 0; i < nh; i++) {
+		int li = t->hits[i];
+		struct ent *e = &t->ent[t->leaf[li].ent];
+		int n;
+		if (e->stale)
+			continue;
+		n = add_leaf_roots(t, e, li, p);
+		if (n < 0) {
+			rc = n;
+			e->stale = 1;
+			fail = 1;
+			break;
+		}
+		added += n;
+		e->touched = 1;
+	}
+	if (!fail) {
+		for (i = 0; i < t->n_ent; i++) {
+			struct ent *e = &t->ent[i];
+			if (!e->stale && e->touched) {
+				sort_zeros(e);
+				if (ent_check(t, e, p))
+					e->stale = 1;
+			}
+		}
+		for (i = 0; i < t->n_ent; i++) {
+			struct ent *e = &t->ent[i];
+			if (!e->stale && !e->touched) {
+				/* evolved roots kept type and stretch; two
+				 * converging to one root shows as a duplicate */
+				sort_zeros(e);
+				if (ent_dups(e))
+					e->stale = 1;
+			}
+		}
+	}
+	/* anomalies: rebuild those entities here */
+	for (i = 0; i < t->n_ent && !fail; i++) {
+		struct ent *e = &t->ent[i];
+		if (!e->stale)
+			continue;
+		t->st.reinits++;
+		r->source = PX_TRACK_REINIT;
+		rc = ent_reinit(t, e, p);
+		if (rc)
+			fail = 1;
+	}
+	if (fail) {
+		count_fail(t, rc);
+		for (i = 0; i < t->n_ent; i++)
+			t->ent[i].stale = 1;
+		answer_global(t, p, r);
+		return PX_OK;
+	}
+	if (r->source == PX_TRACK_TRACKED) {
+		/* creation / annihilation: roots the re-solved leaves gained */
+		int before = 0;
+		for (i = 0; i < t->n_ent; i++)
+			before += t->ent[i].nold;
+		if (added > before) {
+			r->created = (added - before) / 2;
+			t->st.creations += (uint64_t)r->created;
+		} else if (added < before) {
+			r->annihilated = (before - added) / 2;
+			t->st.annihilations += (uint64_t)r->annihilated;
+		}
+	}
+	answer(t, p, r);
+	r->leaves_solved = nh;
+	verify(t, p, r);
+	return PX_OK;
+}
+
+int px_track_critical(const struct px_track *t, int entity, double *u,
+		      int *type, int cap)
+{
+	const struct ent *e;
+	int i;
+	if (!t || (cap > 0 && (!u || !type)))
+		return PX_E_INVAL;
+	if (entity < 0 || entity >= t->n_ent)
+		return PX_E_RANGE;
+	e = &t->ent[entity];
+	for (i = 0; i < e->nz && i < cap; i++) {
+		u[i] = e->z[i].u;
+		type[i] = e->z[i].type;
+	}
+	return e->nz;
+}
+
+void px_track_get_stats(const struct px_track *t, struct px_track_stats *s)
+{
+	if (!s)
+		return;
+	if (!t) {
+		memset(s, 0, sizeof(*s));
+		return;
+	}
+	*s = t->st;
+}
+
+void px_track_get_info(const struct px_track *t, struct px_track_info *info)
+{
+	if (!info)
+		return;
+	memset(info, 0, sizeof(*info));
+	if (!t)
+		return;
+	info->n_entities = t->n_ent;
+	info->n_spans = t->n_spans;
+	info->n_leaves = t->n_leaves;
+	info->n_boxed_leaves = t->n_boxed;
+	info->n_cells = t->n_prim;
+	info->n_cusps = t->n_cusps;
+	info->n_breaks = t->n_breaks;
+	info->work = t->work;
+	info->bytes = t->bytes;
+}
+
+struct px_dist_model *px_track_dist_model(struct px_track *t)
+{
+	return t ? t->dist : NULL;
+}
+
+/* ------------------------------------------------------------------ */
+/* setup                                                               */
+
+void px_track_opts_default(struct px_track_opts *o)
+{
+	if (!o)
+		return;
+	memset(o, 0, sizeof(*o));
+	o->work.min = px_v3(1, 1, 1);
+	o->work.max = px_v3(-1, -1, -1);
+	o->work_margin = 1.0;
+	o->max_crit = 64;
+	o->leaves_per_span = 4;
+	o->box_depth = 4;
+	o->verify_every = 0;
+	o->dist = NULL;
+}
+
+struct split {
+	double u;
+	int kind;
+};
+
+static double speed_at(const struct px_nurbs_curve *c, double u, int side)
+{
+	px_vec3 d[2];
+	px_nurbs_curve_eval_side(c, u, side, 1, d);
+	return px_v3_norm(d[1]);
+}
+
+/* Split points of one curve (interior knots with their continuity and
+ * interior cusps), sorted, into out (cap). Returns the count. */
+static int curve_splits(const struct px_nurbs_curve *c, struct split *out,
+			int cap, int *n_cusps)
+{
+	int p = c->degree, n = c->n_ctrl, i, ns = 0, k;
+	double a, b, vmax = 0.0;
+	const double *U = c->knots;
+
+	px_nurbs_curve_domain(c, &a, &b);
+	for (i = p + 1; i < n; i++) {
+		int m = 1;
+		if (U[i] <= a || U[i] >= b || U[i] == U[i - 1])
+			continue;
+		while (i + m < n + p + 1 && U[i + m] == U[i])
+			m++;
+		if (ns < cap) {
+			out[ns].u = U[i];
+			out[ns].kind = m >= p ? K_C0 : (m == p - 1 ? K_C1 : K_SMOOTH);
+			ns++;
+		}
+	}
+	/* speed scale */
+	for (k = 0; k <= ns; k++) {
+		double s0 = k == 0 ? a : out[k - 1].u, s1 = k == ns ? b : out[k].u;
+		for (i = 0; i <= 32; i++)
+			vmax = fmax(vmax, speed_at(c, s0 + (s1 - s0) * i / 32.0,
+						   i == 32 ? -1 : 1));
+	}
+	/* cusps: speed (almost) vanishing, at knots or inside spans */
+	{
+		int nsp = ns;
+		for (k = 0; k <= nsp; k++) {
+			double s0 = k == 0 ? a : out[k - 1].u,
+			       s1 = k == nsp ? b : out[k].u, sp[33];
+			for (i = 0; i <= 32; i++)
+				sp[i] = speed_at(c, s0 + (s1 - s0) * i / 32.0,
+						 i == 32 ? -1 : 1);
+			if (k < nsp && (sp[32] <= 1e-7 * vmax ||
+					speed_at(c, s1, 1) <= 1e-7 * vmax))
+				out[k].kind = K_CUSP;
+			for (i = 1; i < 32; i++) {
+				double lo, hi, x1, x2, g = 0.6180339887498949;
+				int it;
+				if (!(sp[i] <= sp[i - 1] && sp[i] <= sp[i + 1] &&
+				      sp[i] <= 1e-3 * vmax))
+					continue;
+				lo = s0 + (s1 - s0) * (i - 1) / 32.0;
+				hi = s0 + (s1 - s0) * (i + 1) / 32.0;
+				for (it = 0; it < 100; it++) {
+					x1 = hi - g * (hi - lo);
+					x2 = lo + g * (hi - lo);
+					if (speed_at(c, x1, 1) < speed_at(c, x2, 1))
+						hi = x2;
+					else
+						lo = x1;
+				}
+				x1 = 0.5 * (lo + hi);
+				if (speed_at(c, x1, 1) <= 1e-7 * vmax &&
+				    x1 > s0 + 1e-9 * (s1 - s0) &&
+				    x1 < s1 - 1e-9 * (s1 - s0) && ns < cap) {
+					out[ns].u = x1;
+					out[ns].kind = K_CUSP;
+					ns++;
+				}
+			}
+		}
+		/* sort */
+		for (i = 1; i < ns; i++) {
+			struct split s = out[i];
+			for (k = i; k > 0 && out[k - 1].u > s.u; k--)
+				out[k] = out[k - 1];
+			out[k] = s;
+		}
+	}
+	for (i = 0; i < ns; i++)
+		if (out[i].kind == K_CUSP)
+			(*n_cusps)++;
+	return ns;
+}
+
+/* Bernstein g (a, b[3]) of a span's Bezier net hb[4][p+1]; degree 3p-1. */
+static void span_g(int p, double hb[4][TRK_MAXD + 1], double *a,
+		   double b[3][TRK_NG])
+{
+	double hd[4][TRK_MAXD + 1], k[3][2 * TRK_MAXD];
+	double t1[PX_BERN_MAX_DEGREE + 1], t2[PX_BERN_MAX_DEGREE + 1];
+	int c, j, n = 3 * p - 1;
+	for (c = 0; c < 4; c++)
+		px_bern_deriv(hb[c], p, hd[c]);
+	for (c = 0; c < 3; c++) {
+		px_bern_mul(hd[c], p - 1, hb[3], p, t1);
+		px_bern_mul(hb[c], p, hd[3], p - 1, t2);
+		for (j = 0; j < 2 * p; j++)
+			k[c][j] = t1[j] - t2[j];
+	}
+	for (j = 0; j <= n; j++)
+		a[j] = 0.0;
+	for (c = 0; c < 3; c++) {
+		px_bern_mul(hb[c], p, k[c], 2 * p - 1, t1);
+		for (j = 0; j <= n; j++)
+			a[j] += t1[j];
+		px_bern_mul(hb[3], p, k[c], 2 * p - 1, b[c]);
+	}
+}
+
+/* Octree exclusion: can the leaf have an event for some p in the cell? */
+static int cell_range(const double *a, int m, px_vec3 c, px_vec3 r, int i,
+		      double tol, double *lo, double *hi)
+{
+	const double *bx = a + m, *by = bx + m, *bz = by + m;
+	double v = a[i] - (c.x * bx[i] + c.y * by[i] + c.z * bz[i]);
+	double e = fabs(bx[i]) * r.x + fabs(by[i]) * r.y + fabs(bz[i]) * r.z;
+	*lo = v - e - tol;
+	*hi = v + e + tol;
+	return 0;
+}
+
+static int cell_definite(const double *a, int m, px_vec3 c, px_vec3 r,
+			 double tol)
+{
+	int i, pos = 0, neg = 0;
+	for (i = 0; i < m; i++) {
+		double lo, hi;
+		cell_range(a, m, c, r, i, tol, &lo, &hi);
+		if (lo > 0.0)
+			pos++;
+		else if (hi < 0.0)
+			neg++;
+		else
+			return 0;
+		if (pos && neg)
+			return 0;
+	}
+	return 1;
+}
+
+static int cell_event(const struct px_track *t, const struct leaf *l,
+		      px_vec3 c, px_vec3 r)
+{
+	const double *a = leaf_a(t, l);
+	int n = l->n, i;
+	if (cell_definite(a, n + 1, c, r, l->tol_g))
+		return 0;
+	for (i = 0; i < 2; i++) {
+		double lo, hi;
+		if (!(l->flags & (i ? LF_EV1 : LF_EV0)))
+			continue;
+		cell_range(a, n + 1, c, r, i ? n : 0, l->tol_g, &lo, &hi);
+		if (lo <= 0.0 && hi >= 0.0)
+			return 1;
+	}
+	if (n < 1)
+		return 0;
+	return !cell_definite(a + 4 * (n + 1), n, c, r, l->tol_d);
+}
+
+struct cellbuf {
+	struct prim *p;
+	long n, cap;
+	int fail;
+};
+
+static void cell_push(struct cellbuf *cb, px_aabb box, int leaf)
+{
+	if (cb->n == cb->cap) {
+		long nc = cb->cap ? 2 * cb->cap : 1024;
+		struct prim *np = realloc(cb->p, (size_t)nc * sizeof(*np));
+		if (!np) {
+			cb->fail = 1;
+			return;
+		}
+		cb->p = np;
+		cb->cap = nc;
+	}
+	cb->p[cb->n].box = box;
+	cb->p[cb->n].leaf = leaf;
+	cb->n++;
+}
+
+/* Octree exclusion over the working volume: the cells at max_depth
+ * where leaf li may have an event (a cell is also kept whole when the
+ * budget runs out, which only makes the cover coarser). */
+static void leaf_cells_rec(const struct px_track *t, int li, px_aabb cell,
+			   int depth, int max_depth, struct cellbuf *cb,
+			   long *budget)
+{
+	const struct leaf *l = &t->leaf[li];
+	px_vec3 c = px_aabb_center(&cell);
+	px_vec3 r = px_v3_scale(px_v3_sub(cell.max, cell.min), 0.5);
+	int k;
+	if (!cell_event(t, l, c, r))
+		return;
+	if (depth >= max_depth || --(*budget) <= 0) {
+		cell_push(cb, cell, li);
+		return;
+	}
+	for (k = 0; k < 8; k++) {
+		px_aabb ch;
+		ch.min = px_v3(k & 1 ? c.x : cell.min.x, k & 2 ? c.y : cell.min.y,
+			       k & 4 ? c.z : cell.min.z);
+		ch.max = px_v3(k & 1 ? cell.max.x : c.x, k & 2 ? cell.max.y : c.y,
+			       k & 4 ? cell.max.z : c.z);
+		leaf_cells_rec(t, li, ch, depth + 1, max_depth, cb, budget);
+	}
+}
+
+
+void px_track_free(struct px_track *t)
+{
+	int i;
+	if (!t)
+		return;
+	px_dist_model_free(t->dist);
+	if (t->ent)
+		for (i = 0; i < t->n_ent; i++) {
+			free(t->ent[i].z);
+			free(t->ent[i].old);
+		}
+	free(t->ent);
+	free(t->span);
+	free(t->leaf);
+	free(t->pool);
+	free(t->cand);
+	free(t->gstart);
+	free(t->gleaf);
+	free(t->hits);
+	free(t);
+}
+
+int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
+		    const struct px_track_opts *opts, struct px_track **out)
+{
+	struct px_track *t;
+	struct px_track_opts o;
+	struct split *spl = NULL;
+	double *work = NULL;
+	size_t work_len = 0, pool_cap = 0;
+	int rc, i, j, k, span_cap = 0, leaf_cap = 0, cand_cap = 0, max_ctrl = 0;
+	px_aabb bounds;
+
+	if (!out || !curves || n_curves <= 0)
+		return PX_E_INVAL;
+	*out = NULL;
+	if (opts)
+		o = *opts;
+	else
+		px_track_opts_default(&o);
+	if (o.max_crit < 2 || o.max_crit > 1 << 20 || o.leaves_per_span < 1 ||
+	    o.leaves_per_span > 64 || o.box_depth < 0 || o.box_depth > 7 ||
+	    o.verify_every < 0 || !(o.work_margin >= 0.0))
+		return PX_E_INVAL;
+	for (i = 0; i < n_curves; i++) {
+		if (curves[i].degree < 1 || curves[i].degree > TRK_MAXD)
+			return PX_E_RANGE;
+		if (!curves[i].knots || !curves[i].pw)
+			return PX_E_INVAL;
+		if (curves[i].n_ctrl > max_ctrl)
+			max_ctrl = curves[i].n_ctrl;
+		/* spans: knots + cusps (bounded by 32 per span) */
+		span_cap += (curves[i].n_ctrl + 1) * 34 + 2;
+	}
+	t = calloc(1, sizeof(*t));
+	if (!t)
+		return PX_E_NOMEM;
+	t->opts = o;
+	rc = px_dist_model_create(curves, n_curves, NULL, 0, o.dist, &t->dist);
+	if (rc) {
+		free(t);
+		return rc;
+	}
+	t->n_ent = n_curves;
+	t->ent = calloc((size_t)n_curves, sizeof(*t->ent));
+	t->span = calloc((size_t)span_cap, sizeof(*t->span));
+	spl = calloc((size_t)span_cap, sizeof(*spl));
+	work_len = PX_NURBS_CURVE_WORK_LEN(TRK_MAXD, max_ctrl);
+	work = calloc(work_len, sizeof(double));
+	if (!t->ent || !t->span || !spl || !work) {
+		rc = PX_E_NOMEM;
+		goto fail;
+	}
+
+	/* spans and entity layout */
+	bounds = px_aabb_empty();
+	for (i = 0; i < n_curves; i++) {
+		const struct px_nurbs_curve *c = &curves[i];
+		struct ent *e = &t->ent[i];
+		int ns, seam, p = c->degree;
+		px_aabb hull = px_nurbs_curve_aabb(c);
+		double a, b;
+
+		px_aabb_extend(&bounds, hull.min);
+		px_aabb_extend(&bounds, hull.max);
+		px_nurbs_curve_domain(c, &a, &b);
+		e->u0 = a;
+		e->u1 = b;
+		e->len = b - a;
+		seam = px_nurbs_curve_seam(c, 1e-12 * (1.0 + px_aabb_diagonal(&hull)),
+					   1e-9);
+		e->cyclic = seam >= 1;
+		ns = curve_splits(c, spl, span_cap - t->n_spans - 2, &t->n_cusps);
+		e->first_span = t->n_spans;
+		for (k = 0; k <= ns; k++) {
+			double s0 = k == 0 ? a : spl[k - 1].u, s1 = k == ns ? b : spl[k].u;
+			struct px_nurbs_curve sub;
+			struct span *s = &t->span[t->n_spans];
+			double hb[4][TRK_MAXD + 1];
+			int q, jj;
+			if (!(s1 > s0))
+				continue;
+			rc = px_nurbs_curve_extract_work(c, s0, s1, work, work_len, &sub);
+			if (rc)
+				goto fail;
+			if (sub.n_ctrl != p + 1) {
+				rc = PX_E_INVAL;
+				goto fail;
+			}
+			s->u0 = s0;
+			s->u1 = s1;
+			s->inv = 1.0 / (s1 - s0);
+			s->deg = p;
+			for (q = 0; q <= p; q++)
+				for (jj = 0; jj < 4; jj++)
+					hb[jj][q] = sub.pw[4 * q + jj];
+			for (jj = 0; jj < 4; jj++)
+				for (q = 0; q <= p; q++) {
+					double v = 0.0;
+					int r;
+					for (r = 0; r <= q; r++)
+						v += (((q - r) & 1) ? -1.0 : 1.0) *
+						     px_bern_binom(q, r) * hb[jj][r];
+					s->pc[jj][q] = px_bern_binom(p, q) * v;
+				}
+			t->n_spans++;
+		}
+		e->n_spans = t->n_spans - e->first_span;
+		/* kinds at span starts: record in a parallel pass below */
+		(void)seam;
+		e->cap = o.max_crit;
+		e->z = calloc((size_t)o.max_crit, sizeof(*e->z));
+		e->old = calloc((size_t)o.max_crit, sizeof(*e->old));
+		if (!e->z || !e->old) {
+			rc = PX_E_NOMEM;
+			goto fail;
+		}
+		leaf_cap += e->n_spans * o.leaves_per_span;
+		cand_cap += ns + 2;
+		for (k = 0; k < e->n_spans; k++) {
+			int n = 3 * p - 1;
+			pool_cap += (size_t)o.leaves_per_span *
+				    (size_t)(4 * (n + 1) + 4 * n);
+		}
+	}
+	t->scale = px_aabb_diagonal(&bounds);
+	if (!(t->scale > 0.0))
+		t->scale = 1.0;
+	if (o.work.min.x <= o.work.max.x && o.work.min.y <= o.work.max.y &&
+	    o.work.min.z <= o.work.max.z) {
+		t->work = o.work;
+	} else {
+		double m = o.work_margin * t->scale;
+		t->work.min = px_v3_sub(bounds.min, px_v3(m, m, m));
+		t->work.max = px_v3_add(bounds.max, px_v3(m, m, m));
+	}
+
+	t->leaf = calloc((size_t)leaf_cap, sizeof(*t->leaf));
+	t->pool = calloc(pool_cap ? pool_cap : 1, sizeof(double));
+	t->cand = calloc((size_t)cand_cap + 1, sizeof(*t->cand));
+	t->hits = calloc((size_t)leaf_cap + 1, sizeof(int));
+	if (!t->leaf || !t->pool || !t->cand || !t->hits) {
+		rc = PX_E_NOMEM;
+		goto fail;
+	}
+
+	/* leaves, candidates */
+	for (i = 0; i < n_curves; i++) {
+		const struct px_nurbs_curve *c = &curves[i];
+		struct ent *e = &t->ent[i];
+		int ns, p = c->degree, seam, nc0 = 0;
+		px_aabb hull = px_nurbs_curve_aabb(c);
+		double wmax = fmax(fmax(fabs(t->work.min.x), fabs(t->work.max.x)),
+				   fmax(fmax(fabs(t->work.min.y), fabs(t->work.max.y)),
+					fmax(fabs(t->work.min.z), fabs(t->work.max.z))));
+
+		ns = curve_splits(c, spl, span_cap, &nc0);
+		seam = px_nurbs_curve_seam(c, 1e-12 * (1.0 + px_aabb_diagonal(&hull)),
+					   1e-9);
+		e->first_leaf = t->n_leaves;
+		e->first_cand = t->n_cand;
+		/* candidates: open ends, cornered seam, C0 breaks, cusps */
+		if (seam < 0) {
+			struct cand *cd = &t->cand[t->n_cand++];
+			cd->q = px_nurbs_curve_point(c, e->u0);
+			cd->u = e->u0;
+			cd->ent = i;
+			cd->kind = PX_TRACK_END;
+			cd = &t->cand[t->n_cand++];
+			cd->q = px_nurbs_curve_point(c, e->u1);
+			cd->u = e->u1;
+			cd->ent = i;
+			cd->kind = PX_TRACK_END;
+		} else if (seam == 0) {
+			struct cand *cd = &t->cand[t->n_cand++];
+			cd->q = px_nurbs_curve_point(c, e->u0);
+			cd->u = e->u0;
+			cd->ent = i;
+			cd->kind = PX_TRACK_BREAK;
+		}
+		for (k = 0; k < ns; k++) {
+			if (spl[k].kind == K_C0 || spl[k].kind == K_CUSP) {
+				struct cand *cd = &t->cand[t->n_cand++];
+				cd->q = px_nurbs_curve_point(c, spl[k].u);
+				cd->u = spl[k].u;
+				cd->ent = i;
+				cd->kind = PX_TRACK_BREAK;
+			}
+			if (spl[k].kind != K_SMOOTH)
+				t->n_breaks++;
+		}
+		e->n_cand = t->n_cand - e->first_cand;
+
+		for (k = 0; k < e->n_spans; k++) {
+			const struct span *s = &t->span[e->first_span + k];
+			int kind0 = K_SMOOTH, kind1 = K_SMOOTH, q, jj, L;
+			double hb[4][TRK_MAXD + 1], ga[TRK_NG], gb[3][TRK_NG];
+			int n = 3 * p - 1;
+			/* kinds of the span's ends */
+			for (q = 0; q < ns; q++) {
+				if (spl[q].u == s->u0)
+					kind0 = spl[q].kind;
+				if (spl[q].u == s->u1)
+					kind1 = spl[q].kind;
+			}
+			if (k == 0)
+				kind0 = seam >= 2 ? K_SMOOTH : seam == 1 ? K_C1 : K_C0;
+			if (k == e->n_spans - 1)
+				kind1 = seam >= 2 ? K_SMOOTH : seam == 1 ? K_C1 : K_C0;
+			/* Bernstein net back from the power basis */
+			for (jj = 0; jj < 4; jj++)
+				for (q = 0; q <= p; q++) {
+					double v = 0.0;
+					int r;
+					for (r = 0; r <= q; r++)
+						v += px_bern_binom(q, r) /
+						     px_bern_binom(p, r) * s->pc[jj][r];
+					hb[jj][q] = v;
+				}
+			span_g(p, hb, ga, gb);
+			for (L = 0; L < o.leaves_per_span; L++) {
+				struct leaf *l = &t->leaf[t->n_leaves];
+				double t0 = (double)L / o.leaves_per_span,
+				       t1 = (double)(L + 1) / o.leaves_per_span;
+				double *a = t->pool + t->pool_len, *b;
+				int m = n, cc;
+				l->u0 = s->u0 + (s->u1 - s->u0) * t0;
+				l->u1 = L == o.leaves_per_span - 1
+						? s->u1
+						: s->u0 + (s->u1 - s->u0) * t1;
+				l->ent = i;
+				l->span = e->first_span + k;
+				l->off = t->pool_len;
+				b = a + n + 1;
+				px_bern_restrict(ga, n, t0, t1, a);
+				for (cc = 0; cc < 3; cc++)
+					px_bern_restrict(gb[cc], n, t0, t1,
+							 b + cc * (n + 1));
+				if (L == 0 && kind0 == K_CUSP) {
+					l->flags |= LF_CUSP0;
+					bern_divide(a, m, 0);
+					for (cc = 0; cc < 3; cc++)
+						bern_divide(b + cc * (n + 1), m, 0);
+					m--;
+				}
+				if (L == o.leaves_per_span - 1 && kind1 == K_CUSP &&
+				    m >= 1) {
+					l->flags |= LF_CUSP1;
+					bern_divide(a, m, 1);
+					for (cc = 0; cc < 3; cc++)
+						bern_divide(b + cc * (n + 1), m, 1);
+					m--;
+				}
+				/* compact to stride m + 1 */
+				if (m != n) {
+					double tmp[4 * (TRK_NG + 1)];
+					for (cc = 0; cc < 4; cc++)
+						memcpy(tmp + cc * (m + 1),
+						       a + cc * (n + 1),
+						       (size_t)(m + 1) * sizeof(double));
+					memcpy(a, tmp, (size_t)(4 * (m + 1)) * sizeof(double));
+				}
+				l->n = m;
+				/* derivative coefficients */
+				{
+					double *da = a + 4 * (m + 1);
+					if (m >= 1)
+						for (cc = 0; cc < 4; cc++)
+							px_bern_deriv(a + cc * (m + 1), m,
+								      da + cc * m);
+				}
+				/* tolerances: rounding of the affine forms */
+				{
+					double tg = 0.0, td = 0.0;
+					for (q = 0; q <= m; q++) {
+						double s2 = fabs(a[q]) +
+							    wmax * (fabs(a[m + 1 + q]) +
+								    fabs(a[2 * (m + 1) + q]) +
+								    fabs(a[3 * (m + 1) + q]));
+						tg = fmax(tg, s2);
+					}
+					for (q = 0; q < m; q++) {
+						const double *da = a + 4 * (m + 1);
+						double s2 = fabs(da[q]) +
+							    wmax * (fabs(da[m + q]) +
+								    fabs(da[2 * m + q]) +
+								    fabs(da[3 * m + q]));
+						td = fmax(td, s2);
+					}
+					l->tol_g = 1e-12 * tg;
+					l->tol_d = 1e-12 * td;
+				}
+				t->pool_len += (size_t)(4 * (m + 1) + 4 * m);
+				if (L == 0 && kind0 != K_SMOOTH)
+					l->flags |= LF_EV0;
+				if (L == o.leaves_per_span - 1 && kind1 != K_SMOOTH)
+					l->flags |= LF_EV1;
+				if (L == 0 && (kind0 == K_C0 || kind0 == K_CUSP))
+					l->flags |= LF_SB0;
+				if (L == o.leaves_per_span - 1 &&
+				    (kind1 == K_C0 || kind1 == K_CUSP))
+					l->flags |= LF_SB1;
+				t->n_leaves++;
+			}
+		}
+		e->n_leaves = t->n_leaves - e->first_leaf;
+		if (!e->cyclic) {
+			/* open or cornered: parameters do not wrap */
+			t->leaf[e->first_leaf].flags |= LF_EV0 | LF_SB0;
+			t->leaf[t->n_leaves - 1].flags |= LF_EV1 | LF_SB1;
+		}
+		for (k = 0; k < e->n_leaves; k++)
+			if (t->leaf[e->first_leaf + k].flags & LF_SB0)
+				e->n_sb++;
+	}
+
+	/* event cells: octree exclusion per leaf down to the grid level */
+	{
+		struct cellbuf cb = {0};
+		long q, ncell;
+		int gn = 1 << o.box_depth, ax;
+		const double *wl = &t->work.min.x, *wh = &t->work.max.x;
+		double *gi = &t->ginv.x;
+		t->gn = gn;
+		for (ax = 0; ax < 3; ax++)
+			gi[ax] = wh[ax] > wl[ax] ? gn / (wh[ax] - wl[ax]) : 0.0;
+		for (i = 0; i < t->n_leaves; i++) {
+			long budget = 1L << 14, first = cb.n;
+			struct leaf *l = &t->leaf[i];
+			leaf_cells_rec(t, i, t->work, 0, o.box_depth, &cb, &budget);
+			if (cb.fail) {
+				free(cb.p);
+				rc = PX_E_NOMEM;
+				goto fail;
+			}
+			l->box = px_aabb_empty();
+			for (q = first; q < cb.n; q++) {
+				px_aabb_extend(&l->box, cb.p[q].box.min);
+				px_aabb_extend(&l->box, cb.p[q].box.max);
+			}
+			if (cb.n > first) {
+				l->boxed = 1;
+				t->n_boxed++;
+			}
+		}
+		ncell = (long)gn * gn * gn;
+		t->gstart = calloc((size_t)ncell + 1, sizeof(int));
+		if (!t->gstart) {
+			free(cb.p);
+			rc = PX_E_NOMEM;
+			goto fail;
+		}
+		/* two passes: count, then fill (a cell cut short by the budget
+		 * covers several grid cells) */
+		for (ax = 0; ax < 2; ax++) {
+			long total = 0;
+			if (ax == 1) {
+				for (q = 0; q < ncell; q++) {
+					int c = t->gstart[q];
+					t->gstart[q] = (int)total;
+					total += c;
+				}
+				t->gstart[ncell] = (int)total;
+				t->n_prim = (int)total;
+				t->gleaf = calloc((size_t)total + 1, sizeof(int));
+				if (!t->gleaf) {
+					free(cb.p);
+					rc = PX_E_NOMEM;
+					goto fail;
+				}
+				/* reuse gstart as fill cursors, restored below */
+			}
+			for (q = 0; q < cb.n; q++) {
+				int lo3[3], hi3[3], ii, jj, kk, d;
+				const double *bl = &cb.p[q].box.min.x, *bh = &cb.p[q].box.max.x;
+				for (d = 0; d < 3; d++) {
+					double x0 = (bl[d] - wl[d]) * gi[d] + 1e-6;
+					double x1 = (bh[d] - wl[d]) * gi[d] - 1e-6;
+					lo3[d] = x0 < 0 ? 0 : (x0 > gn - 1 ? gn - 1 : (int)x0);
+					hi3[d] = x1 < 0 ? 0 : (x1 > gn - 1 ? gn - 1 : (int)x1);
+				}
+				for (kk = lo3[2]; kk <= hi3[2]; kk++)
+					for (jj = lo3[1]; jj <= hi3[1]; jj++)
+						for (ii = lo3[0]; ii <= hi3[0]; ii++) {
+							int c = (kk * gn + jj) * gn + ii;
+							if (ax == 0)
+								t->gstart[c]++;
+							else
+								t->gleaf[t->gstart[c]++] = cb.p[q].leaf;
+						}
+			}
+			if (ax == 1) {
+				/* cursors ended at the next cell's start: shift back */
+				for (q = ncell; q > 0; q--)
+					t->gstart[q] = t->gstart[q - 1];
+				t->gstart[0] = 0;
+			}
+		}
+		free(cb.p);
+	}
+
+	t->bytes = sizeof(*t) + (size_t)t->n_ent * sizeof(*t->ent) +
+		   (size_t)t->n_ent * 2 * (size_t)o.max_crit * sizeof(struct zero) +
+		   (size_t)span_cap * sizeof(*t->span) +
+		   (size_t)leaf_cap * (sizeof(*t->leaf) + 2 * sizeof(int)) +
+		   pool_cap * sizeof(double) +
+		   (size_t)(cand_cap + 1) * sizeof(*t->cand) +
+		   ((size_t)t->gn * t->gn * t->gn + 1 + (size_t)t->n_prim) *
+			   sizeof(int);
+	t->epoch = 1;
+	free(spl);
+	free(work);
+	(void)j;
+	*out = t;
+	return PX_OK;
+fail:
+	free(spl);
+	free(work);
+	px_track_free(t);
+	return rc;
+}

@@ -1,0 +1,217 @@
+/*
+ * px_track.h - coherent tracking of every critical distance from a moving
+ * point to a set of NURBS curves (planar or space), the real-time path of
+ * the distance core.
+ *
+ * In a 1 kHz loop the query point moves a little each cycle. Newton from
+ * last cycle's foot point silently follows the wrong branch when the
+ * closest point jumps; re-running the global query every cycle wastes the
+ * budget. The tracker keeps ALL critical points of f(s) = |C(s) - p|^2
+ * (local minima and maxima, per entity) and detects the moments when
+ * pairs of them are born or die, following Chen, Cohen and Riesenfeld,
+ * "Tracking point-curve critical distances" (lifted surface g = f'/2 = 0
+ * in (p, s) space):
+ *
+ *  - Evolution (their Eq. 6): each critical point moves by the tangent
+ *    predictor ds = (dp . C') / D, D = (C - p) . C'' + |C'|^2, then Newton
+ *    on (C - p) . C' = 0 with the new point held fixed, staying inside its
+ *    C1 stretch (across knot spans, wrapping at smooth closed seams).
+ *  - Transitions: pairs appear or vanish only where the moving point
+ *    crosses the transition set {p : g = 0 and dg/ds = 0} (the evolute of
+ *    a planar curve, a ruled surface of polar lines for a space curve) or,
+ *    at C0/C1 breaks, cusps and open ends, the normal planes there (the
+ *    extended evolute of section 8 is contained in them). Each curve is
+ *    cut into Bezier spans and those into parameter leaves; for every leaf
+ *    the Bernstein coefficients of w^3 g (affine in p, as in px_cpiece.h)
+ *    are precomputed, and the part of a working volume where the leaf can
+ *    have an event is covered by octree cells (exclusion with exact
+ *    interval bounds of those affine coefficients: a cell where the
+ *    coefficients of g, or of dg/ds, keep one sign holds no event). The
+ *    cells of the finest level form a uniform grid whose cells list their
+ *    leaves (a segment of one cycle meets a few grid cells, so the lookup
+ *    is O(1), unlike a tree of the overlapping boxes, which measured
+ *    slower). An update looks up the grid cells of the segment p_old ->
+ *    p_new, then tests each listed leaf exactly along the segment (the
+ *    coefficients are affine in the segment parameter, so sign-definite
+ *    coefficients at both ends prove there is no event - the exact
+ *    counterpart of the paper's line/box-diagonal stage), and re-solves
+ *    the leaves that may hold one with a certified Bernstein/Descartes
+ *    root isolation at the new point. A region is grown while a root
+ *    crosses its outer boundary, so created pairs that drift away from the
+ *    crossing are found too. Creation and annihilation are counted by the
+ *    change in the number of roots of the re-solved leaves.
+ *  - Candidates: open-curve ends, C0 breaks, cusps and a cornered closed
+ *    seam are always candidates for the minimum.
+ *  - Never silent: every evolved root is checked (converged, kept its
+ *    type); types must alternate inside each C1 stretch and agree with the
+ *    sign of f' at the stretch ends; duplicates are caught. Any anomaly
+ *    re-initialises that entity by re-solving all its leaves (counted).
+ *    A point outside the working volume re-initialises too (counted). A
+ *    capacity overflow or an uncertified root isolation answers that
+ *    update from the global query px_dist_query() (counted). An optional
+ *    verification compares with the global query every N updates and
+ *    counts disagreements (each re-initialises and answers globally).
+ *
+ * Surfaces are not tracked yet: px_track_create() takes curves only (see
+ * the design note in px_track.c for how patches will fit).
+ *
+ * Memory and real-time rules: px_track_create() allocates everything
+ * (spans, leaves, coefficient pool, event grid, per-entity critical-point
+ * arrays of fixed capacity, the global-query model) and may take long.
+ * px_track_update() and the accessors never allocate, lock or print, and
+ * every loop has a bound. One tracker follows one moving point; it must
+ * not be updated from two threads at once.
+ */
+#ifndef PX_TRACK_H
+#define PX_TRACK_H
+
+#include <stdint.h>
+
+#include "px_base.h"
+#include "px_dist.h"
+#include "px_math.h"
+#include "px_nurbs.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+struct px_track_opts {
+	/* Working volume: the transition boxes are clipped to it; a query
+	 * point outside it re-initialises. An empty box (lo > hi, the
+	 * default) takes the model bounds grown by work_margin times their
+	 * diagonal on every side. */
+	px_aabb work;
+	double work_margin;   /* default 1.0 */
+	/* Critical points each entity can hold (default 64). */
+	int max_crit;
+	/* Parameter leaves per Bezier span (default 4, 1..64). */
+	int leaves_per_span;
+	/* Octree depth of the event cells of a leaf inside the working
+	 * volume (default 4, 0..7). */
+	int box_depth;
+	/* Compare with the global query every verify_every updates (0: off,
+	 * the default). */
+	int verify_every;
+	/* Options of the global query model (NULL for its defaults). */
+	const struct px_dist_opts *dist;
+};
+
+/* Defaults as documented above. */
+PX_API void px_track_opts_default(struct px_track_opts *o);
+
+/* How an update was answered (px_track_result.source). */
+enum px_track_source {
+	PX_TRACK_TRACKED = 0, /* from the tracked critical points */
+	PX_TRACK_REINIT = 1,  /* state rebuilt at this point, then tracked */
+	PX_TRACK_GLOBAL = 2   /* fallback to px_dist_query() */
+};
+
+/* Kind of the closest feature (px_track_result.feature). */
+enum px_track_feature {
+	PX_TRACK_MIN = 0,     /* interior local minimum (f' = 0) */
+	PX_TRACK_END = 1,     /* end point of an open curve */
+	PX_TRACK_BREAK = 2,   /* C0 break, cusp or cornered seam */
+	PX_TRACK_FROM_GLOBAL = 3
+};
+
+struct px_track_result {
+	double dist;       /* distance to the closest point */
+	px_vec3 point;     /* closest point */
+	double u;          /* its curve parameter */
+	int entity;        /* curve index */
+	int feature;       /* enum px_track_feature */
+	px_vec3 dir;       /* unit vector from point to the query (zero on
+			    * the curve) */
+	/* 1 when the closest point is not the continuation of last update's
+	 * closest point (another entity, another branch, a candidate). */
+	int jumped;
+	int n_crit;        /* live interior critical points, all entities */
+	int n_min;         /* of which minima */
+	int source;        /* enum px_track_source */
+	int leaves_solved; /* leaves re-solved this update */
+	int created;       /* pairs created this update */
+	int annihilated;   /* pairs annihilated this update */
+	int verified;      /* 1 when compared with the global query */
+};
+
+struct px_track_stats {
+	uint64_t updates;
+	uint64_t reinits;        /* entity re-initialisations (anomalies) */
+	uint64_t outside;        /* updates with a point outside the volume */
+	uint64_t fallbacks;      /* answered by the global query */
+	uint64_t overflows;      /* capacity exceeded (also a fallback) */
+	uint64_t unresolved;     /* root isolation not certified (fallback) */
+	uint64_t verifications;
+	uint64_t disagreements;  /* verification found a closer point */
+	uint64_t leaf_solves;
+	uint64_t box_hits;       /* leaves whose box the segment hit */
+	uint64_t creations, annihilations; /* pairs */
+};
+
+struct px_track_info {
+	int n_entities, n_spans, n_leaves, n_boxed_leaves;
+	int n_cells;             /* (grid cell, leaf) event entries */
+	int n_cusps, n_breaks;   /* detected cusps, C0/C1 breaks (all) */
+	px_aabb work;
+	size_t bytes;            /* tracker memory without the global model */
+};
+
+struct px_track;
+
+/*
+ * Prepare a tracker for n_curves curves (valid NURBS curves, copied).
+ * opts may be NULL. Setup only: allocates, may take long.
+ * Returns PX_OK, PX_E_INVAL (NULL, no curve, bad options), PX_E_RANGE
+ * (degree above PX_NURBS_MAX_DEGREE), PX_E_NOMEM, or an error of
+ * px_dist_model_create().
+ */
+PX_API int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
+			   const struct px_track_opts *opts,
+			   struct px_track **out);
+
+/* NULL is a no-op. */
+PX_API void px_track_free(struct px_track *t);
+
+/*
+ * Rebuild the tracked state at p (all critical points by root isolation)
+ * and answer for p. The first px_track_update() does this by itself.
+ * Returns as px_track_update(). @note RT-safe (bounded, but costs as
+ * much as a global query or more).
+ */
+PX_API int px_track_reset(struct px_track *t, px_vec3 p,
+			  struct px_track_result *r);
+
+/*
+ * Move the point to p and answer: the closest point of all curves.
+ * Returns PX_OK, PX_E_INVAL (NULL) or PX_E_NAN (p not finite; state and
+ * r untouched). @note RT-safe.
+ */
+PX_API int px_track_update(struct px_track *t, px_vec3 p,
+			   struct px_track_result *r);
+
+/*
+ * The live critical points of an entity, sorted by parameter: u[i] and
+ * type[i] (+1 minimum, -1 maximum), up to cap of them. Returns the
+ * number held (may exceed cap) or PX_E_INVAL / PX_E_RANGE (entity).
+ * @note RT-safe.
+ */
+PX_API int px_track_critical(const struct px_track *t, int entity, double *u,
+			     int *type, int cap);
+
+/* Counters since creation. @note RT-safe. */
+PX_API void px_track_get_stats(const struct px_track *t,
+			       struct px_track_stats *s);
+
+PX_API void px_track_get_info(const struct px_track *t,
+			      struct px_track_info *info);
+
+/* The global-query model the tracker verifies and falls back with
+ * (owned by the tracker). @note RT-safe. */
+PX_API struct px_dist_model *px_track_dist_model(struct px_track *t);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
