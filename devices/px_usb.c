@@ -172,8 +172,18 @@ static void LIBUSB_CALL on_in(struct libusb_transfer *t)
 			      t->endpoint, NULL, "USB IN transfer failed", now);
 		break;
 	}
-	if (atomic_load(&u->stop) || libusb_submit_transfer(t) != 0)
+	if (atomic_load(&u->stop)) {
 		atomic_fetch_sub(&u->in_flight, 1);
+		return;
+	}
+	/* On a disconnect the pending transfer may end in a plain error
+	 * (dummy_hcd, some host controllers) and only the resubmission says
+	 * NO_DEVICE. A transfer that cannot go again leaves no reader:
+	 * handled like an unplug, so the device is reopened. */
+	if (libusb_submit_transfer(t) != 0) {
+		atomic_fetch_sub(&u->in_flight, 1);
+		atomic_store(&u->gone, 1);
+	}
 }
 
 static int submit_all(struct usb *u)
@@ -231,6 +241,17 @@ static void *events_main(void *p)
 		if (!u->h) {
 			sleep_ns(REOPEN_NS);
 			pthread_mutex_lock(&u->lock);
+			/* A fresh context lists the bus again: libusb's udev back
+			 * end learns of new devices only from udevd's events, and
+			 * without udevd (containers, minimal systems) a replugged
+			 * device would never appear in the old context. */
+			if (atomic_load(&u->in_flight) == 0) {
+				libusb_context *c = NULL;
+				if (libusb_init(&c) == 0) {
+					libusb_exit(u->ctx);
+					u->ctx = c;
+				}
+			}
 			if (usb_open(u, px_dev_name(u->dev), NULL, 0) == PX_OK) {
 				if (submit_all(u) == 0)
 					px_dev_set_state(u->dev,

@@ -491,6 +491,8 @@ static void test_raw_on_vcan(void)
 	c.error_frames = 1;
 	if (px_can_raw_open(&c, &tx, &e, msg, sizeof msg) != PX_OK)
 		PX_SKIP("no usable vcan0 here (%s)", msg);
+	/* virtual: no controller, so no state (and nothing on stderr) */
+	PX_CHECK_INT_EQ(px_can_iface_state("vcan0", &e), PX_E_UNSUPPORTED);
 	c.filters = &flt;
 	c.n_filters = 1;
 	PX_CHECK_INT_EQ(px_can_raw_open(&c, &rx, &e, msg, sizeof msg), PX_OK);
