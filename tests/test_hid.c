@@ -288,6 +288,21 @@ static void test_usb_hid_gadget(void)
 	PX_CHECK_NEAR(s.pos_m.x, -0.004, 1e-12);
 	PX_CHECK_NEAR(s.pos_m.z, 0.5, 1e-12);
 	PX_CHECK_INT_EQ(s.buttons, 3);
+	/* output report 2 through the back end, read by the gadget:
+	 * 1.5 N, -0.25 N, 7 N clamped to 3 N, in mN */
+	{
+		struct px_force_cmd cmd = {{1.5, -0.25, 7.0}, {0, 0, 0}, 1};
+		struct pollfd p = {fd, POLLIN, 0};
+		PX_CHECK_INT_EQ(px_dev_force_write(d, &cmd, px_dev_mono_ns()),
+				PX_OK);
+		PX_CHECK(poll(&p, 1, 5000) == 1);
+		n = (int)read(fd, rep, sizeof rep);
+		PX_CHECK_INT_EQ(n, 7);
+		PX_CHECK_INT_EQ(rep[0], 2);
+		PX_CHECK_INT_EQ(rep[1] | (rep[2] << 8), 1500);
+		PX_CHECK_INT_EQ((int16_t)(rep[3] | (rep[4] << 8)), -250);
+		PX_CHECK_INT_EQ(rep[5] | (rep[6] << 8), 3000);
+	}
 	close(fd);
 	px_dev_free(d);
 }

@@ -23,7 +23,8 @@ cp "$vmdir"/kernel/modules/*.ko "$vmdir/kernel/modules/load.list" "$root/lib/mod
 [ -f "$vmdir/kernel/no-gpio-sim" ] && cp "$vmdir/kernel/no-gpio-sim" "$root/px/vm/"
 cp "$here/init" "$root/init"
 chmod 755 "$root/init"
-cp "$here/guest.sh" "$here/guest_probe.sh" "$here/setup_report.sh" "$root/px/vm/"
+cp "$here/guest.sh" "$here/guest_probe.sh" "$here/setup_report.sh" \
+	"$here/guest_e2e.sh" "$here/e2e.yaml" "$root/px/vm/"
 cp "$vmdir/tests.list" "$root/px/vm/tests.list"
 # the report descriptor of the USB HID gadget: the built-in "haptic" codec
 # map (report 1 in: x, y, z int32, 4 buttons; report 2 out: 3 x int16)

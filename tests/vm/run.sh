@@ -55,6 +55,7 @@ $build/tests/test_usb=$g/tests/test_usb
 $build/tests/test_gpio=$g/tests/test_gpio
 $build/bin/proxima-probe=$g/bin/proxima-probe
 $build/bin/proxima-simarm=$g/bin/proxima-simarm
+$build/bin/proxima-run=$g/bin/proxima-run
 $top/tests/run.sh=/px/tests/run.sh
 $top/tests/test_probe.sh=/px/tests/test_probe.sh"
 for a in $files; do
@@ -65,7 +66,8 @@ done
 [ -n "${PX_VM_TESTS:-}" ] && printf '%s\n' $PX_VM_TESTS >"$vmdir/tests.list" ||
 printf '%s\n' $g/tests/test_can $g/tests/test_canopen $g/tests/test_hid \
 	$g/tests/test_hid_libusb $g/tests/test_usb $g/tests/test_gpio \
-	/px/tests/test_probe.sh /px/vm/guest_probe.sh >"$vmdir/tests.list"
+	/px/tests/test_probe.sh /px/vm/guest_probe.sh /px/vm/guest_e2e.sh \
+	>"$vmdir/tests.list"
 # shellcheck disable=SC2086
 if ! sh "$here/mkinitrd.sh" "$vmdir" "$vmdir/initramfs.cpio" $files; then
 	echo "FAIL VM suite: building the initramfs failed"
