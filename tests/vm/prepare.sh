@@ -28,8 +28,16 @@ sh "$top/tools/install-deps.sh" qemu-system-x86 busybox-static cpio kmod ||
 	skip "host packages qemu-system-x86 busybox-static cpio kmod are missing and could not be installed"
 
 # The kernel ABI the linux-image-amd64 metapackage depends on now.
-abi=$(apt-cache depends linux-image-amd64 2>/dev/null |
-	sed -n 's/^ *Depends: linux-image-\([0-9][^ ]*\)-amd64$/\1/p' | head -n 1)
+resolve_abi() {
+	apt-cache depends linux-image-amd64 2>/dev/null |
+		sed -n 's/^ *Depends: linux-image-\([0-9][^ ]*\)-amd64$/\1/p' | head -n 1
+}
+abi=$(resolve_abi)
+# empty or stale package lists (a fresh container): refresh once, as root
+if [ -z "$abi" ] && [ "$(id -u)" = 0 ]; then
+	apt-get update -qq >/dev/null 2>&1
+	abi=$(resolve_abi)
+fi
 [ -n "$abi" ] || skip "apt-cache knows no linux-image-amd64 (no Debian kernel packages in the apt sources)"
 kver=$abi-amd64
 pkgver=$(apt-cache show "linux-image-$kver" 2>/dev/null | sed -n 's/^Version: //p' | head -n 1)
@@ -42,7 +50,11 @@ rm -rf "$kdir"
 mkdir -p "$kdir/modules"
 
 # ---- kernel and modules (downloaded and unpacked, never installed) --------
-(cd "$tmp" && apt-get download -q "linux-image-$kver=$pkgver" >/dev/null 2>"$tmp/dl.err") ||
+fetch() { (cd "$tmp" && apt-get download -q "$1" >/dev/null 2>"$tmp/dl.err"); }
+# a 404 from lists older than the mirror: refresh once, as root
+fetch "linux-image-$kver=$pkgver" ||
+	{ [ "$(id -u)" = 0 ] && apt-get update -qq >/dev/null 2>&1 &&
+		fetch "linux-image-$kver=$pkgver"; } ||
 	{ cat "$tmp/dl.err" >&2; skip "apt-get download linux-image-$kver failed (no network or mirror?)"; }
 dpkg -x "$tmp"/linux-image-*.deb "$tmp/root" || die "dpkg -x linux-image-$kver"
 rm -f "$tmp"/linux-image-*.deb
@@ -76,7 +88,7 @@ else
 		srcver=$(apt-cache show linux-source-6.1 2>/dev/null | sed -n 's/^Version: //p' | head -n 1)
 	if [ -z "$srcver" ]; then
 		gpio_note="apt knows no linux-source-6.1"
-	elif ! (cd "$tmp" && apt-get download -q "linux-source-6.1=$srcver" >/dev/null 2>"$tmp/dl.err"); then
+	elif ! fetch "linux-source-6.1=$srcver"; then
 		gpio_note="apt-get download linux-source-6.1=$srcver failed: $(tail -n 1 "$tmp/dl.err")"
 	else
 		[ "$srcver" = "$pkgver" ] || say "note: linux-source-6.1 $srcver with kernel $pkgver"
