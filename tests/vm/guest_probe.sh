@@ -10,11 +10,22 @@ if [ -n "${PX_TEST_GADGET_DIR:-}" ] && [ -z "$(cat "$PX_TEST_GADGET_DIR/UDC")" ]
 	echo "$PX_TEST_UDC" >"$PX_TEST_GADGET_DIR/UDC"
 	sleep 2
 fi
+# a uhid device for as long as fd 3 stays open
+uhid=0
+if exec 3<>/dev/uhid && cat /px/vm/uhid_create.bin >&3; then
+	uhid=1
+	n=50
+	while [ "$n" -gt 0 ] && ! grep -qs 'HID_ID=0003:00001234:00000002' /sys/class/hidraw/*/device/uevent; do
+		sleep 0.1; n=$((n - 1))
+	done
+fi
 out=$(/px/build/bin/proxima-probe --lines 2>&1); rc=$?
+[ "$uhid" = 1 ] && exec 3>&-
 echo "$out" | sed 's/^/    /'
 has() { echo "$out" | grep -qE "$1"; }
 check "exit status 0" test "$rc" -eq 0
 check "can: vcan0 listed (virtual: no controller state)" has '^can:  vcan0 \(no controller state: virtual\)$'
+check "hid: the uhid device 1234:0002" has '^hid: .*1234:0002.*"proxima uhid haptic"'
 if [ -n "${PX_TEST_USB_VIDPID:-}" ]; then
 	check "usb: the gadget $PX_TEST_USB_VIDPID" has "^usb: .* ${PX_TEST_USB_VIDPID}"
 	check "hid: the gadget through usbhid/hidraw" has "^hid: .*${PX_TEST_USB_VIDPID}"

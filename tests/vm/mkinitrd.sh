@@ -30,6 +30,17 @@ cp "$vmdir/tests.list" "$root/px/vm/tests.list"
 # map (report 1 in: x, y, z int32, 4 buttons; report 2 out: 3 x int16)
 printf '\005\001\011\010\241\001\205\001\011\060\011\061\011\062\027\000\000\000\200\047\377\377\377\177\165\040\225\003\201\002\005\011\031\001\051\004\025\000\045\001\165\001\225\004\201\002\165\004\225\001\201\001\205\002\006\000\377\011\001\026\000\200\046\377\177\165\020\225\003\221\002\300' \
 	>"$root/px/vm/haptic.rd"
+# a UHID_CREATE2 event (struct uhid_event, packed; the kernel zeroes what
+# a short write leaves out) for a uhid device 1234:0002 with that layout
+rdlen=$(wc -c <"$root/px/vm/haptic.rd")
+{
+	printf '\013\000\000\000proxima uhid haptic'
+	head -c $((128 - 19 + 64 + 64)) /dev/zero
+	printf "\\$(printf %03o $((rdlen % 256)))\\$(printf %03o $((rdlen / 256)))"
+	printf '\003\000\064\022\000\000\002\000\000\000'
+	head -c 8 /dev/zero
+	cat "$root/px/vm/haptic.rd"
+} >"$root/px/vm/uhid_create.bin"
 libs=$(mktemp)
 for a in "$@"; do
 	f=${a%%=*} d=${a#*=}
