@@ -212,7 +212,8 @@ PX_API int px_can_raw_open(const struct px_can_raw_config *c,
 			   char *msg, size_t cap);
 
 /* Interface state and restart through libsocketcan (netlink; not RT).
- * Return PX_OK or PX_E_NODEV / PX_E_IO / PX_E_UNSUPPORTED. */
+ * Return PX_OK or PX_E_NODEV / PX_E_IO / PX_E_UNSUPPORTED (state: also
+ * a virtual interface such as vcan, which has no controller). */
 PX_API int px_can_iface_state(const char *iface, int *state);
 PX_API int px_can_iface_restart(const char *iface);
 

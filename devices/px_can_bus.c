@@ -542,11 +542,18 @@ static int raw_recv(struct px_can_bus *b, int64_t now, struct px_can_msg *m)
 
 int px_can_iface_state(const char *iface, int *state)
 {
+	char p[64];
 	int s = 0;
 	if (!iface || !state)
 		return PX_E_INVAL;
 	if (if_nametoindex(iface) == 0)
 		return PX_E_NODEV;
+	/* vcan/vxcan have no controller, hence no state; libsocketcan would
+	 * print "no link data found" on stderr for them. Controllers (also
+	 * USB adapters) have a parent device in sysfs. */
+	snprintf(p, sizeof p, "/sys/class/net/%s/device", iface);
+	if (strlen(iface) >= IF_NAMESIZE || access(p, F_OK) != 0)
+		return PX_E_UNSUPPORTED;
 	if (can_get_state(iface, &s) != 0)
 		return PX_E_IO;
 	switch (s) {

@@ -172,8 +172,18 @@ static void LIBUSB_CALL on_in(struct libusb_transfer *t)
 			      t->endpoint, NULL, "USB IN transfer failed", now);
 		break;
 	}
-	if (atomic_load(&u->stop) || libusb_submit_transfer(t) != 0)
+	if (atomic_load(&u->stop)) {
 		atomic_fetch_sub(&u->in_flight, 1);
+		return;
+	}
+	/* On a disconnect the pending transfer may end in a plain error
+	 * (dummy_hcd, some host controllers) and only the resubmission says
+	 * NO_DEVICE. A transfer that cannot go again leaves no reader:
+	 * handled like an unplug, so the device is reopened. */
+	if (libusb_submit_transfer(t) != 0) {
+		atomic_fetch_sub(&u->in_flight, 1);
+		atomic_store(&u->gone, 1);
+	}
 }
 
 static int submit_all(struct usb *u)
@@ -214,6 +224,33 @@ static void sleep_ns(int64_t ns)
 	nanosleep(&ts, NULL);
 }
 
+/* A fresh context lists the bus again: libusb's udev back end learns of
+ * new devices only from udevd's events, and without udevd (containers,
+ * minimal systems) a replugged device would never appear in the old
+ * context. libusb transfers keep a reference to the device they last ran
+ * on, so they are replaced too, and released while their context still
+ * exists. Not for the cycle: runs in the events thread, device closed,
+ * no transfer in flight. */
+static void renew_context(struct usb *u)
+{
+	struct libusb_transfer *t[MAX_XFER] = {0};
+	libusb_context *c = NULL;
+	int i, ok = 1;
+	for (i = 0; i < u->cfg.n_transfers; i++)
+		ok = ok && (t[i] = libusb_alloc_transfer(0)) != NULL;
+	if (!ok || libusb_init(&c) != 0) {
+		for (i = 0; i < u->cfg.n_transfers; i++)
+			libusb_free_transfer(t[i]);
+		return;
+	}
+	for (i = 0; i < u->cfg.n_transfers; i++) {
+		libusb_free_transfer(u->xfer[i]);
+		u->xfer[i] = t[i];
+	}
+	libusb_exit(u->ctx);
+	u->ctx = c;
+}
+
 static void *events_main(void *p)
 {
 	struct usb *u = p;
@@ -231,6 +268,8 @@ static void *events_main(void *p)
 		if (!u->h) {
 			sleep_ns(REOPEN_NS);
 			pthread_mutex_lock(&u->lock);
+			if (atomic_load(&u->in_flight) == 0)
+				renew_context(u);
 			if (usb_open(u, px_dev_name(u->dev), NULL, 0) == PX_OK) {
 				if (submit_all(u) == 0)
 					px_dev_set_state(u->dev,

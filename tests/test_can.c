@@ -491,6 +491,8 @@ static void test_raw_on_vcan(void)
 	c.error_frames = 1;
 	if (px_can_raw_open(&c, &tx, &e, msg, sizeof msg) != PX_OK)
 		PX_SKIP("no usable vcan0 here (%s)", msg);
+	/* virtual: no controller, so no state (and nothing on stderr) */
+	PX_CHECK_INT_EQ(px_can_iface_state("vcan0", &e), PX_E_UNSUPPORTED);
 	c.filters = &flt;
 	c.n_filters = 1;
 	PX_CHECK_INT_EQ(px_can_raw_open(&c, &rx, &e, msg, sizeof msg), PX_OK);
@@ -519,6 +521,61 @@ static void test_raw_on_vcan(void)
 	PX_CHECK_INT_EQ(px_can_bus_recv(rx, 0, &m), PX_E_AGAIN); /* filtered */
 	px_can_bus_close(tx);
 	px_can_bus_close(rx);
+}
+
+static void test_error_frames_on_vcan(void)
+{
+	/* vcan has no controller, but error frames written to it by a raw
+	 * socket reach the other sockets whose error mask takes them: the
+	 * back end decodes them and follows the bus state. One without
+	 * error_frames never sees them. */
+	struct px_can_raw_config c;
+	struct px_can_bus *rx, *plain;
+	struct px_can_bus_stats st;
+	struct px_can_msg m;
+	struct sockaddr_can a;
+	struct can_frame f[2];
+	char msg[400];
+	int e, i, s, got = 0;
+	memset(&c, 0, sizeof c);
+	c.interface = "vcan0";
+	c.error_frames = 1;
+	if (px_can_raw_open(&c, &rx, &e, msg, sizeof msg) != PX_OK)
+		PX_SKIP("no usable vcan0 here (%s)", msg);
+	c.error_frames = 0;
+	PX_CHECK_INT_EQ(px_can_raw_open(&c, &plain, &e, msg, sizeof msg), PX_OK);
+	s = socket(PF_CAN, SOCK_RAW, CAN_RAW);
+	PX_CHECK(s >= 0);
+	memset(&a, 0, sizeof a);
+	a.can_family = AF_CAN;
+	a.can_ifindex = (int)if_nametoindex("vcan0");
+	PX_CHECK(bind(s, (struct sockaddr *)&a, sizeof a) == 0);
+	memset(f, 0, sizeof f);
+	f[0].can_id = CAN_ERR_FLAG | CAN_ERR_CRTL;
+	f[0].len = CAN_ERR_DLC;
+	f[0].data[1] = CAN_ERR_CRTL_RX_PASSIVE | CAN_ERR_CRTL_TX_PASSIVE;
+	f[1].can_id = CAN_ERR_FLAG | CAN_ERR_BUSOFF;
+	f[1].len = CAN_ERR_DLC;
+	for (i = 0; i < 2; i++)
+		PX_CHECK(write(s, &f[i], sizeof f[i]) == (ssize_t)sizeof f[i]);
+	for (i = 0; i < 200 && got < 2; i++) {
+		if (px_can_bus_recv(rx, 0, &m) != PX_OK) {
+			wait_ms(5);
+			continue;
+		}
+		PX_CHECK(m.f.can_id & CAN_ERR_FLAG);
+		px_can_bus_stats(rx, &st);
+		PX_CHECK_INT_EQ(st.state, got == 0 ? PX_CAN_STATE_PASSIVE
+						   : PX_CAN_STATE_BUS_OFF);
+		got++;
+	}
+	PX_CHECK_INT_EQ(got, 2);
+	px_can_bus_stats(rx, &st);
+	PX_CHECK_INT_EQ(st.err_frames, 2);
+	PX_CHECK_INT_EQ(px_can_bus_recv(plain, 0, &m), PX_E_AGAIN);
+	close(s);
+	px_can_bus_close(rx);
+	px_can_bus_close(plain);
 }
 
 static void test_replay_and_record(void)
@@ -814,6 +871,7 @@ static const struct px_test tests[] = {
 	PX_T(test_unix_bus_between_processes),
 	PX_T(test_raw_open_path),
 	PX_T(test_raw_on_vcan),
+	PX_T(test_error_frames_on_vcan),
 	PX_T(test_replay_and_record),
 	PX_T(test_can_device_on_sim_bus),
 };

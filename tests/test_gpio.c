@@ -349,12 +349,64 @@ static void test_gpiod_on_gpio_sim(void)
 	px_dev_free(d);
 }
 
+static void test_gpiod_by_name_on_gpio_sim(void)
+{
+	/* Lines found by their kernel names and the chip by its label (the
+	 * VM suite names gpio-sim lines 0 and 1 "estop" and "enable" and
+	 * labels the chip PX_TEST_GPIO_LABEL). Press, release and press
+	 * again through "pull": each edge reaches the e-stop. */
+	const char *label = getenv("PX_TEST_GPIO_LABEL");
+	const char *dir = getenv("PX_TEST_GPIOSIM_DIR");
+	struct px_gpio_config c = io_cfg(0);
+	struct px_dev_config dc;
+	struct px_dev *d;
+	char msg[400];
+	int e, p = -1, i, k;
+	if (!label || !dir)
+		PX_SKIP("PX_TEST_GPIO_LABEL/PX_TEST_GPIOSIM_DIR not set: the VM "
+			"suite runs this on gpio-sim");
+	c.chip = label;
+	c.line[PX_GPIO_ESTOP].line_name = "estop";
+	c.line[PX_GPIO_ESTOP].offset = 99; /* ignored: the name wins */
+	c.line[PX_GPIO_ESTOP].debounce_ns = 1000000;
+	c.line[PX_GPIO_ENABLE].line_name = "enable";
+	c.line[PX_GPIO_ENABLE].offset = 98;
+	c.line[PX_GPIO_TIMING].present = 0;
+	PX_CHECK_INT_EQ(sysfs_write(dir, "sim_gpio0/pull", "pull-down"), 0);
+	px_dev_config_default(&dc);
+	dc.name = "io";
+	PX_CHECK_MSG(px_gpiod_create(&dc, &c, &d, &e, msg, sizeof msg) == PX_OK,
+		     "%s", msg);
+	PX_CHECK_INT_EQ(px_dev_dio_write(d, PX_DIO_ENABLE, 1, mono()), PX_OK);
+	PX_CHECK_INT_EQ(sysfs_read(dir, "sim_gpio1/value"), 1);
+	for (k = 0; k < 3; k++) {
+		int want = k % 2 == 0;
+		PX_CHECK_INT_EQ(sysfs_write(dir, "sim_gpio0/pull",
+					    want ? "pull-up" : "pull-down"),
+				0);
+		for (i = 0; i < 500 && p != want; i++) {
+			struct timespec ts = {0, 2000000};
+			nanosleep(&ts, NULL);
+			px_dev_estop_read(d, mono(), &p);
+		}
+		PX_CHECK_MSG(p == want, "edge %d: e-stop %d", k, p);
+	}
+	PX_CHECK_INT_EQ(px_dev_dio_write(d, PX_DIO_ENABLE, 0, mono()), PX_OK);
+	PX_CHECK_INT_EQ(sysfs_read(dir, "sim_gpio1/value"), 0);
+	px_dev_free(d);
+	/* a name the chip does not have is named in the error */
+	c.line[PX_GPIO_ENABLE].line_name = "no-such-line";
+	PX_CHECK(px_gpiod_create(&dc, &c, &d, &e, msg, sizeof msg) != PX_OK);
+	PX_CHECK_MSG(strstr(msg, "no-such-line") != NULL, "%s", msg);
+}
+
 static const struct px_test tests[] = {
 	PX_T(test_debounce_matches_reference),
 	PX_T(test_chatter_gives_one_press),
 	PX_T(test_estop_trips_loop_and_holds_safe_state),
 	PX_T(test_gpiod_open_path),
 	PX_T(test_gpiod_on_gpio_sim),
+	PX_T(test_gpiod_by_name_on_gpio_sim),
 };
 
 PX_TEST_MAIN(tests)

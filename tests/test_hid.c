@@ -238,12 +238,75 @@ static void test_uhid_device_roundtrip(void)
 	close(fd);
 }
 
+static int write_file(const char *dir, const char *name, const char *v)
+{
+	char p[512];
+	FILE *f;
+	snprintf(p, sizeof p, "%s/%s", dir, name);
+	f = fopen(p, "w");
+	if (!f)
+		return -1;
+	fputs(v, f);
+	return fclose(f);
+}
+
+/* Unbind the gadget's UDC (an unplug) and bind it again (a replug). The
+ * back end must report the device stale and unplugged, then, for hidraw,
+ * reopen it and deliver reports again. hidapi-libusb keeps one libusb
+ * context per process, which learns of a new device only from udevd: in
+ * a system without udevd (the guest) it cannot see the replug. */
+static void gadget_unplug_replug(struct px_dev *d, const char *gdir,
+				 const char *udc, const char *hidg)
+{
+	const struct px_codec_map *m = px_codec_builtin("haptic");
+	double a[6] = {0.007, 0.001, -0.002, 0, 0, 0};
+	struct px_pose_sample s;
+	struct px_dev_status st;
+	uint8_t rep[64];
+	int i, n, fd, rc = 0;
+	PX_CHECK_INT_EQ(write_file(gdir, "UDC", "\n"), 0);
+	for (i = 0; i < 500; i++) {
+		rc = px_dev_pose_read(d, px_dev_mono_ns(), &s);
+		if (rc == PX_E_NODEV)
+			break;
+		wait_ms(10);
+	}
+	PX_CHECK_INT_EQ(rc, PX_E_NODEV);
+	PX_CHECK(!s.valid && s.stale);
+	PX_CHECK_INT_EQ(write_file(gdir, "UDC", udc), 0);
+	if (px_hid_driver() == PX_HID_LIBUSB)
+		return;
+	for (i = 0; i < 500 && px_dev_state(d) != PX_DEV_STATE_RUNNING; i++)
+		wait_ms(10);
+	PX_CHECK_INT_EQ(px_dev_state(d), PX_DEV_STATE_RUNNING);
+	fd = open(hidg, O_RDWR);
+	PX_CHECK_MSG(fd >= 0, "%s: %s", hidg, strerror(errno));
+	n = px_codec_encode_input(m, 1, a, 9, rep, sizeof rep);
+	for (i = 0; i < 300; i++) {
+		if (write(fd, rep, (size_t)n) != n)
+			wait_ms(5);
+		px_dev_pose_read(d, px_dev_mono_ns(), &s);
+		if (s.valid && s.buttons == 9)
+			break;
+		wait_ms(10);
+	}
+	PX_CHECK(s.valid && !s.stale);
+	PX_CHECK_NEAR(s.pos_m.x, 0.007, 1e-12);
+	PX_CHECK_INT_EQ(s.buttons, 9);
+	px_dev_status(d, &st);
+	PX_CHECK_INT_EQ(st.unplugs, 1);
+	PX_CHECK_INT_EQ(st.replugs, 1);
+	close(fd);
+}
+
 static void test_usb_hid_gadget(void)
 {
 	/* A configfs USB HID gadget (PX_TEST_USB_VIDPID, PX_TEST_HIDG): seen
 	 * by hidraw through usbhid, or by hidapi-libusb directly. */
 	const char *vp = getenv("PX_TEST_USB_VIDPID");
 	const char *hidg = getenv("PX_TEST_HIDG");
+	const char *gdir = getenv("PX_TEST_GADGET_DIR");
+	const char *udc = getenv("PX_TEST_UDC");
 	const struct px_codec_map *m = px_codec_builtin("haptic");
 	struct px_dev_config c;
 	struct px_hid_config h;
@@ -288,7 +351,24 @@ static void test_usb_hid_gadget(void)
 	PX_CHECK_NEAR(s.pos_m.x, -0.004, 1e-12);
 	PX_CHECK_NEAR(s.pos_m.z, 0.5, 1e-12);
 	PX_CHECK_INT_EQ(s.buttons, 3);
+	/* output report 2 through the back end, read by the gadget:
+	 * 1.5 N, -0.25 N, 7 N clamped to 3 N, in mN */
+	{
+		struct px_force_cmd cmd = {{1.5, -0.25, 7.0}, {0, 0, 0}, 1};
+		struct pollfd p = {fd, POLLIN, 0};
+		PX_CHECK_INT_EQ(px_dev_force_write(d, &cmd, px_dev_mono_ns()),
+				PX_OK);
+		PX_CHECK(poll(&p, 1, 5000) == 1);
+		n = (int)read(fd, rep, sizeof rep);
+		PX_CHECK_INT_EQ(n, 7);
+		PX_CHECK_INT_EQ(rep[0], 2);
+		PX_CHECK_INT_EQ(rep[1] | (rep[2] << 8), 1500);
+		PX_CHECK_INT_EQ((int16_t)(rep[3] | (rep[4] << 8)), -250);
+		PX_CHECK_INT_EQ(rep[5] | (rep[6] << 8), 3000);
+	}
 	close(fd);
+	if (gdir && udc)
+		gadget_unplug_replug(d, gdir, udc, hidg);
 	px_dev_free(d);
 }
 

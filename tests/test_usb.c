@@ -126,11 +126,17 @@ static void test_hid_gadget_frames_unplug_replug(void)
 	if (gdir && udc) {
 		PX_CHECK_INT_EQ(write_file(gdir, "UDC", "\n"), 0); /* unplug */
 		for (i = 0; i < 300; i++) {
-			if (px_dev_pose_read(d, px_dev_mono_ns(), &s) == PX_E_NODEV)
+			rc = px_dev_pose_read(d, px_dev_mono_ns(), &s);
+			if (rc == PX_E_NODEV)
 				break;
 			wait_ms(10);
 		}
-		PX_CHECK(!s.valid && s.stale);
+		px_dev_status(d, &st);
+		PX_CHECK_MSG(!s.valid && s.stale,
+			     "after unplug: read %d, valid %d, stale %d, "
+			     "state %d, unplugs %d: %s",
+			     rc, s.valid, s.stale, px_dev_state(d),
+			     (int)st.unplugs, st.last_msg);
 		PX_CHECK_INT_EQ(write_file(gdir, "UDC", udc), 0); /* replug */
 		for (i = 0; i < 500; i++) {
 			px_dev_pose_read(d, px_dev_mono_ns(), &s);

@@ -1,0 +1,2 @@
+#!/bin/sh
+cat /tmp/vm_setup.out
