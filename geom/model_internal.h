@@ -23,4 +23,11 @@ int px__import_file(const char *path, int want_tri, double **xyz,
 		    size_t *nv, uint32_t **tri, size_t *nt, size_t *n_skipped,
 		    char *msg, size_t msg_cap);
 
+/*
+ * Quickselect for the hierarchies (mesh, cloud, scene): reorder the index
+ * array a[0..n) so that a[k] holds the element whose key[3 * a[k] + axis]
+ * is the k-th smallest, smaller keys before it and larger after. Setup.
+ */
+void px__select_k(uint32_t *a, long n, long k, const double *key, int axis);
+
 #endif

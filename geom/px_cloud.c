@@ -64,34 +64,6 @@ static void cloud_free(void *impl)
 
 /* ---- build ------------------------------------------------------------------ */
 
-static void select_k(uint32_t *a, long n, long k, const double *xyz, int axis)
-{
-	long lo = 0, hi = n - 1;
-	while (lo < hi) {
-		double pv = xyz[3 * (size_t)a[lo + (hi - lo) / 2] + axis];
-		long i = lo, j = hi;
-		while (i <= j) {
-			while (xyz[3 * (size_t)a[i] + axis] < pv)
-				i++;
-			while (xyz[3 * (size_t)a[j] + axis] > pv)
-				j--;
-			if (i <= j) {
-				uint32_t t = a[i];
-				a[i] = a[j];
-				a[j] = t;
-				i++;
-				j--;
-			}
-		}
-		if (k <= j)
-			hi = j;
-		else if (k >= i)
-			lo = i;
-		else
-			break;
-	}
-}
-
 struct build {
 	uint32_t *perm;
 	const double *xyz;
@@ -129,7 +101,7 @@ static uint32_t build_node(struct build *B, size_t s, size_t n, int depth,
 	for (k = 1; k < 3; k++)
 		if (hi[k] - lo[k] > hi[axis] - lo[axis])
 			axis = k;
-	select_k(B->perm + s, (long)n, (long)half, B->xyz, axis);
+	px__select_k(B->perm + s, (long)n, (long)half, B->xyz, axis);
 	part[0][0] = s;
 	part[0][1] = half;
 	part[1][0] = s + half;

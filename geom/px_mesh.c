@@ -309,35 +309,6 @@ static double ang(px_vec3 u, px_vec3 w)
 	return atan2(px_v3_norm(px_v3_cross(u, w)), px_v3_dot(u, w));
 }
 
-/* quickselect: put the k-th smallest centroid (on axis) at a[k] */
-static void select_k(uint32_t *a, long n, long k, const double *cen, int axis)
-{
-	long lo = 0, hi = n - 1;
-	while (lo < hi) {
-		double pv = cen[3 * (size_t)a[lo + (hi - lo) / 2] + axis];
-		long i = lo, j = hi;
-		while (i <= j) {
-			while (cen[3 * (size_t)a[i] + axis] < pv)
-				i++;
-			while (cen[3 * (size_t)a[j] + axis] > pv)
-				j--;
-			if (i <= j) {
-				uint32_t t = a[i];
-				a[i] = a[j];
-				a[j] = t;
-				i++;
-				j--;
-			}
-		}
-		if (k <= j)
-			hi = j;
-		else if (k >= i)
-			lo = i;
-		else
-			break;
-	}
-}
-
 struct build {
 	uint32_t *perm;
 	const double *cen;  /* 3 per input triangle */
@@ -502,7 +473,7 @@ static uint32_t build_node(struct build *B, size_t s, size_t n, int depth)
 		for (k = 1; k < 3; k++)
 			if (chi[k] - clo[k] > chi[axis] - clo[axis])
 				axis = k;
-		select_k(B->perm + s, (long)n, (long)half, B->cen, axis);
+		px__select_k(B->perm + s, (long)n, (long)half, B->cen, axis);
 	}
 	part[0][0] = s;
 	part[0][1] = half;

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "px_model.h"
+#include "model_internal.h"
 
 struct px_model {
 	const struct px_model_ops *ops;
@@ -266,4 +267,32 @@ unsigned long px_model_cache_queries(const struct px_model_cache *c)
 unsigned long px_model_cache_refills(const struct px_model_cache *c)
 {
 	return c ? c->refills_ : 0;
+}
+
+void px__select_k(uint32_t *a, long n, long k, const double *key, int axis)
+{
+	long lo = 0, hi = n - 1;
+	while (lo < hi) {
+		double pv = key[3 * (size_t)a[lo + (hi - lo) / 2] + axis];
+		long i = lo, j = hi;
+		while (i <= j) {
+			while (key[3 * (size_t)a[i] + axis] < pv)
+				i++;
+			while (key[3 * (size_t)a[j] + axis] > pv)
+				j--;
+			if (i <= j) {
+				uint32_t t = a[i];
+				a[i] = a[j];
+				a[j] = t;
+				i++;
+				j--;
+			}
+		}
+		if (k <= j)
+			hi = j;
+		else if (k >= i)
+			lo = i;
+		else
+			break;
+	}
 }

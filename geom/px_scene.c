@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "px_scene.h"
+#include "model_internal.h"
 
 #define LEAF 2
 #define STACK 64 /* depth <= log2(PX_SCENE_MAX_CAPACITY) + 2 */
@@ -94,34 +95,6 @@ size_t px_scene_count(const struct px_scene *s)
 
 /* ---- hierarchy ------------------------------------------------------------- */
 
-static void select_k(uint32_t *a, long n, long k, const double *cen, int axis)
-{
-	long lo = 0, hi = n - 1;
-	while (lo < hi) {
-		double pv = cen[3 * (size_t)a[lo + (hi - lo) / 2] + axis];
-		long i = lo, j = hi;
-		while (i <= j) {
-			while (cen[3 * (size_t)a[i] + axis] < pv)
-				i++;
-			while (cen[3 * (size_t)a[j] + axis] > pv)
-				j--;
-			if (i <= j) {
-				uint32_t t = a[i];
-				a[i] = a[j];
-				a[j] = t;
-				i++;
-				j--;
-			}
-		}
-		if (k <= j)
-			hi = j;
-		else if (k >= i)
-			lo = i;
-		else
-			break;
-	}
-}
-
 static void range_box(const struct px_scene *s, size_t b, size_t n, double lo[3],
 		      double hi[3])
 {
@@ -159,7 +132,7 @@ static uint32_t build(struct px_scene *s, size_t b, size_t n)
 	for (k = 1; k < 3; k++)
 		if (chi[k] - clo[k] > chi[axis] - clo[axis])
 			axis = k;
-	select_k(s->perm + b, (long)n, (long)half, s->cen, axis);
+	px__select_k(s->perm + b, (long)n, (long)half, s->cen, axis);
 	part[0][0] = b;
 	part[0][1] = half;
 	part[1][0] = b + half;
