@@ -436,6 +436,79 @@ static void test_pillow(void)
 	PX_CHECK(st.inside > 100 && st.outside > 100);
 }
 
+/* Bilinear quad with corners c0..c3 counterclockwise seen from the side
+ * Su x Sv points to. */
+static void quad(struct px_nurbs_surf *s, px_vec3 c0, px_vec3 c1, px_vec3 c2, px_vec3 c3)
+{
+	static const double k1[4] = {0, 0, 1, 1};
+	double xyz[12] = {c0.x, c0.y, c0.z, c1.x, c1.y, c1.z,
+			  c3.x, c3.y, c3.z, c2.x, c2.y, c2.z};
+	PX_CHECK_INT_EQ(px_nurbs_surf_init(s, &arena, 1, 1, 2, 2, k1, 4, k1, 4, xyz, NULL,
+					   NULL),
+			PX_OK);
+}
+
+static int l_inside(px_vec3 x, double h)
+{
+	if (x.z <= 0.0 || x.z >= h || x.x <= 0.0 || x.y <= 0.0)
+		return 0;
+	return (x.x < 2.0 && x.y < 1.0) || (x.x < 1.0 && x.y < 2.0);
+}
+
+/* An L-shaped prism: a reflex (concave) edge, T-junctions between the
+ * caps (two rectangles each) and the long side faces. */
+static void test_l_prism(void)
+{
+	static const double poly[6][2] = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+	struct px_nurbs_surf s[10];
+	struct px_model *m;
+	struct stats st = {0, 0};
+	const double h = 0.8;
+	uint64_t a;
+	int i, n = 0;
+	arena_reset();
+	for (i = 0; i < 6; i++) {
+		const double *p0 = poly[i], *p1 = poly[(i + 1) % 6];
+		quad(&s[n++], px_v3(p0[0], p0[1], 0), px_v3(p1[0], p1[1], 0),
+		     px_v3(p1[0], p1[1], h), px_v3(p0[0], p0[1], h));
+	}
+	/* caps: [0,2]x[0,1] and [0,1]x[1,2], top facing +z, bottom -z */
+	quad(&s[n++], px_v3(0, 0, h), px_v3(2, 0, h), px_v3(2, 1, h), px_v3(0, 1, h));
+	quad(&s[n++], px_v3(0, 1, h), px_v3(1, 1, h), px_v3(1, 2, h), px_v3(0, 2, h));
+	quad(&s[n++], px_v3(0, 0, 0), px_v3(0, 1, 0), px_v3(2, 1, 0), px_v3(2, 0, 0));
+	quad(&s[n++], px_v3(0, 1, 0), px_v3(0, 2, 0), px_v3(1, 2, 0), px_v3(1, 1, 0));
+	PX_CHECK_INT_EQ(px_nurbs_model_create(NULL, 0, s, n, NULL, &m), PX_OK);
+	check_closed(m, 3.0 * h, 1e-9);
+	a = px_alloc_region_begin();
+	for (i = 0; i < 400; i++) {
+		px_vec3 x = px_v3(px_rand_range(-0.5, 2.5), px_rand_range(-0.5, 2.5),
+				  px_rand_range(-0.4, 1.2));
+		check_point(m, x, l_inside(x, h), &st);
+	}
+	/* Around the reflex edge x = y = 1 and its two end corners, and
+	 * around the T-junction points (0, 1, z) and (1, 1, 0). */
+	for (i = 0; i < 300; i++) {
+		static const double anchors[5][3] = {{1, 1, 0.4}, {1, 1, 0}, {1, 1, 0.8},
+						     {0, 1, 0.3}, {1.5, 1, 0}};
+		const double *k = anchors[i % 5];
+		double sc = (i / 5) % 3 == 0 ? 1e-6 : (i / 5) % 3 == 1 ? 1e-3 : 0.1;
+		px_vec3 x = px_v3_madd(px_v3(k[0], k[1], k[2]),
+				       px_v3(px_rand_normal(), px_rand_normal(), px_rand_normal()),
+				       sc);
+		check_point(m, x, l_inside(x, h), &st);
+	}
+	/* The bisector of the reflex edge, inside and outside. */
+	for (i = 1; i <= 10; i++) {
+		double e = pow(10.0, -i * 0.6);
+		check_point(m, px_v3(1 + e, 1 + e, 0.4), 0, &st);
+		check_point(m, px_v3(1 - e, 1 - e, 0.4), 1, &st);
+	}
+	PX_CHECK_INT_EQ(px_alloc_region_end(a), 0);
+	px_model_free(m);
+	printf("    L prism: %d inside, %d outside\n", st.inside, st.outside);
+	PX_CHECK(st.inside > 100 && st.outside > 200);
+}
+
 static void test_unsigned_cases(void)
 {
 	struct px_nurbs_surf s[6];
@@ -518,6 +591,7 @@ static const struct px_test tests[] = {
 	PX_T(test_torus),
 	PX_T(test_box),
 	PX_T(test_pillow),
+	PX_T(test_l_prism),
 	PX_T(test_unsigned_cases),
 	PX_T(test_on_surface_and_pose),
 };
