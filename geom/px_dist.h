@@ -175,7 +175,8 @@ PX_API int px_dist_query_ws(const struct px_dist_model *m,
 
 /*
  * The same model behind the point-to-model interface (px_model.h), for
- * scenes and model-to-model queries: unsigned distance, entity index and
+ * scenes and model-to-model queries: distance (signed for closed
+ * surface shells, see below), entity index and
  * piece in index/sub, (u, v) of the foot point, certified flag and gap.
  * Up to four threads may query it at once (each borrows a workspace
  * without waiting; a fifth gets PX_E_BUSY). Setup only. Returns as
@@ -186,6 +187,34 @@ PX_API int px_nurbs_model_create(const struct px_nurbs_curve *curves,
 				 int n_curves, const struct px_nurbs_surf *surfs,
 				 int n_surfs, const struct px_dist_opts *opts,
 				 struct px_model **out);
+
+/*
+ * Signed distance. A model of surfaces only that form a closed,
+ * consistently oriented shell gets PX_MODEL_CAP_SIGNED: its answers carry
+ * is_signed, negative distance and inside = 1 for points inside, with
+ * direction pointing out of the solid. Setup checks (px_model_nurbs.c
+ * tells the details): every edge sample of every surface edge that is
+ * not a pole nor a seam lies within tol (1e-6 of the box diagonal) on an
+ * edge of another surface, run in the opposite direction (consistent
+ * orientation); the enclosed volume (divergence theorem, Gauss-Legendre)
+ * is not zero and its sign fixes which side is out. Any model failing a
+ * check stays unsigned and why says which check and where. Queries sign
+ * by the normal at smooth foot points and by the angle-weighted
+ * pseudo-normal on edges, corners, seams, creases and poles; a point on
+ * the surface (distance 0) is outside.
+ */
+struct px_nurbs_sign_info {
+	int closed;        /* 1: signed queries */
+	double volume;     /* enclosed volume (closed only) */
+	int edge_samples;  /* edge samples checked */
+	double tol;        /* matching tolerance used */
+	char why[160];     /* outcome in a sentence */
+};
+
+/* Fill info for a model from px_nurbs_model_create(). Returns PX_OK or
+ * PX_E_INVAL (NULL, or not such a model). @note RT-safe. */
+PX_API int px_nurbs_model_sign_info(const struct px_model *m,
+				    struct px_nurbs_sign_info *info);
 
 /* n queries; stops at the first error and returns it. @note RT-safe. */
 PX_API int px_dist_query_batch(struct px_dist_model *m, const px_vec3 *p,

@@ -400,10 +400,11 @@ static void test_as_posed_model(void)
 	for (i = 0; i < 200; i++) {
 		px_vec3 x = px_v3(px_rand_range(-2, 8), px_rand_range(-6, 4), px_rand_range(-3, 7));
 		PX_CHECK_INT_EQ(px_model_query(m, x, &r), 1);
-		PX_CHECK_CLOSE(r.distance, fabs(px_v3_dist(x, pose.t) - 1.5), 1e-10, 1e-10);
+		/* A closed shell: signed, inside negative. */
+		PX_CHECK_CLOSE(r.distance, px_v3_dist(x, pose.t) - 1.5, 1e-10, 1e-10);
 		PX_CHECK_CLOSE(px_v3_dist(r.point, pose.t), 1.5, 1e-10, 0);
 		PX_CHECK_CLOSE(px_v3_dist(px_v3_madd(r.point, r.direction, r.distance), x), 0.0, 1e-9, 0);
-		PX_CHECK(r.certified && !r.is_signed);
+		PX_CHECK(r.certified && r.is_signed);
 	}
 	PX_CHECK_INT_EQ(px_alloc_region_end(a), 0);
 	px_model_free(m);
