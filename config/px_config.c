@@ -71,6 +71,9 @@ static const char *const axis_names[] = {"x", "y", "z", "rx", "ry", "rz", NULL};
 static const char *const xyz_names[] = {"x", "y", "z", NULL};
 static const char *const wrench_names[] = {"fx", "fy", "fz",
 					   "tx", "ty", "tz", NULL};
+static const char *const signal_axis_names[] = {
+	"none", "x", "y", "z", "rx", "ry", "rz",
+	"fx", "fy", "fz", "tx", "ty", "tz", NULL};
 static const char *const hid_driver_names[] = {"hidraw", "libusb", NULL};
 static const char *const transfer_names[] = {"interrupt", "bulk", NULL};
 static const char *const dir_names[] = {"input", "output", NULL};
@@ -420,6 +423,22 @@ static void signal_check(struct px_config_reader *r,
 	if (s->has_min && s->has_max && !(s->min < s->max))
 		px_config_reader_error(r, px_config_node_get(map, "max"), "max",
 				       "must be greater than min");
+	if (s->direction == PX_CONFIG_SIGNAL_INPUT &&
+	    s->axis >= PX_CONFIG_SIGNAL_AXIS_FX)
+		px_config_reader_error(r, px_config_node_get(map, "axis"),
+				       "axis",
+				       "an input signal feeds a pose axis (x, "
+				       "y, z, rx, ry, rz), not '%s'",
+				       signal_axis_names[s->axis]);
+	if (s->direction == PX_CONFIG_SIGNAL_OUTPUT &&
+	    s->axis != PX_CONFIG_SIGNAL_AXIS_NONE &&
+	    s->axis < PX_CONFIG_SIGNAL_AXIS_FX)
+		px_config_reader_error(r, px_config_node_get(map, "axis"),
+				       "axis",
+				       "an output signal carries a force or "
+				       "torque (fx, fy, fz, tx, ty, tz), not "
+				       "'%s'",
+				       signal_axis_names[s->axis]);
 }
 
 static const struct px_config_key signal_keys[] = {
@@ -440,6 +459,8 @@ static const struct px_config_key signal_keys[] = {
 	K_DBL(struct px_config_can_signal, offset, "offset", 0, -BIG, BIG, 0.0),
 	K_DBLP(struct px_config_can_signal, min, "min", -BIG, BIG, has_min),
 	K_DBLP(struct px_config_can_signal, max, "max", -BIG, BIG, has_max),
+	K_ENUM(struct px_config_can_signal, axis, "axis", 0, signal_axis_names,
+	       PX_CONFIG_SIGNAL_AXIS_NONE),
 };
 SCHEMA(signal_schema, "signal", signal_keys, signal_check);
 
@@ -450,6 +471,14 @@ static const struct px_config_key drive_keys[] = {
 	       PX_CONFIG_CIA402_CSP),
 	K_INT(struct px_config_canopen_drive, joint, "joint", PX_CONFIG_REQUIRED,
 	      0, 63, 0),
+	{.name = "counts_per_unit", .type = PX_CONFIG_T_DOUBLE,
+	 .offset = offsetof(struct px_config_canopen_drive, counts_per_unit),
+	 .flags = RANGE | PX_CONFIG_MIN_EXCL | PX_CONFIG_PRESENT, .dmin = 0.0,
+	 .dmax = BIG, .ddef = 1.0,
+	 .present_offset = offsetof(struct px_config_canopen_drive,
+				    has_counts_per_unit)},
+	K_DBL(struct px_config_canopen_drive, rated_torque_n_m,
+	      "rated_torque_n_m", PX_CONFIG_MIN_EXCL, 0.0, BIG, 1.0),
 };
 SCHEMA(drive_schema, "drive", drive_keys, NULL);
 
