@@ -482,6 +482,15 @@ static const struct px_config_key drive_keys[] = {
 };
 SCHEMA(drive_schema, "drive", drive_keys, NULL);
 
+static const struct px_config_key pdo_entry_keys[] = {
+	K_INT(struct px_config_pdo_entry, index, "index", PX_CONFIG_REQUIRED,
+	      0x1000, 0xffff, 0x1000),
+	K_INT(struct px_config_pdo_entry, subindex, "subindex", 0, 0, 255, 0),
+	K_INT(struct px_config_pdo_entry, bits, "bits", PX_CONFIG_REQUIRED, 1,
+	      64, 8),
+};
+SCHEMA(pdo_entry_schema, "pdo entry", pdo_entry_keys, NULL);
+
 static void canopen_check(struct px_config_reader *r,
 			  const struct px_config_node *map, void *obj)
 {
@@ -524,6 +533,12 @@ static const struct px_config_key canopen_keys[] = {
 	      "heartbeat_timeout_ns", 0, 0, 10 * NS_PER_S, 300000000),
 	K_SEQ(struct px_config_canopen, drives, n_drives, "drives", 0,
 	      drive_schema, struct px_config_canopen_drive, 0, 64),
+	K_SEQ(struct px_config_canopen, rpdo, n_rpdo, "rpdo", 0,
+	      pdo_entry_schema, struct px_config_pdo_entry, 0, 8),
+	K_SEQ(struct px_config_canopen, tpdo1, n_tpdo1, "tpdo1", 0,
+	      pdo_entry_schema, struct px_config_pdo_entry, 0, 8),
+	K_SEQ(struct px_config_canopen, tpdo2, n_tpdo2, "tpdo2", 0,
+	      pdo_entry_schema, struct px_config_pdo_entry, 0, 8),
 };
 SCHEMA(canopen_schema, "canopen", canopen_keys, canopen_check);
 

@@ -542,8 +542,18 @@ struct px_config_canopen_drive {
 	double rated_torque_n_m; /* CST: target 1000 = this torque */
 };
 
+/* One object of a PDO mapping (CANopen index, subindex, bit length). */
+struct px_config_pdo_entry {
+	int64_t index;
+	int64_t subindex;
+	int64_t bits;
+};
+
 struct px_config_canopen {
 	bool present;
+	/* PDO layouts; absent or empty = the fixed default layout. */
+	struct px_config_pdo_entry *rpdo, *tpdo1, *tpdo2;
+	size_t n_rpdo, n_tpdo1, n_tpdo2;
 	bool sync;                      /* produce SYNC every cycle */
 	int64_t heartbeat_period_ns;    /* own heartbeat, 0 = none */
 	int64_t heartbeat_timeout_ns;   /* consumer timeout per drive */

@@ -24,7 +24,47 @@ struct px_devcfg {
 	struct px_can_signal *signals;
 	struct px_canopen_drive_cfg drives[PX_CANOPEN_MAX_DRIVES];
 	size_t n_drives;
+	struct px_canopen_pdo_map pdo;
 };
+
+/* Config PDO entries over the default layout; a failed check names the
+ * entry ("socketcan.canopen.tpdo1[1]"). */
+static int pdo_from_cfg(struct px_devcfg *h, const struct px_config_canopen *c,
+			char *key, size_t kcap, char *why, size_t wcap)
+{
+	const struct px_config_pdo_entry *src[3] = {c->rpdo, c->tpdo1,
+						    c->tpdo2};
+	const size_t n[3] = {c->n_rpdo, c->n_tpdo1, c->n_tpdo2};
+	struct px_canopen_pdo *dst[3] = {&h->pdo.rpdo, &h->pdo.tpdo1,
+					 &h->pdo.tpdo2};
+	size_t k, i;
+	const char *p;
+	px_canopen_pdo_map_default(&h->pdo);
+	for (k = 0; k < 3; k++) {
+		if (!n[k])
+			continue;
+		if (n[k] > PX_CANOPEN_MAX_MAP) {
+			snprintf(key, kcap, "socketcan.canopen");
+			snprintf(why, wcap, "at most %d PDO entries",
+				 PX_CANOPEN_MAX_MAP);
+			return PX_E_INVAL;
+		}
+		memset(dst[k], 0, sizeof(*dst[k]));
+		for (i = 0; i < n[k]; i++) {
+			dst[k]->e[i].index = (uint16_t)src[k][i].index;
+			dst[k]->e[i].subindex = (uint8_t)src[k][i].subindex;
+			dst[k]->e[i].bits = (uint8_t)src[k][i].bits;
+		}
+		dst[k]->n = n[k];
+	}
+	if (px_canopen_pdo_map_check(&h->pdo, why, wcap) == PX_OK)
+		return PX_OK;
+	/* why starts with "rpdo[2]: ..." or "tpdo1/tpdo2: ..." */
+	p = strchr(why, ':');
+	snprintf(key, kcap, "socketcan.canopen.%.*s",
+		 p ? (int)(p - why) : 0, why);
+	return PX_E_INVAL;
+}
 
 static const char *backend_name(int b)
 {
@@ -449,7 +489,12 @@ static int open_can(struct px_devcfg *h, const struct px_config *cfg,
 			o->rated_torque_n_m = d->rated_torque_n_m;
 		}
 		h->n_drives = c->canopen.n_drives;
+		rc = pdo_from_cfg(h, &c->canopen, key, sizeof(key), why,
+				  sizeof(why));
+		if (rc != PX_OK)
+			return fail(msg, cap, cfg, dc, key, rc, "%s", why);
 		px_canopen_config_default(&cc);
+		cc.pdo = &h->pdo;
 		cc.sync = c->canopen.sync;
 		cc.heartbeat_period_ns = c->canopen.heartbeat_period_ns;
 		cc.heartbeat_timeout_ns = c->canopen.heartbeat_timeout_ns;
@@ -638,6 +683,11 @@ struct px_can_bus *px_devcfg_canopen_bus(const struct px_devcfg *h)
 struct px_can_sim *px_devcfg_can_sim(const struct px_devcfg *h)
 {
 	return h ? h->sim_bus : NULL;
+}
+
+const struct px_canopen_pdo_map *px_devcfg_pdo(const struct px_devcfg *h)
+{
+	return h && h->co ? &h->pdo : NULL;
 }
 
 int px_devcfg_drives(const struct px_devcfg *h,

@@ -20,7 +20,8 @@
  *  - socketcan: signals with an axis (see docs/config.md, key "axis")
  *    make a pose source / force sink (px_can_dev_create()); canopen makes
  *    a px_canopen master whose drives take counts_per_unit and
- *    rated_torque_n_m from the config. The two get separate sockets on a
+ *    rated_torque_n_m from the config, and whose PDO layouts are the
+ *    config's rpdo/tpdo1/tpdo2 entries over the default layout. The two get separate sockets on a
  *    kernel interface, separate endpoints of an in-process simulated bus;
  *    transport unix has one socket (bound at socket_path, sending to
  *    socket_path + ".peer"), so it takes signals or canopen, not both.
@@ -88,6 +89,10 @@ PX_API struct px_can_bus *px_devcfg_canopen_bus(const struct px_devcfg *h);
 /* The simulated bus of transport sim (given in the options or created);
  * NULL otherwise. */
 PX_API struct px_can_sim *px_devcfg_can_sim(const struct px_devcfg *h);
+/* The PDO layout the master uses (config rpdo/tpdo1/tpdo2 over the
+ * default), e.g. for a simulated arm; NULL without canopen. */
+PX_API const struct px_canopen_pdo_map *
+px_devcfg_pdo(const struct px_devcfg *h);
 /* Fill drives (cap entries) with the master's drive table as opened
  * (counts_per_unit etc.), e.g. for a simulated arm. Returns the count,
  * PX_E_NOSPC or PX_E_INVAL. */

@@ -244,6 +244,8 @@ static void test_canopen_drives(void)
 		"      canopen:\n"
 		"        heartbeat_period_ns: 0\n"
 		"        heartbeat_timeout_ns: 0\n"
+		"        rpdo: [{index: 0x6060, bits: 8}, {index: 0x6040, bits: 16}, {index: 0x607A, bits: 32}]\n"
+		"        tpdo1: [{index: 0x6064, bits: 32}, {index: 0x6041, subindex: 0, bits: 16}]\n"
 		"        drives:\n"
 		"          - {node_id: 3, mode: csp, joint: 1, counts_per_unit: 1000}\n"
 		"          - {node_id: 9, mode: csv, joint: 0, counts_per_unit: 20000, rated_torque_n_m: 4.5}\n";
@@ -278,7 +280,12 @@ static void test_canopen_drives(void)
 	PX_CHECK_INT_EQ(dr[1].mode, PX_CIA402_CSV);
 	PX_CHECK_CLOSE(dr[1].counts_per_unit, 20000.0, 0, 0);
 	PX_CHECK_CLOSE(dr[1].rated_torque_n_m, 4.5, 0, 0);
+	PX_CHECK(px_devcfg_pdo(h) != NULL);
+	PX_CHECK_INT_EQ(px_devcfg_pdo(h)->rpdo.e[0].index, 0x6060);
+	PX_CHECK_INT_EQ(px_devcfg_pdo(h)->tpdo1.e[1].index, 0x6041);
+	PX_CHECK_INT_EQ(px_devcfg_pdo(h)->tpdo2.e[0].index, 0x606C);
 	memset(&sc, 0, sizeof(sc));
+	sc.pdo = px_devcfg_pdo(h); /* the arm speaks the config's layout */
 	sc.drives = dr;
 	sc.n_drives = (size_t)n;
 	sc.heartbeat_period_ns = 100000000;
@@ -402,6 +409,17 @@ static void test_errors(void)
 		 "    sim:\n"
 		 "      trajectory: {kind: csv, file: /nonexistent/hand.csv}\n",
 		 "devices[0].sim.trajectory.file", "/nonexistent/hand.csv"},
+		{"version: 1\n"
+		 "devices:\n"
+		 "  - name: arm\n"
+		 "    backend: socketcan\n"
+		 "    socketcan:\n"
+		 "      interface: x\n"
+		 "      transport: sim\n"
+		 "      canopen:\n"
+		 "        drives: [{node_id: 1, joint: 0}]\n"
+		 "        tpdo1: [{index: 0x6041, bits: 16}, {index: 0x6064, bits: 16}]\n",
+		 "devices[0].socketcan.canopen.tpdo1[1]", "is 32 bits, not 16"},
 	};
 	size_t i;
 	for (i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
