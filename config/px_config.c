@@ -71,6 +71,9 @@ static const char *const axis_names[] = {"x", "y", "z", "rx", "ry", "rz", NULL};
 static const char *const xyz_names[] = {"x", "y", "z", NULL};
 static const char *const wrench_names[] = {"fx", "fy", "fz",
 					   "tx", "ty", "tz", NULL};
+static const char *const signal_axis_names[] = {
+	"none", "x", "y", "z", "rx", "ry", "rz",
+	"fx", "fy", "fz", "tx", "ty", "tz", NULL};
 static const char *const hid_driver_names[] = {"hidraw", "libusb", NULL};
 static const char *const transfer_names[] = {"interrupt", "bulk", NULL};
 static const char *const dir_names[] = {"input", "output", NULL};
@@ -420,6 +423,22 @@ static void signal_check(struct px_config_reader *r,
 	if (s->has_min && s->has_max && !(s->min < s->max))
 		px_config_reader_error(r, px_config_node_get(map, "max"), "max",
 				       "must be greater than min");
+	if (s->direction == PX_CONFIG_SIGNAL_INPUT &&
+	    s->axis >= PX_CONFIG_SIGNAL_AXIS_FX)
+		px_config_reader_error(r, px_config_node_get(map, "axis"),
+				       "axis",
+				       "an input signal feeds a pose axis (x, "
+				       "y, z, rx, ry, rz), not '%s'",
+				       signal_axis_names[s->axis]);
+	if (s->direction == PX_CONFIG_SIGNAL_OUTPUT &&
+	    s->axis != PX_CONFIG_SIGNAL_AXIS_NONE &&
+	    s->axis < PX_CONFIG_SIGNAL_AXIS_FX)
+		px_config_reader_error(r, px_config_node_get(map, "axis"),
+				       "axis",
+				       "an output signal carries a force or "
+				       "torque (fx, fy, fz, tx, ty, tz), not "
+				       "'%s'",
+				       signal_axis_names[s->axis]);
 }
 
 static const struct px_config_key signal_keys[] = {
@@ -440,6 +459,8 @@ static const struct px_config_key signal_keys[] = {
 	K_DBL(struct px_config_can_signal, offset, "offset", 0, -BIG, BIG, 0.0),
 	K_DBLP(struct px_config_can_signal, min, "min", -BIG, BIG, has_min),
 	K_DBLP(struct px_config_can_signal, max, "max", -BIG, BIG, has_max),
+	K_ENUM(struct px_config_can_signal, axis, "axis", 0, signal_axis_names,
+	       PX_CONFIG_SIGNAL_AXIS_NONE),
 };
 SCHEMA(signal_schema, "signal", signal_keys, signal_check);
 
@@ -450,8 +471,25 @@ static const struct px_config_key drive_keys[] = {
 	       PX_CONFIG_CIA402_CSP),
 	K_INT(struct px_config_canopen_drive, joint, "joint", PX_CONFIG_REQUIRED,
 	      0, 63, 0),
+	{.name = "counts_per_unit", .type = PX_CONFIG_T_DOUBLE,
+	 .offset = offsetof(struct px_config_canopen_drive, counts_per_unit),
+	 .flags = RANGE | PX_CONFIG_MIN_EXCL | PX_CONFIG_PRESENT, .dmin = 0.0,
+	 .dmax = BIG, .ddef = 1.0,
+	 .present_offset = offsetof(struct px_config_canopen_drive,
+				    has_counts_per_unit)},
+	K_DBL(struct px_config_canopen_drive, rated_torque_n_m,
+	      "rated_torque_n_m", PX_CONFIG_MIN_EXCL, 0.0, BIG, 1.0),
 };
 SCHEMA(drive_schema, "drive", drive_keys, NULL);
+
+static const struct px_config_key pdo_entry_keys[] = {
+	K_INT(struct px_config_pdo_entry, index, "index", PX_CONFIG_REQUIRED,
+	      0x1000, 0xffff, 0x1000),
+	K_INT(struct px_config_pdo_entry, subindex, "subindex", 0, 0, 255, 0),
+	K_INT(struct px_config_pdo_entry, bits, "bits", PX_CONFIG_REQUIRED, 1,
+	      64, 8),
+};
+SCHEMA(pdo_entry_schema, "pdo entry", pdo_entry_keys, NULL);
 
 static void canopen_check(struct px_config_reader *r,
 			  const struct px_config_node *map, void *obj)
@@ -495,6 +533,12 @@ static const struct px_config_key canopen_keys[] = {
 	      "heartbeat_timeout_ns", 0, 0, 10 * NS_PER_S, 300000000),
 	K_SEQ(struct px_config_canopen, drives, n_drives, "drives", 0,
 	      drive_schema, struct px_config_canopen_drive, 0, 64),
+	K_SEQ(struct px_config_canopen, rpdo, n_rpdo, "rpdo", 0,
+	      pdo_entry_schema, struct px_config_pdo_entry, 0, 8),
+	K_SEQ(struct px_config_canopen, tpdo1, n_tpdo1, "tpdo1", 0,
+	      pdo_entry_schema, struct px_config_pdo_entry, 0, 8),
+	K_SEQ(struct px_config_canopen, tpdo2, n_tpdo2, "tpdo2", 0,
+	      pdo_entry_schema, struct px_config_pdo_entry, 0, 8),
 };
 SCHEMA(canopen_schema, "canopen", canopen_keys, canopen_check);
 

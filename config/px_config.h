@@ -498,6 +498,27 @@ struct px_config_can_signal {
 	double offset;
 	bool has_min, has_max;
 	double min, max;     /* physical clamp (outputs), plausibility (inputs) */
+	/* What the signal carries on the device (enum px_config_signal_axis):
+	 * an input feeds a pose axis, an output a force/torque channel. */
+	int axis;
+};
+
+/* Key "axis" of a CAN signal: none (a plain signal, read by name), a pose
+ * axis (inputs) or a wrench channel (outputs). */
+enum px_config_signal_axis {
+	PX_CONFIG_SIGNAL_AXIS_NONE = 0,
+	PX_CONFIG_SIGNAL_AXIS_X,  /* x y z rx ry rz: enum px_config_axis + 1 */
+	PX_CONFIG_SIGNAL_AXIS_Y,
+	PX_CONFIG_SIGNAL_AXIS_Z,
+	PX_CONFIG_SIGNAL_AXIS_RX,
+	PX_CONFIG_SIGNAL_AXIS_RY,
+	PX_CONFIG_SIGNAL_AXIS_RZ,
+	PX_CONFIG_SIGNAL_AXIS_FX, /* fx .. tz: enum px_config_wrench_axis + 7 */
+	PX_CONFIG_SIGNAL_AXIS_FY,
+	PX_CONFIG_SIGNAL_AXIS_FZ,
+	PX_CONFIG_SIGNAL_AXIS_TX,
+	PX_CONFIG_SIGNAL_AXIS_TY,
+	PX_CONFIG_SIGNAL_AXIS_TZ
 };
 
 enum px_config_can_transport {
@@ -516,10 +537,23 @@ struct px_config_canopen_drive {
 	int64_t node_id; /* 1..127 */
 	int mode;        /* enum px_config_cia402_mode */
 	int64_t joint;   /* joint index fed by this drive */
+	bool has_counts_per_unit;
+	double counts_per_unit;  /* encoder counts per rad (or m); default 1 */
+	double rated_torque_n_m; /* CST: target 1000 = this torque */
+};
+
+/* One object of a PDO mapping (CANopen index, subindex, bit length). */
+struct px_config_pdo_entry {
+	int64_t index;
+	int64_t subindex;
+	int64_t bits;
 };
 
 struct px_config_canopen {
 	bool present;
+	/* PDO layouts; absent or empty = the fixed default layout. */
+	struct px_config_pdo_entry *rpdo, *tpdo1, *tpdo2;
+	size_t n_rpdo, n_tpdo1, n_tpdo2;
 	bool sync;                      /* produce SYNC every cycle */
 	int64_t heartbeat_period_ns;    /* own heartbeat, 0 = none */
 	int64_t heartbeat_timeout_ns;   /* consumer timeout per drive */

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "px_canopen.h"
+#include "px_codec.h"
 
 /* ---- CiA 402 ------------------------------------------------------------- */
 
@@ -137,24 +138,9 @@ static void put16(uint8_t *p, uint16_t v)
 	p[1] = (uint8_t)(v >> 8);
 }
 
-static void put32(uint8_t *p, int32_t v)
-{
-	uint32_t u = (uint32_t)v;
-	p[0] = (uint8_t)u;
-	p[1] = (uint8_t)(u >> 8);
-	p[2] = (uint8_t)(u >> 16);
-	p[3] = (uint8_t)(u >> 24);
-}
-
 static uint16_t get16(const uint8_t *p)
 {
 	return (uint16_t)(p[0] | (p[1] << 8));
-}
-
-static int32_t get32(const uint8_t *p)
-{
-	return (int32_t)((uint32_t)p[0] | ((uint32_t)p[1] << 8) |
-			 ((uint32_t)p[2] << 16) | ((uint32_t)p[3] << 24));
 }
 
 static int32_t to_i32(double v)
@@ -190,10 +176,213 @@ static int drive_cfg_ok(const struct px_canopen_drive_cfg *d)
 		(isfinite(d->rated_torque_n_m) && d->rated_torque_n_m > 0));
 }
 
+/* ---- PDO mapping ------------------------------------------------------------- */
+
+enum { IN_RPDO = 1, IN_TPDO = 2 };
+
+struct obj_info {
+	uint16_t index;
+	uint8_t bits;
+	uint8_t is_signed;
+	uint8_t where;
+};
+
+static const struct obj_info objs[] = {
+	{0x6040, 16, 0, IN_RPDO}, {0x6060, 8, 1, IN_RPDO},
+	{0x607A, 32, 1, IN_RPDO}, {0x60FF, 32, 1, IN_RPDO},
+	{0x6071, 16, 1, IN_RPDO}, {0x6041, 16, 0, IN_TPDO},
+	{0x6064, 32, 1, IN_TPDO}, {0x606C, 32, 1, IN_TPDO},
+	{0x6077, 16, 1, IN_TPDO},
+};
+
+static const struct obj_info *obj_find(uint16_t index)
+{
+	size_t i;
+	for (i = 0; i < sizeof objs / sizeof objs[0]; i++)
+		if (objs[i].index == index)
+			return &objs[i];
+	return NULL;
+}
+
+static int is_target(uint16_t index)
+{
+	return index == 0x607A || index == 0x60FF || index == 0x6071;
+}
+
+void px_canopen_pdo_map_default(struct px_canopen_pdo_map *m)
+{
+	static const struct px_canopen_pdo_map def = {
+		{3, {{0x6040, 0, 16}, {0x607A, 0, 32}, {0x6060, 0, 8}}},
+		{2, {{0x6041, 0, 16}, {0x6064, 0, 32}}},
+		{2, {{0x606C, 0, 32}, {0x6077, 0, 16}}},
+	};
+	if (m)
+		*m = def;
+}
+
+static int pdo_has(const struct px_canopen_pdo *p, uint16_t index)
+{
+	size_t i;
+	for (i = 0; i < p->n && i < PX_CANOPEN_MAX_MAP; i++)
+		if (p->e[i].index == index)
+			return 1;
+	return 0;
+}
+
+static int pdo_check(const struct px_canopen_pdo *p, const char *nm,
+		     int where, char *msg, size_t cap)
+{
+	size_t i, j;
+	unsigned bits = 0;
+	if (p->n > PX_CANOPEN_MAX_MAP) {
+		if (msg)
+			snprintf(msg, cap, "%s: %zu entries; at most %d", nm,
+				 p->n, PX_CANOPEN_MAX_MAP);
+		return PX_E_INVAL;
+	}
+	for (i = 0; i < p->n; i++) {
+		const struct px_canopen_map_entry *e = &p->e[i];
+		const struct obj_info *o = obj_find(e->index);
+		if (!o || o->where != where) {
+			if (msg)
+				snprintf(msg, cap, "%s[%zu]: object 0x%04X is "
+					 "not one a%s carries in this subset",
+					 nm, i, e->index,
+					 where == IN_RPDO ? "n RPDO" : " TPDO");
+			return PX_E_INVAL;
+		}
+		if (e->subindex != 0) {
+			if (msg)
+				snprintf(msg, cap, "%s[%zu]: object 0x%04X has "
+					 "subindex 0, not %u", nm, i, e->index,
+					 e->subindex);
+			return PX_E_INVAL;
+		}
+		if (e->bits != o->bits) {
+			if (msg)
+				snprintf(msg, cap, "%s[%zu]: object 0x%04X is "
+					 "%u bits, not %u", nm, i, e->index,
+					 o->bits, e->bits);
+			return PX_E_INVAL;
+		}
+		for (j = 0; j < i; j++)
+			if (p->e[j].index == e->index ||
+			    (is_target(e->index) && is_target(p->e[j].index))) {
+				if (msg)
+					snprintf(msg, cap, "%s[%zu]: object "
+						 "0x%04X repeats %s[%zu]'s "
+						 "role", nm, i, e->index, nm, j);
+				return PX_E_INVAL;
+			}
+		bits += e->bits;
+	}
+	if (bits > 64) {
+		if (msg)
+			snprintf(msg, cap, "%s: %u bits; a PDO holds at most 64",
+				 nm, bits);
+		return PX_E_INVAL;
+	}
+	return PX_OK;
+}
+
+int px_canopen_pdo_map_check(const struct px_canopen_pdo_map *m, char *msg,
+			     size_t cap)
+{
+	int rc;
+	if (msg && cap)
+		msg[0] = 0;
+	if (!m)
+		return PX_E_INVAL;
+	if ((rc = pdo_check(&m->rpdo, "rpdo", IN_RPDO, msg, cap)) ||
+	    (rc = pdo_check(&m->tpdo1, "tpdo1", IN_TPDO, msg, cap)) ||
+	    (rc = pdo_check(&m->tpdo2, "tpdo2", IN_TPDO, msg, cap)))
+		return rc;
+	if (!pdo_has(&m->rpdo, 0x6040) ||
+	    !(pdo_has(&m->rpdo, 0x607A) || pdo_has(&m->rpdo, 0x60FF) ||
+	      pdo_has(&m->rpdo, 0x6071))) {
+		if (msg)
+			snprintf(msg, cap, "rpdo: needs the controlword "
+				 "0x6040 and a target (0x607A, 0x60FF or "
+				 "0x6071)");
+		return PX_E_INVAL;
+	}
+	if (m->tpdo1.n == 0) {
+		if (msg)
+			snprintf(msg, cap, "tpdo1: empty (it carries the "
+				 "feedback)");
+		return PX_E_INVAL;
+	}
+	if (!(pdo_has(&m->tpdo1, 0x6041) || pdo_has(&m->tpdo2, 0x6041)) ||
+	    !(pdo_has(&m->tpdo1, 0x6064) || pdo_has(&m->tpdo2, 0x6064))) {
+		if (msg)
+			snprintf(msg, cap, "tpdo1/tpdo2: need the statusword "
+				 "0x6041 and position actual 0x6064");
+		return PX_E_INVAL;
+	}
+	return PX_OK;
+}
+
+size_t px_canopen_pdo_bytes(const struct px_canopen_pdo *p)
+{
+	size_t i, bits = 0;
+	if (!p)
+		return 0;
+	for (i = 0; i < p->n && i < PX_CANOPEN_MAX_MAP; i++)
+		bits += p->e[i].bits;
+	return (bits + 7) / 8;
+}
+
+int px_canopen_pdo_pack(const struct px_canopen_pdo *p, const int64_t *vals,
+			uint8_t *data, size_t len)
+{
+	size_t i;
+	unsigned pos = 0;
+	if (!p || !vals || !data || p->n > PX_CANOPEN_MAX_MAP)
+		return PX_E_INVAL;
+	for (i = 0; i < p->n; i++) {
+		int rc = px_codec_put_raw(data, len, pos / 8, pos % 8,
+					  p->e[i].bits, PX_LITTLE_ENDIAN,
+					  (uint64_t)vals[i]);
+		if (rc != PX_OK)
+			return rc;
+		pos += p->e[i].bits;
+	}
+	return PX_OK;
+}
+
+int px_canopen_pdo_unpack(const struct px_canopen_pdo *p, const uint8_t *data,
+			  size_t len, int64_t *vals)
+{
+	size_t i;
+	unsigned pos = 0;
+	if (!p || !vals || !data || p->n > PX_CANOPEN_MAX_MAP)
+		return PX_E_INVAL;
+	for (i = 0; i < p->n; i++) {
+		const struct obj_info *o = obj_find(p->e[i].index);
+		int rc = px_codec_get_raw(data, len, pos / 8, pos % 8,
+					  p->e[i].bits, o ? o->is_signed : 0,
+					  PX_LITTLE_ENDIAN, &vals[i]);
+		if (rc != PX_OK)
+			return rc;
+		pos += p->e[i].bits;
+	}
+	return PX_OK;
+}
+
+/* v clamped to what a bits-wide object holds (signed or not). */
+static int64_t fit(int64_t v, unsigned bits, int is_signed)
+{
+	int64_t lo = is_signed ? -((int64_t)1 << (bits - 1)) : 0;
+	int64_t hi = is_signed ? ((int64_t)1 << (bits - 1)) - 1
+			       : ((int64_t)1 << bits) - 1;
+	return v < lo ? lo : v > hi ? hi : v;
+}
+
 /* ---- master ------------------------------------------------------------------ */
 
 struct px_canopen {
 	struct px_canopen_config cfg;
+	struct px_canopen_pdo_map pdo;
 	struct px_canopen_drive_cfg drv[PX_CANOPEN_MAX_DRIVES];
 	struct px_canopen_drive_status st[PX_CANOPEN_MAX_DRIVES];
 	struct px_can_bus *bus;
@@ -251,10 +440,17 @@ int px_canopen_create(const struct px_canopen_config *c,
 				return PX_E_INVAL;
 			}
 	}
+	if (c->pdo && px_canopen_pdo_map_check(c->pdo, msg, cap) != PX_OK)
+		return PX_E_INVAL;
 	co = calloc(1, sizeof *co);
 	if (!co)
 		return PX_E_NOMEM;
 	co->cfg = *c;
+	if (c->pdo)
+		co->pdo = *c->pdo;
+	else
+		px_canopen_pdo_map_default(&co->pdo);
+	co->cfg.pdo = &co->pdo;
 	memcpy(co->drv, c->drives, c->n_drives * sizeof *c->drives);
 	co->cfg.drives = co->drv;
 	for (i = 0; i < c->n_drives; i++) {
@@ -310,15 +506,36 @@ int px_canopen_rx(struct px_canopen *co, int64_t now)
 		s = &co->st[d];
 		c = &co->drv[d];
 		n++;
-		if (fn == 0x180 && m.f.len >= 6) {
-			s->statusword = get16(m.f.data);
-			s->state = px_cia402_state_of(s->statusword);
-			s->position = get32(m.f.data + 2) / c->counts_per_unit;
-			s->feedback_ns = m.t_ns;
-		} else if (fn == 0x280 && m.f.len >= 6) {
-			s->velocity = get32(m.f.data) / c->counts_per_unit;
-			s->torque_n_m = (int16_t)get16(m.f.data + 4) / 1000.0 *
-					c->rated_torque_n_m;
+		if ((fn == 0x180 || fn == 0x280) &&
+		    (fn == 0x180 ? co->pdo.tpdo1.n : co->pdo.tpdo2.n)) {
+			const struct px_canopen_pdo *p =
+				fn == 0x180 ? &co->pdo.tpdo1 : &co->pdo.tpdo2;
+			int64_t v[PX_CANOPEN_MAX_MAP];
+			size_t e;
+			if (px_canopen_pdo_unpack(p, m.f.data, m.f.len, v) !=
+			    PX_OK)
+				continue; /* short frame: not this layout */
+			for (e = 0; e < p->n; e++)
+				switch (p->e[e].index) {
+				case 0x6041:
+					s->statusword = (uint16_t)v[e];
+					s->state = px_cia402_state_of(
+						s->statusword);
+					break;
+				case 0x6064:
+					s->position = (double)v[e] /
+						      c->counts_per_unit;
+					s->feedback_ns = m.t_ns;
+					break;
+				case 0x606C:
+					s->velocity = (double)v[e] /
+						      c->counts_per_unit;
+					break;
+				case 0x6077:
+					s->torque_n_m = (double)v[e] / 1000.0 *
+							c->rated_torque_n_m;
+					break;
+				}
 		} else if (fn == 0x700 && m.f.len >= 1) {
 			s->heartbeat_ns = m.t_ns;
 			s->nmt_state = m.f.data[0] & 0x7F;
@@ -379,10 +596,21 @@ int px_canopen_tx(struct px_canopen *co, int64_t now, const double *targets,
 			raw = to_i32(t / c->rated_torque_n_m * 1000.0);
 		else
 			raw = to_i32(t * c->counts_per_unit);
-		put16(b, s->controlword);
-		put32(b + 2, raw);
-		b[6] = (uint8_t)(int8_t)c->mode;
-		r = send_frame(co->bus, 0x200u + c->node_id, b, 7, now);
+		{
+			const struct px_canopen_pdo *p = &co->pdo.rpdo;
+			int64_t v[PX_CANOPEN_MAX_MAP];
+			size_t e;
+			for (e = 0; e < p->n; e++) {
+				uint16_t ix = p->e[e].index;
+				v[e] = ix == 0x6040   ? s->controlword
+				       : ix == 0x6060 ? c->mode
+						      : fit(raw, p->e[e].bits, 1);
+			}
+			memset(b, 0, sizeof b);
+			px_canopen_pdo_pack(p, v, b, sizeof b);
+			r = send_frame(co->bus, 0x200u + c->node_id, b,
+				       (int)px_canopen_pdo_bytes(p), now);
+		}
 		if (r == PX_E_IO)
 			rc = PX_E_IO;
 	}
@@ -447,6 +675,7 @@ struct simdrv {
 
 struct px_canopen_sim {
 	struct px_canopen_sim_config cfg;
+	struct px_canopen_pdo_map pdo;
 	struct px_canopen_drive_cfg drv[PX_CANOPEN_MAX_DRIVES];
 	struct px_sim_fault faults[PX_SIM_MAX_FAULTS];
 	struct simdrv d[PX_CANOPEN_MAX_DRIVES];
@@ -473,10 +702,17 @@ int px_canopen_sim_create(const struct px_canopen_sim_config *c,
 		    c->faults[i].duration_ns <= 0 || c->faults[i].delay_ns < 0 ||
 		    (size_t)c->faults[i].delay_ns >= c->n_drives)
 			return PX_E_INVAL;
+	if (c->pdo && px_canopen_pdo_map_check(c->pdo, NULL, 0) != PX_OK)
+		return PX_E_INVAL;
 	s = calloc(1, sizeof *s);
 	if (!s)
 		return PX_E_NOMEM;
 	s->cfg = *c;
+	if (c->pdo)
+		s->pdo = *c->pdo;
+	else
+		px_canopen_pdo_map_default(&s->pdo);
+	s->cfg.pdo = &s->pdo;
 	memcpy(s->drv, c->drives, c->n_drives * sizeof *c->drives);
 	s->cfg.drives = s->drv;
 	if (c->n_faults)
@@ -546,16 +782,50 @@ static void sim_sync(struct px_canopen_sim *s, int64_t now)
 			if (d->state == PX_CIA402_QUICK_STOP_ACTIVE)
 				d->state = PX_CIA402_SWITCH_ON_DISABLED;
 		}
-		put16(b, px_cia402_statusword(d->state));
-		put32(b + 2, to_i32(d->pos * c->counts_per_unit));
-		send_frame(s->bus, 0x180u + c->node_id, b, 6, now);
-		put32(b, to_i32(d->vel * c->counts_per_unit));
-		put16(b + 4, (uint16_t)(int16_t)to_i32(
-				     c->rated_torque_n_m > 0
-					     ? d->torque / c->rated_torque_n_m *
-						       1000.0
-					     : 0.0));
-		send_frame(s->bus, 0x280u + c->node_id, b, 6, now);
+		{
+			int k;
+			for (k = 0; k < 2; k++) {
+				const struct px_canopen_pdo *p =
+					k ? &s->pdo.tpdo2 : &s->pdo.tpdo1;
+				int64_t v[PX_CANOPEN_MAX_MAP];
+				size_t e;
+				if (!p->n)
+					continue;
+				for (e = 0; e < p->n; e++) {
+					int64_t x = 0;
+					switch (p->e[e].index) {
+					case 0x6041:
+						x = px_cia402_statusword(
+							d->state);
+						break;
+					case 0x6064:
+						x = to_i32(d->pos *
+							   c->counts_per_unit);
+						break;
+					case 0x606C:
+						x = to_i32(d->vel *
+							   c->counts_per_unit);
+						break;
+					case 0x6077:
+						x = to_i32(
+							c->rated_torque_n_m > 0
+								? d->torque /
+									  c->rated_torque_n_m *
+									  1000.0
+								: 0.0);
+						break;
+					}
+					v[e] = fit(x, p->e[e].bits,
+						   p->e[e].index != 0x6041);
+				}
+				memset(b, 0, sizeof b);
+				px_canopen_pdo_pack(p, v, b, sizeof b);
+				send_frame(s->bus,
+					   (k ? 0x280u : 0x180u) + c->node_id,
+					   b, (int)px_canopen_pdo_bytes(p),
+					   now);
+			}
+		}
 	}
 }
 
@@ -606,16 +876,28 @@ int px_canopen_sim_step(struct px_canopen_sim *s, int64_t now)
 				}
 		} else if (id == 0x080 && m.f.len == 0) {
 			sim_sync(s, m.t_ns);
-		} else if ((id & 0x780) == 0x200 && m.f.len >= 7) {
+		} else if ((id & 0x780) == 0x200 &&
+			   m.f.len >= px_canopen_pdo_bytes(&s->pdo.rpdo)) {
+			int64_t v[PX_CANOPEN_MAX_MAP];
+			size_t e;
+			if (px_canopen_pdo_unpack(&s->pdo.rpdo, m.f.data,
+						  m.f.len, v) != PX_OK)
+				continue;
 			for (i = 0; i < s->cfg.n_drives; i++) {
 				struct simdrv *d = &s->d[i];
 				if (s->drv[i].node_id != (id & 0x7F) || d->silent ||
 				    d->nmt != 5)
 					continue;
 				d->prev_cw = d->cw;
-				d->cw = get16(m.f.data);
-				d->target = get32(m.f.data + 2);
-				d->mode = (int8_t)m.f.data[6];
+				for (e = 0; e < s->pdo.rpdo.n; e++) {
+					uint16_t ix = s->pdo.rpdo.e[e].index;
+					if (ix == 0x6040)
+						d->cw = (uint16_t)v[e];
+					else if (ix == 0x6060)
+						d->mode = (int)v[e];
+					else
+						d->target = (int32_t)v[e];
+				}
 				if (d->state == PX_CIA402_NOT_READY)
 					d->state = PX_CIA402_SWITCH_ON_DISABLED;
 				if (d->state != PX_CIA402_FAULT ||

@@ -2,7 +2,8 @@
  * px_canopen.h - CANopen-lite master with CiA 402 drives, and a simulated
  * multi-joint arm that speaks the same subset, on any px_can_bus.
  *
- * The subset ("lite": no SDO, no object dictionary, fixed PDO layouts):
+ * The subset ("lite": no SDO, no object dictionary; PDO layouts are
+ * fixed by default and configurable with a px_canopen_pdo_map):
  *  - NMT: the master sends "start remote node" (0x000: 01 00) at its
  *    first cycle, and again to a node whose heartbeat says boot-up or
  *    pre-operational (it started after the master);
@@ -99,7 +100,62 @@ struct px_canopen_drive_cfg {
 	double rated_torque_n_m;/* CST scale: target 1000 = rated */
 };
 
+/* ---- PDO mapping ------------------------------------------------------------ */
+
+/*
+ * A PDO's content as CANopen maps it: objects (index, subindex, bit
+ * length) packed from bit 0 of byte 0 upwards, each little-endian, at
+ * most 64 bits in all. Objects the subset knows:
+ *   RPDO (master to drive, 0x200 + node): 0x6040 controlword (16),
+ *     0x6060 modes of operation (8, signed), and the cyclic target in
+ *     one of 0x607A target position (32), 0x60FF target velocity (32),
+ *     0x6071 target torque (16): each carries the drive's target in its
+ *     mode's units (counts, counts/s, thousandths of rated torque).
+ *   TPDO1 / TPDO2 (drive to master, 0x180 / 0x280 + node): 0x6041
+ *     statusword (16), 0x6064 position actual (32), 0x606C velocity
+ *     actual (32), 0x6077 torque actual (16).
+ * The RPDO must carry 0x6040 and a target; the TPDOs together 0x6041 and
+ * 0x6064 (TPDO2 may be empty: not sent). Subindex is 0 for all of them.
+ * The default (px_canopen_pdo_map_default) is the fixed layout above.
+ */
+#define PX_CANOPEN_MAX_MAP 8
+
+struct px_canopen_map_entry {
+	uint16_t index;
+	uint8_t subindex;
+	uint8_t bits;
+};
+
+struct px_canopen_pdo {
+	size_t n;
+	struct px_canopen_map_entry e[PX_CANOPEN_MAX_MAP];
+};
+
+struct px_canopen_pdo_map {
+	struct px_canopen_pdo rpdo;
+	struct px_canopen_pdo tpdo1, tpdo2;
+};
+
+/* The fixed layout of the header comment. */
+PX_API void px_canopen_pdo_map_default(struct px_canopen_pdo_map *m);
+/* Check a mapping; msg (cap bytes, may be NULL) names the PDO and entry,
+ * e.g. "tpdo1[2]: object 0x6064 is 32 bits, not 16". PX_OK / PX_E_INVAL. */
+PX_API int px_canopen_pdo_map_check(const struct px_canopen_pdo_map *m,
+				    char *msg, size_t cap);
+/* Bytes a PDO's frame carries (ceil of its bits / 8). @note RT-safe. */
+PX_API size_t px_canopen_pdo_bytes(const struct px_canopen_pdo *p);
+/* Pack / unpack object values (vals[i] for entry i, raw integers, sign
+ * extended on unpack for signed objects). Return PX_OK, PX_E_PARSE (frame
+ * too short), PX_E_INVAL. @note RT-safe. */
+PX_API int px_canopen_pdo_pack(const struct px_canopen_pdo *p,
+			       const int64_t *vals, uint8_t *data, size_t len);
+PX_API int px_canopen_pdo_unpack(const struct px_canopen_pdo *p,
+				 const uint8_t *data, size_t len,
+				 int64_t *vals);
+
 struct px_canopen_config {
+	/* PDO layouts (copied); NULL = px_canopen_pdo_map_default. */
+	const struct px_canopen_pdo_map *pdo;
 	uint8_t own_node_id;          /* heartbeat producer id (default 127) */
 	int sync;                     /* send SYNC each cycle (default 1) */
 	int64_t heartbeat_period_ns;  /* 0 = no heartbeat producer */
@@ -155,6 +211,8 @@ PX_API int px_canopen_drive_status(const struct px_canopen *co, size_t i,
 struct px_canopen_sim;
 
 struct px_canopen_sim_config {
+	/* PDO layouts (copied); NULL = the default, as for the master. */
+	const struct px_canopen_pdo_map *pdo;
 	const struct px_canopen_drive_cfg *drives; /* copied */
 	size_t n_drives;
 	int64_t heartbeat_period_ns;  /* default 100 ms */

@@ -38,6 +38,11 @@ struct usb {
 	uint8_t buf[MAX_XFER][FRAME_MAX];
 	atomic_int in_flight;
 	atomic_int gone;
+	/* hotplug: callback registered on ctx (0 = poll only), and a
+	 * matching device arrived since the last reopen attempt */
+	int hp_active;
+	libusb_hotplug_callback_handle hp;
+	atomic_int arrived;
 	struct px_arena arena;
 	uint8_t arena_buf[4 * sizeof(struct outframe) + 512];
 	struct px_param *out;
@@ -231,6 +236,64 @@ static void sleep_ns(int64_t ns)
  * on, so they are replaced too, and released while their context still
  * exists. Not for the cycle: runs in the events thread, device closed,
  * no transfer in flight. */
+/* Runs inside libusb_handle_events on the events thread (the only
+ * thread that closes u->h, so reading it here is safe). */
+static int LIBUSB_CALL on_hotplug(libusb_context *ctx, libusb_device *dev,
+				  libusb_hotplug_event ev, void *p)
+{
+	struct usb *u = p;
+	(void)ctx;
+	if (ev == LIBUSB_HOTPLUG_EVENT_DEVICE_ARRIVED)
+		atomic_store(&u->arrived, 1);
+	else if (ev == LIBUSB_HOTPLUG_EVENT_DEVICE_LEFT && u->h &&
+		 libusb_get_device(u->h) == dev)
+		atomic_store(&u->gone, 1);
+	return 0; /* stay registered */
+}
+
+/* Register for arrival/departure of our VID:PID where libusb can (its
+ * Linux back ends learn of them from udev or netlink); otherwise, or with
+ * no_hotplug, the events thread polls every REOPEN_NS. */
+static void hotplug_register(struct usb *u)
+{
+	u->hp_active = 0;
+	if (u->cfg.no_hotplug || !u->ctx ||
+	    !libusb_has_capability(LIBUSB_CAP_HAS_HOTPLUG))
+		return;
+	if (libusb_hotplug_register_callback(
+		    u->ctx,
+		    LIBUSB_HOTPLUG_EVENT_DEVICE_ARRIVED |
+			    LIBUSB_HOTPLUG_EVENT_DEVICE_LEFT,
+		    0, u->cfg.vid, u->cfg.pid, LIBUSB_HOTPLUG_MATCH_ANY,
+		    on_hotplug, u, &u->hp) == LIBUSB_SUCCESS)
+		u->hp_active = 1;
+}
+
+static void hotplug_deregister(struct usb *u)
+{
+	if (u->hp_active && u->ctx)
+		libusb_hotplug_deregister_callback(u->ctx, u->hp);
+	u->hp_active = 0;
+}
+
+/* Wait before a reopen attempt: until a matching device arrives (hotplug)
+ * or REOPEN_NS have passed, whichever is first; the poll stays as the
+ * fallback because arrival events need udev, which containers and
+ * minimal systems lack. */
+static void wait_reopen(struct usb *u)
+{
+	int64_t t0 = mono_ns();
+	struct timeval tv = {0, 20000};
+	if (!u->hp_active) {
+		sleep_ns(REOPEN_NS);
+		return;
+	}
+	while (!atomic_load(&u->stop) && !atomic_load(&u->arrived) &&
+	       mono_ns() - t0 < REOPEN_NS)
+		libusb_handle_events_timeout_completed(u->ctx, &tv, NULL);
+	atomic_store(&u->arrived, 0);
+}
+
 static void renew_context(struct usb *u)
 {
 	struct libusb_transfer *t[MAX_XFER] = {0};
@@ -247,8 +310,10 @@ static void renew_context(struct usb *u)
 		libusb_free_transfer(u->xfer[i]);
 		u->xfer[i] = t[i];
 	}
+	hotplug_deregister(u);
 	libusb_exit(u->ctx);
 	u->ctx = c;
+	hotplug_register(u);
 }
 
 static void *events_main(void *p)
@@ -266,7 +331,7 @@ static void *events_main(void *p)
 			atomic_store(&u->gone, 0);
 		}
 		if (!u->h) {
-			sleep_ns(REOPEN_NS);
+			wait_reopen(u);
 			pthread_mutex_lock(&u->lock);
 			if (atomic_load(&u->in_flight) == 0)
 				renew_context(u);
@@ -404,6 +469,7 @@ static void usb_destroy(struct px_dev *d)
 		if (u->xfer[i])
 			libusb_free_transfer(u->xfer[i]);
 	usb_close_handle(u);
+	hotplug_deregister(u);
 	if (u->ctx)
 		libusb_exit(u->ctx);
 	sem_destroy(&u->wake);
@@ -418,6 +484,13 @@ static const struct px_dev_ops usb_ops = {
 	.force = usb_force,
 	.destroy = usb_destroy,
 };
+
+int px_usb_hotplug_active(struct px_dev *d)
+{
+	if (!d || px_dev_ops(d) != &usb_ops)
+		return PX_E_INVAL;
+	return ((struct usb *)px_dev_impl(d))->hp_active;
+}
 
 int px_usb_create(const struct px_dev_config *dcfg,
 		  const struct px_usb_config *uc, struct px_dev **out,
@@ -480,6 +553,7 @@ int px_usb_create(const struct px_dev_config *dcfg,
 	atomic_init(&u->stop, 0);
 	atomic_init(&u->in_flight, 0);
 	atomic_init(&u->gone, 0);
+	atomic_init(&u->arrived, 0);
 	for (i = 0; i < u->cfg.n_transfers; i++) {
 		u->xfer[i] = libusb_alloc_transfer(0);
 		if (!u->xfer[i]) {
@@ -498,6 +572,7 @@ int px_usb_create(const struct px_dev_config *dcfg,
 		*out = NULL;
 		return rc;
 	}
+	hotplug_register(u);
 	return PX_OK;
 }
 

@@ -11,8 +11,13 @@
  * with CLOCK_MONOTONIC, and a writer thread for output frames (the cycle
  * only encodes and hands over). Unplug (LIBUSB_ERROR_NO_DEVICE or a
  * transfer reporting no device) marks the device unplugged: samples go
- * stale and the loop into safe state; the event thread reopens it every
- * 200 ms and marks it running again (the loop resumes after re-arm).
+ * stale and the loop into safe state; the event thread reopens it and
+ * marks it running again (the loop resumes after re-arm). Where libusb
+ * has hotplug (libusb_has_capability(LIBUSB_CAP_HAS_HOTPLUG)) and
+ * no_hotplug is 0, arrival and departure callbacks for the VID:PID make
+ * the reopen immediate and the unplug visible at once; a reopen attempt
+ * every 200 ms stays as the fallback, because arrival events need udev,
+ * which containers and minimal systems lack.
  *
  * Memory: libusb allocates on its own threads and at open; the cycle
  * side allocates nothing. Listing allocates (not for the cycle).
@@ -52,6 +57,8 @@ struct px_usb_config {
 	size_t frame_len;          /* bytes of one input frame, 1..1024 */
 	int detach_kernel_driver;  /* let go of e.g. usbhid first */
 	int n_transfers;           /* IN transfers in flight (default 4) */
+	int no_hotplug;            /* 1: find a replugged device by polling
+				    * only (see below) */
 };
 
 /*
@@ -65,6 +72,10 @@ struct px_usb_config {
 PX_API int px_usb_create(const struct px_dev_config *dcfg,
 			 const struct px_usb_config *uc, struct px_dev **out,
 			 char *msg, size_t cap);
+
+/* 1 when d's hotplug callbacks are registered (0: polling only), or
+ * PX_E_INVAL when d is not a libusb device. */
+PX_API int px_usb_hotplug_active(struct px_dev *d);
 
 PX_API int px_usb_list(void (*fn)(void *user, const char *line), void *user,
 		       char *msg, size_t cap);

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "px_dev.h"
+#include "px_sim.h"
 #include "px_usb.h"
 #include "px_test.h"
 
@@ -78,7 +79,9 @@ static int write_file(const char *dir, const char *name, const char *v)
 	return fclose(f);
 }
 
-static void test_hid_gadget_frames_unplug_replug(void)
+/* no_hotplug 0: hotplug callbacks where libusb has them; 1: the 200 ms
+ * reopen poll alone (the fallback for systems without udev). */
+static void gadget_run(int no_hotplug)
 {
 	const char *vp = getenv("PX_TEST_USB_VIDPID");
 	const char *hidg = getenv("PX_TEST_HIDG");
@@ -101,12 +104,19 @@ static void test_hid_gadget_frames_unplug_replug(void)
 	u.vid = (uint16_t)vid;
 	u.pid = (uint16_t)pid;
 	u.endpoint_out = 0;
+	u.no_hotplug = no_hotplug;
 	px_dev_config_default(&c);
 	c.name = "gadget";
 	c.codec = m;
 	c.stale_timeout_ns = 1000000000;
 	PX_CHECK_MSG((rc = px_usb_create(&c, &u, &d, msg, sizeof msg)) == PX_OK,
 		     "%s", msg);
+	if (no_hotplug)
+		PX_CHECK_INT_EQ(px_usb_hotplug_active(d), 0);
+	else
+		printf("    hotplug callbacks: %s\n",
+		       px_usb_hotplug_active(d) == 1 ? "registered"
+						    : "not available (poll)");
 	PX_CHECK_INT_EQ(px_dev_start(d), PX_OK);
 	fd = open(hidg, O_RDWR);
 	PX_CHECK_MSG(fd >= 0, "%s: %s", hidg, strerror(errno));
@@ -153,9 +163,36 @@ static void test_hid_gadget_frames_unplug_replug(void)
 	px_dev_free(d);
 }
 
+static void test_hid_gadget_frames_unplug_replug(void)
+{
+	gadget_run(0);
+}
+
+static void test_hid_gadget_replug_poll_fallback(void)
+{
+	gadget_run(1);
+}
+
+/* px_usb_hotplug_active refuses what is not a libusb device. */
+static void test_hotplug_query_args(void)
+{
+	struct px_dev_config c;
+	struct px_sim_haptic_config hc;
+	struct px_dev *d = NULL;
+	PX_CHECK_INT_EQ(px_usb_hotplug_active(NULL), PX_E_INVAL);
+	px_dev_config_default(&c);
+	c.name = "sim";
+	px_sim_haptic_config_default(&hc);
+	PX_CHECK_INT_EQ(px_sim_haptic_create(&c, &hc, &d, NULL, 0), PX_OK);
+	PX_CHECK_INT_EQ(px_usb_hotplug_active(d), PX_E_INVAL);
+	px_dev_free(d);
+}
+
 static const struct px_test tests[] = {
 	PX_T(test_open_errors),
 	PX_T(test_hid_gadget_frames_unplug_replug),
+	PX_T(test_hid_gadget_replug_poll_fallback),
+	PX_T(test_hotplug_query_args),
 };
 
 PX_TEST_MAIN(tests)

@@ -1,0 +1,106 @@
+/*
+ * px_devcfg.h - open the devices a configuration describes: the glue from
+ * a struct px_config_device (config/px_config.h) to the back ends
+ * (simulated haptic/pose and GPIO, hidapi, libusb, SocketCAN signals,
+ * CANopen-lite drives, libgpiod).
+ *
+ * What a config device becomes:
+ *  - sim haptic / pose: px_sim_haptic_create() with the sim keys; the
+ *    codec from inputs/buttons/outputs when given, else the built-in
+ *    "haptic" map; a csv trajectory is loaded (path as written, relative
+ *    to the working directory).
+ *  - sim gpio and gpiod: a DIO device. Each line gets a role: the line
+ *    named by safety.estop is the e-stop input and the one named by
+ *    safety.enable the enable output; otherwise a line named "estop"
+ *    (input), "enable" or "timing" (outputs) takes that role. Any other
+ *    line, a role given twice or a direction that does not fit the role
+ *    is an error naming the line.
+ *  - hidapi, libusb: px_hid_create() / px_usb_create() with the codec
+ *    from the config (it must have inputs).
+ *  - socketcan: signals with an axis (see docs/config.md, key "axis")
+ *    make a pose source / force sink (px_can_dev_create()); canopen makes
+ *    a px_canopen master whose drives take counts_per_unit and
+ *    rated_torque_n_m from the config, and whose PDO layouts are the
+ *    config's rpdo/tpdo1/tpdo2 entries over the default layout. The two get separate sockets on a
+ *    kernel interface, separate endpoints of an in-process simulated bus;
+ *    transport unix has one socket (bound at socket_path, sending to
+ *    socket_path + ".peer"), so it takes signals or canopen, not both.
+ *    A kernel bus with a bitrate is not reconfigured here (that needs
+ *    privilege; ip link does it).
+ *
+ * Errors: every failure leaves a one-line message naming the device, the
+ * config key concerned and the back end's reason with its hint, e.g.
+ * "device 'haptic' (hidapi, devices[0].hidapi.vid): no HID device
+ * 1234:0001 found (...)".
+ *
+ * Memory: px_devcfg_open() allocates (setup time): the handle holds the
+ * codec and signal tables the devices point into, so it must outlive
+ * them (px_devcfg_free() frees everything it opened). Nothing here runs
+ * in a cycle; the devices it returns follow their own RT rules.
+ */
+#ifndef PX_DEVCFG_H
+#define PX_DEVCFG_H
+
+#include <stddef.h>
+
+#include "px_base.h"
+#include "px_can.h"
+#include "px_canopen.h"
+#include "px_config.h"
+#include "px_dev.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+struct px_devcfg;
+
+struct px_devcfg_options {
+	/* transport sim: the in-process bus to join (so a simulated arm or
+	 * test can sit on it); NULL = the handle creates its own
+	 * (px_devcfg_can_sim()). Not owned. */
+	struct px_can_sim *can_sim;
+};
+
+/*
+ * Open config device dc of cfg (dc must be one of cfg->devices; cfg
+ * gives the safety line references and the default stale timeout).
+ * opt may be NULL. On success *out holds the device(s); on failure *out
+ * is NULL and msg (cap bytes, may be NULL) says which device, which key
+ * and why. Returns PX_OK, PX_E_INVAL (a value the back end cannot
+ * take), PX_E_NOMEM, or the back end's open error (PX_E_NOTFOUND,
+ * PX_E_PERM, PX_E_UNSUPPORTED, PX_E_NODEV, PX_E_IO, ...).
+ */
+PX_API int px_devcfg_open(const struct px_config *cfg,
+			  const struct px_config_device *dc,
+			  const struct px_devcfg_options *opt,
+			  struct px_devcfg **out, char *msg, size_t cap);
+
+/* Free the devices, master, buses and tables. NULL is a no-op. */
+PX_API void px_devcfg_free(struct px_devcfg *h);
+
+/* The pose/force/DIO device; NULL for a socketcan device with canopen
+ * only. Owned by the handle. */
+PX_API struct px_dev *px_devcfg_dev(const struct px_devcfg *h);
+/* The CANopen master (NULL without canopen). Owned by the handle. */
+PX_API struct px_canopen *px_devcfg_canopen(const struct px_devcfg *h);
+/* The bus the master uses (NULL without canopen). Owned by the handle. */
+PX_API struct px_can_bus *px_devcfg_canopen_bus(const struct px_devcfg *h);
+/* The simulated bus of transport sim (given in the options or created);
+ * NULL otherwise. */
+PX_API struct px_can_sim *px_devcfg_can_sim(const struct px_devcfg *h);
+/* The PDO layout the master uses (config rpdo/tpdo1/tpdo2 over the
+ * default), e.g. for a simulated arm; NULL without canopen. */
+PX_API const struct px_canopen_pdo_map *
+px_devcfg_pdo(const struct px_devcfg *h);
+/* Fill drives (cap entries) with the master's drive table as opened
+ * (counts_per_unit etc.), e.g. for a simulated arm. Returns the count,
+ * PX_E_NOSPC or PX_E_INVAL. */
+PX_API int px_devcfg_drives(const struct px_devcfg *h,
+			    struct px_canopen_drive_cfg *drives, size_t cap);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
