@@ -20,7 +20,7 @@ NAME    := proxima
 VERSION := $(shell sed -n 's/^\#define PX_VERSION_STRING "\(.*\)"/\1/p' core/px_base.h)
 SOMAJOR := $(firstword $(subst ., ,$(VERSION)))
 
-MODULE_DIRS := core geom rt devices config control
+MODULE_DIRS := core geom rt devices config control scene
 WARN    := -Wall -Wextra -Wshadow -Wstrict-prototypes -Werror
 INCS    := $(addprefix -I,$(MODULE_DIRS))
 BASE_CFLAGS := -std=c11 -D_GNU_SOURCE $(WARN) $(INCS) -fvisibility=hidden -MMD -MP
