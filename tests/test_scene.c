@@ -418,6 +418,56 @@ static void test_config_errors(void)
 	px_scene_free(s);
 }
 
+/* Haptic proxy on a scene: pressed into the -x face of a box, then the
+ * device slides along y past the end of that face, into free space. The
+ * proxy must follow it out (no phantom wall left by the face's plane),
+ * never be inside the box, and the force must fall back to zero. */
+static void test_proxy_leaves_the_end_of_a_face(void)
+{
+	struct px_scene *s;
+	struct px_model *m;
+	struct px_prim box = {PX_PRIM_BOX, 0.02, 0.02, 0.02};
+	struct px_control_query q;
+	struct px_control_haptic_params hp;
+	struct px_control_haptic h;
+	struct px_control_haptic_out out;
+	int k, inside = 0;
+	double max_pen = 0;
+	px_vec3 dev = px_v3(-0.05, 0, 0);
+	PX_CHECK_INT_EQ(px_scene_create(1, &s), PX_OK);
+	PX_CHECK_INT_EQ(px_prim_model(&box, &m), PX_OK);
+	PX_CHECK_INT_EQ(px_scene_add(s, m, "box"), 0);
+	px_scene_control_query(s, &q);
+	px_control_haptic_params_default(&hp);
+	PX_CHECK_INT_EQ(px_control_haptic_init(&h, &hp, 1000000), PX_OK);
+	for (k = 0; k < 400; k++) {
+		struct px_scene_hit sh;
+		if (k < 40)
+			dev.x += 0.001; /* into the face, 10 mm deep */
+		else if (k < 120)
+			dev.y += 0.001; /* along it, past its end at y = 0.02 */
+		PX_CHECK_INT_EQ(px_control_haptic_step(&h, &q, dev, NULL, &out),
+				PX_OK);
+		if (k == 60)
+			PX_CHECK(out.contact && out.penetration_m > 0.009);
+		if (out.penetration_m > max_pen)
+			max_pen = out.penetration_m;
+		PX_CHECK_INT_EQ(px_scene_nearest(s, out.proxy_m, INFINITY, &sh), 1);
+		if (sh.distance_m < 0)
+			inside++;
+	}
+	PX_CHECK_INT_EQ(inside, 0);
+	PX_CHECK(max_pen > 0.009 && max_pen < 0.012);
+	PX_CHECK_MSG(!out.contact && out.penetration_m == 0,
+		     "proxy held %.4f m behind a face it has left (proxy %.4f "
+		     "%.4f %.4f, device %.4f %.4f %.4f)",
+		     out.penetration_m, out.proxy_m.x, out.proxy_m.y,
+		     out.proxy_m.z, dev.x, dev.y, dev.z);
+	PX_CHECK_NEAR(px_v3_dist(out.proxy_m, dev), 0, 1e-9);
+	PX_CHECK(px_v3_norm(out.force_n) < 0.05);
+	px_scene_free(s);
+}
+
 static char *slurp(const char *path)
 {
 	FILE *f = fopen(path, "rb");
@@ -477,6 +527,7 @@ static const struct px_test tests[] = {
 	PX_T(test_config_example_scene),
 	PX_T(test_config_scale),
 	PX_T(test_config_errors),
+	PX_T(test_proxy_leaves_the_end_of_a_face),
 	PX_T(test_schema_documented),
 };
 PX_TEST_MAIN(tests)
