@@ -210,5 +210,32 @@ expect "run with a missing scene file" 1 "$bin" "$tmp/noscene.yaml" --virtual-ti
 if grep -q "^$tmp/noscene.yaml:[0-9]*:[0-9]*: scene.models\[1\].file: .*knob-missing.stl" "$tmp/err"; then
 	ok "missing scene file placed"; else bad "missing scene file placed"; fi
 
+# The fault campaign: every kind injected; the loop trips and re-arms.
+fj="$tmp/haptic_faults.json"
+if [ -s "$fj" ]; then
+	check "faults: safe state entered" "$(num "$fj" safe_state_trips) >= 3"
+	for k in drop delay duplicate corrupt stuck nan unplug; do
+		if grep -q "{\"kind\": \"$k\", \"device\": \"haptic\"" "$fj"; then ok "faults: $k reported"; else bad "faults: $k reported"; fi
+	done
+	for k in delay stuck nan unplug; do
+		after=$(sed -n "s/.*\"kind\": \"$k\".*\"safe_after_ns\": \(-\{0,1\}[0-9]*\)}.*/\1/p" "$fj")
+		check "faults: $k trips safe state within 100 ms ($after ns)" "$after >= 0 && $after <= 100000000"
+	done
+	check "faults: corrupt reports counted" "$(num "$fj" device_decode) > 0"
+	check "faults: zero force whenever in safe state" \
+		"$(awk -F, 'NR > 1 && $16 == 1 && $12 != 0 { n++ } END { print n + 0 }' "$tmp/haptic_faults.csv") == 0"
+else
+	bad "faults: the shipped fault campaign ran"
+fi
+printf 'devices:\n  - {name: pen, backend: sim}\nsim:\n  faults:\n    - {device: pem, kind: delay, start_ns: 0, duration_ns: 10}\n    - {device: pen, kind: jam, start_ns: 0, duration_ns: 10}\n' >"$tmp/badfault.yaml"
+expect "--check on bad faults" 1 "$bin" --check "$tmp/badfault.yaml"
+has "fault without delay_ns" "$tmp/err" "$tmp/badfault.yaml:5:7: sim.faults[0].delay_ns: missing or zero for kind 'delay'"
+has "fault on an unknown device" "$tmp/err" "$tmp/badfault.yaml:5:16: sim.faults[0].device: no device named 'pem' in devices"
+has "unknown fault kind" "$tmp/err" "$tmp/badfault.yaml:6:27: sim.faults[1].kind: unknown value 'jam' (expected one of: drop, delay, duplicate, corrupt, stuck, nan, unplug)"
+for k in faults device kind start_ns duration_ns probability delay_ns drop delay duplicate corrupt stuck nan unplug; do
+	grep -qF "\`$k\`" docs/config.md || { echo "    docs/config.md lacks \`$k\`"; bad "sim keys documented"; }
+done
+ok "sim keys documented (checked above)"
+
 echo "$name: $pass passed, $fail failed, $skip skipped"
 [ "$fail" -eq 0 ]

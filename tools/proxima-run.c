@@ -266,6 +266,112 @@ static const char *heap_counter_setup(void)
 }
 #endif
 
+/* ---- the `sim` section: fault campaigns --------------------------- */
+
+#define SIM_RANGE (PX_CONFIG_HAS_MIN | PX_CONFIG_HAS_MAX)
+#define MAX_CAMPAIGN 64
+
+/* Fault kinds a simulated haptic/pose device takes (enum px_sim_fault_kind
+ * is index + 1). */
+static const char *const fault_kind_names[] = {
+	"drop", "delay", "duplicate", "corrupt", "stuck", "nan", "unplug", NULL};
+
+struct raw_fault {
+	const char *device;
+	int kind;
+	int64_t start_ns, duration_ns, delay_ns;
+	double probability;
+};
+
+struct raw_sim {
+	struct raw_fault *faults;
+	size_t n_faults;
+	const struct px_config *cfg_; /* not a key: context for the check */
+};
+
+static void fault_check(struct px_config_reader *r,
+			const struct px_config_node *map, void *obj)
+{
+	const struct raw_fault *f = obj;
+	int delay = f->kind + 1 == PX_SIM_FAULT_DELAY;
+	if (delay && f->delay_ns <= 0)
+		px_config_reader_error(r, map, "delay_ns",
+				       "missing or zero for kind 'delay'");
+	if (!delay && f->delay_ns > 0)
+		px_config_reader_error(r, px_config_node_get(map, "delay_ns"),
+				       "delay_ns", "only for kind 'delay'");
+}
+
+static const struct px_config_key fault_keys[] = {
+	{.name = "device", .type = PX_CONFIG_T_STRING,
+	 .offset = offsetof(struct raw_fault, device),
+	 .flags = PX_CONFIG_REQUIRED | PX_CONFIG_NONEMPTY},
+	{.name = "kind", .type = PX_CONFIG_T_ENUM,
+	 .offset = offsetof(struct raw_fault, kind), .flags = PX_CONFIG_REQUIRED,
+	 .names = fault_kind_names},
+	{.name = "start_ns", .type = PX_CONFIG_T_DURATION,
+	 .offset = offsetof(struct raw_fault, start_ns),
+	 .flags = PX_CONFIG_REQUIRED | SIM_RANGE, .imin = 0,
+	 .imax = 1000000000000000},
+	{.name = "duration_ns", .type = PX_CONFIG_T_DURATION,
+	 .offset = offsetof(struct raw_fault, duration_ns),
+	 .flags = PX_CONFIG_REQUIRED | SIM_RANGE, .imin = 1,
+	 .imax = 1000000000000000, .idef = 1},
+	{.name = "probability", .type = PX_CONFIG_T_DOUBLE,
+	 .offset = offsetof(struct raw_fault, probability),
+	 .flags = SIM_RANGE | PX_CONFIG_MIN_EXCL, .dmin = 0, .dmax = 1,
+	 .ddef = 1},
+	{.name = "delay_ns", .type = PX_CONFIG_T_DURATION,
+	 .offset = offsetof(struct raw_fault, delay_ns), .flags = SIM_RANGE,
+	 .imin = 0, .imax = 10000000000},
+};
+static const struct px_config_schema fault_schema = {
+	"fault", fault_keys, sizeof(fault_keys) / sizeof(fault_keys[0]),
+	fault_check};
+
+static void sim_check(struct px_config_reader *r,
+		      const struct px_config_node *map, void *obj)
+{
+	const struct raw_sim *sm = obj;
+	const struct px_config_node *seq = px_config_node_get(map, "faults");
+	size_t i;
+	char where[48];
+	for (i = 0; i < sm->n_faults; i++) {
+		const struct raw_fault *f = &sm->faults[i];
+		const struct px_config_node *it =
+			seq && seq->kind == PX_CONFIG_NODE_SEQ && i < seq->len
+				? seq->items[i]
+				: map;
+		const struct px_config_device *d;
+		if (!f->device)
+			continue;
+		d = px_config_device_find(sm->cfg_, f->device);
+		snprintf(where, sizeof(where), "faults[%zu].device", i);
+		if (!d)
+			px_config_reader_error(r, px_config_node_get(it, "device"),
+					       where,
+					       "no device named '%s' in devices",
+					       f->device);
+		else if (d->backend != PX_CONFIG_BACKEND_SIM ||
+			 d->sim.kind == PX_CONFIG_SIM_GPIO)
+			px_config_reader_error(r, px_config_node_get(it, "device"),
+					       where,
+					       "'%s' is not a simulated haptic or "
+					       "pose device",
+					       f->device);
+	}
+}
+
+static const struct px_config_key sim_keys[] = {
+	{.name = "faults", .type = PX_CONFIG_T_SEQ,
+	 .offset = offsetof(struct raw_sim, faults), .sub = &fault_schema,
+	 .elem = PX_CONFIG_T_SUB, .elem_size = sizeof(struct raw_fault),
+	 .count_offset = offsetof(struct raw_sim, n_faults),
+	 .max_count = MAX_CAMPAIGN},
+};
+static const struct px_config_schema sim_schema = {
+	"sim", sim_keys, sizeof(sim_keys) / sizeof(sim_keys[0]), sim_check};
+
 /* ---- the application ----------------------------------------------- */
 
 #define MAX_DEVS 64
@@ -332,6 +438,11 @@ struct app {
 	uint64_t faults_popped;
 	struct tele last;
 	int have_last;
+	/* fault campaign */
+	struct raw_sim sim;
+	int64_t clock0_ns;      /* loop clock at setup: fault windows start here */
+	struct px_fault *lfaults; /* loop faults seen, for the campaign report */
+	size_t n_lfaults, cap_lfaults;
 };
 
 static struct app A;
@@ -447,7 +558,10 @@ static int phase_write(struct px_loop *l, const struct px_loop_cycle *c,
 		 a->cmd.force_n[2] * a->cmd.force_n[2]);
 	if (f > a->max_force_n)
 		a->max_force_n = f;
-	if (a->have_out) {
+	/* Figures of the rendering only while it drives the device: not in
+	 * safe state (force zeroed) nor on a sample that broke the velocity
+	 * limit (a corrupted report the loop is tripping on). */
+	if (a->have_out && !c->safe && !a->over_velocity) {
 		if (a->out.distance_m < a->min_distance_m)
 			a->min_distance_m = a->out.distance_m;
 		if (a->out.penetration_m > a->max_penetration_m)
@@ -473,8 +587,13 @@ static int phase_write(struct px_loop *l, const struct px_loop_cycle *c,
 		r.proxy_m[2] = a->out.proxy_m.z;
 		memcpy(r.force_n, a->cmd.force_n, sizeof(r.force_n));
 		r.force_mag_n = f;
-		r.distance_m = a->have_out ? a->out.distance_m : NAN;
-		r.penetration_m = a->have_out ? a->out.penetration_m : NAN;
+		/* a sample that broke the velocity limit has no meaningful
+		 * distance: left empty (NaN) rather than spoiling the plots */
+		r.distance_m = a->have_out && !a->over_velocity ? a->out.distance_m
+								: NAN;
+		r.penetration_m = a->have_out && !a->over_velocity
+					  ? a->out.penetration_m
+					  : NAN;
 		r.latency_ns = c->wake_ns - c->deadline_ns;
 		r.compute_ns = a->compute_t0;
 		r.contact = a->out.contact;
@@ -612,6 +731,34 @@ static int make_device(int k)
 		}
 		sc.traj.csv = A.csv[k];
 	}
+	{
+		static struct px_sim_fault fl[PX_SIM_MAX_FAULTS];
+		size_t n = 0;
+		for (i = 0; i < A.sim.n_faults; i++) {
+			const struct raw_fault *f = &A.sim.faults[i];
+			if (strcmp(f->device, d->name) != 0)
+				continue;
+			if (n == PX_SIM_MAX_FAULTS) {
+				fprintf(stderr,
+					"proxima-run: device '%s': more than %d "
+					"faults\n",
+					d->name, PX_SIM_MAX_FAULTS);
+				return 1;
+			}
+			fl[n].kind = f->kind + 1;
+			fl[n].start_ns = A.clock0_ns + f->start_ns;
+			fl[n].duration_ns = f->duration_ns;
+			fl[n].probability = f->probability;
+			fl[n].delay_ns = f->delay_ns;
+			n++;
+		}
+		sc.faults = fl;
+		sc.n_faults = n;
+	}
+	/* A noisy position never repeats exactly: identical samples mean a
+	 * frozen sensor (the stuck fault), so let the device detect it. */
+	if (s->position_noise_m > 0)
+		dc.stuck_limit = 50;
 	rc = px_sim_haptic_create(&dc, &sc, &A.dev[A.n_dev], msg, sizeof(msg));
 	if (rc != PX_OK) {
 		fprintf(stderr, "proxima-run: device '%s': %s\n", d->name,
@@ -644,6 +791,7 @@ static int setup(void)
 	int i, rc;
 
 	A.ctl_dev = -1;
+	A.clock0_ns = A.o.virtual_time ? 0 : mono_ns();
 	A.min_distance_m = INFINITY;
 	A.min_proxy_distance_m = INFINITY;
 	A.decimation = cfg->telemetry.decimation > 0 ? cfg->telemetry.decimation : 1;
@@ -764,6 +912,7 @@ static void teardown(void)
 	px_scene_free(A.scene);
 	px_arena_fini(&A.arena);
 	free(A.recs);
+	free(A.lfaults);
 	px_config_free(A.cfg);
 }
 
@@ -811,6 +960,18 @@ static void drain(void)
 		if (f.cause >= 0 && f.cause < PX_FAULT__COUNT)
 			A.faults_by_cause[f.cause]++;
 		A.faults_popped++;
+		if (A.sim.n_faults && A.n_lfaults < 100000) {
+			if (A.n_lfaults == A.cap_lfaults) {
+				size_t cap = A.cap_lfaults ? 2 * A.cap_lfaults : 256;
+				struct px_fault *p =
+					realloc(A.lfaults, cap * sizeof(*p));
+				if (!p)
+					continue;
+				A.lfaults = p;
+				A.cap_lfaults = cap;
+			}
+			A.lfaults[A.n_lfaults++] = f;
+		}
 	}
 }
 
@@ -1039,6 +1200,8 @@ static void device_faults(struct dev_faults *df)
 	}
 }
 
+static void json_campaign(FILE *f);
+
 static int write_json(const char *path, const struct px_loop_status *st,
 		      const struct px_stats_snapshot *lat,
 		      const struct px_stats_snapshot *cmp, double wall_s,
@@ -1090,6 +1253,7 @@ static int write_json(const char *path, const struct px_loop_status *st,
 		(unsigned long long)A.velocity_trips,
 		(unsigned long long)A.query_errors,
 		(unsigned long long)st->faults_dropped);
+	json_campaign(f);
 	fprintf(f,
 		"  \"allocations_after_setup\": %llu,\n"
 		"  \"allocations_setup\": %llu,\n"
@@ -1110,6 +1274,77 @@ static int write_json(const char *path, const struct px_loop_status *st,
 	json_string(f, lat_svg);
 	fputs("]\n}\n", f);
 	return fclose(f) == 0 ? 0 : -1;
+}
+
+/* What the safety layer did about configured fault i: loop faults seen
+ * from the window's start to its end plus the device timeout (and 10 ms),
+ * and the time from the start to the first that put or kept the loop in
+ * safe state (-1: none). */
+static void campaign_reaction(size_t i, uint64_t *n, int64_t *safe_after_ns,
+			      int64_t *t0, int64_t *t1)
+{
+	const struct raw_fault *f = &A.sim.faults[i];
+	const struct px_config_device *d = px_config_device_find(A.cfg, f->device);
+	int64_t tmo = d && d->stale_timeout_ns ? d->stale_timeout_ns
+					       : A.cfg->safety.watchdog.device_timeout_ns;
+	size_t k;
+	*t0 = A.clock0_ns + f->start_ns;
+	*t1 = *t0 + f->duration_ns + tmo + 10000000;
+	*n = 0;
+	*safe_after_ns = -1;
+	for (k = 0; k < A.n_lfaults; k++) {
+		const struct px_fault *lf = &A.lfaults[k];
+		if (lf->t_ns < *t0 || lf->t_ns > *t1)
+			continue;
+		(*n)++;
+		if (lf->safe && *safe_after_ns < 0)
+			*safe_after_ns = lf->t_ns - *t0;
+	}
+}
+
+static void print_campaign(void)
+{
+	size_t i;
+	if (!A.sim.n_faults)
+		return;
+	printf("  fault campaign    (loop faults from each window's start to "
+	       "its end + device timeout)\n");
+	for (i = 0; i < A.sim.n_faults; i++) {
+		const struct raw_fault *f = &A.sim.faults[i];
+		uint64_t n;
+		int64_t after, t0, t1;
+		campaign_reaction(i, &n, &after, &t0, &t1);
+		printf("    %-9s %-8s %7.3f..%7.3f s p %.2f: %4llu loop faults, ",
+		       fault_kind_names[f->kind], f->device, (double)f->start_ns * 1e-9,
+		       (double)(f->start_ns + f->duration_ns) * 1e-9, f->probability,
+		       (unsigned long long)n);
+		if (after >= 0)
+			printf("safe state after %.1f ms\n", (double)after * 1e-6);
+		else
+			printf("no safe state (samples stayed fresh)\n");
+	}
+}
+
+static void json_campaign(FILE *f)
+{
+	size_t i;
+	fputs("  \"fault_campaign\": [", f);
+	for (i = 0; i < A.sim.n_faults; i++) {
+		const struct raw_fault *x = &A.sim.faults[i];
+		uint64_t n;
+		int64_t after, t0, t1;
+		campaign_reaction(i, &n, &after, &t0, &t1);
+		fprintf(f,
+			"%s\n    {\"kind\": \"%s\", \"device\": ", i ? "," : "",
+			fault_kind_names[x->kind]);
+		json_string(f, x->device);
+		fprintf(f,
+			", \"start_ns\": %lld, \"duration_ns\": %lld, "
+			"\"loop_faults\": %llu, \"safe_after_ns\": %lld}",
+			(long long)x->start_ns, (long long)x->duration_ns,
+			(unsigned long long)n, (long long)after);
+	}
+	fputs(A.sim.n_faults ? "\n  ],\n" : "],\n", f);
 }
 
 static void print_summary(const struct px_loop_status *st,
@@ -1170,6 +1405,7 @@ static void print_summary(const struct px_loop_status *st,
 	       "dropped\n",
 	       (unsigned long long)A.n_recs, (long long)A.decimation,
 	       (unsigned long long)px_ring_dropped(A.ring));
+	print_campaign();
 }
 
 int main(int argc, char **argv)
@@ -1188,6 +1424,14 @@ int main(int argc, char **argv)
 	if (rc != PX_OK)
 		return report_config(rc, &diag);
 	rc = px_control_config_read(A.cfg, &A.ctl, &diag);
+	if (rc != PX_OK) {
+		report_config(rc, &diag);
+		px_config_free(A.cfg);
+		return 1;
+	}
+	A.sim.cfg_ = A.cfg;
+	rc = px_config_read(A.cfg->doc, A.cfg->sim, "sim", &sim_schema, &A.sim,
+			    &diag);
 	if (rc != PX_OK) {
 		report_config(rc, &diag);
 		px_config_free(A.cfg);
