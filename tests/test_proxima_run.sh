@@ -130,7 +130,7 @@ absolute() { sed "s|file: scenes/|file: $PWD/config/examples/scenes/|" "$1"; }
 ran=0
 for f in config/examples/*.yaml; do
 	base=$(basename "$f" .yaml)
-	if grep -qE 'backend: (hidapi|libusb|socketcan|gpiod)' "$f"; then
+	if grep -qE 'backend: (hidapi|libusb|gpiod)|transport: (kernel|unix)' "$f"; then
 		# needs hardware or a second process: the runner says so
 		expect "$f is refused without its hardware" 2 "$bin" "$f" --virtual-time --duration-s 1
 		if grep -q "is not driven by proxima-run" "$tmp/err"; then ok "$f: reason given"; else bad "$f: reason given"; fi
@@ -236,6 +236,29 @@ for k in faults device kind start_ns duration_ns probability delay_ns drop delay
 	grep -qF "\`$k\`" docs/config.md || { echo "    docs/config.md lacks \`$k\`"; bad "sim keys documented"; }
 done
 ok "sim keys documented (checked above)"
+
+# Collision avoidance over CANopen on the simulated bus: the arm is kept
+# outside the protective distance, and the avoidance had to act.
+aj="$tmp/can_avoid_sim.json"
+if [ -s "$aj" ]; then
+	check "avoidance: min clearance $(num "$aj" min_clearance_m) >= protective $(num "$aj" protective_distance_m)" \
+		"$(num "$aj" min_clearance_m) >= $(num "$aj" protective_distance_m)"
+	check "avoidance: the speed was scaled down" "$(num "$aj" min_speed_scale) < 1"
+	check "avoidance: no safe state" "$(num "$aj" safe_state_trips) == 0"
+else
+	bad "avoidance: the shipped demo ran"
+fi
+# The same arm without the pillar's influence: a pillar in the sweep with
+# protective distance 0.2 m; the arm still stays outside it.
+sed 's/protective_distance_m: 0.05/protective_distance_m: 0.2/; s/influence_distance_m: 0.25/influence_distance_m: 0.4/' \
+	config/examples/can_avoid_sim.yaml >"$tmp/avoid2.yaml"
+expect "avoidance with a larger protective distance" 0 "$bin" "$tmp/avoid2.yaml" --virtual-time \
+	--duration-s 3 --summary-json "$tmp/avoid2.json" --telemetry "$tmp/avoid2.csv"
+check "avoidance: clearance $(num "$tmp/avoid2.json" min_clearance_m) >= 0.2 - 1 mm" \
+	"$(num "$tmp/avoid2.json" min_clearance_m) >= 0.199"
+for k in nominal joint amplitude_rad_per_s frequency_hz phase_rad; do
+	grep -qF "\`$k\`" docs/config.md || { echo "    docs/config.md lacks \`$k\`"; bad "nominal keys documented"; }
+done
 
 echo "$name: $pass passed, $fail failed, $skip skipped"
 [ "$fail" -eq 0 ]

@@ -24,9 +24,14 @@
  * PX_RUN_ALLOC_PROBE=1 in the environment makes cycle 10 allocate and
  * free once on purpose: the count is then 2 (a self-check for tests).
  *
+ * Devices driven: simulated haptic and pose devices (haptic rendering or
+ * mode none), and a CANopen arm on the in-process simulated CAN bus
+ * (collision avoidance; the drives' side is stepped in the read phase as
+ * another node on the bus). The `sim` section adds fault campaigns and
+ * the avoidance demo's nominal task.
+ *
  * Exit status: 0 ok, 1 invalid config or setup failure, 2 usage error or
- * a configuration this runner does not drive yet (a back end other than
- * sim, control mode avoidance).
+ * a configuration this runner does not drive yet (hardware back ends).
  */
 #include <errno.h>
 #include <math.h>
@@ -41,6 +46,8 @@
 #include <unistd.h>
 
 #include "px_arena.h"
+#include "px_can.h"
+#include "px_canopen.h"
 #include "px_config.h"
 #include "px_control.h"
 #include "px_dev.h"
@@ -283,9 +290,18 @@ struct raw_fault {
 	double probability;
 };
 
+/* Nominal joint velocity of the avoidance demo's task: a sum of
+ * sinusoids per joint. */
+struct raw_nominal {
+	int64_t joint;
+	double amplitude_rad_per_s, frequency_hz, phase_rad;
+};
+
 struct raw_sim {
 	struct raw_fault *faults;
 	size_t n_faults;
+	struct raw_nominal *nominal;
+	size_t n_nominal;
 	const struct px_config *cfg_; /* not a key: context for the check */
 };
 
@@ -362,12 +378,35 @@ static void sim_check(struct px_config_reader *r,
 	}
 }
 
+static const struct px_config_key nominal_keys[] = {
+	{.name = "joint", .type = PX_CONFIG_T_INT64,
+	 .offset = offsetof(struct raw_nominal, joint),
+	 .flags = PX_CONFIG_REQUIRED | SIM_RANGE, .imin = 0,
+	 .imax = PX_CONTROL_MAX_JOINTS - 1},
+	{.name = "amplitude_rad_per_s", .type = PX_CONFIG_T_DOUBLE,
+	 .offset = offsetof(struct raw_nominal, amplitude_rad_per_s),
+	 .flags = PX_CONFIG_REQUIRED | SIM_RANGE, .dmin = -100, .dmax = 100},
+	{.name = "frequency_hz", .type = PX_CONFIG_T_DOUBLE,
+	 .offset = offsetof(struct raw_nominal, frequency_hz),
+	 .flags = SIM_RANGE, .dmin = 0, .dmax = 1000},
+	{.name = "phase_rad", .type = PX_CONFIG_T_DOUBLE,
+	 .offset = offsetof(struct raw_nominal, phase_rad), .flags = SIM_RANGE,
+	 .dmin = -1000, .dmax = 1000},
+};
+static const struct px_config_schema nominal_schema = {
+	"nominal", nominal_keys, sizeof(nominal_keys) / sizeof(nominal_keys[0]),
+	NULL};
+
 static const struct px_config_key sim_keys[] = {
 	{.name = "faults", .type = PX_CONFIG_T_SEQ,
 	 .offset = offsetof(struct raw_sim, faults), .sub = &fault_schema,
 	 .elem = PX_CONFIG_T_SUB, .elem_size = sizeof(struct raw_fault),
 	 .count_offset = offsetof(struct raw_sim, n_faults),
 	 .max_count = MAX_CAMPAIGN},
+	{.name = "nominal", .type = PX_CONFIG_T_SEQ,
+	 .offset = offsetof(struct raw_sim, nominal), .sub = &nominal_schema,
+	 .elem = PX_CONFIG_T_SUB, .elem_size = sizeof(struct raw_nominal),
+	 .count_offset = offsetof(struct raw_sim, n_nominal), .max_count = 64},
 };
 static const struct px_config_schema sim_schema = {
 	"sim", sim_keys, sizeof(sim_keys) / sizeof(sim_keys[0]), sim_check};
@@ -375,6 +414,7 @@ static const struct px_config_schema sim_schema = {
 /* ---- the application ----------------------------------------------- */
 
 #define MAX_DEVS 64
+#define PLOT_MAX ((size_t)1 << 20)
 
 /* One telemetry record, pushed by the write phase every decimation-th
  * cycle. */
@@ -433,11 +473,30 @@ struct app {
 	char csv_path[1024];
 	struct tele *recs;
 	size_t n_recs, cap_recs;
+	uint64_t n_rows;        /* records drained (CSV rows) */
 	double min_proxy_distance_m;
 	uint64_t faults_by_cause[PX_FAULT__COUNT];
 	uint64_t faults_popped;
 	struct tele last;
 	int have_last;
+	/* avoidance: a CANopen arm on the in-process simulated CAN bus */
+	int avoiding;
+	struct px_can_sim *canbus;
+	struct px_can_bus *ep_master, *ep_arm;
+	struct px_canopen *co;
+	struct px_canopen_sim *arm;
+	int arm_input;          /* loop input index of the drives' feedback */
+	int n_drives;
+	int drive_joint[PX_CANOPEN_MAX_DRIVES];
+	int started;
+	int csp;                /* drives in CSP: targets are positions */
+	double q[PX_CONTROL_MAX_JOINTS], qcmd[PX_CONTROL_MAX_JOINTS];
+	double targets[PX_CONTROL_MAX_JOINTS];
+	int have_q, enabled;
+	int64_t last_feedback_ns;
+	struct px_control_avoid_out aout;
+	double min_clearance_m, min_scale;
+	uint64_t stop_cycles;   /* cycles with the nominal motion stopped */
 	/* fault campaign */
 	struct raw_sim sim;
 	int64_t clock0_ns;      /* loop clock at setup: fault windows start here */
@@ -476,6 +535,31 @@ static int phase_read(struct px_loop *l, const struct px_loop_cycle *c,
 		a->heap_base = heap_count();
 		a->t0_ns = c->read_ns;
 	}
+	if (a->canbus) {
+		int64_t newest = 0;
+		int have = a->n_drives > 0;
+		/* the robot's side of the bus first, as another process would
+		 * have answered the last SYNC by now */
+		px_canopen_sim_step(a->arm, c->read_ns);
+		px_canopen_rx(a->co, c->read_ns);
+		for (i = 0; i < a->n_drives; i++) {
+			struct px_canopen_drive_status ds;
+			px_canopen_drive_status(a->co, (size_t)i, &ds);
+			if (ds.feedback_ns == 0) {
+				have = 0;
+				continue;
+			}
+			a->q[a->drive_joint[i]] = ds.position;
+			if (ds.feedback_ns > newest)
+				newest = ds.feedback_ns;
+		}
+		a->have_q = have;
+		if (have && newest > a->last_feedback_ns) {
+			a->last_feedback_ns = newest;
+			px_loop_input_stamp(l, a->arm_input, newest);
+		}
+		a->enabled = px_canopen_all_enabled(a->co);
+	}
 	for (i = 0; i < a->n_dev; i++) {
 		int rc = px_dev_pose_read(a->dev[i], c->read_ns, &a->sample[i]);
 		(void)rc; /* staleness reaches the watchdog through the stamp */
@@ -497,6 +581,45 @@ static int phase_read(struct px_loop *l, const struct px_loop_cycle *c,
 	return PX_OK;
 }
 
+/* Avoidance: nominal joint velocity from the demo task, scaled and
+ * deflected by the clearances (px_control_avoid_step), into drive
+ * targets (CSP: integrated positions; CSV: velocities). */
+static void avoid_compute(struct app *a, const struct px_loop_cycle *c)
+{
+	double qnom[PX_CONTROL_MAX_JOINTS] = {0};
+	double t = (double)(c->deadline_ns - a->t0_ns) * 1e-9;
+	double dt = (double)c->period_ns * 1e-9;
+	size_t k;
+	int i, rc;
+	if (!a->have_q || !a->enabled) {
+		for (i = 0; i < PX_CONTROL_MAX_JOINTS; i++)
+			a->targets[i] = a->csp ? a->q[i] : 0.0;
+		return;
+	}
+	if (!a->started) {
+		memcpy(a->qcmd, a->q, sizeof(a->qcmd));
+		a->started = 1;
+	}
+	for (k = 0; k < a->sim.n_nominal; k++) {
+		const struct raw_nominal *nm = &a->sim.nominal[k];
+		if (nm->joint < a->ctl.chain.n_joints)
+			qnom[nm->joint] += nm->amplitude_rad_per_s *
+					   cos(2 * M_PI * nm->frequency_hz * t +
+					       nm->phase_rad);
+	}
+	rc = px_control_avoid_step(&a->ctl.chain, &a->ctl.avoid, &a->query, a->q,
+				   qnom, c->period_ns, &a->aout);
+	if (rc < 0) {
+		a->query_errors++;
+		a->last_query_err = rc;
+	}
+	for (i = 0; i < a->ctl.chain.n_joints; i++) {
+		double v = rc < 0 ? 0.0 : a->aout.qdot[i];
+		a->qcmd[i] += v * dt;
+		a->targets[i] = a->csp ? a->qcmd[i] : v;
+	}
+}
+
 static int phase_compute(struct px_loop *l, const struct px_loop_cycle *c,
 			 void *user)
 {
@@ -504,6 +627,8 @@ static int phase_compute(struct px_loop *l, const struct px_loop_cycle *c,
 	int64_t t = mono_ns();
 	(void)l;
 	a->have_out = 0;
+	if (a->avoiding)
+		avoid_compute(a, c);
 	if (a->ctl_dev >= 0 && a->sample[a->ctl_dev].valid) {
 		const struct px_pose_sample *s = &a->sample[a->ctl_dev];
 		if (a->rendering) {
@@ -553,6 +678,26 @@ static int phase_write(struct px_loop *l, const struct px_loop_cycle *c,
 		    PX_OK)
 			a->write_errors++;
 	}
+	if (a->canbus) {
+		int i;
+		if (c->safe) /* hold where the arm is; drives to quick stop */
+			for (i = 0; i < PX_CONTROL_MAX_JOINTS; i++)
+				a->targets[i] = a->csp ? a->q[i] : 0.0;
+		if (px_canopen_tx(a->co, c->write_ns, a->targets,
+				  PX_CONTROL_MAX_JOINTS,
+				  !c->safe && a->have_q) != PX_OK)
+			a->write_errors++;
+		if (a->avoiding && a->started && !c->safe) {
+			if (a->aout.min_clearance_m < a->min_clearance_m)
+				a->min_clearance_m = a->aout.min_clearance_m;
+			if (a->aout.min_clearance_m < a->min_distance_m)
+				a->min_distance_m = a->aout.min_clearance_m;
+			if (a->aout.scale < a->min_scale)
+				a->min_scale = a->aout.scale;
+			if (a->aout.scale == 0)
+				a->stop_cycles++;
+		}
+	}
 	f = sqrt(a->cmd.force_n[0] * a->cmd.force_n[0] +
 		 a->cmd.force_n[1] * a->cmd.force_n[1] +
 		 a->cmd.force_n[2] * a->cmd.force_n[2]);
@@ -596,9 +741,27 @@ static int phase_write(struct px_loop *l, const struct px_loop_cycle *c,
 					  : NAN;
 		r.latency_ns = c->wake_ns - c->deadline_ns;
 		r.compute_ns = a->compute_t0;
+		if (a->avoiding && a->started) {
+			int k = a->aout.closest_capsule;
+			r.distance_m = a->aout.min_clearance_m;
+			r.penetration_m = 0;
+			r.queries = a->aout.point_queries;
+			r.valid = 1;
+			if (k >= 0) {
+				px_vec3 pa = a->aout.caps[k].point_m;
+				px_vec3 pb = a->aout.caps[k].obstacle_m;
+				r.dev_m[0] = pa.x;
+				r.dev_m[1] = pa.y;
+				r.dev_m[2] = pa.z;
+				r.proxy_m[0] = pb.x;
+				r.proxy_m[1] = pb.y;
+				r.proxy_m[2] = pb.z;
+			}
+		}
 		r.contact = a->out.contact;
 		r.safe = c->safe;
-		r.queries = a->out.point_queries;
+		if (!a->avoiding)
+			r.queries = a->out.point_queries;
 		px_ring_push(a->ring, &r);
 	}
 	atomic_store_explicit(&a->allocs, heap_count() - a->heap_base,
@@ -669,6 +832,77 @@ static const struct px_codec_map *make_codec(int k, const struct px_config_codec
 	return m;
 }
 
+/* A CANopen arm on the in-process simulated CAN bus: the master (the
+ * controller's side) on one endpoint, the simulated drives (the robot's
+ * side, stepped in the read phase as if it were another process on the
+ * bus) on the other. Returns 0 or 1 (said why). */
+static int make_can_arm(const struct px_config_device *d)
+{
+	const struct px_config_canopen *c = &d->socketcan.canopen;
+	struct px_canopen_drive_cfg drv[PX_CANOPEN_MAX_DRIVES];
+	struct px_canopen_config mc;
+	struct px_canopen_sim_config sc;
+	struct px_can_sim_config bc;
+	char msg[256] = "";
+	size_t i;
+	int rc;
+	if (A.canbus) {
+		fprintf(stderr, "proxima-run: device '%s': one simulated CAN arm "
+				"per run\n",
+			d->name);
+		return 1;
+	}
+	memset(drv, 0, sizeof(drv));
+	for (i = 0; i < c->n_drives && i < PX_CANOPEN_MAX_DRIVES; i++) {
+		drv[i].node_id = (uint8_t)c->drives[i].node_id;
+		drv[i].mode = PX_CIA402_CSP + c->drives[i].mode;
+		drv[i].joint = (int)c->drives[i].joint;
+		A.drive_joint[i] = drv[i].joint;
+		drv[i].counts_per_unit = 100000.0; /* as proxima-simarm */
+		drv[i].rated_torque_n_m = 1.0;
+		if (drv[i].mode == PX_CIA402_CST) {
+			fprintf(stderr, "proxima-run: device '%s': drives in cst "
+					"take torques; avoidance commands csp or "
+					"csv\n",
+				d->name);
+			return 1;
+		}
+	}
+	A.n_drives = (int)i;
+	A.csp = A.n_drives > 0 && drv[0].mode == PX_CIA402_CSP;
+	px_can_sim_config_default(&bc);
+	rc = px_can_sim_create(&bc, &A.canbus);
+	if (rc == PX_OK)
+		rc = px_can_sim_endpoint(A.canbus, &A.ep_master);
+	if (rc == PX_OK)
+		rc = px_can_sim_endpoint(A.canbus, &A.ep_arm);
+	if (rc == PX_OK) {
+		px_canopen_config_default(&mc);
+		mc.sync = 1;
+		mc.heartbeat_period_ns = c->heartbeat_period_ns;
+		mc.heartbeat_timeout_ns = c->heartbeat_timeout_ns;
+		mc.drives = drv;
+		mc.n_drives = (size_t)A.n_drives;
+		rc = px_canopen_create(&mc, A.ep_master, &A.co, msg, sizeof(msg));
+	}
+	if (rc == PX_OK) {
+		memset(&sc, 0, sizeof(sc));
+		sc.drives = drv;
+		sc.n_drives = (size_t)A.n_drives;
+		sc.heartbeat_period_ns = 100000000;
+		sc.inertia_kg_m2 = 0.01;
+		rc = px_canopen_sim_create(&sc, A.ep_arm, &A.arm);
+	}
+	if (rc != PX_OK) {
+		fprintf(stderr, "proxima-run: device '%s': %s\n", d->name,
+			msg[0] ? msg : px_strerror(rc));
+		return 1;
+	}
+	if (A.ctl.device && strcmp(A.ctl.device, d->name) == 0)
+		A.avoiding = A.ctl.mode == PX_CONTROL_MODE_AVOIDANCE;
+	return 0;
+}
+
 /* Create device k of the config. Returns 0, 1 (setup failed: said why)
  * or 2 (back end this runner does not drive). */
 static int make_device(int k)
@@ -681,6 +915,10 @@ static int make_device(int k)
 	char msg[256] = "";
 	size_t i;
 	int rc;
+	if (d->backend == PX_CONFIG_BACKEND_SOCKETCAN &&
+	    d->socketcan.transport == PX_CONFIG_CAN_SIM &&
+	    d->socketcan.canopen.present)
+		return make_can_arm(d);
 	if (d->backend != PX_CONFIG_BACKEND_SIM) {
 		fprintf(stderr,
 			"proxima-run: device '%s': back end %s is not driven "
@@ -800,17 +1038,20 @@ static int setup(void)
 	if (rc != PX_OK)
 		return report_config(rc, &diag);
 	px_scene_control_query(A.scene, &A.query);
-	if (A.ctl.mode == PX_CONTROL_MODE_AVOIDANCE) {
-		fprintf(stderr,
-			"proxima-run: control mode 'avoidance' is not driven by "
-			"proxima-run in this version (haptic and none are)\n");
-		return 2;
-	}
 	for (i = 0; i < (int)cfg->n_devices && i < MAX_DEVS; i++) {
 		rc = make_device(i);
 		if (rc)
 			return rc;
 	}
+	if (A.ctl.mode == PX_CONTROL_MODE_AVOIDANCE && !A.avoiding) {
+		fprintf(stderr,
+			"proxima-run: control mode 'avoidance' is driven by "
+			"proxima-run only on a CANopen arm on the simulated CAN "
+			"bus (socketcan transport sim) in this version\n");
+		return 2;
+	}
+	A.min_clearance_m = INFINITY;
+	A.min_scale = 1.0;
 	A.rendering = A.ctl.mode == PX_CONTROL_MODE_HAPTIC && A.ctl_dev >= 0;
 	if (A.ctl.mode == PX_CONTROL_MODE_HAPTIC && A.ctl_dev < 0) {
 		fprintf(stderr, "proxima-run: control.device '%s' is not a "
@@ -818,7 +1059,7 @@ static int setup(void)
 			A.ctl.device);
 		return 1;
 	}
-	if (A.ctl_dev < 0 && A.n_dev > 0)
+	if (A.ctl_dev < 0 && A.n_dev > 0 && !A.avoiding)
 		A.ctl_dev = 0; /* mode none: report the first device's distance */
 	if (A.rendering) {
 		if (!(px_dev_caps(A.dev[A.ctl_dev]) & PX_DEV_CAP_FORCE)) {
@@ -877,6 +1118,17 @@ static int setup(void)
 			return 1;
 		}
 	}
+	if (A.avoiding) {
+		const struct px_config_device *d = px_config_device_find(cfg, A.ctl.device);
+		int64_t tmo = d && d->stale_timeout_ns ? d->stale_timeout_ns
+						       : cfg->safety.watchdog.device_timeout_ns;
+		A.arm_input = px_loop_input_add(A.loop, A.ctl.device, tmo);
+		if (A.arm_input < 0) {
+			fprintf(stderr, "proxima-run: arm watchdog: %s\n",
+				px_strerror(A.arm_input));
+			return 1;
+		}
+	}
 	if (ring_cap < 16)
 		ring_cap = 16;
 	rc = px_arena_init_alloc(&A.arena, px_ring_size(ring_cap, sizeof(struct tele)) +
@@ -909,6 +1161,9 @@ static void teardown(void)
 		free(A.fields[i][1]);
 		free(A.buttons[i]);
 	}
+	px_canopen_free(A.co);
+	px_canopen_sim_free(A.arm);
+	px_can_sim_free(A.canbus);
 	px_scene_free(A.scene);
 	px_arena_fini(&A.arena);
 	free(A.recs);
@@ -923,6 +1178,11 @@ static void drain(void)
 	struct tele r;
 	struct px_fault f;
 	while (px_ring_pop(A.ring, &r) == PX_OK) {
+		A.n_rows++;
+		/* the plots keep the first PLOT_MAX records (about 17 min at
+		 * 1 kHz); the CSV gets everything */
+		if (A.n_recs == PLOT_MAX)
+			goto stored;
 		if (A.n_recs == A.cap_recs) {
 			size_t cap = A.cap_recs ? 2 * A.cap_recs : 4096;
 			struct tele *p = realloc(A.recs, cap * sizeof(*p));
@@ -932,6 +1192,7 @@ static void drain(void)
 			A.cap_recs = cap;
 		}
 		A.recs[A.n_recs++] = r;
+	stored:
 		A.last = r;
 		A.have_last = 1;
 		if (A.csv_f)
@@ -1232,11 +1493,16 @@ static int write_json(const char *path, const struct px_loop_status *st,
 		"  \"max_force_n\": %.9g,\n  \"force_clamp_n\": %.9g,\n"
 		"  \"min_distance_m\": %.9g,\n  \"max_penetration_m\": %.9g,\n"
 		"  \"min_proxy_distance_m\": %.9g,\n"
+		"  \"min_clearance_m\": %.9g,\n  \"protective_distance_m\": %.9g,\n"
+		"  \"min_speed_scale\": %.9g,\n"
 		"  \"contact_cycles\": %llu,\n  \"safe_state_trips\": %llu,\n"
 		"  \"faults\": {",
 		A.max_force_n, A.rendering ? A.ctl.haptic.max_force_n : 0.0,
 		json_num(A.min_distance_m), A.max_penetration_m,
 		json_num(A.min_proxy_distance_m),
+		A.avoiding ? json_num(A.min_clearance_m) : 0.0,
+		A.avoiding ? A.ctl.avoid.protective_distance_m : 0.0,
+		A.avoiding ? A.min_scale : 1.0,
 		(unsigned long long)A.contact_cycles,
 		(unsigned long long)st->safe_entries);
 	for (k = 1; k < PX_FAULT__COUNT; k++)
@@ -1262,7 +1528,7 @@ static int write_json(const char *path, const struct px_loop_status *st,
 		"  \"realtime\": %d,\n  \"csv\": ",
 		(unsigned long long)atomic_load(&A.allocs),
 		(unsigned long long)A.setup_heap_calls, counter,
-		(unsigned long long)A.n_recs,
+		(unsigned long long)A.n_rows,
 		(unsigned long long)px_ring_dropped(A.ring), st->realtime);
 	if (A.csv_path[0])
 		json_string(f, A.csv_path);
@@ -1380,6 +1646,15 @@ static void print_summary(const struct px_loop_status *st,
 		       st->cycles ? 100.0 * (double)A.contact_cycles /
 					    (double)st->cycles
 				  : 0.0);
+	if (A.avoiding)
+		printf("  avoidance         min clearance %.1f mm (protective %.1f "
+		       "mm, influence %.1f mm), speed scale min %.2f, nominal "
+		       "motion stopped in %llu cycles\n",
+		       json_num(A.min_clearance_m) * 1e3,
+		       A.ctl.avoid.protective_distance_m * 1e3,
+		       A.ctl.avoid.influence_distance_m * 1e3, A.min_scale,
+		       (unsigned long long)A.stop_cycles);
+	else
 	printf("  distance          min %+.3f mm, max penetration %.3f mm, "
 	       "proxy min clearance %+.3f mm\n",
 	       json_num(A.min_distance_m) * 1e3, A.max_penetration_m * 1e3,
@@ -1403,7 +1678,7 @@ static void print_summary(const struct px_loop_status *st,
 	       (unsigned long long)A.setup_heap_calls);
 	printf("  telemetry         %llu records (every %lld cycles), %llu "
 	       "dropped\n",
-	       (unsigned long long)A.n_recs, (long long)A.decimation,
+	       (unsigned long long)A.n_rows, (long long)A.decimation,
 	       (unsigned long long)px_ring_dropped(A.ring));
 	print_campaign();
 }
@@ -1483,7 +1758,8 @@ int main(int argc, char **argv)
 		A.rendering ? (A.ctl.haptic.renderer == PX_CONTROL_PROXY
 				       ? "haptic proxy rendering"
 				       : "haptic penalty rendering")
-			    : "no control output",
+		: A.avoiding ? "collision avoidance over CANopen"
+			     : "no control output",
 		A.o.virtual_time ? "virtual" : "real-time",
 		A.max_cycles ? "fixed duration" : "until Ctrl-C");
 	wall0 = mono_ns();
