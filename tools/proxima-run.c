@@ -1753,8 +1753,9 @@ int main(int argc, char **argv)
 		"proxima-run: %s: %zu scene model%s, %d device%s, %s, %s clock, "
 		"%s\n",
 		A.o.config, px_scene_count(A.scene),
-		px_scene_count(A.scene) == 1 ? "" : "s", A.n_dev,
-		A.n_dev == 1 ? "" : "s",
+		px_scene_count(A.scene) == 1 ? "" : "s",
+		A.n_dev + (A.canbus ? 1 : 0),
+		A.n_dev + (A.canbus ? 1 : 0) == 1 ? "" : "s",
 		A.rendering ? (A.ctl.haptic.renderer == PX_CONTROL_PROXY
 				       ? "haptic proxy rendering"
 				       : "haptic penalty rendering")
