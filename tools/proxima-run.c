@@ -5,7 +5,7 @@
  *                      [--telemetry FILE]
  *   proxima-run --check CONFIG
  *
- * Setup: config, scene (px_scene_config_load), control, devices (the
+ * Setup: config, scene (px_world_config_load), control, devices (the
  * simulated back end), the loop. Then the 1 kHz cycle: read the device
  * pose, query the scene and render the force (compute), send the force
  * (write). A live status line goes to stderr a few times per second; at
@@ -53,7 +53,7 @@
 #include "px_dev.h"
 #include "px_loop.h"
 #include "px_ring.h"
-#include "px_scene.h"
+#include "px_world.h"
 #include "px_sim.h"
 #include "px_stats.h"
 #include "tool_svg.h"
@@ -433,7 +433,7 @@ struct app {
 	struct options o;
 	struct px_config *cfg;
 	struct px_control_config ctl;
-	struct px_scene *scene;
+	struct px_world *scene;
 	struct px_control_query query;
 	struct px_control_haptic haptic;
 	struct px_dev *dev[MAX_DEVS];
@@ -1034,10 +1034,10 @@ static int setup(void)
 	A.min_proxy_distance_m = INFINITY;
 	A.decimation = cfg->telemetry.decimation > 0 ? cfg->telemetry.decimation : 1;
 	px_config_diag_init(&diag);
-	rc = px_scene_config_load(cfg, &A.scene, &diag);
+	rc = px_world_config_load(cfg, &A.scene, &diag);
 	if (rc != PX_OK)
 		return report_config(rc, &diag);
-	px_scene_control_query(A.scene, &A.query);
+	px_world_control_query(A.scene, &A.query);
 	for (i = 0; i < (int)cfg->n_devices && i < MAX_DEVS; i++) {
 		rc = make_device(i);
 		if (rc)
@@ -1164,7 +1164,7 @@ static void teardown(void)
 	px_canopen_free(A.co);
 	px_canopen_sim_free(A.arm);
 	px_can_sim_free(A.canbus);
-	px_scene_free(A.scene);
+	px_world_free(A.scene);
 	px_arena_fini(&A.arena);
 	free(A.recs);
 	free(A.lfaults);
@@ -1210,9 +1210,9 @@ static void drain(void)
 		 * check each recorded proxy against the scene (not in the
 		 * cycle; the scene is only read). */
 		if (A.rendering && r.valid && !r.safe) {
-			struct px_scene_hit h;
+			struct px_world_hit h;
 			px_vec3 p = px_v3(r.proxy_m[0], r.proxy_m[1], r.proxy_m[2]);
-			if (px_scene_nearest(A.scene, p, INFINITY, &h) == 1 &&
+			if (px_world_nearest(A.scene, p, INFINITY, &h) == 1 &&
 			    h.distance_m < A.min_proxy_distance_m)
 				A.min_proxy_distance_m = h.distance_m;
 		}
@@ -1752,8 +1752,8 @@ int main(int argc, char **argv)
 	fprintf(stderr,
 		"proxima-run: %s: %zu scene model%s, %d device%s, %s, %s clock, "
 		"%s\n",
-		A.o.config, px_scene_count(A.scene),
-		px_scene_count(A.scene) == 1 ? "" : "s",
+		A.o.config, px_world_count(A.scene),
+		px_world_count(A.scene) == 1 ? "" : "s",
 		A.n_dev + (A.canbus ? 1 : 0),
 		A.n_dev + (A.canbus ? 1 : 0) == 1 ? "" : "s",
 		A.rendering ? (A.ctl.haptic.renderer == PX_CONTROL_PROXY

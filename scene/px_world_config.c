@@ -16,7 +16,7 @@
 #include "px_mesh.h"
 #include "px_obj.h"
 #include "px_prim.h"
-#include "px_scene.h"
+#include "px_world.h"
 
 #define RANGE (PX_CONFIG_HAS_MIN | PX_CONFIG_HAS_MAX)
 #define BIG 1e6
@@ -96,7 +96,7 @@ struct raw_scene {
 	const struct px_config *cfg_;
 	const struct px_config_diag *diag_;
 	int errors_before_;
-	struct px_scene *scene_;
+	struct px_world *scene_;
 	int failed_;
 };
 
@@ -186,13 +186,13 @@ static void scene_check(struct px_config_reader *r,
 
 static const struct px_config_key scene_keys[] = {
 	K_SEQ(struct raw_scene, models, n_models, "models", 0, model_schema,
-	      struct raw_model, 0, PX_SCENE_MAX_MODELS),
+	      struct raw_model, 0, PX_WORLD_MAX_MODELS),
 	K_SEQ(struct raw_scene, prims, n_prims, "primitives", 0, prim_schema,
-	      struct raw_prim, 0, PX_SCENE_MAX_MODELS),
+	      struct raw_prim, 0, PX_WORLD_MAX_MODELS),
 };
 SCHEMA(scene_schema, "scene", scene_keys, scene_check);
 
-const struct px_config_schema *px_scene_config_schema(void)
+const struct px_config_schema *px_world_config_schema(void)
 {
 	return &scene_schema;
 }
@@ -395,7 +395,7 @@ static void add_model(struct px_config_reader *r, struct raw_scene *sc,
 		sc->failed_ = 1;
 		return;
 	}
-	rc = px_scene_add(sc->scene_, m, name);
+	rc = px_world_add(sc->scene_, m, name);
 	if (rc < 0) {
 		px_config_reader_error(r, at, where, "cannot add: %s",
 				       px_strerror(rc));
@@ -415,7 +415,7 @@ static void scene_check(struct px_config_reader *r,
 		sc->failed_ = 1;
 		return;
 	}
-	rc = px_scene_create(total ? total : 1, &sc->scene_);
+	rc = px_world_create(total ? total : 1, &sc->scene_);
 	if (rc != PX_OK) {
 		px_config_reader_error(r, map, "", "%s", px_strerror(rc));
 		sc->failed_ = 1;
@@ -485,7 +485,7 @@ static void scene_check(struct px_config_reader *r,
 	}
 }
 
-int px_scene_config_load(const struct px_config *cfg, struct px_scene **out,
+int px_world_config_load(const struct px_config *cfg, struct px_world **out,
 			 struct px_config_diag *diag)
 {
 	struct raw_scene raw;
@@ -503,9 +503,9 @@ int px_scene_config_load(const struct px_config *cfg, struct px_scene **out,
 	if (rc == PX_OK && raw.failed_)
 		rc = PX_E_PARSE;
 	if (rc == PX_OK && !raw.scene_)
-		rc = px_scene_create(1, &raw.scene_);
+		rc = px_world_create(1, &raw.scene_);
 	if (rc != PX_OK) {
-		px_scene_free(raw.scene_);
+		px_world_free(raw.scene_);
 		return rc;
 	}
 	*out = raw.scene_;

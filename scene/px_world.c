@@ -2,7 +2,7 @@
  * Scene: posed models, nearest surface with a box broad phase, and the
  * adapter to the control module's query interface.
  */
-#include "px_scene.h"
+#include "px_world.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -11,25 +11,25 @@
 
 #include "px_control.h"
 
-struct px_scene_entry {
+struct px_world_entry {
 	struct px_model *m;
 	px_aabb local;   /* model-frame box, cached at add */
 	int bounded;     /* every bound finite */
 	int is_signed;   /* PX_MODEL_CAP_SIGNED */
-	char name[PX_SCENE_NAME_LEN];
+	char name[PX_WORLD_NAME_LEN];
 };
 
-struct px_scene {
+struct px_world {
 	size_t cap, n;
-	struct px_scene_entry e[];
+	struct px_world_entry e[];
 };
 
-int px_scene_create(size_t capacity, struct px_scene **out)
+int px_world_create(size_t capacity, struct px_world **out)
 {
-	struct px_scene *s;
+	struct px_world *s;
 	if (out)
 		*out = NULL;
-	if (!out || capacity == 0 || capacity > PX_SCENE_MAX_MODELS)
+	if (!out || capacity == 0 || capacity > PX_WORLD_MAX_MODELS)
 		return PX_E_INVAL;
 	s = calloc(1, sizeof(*s) + capacity * sizeof(s->e[0]));
 	if (!s)
@@ -39,7 +39,7 @@ int px_scene_create(size_t capacity, struct px_scene **out)
 	return PX_OK;
 }
 
-void px_scene_free(struct px_scene *s)
+void px_world_free(struct px_world *s)
 {
 	size_t i;
 	if (!s)
@@ -49,9 +49,9 @@ void px_scene_free(struct px_scene *s)
 	free(s);
 }
 
-int px_scene_add(struct px_scene *s, struct px_model *m, const char *name)
+int px_world_add(struct px_world *s, struct px_model *m, const char *name)
 {
-	struct px_scene_entry *e;
+	struct px_world_entry *e;
 	if (!s || !m) {
 		px_model_free(m);
 		return PX_E_INVAL;
@@ -72,22 +72,22 @@ int px_scene_add(struct px_scene *s, struct px_model *m, const char *name)
 	return (int)s->n++;
 }
 
-size_t px_scene_count(const struct px_scene *s)
+size_t px_world_count(const struct px_world *s)
 {
 	return s ? s->n : 0;
 }
 
-struct px_model *px_scene_model(const struct px_scene *s, size_t i)
+struct px_model *px_world_model(const struct px_world *s, size_t i)
 {
 	return s && i < s->n ? s->e[i].m : NULL;
 }
 
-const char *px_scene_name(const struct px_scene *s, size_t i)
+const char *px_world_name(const struct px_world *s, size_t i)
 {
 	return s && i < s->n ? s->e[i].name : "";
 }
 
-int px_scene_set_pose(struct px_scene *s, size_t i, px_pose pose)
+int px_world_set_pose(struct px_world *s, size_t i, px_pose pose)
 {
 	if (!s || i >= s->n)
 		return PX_E_INVAL;
@@ -97,7 +97,7 @@ int px_scene_set_pose(struct px_scene *s, size_t i, px_pose pose)
 /* Lower bound of model e's signed distance to p. The box distance is
  * shrunk by a relative 1e-9 so that rounding in the box transform never
  * makes it exceed the true distance. */
-static double lower_bound(const struct px_scene_entry *e, px_vec3 p)
+static double lower_bound(const struct px_world_entry *e, px_vec3 p)
 {
 	px_obb b;
 	double d;
@@ -120,11 +120,11 @@ static double reported(const struct px_model_result *r)
 	return d;
 }
 
-int px_scene_nearest(const struct px_scene *s, px_vec3 p,
-		     double max_distance_m, struct px_scene_hit *out)
+int px_world_nearest(const struct px_world *s, px_vec3 p,
+		     double max_distance_m, struct px_world_hit *out)
 {
-	double lb[PX_SCENE_MAX_MODELS];
-	unsigned char done[PX_SCENE_MAX_MODELS];
+	double lb[PX_WORLD_MAX_MODELS];
+	unsigned char done[PX_WORLD_MAX_MODELS];
 	double best = INFINITY;
 	size_t i, n;
 	int queried = 0;
@@ -186,8 +186,8 @@ int px_scene_nearest(const struct px_scene *s, px_vec3 p,
 static int scene_point(void *ctx, px_vec3 p_m, double max_distance_m,
 		       struct px_control_hit *out)
 {
-	struct px_scene_hit h;
-	int rc = px_scene_nearest(ctx, p_m, max_distance_m, &h);
+	struct px_world_hit h;
+	int rc = px_world_nearest(ctx, p_m, max_distance_m, &h);
 	memset(out, 0, sizeof(*out));
 	if (rc < 0)
 		return rc;
@@ -203,7 +203,7 @@ static int scene_point(void *ctx, px_vec3 p_m, double max_distance_m,
 	return PX_OK;
 }
 
-int px_scene_control_query(const struct px_scene *s, struct px_control_query *q)
+int px_world_control_query(const struct px_world *s, struct px_control_query *q)
 {
 	if (!s || !q)
 		return PX_E_INVAL;

@@ -1,8 +1,11 @@
 /*
- * px_scene.h - a scene: a fixed list of posed models (primitives,
- * meshes, point clouds, NURBS), the nearest surface to a point with a
- * broad phase, the scene as the control module's query interface, and
- * the `scene` section of a proxima config.
+ * px_world.h - the world an application's loop lives in: the `scene`
+ * section of a proxima config turned into a fixed list of named, posed
+ * models (primitives, meshes, point clouds, NURBS), the nearest surface
+ * to a point with a broad phase, and that answer as the control module's
+ * query interface. (geom/px_scene.h is the general scene with a
+ * hierarchy, within-distance and tool queries; this module is the
+ * runner's view of a config. Building it on px_scene is planned.)
  *
  * Nearest query. The answer is the smallest signed distance over the
  * models (closed models: negative inside; open ones, e.g. NURBS
@@ -16,7 +19,7 @@
  * cost one box test each. A point inside a model's box has bound
  * -infinity for closed models (it may be inside) and 0 for open ones.
  *
- * As the control module's query (px_scene_control_query): the hit is
+ * As the control module's query (px_world_control_query): the hit is
  * the nearest answer with two_sided = the model is unsigned. Answers a
  * model does not certify (a bound cut its search short) report distance
  * - gap, so the reported |distance| never exceeds the true one, as
@@ -25,16 +28,16 @@
  * whichever side it started on, because every proxy step is shorter
  * than the distance at its start.
  *
- * Memory and real-time rules: px_scene_create() takes one allocation of
- * the fixed capacity; px_scene_add() takes ownership of a model. Adding,
- * loading and freeing are setup-time. px_scene_nearest(), the control
- * adapter's callback and px_scene_set_pose() are RT-safe (no allocation,
+ * Memory and real-time rules: px_world_create() takes one allocation of
+ * the fixed capacity; px_world_add() takes ownership of a model. Adding,
+ * loading and freeing are setup-time. px_world_nearest(), the control
+ * adapter's callback and px_world_set_pose() are RT-safe (no allocation,
  * no locks, bounded by the capacity and the models' own bounds). Queries
  * only read the scene; poses must not change while another thread
  * queries.
  */
-#ifndef PX_SCENE_H
-#define PX_SCENE_H
+#ifndef PX_WORLD_H
+#define PX_WORLD_H
 
 #include <stdbool.h>
 #include <stddef.h>
@@ -47,21 +50,21 @@
 extern "C" {
 #endif
 
-#define PX_SCENE_MAX_MODELS 256 /* largest capacity */
-#define PX_SCENE_NAME_LEN 32
+#define PX_WORLD_MAX_MODELS 256 /* largest capacity */
+#define PX_WORLD_NAME_LEN 32
 
-struct px_scene;
+struct px_world;
 struct px_control_query;
 
 /*
- * An empty scene for up to capacity (1 .. PX_SCENE_MAX_MODELS) models.
+ * An empty scene for up to capacity (1 .. PX_WORLD_MAX_MODELS) models.
  * Setup only. Returns PX_OK, PX_E_INVAL, PX_E_NOMEM. Free with
- * px_scene_free().
+ * px_world_free().
  */
-PX_API int px_scene_create(size_t capacity, struct px_scene **out);
+PX_API int px_world_create(size_t capacity, struct px_world **out);
 
 /* Free the scene and every model it owns. NULL is a no-op. */
-PX_API void px_scene_free(struct px_scene *s);
+PX_API void px_world_free(struct px_world *s);
 
 /*
  * Add model m (its pose as set) under name (may be NULL; copied, up to
@@ -69,21 +72,21 @@ PX_API void px_scene_free(struct px_scene *s);
  * freed). Setup only. Returns the model's index, PX_E_INVAL or
  * PX_E_NOSPC (capacity reached).
  */
-PX_API int px_scene_add(struct px_scene *s, struct px_model *m,
+PX_API int px_world_add(struct px_world *s, struct px_model *m,
 			const char *name);
 
 /* Number of models, model i (NULL for a bad index), its name ("" for a
  * bad index). @note RT-safe. */
-PX_API size_t px_scene_count(const struct px_scene *s);
-PX_API struct px_model *px_scene_model(const struct px_scene *s, size_t i);
-PX_API const char *px_scene_name(const struct px_scene *s, size_t i);
+PX_API size_t px_world_count(const struct px_world *s);
+PX_API struct px_model *px_world_model(const struct px_world *s, size_t i);
+PX_API const char *px_world_name(const struct px_world *s, size_t i);
 
 /* Set the pose of model i. Returns px_model_set_pose()'s codes or
  * PX_E_INVAL for a bad index. @note RT-safe. */
-PX_API int px_scene_set_pose(struct px_scene *s, size_t i, px_pose pose);
+PX_API int px_world_set_pose(struct px_world *s, size_t i, px_pose pose);
 
 /* Nearest answer. */
-struct px_scene_hit {
+struct px_world_hit {
 	int model;                   /* index, -1 when nothing in range */
 	struct px_model_result r;    /* that model's answer, world frame */
 	/* r.distance, lowered by r.gap when not certified (see above) */
@@ -98,8 +101,8 @@ struct px_scene_hit {
  * bad range), PX_E_NAN (p not finite) or a model's error.
  * @note RT-safe.
  */
-PX_API int px_scene_nearest(const struct px_scene *s, px_vec3 p,
-			    double max_distance_m, struct px_scene_hit *out);
+PX_API int px_world_nearest(const struct px_world *s, px_vec3 p,
+			    double max_distance_m, struct px_world_hit *out);
 
 /*
  * Fill q so that the control module queries scene s (point callback;
@@ -107,7 +110,7 @@ PX_API int px_scene_nearest(const struct px_scene *s, px_vec3 p,
  * point queries is used). s must outlive q's use. The callback is
  * RT-safe. Returns PX_OK or PX_E_INVAL.
  */
-PX_API int px_scene_control_query(const struct px_scene *s,
+PX_API int px_world_control_query(const struct px_world *s,
 				  struct px_control_query *q);
 
 /* ---- configuration (setup time) --------------------------------- */
@@ -124,12 +127,12 @@ struct px_config_schema;
  * "file:line:column: scene.key: what", and *out is then NULL.
  * Returns PX_OK, PX_E_PARSE (problems found), PX_E_NOMEM, PX_E_INVAL.
  */
-PX_API int px_scene_config_load(const struct px_config *cfg,
-				struct px_scene **out,
+PX_API int px_world_config_load(const struct px_config *cfg,
+				struct px_world **out,
 				struct px_config_diag *diag);
 
 /* Schema of the scene section (for tools and the docs check). */
-PX_API const struct px_config_schema *px_scene_config_schema(void);
+PX_API const struct px_config_schema *px_world_config_schema(void);
 
 #ifdef __cplusplus
 }
