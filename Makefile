@@ -20,7 +20,7 @@ NAME    := proxima
 VERSION := $(shell sed -n 's/^\#define PX_VERSION_STRING "\(.*\)"/\1/p' core/px_base.h)
 SOMAJOR := $(firstword $(subst ., ,$(VERSION)))
 
-MODULE_DIRS := core geom rt devices config control
+MODULE_DIRS := core geom rt devices config control scene
 WARN    := -Wall -Wextra -Wshadow -Wstrict-prototypes -Werror
 INCS    := $(addprefix -I,$(MODULE_DIRS))
 BASE_CFLAGS := -std=c11 -D_GNU_SOURCE $(WARN) $(INCS) -fvisibility=hidden -MMD -MP
@@ -203,6 +203,16 @@ $(BUILD)/bench/fcl_models: bench/fcl_models.cpp bench/models_common.h tests/mesh
 sanitize:
 	$(MAKE) BUILD=$(BUILD)/san SAN=1 test
 
+# The main job: a simulated haptic device exploring NURBS surfaces and a
+# mesh at 1 kHz for RUN_SECONDS, live status line, summary, CSV and plots.
+RUN_CONFIG  ?= config/examples/haptic_sim.yaml
+RUN_SECONDS ?= 10
+RUN_ARGS    ?=
+.PHONY: run
+run: deps all
+	$(BUILD)/bin/proxima-run $(RUN_CONFIG) --duration-s $(RUN_SECONDS) \
+	  --summary-json $(BUILD)/run-summary.json $(RUN_ARGS)
+
 deps:
 	@sh tools/install-deps.sh $(DEB_PACKAGES)
 
@@ -231,6 +241,7 @@ help:
 	@echo '  test       install missing packages, build, run the whole test suite'
 	@echo '  bench      build and run the benchmarks'
 	@echo '  sanitize   the test suite built with AddressSanitizer + UBSan'
+	@echo '  run        build, then run proxima-run on RUN_CONFIG for RUN_SECONDS (default config, 10 s)'
 	@echo '  fuzz       build fuzz/fuzz_*.c with libFuzzer, run each FUZZ_SECONDS=$(FUZZ_SECONDS) s'
 	@echo '  install    library, headers, tools and proxima.pc under DESTDIR/PREFIX'
 	@echo '  uninstall  remove what install put there'

@@ -307,7 +307,13 @@ static int proxy_move(struct px_control_haptic *h,
 		double b[3], len, t = 0;
 		int i, contact = 0;
 		prune_planes(h, *x);
-		if (hit->valid && hit->distance_m < CONTACT_BAND * r)
+		/* A plane holds only while some surface is within the band:
+		 * planes are infinite, faces are not, so a proxy that slid
+		 * past the end of a face would otherwise keep a phantom wall
+		 * there. Motion stays certified by the queries either way. */
+		if (!hit->valid || fabs(hit->distance_m) >= CONTACT_BAND * r)
+			h->n_planes_ = 0;
+		else
 			add_plane(h, hit, *x);
 		u = px_v3_sub(goal, *x);
 		if (px_v3_norm2(u) == 0)

@@ -26,5 +26,6 @@
 #include "px_canopen.h"
 #include "px_gpio.h"
 #include "px_control.h"
+#include "px_world.h"
 
 #endif

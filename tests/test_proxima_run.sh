@@ -1,7 +1,10 @@
 #!/bin/sh
 # proxima-run's command-line contract: --check on good and bad configs
-# (exit status and message format), flag parsing, and the honest "not
-# built yet" answer without --check. Prints a harness-style summary line.
+# (exit status and message format), flag parsing; then every shipped
+# config end to end in virtual time (summary JSON, no allocation after
+# setup, force within the clamp, CSV and SVG files), reproducibility, the
+# heap counter's self-check, safe state on a velocity limit, scene errors.
+# Prints a harness-style summary line.
 set -u
 name=test_proxima_run
 bin="${BUILD:-build}/bin/proxima-run"
@@ -82,8 +85,6 @@ expect "--flag=value form" 0 "$bin" --check --duration-s=3 --summary-json="$tmp/
 expect "--help" 0 "$bin" --help
 if grep -q "^usage: proxima-run CONFIG \[--duration-s N\] \[--virtual-time\] \[--summary-json FILE\]$" "$tmp/out"; then ok "usage line"; else bad "usage line"; fi
 
-expect "runner not built yet" 2 "$bin" "$good" --duration-s 1 --virtual-time
-if grep -q "runner .* is not built yet" "$tmp/err"; then ok "says the runner is not built"; else bad "says the runner is not built"; fi
 expect "runner on a bad config reports the config" 1 "$bin" "$tmp/bad.yaml"
 
 # control section: errors fail --check; a stiffness beyond the passive
@@ -109,6 +110,155 @@ sed 's/device: pen$/device: pem/' "$tmp/ctl.yaml" >"$tmp/ctl3.yaml"
 expect "--check on a bad control section" 1 "$bin" --check "$tmp/ctl3.yaml"
 has "control error placed" "$tmp/err" \
 	"$tmp/ctl3.yaml:6:11: control.device: no device named 'pem' in devices"
+
+
+# ---- end-to-end runs in virtual time ---------------------------------
+# num FILE KEY: the number after "KEY": on its line of a summary JSON.
+num() { sed -n "s/.*\"$2\": \(-\{0,1\}[0-9][0-9.e+-]*\).*/\1/p" "$1" | head -n 1; }
+# sub FILE OBJECT KEY: KEY inside the one-line object OBJECT.
+sub() { sed -n "s/.*\"$2\": {.*\"$3\": \([0-9][0-9]*\).*/\1/p" "$1" | head -n 1; }
+# check DESCRIPTION AWK-CONDITION: pass when awk says the condition holds.
+check() { if awk "BEGIN { exit !($2) }"; then ok "$1"; else echo "    false: $2"; bad "$1"; fi; }
+# svg DESCRIPTION FILE: a complete SVG document with at least one path.
+svg() {
+	if [ -s "$2" ] && head -n 1 "$2" | grep -q '^<?xml' && tail -n 1 "$2" | grep -qx '</svg>' &&
+		grep -q "<path " "$2"; then ok "$1"; else echo "    bad SVG: $2"; bad "$1"; fi
+}
+# A config with its scene paths made absolute, so it runs from $tmp.
+absolute() { sed "s|file: scenes/|file: $PWD/config/examples/scenes/|" "$1"; }
+
+ran=0
+for f in config/examples/*.yaml; do
+	base=$(basename "$f" .yaml)
+	if grep -qE 'backend: (hidapi|libusb|gpiod)|transport: (kernel|unix)' "$f"; then
+		# needs hardware or a second process: the runner says so
+		expect "$f is refused without its hardware" 2 "$bin" "$f" --virtual-time --duration-s 1
+		if grep -q "is not driven by proxima-run" "$tmp/err"; then ok "$f: reason given"; else bad "$f: reason given"; fi
+		continue
+	fi
+	ran=$((ran + 1))
+	j="$tmp/$base.json" c="$tmp/$base.csv"
+	expect "$f runs in virtual time" 0 "$bin" "$f" --virtual-time --duration-s 3 \
+		--summary-json "$j" --telemetry "$c"
+	[ -s "$j" ] || { bad "$f: summary JSON written"; continue; }
+	cycles=$(num "$j" cycles)
+	check "$f: 3000 cycles" "$cycles == 3000"
+	check "$f: no overrun on the virtual clock" "$(num "$j" overruns) == 0"
+	check "$f: no allocation after setup" "$(num "$j" allocations_after_setup) == 0"
+	check "$f: the counter saw setup's allocations" "$(num "$j" allocations_setup) > 0"
+	for o in wakeup_latency_ns compute_ns; do
+		for k in p50 p99 p999 max; do
+			v=$(sub "$j" "$o" "$k")
+			check "$f: $o.$k present" "\"$v\" != \"\""
+		done
+	done
+	check "$f: compute p50 <= p99 <= p999 <= max" \
+		"$(sub "$j" compute_ns p50) <= $(sub "$j" compute_ns p99) && $(sub "$j" compute_ns p99) <= $(sub "$j" compute_ns p999) && $(sub "$j" compute_ns p999) <= $(sub "$j" compute_ns max)"
+	clamp=$(num "$j" force_clamp_n)
+	check "$f: force within the clamp ($(num "$j" max_force_n) <= $clamp)" \
+		"$(num "$j" max_force_n) <= $clamp + 1e-9"
+	check "$f: min_distance_m is a number" "\"$(num "$j" min_distance_m)\" != \"\""
+	check "$f: proxy never inside a closed model" "$(num "$j" min_proxy_distance_m) >= 0"
+	check "$f: safe_state_trips counted" "\"$(num "$j" safe_state_trips)\" != \"\""
+	if grep -q '"faults": {"input_stale": [0-9]*, ' "$j"; then ok "$f: faults by kind"; else bad "$f: faults by kind"; fi
+	# CSV: header plus one line per (decimated) cycle; force column within the clamp
+	lines=$(($(wc -l <"$c") - 1))
+	check "$f: telemetry rows ($lines)" "$lines == $(num "$j" telemetry_records) && $lines > 0"
+	check "$f: CSV forces within the clamp" \
+		"$(awk -F, 'NR > 1 && $12 > m { m = $12 } END { print m + 0 }' "$c") <= $clamp + 1e-6"
+	svg "$f: time plot" "$tmp/${base}_time.svg"
+	svg "$f: latency plot" "$tmp/${base}_latency.svg"
+	if grep -qF "  plots             $tmp/${base}_time.svg" "$tmp/out"; then ok "$f: plot paths printed"; else bad "$f: plot paths printed"; fi
+done
+check "at least one shipped config ran end to end" "$ran >= 1"
+
+# The virtual clock is deterministic: the same run twice gives the same
+# telemetry (apart from the compute time, measured on the real clock).
+expect "second identical run" 0 "$bin" "$good" --virtual-time --duration-s 3 \
+	--telemetry "$tmp/det.csv"
+cut -d, -f1-17,19 "$tmp/haptic_sim.csv" >"$tmp/a.cut"
+cut -d, -f1-17,19 "$tmp/det.csv" >"$tmp/b.cut"
+if [ -s "$tmp/a.cut" ] && cmp -s "$tmp/a.cut" "$tmp/b.cut"; then
+	ok "virtual-time runs are reproducible"; else bad "virtual-time runs are reproducible"; fi
+
+# The heap counter is live: a deliberate allocation in cycle 10 shows.
+expect "allocation probe run" 0 env PX_RUN_ALLOC_PROBE=1 "$bin" "$good" --virtual-time \
+	--duration-s 0.1 --summary-json "$tmp/probe.json" --telemetry "$tmp/probe.csv"
+check "the probe's malloc and free are counted" "$(num "$tmp/probe.json" allocations_after_setup) == 2"
+
+# Penalty renderer on the same scene: force still within the clamp.
+absolute "$good" | sed 's/renderer: proxy /renderer: penalty/' >"$tmp/penalty.yaml"
+expect "penalty renderer run" 0 "$bin" "$tmp/penalty.yaml" --virtual-time --duration-s 2 \
+	--summary-json "$tmp/pen.json" --telemetry "$tmp/pen.csv"
+check "penalty: force within the clamp" "$(num "$tmp/pen.json" max_force_n) <= $(num "$tmp/pen.json" force_clamp_n) + 1e-9"
+check "penalty: contact happened" "$(num "$tmp/pen.json" contact_cycles) > 0"
+
+# Safety: a velocity limit below the hand's speed trips safe state; from
+# then on every force sent is zero (no auto re-arm).
+absolute "$good" | sed 's/velocity_limit_m_per_s: .*/velocity_limit_m_per_s: 0.05/' >"$tmp/slow.yaml"
+expect "velocity-limit run" 0 "$bin" "$tmp/slow.yaml" --virtual-time --duration-s 2 \
+	--summary-json "$tmp/slow.json" --telemetry "$tmp/slow.csv"
+check "velocity limit trips safe state" "$(num "$tmp/slow.json" safe_state_trips) >= 1"
+if grep -q '"velocity_limit": [1-9]' "$tmp/slow.json"; then ok "velocity_limit fault counted"; else bad "velocity_limit fault counted"; fi
+check "zero force after the trip" \
+	"$(awk -F, 'NR > 1 && $16 == 1 { s = 1 } s && $12 != 0 { n++ } END { print n + 0 }' "$tmp/slow.csv") == 0"
+if grep -q "SAFE STATE" "$tmp/err"; then ok "status line shows safe state"; else bad "status line shows safe state"; fi
+
+# Scene errors are reported like config errors, with their place.
+absolute "$good" | sed 's|scenes/knob.stl|scenes/knob-missing.stl|' >"$tmp/noscene.yaml"
+expect "run with a missing scene file" 1 "$bin" "$tmp/noscene.yaml" --virtual-time --duration-s 1
+if grep -q "^$tmp/noscene.yaml:[0-9]*:[0-9]*: scene.models\[1\].file: .*knob-missing.stl" "$tmp/err"; then
+	ok "missing scene file placed"; else bad "missing scene file placed"; fi
+
+# The fault campaign: every kind injected; the loop trips and re-arms.
+fj="$tmp/haptic_faults.json"
+if [ -s "$fj" ]; then
+	check "faults: safe state entered" "$(num "$fj" safe_state_trips) >= 3"
+	for k in drop delay duplicate corrupt stuck nan unplug; do
+		if grep -q "{\"kind\": \"$k\", \"device\": \"haptic\"" "$fj"; then ok "faults: $k reported"; else bad "faults: $k reported"; fi
+	done
+	for k in delay stuck nan unplug; do
+		after=$(sed -n "s/.*\"kind\": \"$k\".*\"safe_after_ns\": \(-\{0,1\}[0-9]*\)}.*/\1/p" "$fj")
+		check "faults: $k trips safe state within 100 ms ($after ns)" "$after >= 0 && $after <= 100000000"
+	done
+	check "faults: corrupt reports counted" "$(num "$fj" device_decode) > 0"
+	check "faults: zero force whenever in safe state" \
+		"$(awk -F, 'NR > 1 && $16 == 1 && $12 != 0 { n++ } END { print n + 0 }' "$tmp/haptic_faults.csv") == 0"
+else
+	bad "faults: the shipped fault campaign ran"
+fi
+printf 'devices:\n  - {name: pen, backend: sim}\nsim:\n  faults:\n    - {device: pem, kind: delay, start_ns: 0, duration_ns: 10}\n    - {device: pen, kind: jam, start_ns: 0, duration_ns: 10}\n' >"$tmp/badfault.yaml"
+expect "--check on bad faults" 1 "$bin" --check "$tmp/badfault.yaml"
+has "fault without delay_ns" "$tmp/err" "$tmp/badfault.yaml:5:7: sim.faults[0].delay_ns: missing or zero for kind 'delay'"
+has "fault on an unknown device" "$tmp/err" "$tmp/badfault.yaml:5:16: sim.faults[0].device: no device named 'pem' in devices"
+has "unknown fault kind" "$tmp/err" "$tmp/badfault.yaml:6:27: sim.faults[1].kind: unknown value 'jam' (expected one of: drop, delay, duplicate, corrupt, stuck, nan, unplug)"
+for k in faults device kind start_ns duration_ns probability delay_ns drop delay duplicate corrupt stuck nan unplug; do
+	grep -qF "\`$k\`" docs/config.md || { echo "    docs/config.md lacks \`$k\`"; bad "sim keys documented"; }
+done
+ok "sim keys documented (checked above)"
+
+# Collision avoidance over CANopen on the simulated bus: the arm is kept
+# outside the protective distance, and the avoidance had to act.
+aj="$tmp/can_avoid_sim.json"
+if [ -s "$aj" ]; then
+	check "avoidance: min clearance $(num "$aj" min_clearance_m) >= protective $(num "$aj" protective_distance_m)" \
+		"$(num "$aj" min_clearance_m) >= $(num "$aj" protective_distance_m)"
+	check "avoidance: the speed was scaled down" "$(num "$aj" min_speed_scale) < 1"
+	check "avoidance: no safe state" "$(num "$aj" safe_state_trips) == 0"
+else
+	bad "avoidance: the shipped demo ran"
+fi
+# The same arm without the pillar's influence: a pillar in the sweep with
+# protective distance 0.2 m; the arm still stays outside it.
+sed 's/protective_distance_m: 0.05/protective_distance_m: 0.2/; s/influence_distance_m: 0.25/influence_distance_m: 0.4/' \
+	config/examples/can_avoid_sim.yaml >"$tmp/avoid2.yaml"
+expect "avoidance with a larger protective distance" 0 "$bin" "$tmp/avoid2.yaml" --virtual-time \
+	--duration-s 3 --summary-json "$tmp/avoid2.json" --telemetry "$tmp/avoid2.csv"
+check "avoidance: clearance $(num "$tmp/avoid2.json" min_clearance_m) >= 0.2 - 1 mm" \
+	"$(num "$tmp/avoid2.json" min_clearance_m) >= 0.199"
+for k in nominal joint amplitude_rad_per_s frequency_hz phase_rad; do
+	grep -qF "\`$k\`" docs/config.md || { echo "    docs/config.md lacks \`$k\`"; bad "nominal keys documented"; }
+done
 
 echo "$name: $pass passed, $fail failed, $skip skipped"
 [ "$fail" -eq 0 ]

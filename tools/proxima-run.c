@@ -2,21 +2,61 @@
  * proxima-run - run a proxima application from its YAML config.
  *
  *   proxima-run CONFIG [--duration-s N] [--virtual-time] [--summary-json FILE]
+ *                      [--telemetry FILE]
  *   proxima-run --check CONFIG
  *
- * This version validates configurations; the runner itself (loop,
- * devices, scene, control) is not built yet, and says so.
- * Exit status: 0 config valid (--check), 1 config invalid or unreadable,
- * 2 usage error or runner not available.
+ * Setup: config, scene (px_world_config_load), control, devices (the
+ * simulated back end), the loop. Then the 1 kHz cycle: read the device
+ * pose, query the scene and render the force (compute), send the force
+ * (write). A live status line goes to stderr a few times per second; at
+ * the end come a summary (stdout, and JSON with --summary-json), the
+ * telemetry CSV and SVG plots next to it.
+ *
+ * Threads: with the real clock the loop runs on its own thread (with the
+ * config's real-time setup) while the main thread drains the telemetry
+ * ring, writes the CSV and prints the status; with --virtual-time the
+ * main thread steps the loop itself and drains the ring between batches
+ * of cycles. Heap calls are counted per thread by an allocator hook in
+ * this program (glibc: interposed malloc family; sanitizer builds: the
+ * sanitizer's malloc/free hooks) and only the calls the loop's thread
+ * makes while cycles run are reported (allocations_after_setup), beside
+ * the calls setup made (allocations_setup, showing the counter is live).
+ * PX_RUN_ALLOC_PROBE=1 in the environment makes cycle 10 allocate and
+ * free once on purpose: the count is then 2 (a self-check for tests).
+ *
+ * Devices driven: simulated haptic and pose devices (haptic rendering or
+ * mode none), and a CANopen arm on the in-process simulated CAN bus
+ * (collision avoidance; the drives' side is stepped in the read phase as
+ * another node on the bus). The `sim` section adds fault campaigns and
+ * the avoidance demo's nominal task.
+ *
+ * Exit status: 0 ok, 1 invalid config or setup failure, 2 usage error or
+ * a configuration this runner does not drive yet (hardware back ends).
  */
 #include <errno.h>
 #include <math.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdatomic.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
+#include <unistd.h>
 
+#include "px_arena.h"
+#include "px_can.h"
+#include "px_canopen.h"
 #include "px_config.h"
 #include "px_control.h"
+#include "px_dev.h"
+#include "px_loop.h"
+#include "px_ring.h"
+#include "px_world.h"
+#include "px_sim.h"
+#include "px_stats.h"
+#include "tool_svg.h"
 
 static const char usage_text[] =
 	"usage: proxima-run CONFIG [--duration-s N] [--virtual-time] "
@@ -24,13 +64,19 @@ static const char usage_text[] =
 	"       proxima-run --check CONFIG\n"
 	"\n"
 	"  --check            validate CONFIG, print every problem, and exit\n"
-	"  --duration-s N     run for N seconds (N > 0)\n"
+	"  --duration-s N     run for N seconds (N > 0); default: until "
+	"Ctrl-C\n"
 	"  --virtual-time     run the loop on the virtual clock, as fast as "
 	"possible\n"
 	"  --summary-json F   write a machine-readable summary to F\n"
+	"  --telemetry F      telemetry CSV (default: telemetry.file of "
+	"CONFIG);\n"
+	"                     plots go next to it as <stem>_time.svg and "
+	"<stem>_latency.svg\n"
 	"  --help             this text\n"
-	"Exit status: 0 ok, 1 invalid config, 2 usage error or runner not "
-	"available.\n";
+	"Exit status: 0 ok, 1 invalid config or setup failure, 2 usage error "
+	"or\n"
+	"a configuration this runner does not drive.\n";
 
 static int usage_error(const char *fmt, const char *arg)
 {
@@ -46,6 +92,7 @@ struct options {
 	int virtual_time;
 	double duration_s; /* 0 = until stopped */
 	const char *summary_json;
+	const char *telemetry; /* overrides telemetry.file */
 };
 
 /* Value of an option given as "--opt VALUE" or "--opt=VALUE". */
@@ -100,6 +147,11 @@ static int parse_args(int argc, char **argv, struct options *o)
 			if (!v || !*v)
 				return usage_error("%s needs a file name", a);
 			o->summary_json = v;
+		} else if (!rest && matches(a, "--telemetry")) {
+			const char *v = opt_value(argc, argv, &i, "--telemetry");
+			if (!v || !*v)
+				return usage_error("%s needs a file name", a);
+			o->telemetry = v;
 		} else if (!rest && a[0] == '-' && a[1] != '\0') {
 			return usage_error("unknown option '%s'", a);
 		} else if (!o->config) {
@@ -115,53 +167,1639 @@ static int parse_args(int argc, char **argv, struct options *o)
 	return 0;
 }
 
+/* ---- heap call counter (per thread) -------------------------------- */
+
+static _Thread_local uint64_t heap_calls;
+
+static uint64_t heap_count(void)
+{
+	return heap_calls;
+}
+
+#if defined(__SANITIZE_ADDRESS__)
+/* The sanitizer owns malloc; it calls these hooks on every allocation
+ * and release (realloc counts as both). */
+int __sanitizer_install_malloc_and_free_hooks(
+	void (*malloc_hook)(const volatile void *, size_t),
+	void (*free_hook)(const volatile void *));
+
+static void on_malloc(const volatile void *p, size_t n)
+{
+	(void)p;
+	(void)n;
+	heap_calls++;
+}
+
+static void on_free(const volatile void *p)
+{
+	(void)p;
+	heap_calls++;
+}
+
+static const char *heap_counter_setup(void)
+{
+	__sanitizer_install_malloc_and_free_hooks(on_malloc, on_free);
+	return "sanitizer hooks";
+}
+#else
+/* glibc's own entry points, exported for interposition. */
+extern void *__libc_malloc(size_t n);
+extern void *__libc_calloc(size_t n, size_t m);
+extern void *__libc_realloc(void *p, size_t n);
+extern void __libc_free(void *p);
+extern void *__libc_memalign(size_t a, size_t n);
+
+void *malloc(size_t n);
+void *calloc(size_t n, size_t m);
+void *realloc(void *p, size_t n);
+void free(void *p);
+int posix_memalign(void **p, size_t a, size_t n);
+void *aligned_alloc(size_t a, size_t n);
+void *memalign(size_t a, size_t n);
+
+void *malloc(size_t n)
+{
+	heap_calls++;
+	return __libc_malloc(n);
+}
+
+void *calloc(size_t n, size_t m)
+{
+	heap_calls++;
+	return __libc_calloc(n, m);
+}
+
+void *realloc(void *p, size_t n)
+{
+	heap_calls++;
+	return __libc_realloc(p, n);
+}
+
+void free(void *p)
+{
+	if (p)
+		heap_calls++;
+	__libc_free(p);
+}
+
+int posix_memalign(void **p, size_t a, size_t n)
+{
+	void *q;
+	heap_calls++;
+	if (a < sizeof(void *) || (a & (a - 1)))
+		return EINVAL;
+	q = __libc_memalign(a, n);
+	if (!q && n)
+		return ENOMEM;
+	*p = q;
+	return 0;
+}
+
+void *aligned_alloc(size_t a, size_t n)
+{
+	heap_calls++;
+	return __libc_memalign(a, n);
+}
+
+void *memalign(size_t a, size_t n)
+{
+	heap_calls++;
+	return __libc_memalign(a, n);
+}
+
+static const char *heap_counter_setup(void)
+{
+	return "interposed malloc";
+}
+#endif
+
+/* ---- the `sim` section: fault campaigns --------------------------- */
+
+#define SIM_RANGE (PX_CONFIG_HAS_MIN | PX_CONFIG_HAS_MAX)
+#define MAX_CAMPAIGN 64
+
+/* Fault kinds a simulated haptic/pose device takes (enum px_sim_fault_kind
+ * is index + 1). */
+static const char *const fault_kind_names[] = {
+	"drop", "delay", "duplicate", "corrupt", "stuck", "nan", "unplug", NULL};
+
+struct raw_fault {
+	const char *device;
+	int kind;
+	int64_t start_ns, duration_ns, delay_ns;
+	double probability;
+};
+
+/* Nominal joint velocity of the avoidance demo's task: a sum of
+ * sinusoids per joint. */
+struct raw_nominal {
+	int64_t joint;
+	double amplitude_rad_per_s, frequency_hz, phase_rad;
+};
+
+struct raw_sim {
+	struct raw_fault *faults;
+	size_t n_faults;
+	struct raw_nominal *nominal;
+	size_t n_nominal;
+	const struct px_config *cfg_; /* not a key: context for the check */
+};
+
+static void fault_check(struct px_config_reader *r,
+			const struct px_config_node *map, void *obj)
+{
+	const struct raw_fault *f = obj;
+	int delay = f->kind + 1 == PX_SIM_FAULT_DELAY;
+	if (delay && f->delay_ns <= 0)
+		px_config_reader_error(r, map, "delay_ns",
+				       "missing or zero for kind 'delay'");
+	if (!delay && f->delay_ns > 0)
+		px_config_reader_error(r, px_config_node_get(map, "delay_ns"),
+				       "delay_ns", "only for kind 'delay'");
+}
+
+static const struct px_config_key fault_keys[] = {
+	{.name = "device", .type = PX_CONFIG_T_STRING,
+	 .offset = offsetof(struct raw_fault, device),
+	 .flags = PX_CONFIG_REQUIRED | PX_CONFIG_NONEMPTY},
+	{.name = "kind", .type = PX_CONFIG_T_ENUM,
+	 .offset = offsetof(struct raw_fault, kind), .flags = PX_CONFIG_REQUIRED,
+	 .names = fault_kind_names},
+	{.name = "start_ns", .type = PX_CONFIG_T_DURATION,
+	 .offset = offsetof(struct raw_fault, start_ns),
+	 .flags = PX_CONFIG_REQUIRED | SIM_RANGE, .imin = 0,
+	 .imax = 1000000000000000},
+	{.name = "duration_ns", .type = PX_CONFIG_T_DURATION,
+	 .offset = offsetof(struct raw_fault, duration_ns),
+	 .flags = PX_CONFIG_REQUIRED | SIM_RANGE, .imin = 1,
+	 .imax = 1000000000000000, .idef = 1},
+	{.name = "probability", .type = PX_CONFIG_T_DOUBLE,
+	 .offset = offsetof(struct raw_fault, probability),
+	 .flags = SIM_RANGE | PX_CONFIG_MIN_EXCL, .dmin = 0, .dmax = 1,
+	 .ddef = 1},
+	{.name = "delay_ns", .type = PX_CONFIG_T_DURATION,
+	 .offset = offsetof(struct raw_fault, delay_ns), .flags = SIM_RANGE,
+	 .imin = 0, .imax = 10000000000},
+};
+static const struct px_config_schema fault_schema = {
+	"fault", fault_keys, sizeof(fault_keys) / sizeof(fault_keys[0]),
+	fault_check};
+
+static void sim_check(struct px_config_reader *r,
+		      const struct px_config_node *map, void *obj)
+{
+	const struct raw_sim *sm = obj;
+	const struct px_config_node *seq = px_config_node_get(map, "faults");
+	size_t i;
+	char where[48];
+	for (i = 0; i < sm->n_faults; i++) {
+		const struct raw_fault *f = &sm->faults[i];
+		const struct px_config_node *it =
+			seq && seq->kind == PX_CONFIG_NODE_SEQ && i < seq->len
+				? seq->items[i]
+				: map;
+		const struct px_config_device *d;
+		if (!f->device)
+			continue;
+		d = px_config_device_find(sm->cfg_, f->device);
+		snprintf(where, sizeof(where), "faults[%zu].device", i);
+		if (!d)
+			px_config_reader_error(r, px_config_node_get(it, "device"),
+					       where,
+					       "no device named '%s' in devices",
+					       f->device);
+		else if (d->backend != PX_CONFIG_BACKEND_SIM ||
+			 d->sim.kind == PX_CONFIG_SIM_GPIO)
+			px_config_reader_error(r, px_config_node_get(it, "device"),
+					       where,
+					       "'%s' is not a simulated haptic or "
+					       "pose device",
+					       f->device);
+	}
+}
+
+static const struct px_config_key nominal_keys[] = {
+	{.name = "joint", .type = PX_CONFIG_T_INT64,
+	 .offset = offsetof(struct raw_nominal, joint),
+	 .flags = PX_CONFIG_REQUIRED | SIM_RANGE, .imin = 0,
+	 .imax = PX_CONTROL_MAX_JOINTS - 1},
+	{.name = "amplitude_rad_per_s", .type = PX_CONFIG_T_DOUBLE,
+	 .offset = offsetof(struct raw_nominal, amplitude_rad_per_s),
+	 .flags = PX_CONFIG_REQUIRED | SIM_RANGE, .dmin = -100, .dmax = 100},
+	{.name = "frequency_hz", .type = PX_CONFIG_T_DOUBLE,
+	 .offset = offsetof(struct raw_nominal, frequency_hz),
+	 .flags = SIM_RANGE, .dmin = 0, .dmax = 1000},
+	{.name = "phase_rad", .type = PX_CONFIG_T_DOUBLE,
+	 .offset = offsetof(struct raw_nominal, phase_rad), .flags = SIM_RANGE,
+	 .dmin = -1000, .dmax = 1000},
+};
+static const struct px_config_schema nominal_schema = {
+	"nominal", nominal_keys, sizeof(nominal_keys) / sizeof(nominal_keys[0]),
+	NULL};
+
+static const struct px_config_key sim_keys[] = {
+	{.name = "faults", .type = PX_CONFIG_T_SEQ,
+	 .offset = offsetof(struct raw_sim, faults), .sub = &fault_schema,
+	 .elem = PX_CONFIG_T_SUB, .elem_size = sizeof(struct raw_fault),
+	 .count_offset = offsetof(struct raw_sim, n_faults),
+	 .max_count = MAX_CAMPAIGN},
+	{.name = "nominal", .type = PX_CONFIG_T_SEQ,
+	 .offset = offsetof(struct raw_sim, nominal), .sub = &nominal_schema,
+	 .elem = PX_CONFIG_T_SUB, .elem_size = sizeof(struct raw_nominal),
+	 .count_offset = offsetof(struct raw_sim, n_nominal), .max_count = 64},
+};
+static const struct px_config_schema sim_schema = {
+	"sim", sim_keys, sizeof(sim_keys) / sizeof(sim_keys[0]), sim_check};
+
+/* ---- the application ----------------------------------------------- */
+
+#define MAX_DEVS 64
+#define PLOT_MAX ((size_t)1 << 20)
+
+/* One telemetry record, pushed by the write phase every decimation-th
+ * cycle. */
+struct tele {
+	double t_s;
+	uint64_t cycle;
+	double dev_m[3], proxy_m[3], force_n[3];
+	double force_mag_n;
+	double distance_m;
+	double penetration_m;
+	int64_t latency_ns, compute_ns;
+	int32_t contact, safe, queries, valid;
+};
+
+struct app {
+	struct options o;
+	struct px_config *cfg;
+	struct px_control_config ctl;
+	struct px_world *scene;
+	struct px_control_query query;
+	struct px_control_haptic haptic;
+	struct px_dev *dev[MAX_DEVS];
+	struct px_pose_sample sample[MAX_DEVS];
+	struct px_sim_csv *csv[MAX_DEVS];
+	struct px_codec_field *fields[MAX_DEVS][2];
+	struct px_codec_buttons *buttons[MAX_DEVS];
+	struct px_codec_map codec[MAX_DEVS];
+	int n_dev;
+	int ctl_dev;          /* index of control.device, -1 none */
+	int rendering;        /* mode haptic */
+	struct px_force_cmd cmd;
+	struct px_loop *loop;
+	struct px_arena arena;
+	struct px_ring *ring;
+	struct px_stats *compute;
+	int64_t decimation;
+	uint64_t max_cycles;  /* 0 = until stopped */
+	int64_t t0_ns;        /* loop clock at the first read */
+	int64_t compute_t0;
+	struct px_control_haptic_out out;
+	int have_out;
+	/* statistics of every cycle (loop thread; read after the run or
+	 * approximately by the status line) */
+	double max_force_n, min_distance_m, max_penetration_m;
+	uint64_t query_errors, write_errors, velocity_trips, contact_cycles;
+	int last_query_err;
+	int over_velocity;
+	/* allocation counting in the loop thread */
+	int counting;
+	uint64_t heap_base;
+	_Atomic uint64_t allocs;
+	int alloc_probe;
+	uint64_t setup_heap_calls;
+	/* main thread */
+	FILE *csv_f;
+	char csv_path[1024];
+	struct tele *recs;
+	size_t n_recs, cap_recs;
+	uint64_t n_rows;        /* records drained (CSV rows) */
+	double min_proxy_distance_m;
+	uint64_t faults_by_cause[PX_FAULT__COUNT];
+	uint64_t faults_popped;
+	struct tele last;
+	int have_last;
+	/* avoidance: a CANopen arm on the in-process simulated CAN bus */
+	int avoiding;
+	struct px_can_sim *canbus;
+	struct px_can_bus *ep_master, *ep_arm;
+	struct px_canopen *co;
+	struct px_canopen_sim *arm;
+	int arm_input;          /* loop input index of the drives' feedback */
+	int n_drives;
+	int drive_joint[PX_CANOPEN_MAX_DRIVES];
+	int started;
+	int csp;                /* drives in CSP: targets are positions */
+	double q[PX_CONTROL_MAX_JOINTS], qcmd[PX_CONTROL_MAX_JOINTS];
+	double targets[PX_CONTROL_MAX_JOINTS];
+	int have_q, enabled;
+	int64_t last_feedback_ns;
+	struct px_control_avoid_out aout;
+	double min_clearance_m, min_scale;
+	uint64_t stop_cycles;   /* cycles with the nominal motion stopped */
+	/* fault campaign */
+	struct raw_sim sim;
+	int64_t clock0_ns;      /* loop clock at setup: fault windows start here */
+	struct px_fault *lfaults; /* loop faults seen, for the campaign report */
+	size_t n_lfaults, cap_lfaults;
+};
+
+static struct app A;
+static volatile sig_atomic_t interrupted;
+
+static void on_signal(int sig)
+{
+	(void)sig;
+	interrupted = 1;
+	if (A.loop)
+		px_loop_stop(A.loop);
+}
+
+static int64_t mono_ns(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+
+/* ---- loop phases (real-time rules: no allocation, no I/O) --------- */
+
+static int phase_read(struct px_loop *l, const struct px_loop_cycle *c,
+		      void *user)
+{
+	struct app *a = user;
+	int i;
+	if (!a->counting) {
+		/* Everything this thread does from here on counts. */
+		a->counting = 1;
+		a->heap_base = heap_count();
+		a->t0_ns = c->read_ns;
+	}
+	if (a->canbus) {
+		int64_t newest = 0;
+		int have = a->n_drives > 0;
+		/* the robot's side of the bus first, as another process would
+		 * have answered the last SYNC by now */
+		px_canopen_sim_step(a->arm, c->read_ns);
+		px_canopen_rx(a->co, c->read_ns);
+		for (i = 0; i < a->n_drives; i++) {
+			struct px_canopen_drive_status ds;
+			px_canopen_drive_status(a->co, (size_t)i, &ds);
+			if (ds.feedback_ns == 0) {
+				have = 0;
+				continue;
+			}
+			a->q[a->drive_joint[i]] = ds.position;
+			if (ds.feedback_ns > newest)
+				newest = ds.feedback_ns;
+		}
+		a->have_q = have;
+		if (have && newest > a->last_feedback_ns) {
+			a->last_feedback_ns = newest;
+			px_loop_input_stamp(l, a->arm_input, newest);
+		}
+		a->enabled = px_canopen_all_enabled(a->co);
+	}
+	for (i = 0; i < a->n_dev; i++) {
+		int rc = px_dev_pose_read(a->dev[i], c->read_ns, &a->sample[i]);
+		(void)rc; /* staleness reaches the watchdog through the stamp */
+	}
+	if (a->ctl_dev >= 0) {
+		const struct px_pose_sample *s = &a->sample[a->ctl_dev];
+		double v = px_v3_norm(s->vel_m_s);
+		double lim = a->cfg->safety.velocity_limit_m_per_s;
+		if (s->valid && v > lim) {
+			if (!a->over_velocity) {
+				a->velocity_trips++;
+				px_loop_trip(l);
+			}
+			a->over_velocity = 1;
+		} else {
+			a->over_velocity = 0;
+		}
+	}
+	return PX_OK;
+}
+
+/* Avoidance: nominal joint velocity from the demo task, scaled and
+ * deflected by the clearances (px_control_avoid_step), into drive
+ * targets (CSP: integrated positions; CSV: velocities). */
+static void avoid_compute(struct app *a, const struct px_loop_cycle *c)
+{
+	double qnom[PX_CONTROL_MAX_JOINTS] = {0};
+	double t = (double)(c->deadline_ns - a->t0_ns) * 1e-9;
+	double dt = (double)c->period_ns * 1e-9;
+	size_t k;
+	int i, rc;
+	if (!a->have_q || !a->enabled) {
+		for (i = 0; i < PX_CONTROL_MAX_JOINTS; i++)
+			a->targets[i] = a->csp ? a->q[i] : 0.0;
+		return;
+	}
+	if (!a->started) {
+		memcpy(a->qcmd, a->q, sizeof(a->qcmd));
+		a->started = 1;
+	}
+	for (k = 0; k < a->sim.n_nominal; k++) {
+		const struct raw_nominal *nm = &a->sim.nominal[k];
+		if (nm->joint < a->ctl.chain.n_joints)
+			qnom[nm->joint] += nm->amplitude_rad_per_s *
+					   cos(2 * M_PI * nm->frequency_hz * t +
+					       nm->phase_rad);
+	}
+	rc = px_control_avoid_step(&a->ctl.chain, &a->ctl.avoid, &a->query, a->q,
+				   qnom, c->period_ns, &a->aout);
+	if (rc < 0) {
+		a->query_errors++;
+		a->last_query_err = rc;
+	}
+	for (i = 0; i < a->ctl.chain.n_joints; i++) {
+		double v = rc < 0 ? 0.0 : a->aout.qdot[i];
+		a->qcmd[i] += v * dt;
+		a->targets[i] = a->csp ? a->qcmd[i] : v;
+	}
+}
+
+static int phase_compute(struct px_loop *l, const struct px_loop_cycle *c,
+			 void *user)
+{
+	struct app *a = user;
+	int64_t t = mono_ns();
+	(void)l;
+	a->have_out = 0;
+	if (a->avoiding)
+		avoid_compute(a, c);
+	if (a->ctl_dev >= 0 && a->sample[a->ctl_dev].valid) {
+		const struct px_pose_sample *s = &a->sample[a->ctl_dev];
+		if (a->rendering) {
+			int rc = px_control_haptic_step(&a->haptic, &a->query,
+							s->pos_m, &s->vel_m_s,
+							&a->out);
+			if (rc < 0) {
+				a->query_errors++;
+				a->last_query_err = rc;
+			}
+			a->cmd.force_n[0] = a->out.force_n.x;
+			a->cmd.force_n[1] = a->out.force_n.y;
+			a->cmd.force_n[2] = a->out.force_n.z;
+			a->cmd.enable = 1;
+		} else {
+			struct px_control_hit h;
+			memset(&a->out, 0, sizeof(a->out));
+			a->out.proxy_m = s->pos_m;
+			if (a->query.point(a->query.ctx, s->pos_m, 1e3, &h) == PX_OK &&
+			    h.valid)
+				a->out.distance_m = h.distance_m;
+			else
+				a->out.distance_m = INFINITY;
+		}
+		a->have_out = 1;
+	}
+	if (a->alloc_probe && c->index == 10) {
+		/* self-check of the heap counter (PX_RUN_ALLOC_PROBE=1): one
+		 * deliberate allocation and release inside a cycle */
+		void *volatile p = malloc(64);
+		free(p);
+	}
+	a->compute_t0 = mono_ns() - t;
+	px_stats_record(a->compute, a->compute_t0);
+	return PX_OK;
+}
+
+static int phase_write(struct px_loop *l, const struct px_loop_cycle *c,
+		       void *user)
+{
+	struct app *a = user;
+	double f;
+	(void)l;
+	if (a->rendering && a->ctl_dev >= 0) {
+		/* In safe state the loop has zeroed cmd and cleared enable. */
+		if (px_dev_force_write(a->dev[a->ctl_dev], &a->cmd, c->write_ns) !=
+		    PX_OK)
+			a->write_errors++;
+	}
+	if (a->canbus) {
+		int i;
+		if (c->safe) /* hold where the arm is; drives to quick stop */
+			for (i = 0; i < PX_CONTROL_MAX_JOINTS; i++)
+				a->targets[i] = a->csp ? a->q[i] : 0.0;
+		if (px_canopen_tx(a->co, c->write_ns, a->targets,
+				  PX_CONTROL_MAX_JOINTS,
+				  !c->safe && a->have_q) != PX_OK)
+			a->write_errors++;
+		if (a->avoiding && a->started && !c->safe) {
+			if (a->aout.min_clearance_m < a->min_clearance_m)
+				a->min_clearance_m = a->aout.min_clearance_m;
+			if (a->aout.min_clearance_m < a->min_distance_m)
+				a->min_distance_m = a->aout.min_clearance_m;
+			if (a->aout.scale < a->min_scale)
+				a->min_scale = a->aout.scale;
+			if (a->aout.scale == 0)
+				a->stop_cycles++;
+		}
+	}
+	f = sqrt(a->cmd.force_n[0] * a->cmd.force_n[0] +
+		 a->cmd.force_n[1] * a->cmd.force_n[1] +
+		 a->cmd.force_n[2] * a->cmd.force_n[2]);
+	if (f > a->max_force_n)
+		a->max_force_n = f;
+	/* Figures of the rendering only while it drives the device: not in
+	 * safe state (force zeroed) nor on a sample that broke the velocity
+	 * limit (a corrupted report the loop is tripping on). */
+	if (a->have_out && !c->safe && !a->over_velocity) {
+		if (a->out.distance_m < a->min_distance_m)
+			a->min_distance_m = a->out.distance_m;
+		if (a->out.penetration_m > a->max_penetration_m)
+			a->max_penetration_m = a->out.penetration_m;
+		if (a->out.contact)
+			a->contact_cycles++;
+	}
+	if (c->index % (uint64_t)a->decimation == 0) {
+		struct tele r;
+		const struct px_pose_sample *s =
+			a->ctl_dev >= 0 ? &a->sample[a->ctl_dev] : NULL;
+		memset(&r, 0, sizeof(r));
+		r.t_s = (double)(c->deadline_ns - a->t0_ns) * 1e-9;
+		r.cycle = c->index;
+		if (s) {
+			r.dev_m[0] = s->pos_m.x;
+			r.dev_m[1] = s->pos_m.y;
+			r.dev_m[2] = s->pos_m.z;
+			r.valid = s->valid;
+		}
+		r.proxy_m[0] = a->out.proxy_m.x;
+		r.proxy_m[1] = a->out.proxy_m.y;
+		r.proxy_m[2] = a->out.proxy_m.z;
+		memcpy(r.force_n, a->cmd.force_n, sizeof(r.force_n));
+		r.force_mag_n = f;
+		/* a sample that broke the velocity limit has no meaningful
+		 * distance: left empty (NaN) rather than spoiling the plots */
+		r.distance_m = a->have_out && !a->over_velocity ? a->out.distance_m
+								: NAN;
+		r.penetration_m = a->have_out && !a->over_velocity
+					  ? a->out.penetration_m
+					  : NAN;
+		r.latency_ns = c->wake_ns - c->deadline_ns;
+		r.compute_ns = a->compute_t0;
+		if (a->avoiding && a->started) {
+			int k = a->aout.closest_capsule;
+			r.distance_m = a->aout.min_clearance_m;
+			r.penetration_m = 0;
+			r.queries = a->aout.point_queries;
+			r.valid = 1;
+			if (k >= 0) {
+				px_vec3 pa = a->aout.caps[k].point_m;
+				px_vec3 pb = a->aout.caps[k].obstacle_m;
+				r.dev_m[0] = pa.x;
+				r.dev_m[1] = pa.y;
+				r.dev_m[2] = pa.z;
+				r.proxy_m[0] = pb.x;
+				r.proxy_m[1] = pb.y;
+				r.proxy_m[2] = pb.z;
+			}
+		}
+		r.contact = a->out.contact;
+		r.safe = c->safe;
+		if (!a->avoiding)
+			r.queries = a->out.point_queries;
+		px_ring_push(a->ring, &r);
+	}
+	atomic_store_explicit(&a->allocs, heap_count() - a->heap_base,
+			      memory_order_relaxed);
+	return PX_OK;
+}
+
+/* ---- setup --------------------------------------------------------- */
+
+static void config_dir_path(char *out, size_t cap, const char *cfg_path,
+			    const char *file)
+{
+	const char *slash = strrchr(cfg_path, '/');
+	if (file[0] == '/' || !slash)
+		snprintf(out, cap, "%s", file);
+	else
+		snprintf(out, cap, "%.*s/%s", (int)(slash - cfg_path), cfg_path,
+			 file);
+}
+
+static void codec_field(struct px_codec_field *d, const struct px_config_field *s)
+{
+	memset(d, 0, sizeof(*d));
+	d->report_id = (int)s->report_id;
+	d->byte_offset = (uint32_t)s->byte_offset;
+	d->bit_offset = (uint8_t)s->bit_offset;
+	d->bit_width = (uint8_t)s->bit_width;
+	d->is_signed = s->is_signed;
+	d->byte_order = (uint8_t)s->byte_order;
+	d->scale = s->scale;
+	d->offset = s->offset;
+	d->axis = s->axis;
+	d->max_abs = s->max_abs;
+}
+
+/* The config's report format as a codec map (NULL when none is given:
+ * the simulated device's built-in one). */
+static const struct px_codec_map *make_codec(int k, const struct px_config_codec *c)
+{
+	struct px_codec_map *m = &A.codec[k];
+	size_t i;
+	if (c->n_inputs == 0 && c->n_outputs == 0)
+		return NULL;
+	A.fields[k][0] = calloc(c->n_inputs + 1, sizeof(struct px_codec_field));
+	A.fields[k][1] = calloc(c->n_outputs + 1, sizeof(struct px_codec_field));
+	A.buttons[k] = calloc(c->n_buttons + 1, sizeof(struct px_codec_buttons));
+	if (!A.fields[k][0] || !A.fields[k][1] || !A.buttons[k])
+		return NULL;
+	for (i = 0; i < c->n_inputs; i++)
+		codec_field(&A.fields[k][0][i], &c->inputs[i]);
+	for (i = 0; i < c->n_outputs; i++)
+		codec_field(&A.fields[k][1][i], &c->outputs[i]);
+	for (i = 0; i < c->n_buttons; i++) {
+		A.buttons[k][i].report_id = (int)c->buttons[i].report_id;
+		A.buttons[k][i].byte_offset = (uint32_t)c->buttons[i].byte_offset;
+		A.buttons[k][i].first_bit = (uint8_t)c->buttons[i].first_bit;
+		A.buttons[k][i].count = (uint8_t)c->buttons[i].count;
+		A.buttons[k][i].first_button = (uint8_t)c->buttons[i].first_button;
+	}
+	m->inputs = A.fields[k][0];
+	m->n_inputs = c->n_inputs;
+	m->outputs = A.fields[k][1];
+	m->n_outputs = c->n_outputs;
+	m->buttons = A.buttons[k];
+	m->n_buttons = c->n_buttons;
+	m->output_report_id = (int)c->output_report_id;
+	m->output_report_len = (size_t)c->output_report_len;
+	return m;
+}
+
+/* A CANopen arm on the in-process simulated CAN bus: the master (the
+ * controller's side) on one endpoint, the simulated drives (the robot's
+ * side, stepped in the read phase as if it were another process on the
+ * bus) on the other. Returns 0 or 1 (said why). */
+static int make_can_arm(const struct px_config_device *d)
+{
+	const struct px_config_canopen *c = &d->socketcan.canopen;
+	struct px_canopen_drive_cfg drv[PX_CANOPEN_MAX_DRIVES];
+	struct px_canopen_config mc;
+	struct px_canopen_sim_config sc;
+	struct px_can_sim_config bc;
+	char msg[256] = "";
+	size_t i;
+	int rc;
+	if (A.canbus) {
+		fprintf(stderr, "proxima-run: device '%s': one simulated CAN arm "
+				"per run\n",
+			d->name);
+		return 1;
+	}
+	memset(drv, 0, sizeof(drv));
+	for (i = 0; i < c->n_drives && i < PX_CANOPEN_MAX_DRIVES; i++) {
+		drv[i].node_id = (uint8_t)c->drives[i].node_id;
+		drv[i].mode = PX_CIA402_CSP + c->drives[i].mode;
+		drv[i].joint = (int)c->drives[i].joint;
+		A.drive_joint[i] = drv[i].joint;
+		drv[i].counts_per_unit = 100000.0; /* as proxima-simarm */
+		drv[i].rated_torque_n_m = 1.0;
+		if (drv[i].mode == PX_CIA402_CST) {
+			fprintf(stderr, "proxima-run: device '%s': drives in cst "
+					"take torques; avoidance commands csp or "
+					"csv\n",
+				d->name);
+			return 1;
+		}
+	}
+	A.n_drives = (int)i;
+	A.csp = A.n_drives > 0 && drv[0].mode == PX_CIA402_CSP;
+	px_can_sim_config_default(&bc);
+	rc = px_can_sim_create(&bc, &A.canbus);
+	if (rc == PX_OK)
+		rc = px_can_sim_endpoint(A.canbus, &A.ep_master);
+	if (rc == PX_OK)
+		rc = px_can_sim_endpoint(A.canbus, &A.ep_arm);
+	if (rc == PX_OK) {
+		px_canopen_config_default(&mc);
+		mc.sync = 1;
+		mc.heartbeat_period_ns = c->heartbeat_period_ns;
+		mc.heartbeat_timeout_ns = c->heartbeat_timeout_ns;
+		mc.drives = drv;
+		mc.n_drives = (size_t)A.n_drives;
+		rc = px_canopen_create(&mc, A.ep_master, &A.co, msg, sizeof(msg));
+	}
+	if (rc == PX_OK) {
+		memset(&sc, 0, sizeof(sc));
+		sc.drives = drv;
+		sc.n_drives = (size_t)A.n_drives;
+		sc.heartbeat_period_ns = 100000000;
+		sc.inertia_kg_m2 = 0.01;
+		rc = px_canopen_sim_create(&sc, A.ep_arm, &A.arm);
+	}
+	if (rc != PX_OK) {
+		fprintf(stderr, "proxima-run: device '%s': %s\n", d->name,
+			msg[0] ? msg : px_strerror(rc));
+		return 1;
+	}
+	if (A.ctl.device && strcmp(A.ctl.device, d->name) == 0)
+		A.avoiding = A.ctl.mode == PX_CONTROL_MODE_AVOIDANCE;
+	return 0;
+}
+
+/* Create device k of the config. Returns 0, 1 (setup failed: said why)
+ * or 2 (back end this runner does not drive). */
+static int make_device(int k)
+{
+	const struct px_config_device *d = &A.cfg->devices[k];
+	const struct px_config_sim *s = &d->sim;
+	struct px_dev_config dc;
+	struct px_sim_haptic_config sc;
+	struct px_sim_sine sines[PX_SIM_MAX_SINES];
+	char msg[256] = "";
+	size_t i;
+	int rc;
+	if (d->backend == PX_CONFIG_BACKEND_SOCKETCAN &&
+	    d->socketcan.transport == PX_CONFIG_CAN_SIM &&
+	    d->socketcan.canopen.present)
+		return make_can_arm(d);
+	if (d->backend != PX_CONFIG_BACKEND_SIM) {
+		fprintf(stderr,
+			"proxima-run: device '%s': back end %s is not driven "
+			"by proxima-run in this version (only sim); check the "
+			"file with --check\n",
+			d->name, px_config_backend_names()[d->backend]);
+		return 2;
+	}
+	if (s->kind == PX_CONFIG_SIM_GPIO)
+		return 0; /* simulated lines: nothing in the cycle uses them */
+	px_dev_config_default(&dc);
+	dc.name = d->name;
+	dc.stale_timeout_ns = d->stale_timeout_ns
+				      ? d->stale_timeout_ns
+				      : A.cfg->safety.watchdog.device_timeout_ns;
+	dc.codec = make_codec(k, &s->codec);
+	px_sim_haptic_config_default(&sc);
+	sc.mass_kg = s->mass_kg;
+	sc.damping_n_s_per_m = s->damping_n_s_per_m;
+	sc.hand_stiffness_n_per_m = s->hand_stiffness_n_per_m;
+	sc.hand_damping_n_s_per_m = s->hand_damping_n_s_per_m;
+	sc.report_period_ns = s->report_period_ns ? s->report_period_ns
+						  : A.cfg->loop.period_ns;
+	sc.seed = (uint64_t)s->seed;
+	sc.position_noise_m = s->position_noise_m;
+	sc.follow_hand = s->kind == PX_CONFIG_SIM_POSE;
+	sc.traj.kind = s->trajectory.kind == PX_CONFIG_TRAJ_SINES ? PX_SIM_TRAJ_SINES
+		       : s->trajectory.kind == PX_CONFIG_TRAJ_CSV ? PX_SIM_TRAJ_CSV
+								  : PX_SIM_TRAJ_HOLD;
+	memcpy(sc.traj.center_m, s->trajectory.center_m, sizeof(sc.traj.center_m));
+	for (i = 0; i < s->trajectory.n_sines && i < PX_SIM_MAX_SINES; i++) {
+		sines[i].axis = s->trajectory.sines[i].axis;
+		sines[i].amplitude_m = s->trajectory.sines[i].amplitude_m;
+		sines[i].frequency_hz = s->trajectory.sines[i].frequency_hz;
+		sines[i].phase_rad = s->trajectory.sines[i].phase_rad;
+	}
+	sc.traj.sines = sines;
+	sc.traj.n_sines = i;
+	sc.traj.repeat = s->trajectory.repeat;
+	if (sc.traj.kind == PX_SIM_TRAJ_CSV) {
+		char path[2048];
+		config_dir_path(path, sizeof(path), A.o.config, s->trajectory.file);
+		rc = px_sim_csv_load(path, &A.csv[k], msg, sizeof(msg));
+		if (rc != PX_OK) {
+			fprintf(stderr, "proxima-run: device '%s': %s\n", d->name,
+				msg[0] ? msg : px_strerror(rc));
+			return 1;
+		}
+		sc.traj.csv = A.csv[k];
+	}
+	{
+		static struct px_sim_fault fl[PX_SIM_MAX_FAULTS];
+		size_t n = 0;
+		for (i = 0; i < A.sim.n_faults; i++) {
+			const struct raw_fault *f = &A.sim.faults[i];
+			if (strcmp(f->device, d->name) != 0)
+				continue;
+			if (n == PX_SIM_MAX_FAULTS) {
+				fprintf(stderr,
+					"proxima-run: device '%s': more than %d "
+					"faults\n",
+					d->name, PX_SIM_MAX_FAULTS);
+				return 1;
+			}
+			fl[n].kind = f->kind + 1;
+			fl[n].start_ns = A.clock0_ns + f->start_ns;
+			fl[n].duration_ns = f->duration_ns;
+			fl[n].probability = f->probability;
+			fl[n].delay_ns = f->delay_ns;
+			n++;
+		}
+		sc.faults = fl;
+		sc.n_faults = n;
+	}
+	/* A noisy position never repeats exactly: identical samples mean a
+	 * frozen sensor (the stuck fault), so let the device detect it. */
+	if (s->position_noise_m > 0)
+		dc.stuck_limit = 50;
+	rc = px_sim_haptic_create(&dc, &sc, &A.dev[A.n_dev], msg, sizeof(msg));
+	if (rc != PX_OK) {
+		fprintf(stderr, "proxima-run: device '%s': %s\n", d->name,
+			msg[0] ? msg : px_strerror(rc));
+		return 1;
+	}
+	if (A.ctl.device && strcmp(A.ctl.device, d->name) == 0)
+		A.ctl_dev = A.n_dev;
+	A.n_dev++;
+	return 0;
+}
+
+static int report_config(int rc, const struct px_config_diag *diag)
+{
+	int n = px_config_diag_total(diag);
+	px_config_diag_print(diag, stderr);
+	if (n == 0)
+		fprintf(stderr, "%s: %s\n", A.o.config, px_strerror(rc));
+	fprintf(stderr, "%s: invalid configuration (%d error%s)\n", A.o.config,
+		n, n == 1 ? "" : "s");
+	return 1;
+}
+
+static int setup(void)
+{
+	static struct px_config_diag diag;
+	struct px_loop_config lc;
+	const struct px_config *cfg = A.cfg;
+	size_t ring_cap = (size_t)cfg->telemetry.ring_records;
+	int i, rc;
+
+	A.ctl_dev = -1;
+	A.clock0_ns = A.o.virtual_time ? 0 : mono_ns();
+	A.min_distance_m = INFINITY;
+	A.min_proxy_distance_m = INFINITY;
+	A.decimation = cfg->telemetry.decimation > 0 ? cfg->telemetry.decimation : 1;
+	px_config_diag_init(&diag);
+	rc = px_world_config_load(cfg, &A.scene, &diag);
+	if (rc != PX_OK)
+		return report_config(rc, &diag);
+	px_world_control_query(A.scene, &A.query);
+	for (i = 0; i < (int)cfg->n_devices && i < MAX_DEVS; i++) {
+		rc = make_device(i);
+		if (rc)
+			return rc;
+	}
+	if (A.ctl.mode == PX_CONTROL_MODE_AVOIDANCE && !A.avoiding) {
+		fprintf(stderr,
+			"proxima-run: control mode 'avoidance' is driven by "
+			"proxima-run only on a CANopen arm on the simulated CAN "
+			"bus (socketcan transport sim) in this version\n");
+		return 2;
+	}
+	A.min_clearance_m = INFINITY;
+	A.min_scale = 1.0;
+	A.rendering = A.ctl.mode == PX_CONTROL_MODE_HAPTIC && A.ctl_dev >= 0;
+	if (A.ctl.mode == PX_CONTROL_MODE_HAPTIC && A.ctl_dev < 0) {
+		fprintf(stderr, "proxima-run: control.device '%s' is not a "
+				"pose device\n",
+			A.ctl.device);
+		return 1;
+	}
+	if (A.ctl_dev < 0 && A.n_dev > 0 && !A.avoiding)
+		A.ctl_dev = 0; /* mode none: report the first device's distance */
+	if (A.rendering) {
+		if (!(px_dev_caps(A.dev[A.ctl_dev]) & PX_DEV_CAP_FORCE)) {
+			fprintf(stderr,
+				"proxima-run: control.device '%s' takes no force "
+				"(a sim device of kind pose?)\n",
+				A.ctl.device);
+			return 1;
+		}
+		rc = px_control_haptic_init(&A.haptic, &A.ctl.haptic,
+					    cfg->loop.period_ns);
+		if (rc != PX_OK) {
+			fprintf(stderr, "proxima-run: haptic setup: %s\n",
+				px_strerror(rc));
+			return 1;
+		}
+	}
+
+	px_loop_config_default(&lc);
+	lc.period_ns = cfg->loop.period_ns;
+	lc.clock = A.o.virtual_time ? PX_LOOP_CLOCK_VIRTUAL : PX_LOOP_CLOCK_MONOTONIC;
+	lc.overrun = cfg->loop.overrun_policy == PX_CONFIG_OVERRUN_CATCH_UP
+			     ? PX_LOOP_OVERRUN_CATCH_UP
+			     : PX_LOOP_OVERRUN_SKIP;
+	lc.overrun_limit = (uint32_t)cfg->loop.max_consecutive_overruns;
+	lc.compute_budget_ns = cfg->safety.watchdog.compute_budget_ns;
+	lc.budget_limit = (uint32_t)cfg->safety.watchdog.max_over_budget;
+	/* auto_rearm: leave safe state after 50 ms without a fault */
+	lc.rearm_after_ok_cycles =
+		cfg->safety.watchdog.auto_rearm
+			? (uint32_t)(50000000 / cfg->loop.period_ns + 1)
+			: 0;
+	lc.read = phase_read;
+	lc.compute = phase_compute;
+	lc.write = phase_write;
+	lc.user = &A;
+	lc.rt_enable = !A.o.virtual_time;
+	lc.rt.priority = (int)cfg->loop.priority;
+	lc.rt.cpu = (int)cfg->loop.cpu;
+	lc.rt.lock_memory = cfg->loop.lock_memory;
+	lc.rt.dma_latency = cfg->loop.dma_latency;
+	rc = px_loop_create(&lc, &A.loop);
+	if (rc != PX_OK) {
+		fprintf(stderr, "proxima-run: loop: %s\n", px_strerror(rc));
+		return 1;
+	}
+	for (i = 0; i < A.n_dev; i++) {
+		rc = px_dev_start(A.dev[i]);
+		if (rc == PX_OK)
+			rc = px_dev_attach(A.dev[i], A.loop);
+		if (rc >= 0 && A.rendering && i == A.ctl_dev)
+			rc = px_dev_force_attach(A.dev[i], A.loop, &A.cmd);
+		if (rc < 0) {
+			fprintf(stderr, "proxima-run: device '%s': %s\n",
+				px_dev_name(A.dev[i]), px_strerror(rc));
+			return 1;
+		}
+	}
+	if (A.avoiding) {
+		const struct px_config_device *d = px_config_device_find(cfg, A.ctl.device);
+		int64_t tmo = d && d->stale_timeout_ns ? d->stale_timeout_ns
+						       : cfg->safety.watchdog.device_timeout_ns;
+		A.arm_input = px_loop_input_add(A.loop, A.ctl.device, tmo);
+		if (A.arm_input < 0) {
+			fprintf(stderr, "proxima-run: arm watchdog: %s\n",
+				px_strerror(A.arm_input));
+			return 1;
+		}
+	}
+	if (ring_cap < 16)
+		ring_cap = 16;
+	rc = px_arena_init_alloc(&A.arena, px_ring_size(ring_cap, sizeof(struct tele)) +
+						   px_stats_size(PX_STATS_DEFAULT_BINS) +
+						   4096);
+	if (rc == PX_OK)
+		rc = px_ring_create(&A.arena, ring_cap, sizeof(struct tele), &A.ring);
+	if (rc == PX_OK)
+		rc = px_stats_create(&A.arena, 0, 0, &A.compute);
+	if (rc != PX_OK) {
+		fprintf(stderr, "proxima-run: telemetry buffers: %s\n",
+			px_strerror(rc));
+		return 1;
+	}
+	if (A.o.duration_s > 0)
+		A.max_cycles = (uint64_t)ceil(A.o.duration_s * 1e9 /
+					      (double)cfg->loop.period_ns);
+	return 0;
+}
+
+static void teardown(void)
+{
+	int i;
+	px_loop_free(A.loop);
+	for (i = 0; i < A.n_dev; i++)
+		px_dev_free(A.dev[i]);
+	for (i = 0; i < MAX_DEVS; i++) {
+		px_sim_csv_free(A.csv[i]);
+		free(A.fields[i][0]);
+		free(A.fields[i][1]);
+		free(A.buttons[i]);
+	}
+	px_canopen_free(A.co);
+	px_canopen_sim_free(A.arm);
+	px_can_sim_free(A.canbus);
+	px_world_free(A.scene);
+	px_arena_fini(&A.arena);
+	free(A.recs);
+	free(A.lfaults);
+	px_config_free(A.cfg);
+}
+
+/* ---- outside the cycle: telemetry, faults, status ------------------ */
+
+static void drain(void)
+{
+	struct tele r;
+	struct px_fault f;
+	while (px_ring_pop(A.ring, &r) == PX_OK) {
+		A.n_rows++;
+		/* the plots keep the first PLOT_MAX records (about 17 min at
+		 * 1 kHz); the CSV gets everything */
+		if (A.n_recs == PLOT_MAX)
+			goto stored;
+		if (A.n_recs == A.cap_recs) {
+			size_t cap = A.cap_recs ? 2 * A.cap_recs : 4096;
+			struct tele *p = realloc(A.recs, cap * sizeof(*p));
+			if (!p)
+				break;
+			A.recs = p;
+			A.cap_recs = cap;
+		}
+		A.recs[A.n_recs++] = r;
+	stored:
+		A.last = r;
+		A.have_last = 1;
+		if (A.csv_f)
+			fprintf(A.csv_f,
+				"%.6f,%llu,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,"
+				"%.6g,%.6g,%.9g,%.9g,%d,%d,%lld,%lld,%d\n",
+				r.t_s, (unsigned long long)r.cycle, r.dev_m[0],
+				r.dev_m[1], r.dev_m[2], r.proxy_m[0], r.proxy_m[1],
+				r.proxy_m[2], r.force_n[0], r.force_n[1],
+				r.force_n[2], r.force_mag_n, r.distance_m,
+				r.penetration_m, r.contact, r.safe,
+				(long long)r.latency_ns, (long long)r.compute_ns,
+				r.queries);
+		/* The proxy must stay on the free side of closed models:
+		 * check each recorded proxy against the scene (not in the
+		 * cycle; the scene is only read). */
+		if (A.rendering && r.valid && !r.safe) {
+			struct px_world_hit h;
+			px_vec3 p = px_v3(r.proxy_m[0], r.proxy_m[1], r.proxy_m[2]);
+			if (px_world_nearest(A.scene, p, INFINITY, &h) == 1 &&
+			    h.distance_m < A.min_proxy_distance_m)
+				A.min_proxy_distance_m = h.distance_m;
+		}
+	}
+	while (px_loop_fault_pop(A.loop, &f) == PX_OK) {
+		if (f.cause >= 0 && f.cause < PX_FAULT__COUNT)
+			A.faults_by_cause[f.cause]++;
+		A.faults_popped++;
+		if (A.sim.n_faults && A.n_lfaults < 100000) {
+			if (A.n_lfaults == A.cap_lfaults) {
+				size_t cap = A.cap_lfaults ? 2 * A.cap_lfaults : 256;
+				struct px_fault *p =
+					realloc(A.lfaults, cap * sizeof(*p));
+				if (!p)
+					continue;
+				A.lfaults = p;
+				A.cap_lfaults = cap;
+			}
+			A.lfaults[A.n_lfaults++] = f;
+		}
+	}
+}
+
+static void status_line(int final, double wall_s, double rate)
+{
+	struct px_stats_snapshot lat, cmp;
+	struct px_loop_status st;
+	static int tty = -1;
+	if (tty < 0)
+		tty = isatty(2);
+	px_loop_stats(A.loop, PX_LOOP_STAT_LATENCY, &lat);
+	px_stats_read(A.compute, &cmp);
+	px_loop_status(A.loop, &st);
+	fprintf(stderr,
+		"%s[%7.2f s] %6.0f cycles/s | wake p99 %5.1f us | compute p99 "
+		"%5.1f us | distance %+8.2f mm | force %5.2f N | faults %llu%s%s",
+		tty ? "\r" : "", A.have_last ? A.last.t_s : 0.0, rate,
+		(double)lat.p99_ns / 1e3, (double)cmp.p99_ns / 1e3,
+		A.have_last && isfinite(A.last.distance_m) ? A.last.distance_m * 1e3
+							     : 0.0,
+		A.have_last ? A.last.force_mag_n : 0.0,
+		(unsigned long long)st.faults, st.safe ? " | SAFE STATE" : "",
+		tty ? "\033[K" : "\n");
+	if (final && tty)
+		fputc('\n', stderr);
+	(void)wall_s;
+	fflush(stderr);
+}
+
+struct rate_meter {
+	int64_t t_ns;
+	uint64_t cycles;
+	double rate;
+};
+
+static void maybe_status(struct rate_meter *m, int64_t now, int64_t every_ns)
+{
+	struct px_loop_status st;
+	if (now - m->t_ns < every_ns)
+		return;
+	px_loop_status(A.loop, &st);
+	m->rate = (double)(st.cycles - m->cycles) / ((double)(now - m->t_ns) * 1e-9);
+	m->cycles = st.cycles;
+	m->t_ns = now;
+	status_line(0, 0, m->rate);
+}
+
+static _Atomic int loop_done;
+static int loop_rc;
+
+static void *loop_thread(void *arg)
+{
+	(void)arg;
+	loop_rc = px_loop_run(A.loop, A.max_cycles);
+	atomic_store(&loop_done, 1);
+	return NULL;
+}
+
+static int run(void)
+{
+	struct rate_meter m;
+	int64_t status_every = isatty(2) ? 250000000 : 1000000000;
+	memset(&m, 0, sizeof(m));
+	m.t_ns = mono_ns();
+	if (A.o.virtual_time) {
+		/* Drain well before the ring can fill. */
+		uint64_t batch = (uint64_t)A.decimation *
+				 (px_ring_capacity(A.ring) / 2);
+		uint64_t done = 0, allocs = 0;
+		int rc = PX_OK;
+		if (batch > 1000)
+			batch = 1000;
+		while (!interrupted && rc == PX_OK &&
+		       (A.max_cycles == 0 || done < A.max_cycles)) {
+			uint64_t k, before = heap_count();
+			for (k = 0; k < batch && rc == PX_OK &&
+				    (A.max_cycles == 0 || done < A.max_cycles);
+			     k++, done++)
+				rc = px_loop_step(A.loop);
+			/* only the cycles' own heap calls, not the drain's */
+			allocs += heap_count() - before;
+			drain();
+			maybe_status(&m, mono_ns(), status_every);
+		}
+		atomic_store(&A.allocs, allocs);
+		return rc < 0 ? rc : PX_OK;
+	} else {
+		pthread_t th;
+		if (pthread_create(&th, NULL, loop_thread, NULL) != 0) {
+			fprintf(stderr, "proxima-run: cannot start the loop thread\n");
+			return PX_E_NOMEM;
+		}
+		while (!atomic_load(&loop_done)) {
+			struct timespec ts = {0, 20000000};
+			nanosleep(&ts, NULL);
+			drain();
+			maybe_status(&m, mono_ns(), status_every);
+		}
+		pthread_join(th, NULL);
+		drain();
+		return loop_rc;
+	}
+}
+
+/* ---- results -------------------------------------------------------- */
+
+static void plot_paths(char *time_svg, char *lat_svg, size_t cap)
+{
+	const char *base = A.csv_path[0] ? A.csv_path : "proxima-run.csv";
+	size_t n = strlen(base);
+	if (n > 4 && strcmp(base + n - 4, ".csv") == 0)
+		n -= 4;
+	snprintf(time_svg, cap, "%.*s_time.svg", (int)n, base);
+	snprintf(lat_svg, cap, "%.*s_latency.svg", (int)n, base);
+}
+
+static int write_plots(const char *time_svg, const char *lat_svg)
+{
+	size_t n = A.n_recs, i;
+	double *x = calloc(n + 1, sizeof(double));
+	double *d = calloc(n + 1, sizeof(double));
+	double *f = calloc(n + 1, sizeof(double));
+	double *pen = calloc(n + 1, sizeof(double));
+	double *fz = calloc(n + 1, sizeof(double));
+	int rc = -1;
+	static uint64_t lbins[PX_STATS_DEFAULT_BINS], cbins[PX_STATS_DEFAULT_BINS];
+	uint64_t lover = 0, cover = 0;
+	int nl, nc;
+	if (x && d && f && pen && fz) {
+		struct tool_svg_series sd[] = {{"distance", d, "#1f77b4"}};
+		struct tool_svg_series sf[] = {{"|F|", f, "#d62728"},
+					       {"Fz", fz, "#ff7f0e"}};
+		struct tool_svg_series sp[] = {{"penetration", pen, "#2ca02c"}};
+		struct tool_svg_panel p[] = {{"distance (mm)", sd, 1},
+					     {"force (N)", sf, 2},
+					     {"proxy penetration (mm)", sp, 1}};
+		for (i = 0; i < n; i++) {
+			x[i] = A.recs[i].t_s;
+			d[i] = A.recs[i].distance_m * 1e3;
+			f[i] = A.recs[i].force_mag_n;
+			fz[i] = A.recs[i].force_n[2];
+			pen[i] = A.recs[i].penetration_m * 1e3;
+		}
+		rc = tool_svg_lines(time_svg,
+				    "proxima-run: distance, force and proxy "
+				    "penetration",
+				    "time (s)", x, n, p, 3);
+	}
+	free(x);
+	free(d);
+	free(f);
+	free(pen);
+	free(fz);
+	nl = px_stats_copy_bins(px_loop_stats_handle(A.loop, PX_LOOP_STAT_LATENCY),
+				lbins, PX_STATS_DEFAULT_BINS, &lover);
+	nc = px_stats_copy_bins(A.compute, cbins, PX_STATS_DEFAULT_BINS, &cover);
+	if (rc == 0 && nl >= 0 && nc >= 0) {
+		struct tool_svg_hist h[] = {
+			{"wake-up latency", lbins, (size_t)nl, lover,
+			 (double)px_stats_bin_ns(px_loop_stats_handle(
+				 A.loop, PX_LOOP_STAT_LATENCY)) /
+				 1e3,
+			 "#1f77b4"},
+			{"compute time", cbins, (size_t)nc, cover,
+			 (double)px_stats_bin_ns(A.compute) / 1e3, "#9467bd"}};
+		rc = tool_svg_histograms(lat_svg,
+					 A.o.virtual_time
+						 ? "proxima-run: latency (virtual "
+						   "clock: wake-up is 0 by "
+						   "construction)"
+						 : "proxima-run: latency",
+					 "microseconds", h, 2);
+	}
+	return rc;
+}
+
+static void json_stats(FILE *f, const char *name,
+		       const struct px_stats_snapshot *s, int last)
+{
+	fprintf(f,
+		"  \"%s\": {\"count\": %llu, \"p50\": %lld, \"p99\": %lld, "
+		"\"p999\": %lld, \"max\": %lld, \"mean\": %lld}%s\n",
+		name, (unsigned long long)s->count, (long long)s->p50_ns,
+		(long long)s->p99_ns, (long long)s->p999_ns, (long long)s->max_ns,
+		(long long)s->mean_ns, last ? "" : ",");
+}
+
+static void json_string(FILE *f, const char *s)
+{
+	fputc('"', f);
+	for (; *s; s++) {
+		if (*s == '"' || *s == '\\')
+			fprintf(f, "\\%c", *s);
+		else if ((unsigned char)*s < 0x20)
+			fprintf(f, "\\u%04x", *s);
+		else
+			fputc(*s, f);
+	}
+	fputc('"', f);
+}
+
+static double json_num(double v)
+{
+	return isfinite(v) ? v : 0.0;
+}
+
+struct dev_faults {
+	uint64_t by_kind[PX_DEV_ERR__COUNT];
+};
+
+static void device_faults(struct dev_faults *df)
+{
+	int i;
+	memset(df, 0, sizeof(*df));
+	for (i = 0; i < A.n_dev; i++) {
+		struct px_dev_status s;
+		if (px_dev_status(A.dev[i], &s) != PX_OK)
+			continue;
+		df->by_kind[PX_DEV_ERR_DECODE] += s.decode_errors;
+		df->by_kind[PX_DEV_ERR_NONFINITE] += s.nonfinite;
+		df->by_kind[PX_DEV_ERR_DUPLICATE] += s.duplicates;
+		df->by_kind[PX_DEV_ERR_STUCK] += s.stuck;
+		df->by_kind[PX_DEV_ERR_UNPLUG] += s.unplugs;
+		df->by_kind[PX_DEV_ERR_IO] += s.io_errors + s.write_errors;
+		df->by_kind[PX_DEV_ERR_BUS] += s.bus_errors;
+	}
+}
+
+static void json_campaign(FILE *f);
+
+static int write_json(const char *path, const struct px_loop_status *st,
+		      const struct px_stats_snapshot *lat,
+		      const struct px_stats_snapshot *cmp, double wall_s,
+		      const char *time_svg, const char *lat_svg,
+		      const char *counter)
+{
+	FILE *f = fopen(path, "w");
+	struct dev_faults df;
+	int k;
+	if (!f)
+		return -1;
+	device_faults(&df);
+	fprintf(f, "{\n  \"config\": ");
+	json_string(f, A.o.config);
+	fprintf(f,
+		",\n  \"clock\": \"%s\",\n  \"period_ns\": %lld,\n"
+		"  \"simulated_s\": %.6f,\n  \"wall_s\": %.3f,\n"
+		"  \"cycles\": %llu,\n  \"overruns\": %llu,\n"
+		"  \"missed_periods\": %llu,\n",
+		A.o.virtual_time ? "virtual" : "monotonic",
+		(long long)st->period_ns,
+		(double)st->cycles * (double)st->period_ns * 1e-9, wall_s,
+		(unsigned long long)st->cycles, (unsigned long long)st->overruns,
+		(unsigned long long)st->missed_periods);
+	json_stats(f, "wakeup_latency_ns", lat, 0);
+	json_stats(f, "compute_ns", cmp, 0);
+	fprintf(f,
+		"  \"max_force_n\": %.9g,\n  \"force_clamp_n\": %.9g,\n"
+		"  \"min_distance_m\": %.9g,\n  \"max_penetration_m\": %.9g,\n"
+		"  \"min_proxy_distance_m\": %.9g,\n"
+		"  \"min_clearance_m\": %.9g,\n  \"protective_distance_m\": %.9g,\n"
+		"  \"min_speed_scale\": %.9g,\n"
+		"  \"contact_cycles\": %llu,\n  \"safe_state_trips\": %llu,\n"
+		"  \"faults\": {",
+		A.max_force_n, A.rendering ? A.ctl.haptic.max_force_n : 0.0,
+		json_num(A.min_distance_m), A.max_penetration_m,
+		json_num(A.min_proxy_distance_m),
+		A.avoiding ? json_num(A.min_clearance_m) : 0.0,
+		A.avoiding ? A.ctl.avoid.protective_distance_m : 0.0,
+		A.avoiding ? A.min_scale : 1.0,
+		(unsigned long long)A.contact_cycles,
+		(unsigned long long)st->safe_entries);
+	for (k = 1; k < PX_FAULT__COUNT; k++)
+		fprintf(f, "\"%s\": %llu, ", px_fault_cause_name(k),
+			(unsigned long long)A.faults_by_cause[k]);
+	for (k = 1; k < PX_DEV_ERR__COUNT; k++)
+		if (k != PX_DEV_ERR_OPEN && k != PX_DEV_ERR_ESTOP &&
+		    k != PX_DEV_ERR_ENCODE)
+			fprintf(f, "\"device_%s\": %llu, ", px_dev_errkind_name(k),
+				(unsigned long long)df.by_kind[k]);
+	fprintf(f,
+		"\"velocity_limit\": %llu, \"query_error\": %llu, "
+		"\"dropped\": %llu},\n",
+		(unsigned long long)A.velocity_trips,
+		(unsigned long long)A.query_errors,
+		(unsigned long long)st->faults_dropped);
+	json_campaign(f);
+	fprintf(f,
+		"  \"allocations_after_setup\": %llu,\n"
+		"  \"allocations_setup\": %llu,\n"
+		"  \"allocation_counter\": \"%s\",\n"
+		"  \"telemetry_records\": %llu,\n  \"telemetry_dropped\": %llu,\n"
+		"  \"realtime\": %d,\n  \"csv\": ",
+		(unsigned long long)atomic_load(&A.allocs),
+		(unsigned long long)A.setup_heap_calls, counter,
+		(unsigned long long)A.n_rows,
+		(unsigned long long)px_ring_dropped(A.ring), st->realtime);
+	if (A.csv_path[0])
+		json_string(f, A.csv_path);
+	else
+		fputs("null", f);
+	fputs(",\n  \"plots\": [", f);
+	json_string(f, time_svg);
+	fputs(", ", f);
+	json_string(f, lat_svg);
+	fputs("]\n}\n", f);
+	return fclose(f) == 0 ? 0 : -1;
+}
+
+/* What the safety layer did about configured fault i: loop faults seen
+ * from the window's start to its end plus the device timeout (and 10 ms),
+ * and the time from the start to the first that put or kept the loop in
+ * safe state (-1: none). */
+static void campaign_reaction(size_t i, uint64_t *n, int64_t *safe_after_ns,
+			      int64_t *t0, int64_t *t1)
+{
+	const struct raw_fault *f = &A.sim.faults[i];
+	const struct px_config_device *d = px_config_device_find(A.cfg, f->device);
+	int64_t tmo = d && d->stale_timeout_ns ? d->stale_timeout_ns
+					       : A.cfg->safety.watchdog.device_timeout_ns;
+	size_t k;
+	*t0 = A.clock0_ns + f->start_ns;
+	*t1 = *t0 + f->duration_ns + tmo + 10000000;
+	*n = 0;
+	*safe_after_ns = -1;
+	for (k = 0; k < A.n_lfaults; k++) {
+		const struct px_fault *lf = &A.lfaults[k];
+		if (lf->t_ns < *t0 || lf->t_ns > *t1)
+			continue;
+		(*n)++;
+		if (lf->safe && *safe_after_ns < 0)
+			*safe_after_ns = lf->t_ns - *t0;
+	}
+}
+
+static void print_campaign(void)
+{
+	size_t i;
+	if (!A.sim.n_faults)
+		return;
+	printf("  fault campaign    (loop faults from each window's start to "
+	       "its end + device timeout)\n");
+	for (i = 0; i < A.sim.n_faults; i++) {
+		const struct raw_fault *f = &A.sim.faults[i];
+		uint64_t n;
+		int64_t after, t0, t1;
+		campaign_reaction(i, &n, &after, &t0, &t1);
+		printf("    %-9s %-8s %7.3f..%7.3f s p %.2f: %4llu loop faults, ",
+		       fault_kind_names[f->kind], f->device, (double)f->start_ns * 1e-9,
+		       (double)(f->start_ns + f->duration_ns) * 1e-9, f->probability,
+		       (unsigned long long)n);
+		if (after >= 0)
+			printf("safe state after %.1f ms\n", (double)after * 1e-6);
+		else
+			printf("no safe state (samples stayed fresh)\n");
+	}
+}
+
+static void json_campaign(FILE *f)
+{
+	size_t i;
+	fputs("  \"fault_campaign\": [", f);
+	for (i = 0; i < A.sim.n_faults; i++) {
+		const struct raw_fault *x = &A.sim.faults[i];
+		uint64_t n;
+		int64_t after, t0, t1;
+		campaign_reaction(i, &n, &after, &t0, &t1);
+		fprintf(f,
+			"%s\n    {\"kind\": \"%s\", \"device\": ", i ? "," : "",
+			fault_kind_names[x->kind]);
+		json_string(f, x->device);
+		fprintf(f,
+			", \"start_ns\": %lld, \"duration_ns\": %lld, "
+			"\"loop_faults\": %llu, \"safe_after_ns\": %lld}",
+			(long long)x->start_ns, (long long)x->duration_ns,
+			(unsigned long long)n, (long long)after);
+	}
+	fputs(A.sim.n_faults ? "\n  ],\n" : "],\n", f);
+}
+
+static void print_summary(const struct px_loop_status *st,
+			  const struct px_stats_snapshot *lat,
+			  const struct px_stats_snapshot *cmp, double wall_s)
+{
+	int k;
+	printf("proxima-run: %s (%s clock)\n", A.o.config,
+	       A.o.virtual_time ? "virtual" : "monotonic");
+	printf("  cycles            %llu in %.3f s simulated, %.3f s wall "
+	       "(%.0f cycles/s)\n",
+	       (unsigned long long)st->cycles,
+	       (double)st->cycles * (double)st->period_ns * 1e-9, wall_s,
+	       wall_s > 0 ? (double)st->cycles / wall_s : 0.0);
+	printf("  overruns          %llu (missed periods %llu)%s\n",
+	       (unsigned long long)st->overruns,
+	       (unsigned long long)st->missed_periods,
+	       A.o.virtual_time ? ""
+	       : st->realtime   ? " on SCHED_FIFO"
+				: " (not real-time scheduled)");
+	printf("  wake-up latency   p50 %.1f us, p99 %.1f us, p99.9 %.1f us, "
+	       "max %.1f us\n",
+	       lat->p50_ns / 1e3, lat->p99_ns / 1e3, lat->p999_ns / 1e3,
+	       lat->max_ns / 1e3);
+	printf("  compute           p50 %.1f us, p99 %.1f us, p99.9 %.1f us, "
+	       "max %.1f us\n",
+	       cmp->p50_ns / 1e3, cmp->p99_ns / 1e3, cmp->p999_ns / 1e3,
+	       cmp->max_ns / 1e3);
+	if (A.rendering)
+		printf("  force             max %.3f N (clamp %.3f N), contact "
+		       "in %.1f %% of cycles\n",
+		       A.max_force_n, A.ctl.haptic.max_force_n,
+		       st->cycles ? 100.0 * (double)A.contact_cycles /
+					    (double)st->cycles
+				  : 0.0);
+	if (A.avoiding)
+		printf("  avoidance         min clearance %.1f mm (protective %.1f "
+		       "mm, influence %.1f mm), speed scale min %.2f, nominal "
+		       "motion stopped in %llu cycles\n",
+		       json_num(A.min_clearance_m) * 1e3,
+		       A.ctl.avoid.protective_distance_m * 1e3,
+		       A.ctl.avoid.influence_distance_m * 1e3, A.min_scale,
+		       (unsigned long long)A.stop_cycles);
+	else
+	printf("  distance          min %+.3f mm, max penetration %.3f mm, "
+	       "proxy min clearance %+.3f mm\n",
+	       json_num(A.min_distance_m) * 1e3, A.max_penetration_m * 1e3,
+	       json_num(A.min_proxy_distance_m) * 1e3);
+	printf("  safe state        %llu trip%s",
+	       (unsigned long long)st->safe_entries,
+	       st->safe_entries == 1 ? "" : "s");
+	for (k = 1; k < PX_FAULT__COUNT; k++)
+		if (A.faults_by_cause[k])
+			printf(", %s %llu", px_fault_cause_name(k),
+			       (unsigned long long)A.faults_by_cause[k]);
+	if (A.velocity_trips)
+		printf(", velocity limit %llu", (unsigned long long)A.velocity_trips);
+	if (A.query_errors)
+		printf(", query errors %llu (last: %s)",
+		       (unsigned long long)A.query_errors,
+		       px_strerror(A.last_query_err));
+	printf("\n  allocations       %llu after setup (loop thread; setup made "
+	       "%llu)\n",
+	       (unsigned long long)atomic_load(&A.allocs),
+	       (unsigned long long)A.setup_heap_calls);
+	printf("  telemetry         %llu records (every %lld cycles), %llu "
+	       "dropped\n",
+	       (unsigned long long)A.n_rows, (long long)A.decimation,
+	       (unsigned long long)px_ring_dropped(A.ring));
+	print_campaign();
+}
+
 int main(int argc, char **argv)
 {
 	static struct px_config_diag diag;
-	struct options o;
-	struct px_config *cfg = NULL;
-	int rc = parse_args(argc, argv, &o);
+	const char *counter = heap_counter_setup();
+	struct px_loop_status st;
+	struct px_stats_snapshot lat, cmp;
+	char time_svg[1100], lat_svg[1100];
+	int64_t wall0;
+	double wall_s;
+	int rc = parse_args(argc, argv, &A.o);
 	if (rc)
 		return rc == 1 ? 0 : rc;
-	rc = px_config_load_file(o.config, &cfg, &diag);
+	rc = px_config_load_file(A.o.config, &A.cfg, &diag);
+	if (rc != PX_OK)
+		return report_config(rc, &diag);
+	rc = px_control_config_read(A.cfg, &A.ctl, &diag);
 	if (rc != PX_OK) {
-		int n = px_config_diag_total(&diag);
-		px_config_diag_print(&diag, stderr);
-		if (n == 0)
-			fprintf(stderr, "%s: %s\n", o.config, px_strerror(rc));
-		fprintf(stderr, "%s: invalid configuration (%d error%s)\n",
-			o.config, n, n == 1 ? "" : "s");
+		report_config(rc, &diag);
+		px_config_free(A.cfg);
 		return 1;
 	}
-	{
-		static struct px_control_config ctl;
-		rc = px_control_config_read(cfg, &ctl, &diag);
-		if (rc != PX_OK) {
-			int n = px_config_diag_total(&diag);
-			px_config_diag_print(&diag, stderr);
-			if (n == 0)
-				fprintf(stderr, "%s: %s\n", o.config,
-					px_strerror(rc));
-			fprintf(stderr, "%s: invalid configuration (%d error%s)\n",
-				o.config, n, n == 1 ? "" : "s");
-			px_config_free(cfg);
-			return 1;
-		}
-		if (ctl.warning[0])
-			fprintf(stderr, "%s\n", ctl.warning);
+	A.sim.cfg_ = A.cfg;
+	rc = px_config_read(A.cfg->doc, A.cfg->sim, "sim", &sim_schema, &A.sim,
+			    &diag);
+	if (rc != PX_OK) {
+		report_config(rc, &diag);
+		px_config_free(A.cfg);
+		return 1;
 	}
-	if (o.check) {
-		printf("%s: OK (%zu device%s, loop period %lld ns)\n", o.config,
-		       cfg->n_devices, cfg->n_devices == 1 ? "" : "s",
-		       (long long)cfg->loop.period_ns);
-		px_config_free(cfg);
+	if (A.ctl.warning[0])
+		fprintf(stderr, "%s\n", A.ctl.warning);
+	if (A.o.check) {
+		printf("%s: OK (%zu device%s, loop period %lld ns)\n", A.o.config,
+		       A.cfg->n_devices, A.cfg->n_devices == 1 ? "" : "s",
+		       (long long)A.cfg->loop.period_ns);
+		px_config_free(A.cfg);
 		return 0;
 	}
-	px_config_free(cfg);
+	rc = setup();
+	if (rc) {
+		teardown();
+		return rc;
+	}
+	if (A.o.telemetry)
+		snprintf(A.csv_path, sizeof(A.csv_path), "%s", A.o.telemetry);
+	else if (A.cfg->telemetry.file && A.cfg->telemetry.file[0])
+		snprintf(A.csv_path, sizeof(A.csv_path), "%s",
+			 A.cfg->telemetry.file);
+	if (A.csv_path[0]) {
+		A.csv_f = fopen(A.csv_path, "w");
+		if (!A.csv_f) {
+			fprintf(stderr, "proxima-run: %s: %s\n", A.csv_path,
+				strerror(errno));
+			teardown();
+			return 1;
+		}
+		fprintf(A.csv_f,
+			"t_s,cycle,x_m,y_m,z_m,proxy_x_m,proxy_y_m,proxy_z_m,"
+			"fx_n,fy_n,fz_n,force_n,distance_m,penetration_m,"
+			"contact,safe,wakeup_latency_ns,compute_ns,queries\n");
+	}
+	A.alloc_probe = getenv("PX_RUN_ALLOC_PROBE") &&
+			strcmp(getenv("PX_RUN_ALLOC_PROBE"), "1") == 0;
+	A.setup_heap_calls = heap_count();
+	signal(SIGINT, on_signal);
+	signal(SIGTERM, on_signal);
 	fprintf(stderr,
-		"proxima-run: %s is valid, but the runner (loop, devices, "
-		"scene, control) is not built yet in this version; only "
-		"--check works\n",
-		o.config);
-	return 2;
+		"proxima-run: %s: %zu scene model%s, %d device%s, %s, %s clock, "
+		"%s\n",
+		A.o.config, px_world_count(A.scene),
+		px_world_count(A.scene) == 1 ? "" : "s",
+		A.n_dev + (A.canbus ? 1 : 0),
+		A.n_dev + (A.canbus ? 1 : 0) == 1 ? "" : "s",
+		A.rendering ? (A.ctl.haptic.renderer == PX_CONTROL_PROXY
+				       ? "haptic proxy rendering"
+				       : "haptic penalty rendering")
+		: A.avoiding ? "collision avoidance over CANopen"
+			     : "no control output",
+		A.o.virtual_time ? "virtual" : "real-time",
+		A.max_cycles ? "fixed duration" : "until Ctrl-C");
+	wall0 = mono_ns();
+	rc = run();
+	wall_s = (double)(mono_ns() - wall0) * 1e-9;
+	drain();
+	{
+		struct px_loop_status s0;
+		px_loop_status(A.loop, &s0);
+		status_line(1, wall_s,
+			    wall_s > 0 ? (double)s0.cycles / wall_s : 0.0);
+	}
+	if (A.csv_f && fclose(A.csv_f) != 0)
+		fprintf(stderr, "proxima-run: %s: %s\n", A.csv_path, strerror(errno));
+	A.csv_f = NULL;
+	px_loop_status(A.loop, &st);
+	px_loop_stats(A.loop, PX_LOOP_STAT_LATENCY, &lat);
+	px_stats_read(A.compute, &cmp);
+	print_summary(&st, &lat, &cmp, wall_s);
+	plot_paths(time_svg, lat_svg, sizeof(time_svg));
+	if (A.csv_path[0])
+		printf("  csv               %s\n", A.csv_path);
+	if (write_plots(time_svg, lat_svg) == 0)
+		printf("  plots             %s\n                    %s\n", time_svg,
+		       lat_svg);
+	else
+		fprintf(stderr, "proxima-run: cannot write the plots (%s): %s\n",
+			time_svg, strerror(errno));
+	if (A.o.summary_json) {
+		if (write_json(A.o.summary_json, &st, &lat, &cmp, wall_s, time_svg,
+			       lat_svg, counter) == 0)
+			printf("  summary           %s\n", A.o.summary_json);
+		else
+			fprintf(stderr, "proxima-run: %s: %s\n", A.o.summary_json,
+				strerror(errno));
+	}
+	if (rc < 0)
+		fprintf(stderr, "proxima-run: the loop stopped: %s\n",
+			px_strerror(rc));
+	teardown();
+	return rc < 0 ? 1 : 0;
 }

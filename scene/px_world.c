@@ -1,0 +1,215 @@
+/*
+ * Scene: posed models, nearest surface with a box broad phase, and the
+ * adapter to the control module's query interface.
+ */
+#include "px_world.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "px_control.h"
+
+struct px_world_entry {
+	struct px_model *m;
+	px_aabb local;   /* model-frame box, cached at add */
+	int bounded;     /* every bound finite */
+	int is_signed;   /* PX_MODEL_CAP_SIGNED */
+	char name[PX_WORLD_NAME_LEN];
+};
+
+struct px_world {
+	size_t cap, n;
+	struct px_world_entry e[];
+};
+
+int px_world_create(size_t capacity, struct px_world **out)
+{
+	struct px_world *s;
+	if (out)
+		*out = NULL;
+	if (!out || capacity == 0 || capacity > PX_WORLD_MAX_MODELS)
+		return PX_E_INVAL;
+	s = calloc(1, sizeof(*s) + capacity * sizeof(s->e[0]));
+	if (!s)
+		return PX_E_NOMEM;
+	s->cap = capacity;
+	*out = s;
+	return PX_OK;
+}
+
+void px_world_free(struct px_world *s)
+{
+	size_t i;
+	if (!s)
+		return;
+	for (i = 0; i < s->n; i++)
+		px_model_free(s->e[i].m);
+	free(s);
+}
+
+int px_world_add(struct px_world *s, struct px_model *m, const char *name)
+{
+	struct px_world_entry *e;
+	if (!s || !m) {
+		px_model_free(m);
+		return PX_E_INVAL;
+	}
+	if (s->n >= s->cap) {
+		px_model_free(m);
+		return PX_E_NOSPC;
+	}
+	e = &s->e[s->n];
+	memset(e, 0, sizeof(*e));
+	e->m = m;
+	e->local = px_model_local_aabb(m);
+	e->bounded = !px_aabb_is_empty(&e->local) &&
+		     px_v3_isfinite(e->local.min) && px_v3_isfinite(e->local.max);
+	e->is_signed = (px_model_caps(m) & PX_MODEL_CAP_SIGNED) != 0;
+	if (name)
+		snprintf(e->name, sizeof(e->name), "%s", name);
+	return (int)s->n++;
+}
+
+size_t px_world_count(const struct px_world *s)
+{
+	return s ? s->n : 0;
+}
+
+struct px_model *px_world_model(const struct px_world *s, size_t i)
+{
+	return s && i < s->n ? s->e[i].m : NULL;
+}
+
+const char *px_world_name(const struct px_world *s, size_t i)
+{
+	return s && i < s->n ? s->e[i].name : "";
+}
+
+int px_world_set_pose(struct px_world *s, size_t i, px_pose pose)
+{
+	if (!s || i >= s->n)
+		return PX_E_INVAL;
+	return px_model_set_pose(s->e[i].m, pose);
+}
+
+/* Lower bound of model e's signed distance to p. The box distance is
+ * shrunk by a relative 1e-9 so that rounding in the box transform never
+ * makes it exceed the true distance. */
+static double lower_bound(const struct px_world_entry *e, px_vec3 p)
+{
+	px_obb b;
+	double d;
+	if (!e->bounded)
+		return e->is_signed ? -INFINITY : 0.0;
+	b = px_obb_from_aabb(&e->local, px_model_pose(e->m));
+	d = sqrt(px_obb_dist2(&b, p));
+	if (!(d > 0))
+		return e->is_signed ? -INFINITY : 0.0;
+	return d * (1 - 1e-9) - 1e-12;
+}
+
+/* The distance the scene reports for a model's answer: never farther
+ * from the surface than the truth (uncertified answers lose their gap). */
+static double reported(const struct px_model_result *r)
+{
+	double d = r->distance;
+	if (!r->certified && r->gap > 0)
+		d = d >= 0 ? fmax(d - r->gap, 0.0) : fmin(d + r->gap, 0.0);
+	return d;
+}
+
+int px_world_nearest(const struct px_world *s, px_vec3 p,
+		     double max_distance_m, struct px_world_hit *out)
+{
+	double lb[PX_WORLD_MAX_MODELS];
+	unsigned char done[PX_WORLD_MAX_MODELS];
+	double best = INFINITY;
+	size_t i, n;
+	int queried = 0;
+	if (!out)
+		return PX_E_INVAL;
+	memset(out, 0, sizeof(*out));
+	out->model = -1;
+	out->distance_m = INFINITY;
+	out->r.distance = INFINITY;
+	out->r.index = -1;
+	if (!s || !(max_distance_m >= 0))
+		return PX_E_INVAL;
+	if (!px_v3_isfinite(p))
+		return PX_E_NAN;
+	n = s->n;
+	for (i = 0; i < n; i++) {
+		lb[i] = lower_bound(&s->e[i], p);
+		done[i] = lb[i] > max_distance_m;
+	}
+	/* Best-first over the bounds; at most n rounds of n. */
+	for (;;) {
+		size_t k = n;
+		double lo = INFINITY, range;
+		struct px_model_result r;
+		int rc;
+		for (i = 0; i < n; i++)
+			if (!done[i] && (k == n || lb[i] < lo)) {
+				k = i;
+				lo = lb[i];
+			}
+		if (k == n || lo >= best)
+			break;
+		done[k] = 1;
+		/* |d| may be bounded by the best so far only when d cannot be
+		 * negative here (unsigned model or point outside its box). */
+		range = max_distance_m;
+		if ((!s->e[k].is_signed || lo > 0) && best >= 0 && best < range)
+			range = best;
+		rc = px_model_query_ex(s->e[k].m, p, range, -1, 0, &r);
+		queried++;
+		if (rc < 0) {
+			out->models_queried = queried;
+			return rc;
+		}
+		if (rc == 1) {
+			double d = reported(&r);
+			if (d < best && fabs(d) <= max_distance_m) {
+				best = d;
+				out->model = (int)k;
+				out->r = r;
+				out->distance_m = d;
+			}
+		}
+	}
+	out->models_queried = queried;
+	return out->model >= 0 ? 1 : 0;
+}
+
+static int scene_point(void *ctx, px_vec3 p_m, double max_distance_m,
+		       struct px_control_hit *out)
+{
+	struct px_world_hit h;
+	int rc = px_world_nearest(ctx, p_m, max_distance_m, &h);
+	memset(out, 0, sizeof(*out));
+	if (rc < 0)
+		return rc;
+	out->valid = rc == 1;
+	if (!out->valid) {
+		out->distance_m = INFINITY;
+		return PX_OK;
+	}
+	out->two_sided = !h.r.is_signed;
+	out->distance_m = h.distance_m;
+	out->point_m = h.r.point;
+	out->normal = h.r.direction;
+	return PX_OK;
+}
+
+int px_world_control_query(const struct px_world *s, struct px_control_query *q)
+{
+	if (!s || !q)
+		return PX_E_INVAL;
+	memset(q, 0, sizeof(*q));
+	q->point = scene_point;
+	q->segment = NULL;
+	q->ctx = (void *)s;
+	return PX_OK;
+}

@@ -1,0 +1,141 @@
+/*
+ * px_world.h - the world an application's loop lives in: the `scene`
+ * section of a proxima config turned into a fixed list of named, posed
+ * models (primitives, meshes, point clouds, NURBS), the nearest surface
+ * to a point with a broad phase, and that answer as the control module's
+ * query interface. (geom/px_scene.h is the general scene with a
+ * hierarchy, within-distance and tool queries; this module is the
+ * runner's view of a config. Building it on px_scene is planned.)
+ *
+ * Nearest query. The answer is the smallest signed distance over the
+ * models (closed models: negative inside; open ones, e.g. NURBS
+ * surfaces and open meshes, unsigned). For a union of solids this is the
+ * exact distance outside every solid and never more than the true
+ * penetration depth inside (any point of the union's boundary is outside
+ * every solid). Broad phase: each model's world oriented box (its local
+ * bounding box under the current pose) gives a lower bound of its
+ * distance; models are visited in increasing bound and the search stops
+ * at the first bound not below the best distance found, so far models
+ * cost one box test each. A point inside a model's box has bound
+ * -infinity for closed models (it may be inside) and 0 for open ones.
+ *
+ * As the control module's query (px_world_control_query): the hit is
+ * the nearest answer with two_sided = the model is unsigned. Answers a
+ * model does not certify (a bound cut its search short) report distance
+ * - gap, so the reported |distance| never exceeds the true one, as
+ * px_control.h requires. Unsigned models (NURBS surfaces, open meshes,
+ * clouds) are thin shells to the haptic proxy: it never crosses them,
+ * whichever side it started on, because every proxy step is shorter
+ * than the distance at its start.
+ *
+ * Memory and real-time rules: px_world_create() takes one allocation of
+ * the fixed capacity; px_world_add() takes ownership of a model. Adding,
+ * loading and freeing are setup-time. px_world_nearest(), the control
+ * adapter's callback and px_world_set_pose() are RT-safe (no allocation,
+ * no locks, bounded by the capacity and the models' own bounds). Queries
+ * only read the scene; poses must not change while another thread
+ * queries.
+ */
+#ifndef PX_WORLD_H
+#define PX_WORLD_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "px_base.h"
+#include "px_math.h"
+#include "px_model.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define PX_WORLD_MAX_MODELS 256 /* largest capacity */
+#define PX_WORLD_NAME_LEN 32
+
+struct px_world;
+struct px_control_query;
+
+/*
+ * An empty scene for up to capacity (1 .. PX_WORLD_MAX_MODELS) models.
+ * Setup only. Returns PX_OK, PX_E_INVAL, PX_E_NOMEM. Free with
+ * px_world_free().
+ */
+PX_API int px_world_create(size_t capacity, struct px_world **out);
+
+/* Free the scene and every model it owns. NULL is a no-op. */
+PX_API void px_world_free(struct px_world *s);
+
+/*
+ * Add model m (its pose as set) under name (may be NULL; copied, up to
+ * 31 bytes). The scene owns m from now on, also on failure (then m is
+ * freed). Setup only. Returns the model's index, PX_E_INVAL or
+ * PX_E_NOSPC (capacity reached).
+ */
+PX_API int px_world_add(struct px_world *s, struct px_model *m,
+			const char *name);
+
+/* Number of models, model i (NULL for a bad index), its name ("" for a
+ * bad index). @note RT-safe. */
+PX_API size_t px_world_count(const struct px_world *s);
+PX_API struct px_model *px_world_model(const struct px_world *s, size_t i);
+PX_API const char *px_world_name(const struct px_world *s, size_t i);
+
+/* Set the pose of model i. Returns px_model_set_pose()'s codes or
+ * PX_E_INVAL for a bad index. @note RT-safe. */
+PX_API int px_world_set_pose(struct px_world *s, size_t i, px_pose pose);
+
+/* Nearest answer. */
+struct px_world_hit {
+	int model;                   /* index, -1 when nothing in range */
+	struct px_model_result r;    /* that model's answer, world frame */
+	/* r.distance, lowered by r.gap when not certified (see above) */
+	double distance_m;
+	int models_queried;          /* narrow-phase queries made */
+};
+
+/*
+ * Nearest surface to the world point p within max_distance_m (>= 0,
+ * INFINITY for none). Returns 1 with *out filled, 0 when nothing lies
+ * within range (out->model = -1, distance INFINITY), PX_E_INVAL (NULL,
+ * bad range), PX_E_NAN (p not finite) or a model's error.
+ * @note RT-safe.
+ */
+PX_API int px_world_nearest(const struct px_world *s, px_vec3 p,
+			    double max_distance_m, struct px_world_hit *out);
+
+/*
+ * Fill q so that the control module queries scene s (point callback;
+ * segment left NULL: the control module's certified bisection over
+ * point queries is used). s must outlive q's use. The callback is
+ * RT-safe. Returns PX_OK or PX_E_INVAL.
+ */
+PX_API int px_world_control_query(const struct px_world *s,
+				  struct px_control_query *q);
+
+/* ---- configuration (setup time) --------------------------------- */
+
+struct px_config;
+struct px_config_diag;
+struct px_config_schema;
+
+/*
+ * Build the scene described by cfg->scene (absent: an empty scene with
+ * capacity 1). Model files are read relative to the directory of the
+ * config file (absolute paths as given). Problems (keys, values, files
+ * that cannot be read, geometry errors) are appended to diag as
+ * "file:line:column: scene.key: what", and *out is then NULL.
+ * Returns PX_OK, PX_E_PARSE (problems found), PX_E_NOMEM, PX_E_INVAL.
+ */
+PX_API int px_world_config_load(const struct px_config *cfg,
+				struct px_world **out,
+				struct px_config_diag *diag);
+
+/* Schema of the scene section (for tools and the docs check). */
+PX_API const struct px_config_schema *px_world_config_schema(void);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

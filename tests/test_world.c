@@ -1,0 +1,533 @@
+/* Scene: nearest surface against brute force over every model, the
+ * broad phase, the control adapter's no-overestimate contract, scale,
+ * config loading and its errors, no allocation in queries. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "px_alloc_count.h"
+#include "px_config.h"
+#include "px_control.h"
+#include "px_model.h"
+#include "px_prim.h"
+#include "px_world.h"
+#include "px_test.h"
+
+static px_pose random_pose(double spread)
+{
+	px_pose p;
+	px_vec3 axis = px_v3(px_rand_normal(), px_rand_normal(), px_rand_normal());
+	if (px_v3_norm(axis) < 1e-6)
+		axis = px_v3(0, 0, 1);
+	px_quat_from_axis_angle(axis, px_rand_range(-3.14, 3.14), &p.q);
+	p.t = px_v3(px_rand_range(-spread, spread), px_rand_range(-spread, spread),
+		    px_rand_range(-spread, spread));
+	return p;
+}
+
+static struct px_world *random_scene(int n)
+{
+	struct px_world *s;
+	int i;
+	PX_CHECK_INT_EQ(px_world_create((size_t)n, &s), PX_OK);
+	for (i = 0; i < n; i++) {
+		struct px_prim pr;
+		struct px_model *m;
+		memset(&pr, 0, sizeof(pr));
+		switch (px_rand_int(0, 3)) {
+		case 0:
+			pr.type = PX_PRIM_SPHERE;
+			pr.a = px_rand_range(0.05, 0.5);
+			break;
+		case 1:
+			pr.type = PX_PRIM_BOX;
+			pr.a = px_rand_range(0.05, 0.5);
+			pr.b = px_rand_range(0.05, 0.5);
+			pr.c = px_rand_range(0.05, 0.5);
+			break;
+		case 2:
+			pr.type = PX_PRIM_CAPSULE;
+			pr.a = px_rand_range(0.05, 0.3);
+			pr.b = px_rand_range(0.05, 0.5);
+			break;
+		default:
+			pr.type = PX_PRIM_TORUS;
+			pr.a = px_rand_range(0.2, 0.5);
+			pr.b = px_rand_range(0.02, 0.15);
+			break;
+		}
+		PX_CHECK_INT_EQ(px_prim_model(&pr, &m), PX_OK);
+		PX_CHECK_INT_EQ(px_model_set_pose(m, random_pose(3.0)), PX_OK);
+		PX_CHECK_INT_EQ(px_world_add(s, m, NULL), i);
+	}
+	return s;
+}
+
+/* min over models of the signed distance, no broad phase */
+static double brute(const struct px_world *s, px_vec3 p, int *which)
+{
+	double best = INFINITY;
+	size_t i;
+	*which = -1;
+	for (i = 0; i < px_world_count(s); i++) {
+		struct px_model_result r;
+		PX_CHECK_INT_EQ(px_model_query(px_world_model(s, i), p, &r), 1);
+		if (r.distance < best) {
+			best = r.distance;
+			*which = (int)i;
+		}
+	}
+	return best;
+}
+
+static void test_nearest_matches_brute_force(void)
+{
+	int round;
+	long queried = 0, points = 0;
+	for (round = 0; round < 10; round++) {
+		int n = px_rand_int(1, 40), k;
+		struct px_world *s = random_scene(n);
+		for (k = 0; k < 200; k++) {
+			px_vec3 p = px_v3(px_rand_range(-4, 4), px_rand_range(-4, 4),
+					  px_rand_range(-4, 4));
+			struct px_world_hit h;
+			int which;
+			double d = brute(s, p, &which);
+			PX_CHECK_INT_EQ(px_world_nearest(s, p, INFINITY, &h), 1);
+			PX_CHECK_NEAR(h.distance_m, d, 1e-12);
+			PX_CHECK(h.model >= 0 && h.model < n);
+			PX_CHECK_NEAR(h.r.distance, d, 1e-12);
+			/* the answer's point lies on the model it names */
+			{
+				struct px_model_result r;
+				px_model_query(px_world_model(s, (size_t)h.model),
+					       h.r.point, &r);
+				PX_CHECK_NEAR(r.distance, 0, 1e-9);
+			}
+			queried += h.models_queried;
+			points++;
+			/* range: nothing reported beyond it */
+			{
+				double range = fabs(d) * px_rand_range(0.2, 1.8);
+				int rc = px_world_nearest(s, p, range, &h);
+				if (fabs(d) < range * (1 - 1e-9)) {
+					PX_CHECK_INT_EQ(rc, 1);
+					PX_CHECK_NEAR(h.distance_m, d, 1e-12);
+				} else if (fabs(d) > range * (1 + 1e-9)) {
+					PX_CHECK_INT_EQ(rc, 0);
+					PX_CHECK_INT_EQ(h.model, -1);
+				}
+			}
+		}
+		px_world_free(s);
+	}
+	printf("  broad phase: %.2f narrow-phase queries per point\n",
+	       (double)queried / (double)points);
+}
+
+static void test_broad_phase_skips_far_models(void)
+{
+	/* 50 unit spheres on a line, 10 m apart: a point near one of them
+	 * needs that one and at most its box neighbours. */
+	struct px_world *s;
+	struct px_world_hit h;
+	int i;
+	PX_CHECK_INT_EQ(px_world_create(50, &s), PX_OK);
+	for (i = 0; i < 50; i++) {
+		struct px_prim pr = {PX_PRIM_SPHERE, 1.0, 0, 0};
+		struct px_model *m;
+		px_pose pose = px_pose_identity();
+		pose.t = px_v3(10.0 * i, 0, 0);
+		PX_CHECK_INT_EQ(px_prim_model(&pr, &m), PX_OK);
+		px_model_set_pose(m, pose);
+		PX_CHECK(px_world_add(s, m, "ball") >= 0);
+	}
+	PX_CHECK_INT_EQ(px_world_nearest(s, px_v3(201.5, 0.2, 0), INFINITY, &h), 1);
+	PX_CHECK_INT_EQ(h.model, 20);
+	PX_CHECK(h.models_queried <= 2);
+	PX_CHECK_INT_EQ(px_world_nearest(s, px_v3(200, 0, 0), INFINITY, &h), 1);
+	PX_CHECK_NEAR(h.distance_m, -1.0, 1e-12);
+	PX_CHECK(h.r.inside);
+	PX_CHECK_INT_EQ(px_world_nearest(s, px_v3(NAN, 0, 0), 1, &h), PX_E_NAN);
+	PX_CHECK_INT_EQ(px_world_nearest(s, px_v3(0, 0, 0), -1, &h), PX_E_INVAL);
+	/* capacity */
+	{
+		struct px_prim pr = {PX_PRIM_SPHERE, 1.0, 0, 0};
+		struct px_model *m;
+		PX_CHECK_INT_EQ(px_prim_model(&pr, &m), PX_OK);
+		PX_CHECK_INT_EQ(px_world_add(s, m, "extra"), PX_E_NOSPC);
+	}
+	PX_CHECK(strcmp(px_world_name(s, 3), "ball") == 0);
+	PX_CHECK(strcmp(px_world_name(s, 99), "") == 0);
+	px_world_free(s);
+	px_world_free(NULL);
+}
+
+/* A model that answers like a unit sphere but claims a gap. */
+static int loose_closest(const void *impl, const struct px_model_query *q,
+			 struct px_model_result *r)
+{
+	struct px_prim pr = {PX_PRIM_SPHERE, 1.0, 0, 0};
+	(void)impl;
+	px_prim_closest(&pr, q->p, 1, r);
+	r->is_signed = 0;
+	r->inside = 0;
+	r->certified = 0;
+	r->gap = 0.25;
+	return 1;
+}
+
+static px_aabb loose_aabb(const void *impl)
+{
+	px_aabb b = {{-1, -1, -1}, {1, 1, 1}};
+	(void)impl;
+	return b;
+}
+
+static const struct px_model_ops loose_ops = {"loose", PX_MODEL_CUSTOM,
+					      loose_closest, loose_aabb, NULL,
+					      NULL};
+
+static void test_control_adapter_never_overestimates(void)
+{
+	struct px_world *s = random_scene(12);
+	struct px_control_query q;
+	struct px_model *m;
+	struct px_control_hit hit;
+	int k;
+	uint64_t a;
+	PX_CHECK_INT_EQ(px_world_control_query(s, &q), PX_OK);
+	a = px_alloc_region_begin();
+	for (k = 0; k < 500; k++) {
+		px_vec3 p = px_v3(px_rand_range(-4, 4), px_rand_range(-4, 4),
+				  px_rand_range(-4, 4));
+		int which;
+		double d = brute(s, p, &which);
+		PX_CHECK_INT_EQ(q.point(q.ctx, p, 10.0, &hit), PX_OK);
+		PX_CHECK(hit.valid == (fabs(d) <= 10.0));
+		if (!hit.valid)
+			continue;
+		PX_CHECK(fabs(hit.distance_m) <= fabs(d) + 1e-12);
+		PX_CHECK(!hit.two_sided);
+		PX_CHECK_NEAR(px_v3_norm(hit.normal), 1, 1e-9);
+		/* query = point + distance * normal for exact answers */
+		PX_CHECK_NEAR(px_v3_dist(px_v3_madd(hit.point_m, hit.normal,
+						    hit.distance_m),
+					 p),
+			      0, 1e-9);
+	}
+	PX_CHECK_INT_EQ(px_alloc_region_end(a), 0);
+	px_world_free(s);
+
+	/* an uncertified answer reports distance - gap, two-sided */
+	PX_CHECK_INT_EQ(px_world_create(1, &s), PX_OK);
+	PX_CHECK_INT_EQ(px_model_create(&loose_ops, NULL, 0, &m), PX_OK);
+	PX_CHECK_INT_EQ(px_world_add(s, m, "loose"), 0);
+	px_world_control_query(s, &q);
+	PX_CHECK_INT_EQ(q.point(q.ctx, px_v3(3, 0, 0), 10.0, &hit), PX_OK);
+	PX_CHECK(hit.valid && hit.two_sided);
+	PX_CHECK_NEAR(hit.distance_m, 2.0 - 0.25, 1e-12);
+	PX_CHECK_INT_EQ(q.point(q.ctx, px_v3(1.1, 0, 0), 10.0, &hit), PX_OK);
+	PX_CHECK_NEAR(hit.distance_m, 0.0, 0);
+	px_world_free(s);
+}
+
+static const char *write_tmp(const char *name, const char *text)
+{
+	static char path[4][256];
+	static int k;
+	FILE *f;
+	char *p = path[k++ % 4];
+	snprintf(p, 256, "build/tmp_scene_%d_%s", (int)px_test_seed() % 1000, name);
+	f = fopen(p, "w");
+	PX_CHECK(f != NULL);
+	if (f) {
+		fputs(text, f);
+		fclose(f);
+	}
+	return p;
+}
+
+static int load(const char *text, struct px_world **s,
+		struct px_config_diag *diag)
+{
+	struct px_config *cfg = NULL;
+	int rc = px_config_load_mem("scene.yaml", text, strlen(text), &cfg, diag);
+	if (rc != PX_OK)
+		return rc;
+	rc = px_world_config_load(cfg, s, diag);
+	px_config_free(cfg);
+	return rc;
+}
+
+static void test_config_example_scene(void)
+{
+	static struct px_config_diag diag;
+	struct px_config *cfg;
+	struct px_world *s;
+	struct px_world_hit h;
+	struct px_control_query q;
+	struct px_control_hit hit;
+	uint64_t a;
+	int k;
+	if (px_config_load_file("config/examples/haptic_sim.yaml", &cfg, &diag) !=
+	    PX_OK)
+		PX_SKIP("config/examples/haptic_sim.yaml not found");
+	PX_CHECK_INT_EQ(px_world_config_load(cfg, &s, &diag), PX_OK);
+	px_config_diag_print(&diag, stdout);
+	px_config_free(cfg);
+	PX_CHECK_INT_EQ(px_world_count(s), 3);
+	PX_CHECK_INT_EQ(px_model_kind(px_world_model(s, 0)), PX_MODEL_NURBS);
+	PX_CHECK_INT_EQ(px_model_kind(px_world_model(s, 1)), PX_MODEL_MESH);
+	PX_CHECK_INT_EQ(px_model_kind(px_world_model(s, 2)), PX_MODEL_PRIMITIVE);
+	PX_CHECK(strcmp(px_world_name(s, 1), "knob") == 0);
+	/* above the terrain's middle, far from the rest: NURBS, unsigned */
+	PX_CHECK_INT_EQ(px_world_nearest(s, px_v3(-0.08, -0.08, 0.0), 1.0, &h), 1);
+	PX_CHECK_INT_EQ(h.model, 0);
+	PX_CHECK(!h.r.is_signed && h.distance_m > 0);
+	/* centre of the knob (scaled 1.2: radius 0.024, inscribed >= 0.023) */
+	PX_CHECK_INT_EQ(px_world_nearest(s, px_v3(-0.035, 0, 0), 1.0, &h), 1);
+	PX_CHECK_INT_EQ(h.model, 1);
+	PX_CHECK(h.distance_m < -0.022 && h.distance_m > -0.0241);
+	px_world_control_query(s, &q);
+	a = px_alloc_region_begin();
+	for (k = 0; k < 300; k++) {
+		px_vec3 p = px_v3(px_rand_range(-0.1, 0.1), px_rand_range(-0.1, 0.1),
+				  px_rand_range(-0.02, 0.1));
+		size_t i;
+		double best = INFINITY;
+		PX_CHECK_INT_EQ(q.point(q.ctx, p, 1.0, &hit), PX_OK);
+		PX_CHECK(hit.valid);
+		for (i = 0; i < px_world_count(s); i++) {
+			struct px_model_result r;
+			px_model_query(px_world_model(s, i), p, &r);
+			if (r.distance < best)
+				best = r.distance;
+		}
+		PX_CHECK(fabs(hit.distance_m) <= fabs(best) + 1e-12);
+		PX_CHECK_NEAR(hit.distance_m, best, 1e-9);
+	}
+	PX_CHECK_INT_EQ(px_alloc_region_end(a), 0);
+	px_world_free(s);
+}
+
+static void test_config_scale(void)
+{
+	static struct px_config_diag diag;
+	struct px_world *s;
+	char text[2048];
+	const char *stl = "solid t\n facet normal 0 0 1\n  outer loop\n"
+			  "   vertex 0 0 0\n   vertex 1 0 0\n   vertex 0 1 0\n"
+			  "  endloop\n endfacet\nendsolid t\n";
+	const char *path = write_tmp("tri.stl", stl);
+	int k;
+	/* relative file names are relative to the config: use absolute */
+	{
+		char abs_path[512], cwd[400];
+		PX_CHECK(getcwd(cwd, sizeof(cwd)) != NULL);
+		snprintf(abs_path, sizeof(abs_path), "%s/%s", cwd, path);
+		snprintf(text, sizeof(text),
+			 "scene:\n  models:\n"
+			 "    - {file: %s, kind: mesh}\n"
+			 "    - {file: %s, kind: mesh, scale: 2.5, pose: {xyz_m: "
+			 "[0, 0, 10]}}\n",
+			 abs_path, abs_path);
+	}
+	PX_CHECK_INT_EQ(load(text, &s, &diag), PX_OK);
+	px_config_diag_print(&diag, stdout);
+	PX_CHECK_INT_EQ(px_world_count(s), 2);
+	for (k = 0; k < 100; k++) {
+		px_vec3 p = px_v3(px_rand_range(-1, 1), px_rand_range(-1, 1),
+				  px_rand_range(-1, 1));
+		struct px_model_result r1, r2;
+		PX_CHECK_INT_EQ(px_model_query(px_world_model(s, 0), p, &r1), 1);
+		PX_CHECK_INT_EQ(px_model_query(px_world_model(s, 1),
+					       px_v3_add(px_v3_scale(p, 2.5),
+							 px_v3(0, 0, 10)),
+					       &r2),
+				1);
+		PX_CHECK_NEAR(r2.distance, 2.5 * r1.distance, 1e-6);
+		PX_CHECK_NEAR(px_v3_dist(r2.point,
+					 px_v3_add(px_v3_scale(r1.point, 2.5),
+						   px_v3(0, 0, 10))),
+			      0, 1e-6);
+	}
+	PX_CHECK_INT_EQ(px_model_kind(px_world_model(s, 1)), PX_MODEL_MESH);
+	px_world_free(s);
+	remove(path);
+}
+
+static int has(const struct px_config_diag *d, const char *msg)
+{
+	int i;
+	for (i = 0; i < d->count; i++)
+		if (strcmp(d->errors[i].msg, msg) == 0)
+			return 1;
+	for (i = 0; i < d->count; i++)
+		printf("  got: %s\n", d->errors[i].msg);
+	return 0;
+}
+
+static void test_config_errors(void)
+{
+	static struct px_config_diag diag;
+	struct px_world *s = (struct px_world *)&diag;
+	PX_CHECK_INT_EQ(load("scene:\n  models:\n    - {file: nope.stl, kind: mesh}\n",
+			     &s, &diag),
+			PX_E_PARSE);
+	PX_CHECK(s == NULL);
+	PX_CHECK_INT_EQ(diag.count, 1);
+	PX_CHECK(strncmp(diag.errors[0].msg,
+			 "scene.yaml:3:14: scene.models[0].file: nope.stl: ", 49) == 0);
+	PX_CHECK_INT_EQ(load("scene:\n  primitives:\n    - type: sphere\n"
+			     "      half_height_m: 1\n",
+			     &s, &diag),
+			PX_E_PARSE);
+	PX_CHECK(has(&diag, "scene.yaml:3:7: scene.primitives[0].radius_m: "
+			    "missing required key for type 'sphere'"));
+	PX_CHECK(has(&diag, "scene.yaml:4:22: scene.primitives[0].half_height_m: "
+			    "not used by type 'sphere'"));
+	PX_CHECK_INT_EQ(load("scene:\n  models:\n    - {file: a.obj, kind: nurb}\n",
+			     &s, &diag),
+			PX_E_PARSE);
+	PX_CHECK(has(&diag, "scene.yaml:3:27: scene.models[0].kind: unknown value "
+			    "'nurb' (expected one of: mesh, nurbs, cloud)"));
+	PX_CHECK_INT_EQ(load("scene:\n  models:\n    - {file: a.ply, kind: mesh, "
+			     "cloud_radius_m: 0.1}\n",
+			     &s, &diag),
+			PX_E_PARSE);
+	PX_CHECK(has(&diag, "scene.yaml:3:49: scene.models[0].cloud_radius_m: "
+			    "only for kind 'cloud' (kind is 'mesh')"));
+	PX_CHECK_INT_EQ(load("scene:\n  primitives:\n    - {type: torus, radius_m: "
+			     "0.1, tube_radius_m: 0.2}\n",
+			     &s, &diag),
+			PX_E_PARSE);
+	PX_CHECK(has(&diag, "scene.yaml:3:7: scene.primitives[0]: invalid torus "
+			    "dimensions: value out of range"));
+	PX_CHECK_INT_EQ(load("scene:\n  modles: []\n", &s, &diag), PX_E_PARSE);
+	PX_CHECK(diag.count == 1 && strstr(diag.errors[0].msg, "scene.modles: unknown key"));
+	/* an absent section is an empty scene */
+	PX_CHECK_INT_EQ(load("loop: {period_ns: 1000000}\n", &s, &diag), PX_OK);
+	PX_CHECK_INT_EQ(px_world_count(s), 0);
+	{
+		struct px_world_hit h;
+		PX_CHECK_INT_EQ(px_world_nearest(s, px_v3(0, 0, 0), INFINITY, &h), 0);
+	}
+	px_world_free(s);
+}
+
+/* Haptic proxy on a scene: pressed into the -x face of a box, then the
+ * device slides along y past the end of that face, into free space. The
+ * proxy must follow it out (no phantom wall left by the face's plane),
+ * never be inside the box, and the force must fall back to zero. */
+static void test_proxy_leaves_the_end_of_a_face(void)
+{
+	struct px_world *s;
+	struct px_model *m;
+	struct px_prim box = {PX_PRIM_BOX, 0.02, 0.02, 0.02};
+	struct px_control_query q;
+	struct px_control_haptic_params hp;
+	struct px_control_haptic h;
+	struct px_control_haptic_out out;
+	int k, inside = 0;
+	double max_pen = 0;
+	px_vec3 dev = px_v3(-0.05, 0, 0);
+	PX_CHECK_INT_EQ(px_world_create(1, &s), PX_OK);
+	PX_CHECK_INT_EQ(px_prim_model(&box, &m), PX_OK);
+	PX_CHECK_INT_EQ(px_world_add(s, m, "box"), 0);
+	px_world_control_query(s, &q);
+	px_control_haptic_params_default(&hp);
+	PX_CHECK_INT_EQ(px_control_haptic_init(&h, &hp, 1000000), PX_OK);
+	for (k = 0; k < 400; k++) {
+		struct px_world_hit sh;
+		if (k < 40)
+			dev.x += 0.001; /* into the face, 10 mm deep */
+		else if (k < 120)
+			dev.y += 0.001; /* along it, past its end at y = 0.02 */
+		PX_CHECK_INT_EQ(px_control_haptic_step(&h, &q, dev, NULL, &out),
+				PX_OK);
+		if (k == 60)
+			PX_CHECK(out.contact && out.penetration_m > 0.009);
+		if (out.penetration_m > max_pen)
+			max_pen = out.penetration_m;
+		PX_CHECK_INT_EQ(px_world_nearest(s, out.proxy_m, INFINITY, &sh), 1);
+		if (sh.distance_m < 0)
+			inside++;
+	}
+	PX_CHECK_INT_EQ(inside, 0);
+	PX_CHECK(max_pen > 0.009 && max_pen < 0.012);
+	PX_CHECK_MSG(!out.contact && out.penetration_m == 0,
+		     "proxy held %.4f m behind a face it has left (proxy %.4f "
+		     "%.4f %.4f, device %.4f %.4f %.4f)",
+		     out.penetration_m, out.proxy_m.x, out.proxy_m.y,
+		     out.proxy_m.z, dev.x, dev.y, dev.z);
+	PX_CHECK_NEAR(px_v3_dist(out.proxy_m, dev), 0, 1e-9);
+	PX_CHECK(px_v3_norm(out.force_n) < 0.05);
+	px_world_free(s);
+}
+
+static char *slurp(const char *path)
+{
+	FILE *f = fopen(path, "rb");
+	static char buf[1 << 17];
+	size_t n;
+	if (!f)
+		return NULL;
+	n = fread(buf, 1, sizeof(buf) - 1, f);
+	fclose(f);
+	buf[n] = '\0';
+	return buf;
+}
+
+static void check_doc_keys(const char *docs, const struct px_config_schema *sc,
+			   int depth)
+{
+	size_t i;
+	char needle[96];
+	PX_CHECK(depth < 8);
+	for (i = 0; i < sc->n_keys; i++) {
+		const struct px_config_key *k = &sc->keys[i];
+		snprintf(needle, sizeof(needle), "`%s`", k->name);
+		PX_CHECK_MSG(strstr(docs, needle) != NULL,
+			     "docs/config.md does not document %s.%s", sc->name,
+			     k->name);
+		if (k->names) {
+			int j;
+			for (j = 0; k->names[j]; j++) {
+				snprintf(needle, sizeof(needle), "`%s`", k->names[j]);
+				PX_CHECK_MSG(strstr(docs, needle) != NULL,
+					     "docs/config.md lacks value %s of %s.%s",
+					     k->names[j], sc->name, k->name);
+			}
+		}
+		if (k->sub)
+			check_doc_keys(docs, k->sub, depth + 1);
+	}
+}
+
+static void test_schema_documented(void)
+{
+	char why[200];
+	const char *docs = slurp("docs/config.md");
+	PX_CHECK_INT_EQ(px_config_schema_validate(px_world_config_schema(), why,
+						  sizeof(why)),
+			PX_OK);
+	if (!docs)
+		PX_SKIP("docs/config.md not found (run from the source tree)");
+	PX_CHECK(strstr(docs, "## scene") != NULL);
+	check_doc_keys(docs, px_world_config_schema(), 0);
+}
+
+static const struct px_test tests[] = {
+	PX_T(test_nearest_matches_brute_force),
+	PX_T(test_broad_phase_skips_far_models),
+	PX_T(test_control_adapter_never_overestimates),
+	PX_T(test_config_example_scene),
+	PX_T(test_config_scale),
+	PX_T(test_config_errors),
+	PX_T(test_proxy_leaves_the_end_of_a_face),
+	PX_T(test_schema_documented),
+};
+PX_TEST_MAIN(tests)
