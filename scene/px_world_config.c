@@ -247,7 +247,8 @@ static void scaled_free(void *impl)
 }
 
 #define SCALED_OPS(k)                                                       \
-	{"scaled", k, scaled_closest, scaled_aabb, scaled_bytes, scaled_free}
+	{.name = "scaled", .kind = k, .closest = scaled_closest,              \
+	 .aabb = scaled_aabb, .memory_bytes = scaled_bytes, .free = scaled_free}
 static const struct px_model_ops scaled_ops[] = {
 	SCALED_OPS(PX_MODEL_CUSTOM),    SCALED_OPS(PX_MODEL_PRIMITIVE),
 	SCALED_OPS(PX_MODEL_MESH),      SCALED_OPS(PX_MODEL_CLOUD),

@@ -186,9 +186,12 @@ static px_aabb loose_aabb(const void *impl)
 	return b;
 }
 
-static const struct px_model_ops loose_ops = {"loose", PX_MODEL_CUSTOM,
-					      loose_closest, loose_aabb, NULL,
-					      NULL};
+static const struct px_model_ops loose_ops = {
+	.name = "loose",
+	.kind = PX_MODEL_CUSTOM,
+	.closest = loose_closest,
+	.aabb = loose_aabb,
+};
 
 static void test_control_adapter_never_overestimates(void)
 {
