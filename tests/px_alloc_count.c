@@ -23,70 +23,36 @@ uint64_t px_alloc_count_total(void)
 	return atomic_load_explicit(&total_calls, memory_order_relaxed);
 }
 
-#if defined(__SANITIZE_ADDRESS__) || defined(PX_ALLOC_WRAP)
+#if defined(__SANITIZE_ADDRESS__)
 
-/* Linked with -Wl,--wrap=malloc,... (see the Makefile's SAN build). */
-void *__real_malloc(size_t n);
-void *__real_calloc(size_t n, size_t m);
-void *__real_realloc(void *p, size_t n);
-void __real_free(void *p);
-int __real_posix_memalign(void **p, size_t a, size_t n);
-void *__real_aligned_alloc(size_t a, size_t n);
-void *__real_memalign(size_t a, size_t n);
+/* The sanitizer owns malloc; it calls these hooks on every allocation
+ * and every release made through it (realloc counts as both), in the
+ * calling thread, whoever the caller is. Installed before main(). */
+int __sanitizer_install_malloc_and_free_hooks(
+	void (*malloc_hook)(const volatile void *, size_t),
+	void (*free_hook)(const volatile void *));
 
-void *__wrap_malloc(size_t n);
-void *__wrap_calloc(size_t n, size_t m);
-void *__wrap_realloc(void *p, size_t n);
-void __wrap_free(void *p);
-int __wrap_posix_memalign(void **p, size_t a, size_t n);
-void *__wrap_aligned_alloc(size_t a, size_t n);
-void *__wrap_memalign(size_t a, size_t n);
-
-void *__wrap_malloc(size_t n)
+static void on_malloc(const volatile void *p, size_t n)
 {
+	(void)p;
+	(void)n;
 	count();
-	return __real_malloc(n);
 }
 
-void *__wrap_calloc(size_t n, size_t m)
+static void on_free(const volatile void *p)
 {
+	(void)p;
 	count();
-	return __real_calloc(n, m);
 }
 
-void *__wrap_realloc(void *p, size_t n)
+__attribute__((constructor)) static void install_hooks(void)
 {
-	count();
-	return __real_realloc(p, n);
-}
-
-void __wrap_free(void *p)
-{
-	count();
-	__real_free(p);
-}
-
-int __wrap_posix_memalign(void **p, size_t a, size_t n)
-{
-	count();
-	return __real_posix_memalign(p, a, n);
-}
-
-void *__wrap_aligned_alloc(size_t a, size_t n)
-{
-	count();
-	return __real_aligned_alloc(a, n);
-}
-
-void *__wrap_memalign(size_t a, size_t n)
-{
-	count();
-	return __real_memalign(a, n);
+	__sanitizer_install_malloc_and_free_hooks(on_malloc, on_free);
 }
 
 const char *px_alloc_count_mode(void)
 {
-	return "wrap";
+	return "sanitizer hooks";
 }
 
 #else

@@ -7,14 +7,14 @@
  * allocates legitimately does not disturb the loop thread's count; a
  * process-wide total is kept as well.
  *
- * Two mechanisms, chosen at build time:
- *  - normal builds interpose the allocator symbols in the test binary and
- *    forward to glibc's __libc_* entry points, so every call in the
- *    process is seen, including those made inside libc or a device
- *    library on behalf of our code;
- *  - sanitizer builds (where the sanitizer runtime owns malloc) use
- *    -Wl,--wrap, which sees every call made from proxima's and the
- *    test's own object files.
+ * Two mechanisms, chosen at build time; both see every call in the
+ * process, including those made inside libc or a device library on
+ * behalf of our code:
+ *  - normal builds interpose the allocator symbols in the binary and
+ *    forward to glibc's __libc_* entry points;
+ *  - AddressSanitizer builds (where the sanitizer runtime owns malloc)
+ *    install its malloc/free hooks before main().
+ * Used by the tests and by proxima-run (allocations after setup).
  */
 #ifndef PX_ALLOC_COUNT_H
 #define PX_ALLOC_COUNT_H
@@ -25,7 +25,7 @@
 uint64_t px_alloc_count_thread(void);
 /* Heap calls made by all threads. */
 uint64_t px_alloc_count_total(void);
-/* Name of the mechanism in use ("interpose" or "wrap"). */
+/* Name of the mechanism in use ("interpose" or "sanitizer hooks"). */
 const char *px_alloc_count_mode(void);
 
 /* Region helpers: begin returns the thread's count, end the difference. */

@@ -48,6 +48,7 @@
 #include "px_arena.h"
 #include "px_can.h"
 #include "px_canopen.h"
+#include "px_alloc_count.h"
 #include "px_config.h"
 #include "px_control.h"
 #include "px_dev.h"
@@ -169,109 +170,12 @@ static int parse_args(int argc, char **argv, struct options *o)
 
 /* ---- heap call counter (per thread) -------------------------------- */
 
-static _Thread_local uint64_t heap_calls;
-
+/* The same counter the tests use (tests/px_alloc_count.c, linked into
+ * the tools): every malloc-family call of the loop thread is seen. */
 static uint64_t heap_count(void)
 {
-	return heap_calls;
+	return px_alloc_count_thread();
 }
-
-#if defined(__SANITIZE_ADDRESS__)
-/* The sanitizer owns malloc; it calls these hooks on every allocation
- * and release (realloc counts as both). */
-int __sanitizer_install_malloc_and_free_hooks(
-	void (*malloc_hook)(const volatile void *, size_t),
-	void (*free_hook)(const volatile void *));
-
-static void on_malloc(const volatile void *p, size_t n)
-{
-	(void)p;
-	(void)n;
-	heap_calls++;
-}
-
-static void on_free(const volatile void *p)
-{
-	(void)p;
-	heap_calls++;
-}
-
-static const char *heap_counter_setup(void)
-{
-	__sanitizer_install_malloc_and_free_hooks(on_malloc, on_free);
-	return "sanitizer hooks";
-}
-#else
-/* glibc's own entry points, exported for interposition. */
-extern void *__libc_malloc(size_t n);
-extern void *__libc_calloc(size_t n, size_t m);
-extern void *__libc_realloc(void *p, size_t n);
-extern void __libc_free(void *p);
-extern void *__libc_memalign(size_t a, size_t n);
-
-void *malloc(size_t n);
-void *calloc(size_t n, size_t m);
-void *realloc(void *p, size_t n);
-void free(void *p);
-int posix_memalign(void **p, size_t a, size_t n);
-void *aligned_alloc(size_t a, size_t n);
-void *memalign(size_t a, size_t n);
-
-void *malloc(size_t n)
-{
-	heap_calls++;
-	return __libc_malloc(n);
-}
-
-void *calloc(size_t n, size_t m)
-{
-	heap_calls++;
-	return __libc_calloc(n, m);
-}
-
-void *realloc(void *p, size_t n)
-{
-	heap_calls++;
-	return __libc_realloc(p, n);
-}
-
-void free(void *p)
-{
-	if (p)
-		heap_calls++;
-	__libc_free(p);
-}
-
-int posix_memalign(void **p, size_t a, size_t n)
-{
-	void *q;
-	heap_calls++;
-	if (a < sizeof(void *) || (a & (a - 1)))
-		return EINVAL;
-	q = __libc_memalign(a, n);
-	if (!q && n)
-		return ENOMEM;
-	*p = q;
-	return 0;
-}
-
-void *aligned_alloc(size_t a, size_t n)
-{
-	heap_calls++;
-	return __libc_memalign(a, n);
-}
-
-void *memalign(size_t a, size_t n)
-{
-	heap_calls++;
-	return __libc_memalign(a, n);
-}
-
-static const char *heap_counter_setup(void)
-{
-	return "interposed malloc";
-}
-#endif
 
 /* ---- the `sim` section: fault campaigns --------------------------- */
 
@@ -1686,7 +1590,7 @@ static void print_summary(const struct px_loop_status *st,
 int main(int argc, char **argv)
 {
 	static struct px_config_diag diag;
-	const char *counter = heap_counter_setup();
+	const char *counter = px_alloc_count_mode();
 	struct px_loop_status st;
 	struct px_stats_snapshot lat, cmp;
 	char time_svg[1100], lat_svg[1100];
