@@ -7,6 +7,7 @@
 
 #include "px_config.h"
 #include "px_test.h"
+#include "px_test_config.h"
 
 static struct px_config_diag g_diag;
 
@@ -991,63 +992,12 @@ static void test_schema_validate(void)
 	PX_CHECK(strstr(why, "enum default"));
 }
 
-static char *read_text(const char *path)
-{
-	FILE *f = fopen(path, "rb");
-	char *buf;
-	long n;
-	if (!f)
-		return NULL;
-	fseek(f, 0, SEEK_END);
-	n = ftell(f);
-	fseek(f, 0, SEEK_SET);
-	buf = malloc((size_t)n + 1);
-	if (buf && fread(buf, 1, (size_t)n, f) != (size_t)n) {
-		free(buf);
-		buf = NULL;
-	}
-	if (buf)
-		buf[n] = '\0';
-	fclose(f);
-	return buf;
-}
-
-/* Every key of every section appears in docs/config.md as `name`, and
- * every enum name too. */
-static void check_documented(const char *docs, const struct px_config_schema *s,
-			     int depth)
-{
-	size_t i;
-	char needle[96];
-	PX_CHECK(depth < 16);
-	for (i = 0; i < s->n_keys; i++) {
-		const struct px_config_key *k = &s->keys[i];
-		snprintf(needle, sizeof(needle), "`%s`", k->name);
-		PX_CHECK_MSG(strstr(docs, needle) != NULL,
-			     "docs/config.md does not document %s.%s", s->name,
-			     k->name);
-		if (k->names) {
-			int j;
-			for (j = 0; k->names[j]; j++) {
-				snprintf(needle, sizeof(needle), "`%s`",
-					 k->names[j]);
-				PX_CHECK_MSG(strstr(docs, needle) != NULL,
-					     "docs/config.md lacks value %s of "
-					     "%s.%s",
-					     k->names[j], s->name, k->name);
-			}
-		}
-		if (k->sub)
-			check_documented(docs, k->sub, depth + 1);
-	}
-}
-
 static void test_docs_cover_every_key(void)
 {
-	char *docs = read_text("docs/config.md");
+	char *docs = px_test_read_text("docs/config.md");
 	if (!docs)
 		PX_SKIP("docs/config.md not found (run from the source tree)");
-	check_documented(docs, px_config_schema_root(), 0);
+	px_test_check_documented(docs, px_config_schema_root(), 16);
 	free(docs);
 }
 
@@ -1118,7 +1068,7 @@ static void test_examples_mutated(void)
 	if (n < 0)
 		PX_SKIP("config/examples not found (run from the source tree)");
 	for (i = 0; i < n; i++) {
-		char *text = read_text(names[i]), *buf;
+		char *text = px_test_read_text(names[i]), *buf;
 		size_t len, cut;
 		PX_CHECK(text != NULL);
 		len = strlen(text);

@@ -5,12 +5,14 @@
  */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "px_alloc_count.h"
 #include "px_config.h"
 #include "px_control.h"
 #include "px_test.h"
+#include "px_test_config.h"
 
 /* ------------------------------------------------------------------ */
 /* Exact analytic scene                                                */
@@ -1804,59 +1806,21 @@ static void test_config_chain_matches_code(void)
 	}
 }
 
-static char *slurp(const char *path)
-{
-	FILE *f = fopen(path, "rb");
-	static char buf[1 << 16];
-	size_t n;
-	if (!f)
-		return NULL;
-	n = fread(buf, 1, sizeof(buf) - 1, f);
-	fclose(f);
-	buf[n] = '\0';
-	return buf;
-}
-
-static void check_doc_keys(const char *docs, const struct px_config_schema *s,
-			   int depth)
-{
-	size_t i;
-	char needle[96];
-	PX_CHECK(depth < 8);
-	for (i = 0; i < s->n_keys; i++) {
-		const struct px_config_key *k = &s->keys[i];
-		snprintf(needle, sizeof(needle), "`%s`", k->name);
-		PX_CHECK_MSG(strstr(docs, needle) != NULL,
-			     "docs/config.md does not document %s.%s", s->name,
-			     k->name);
-		if (k->names) {
-			int j;
-			for (j = 0; k->names[j]; j++) {
-				snprintf(needle, sizeof(needle), "`%s`", k->names[j]);
-				PX_CHECK_MSG(strstr(docs, needle) != NULL,
-					     "docs/config.md lacks value %s of %s.%s",
-					     k->names[j], s->name, k->name);
-			}
-		}
-		if (k->sub)
-			check_doc_keys(docs, k->sub, depth + 1);
-	}
-}
-
 static void test_config_docs_and_examples(void)
 {
 	static struct px_config_diag diag;
 	static struct px_control_config c;
 	struct px_config *cfg;
 	char why[200];
-	const char *docs = slurp("docs/config.md");
+	char *docs = px_test_read_text("docs/config.md");
 	if (!docs)
 		PX_SKIP("docs/config.md not found (run from the source tree)");
 	PX_CHECK_INT_EQ(px_config_schema_validate(px_control_config_schema(), why,
 						  sizeof(why)),
 			PX_OK);
 	PX_CHECK(strstr(docs, "## control") != NULL);
-	check_doc_keys(docs, px_control_config_schema(), 0);
+	px_test_check_documented(docs, px_control_config_schema(), 8);
+	free(docs);
 	PX_CHECK_INT_EQ(px_config_load_file("config/examples/haptic_sim.yaml", &cfg,
 					    &diag),
 			PX_OK);

@@ -14,6 +14,7 @@
 #include "px_prim.h"
 #include "px_world.h"
 #include "px_test.h"
+#include "px_test_config.h"
 
 static px_pose random_pose(double spread)
 {
@@ -471,56 +472,19 @@ static void test_proxy_leaves_the_end_of_a_face(void)
 	px_world_free(s);
 }
 
-static char *slurp(const char *path)
-{
-	FILE *f = fopen(path, "rb");
-	static char buf[1 << 17];
-	size_t n;
-	if (!f)
-		return NULL;
-	n = fread(buf, 1, sizeof(buf) - 1, f);
-	fclose(f);
-	buf[n] = '\0';
-	return buf;
-}
-
-static void check_doc_keys(const char *docs, const struct px_config_schema *sc,
-			   int depth)
-{
-	size_t i;
-	char needle[96];
-	PX_CHECK(depth < 8);
-	for (i = 0; i < sc->n_keys; i++) {
-		const struct px_config_key *k = &sc->keys[i];
-		snprintf(needle, sizeof(needle), "`%s`", k->name);
-		PX_CHECK_MSG(strstr(docs, needle) != NULL,
-			     "docs/config.md does not document %s.%s", sc->name,
-			     k->name);
-		if (k->names) {
-			int j;
-			for (j = 0; k->names[j]; j++) {
-				snprintf(needle, sizeof(needle), "`%s`", k->names[j]);
-				PX_CHECK_MSG(strstr(docs, needle) != NULL,
-					     "docs/config.md lacks value %s of %s.%s",
-					     k->names[j], sc->name, k->name);
-			}
-		}
-		if (k->sub)
-			check_doc_keys(docs, k->sub, depth + 1);
-	}
-}
-
 static void test_schema_documented(void)
 {
 	char why[200];
-	const char *docs = slurp("docs/config.md");
+	char *docs;
 	PX_CHECK_INT_EQ(px_config_schema_validate(px_world_config_schema(), why,
 						  sizeof(why)),
 			PX_OK);
+	docs = px_test_read_text("docs/config.md");
 	if (!docs)
 		PX_SKIP("docs/config.md not found (run from the source tree)");
 	PX_CHECK(strstr(docs, "## scene") != NULL);
-	check_doc_keys(docs, px_world_config_schema(), 0);
+	px_test_check_documented(docs, px_world_config_schema(), 8);
+	free(docs);
 }
 
 static const struct px_test tests[] = {
