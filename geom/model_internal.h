@@ -30,4 +30,8 @@ int px__import_file(const char *path, int want_tri, double **xyz,
  */
 void px__select_k(uint32_t *a, long n, long k, const double *key, int axis);
 
+/* Rewrite msg (cap bytes, NUL-terminated) as "<path>: <msg>", cut to
+ * fit. Setup only. */
+void px__prefix_path(char *msg, size_t cap, const char *path);
+
 #endif

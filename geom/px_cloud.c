@@ -610,15 +610,7 @@ int px_cloud_load(const char *path, double radius_m,
 	}
 	rc = px_cloud_model(xyz, n, radius_m, rep, out);
 	if (rc != PX_OK && rep->message[0]) {
-		char tmp[sizeof(rep->message)];
-		size_t lp = strlen(path);
-		memcpy(tmp, rep->message, sizeof(tmp));
-		if (lp > sizeof(rep->message) - 3)
-			lp = sizeof(rep->message) - 3;
-		memcpy(rep->message, path, lp);
-		memcpy(rep->message + lp, ": ", 2);
-		memcpy(rep->message + lp + 2, tmp, sizeof(rep->message) - lp - 3);
-		rep->message[sizeof(rep->message) - 1] = '\0';
+		px__prefix_path(rep->message, sizeof(rep->message), path);
 	}
 	free(xyz);
 	return rc;

@@ -1375,16 +1375,7 @@ int px_mesh_load(const char *path, const struct px_mesh_opts *opt,
 	}
 	rc = px_mesh_model(xyz, nv, tri, nt, opt, rep, out);
 	if (rep->message[0]) {
-		char tmp[sizeof(rep->message)];
-		size_t lp = strlen(path);
-		memcpy(tmp, rep->message, sizeof(tmp));
-		/* "<path>: <message>", cut to fit */
-		if (lp > sizeof(rep->message) - 3)
-			lp = sizeof(rep->message) - 3;
-		memcpy(rep->message, path, lp);
-		memcpy(rep->message + lp, ": ", 2);
-		memcpy(rep->message + lp + 2, tmp, sizeof(rep->message) - lp - 3);
-		rep->message[sizeof(rep->message) - 1] = '\0';
+		px__prefix_path(rep->message, sizeof(rep->message), path);
 	}
 	free(xyz);
 	free(tri);

@@ -3,6 +3,7 @@
  */
 #include <math.h>
 #include <stdlib.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "px_model.h"
@@ -295,4 +296,24 @@ void px__select_k(uint32_t *a, long n, long k, const double *key, int axis)
 		else
 			break;
 	}
+}
+
+void px__prefix_path(char *msg, size_t cap, const char *path)
+{
+	char tmp[512];
+	size_t lp = strlen(path), lm;
+
+	if (cap < 4)
+		return;
+	lm = strnlen(msg, cap - 1);
+	if (lm > sizeof(tmp) - 1)
+		lm = sizeof(tmp) - 1;
+	memcpy(tmp, msg, lm);
+	tmp[lm] = '\0';
+	if (lp > cap - 3)
+		lp = cap - 3;
+	memcpy(msg, path, lp);
+	memcpy(msg + lp, ": ", 2);
+	/* what is left of the message after the prefix, NUL included */
+	snprintf(msg + lp + 2, cap - lp - 2, "%s", tmp);
 }
