@@ -4,6 +4,7 @@
 
 #include <stdint.h>
 
+#include "px_can.h"
 #include "px_dev.h"
 #include "px_gpio.h"
 
@@ -32,5 +33,47 @@ int px__dio_estop(struct px_dev *d, struct px__dio *io, int64_t now_ns,
 		  int gone, int *pressed);
 /* Logical to physical for an output role. */
 int px__dio_physical(const struct px__dio *io, int role, int logical);
+
+/* Fault engine of the simulated CAN buses (px_can_fault.c): the
+ * in-process bus runs one bus-wide on the sending side, the fault
+ * wrapper (px_can_fault_open) one on the receiving side of any bus.
+ * Fixed memory; every call is RT-safe. */
+#define PX__CAN_FX_DELAY 256 /* frames held back at once by delay */
+#define PX__CAN_FX_IDS 64    /* ids remembered by stuck */
+struct px__can_fx_item {
+	struct px_can_msg m;
+	int64_t due_ns;
+	const void *tag;     /* the sender, for the in-process bus */
+};
+struct px__can_fx {
+	struct px_sim_fault f[PX_SIM_MAX_FAULTS];
+	size_t n;
+	uint64_t rng;
+	struct px__can_fx_item dq[PX__CAN_FX_DELAY];
+	size_t dh, dn;
+	uint32_t stuck_id[PX__CAN_FX_IDS];
+	struct canfd_frame stuck_f[PX__CAN_FX_IDS];
+	size_t n_stuck;
+	int busoff, unplugged;
+	uint64_t hits, delay_dropped;
+};
+/* Check and copy the faults (kinds drop, delay, duplicate, corrupt,
+ * stuck, nan, unplug, bus_off). PX_E_INVAL with the fault's index and
+ * why in msg (cap bytes, may be NULL). */
+int px__can_fx_init(struct px__can_fx *fx, const struct px_sim_fault *f,
+		    size_t n, uint64_t seed, char *msg, size_t cap);
+/* Window states at now: bits 1 = bus-off changed, 2 = unplug changed;
+ * fx->busoff / fx->unplugged hold the new states. Entering unplug
+ * discards held frames. */
+int px__can_fx_tick(struct px__can_fx *fx, int64_t now);
+/* Pass frame m (at now) through drop, stuck, corrupt, nan, delay and
+ * duplicate. Fills out[0..1] with the frames to deliver now and returns
+ * their count (0: dropped or held back by delay). */
+int px__can_fx_apply(struct px__can_fx *fx, const struct px_can_msg *m,
+		     const void *tag, int64_t now, struct px_can_msg out[2]);
+/* A held-back frame due at now (stamped now), FIFO. 1 when *m was
+ * filled, 0 none. */
+int px__can_fx_due(struct px__can_fx *fx, int64_t now, struct px_can_msg *m,
+		   const void **tag);
 
 #endif

@@ -139,12 +139,13 @@ struct px_can_bus_stats {
 };
 
 /* Send one frame; non-blocking. PX_OK, PX_E_AGAIN (queue full: frame
- * dropped and counted), PX_E_IO (bus-off, socket error; errno in
+ * dropped and counted), PX_E_NODEV (interface gone: ENODEV), PX_E_IO
+ * (bus-off, socket error; errno in
  * px_can_bus_errno), PX_E_INVAL. @note RT-safe. */
 PX_API int px_can_bus_send(struct px_can_bus *b, const struct px_can_msg *m,
 			   int64_t now_ns);
 /* Receive one frame if there is one; non-blocking. PX_OK, PX_E_AGAIN,
- * PX_E_IO. Error frames are returned too (CAN_ERR_FLAG) after updating
+ * PX_E_NODEV (interface gone), PX_E_IO. Error frames are returned too (CAN_ERR_FLAG) after updating
  * the bus state. @note RT-safe. */
 PX_API int px_can_bus_recv(struct px_can_bus *b, int64_t now_ns,
 			   struct px_can_msg *m);
@@ -162,9 +163,8 @@ struct px_can_sim;
 struct px_can_sim_config {
 	size_t queue;      /* frames per endpoint queue (default 256) */
 	size_t max_endpoints; /* default 8 */
-	/* fault windows (px_sim.h kinds: drop, duplicate, corrupt = frame
-	 * truncated to half its length, bus_off = sends fail and receivers
-	 * get a bus-off error frame, then a restarted one). */
+	/* fault windows on the simulation clock (now_ns of the calls),
+	 * bus-wide on the sending side; kinds as px_can_fault_open(). */
 	const struct px_sim_fault *faults;
 	size_t n_faults;
 	uint64_t seed;
@@ -175,6 +175,38 @@ PX_API int px_can_sim_create(const struct px_can_sim_config *c,
 PX_API int px_can_sim_endpoint(struct px_can_sim *s, struct px_can_bus **out);
 /* Free the bus and its endpoints (close endpoints first or not). */
 PX_API void px_can_sim_free(struct px_can_sim *s);
+
+/*
+ * Fault injection on any bus (simulated buses above all): returns a bus
+ * that passes calls through to inner (which it then owns; on failure
+ * inner stays the caller's) and applies fault windows [start_ns,
+ * start_ns + duration_ns) of now_ns to the frames it receives, each
+ * data frame hit with the fault's probability (seeded):
+ *   drop       the frame is lost;
+ *   delay      frames are held back delay_ns (a gap, then a burst in
+ *              order, stamped on arrival; at most 256 held at once);
+ *   duplicate  the frame arrives twice;
+ *   corrupt    the frame is truncated to half its length (signals past
+ *              the end fail to decode);
+ *   stuck      each id repeats the first frame it had in the window;
+ *   nan        the data bytes become all ones: NaN in IEEE float
+ *              payloads, J1939's "not available" in integer signals,
+ *              which a signal's min/max rejects as implausible;
+ *   unplug     the adapter is gone: send and receive fail with
+ *              PX_E_NODEV (errno ENODEV), frames are lost; back when the
+ *              window ends;
+ *   bus_off    sends fail (PX_E_IO, errno ENETDOWN), nothing is
+ *              received but a bus-off error frame on entry and a
+ *              restarted one on exit.
+ * estop is refused (PX_E_INVAL): on CAN an e-stop is the drives' own
+ * fault (px_canopen_sim) or a GPIO line. msg (cap bytes, may be NULL)
+ * names the bad fault. Returns PX_OK, PX_E_INVAL, PX_E_NOMEM. Send and
+ * receive stay RT-safe (fixed memory).
+ */
+PX_API int px_can_fault_open(struct px_can_bus *inner,
+			     const struct px_sim_fault *faults,
+			     size_t n_faults, uint64_t seed,
+			     struct px_can_bus **out, char *msg, size_t cap);
 
 /* Simulated bus over a UNIX datagram socket bound at local_path (an
  * existing socket file there is replaced), sending to peer_path.

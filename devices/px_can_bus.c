@@ -17,19 +17,18 @@
 #include <linux/can/netlink.h>
 #include <linux/can/raw.h>
 
+#include "internal.h"
 #include "px_arena.h"
 #include "px_can.h"
 #include "px_ring.h"
 
-enum { K_SIM, K_UNIX, K_RAW, K_REPLAY, K_REC };
+enum { K_SIM, K_UNIX, K_RAW, K_REPLAY, K_REC, K_FAULT };
 
 struct px_can_sim {
 	struct px_can_sim_config cfg;
-	struct px_sim_fault faults[PX_SIM_MAX_FAULTS];
 	struct px_can_bus **eps;
 	size_t n_eps;
-	uint64_t rng;
-	int busoff;
+	struct px__can_fx fx;
 };
 
 struct px_can_bus {
@@ -51,8 +50,11 @@ struct px_can_bus {
 	size_t n_recs, next;
 	int started;
 	int64_t t0_now;
-	/* recorder */
+	/* recorder, fault wrapper */
 	struct px_can_bus *inner;
+	struct px__can_fx *fx;
+	struct px_can_msg pend[4];
+	size_t npend;
 	struct px_arena arena;
 	struct px_ring *ring;
 	char iface[IFNAMSIZ + 8];
@@ -85,31 +87,24 @@ int px_can_sim_create(const struct px_can_sim_config *c,
 		      struct px_can_sim **out)
 {
 	struct px_can_sim *s;
-	size_t i;
 	if (!c || !out || c->queue < 1 || c->max_endpoints < 2 ||
-	    c->max_endpoints > 64 || c->n_faults > PX_SIM_MAX_FAULTS ||
-	    (c->n_faults && !c->faults))
+	    c->max_endpoints > 64)
 		return PX_E_INVAL;
-	for (i = 0; i < c->n_faults; i++) {
-		int k = c->faults[i].kind;
-		if ((k != PX_SIM_FAULT_DROP && k != PX_SIM_FAULT_DUPLICATE &&
-		     k != PX_SIM_FAULT_CORRUPT && k != PX_SIM_FAULT_BUSOFF) ||
-		    c->faults[i].duration_ns <= 0)
-			return PX_E_INVAL;
-	}
 	s = calloc(1, sizeof *s);
 	if (!s)
 		return PX_E_NOMEM;
+	if (px__can_fx_init(&s->fx, c->faults, c->n_faults, c->seed, NULL, 0) !=
+	    PX_OK) {
+		free(s);
+		return PX_E_INVAL;
+	}
 	s->eps = calloc(c->max_endpoints, sizeof *s->eps);
 	if (!s->eps) {
 		free(s);
 		return PX_E_NOMEM;
 	}
 	s->cfg = *c;
-	if (c->n_faults)
-		memcpy(s->faults, c->faults, c->n_faults * sizeof *c->faults);
-	s->cfg.faults = s->faults;
-	s->rng = c->seed ? c->seed : 1;
+	s->cfg.faults = s->fx.f;
 	*out = s;
 	return PX_OK;
 }
@@ -151,33 +146,6 @@ void px_can_sim_free(struct px_can_sim *s)
 	free(s);
 }
 
-static double sim_unit(struct px_can_sim *s)
-{
-	uint64_t x = s->rng;
-	x ^= x >> 12;
-	x ^= x << 25;
-	x ^= x >> 27;
-	s->rng = x;
-	return (double)((x * 2685821657736338717ull) >> 11) *
-	       (1.0 / 9007199254740992.0);
-}
-
-static int sim_fault(struct px_can_sim *s, int kind, int64_t now, int roll)
-{
-	size_t i;
-	for (i = 0; i < s->cfg.n_faults; i++) {
-		const struct px_sim_fault *f = &s->faults[i];
-		double p;
-		if (f->kind != kind || now < f->start_ns ||
-		    now >= f->start_ns + f->duration_ns)
-			continue;
-		p = f->probability > 0 ? f->probability : 1.0;
-		if (!roll || p >= 1.0 || sim_unit(s) < p)
-			return 1;
-	}
-	return 0;
-}
-
 static void q_push(struct px_can_bus *b, const struct px_can_msg *m)
 {
 	if (b->qn >= b->qcap) {
@@ -197,55 +165,175 @@ static void sim_broadcast(struct px_can_sim *s, const struct px_can_bus *from,
 			q_push(s->eps[i], m);
 }
 
-/* Bus-off windows: an error frame to everyone on entry and on exit. */
+static void err_frame(struct px_can_msg *e, int off, int64_t now)
+{
+	memset(e, 0, sizeof *e);
+	e->f.can_id = CAN_ERR_FLAG | (off ? CAN_ERR_BUSOFF : CAN_ERR_RESTARTED);
+	e->f.len = CAN_ERR_DLC;
+	e->t_ns = now;
+}
+
+/* Fault windows at now: bus-off sends an error frame to everyone on
+ * entry and on exit; unplug loses the frames in flight; frames held
+ * back by delay arrive when due. */
 static void sim_tick(struct px_can_sim *s, int64_t now)
 {
-	int off = sim_fault(s, PX_SIM_FAULT_BUSOFF, now, 0);
+	int ch = px__can_fx_tick(&s->fx, now);
 	struct px_can_msg e;
-	if (off == s->busoff)
-		return;
-	s->busoff = off;
-	memset(&e, 0, sizeof e);
-	e.f.can_id = CAN_ERR_FLAG | (off ? CAN_ERR_BUSOFF : CAN_ERR_RESTARTED);
-	e.f.len = CAN_ERR_DLC;
-	e.t_ns = now;
-	sim_broadcast(s, NULL, &e);
+	const void *from;
+	size_t i;
+	if (ch & 1) {
+		err_frame(&e, s->fx.busoff, now);
+		sim_broadcast(s, NULL, &e);
+	}
+	if ((ch & 2) && s->fx.unplugged)
+		for (i = 0; i < s->n_eps; i++)
+			if (s->eps[i])
+				s->eps[i]->qn = 0;
+	while (px__can_fx_due(&s->fx, now, &e, &from))
+		sim_broadcast(s, from, &e);
 }
 
 static int sim_send(struct px_can_bus *b, const struct px_can_msg *m,
 		    int64_t now)
 {
 	struct px_can_sim *s = b->sim;
-	struct px_can_msg c;
+	struct px_can_msg c[2];
+	int n, k;
 	if (!s)
 		return PX_E_IO;
 	sim_tick(s, now);
-	if (s->busoff) {
+	if (s->fx.unplugged) {
+		b->last_errno = ENODEV;
+		return PX_E_NODEV;
+	}
+	if (s->fx.busoff) {
 		b->last_errno = ENETDOWN;
 		return PX_E_IO;
 	}
-	if (sim_fault(s, PX_SIM_FAULT_DROP, now, 1))
-		return PX_OK; /* lost on the wire: the sender cannot know */
-	c = *m;
-	c.t_ns = now;
-	if (sim_fault(s, PX_SIM_FAULT_CORRUPT, now, 1))
-		c.f.len /= 2;
-	sim_broadcast(s, b, &c);
-	if (sim_fault(s, PX_SIM_FAULT_DUPLICATE, now, 1))
-		sim_broadcast(s, b, &c);
+	n = px__can_fx_apply(&s->fx, m, b, now, c);
+	for (k = 0; k < n; k++)
+		sim_broadcast(s, b, &c[k]);
 	return PX_OK;
 }
 
 static int sim_recv(struct px_can_bus *b, int64_t now, struct px_can_msg *m)
 {
-	if (b->sim)
+	if (b->sim) {
 		sim_tick(b->sim, now);
+		if (b->sim->fx.unplugged) {
+			b->last_errno = ENODEV;
+			return PX_E_NODEV;
+		}
+	}
 	if (!b->qn)
 		return PX_E_AGAIN;
 	*m = b->q[b->qhead];
 	b->qhead = (b->qhead + 1) % b->qcap;
 	b->qn--;
 	return PX_OK;
+}
+
+/* ---- fault wrapper --------------------------------------------------------- */
+
+int px_can_fault_open(struct px_can_bus *inner,
+		      const struct px_sim_fault *faults, size_t n_faults,
+		      uint64_t seed, struct px_can_bus **out, char *msg,
+		      size_t cap)
+{
+	struct px_can_bus *b;
+	struct px__can_fx *fx;
+	int rc;
+	if (msg && cap)
+		msg[0] = 0;
+	if (!inner || !out)
+		return PX_E_INVAL;
+	*out = NULL;
+	fx = calloc(1, sizeof *fx);
+	if (!fx)
+		return PX_E_NOMEM;
+	rc = px__can_fx_init(fx, faults, n_faults, seed, msg, cap);
+	if (rc != PX_OK) {
+		free(fx);
+		return rc;
+	}
+	b = bus_new(K_FAULT);
+	if (!b) {
+		free(fx);
+		return PX_E_NOMEM;
+	}
+	b->fx = fx;
+	b->inner = inner;
+	b->fd_frames = inner->fd_frames;
+	*out = b;
+	return PX_OK;
+}
+
+static void fault_tick(struct px_can_bus *b, int64_t now)
+{
+	int ch = px__can_fx_tick(b->fx, now);
+	if ((ch & 1) && b->npend < 4)
+		err_frame(&b->pend[b->npend++], b->fx->busoff, now);
+	if ((ch & 2) && b->fx->unplugged)
+		b->npend = 0;
+}
+
+static int fault_send(struct px_can_bus *b, const struct px_can_msg *m,
+		      int64_t now)
+{
+	int rc;
+	fault_tick(b, now);
+	if (b->fx->unplugged) {
+		b->last_errno = ENODEV;
+		return PX_E_NODEV;
+	}
+	if (b->fx->busoff) {
+		b->last_errno = ENETDOWN;
+		return PX_E_IO;
+	}
+	rc = px_can_bus_send(b->inner, m, now);
+	b->last_errno = px_can_bus_errno(b->inner);
+	return rc;
+}
+
+static int fault_recv(struct px_can_bus *b, int64_t now, struct px_can_msg *m)
+{
+	struct px_can_msg c[2];
+	int k, n, rc;
+	fault_tick(b, now);
+	if (b->npend) {
+		*m = b->pend[0];
+		memmove(b->pend, b->pend + 1, --b->npend * sizeof b->pend[0]);
+		return PX_OK;
+	}
+	if (b->fx->unplugged) {
+		/* the adapter is gone: what the peer sends meanwhile is lost */
+		for (k = 0; k < 256 && px_can_bus_recv(b->inner, now, &c[0]) ==
+					       PX_OK;
+		     k++)
+			;
+		b->last_errno = ENODEV;
+		return PX_E_NODEV;
+	}
+	for (k = 0; k < 256; k++) {
+		if (px__can_fx_due(b->fx, now, m, NULL))
+			return PX_OK;
+		rc = px_can_bus_recv(b->inner, now, m);
+		if (rc != PX_OK) {
+			b->last_errno = px_can_bus_errno(b->inner);
+			return rc;
+		}
+		if (b->fx->busoff && !(m->f.can_id & CAN_ERR_FLAG))
+			continue; /* nothing reaches a bus-off controller */
+		n = px__can_fx_apply(b->fx, m, NULL, now, c);
+		if (n == 0)
+			continue;
+		*m = c[0];
+		if (n == 2)
+			b->pend[b->npend++] = c[1];
+		return PX_OK;
+	}
+	return PX_E_AGAIN;
 }
 
 /* ---- UNIX datagram simulation ------------------------------------------- */
@@ -492,7 +580,7 @@ static int raw_send(struct px_can_bus *b, const struct px_can_msg *m,
 		b->st.tx_dropped++;
 		return PX_E_AGAIN;
 	}
-	return PX_E_IO;
+	return errno == ENODEV || errno == ENXIO ? PX_E_NODEV : PX_E_IO;
 }
 
 static int raw_recv(struct px_can_bus *b, int64_t now, struct px_can_msg *m)
@@ -516,7 +604,8 @@ static int raw_recv(struct px_can_bus *b, int64_t now, struct px_can_msg *m)
 		if (errno == EAGAIN || errno == EWOULDBLOCK)
 			return PX_E_AGAIN;
 		b->last_errno = errno;
-		return PX_E_IO;
+		/* a USB adapter pulled out: the interface is gone */
+		return errno == ENODEV || errno == ENXIO ? PX_E_NODEV : PX_E_IO;
 	}
 	if (n != CAN_MTU && n != CANFD_MTU) {
 		b->st.rx_dropped++;
@@ -688,6 +777,7 @@ int px_can_bus_send(struct px_can_bus *b, const struct px_can_msg *m,
 			px_ring_push(b->ring, &c);
 		}
 		break;
+	case K_FAULT: rc = fault_send(b, m, now_ns); break;
 	default: rc = PX_OK; break; /* replay: sends go nowhere */
 	}
 	if (rc == PX_OK)
@@ -711,6 +801,7 @@ int px_can_bus_recv(struct px_can_bus *b, int64_t now_ns,
 		if (rc == PX_OK)
 			px_ring_push(b->ring, m);
 		break;
+	case K_FAULT: rc = fault_recv(b, now_ns, m); break;
 	default: rc = replay_recv(b, now_ns, m); break;
 	}
 	if (rc != PX_OK)
@@ -762,6 +853,9 @@ void px_can_bus_close(struct px_can_bus *b)
 		px_can_bus_close(b->inner);
 		px_arena_fini(&b->arena);
 	}
+	if (b->kind == K_FAULT)
+		px_can_bus_close(b->inner);
+	free(b->fx);
 	free(b);
 }
 

@@ -10,6 +10,7 @@
 #define MAX_SIG 64
 #define MAX_OUT_IDS 8
 #define MAX_RX_PER_POLL 256
+#define MAX_IN_IDS 16
 
 struct cdev {
 	struct px_can_bus *bus;
@@ -22,6 +23,12 @@ struct cdev {
 	uint32_t out_id[MAX_OUT_IDS];  /* with CAN_EFF_FLAG */
 	uint8_t out_len[MAX_OUT_IDS];
 	size_t n_out;
+	/* duplicate check: last frame per input id */
+	uint32_t in_id[MAX_IN_IDS];
+	struct canfd_frame in_last[MAX_IN_IDS];
+	int64_t in_t[MAX_IN_IDS];
+	int in_have[MAX_IN_IDS];
+	size_t n_in;
 };
 
 static uint32_t wire_id(const struct px_can_signal *s)
@@ -54,6 +61,33 @@ static const char *err_what(const struct px_can_err_info *e)
 	return "bus error";
 }
 
+/* The same frame (id, length, bytes) again sooner than the device's
+ * min_report_interval_ns: a duplicate (a retransmission or a gateway
+ * forwarding twice), dropped so it does not count as a fresh sample. */
+static int is_duplicate(struct px_dev *d, struct cdev *c,
+			const struct px_can_msg *m)
+{
+	int64_t min_ns = px_dev_config(d)->min_report_interval_ns;
+	uint32_t id = m->f.can_id & (CAN_EFF_FLAG | CAN_EFF_MASK);
+	size_t k;
+	for (k = 0; k < c->n_in && c->in_id[k] != id; k++)
+		;
+	if (k == c->n_in)
+		return 0; /* not an input frame */
+	if (min_ns > 0 && c->in_have[k] && m->f.len == c->in_last[k].len &&
+	    m->t_ns - c->in_t[k] < min_ns &&
+	    !memcmp(m->f.data, c->in_last[k].data, m->f.len)) {
+		px_dev_record(d, PX_DEV_ERR_DUPLICATE, PX_E_CORRUPT, 0,
+			      (int64_t)(id & CAN_EFF_MASK), NULL, NULL,
+			      m->t_ns);
+		return 1;
+	}
+	c->in_last[k] = m->f;
+	c->in_t[k] = m->t_ns;
+	c->in_have[k] = 1;
+	return 0;
+}
+
 static void handle(struct px_dev *d, struct cdev *c, const struct px_can_msg *m)
 {
 	double axis[PX_AXIS__COUNT] = {0};
@@ -75,6 +109,8 @@ static void handle(struct px_dev *d, struct cdev *c, const struct px_can_msg *m)
 	}
 	if (m->f.can_id & CAN_RTR_FLAG)
 		return;
+	if (is_duplicate(d, c, m))
+		return;
 	for (i = 0; i < c->n; i++) {
 		const struct px_can_signal *s = &c->sig[i];
 		double v;
@@ -84,8 +120,10 @@ static void handle(struct px_dev *d, struct cdev *c, const struct px_can_msg *m)
 		rc = px_can_signal_decode(s, m->f.data, m->f.len, &v);
 		if (rc != PX_OK) {
 			/* the signal's name says where; frame id in the record */
-			px_dev_record(d, PX_DEV_ERR_DECODE, rc, 0,
-				      (int64_t)s->id, NULL, s->name, m->t_ns);
+			px_dev_record(d, rc == PX_E_NAN ? PX_DEV_ERR_NONFINITE
+							: PX_DEV_ERR_DECODE,
+				      rc, 0, (int64_t)s->id, NULL, s->name,
+				      m->t_ns);
 			return; /* a bad frame feeds nothing */
 		}
 		c->val[i] = v;
@@ -111,14 +149,25 @@ static int cdev_poll(struct px_dev *d, int64_t now)
 			rc = PX_OK;
 			break;
 		}
+		if (rc == PX_E_NODEV) {
+			/* the adapter (or its simulation) is gone: stale and
+			 * safe until it answers again */
+			if (px_dev_state(d) != PX_DEV_STATE_UNPLUGGED)
+				px_dev_set_state(d, PX_DEV_STATE_UNPLUGGED, now);
+			return rc;
+		}
 		if (rc != PX_OK) {
 			px_dev_record(d, PX_DEV_ERR_IO, rc,
 				      px_can_bus_errno(c->bus), -1, NULL,
 				      "CAN receive failed", now);
 			break;
 		}
+		if (px_dev_state(d) == PX_DEV_STATE_UNPLUGGED)
+			px_dev_set_state(d, PX_DEV_STATE_RUNNING, m.t_ns);
 		handle(d, c, &m);
 	}
+	if (rc == PX_OK && px_dev_state(d) == PX_DEV_STATE_UNPLUGGED)
+		px_dev_set_state(d, PX_DEV_STATE_RUNNING, now);
 	return rc;
 }
 
@@ -259,6 +308,15 @@ int px_can_dev_create(const struct px_dev_config *dcfg, struct px_can_bus *bus,
 	c->fd = fd_frames;
 	c->sig = signals;
 	c->n = n_signals;
+	for (i = 0; i < n_signals; i++) {
+		uint32_t w = wire_id(&signals[i]);
+		if (signals[i].output)
+			continue;
+		for (j = 0; j < c->n_in && c->in_id[j] != w; j++)
+			;
+		if (j == c->n_in && c->n_in < MAX_IN_IDS)
+			c->in_id[c->n_in++] = w;
+	}
 	for (j = 0; j < n_out; j++) {
 		c->out_id[j] = ids[j];
 		c->out_len[j] = fd_frames ? fd_len(lens[j]) : lens[j];
