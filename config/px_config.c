@@ -82,6 +82,10 @@ static const char *const can_transport_names[] = {"kernel", "sim", "unix",
 static const char *const cia402_names[] = {"csp", "csv", "cst", NULL};
 static const char *const sim_kind_names[] = {"haptic", "pose", "gpio", NULL};
 static const char *const traj_names[] = {"hold", "sines", "csv", NULL};
+/* enum px_config_fault_kind order (px_sim.h's numbering minus 1) */
+static const char *const fault_names[] = {
+	"drop", "delay", "duplicate", "corrupt", "stuck", "nan", "unplug",
+	"bus_off", "estop", NULL};
 
 const char *const *px_config_backend_names(void)
 {
@@ -361,8 +365,58 @@ static const struct px_config_key libusb_keys[] = {
 	K_BOOL(struct px_config_libusb, detach_kernel_driver,
 	       "detach_kernel_driver", 1),
 	CODEC_KEYS(struct px_config_libusb),
+	K_BOOL(struct px_config_libusb, no_hotplug, "no_hotplug", 0),
 };
 SCHEMA(libusb_schema, "libusb", libusb_keys, libusb_check);
+
+/* ---- fault windows (sim devices, simulated CAN buses) ------------- */
+
+static void fault_check(struct px_config_reader *r,
+			const struct px_config_node *map, void *obj)
+{
+	struct px_config_fault *f = obj;
+	int delay = f->kind == PX_CONFIG_FAULT_DELAY;
+	if (!map)
+		return;
+	if (delay && f->delay_ns <= 0)
+		px_config_reader_error(r, map, "delay_ns",
+				       "missing or zero for kind 'delay'");
+	if (!delay && f->delay_ns > 0)
+		px_config_reader_error(r, px_config_node_get(map, "delay_ns"),
+				       "delay_ns", "only for kind 'delay'");
+}
+
+static const struct px_config_key fault_keys[] = {
+	{.name = "kind", .type = PX_CONFIG_T_ENUM,
+	 .offset = offsetof(struct px_config_fault, kind),
+	 .flags = PX_CONFIG_REQUIRED, .names = fault_names},
+	K_DUR(struct px_config_fault, start_ns, "start_ns", PX_CONFIG_REQUIRED,
+	      0, 1000000000000000LL, 0),
+	K_DUR(struct px_config_fault, duration_ns, "duration_ns",
+	      PX_CONFIG_REQUIRED, 1, 1000000000000000LL, 1),
+	K_DBL(struct px_config_fault, probability, "probability",
+	      PX_CONFIG_MIN_EXCL, 0, 1, 1.0),
+	K_DUR(struct px_config_fault, delay_ns, "delay_ns", 0, 0, 10 * NS_PER_S,
+	      0),
+};
+SCHEMA(fault_schema, "fault", fault_keys, fault_check);
+
+/* Kinds allowed by a back end: bit k for kind k. */
+#define FK(k) (1u << (k))
+static void faults_check(struct px_config_reader *r,
+			 const struct px_config_node *map,
+			 const struct px_config_fault *f, size_t n,
+			 unsigned allowed, const char *why)
+{
+	size_t i;
+	char what[256];
+	for (i = 0; i < n; i++)
+		if (!(allowed & FK(f[i].kind))) {
+			snprintf(what, sizeof(what), "kind '%s' %s",
+				 fault_names[f[i].kind], why);
+			err_item(r, map, "faults", i, "kind", what);
+		}
+}
 
 static const struct px_config_key filter_keys[] = {
 	K_INT(struct px_config_can_filter, id, "id", PX_CONFIG_REQUIRED, 0,
@@ -499,7 +553,14 @@ static void canopen_check(struct px_config_reader *r,
 	char what[256];
 	if (!map)
 		return;
-	for (i = 0; i < c->n_drives; i++)
+	for (i = 0; i < c->n_drives; i++) {
+		if (c->has_node_id && c->drives[i].node_id == c->node_id) {
+			snprintf(what, sizeof(what),
+				 "node id %lld is the master's own (canopen."
+				 "node_id)",
+				 (long long)c->node_id);
+			err_item(r, map, "drives", i, "node_id", what);
+		}
 		for (j = 0; j < i; j++) {
 			if (c->drives[i].node_id == c->drives[j].node_id) {
 				snprintf(what, sizeof(what),
@@ -516,6 +577,7 @@ static void canopen_check(struct px_config_reader *r,
 				err_item(r, map, "drives", i, "joint", what);
 			}
 		}
+	}
 	if (c->heartbeat_timeout_ns && c->heartbeat_period_ns &&
 	    c->heartbeat_timeout_ns <= c->heartbeat_period_ns)
 		px_config_reader_error(r,
@@ -539,6 +601,8 @@ static const struct px_config_key canopen_keys[] = {
 	      pdo_entry_schema, struct px_config_pdo_entry, 0, 8),
 	K_SEQ(struct px_config_canopen, tpdo2, n_tpdo2, "tpdo2", 0,
 	      pdo_entry_schema, struct px_config_pdo_entry, 0, 8),
+	K_INTP(struct px_config_canopen, node_id, "node_id", 0, 1, 127, 127,
+	       has_node_id),
 };
 SCHEMA(canopen_schema, "canopen", canopen_keys, canopen_check);
 
@@ -559,6 +623,23 @@ static void socketcan_check(struct px_config_reader *r,
 		px_config_reader_error(r, px_config_node_get(map, "socket_path"),
 				       "socket_path",
 				       "only used with transport 'unix'");
+	if (c->transport == PX_CONFIG_CAN_KERNEL && c->n_faults)
+		px_config_reader_error(r, px_config_node_get(map, "faults"),
+				       "faults",
+				       "faults are injected on simulated buses "
+				       "only (transport 'sim' or 'unix')");
+	faults_check(r, map, c->faults, c->n_faults, ~FK(PX_CONFIG_FAULT_ESTOP),
+		     "is not a CAN bus fault: give estop to a GPIO e-stop line "
+		     "(sim kind gpio) or to the simulated arm");
+	if (c->transport != PX_CONFIG_CAN_KERNEL && c->bitrate)
+		px_config_reader_error(r, px_config_node_get(map, "bitrate"),
+				       "bitrate",
+				       "only for a kernel interface (transport "
+				       "'kernel')");
+	if (c->restart_ms && !c->bitrate)
+		px_config_reader_error(r, px_config_node_get(map, "restart_ms"),
+				       "restart_ms",
+				       "applied with bitrate: give bitrate too");
 	for (i = 0; i < c->n_signals; i++) {
 		const struct px_config_can_signal *s = &c->signals[i];
 		int64_t end = signal_end_bit(s);
@@ -595,6 +676,10 @@ static const struct px_config_key socketcan_keys[] = {
 	      signal_schema, struct px_config_can_signal, 0, 256),
 	K_SUBP(struct px_config_socketcan, canopen, "canopen", canopen_schema,
 	       canopen.present),
+	K_INT(struct px_config_socketcan, restart_ms, "restart_ms", 0, 0, 60000,
+	      0),
+	K_SEQ(struct px_config_socketcan, faults, n_faults, "faults", 0,
+	      fault_schema, struct px_config_fault, 0, 16),
 };
 SCHEMA(socketcan_schema, "socketcan", socketcan_keys, socketcan_check);
 
@@ -711,6 +796,18 @@ static void sim_check(struct px_config_reader *r,
 				       "missing required key (kind is 'gpio')");
 	lines_check(r, map, s->lines, s->n_lines, false);
 	codec_check(r, map, &s->codec);
+	if (s->kind == PX_CONFIG_SIM_GPIO)
+		faults_check(r, map, s->faults, s->n_faults,
+			     FK(PX_CONFIG_FAULT_ESTOP) | FK(PX_CONFIG_FAULT_UNPLUG),
+			     "does not apply to simulated GPIO lines (estop, "
+			     "unplug)");
+	else
+		faults_check(r, map, s->faults, s->n_faults,
+			     ~(FK(PX_CONFIG_FAULT_BUS_OFF) |
+			       FK(PX_CONFIG_FAULT_ESTOP)),
+			     "does not apply to a simulated haptic or pose "
+			     "device (drop, delay, duplicate, corrupt, stuck, "
+			     "nan, unplug)");
 }
 
 static const struct px_config_key sim_keys[] = {
@@ -733,6 +830,8 @@ static const struct px_config_key sim_keys[] = {
 	CODEC_KEYS(struct px_config_sim),
 	K_SEQ(struct px_config_sim, lines, n_lines, "lines", 0, line_schema,
 	      struct px_config_gpio_line, 0, 64),
+	K_SEQ(struct px_config_sim, faults, n_faults, "faults", 0, fault_schema,
+	      struct px_config_fault, 0, 16),
 };
 SCHEMA(sim_schema, "sim", sim_keys, sim_check);
 
@@ -784,6 +883,10 @@ static const struct px_config_key device_keys[] = {
 	K_SUBP(struct px_config_device, socketcan, "socketcan", socketcan_schema,
 	       has_socketcan),
 	K_SUBP(struct px_config_device, gpiod, "gpiod", gpiod_schema, has_gpiod),
+	K_INT(struct px_config_device, stuck_limit, "stuck_limit", 0, 0, 1000000,
+	      0),
+	K_DUR(struct px_config_device, min_report_interval_ns,
+	      "min_report_interval_ns", 0, 0, NS_PER_S, 0),
 };
 SCHEMA(device_schema, "device", device_keys, device_check);
 

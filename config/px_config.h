@@ -470,6 +470,7 @@ struct px_config_libusb {
 	int64_t frame_len;     /* bytes of one input frame */
 	bool detach_kernel_driver;
 	struct px_config_codec codec;
+	bool no_hotplug;       /* find a replugged device by polling (no udev) */
 };
 
 struct px_config_can_filter {
@@ -559,6 +560,33 @@ struct px_config_canopen {
 	int64_t heartbeat_timeout_ns;   /* consumer timeout per drive */
 	struct px_config_canopen_drive *drives;
 	size_t n_drives;
+	/* The master's own node id (heartbeat 0x700 + id), 1..127; absent:
+	 * the highest id no drive uses (127 mostly). */
+	bool has_node_id;
+	int64_t node_id;
+};
+
+/* A fault window of a simulated device or bus (key "faults"): kind is
+ * enum px_config_fault_kind; px_sim.h's enum px_sim_fault_kind is kind
+ * + 1. Times are from the start of the run. */
+enum px_config_fault_kind {
+	PX_CONFIG_FAULT_DROP = 0,
+	PX_CONFIG_FAULT_DELAY,
+	PX_CONFIG_FAULT_DUPLICATE,
+	PX_CONFIG_FAULT_CORRUPT,
+	PX_CONFIG_FAULT_STUCK,
+	PX_CONFIG_FAULT_NAN,
+	PX_CONFIG_FAULT_UNPLUG,
+	PX_CONFIG_FAULT_BUS_OFF,
+	PX_CONFIG_FAULT_ESTOP
+};
+
+struct px_config_fault {
+	int kind;              /* enum px_config_fault_kind */
+	int64_t start_ns;
+	int64_t duration_ns;
+	double probability;    /* (0, 1] */
+	int64_t delay_ns;      /* kind delay */
 };
 
 struct px_config_socketcan {
@@ -572,6 +600,11 @@ struct px_config_socketcan {
 	struct px_config_can_signal *signals;
 	size_t n_signals;
 	struct px_config_canopen canopen;
+	int64_t restart_ms;      /* bus-off auto restart (with bitrate); 0 = off */
+	/* transport sim/unix: fault windows on the frames this device
+	 * receives */
+	struct px_config_fault *faults;
+	size_t n_faults;
 };
 
 enum px_config_gpio_dir {
@@ -637,6 +670,8 @@ struct px_config_sim {
 	struct px_config_codec codec;    /* report format; empty = built-in */
 	struct px_config_gpio_line *lines; /* kind gpio */
 	size_t n_lines;
+	struct px_config_fault *faults;  /* fault windows of this device */
+	size_t n_faults;
 };
 
 struct px_config_device {
@@ -650,6 +685,11 @@ struct px_config_device {
 	struct px_config_socketcan socketcan;
 	struct px_config_gpiod gpiod;
 	const struct px_config_node *node_; /* the device's mapping */
+	/* Pose inputs: identical samples this many times in a row mark the
+	 * device stuck (0 = off), and an identical report/frame sooner than
+	 * min_report_interval_ns after the last is a duplicate (0 = off). */
+	int64_t stuck_limit;
+	int64_t min_report_interval_ns;
 };
 
 struct px_config {

@@ -249,6 +249,39 @@ PX_API int px_can_raw_open(const struct px_can_raw_config *c,
 PX_API int px_can_iface_state(const char *iface, int *state);
 PX_API int px_can_iface_restart(const char *iface);
 
+/*
+ * Set a CAN interface's bitrate (and, when restart_ms > 0, its bus-off
+ * restart delay) through libsocketcan: down, set, up (up again also
+ * after a failed setting). Without restart_ms, an interface already at
+ * bitrate is left alone (no privilege needed). Setup only; needs CAP_NET_ADMIN. Returns
+ * PX_OK; PX_E_UNSUPPORTED for a virtual interface (vcan has no bitrate;
+ * msg says it was not applied: callers go on) or a refused value;
+ * PX_E_NODEV (no such interface), PX_E_PERM (msg has the errno and the
+ * CAP_NET_ADMIN hint), PX_E_IO, PX_E_INVAL. *sys_errno (may be NULL)
+ * gets the errno, msg (cap bytes, may be NULL) the call that failed,
+ * e.g. "can0: can_do_stop (ip link set down): errno EPERM (1): Operation
+ * not permitted (setting a CAN bitrate needs CAP_NET_ADMIN: ...)".
+ */
+PX_API int px_can_iface_set_bitrate(const char *iface, uint32_t bitrate,
+				    uint32_t restart_ms, int *sys_errno,
+				    char *msg, size_t cap);
+
+/* The netlink calls px_can_iface_set_bitrate() makes (libsocketcan's,
+ * each returning 0 or -1 with errno), replaceable to simulate a
+ * controller or a refusal in tests. exists/is_virtual return 1 or 0. */
+struct px_can_netlink_ops {
+	int (*exists)(const char *iface);
+	int (*is_virtual)(const char *iface);
+	int (*do_stop)(const char *iface);
+	int (*do_start)(const char *iface);
+	int (*set_bitrate)(const char *iface, uint32_t bitrate);
+	int (*set_restart_ms)(const char *iface, uint32_t restart_ms);
+	/* current bitrate; may be NULL */
+	int (*get_bitrate)(const char *iface, uint32_t *bitrate);
+};
+/* Use ops (NULL: libsocketcan again). Setup only, one thread. */
+PX_API void px_can_netlink_set_ops(const struct px_can_netlink_ops *ops);
+
 /* ---- candump -l logs ---------------------------------------------------- */
 
 /* One log line "(sec.usec) iface id#data" (classic), "id##Fdata" (FD,

@@ -656,6 +656,143 @@ int px_can_iface_state(const char *iface, int *state)
 	return PX_OK;
 }
 
+/* ---- bitrate through libsocketcan ----------------------------------------- */
+
+static int nl_exists(const char *iface)
+{
+	return if_nametoindex(iface) != 0;
+}
+
+/* vcan/vxcan have no controller: no parent device in sysfs. */
+static int nl_is_virtual(const char *iface)
+{
+	char p[64];
+	snprintf(p, sizeof p, "/sys/class/net/%s/device", iface);
+	return access(p, F_OK) != 0;
+}
+
+static int nl_set_bitrate(const char *iface, uint32_t bitrate)
+{
+	return can_set_bitrate(iface, bitrate);
+}
+
+static int nl_set_restart_ms(const char *iface, uint32_t ms)
+{
+	return can_set_restart_ms(iface, ms);
+}
+
+static int nl_get_bitrate(const char *iface, uint32_t *bitrate)
+{
+	struct can_bittiming bt;
+	memset(&bt, 0, sizeof bt);
+	if (can_get_bittiming(iface, &bt) != 0)
+		return -1;
+	*bitrate = bt.bitrate;
+	return 0;
+}
+
+static const struct px_can_netlink_ops nl_default = {
+	nl_exists,	    nl_is_virtual,  can_do_stop,   can_do_start,
+	nl_set_bitrate, nl_set_restart_ms, nl_get_bitrate,
+};
+static const struct px_can_netlink_ops *nl = &nl_default;
+
+void px_can_netlink_set_ops(const struct px_can_netlink_ops *ops)
+{
+	nl = ops ? ops : &nl_default;
+}
+
+#define NLFAIL(code, call)                                                  \
+	do {                                                                \
+		e = errno ? errno : EIO;                                    \
+		nm = strerrorname_np(e);                                    \
+		if (msg)                                                    \
+			snprintf(msg, cap,                                  \
+				 "%s: %s: errno %s (%d): %s%s", iface, call, \
+				 nm ? nm : "?", e, strerror(e),             \
+				 e == EPERM || e == EACCES                  \
+					 ? " (setting a CAN bitrate needs "  \
+					   "CAP_NET_ADMIN: run as root, "   \
+					   "give the program the capability, " \
+					   "or set it with ip link set "    \
+					   "<iface> type can bitrate N)"    \
+					 : "");                              \
+		if (sys_errno)                                              \
+			*sys_errno = e;                                     \
+		rc = (code);                                                \
+	} while (0)
+
+int px_can_iface_set_bitrate(const char *iface, uint32_t bitrate,
+			     uint32_t restart_ms, int *sys_errno, char *msg,
+			     size_t cap)
+{
+	const char *nm;
+	int e, rc = PX_OK;
+	if (msg && cap)
+		msg[0] = 0;
+	if (sys_errno)
+		*sys_errno = 0;
+	if (!iface || !*iface || strlen(iface) >= IFNAMSIZ || bitrate == 0 ||
+	    bitrate > 8000000) {
+		if (msg)
+			snprintf(msg, cap, "CAN bitrate: interface name (< %d "
+				 "bytes) and a bitrate of 1 .. 8000000 bit/s",
+				 IFNAMSIZ);
+		return PX_E_INVAL;
+	}
+	if (!nl->exists(iface)) {
+		if (msg)
+			snprintf(msg, cap, "%s: no such network interface (ip "
+				 "-details link show type can lists CAN "
+				 "interfaces)", iface);
+		if (sys_errno)
+			*sys_errno = ENODEV;
+		return PX_E_NODEV;
+	}
+	if (nl->is_virtual(iface)) {
+		if (msg)
+			snprintf(msg, cap, "%s: a virtual CAN interface (vcan, "
+				 "vxcan) has no bitrate: %u bit/s not applied",
+				 iface, bitrate);
+		return PX_E_UNSUPPORTED;
+	}
+	/* Already so (set by ip link, say): nothing to do, no privilege
+	 * needed. */
+	{
+		uint32_t now_bps = 0;
+		if (!restart_ms && nl->get_bitrate &&
+		    nl->get_bitrate(iface, &now_bps) == 0 && now_bps == bitrate)
+			return PX_OK;
+	}
+	/* The bitrate can only change while the interface is down. */
+	errno = 0;
+	if (nl->do_stop(iface) != 0) {
+		NLFAIL(errno == EPERM || errno == EACCES ? PX_E_PERM : PX_E_IO,
+		       "can_do_stop (ip link set down)");
+		return rc;
+	}
+	errno = 0;
+	if (nl->set_bitrate(iface, bitrate) != 0)
+		NLFAIL(errno == EPERM || errno == EACCES ? PX_E_PERM
+		       : errno == EOPNOTSUPP || errno == EINVAL
+			       ? PX_E_UNSUPPORTED
+			       : PX_E_IO,
+		       "can_set_bitrate");
+	if (rc == PX_OK && restart_ms) {
+		errno = 0;
+		if (nl->set_restart_ms(iface, restart_ms) != 0)
+			NLFAIL(errno == EPERM || errno == EACCES ? PX_E_PERM
+								 : PX_E_IO,
+			       "can_set_restart_ms");
+	}
+	/* Up again even after a failed setting: the bus worked before. */
+	errno = 0;
+	if (nl->do_start(iface) != 0 && rc == PX_OK)
+		NLFAIL(errno == EPERM || errno == EACCES ? PX_E_PERM : PX_E_IO,
+		       "can_do_start (ip link set up)");
+	return rc;
+}
+
 int px_can_iface_restart(const char *iface)
 {
 	if (!iface)

@@ -25,7 +25,25 @@ struct px_devcfg {
 	struct px_canopen_drive_cfg drives[PX_CANOPEN_MAX_DRIVES];
 	size_t n_drives;
 	struct px_canopen_pdo_map pdo;
+	char notes[256];
 };
+
+/* Config fault windows as px_sim faults, moved onto the loop clock. */
+static size_t conv_faults(const struct px_config_fault *f, size_t n,
+			  const struct px_devcfg_options *opt,
+			  struct px_sim_fault *o)
+{
+	size_t i;
+	int64_t t0 = opt ? opt->clock0_ns : 0;
+	for (i = 0; i < n && i < PX_SIM_MAX_FAULTS; i++) {
+		o[i].kind = f[i].kind + 1;
+		o[i].start_ns = t0 + f[i].start_ns;
+		o[i].duration_ns = f[i].duration_ns;
+		o[i].probability = f[i].probability;
+		o[i].delay_ns = f[i].delay_ns;
+	}
+	return i;
+}
 
 /* Config PDO entries over the default layout; a failed check names the
  * entry ("socketcan.canopen.tpdo1[1]"). */
@@ -196,10 +214,12 @@ static int open_codec(struct px_devcfg *h, const struct px_config *cfg,
 
 static int open_sim_haptic(struct px_devcfg *h, const struct px_config *cfg,
 			   const struct px_config_device *dc,
+			   const struct px_devcfg_options *opt,
 			   struct px_dev_config *dcfg, char *msg, size_t cap)
 {
 	const struct px_config_sim *s = &dc->sim;
 	struct px_sim_haptic_config hc;
+	struct px_sim_fault faults[PX_SIM_MAX_FAULTS];
 	struct px_sim_sine sines[PX_SIM_MAX_SINES];
 	char why[256];
 	size_t i;
@@ -252,6 +272,8 @@ static int open_sim_haptic(struct px_devcfg *h, const struct px_config *cfg,
 			return rc;
 		dcfg->codec = &h->map;
 	}
+	hc.n_faults = conv_faults(s->faults, s->n_faults, opt, faults);
+	hc.faults = faults;
 	rc = px_sim_haptic_create(dcfg, &hc, &h->dev, why, sizeof(why));
 	if (rc != PX_OK)
 		return fail(msg, cap, cfg, dc, "sim", rc, "%s", why);
@@ -334,6 +356,25 @@ static int can_bus_open(struct px_devcfg *h, const struct px_config *cfg,
 	char why[512], peer[128];
 	int rc, e = 0;
 	size_t i;
+	if (c->transport != PX_CONFIG_CAN_KERNEL && c->n_faults) {
+		/* the bare endpoint or socket first, then the wrapper */
+		struct px_config_device bare = *dc;
+		struct px_sim_fault f[PX_SIM_MAX_FAULTS];
+		struct px_can_bus *in = NULL;
+		size_t n = conv_faults(c->faults, c->n_faults, opt, f);
+		bare.socketcan.n_faults = 0;
+		rc = can_bus_open(h, cfg, &bare, opt, &in, msg, cap);
+		if (rc != PX_OK)
+			return rc;
+		rc = px_can_fault_open(in, f, n, 1 + (uint64_t)(dc - cfg->devices),
+				       bus, why, sizeof(why));
+		if (rc != PX_OK) {
+			px_can_bus_close(in);
+			return fail(msg, cap, cfg, dc, "socketcan.faults", rc, "%s",
+				    why);
+		}
+		return PX_OK;
+	}
 	if (c->transport == PX_CONFIG_CAN_SIM) {
 		if (!h->sim_bus) {
 			if (opt && opt->can_sim) {
@@ -407,6 +448,17 @@ static int open_can(struct px_devcfg *h, const struct px_config *cfg,
 		return fail(msg, cap, cfg, dc, "socketcan.signals", PX_E_INVAL,
 			    "transport 'unix' has one socket: give signals "
 			    "or canopen, not both");
+	if (c->transport == PX_CONFIG_CAN_KERNEL && c->bitrate > 0) {
+		int e = 0;
+		rc = px_can_iface_set_bitrate(c->interface, (uint32_t)c->bitrate,
+					      (uint32_t)c->restart_ms, &e, why,
+					      sizeof(why));
+		if (rc == PX_E_UNSUPPORTED && e == 0)
+			snprintf(h->notes, sizeof(h->notes), "%s", why);
+		else if (rc != PX_OK)
+			return fail(msg, cap, cfg, dc, "socketcan.bitrate", rc,
+				    "%s", why);
+	}
 	if (c->n_signals) {
 		if (c->n_signals > 64)
 			return fail(msg, cap, cfg, dc, "socketcan.signals",
@@ -500,6 +552,21 @@ static int open_can(struct px_devcfg *h, const struct px_config *cfg,
 		cc.heartbeat_timeout_ns = c->canopen.heartbeat_timeout_ns;
 		cc.drives = h->drives;
 		cc.n_drives = h->n_drives;
+		if (c->canopen.has_node_id) {
+			cc.own_node_id = (uint8_t)c->canopen.node_id;
+		} else {
+			/* the highest id no drive uses */
+			int id;
+			for (id = 127; id > 1; id--) {
+				for (i = 0; i < h->n_drives &&
+					    h->drives[i].node_id != id;
+				     i++)
+					;
+				if (i == h->n_drives)
+					break;
+			}
+			cc.own_node_id = (uint8_t)id;
+		}
 		rc = can_bus_open(h, cfg, dc, opt, &h->co_bus, msg, cap);
 		if (rc != PX_OK)
 			return rc;
@@ -544,6 +611,8 @@ int px_devcfg_open(const struct px_config *cfg,
 					: cfg->safety.watchdog.device_timeout_ns;
 	if (dcfg.stale_timeout_ns <= 0)
 		px_dev_config_default(&dcfg), dcfg.name = dc->name;
+	dcfg.stuck_limit = (uint32_t)dc->stuck_limit;
+	dcfg.min_report_interval_ns = dc->min_report_interval_ns;
 
 	switch (dc->backend) {
 	case PX_CONFIG_BACKEND_SIM:
@@ -552,7 +621,10 @@ int px_devcfg_open(const struct px_config *cfg,
 			rc = gpio_cfg(cfg, dc, "sim", dc->sim.lines,
 				      dc->sim.n_lines, &gc, msg, cap);
 			if (rc == PX_OK) {
-				rc = px_gpio_sim_create(&dcfg, &gc, NULL, 0,
+				struct px_sim_fault f[PX_SIM_MAX_FAULTS];
+				size_t n = conv_faults(dc->sim.faults,
+						       dc->sim.n_faults, opt, f);
+				rc = px_gpio_sim_create(&dcfg, &gc, f, n,
 							&h->dev, why,
 							sizeof(why));
 				if (rc != PX_OK)
@@ -560,7 +632,7 @@ int px_devcfg_open(const struct px_config *cfg,
 					     "%s", why);
 			}
 		} else {
-			rc = open_sim_haptic(h, cfg, dc, &dcfg, msg, cap);
+			rc = open_sim_haptic(h, cfg, dc, opt, &dcfg, msg, cap);
 		}
 		break;
 	case PX_CONFIG_BACKEND_HIDAPI: {
@@ -613,6 +685,7 @@ int px_devcfg_open(const struct px_config *cfg,
 								: PX_USB_INTERRUPT;
 		uc.frame_len = (size_t)c->frame_len;
 		uc.detach_kernel_driver = c->detach_kernel_driver;
+		uc.no_hotplug = c->no_hotplug;
 		uc.n_transfers = 4;
 		rc = px_usb_create(&dcfg, &uc, &h->dev, why, sizeof(why));
 		if (rc != PX_OK)
@@ -663,6 +736,11 @@ void px_devcfg_free(struct px_devcfg *h)
 	free(h->buttons);
 	free(h->signals);
 	free(h);
+}
+
+const char *px_devcfg_notes(const struct px_devcfg *h)
+{
+	return h ? h->notes : "";
 }
 
 struct px_dev *px_devcfg_dev(const struct px_devcfg *h)

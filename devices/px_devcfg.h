@@ -25,8 +25,17 @@
  *    kernel interface, separate endpoints of an in-process simulated bus;
  *    transport unix has one socket (bound at socket_path, sending to
  *    socket_path + ".peer"), so it takes signals or canopen, not both.
- *    A kernel bus with a bitrate is not reconfigured here (that needs
- *    privilege; ip link does it).
+ *    A kernel bus with a bitrate gets it (and restart_ms) through
+ *    libsocketcan before its sockets open (px_can_iface_set_bitrate():
+ *    needs CAP_NET_ADMIN unless the interface already runs at that
+ *    bitrate; on a virtual interface it is skipped, see
+ *    px_devcfg_notes()). The canopen master's own node id is node_id,
+ *    else the highest id no drive uses.
+ *  - faults: the sim device's faults go to the simulated device (haptic,
+ *    pose, gpio); a simulated bus's (transport sim or unix) wrap each
+ *    endpoint the device opens (px_can_fault_open(), seeded by the
+ *    device index), so they hit what this device receives.
+ *  - stuck_limit and min_report_interval_ns go to the device config.
  *
  * Errors: every failure leaves a one-line message naming the device, the
  * config key concerned and the back end's reason with its hint, e.g.
@@ -60,6 +69,10 @@ struct px_devcfg_options {
 	 * test can sit on it); NULL = the handle creates its own
 	 * (px_devcfg_can_sim()). Not owned. */
 	struct px_can_sim *can_sim;
+	/* Loop clock at the start of the run: fault windows of the config
+	 * (start_ns from the start of the run) are moved by it. 0 for a
+	 * virtual clock starting at 0. */
+	int64_t clock0_ns;
 };
 
 /*
@@ -75,6 +88,10 @@ PX_API int px_devcfg_open(const struct px_config *cfg,
 			  const struct px_config_device *dc,
 			  const struct px_devcfg_options *opt,
 			  struct px_devcfg **out, char *msg, size_t cap);
+
+/* What was noted while opening without failing it (e.g. a bitrate
+ * skipped on a virtual CAN interface), "" when nothing. Owned by h. */
+PX_API const char *px_devcfg_notes(const struct px_devcfg *h);
 
 /* Free the devices, master, buses and tables. NULL is a no-op. */
 PX_API void px_devcfg_free(struct px_devcfg *h);
