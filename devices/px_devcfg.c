@@ -429,6 +429,68 @@ static int can_bus_open(struct px_devcfg *h, const struct px_config *cfg,
 	return PX_OK;
 }
 
+static void drives_from_cfg(struct px_devcfg *h,
+			    const struct px_config_canopen *c)
+{
+	size_t i;
+	for (i = 0; i < c->n_drives && i < PX_CANOPEN_MAX_DRIVES; i++) {
+		const struct px_config_canopen_drive *d = &c->drives[i];
+		struct px_canopen_drive_cfg *o = &h->drives[i];
+		o->node_id = (uint8_t)d->node_id;
+		o->mode = d->mode == PX_CONFIG_CIA402_CSV   ? PX_CIA402_CSV
+			  : d->mode == PX_CONFIG_CIA402_CST ? PX_CIA402_CST
+							    : PX_CIA402_CSP;
+		o->joint = (int)d->joint;
+		o->counts_per_unit =
+			d->has_counts_per_unit ? d->counts_per_unit : 1.0;
+		o->rated_torque_n_m = d->rated_torque_n_m;
+	}
+	h->n_drives = i;
+}
+
+int px_devcfg_canopen_layout(const struct px_config *cfg,
+			     const struct px_config_device *dc,
+			     struct px_canopen_drive_cfg *drives, size_t cap,
+			     size_t *n_drives, struct px_canopen_pdo_map *pdo,
+			     char *msg, size_t mcap)
+{
+	struct px_devcfg *h;
+	char why[256], key[64];
+	int rc;
+	if (msg && mcap)
+		msg[0] = '\0';
+	if (!cfg || !dc || !drives || !n_drives || !pdo ||
+	    dc < cfg->devices || dc >= cfg->devices + cfg->n_devices)
+		return PX_E_INVAL;
+	if (dc->backend != PX_CONFIG_BACKEND_SOCKETCAN ||
+	    !dc->socketcan.canopen.present ||
+	    dc->socketcan.canopen.n_drives == 0)
+		return fail(msg, mcap, cfg, dc, "socketcan.canopen",
+			    PX_E_NOTFOUND, "no CANopen drives configured");
+	if (dc->socketcan.canopen.n_drives > PX_CANOPEN_MAX_DRIVES ||
+	    dc->socketcan.canopen.n_drives > cap)
+		return fail(msg, mcap, cfg, dc, "socketcan.canopen.drives",
+			    PX_E_NOSPC, "%zu drives; room for %zu",
+			    dc->socketcan.canopen.n_drives,
+			    cap < PX_CANOPEN_MAX_DRIVES ? cap
+							: PX_CANOPEN_MAX_DRIVES);
+	h = calloc(1, sizeof(*h));
+	if (!h)
+		return PX_E_NOMEM;
+	drives_from_cfg(h, &dc->socketcan.canopen);
+	rc = pdo_from_cfg(h, &dc->socketcan.canopen, key, sizeof(key), why,
+			  sizeof(why));
+	if (rc != PX_OK) {
+		fail(msg, mcap, cfg, dc, key, rc, "%s", why);
+	} else {
+		memcpy(drives, h->drives, h->n_drives * sizeof(*drives));
+		*n_drives = h->n_drives;
+		*pdo = h->pdo;
+	}
+	free(h);
+	return rc;
+}
+
 static int open_can(struct px_devcfg *h, const struct px_config *cfg,
 		    const struct px_config_device *dc,
 		    const struct px_devcfg_options *opt,
@@ -527,20 +589,7 @@ static int open_can(struct px_devcfg *h, const struct px_config *cfg,
 				    PX_E_INVAL, "%zu drives; the master takes "
 				    "at most %d", c->canopen.n_drives,
 				    PX_CANOPEN_MAX_DRIVES);
-		for (i = 0; i < c->canopen.n_drives; i++) {
-			const struct px_config_canopen_drive *d =
-				&c->canopen.drives[i];
-			struct px_canopen_drive_cfg *o = &h->drives[i];
-			o->node_id = (uint8_t)d->node_id;
-			o->mode = d->mode == PX_CONFIG_CIA402_CSV   ? PX_CIA402_CSV
-				  : d->mode == PX_CONFIG_CIA402_CST ? PX_CIA402_CST
-								    : PX_CIA402_CSP;
-			o->joint = (int)d->joint;
-			o->counts_per_unit =
-				d->has_counts_per_unit ? d->counts_per_unit : 1.0;
-			o->rated_torque_n_m = d->rated_torque_n_m;
-		}
-		h->n_drives = c->canopen.n_drives;
+		drives_from_cfg(h, &c->canopen);
 		rc = pdo_from_cfg(h, &c->canopen, key, sizeof(key), why,
 				  sizeof(why));
 		if (rc != PX_OK)

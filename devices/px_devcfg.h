@@ -116,6 +116,21 @@ px_devcfg_pdo(const struct px_devcfg *h);
 PX_API int px_devcfg_drives(const struct px_devcfg *h,
 			    struct px_canopen_drive_cfg *drives, size_t cap);
 
+/*
+ * The drive table and PDO layout a canopen device's master would use,
+ * without opening anything: for the other side of the bus (a simulated
+ * arm in its own process) to speak the same mapping. drives has cap
+ * entries. Returns PX_OK, PX_E_NOTFOUND (no canopen drives on dc),
+ * PX_E_NOSPC, PX_E_INVAL (a PDO entry the subset does not take; msg
+ * names it), PX_E_NOMEM.
+ */
+PX_API int px_devcfg_canopen_layout(const struct px_config *cfg,
+				    const struct px_config_device *dc,
+				    struct px_canopen_drive_cfg *drives,
+				    size_t cap, size_t *n_drives,
+				    struct px_canopen_pdo_map *pdo, char *msg,
+				    size_t mcap);
+
 #ifdef __cplusplus
 }
 #endif

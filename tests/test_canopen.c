@@ -15,6 +15,8 @@
 
 #include "px_alloc_count.h"
 #include "px_canopen.h"
+#include "px_config.h"
+#include "px_devcfg.h"
 #include "px_loop.h"
 #include "px_test.h"
 
@@ -388,8 +390,101 @@ static void test_master_with_simarm_on_vcan(void)
 	master_with_simarm(1);
 }
 
+/* proxima-simarm --config takes the controller's drives, PDO mapping
+ * and bus from the controller's own config: with a reordered RPDO and
+ * TPDO1 an arm on the default layout would never enable. */
+static void test_simarm_takes_the_config_mapping(void)
+{
+	const char *build = getenv("BUILD");
+	char tool[256], path[64], sock[64], msg[512];
+	struct px_config *cfg = NULL;
+	struct px_config_diag diag;
+	struct px_devcfg *h = NULL;
+	struct px_canopen *co;
+	struct px_canopen_drive_status ds;
+	double targets[2] = {0.3, -0.4};
+	pid_t pid;
+	int i, ok = 0, st;
+	FILE *f;
+	snprintf(tool, sizeof tool, "%s/bin/proxima-simarm",
+		 build && *build ? build : "build");
+	if (access(tool, X_OK) != 0)
+		PX_SKIP("%s not built", tool);
+	snprintf(path, sizeof path, "/tmp/pxarm-cfg-%d.yaml", (int)getpid());
+	snprintf(sock, sizeof sock, "/tmp/pxarm-cfg-%d", (int)getpid());
+	f = fopen(path, "w");
+	PX_CHECK(f != NULL);
+	if (!f)
+		return;
+	fprintf(f,
+		"version: 1\n"
+		"devices:\n"
+		"  - name: arm\n"
+		"    backend: socketcan\n"
+		"    socketcan:\n"
+		"      interface: simbus\n"
+		"      transport: unix\n"
+		"      socket_path: %s\n"
+		"      canopen:\n"
+		"        heartbeat_timeout_ns: 0\n"
+		"        rpdo: [{index: 0x6060, bits: 8}, {index: 0x607A, bits: 32}, {index: 0x6040, bits: 16}]\n"
+		"        tpdo1: [{index: 0x6064, bits: 32}, {index: 0x6041, bits: 16}]\n"
+		"        drives:\n"
+		"          - {node_id: 7, mode: csp, joint: 0, counts_per_unit: 5000}\n"
+		"          - {node_id: 3, mode: csp, joint: 1, counts_per_unit: 20000}\n",
+		sock);
+	fclose(f);
+	px_config_diag_init(&diag);
+	PX_CHECK_INT_EQ(px_config_load_file(path, &cfg, &diag), PX_OK);
+	if (!cfg)
+		goto out;
+	PX_CHECK_MSG(px_devcfg_open(cfg, &cfg->devices[0], NULL, &h, msg,
+				    sizeof msg) == PX_OK,
+		     "%s", msg);
+	if (!h)
+		goto out;
+	co = px_devcfg_canopen(h);
+	pid = fork();
+	PX_CHECK(pid >= 0);
+	if (pid == 0) {
+		execl(tool, tool, "--config", path, "--seconds", "20",
+		      (char *)NULL);
+		_exit(127);
+	}
+	for (i = 0; i < 10000 && !ok; i++) {
+		struct timespec ts = {0, 1000000};
+		int64_t now = mono();
+		px_canopen_rx(co, now);
+		px_canopen_tx(co, now, targets, 2, 1);
+		px_canopen_drive_status(co, 1, &ds);
+		ok = px_canopen_all_enabled(co) &&
+		     fabs(ds.position + 0.4) < 1e-3;
+		nanosleep(&ts, NULL);
+	}
+	kill(pid, SIGTERM);
+	waitpid(pid, &st, 0);
+	PX_CHECK_MSG(ok, "drive node 3: %s, position %g",
+		     px_cia402_state_name(ds.state), ds.position);
+	PX_CHECK(WIFEXITED(st) && WEXITSTATUS(st) == 0);
+	/* the layout flags and --config do not mix */
+	pid = fork();
+	if (pid == 0) {
+		freopen("/dev/null", "w", stderr);
+		execl(tool, tool, "--config", path, "--drives", "2",
+		      (char *)NULL);
+		_exit(127);
+	}
+	waitpid(pid, &st, 0);
+	PX_CHECK(WIFEXITED(st) && WEXITSTATUS(st) == 2);
+out:
+	px_devcfg_free(h);
+	px_config_free(cfg);
+	unlink(path);
+}
+
 static const struct px_test tests[] = {
 	PX_T(test_master_with_simarm_process),
+	PX_T(test_simarm_takes_the_config_mapping),
 	PX_T(test_master_with_simarm_on_vcan),
 	PX_T(test_statusword_table),
 	PX_T(test_drive_transitions),

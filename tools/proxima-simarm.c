@@ -1,7 +1,9 @@
 /* proxima-simarm: a simulated arm of CiA 402 drives speaking proxima's
  * CANopen-lite subset, as its own process, on a SocketCAN interface
  * (vcan0, can0) or on a simulated bus over a UNIX datagram socket - the
- * other side of a controller using px_canopen. */
+ * other side of a controller using px_canopen. With --config it takes
+ * the controller's drive table and PDO mapping (and, unless --can or
+ * --unix is given, its bus) from the controller's configuration file. */
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -9,6 +11,8 @@
 #include <time.h>
 
 #include "px_canopen.h"
+#include "px_config.h"
+#include "px_devcfg.h"
 
 static volatile sig_atomic_t stop;
 
@@ -30,15 +34,27 @@ static void usage(FILE *f)
 	fprintf(f,
 		"usage: proxima-simarm (--can IFACE | --unix LOCAL PEER) "
 		"[--drives N] [--mode csp|csv|cst] [--seconds S]\n"
+		"       proxima-simarm --config FILE [--device NAME] "
+		"[--can IFACE | --unix LOCAL PEER] [--seconds S]\n"
 		"Simulates N (default 6) CiA 402 drives, node ids 1..N, joint "
-		"i on node i+1,\n100000 counts per rad, rated torque 1 N m; "
-		"runs S seconds (default: until a signal).\n");
+		"i on node i+1,\n100000 counts per rad, rated torque 1 N m, "
+		"the default PDO layout; runs S seconds\n(default: until a "
+		"signal). With --config, the drives (node ids, modes, joints, "
+		"counts_per_unit,\nrated torque) and the rpdo/tpdo1/tpdo2 "
+		"mapping are those of the controller's socketcan\ndevice NAME "
+		"(default: the first with canopen drives), and so is the bus: "
+		"its kernel\ninterface, or for transport unix the other end "
+		"(binds socket_path.peer, sends to\nsocket_path).\n");
 }
 
 int main(int argc, char **argv)
 {
 	const char *iface = NULL, *local = NULL, *peer = NULL;
-	int n = 6, mode = PX_CIA402_CSV, i, rc, e;
+	const char *config = NULL, *devname = NULL;
+	int n = 6, mode = PX_CIA402_CSV, i, rc, e, layout_flags = 0;
+	struct px_config *cfg = NULL;
+	struct px_canopen_pdo_map pdo;
+	char upeer[256], ulocal[256];
 	double seconds = 0;
 	struct px_can_bus *bus = NULL;
 	struct px_canopen_drive_cfg drv[PX_CANOPEN_MAX_DRIVES];
@@ -52,12 +68,18 @@ int main(int argc, char **argv)
 		} else if (!strcmp(argv[i], "--unix") && i + 2 < argc) {
 			local = argv[++i];
 			peer = argv[++i];
+		} else if (!strcmp(argv[i], "--config") && i + 1 < argc) {
+			config = argv[++i];
+		} else if (!strcmp(argv[i], "--device") && i + 1 < argc) {
+			devname = argv[++i];
 		} else if (!strcmp(argv[i], "--drives") && i + 1 < argc) {
 			n = atoi(argv[++i]);
+			layout_flags = 1;
 		} else if (!strcmp(argv[i], "--seconds") && i + 1 < argc) {
 			seconds = atof(argv[++i]);
 		} else if (!strcmp(argv[i], "--mode") && i + 1 < argc) {
 			const char *m = argv[++i];
+			layout_flags = 1;
 			mode = !strcmp(m, "csp") ? PX_CIA402_CSP
 			       : !strcmp(m, "cst") ? PX_CIA402_CST
 			       : !strcmp(m, "csv") ? PX_CIA402_CSV
@@ -75,8 +97,75 @@ int main(int argc, char **argv)
 			return 2;
 		}
 	}
+	if (config) {
+		static struct px_config_diag diag;
+		const struct px_config_device *dc = NULL;
+		size_t k, nd = 0;
+		if (layout_flags) {
+			fprintf(stderr, "proxima-simarm: --drives and --mode "
+				"come from the config with --config\n");
+			return 2;
+		}
+		px_config_diag_init(&diag);
+		rc = px_config_load_file(config, &cfg, &diag);
+		if (rc != PX_OK) {
+			px_config_diag_print(&diag, stderr);
+			fprintf(stderr, "proxima-simarm: %s: invalid "
+				"configuration\n", config);
+			return 1;
+		}
+		for (k = 0; k < cfg->n_devices && !dc; k++) {
+			const struct px_config_device *d = &cfg->devices[k];
+			if (devname ? !strcmp(d->name, devname)
+				    : d->backend == PX_CONFIG_BACKEND_SOCKETCAN &&
+					      d->socketcan.canopen.n_drives)
+				dc = d;
+		}
+		if (!dc) {
+			fprintf(stderr, "proxima-simarm: %s: %s\n", config,
+				devname ? "no device of that name"
+					: "no socketcan device with canopen "
+					  "drives");
+			px_config_free(cfg);
+			return 1;
+		}
+		rc = px_devcfg_canopen_layout(cfg, dc, drv,
+					      PX_CANOPEN_MAX_DRIVES, &nd, &pdo,
+					      msg, sizeof msg);
+		if (rc != PX_OK) {
+			fprintf(stderr, "proxima-simarm: %s: %s\n", config,
+				msg[0] ? msg : px_strerror(rc));
+			px_config_free(cfg);
+			return 1;
+		}
+		n = (int)nd;
+		if (!iface && !local) {
+			const struct px_config_socketcan *c = &dc->socketcan;
+			if (c->transport == PX_CONFIG_CAN_KERNEL) {
+				iface = c->interface;
+			} else if (c->transport == PX_CONFIG_CAN_UNIX) {
+				/* the controller binds socket_path and sends
+				 * to socket_path.peer: the other end */
+				snprintf(ulocal, sizeof ulocal, "%s.peer",
+					 c->socket_path);
+				snprintf(upeer, sizeof upeer, "%s",
+					 c->socket_path);
+				local = ulocal;
+				peer = upeer;
+			} else {
+				fprintf(stderr, "proxima-simarm: device '%s' is "
+					"on an in-process simulated bus "
+					"(transport sim), which another process "
+					"cannot join: use transport unix or give "
+					"--can / --unix\n", dc->name);
+				px_config_free(cfg);
+				return 2;
+			}
+		}
+	}
 	if ((!iface && !local) || n < 1 || n > PX_CANOPEN_MAX_DRIVES) {
 		usage(stderr);
+		px_config_free(cfg);
 		return 2;
 	}
 	if (iface) {
@@ -89,9 +178,10 @@ int main(int argc, char **argv)
 	}
 	if (rc != PX_OK) {
 		fprintf(stderr, "proxima-simarm: %s\n", msg);
+		px_config_free(cfg);
 		return 1;
 	}
-	for (i = 0; i < n; i++) {
+	for (i = 0; i < n && !config; i++) {
 		drv[i].node_id = (uint8_t)(i + 1);
 		drv[i].mode = mode;
 		drv[i].joint = i;
@@ -99,16 +189,19 @@ int main(int argc, char **argv)
 		drv[i].rated_torque_n_m = 1.0;
 	}
 	memset(&sc, 0, sizeof sc);
+	sc.pdo = config ? &pdo : NULL;
 	sc.drives = drv;
 	sc.n_drives = (size_t)n;
 	if (px_canopen_sim_create(&sc, bus, &sim) != PX_OK) {
 		fprintf(stderr, "proxima-simarm: cannot create the arm\n");
 		px_can_bus_close(bus);
+		px_config_free(cfg);
 		return 1;
 	}
 	signal(SIGINT, on_signal);
 	signal(SIGTERM, on_signal);
-	printf("proxima-simarm: %d drives on %s\n", n, iface ? iface : local);
+	printf("proxima-simarm: %d drives on %s%s%s\n", n, iface ? iface : local,
+	       config ? ", layout from " : "", config ? config : "");
 	fflush(stdout);
 	t0 = next = mono();
 	while (!stop && (seconds <= 0 || mono() - t0 < (int64_t)(seconds * 1e9))) {
@@ -125,5 +218,6 @@ int main(int argc, char **argv)
 	}
 	px_canopen_sim_free(sim);
 	px_can_bus_close(bus);
+	px_config_free(cfg);
 	return 0;
 }
