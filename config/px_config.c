@@ -798,9 +798,10 @@ static void sim_check(struct px_config_reader *r,
 	codec_check(r, map, &s->codec);
 	if (s->kind == PX_CONFIG_SIM_GPIO)
 		faults_check(r, map, s->faults, s->n_faults,
-			     FK(PX_CONFIG_FAULT_ESTOP) | FK(PX_CONFIG_FAULT_UNPLUG),
-			     "does not apply to simulated GPIO lines (estop, "
-			     "unplug)");
+			     ~(FK(PX_CONFIG_FAULT_NAN) |
+			       FK(PX_CONFIG_FAULT_BUS_OFF)),
+			     "does not apply to simulated GPIO lines (drop, "
+			     "delay, duplicate, corrupt, stuck, unplug, estop)");
 	else
 		faults_check(r, map, s->faults, s->n_faults,
 			     ~(FK(PX_CONFIG_FAULT_BUS_OFF) |

@@ -104,20 +104,95 @@ struct gsim {
 	int64_t ev_t[SIMQ];
 	int ev_v[SIMQ];
 	unsigned ev_head, ev_n;
-	int physical_in;
+	int physical_in;      /* the line's true level */
 	int phys_out[PX_GPIO__ROLES];
 	int in_estop_fault;
 	int unplugged;
+	/* edge events as the reader sees them (faults drop, delay,
+	 * duplicate, corrupt act on them) */
+	int delivered;        /* level of the last event handed on */
+	int64_t resync_ns;    /* last level check that corrected it */
+	int64_t dl_t[SIMQ], dl_due[SIMQ];
+	int dl_v[SIMQ];
+	unsigned dl_head, dl_n;
+	uint64_t rng;
 };
+
+static double gunit(struct gsim *g)
+{
+	uint64_t x = g->rng;
+	x ^= x >> 12;
+	x ^= x << 25;
+	x ^= x >> 27;
+	g->rng = x;
+	return (double)((x * 2685821657736338717ull) >> 11) *
+	       (1.0 / 9007199254740992.0);
+}
+
+/* The fault of kind in effect at t; roll: also draw its probability. */
+static const struct px_sim_fault *gfault_p(struct gsim *g, int kind, int64_t t,
+					   int roll)
+{
+	size_t i;
+	for (i = 0; i < g->n_faults; i++) {
+		const struct px_sim_fault *f = &g->faults[i];
+		double p;
+		if (f->kind != kind || t < f->start_ns ||
+		    t - f->start_ns >= f->duration_ns)
+			continue;
+		p = f->probability > 0 ? f->probability : 1.0;
+		if (!roll || p >= 1.0 || gunit(g) < p)
+			return f;
+	}
+	return NULL;
+}
 
 static const struct px_sim_fault *gfault(struct gsim *g, int kind, int64_t t)
 {
-	size_t i;
-	for (i = 0; i < g->n_faults; i++)
-		if (g->faults[i].kind == kind && t >= g->faults[i].start_ns &&
-		    t < g->faults[i].start_ns + g->faults[i].duration_ns)
-			return &g->faults[i];
-	return NULL;
+	return gfault_p(g, kind, t, 0);
+}
+
+/* An edge event reaches the reader. The same level again is a repeated
+ * event: harmless, counted, unless it is a late one the level check
+ * already made up for. */
+static void gfeed(struct px_dev *d, struct gsim *g, int v, int64_t t)
+{
+	if (v == g->delivered) {
+		if (t > g->resync_ns)
+			px_dev_record(d, PX_DEV_ERR_DUPLICATE, PX_E_CORRUPT, 0,
+				      g->io.cfg.line[PX_GPIO_ESTOP].offset, NULL,
+				      "e-stop edge event repeated", t);
+		return;
+	}
+	g->delivered = v;
+	px__dio_edge(&g->io, v, t);
+}
+
+/* A scripted level change at t (the line changed then): what the edge
+ * event suffers. */
+static void gevent(struct px_dev *d, struct gsim *g, int v, int64_t t)
+{
+	const struct px_sim_fault *f;
+	if (gfault_p(g, PX_SIM_FAULT_DROP, t, 1))
+		return; /* lost: the level check finds it */
+	if (gfault_p(g, PX_SIM_FAULT_CORRUPT, t, 1)) {
+		/* the event reports the other edge */
+		gfeed(d, g, !v, t);
+		return;
+	}
+	if ((f = gfault_p(g, PX_SIM_FAULT_DELAY, t, 1)) || g->dl_n) {
+		unsigned k = (g->dl_head + g->dl_n) % SIMQ;
+		if (g->dl_n == SIMQ)
+			return;
+		g->dl_t[k] = t;
+		g->dl_v[k] = v;
+		g->dl_due[k] = t + (f ? f->delay_ns : 0);
+		g->dl_n++;
+		return;
+	}
+	gfeed(d, g, v, t);
+	if (gfault_p(g, PX_SIM_FAULT_DUPLICATE, t, 1))
+		gfeed(d, g, v, t);
 }
 
 static void gsim_advance(struct px_dev *d, struct gsim *g, int64_t now)
@@ -125,12 +200,21 @@ static void gsim_advance(struct px_dev *d, struct gsim *g, int64_t now)
 	const struct px_sim_fault *f;
 	int pressed_phys = !g->io.cfg.line[PX_GPIO_ESTOP].active_low;
 	while (g->ev_n && g->ev_t[g->ev_head] <= now) {
-		g->physical_in = g->ev_v[g->ev_head];
-		if (!g->in_estop_fault)
-			px__dio_edge(&g->io, g->physical_in,
-				     g->ev_t[g->ev_head]);
+		int64_t t = g->ev_t[g->ev_head];
+		int v = g->ev_v[g->ev_head];
 		g->ev_head = (g->ev_head + 1) % SIMQ;
 		g->ev_n--;
+		if (gfault(g, PX_SIM_FAULT_STUCK, t))
+			continue; /* the contact is welded: the line holds */
+		g->physical_in = v;
+		if (!g->in_estop_fault)
+			gevent(d, g, v, t);
+	}
+	while (g->dl_n && g->dl_due[g->dl_head] <= now) {
+		if (!g->in_estop_fault)
+			gfeed(d, g, g->dl_v[g->dl_head], g->dl_t[g->dl_head]);
+		g->dl_head = (g->dl_head + 1) % SIMQ;
+		g->dl_n--;
 	}
 	f = gfault(g, PX_SIM_FAULT_ESTOP, now);
 	if (f && !g->in_estop_fault) {
@@ -144,6 +228,8 @@ static void gsim_advance(struct px_dev *d, struct gsim *g, int64_t now)
 		g->in_estop_fault = 0;
 		px__dio_edge(&g->io, g->physical_in,
 			     now > 0 ? now : 0);
+		g->delivered = g->physical_in;
+		g->resync_ns = now;
 	}
 	if (gfault(g, PX_SIM_FAULT_UNPLUG, now)) {
 		if (!g->unplugged) {
@@ -160,6 +246,20 @@ static int gsim_estop(struct px_dev *d, int64_t now, int *pressed)
 {
 	struct gsim *g = px_dev_impl(d);
 	gsim_advance(d, g, now);
+	/* Level check: the line is read besides its edge events, so a lost,
+	 * late or wrong event is corrected within a cycle (a press is
+	 * never missed for longer than that). */
+	if (!g->in_estop_fault && !g->unplugged &&
+	    g->delivered != g->physical_in) {
+		px_dev_record(d, PX_DEV_ERR_IO, PX_E_CORRUPT, 0,
+			      g->io.cfg.line[PX_GPIO_ESTOP].offset, NULL,
+			      "e-stop line level differs from its edge events "
+			      "(event lost, late or wrong): resynchronised",
+			      now);
+		g->delivered = g->physical_in;
+		g->resync_ns = now;
+		px__dio_edge(&g->io, g->physical_in, now);
+	}
 	return px__dio_estop(d, &g->io, now, g->unplugged, pressed);
 }
 
@@ -173,6 +273,23 @@ static int gsim_write(struct px_dev *d, int which, int value, int64_t now)
 	if (g->unplugged)
 		return PX_E_NODEV;
 	g->io.out[role] = value;
+	if (gfault(g, PX_SIM_FAULT_STUCK, now)) {
+		/* a welded relay: the output keeps its level; the feedback
+		 * (readback) shows it */
+		if (g->phys_out[role] !=
+		    px__dio_physical(&g->io, role, value)) {
+			px_dev_record(d, PX_DEV_ERR_IO, PX_E_IO, 0,
+				      g->io.cfg.line[role].offset, NULL,
+				      role == PX_GPIO_ENABLE
+					      ? "enable output stuck: readback "
+						"differs from the command"
+					      : "timing output stuck: readback "
+						"differs from the command",
+				      now);
+			return PX_E_IO;
+		}
+		return PX_OK;
+	}
 	g->phys_out[role] = px__dio_physical(&g->io, role, value);
 	return PX_OK;
 }
@@ -204,16 +321,25 @@ int px_gpio_sim_create(const struct px_dev_config *dcfg,
 				 nm, PX_SIM_MAX_FAULTS);
 		return PX_E_INVAL;
 	}
-	for (i = 0; i < n_faults; i++)
-		if ((faults[i].kind != PX_SIM_FAULT_ESTOP &&
-		     faults[i].kind != PX_SIM_FAULT_UNPLUG) ||
-		    faults[i].duration_ns <= 0) {
+	for (i = 0; i < n_faults; i++) {
+		int k = faults[i].kind;
+		if (k <= PX_SIM_FAULT_NONE || k >= PX_SIM_FAULT__COUNT ||
+		    k == PX_SIM_FAULT_NAN || k == PX_SIM_FAULT_BUSOFF ||
+		    faults[i].duration_ns <= 0 ||
+		    (k == PX_SIM_FAULT_DELAY && faults[i].delay_ns <= 0)) {
 			if (msg)
-				snprintf(msg, cap, "%s: faults[%zu]: simulated "
-					 "GPIO takes estop and unplug faults "
-					 "with duration_ns > 0", nm, i);
+				snprintf(msg, cap, "%s: faults[%zu] (%s): "
+					 "simulated GPIO takes drop, delay "
+					 "(delay_ns > 0), duplicate, corrupt, "
+					 "stuck, unplug and estop, with "
+					 "duration_ns > 0 (nan and bus_off do "
+					 "not apply to digital lines)",
+					 nm, i,
+					 px_sim_fault_name(k) ? px_sim_fault_name(k)
+							      : "?");
 			return PX_E_INVAL;
 		}
+	}
 	if (cfg->line[PX_GPIO_ESTOP].debounce_ns < 0) {
 		if (msg)
 			snprintf(msg, cap, "%s: debounce_ns must be >= 0", nm);
@@ -225,6 +351,9 @@ int px_gpio_sim_create(const struct px_dev_config *dcfg,
 	g = px_dev_impl(*out);
 	/* at rest: the e-stop line at its released level */
 	g->physical_in = cfg->line[PX_GPIO_ESTOP].active_low ? 1 : 0;
+	g->delivered = g->physical_in;
+	g->resync_ns = INT64_MIN;
+	g->rng = 0x9E3779B97F4A7C15ull;
 	px__dio_init(&g->io, cfg, g->physical_in, 0);
 	g->io.cfg.chip = NULL;
 	for (r = PX_GPIO_ENABLE; r < PX_GPIO__ROLES; r++)

@@ -74,8 +74,21 @@ PX_API int px_debounce_get(struct px_debounce *db, int64_t now_ns);
 /*
  * Simulated GPIO lines: the roles of cfg (chip ignored), inputs driven
  * with px_gpio_sim_drive(), outputs read back with px_gpio_sim_output().
- * Faults (px_sim_fault windows on the time given to the reads): estop
- * (line held at pressed, after a short bounce), unplug (device gone).
+ * Faults (px_sim_fault windows on the time given to the reads):
+ *   estop      the line held at pressed, after a short bounce;
+ *   unplug     the device gone (e-stop reads pressed, PX_E_NODEV);
+ *   drop, delay, duplicate, corrupt: the e-stop's edge events lost,
+ *              late by delay_ns, repeated, or reporting the other edge.
+ *              Each read also checks the line's level against the
+ *              events: a lost, late or wrong event is corrected within
+ *              one read and recorded (a press is never missed), a
+ *              repeated one is counted as a duplicate;
+ *   stuck      a welded contact: the e-stop line keeps its level (not
+ *              detectable on one channel), and outputs keep theirs:
+ *              writes that would change them fail with PX_E_IO and a
+ *              record ("enable output stuck: readback differs"), as a
+ *              relay's feedback contact shows it.
+ * nan and bus_off do not apply to digital lines (PX_E_INVAL).
  * Returns PX_OK, PX_E_INVAL (msg says what), PX_E_NOMEM.
  */
 PX_API int px_gpio_sim_create(const struct px_dev_config *dcfg,

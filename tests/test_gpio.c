@@ -143,13 +143,15 @@ struct app {
 	int out_enable[1200];
 	int64_t read_ns[1200];
 	int nodev;
+	int write_errors;
+	int trip_at;             /* cycle index at which the app trips; 0 none */
+	struct px_loop *loop;
 };
 
 static int a_read(struct px_loop *l, const struct px_loop_cycle *c, void *u)
 {
 	struct app *a = u;
 	int p = 0, rc;
-	(void)l;
 	rc = px_dev_estop_read(a->io, c->read_ns, &p);
 	if (c->index < 1200) {
 		a->pressed[c->index] = p;
@@ -157,6 +159,8 @@ static int a_read(struct px_loop *l, const struct px_loop_cycle *c, void *u)
 	}
 	if (rc == PX_E_NODEV)
 		a->nodev++;
+	if (a->trip_at && (int)c->index == a->trip_at)
+		px_loop_trip(l); /* the application asks for safe state */
 	return PX_OK; /* the e-stop trips the loop itself */
 }
 
@@ -172,11 +176,16 @@ static int a_compute(struct px_loop *l, const struct px_loop_cycle *c, void *u)
 static int a_write(struct px_loop *l, const struct px_loop_cycle *c, void *u)
 {
 	struct app *a = u;
+	int rc;
 	(void)l;
-	px_dev_dio_write(a->io, PX_DIO_ENABLE, a->enable, c->write_ns);
+	rc = px_dev_dio_write(a->io, PX_DIO_ENABLE, a->enable, c->write_ns);
 	px_dev_dio_write(a->io, PX_DIO_TIMING, (int)(c->index & 1), c->write_ns);
 	if (c->index < 1200)
 		a->out_enable[c->index] = px_gpio_sim_output(a->io, PX_GPIO_ENABLE);
+	if (rc == PX_E_IO) {
+		a->write_errors++;
+		return rc; /* the enable did not follow: a loop fault */
+	}
 	return PX_OK;
 }
 
@@ -249,6 +258,173 @@ static void test_estop_trips_loop_and_holds_safe_state(void)
 	PX_CHECK_INT_EQ(a.pressed[601], 1);
 	px_loop_free(l);
 	px_dev_free(a.io);
+}
+
+/* One fault window at 50-250 ms; the e-stop is pressed at 100 ms and
+ * released at 150 ms (active-low, 5 ms debounce). */
+struct gfault_run {
+	int64_t first_pressed, first_released; /* read times, -1 none */
+	int safe_during, safe_at_end;
+	struct px_loop_status during;
+	struct px_dev_status ds;
+	int write_errors;
+	int enable_at_130;
+};
+
+static void run_gpio_fault(int kind, int64_t delay_ns, int trip_at,
+			   struct gfault_run *out)
+{
+	struct px_gpio_config c = io_cfg(1);
+	struct px_sim_fault f = {kind, 50000000, 200000000, 1.0, delay_ns};
+	struct px_dev_config dc;
+	struct px_loop_config lc;
+	struct px_loop *l;
+	static struct app a;
+	char msg[300];
+	uint64_t r;
+	int i;
+	memset(&a, 0, sizeof a);
+	memset(out, 0, sizeof *out);
+	px_dev_config_default(&dc);
+	dc.name = "io";
+	PX_CHECK_MSG(px_gpio_sim_create(&dc, &c, &f, 1, &a.io, msg, sizeof msg) ==
+			     PX_OK,
+		     "%s", msg);
+	if (!a.io)
+		return;
+	px_gpio_sim_drive(a.io, PX_GPIO_ESTOP, 0, 100000000);
+	px_gpio_sim_drive(a.io, PX_GPIO_ESTOP, 1, 150000000);
+	a.trip_at = trip_at;
+	px_loop_config_default(&lc);
+	lc.clock = PX_LOOP_CLOCK_VIRTUAL;
+	lc.read = a_read;
+	lc.compute = a_compute;
+	lc.write = a_write;
+	lc.user = &a;
+	lc.hist_bins = 100;
+	PX_CHECK_INT_EQ(px_loop_create(&lc, &l), PX_OK);
+	PX_CHECK_INT_EQ(px_loop_enable_add(l, "enable", &a.enable), 0);
+	PX_CHECK_INT_EQ(px_dev_attach(a.io, l), 0);
+	r = px_alloc_region_begin();
+	PX_CHECK_INT_EQ(px_loop_run(l, 200), PX_OK); /* to 200 ms */
+	PX_CHECK_INT_EQ(px_alloc_region_end(r), 0);
+	out->safe_during = px_loop_is_safe(l);
+	px_loop_status(l, &out->during);
+	PX_CHECK_INT_EQ(px_loop_run(l, 100), PX_OK); /* window over */
+	for (i = 0; i < 3; i++) {
+		px_loop_rearm(l);
+		px_loop_run(l, 20);
+	}
+	out->safe_at_end = px_loop_is_safe(l);
+	out->first_pressed = out->first_released = -1;
+	for (i = 0; i < 300; i++) {
+		if (a.pressed[i] && out->first_pressed < 0)
+			out->first_pressed = a.read_ns[i];
+		if (out->first_pressed >= 0 && !a.pressed[i] &&
+		    out->first_released < 0)
+			out->first_released = a.read_ns[i];
+	}
+	out->write_errors = a.write_errors;
+	out->enable_at_130 = a.out_enable[130];
+	px_dev_status(a.io, &out->ds);
+	px_loop_free(l);
+	px_dev_free(a.io);
+}
+
+/* Lost, late and wrong edge events: the level check corrects them in the
+ * same read, so the press is seen as without the fault (100 ms + 5 ms
+ * debounce) and trips the loop; the correction is recorded. */
+static void test_gpio_fault_lost_late_wrong_events(void)
+{
+	static const int kinds[] = {PX_SIM_FAULT_DROP, PX_SIM_FAULT_DELAY,
+				    PX_SIM_FAULT_CORRUPT};
+	struct gfault_run fr;
+	size_t k;
+	for (k = 0; k < 3; k++) {
+		const char *nm = px_sim_fault_name(kinds[k]);
+		run_gpio_fault(kinds[k], 20000000, 0, &fr);
+		PX_CHECK_MSG(fr.first_pressed == 105000000, "%s: pressed at %lld",
+			     nm, (long long)fr.first_pressed);
+		PX_CHECK_MSG(fr.first_released == 155000000,
+			     "%s: released at %lld", nm,
+			     (long long)fr.first_released);
+		PX_CHECK_MSG(fr.during.safe_entries >= 1 &&
+				     fr.during.safe_cause == PX_FAULT_TRIP,
+			     "%s: cause %d", nm, (int)fr.during.safe_cause);
+		PX_CHECK_MSG(!fr.safe_at_end, "%s: safe after re-arm", nm);
+		PX_CHECK_MSG(strstr(fr.ds.last_msg, "io (sim-gpio): ") &&
+				     strstr(fr.ds.last_msg,
+					    "differs from its edge events"),
+			     "%s: %s", nm, fr.ds.last_msg);
+		PX_CHECK_MSG(fr.ds.io_errors == 2, "%s: %llu", nm,
+			     (unsigned long long)fr.ds.io_errors);
+	}
+	/* events that arrive as they happened need no correction (an unplug
+	 * window reads fail-safe pressed, and corrects nothing either) */
+	run_gpio_fault(PX_SIM_FAULT_UNPLUG, 0, 0, &fr);
+	PX_CHECK_INT_EQ(fr.ds.io_errors, 0);
+	PX_CHECK_INT_EQ(fr.ds.unplugs, 1);
+}
+
+static void test_gpio_fault_duplicate_events(void)
+{
+	struct gfault_run fr;
+	run_gpio_fault(PX_SIM_FAULT_DUPLICATE, 0, 0, &fr);
+	PX_CHECK_INT_EQ(fr.first_pressed, 105000000);
+	PX_CHECK_INT_EQ(fr.first_released, 155000000);
+	PX_CHECK_INT_EQ(fr.ds.duplicates, 2);
+	PX_CHECK_INT_EQ(fr.ds.io_errors, 0);
+	PX_CHECK_MSG(strstr(fr.ds.last_msg, "e-stop edge event repeated") ||
+			     fr.ds.last_kind == PX_DEV_ERR_ESTOP,
+		     "%s", fr.ds.last_msg);
+	PX_CHECK(fr.safe_during || fr.during.safe_entries >= 1);
+	PX_CHECK(!fr.safe_at_end);
+}
+
+/* A welded contact: the e-stop line holds (one channel cannot see it:
+ * the press at 100 ms is missed), and the enable relay holds too: when
+ * the application trips at 120 ms the enable output does not drop, the
+ * readback shows it, and the write phase fails every cycle. */
+static void test_gpio_fault_stuck(void)
+{
+	struct gfault_run fr;
+	run_gpio_fault(PX_SIM_FAULT_STUCK, 0, 120, &fr);
+	PX_CHECK_INT_EQ(fr.first_pressed, -1);
+	PX_CHECK_INT_EQ(fr.enable_at_130, 1); /* welded at 1 */
+	PX_CHECK_MSG(fr.write_errors >= 120 && fr.write_errors <= 131, "%d",
+		     fr.write_errors);
+	PX_CHECK(fr.safe_during);
+	PX_CHECK(fr.during.faults >= 2);
+	PX_CHECK_MSG(strstr(fr.ds.last_msg, "enable output stuck: readback "
+					   "differs from the command") != NULL,
+		     "%s", fr.ds.last_msg);
+	PX_CHECK(!fr.safe_at_end);
+}
+
+static void test_gpio_fault_kinds_refused(void)
+{
+	struct px_gpio_config c = io_cfg(1);
+	struct px_sim_fault f = {PX_SIM_FAULT_NAN, 0, 1000, 1.0, 0};
+	struct px_dev_config dc;
+	struct px_dev *d = NULL;
+	char msg[300];
+	px_dev_config_default(&dc);
+	dc.name = "io";
+	PX_CHECK_INT_EQ(px_gpio_sim_create(&dc, &c, &f, 1, &d, msg, sizeof msg),
+			PX_E_INVAL);
+	PX_CHECK_MSG(strstr(msg, "io: faults[0] (nan)") &&
+			     strstr(msg, "do not apply to digital lines"),
+		     "%s", msg);
+	f.kind = PX_SIM_FAULT_BUSOFF;
+	PX_CHECK_INT_EQ(px_gpio_sim_create(&dc, &c, &f, 1, &d, msg, sizeof msg),
+			PX_E_INVAL);
+	f.kind = PX_SIM_FAULT_DELAY;
+	PX_CHECK_INT_EQ(px_gpio_sim_create(&dc, &c, &f, 1, &d, msg, sizeof msg),
+			PX_E_INVAL);
+	f.delay_ns = 1000;
+	PX_CHECK_INT_EQ(px_gpio_sim_create(&dc, &c, &f, 1, &d, msg, sizeof msg),
+			PX_OK);
+	px_dev_free(d);
 }
 
 static void test_gpiod_open_path(void)
@@ -401,6 +577,10 @@ static void test_gpiod_by_name_on_gpio_sim(void)
 }
 
 static const struct px_test tests[] = {
+	PX_T(test_gpio_fault_lost_late_wrong_events),
+	PX_T(test_gpio_fault_duplicate_events),
+	PX_T(test_gpio_fault_stuck),
+	PX_T(test_gpio_fault_kinds_refused),
 	PX_T(test_debounce_matches_reference),
 	PX_T(test_chatter_gives_one_press),
 	PX_T(test_estop_trips_loop_and_holds_safe_state),
