@@ -472,6 +472,29 @@ static void test_raw_open_path(void)
 	px_can_bus_close(b);
 }
 
+/* The bitrate path through the real libsocketcan/sysfs: vcan0 (the VM
+ * suite) is virtual, so the bitrate is refused with a note and nothing
+ * is changed; without vcan0 the interface is named as missing. */
+static void test_bitrate_on_vcan_or_absent(void)
+{
+	char msg[400];
+	int e = -1, rc;
+	rc = px_can_iface_set_bitrate("vcan0", 500000, 0, &e, msg, sizeof msg);
+	if (if_nametoindex("vcan0") == 0) {
+		PX_CHECK_INT_EQ(rc, PX_E_NODEV);
+		PX_CHECK_MSG(strstr(msg, "vcan0: no such network interface") !=
+				     NULL,
+			     "%s", msg);
+		PX_CHECK_INT_EQ(e, ENODEV);
+		return;
+	}
+	PX_CHECK_INT_EQ(rc, PX_E_UNSUPPORTED);
+	PX_CHECK_INT_EQ(e, 0);
+	PX_CHECK_MSG(strstr(msg, "vcan0: a virtual CAN interface (vcan, vxcan) "
+				 "has no bitrate") != NULL,
+		     "%s", msg);
+}
+
 static void test_raw_on_vcan(void)
 {
 	/* Runs where vcan0 exists (the VM suite). Two sockets on vcan0: the
@@ -861,6 +884,7 @@ static void test_record_then_replay(void)
 }
 
 static const struct px_test tests[] = {
+	PX_T(test_bitrate_on_vcan_or_absent),
 	PX_T(test_record_then_replay),
 	PX_T(test_can_faults_reach_the_watchdog),
 	PX_T(test_signal_bits_match_dbc_reference),
