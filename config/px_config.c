@@ -474,6 +474,15 @@ static void signal_check(struct px_config_reader *r,
 	if (s->scale == 0.0)
 		px_config_reader_error(r, px_config_node_get(map, "scale"),
 				       "scale", "must not be 0");
+	if (s->is_float && s->length != 32 && s->length != 64)
+		px_config_reader_error(r, px_config_node_get(map, "length"),
+				       "length",
+				       "a float signal is 32 (binary32) or 64 "
+				       "(binary64) bits long");
+	if (s->is_float && s->is_signed)
+		px_config_reader_error(r, px_config_node_get(map, "signed"),
+				       "signed",
+				       "does not apply to a float signal");
 	if (s->has_min && s->has_max && !(s->min < s->max))
 		px_config_reader_error(r, px_config_node_get(map, "max"), "max",
 				       "must be greater than min");
@@ -515,6 +524,7 @@ static const struct px_config_key signal_keys[] = {
 	K_DBLP(struct px_config_can_signal, max, "max", -BIG, BIG, has_max),
 	K_ENUM(struct px_config_can_signal, axis, "axis", 0, signal_axis_names,
 	       PX_CONFIG_SIGNAL_AXIS_NONE),
+	K_BOOL(struct px_config_can_signal, is_float, "float", 0),
 };
 SCHEMA(signal_schema, "signal", signal_keys, signal_check);
 

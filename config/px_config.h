@@ -502,6 +502,7 @@ struct px_config_can_signal {
 	/* What the signal carries on the device (enum px_config_signal_axis):
 	 * an input feeds a pose axis, an output a force/torque channel. */
 	int axis;
+	bool is_float;       /* IEEE 754 payload: length 32 or 64 */
 };
 
 /* Key "axis" of a CAN signal: none (a plain signal, read by name), a pose

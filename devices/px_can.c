@@ -3,6 +3,7 @@
 #include <ctype.h>
 #include <errno.h>
 #include <inttypes.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -53,6 +54,8 @@ int px_can_signal_check(const struct px_can_signal *s, size_t frame_len)
 	    (s->has_min && s->has_max && s->min > s->max))
 		return PX_E_INVAL;
 	if (px_can_signal_bytes(s) > frame_len)
+		return PX_E_INVAL;
+	if (s->is_float && s->length != 32 && s->length != 64)
 		return PX_E_INVAL;
 	return PX_OK;
 }
@@ -125,8 +128,27 @@ int px_can_signal_decode(const struct px_can_signal *s, const uint8_t *data,
 	rc = px_can_signal_get_raw(s, data, len, &raw);
 	if (rc != PX_OK)
 		return rc;
-	v = (s->is_signed ? (double)raw : (double)(uint64_t)raw) * s->scale +
-	    s->offset;
+	if (s->is_float) {
+		double x;
+		if (s->length == 32) {
+			uint32_t b = (uint32_t)(uint64_t)raw;
+			float fl;
+			memcpy(&fl, &b, sizeof fl);
+			x = fl;
+		} else if (s->length == 64) {
+			uint64_t b = (uint64_t)raw;
+			memcpy(&x, &b, sizeof x);
+		} else {
+			return PX_E_INVAL;
+		}
+		if (!isfinite(x))
+			return PX_E_NAN;
+		v = x * s->scale + s->offset;
+	} else {
+		v = (s->is_signed ? (double)raw : (double)(uint64_t)raw) *
+			    s->scale +
+		    s->offset;
+	}
 	if ((s->has_min && v < s->min) || (s->has_max && v > s->max) ||
 	    !isfinite(v))
 		return PX_E_RANGE;
@@ -156,6 +178,27 @@ int px_can_signal_encode(const struct px_can_signal *s, double value,
 		cl = 1;
 	}
 	w = s->length;
+	if (s->is_float) {
+		double x = (value - s->offset) / s->scale;
+		if (w == 32) {
+			float fl;
+			uint32_t b;
+			if (x > FLT_MAX || x < -FLT_MAX) {
+				x = x > 0 ? FLT_MAX : -FLT_MAX;
+				cl = 1;
+			}
+			fl = (float)x;
+			memcpy(&b, &fl, sizeof b);
+			raw = b;
+		} else if (w == 64) {
+			memcpy(&raw, &x, sizeof raw);
+		} else {
+			return PX_E_INVAL;
+		}
+		if (clamped)
+			*clamped = cl;
+		return px_can_signal_put_raw(s, data, len, raw);
+	}
 	r = round((value - s->offset) / s->scale);
 	if (s->is_signed) {
 		double hi = ldexp(1.0, (int)w - 1);

@@ -66,11 +66,16 @@ struct px_can_signal {
 	/* px_can dev: pose axis (enum px_axis) of an input, wrench channel
 	 * (enum px_wrench_axis) of an output; -1 none. */
 	int axis;
+	/* IEEE 754 payload (DBC SIG_VALTYPE_ 1 and 2): binary32 for length
+	 * 32, binary64 for length 64; is_signed does not apply. A NaN or
+	 * infinite input is PX_E_NAN. */
+	int is_float;
 };
 
 /* Check a signal against a frame of frame_len bytes (8 classic, up to
  * 64 FD): bits inside the frame, length, finite non-zero scale, min <=
- * max. Returns PX_OK or PX_E_INVAL. @note RT-safe. */
+ * max, a float signal 32 or 64 bits long. Returns PX_OK or PX_E_INVAL.
+ * @note RT-safe. */
 PX_API int px_can_signal_check(const struct px_can_signal *s,
 			       size_t frame_len);
 
@@ -89,7 +94,8 @@ PX_API int px_can_signal_put_raw(const struct px_can_signal *s,
 				 uint8_t *data, size_t len, uint64_t raw);
 
 /* Physical value of an input signal. PX_OK, PX_E_PARSE (short frame),
- * PX_E_RANGE (outside [min, max]: implausible), PX_E_INVAL.
+ * PX_E_RANGE (outside [min, max]: implausible), PX_E_NAN (a float
+ * signal carrying NaN or infinity), PX_E_INVAL.
  * @note RT-safe. */
 PX_API int px_can_signal_decode(const struct px_can_signal *s,
 				const uint8_t *data, size_t len, double *value);

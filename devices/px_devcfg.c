@@ -544,6 +544,7 @@ static int open_can(struct px_devcfg *h, const struct px_config *cfg,
 						? PX_BIG_ENDIAN
 						: PX_LITTLE_ENDIAN;
 			o->is_signed = s->is_signed;
+			o->is_float = s->is_float;
 			o->scale = s->scale;
 			o->offset = s->offset;
 			o->has_min = s->has_min;

@@ -103,13 +103,13 @@ static void test_signal_known_layouts_and_roundtrip(void)
 {
 	uint8_t d[8] = {0x12, 0x34, 0, 0, 0, 0, 0xAB, 0};
 	struct px_can_signal be16 = {"be", 0x100, 0, 0, 7, 16, PX_BIG_ENDIAN, 0,
-				     1.0, 0, 0, 0, 0, 0, -1};
+				     1.0, 0, 0, 0, 0, 0, -1, 0};
 	struct px_can_signal le16 = {"le", 0x100, 0, 0, 0, 16, PX_LITTLE_ENDIAN,
-				     0, 1.0, 0, 0, 0, 0, 0, -1};
+				     0, 1.0, 0, 0, 0, 0, 0, -1, 0};
 	struct px_can_signal st = {"ft_status", 0x1a0, 0, 0, 55, 8, PX_BIG_ENDIAN,
-				   0, 1.0, 0, 0, 0, 0, 0, -1};
+				   0, 1.0, 0, 0, 0, 0, 0, -1, 0};
 	struct px_can_signal ph = {"fz", 0x1a0, 0, 1, 32, 16, PX_LITTLE_ENDIAN, 1,
-				   0.02, 0.5, 1, 1, -500, 500, PX_WRENCH_FZ};
+				   0.02, 0.5, 1, 1, -500, 500, PX_WRENCH_FZ, 0};
 	int64_t raw;
 	double v;
 	int cl, it;
@@ -151,6 +151,69 @@ static void test_signal_known_layouts_and_roundtrip(void)
 	PX_CHECK_INT_EQ(px_can_signal_check(&le16, 8), PX_OK);
 	le16.scale = 0;
 	PX_CHECK_INT_EQ(px_can_signal_check(&le16, 8), PX_E_INVAL);
+}
+
+/* Float signals (binary32/binary64) at random places and byte orders
+ * round-trip bit-exactly through the reference bit reader; NaN and
+ * infinity decode as PX_E_NAN; a bad length is refused. */
+static void test_float_signals(void)
+{
+	int i;
+	for (i = 0; i < 2000; i++) {
+		struct px_can_signal s;
+		uint8_t d[64];
+		double v = px_rand_range(-1e6, 1e6), got;
+		uint64_t bits;
+		random_signal(&s, 64);
+		s.length = px_rand_int(0, 1) ? 32 : 64;
+		s.is_float = 1;
+		s.is_signed = 0;
+		while (px_can_signal_check(&s, 64) != PX_OK)
+			s.start_bit = (uint16_t)px_rand_int(0, 511);
+		memset(d, 0, sizeof d);
+		PX_CHECK_INT_EQ(px_can_signal_encode(&s, v, d, 64, NULL), PX_OK);
+		bits = ref_get(&s, d);
+		if (s.length == 32) {
+			float f = (float)v;
+			uint32_t b;
+			memcpy(&b, &f, sizeof b);
+			PX_CHECK_INT_EQ(bits, b);
+		} else {
+			uint64_t b;
+			memcpy(&b, &v, sizeof b);
+			PX_CHECK_INT_EQ(bits, b);
+		}
+		PX_CHECK_INT_EQ(px_can_signal_decode(&s, d, 64, &got), PX_OK);
+		PX_CHECK_CLOSE(got, s.length == 32 ? (double)(float)v : v, 0, 0);
+		/* all ones: a NaN */
+		memset(d, 0xFF, sizeof d);
+		PX_CHECK_INT_EQ(px_can_signal_decode(&s, d, 64, &got), PX_E_NAN);
+	}
+	{
+		struct px_can_signal s = {"f", 0x10, 0, 0, 0, 16, PX_LITTLE_ENDIAN,
+					  0, 1.0, 0, 0, 0, 0, 0, -1, 1};
+		uint8_t d[8] = {0};
+		float inf = INFINITY;
+		PX_CHECK_INT_EQ(px_can_signal_check(&s, 8), PX_E_INVAL);
+		s.length = 32;
+		PX_CHECK_INT_EQ(px_can_signal_check(&s, 8), PX_OK);
+		memcpy(d, &inf, 4);
+		PX_CHECK_INT_EQ(px_can_signal_decode(&s, d, 8, &(double){0}),
+				PX_E_NAN);
+		/* scale and offset apply to float payloads too */
+		s.scale = 0.5;
+		s.offset = 1.0;
+		PX_CHECK_INT_EQ(px_can_signal_encode(&s, 2.0, d, 8, NULL), PX_OK);
+		{
+			float f;
+			double got;
+			memcpy(&f, d, 4);
+			PX_CHECK_CLOSE(f, 2.0f, 0, 0);
+			PX_CHECK_INT_EQ(px_can_signal_decode(&s, d, 8, &got),
+					PX_OK);
+			PX_CHECK_CLOSE(got, 2.0, 0, 0);
+		}
+	}
 }
 
 static void test_error_frames_decoded(void)
@@ -645,15 +708,15 @@ static void test_replay_and_record(void)
 
 static const struct px_can_signal dev_sigs[] = {
 	{"x", 0x100, 0, 0, 0, 16, PX_LITTLE_ENDIAN, 1, 1e-4, 0, 0, 0, 0, 0,
-	 PX_AXIS_X},
+	 PX_AXIS_X, 0},
 	{"y", 0x100, 0, 0, 16, 16, PX_LITTLE_ENDIAN, 1, 1e-4, 0, 0, 0, 0, 0,
-	 PX_AXIS_Y},
+	 PX_AXIS_Y, 0},
 	{"z", 0x100, 0, 0, 39, 16, PX_BIG_ENDIAN, 1, 1e-4, 0, 1, 1, -1, 1,
-	 PX_AXIS_Z},
+	 PX_AXIS_Z, 0},
 	{"fx", 0x200, 0, 1, 0, 16, PX_LITTLE_ENDIAN, 1, 1e-3, 0, 1, 1, -5, 5,
-	 PX_WRENCH_FX},
+	 PX_WRENCH_FX, 0},
 	{"fz", 0x200, 0, 1, 16, 16, PX_LITTLE_ENDIAN, 1, 1e-3, 0, 1, 1, -5, 5,
-	 PX_WRENCH_FZ},
+	 PX_WRENCH_FZ, 0},
 };
 
 static void test_can_device_on_sim_bus(void)
@@ -884,6 +947,7 @@ static void test_record_then_replay(void)
 }
 
 static const struct px_test tests[] = {
+	PX_T(test_float_signals),
 	PX_T(test_bitrate_on_vcan_or_absent),
 	PX_T(test_record_then_replay),
 	PX_T(test_can_faults_reach_the_watchdog),

@@ -20,10 +20,20 @@
  * all-ones "not available" pattern decodes far outside [min, max]. */
 static const struct px_can_signal sigs[] = {
 	{"x", 0x100, 0, 0, 0, 16, PX_LITTLE_ENDIAN, 0, 1e-4, -3.2768, 1, 1, -2,
-	 2, PX_AXIS_X},
+	 2, PX_AXIS_X, 0},
 	{"y", 0x100, 0, 0, 48, 16, PX_LITTLE_ENDIAN, 0, 1e-4, -3.2768, 1, 1, -2,
-	 2, PX_AXIS_Y},
+	 2, PX_AXIS_Y, 0},
 };
+
+/* The same as IEEE 754 binary32 values (DBC float signals). */
+static const struct px_can_signal fsigs[] = {
+	{"x", 0x100, 0, 0, 0, 32, PX_LITTLE_ENDIAN, 0, 1, 0, 1, 1, -2, 2,
+	 PX_AXIS_X, 1},
+	{"y", 0x100, 0, 0, 32, 32, PX_LITTLE_ENDIAN, 0, 1, 0, 1, 1, -2, 2,
+	 PX_AXIS_Y, 1},
+};
+
+static const struct px_can_signal *g_sigs = sigs;
 
 enum { T_SIM, T_UNIX };
 
@@ -47,9 +57,9 @@ static int app_read(struct px_loop *l, const struct px_loop_cycle *c, void *u)
 	memset(&m, 0, sizeof m);
 	m.f.can_id = 0x100;
 	m.f.len = 8;
-	px_can_signal_encode(&sigs[0], 1e-4 * (double)(a->n % 5000), m.f.data,
+	px_can_signal_encode(&g_sigs[0], 1e-4 * (double)(a->n % 5000), m.f.data,
 			     8, NULL);
-	px_can_signal_encode(&sigs[1], -0.25, m.f.data, 8, NULL);
+	px_can_signal_encode(&g_sigs[1], -0.25, m.f.data, 8, NULL);
 	a->n++;
 	px_can_bus_send(a->robot, &m, c->read_ns);
 	rc = px_dev_pose_read(a->dev, c->read_ns, &s);
@@ -116,7 +126,7 @@ static void run_fault(int transport, int kind, int64_t delay_ns, double prob,
 	dc.name = "arm";
 	dc.stuck_limit = stuck_limit;
 	dc.min_report_interval_ns = 500000; /* frames come every 1 ms */
-	PX_CHECK_INT_EQ(px_can_dev_create(&dc, ctl, 0, sigs, 2, &a.dev, msg,
+	PX_CHECK_INT_EQ(px_can_dev_create(&dc, ctl, 0, g_sigs, 2, &a.dev, msg,
 					  sizeof msg),
 			PX_OK);
 	PX_CHECK_INT_EQ(px_dev_start(a.dev), PX_OK);
@@ -260,6 +270,17 @@ static void test_can_fault_nan(void)
 		PX_CHECK(r.ds.decode_errors >= 199 && r.ds.decode_errors <= 201);
 		PX_CHECK_MSG(strstr(r.ds.last_msg, "plausible") != NULL, "%s",
 			     r.ds.last_msg);
+		PX_CHECK_INT_EQ(r.ds.nonfinite, 0);
+		/* float signals: all ones is a NaN, rejected as non-finite */
+		g_sigs = fsigs;
+		run_fault(t, PX_SIM_FAULT_NAN, 0, 1.0, 0, &r);
+		g_sigs = sigs;
+		check_tripped(&r, PX_FAULT_INPUT_STALE, tname(t));
+		PX_CHECK(r.ds.nonfinite >= 199 && r.ds.nonfinite <= 201);
+		PX_CHECK_INT_EQ(r.ds.decode_errors, 0);
+		PX_CHECK_MSG(strstr(r.ds.last_msg, "non-finite") != NULL, "%s",
+			     r.ds.last_msg);
+		PX_CHECK_INT_EQ(r.ds.samples, 750 - 200);
 	}
 }
 

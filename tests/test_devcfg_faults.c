@@ -56,7 +56,7 @@ static void send_xy(struct px_can_bus *b, double x, int64_t t)
 {
 	static const struct px_can_signal sx = {
 		"x", 0x100, 0, 0, 0, 16, PX_LITTLE_ENDIAN, 1, 1e-4, 0,
-		0, 0, 0, 0, PX_AXIS_X};
+		0, 0, 0, 0, PX_AXIS_X, 0};
 	struct px_can_msg m;
 	memset(&m, 0, sizeof m);
 	m.f.can_id = 0x100;
