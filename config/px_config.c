@@ -398,6 +398,8 @@ static const struct px_config_key fault_keys[] = {
 	      PX_CONFIG_MIN_EXCL, 0, 1, 1.0),
 	K_DUR(struct px_config_fault, delay_ns, "delay_ns", 0, 0, 10 * NS_PER_S,
 	      0),
+	K_INTP(struct px_config_fault, node_id, "node_id", 0, 1, 127, 1,
+	       has_node_id),
 };
 SCHEMA(fault_schema, "fault", fault_keys, fault_check);
 
@@ -633,14 +635,38 @@ static void socketcan_check(struct px_config_reader *r,
 		px_config_reader_error(r, px_config_node_get(map, "socket_path"),
 				       "socket_path",
 				       "only used with transport 'unix'");
-	if (c->transport == PX_CONFIG_CAN_KERNEL && c->n_faults)
-		px_config_reader_error(r, px_config_node_get(map, "faults"),
-				       "faults",
-				       "faults are injected on simulated buses "
-				       "only (transport 'sim' or 'unix')");
-	faults_check(r, map, c->faults, c->n_faults, ~FK(PX_CONFIG_FAULT_ESTOP),
-		     "is not a CAN bus fault: give estop to a GPIO e-stop line "
-		     "(sim kind gpio) or to the simulated arm");
+	for (i = 0; i < c->n_faults; i++) {
+		const struct px_config_fault *f = &c->faults[i];
+		if (!f->has_node_id && c->transport == PX_CONFIG_CAN_KERNEL) {
+			err_item(r, map, "faults", i, NULL,
+				 "bus faults are injected on simulated buses "
+				 "only (transport 'sim' or 'unix'); a fault "
+				 "with node_id goes to the simulated arm");
+		} else if (!f->has_node_id &&
+			   f->kind == PX_CONFIG_FAULT_ESTOP) {
+			err_item(r, map, "faults", i, "kind",
+				 "kind 'estop' is not a CAN bus fault: give the "
+				 "node_id of the simulated arm's drive it "
+				 "stops, or use a GPIO e-stop line");
+		} else if (f->has_node_id &&
+			   f->kind != PX_CONFIG_FAULT_ESTOP &&
+			   f->kind != PX_CONFIG_FAULT_UNPLUG) {
+			err_item(r, map, "faults", i, "node_id",
+				 "a drive of the simulated arm takes estop "
+				 "(drive fault) and unplug (falls silent)");
+		} else if (f->has_node_id) {
+			for (j = 0; j < c->canopen.n_drives &&
+				    c->canopen.drives[j].node_id != f->node_id;
+			     j++)
+				;
+			if (j == c->canopen.n_drives) {
+				snprintf(what, sizeof(what),
+					 "no canopen drive has node id %lld",
+					 (long long)f->node_id);
+				err_item(r, map, "faults", i, "node_id", what);
+			}
+		}
+	}
 	if (c->transport != PX_CONFIG_CAN_KERNEL && c->bitrate)
 		px_config_reader_error(r, px_config_node_get(map, "bitrate"),
 				       "bitrate",

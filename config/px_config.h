@@ -588,6 +588,10 @@ struct px_config_fault {
 	int64_t duration_ns;
 	double probability;    /* (0, 1] */
 	int64_t delay_ns;      /* kind delay */
+	/* socketcan: a fault of the simulated arm's drive with this node
+	 * id (kinds estop and unplug), not of the bus */
+	bool has_node_id;
+	int64_t node_id;
 };
 
 struct px_config_socketcan {

@@ -28,21 +28,62 @@ struct px_devcfg {
 	char notes[256];
 };
 
-/* Config fault windows as px_sim faults, moved onto the loop clock. */
+/* Config fault windows as px_sim faults, moved onto the loop clock;
+ * those of a drive (node_id) are the simulated arm's, not here. */
 static size_t conv_faults(const struct px_config_fault *f, size_t n,
 			  const struct px_devcfg_options *opt,
 			  struct px_sim_fault *o)
 {
-	size_t i;
+	size_t i, k = 0;
 	int64_t t0 = opt ? opt->clock0_ns : 0;
-	for (i = 0; i < n && i < PX_SIM_MAX_FAULTS; i++) {
-		o[i].kind = f[i].kind + 1;
-		o[i].start_ns = t0 + f[i].start_ns;
-		o[i].duration_ns = f[i].duration_ns;
-		o[i].probability = f[i].probability;
-		o[i].delay_ns = f[i].delay_ns;
+	for (i = 0; i < n && k < PX_SIM_MAX_FAULTS; i++) {
+		if (f[i].has_node_id)
+			continue;
+		o[k].kind = f[i].kind + 1;
+		o[k].start_ns = t0 + f[i].start_ns;
+		o[k].duration_ns = f[i].duration_ns;
+		o[k].probability = f[i].probability;
+		o[k].delay_ns = f[i].delay_ns;
+		k++;
 	}
-	return i;
+	return k;
+}
+
+int px_devcfg_arm_faults(const struct px_config *cfg,
+			 const struct px_config_device *dc, int64_t clock0_ns,
+			 struct px_sim_fault *faults, size_t cap)
+{
+	const struct px_config_socketcan *c;
+	size_t i, j;
+	int n = 0;
+	if (!cfg || !dc || (!faults && cap) || dc < cfg->devices ||
+	    dc >= cfg->devices + cfg->n_devices)
+		return PX_E_INVAL;
+	if (dc->backend != PX_CONFIG_BACKEND_SOCKETCAN)
+		return 0;
+	c = &dc->socketcan;
+	for (i = 0; i < c->n_faults; i++) {
+		const struct px_config_fault *f = &c->faults[i];
+		if (!f->has_node_id)
+			continue;
+		for (j = 0; j < c->canopen.n_drives &&
+			    c->canopen.drives[j].node_id != f->node_id;
+		     j++)
+			;
+		if (j == c->canopen.n_drives)
+			return PX_E_INVAL;
+		if ((size_t)n == cap)
+			return PX_E_NOSPC;
+		memset(&faults[n], 0, sizeof(faults[n]));
+		faults[n].kind = f->kind + 1;
+		faults[n].start_ns = clock0_ns + f->start_ns;
+		faults[n].duration_ns = f->duration_ns;
+		faults[n].probability = 1.0;
+		/* px_canopen_sim takes the drive's index here */
+		faults[n].delay_ns = (int64_t)j;
+		n++;
+	}
+	return n;
 }
 
 /* Config PDO entries over the default layout; a failed check names the
@@ -356,7 +397,9 @@ static int can_bus_open(struct px_devcfg *h, const struct px_config *cfg,
 	char why[512], peer[128];
 	int rc, e = 0;
 	size_t i;
-	if (c->transport != PX_CONFIG_CAN_KERNEL && c->n_faults) {
+	for (i = 0; i < c->n_faults && c->faults[i].has_node_id; i++)
+		;
+	if (c->transport != PX_CONFIG_CAN_KERNEL && i < c->n_faults) {
 		/* the bare endpoint or socket first, then the wrapper */
 		struct px_config_device bare = *dc;
 		struct px_sim_fault f[PX_SIM_MAX_FAULTS];

@@ -117,6 +117,18 @@ PX_API int px_devcfg_drives(const struct px_devcfg *h,
 			    struct px_canopen_drive_cfg *drives, size_t cap);
 
 /*
+ * The faults of a socketcan device's config that belong to the simulated
+ * arm (entries with node_id: estop = that drive faults, unplug = it
+ * falls silent), as px_canopen_sim faults (drive index in delay_ns),
+ * start times moved by clock0_ns. Returns the count (0 none), PX_E_NOSPC
+ * (cap too small), PX_E_INVAL.
+ */
+PX_API int px_devcfg_arm_faults(const struct px_config *cfg,
+				const struct px_config_device *dc,
+				int64_t clock0_ns, struct px_sim_fault *faults,
+				size_t cap);
+
+/*
  * The drive table and PDO layout a canopen device's master would use,
  * without opening anything: for the other side of the bus (a simulated
  * arm in its own process) to speak the same mapping. drives has cap

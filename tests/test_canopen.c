@@ -390,9 +390,10 @@ static void test_master_with_simarm_on_vcan(void)
 	master_with_simarm(1);
 }
 
-/* proxima-simarm --config takes the controller's drives, PDO mapping
- * and bus from the controller's own config: with a reordered RPDO and
- * TPDO1 an arm on the default layout would never enable. */
+/* proxima-simarm --config takes the controller's drives, PDO mapping,
+ * bus and drive faults from the controller's own config: with a
+ * reordered RPDO and TPDO1 an arm on the default layout would never
+ * enable; the e-stop of node 7 in the first 300 ms shows as its EMCY. */
 static void test_simarm_takes_the_config_mapping(void)
 {
 	const char *build = getenv("BUILD");
@@ -431,7 +432,9 @@ static void test_simarm_takes_the_config_mapping(void)
 		"        tpdo1: [{index: 0x6064, bits: 32}, {index: 0x6041, bits: 16}]\n"
 		"        drives:\n"
 		"          - {node_id: 7, mode: csp, joint: 0, counts_per_unit: 5000}\n"
-		"          - {node_id: 3, mode: csp, joint: 1, counts_per_unit: 20000}\n",
+		"          - {node_id: 3, mode: csp, joint: 1, counts_per_unit: 20000}\n"
+		"      faults:\n"
+		"        - {kind: estop, node_id: 7, start_ns: 0, duration_ns: 300000000}\n",
 		sock);
 	fclose(f);
 	px_config_diag_init(&diag);
@@ -465,6 +468,12 @@ static void test_simarm_takes_the_config_mapping(void)
 	waitpid(pid, &st, 0);
 	PX_CHECK_MSG(ok, "drive node 3: %s, position %g",
 		     px_cia402_state_name(ds.state), ds.position);
+	/* node 7's e-stop window from the config: its EMCY reached us, and
+	 * after the window the master brought it back */
+	px_canopen_drive_status(co, 0, &ds);
+	PX_CHECK_MSG(ds.emcy_count >= 1 && ds.emcy_code == 0x5441,
+		     "node 7: %llu EMCY, code 0x%04x",
+		     (unsigned long long)ds.emcy_count, ds.emcy_code);
 	PX_CHECK(WIFEXITED(st) && WEXITSTATUS(st) == 0);
 	/* the layout flags and --config do not mix */
 	pid = fork();

@@ -276,13 +276,29 @@ static void test_fault_config_errors(void)
 	load_fails_with("version: 1\ndevices:\n  - name: a\n    backend: socketcan\n"
 			"    socketcan:\n      interface: can0\n" CAN_SIGNALS
 			"      faults: [{kind: drop, start_ns: 0, duration_ns: 1}]\n",
-			"faults: faults are injected on simulated buses only");
+			"faults[0]: bus faults are injected on simulated buses "
+			"only");
 	load_fails_with("version: 1\ndevices:\n  - name: a\n    backend: socketcan\n"
 			"    socketcan:\n      interface: b\n      transport: sim\n"
 			CAN_SIGNALS
 			"      faults: [{kind: drop, start_ns: 0, duration_ns: 1},"
 			" {kind: estop, start_ns: 0, duration_ns: 1}]\n",
-			"faults[1].kind: kind 'estop' is not a CAN bus fault");
+			"faults[1].kind: kind 'estop' is not a CAN bus fault: "
+			"give the node_id");
+	load_fails_with("version: 1\ndevices:\n  - name: a\n    backend: socketcan\n"
+			"    socketcan:\n      interface: b\n      transport: sim\n"
+			"      canopen:\n        drives: [{node_id: 4, joint: 0}]\n"
+			"      faults: [{kind: estop, node_id: 5, start_ns: 0, "
+			"duration_ns: 1}, {kind: drop, node_id: 4, start_ns: 0, "
+			"duration_ns: 1}]\n",
+			"faults[0].node_id: no canopen drive has node id 5");
+	load_fails_with("version: 1\ndevices:\n  - name: a\n    backend: socketcan\n"
+			"    socketcan:\n      interface: b\n      transport: sim\n"
+			"      canopen:\n        drives: [{node_id: 4, joint: 0}]\n"
+			"      faults: [{kind: drop, node_id: 4, start_ns: 0, "
+			"duration_ns: 1}]\n",
+			"faults[0].node_id: a drive of the simulated arm takes "
+			"estop");
 	load_fails_with("version: 1\ndevices:\n  - name: a\n    backend: sim\n"
 			"    sim:\n      faults: [{kind: bus_off, start_ns: 0, "
 			"duration_ns: 1}]\n",
@@ -362,6 +378,98 @@ static void test_canopen_own_node_id(void)
 					     "joint: 0}]\n"),
 			5);
 #undef CO_HEAD
+}
+
+/* Faults with node_id go to the simulated arm: an e-stop of drive 3
+ * (safe torque off: FAULT and EMCY) and drive 9 falling silent, seen by
+ * the master opened from the same config; bus faults stay off. */
+static void test_arm_faults_from_config(void)
+{
+	static const char y[] =
+		"version: 1\n"
+		"devices:\n"
+		"  - name: arm\n"
+		"    backend: socketcan\n"
+		"    socketcan:\n"
+		"      interface: simbus\n"
+		"      transport: sim\n"
+		"      canopen:\n"
+		"        heartbeat_period_ns: 10000000\n"
+		"        heartbeat_timeout_ns: 30000000\n"
+		"        drives:\n"
+		"          - {node_id: 3, mode: csv, joint: 0}\n"
+		"          - {node_id: 9, mode: csv, joint: 1}\n"
+		"      faults:\n"
+		"        - {kind: estop, node_id: 3, start_ns: 100000000, duration_ns: 50000000}\n"
+		"        - {kind: unplug, node_id: 9, start_ns: 200000000, duration_ns: 100000000}\n";
+	struct px_config *cfg = load(y);
+	struct px_devcfg *h = NULL;
+	struct px_canopen_drive_cfg dr[4];
+	struct px_canopen_pdo_map pdo;
+	struct px_sim_fault f[4];
+	struct px_canopen_sim_config sc;
+	struct px_canopen_sim *arm = NULL;
+	struct px_can_bus *ep = NULL;
+	struct px_canopen_drive_status d0, d1;
+	double tg[2] = {0.1, 0.1};
+	size_t nd = 0;
+	char msg[512];
+	int k, n, fault_seen = 0, lost_seen = 0;
+	PX_CHECK(cfg != NULL);
+	if (!cfg)
+		return;
+	PX_CHECK_MSG(px_devcfg_open(cfg, &cfg->devices[0], NULL, &h, msg,
+				    sizeof msg) == PX_OK,
+		     "%s", msg);
+	n = px_devcfg_arm_faults(cfg, &cfg->devices[0], 0, f, 4);
+	PX_CHECK_INT_EQ(n, 2);
+	PX_CHECK_INT_EQ(px_devcfg_arm_faults(cfg, &cfg->devices[0], 0, f, 1),
+			PX_E_NOSPC);
+	PX_CHECK_INT_EQ(px_devcfg_canopen_layout(cfg, &cfg->devices[0], dr, 4,
+						 &nd, &pdo, msg, sizeof msg),
+			PX_OK);
+	if (!h || n != 2)
+		goto out;
+	PX_CHECK_INT_EQ(f[0].kind, PX_SIM_FAULT_ESTOP);
+	PX_CHECK_INT_EQ(f[0].delay_ns, 0); /* drive index */
+	PX_CHECK_INT_EQ(f[1].kind, PX_SIM_FAULT_UNPLUG);
+	PX_CHECK_INT_EQ(f[1].delay_ns, 1);
+	memset(&sc, 0, sizeof sc);
+	sc.pdo = &pdo;
+	sc.drives = dr;
+	sc.n_drives = nd;
+	sc.heartbeat_period_ns = 10000000;
+	sc.faults = f;
+	sc.n_faults = (size_t)n;
+	PX_CHECK_INT_EQ(px_can_sim_endpoint(px_devcfg_can_sim(h), &ep), PX_OK);
+	PX_CHECK_INT_EQ(px_canopen_sim_create(&sc, ep, &arm), PX_OK);
+	for (k = 1; k <= 400; k++) {
+		int64_t t = k * 1000000LL;
+		px_canopen_sim_step(arm, t);
+		px_canopen_rx(px_devcfg_canopen(h), t);
+		px_canopen_tx(px_devcfg_canopen(h), t, tg, 2, 1);
+		px_canopen_drive_status(px_devcfg_canopen(h), 0, &d0);
+		px_canopen_drive_status(px_devcfg_canopen(h), 1, &d1);
+		if (d0.state == PX_CIA402_FAULT && d0.emcy_code == 0x5441) {
+			PX_CHECK_MSG(t >= 100000000 && t < 160000000, "t %lld",
+				     (long long)t);
+			fault_seen++;
+		}
+		if (d1.lost) {
+			PX_CHECK_MSG(t >= 200000000 && t < 320000000, "t %lld",
+				     (long long)t);
+			lost_seen++;
+		}
+	}
+	PX_CHECK(fault_seen > 10);
+	PX_CHECK(lost_seen > 10);
+	/* both back: the master enabled them again */
+	PX_CHECK(px_canopen_all_enabled(px_devcfg_canopen(h)));
+out:
+	px_canopen_sim_free(arm);
+	px_can_bus_close(ep);
+	px_devcfg_free(h);
+	px_config_free(cfg);
 }
 
 static void test_usb_no_hotplug_key(void)
@@ -586,6 +694,7 @@ static const struct px_test tests[] = {
 	PX_T(test_sim_faults_from_config),
 	PX_T(test_fault_config_errors),
 	PX_T(test_canopen_own_node_id),
+	PX_T(test_arm_faults_from_config),
 	PX_T(test_usb_no_hotplug_key),
 	PX_T(test_bitrate_applied),
 	PX_T(test_bitrate_from_config),

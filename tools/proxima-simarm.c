@@ -44,7 +44,9 @@ static void usage(FILE *f)
 		"mapping are those of the controller's socketcan\ndevice NAME "
 		"(default: the first with canopen drives), and so is the bus: "
 		"its kernel\ninterface, or for transport unix the other end "
-		"(binds socket_path.peer, sends to\nsocket_path).\n");
+		"(binds socket_path.peer, sends to\nsocket_path); the "
+		"device's faults with node_id (estop, unplug of that drive)\n"
+		"are injected, timed from the start of proxima-simarm.\n");
 }
 
 int main(int argc, char **argv)
@@ -54,6 +56,8 @@ int main(int argc, char **argv)
 	int n = 6, mode = PX_CIA402_CSV, i, rc, e, layout_flags = 0;
 	struct px_config *cfg = NULL;
 	struct px_canopen_pdo_map pdo;
+	struct px_sim_fault faults[PX_SIM_MAX_FAULTS];
+	int n_faults = 0;
 	char upeer[256], ulocal[256];
 	double seconds = 0;
 	struct px_can_bus *bus = NULL;
@@ -139,6 +143,16 @@ int main(int argc, char **argv)
 			return 1;
 		}
 		n = (int)nd;
+		/* the config's drive faults (node_id), from our start */
+		n_faults = px_devcfg_arm_faults(cfg, dc, 0, faults,
+						PX_SIM_MAX_FAULTS);
+		if (n_faults < 0) {
+			fprintf(stderr, "proxima-simarm: %s: device '%s': "
+				"faults: %s\n", config, dc->name,
+				px_strerror(n_faults));
+			px_config_free(cfg);
+			return 1;
+		}
 		if (!iface && !local) {
 			const struct px_config_socketcan *c = &dc->socketcan;
 			if (c->transport == PX_CONFIG_CAN_KERNEL) {
@@ -188,8 +202,13 @@ int main(int argc, char **argv)
 		drv[i].counts_per_unit = 100000.0;
 		drv[i].rated_torque_n_m = 1.0;
 	}
+	t0 = next = mono();
+	for (i = 0; i < n_faults; i++)
+		faults[i].start_ns += t0;
 	memset(&sc, 0, sizeof sc);
 	sc.pdo = config ? &pdo : NULL;
+	sc.faults = n_faults > 0 ? faults : NULL;
+	sc.n_faults = n_faults > 0 ? (size_t)n_faults : 0;
 	sc.drives = drv;
 	sc.n_drives = (size_t)n;
 	if (px_canopen_sim_create(&sc, bus, &sim) != PX_OK) {
@@ -203,7 +222,6 @@ int main(int argc, char **argv)
 	printf("proxima-simarm: %d drives on %s%s%s\n", n, iface ? iface : local,
 	       config ? ", layout from " : "", config ? config : "");
 	fflush(stdout);
-	t0 = next = mono();
 	while (!stop && (seconds <= 0 || mono() - t0 < (int64_t)(seconds * 1e9))) {
 		struct timespec ts;
 		if (px_canopen_sim_step(sim, mono()) == PX_E_IO) {
