@@ -388,36 +388,15 @@ static int gpio_cfg(const struct px_config *cfg,
 
 /* ---- CAN ------------------------------------------------------------- */
 
-static int can_bus_open(struct px_devcfg *h, const struct px_config *cfg,
-			const struct px_config_device *dc,
-			const struct px_devcfg_options *opt,
-			struct px_can_bus **bus, char *msg, size_t cap)
+static int can_bus_open_bare(struct px_devcfg *h, const struct px_config *cfg,
+			     const struct px_config_device *dc,
+			     const struct px_devcfg_options *opt,
+			     struct px_can_bus **bus, char *msg, size_t cap)
 {
 	const struct px_config_socketcan *c = &dc->socketcan;
 	char why[512], peer[128];
 	int rc, e = 0;
 	size_t i;
-	for (i = 0; i < c->n_faults && c->faults[i].has_node_id; i++)
-		;
-	if (c->transport != PX_CONFIG_CAN_KERNEL && i < c->n_faults) {
-		/* the bare endpoint or socket first, then the wrapper */
-		struct px_config_device bare = *dc;
-		struct px_sim_fault f[PX_SIM_MAX_FAULTS];
-		struct px_can_bus *in = NULL;
-		size_t n = conv_faults(c->faults, c->n_faults, opt, f);
-		bare.socketcan.n_faults = 0;
-		rc = can_bus_open(h, cfg, &bare, opt, &in, msg, cap);
-		if (rc != PX_OK)
-			return rc;
-		rc = px_can_fault_open(in, f, n, 1 + (uint64_t)(dc - cfg->devices),
-				       bus, why, sizeof(why));
-		if (rc != PX_OK) {
-			px_can_bus_close(in);
-			return fail(msg, cap, cfg, dc, "socketcan.faults", rc, "%s",
-				    why);
-		}
-		return PX_OK;
-	}
 	if (c->transport == PX_CONFIG_CAN_SIM) {
 		if (!h->sim_bus) {
 			if (opt && opt->can_sim) {
@@ -468,6 +447,30 @@ static int can_bus_open(struct px_devcfg *h, const struct px_config *cfg,
 		if (rc != PX_OK)
 			return fail(msg, cap, cfg, dc, "socketcan.interface", rc,
 				    "%s", why);
+	}
+	return PX_OK;
+}
+
+/* The bus, wrapped in the config's bus faults when it has any (drive
+ * faults, with node_id, are the simulated arm's). */
+static int can_bus_open(struct px_devcfg *h, const struct px_config *cfg,
+			const struct px_config_device *dc,
+			const struct px_devcfg_options *opt,
+			struct px_can_bus **bus, char *msg, size_t cap)
+{
+	const struct px_config_socketcan *c = &dc->socketcan;
+	struct px_sim_fault f[PX_SIM_MAX_FAULTS];
+	struct px_can_bus *in = NULL;
+	char why[512];
+	size_t n = conv_faults(c->faults, c->n_faults, opt, f);
+	int rc = can_bus_open_bare(h, cfg, dc, opt, n ? &in : bus, msg, cap);
+	if (rc != PX_OK || !n)
+		return rc;
+	rc = px_can_fault_open(in, f, n, 1 + (uint64_t)(dc - cfg->devices), bus,
+			       why, sizeof(why));
+	if (rc != PX_OK) {
+		px_can_bus_close(in);
+		return fail(msg, cap, cfg, dc, "socketcan.faults", rc, "%s", why);
 	}
 	return PX_OK;
 }
