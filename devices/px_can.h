@@ -146,13 +146,13 @@ struct px_can_bus_stats {
 
 /* Send one frame; non-blocking. PX_OK, PX_E_AGAIN (queue full: frame
  * dropped and counted), PX_E_NODEV (interface gone: ENODEV), PX_E_IO
- * (bus-off, socket error; errno in
- * px_can_bus_errno), PX_E_INVAL. @note RT-safe. */
+ * (bus-off, socket error; errno in px_can_bus_errno), PX_E_INVAL.
+ * @note RT-safe. */
 PX_API int px_can_bus_send(struct px_can_bus *b, const struct px_can_msg *m,
 			   int64_t now_ns);
 /* Receive one frame if there is one; non-blocking. PX_OK, PX_E_AGAIN,
- * PX_E_NODEV (interface gone), PX_E_IO. Error frames are returned too (CAN_ERR_FLAG) after updating
- * the bus state. @note RT-safe. */
+ * PX_E_NODEV (interface gone), PX_E_IO. Error frames are returned too
+ * (CAN_ERR_FLAG) after updating the bus state. @note RT-safe. */
 PX_API int px_can_bus_recv(struct px_can_bus *b, int64_t now_ns,
 			   struct px_can_msg *m);
 PX_API void px_can_bus_stats(const struct px_can_bus *b,
