@@ -488,7 +488,7 @@ static int newton_f(struct qctx *x, const struct rect *r, int *iters,
 	for (it = 0; it < PX_SPIECE_MAX_ITERS; it++) {
 		px_vec3 su, sv, suu, suv, svv, d, S;
 		double gs, gt, a, b, c, det, ds, dt, al;
-		int k;
+		int k, out_s, out_t;
 
 		(*iters)++;
 		S = px_spiece_eval(sp, s, t, &su, &sv, &suu, &suv, &svv);
@@ -507,7 +507,22 @@ static int newton_f(struct qctx *x, const struct rect *r, int *iters,
 		det = a * c - b * b;
 		if (gs == 0.0 && gt == 0.0)
 			break;
-		if (a > 0.0 && det > 0.0) {
+		/* On the border with descent pointing out through it: that
+		 * coordinate stays (projected Newton), the other one goes on
+		 * in 1D, so that the point ends at the rectangle's constrained
+		 * minimum; the caller can then prove from it that no critical
+		 * point lies inside (monotone_settles()). */
+		out_s = (s <= r->s0 && gs > 0.0) || (s >= r->s1 && gs < 0.0);
+		out_t = (t <= r->t0 && gt > 0.0) || (t >= r->t1 && gt < 0.0);
+		if (out_s && out_t)
+			goto done; /* a corner with descent pointing out */
+		if (out_s) {
+			ds = 0.0;
+			dt = c > 0.0 ? -gt / c : -copysign(wmax, gt);
+		} else if (out_t) {
+			dt = 0.0;
+			ds = a > 0.0 ? -gs / a : -copysign(wmax, gs);
+		} else if (a > 0.0 && det > 0.0) {
 			ds = -(c * gs - b * gt) / det;
 			dt = -(a * gt - b * gs) / det;
 		} else {
@@ -520,9 +535,8 @@ static int newton_f(struct qctx *x, const struct rect *r, int *iters,
 		 * search there would halve the step to nothing. */
 		if (fabs(ds) <= 1e-13 && fabs(dt) <= 1e-13)
 			goto done;
-		/* Sitting on the border and pushed out through it: the
-		 * minimum is not inside this rectangle (or not reachable from
-		 * here); give up, the caller subdivides, which is safe. */
+		/* Sitting on the border and the step still pushed out through
+		 * it: give up, the caller subdivides, which is safe. */
 		if ((s <= r->s0 && ds < 0.0) || (s >= r->s1 && ds > 0.0) ||
 		    (t <= r->t0 && dt < 0.0) || (t >= r->t1 && dt > 0.0))
 			goto done;
@@ -671,6 +685,87 @@ static double rect_lb(const double *F, const double *W, int fn, int fm,
 	return ratio_min(rf, W ? rw : NULL, tsize(fn, fm));
 }
 
+/* Value of a tensor at (s, t) from its Bernstein basis values. */
+static double t_eval(const double *c, int n, int m, double s, double t)
+{
+	double bs[3 * MD + 2], bt[3 * MD + 2], acc = 0.0;
+	int i, j, k;
+
+	bs[0] = 1.0;
+	for (k = 1; k <= n; k++)
+		raise(bs, k, s, 1.0 - s);
+	bt[0] = 1.0;
+	for (k = 1; k <= m; k++)
+		raise(bt, k, t, 1.0 - t);
+	for (i = 0; i <= n; i++) {
+		double row = 0.0;
+		for (j = 0; j <= m; j++)
+			row += c[i * (m + 1) + j] * bt[j];
+		acc += row * bs[i];
+	}
+	return acc;
+}
+
+/*
+ * Rounding bound of gu or gv evaluated at one point: each coefficient
+ * a - P . b is formed with an error of a few ulps of |a| + |P| |b|
+ * (cancellation included), the convex combination of the basis keeps the
+ * largest, and the summation adds a few ulps per term.
+ */
+static double point_rounding(const struct px_spiece *sp, px_vec3 p, size_t ngu,
+			     size_t ngv)
+{
+	double m = 0.0, ax = fabs(p.x), ay = fabs(p.y), az = fabs(p.z);
+	size_t i;
+	for (i = 0; i < ngu; i++) {
+		double e = fabs(sp->gua_[i]) + ax * fabs(sp->gub_[i]) +
+			   ay * fabs(sp->gub_[ngu + i]) + az * fabs(sp->gub_[2 * ngu + i]);
+		m = e > m ? e : m;
+	}
+	for (i = 0; i < ngv; i++) {
+		double e = fabs(sp->gva_[i]) + ax * fabs(sp->gvb_[i]) +
+			   ay * fabs(sp->gvb_[ngv + i]) + az * fabs(sp->gvb_[2 * ngv + i]);
+		m = e > m ? e : m;
+	}
+	/* 8 ulps per coefficient plus 2 per term of a sum of at most
+	 * (3 MD + 1)^2 terms, rounded up generously. */
+	return (8.0 + 2.0 * (6 * MD + 2)) * 0x1p-52 * m;
+}
+
+/* What monotone_settles() needs besides the rectangle and the point. */
+struct mono {
+	double mu;             /* lower bound of the symmetric Jacobian part */
+	double gu, gv;         /* (gu, gv) at the point */
+	double eps_gu, eps_gv; /* their rounding */
+	double gmax;           /* bound of |grad f| on the rectangle */
+};
+
+/*
+ * Proof that a rectangle whose (gu, gv) is strongly monotone (modulus mu,
+ * from the Jacobian bounds) holds no critical point closer than the point
+ * x* = (s, t) the projected Newton ended at (on the border, its descent
+ * pointing out). For a zero z in the rectangle, monotonicity gives
+ *     mu |z - x*|^2 <= (G(z) - G(x*)) . (z - x*) = -G(x*) . (z - x*).
+ * A component of G(x*) pointing out through a border x* lies on makes
+ * its term <= 0 (z lies inside), so |z - x*| <= |G_rest| / mu = rho, and
+ * f(z) >= f(x*) - rho * max |grad f|. When that is within the rounding
+ * slack, x* (already considered) is as good as any interior minimum and
+ * the rectangle is settled without subdividing around the border.
+ */
+static int monotone_settles(const struct qctx *x, const struct rect *r,
+			    double s, double t, const struct mono *mo)
+{
+	int out_s = (s <= r->s0 && mo->gu > mo->eps_gu) ||
+		    (s >= r->s1 && mo->gu < -mo->eps_gu);
+	int out_t = (t <= r->t0 && mo->gv > mo->eps_gv) ||
+		    (t >= r->t1 && mo->gv < -mo->eps_gv);
+	double rs = out_s ? 0.0 : fabs(mo->gu) + mo->eps_gu;
+	double rt = out_t ? 0.0 : fabs(mo->gv) + mo->eps_gv;
+	double rho = sqrt(rs * rs + rt * rt) / mo->mu;
+
+	return rho * mo->gmax <= x->slack;
+}
+
 int px_spiece_closest(const struct px_spiece *sp, px_vec3 p, double *best_d2,
 		      struct px_spiece_hit *hit)
 {
@@ -694,8 +789,19 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 	double pp = px_v3_dot(p, p), lb_unresolved = INFINITY;
 	int hn = 0, k, have_gu = 0, have_gv = 0;
 	double eps_gu = 0.0, eps_gv = 0.0;
+	/* Smallest weight: w on the patch is at least the smallest weight
+	 * coefficient (convex combination). */
+	double wmin = INFINITY;
+	double rnd_g = -1.0; /* point_rounding(), on first use */
 	size_t i;
 
+	if (sp->wconst_) {
+		wmin = 1.0; /* divided out at setup */
+	} else {
+		const double *w = sp->h_ + 3 * tsize(P, Q);
+		for (i = 0; i < tsize(P, Q); i++)
+			wmin = w[i] < wmin ? w[i] : wmin;
+	}
 	x.sp = sp;
 	x.p = p;
 	x.hint_s = hint_s;
@@ -736,7 +842,7 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 	consider(&x, 0.5, 0.5);
 	while (hn > 0 && hit->nodes < PX_SPIECE_MAX_NODES) {
 		struct rect r = heap_pop(heap, &hn);
-		double ws = r.s1 - r.s0, wt = r.t1 - r.t0;
+		double ws = r.s1 - r.s0, wt = r.t1 - r.t0, mu = 0.0;
 		int certain = 0;
 
 		if (r.lb >= x.best - x.slack)
@@ -785,9 +891,14 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 			d_lo /= wt;
 			d_hi /= wt;
 			off = 0.5 * fmax(fabs(b_lo + c_lo), fabs(b_hi + c_hi));
-			if (a_lo > 0.0 && d_lo > 0.0 && a_lo * d_lo > off * off)
+			if (a_lo > 0.0 && d_lo > 0.0 && a_lo * d_lo > off * off) {
 				certain = 1; /* monotone: one zero at most, a minimum */
-			else if (a_hi < 0.0 && d_hi < 0.0 && a_hi * d_hi > off * off)
+				/* Its modulus: the smallest eigenvalue of the
+				 * symmetric part grows with a and d and falls
+				 * with |off|, so the corner values bound it. */
+				mu = 0.5 * (a_lo + d_lo) -
+				     sqrt(0.25 * (a_lo - d_lo) * (a_lo - d_lo) + off * off);
+			} else if (a_hi < 0.0 && d_hi < 0.0 && a_hi * d_hi > off * off)
 				continue; /* at most one zero, and a maximum */
 		}
 		if (certain) {
@@ -797,6 +908,20 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 				consider(&x, s, t); /* a real point: a valid bound */
 			if (found)
 				continue;
+			if (s == s && mu > 0.0) {
+				struct mono mo;
+				double mg = max_abs(rg, ngu), mv = max_abs(rv, ngv);
+				mo.mu = mu;
+				mo.gu = t_eval(GU, un, um, s, t);
+				mo.gv = t_eval(GV, vn, vm, s, t);
+				if (rnd_g < 0.0)
+					rnd_g = point_rounding(sp, p, ngu, ngv);
+				mo.eps_gu = rnd_g;
+				mo.eps_gv = rnd_g;
+				mo.gmax = 2.0 * sqrt(mg * mg + mv * mv) / (wmin * wmin * wmin);
+				if (monotone_settles(&x, &r, s, t, &mo))
+					continue;
+			}
 		} else {
 			/* Keep the upper bound moving while we subdivide. */
 			consider(&x, 0.5 * (r.s0 + r.s1), 0.5 * (r.t0 + r.t1));
