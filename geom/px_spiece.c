@@ -131,6 +131,8 @@ static int strict_sign(const double *c, size_t k, double eps)
 	for (i = 0; i < k; i++) {
 		pos &= c[i] > eps;
 		neg &= c[i] < -eps;
+		if (!(pos | neg))
+			return 0; /* mixed: most rectangles worth a look are */
 	}
 	return pos ? 1 : (neg ? -1 : 0);
 }
@@ -144,14 +146,31 @@ static double max_abs(const double *c, size_t k)
 	return m;
 }
 
-static void t_range(const double *c, size_t k, double *lo, double *hi)
+/* Range of the coefficients of the derivative along s (dir 0) or t
+ * (dir 1) of c (n, m), without storing them: the Jacobian bounds. */
+static void t_deriv_range(const double *c, int n, int m, int dir, double *lo,
+			  double *hi)
 {
-	size_t i;
-	*lo = INFINITY;
-	*hi = -INFINITY;
-	for (i = 0; i < k; i++) {
-		*lo = c[i] < *lo ? c[i] : *lo;
-		*hi = c[i] > *hi ? c[i] : *hi;
+	double a = INFINITY, b = -INFINITY;
+	int i, j;
+	if (dir == 0) {
+		for (i = 0; i < n; i++)
+			for (j = 0; j <= m; j++) {
+				double d = c[(i + 1) * (m + 1) + j] - c[i * (m + 1) + j];
+				a = d < a ? d : a;
+				b = d > b ? d : b;
+			}
+		*lo = n * a;
+		*hi = n * b;
+	} else {
+		for (i = 0; i <= n; i++)
+			for (j = 0; j < m; j++) {
+				double d = c[i * (m + 1) + j + 1] - c[i * (m + 1) + j];
+				a = d < a ? d : a;
+				b = d > b ? d : b;
+			}
+		*lo = m * a;
+		*hi = m * b;
 	}
 }
 
@@ -385,22 +404,27 @@ px_vec3 px_spiece_eval(const struct px_spiece *sp, double s, double t,
 	basis(p, s, bs[0], bs[1], bs[2]);
 	basis(q, t, bt[0], bt[1], bt[2]);
 	memset(d, 0, sizeof(d));
-	for (i = 0; i <= p; i++)
-		for (j = 0; j <= q; j++) {
-			size_t k = (size_t)i * (q + 1) + j;
-			double w00 = bs[0][i] * bt[0][j], w10 = bs[1][i] * bt[0][j];
-			double w01 = bs[0][i] * bt[1][j], w20 = bs[2][i] * bt[0][j];
-			double w11 = bs[1][i] * bt[1][j], w02 = bs[0][i] * bt[2][j];
-			for (c = 0; c < 4; c++) {
-				double h = sp->h_[c * np + k];
-				d[0][0][c] += w00 * h;
-				d[1][0][c] += w10 * h;
-				d[0][1][c] += w01 * h;
-				d[2][0][c] += w20 * h;
-				d[1][1][c] += w11 * h;
-				d[0][2][c] += w02 * h;
+	/* Row by row: the t-sums of a row (value, first and second
+	 * derivative) first, then their s-weights; fewer products than
+	 * weighting every control point six times. */
+	for (c = 0; c < 4; c++) {
+		const double *h = sp->h_ + c * np;
+		for (i = 0; i <= p; i++) {
+			const double *row = h + (size_t)i * (q + 1);
+			double r0 = 0.0, r1 = 0.0, r2 = 0.0;
+			for (j = 0; j <= q; j++) {
+				r0 += bt[0][j] * row[j];
+				r1 += bt[1][j] * row[j];
+				r2 += bt[2][j] * row[j];
 			}
+			d[0][0][c] += bs[0][i] * r0;
+			d[1][0][c] += bs[1][i] * r0;
+			d[2][0][c] += bs[2][i] * r0;
+			d[0][1][c] += bs[0][i] * r1;
+			d[1][1][c] += bs[1][i] * r1;
+			d[0][2][c] += bs[0][i] * r2;
 		}
+	}
 	{
 		/* Quotient rule for S = H / w up to second order. */
 		double w = d[0][0][3], iw = 1.0 / w;
@@ -459,6 +483,12 @@ static void consider(struct qctx *x, double s, double t)
 		x->hit->v = x->sp->v0_ + t * (x->sp->v1_ - x->sp->v0_);
 		x->improved = 1;
 	}
+}
+
+/* Hot-path clamp: fmin/fmax are library calls without -ffast-math. */
+static inline double clampd(double v, double lo, double hi)
+{
+	return v > lo ? (v < hi ? v : hi) : lo;
 }
 
 /*
@@ -541,10 +571,10 @@ static int newton_f(struct qctx *x, const struct rect *r, int *iters,
 		    (t <= r->t0 && dt < 0.0) || (t >= r->t1 && dt > 0.0))
 			goto done;
 		for (al = 1.0, k = 0; k < 12; k++, al *= 0.5) {
-			double ns = fmin(r->s1, fmax(r->s0, s + al * ds));
-			double nt = fmin(r->t1, fmax(r->t0, t + al * dt));
+			double ns = clampd(s + al * ds, r->s0, r->s1);
+			double nt = clampd(t + al * dt, r->t0, r->t1);
 			double fn = px_v3_dist2(spiece_point(sp, ns, nt), x->p);
-			double moved = fmax(fabs(ns - s), fabs(nt - t));
+			double moved = fabs(ns - s) > fabs(nt - t) ? fabs(ns - s) : fabs(nt - t);
 			if (fn <= fcur || moved <= 1e-15) {
 				s = ns;
 				t = nt;
@@ -781,7 +811,7 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 	const int un = sp->gun_, um = sp->gum_, vn = sp->gvn_, vm = sp->gvm_;
 	const size_t nfs = tsize(fn, fm), ngu = tsize(un, um), ngv = tsize(vn, vm);
 	double F[TMAX], GU[TMAX], GV[TMAX];
-	double rf[TMAX], rw[TMAX], rg[TMAX], rv[TMAX], dg[TMAX];
+	double rf[TMAX], rw[TMAX], rg[TMAX], rv[TMAX];
 	/* Each split replaces one rectangle by four: the heap never holds
 	 * more than 3 * nodes + 1. */
 	struct rect heap[3 * PX_SPIECE_MAX_NODES + 4];
@@ -818,11 +848,12 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 		if (dc > 0.0 && dc * dc >= x.best)
 			goto out;
 	}
+	/* Equal weights: W is the constant 1 and need not be read. */
 	for (i = 0; i < nfs; i++)
 		F[i] = sp->fa_[i] -
 		       2.0 * (p.x * sp->fb_[i] + p.y * sp->fb_[nfs + i] +
 			      p.z * sp->fb_[2 * nfs + i]) +
-		       pp * sp->fw_[i];
+		       pp * (sp->wconst_ ? 1.0 : sp->fw_[i]);
 	{
 		double r = px_v3_dist(sp->center_, p) + 2.0 * sp->radius_;
 		x.slack = 1e-13 * (r * r + px_v3_dot(sp->center_, sp->center_));
@@ -874,14 +905,10 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 			/* Bernstein bounds of the Jacobian of (gu, gv), in the
 			 * piece's local scale (d/ds = (1/ws) d/ds_sub). */
 			double a_lo, a_hi, b_lo, b_hi, c_lo, c_hi, d_lo, d_hi, off;
-			t_deriv_s(rg, un, um, dg);
-			t_range(dg, tsize(un - 1, um), &a_lo, &a_hi);
-			t_deriv_t(rg, un, um, dg);
-			t_range(dg, tsize(un, um - 1), &b_lo, &b_hi);
-			t_deriv_s(rv, vn, vm, dg);
-			t_range(dg, tsize(vn - 1, vm), &c_lo, &c_hi);
-			t_deriv_t(rv, vn, vm, dg);
-			t_range(dg, tsize(vn, vm - 1), &d_lo, &d_hi);
+			t_deriv_range(rg, un, um, 0, &a_lo, &a_hi);
+			t_deriv_range(rg, un, um, 1, &b_lo, &b_hi);
+			t_deriv_range(rv, vn, vm, 0, &c_lo, &c_hi);
+			t_deriv_range(rv, vn, vm, 1, &d_lo, &d_hi);
 			a_lo /= ws;
 			a_hi /= ws;
 			c_lo /= ws;

@@ -20,6 +20,12 @@
  *    of (gu, gv) make its symmetric part positive definite, so (gu, gv)
  *    is strictly monotone on the rectangle; Newton started inside finds
  *    that single zero. Negative definite means a single maximum: dropped.
+ *    When the minimum lies just outside the rectangle (beside a piece
+ *    border or the patch edge), a projected Newton ends on the border
+ *    with the gradient pointing out, and the monotonicity modulus bounds
+ *    how far an interior zero could be from that point and how much
+ *    lower it could be: within rounding, the rectangle is settled
+ *    without subdividing towards the border.
  * Anything else is split in four, down to a depth and node bound; what
  * the bound cuts short is reported as uncertified with a gap.
  *
