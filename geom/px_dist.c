@@ -1328,8 +1328,8 @@ static inline void visit_piece(const struct px_dist_model *m,
 			       struct qstate *q)
 {
 	const struct piece *pc = &m->pieces[id];
-	double lb;
-	int s, e;
+	double lb, near_d2 = INFINITY;
+	int s, e, near = 0;
 
 	if (ws->stamp[id] == ws->epoch)
 		return;
@@ -1337,13 +1337,18 @@ static inline void visit_piece(const struct px_dist_model *m,
 	lb = box_d2(&pc->box, p);
 	if (lb >= q->best)
 		return;
+	/* Branch-free scan (conditional moves): which sample of a random
+	 * query's piece is nearest is unpredictable. */
 	for (s = pc->sample_start, e = s + pc->ns * pc->nt; s < e; s++) {
 		double d2 = px_v3_dist2(m->samples[s], p);
-		if (d2 < q->best) {
-			q->best = d2;
-			q->best_sample = s;
-			q->best_piece = id;
-		}
+		int nearer = d2 < near_d2;
+		near_d2 = nearer ? d2 : near_d2;
+		near = nearer ? s : near;
+	}
+	if (near_d2 < q->best) {
+		q->best = near_d2;
+		q->best_sample = near;
+		q->best_piece = id;
 	}
 	ws->cand[q->n_cand].lb = lb;
 	ws->cand[q->n_cand].piece = id;
