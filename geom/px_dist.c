@@ -985,7 +985,8 @@ int px_dist_model_create(const struct px_nurbs_curve *curves, int n_curves,
 			n_cp++;
 		} else {
 			n_sp++;
-			sp_doubles += px_spiece_doubles(bl.tp[i].p, bl.tp[i].q);
+			sp_doubles += px_spiece_doubles_hw(bl.tp[i].p, bl.tp[i].q,
+							   (const double(*)[4])bl.tp[i].hw);
 		}
 	}
 
@@ -1161,7 +1162,8 @@ int px_dist_model_create(const struct px_nurbs_curve *curves, int n_curves,
 							    spmem);
 					if (rc)
 						goto fail;
-					spmem += px_spiece_doubles(t->p, t->q);
+					spmem += px_spiece_doubles_hw(t->p, t->q,
+								      (const double(*)[4])t->hw);
 					for (a = 0; a < pc->ns; a++)
 						for (b = 0; b < pc->nt; b++)
 							m->samples[smp++] = px_spiece_eval(

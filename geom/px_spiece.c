@@ -29,6 +29,27 @@ size_t px_spiece_doubles(int p, int q)
 	       4 * tsize(ngu_s(p), ngu_t(q)) + 4 * tsize(ngv_s(p), ngv_t(q));
 }
 
+/* Every weight equal: the patch is polynomial once they are divided out,
+ * and its critical-point tensors have the lower degrees. */
+static int equal_weights(const double (*hw)[4], size_t np)
+{
+	size_t i;
+	for (i = 1; i < np; i++)
+		if (hw[i][3] != hw[0][3])
+			return 0;
+	return 1;
+}
+
+size_t px_spiece_doubles_hw(int p, int q, const double (*hw)[4])
+{
+	if (p < 1 || q < 1 || p > MD || q > MD || !hw)
+		return 0;
+	if (!equal_weights(hw, tsize(p, q)))
+		return px_spiece_doubles(p, q);
+	return 4 * tsize(p, q) + 5 * tsize(nf_s(p), nf_s(q)) +
+	       4 * tsize(2 * p - 1, 2 * q) + 4 * tsize(2 * p, 2 * q - 1);
+}
+
 /* ---- tensor Bernstein helpers (row i along s, column j along t) ---------- */
 
 static void binom_row(int n, double *row)
@@ -202,8 +223,15 @@ int px_spiece_init(struct px_spiece *sp, int p, int q, const double (*hw)[4],
 	sp->v0_ = v0;
 	sp->v1_ = v1;
 	nfs = tsize(nf_s(p), nf_s(q));
-	ngu = tsize(ngu_s(p), ngu_t(q));
-	ngv = tsize(ngv_s(p), ngv_t(q));
+	/* Blocks packed at the degrees the weights give (see
+	 * px_spiece_doubles_hw()). */
+	if (equal_weights(hw, np)) {
+		ngu = tsize(2 * p - 1, 2 * q);
+		ngv = tsize(2 * p, 2 * q - 1);
+	} else {
+		ngu = tsize(ngu_s(p), ngu_t(q));
+		ngv = tsize(ngv_s(p), ngv_t(q));
+	}
 	sp->h_ = cur;
 	cur += 4 * np;
 	sp->fa_ = cur;
@@ -252,8 +280,7 @@ int px_spiece_init(struct px_spiece *sp, int p, int q, const double (*hw)[4],
 	sp->gum_ = 2 * q + wq;
 	sp->gvn_ = 2 * p + wp;
 	sp->gvm_ = 2 * q + wq - 1;
-	/* The coefficient blocks were laid out for the rational degrees;
-	 * within them the arrays are packed at the actual ones. */
+	/* The same decision as the layout above (the same weights). */
 	ngu = tsize(sp->gun_, sp->gum_);
 	ngv = tsize(sp->gvn_, sp->gvm_);
 	{

@@ -343,6 +343,42 @@ static void test_minimum_beside_piece_border(void)
 	PX_CHECK_INT_EQ(unc, 0);
 }
 
+/* A piece with equal weights packs its tables at the lower degrees: it
+ * fits in px_spiece_doubles_hw() doubles (nothing written past them) and
+ * answers exactly as with the full px_spiece_doubles() block. */
+static void test_packed_memory(void)
+{
+	static double small[200000];
+	double hw[(MAXD + 1) * (MAXD + 1)][4];
+	int trial;
+	for (trial = 0; trial < 40; trial++) {
+		int p = px_rand_int(1, MAXD), q = px_rand_int(1, MAXD), rational = trial % 2;
+		size_t n, full = px_spiece_doubles(p, q), k;
+		struct px_spiece a, b;
+		struct px_spiece_hit ha, hb;
+		double da = INFINITY, db = INFINITY;
+		px_vec3 x = px_v3(px_rand_range(-0.5, 1.5), px_rand_range(-0.5, 1.5),
+				  px_rand_range(-1, 1));
+		random_patch(hw, p, q, rational);
+		n = px_spiece_doubles_hw(p, q, (const double(*)[4])hw);
+		PX_CHECK(n > 0 && n <= full);
+		if (!rational)
+			PX_CHECK(n < full);
+		for (k = 0; k < full + 8; k++)
+			small[k] = 12345.0;
+		PX_CHECK_INT_EQ(px_spiece_init(&a, p, q, (const double(*)[4])hw, 0, 1, 0, 1,
+					       small), PX_OK);
+		for (k = n; k < full + 8; k++)
+			PX_CHECK_MSG(small[k] == 12345.0, "written past the packed size at %zu", k);
+		PX_CHECK_INT_EQ(px_spiece_init(&b, p, q, (const double(*)[4])hw, 0, 1, 0, 1,
+					       mem), PX_OK);
+		PX_CHECK_INT_EQ(px_spiece_closest(&a, x, &da, &ha), px_spiece_closest(&b, x, &db, &hb));
+		PX_CHECK(da == db);
+	}
+	PX_CHECK_INT_EQ(px_spiece_doubles_hw(0, 2, (const double(*)[4])hw), 0);
+	PX_CHECK_INT_EQ(px_spiece_doubles_hw(2, 2, NULL), 0);
+}
+
 static void test_query_allocates_nothing(void)
 {
 	double hw[16][4];
@@ -380,6 +416,7 @@ static const struct px_test tests[] = {
 	PX_T(test_sphere_octant_focal_point),
 	PX_T(test_symmetric_patch_split_lines),
 	PX_T(test_minimum_beside_piece_border),
+	PX_T(test_packed_memory),
 	PX_T(test_query_allocates_nothing),
 	PX_T(test_bad_input),
 };
