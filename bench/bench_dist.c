@@ -3,6 +3,13 @@
  * points in the enlarged bounding box of representative curves, the
  * root-iteration histogram, pieces solved per query, and model memory.
  * Prints figures only; nothing here is a pass/fail test.
+ *
+ *   bench_dist [PREFIX [N [tail]]]
+ * runs only the models whose name starts with PREFIX, N queries each
+ * (repeatable instruction counts: valgrind --tool=callgrind
+ * --toggle-collect=px_dist_query_ws build/bench/bench_dist "bicubic patch"
+ * 4000, which counts the 1000 warm-up queries too), and with "tail" lists
+ * the slowest points (best of five runs each) with what they cost.
  */
 #include <math.h>
 #include <stdint.h>
@@ -37,18 +44,37 @@ static int cmp_i64(const void *a, const void *b)
 	return (x > y) - (x < y);
 }
 
-#define NQ 20000
+#define NQ_MAX 20000
+
+/* Optional arguments: a name prefix, the query count (for instruction
+ * counts under callgrind), and "tail" to list the slowest queries. */
+static const char *filter;
+static int NQ = NQ_MAX;
+static int show_tail;
+
+struct slow {
+	int64_t ns;
+	int i;
+};
+
+static int cmp_slow(const void *a, const void *b)
+{
+	int64_t x = ((const struct slow *)a)->ns, y = ((const struct slow *)b)->ns;
+	return (x < y) - (x > y);
+}
 
 static void run(const char *name, const struct px_nurbs_curve *c, int nc,
 		const struct px_nurbs_surf *sf, int ns, const struct px_dist_opts *o)
 {
-	static int64_t t[NQ];
-	static px_vec3 q[NQ];
+	static int64_t t[NQ_MAX];
+	static px_vec3 q[NQ_MAX];
+	static struct slow sl[NQ_MAX];
 	struct px_dist_model *m;
 	struct px_dist_info info;
 	struct px_dist_result r;
 	long hist[8] = {0};
 	long solved = 0, unc = 0;
+	double mean_ns;
 	int64_t t0;
 	int i, rc;
 
@@ -65,12 +91,18 @@ static void run(const char *name, const struct px_nurbs_curve *c, int nc,
 		px_vec3 e = px_v3_scale(px_v3_sub(hi, lo), 0.25);
 		lo = px_v3_sub(lo, e);
 		hi = px_v3_add(hi, e);
-		for (i = 0; i < NQ; i++)
+		for (i = 0; i < NQ_MAX; i++)
 			q[i] = px_v3(lo.x + (hi.x - lo.x) * urand(),
 				     lo.y + (hi.y - lo.y) * urand(),
 				     lo.z + (hi.z - lo.z) * urand());
 	}
-	for (i = 0; i < 1000; i++) /* warm the caches */
+	/* Filtered out: the points were still drawn, so that the models
+	 * after this one are the same as in a full run. */
+	if (filter && strncmp(name, filter, strlen(filter))) {
+		px_dist_model_free(m);
+		return;
+	}
+	for (i = 0; i < 1000 && i < NQ; i++) /* warm the caches */
 		px_dist_query(m, q[i], &r);
 	for (i = 0; i < NQ; i++) {
 		int64_t a = now_ns();
@@ -80,14 +112,50 @@ static void run(const char *name, const struct px_nurbs_curve *c, int nc,
 		solved += r.pieces_solved;
 		unc += !r.certified;
 	}
+	if (show_tail) {
+		/* Best of five per point: what is left is the point's own
+		 * cost, not the machine's noise. */
+		for (i = 0; i < NQ; i++) {
+			int k;
+			sl[i].i = i;
+			sl[i].ns = INT64_MAX;
+			for (k = 0; k < 5; k++) {
+				int64_t a = now_ns();
+				px_dist_query(m, q[i], &r);
+				a = now_ns() - a;
+				sl[i].ns = a < sl[i].ns ? a : sl[i].ns;
+			}
+		}
+		qsort(sl, NQ, sizeof(sl[0]), cmp_slow);
+		printf("%-28s slowest (best of 5): ns, point, dist, pieces solved, "
+		       "root iterations, cells\n", name);
+		for (i = 0; i < 12 && i < NQ; i++) {
+			px_vec3 x = q[sl[i].i];
+			px_dist_query(m, x, &r);
+			printf("  %7lld  (%.6f, %.6f, %.6f)  d %.6f  solved %d  iters %d  cells %d  piece %d (u %.9f v %.9f)\n",
+			       (long long)sl[i].ns, x.x, x.y, x.z, r.dist, r.pieces_solved,
+			       r.iters, r.cells_visited, r.piece, r.u, r.v);
+		}
+		printf("%-28s best-of-5 p50 %lld  p99 %lld\n", "",
+		       (long long)sl[NQ / 2].ns, (long long)sl[NQ / 100].ns);
+	}
 	qsort(t, NQ, sizeof(t[0]), cmp_i64);
+	{
+		/* Mean of all but the slowest 0.1 %: those are the machine's
+		 * (preemption), not the query's. */
+		int64_t sum = 0;
+		int nm = NQ - NQ / 1000;
+		for (i = 0; i < nm; i++)
+			sum += t[i];
+		mean_ns = (double)sum / nm;
+	}
 	printf("%-28s prepare %.2f ms, %d pieces, grid %dx%dx%d, %zu bytes\n",
 	       name, t0 / 1e6, info.n_pieces, info.grid[0], info.grid[1],
 	       info.grid[2], info.bytes);
-	printf("%-28s per query ns: median %lld  p99 %lld  max %lld; "
+	printf("%-28s per query ns: median %lld  p99 %lld  max %lld  mean %.0f; "
 	       "pieces solved %.2f/query; uncertified %ld\n",
 	       "", (long long)t[NQ / 2], (long long)t[NQ * 99 / 100],
-	       (long long)t[NQ - 1], (double)solved / NQ, unc);
+	       (long long)t[NQ - 1], mean_ns, (double)solved / NQ, unc);
 	printf("%-28s root iterations per query:", "");
 	for (i = 0; i < 8; i++)
 		printf(" %s%d:%.1f%%", i == 7 ? ">=" : "", i, 100.0 * hist[i] / NQ);
@@ -95,7 +163,7 @@ static void run(const char *name, const struct px_nurbs_curve *c, int nc,
 	px_dist_model_free(m);
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
 	static unsigned char mem[1 << 20];
 	struct px_arena a;
@@ -111,6 +179,13 @@ int main(void)
 	double wc[9] = {1, s, 1, s, 1, s, 1, s, 1};
 	int i;
 
+	if (argc > 1 && argv[1][0])
+		filter = argv[1];
+	if (argc > 2) {
+		NQ = atoi(argv[2]);
+		NQ = NQ < 100 ? 100 : (NQ > NQ_MAX ? NQ_MAX : NQ);
+	}
+	show_tail = argc > 3 && !strcmp(argv[3], "tail");
 	px_arena_init(&a, mem, sizeof(mem));
 	for (i = 0; i < 8; i++) {
 		xyz8[3 * i] = i / 7.0;

@@ -33,7 +33,8 @@ PX_API double px_bern_eval(const double *c, int n, double t);
 /* Value and first derivative at t. @note RT-safe. */
 PX_API double px_bern_eval_d(const double *c, int n, double t, double *dt);
 
-/* Multiply c_i by C(n, i), for px_bern_eval_scaled(). out may alias c.
+/* Multiply c_i by C(n, i) (n <= PX_BERN_MAX_DEGREE), for
+ * px_bern_eval_scaled(). out may alias c.
  * @note RT-safe. */
 PX_API void px_bern_scale(const double *c, int n, double *out);
 

@@ -103,13 +103,58 @@ px_aabb px_cpiece_box(const struct px_cpiece *pc)
 	return pc->box_;
 }
 
+/*
+ * The four homogeneous components at t at once: the same Horner scheme
+ * as px_bern_eval_scaled() (ratio t / (1 - t) or its mirror, at most 1),
+ * with the ratio and the power of the base computed once for all four.
+ */
+static void eval4(const double (*cb)[PX_CPIECE_MAX_DEGREE + 1], int n, double t,
+		  double v[4])
+{
+	double s, base, scale = 1.0, a0, a1, a2, a3;
+	int i;
+
+	if (t <= 0.5) {
+		base = 1.0 - t;
+		s = t / base;
+		a0 = cb[0][n];
+		a1 = cb[1][n];
+		a2 = cb[2][n];
+		a3 = cb[3][n];
+		for (i = n - 1; i >= 0; i--) {
+			a0 = a0 * s + cb[0][i];
+			a1 = a1 * s + cb[1][i];
+			a2 = a2 * s + cb[2][i];
+			a3 = a3 * s + cb[3][i];
+		}
+	} else {
+		base = t;
+		s = (1.0 - t) / t;
+		a0 = cb[0][0];
+		a1 = cb[1][0];
+		a2 = cb[2][0];
+		a3 = cb[3][0];
+		for (i = 1; i <= n; i++) {
+			a0 = a0 * s + cb[0][i];
+			a1 = a1 * s + cb[1][i];
+			a2 = a2 * s + cb[2][i];
+			a3 = a3 * s + cb[3][i];
+		}
+	}
+	for (i = 0; i < n; i++)
+		scale *= base;
+	v[0] = a0 * scale;
+	v[1] = a1 * scale;
+	v[2] = a2 * scale;
+	v[3] = a3 * scale;
+}
+
 px_vec3 px_cpiece_eval(const struct px_cpiece *pc, double t, px_vec3 *d1)
 {
 	double v[4], d[4];
 	int c;
 
-	for (c = 0; c < 4; c++)
-		v[c] = px_bern_eval_scaled(pc->hb_[c], pc->degree_, t);
+	eval4((const double(*)[PX_CPIECE_MAX_DEGREE + 1])pc->hb_, pc->degree_, t, v);
 	if (d1) {
 		for (c = 0; c < 4; c++)
 			d[c] = px_bern_eval_scaled(pc->hd_[c], pc->degree_ - 1, t);
@@ -144,6 +189,44 @@ static double lower_bound(const double *f, const double *w, int n, double s,
 }
 
 /*
+ * A polynomial of degree n (binomial-scaled coefficients cb) and its
+ * derivative (degree n - 1, db) at x, sharing the ratio and the power of
+ * the Horner scheme of px_bern_eval_scaled().
+ */
+static double eval_with_deriv(const double *cb, const double *db, int n,
+			      double x, double *dv)
+{
+	double s, base, scale = 1.0, a, d;
+	int i;
+
+	if (x <= 0.5) {
+		base = 1.0 - x;
+		s = x / base;
+		a = cb[n];
+		d = db[n - 1];
+		for (i = n - 1; i >= 0; i--) {
+			a = a * s + cb[i];
+			if (i < n - 1)
+				d = d * s + db[i];
+		}
+	} else {
+		base = x;
+		s = (1.0 - x) / x;
+		a = cb[0];
+		d = db[0];
+		for (i = 1; i <= n; i++) {
+			a = a * s + cb[i];
+			if (i < n)
+				d = d * s + db[i];
+		}
+	}
+	for (i = 0; i < n - 1; i++)
+		scale *= base;
+	*dv = d * scale;
+	return a * scale * base;
+}
+
+/*
  * Root of a Bernstein polynomial with one sign change from - to + on
  * [0, 1]: Newton steps kept inside a shrinking bracket, bisection when a
  * step would leave it. Always converges; the bracket halves at worst.
@@ -171,7 +254,7 @@ static double refine_root(const double *c, int n, int *iters)
 		}
 	}
 	for (it = 0; it < PX_CPIECE_MAX_ITERS; it++) {
-		double v = px_bern_eval_scaled(cb, n, x), dv, xn;
+		double dv, v = eval_with_deriv(cb, db, n, x, &dv), xn;
 		if (v == 0.0)
 			break;
 		if (v < 0.0) {
@@ -189,7 +272,6 @@ static double refine_root(const double *c, int n, int *iters)
 				flo *= 0.5;
 			side = 1;
 		}
-		dv = px_bern_eval_scaled(db, n - 1, x);
 		xn = (dv != 0.0) ? x - v / dv : lo - 1.0;
 		/* A Newton step leaving the bracket is replaced by false
 		 * position inside it, which keeps the good start rather than
@@ -264,7 +346,7 @@ int px_cpiece_closest(const struct px_cpiece *pc, px_vec3 p, double *best_d2,
 		f[i] = pc->fa_[i] -
 		       2.0 * (p.x * pc->fb_[0][i] + p.y * pc->fb_[1][i] +
 			      p.z * pc->fb_[2][i]) +
-		       pp * pc->fw_[i];
+		       pp * (pc->wconst_ ? 1.0 : pc->fw_[i]);
 	/* Rounding in F is about 1e-16 of |H|^2 + |P|^2 w^2; an interval
 	 * whose bound is within a few hundred times that of the best can
 	 * only improve it by rounding noise, so it is settled. This is what

@@ -57,6 +57,11 @@ struct piece {
 	double iso_t;
 	int sample_start;
 	int ns, nt; /* samples: ns along the piece (curves) or ns x nt */
+	/* Oriented box around the control net (so around the piece):
+	 * candidates the axis-aligned box kept are dropped by it before
+	 * their solve reads the coefficient tables (most neighbours of the
+	 * foot point are nearly flat slabs that it bounds tightly). */
+	px_obb obb;
 };
 
 struct px_dist_model {
@@ -505,6 +510,66 @@ static struct tmp_piece *new_piece(struct builder *bl)
 	return &bl->tp[bl->n++];
 }
 
+/*
+ * Oriented box of n control points pw (x w, y w, z w, w): first axis
+ * along a0, second along a1 made orthogonal to it (any perpendicular
+ * when degenerate), extents from the projections of the points, padded
+ * by 1e-12 of the size so rounding cannot cut the piece.
+ */
+static px_obb net_obb(const double *pw, int n, px_vec3 a0, px_vec3 a1)
+{
+	px_obb b;
+	px_vec3 lo = px_v3(INFINITY, INFINITY, INFINITY);
+	px_vec3 hi = px_v3(-INFINITY, -INFINITY, -INFINITY);
+	double l0 = px_v3_norm(a0), l1, pad;
+	int k, d;
+
+	if (!(l0 > 0.0) || !isfinite(l0)) {
+		a0 = px_v3(1, 0, 0);
+		a1 = px_v3(0, 1, 0);
+	} else {
+		a0 = px_v3_scale(a0, 1.0 / l0);
+	}
+	a1 = px_v3_madd(a1, a0, -px_v3_dot(a1, a0));
+	l1 = px_v3_norm(a1);
+	if (!(l1 > 1e-9) || !isfinite(l1)) {
+		/* Any perpendicular: cross with the coordinate axis least
+		 * aligned with a0. */
+		px_vec3 e = fabs(a0.x) < 0.6 ? px_v3(1, 0, 0)
+				: (fabs(a0.y) < 0.6 ? px_v3(0, 1, 0) : px_v3(0, 0, 1));
+		a1 = px_v3_cross(a0, e);
+		l1 = px_v3_norm(a1);
+	}
+	b.axis[0] = a0;
+	b.axis[1] = px_v3_scale(a1, 1.0 / l1);
+	b.axis[2] = px_v3_cross(b.axis[0], b.axis[1]);
+	for (k = 0; k < n; k++) {
+		px_vec3 x = px_v3(pw[4 * k] / pw[4 * k + 3], pw[4 * k + 1] / pw[4 * k + 3],
+				  pw[4 * k + 2] / pw[4 * k + 3]);
+		double c[3];
+		for (d = 0; d < 3; d++)
+			c[d] = px_v3_dot(x, b.axis[d]);
+		lo = px_v3(c[0] < lo.x ? c[0] : lo.x, c[1] < lo.y ? c[1] : lo.y,
+			   c[2] < lo.z ? c[2] : lo.z);
+		hi = px_v3(c[0] > hi.x ? c[0] : hi.x, c[1] > hi.y ? c[1] : hi.y,
+			   c[2] > hi.z ? c[2] : hi.z);
+	}
+	pad = 1e-12 * (px_v3_norm(px_v3_sub(hi, lo)) + px_v3_norm(lo) + px_v3_norm(hi)) +
+	      1e-300;
+	b.half = px_v3(0.5 * (hi.x - lo.x) + pad, 0.5 * (hi.y - lo.y) + pad,
+		       0.5 * (hi.z - lo.z) + pad);
+	b.center = px_v3_add(px_v3_add(px_v3_scale(b.axis[0], 0.5 * (lo.x + hi.x)),
+				       px_v3_scale(b.axis[1], 0.5 * (lo.y + hi.y))),
+			     px_v3_scale(b.axis[2], 0.5 * (lo.z + hi.z)));
+	return b;
+}
+
+static px_vec3 net_point(const double *pw, int k)
+{
+	return px_v3(pw[4 * k] / pw[4 * k + 3], pw[4 * k + 1] / pw[4 * k + 3],
+		     pw[4 * k + 2] / pw[4 * k + 3]);
+}
+
 static int clamp_count(double x, int lo, int hi)
 {
 	if (!(x >= lo))
@@ -568,6 +633,22 @@ static int add_curve_pieces(struct builder *bl, const struct px_nurbs_curve *c,
 		t->pc.iso_dir = iso_dir;
 		t->pc.iso_t = iso_t;
 		t->pc.box = px_cpiece_box(&t->cp);
+		{
+			/* Along the chord; the second axis towards the control
+			 * point farthest from it. */
+			px_vec3 p0 = net_point(bz.pw, 0);
+			px_vec3 ch = px_v3_sub(net_point(bz.pw, c->degree), p0), far = ch;
+			double cl = px_v3_dot(ch, ch), fd = -1.0;
+			for (k = 1; k < c->degree; k++) {
+				px_vec3 v = px_v3_sub(net_point(bz.pw, k), p0);
+				px_vec3 r = cl > 0.0 ? px_v3_madd(v, ch, -px_v3_dot(v, ch) / cl) : v;
+				if (px_v3_dot(r, r) > fd) {
+					fd = px_v3_dot(r, r);
+					far = r;
+				}
+			}
+			t->pc.obb = net_obb(bz.pw, c->degree + 1, ch, far);
+		}
 		/* The control polygon is longer than the piece. */
 		for (k = 0; k < c->degree; k++)
 			l += px_v3_dist(px_v3(bz.pw[4 * k] / bz.pw[4 * k + 3],
@@ -682,6 +763,16 @@ static int add_surface(struct builder *bl, const struct px_nurbs_surf *s,
 						       px_v3(src[0] / src[3], src[1] / src[3],
 							     src[2] / src[3]));
 				}
+			{
+				/* Axes along the averaged u and v edges of the net. */
+				const double *h = t->hw;
+				int c00 = 0, c10 = p * (q + 1), c01 = q, c11 = p * (q + 1) + q;
+				px_vec3 du = px_v3_add(px_v3_sub(net_point(h, c10), net_point(h, c00)),
+						       px_v3_sub(net_point(h, c11), net_point(h, c01)));
+				px_vec3 dv = px_v3_add(px_v3_sub(net_point(h, c01), net_point(h, c00)),
+						       px_v3_sub(net_point(h, c11), net_point(h, c10)));
+				t->pc.obb = net_obb(h, (p + 1) * (q + 1), du, dv);
+			}
 			ext = px_aabb_diagonal(&t->pc.box);
 			t->pc.ns = len > 0.0 ? clamp_count(ext / (so.sample_tol * len) + 1.0, 2, 4) : 2;
 			t->pc.nt = t->pc.ns;
@@ -894,7 +985,8 @@ int px_dist_model_create(const struct px_nurbs_curve *curves, int n_curves,
 			n_cp++;
 		} else {
 			n_sp++;
-			sp_doubles += px_spiece_doubles(bl.tp[i].p, bl.tp[i].q);
+			sp_doubles += px_spiece_doubles_hw(bl.tp[i].p, bl.tp[i].q,
+							   (const double(*)[4])bl.tp[i].hw);
 		}
 	}
 
@@ -1070,7 +1162,8 @@ int px_dist_model_create(const struct px_nurbs_curve *curves, int n_curves,
 							    spmem);
 					if (rc)
 						goto fail;
-					spmem += px_spiece_doubles(t->p, t->q);
+					spmem += px_spiece_doubles_hw(t->p, t->q,
+								      (const double(*)[4])t->hw);
 					for (a = 0; a < pc->ns; a++)
 						for (b = 0; b < pc->nt; b++)
 							m->samples[smp++] = px_spiece_eval(
@@ -1198,12 +1291,15 @@ static double outside_lb2(const struct px_dist_model *m, px_vec3 p,
 		if (lo[d] > 0) {
 			slab = m->bounds;
 			*mx = g0[d] + lo[d] * m->h;
-			best = fmin(best, box_d2(&slab, p));
+			double b2 = box_d2(&slab, p);
+			best = b2 < best ? b2 : best;
 		}
 		if (hi[d] < n[d] - 1) {
+			double b2;
 			slab = m->bounds;
 			*mn = g0[d] + (hi[d] + 1) * m->h;
-			best = fmin(best, box_d2(&slab, p));
+			b2 = box_d2(&slab, p);
+			best = b2 < best ? b2 : best;
 		}
 	}
 	return best;
@@ -1228,12 +1324,14 @@ struct qstate {
 	int cells;
 };
 
-static void visit_piece(const struct px_dist_model *m, struct px_dist_ws *ws,
-			px_vec3 p, int id, struct qstate *q)
+/* Inline: called for every piece of every visited cell. */
+static inline void visit_piece(const struct px_dist_model *m,
+			       struct px_dist_ws *ws, px_vec3 p, int id,
+			       struct qstate *q)
 {
 	const struct piece *pc = &m->pieces[id];
-	double lb;
-	int s, e;
+	double lb, near_d2 = INFINITY;
+	int s, e, near = 0;
 
 	if (ws->stamp[id] == ws->epoch)
 		return;
@@ -1241,13 +1339,18 @@ static void visit_piece(const struct px_dist_model *m, struct px_dist_ws *ws,
 	lb = box_d2(&pc->box, p);
 	if (lb >= q->best)
 		return;
+	/* Branch-free scan (conditional moves): which sample of a random
+	 * query's piece is nearest is unpredictable. */
 	for (s = pc->sample_start, e = s + pc->ns * pc->nt; s < e; s++) {
 		double d2 = px_v3_dist2(m->samples[s], p);
-		if (d2 < q->best) {
-			q->best = d2;
-			q->best_sample = s;
-			q->best_piece = id;
-		}
+		int nearer = d2 < near_d2;
+		near_d2 = nearer ? d2 : near_d2;
+		near = nearer ? s : near;
+	}
+	if (near_d2 < q->best) {
+		q->best = near_d2;
+		q->best_sample = near;
+		q->best_piece = id;
 	}
 	ws->cand[q->n_cand].lb = lb;
 	ws->cand[q->n_cand].piece = id;
@@ -1383,7 +1486,7 @@ int px_dist_query_ws(const struct px_dist_model *m, struct px_dist_ws *ws,
 		     px_vec3 p, struct px_dist_result *r)
 {
 	struct qstate q;
-	int c[3], k, kmax, i;
+	int c[3], k, kmax, i, sorted;
 	double gap = 0.0, best;
 
 	if (!m || !ws || !r || ws->n_pieces != m->n_pieces || ws->n_ent != m->n_ent)
@@ -1456,22 +1559,35 @@ int px_dist_query_ws(const struct px_dist_model *m, struct px_dist_ws *ws,
 	r->piece = q.best_piece;
 	sample_params(m, q.best_piece, q.best_sample, &r->u, &r->v);
 
-	/* Exact solve of every piece that may still hold something closer,
-	 * nearest lower bound first. */
-	sort_cand(ws->cand, q.n_cand);
-	/* The piece holding the best sample goes first: its solve usually
-	 * lands on the global minimum, after which most other candidates
-	 * fall to their first bound. */
+	/* Exact solve of every piece that may still hold something closer.
+	 * The piece holding the best sample goes first: its solve usually
+	 * lands on the global minimum. Only the candidates whose bound
+	 * still beats the best after it are sorted (nearest bound first):
+	 * most fall out there, and sorting a handful costs little. */
 	for (i = 0; i < q.n_cand; i++)
 		if (ws->cand[i].piece == q.best_piece) {
 			struct cand t = ws->cand[i];
-			memmove(&ws->cand[1], &ws->cand[0], (size_t)i * sizeof(t));
+			ws->cand[i] = ws->cand[0];
 			ws->cand[0] = t;
 			break;
 		}
+	sorted = q.n_cand <= 1;
 	for (i = 0; i < q.n_cand; i++) {
-		const struct cand *cd = &ws->cand[i];
-		const struct piece *pc = &m->pieces[cd->piece];
+		const struct cand *cd;
+		const struct piece *pc;
+		if (i == 1 && !sorted) {
+			int j, n = 1;
+			for (j = 1; j < q.n_cand; j++)
+				if (ws->cand[j].lb < best)
+					ws->cand[n++] = ws->cand[j];
+			q.n_cand = n;
+			sort_cand(ws->cand + 1, n - 1);
+			sorted = 1;
+			if (n <= 1)
+				break;
+		}
+		cd = &ws->cand[i];
+		pc = &m->pieces[cd->piece];
 		/* Past the first, the list is sorted by lower bound. */
 		if (i > 0 && cd->lb >= best)
 			break;
@@ -1494,6 +1610,10 @@ int px_dist_query_ws(const struct px_dist_model *m, struct px_dist_ws *ws,
 			}
 			/* No closed form for this query: solve the pieces. */
 		}
+		/* The oriented box can only drop a piece (the list order is
+		 * by the axis-aligned bound, so go on to the next). */
+		if (i > 0 && px_obb_dist2(&pc->obb, p) >= best)
+			continue;
 		r->pieces_solved++;
 		if (pc->kind == PK_CURVE) {
 			struct px_cpiece_hit hit;

@@ -20,7 +20,9 @@
  * bounded below by their boxes and above by their samples, and the wave
  * stops once the best sample distance is no larger than the distance to
  * every cell not yet reached. Every piece whose lower bound is still below
- * the best is then solved exactly
+ * the best (axis-aligned box, then an oriented box around its control
+ * net, tight for the nearly flat neighbours of the foot point) is then
+ * solved exactly
  * by px_cpiece_closest() or px_spiece_closest(), which prove where the
  * piece's minimum lies instead of trusting one Newton start.
  * Open ends, C0 corners, closed-curve seams and cusps are piece end points
@@ -64,7 +66,12 @@ struct px_dist_opts {
 	double jitter;
 	/* Pre-sample spacing as a fraction of the arc length (curve pieces
 	 * take 2 to 64 samples, patches 2x2 to 4x4: samples only give the
-	 * wave its first upper bound; the piece solvers prove the rest). */
+	 * wave its first upper bound and the best piece its Newton start;
+	 * the piece solvers prove the rest, so the cap costs no correctness.
+	 * Measured: 2x2 to 3x3 caps cost about the same, 6x6 and 8x8 caps
+	 * 9 % and 17 % more instructions per bicubic query, for the same
+	 * pieces solved per query; the paper's 1 % (about 26x26 per patch)
+	 * would scan hundreds of samples per visited piece). */
 	double sample_tol;
 	/* References a grid cell holds before spilling. */
 	int cell_cap;

@@ -29,6 +29,27 @@ size_t px_spiece_doubles(int p, int q)
 	       4 * tsize(ngu_s(p), ngu_t(q)) + 4 * tsize(ngv_s(p), ngv_t(q));
 }
 
+/* Every weight equal: the patch is polynomial once they are divided out,
+ * and its critical-point tensors have the lower degrees. */
+static int equal_weights(const double (*hw)[4], size_t np)
+{
+	size_t i;
+	for (i = 1; i < np; i++)
+		if (hw[i][3] != hw[0][3])
+			return 0;
+	return 1;
+}
+
+size_t px_spiece_doubles_hw(int p, int q, const double (*hw)[4])
+{
+	if (p < 1 || q < 1 || p > MD || q > MD || !hw)
+		return 0;
+	if (!equal_weights(hw, tsize(p, q)))
+		return px_spiece_doubles(p, q);
+	return 4 * tsize(p, q) + 5 * tsize(nf_s(p), nf_s(q)) +
+	       4 * tsize(2 * p - 1, 2 * q) + 4 * tsize(2 * p, 2 * q - 1);
+}
+
 /* ---- tensor Bernstein helpers (row i along s, column j along t) ---------- */
 
 static void binom_row(int n, double *row)
@@ -131,6 +152,8 @@ static int strict_sign(const double *c, size_t k, double eps)
 	for (i = 0; i < k; i++) {
 		pos &= c[i] > eps;
 		neg &= c[i] < -eps;
+		if (!(pos | neg))
+			return 0; /* mixed: most rectangles worth a look are */
 	}
 	return pos ? 1 : (neg ? -1 : 0);
 }
@@ -144,14 +167,31 @@ static double max_abs(const double *c, size_t k)
 	return m;
 }
 
-static void t_range(const double *c, size_t k, double *lo, double *hi)
+/* Range of the coefficients of the derivative along s (dir 0) or t
+ * (dir 1) of c (n, m), without storing them: the Jacobian bounds. */
+static void t_deriv_range(const double *c, int n, int m, int dir, double *lo,
+			  double *hi)
 {
-	size_t i;
-	*lo = INFINITY;
-	*hi = -INFINITY;
-	for (i = 0; i < k; i++) {
-		*lo = c[i] < *lo ? c[i] : *lo;
-		*hi = c[i] > *hi ? c[i] : *hi;
+	double a = INFINITY, b = -INFINITY;
+	int i, j;
+	if (dir == 0) {
+		for (i = 0; i < n; i++)
+			for (j = 0; j <= m; j++) {
+				double d = c[(i + 1) * (m + 1) + j] - c[i * (m + 1) + j];
+				a = d < a ? d : a;
+				b = d > b ? d : b;
+			}
+		*lo = n * a;
+		*hi = n * b;
+	} else {
+		for (i = 0; i <= n; i++)
+			for (j = 0; j < m; j++) {
+				double d = c[i * (m + 1) + j + 1] - c[i * (m + 1) + j];
+				a = d < a ? d : a;
+				b = d > b ? d : b;
+			}
+		*lo = m * a;
+		*hi = m * b;
 	}
 }
 
@@ -183,8 +223,15 @@ int px_spiece_init(struct px_spiece *sp, int p, int q, const double (*hw)[4],
 	sp->v0_ = v0;
 	sp->v1_ = v1;
 	nfs = tsize(nf_s(p), nf_s(q));
-	ngu = tsize(ngu_s(p), ngu_t(q));
-	ngv = tsize(ngv_s(p), ngv_t(q));
+	/* Blocks packed at the degrees the weights give (see
+	 * px_spiece_doubles_hw()). */
+	if (equal_weights(hw, np)) {
+		ngu = tsize(2 * p - 1, 2 * q);
+		ngv = tsize(2 * p, 2 * q - 1);
+	} else {
+		ngu = tsize(ngu_s(p), ngu_t(q));
+		ngv = tsize(ngv_s(p), ngv_t(q));
+	}
 	sp->h_ = cur;
 	cur += 4 * np;
 	sp->fa_ = cur;
@@ -233,8 +280,7 @@ int px_spiece_init(struct px_spiece *sp, int p, int q, const double (*hw)[4],
 	sp->gum_ = 2 * q + wq;
 	sp->gvn_ = 2 * p + wp;
 	sp->gvm_ = 2 * q + wq - 1;
-	/* The coefficient blocks were laid out for the rational degrees;
-	 * within them the arrays are packed at the actual ones. */
+	/* The same decision as the layout above (the same weights). */
 	ngu = tsize(sp->gun_, sp->gum_);
 	ngv = tsize(sp->gvn_, sp->gvm_);
 	{
@@ -385,22 +431,27 @@ px_vec3 px_spiece_eval(const struct px_spiece *sp, double s, double t,
 	basis(p, s, bs[0], bs[1], bs[2]);
 	basis(q, t, bt[0], bt[1], bt[2]);
 	memset(d, 0, sizeof(d));
-	for (i = 0; i <= p; i++)
-		for (j = 0; j <= q; j++) {
-			size_t k = (size_t)i * (q + 1) + j;
-			double w00 = bs[0][i] * bt[0][j], w10 = bs[1][i] * bt[0][j];
-			double w01 = bs[0][i] * bt[1][j], w20 = bs[2][i] * bt[0][j];
-			double w11 = bs[1][i] * bt[1][j], w02 = bs[0][i] * bt[2][j];
-			for (c = 0; c < 4; c++) {
-				double h = sp->h_[c * np + k];
-				d[0][0][c] += w00 * h;
-				d[1][0][c] += w10 * h;
-				d[0][1][c] += w01 * h;
-				d[2][0][c] += w20 * h;
-				d[1][1][c] += w11 * h;
-				d[0][2][c] += w02 * h;
+	/* Row by row: the t-sums of a row (value, first and second
+	 * derivative) first, then their s-weights; fewer products than
+	 * weighting every control point six times. */
+	for (c = 0; c < 4; c++) {
+		const double *h = sp->h_ + c * np;
+		for (i = 0; i <= p; i++) {
+			const double *row = h + (size_t)i * (q + 1);
+			double r0 = 0.0, r1 = 0.0, r2 = 0.0;
+			for (j = 0; j <= q; j++) {
+				r0 += bt[0][j] * row[j];
+				r1 += bt[1][j] * row[j];
+				r2 += bt[2][j] * row[j];
 			}
+			d[0][0][c] += bs[0][i] * r0;
+			d[1][0][c] += bs[1][i] * r0;
+			d[2][0][c] += bs[2][i] * r0;
+			d[0][1][c] += bs[0][i] * r1;
+			d[1][1][c] += bs[1][i] * r1;
+			d[0][2][c] += bs[0][i] * r2;
 		}
+	}
 	{
 		/* Quotient rule for S = H / w up to second order. */
 		double w = d[0][0][3], iw = 1.0 / w;
@@ -461,6 +512,12 @@ static void consider(struct qctx *x, double s, double t)
 	}
 }
 
+/* Hot-path clamp: fmin/fmax are library calls without -ffast-math. */
+static inline double clampd(double v, double lo, double hi)
+{
+	return v > lo ? (v < hi ? v : hi) : lo;
+}
+
 /*
  * The minimum of f inside a rectangle where the caller proved that there
  * is at most one critical point, and that it is a minimum: Newton on
@@ -488,7 +545,7 @@ static int newton_f(struct qctx *x, const struct rect *r, int *iters,
 	for (it = 0; it < PX_SPIECE_MAX_ITERS; it++) {
 		px_vec3 su, sv, suu, suv, svv, d, S;
 		double gs, gt, a, b, c, det, ds, dt, al;
-		int k;
+		int k, out_s, out_t;
 
 		(*iters)++;
 		S = px_spiece_eval(sp, s, t, &su, &sv, &suu, &suv, &svv);
@@ -507,7 +564,22 @@ static int newton_f(struct qctx *x, const struct rect *r, int *iters,
 		det = a * c - b * b;
 		if (gs == 0.0 && gt == 0.0)
 			break;
-		if (a > 0.0 && det > 0.0) {
+		/* On the border with descent pointing out through it: that
+		 * coordinate stays (projected Newton), the other one goes on
+		 * in 1D, so that the point ends at the rectangle's constrained
+		 * minimum; the caller can then prove from it that no critical
+		 * point lies inside (monotone_settles()). */
+		out_s = (s <= r->s0 && gs > 0.0) || (s >= r->s1 && gs < 0.0);
+		out_t = (t <= r->t0 && gt > 0.0) || (t >= r->t1 && gt < 0.0);
+		if (out_s && out_t)
+			goto done; /* a corner with descent pointing out */
+		if (out_s) {
+			ds = 0.0;
+			dt = c > 0.0 ? -gt / c : -copysign(wmax, gt);
+		} else if (out_t) {
+			dt = 0.0;
+			ds = a > 0.0 ? -gs / a : -copysign(wmax, gs);
+		} else if (a > 0.0 && det > 0.0) {
 			ds = -(c * gs - b * gt) / det;
 			dt = -(a * gt - b * gs) / det;
 		} else {
@@ -520,17 +592,16 @@ static int newton_f(struct qctx *x, const struct rect *r, int *iters,
 		 * search there would halve the step to nothing. */
 		if (fabs(ds) <= 1e-13 && fabs(dt) <= 1e-13)
 			goto done;
-		/* Sitting on the border and pushed out through it: the
-		 * minimum is not inside this rectangle (or not reachable from
-		 * here); give up, the caller subdivides, which is safe. */
+		/* Sitting on the border and the step still pushed out through
+		 * it: give up, the caller subdivides, which is safe. */
 		if ((s <= r->s0 && ds < 0.0) || (s >= r->s1 && ds > 0.0) ||
 		    (t <= r->t0 && dt < 0.0) || (t >= r->t1 && dt > 0.0))
 			goto done;
 		for (al = 1.0, k = 0; k < 12; k++, al *= 0.5) {
-			double ns = fmin(r->s1, fmax(r->s0, s + al * ds));
-			double nt = fmin(r->t1, fmax(r->t0, t + al * dt));
+			double ns = clampd(s + al * ds, r->s0, r->s1);
+			double nt = clampd(t + al * dt, r->t0, r->t1);
 			double fn = px_v3_dist2(spiece_point(sp, ns, nt), x->p);
-			double moved = fmax(fabs(ns - s), fabs(nt - t));
+			double moved = fabs(ns - s) > fabs(nt - t) ? fabs(ns - s) : fabs(nt - t);
 			if (fn <= fcur || moved <= 1e-15) {
 				s = ns;
 				t = nt;
@@ -671,6 +742,87 @@ static double rect_lb(const double *F, const double *W, int fn, int fm,
 	return ratio_min(rf, W ? rw : NULL, tsize(fn, fm));
 }
 
+/* Value of a tensor at (s, t) from its Bernstein basis values. */
+static double t_eval(const double *c, int n, int m, double s, double t)
+{
+	double bs[3 * MD + 2], bt[3 * MD + 2], acc = 0.0;
+	int i, j, k;
+
+	bs[0] = 1.0;
+	for (k = 1; k <= n; k++)
+		raise(bs, k, s, 1.0 - s);
+	bt[0] = 1.0;
+	for (k = 1; k <= m; k++)
+		raise(bt, k, t, 1.0 - t);
+	for (i = 0; i <= n; i++) {
+		double row = 0.0;
+		for (j = 0; j <= m; j++)
+			row += c[i * (m + 1) + j] * bt[j];
+		acc += row * bs[i];
+	}
+	return acc;
+}
+
+/*
+ * Rounding bound of gu or gv evaluated at one point: each coefficient
+ * a - P . b is formed with an error of a few ulps of |a| + |P| |b|
+ * (cancellation included), the convex combination of the basis keeps the
+ * largest, and the summation adds a few ulps per term.
+ */
+static double point_rounding(const struct px_spiece *sp, px_vec3 p, size_t ngu,
+			     size_t ngv)
+{
+	double m = 0.0, ax = fabs(p.x), ay = fabs(p.y), az = fabs(p.z);
+	size_t i;
+	for (i = 0; i < ngu; i++) {
+		double e = fabs(sp->gua_[i]) + ax * fabs(sp->gub_[i]) +
+			   ay * fabs(sp->gub_[ngu + i]) + az * fabs(sp->gub_[2 * ngu + i]);
+		m = e > m ? e : m;
+	}
+	for (i = 0; i < ngv; i++) {
+		double e = fabs(sp->gva_[i]) + ax * fabs(sp->gvb_[i]) +
+			   ay * fabs(sp->gvb_[ngv + i]) + az * fabs(sp->gvb_[2 * ngv + i]);
+		m = e > m ? e : m;
+	}
+	/* 8 ulps per coefficient plus 2 per term of a sum of at most
+	 * (3 MD + 1)^2 terms, rounded up generously. */
+	return (8.0 + 2.0 * (6 * MD + 2)) * 0x1p-52 * m;
+}
+
+/* What monotone_settles() needs besides the rectangle and the point. */
+struct mono {
+	double mu;             /* lower bound of the symmetric Jacobian part */
+	double gu, gv;         /* (gu, gv) at the point */
+	double eps_gu, eps_gv; /* their rounding */
+	double gmax;           /* bound of |grad f| on the rectangle */
+};
+
+/*
+ * Proof that a rectangle whose (gu, gv) is strongly monotone (modulus mu,
+ * from the Jacobian bounds) holds no critical point closer than the point
+ * x* = (s, t) the projected Newton ended at (on the border, its descent
+ * pointing out). For a zero z in the rectangle, monotonicity gives
+ *     mu |z - x*|^2 <= (G(z) - G(x*)) . (z - x*) = -G(x*) . (z - x*).
+ * A component of G(x*) pointing out through a border x* lies on makes
+ * its term <= 0 (z lies inside), so |z - x*| <= |G_rest| / mu = rho, and
+ * f(z) >= f(x*) - rho * max |grad f|. When that is within the rounding
+ * slack, x* (already considered) is as good as any interior minimum and
+ * the rectangle is settled without subdividing around the border.
+ */
+static int monotone_settles(const struct qctx *x, const struct rect *r,
+			    double s, double t, const struct mono *mo)
+{
+	int out_s = (s <= r->s0 && mo->gu > mo->eps_gu) ||
+		    (s >= r->s1 && mo->gu < -mo->eps_gu);
+	int out_t = (t <= r->t0 && mo->gv > mo->eps_gv) ||
+		    (t >= r->t1 && mo->gv < -mo->eps_gv);
+	double rs = out_s ? 0.0 : fabs(mo->gu) + mo->eps_gu;
+	double rt = out_t ? 0.0 : fabs(mo->gv) + mo->eps_gv;
+	double rho = sqrt(rs * rs + rt * rt) / mo->mu;
+
+	return rho * mo->gmax <= x->slack;
+}
+
 int px_spiece_closest(const struct px_spiece *sp, px_vec3 p, double *best_d2,
 		      struct px_spiece_hit *hit)
 {
@@ -686,7 +838,7 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 	const int un = sp->gun_, um = sp->gum_, vn = sp->gvn_, vm = sp->gvm_;
 	const size_t nfs = tsize(fn, fm), ngu = tsize(un, um), ngv = tsize(vn, vm);
 	double F[TMAX], GU[TMAX], GV[TMAX];
-	double rf[TMAX], rw[TMAX], rg[TMAX], rv[TMAX], dg[TMAX];
+	double rf[TMAX], rw[TMAX], rg[TMAX], rv[TMAX];
 	/* Each split replaces one rectangle by four: the heap never holds
 	 * more than 3 * nodes + 1. */
 	struct rect heap[3 * PX_SPIECE_MAX_NODES + 4];
@@ -694,8 +846,19 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 	double pp = px_v3_dot(p, p), lb_unresolved = INFINITY;
 	int hn = 0, k, have_gu = 0, have_gv = 0;
 	double eps_gu = 0.0, eps_gv = 0.0;
+	/* Smallest weight: w on the patch is at least the smallest weight
+	 * coefficient (convex combination). */
+	double wmin = INFINITY;
+	double rnd_g = -1.0; /* point_rounding(), on first use */
 	size_t i;
 
+	if (sp->wconst_) {
+		wmin = 1.0; /* divided out at setup */
+	} else {
+		const double *w = sp->h_ + 3 * tsize(P, Q);
+		for (i = 0; i < tsize(P, Q); i++)
+			wmin = w[i] < wmin ? w[i] : wmin;
+	}
 	x.sp = sp;
 	x.p = p;
 	x.hint_s = hint_s;
@@ -712,11 +875,12 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 		if (dc > 0.0 && dc * dc >= x.best)
 			goto out;
 	}
+	/* Equal weights: W is the constant 1 and need not be read. */
 	for (i = 0; i < nfs; i++)
 		F[i] = sp->fa_[i] -
 		       2.0 * (p.x * sp->fb_[i] + p.y * sp->fb_[nfs + i] +
 			      p.z * sp->fb_[2 * nfs + i]) +
-		       pp * sp->fw_[i];
+		       pp * (sp->wconst_ ? 1.0 : sp->fw_[i]);
 	{
 		double r = px_v3_dist(sp->center_, p) + 2.0 * sp->radius_;
 		x.slack = 1e-13 * (r * r + px_v3_dot(sp->center_, sp->center_));
@@ -736,7 +900,7 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 	consider(&x, 0.5, 0.5);
 	while (hn > 0 && hit->nodes < PX_SPIECE_MAX_NODES) {
 		struct rect r = heap_pop(heap, &hn);
-		double ws = r.s1 - r.s0, wt = r.t1 - r.t0;
+		double ws = r.s1 - r.s0, wt = r.t1 - r.t0, mu = 0.0;
 		int certain = 0;
 
 		if (r.lb >= x.best - x.slack)
@@ -768,14 +932,10 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 			/* Bernstein bounds of the Jacobian of (gu, gv), in the
 			 * piece's local scale (d/ds = (1/ws) d/ds_sub). */
 			double a_lo, a_hi, b_lo, b_hi, c_lo, c_hi, d_lo, d_hi, off;
-			t_deriv_s(rg, un, um, dg);
-			t_range(dg, tsize(un - 1, um), &a_lo, &a_hi);
-			t_deriv_t(rg, un, um, dg);
-			t_range(dg, tsize(un, um - 1), &b_lo, &b_hi);
-			t_deriv_s(rv, vn, vm, dg);
-			t_range(dg, tsize(vn - 1, vm), &c_lo, &c_hi);
-			t_deriv_t(rv, vn, vm, dg);
-			t_range(dg, tsize(vn, vm - 1), &d_lo, &d_hi);
+			t_deriv_range(rg, un, um, 0, &a_lo, &a_hi);
+			t_deriv_range(rg, un, um, 1, &b_lo, &b_hi);
+			t_deriv_range(rv, vn, vm, 0, &c_lo, &c_hi);
+			t_deriv_range(rv, vn, vm, 1, &d_lo, &d_hi);
 			a_lo /= ws;
 			a_hi /= ws;
 			c_lo /= ws;
@@ -785,9 +945,14 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 			d_lo /= wt;
 			d_hi /= wt;
 			off = 0.5 * fmax(fabs(b_lo + c_lo), fabs(b_hi + c_hi));
-			if (a_lo > 0.0 && d_lo > 0.0 && a_lo * d_lo > off * off)
+			if (a_lo > 0.0 && d_lo > 0.0 && a_lo * d_lo > off * off) {
 				certain = 1; /* monotone: one zero at most, a minimum */
-			else if (a_hi < 0.0 && d_hi < 0.0 && a_hi * d_hi > off * off)
+				/* Its modulus: the smallest eigenvalue of the
+				 * symmetric part grows with a and d and falls
+				 * with |off|, so the corner values bound it. */
+				mu = 0.5 * (a_lo + d_lo) -
+				     sqrt(0.25 * (a_lo - d_lo) * (a_lo - d_lo) + off * off);
+			} else if (a_hi < 0.0 && d_hi < 0.0 && a_hi * d_hi > off * off)
 				continue; /* at most one zero, and a maximum */
 		}
 		if (certain) {
@@ -797,6 +962,20 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 				consider(&x, s, t); /* a real point: a valid bound */
 			if (found)
 				continue;
+			if (s == s && mu > 0.0) {
+				struct mono mo;
+				double mg = max_abs(rg, ngu), mv = max_abs(rv, ngv);
+				mo.mu = mu;
+				mo.gu = t_eval(GU, un, um, s, t);
+				mo.gv = t_eval(GV, vn, vm, s, t);
+				if (rnd_g < 0.0)
+					rnd_g = point_rounding(sp, p, ngu, ngv);
+				mo.eps_gu = rnd_g;
+				mo.eps_gv = rnd_g;
+				mo.gmax = 2.0 * sqrt(mg * mg + mv * mv) / (wmin * wmin * wmin);
+				if (monotone_settles(&x, &r, s, t, &mo))
+					continue;
+			}
 		} else {
 			/* Keep the upper bound moving while we subdivide. */
 			consider(&x, 0.5 * (r.s0 + r.s1), 0.5 * (r.t0 + r.t1));

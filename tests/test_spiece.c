@@ -281,6 +281,104 @@ static void test_symmetric_patch_split_lines(void)
 	PX_CHECK_INT_EQ(unc, 0);
 }
 
+/* The half [s0, s1] of a patch along s: every column of the homogeneous
+ * net restricted in Bernstein form. */
+static void half_patch(const double (*hw)[4], int p, int q, double s0, double s1,
+		       double (*out)[4])
+{
+	double col[MAXD + 1];
+	int i, j, c;
+	for (j = 0; j <= q; j++)
+		for (c = 0; c < 4; c++) {
+			for (i = 0; i <= p; i++)
+				col[i] = hw[i * (q + 1) + j][c];
+			px_bern_restrict(col, p, s0, s1, col);
+			for (i = 0; i <= p; i++)
+				out[i * (q + 1) + j][c] = col[i];
+		}
+}
+
+/* Query points whose foot lies just beside the line that cuts a patch in
+ * two (1e-5 to 1e-2 of the parameter range, either side, sometimes near
+ * a corner too): the half without the foot must prove that it holds no
+ * interior minimum from the point its Newton ends at on the cut (the
+ * monotone argument), the other half must still find the minimum. The
+ * two halves with their edges must give the oracle's answer on the
+ * whole patch. */
+static void test_minimum_beside_piece_border(void)
+{
+	double hw[(MAXD + 1) * (MAXD + 1)][4], lo[(MAXD + 1) * (MAXD + 1)][4];
+	double hi[(MAXD + 1) * (MAXD + 1)][4];
+	int trial, unc = 0, interior = 0;
+	for (trial = 0; trial < 60; trial++) {
+		int p = px_rand_int(2, 4), q = px_rand_int(2, 4);
+		struct px_spiece_hit h1, h2;
+		double cut = px_rand_range(0.3, 0.7), del, s0, t0, got, ref, h;
+		px_vec3 S, su, sv, n;
+		struct px_spiece sp;
+		random_patch(hw, p, q, trial % 2);
+		del = exp(px_rand_range(log(1e-5), log(1e-2)));
+		s0 = cut + (px_rand_int(0, 1) ? del : -del);
+		t0 = trial % 3 == 0 ? px_rand_range(1e-4, 1e-2) : px_rand_range(0.1, 0.9);
+		PX_CHECK_INT_EQ(px_spiece_init(&sp, p, q, (const double(*)[4])hw, 0, 1, 0, 1,
+					       mem), PX_OK);
+		S = px_spiece_eval(&sp, s0, t0, &su, &sv, NULL, NULL, NULL);
+		n = px_v3_cross(su, sv);
+		h = px_rand_range(-0.15, 0.15);
+		S = px_v3_madd(S, n, h / (px_v3_norm(n) + 1e-300));
+		half_patch((const double(*)[4])hw, p, q, 0.0, cut, lo);
+		half_patch((const double(*)[4])hw, p, q, cut, 1.0, hi);
+		got = fmin(solve((const double(*)[4])lo, p, q, S, &unc, &h1),
+			   solve((const double(*)[4])hi, p, q, S, &unc, &h2));
+		ref = oracle((const double(*)[4])hw, p, q, S);
+		interior += h1.d2 < INFINITY || h2.d2 < INFINITY;
+		PX_CHECK_MSG(got <= ref + 1e-9,
+			     "wrong branch: %.17g vs oracle %.17g (p %d q %d, rational %d, "
+			     "foot %.9f %.9f, cut %.9f)", got, ref, p, q, trial % 2, s0, t0, cut);
+		PX_CHECK_MSG(got >= ref - 1e-7 || h1.d2 < INFINITY || h2.d2 < INFINITY,
+			     "below oracle without a witness: %.17g vs %.17g", got, ref);
+	}
+	printf("    interior answers %d of 60, uncertified %d\n", interior, unc);
+	PX_CHECK(interior > 20);
+	PX_CHECK_INT_EQ(unc, 0);
+}
+
+/* A piece with equal weights packs its tables at the lower degrees: it
+ * fits in px_spiece_doubles_hw() doubles (nothing written past them) and
+ * answers exactly as with the full px_spiece_doubles() block. */
+static void test_packed_memory(void)
+{
+	static double small[200000];
+	double hw[(MAXD + 1) * (MAXD + 1)][4];
+	int trial;
+	for (trial = 0; trial < 40; trial++) {
+		int p = px_rand_int(1, MAXD), q = px_rand_int(1, MAXD), rational = trial % 2;
+		size_t n, full = px_spiece_doubles(p, q), k;
+		struct px_spiece a, b;
+		struct px_spiece_hit ha, hb;
+		double da = INFINITY, db = INFINITY;
+		px_vec3 x = px_v3(px_rand_range(-0.5, 1.5), px_rand_range(-0.5, 1.5),
+				  px_rand_range(-1, 1));
+		random_patch(hw, p, q, rational);
+		n = px_spiece_doubles_hw(p, q, (const double(*)[4])hw);
+		PX_CHECK(n > 0 && n <= full);
+		if (!rational)
+			PX_CHECK(n < full);
+		for (k = 0; k < full + 8; k++)
+			small[k] = 12345.0;
+		PX_CHECK_INT_EQ(px_spiece_init(&a, p, q, (const double(*)[4])hw, 0, 1, 0, 1,
+					       small), PX_OK);
+		for (k = n; k < full + 8; k++)
+			PX_CHECK_MSG(small[k] == 12345.0, "written past the packed size at %zu", k);
+		PX_CHECK_INT_EQ(px_spiece_init(&b, p, q, (const double(*)[4])hw, 0, 1, 0, 1,
+					       mem), PX_OK);
+		PX_CHECK_INT_EQ(px_spiece_closest(&a, x, &da, &ha), px_spiece_closest(&b, x, &db, &hb));
+		PX_CHECK(da == db);
+	}
+	PX_CHECK_INT_EQ(px_spiece_doubles_hw(0, 2, (const double(*)[4])hw), 0);
+	PX_CHECK_INT_EQ(px_spiece_doubles_hw(2, 2, NULL), 0);
+}
+
 static void test_query_allocates_nothing(void)
 {
 	double hw[16][4];
@@ -317,6 +415,8 @@ static const struct px_test tests[] = {
 	PX_T(test_random_patches_vs_oracle),
 	PX_T(test_sphere_octant_focal_point),
 	PX_T(test_symmetric_patch_split_lines),
+	PX_T(test_minimum_beside_piece_border),
+	PX_T(test_packed_memory),
 	PX_T(test_query_allocates_nothing),
 	PX_T(test_bad_input),
 };
