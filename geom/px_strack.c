@@ -1,0 +1,1240 @@
+/*
+ * px_strack.c - coherent tracking of point-surface critical distances.
+ *
+ * f(u, v) = |S - p|^2 / 2 has gradient E = ((S - p) . Su, (S - p) . Sv)
+ * and Hessian H = [Su.Su + (S - p).Suu, Su.Sv + (S - p).Suv; .,
+ * Sv.Sv + (S - p).Svv]. With p = S + l N on the normal line, H = I - l II
+ * (first and second fundamental forms), singular exactly at l = 1 / k_i:
+ * the focal sheets, where critical points are born and die in pairs
+ * (Seong-Johnson-Cohen section 4.3). Moving p by dp moves a regular
+ * critical point by H^-1 (Su . dp, Sv . dp) (differentiate E = 0, their
+ * section 4.2): the predictor.
+ *
+ * A critical point that is already tracked is only ever followed; a new
+ * one comes from the solve of a cell whose transition box the path met.
+ * Everything found is a verified zero of E (Newton converged), so the
+ * tracked set can miss points but never holds a false one; a missed
+ * minimum can only come from a transition box drawn too small, which the
+ * optional verification would report.
+ */
+#include "px_strack.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define ST_NEWTON 16
+#define ST_NBOX 3
+
+struct crit {
+	double u, v;
+	int type;       /* +1 min, -1 max, 0 saddle */
+	uint32_t id;
+	px_vec3 s, su, sv;
+	double h11, h12, h22;
+};
+
+struct scell {
+	double u0, u1, v0, v1;
+	int surf;
+	int nbox;
+	px_aabb box[ST_NBOX];
+	double expiry;
+	int hpos;
+	uint32_t mark;
+};
+
+struct ssurf {
+	struct px_nurbs_surf s;
+	double *mem;            /* owned copy of knots and pw */
+	double u0, u1, v0, v1, du, dv;
+	int wrap_u, wrap_v;
+	int first_cell, ncu, ncv;
+	double *cu, *cv;        /* cell bounds along u (ncu + 1), v */
+	struct crit *z, *tmp;
+	int nz, cap;
+};
+
+struct edge {
+	int surf, dir;  /* dir 0: curve in u at v = t; 1: curve in v at u = t */
+	double t;
+};
+
+struct pole {
+	px_vec3 q;
+	double u, v;
+	int surf;
+};
+
+struct px_strack {
+	struct px_strack_opts opts;
+	struct px_dist_model *dist;
+	struct px_track *ct;    /* free curves + edges */
+	int n_curves, n_surf, n_edges, n_cells, n_poles, n_unbounded;
+	int n_patches;
+	struct ssurf *sf;
+	struct scell *cell;
+	struct edge *edge;
+	struct pole *pole;
+	int *heap, *popped, *hits;
+	double travel;
+	int heap_ok;
+	px_aabb work;
+	double scale;
+	px_vec3 p;
+	int init;
+	uint32_t epoch, next_id;
+	int best_kind;          /* 0 none, 1 surface min, 2 curve tracker, 3 pole */
+	uint32_t best_id;
+	struct px_strack_stats st;
+};
+
+/* ------------------------------------------------------------------ */
+/* evaluation and Newton                                               */
+
+static void crit_eval(const struct ssurf *f, struct crit *z, px_vec3 p,
+		      px_vec3 *grad_out)
+{
+	struct px_nurbs_surf_derivs d;
+	px_vec3 w;
+	px_nurbs_surf_eval(&f->s, z->u, z->v, 2, &d);
+	w = px_v3_sub(d.s, p);
+	z->s = d.s;
+	z->su = d.su;
+	z->sv = d.sv;
+	z->h11 = px_v3_dot(d.su, d.su) + px_v3_dot(w, d.suu);
+	z->h12 = px_v3_dot(d.su, d.sv) + px_v3_dot(w, d.suv);
+	z->h22 = px_v3_dot(d.sv, d.sv) + px_v3_dot(w, d.svv);
+	grad_out->x = px_v3_dot(w, d.su);
+	grad_out->y = px_v3_dot(w, d.sv);
+	grad_out->z = 0.0;
+}
+
+static int crit_type(const struct crit *z)
+{
+	double det = z->h11 * z->h22 - z->h12 * z->h12;
+	if (det > 0.0)
+		return z->h11 > 0.0 ? 1 : -1;
+	return 0;
+}
+
+/* Bring (u, v) into the domain: wrap a seam direction; 1 when an open
+ * direction is left. */
+static int domain_fix(const struct ssurf *f, double *u, double *v)
+{
+	if (*u < f->u0 || *u > f->u1) {
+		if (!f->wrap_u)
+			return 1;
+		*u = f->u0 + fmod(*u - f->u0, f->du);
+		if (*u < f->u0)
+			*u += f->du;
+	}
+	if (*v < f->v0 || *v > f->v1) {
+		if (!f->wrap_v)
+			return 1;
+		*v = f->v0 + fmod(*v - f->v0, f->dv);
+		if (*v < f->v0)
+			*v += f->dv;
+	}
+	return 0;
+}
+
+/*
+ * Newton on E = 0 with p fixed from z->u, z->v; steps clamped to lu, lv.
+ * Returns 0 with z evaluated at the root, 1 on failure (no convergence,
+ * singular Hessian, the domain left through an open edge).
+ */
+static int snewton(const struct ssurf *f, struct crit *z, px_vec3 p,
+		   double lu, double lv)
+{
+	double tu = 1e-11 * f->du, tv = 1e-11 * f->dv;
+	int k, outs = 0;
+	for (k = 0; k < ST_NEWTON; k++) {
+		px_vec3 g;
+		double det, su, sv;
+		if (domain_fix(f, &z->u, &z->v)) {
+			/* an overshoot past an open edge: back onto it (a
+			 * point just inside the edge is reached from there);
+			 * pushing out again means the point has left */
+			if (++outs > 2)
+				return 1;
+			z->u = fmin(fmax(z->u, f->u0), f->u1);
+			z->v = fmin(fmax(z->v, f->v0), f->v1);
+		}
+		crit_eval(f, z, p, &g);
+		det = z->h11 * z->h22 - z->h12 * z->h12;
+		if (!(fabs(det) > 0.0))
+			return 1;
+		su = -(z->h22 * g.x - z->h12 * g.y) / det;
+		sv = -(-z->h12 * g.x + z->h11 * g.y) / det;
+		if (!isfinite(su) || !isfinite(sv))
+			return 1;
+		if (fabs(su) <= tu && fabs(sv) <= tv) {
+			z->type = crit_type(z);
+			return 0;
+		}
+		if (fabs(su) > lu)
+			su = su > 0 ? lu : -lu;
+		if (fabs(sv) > lv)
+			sv = sv > 0 ? lv : -lv;
+		z->u += su;
+		z->v += sv;
+	}
+	return 1;
+}
+
+/* ------------------------------------------------------------------ */
+/* critical-point sets                                                 */
+
+static int crit_dup(const struct ssurf *f, const struct crit *a,
+		    const struct crit *b)
+{
+	double du = fabs(a->u - b->u), dv = fabs(a->v - b->v);
+	if (f->wrap_u)
+		du = fmin(du, f->du - du);
+	if (f->wrap_v)
+		dv = fmin(dv, f->dv - dv);
+	return du <= 1e-7 * f->du && dv <= 1e-7 * f->dv;
+}
+
+/* Add z unless it duplicates a held point. Returns 1 added, 0 duplicate,
+ * PX_E_NOSPC. */
+static int crit_add(struct px_strack *t, struct ssurf *f, const struct crit *z)
+{
+	int i;
+	for (i = 0; i < f->nz; i++)
+		if (crit_dup(f, &f->z[i], z))
+			return 0;
+	if (f->nz >= f->cap)
+		return PX_E_NOSPC;
+	f->z[f->nz] = *z;
+	if (!f->z[f->nz].id) {
+		if (++t->next_id >= 0x7fffffffu)
+			t->next_id = 1;
+		f->z[f->nz].id = t->next_id;
+	}
+	f->nz++;
+	return 1;
+}
+
+/* Solve cell c at p from its seed grid. Returns 0 or PX_E_NOSPC. */
+static int cell_solve(struct px_strack *t, const struct scell *c, px_vec3 p)
+{
+	struct ssurf *f = &t->sf[c->surf];
+	int n = t->opts.seeds, i, j, rc;
+	double lu = c->u1 - c->u0, lv = c->v1 - c->v0;
+	t->st.cell_solves++;
+	for (j = 0; j < n; j++)
+		for (i = 0; i < n; i++) {
+			struct crit z;
+			memset(&z, 0, sizeof(z));
+			z.u = c->u0 + lu * (i + 0.5) / n;
+			z.v = c->v0 + lv * (j + 0.5) / n;
+			if (snewton(f, &z, p, 0.5 * lu, 0.5 * lv))
+				continue;
+			rc = crit_add(t, f, &z);
+			if (rc < 0)
+				return rc;
+		}
+	return 0;
+}
+
+static int surf_reinit(struct px_strack *t, struct ssurf *f, int si, px_vec3 p)
+{
+	int c, rc;
+	f->nz = 0;
+	for (c = 0; c < f->ncu * f->ncv; c++) {
+		const struct scell *cl = &t->cell[f->first_cell + c];
+		if (cl->surf != si)
+			continue;
+		rc = cell_solve(t, cl, p);
+		if (rc)
+			return rc;
+	}
+	return 0;
+}
+
+/* ------------------------------------------------------------------ */
+/* transition boxes: lazy tests                                        */
+
+static double box_dist(const px_aabb *b, px_vec3 p)
+{
+	return sqrt(px_aabb_dist2(b, p));
+}
+
+static double cell_radius(const struct scell *c, px_vec3 p)
+{
+	double r = INFINITY;
+	int i;
+	for (i = 0; i < c->nbox; i++)
+		r = fmin(r, box_dist(&c->box[i], p));
+	return r;
+}
+
+/* Segment p0 -> p1 meets box b (slab test, closed). */
+static int seg_box(const px_aabb *b, px_vec3 p0, px_vec3 p1)
+{
+	const double *a0 = &p0.x, *a1 = &p1.x, *lo = &b->min.x, *hi = &b->max.x;
+	double s0 = 0.0, s1 = 1.0;
+	int ax;
+	for (ax = 0; ax < 3; ax++) {
+		double d = a1[ax] - a0[ax];
+		if (d == 0.0) {
+			if (a0[ax] < lo[ax] || a0[ax] > hi[ax])
+				return 0;
+			continue;
+		}
+		{
+			double ta = (lo[ax] - a0[ax]) / d, tb = (hi[ax] - a0[ax]) / d;
+			if (ta > tb) {
+				double x = ta;
+				ta = tb;
+				tb = x;
+			}
+			s0 = fmax(s0, ta);
+			s1 = fmin(s1, tb);
+			if (s0 > s1)
+				return 0;
+		}
+	}
+	return 1;
+}
+
+static void heap_set(struct px_strack *t, int pos, int ci)
+{
+	t->heap[pos] = ci;
+	t->cell[ci].hpos = pos;
+}
+
+static void heap_down(struct px_strack *t, int pos, int n)
+{
+	int ci = t->heap[pos];
+	double x = t->cell[ci].expiry;
+	for (;;) {
+		int c = 2 * pos + 1;
+		if (c >= n)
+			break;
+		if (c + 1 < n && t->cell[t->heap[c + 1]].expiry <
+				       t->cell[t->heap[c]].expiry)
+			c++;
+		if (!(t->cell[t->heap[c]].expiry < x))
+			break;
+		heap_set(t, pos, t->heap[c]);
+		pos = c;
+	}
+	heap_set(t, pos, ci);
+}
+
+static void heap_up(struct px_strack *t, int pos)
+{
+	int ci = t->heap[pos];
+	double x = t->cell[ci].expiry;
+	while (pos > 0) {
+		int par = (pos - 1) / 2;
+		if (!(x < t->cell[t->heap[par]].expiry))
+			break;
+		heap_set(t, pos, t->heap[par]);
+		pos = par;
+	}
+	heap_set(t, pos, ci);
+}
+
+static void heap_rebuild(struct px_strack *t, px_vec3 p)
+{
+	int i;
+	for (i = 0; i < t->n_cells; i++) {
+		t->cell[i].expiry = t->travel + cell_radius(&t->cell[i], p) *
+							(1.0 - 1e-9);
+		heap_set(t, i, i);
+	}
+	for (i = t->n_cells / 2 - 1; i >= 0; i--)
+		heap_down(t, i, t->n_cells);
+	t->heap_ok = 1;
+}
+
+/* Cells whose boxes the segment p0 -> p1 meets. Returns their count. */
+static int collect_cells(struct px_strack *t, px_vec3 p0, px_vec3 p1)
+{
+	int n = t->n_cells, np = 0, nh = 0, k;
+	if (!t->heap_ok)
+		heap_rebuild(t, p0);
+	t->travel += px_v3_dist(p0, p1);
+	while (n > 0 && t->cell[t->heap[0]].expiry <= t->travel) {
+		t->popped[np++] = t->heap[0];
+		n--;
+		if (n > 0) {
+			heap_set(t, 0, t->heap[n]);
+			heap_down(t, 0, n);
+		}
+	}
+	for (k = 0; k < np; k++) {
+		int ci = t->popped[k], b;
+		struct scell *c = &t->cell[ci];
+		t->st.box_tests++;
+		for (b = 0; b < c->nbox; b++)
+			if (seg_box(&c->box[b], p0, p1)) {
+				c->mark = t->epoch;
+				t->hits[nh++] = ci;
+				break;
+			}
+		c->expiry = t->travel + cell_radius(c, p1) * (1.0 - 1e-9);
+		heap_set(t, n, ci);
+		heap_up(t, n);
+		n++;
+	}
+	return nh;
+}
+
+/* ------------------------------------------------------------------ */
+/* answer                                                              */
+
+static int in_work(const struct px_strack *t, px_vec3 p)
+{
+	return px_aabb_contains(&t->work, p);
+}
+
+static void fill_dir(struct px_strack_result *r, px_vec3 p)
+{
+	px_vec3 d = px_v3_sub(p, r->point);
+	double n = px_v3_norm(d);
+	r->dist = n;
+	r->dir = n > 0.0 ? px_v3_scale(d, 1.0 / n) : px_v3(0, 0, 0);
+}
+
+static void count_crit(const struct px_strack *t, struct px_strack_result *r,
+		       int curve_crit)
+{
+	int i, j;
+	r->n_min = r->n_max = r->n_saddle = 0;
+	for (i = 0; i < t->n_surf; i++)
+		for (j = 0; j < t->sf[i].nz; j++) {
+			int ty = t->sf[i].z[j].type;
+			if (ty > 0)
+				r->n_min++;
+			else if (ty < 0)
+				r->n_max++;
+			else
+				r->n_saddle++;
+		}
+	r->n_crit = r->n_min + r->n_max + r->n_saddle + curve_crit;
+}
+
+static void answer(struct px_strack *t, px_vec3 p,
+		   const struct px_track_result *cr, struct px_strack_result *r)
+{
+	double best = INFINITY;
+	int kind = 0, i, j;
+	uint32_t id = 0;
+
+	if (cr->entity >= 0) {
+		best = cr->dist * cr->dist;
+		kind = 2;
+		r->point = cr->point;
+		if (cr->entity < t->n_curves) {
+			r->entity = cr->entity;
+			r->u = cr->u;
+			r->v = 0.0;
+			r->feature = PX_STRACK_CURVE;
+		} else {
+			const struct edge *e = &t->edge[cr->entity - t->n_curves];
+			r->entity = t->n_curves + e->surf;
+			r->u = e->dir ? e->t : cr->u;
+			r->v = e->dir ? cr->u : e->t;
+			r->feature = PX_STRACK_EDGE;
+		}
+	}
+	for (i = 0; i < t->n_surf; i++)
+		for (j = 0; j < t->sf[i].nz; j++) {
+			const struct crit *z = &t->sf[i].z[j];
+			double d2;
+			if (z->type <= 0)
+				continue;
+			d2 = px_v3_dist2(z->s, p);
+			if (d2 < best) {
+				best = d2;
+				kind = 1;
+				id = z->id;
+				r->point = z->s;
+				r->u = z->u;
+				r->v = z->v;
+				r->entity = t->n_curves + i;
+				r->feature = PX_STRACK_MIN;
+			}
+		}
+	for (i = 0; i < t->n_poles; i++) {
+		double d2 = px_v3_dist2(t->pole[i].q, p);
+		if (d2 < best) {
+			best = d2;
+			kind = 3;
+			id = (uint32_t)i;
+			r->point = t->pole[i].q;
+			r->u = t->pole[i].u;
+			r->v = t->pole[i].v;
+			r->entity = t->n_curves + t->pole[i].surf;
+			r->feature = PX_STRACK_POLE;
+		}
+	}
+	fill_dir(r, p);
+	count_crit(t, r, cr->n_crit);
+	r->jumped = kind != t->best_kind || (kind == 2 && cr->jumped) ||
+		    (kind != 2 && id != t->best_id);
+	t->best_kind = kind;
+	t->best_id = id;
+}
+
+static void answer_global(struct px_strack *t, px_vec3 p,
+			  struct px_strack_result *r)
+{
+	struct px_dist_result g;
+	px_dist_query(t->dist, p, &g);
+	r->point = g.point;
+	r->u = g.u;
+	r->v = g.v;
+	r->entity = g.entity;
+	r->feature = PX_STRACK_GLOBAL;
+	fill_dir(r, p);
+	count_crit(t, r, 0);
+	r->jumped = 1;
+	t->best_kind = 0;
+	r->source = PX_TRACK_GLOBAL;
+	t->st.fallbacks++;
+}
+
+static int reinit_all(struct px_strack *t, px_vec3 p)
+{
+	int i, rc = 0;
+	for (i = 0; i < t->n_surf; i++) {
+		int r2 = surf_reinit(t, &t->sf[i], i, p);
+		if (r2 && !rc)
+			rc = r2;
+	}
+	return rc;
+}
+
+static void verify(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
+{
+	struct px_dist_result g;
+	if (t->opts.verify_every <= 0 ||
+	    t->st.updates % (uint64_t)t->opts.verify_every != 0)
+		return;
+	if (px_dist_query(t->dist, p, &g))
+		return;
+	t->st.verifications++;
+	r->verified = 1;
+	if (r->dist > g.dist + 1e-9 * (t->scale + g.dist)) {
+		t->st.disagreements++;
+		t->st.reinits++;
+		if (reinit_all(t, p))
+			t->st.overflows++;
+		answer_global(t, p, r);
+		r->verified = 1;
+	}
+}
+
+static void result_clear(struct px_strack_result *r)
+{
+	memset(r, 0, sizeof(*r));
+	r->entity = -1;
+}
+
+/* The curve tracker's answer (none when the model has no curve and no
+ * open edge: closed in both directions or all poles). */
+static void curves_update(struct px_strack *t, px_vec3 p,
+			  struct px_track_result *cr, int reset)
+{
+	if (!t->ct) {
+		memset(cr, 0, sizeof(*cr));
+		cr->entity = -1;
+		return;
+	}
+	if (reset)
+		px_track_reset(t->ct, p, cr);
+	else
+		px_track_update(t->ct, p, cr);
+}
+
+static int full_reset(struct px_strack *t, px_vec3 p,
+		      struct px_strack_result *r)
+{
+	struct px_track_result cr;
+	int rc;
+	t->heap_ok = 0;
+	curves_update(t, p, &cr, 1);
+	rc = reinit_all(t, p);
+	r->source = PX_TRACK_REINIT;
+	if (rc) {
+		t->st.overflows++;
+		answer_global(t, p, r);
+	} else {
+		answer(t, p, &cr, r);
+		r->jumped = 1;
+		verify(t, p, r);
+	}
+	return PX_OK;
+}
+
+int px_strack_reset(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
+{
+	if (!t || !r)
+		return PX_E_INVAL;
+	if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
+		return PX_E_NAN;
+	result_clear(r);
+	t->st.updates++;
+	t->p = p;
+	t->init = 1;
+	t->best_kind = 0;
+	return full_reset(t, p, r);
+}
+
+static int bsearch_bounds(const double *b, int n, double x)
+{
+	int lo = 0, hi = n - 1;
+	while (lo < hi) {
+		int mid = (lo + hi + 1) / 2;
+		if (b[mid] <= x)
+			lo = mid;
+		else
+			hi = mid - 1;
+	}
+	return lo;
+}
+
+/* Cell index (within the surface) holding (u, v). */
+static int cell_of(const struct ssurf *f, double u, double v)
+{
+	int i = bsearch_bounds(f->cu, f->ncu, u), j = bsearch_bounds(f->cv, f->ncv, v);
+	return j * f->ncu + i;
+}
+
+/* Follow one point from its state at p0 to p (predictor, Newton). */
+static int evolve(const struct ssurf *f, struct crit *z, px_vec3 dp,
+		  px_vec3 p)
+{
+	double a = px_v3_dot(z->su, dp), b = px_v3_dot(z->sv, dp);
+	double det = z->h11 * z->h22 - z->h12 * z->h12;
+	if (fabs(det) > 0.0) {
+		double su = (z->h22 * a - z->h12 * b) / det;
+		double sv = (-z->h12 * a + z->h11 * b) / det;
+		if (isfinite(su) && isfinite(sv) && fabs(su) <= 0.25 * f->du &&
+		    fabs(sv) <= 0.25 * f->dv) {
+			z->u += su;
+			z->v += sv;
+		}
+	}
+	return snewton(f, z, p, 0.125 * f->du, 0.125 * f->dv);
+}
+
+int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
+{
+	struct px_track_result cr;
+	px_vec3 p0, dp;
+	int i, j, nh, rc = 0;
+
+	if (!t || !r)
+		return PX_E_INVAL;
+	if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
+		return PX_E_NAN;
+	if (!t->init)
+		return px_strack_reset(t, p, r);
+	result_clear(r);
+	t->st.updates++;
+	p0 = t->p;
+	dp = px_v3_sub(p, p0);
+	t->p = p;
+	r->source = PX_TRACK_TRACKED;
+	if (++t->epoch == 0)
+		t->epoch = 1;
+	if (!in_work(t, p) || !in_work(t, p0)) {
+		t->st.outside++;
+		return full_reset(t, p, r);
+	}
+	curves_update(t, p, &cr, 0);
+	nh = collect_cells(t, p0, p);
+	for (i = 0; i < t->n_surf; i++) {
+		struct ssurf *f = &t->sf[i];
+		int n = f->nz;
+		memcpy(f->tmp, f->z, (size_t)n * sizeof(*f->z));
+		f->nz = 0;
+		for (j = 0; j < n; j++) {
+			struct crit z = f->tmp[j];
+			if (evolve(f, &z, dp, p)) {
+				/* died at a fold, or Newton lost it: solve its
+				 * cell so a survivor is found again */
+				int ci = cell_of(f, f->tmp[j].u, f->tmp[j].v);
+				struct scell *c = &t->cell[f->first_cell + ci];
+				t->st.lost++;
+				if (c->mark != t->epoch && nh < t->n_cells) {
+					c->mark = t->epoch;
+					t->hits[nh++] = f->first_cell + ci;
+				}
+				continue;
+			}
+			rc = crit_add(t, f, &z);
+			if (rc < 0)
+				break;
+		}
+		if (rc < 0)
+			break;
+	}
+	for (i = 0; i < nh && rc >= 0; i++)
+		rc = cell_solve(t, &t->cell[t->hits[i]], p);
+	r->cells_solved = nh;
+	if (rc < 0) {
+		t->st.overflows++;
+		t->st.reinits++;
+		if (reinit_all(t, p))
+			t->st.overflows++;
+		answer_global(t, p, r);
+		return PX_OK;
+	}
+	answer(t, p, &cr, r);
+	if (cr.source != PX_TRACK_TRACKED)
+		r->source = cr.source;
+	verify(t, p, r);
+	return PX_OK;
+}
+
+int px_strack_critical(const struct px_strack *t, int s, double *u, double *v,
+		       int *type, int cap)
+{
+	const struct ssurf *f;
+	int i;
+	if (!t || (cap > 0 && (!u || !v || !type)))
+		return PX_E_INVAL;
+	if (s < 0 || s >= t->n_surf)
+		return PX_E_RANGE;
+	f = &t->sf[s];
+	for (i = 0; i < f->nz && i < cap; i++) {
+		u[i] = f->z[i].u;
+		v[i] = f->z[i].v;
+		type[i] = f->z[i].type;
+	}
+	return f->nz;
+}
+
+void px_strack_get_stats(const struct px_strack *t, struct px_strack_stats *s)
+{
+	if (!s)
+		return;
+	if (!t)
+		memset(s, 0, sizeof(*s));
+	else
+		*s = t->st;
+}
+
+void px_strack_get_info(const struct px_strack *t, struct px_strack_info *info)
+{
+	if (!info)
+		return;
+	memset(info, 0, sizeof(*info));
+	if (!t)
+		return;
+	info->n_surfaces = t->n_surf;
+	info->n_curves = t->n_curves;
+	info->n_patches = t->n_patches;
+	info->n_cells = t->n_cells;
+	info->n_edges = t->n_edges;
+	info->n_poles = t->n_poles;
+	info->n_unbounded = t->n_unbounded;
+	info->work = t->work;
+}
+
+struct px_dist_model *px_strack_dist_model(struct px_strack *t)
+{
+	return t ? t->dist : NULL;
+}
+
+/* ------------------------------------------------------------------ */
+/* setup                                                               */
+
+void px_strack_opts_default(struct px_strack_opts *o)
+{
+	if (!o)
+		return;
+	memset(o, 0, sizeof(*o));
+	o->cells_per_span = 2;
+	o->seeds = 3;
+	o->samples = 6;
+	o->max_crit = 256;
+	o->work_margin = 1.0;
+	o->verify_every = 0;
+	o->dist = NULL;
+}
+
+/* Distinct knot values of one direction inside the domain, with both
+ * ends: the Bezier patch bounds. Returns the count. */
+static int span_bounds(const struct px_nurbs_surf *s, int dir, double a,
+		       double b, double *out)
+{
+	const double *U = s->knots[dir];
+	int i, n = 0;
+	out[n++] = a;
+	for (i = 0; i < s->n_knots[dir]; i++)
+		if (U[i] > out[n - 1] && U[i] < b)
+			out[n++] = U[i];
+	out[n++] = b;
+	return n;
+}
+
+/* Sample of the surface for the focal boxes: point, unit normal, the
+ * two principal curvatures (0 when the normal is undefined). */
+static void sample(const struct px_nurbs_surf *s, double u, double v, int su,
+		   int sv, px_vec3 *q, px_vec3 *nrm, double k[2], int *ok)
+{
+	struct px_nurbs_surf_derivs d;
+	px_vec3 n;
+	double E, F, G, L, M, N, det, H, K, disc, nn;
+	px_nurbs_surf_eval_side(s, u, v, su, sv, 2, &d);
+	*q = d.s;
+	n = px_v3_cross(d.su, d.sv);
+	nn = px_v3_norm(n);
+	*ok = 0;
+	k[0] = k[1] = 0.0;
+	*nrm = px_v3(0, 0, 0);
+	if (!(nn > 1e-14 * (px_v3_norm(d.su) * px_v3_norm(d.sv))) || !(nn > 0.0))
+		return;
+	n = px_v3_scale(n, 1.0 / nn);
+	E = px_v3_dot(d.su, d.su);
+	F = px_v3_dot(d.su, d.sv);
+	G = px_v3_dot(d.sv, d.sv);
+	L = px_v3_dot(d.suu, n);
+	M = px_v3_dot(d.suv, n);
+	N = px_v3_dot(d.svv, n);
+	det = E * G - F * F;
+	if (!(det > 0.0))
+		return;
+	K = (L * N - M * M) / det;
+	H = (E * N + G * L - 2.0 * F * M) / (2.0 * det);
+	/* umbilic: H^2 - K rounds below zero, clamp (equal curvatures) */
+	disc = H * H - K;
+	disc = disc > 0.0 ? sqrt(disc) : 0.0;
+	k[0] = H + disc;
+	k[1] = H - disc;
+	*nrm = n;
+	*ok = 1;
+}
+
+static px_aabb clip(px_aabb b, const px_aabb *w)
+{
+	b.min.x = fmax(b.min.x, w->min.x);
+	b.min.y = fmax(b.min.y, w->min.y);
+	b.min.z = fmax(b.min.z, w->min.z);
+	b.max.x = fmin(b.max.x, w->max.x);
+	b.max.y = fmin(b.max.y, w->max.y);
+	b.max.z = fmin(b.max.z, w->max.z);
+	return b;
+}
+
+/* Transition boxes of one cell. pts/nrm/kk: scratch of m*m samples. */
+static void cell_boxes(struct px_strack *t, struct scell *c,
+		       const struct ssurf *f, px_vec3 *pts, px_vec3 *nrm,
+		       double *kk, int *okk)
+{
+	int m = t->opts.samples, i, j, sh, e;
+	double Lw = 0.0, sp = 0.0;
+
+	c->nbox = 0;
+	for (j = 0; j < m; j++)
+		for (i = 0; i < m; i++) {
+			int q = j * m + i;
+			double u = c->u0 + (c->u1 - c->u0) * i / (m - 1);
+			double v = c->v0 + (c->v1 - c->v0) * j / (m - 1);
+			sample(&f->s, u, v, i == m - 1 ? -1 : 1, j == m - 1 ? -1 : 1,
+			       &pts[q], &nrm[q], &kk[2 * q], &okk[q]);
+			if (!okk[q]) {
+				/* pole or degenerate point: step inside */
+				double uu = u + (i == m - 1 ? -1e-6 : 1e-6) * (c->u1 - c->u0);
+				double vv = v + (j == m - 1 ? -1e-6 : 1e-6) * (c->v1 - c->v0);
+				px_vec3 q2;
+				sample(&f->s, uu, vv, 1, 1, &q2, &nrm[q], &kk[2 * q],
+				       &okk[q]);
+			}
+			Lw = fmax(Lw, sqrt(px_aabb_max_dist2(&t->work, pts[q])));
+			if (i > 0)
+				sp = fmax(sp, px_v3_dist(pts[q], pts[q - 1]));
+			if (j > 0)
+				sp = fmax(sp, px_v3_dist(pts[q], pts[q - m]));
+		}
+	for (sh = 0; sh < 2; sh++) {
+		px_aabb b = px_aabb_empty();
+		int unbounded = 0, sg = 0;
+		double gap = 0.0;
+		for (i = 0; i < m * m; i++) {
+			double k = kk[2 * i + sh];
+			int s = k > 0.0 ? 1 : (k < 0.0 ? -1 : 0);
+			if (!okk[i] || fabs(k) * Lw < 1.0 || !s || (sg && s != sg))
+				unbounded = 1;
+			if (s)
+				sg = s;
+		}
+		if (unbounded) {
+			/* the sheet reaches infinity in this cell (or is out
+			 * of reach): every normal line of the cell within the
+			 * working volume */
+			for (i = 0; i < m * m; i++) {
+				if (!okk[i]) {
+					px_aabb_extend(&b, px_v3_sub(pts[i], px_v3(Lw, Lw, Lw)));
+					px_aabb_extend(&b, px_v3_add(pts[i], px_v3(Lw, Lw, Lw)));
+					continue;
+				}
+				px_aabb_extend(&b, px_v3_add(pts[i], px_v3_scale(nrm[i], Lw)));
+				px_aabb_extend(&b, px_v3_sub(pts[i], px_v3_scale(nrm[i], Lw)));
+				px_aabb_extend(&b, pts[i]);
+			}
+			b = px_aabb_inflate(&b, sp);
+			t->n_unbounded++;
+		} else {
+			for (j = 0; j < m; j++)
+				for (i = 0; i < m; i++) {
+					int q = j * m + i;
+					px_vec3 fp = px_v3_add(pts[q],
+							       px_v3_scale(nrm[q], 1.0 / kk[2 * q + sh]));
+					px_aabb_extend(&b, fp);
+					if (i > 0)
+						gap = fmax(gap, px_v3_dist(fp, px_v3_add(pts[q - 1],
+							px_v3_scale(nrm[q - 1], 1.0 / kk[2 * (q - 1) + sh]))));
+					if (j > 0)
+						gap = fmax(gap, px_v3_dist(fp, px_v3_add(pts[q - m],
+							px_v3_scale(nrm[q - m], 1.0 / kk[2 * (q - m) + sh]))));
+				}
+			/* between samples the sheet bulges by a fraction of
+			 * the sample spacing: grow by the largest spacing */
+			b = px_aabb_inflate(&b, gap + sp + 1e-9 * t->scale);
+		}
+		b = clip(b, &t->work);
+		if (!px_aabb_is_empty(&b) && c->nbox < ST_NBOX)
+			c->box[c->nbox++] = b;
+	}
+	/* cells on an open edge: points enter or leave the interior where p
+	 * crosses a normal line along the edge */
+	for (e = 0; e < 4; e++) {
+		int on = 0;
+		px_aabb b = px_aabb_empty();
+		if (e == 0)
+			on = !f->wrap_u && c->u0 == f->u0;
+		else if (e == 1)
+			on = !f->wrap_u && c->u1 == f->u1;
+		else if (e == 2)
+			on = !f->wrap_v && c->v0 == f->v0;
+		else
+			on = !f->wrap_v && c->v1 == f->v1;
+		if (!on)
+			continue;
+		for (i = 0; i < m; i++) {
+			int q = e == 0 ? i * m : e == 1 ? i * m + m - 1
+						   : e == 2 ? i : (m - 1) * m + i;
+			px_vec3 nv = okk[q] ? nrm[q] : px_v3(0, 0, 0);
+			if (!okk[q]) {
+				px_aabb_extend(&b, px_v3_sub(pts[q], px_v3(Lw, Lw, Lw)));
+				px_aabb_extend(&b, px_v3_add(pts[q], px_v3(Lw, Lw, Lw)));
+			}
+			px_aabb_extend(&b, px_v3_add(pts[q], px_v3_scale(nv, Lw)));
+			px_aabb_extend(&b, px_v3_sub(pts[q], px_v3_scale(nv, Lw)));
+		}
+		b = clip(px_aabb_inflate(&b, sp), &t->work);
+		if (px_aabb_is_empty(&b))
+			continue;
+		if (c->nbox < ST_NBOX)
+			c->box[c->nbox++] = b;
+		else
+			c->box[ST_NBOX - 1] = px_aabb_union(&c->box[ST_NBOX - 1], &b);
+	}
+}
+
+void px_strack_free(struct px_strack *t)
+{
+	int i;
+	if (!t)
+		return;
+	px_dist_model_free(t->dist);
+	px_track_free(t->ct);
+	if (t->sf)
+		for (i = 0; i < t->n_surf; i++) {
+			free(t->sf[i].mem);
+			free(t->sf[i].cu);
+			free(t->sf[i].cv);
+			free(t->sf[i].z);
+			free(t->sf[i].tmp);
+		}
+	free(t->sf);
+	free(t->cell);
+	free(t->edge);
+	free(t->pole);
+	free(t->heap);
+	free(t->popped);
+	free(t->hits);
+	free(t);
+}
+
+/* Copy a surface into owned memory. */
+static int surf_copy(struct ssurf *f, const struct px_nurbs_surf *s)
+{
+	size_t nu = (size_t)s->n_knots[0], nv = (size_t)s->n_knots[1];
+	size_t np = 4 * (size_t)s->n_ctrl[0] * (size_t)s->n_ctrl[1];
+	f->mem = malloc((nu + nv + np) * sizeof(double));
+	if (!f->mem)
+		return PX_E_NOMEM;
+	memcpy(f->mem, s->knots[0], nu * sizeof(double));
+	memcpy(f->mem + nu, s->knots[1], nv * sizeof(double));
+	memcpy(f->mem + nu + nv, s->pw, np * sizeof(double));
+	f->s = *s;
+	f->s.knots[0] = f->mem;
+	f->s.knots[1] = f->mem + nu;
+	f->s.pw = f->mem + nu + nv;
+	return PX_OK;
+}
+
+int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
+		     const struct px_nurbs_surf *surfs, int n_surfs,
+		     const struct px_strack_opts *opts, struct px_strack **out)
+{
+	struct px_strack *t;
+	struct px_strack_opts o;
+	struct px_nurbs_curve *cc = NULL;
+	double **cpw = NULL, *ub = NULL, *vb = NULL;
+	px_vec3 *pts = NULL, *nrm = NULL;
+	double *kk = NULL;
+	int *okk = NULL;
+	int rc, i, j, k, max_knots = 0, cap_edges, n_cc = 0, cell_cap = 0;
+	px_aabb bounds;
+
+	if (!out || (n_curves > 0 && !curves) || !surfs || n_surfs <= 0 ||
+	    n_curves < 0)
+		return PX_E_INVAL;
+	*out = NULL;
+	if (opts)
+		o = *opts;
+	else
+		px_strack_opts_default(&o);
+	if (o.cells_per_span < 1 || o.cells_per_span > 16 || o.seeds < 1 ||
+	    o.seeds > 8 || o.samples < 2 || o.samples > 32 || o.max_crit < 2 ||
+	    o.max_crit > 1 << 20 || o.verify_every < 0 ||
+	    !(o.work_margin >= 0.0))
+		return PX_E_INVAL;
+	for (i = 0; i < n_surfs; i++) {
+		if (surfs[i].degree[0] < 1 || surfs[i].degree[1] < 1 ||
+		    surfs[i].degree[0] > PX_NURBS_MAX_DEGREE ||
+		    surfs[i].degree[1] > PX_NURBS_MAX_DEGREE)
+			return PX_E_RANGE;
+		if (!surfs[i].knots[0] || !surfs[i].knots[1] || !surfs[i].pw)
+			return PX_E_INVAL;
+		for (k = 0; k < 2; k++)
+			if (surfs[i].n_knots[k] > max_knots)
+				max_knots = surfs[i].n_knots[k];
+	}
+	t = calloc(1, sizeof(*t));
+	if (!t)
+		return PX_E_NOMEM;
+	t->opts = o;
+	t->n_curves = n_curves;
+	t->n_surf = n_surfs;
+	rc = px_dist_model_create(curves, n_curves, surfs, n_surfs, o.dist,
+				  &t->dist);
+	if (rc) {
+		free(t);
+		return rc;
+	}
+	t->sf = calloc((size_t)n_surfs, sizeof(*t->sf));
+	ub = calloc((size_t)max_knots + 2, sizeof(double));
+	vb = calloc((size_t)max_knots + 2, sizeof(double));
+	if (!t->sf || !ub || !vb) {
+		rc = PX_E_NOMEM;
+		goto fail;
+	}
+	/* surfaces, domains, cells */
+	bounds = px_aabb_empty();
+	for (i = 0; i < n_curves; i++) {
+		px_aabb hb = px_nurbs_curve_aabb(&curves[i]);
+		bounds = px_aabb_union(&bounds, &hb);
+	}
+	for (i = 0; i < n_surfs; i++) {
+		struct ssurf *f = &t->sf[i];
+		px_aabb hb = px_nurbs_surf_aabb(&surfs[i]);
+		int nu, nv;
+		bounds = px_aabb_union(&bounds, &hb);
+		rc = surf_copy(f, &surfs[i]);
+		if (rc)
+			goto fail;
+		px_nurbs_surf_domain(&f->s, &f->u0, &f->u1, &f->v0, &f->v1);
+		f->du = f->u1 - f->u0;
+		f->dv = f->v1 - f->v0;
+		{
+			double tol = 1e-12 * (1.0 + px_aabb_diagonal(&hb));
+			f->wrap_u = px_nurbs_surf_seam(&f->s, 0, tol, 1e-9) >= 1;
+			f->wrap_v = px_nurbs_surf_seam(&f->s, 1, tol, 1e-9) >= 1;
+		}
+		nu = span_bounds(&f->s, 0, f->u0, f->u1, ub);
+		nv = span_bounds(&f->s, 1, f->v0, f->v1, vb);
+		t->n_patches += (nu - 1) * (nv - 1);
+		f->ncu = (nu - 1) * o.cells_per_span;
+		f->ncv = (nv - 1) * o.cells_per_span;
+		f->cu = calloc((size_t)f->ncu + 1, sizeof(double));
+		f->cv = calloc((size_t)f->ncv + 1, sizeof(double));
+		f->cap = o.max_crit;
+		f->z = calloc((size_t)f->cap, sizeof(*f->z));
+		f->tmp = calloc((size_t)f->cap, sizeof(*f->tmp));
+		if (!f->cu || !f->cv || !f->z || !f->tmp) {
+			rc = PX_E_NOMEM;
+			goto fail;
+		}
+		for (k = 0; k < nu - 1; k++)
+			for (j = 0; j < o.cells_per_span; j++)
+				f->cu[k * o.cells_per_span + j] =
+					ub[k] + (ub[k + 1] - ub[k]) * j / o.cells_per_span;
+		f->cu[f->ncu] = f->u1;
+		for (k = 0; k < nv - 1; k++)
+			for (j = 0; j < o.cells_per_span; j++)
+				f->cv[k * o.cells_per_span + j] =
+					vb[k] + (vb[k + 1] - vb[k]) * j / o.cells_per_span;
+		f->cv[f->ncv] = f->v1;
+		f->first_cell = cell_cap;
+		cell_cap += f->ncu * f->ncv;
+	}
+	t->scale = px_aabb_diagonal(&bounds);
+	if (!(t->scale > 0.0))
+		t->scale = 1.0;
+	{
+		double m = o.work_margin * t->scale;
+		t->work.min = px_v3_sub(bounds.min, px_v3(m, m, m));
+		t->work.max = px_v3_add(bounds.max, px_v3(m, m, m));
+	}
+	t->cell = calloc((size_t)cell_cap + 1, sizeof(*t->cell));
+	t->heap = calloc((size_t)cell_cap + 1, sizeof(int));
+	t->popped = calloc((size_t)cell_cap + 1, sizeof(int));
+	t->hits = calloc((size_t)cell_cap + 1, sizeof(int));
+	pts = calloc((size_t)(o.samples * o.samples), sizeof(*pts));
+	nrm = calloc((size_t)(o.samples * o.samples), sizeof(*nrm));
+	kk = calloc((size_t)(2 * o.samples * o.samples), sizeof(double));
+	okk = calloc((size_t)(o.samples * o.samples), sizeof(int));
+	if (!t->cell || !t->heap || !t->popped || !t->hits || !pts || !nrm ||
+	    !kk || !okk) {
+		rc = PX_E_NOMEM;
+		goto fail;
+	}
+	for (i = 0; i < n_surfs; i++) {
+		struct ssurf *f = &t->sf[i];
+		for (j = 0; j < f->ncv; j++)
+			for (k = 0; k < f->ncu; k++) {
+				struct scell *c = &t->cell[f->first_cell + j * f->ncu + k];
+				c->surf = i;
+				c->u0 = f->cu[k];
+				c->u1 = f->cu[k + 1];
+				c->v0 = f->cv[j];
+				c->v1 = f->cv[j + 1];
+				cell_boxes(t, c, f, pts, nrm, kk, okk);
+			}
+	}
+	t->n_cells = cell_cap;
+
+	/* curve tracker: free curves, then open (uncollapsed) edges and
+	 * C0 creases as iso-curves; collapsed edges become poles */
+	cap_edges = 0;
+	for (i = 0; i < n_surfs; i++)
+		cap_edges += 4 + 2 * max_knots;
+	t->edge = calloc((size_t)cap_edges, sizeof(*t->edge));
+	t->pole = calloc((size_t)4 * n_surfs, sizeof(*t->pole));
+	cc = calloc((size_t)(n_curves + cap_edges), sizeof(*cc));
+	cpw = calloc((size_t)cap_edges, sizeof(*cpw));
+	if (!t->edge || !t->pole || !cc || !cpw) {
+		rc = PX_E_NOMEM;
+		goto fail;
+	}
+	for (i = 0; i < n_curves; i++)
+		cc[n_cc++] = curves[i];
+	for (i = 0; i < n_surfs; i++) {
+		struct ssurf *f = &t->sf[i];
+		double tol = 1e-12 * (1.0 + t->scale), brk[64];
+		int e, nb, d;
+		for (e = 0; e < 4; e++) {
+			int dir = e < 2 ? 1 : 0; /* curve direction */
+			double tv = e == 0 ? f->u0 : e == 1 ? f->u1 : e == 2 ? f->v0 : f->v1;
+			if ((e < 2 && f->wrap_u) || (e >= 2 && f->wrap_v))
+				continue;
+			if (px_nurbs_surf_edge_collapsed(&f->s, e, tol)) {
+				struct pole *pl = &t->pole[t->n_poles++];
+				pl->u = e < 2 ? tv : f->u0;
+				pl->v = e < 2 ? f->v0 : tv;
+				pl->q = px_nurbs_surf_point(&f->s, pl->u, pl->v);
+				pl->surf = i;
+				continue;
+			}
+			{
+				size_t len = 4 * (size_t)f->s.n_ctrl[dir];
+				struct edge *ed = &t->edge[t->n_edges];
+				cpw[t->n_edges] = malloc(len * sizeof(double));
+				if (!cpw[t->n_edges]) {
+					rc = PX_E_NOMEM;
+					goto fail;
+				}
+				rc = px_nurbs_surf_iso_curve(&f->s, dir, tv, cpw[t->n_edges],
+							     len, &cc[n_cc]);
+				if (rc) {
+					free(cpw[t->n_edges]);
+					cpw[t->n_edges] = NULL;
+					goto fail;
+				}
+				ed->surf = i;
+				ed->dir = dir;
+				ed->t = tv;
+				t->n_edges++;
+				n_cc++;
+			}
+		}
+		for (d = 0; d < 2; d++) {
+			/* creases across direction d: curves along the other */
+			nb = px_nurbs_surf_breaks(&f->s, d, brk, 64);
+			for (k = 0; k < nb && k < 64; k++) {
+				int dir = 1 - d;
+				size_t len = 4 * (size_t)f->s.n_ctrl[dir];
+				struct edge *ed = &t->edge[t->n_edges];
+				if (t->n_edges >= cap_edges)
+					break;
+				cpw[t->n_edges] = malloc(len * sizeof(double));
+				if (!cpw[t->n_edges]) {
+					rc = PX_E_NOMEM;
+					goto fail;
+				}
+				rc = px_nurbs_surf_iso_curve(&f->s, dir, brk[k], cpw[t->n_edges],
+							     len, &cc[n_cc]);
+				if (rc) {
+					free(cpw[t->n_edges]);
+					cpw[t->n_edges] = NULL;
+					goto fail;
+				}
+				ed->surf = i;
+				ed->dir = dir;
+				ed->t = brk[k];
+				t->n_edges++;
+				n_cc++;
+			}
+		}
+	}
+	if (n_cc > 0) {
+		struct px_track_opts to;
+		px_track_opts_default(&to);
+		to.work = t->work;
+		to.dist = o.dist;
+		rc = px_track_create(cc, n_cc, &to, &t->ct);
+		if (rc)
+			goto fail;
+	}
+	t->epoch = 1;
+	rc = PX_OK;
+	*out = t;
+	t = NULL;
+fail:
+	if (cpw)
+		for (i = 0; i < cap_edges; i++)
+			free(cpw[i]);
+	free(cpw);
+	free(cc);
+	free(ub);
+	free(vb);
+	free(pts);
+	free(nrm);
+	free(kk);
+	free(okk);
+	px_strack_free(t);
+	return rc;
+}
