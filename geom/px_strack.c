@@ -34,11 +34,25 @@ struct crit {
 	double h11, h12, h22;
 };
 
+/* Where a cell can have a transition: every normal line of the cell lies
+ * in the double cone around its central normal line (apex spread rho,
+ * slope a = tan of the largest normal deviation); a focal sheet lies on
+ * those lines at a signed height l in an interval (bounded sheet) or at
+ * |l| >= lo (a sheet through infinity: curvature crossing zero or too
+ * small to matter); edge events anywhere on the lines. */
+struct sreg {
+	double lo, hi;
+	int split;      /* 1: |l| >= lo */
+};
+
 struct scell {
 	double u0, u1, v0, v1;
 	int surf;
-	int nbox;
-	px_aabb box[ST_NBOX];
+	int always;     /* normals too spread for a cone: always solved */
+	px_vec3 sc, nc;
+	double rho, a, ia; /* ia = 1 / sqrt(1 + a^2) */
+	int nreg;
+	struct sreg reg[ST_NBOX];
 	double expiry;
 	int hpos;
 	uint32_t mark;
@@ -257,47 +271,28 @@ static int surf_reinit(struct px_strack *t, struct ssurf *f, int si, px_vec3 p)
 /* ------------------------------------------------------------------ */
 /* transition boxes: lazy tests                                        */
 
-static double box_dist(const px_aabb *b, px_vec3 p)
-{
-	return sqrt(px_aabb_dist2(b, p));
-}
-
+/* Lower bound on the distance from p to the cell's transition set. */
 static double cell_radius(const struct scell *c, px_vec3 p)
 {
-	double r = INFINITY;
+	px_vec3 w;
+	double l, dp, rc, r = INFINITY;
 	int i;
-	for (i = 0; i < c->nbox; i++)
-		r = fmin(r, box_dist(&c->box[i], p));
-	return r;
-}
-
-/* Segment p0 -> p1 meets box b (slab test, closed). */
-static int seg_box(const px_aabb *b, px_vec3 p0, px_vec3 p1)
-{
-	const double *a0 = &p0.x, *a1 = &p1.x, *lo = &b->min.x, *hi = &b->max.x;
-	double s0 = 0.0, s1 = 1.0;
-	int ax;
-	for (ax = 0; ax < 3; ax++) {
-		double d = a1[ax] - a0[ax];
-		if (d == 0.0) {
-			if (a0[ax] < lo[ax] || a0[ax] > hi[ax])
-				return 0;
-			continue;
-		}
-		{
-			double ta = (lo[ax] - a0[ax]) / d, tb = (hi[ax] - a0[ax]) / d;
-			if (ta > tb) {
-				double x = ta;
-				ta = tb;
-				tb = x;
-			}
-			s0 = fmax(s0, ta);
-			s1 = fmin(s1, tb);
-			if (s0 > s1)
-				return 0;
-		}
+	if (c->always)
+		return 0.0;
+	if (c->nreg == 0)
+		return INFINITY;
+	w = px_v3_sub(p, c->sc);
+	l = px_v3_dot(w, c->nc);
+	dp = px_v3_norm(px_v3_sub(w, px_v3_scale(c->nc, l)));
+	/* d_perp - a |l| is sqrt(1 + a^2)-Lipschitz */
+	rc = fmax((dp - c->a * fabs(l) - c->rho) * c->ia, 0.0);
+	for (i = 0; i < c->nreg; i++) {
+		const struct sreg *g = &c->reg[i];
+		double ri = g->split ? fmax(g->lo - fabs(l), 0.0)
+				     : fmax(fmax(g->lo - l, l - g->hi), 0.0);
+		r = fmin(r, fmax(rc, ri));
 	}
-	return 1;
+	return r;
 }
 
 static void heap_set(struct px_strack *t, int pos, int ci)
@@ -356,9 +351,10 @@ static void heap_rebuild(struct px_strack *t, px_vec3 p)
 static int collect_cells(struct px_strack *t, px_vec3 p0, px_vec3 p1)
 {
 	int n = t->n_cells, np = 0, nh = 0, k;
+	double seg = px_v3_dist(p0, p1);
 	if (!t->heap_ok)
 		heap_rebuild(t, p0);
-	t->travel += px_v3_dist(p0, p1);
+	t->travel += seg;
 	while (n > 0 && t->cell[t->heap[0]].expiry <= t->travel) {
 		t->popped[np++] = t->heap[0];
 		n--;
@@ -368,16 +364,17 @@ static int collect_cells(struct px_strack *t, px_vec3 p0, px_vec3 p1)
 		}
 	}
 	for (k = 0; k < np; k++) {
-		int ci = t->popped[k], b;
+		int ci = t->popped[k];
 		struct scell *c = &t->cell[ci];
+		double r1 = cell_radius(c, p1);
 		t->st.box_tests++;
-		for (b = 0; b < c->nbox; b++)
-			if (seg_box(&c->box[b], p0, p1)) {
-				c->mark = t->epoch;
-				t->hits[nh++] = ci;
-				break;
-			}
-		c->expiry = t->travel + cell_radius(c, p1) * (1.0 - 1e-9);
+		/* a point of the segment within reach of the set is at least
+		 * r0 from p0 and r1 from p1: impossible when r0 + r1 > |seg| */
+		if (r1 <= 0.0 || cell_radius(c, p0) + r1 <= seg) {
+			c->mark = t->epoch;
+			t->hits[nh++] = ci;
+		}
+		c->expiry = t->travel + r1 * (1.0 - 1e-9);
 		heap_set(t, n, ci);
 		heap_up(t, n);
 		n++;
@@ -815,130 +812,128 @@ static void sample(const struct px_nurbs_surf *s, double u, double v, int su,
 	*ok = 1;
 }
 
-static px_aabb clip(px_aabb b, const px_aabb *w)
+/* Transition regions of one cell from m x m samples (scratch pts, nrm,
+ * kk, okk). Sampling is not a proof: the cone and the height intervals
+ * are grown by margins for the variation between samples. */
+static void cell_regions(struct px_strack *t, struct scell *c,
+			 const struct ssurf *f, px_vec3 *pts, px_vec3 *nrm,
+			 double *kk, int *okk)
 {
-	b.min.x = fmax(b.min.x, w->min.x);
-	b.min.y = fmax(b.min.y, w->min.y);
-	b.min.z = fmax(b.min.z, w->min.z);
-	b.max.x = fmin(b.max.x, w->max.x);
-	b.max.y = fmin(b.max.y, w->max.y);
-	b.max.z = fmin(b.max.z, w->max.z);
-	return b;
-}
+	int m = t->opts.samples, i, j, sh, q, nq = m * m, edge;
+	double sp = 0.0, rho = 0.0, cmin = 1.0, Lw = 0.0;
+	px_vec3 sc = px_v3(0, 0, 0), nc = px_v3(0, 0, 0);
 
-/* Transition boxes of one cell. pts/nrm/kk: scratch of m*m samples. */
-static void cell_boxes(struct px_strack *t, struct scell *c,
-		       const struct ssurf *f, px_vec3 *pts, px_vec3 *nrm,
-		       double *kk, int *okk)
-{
-	int m = t->opts.samples, i, j, sh, e;
-	double Lw = 0.0, sp = 0.0;
-
-	c->nbox = 0;
+	c->nreg = 0;
+	c->always = 0;
 	for (j = 0; j < m; j++)
 		for (i = 0; i < m; i++) {
-			int q = j * m + i;
 			double u = c->u0 + (c->u1 - c->u0) * i / (m - 1);
 			double v = c->v0 + (c->v1 - c->v0) * j / (m - 1);
+			q = j * m + i;
 			sample(&f->s, u, v, i == m - 1 ? -1 : 1, j == m - 1 ? -1 : 1,
 			       &pts[q], &nrm[q], &kk[2 * q], &okk[q]);
 			if (!okk[q]) {
-				/* pole or degenerate point: step inside */
-				double uu = u + (i == m - 1 ? -1e-6 : 1e-6) * (c->u1 - c->u0);
-				double vv = v + (j == m - 1 ? -1e-6 : 1e-6) * (c->v1 - c->v0);
+				/* pole or degenerate point: the limit from inside */
+				double uu = u + (i == m - 1 ? -1e-7 : 1e-7) * (c->u1 - c->u0);
+				double vv = v + (j == m - 1 ? -1e-7 : 1e-7) * (c->v1 - c->v0);
 				px_vec3 q2;
-				sample(&f->s, uu, vv, 1, 1, &q2, &nrm[q], &kk[2 * q],
-				       &okk[q]);
+				sample(&f->s, uu, vv, 1, 1, &q2, &nrm[q], &kk[2 * q], &okk[q]);
 			}
-			Lw = fmax(Lw, sqrt(px_aabb_max_dist2(&t->work, pts[q])));
+			if (!okk[q])
+				c->always = 1;
 			if (i > 0)
 				sp = fmax(sp, px_v3_dist(pts[q], pts[q - 1]));
 			if (j > 0)
 				sp = fmax(sp, px_v3_dist(pts[q], pts[q - m]));
+			sc = px_v3_add(sc, pts[q]);
+			nc = px_v3_add(nc, nrm[q]);
+			Lw = fmax(Lw, sqrt(px_aabb_max_dist2(&t->work, pts[q])));
 		}
+	if (c->always || !(px_v3_norm(nc) > 0.0)) {
+		c->always = 1;
+		t->n_unbounded++;
+		return;
+	}
+	sc = px_v3_scale(sc, 1.0 / nq);
+	nc = px_v3_scale(nc, 1.0 / px_v3_norm(nc));
+	for (q = 0; q < nq; q++) {
+		rho = fmax(rho, px_v3_dist(pts[q], sc));
+		cmin = fmin(cmin, px_v3_dot(nrm[q], nc));
+	}
+	{
+		double th = acos(fmax(-1.0, fmin(1.0, cmin)));
+		/* normals turn between samples by about a sample step of
+		 * curvature: grow the spread by a quarter and a margin */
+		th = 1.25 * th + 0.02;
+		if (th > 1.3) {
+			c->always = 1;
+			t->n_unbounded++;
+			return;
+		}
+		c->a = tan(th);
+		c->ia = 1.0 / sqrt(1.0 + c->a * c->a);
+		cmin = cos(th);
+	}
+	rho = 1.1 * rho + 0.5 * sp + 1e-9 * t->scale;
+	c->sc = sc;
+	c->nc = nc;
+	c->rho = rho * (1.0 + c->a);
 	for (sh = 0; sh < 2; sh++) {
-		px_aabb b = px_aabb_empty();
-		int unbounded = 0, sg = 0;
-		double gap = 0.0;
-		for (i = 0; i < m * m; i++) {
-			double k = kk[2 * i + sh];
+		double lmin = INFINITY, lmax = -INFINITY, kmax = 0.0, gap = 0.0;
+		int sg = 0, through = 0;
+		struct sreg g;
+		for (q = 0; q < nq; q++) {
+			double k = kk[2 * q + sh];
 			int s = k > 0.0 ? 1 : (k < 0.0 ? -1 : 0);
-			if (!okk[i] || fabs(k) * Lw < 1.0 || !s || (sg && s != sg))
-				unbounded = 1;
+			kmax = fmax(kmax, fabs(k));
+			if (!s || (sg && s != sg) || fabs(k) * Lw < 1.0)
+				through = 1;
 			if (s)
 				sg = s;
 		}
-		if (unbounded) {
-			/* the sheet reaches infinity in this cell (or is out
-			 * of reach): every normal line of the cell within the
-			 * working volume */
-			for (i = 0; i < m * m; i++) {
-				if (!okk[i]) {
-					px_aabb_extend(&b, px_v3_sub(pts[i], px_v3(Lw, Lw, Lw)));
-					px_aabb_extend(&b, px_v3_add(pts[i], px_v3(Lw, Lw, Lw)));
-					continue;
-				}
-				px_aabb_extend(&b, px_v3_add(pts[i], px_v3_scale(nrm[i], Lw)));
-				px_aabb_extend(&b, px_v3_sub(pts[i], px_v3_scale(nrm[i], Lw)));
-				px_aabb_extend(&b, pts[i]);
-			}
-			b = px_aabb_inflate(&b, sp);
+		if (through) {
+			/* the sheet reaches infinity here (or beyond the
+			 * working volume): |l| >= the smallest focal distance,
+			 * from the largest curvature grown for the samples */
+			if (!(kmax > 0.0))
+				continue; /* flat: no focal point at all */
+			g.split = 1;
+			g.lo = 1.0 / (1.25 * kmax + 1e-12 / t->scale) * cmin - c->rho;
+			g.hi = INFINITY;
 			t->n_unbounded++;
 		} else {
 			for (j = 0; j < m; j++)
 				for (i = 0; i < m; i++) {
-					int q = j * m + i;
-					px_vec3 fp = px_v3_add(pts[q],
-							       px_v3_scale(nrm[q], 1.0 / kk[2 * q + sh]));
-					px_aabb_extend(&b, fp);
+					double l;
+					q = j * m + i;
+					l = 1.0 / kk[2 * q + sh];
+					lmin = fmin(lmin, l);
+					lmax = fmax(lmax, l);
 					if (i > 0)
-						gap = fmax(gap, px_v3_dist(fp, px_v3_add(pts[q - 1],
-							px_v3_scale(nrm[q - 1], 1.0 / kk[2 * (q - 1) + sh]))));
+						gap = fmax(gap, fabs(l - 1.0 / kk[2 * (q - 1) + sh]));
 					if (j > 0)
-						gap = fmax(gap, px_v3_dist(fp, px_v3_add(pts[q - m],
-							px_v3_scale(nrm[q - m], 1.0 / kk[2 * (q - m) + sh]))));
+						gap = fmax(gap, fabs(l - 1.0 / kk[2 * (q - m) + sh]));
 				}
-			/* between samples the sheet bulges by a fraction of
-			 * the sample spacing: grow by the largest spacing */
-			b = px_aabb_inflate(&b, gap + sp + 1e-9 * t->scale);
+			g.split = 0;
+			/* the focal point's height on the central line is
+			 * between l cos(theta) - rho and l + rho */
+			lmin -= gap;
+			lmax += gap;
+			g.lo = (lmin > 0.0 ? lmin * cmin : lmin) - c->rho;
+			g.hi = (lmax > 0.0 ? lmax : lmax * cmin) + c->rho;
 		}
-		b = clip(b, &t->work);
-		if (!px_aabb_is_empty(&b) && c->nbox < ST_NBOX)
-			c->box[c->nbox++] = b;
+		c->reg[c->nreg++] = g;
 	}
-	/* cells on an open edge: points enter or leave the interior where p
-	 * crosses a normal line along the edge */
-	for (e = 0; e < 4; e++) {
-		int on = 0;
-		px_aabb b = px_aabb_empty();
-		if (e == 0)
-			on = !f->wrap_u && c->u0 == f->u0;
-		else if (e == 1)
-			on = !f->wrap_u && c->u1 == f->u1;
-		else if (e == 2)
-			on = !f->wrap_v && c->v0 == f->v0;
-		else
-			on = !f->wrap_v && c->v1 == f->v1;
-		if (!on)
-			continue;
-		for (i = 0; i < m; i++) {
-			int q = e == 0 ? i * m : e == 1 ? i * m + m - 1
-						   : e == 2 ? i : (m - 1) * m + i;
-			px_vec3 nv = okk[q] ? nrm[q] : px_v3(0, 0, 0);
-			if (!okk[q]) {
-				px_aabb_extend(&b, px_v3_sub(pts[q], px_v3(Lw, Lw, Lw)));
-				px_aabb_extend(&b, px_v3_add(pts[q], px_v3(Lw, Lw, Lw)));
-			}
-			px_aabb_extend(&b, px_v3_add(pts[q], px_v3_scale(nv, Lw)));
-			px_aabb_extend(&b, px_v3_sub(pts[q], px_v3_scale(nv, Lw)));
-		}
-		b = clip(px_aabb_inflate(&b, sp), &t->work);
-		if (px_aabb_is_empty(&b))
-			continue;
-		if (c->nbox < ST_NBOX)
-			c->box[c->nbox++] = b;
-		else
-			c->box[ST_NBOX - 1] = px_aabb_union(&c->box[ST_NBOX - 1], &b);
+	edge = (!f->wrap_u && (c->u0 == f->u0 || c->u1 == f->u1)) ||
+	       (!f->wrap_v && (c->v0 == f->v0 || c->v1 == f->v1));
+	if (edge) {
+		/* points cross an open edge on its normal lines: any height */
+		struct sreg g;
+		g.split = 0;
+		g.lo = -INFINITY;
+		g.hi = INFINITY;
+		c->nreg = 0; /* the whole cone contains the sheets too */
+		c->reg[c->nreg++] = g;
 	}
 }
 
@@ -1122,7 +1117,7 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 				c->u1 = f->cu[k + 1];
 				c->v0 = f->cv[j];
 				c->v1 = f->cv[j + 1];
-				cell_boxes(t, c, f, pts, nrm, kk, okk);
+				cell_regions(t, c, f, pts, nrm, kk, okk);
 			}
 	}
 	t->n_cells = cell_cap;
