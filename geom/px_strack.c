@@ -11,10 +11,12 @@
  * section 4.2): the predictor.
  *
  * A critical point that is already tracked is only ever followed; a new
- * one comes from the solve of a cell whose transition box the path met.
+ * one comes from the solve of a cell whose transition region the path
+ * came near.
  * Everything found is a verified zero of E (Newton converged), so the
  * tracked set can miss points but never holds a false one; a missed
- * minimum can only come from a transition box drawn too small, which the
+ * minimum can only come from a transition region drawn too small (the
+ * regions come from samples with margins, not from a proof), which the
  * optional verification would report.
  */
 #include "px_strack.h"
@@ -23,8 +25,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "px_bern.h"
+
 #define ST_NEWTON 16
-#define ST_NBOX 3
+#define ST_NBOX 4
 
 struct crit {
 	double u, v;
@@ -43,6 +47,12 @@ struct crit {
 struct sreg {
 	double lo, hi;
 	int split;      /* 1: |l| >= lo */
+	/* edge wedge (wedge = 1): the normal lines along an edge stay near
+	 * the plane through sc spanned by the edge chord and the normal n:
+	 * |w . b| <= rho + a |w . n| for w = x - sc */
+	int wedge;
+	px_vec3 sc, n, b;
+	double rho, a, ia;
 };
 
 struct scell {
@@ -58,11 +68,25 @@ struct scell {
 	uint32_t mark;
 };
 
+/* A Bezier patch of a surface in power form of its local (s, t) in
+ * [0, 1]^2: coefficients of x w, y w, z w, w; c[k][j (p + 1) + i] is
+ * the coefficient of s^i t^j. */
+struct patch {
+	double u0, u1, v0, v1, iu, iv;
+	int p, q;
+	const double *c; /* 4 (p + 1)(q + 1) */
+};
+
 struct ssurf {
 	struct px_nurbs_surf s;
+	struct patch *pt;       /* npu x npv, u fastest */
+	double *pool;
+	double *pu, *pv;        /* patch bounds (npu + 1, npv + 1) */
+	int npu, npv;
 	double *mem;            /* owned copy of knots and pw */
 	double u0, u1, v0, v1, du, dv;
 	int wrap_u, wrap_v;
+	int pole[4];            /* edge collapsed: u0, u1, v0, v1 */
 	int first_cell, ncu, ncv;
 	double *cu, *cv;        /* cell bounds along u (ncu + 1), v */
 	struct crit *z, *tmp;
@@ -106,12 +130,92 @@ struct px_strack {
 /* ------------------------------------------------------------------ */
 /* evaluation and Newton                                               */
 
+static int bsearch_bounds(const double *b, int n, double x)
+{
+	int lo = 0, hi = n - 1;
+	while (lo < hi) {
+		int mid = (lo + hi + 1) / 2;
+		if (b[mid] <= x)
+			lo = mid;
+		else
+			hi = mid - 1;
+	}
+	return lo;
+}
+
+/* Point and derivatives up to order 2 from the patch holding (u, v). */
+static void surf_eval2(const struct ssurf *f, double u, double v,
+		       struct px_nurbs_surf_derivs *d)
+{
+	const struct patch *pt;
+	double s, t, h[4][6]; /* H, Hs, Ht, Hss, Hst, Htt */
+	int k, i, j, p, q;
+	pt = &f->pt[bsearch_bounds(f->pv, f->npv, v) * f->npu +
+		    bsearch_bounds(f->pu, f->npu, u)];
+	p = pt->p;
+	q = pt->q;
+	s = (u - pt->u0) * pt->iu;
+	t = (v - pt->v0) * pt->iv;
+	for (k = 0; k < 4; k++) {
+		const double *c = pt->c + k * (p + 1) * (q + 1);
+		double V0 = 0, V1 = 0, V2 = 0, W0 = 0, W1 = 0, X0 = 0;
+		/* Horner in t over the rows a_j(s) and their s-derivatives:
+		 * V = H, H_t, H_tt; W = H_s, H_st; X = H_ss */
+		for (j = q; j >= 0; j--) {
+			const double *row = c + j * (p + 1);
+			double a = row[p], a1 = 0.0, a2 = 0.0;
+			for (i = p - 1; i >= 0; i--) {
+				a2 = a2 * s + 2.0 * a1;
+				a1 = a1 * s + a;
+				a = a * s + row[i];
+			}
+			V2 = V2 * t + 2.0 * V1;
+			V1 = V1 * t + V0;
+			V0 = V0 * t + a;
+			W1 = W1 * t + W0;
+			W0 = W0 * t + a1;
+			X0 = X0 * t + a2;
+		}
+		h[k][0] = V0;
+		h[k][1] = W0;
+		h[k][2] = V1;
+		h[k][3] = X0;
+		h[k][4] = W1;
+		h[k][5] = V2;
+	}
+	{
+		double w = h[3][0], iw = 1.0 / w, ws = h[3][1], wt = h[3][2],
+		       wss = h[3][3], wst = h[3][4], wtt = h[3][5];
+		px_vec3 C, Cs, Ct, Css, Cst, Ctt;
+		C = px_v3(h[0][0] * iw, h[1][0] * iw, h[2][0] * iw);
+		Cs = px_v3((h[0][1] - ws * C.x) * iw, (h[1][1] - ws * C.y) * iw,
+			   (h[2][1] - ws * C.z) * iw);
+		Ct = px_v3((h[0][2] - wt * C.x) * iw, (h[1][2] - wt * C.y) * iw,
+			   (h[2][2] - wt * C.z) * iw);
+		Css = px_v3((h[0][3] - 2.0 * ws * Cs.x - wss * C.x) * iw,
+			    (h[1][3] - 2.0 * ws * Cs.y - wss * C.y) * iw,
+			    (h[2][3] - 2.0 * ws * Cs.z - wss * C.z) * iw);
+		Ctt = px_v3((h[0][5] - 2.0 * wt * Ct.x - wtt * C.x) * iw,
+			    (h[1][5] - 2.0 * wt * Ct.y - wtt * C.y) * iw,
+			    (h[2][5] - 2.0 * wt * Ct.z - wtt * C.z) * iw);
+		Cst = px_v3((h[0][4] - ws * Ct.x - wt * Cs.x - wst * C.x) * iw,
+			    (h[1][4] - ws * Ct.y - wt * Cs.y - wst * C.y) * iw,
+			    (h[2][4] - ws * Ct.z - wt * Cs.z - wst * C.z) * iw);
+		d->s = C;
+		d->su = px_v3_scale(Cs, pt->iu);
+		d->sv = px_v3_scale(Ct, pt->iv);
+		d->suu = px_v3_scale(Css, pt->iu * pt->iu);
+		d->suv = px_v3_scale(Cst, pt->iu * pt->iv);
+		d->svv = px_v3_scale(Ctt, pt->iv * pt->iv);
+	}
+}
+
 static void crit_eval(const struct ssurf *f, struct crit *z, px_vec3 p,
 		      px_vec3 *grad_out)
 {
 	struct px_nurbs_surf_derivs d;
 	px_vec3 w;
-	px_nurbs_surf_eval(&f->s, z->u, z->v, 2, &d);
+	surf_eval2(f, z->u, z->v, &d);
 	w = px_v3_sub(d.s, p);
 	z->s = d.s;
 	z->su = d.su;
@@ -172,15 +276,63 @@ static int snewton(const struct ssurf *f, struct crit *z, px_vec3 p,
 			 * pushing out again means the point has left */
 			if (++outs > 2)
 				return 1;
-			z->u = fmin(fmax(z->u, f->u0), f->u1);
-			z->v = fmin(fmax(z->v, f->v0), f->v1);
+			z->u = fmin(fmax(z->u, f->u0 + 1e-9 * f->du), f->u1 - 1e-9 * f->du);
+			z->v = fmin(fmax(z->v, f->v0 + 1e-9 * f->dv), f->v1 - 1e-9 * f->dv);
 		}
 		crit_eval(f, z, p, &g);
 		det = z->h11 * z->h22 - z->h12 * z->h12;
-		if (!(fabs(det) > 0.0))
-			return 1;
-		su = -(z->h22 * g.x - z->h12 * g.y) / det;
-		sv = -(-z->h12 * g.x + z->h11 * g.y) / det;
+		if (f->pole[0] | f->pole[1] | f->pole[2] | f->pole[3]) {
+			/* At a collapsed edge u = u0 the v-derivative vanishes,
+			 * so (S - p) . Sv = 0 holds along the whole edge: a
+			 * spurious root set that attracts Newton. Solve with
+			 * that equation divided by the distance to the edge
+			 * (regular there) and reject the edge itself (the pole
+			 * is a candidate of its own). */
+			double du0 = z->u - f->u0, du1 = f->u1 - z->u;
+			double dv0 = z->v - f->v0, dv1 = f->v1 - z->v;
+			double bu = 1.0, bup = 0.0, av = 1.0, avp = 0.0;
+			double j11, j12, j21, j22, g1, g2, dj;
+			if (f->pole[0] && f->pole[1]) {
+				bu = 1.0 / (du0 * du1);
+				bup = -(du1 - du0) * bu * bu;
+			} else if (f->pole[0]) {
+				bu = 1.0 / du0;
+				bup = -bu * bu;
+			} else if (f->pole[1]) {
+				bu = 1.0 / du1;
+				bup = bu * bu;
+			}
+			if (f->pole[2] && f->pole[3]) {
+				av = 1.0 / (dv0 * dv1);
+				avp = -(dv1 - dv0) * av * av;
+			} else if (f->pole[2]) {
+				av = 1.0 / dv0;
+				avp = -av * av;
+			} else if (f->pole[3]) {
+				av = 1.0 / dv1;
+				avp = av * av;
+			}
+			if (fmin(fmin(f->pole[0] ? du0 : 1.0, f->pole[1] ? du1 : 1.0) / f->du,
+				 fmin(f->pole[2] ? dv0 : 1.0, f->pole[3] ? dv1 : 1.0) / f->dv) <
+			    1e-9)
+				return 1;
+			g1 = g.x * av;
+			g2 = g.y * bu;
+			j11 = z->h11 * av;
+			j12 = z->h12 * av + g.x * avp;
+			j21 = z->h12 * bu + g.y * bup;
+			j22 = z->h22 * bu;
+			dj = j11 * j22 - j12 * j21;
+			if (!(fabs(dj) > 0.0))
+				return 1;
+			su = -(j22 * g1 - j12 * g2) / dj;
+			sv = -(-j21 * g1 + j11 * g2) / dj;
+		} else {
+			if (!(fabs(det) > 0.0))
+				return 1;
+			su = -(z->h22 * g.x - z->h12 * g.y) / det;
+			sv = -(-z->h12 * g.x + z->h11 * g.y) / det;
+		}
 		if (!isfinite(su) || !isfinite(sv))
 			return 1;
 		if (fabs(su) <= tu && fabs(sv) <= tv) {
@@ -288,8 +440,16 @@ static double cell_radius(const struct scell *c, px_vec3 p)
 	rc = fmax((dp - c->a * fabs(l) - c->rho) * c->ia, 0.0);
 	for (i = 0; i < c->nreg; i++) {
 		const struct sreg *g = &c->reg[i];
-		double ri = g->split ? fmax(g->lo - fabs(l), 0.0)
-				     : fmax(fmax(g->lo - l, l - g->hi), 0.0);
+		double ri;
+		if (g->wedge) {
+			px_vec3 we = px_v3_sub(p, g->sc);
+			ri = (fabs(px_v3_dot(we, g->b)) - g->a * fabs(px_v3_dot(we, g->n)) -
+			      g->rho) * g->ia;
+			ri = fmax(ri, 0.0);
+		} else {
+			ri = g->split ? fmax(g->lo - fabs(l), 0.0)
+				      : fmax(fmax(g->lo - l, l - g->hi), 0.0);
+		}
 		r = fmin(r, fmax(rc, ri));
 	}
 	return r;
@@ -584,19 +744,6 @@ int px_strack_reset(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 	return full_reset(t, p, r);
 }
 
-static int bsearch_bounds(const double *b, int n, double x)
-{
-	int lo = 0, hi = n - 1;
-	while (lo < hi) {
-		int mid = (lo + hi + 1) / 2;
-		if (b[mid] <= x)
-			lo = mid;
-		else
-			hi = mid - 1;
-	}
-	return lo;
-}
-
 /* Cell index (within the surface) holding (u, v). */
 static int cell_of(const struct ssurf *f, double u, double v)
 {
@@ -750,8 +897,8 @@ void px_strack_opts_default(struct px_strack_opts *o)
 	if (!o)
 		return;
 	memset(o, 0, sizeof(*o));
-	o->cells_per_span = 2;
-	o->seeds = 3;
+	o->cells_per_span = 3;
+	o->seeds = 2;
 	o->samples = 6;
 	o->max_crit = 256;
 	o->work_margin = 1.0;
@@ -882,6 +1029,7 @@ static void cell_regions(struct px_strack *t, struct scell *c,
 		double lmin = INFINITY, lmax = -INFINITY, kmax = 0.0, gap = 0.0;
 		int sg = 0, through = 0;
 		struct sreg g;
+		memset(&g, 0, sizeof(g));
 		for (q = 0; q < nq; q++) {
 			double k = kk[2 * q + sh];
 			int s = k > 0.0 ? 1 : (k < 0.0 ? -1 : 0);
@@ -924,15 +1072,77 @@ static void cell_regions(struct px_strack *t, struct scell *c,
 		}
 		c->reg[c->nreg++] = g;
 	}
-	edge = (!f->wrap_u && (c->u0 == f->u0 || c->u1 == f->u1)) ||
-	       (!f->wrap_v && (c->v0 == f->v0 || c->v1 == f->v1));
-	if (edge) {
-		/* points cross an open edge on its normal lines: any height */
+	for (edge = 0; edge < 4; edge++) {
+		/* points cross an open edge on its normal lines */
 		struct sreg g;
-		g.split = 0;
-		g.lo = -INFINITY;
-		g.hi = INFINITY;
-		c->nreg = 0; /* the whole cone contains the sheets too */
+		px_vec3 e0, e1, tc, en = px_v3(0, 0, 0), ec = px_v3(0, 0, 0);
+		double rb = 0.0, rn = 0.0, sb = 0.0, cn = 1.0, nt;
+		int on;
+		if (edge == 0)
+			on = !f->wrap_u && c->u0 == f->u0;
+		else if (edge == 1)
+			on = !f->wrap_u && c->u1 == f->u1;
+		else if (edge == 2)
+			on = !f->wrap_v && c->v0 == f->v0;
+		else
+			on = !f->wrap_v && c->v1 == f->v1;
+		if (!on || c->nreg >= ST_NBOX)
+			continue;
+#define EQ(ii) (edge == 0 ? (ii) * m : edge == 1 ? (ii) * m + m - 1 \
+			  : edge == 2 ? (ii) : (m - 1) * m + (ii))
+		e0 = pts[EQ(0)];
+		e1 = pts[EQ(m - 1)];
+		for (i = 0; i < m; i++) {
+			ec = px_v3_add(ec, pts[EQ(i)]);
+			en = px_v3_add(en, nrm[EQ(i)]);
+		}
+		ec = px_v3_scale(ec, 1.0 / m);
+		tc = px_v3_sub(e1, e0);
+		nt = px_v3_norm(en);
+		memset(&g, 0, sizeof(g));
+		if (!(nt > 0.0) || !(px_v3_norm(tc) > 0.0)) {
+			g.lo = -INFINITY; /* collapsed or degenerate: the cone */
+			g.hi = INFINITY;
+			c->reg[c->nreg++] = g;
+			continue;
+		}
+		en = px_v3_scale(en, 1.0 / nt);
+		g.b = px_v3_cross(tc, en);
+		nt = px_v3_norm(g.b);
+		if (!(nt > 0.0)) {
+			g.lo = -INFINITY;
+			g.hi = INFINITY;
+			c->reg[c->nreg++] = g;
+			continue;
+		}
+		g.b = px_v3_scale(g.b, 1.0 / nt);
+		g.n = en;
+		g.sc = ec;
+		for (i = 0; i < m; i++) {
+			px_vec3 w = px_v3_sub(pts[EQ(i)], ec);
+			rb = fmax(rb, fabs(px_v3_dot(w, g.b)));
+			rn = fmax(rn, fabs(px_v3_dot(w, g.n)));
+			sb = fmax(sb, fabs(px_v3_dot(nrm[EQ(i)], g.b)));
+			cn = fmin(cn, px_v3_dot(nrm[EQ(i)], g.n));
+		}
+#undef EQ
+		{
+			/* margins for the turn of the normal between samples */
+			double thb = asin(fmin(1.0, sb)) * 1.25 + 0.02;
+			double thn = acos(fmax(-1.0, fmin(1.0, cn))) * 1.25 + 0.02;
+			if (thb > 1.3 || thn > 1.3) {
+				g.lo = -INFINITY;
+				g.hi = INFINITY;
+				c->reg[c->nreg++] = g;
+				continue;
+			}
+			g.a = sin(thb) / cos(thn);
+			rb = 1.1 * rb + 0.05 * sp + 1e-9 * t->scale;
+			rn = 1.1 * rn + 0.05 * sp + 1e-9 * t->scale;
+			g.rho = rb + g.a * rn;
+			g.ia = 1.0 / sqrt(1.0 + g.a * g.a);
+			g.wedge = 1;
+		}
 		c->reg[c->nreg++] = g;
 	}
 }
@@ -947,6 +1157,10 @@ void px_strack_free(struct px_strack *t)
 	if (t->sf)
 		for (i = 0; i < t->n_surf; i++) {
 			free(t->sf[i].mem);
+			free(t->sf[i].pt);
+			free(t->sf[i].pool);
+			free(t->sf[i].pu);
+			free(t->sf[i].pv);
 			free(t->sf[i].cu);
 			free(t->sf[i].cv);
 			free(t->sf[i].z);
@@ -977,6 +1191,80 @@ static int surf_copy(struct ssurf *f, const struct px_nurbs_surf *s)
 	f->s.knots[0] = f->mem;
 	f->s.knots[1] = f->mem + nu;
 	f->s.pw = f->mem + nu + nv;
+	return PX_OK;
+}
+
+/* Power-form Bezier patches of a surface between the bounds ub x vb. */
+static int build_patches(struct ssurf *f, const double *ub, int nu,
+			 const double *vb, int nv)
+{
+	int p = f->s.degree[0], q = f->s.degree[1], np = (p + 1) * (q + 1);
+	int a, b, i, j, k, r;
+	size_t wl = PX_NURBS_SURF_WORK_LEN(p, q, f->s.n_ctrl[0], f->s.n_ctrl[1]);
+	double *work = malloc(wl * sizeof(double)), tmp[PX_NURBS_MAX_DEGREE + 1];
+	f->npu = nu - 1;
+	f->npv = nv - 1;
+	f->pt = calloc((size_t)(f->npu * f->npv), sizeof(*f->pt));
+	f->pool = calloc((size_t)(f->npu * f->npv) * 4 * (size_t)np, sizeof(double));
+	f->pu = malloc((size_t)nu * sizeof(double));
+	f->pv = malloc((size_t)nv * sizeof(double));
+	if (!work || !f->pt || !f->pool || !f->pu || !f->pv) {
+		free(work);
+		return PX_E_NOMEM;
+	}
+	memcpy(f->pu, ub, (size_t)nu * sizeof(double));
+	memcpy(f->pv, vb, (size_t)nv * sizeof(double));
+	for (b = 0; b < f->npv; b++)
+		for (a = 0; a < f->npu; a++) {
+			struct patch *pt = &f->pt[b * f->npu + a];
+			struct px_nurbs_surf sub;
+			double *c = f->pool + (size_t)(b * f->npu + a) * 4 * (size_t)np;
+			int rc = px_nurbs_surf_extract_work(&f->s, ub[a], ub[a + 1], vb[b],
+							    vb[b + 1], work, wl, &sub);
+			if (rc || sub.n_ctrl[0] != p + 1 || sub.n_ctrl[1] != q + 1) {
+				free(work);
+				return rc ? rc : PX_E_INVAL;
+			}
+			pt->u0 = ub[a];
+			pt->u1 = ub[a + 1];
+			pt->v0 = vb[b];
+			pt->v1 = vb[b + 1];
+			pt->iu = 1.0 / (pt->u1 - pt->u0);
+			pt->iv = 1.0 / (pt->v1 - pt->v0);
+			pt->p = p;
+			pt->q = q;
+			pt->c = c;
+			for (k = 0; k < 4; k++) {
+				double *ck = c + k * np;
+				for (j = 0; j <= q; j++)
+					for (i = 0; i <= p; i++)
+						ck[j * (p + 1) + i] = sub.pw[4 * (j * (p + 1) + i) + k];
+				/* Bernstein to power form along s, then along t */
+				for (j = 0; j <= q; j++) {
+					double *row = ck + j * (p + 1);
+					for (i = 0; i <= p; i++) {
+						double v = 0.0;
+						for (r = 0; r <= i; r++)
+							v += (((i - r) & 1) ? -1.0 : 1.0) *
+							     px_bern_binom(i, r) * row[r];
+						tmp[i] = px_bern_binom(p, i) * v;
+					}
+					memcpy(row, tmp, (size_t)(p + 1) * sizeof(double));
+				}
+				for (i = 0; i <= p; i++) {
+					for (j = 0; j <= q; j++) {
+						double v = 0.0;
+						for (r = 0; r <= j; r++)
+							v += (((j - r) & 1) ? -1.0 : 1.0) *
+							     px_bern_binom(j, r) * ck[r * (p + 1) + i];
+						tmp[j] = px_bern_binom(q, j) * v;
+					}
+					for (j = 0; j <= q; j++)
+						ck[j * (p + 1) + i] = tmp[j];
+				}
+			}
+		}
+	free(work);
 	return PX_OK;
 }
 
@@ -1062,6 +1350,9 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 		nu = span_bounds(&f->s, 0, f->u0, f->u1, ub);
 		nv = span_bounds(&f->s, 1, f->v0, f->v1, vb);
 		t->n_patches += (nu - 1) * (nv - 1);
+		rc = build_patches(f, ub, nu, vb, nv);
+		if (rc)
+			goto fail;
 		f->ncu = (nu - 1) * o.cells_per_span;
 		f->ncv = (nv - 1) * o.cells_per_span;
 		f->cu = calloc((size_t)f->ncu + 1, sizeof(double));
@@ -1148,6 +1439,7 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 				continue;
 			if (px_nurbs_surf_edge_collapsed(&f->s, e, tol)) {
 				struct pole *pl = &t->pole[t->n_poles++];
+				f->pole[e] = 1;
 				pl->u = e < 2 ? tv : f->u0;
 				pl->v = e < 2 ? f->v0 : tv;
 				pl->q = px_nurbs_surf_point(&f->s, pl->u, pl->v);

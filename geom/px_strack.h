@@ -12,20 +12,27 @@
  *  - Transitions (section 4.3): pairs are born or die where p crosses a
  *    focal sheet S + N / k_i (k_i the principal curvatures), and interior
  *    points enter or leave through an edge where p crosses the normal
- *    lines along that edge. Each Bezier patch is cut into (u, v) cells;
- *    at setup every cell gets boxes around sampled points of its two
- *    focal sheets (and, for cells on an edge, of the edge's normal lines)
- *    clipped to the working volume. A curvature that changes sign or
- *    nearly vanishes in a cell (parabolic lines; umbilics need no care,
- *    the principal curvatures are taken from a clamped discriminant)
- *    sends that sheet to infinity: its box then spans the normal lines of
- *    the cell out to the working volume instead of holding infinite
- *    coordinates, so nothing is NaN. When the path of the point meets a
- *    cell's box, that cell is solved again at the new point (Newton from
- *    a seed grid and from the evolved points, duplicates merged). The
- *    boxes are tested lazily: each carries a safe radius (the distance of
- *    the point from it when last tested) and a min-heap on the travelled
- *    path length tells which are due.
+ *    lines along that edge. Each Bezier patch is cut into (u, v) cells.
+ *    At setup every cell gets, from samples, a cone that holds all its
+ *    normal lines (central normal line, spread and slope) and, per focal
+ *    sheet, the interval of heights l along it where the sheet lies; a
+ *    curvature that changes sign or nearly vanishes in the cell
+ *    (parabolic lines: the sheet goes through infinity) gives the
+ *    unbounded region |l| >= l_min instead of infinite coordinates, and
+ *    umbilics need no care (the principal curvatures come from a clamped
+ *    discriminant), so nothing is NaN. Cells on an open edge add a wedge
+ *    around the edge's normal lines. When the path of the point comes
+ *    within reach of a cell's regions, that cell is solved again at the
+ *    new point (Newton from a seed grid; evolved points are kept,
+ *    duplicates merged). Each cell carries a safe radius (a lower bound
+ *    on the distance of the point from its regions when last tested) and
+ *    a min-heap on the travelled path length names the cells due.
+ *  - Collapsed edges (poles): (S - p) . Sv vanishes along such an edge,
+ *    a spurious root set that attracts Newton; the tracker solves with
+ *    that equation divided by the distance to the edge and leaves the
+ *    pole itself to its own candidate.
+ *  - Evaluation: each Bezier patch is kept in power form (Horner in both
+ *    directions, rational derivatives up to order 2).
  *  - Boundary candidates: the domain edges (not at a closed seam, not
  *    collapsed) are tracked as curves by an internal px_track, with the
  *    corners as their end points; collapsed edges are point candidates.
@@ -61,13 +68,13 @@ extern "C" {
 #endif
 
 struct px_strack_opts {
-	/* Cells per Bezier patch along u and along v (default 2, 1..16). */
+	/* Cells per Bezier patch along u and along v (default 3, 1..16). */
 	int cells_per_span;
 	/* Newton seeds per cell and direction when a cell is solved
-	 * (default 3, 1..8). */
+	 * (default 2, 1..8). */
 	int seeds;
-	/* Focal-sheet samples per cell and direction at setup (default 6,
-	 * 2..32). */
+	/* Samples per cell and direction for the transition regions at
+	 * setup (default 6, 2..32). */
 	int samples;
 	/* Interior critical points each surface can hold (default 256). */
 	int max_crit;
@@ -111,14 +118,18 @@ struct px_strack_result {
 struct px_strack_stats {
 	uint64_t updates, reinits, outside, fallbacks, overflows;
 	uint64_t verifications, disagreements;
-	uint64_t cell_solves, box_tests, lost; /* lost: Newton failures */
+	/* cells solved, cell region tests, points whose Newton failed (died
+	 * at a fold or left through an edge; their cell is solved again) */
+	uint64_t cell_solves, box_tests, lost;
 };
 
 struct px_strack_info {
 	int n_surfaces, n_curves, n_patches, n_cells;
 	int n_edges;       /* edges tracked as curves */
 	int n_poles;       /* collapsed edges */
-	int n_unbounded;   /* focal boxes sent to the working volume */
+	int n_unbounded;   /* focal sheets through infinity (|l| >= l_min)
+			    * and cells solved on every update (normals
+			    * too spread or undefined) */
 	px_aabb work;
 };
 

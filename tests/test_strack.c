@@ -176,22 +176,51 @@ static double brute_surf(const struct px_nurbs_surf *s, px_vec3 p)
 /* Independent count of interior critical points of |S - p|^2 by Newton
  * from a dense seed grid; *amb set when a point is near-degenerate or
  * near the boundary (the count is then not decisive). */
+/* Seed parameters along one direction: sd per knot span. */
+static int seeds_dir(const struct px_nurbs_surf *s, int dir, double a, double b,
+		     int sd, double *out, int cap)
+{
+	double kn[64];
+	int i, nk = 0, n = 0;
+	kn[nk++] = a;
+	for (i = 0; i < s->n_knots[dir] && nk < 63; i++)
+		if (s->knots[dir][i] > kn[nk - 1] && s->knots[dir][i] < b)
+			kn[nk++] = s->knots[dir][i];
+	kn[nk++] = b;
+	for (i = 0; i + 1 < nk; i++) {
+		int j;
+		for (j = 0; j < sd && n < cap; j++)
+			out[n++] = kn[i] + (kn[i + 1] - kn[i]) * (j + 0.5) / sd;
+	}
+	return n;
+}
+
 static int count_crit(const struct px_nurbs_surf *s, px_vec3 p, int *amb)
 {
-	double u0, u1, v0, v1, fu[512], fv[512];
-	int i, j, n = 0, sd = 24;
+	double u0, u1, v0, v1, fu[512], fv[512], su_[256], sv_[256];
+	int i, j, n = 0, nsu, nsv;
 	px_nurbs_surf_domain(s, &u0, &u1, &v0, &v1);
-	for (j = 0; j < sd; j++)
-		for (i = 0; i < sd; i++) {
-			double u = u0 + (u1 - u0) * (i + 0.5) / sd, v = v0 + (v1 - v0) * (j + 0.5) / sd;
-			int it, ok = 0, q;
+	int col[4];
+	for (i = 0; i < 4; i++)
+		col[i] = px_nurbs_surf_edge_collapsed(s, i, 1e-12);
+	nsu = seeds_dir(s, 0, u0, u1, 10, su_, 256);
+	nsv = seeds_dir(s, 1, v0, v1, 10, sv_, 256);
+	for (j = 0; j < nsv; j++)
+		for (i = 0; i < nsu; i++) {
+			double u = su_[i], v = sv_[j];
+			int it, ok = 0, q, outs = 0;
 			double det = 0.0, hn = 1.0;
 			for (it = 0; it < 30; it++) {
 				struct px_nurbs_surf_derivs d;
 				px_vec3 w;
 				double g1, g2, a, b, c, su, sv;
-				if (u < u0 || u > u1 || v < v0 || v > v1)
-					break;
+				if (u < u0 || u > u1 || v < v0 || v > v1) {
+					/* overshoot: back to the edge, twice at most */
+					if (++outs > 2)
+						break;
+					u = fmin(fmax(u, u0), u1);
+					v = fmin(fmax(v, v0), v1);
+				}
 				px_nurbs_surf_eval(s, u, v, 2, &d);
 				w = px_v3_sub(d.s, p);
 				g1 = px_v3_dot(w, d.su);
@@ -215,6 +244,14 @@ static int count_crit(const struct px_nurbs_surf *s, px_vec3 p, int *amb)
 				}
 			}
 			if (!ok || u < u0 || u > u1 || v < v0 || v > v1)
+				continue;
+			/* Newton drawn onto a collapsed edge: (S - p) . Sv
+			 * vanishes along all of it; the pole is not an
+			 * interior critical point */
+			if ((col[0] && u - u0 < 1e-6 * (u1 - u0)) ||
+			    (col[1] && u1 - u < 1e-6 * (u1 - u0)) ||
+			    (col[2] && v - v0 < 1e-6 * (v1 - v0)) ||
+			    (col[3] && v1 - v < 1e-6 * (v1 - v0)))
 				continue;
 			for (q = 0; q < n; q++)
 				if (fabs(fu[q] - u) < 1e-6 * (u1 - u0) &&
@@ -387,9 +424,9 @@ static void run_model(const char *name, const struct px_nurbs_curve *cs,
 					if (tot->wrong - wrong0 < 3)
 						printf("  %s kind %d step %g k %d: tracked %.12g "
 						       "global %.12g (feature %d entity %d, u %g v %g; "
-						       "global u %g v %g)\n",
+						       "global u %g v %g) p %.17g %.17g %.17g\n",
 						       name, kind, steps[s], k, r.dist, g.dist,
-						       r.feature, r.entity, r.u, r.v, g.u, g.v);
+						       r.feature, r.entity, r.u, r.v, g.u, g.v, q[k].x, q[k].y, q[k].z);
 					tot->wrong++;
 				}
 				nd = naive_step(ss, &nv, q[k]);
@@ -415,11 +452,18 @@ static void run_model(const char *name, const struct px_nurbs_curve *cs,
 						if (amb) {
 							tot->count_amb++;
 						} else if (n != m) {
-							if (tot->count_bad < 5)
+							if (tot->count_bad < 5) {
+								double cu[64], cv[64];
+								int cty[64], qq, mm;
 								printf("  %s kind %d step %g k %d surf %d: "
 								       "tracked %d critical points, "
-								       "sampling %d\n",
+								       "sampling %d:",
 								       name, kind, steps[s], k, e, m, n);
+								mm = px_strack_critical(t, e, cu, cv, cty, 64);
+								for (qq = 0; qq < mm && qq < 64; qq++)
+									printf(" (%.6g %.6g %d)", cu[qq], cv[qq], cty[qq]);
+								printf("\n");
+							}
 							tot->count_bad++;
 						}
 					}
