@@ -66,6 +66,7 @@ struct scell {
 	double expiry;
 	int hpos;
 	uint32_t mark;
+	double cross;   /* hit: segment parameter where the region is met */
 };
 
 /* A Bezier patch of a surface in power form of its local (s, t) in
@@ -263,9 +264,10 @@ static int domain_fix(const struct ssurf *f, double *u, double *v)
  * singular Hessian, the domain left through an open edge).
  */
 static int snewton(const struct ssurf *f, struct crit *z, px_vec3 p,
-		   double lu, double lv)
+		   double lu, double lv, const struct scell *home)
 {
 	double tu = 1e-11 * f->du, tv = 1e-11 * f->dv;
+	double qu = 1e-6 * f->du, qv = 1e-6 * f->dv;
 	int k, outs = 0;
 	for (k = 0; k < ST_NEWTON; k++) {
 		px_vec3 g;
@@ -339,12 +341,32 @@ static int snewton(const struct ssurf *f, struct crit *z, px_vec3 p,
 			z->type = crit_type(z);
 			return 0;
 		}
+		if (fabs(su) <= qu && fabs(sv) <= qv && z->u + su >= f->u0 &&
+		    z->u + su <= f->u1 && z->v + sv >= f->v0 && z->v + sv <= f->v1) {
+			/* quadratic convergence: after this step the error is
+			 * O(step^2), far below the tolerance; move the point to
+			 * first order instead of evaluating again */
+			z->u += su;
+			z->v += sv;
+			z->s = px_v3_add(z->s, px_v3_add(px_v3_scale(z->su, su),
+							 px_v3_scale(z->sv, sv)));
+			z->type = crit_type(z);
+			return 0;
+		}
 		if (fabs(su) > lu)
 			su = su > 0 ? lu : -lu;
 		if (fabs(sv) > lv)
 			sv = sv > 0 ? lv : -lv;
 		z->u += su;
 		z->v += sv;
+		if (home) {
+			/* a seed heading out of its cell (beyond one cell width)
+			 * converges to a point its own cell answers for */
+			double w = home->u1 - home->u0, h = home->v1 - home->v0;
+			if (z->u < home->u0 - w || z->u > home->u1 + w ||
+			    z->v < home->v0 - h || z->v > home->v1 + h)
+				return 1;
+		}
 	}
 	return 1;
 }
@@ -384,25 +406,42 @@ static int crit_add(struct px_strack *t, struct ssurf *f, const struct crit *z)
 }
 
 /* Solve cell c at p from its seed grid. Returns 0 or PX_E_NOSPC. */
-static int cell_solve(struct px_strack *t, const struct scell *c, px_vec3 p)
+static int follow(const struct ssurf *f, struct crit *z, px_vec3 p0,
+		  px_vec3 dp, px_vec3 p, struct crit *last);
+
+/*
+ * Solve cell c: Newton from its seed grid at ps, each root then followed
+ * from ps to p (a pair born where the path met the cell's region keeps
+ * moving for the rest of the step, possibly out of the cell). Returns 0
+ * or PX_E_NOSPC.
+ */
+static int cell_solve_at(struct px_strack *t, const struct scell *c,
+			 px_vec3 ps, px_vec3 p)
 {
 	struct ssurf *f = &t->sf[c->surf];
-	int n = t->opts.seeds, i, j, rc;
+	int n = t->opts.seeds, i, j, rc, same = px_v3_dist2(ps, p) == 0.0;
 	double lu = c->u1 - c->u0, lv = c->v1 - c->v0;
 	t->st.cell_solves++;
 	for (j = 0; j < n; j++)
 		for (i = 0; i < n; i++) {
-			struct crit z;
+			struct crit z, last;
 			memset(&z, 0, sizeof(z));
 			z.u = c->u0 + lu * (i + 0.5) / n;
 			z.v = c->v0 + lv * (j + 0.5) / n;
-			if (snewton(f, &z, p, 0.5 * lu, 0.5 * lv))
+			if (snewton(f, &z, ps, 0.5 * lu, 0.5 * lv, c))
+				continue;
+			if (!same && follow(f, &z, ps, px_v3_sub(p, ps), p, &last))
 				continue;
 			rc = crit_add(t, f, &z);
 			if (rc < 0)
 				return rc;
 		}
 	return 0;
+}
+
+static int cell_solve(struct px_strack *t, const struct scell *c, px_vec3 p)
+{
+	return cell_solve_at(t, c, p, p);
 }
 
 static int surf_reinit(struct px_strack *t, struct ssurf *f, int si, px_vec3 p)
@@ -530,7 +569,12 @@ static int collect_cells(struct px_strack *t, px_vec3 p0, px_vec3 p1)
 		t->st.box_tests++;
 		/* a point of the segment within reach of the set is at least
 		 * r0 from p0 and r1 from p1: impossible when r0 + r1 > |seg| */
-		if (r1 <= 0.0 || cell_radius(c, p0) + r1 <= seg) {
+		double r0 = r1 <= 0.0 || seg <= 0.0 ? 0.0 : cell_radius(c, p0);
+		if (r1 <= 0.0 || r0 + r1 <= seg) {
+			/* where along the segment the region can first be met */
+			double s0 = seg > 0.0 ? fmin(1.0, r0 / seg) : 1.0;
+			double s1 = seg > 0.0 ? fmax(s0, 1.0 - r1 / seg) : 1.0;
+			c->cross = r0 > 0.0 ? 0.5 * (s0 + s1) : 0.5 * s1;
 			c->mark = t->epoch;
 			t->hits[nh++] = ci;
 		}
@@ -766,7 +810,42 @@ static int evolve(const struct ssurf *f, struct crit *z, px_vec3 dp,
 			z->v += sv;
 		}
 	}
-	return snewton(f, z, p, 0.125 * f->du, 0.125 * f->dv);
+	return snewton(f, z, p, 0.125 * f->du, 0.125 * f->dv, NULL);
+}
+
+/*
+ * Follow z from p0 to p0 + dp, keeping its type (a point changes type only
+ * at a fold, where it dies). A long step that fails or changes the type
+ * is retried as a continuation in 4, then 16 sub-steps. Returns 0, or 1
+ * with *last the furthest point reached (to solve its cell again).
+ */
+static int follow(const struct ssurf *f, struct crit *z, px_vec3 p0,
+		  px_vec3 dp, px_vec3 p, struct crit *last)
+{
+	struct crit w = *z;
+	int ns, k;
+	if (!evolve(f, &w, dp, p) && w.type == z->type) {
+		*z = w;
+		return 0;
+	}
+	*last = *z;
+	for (ns = 4; ns <= 16; ns *= 4) {
+		px_vec3 sd = px_v3_scale(dp, 1.0 / ns);
+		w = *z;
+		for (k = 1; k <= ns; k++) {
+			px_vec3 pk = k == ns ? p : px_v3_add(p0, px_v3_scale(dp, (double)k / ns));
+			int ty = w.type;
+			if (evolve(f, &w, sd, pk) || w.type != ty)
+				break;
+			if (ns == 16)
+				*last = w;
+		}
+		if (k > ns) {
+			*z = w;
+			return 0;
+		}
+	}
+	return 1;
 }
 
 int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
@@ -801,16 +880,23 @@ int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 		memcpy(f->tmp, f->z, (size_t)n * sizeof(*f->z));
 		f->nz = 0;
 		for (j = 0; j < n; j++) {
-			struct crit z = f->tmp[j];
-			if (evolve(f, &z, dp, p)) {
-				/* died at a fold, or Newton lost it: solve its
-				 * cell so a survivor is found again */
-				int ci = cell_of(f, f->tmp[j].u, f->tmp[j].v);
-				struct scell *c = &t->cell[f->first_cell + ci];
+			struct crit z = f->tmp[j], last;
+			if (follow(f, &z, p0, dp, p, &last)) {
+				/* died at a fold (or left through an edge), or
+				 * Newton lost it: solve its cell and the cell
+				 * where it was last seen, so a survivor is found
+				 * again */
+				int q;
 				t->st.lost++;
-				if (c->mark != t->epoch && nh < t->n_cells) {
-					c->mark = t->epoch;
-					t->hits[nh++] = f->first_cell + ci;
+				r->died++;
+				for (q = 0; q < 2; q++) {
+					const struct crit *o = q ? &last : &f->tmp[j];
+					int ci = f->first_cell + cell_of(f, o->u, o->v);
+					if (t->cell[ci].mark != t->epoch && nh < t->n_cells) {
+						t->cell[ci].mark = t->epoch;
+						t->cell[ci].cross = 1.0;
+						t->hits[nh++] = ci;
+					}
 				}
 				continue;
 			}
@@ -821,8 +907,26 @@ int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 		if (rc < 0)
 			break;
 	}
-	for (i = 0; i < nh && rc >= 0; i++)
-		rc = cell_solve(t, &t->cell[t->hits[i]], p);
+	{
+		int before = 0, after = 0;
+		for (i = 0; i < t->n_surf; i++)
+			before += t->sf[i].nz;
+		for (i = 0; i < nh && rc >= 0; i++) {
+			const struct scell *c = &t->cell[t->hits[i]];
+			rc = cell_solve(t, c, p);
+			/* a long step after the crossing: also solve where the
+			 * region was met and follow those roots to p */
+			if (rc >= 0 && (1.0 - c->cross) * px_v3_norm(dp) > 0.1 * c->rho)
+				rc = cell_solve_at(t, c, px_v3_add(p0, px_v3_scale(dp, c->cross)),
+						   p);
+		}
+		for (i = 0; i < t->n_surf; i++)
+			after += t->sf[i].nz;
+		/* new points only come from solved cells: births (pairs at
+		 * a focal sheet) and entries through an edge */
+		r->born = after - before;
+		t->st.born += (uint64_t)r->born;
+	}
 	r->cells_solved = nh;
 	if (rc < 0) {
 		t->st.overflows++;

@@ -112,6 +112,11 @@ struct px_strack_result {
 	int n_min, n_max, n_saddle; /* interior surface points by type */
 	int source;        /* enum px_track_source */
 	int cells_solved;  /* cells solved again this update */
+	/* interior points that appeared this update (born in pairs at a
+	 * focal sheet, or entered through an edge) and that ended (died in
+	 * pairs at a focal sheet, left through an edge, or lost by Newton:
+	 * their cell is solved again) */
+	int born, died;
 	int verified;
 };
 
@@ -121,6 +126,7 @@ struct px_strack_stats {
 	/* cells solved, cell region tests, points whose Newton failed (died
 	 * at a fold or left through an edge; their cell is solved again) */
 	uint64_t cell_solves, box_tests, lost;
+	uint64_t born;     /* interior points found by cell solves */
 };
 
 struct px_strack_info {

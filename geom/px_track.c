@@ -26,21 +26,8 @@
  * event: that is where the extended evolute lies (inside the normal
  * planes at the break).
  *
- * Design note - surfaces (next step). A patch gets the same treatment
- * over (u, v) cells instead of parameter leaves: the two lifted equations
- * E1 = (S - p) . S_u, E2 = (S - p) . S_v (Seong-Johnson-Cohen section 4)
- * have Bernstein coefficients affine in p over each Bezier cell, the
- * transition set is {E1 = E2 = det J = 0} (the focal sheets S + N / k_i),
- * and a cell's event box comes from the same octree exclusion (cell
- * excluded when E1 or E2 or det J is sign-definite over the box; det J is
- * quadratic in p, bounded by interval arithmetic), so umbilics and
- * parabolic lines (focal points at infinity) only make boxes larger,
- * never NaN. Evolution is Newton in (u, v) with the 2x2 Jacobian; a hit
- * cell is re-solved by the certified patch solver of px_spiece (all
- * interior critical points, not only the minimum, would need a
- * root-isolating variant of it). Boundary curves and creases are tracked
- * as curve entities by this file, corners are candidates. The model
- * layout (entities -> cells -> event grid -> stretches) stays as here.
+ * Surfaces are tracked by px_strack.c, which hands their edges and creases
+ * to this file as curves.
  */
 #include "px_track.h"
 

@@ -195,12 +195,16 @@ static int seeds_dir(const struct px_nurbs_surf *s, int dir, double a, double b,
 	return n;
 }
 
+static double last_fu[512], last_fv[512];
+static int last_n;
+
 static int count_crit(const struct px_nurbs_surf *s, px_vec3 p, int *amb)
 {
 	double u0, u1, v0, v1, fu[512], fv[512], su_[256], sv_[256];
-	int i, j, n = 0, nsu, nsv;
+	int i, j, n = 0, nsu, nsv, col[4];
+	last_n = 0;
 	px_nurbs_surf_domain(s, &u0, &u1, &v0, &v1);
-	int col[4];
+
 	for (i = 0; i < 4; i++)
 		col[i] = px_nurbs_surf_edge_collapsed(s, i, 1e-12);
 	nsu = seeds_dir(s, 0, u0, u1, 10, su_, 256);
@@ -261,7 +265,10 @@ static int count_crit(const struct px_nurbs_surf *s, px_vec3 p, int *amb)
 				continue;
 			fu[n] = u;
 			fv[n] = v;
+			last_fu[n] = u;
+			last_fv[n] = v;
 			n++;
+			last_n = n;
 			if (fabs(det) < 1e-3 * hn ||
 			    fmin(u - u0, u1 - u) < 1e-3 * (u1 - u0) ||
 			    fmin(v - v0, v1 - v) < 1e-3 * (v1 - v0))
@@ -367,7 +374,7 @@ static void make_path(px_vec3 *q, int n, int kind, px_aabb box, double step)
 
 struct totals {
 	long steps, wrong, naive_wrong, brute_bad, brute_checks, count_checks,
-		count_bad, count_amb, jumps, cells;
+		count_bad, count_amb, jumps, cells, born, died;
 	uint64_t allocs;
 };
 
@@ -419,6 +426,8 @@ static void run_model(const char *name, const struct px_nurbs_curve *cs,
 				tot->steps++;
 				tot->jumps += r.jumped;
 				tot->cells += r.cells_solved;
+				tot->born += r.born;
+				tot->died += r.died;
 				if (fabs(r.dist - g.dist) > tol ||
 				    fabs(px_v3_dist(r.point, q[k]) - r.dist) > tol) {
 					if (tot->wrong - wrong0 < 3)
@@ -462,7 +471,10 @@ static void run_model(const char *name, const struct px_nurbs_curve *cs,
 								mm = px_strack_critical(t, e, cu, cv, cty, 64);
 								for (qq = 0; qq < mm && qq < 64; qq++)
 									printf(" (%.6g %.6g %d)", cu[qq], cv[qq], cty[qq]);
-								printf("\n");
+								printf(" sampling:");
+								for (qq = 0; qq < last_n && qq < n; qq++)
+									printf(" (%.6g %.6g)", last_fu[qq], last_fv[qq]);
+								printf(" p %.17g %.17g %.17g\n", q[k].x, q[k].y, q[k].z);
 							}
 							tot->count_bad++;
 						}
@@ -485,11 +497,14 @@ static void report(const struct totals *tot)
 {
 	printf("  total: %ld steps, wrong %ld, naive wrong %ld, brute %ld/%ld bad, "
 	       "counts %ld checked %ld bad %ld ambiguous, jumps %ld, cells solved "
-	       "%ld, allocations %llu\n",
+	       "%ld, points born %ld died %ld, allocations %llu\n",
 	       tot->steps, tot->wrong, tot->naive_wrong, tot->brute_bad,
 	       tot->brute_checks, tot->count_checks, tot->count_bad,
-	       tot->count_amb, tot->jumps, tot->cells,
+	       tot->count_amb, tot->jumps, tot->cells, tot->born, tot->died,
 	       (unsigned long long)tot->allocs);
+	/* the paths must cross focal sheets and edges many times */
+	PX_CHECK_MSG(tot->born >= 20 && tot->died >= 20,
+		     "too few transitions: born %ld died %ld", tot->born, tot->died);
 	PX_CHECK_INT_EQ(tot->wrong, 0);
 	PX_CHECK_INT_EQ(tot->brute_bad, 0);
 	PX_CHECK_INT_EQ(tot->count_bad, 0);
