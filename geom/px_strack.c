@@ -67,6 +67,7 @@ struct scell {
 	int hpos;
 	uint32_t mark;
 	double cross;   /* hit: segment parameter where the region is met */
+	int child;      /* solve cell: first of its 2 x 2 region cells */
 };
 
 /* A Bezier patch of a surface in power form of its local (s, t) in
@@ -113,6 +114,9 @@ struct px_strack {
 	int n_patches;
 	struct ssurf *sf;
 	struct scell *cell;
+	/* transition regions are held by 2 x 2 children of each solve cell:
+	 * tighter cones and height intervals, the same seeds */
+	struct scell *rcell;
 	struct edge *edge;
 	struct pole *pole;
 	int *heap, *popped, *hits;
@@ -462,8 +466,8 @@ static int surf_reinit(struct px_strack *t, struct ssurf *f, int si, px_vec3 p)
 /* ------------------------------------------------------------------ */
 /* transition boxes: lazy tests                                        */
 
-/* Lower bound on the distance from p to the cell's transition set. */
-static double cell_radius(const struct scell *c, px_vec3 p)
+/* Lower bound on the distance from p to a region cell's transition set. */
+static double region_radius(const struct scell *c, px_vec3 p)
 {
 	px_vec3 w;
 	double l, dp, rc, r = INFINITY;
@@ -492,6 +496,15 @@ static double cell_radius(const struct scell *c, px_vec3 p)
 		r = fmin(r, fmax(rc, ri));
 	}
 	return r;
+}
+
+/* ... and of a solve cell: its children's regions cover all of it. */
+static double cell_radius(const struct px_strack *t, const struct scell *c,
+			  px_vec3 p)
+{
+	const struct scell *ch = &t->rcell[c->child];
+	return fmin(fmin(region_radius(&ch[0], p), region_radius(&ch[1], p)),
+		    fmin(region_radius(&ch[2], p), region_radius(&ch[3], p)));
 }
 
 static void heap_set(struct px_strack *t, int pos, int ci)
@@ -537,7 +550,7 @@ static void heap_rebuild(struct px_strack *t, px_vec3 p)
 {
 	int i;
 	for (i = 0; i < t->n_cells; i++) {
-		t->cell[i].expiry = t->travel + cell_radius(&t->cell[i], p) *
+		t->cell[i].expiry = t->travel + cell_radius(t, &t->cell[i], p) *
 							(1.0 - 1e-9);
 		heap_set(t, i, i);
 	}
@@ -565,11 +578,11 @@ static int collect_cells(struct px_strack *t, px_vec3 p0, px_vec3 p1)
 	for (k = 0; k < np; k++) {
 		int ci = t->popped[k];
 		struct scell *c = &t->cell[ci];
-		double r1 = cell_radius(c, p1);
+		double r1 = cell_radius(t, c, p1);
 		t->st.box_tests++;
 		/* a point of the segment within reach of the set is at least
 		 * r0 from p0 and r1 from p1: impossible when r0 + r1 > |seg| */
-		double r0 = r1 <= 0.0 || seg <= 0.0 ? 0.0 : cell_radius(c, p0);
+		double r0 = r1 <= 0.0 || seg <= 0.0 ? 0.0 : cell_radius(t, c, p0);
 		if (r1 <= 0.0 || r0 + r1 <= seg) {
 			/* where along the segment the region can first be met */
 			double s0 = seg > 0.0 ? fmin(1.0, r0 / seg) : 1.0;
@@ -1272,6 +1285,7 @@ void px_strack_free(struct px_strack *t)
 		}
 	free(t->sf);
 	free(t->cell);
+	free(t->rcell);
 	free(t->edge);
 	free(t->pole);
 	free(t->heap);
@@ -1490,6 +1504,7 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 		t->work.max = px_v3_add(bounds.max, px_v3(m, m, m));
 	}
 	t->cell = calloc((size_t)cell_cap + 1, sizeof(*t->cell));
+	t->rcell = calloc(4 * (size_t)cell_cap + 1, sizeof(*t->rcell));
 	t->heap = calloc((size_t)cell_cap + 1, sizeof(int));
 	t->popped = calloc((size_t)cell_cap + 1, sizeof(int));
 	t->hits = calloc((size_t)cell_cap + 1, sizeof(int));
@@ -1497,7 +1512,8 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	nrm = calloc((size_t)(o.samples * o.samples), sizeof(*nrm));
 	kk = calloc((size_t)(2 * o.samples * o.samples), sizeof(double));
 	okk = calloc((size_t)(o.samples * o.samples), sizeof(int));
-	if (!t->cell || !t->heap || !t->popped || !t->hits || !pts || !nrm ||
+	if (!t->cell || !t->rcell || !t->heap || !t->popped || !t->hits ||
+	    !pts || !nrm ||
 	    !kk || !okk) {
 		rc = PX_E_NOMEM;
 		goto fail;
@@ -1512,7 +1528,22 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 				c->u1 = f->cu[k + 1];
 				c->v0 = f->cv[j];
 				c->v1 = f->cv[j + 1];
-				cell_regions(t, c, f, pts, nrm, kk, okk);
+				{
+					double um = 0.5 * (c->u0 + c->u1), vm = 0.5 * (c->v0 + c->v1);
+					int ch;
+					c->child = 4 * (f->first_cell + j * f->ncu + k);
+					for (ch = 0; ch < 4; ch++) {
+						struct scell *rg = &t->rcell[c->child + ch];
+						rg->surf = i;
+						rg->u0 = ch & 1 ? um : c->u0;
+						rg->u1 = ch & 1 ? c->u1 : um;
+						rg->v0 = ch & 2 ? vm : c->v0;
+						rg->v1 = ch & 2 ? c->v1 : vm;
+						cell_regions(t, rg, f, pts, nrm, kk, okk);
+						/* size scale of the solve cell */
+						c->rho = fmax(c->rho, 2.0 * rg->rho);
+					}
+				}
 			}
 	}
 	t->n_cells = cell_cap;

@@ -12,8 +12,10 @@
  *  - Transitions (section 4.3): pairs are born or die where p crosses a
  *    focal sheet S + N / k_i (k_i the principal curvatures), and interior
  *    points enter or leave through an edge where p crosses the normal
- *    lines along that edge. Each Bezier patch is cut into (u, v) cells.
- *    At setup every cell gets, from samples, a cone that holds all its
+ *    lines along that edge. Each Bezier patch is cut into (u, v) cells,
+ *    each of those into 2 x 2 region cells (a two-level hierarchy: the
+ *    regions of the small cells decide, the big cell is solved). At
+ *    setup every region cell gets, from samples, a cone that holds all its
  *    normal lines (central normal line, spread and slope) and, per focal
  *    sheet, the interval of heights l along it where the sheet lies; a
  *    curvature that changes sign or nearly vanishes in the cell
