@@ -7,6 +7,8 @@
  * global one (must be 0), transitions, leaf re-solves and
  * re-initialisations. Verification inside the tracker is off (the loop
  * configuration); the comparison is made outside the timed call.
+ * Surfaces (px_strack) follow: a single wavy bicubic patch, a wavy
+ * 16-patch bicubic, a concave fold, with cells solved per update.
  * BENCH_TRACK_DEPTH=d overrides the event-grid depth (default 4).
  * Prints figures only; nothing here is a pass/fail test.
  */
@@ -20,6 +22,7 @@
 #include "px_arena.h"
 #include "px_dist.h"
 #include "px_nurbs.h"
+#include "px_strack.h"
 #include "px_track.h"
 
 static uint64_t rng = 0x9e3779b97f4a7c15ull;
@@ -273,6 +276,145 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 	px_dist_model_free(ref);
 }
 
+/* ---- surfaces ------------------------------------------------------- */
+
+static int wavy_surf(struct px_nurbs_surf *s, int n)
+{
+	double U[16], xyz[3 * 49];
+	int i, j, p = 3;
+	for (i = 0; i <= p; i++) {
+		U[i] = 0.0;
+		U[n + i] = 1.0;
+	}
+	for (i = p + 1; i < n; i++)
+		U[i] = (double)(i - p) / (n - p);
+	for (j = 0; j < n; j++)
+		for (i = 0; i < n; i++) {
+			double x = -1 + 2.0 * i / (n - 1), y = -1 + 2.0 * j / (n - 1);
+			double *q = &xyz[3 * (j * n + i)];
+			q[0] = x;
+			q[1] = y + 0.1 * sin(3 * x);
+			q[2] = 0.35 * sin(2.2 * x + 0.3) * cos(2.7 * y - 0.2);
+		}
+	return px_nurbs_surf_init(s, &arena, 3, 3, n, n, U, n + 4, U, n + 4, xyz,
+				  NULL, NULL);
+}
+
+static int fold_surf(struct px_nurbs_surf *s)
+{
+	static const double U[] = {0, 0, 0, 0, 1, 1, 1, 1};
+	static const double V[] = {0, 0, 0, 0, 0.25, 0.5, 0.75, 1, 1, 1, 1};
+	double xyz[3 * 4 * 7];
+	int i, j;
+	for (j = 0; j < 7; j++)
+		for (i = 0; i < 4; i++) {
+			double a = M_PI * (1.15 + 0.7 * j / 6.0);
+			double *q = &xyz[3 * (j * 4 + i)];
+			q[0] = 0.8 * cos(a);
+			q[1] = -1 + 2.0 * i / 3;
+			q[2] = 0.8 * sin(a) + 0.9 + 0.1 * (i == 1) - 0.08 * (i == 2);
+		}
+	return px_nurbs_surf_init(s, &arena, 3, 3, 4, 7, U, 8, V, 11, xyz, NULL,
+				  NULL);
+}
+
+#define NSSTEP 3000
+
+static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
+{
+	static px_vec3 q[NSSTEP];
+	static int64_t tt[NSSTEP], tg[NSSTEP];
+	static const double steps[] = {1e-4, 1e-3, 1e-2, 5e-2};
+	struct px_strack *t = NULL;
+	struct px_strack_info ti;
+	struct px_dist_model *ref = NULL;
+	struct px_dist_info di;
+	int64_t t0;
+	int kind, s, k, rc;
+	double size;
+	px_aabb box;
+
+	t0 = now_ns();
+	rc = px_strack_create(NULL, 0, ss, ns, NULL, &t);
+	if (rc) {
+		printf("%s: tracker setup failed: %s\n", name, px_strerror(rc));
+		return;
+	}
+	t0 = now_ns() - t0;
+	px_dist_model_create(NULL, 0, ss, ns, NULL, &ref);
+	px_strack_get_info(t, &ti);
+	px_dist_model_info(ref, &di);
+	box = di.bounds;
+	size = px_aabb_diagonal(&box);
+	box = px_aabb_inflate(&box, 0.3 * size);
+	printf("%s: %d surfaces, %d patches, %d cells (%d sheets through "
+	       "infinity or unboxed), %d edge curves, setup %.1f ms\n",
+	       name, ti.n_surfaces, ti.n_patches, ti.n_cells, ti.n_unbounded,
+	       ti.n_edges, t0 / 1e6);
+	printf("  %-8s %-7s %8s %8s %8s | %8s %8s | %6s | %5s %7s %6s %5s\n",
+	       "path", "step", "med_ns", "p99_ns", "max_ns", "cold_med",
+	       "cold_p99", "ratio", "wrong", "cells/u", "tests", "crit");
+	for (kind = 0; kind < 2; kind++)
+		for (s = 0; s < 4; s++) {
+			struct px_strack_result r;
+			struct px_strack_stats a, b;
+			struct px_dist_result g;
+			long wrong = 0, crit = 0;
+			make_path(q, NSSTEP, kind, box, steps[s] * size);
+			px_strack_reset(t, q[0], &r);
+			px_strack_get_stats(t, &a);
+			for (k = 0; k < NSSTEP; k++) {
+				int64_t x = now_ns();
+				px_strack_update(t, q[k], &r);
+				tt[k] = now_ns() - x;
+				x = now_ns();
+				px_dist_query(ref, q[k], &g);
+				tg[k] = now_ns() - x;
+				crit += r.n_crit;
+				if (fabs(r.dist - g.dist) > 1e-9 * (size + g.dist))
+					wrong++;
+			}
+			px_strack_get_stats(t, &b);
+			qsort(tt, NSSTEP, sizeof(tt[0]), cmp_i64);
+			qsort(tg, NSSTEP, sizeof(tg[0]), cmp_i64);
+			printf("  %-8s %-7g %8lld %8lld %8lld | %8lld %8lld | %6.1f | %5ld "
+			       "%7.2f %6.2f %5.1f\n",
+			       kind ? "sines" : "random", steps[s] * 100.0,
+			       (long long)tt[NSSTEP / 2], (long long)tt[NSSTEP * 99 / 100],
+			       (long long)tt[NSSTEP - 1], (long long)tg[NSSTEP / 2],
+			       (long long)tg[NSSTEP * 99 / 100],
+			       (double)tg[NSSTEP / 2] / (double)(tt[NSSTEP / 2] ? tt[NSSTEP / 2] : 1),
+			       wrong,
+			       (double)(b.cell_solves - a.cell_solves) / NSSTEP,
+			       (double)(b.box_tests - a.box_tests) / NSSTEP,
+			       (double)crit / NSSTEP);
+		}
+	{
+		struct px_strack *tv = NULL;
+		struct px_strack_opts o;
+		struct px_strack_stats st;
+		struct px_strack_result r;
+		px_strack_opts_default(&o);
+		o.verify_every = 1;
+		if (px_strack_create(NULL, 0, ss, ns, &o, &tv) == PX_OK) {
+			make_path(q, NSSTEP, 0, box, 1e-2 * size);
+			for (k = 0; k < NSSTEP; k++)
+				px_strack_update(tv, q[k], &r);
+			make_path(q, NSSTEP, 1, box, 5e-2 * size);
+			for (k = 0; k < NSSTEP; k++)
+				px_strack_update(tv, q[k], &r);
+			px_strack_get_stats(tv, &st);
+			printf("  verification (every update, %llu checks): %llu "
+			       "disagreements\n",
+			       (unsigned long long)st.verifications,
+			       (unsigned long long)st.disagreements);
+			px_strack_free(tv);
+		}
+	}
+	px_strack_free(t);
+	px_dist_model_free(ref);
+}
+
 int main(void)
 {
 	struct px_nurbs_curve c[6];
@@ -293,5 +435,17 @@ int main(void)
 	circle(&c[2], 0.5, -2.5, 1.0);
 	knot(&c[3], 1.0, 1.0, 1.0);
 	run("multi-entity (4 curves)", c, 4);
+	{
+		struct px_nurbs_surf sf[3];
+		printf("\npx_strack: surfaces, same columns (cells/u: cells solved "
+		       "per update; tests: cell tests per update; crit: live "
+		       "critical points)\n");
+		if (wavy_surf(&sf[0], 4) == PX_OK)
+			run_surf("bicubic patch (wavy)", &sf[0], 1);
+		if (wavy_surf(&sf[1], 7) == PX_OK)
+			run_surf("wavy bicubic, 16 patches", &sf[1], 1);
+		if (fold_surf(&sf[2]) == PX_OK)
+			run_surf("concave fold", &sf[2], 1);
+	}
 	return 0;
 }

@@ -26,21 +26,8 @@
  * event: that is where the extended evolute lies (inside the normal
  * planes at the break).
  *
- * Design note - surfaces (next step). A patch gets the same treatment
- * over (u, v) cells instead of parameter leaves: the two lifted equations
- * E1 = (S - p) . S_u, E2 = (S - p) . S_v (Seong-Johnson-Cohen section 4)
- * have Bernstein coefficients affine in p over each Bezier cell, the
- * transition set is {E1 = E2 = det J = 0} (the focal sheets S + N / k_i),
- * and a cell's event box comes from the same octree exclusion (cell
- * excluded when E1 or E2 or det J is sign-definite over the box; det J is
- * quadratic in p, bounded by interval arithmetic), so umbilics and
- * parabolic lines (focal points at infinity) only make boxes larger,
- * never NaN. Evolution is Newton in (u, v) with the 2x2 Jacobian; a hit
- * cell is re-solved by the certified patch solver of px_spiece (all
- * interior critical points, not only the minimum, would need a
- * root-isolating variant of it). Boundary curves and creases are tracked
- * as curve entities by this file, corners are candidates. The model
- * layout (entities -> cells -> event grid -> stretches) stays as here.
+ * Surfaces are tracked by px_strack.c, which hands their edges and creases
+ * to this file as curves.
  */
 #include "px_track.h"
 
@@ -86,6 +73,9 @@ struct leaf {
 	int boxed;
 	uint32_t mark;  /* re-solved this update */
 	uint32_t tested; /* event test done this update */
+	double expiry;  /* travel after which the event test is due */
+	int hpos;       /* position in the expiry heap */
+	size_t ioff;    /* ipool: 1/|b_i| (n+1), 1/|db_i| (n) */
 };
 
 /* An event cell of one leaf: an octree cell of the working volume where
@@ -140,6 +130,14 @@ struct px_track {
 	int *gstart;         /* gn^3 + 1 offsets into gleaf */
 	int *gleaf;
 	int *hits;           /* scratch: leaves of this update */
+	/* lazy event tests: leaf l cannot have an event while the path
+	 * length travelled stays below l->expiry (a safe radius around the
+	 * point of its last test); a min-heap on expiry makes the usual
+	 * update one comparison at the root */
+	int *heap, *popped;
+	double travel;
+	int heap_ok;
+	double *ipool;
 	px_aabb work;
 	double scale;        /* model diagonal */
 	px_vec3 p;
@@ -529,25 +527,30 @@ static int ent_reinit(struct px_track *t, struct ent *e, px_vec3 p)
  */
 static int newton(const struct px_track *t, const struct ent *e, int type,
 		  double *unw, px_vec3 p, double lim, px_vec3 *c, px_vec3 *d1,
-		  double *D, double *u_out)
+		  double *D, double *u_out, int hint)
 {
-	double u, step, tol = 1e-8 * e->len;
+	double u, step, tol = 1e-8 * e->len, quick = 1e-6 * e->len;
 	int k;
 	px_vec3 d2;
 	for (k = 0;; k++) {
 		double f1;
+		const struct span *sp = hint >= 0 ? &t->span[hint] : NULL;
 		u = *unw;
 		if (e->cyclic) {
-			u = fmod(u - e->u0, e->len);
-			if (u < 0)
-				u += e->len;
-			u += e->u0;
+			if (u < e->u0 || u >= e->u1) {
+				u = fmod(u - e->u0, e->len);
+				if (u < 0)
+					u += e->len;
+				u += e->u0;
+			}
 		} else if (u < e->u0 || u > e->u1) {
 			/* an iterate beyond an open end: come back to it */
 			u = u < e->u0 ? e->u0 : e->u1;
 			*unw = u;
 		}
-		span_eval(find_span(t, e, u), u, c, d1, &d2);
+		if (!sp || u < sp->u0 || u > sp->u1)
+			sp = find_span(t, e, u);
+		span_eval(sp, u, c, d1, &d2);
 		f1 = px_v3_dot(px_v3_sub(*c, p), *d1);
 		*D = px_v3_dot(px_v3_sub(*c, p), d2) + px_v3_dot(*d1, *d1);
 		if (!(*D != 0.0))
@@ -557,6 +560,18 @@ static int newton(const struct px_track *t, const struct ent *e, int type,
 			return 1;
 		if (fabs(step) <= tol)
 			break;
+		if (fabs(step) <= quick && u + step >= sp->u0 &&
+		    u + step <= sp->u1) {
+			/* quadratic convergence: the error after this step is
+			 * O(step^2), below tol; move the point to first order
+			 * (its error is O(step^2) too) instead of evaluating
+			 * again */
+			*unw += step;
+			u += step;
+			*c = px_v3_add(*c, px_v3_scale(*d1, step));
+			*d1 = px_v3_add(*d1, px_v3_scale(d2, step));
+			break;
+		}
 		if (k >= TRK_NEWTON)
 			return 1;
 		if (fabs(step) > lim)
@@ -590,7 +605,8 @@ static int evolve(struct px_track *t, struct ent *e, struct zero *z,
 	if (fabs(step) > lim)
 		step = step > 0 ? lim : -lim;
 	unw = z->u + step;
-	ok = !newton(t, e, z->type, &unw, p, lim, &c, &d1, &D, &u);
+	ok = !newton(t, e, z->type, &unw, p, lim, &c, &d1, &D, &u,
+		     t->leaf[z->leaf].span);
 	if (!ok) {
 		/* continuation in sub-steps */
 		px_vec3 sd = px_v3_scale(dp, 0.25), dk = z->d1;
@@ -604,7 +620,8 @@ static int evolve(struct px_track *t, struct ent *e, struct zero *z,
 			if (fabs(step) > lim)
 				step = step > 0 ? lim : -lim;
 			unw += step;
-			if (newton(t, e, z->type, &unw, pk, lim, &c, &d1, &D, &u))
+			if (newton(t, e, z->type, &unw, pk, lim, &c, &d1, &D, &u,
+				   t->leaf[z->leaf].span))
 				return 1;
 			dk = d1;
 			Dk = D;
@@ -701,6 +718,117 @@ static int leaf_event(const struct px_track *t, const struct leaf *l,
 	return !definite_seg(a + 4 * (n + 1), n, p0, p1, l->tol_d);
 }
 
+
+/* Radius within which coefficients a - p.b (count m, stride m; inverse
+ * norms ib) keep their signs around p: 0 when they are not
+ * sign-definite at p (the linear bound |dp . b_i| <= |dp| |b_i|). */
+static double definite_radius(const double *a, const double *ib, int m,
+			      px_vec3 p, double tol)
+{
+	const double *bx = a + m, *by = bx + m, *bz = by + m;
+	double r = INFINITY;
+	int i, sg = 0;
+	for (i = 0; i < m; i++) {
+		double v = a[i] - (p.x * bx[i] + p.y * by[i] + p.z * bz[i]);
+		int s = v > tol ? 1 : (v < -tol ? -1 : 0);
+		if (!s || (sg && s != sg))
+			return 0.0;
+		sg = s;
+		r = fmin(r, (fabs(v) - tol) * ib[i]);
+	}
+	return r;
+}
+
+static double box_dist(const px_aabb *b, px_vec3 p)
+{
+	double dx = fmax(fmax(b->min.x - p.x, p.x - b->max.x), 0.0);
+	double dy = fmax(fmax(b->min.y - p.y, p.y - b->max.y), 0.0);
+	double dz = fmax(fmax(b->min.z - p.z, p.z - b->max.z), 0.0);
+	return sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+/* Distance p may travel (inside the working volume) before leaf l can
+ * have an event: the distance to its event cells, or the radius where
+ * the exclusion of leaf_event() still holds. */
+static double leaf_radius(const struct px_track *t, const struct leaf *l,
+			  px_vec3 p)
+{
+	const double *a = leaf_a(t, l), *ib = t->ipool + l->ioff;
+	double r, rb;
+	int n = l->n, i;
+	if (!l->boxed)
+		return INFINITY;
+	rb = box_dist(&l->box, p);
+	r = definite_radius(a, ib, n + 1, p, l->tol_g);
+	if (r > 0.0)
+		return fmax(r, rb);
+	r = n >= 1 ? definite_radius(a + 4 * (n + 1), ib + n + 1, n, p,
+				     l->tol_d)
+		   : INFINITY;
+	for (i = 0; i < 2 && r > 0.0; i++) {
+		double v;
+		int e = i ? n : 0;
+		if (!(l->flags & (i ? LF_EV1 : LF_EV0)))
+			continue;
+		v = gco(a, n, e, p);
+		r = fmin(r, fabs(v) > l->tol_g ? (fabs(v) - l->tol_g) * ib[e] : 0.0);
+	}
+	return fmax(r, rb);
+}
+
+static void heap_set(struct px_track *t, int pos, int li)
+{
+	t->heap[pos] = li;
+	t->leaf[li].hpos = pos;
+}
+
+static void heap_down(struct px_track *t, int pos, int n)
+{
+	int li = t->heap[pos];
+	double x = t->leaf[li].expiry;
+	for (;;) {
+		int c = 2 * pos + 1;
+		if (c >= n)
+			break;
+		if (c + 1 < n && t->leaf[t->heap[c + 1]].expiry <
+				       t->leaf[t->heap[c]].expiry)
+			c++;
+		if (!(t->leaf[t->heap[c]].expiry < x))
+			break;
+		heap_set(t, pos, t->heap[c]);
+		pos = c;
+	}
+	heap_set(t, pos, li);
+}
+
+static void heap_up(struct px_track *t, int pos)
+{
+	int li = t->heap[pos];
+	double x = t->leaf[li].expiry;
+	while (pos > 0) {
+		int par = (pos - 1) / 2;
+		if (!(x < t->leaf[t->heap[par]].expiry))
+			break;
+		heap_set(t, pos, t->heap[par]);
+		pos = par;
+	}
+	heap_set(t, pos, li);
+}
+
+/* Safe radii of all leaves at p (inside the working volume). */
+static void heap_rebuild(struct px_track *t, px_vec3 p)
+{
+	int i;
+	for (i = 0; i < t->n_leaves; i++) {
+		t->leaf[i].expiry = t->travel + leaf_radius(t, &t->leaf[i], p) *
+							(1.0 - 1e-9);
+		heap_set(t, i, i);
+	}
+	for (i = t->n_leaves / 2 - 1; i >= 0; i--)
+		heap_down(t, i, t->n_leaves);
+	t->heap_ok = 1;
+}
+
 static void mark_leaf(struct px_track *t, int li, int *nh)
 {
 	if (t->leaf[li].mark == t->epoch)
@@ -710,36 +838,35 @@ static void mark_leaf(struct px_track *t, int li, int *nh)
 }
 
 /* Leaves that may hold an event along p0 -> p1, grown while a root
- * crosses the outer boundary of the region. Returns their count. */
+ * crosses the outer boundary of the region. Returns their count. Only
+ * leaves whose safe radius the travelled path has used up are tested
+ * (exactly, along the segment), then given a new radius at p1. */
 static int collect_events(struct px_track *t, px_vec3 p0, px_vec3 p1)
 {
-	int nh = 0, k, lo[3], hi[3], i, j, ax;
-	const double *a0 = &p0.x, *a1 = &p1.x, *wl = &t->work.min.x,
-		     *gi = &t->ginv.x;
+	int nh = 0, k, np = 0, n = t->n_leaves;
 
-	/* grid cells of the segment's box (both ends are inside the working
-	 * volume, which the grid covers) */
-	for (ax = 0; ax < 3; ax++) {
-		double x0 = (fmin(a0[ax], a1[ax]) - wl[ax]) * gi[ax];
-		double x1 = (fmax(a0[ax], a1[ax]) - wl[ax]) * gi[ax];
-		lo[ax] = x0 <= 0.0 ? 0 : (x0 >= t->gn - 1 ? t->gn - 1 : (int)x0);
-		hi[ax] = x1 <= 0.0 ? 0 : (x1 >= t->gn - 1 ? t->gn - 1 : (int)x1);
+	if (!t->heap_ok)
+		heap_rebuild(t, p0);
+	t->travel += px_v3_dist(p0, p1);
+	while (n > 0 && t->leaf[t->heap[0]].expiry <= t->travel) {
+		t->popped[np++] = t->heap[0];
+		n--;
+		if (n > 0) {
+			heap_set(t, 0, t->heap[n]);
+			heap_down(t, 0, n);
+		}
 	}
-	for (k = lo[2]; k <= hi[2]; k++)
-		for (j = lo[1]; j <= hi[1]; j++)
-			for (i = lo[0]; i <= hi[0]; i++) {
-				int c = (k * t->gn + j) * t->gn + i, q;
-				for (q = t->gstart[c]; q < t->gstart[c + 1]; q++) {
-					int li = t->gleaf[q];
-					struct leaf *l = &t->leaf[li];
-					if (l->tested == t->epoch)
-						continue;
-					l->tested = t->epoch;
-					t->st.box_hits++;
-					if (leaf_event(t, l, p0, p1))
-						mark_leaf(t, li, &nh);
-				}
-			}
+	for (k = 0; k < np; k++) {
+		int li = t->popped[k];
+		struct leaf *l = &t->leaf[li];
+		t->st.box_hits++;
+		if (leaf_event(t, l, p0, p1))
+			mark_leaf(t, li, &nh);
+		l->expiry = t->travel + leaf_radius(t, l, p1) * (1.0 - 1e-9);
+		heap_set(t, n, li);
+		heap_up(t, n);
+		n++;
+	}
 	for (k = 0; k < nh; k++) {
 		int li = t->hits[k], side;
 		const struct leaf *l = &t->leaf[li];
@@ -914,6 +1041,7 @@ int px_track_reset(struct px_track *t, px_vec3 p, struct px_track_result *r)
 	t->p = p;
 	t->init = 1;
 	t->best_id = 0;
+	t->heap_ok = 0;
 	rc = reinit_all(t, p);
 	r->source = PX_TRACK_REINIT;
 	if (rc) {
@@ -949,6 +1077,7 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 
 	if (!in_work(t, p) || !in_work(t, p0)) {
 		t->st.outside++;
+		t->heap_ok = 0;
 		r->source = PX_TRACK_REINIT;
 		rc = reinit_all(t, p);
 		if (rc) {
@@ -1371,6 +1500,9 @@ void px_track_free(struct px_track *t)
 	free(t->gstart);
 	free(t->gleaf);
 	free(t->hits);
+	free(t->heap);
+	free(t->popped);
+	free(t->ipool);
 	free(t);
 }
 
@@ -1513,7 +1645,11 @@ int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
 	t->pool = calloc(pool_cap ? pool_cap : 1, sizeof(double));
 	t->cand = calloc((size_t)cand_cap + 1, sizeof(*t->cand));
 	t->hits = calloc((size_t)leaf_cap + 1, sizeof(int));
-	if (!t->leaf || !t->pool || !t->cand || !t->hits) {
+	t->heap = calloc((size_t)leaf_cap + 1, sizeof(int));
+	t->popped = calloc((size_t)leaf_cap + 1, sizeof(int));
+	t->ipool = calloc((size_t)leaf_cap * (2 * TRK_NG + 2) + 1, sizeof(double));
+	if (!t->leaf || !t->pool || !t->cand || !t->hits || !t->heap ||
+	    !t->popped || !t->ipool) {
 		rc = PX_E_NOMEM;
 		goto fail;
 	}
@@ -1664,6 +1800,26 @@ int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
 					l->tol_g = 1e-12 * tg;
 					l->tol_d = 1e-12 * td;
 				}
+				/* inverse norms of the p-gradients of the
+				 * coefficients (safe radii); 0 for a constant */
+				{
+					double *ib = t->ipool + (size_t)t->n_leaves *
+								       (2 * TRK_NG + 2);
+					const double *da = a + 4 * (m + 1);
+					l->ioff = (size_t)t->n_leaves * (2 * TRK_NG + 2);
+					for (q = 0; q <= m; q++) {
+						double nb = sqrt(a[m + 1 + q] * a[m + 1 + q] +
+								 a[2 * (m + 1) + q] * a[2 * (m + 1) + q] +
+								 a[3 * (m + 1) + q] * a[3 * (m + 1) + q]);
+						ib[q] = nb > 0.0 ? 1.0 / nb : INFINITY;
+					}
+					for (q = 0; q < m; q++) {
+						double nb = sqrt(da[m + q] * da[m + q] +
+								 da[2 * m + q] * da[2 * m + q] +
+								 da[3 * m + q] * da[3 * m + q]);
+						ib[m + 1 + q] = nb > 0.0 ? 1.0 / nb : INFINITY;
+					}
+				}
 				t->pool_len += (size_t)(4 * (m + 1) + 4 * m);
 				if (L == 0 && kind0 != K_SMOOTH)
 					l->flags |= LF_EV0;
@@ -1776,7 +1932,8 @@ int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
 	t->bytes = sizeof(*t) + (size_t)t->n_ent * sizeof(*t->ent) +
 		   (size_t)t->n_ent * 2 * (size_t)o.max_crit * sizeof(struct zero) +
 		   (size_t)span_cap * sizeof(*t->span) +
-		   (size_t)leaf_cap * (sizeof(*t->leaf) + 2 * sizeof(int)) +
+		   (size_t)leaf_cap * (sizeof(*t->leaf) + 4 * sizeof(int) +
+				       (2 * TRK_NG + 2) * sizeof(double)) +
 		   pool_cap * sizeof(double) +
 		   (size_t)(cand_cap + 1) * sizeof(*t->cand) +
 		   ((size_t)t->gn * t->gn * t->gn + 1 + (size_t)t->n_prim) *

@@ -15,7 +15,10 @@
  *  - Evolution (their Eq. 6): each critical point moves by the tangent
  *    predictor ds = (dp . C') / D, D = (C - p) . C'' + |C'|^2, then Newton
  *    on (C - p) . C' = 0 with the new point held fixed, staying inside its
- *    C1 stretch (across knot spans, wrapping at smooth closed seams).
+ *    C1 stretch (across knot spans, wrapping at smooth closed seams). A
+ *    Newton step below 1e-6 of the parameter range ends the iteration
+ *    after one evaluation (quadratic convergence leaves an error far
+ *    below the tolerance; the point is moved to first order).
  *  - Transitions: pairs appear or vanish only where the moving point
  *    crosses the transition set {p : g = 0 and dg/ds = 0} (the evolute of
  *    a planar curve, a ruled surface of polar lines for a space curve) or,
@@ -27,16 +30,19 @@
  *    have an event is covered by octree cells (exclusion with exact
  *    interval bounds of those affine coefficients: a cell where the
  *    coefficients of g, or of dg/ds, keep one sign holds no event). The
- *    cells of the finest level form a uniform grid whose cells list their
- *    leaves (a segment of one cycle meets a few grid cells, so the lookup
- *    is O(1), unlike a tree of the overlapping boxes, which measured
- *    slower). An update looks up the grid cells of the segment p_old ->
- *    p_new, then tests each listed leaf exactly along the segment (the
- *    coefficients are affine in the segment parameter, so sign-definite
- *    coefficients at both ends prove there is no event - the exact
- *    counterpart of the paper's line/box-diagonal stage), and re-solves
- *    the leaves that may hold one with a certified Bernstein/Descartes
- *    root isolation at the new point. A region is grown while a root
+ *    event tests are lazy: each leaf keeps a safe radius - how far the
+ *    point may travel before the leaf can have an event: its distance
+ *    to the box of its event cells, or the radius within which its
+ *    coefficients provably keep their signs (each is affine in p, so
+ *    |coefficient| / |its p-gradient| bounds it) - and a min-heap on the
+ *    travelled path length names the leaves whose radius is used up;
+ *    usually none, so an update costs one comparison at the heap root
+ *    plus the evolution. A due leaf is tested exactly along the segment
+ *    p_old -> p_new (the coefficients are affine in the segment
+ *    parameter, so sign-definite coefficients at both ends prove there is
+ *    no event - the exact counterpart of the paper's line/box-diagonal
+ *    stage), gets a new radius at p_new, and is re-solved with a
+ *    certified Bernstein/Descartes root isolation at the new point. A region is grown while a root
  *    crosses its outer boundary, so created pairs that drift away from the
  *    crossing are found too. Creation and annihilation are counted by the
  *    change in the number of roots of the re-solved leaves.
@@ -52,8 +58,8 @@
  *    verification compares with the global query every N updates and
  *    counts disagreements (each re-initialises and answers globally).
  *
- * Surfaces are not tracked yet: px_track_create() takes curves only (see
- * the design note in px_track.c for how patches will fit).
+ * Surfaces: px_strack.h (it tracks surface edges and creases with this
+ * module).
  *
  * Memory and real-time rules: px_track_create() allocates everything
  * (spans, leaves, coefficient pool, event grid, per-entity critical-point
@@ -88,7 +94,8 @@ struct px_track_opts {
 	/* Parameter leaves per Bezier span (default 4, 1..64). */
 	int leaves_per_span;
 	/* Octree depth of the event cells of a leaf inside the working
-	 * volume (default 4, 0..7). */
+	 * volume (default 4, 0..7); their union per leaf bounds its safe
+	 * radius. */
 	int box_depth;
 	/* Compare with the global query every verify_every updates (0: off,
 	 * the default). */
@@ -145,7 +152,8 @@ struct px_track_stats {
 	uint64_t verifications;
 	uint64_t disagreements;  /* verification found a closer point */
 	uint64_t leaf_solves;
-	uint64_t box_hits;       /* leaves whose box the segment hit */
+	uint64_t box_hits;       /* leaves whose safe radius ran out (given
+				  * the exact segment test) */
 	uint64_t creations, annihilations; /* pairs */
 };
 

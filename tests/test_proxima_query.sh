@@ -95,8 +95,25 @@ for model in circle continuation; do
 done
 expect "--track --stats" 0 "$bin" --track --stats tests/data/circle.obj "$tmp/path.csv"
 err_has "--track stats: tracker counters" '^track_updates 3000 leaf_solves [0-9]+ created [0-9]+ annihilated [0-9]+ reinits [0-9]+ outside [0-9]+ fallbacks 0$'
-expect "--track refuses surfaces clearly" 2 "$bin" --track tests/data/multi.obj "$tmp/pts.csv"
-err_has "--track with surfaces says why" 'curve-only models'
+# Surfaces (px_strack): the bicubic patch and the rational sphere (poles,
+# a closed seam) along the same paths; u and v must reproduce the point.
+for model in bicubic sphere; do
+	for pts in path pts; do
+		expect "--track $model ($pts)" 0 "$bin" --track tests/data/$model.obj "$tmp/$pts.csv"
+		cp "$tmp/out" "$tmp/track.out"
+		"$bin" tests/data/$model.obj "$tmp/$pts.csv" >"$tmp/global.out" 2>/dev/null
+		if paste -d, "$tmp/track.out" "$tmp/global.out" | awk -F, 'function abs(a) { return a < 0 ? -a : a }
+			NF != 12 { print "line " NR ": " NF " fields"; bad = 1; next }
+			abs($1 - $7) > 1e-9 * (1 + $7) { print "line " NR ": tracked " $1 " global " $7; bad = 1 }
+			END { exit bad }' >"$tmp/err"; then
+			ok "--track $model ($pts): same distances as the global query"
+		else bad "--track $model ($pts): same distances as the global query"; fi
+	done
+done
+expect "--track --stats surface" 0 "$bin" --track --stats tests/data/bicubic.obj "$tmp/path.csv"
+err_has "--track stats: surface tracker counters" '^strack_updates 3000 cell_solves [0-9]+ reinits [0-9]+ outside [0-9]+ fallbacks 0$'
+expect "--track refuses faces clearly" 2 "$bin" --track tests/data/multi.obj "$tmp/pts.csv"
+err_has "--track with faces says why" 'free-form curves and surfaces only'
 printf '1,2,3\n4,nan,6\n' >"$tmp/nan.csv"
 expect "NaN point" 1 "$bin" tests/data/circle.obj "$tmp/nan.csv"
 err_has "NaN point: file:line" "nan.csv:2: field 2: not a finite number"

@@ -14,9 +14,10 @@
  * contract is the distance). --stats writes setup time, model memory and
  * per-query times to stderr.
  * --track answers the points in file order as one moving point with the
- * coherent tracker (px_track.h: every critical distance followed, pairs
- * created and annihilated at transitions); curve-only models for now.
- * With --stats it also prints the tracker's counters.
+ * coherent trackers (px_track.h for curves, px_strack.h when the model
+ * has surfaces: every critical distance followed, pairs created and
+ * annihilated at transitions); free-form models only (no faces, meshes or
+ * clouds). With --stats it also prints the tracker's counters.
  */
 #include <ctype.h>
 #include <errno.h>
@@ -31,6 +32,7 @@
 #include "px_mesh.h"
 #include "px_model.h"
 #include "px_obj.h"
+#include "px_strack.h"
 #include "px_track.h"
 
 static const char *prog = "proxima-query";
@@ -45,7 +47,7 @@ static void usage(FILE *f)
 		   "  --stats     setup time, model memory and per-query ns to stderr\n"
 		   "  --track     answer the points in order as one moving point by\n"
 		   "              coherent tracking of all critical distances\n"
-		   "              (curve-only models in this version)\n",
+		   "              (free-form curves and surfaces; no faces)\n",
 		   prog);
 }
 
@@ -190,6 +192,7 @@ int main(int argc, char **argv)
 	struct px_dist_model *m = NULL;
 	struct px_model *mesh = NULL;
 	struct px_track *trk = NULL;
+	struct px_strack *strk = NULL;
 	struct points pts = {0};
 	int64_t t_setup, *times = NULL;
 	const char *ext;
@@ -224,8 +227,8 @@ int main(int argc, char **argv)
 	t_setup = now_ns();
 	if (track && !ieq(ext, "obj")) {
 		fprintf(stderr, "%s: %s: --track: coherent tracking supports "
-				"curve-only models in this version; run without "
-				"--track for independent global queries\n",
+				"free-form curves and surfaces (.obj) only; run "
+				"without --track for independent global queries\n",
 			prog, model_path);
 		return 2;
 	}
@@ -269,16 +272,24 @@ int main(int argc, char **argv)
 			rc = 1;
 			goto out;
 		}
-		if (track && (ns > 0 || obj->n_triangles > 0)) {
+		if (track && obj->n_triangles > 0) {
 			fprintf(stderr, "%s: %s: --track: coherent tracking supports "
-					"curve-only models in this version (the model "
-					"has %s); run without --track for independent "
+					"free-form curves and surfaces only (the model "
+					"has faces); run without --track for independent "
 					"global queries\n",
-				prog, model_path, ns > 0 ? "surfaces" : "faces");
+				prog, model_path);
 			rc = 2;
 			goto out;
 		}
-		if (track) {
+		if (track && ns > 0) {
+			rc = px_strack_create(curves, nc, surfs, ns, NULL, &strk);
+			if (rc) {
+				fprintf(stderr, "%s: %s: cannot prepare the tracker: %s\n",
+					prog, model_path, px_strerror(rc));
+				rc = 1;
+				goto out;
+			}
+		} else if (track) {
 			rc = px_track_create(curves, nc, NULL, &trk);
 			if (rc) {
 				fprintf(stderr, "%s: %s: cannot prepare the tracker: %s\n",
@@ -344,6 +355,16 @@ int main(int argc, char **argv)
 				v = 0.0;
 			}
 		}
+		if (strk) {
+			struct px_strack_result tr;
+			qrc = px_strack_update(strk, pts.p[k], &tr);
+			if (!qrc) {
+				dist = tr.dist;
+				cp = tr.point;
+				u = tr.u;
+				v = tr.v;
+			}
+		}
 		if (m) {
 			struct px_dist_result r;
 			qrc = px_dist_query(m, pts.p[k], &r);
@@ -384,7 +405,8 @@ int main(int argc, char **argv)
 	if (stats) {
 		struct px_dist_info info;
 		size_t bytes = 0;
-		const struct px_dist_model *dm = trk ? px_track_dist_model(trk) : m;
+		const struct px_dist_model *dm = trk ? px_track_dist_model(trk)
+					       : strk ? px_strack_dist_model(strk) : m;
 		if (dm) {
 			px_dist_model_info(dm, &info);
 			bytes += info.bytes;
@@ -429,9 +451,27 @@ int main(int argc, char **argv)
 				(unsigned long long)st.outside,
 				(unsigned long long)st.fallbacks);
 		}
+		if (strk) {
+			struct px_strack_stats st;
+			struct px_strack_info si;
+			px_strack_get_stats(strk, &st);
+			px_strack_get_info(strk, &si);
+			fprintf(stderr, "strack_surfaces %d patches %d cells %d edges %d "
+				"poles %d\n", si.n_surfaces, si.n_patches, si.n_cells,
+				si.n_edges, si.n_poles);
+			fprintf(stderr,
+				"strack_updates %llu cell_solves %llu reinits %llu "
+				"outside %llu fallbacks %llu\n",
+				(unsigned long long)st.updates,
+				(unsigned long long)st.cell_solves,
+				(unsigned long long)st.reinits,
+				(unsigned long long)st.outside,
+				(unsigned long long)st.fallbacks);
+		}
 	}
 	rc = 0;
 out:
+	px_strack_free(strk);
 	px_track_free(trk);
 	px_dist_model_free(m);
 	px_model_free(mesh);

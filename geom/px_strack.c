@@ -1,0 +1,1662 @@
+/*
+ * px_strack.c - coherent tracking of point-surface critical distances.
+ *
+ * f(u, v) = |S - p|^2 / 2 has gradient E = ((S - p) . Su, (S - p) . Sv)
+ * and Hessian H = [Su.Su + (S - p).Suu, Su.Sv + (S - p).Suv; .,
+ * Sv.Sv + (S - p).Svv]. With p = S + l N on the normal line, H = I - l II
+ * (first and second fundamental forms), singular exactly at l = 1 / k_i:
+ * the focal sheets, where critical points are born and die in pairs
+ * (Seong-Johnson-Cohen section 4.3). Moving p by dp moves a regular
+ * critical point by H^-1 (Su . dp, Sv . dp) (differentiate E = 0, their
+ * section 4.2): the predictor.
+ *
+ * A critical point that is already tracked is only ever followed; a new
+ * one comes from the solve of a cell whose transition region the path
+ * came near.
+ * Everything found is a verified zero of E (Newton converged), so the
+ * tracked set can miss points but never holds a false one; a missed
+ * minimum can only come from a transition region drawn too small (the
+ * regions come from samples with margins, not from a proof), which the
+ * optional verification would report.
+ */
+#include "px_strack.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "px_bern.h"
+
+#define ST_NEWTON 16
+#define ST_NBOX 4
+
+struct crit {
+	double u, v;
+	int type;       /* +1 min, -1 max, 0 saddle */
+	uint32_t id;
+	px_vec3 s, su, sv;
+	double h11, h12, h22;
+};
+
+/* Where a cell can have a transition: every normal line of the cell lies
+ * in the double cone around its central normal line (apex spread rho,
+ * slope a = tan of the largest normal deviation); a focal sheet lies on
+ * those lines at a signed height l in an interval (bounded sheet) or at
+ * |l| >= lo (a sheet through infinity: curvature crossing zero or too
+ * small to matter); edge events anywhere on the lines. */
+struct sreg {
+	double lo, hi;
+	int split;      /* 1: |l| >= lo */
+	/* edge wedge (wedge = 1): the normal lines along an edge stay near
+	 * the plane through sc spanned by the edge chord and the normal n:
+	 * |w . b| <= rho + a |w . n| for w = x - sc */
+	int wedge;
+	px_vec3 sc, n, b;
+	double rho, a, ia;
+};
+
+struct scell {
+	double u0, u1, v0, v1;
+	int surf;
+	int always;     /* normals too spread for a cone: always solved */
+	px_vec3 sc, nc;
+	double rho, a, ia; /* ia = 1 / sqrt(1 + a^2) */
+	int nreg;
+	struct sreg reg[ST_NBOX];
+	double expiry;
+	int hpos;
+	uint32_t mark;
+	double cross;   /* hit: segment parameter where the region is met */
+	int child;      /* solve cell: first of its 2 x 2 region cells */
+};
+
+/* A Bezier patch of a surface in power form of its local (s, t) in
+ * [0, 1]^2: coefficients of x w, y w, z w, w; c[k][j (p + 1) + i] is
+ * the coefficient of s^i t^j. */
+struct patch {
+	double u0, u1, v0, v1, iu, iv;
+	int p, q;
+	const double *c; /* 4 (p + 1)(q + 1) */
+};
+
+struct ssurf {
+	struct px_nurbs_surf s;
+	struct patch *pt;       /* npu x npv, u fastest */
+	double *pool;
+	double *pu, *pv;        /* patch bounds (npu + 1, npv + 1) */
+	int npu, npv;
+	double *mem;            /* owned copy of knots and pw */
+	double u0, u1, v0, v1, du, dv;
+	int wrap_u, wrap_v;
+	int pole[4];            /* edge collapsed: u0, u1, v0, v1 */
+	int first_cell, ncu, ncv;
+	double *cu, *cv;        /* cell bounds along u (ncu + 1), v */
+	struct crit *z, *tmp;
+	int nz, cap;
+};
+
+struct edge {
+	int surf, dir;  /* dir 0: curve in u at v = t; 1: curve in v at u = t */
+	double t;
+};
+
+struct pole {
+	px_vec3 q;
+	double u, v;
+	int surf;
+};
+
+struct px_strack {
+	struct px_strack_opts opts;
+	struct px_dist_model *dist;
+	struct px_track *ct;    /* free curves + edges */
+	int n_curves, n_surf, n_edges, n_cells, n_poles, n_unbounded;
+	int n_patches;
+	struct ssurf *sf;
+	struct scell *cell;
+	/* transition regions are held by 2 x 2 children of each solve cell:
+	 * tighter cones and height intervals, the same seeds */
+	struct scell *rcell;
+	struct edge *edge;
+	struct pole *pole;
+	int *heap, *popped, *hits;
+	double travel;
+	int heap_ok;
+	px_aabb work;
+	double scale;
+	px_vec3 p;
+	int init;
+	uint32_t epoch, next_id;
+	int best_kind;          /* 0 none, 1 surface min, 2 curve tracker, 3 pole */
+	uint32_t best_id;
+	struct px_strack_stats st;
+};
+
+/* ------------------------------------------------------------------ */
+/* evaluation and Newton                                               */
+
+static int bsearch_bounds(const double *b, int n, double x)
+{
+	int lo = 0, hi = n - 1;
+	while (lo < hi) {
+		int mid = (lo + hi + 1) / 2;
+		if (b[mid] <= x)
+			lo = mid;
+		else
+			hi = mid - 1;
+	}
+	return lo;
+}
+
+/* Point and derivatives up to order 2 from the patch holding (u, v). */
+static void surf_eval2(const struct ssurf *f, double u, double v,
+		       struct px_nurbs_surf_derivs *d)
+{
+	const struct patch *pt;
+	double s, t, h[4][6]; /* H, Hs, Ht, Hss, Hst, Htt */
+	int k, i, j, p, q;
+	pt = &f->pt[bsearch_bounds(f->pv, f->npv, v) * f->npu +
+		    bsearch_bounds(f->pu, f->npu, u)];
+	p = pt->p;
+	q = pt->q;
+	s = (u - pt->u0) * pt->iu;
+	t = (v - pt->v0) * pt->iv;
+	for (k = 0; k < 4; k++) {
+		const double *c = pt->c + k * (p + 1) * (q + 1);
+		double V0 = 0, V1 = 0, V2 = 0, W0 = 0, W1 = 0, X0 = 0;
+		/* Horner in t over the rows a_j(s) and their s-derivatives:
+		 * V = H, H_t, H_tt; W = H_s, H_st; X = H_ss */
+		for (j = q; j >= 0; j--) {
+			const double *row = c + j * (p + 1);
+			double a = row[p], a1 = 0.0, a2 = 0.0;
+			for (i = p - 1; i >= 0; i--) {
+				a2 = a2 * s + 2.0 * a1;
+				a1 = a1 * s + a;
+				a = a * s + row[i];
+			}
+			V2 = V2 * t + 2.0 * V1;
+			V1 = V1 * t + V0;
+			V0 = V0 * t + a;
+			W1 = W1 * t + W0;
+			W0 = W0 * t + a1;
+			X0 = X0 * t + a2;
+		}
+		h[k][0] = V0;
+		h[k][1] = W0;
+		h[k][2] = V1;
+		h[k][3] = X0;
+		h[k][4] = W1;
+		h[k][5] = V2;
+	}
+	{
+		double w = h[3][0], iw = 1.0 / w, ws = h[3][1], wt = h[3][2],
+		       wss = h[3][3], wst = h[3][4], wtt = h[3][5];
+		px_vec3 C, Cs, Ct, Css, Cst, Ctt;
+		C = px_v3(h[0][0] * iw, h[1][0] * iw, h[2][0] * iw);
+		Cs = px_v3((h[0][1] - ws * C.x) * iw, (h[1][1] - ws * C.y) * iw,
+			   (h[2][1] - ws * C.z) * iw);
+		Ct = px_v3((h[0][2] - wt * C.x) * iw, (h[1][2] - wt * C.y) * iw,
+			   (h[2][2] - wt * C.z) * iw);
+		Css = px_v3((h[0][3] - 2.0 * ws * Cs.x - wss * C.x) * iw,
+			    (h[1][3] - 2.0 * ws * Cs.y - wss * C.y) * iw,
+			    (h[2][3] - 2.0 * ws * Cs.z - wss * C.z) * iw);
+		Ctt = px_v3((h[0][5] - 2.0 * wt * Ct.x - wtt * C.x) * iw,
+			    (h[1][5] - 2.0 * wt * Ct.y - wtt * C.y) * iw,
+			    (h[2][5] - 2.0 * wt * Ct.z - wtt * C.z) * iw);
+		Cst = px_v3((h[0][4] - ws * Ct.x - wt * Cs.x - wst * C.x) * iw,
+			    (h[1][4] - ws * Ct.y - wt * Cs.y - wst * C.y) * iw,
+			    (h[2][4] - ws * Ct.z - wt * Cs.z - wst * C.z) * iw);
+		d->s = C;
+		d->su = px_v3_scale(Cs, pt->iu);
+		d->sv = px_v3_scale(Ct, pt->iv);
+		d->suu = px_v3_scale(Css, pt->iu * pt->iu);
+		d->suv = px_v3_scale(Cst, pt->iu * pt->iv);
+		d->svv = px_v3_scale(Ctt, pt->iv * pt->iv);
+	}
+}
+
+static void crit_eval(const struct ssurf *f, struct crit *z, px_vec3 p,
+		      px_vec3 *grad_out)
+{
+	struct px_nurbs_surf_derivs d;
+	px_vec3 w;
+	surf_eval2(f, z->u, z->v, &d);
+	w = px_v3_sub(d.s, p);
+	z->s = d.s;
+	z->su = d.su;
+	z->sv = d.sv;
+	z->h11 = px_v3_dot(d.su, d.su) + px_v3_dot(w, d.suu);
+	z->h12 = px_v3_dot(d.su, d.sv) + px_v3_dot(w, d.suv);
+	z->h22 = px_v3_dot(d.sv, d.sv) + px_v3_dot(w, d.svv);
+	grad_out->x = px_v3_dot(w, d.su);
+	grad_out->y = px_v3_dot(w, d.sv);
+	grad_out->z = 0.0;
+}
+
+static int crit_type(const struct crit *z)
+{
+	double det = z->h11 * z->h22 - z->h12 * z->h12;
+	if (det > 0.0)
+		return z->h11 > 0.0 ? 1 : -1;
+	return 0;
+}
+
+/* Bring (u, v) into the domain: wrap a seam direction; 1 when an open
+ * direction is left. */
+static int domain_fix(const struct ssurf *f, double *u, double *v)
+{
+	if (*u < f->u0 || *u > f->u1) {
+		if (!f->wrap_u)
+			return 1;
+		*u = f->u0 + fmod(*u - f->u0, f->du);
+		if (*u < f->u0)
+			*u += f->du;
+	}
+	if (*v < f->v0 || *v > f->v1) {
+		if (!f->wrap_v)
+			return 1;
+		*v = f->v0 + fmod(*v - f->v0, f->dv);
+		if (*v < f->v0)
+			*v += f->dv;
+	}
+	return 0;
+}
+
+/*
+ * Newton on E = 0 with p fixed from z->u, z->v; steps clamped to lu, lv.
+ * Returns 0 with z evaluated at the root, 1 on failure (no convergence,
+ * singular Hessian, the domain left through an open edge).
+ */
+static int snewton(const struct ssurf *f, struct crit *z, px_vec3 p,
+		   double lu, double lv, const struct scell *home)
+{
+	double tu = 1e-11 * f->du, tv = 1e-11 * f->dv;
+	double qu = 1e-6 * f->du, qv = 1e-6 * f->dv;
+	int k, outs = 0;
+	for (k = 0; k < ST_NEWTON; k++) {
+		px_vec3 g;
+		double det, su, sv;
+		if (domain_fix(f, &z->u, &z->v)) {
+			/* an overshoot past an open edge: back onto it (a
+			 * point just inside the edge is reached from there);
+			 * pushing out again means the point has left */
+			if (++outs > 2)
+				return 1;
+			z->u = fmin(fmax(z->u, f->u0 + 1e-9 * f->du), f->u1 - 1e-9 * f->du);
+			z->v = fmin(fmax(z->v, f->v0 + 1e-9 * f->dv), f->v1 - 1e-9 * f->dv);
+		}
+		crit_eval(f, z, p, &g);
+		det = z->h11 * z->h22 - z->h12 * z->h12;
+		if (f->pole[0] | f->pole[1] | f->pole[2] | f->pole[3]) {
+			/* At a collapsed edge u = u0 the v-derivative vanishes,
+			 * so (S - p) . Sv = 0 holds along the whole edge: a
+			 * spurious root set that attracts Newton. Solve with
+			 * that equation divided by the distance to the edge
+			 * (regular there) and reject the edge itself (the pole
+			 * is a candidate of its own). */
+			double du0 = z->u - f->u0, du1 = f->u1 - z->u;
+			double dv0 = z->v - f->v0, dv1 = f->v1 - z->v;
+			double bu = 1.0, bup = 0.0, av = 1.0, avp = 0.0;
+			double j11, j12, j21, j22, g1, g2, dj;
+			if (f->pole[0] && f->pole[1]) {
+				bu = 1.0 / (du0 * du1);
+				bup = -(du1 - du0) * bu * bu;
+			} else if (f->pole[0]) {
+				bu = 1.0 / du0;
+				bup = -bu * bu;
+			} else if (f->pole[1]) {
+				bu = 1.0 / du1;
+				bup = bu * bu;
+			}
+			if (f->pole[2] && f->pole[3]) {
+				av = 1.0 / (dv0 * dv1);
+				avp = -(dv1 - dv0) * av * av;
+			} else if (f->pole[2]) {
+				av = 1.0 / dv0;
+				avp = -av * av;
+			} else if (f->pole[3]) {
+				av = 1.0 / dv1;
+				avp = av * av;
+			}
+			if (fmin(fmin(f->pole[0] ? du0 : 1.0, f->pole[1] ? du1 : 1.0) / f->du,
+				 fmin(f->pole[2] ? dv0 : 1.0, f->pole[3] ? dv1 : 1.0) / f->dv) <
+			    1e-9)
+				return 1;
+			g1 = g.x * av;
+			g2 = g.y * bu;
+			j11 = z->h11 * av;
+			j12 = z->h12 * av + g.x * avp;
+			j21 = z->h12 * bu + g.y * bup;
+			j22 = z->h22 * bu;
+			dj = j11 * j22 - j12 * j21;
+			if (!(fabs(dj) > 0.0))
+				return 1;
+			su = -(j22 * g1 - j12 * g2) / dj;
+			sv = -(-j21 * g1 + j11 * g2) / dj;
+		} else {
+			if (!(fabs(det) > 0.0))
+				return 1;
+			su = -(z->h22 * g.x - z->h12 * g.y) / det;
+			sv = -(-z->h12 * g.x + z->h11 * g.y) / det;
+		}
+		if (!isfinite(su) || !isfinite(sv))
+			return 1;
+		if (fabs(su) <= tu && fabs(sv) <= tv) {
+			z->type = crit_type(z);
+			return 0;
+		}
+		if (fabs(su) <= qu && fabs(sv) <= qv && z->u + su >= f->u0 &&
+		    z->u + su <= f->u1 && z->v + sv >= f->v0 && z->v + sv <= f->v1) {
+			/* quadratic convergence: after this step the error is
+			 * O(step^2), far below the tolerance; move the point to
+			 * first order instead of evaluating again */
+			z->u += su;
+			z->v += sv;
+			z->s = px_v3_add(z->s, px_v3_add(px_v3_scale(z->su, su),
+							 px_v3_scale(z->sv, sv)));
+			z->type = crit_type(z);
+			return 0;
+		}
+		if (fabs(su) > lu)
+			su = su > 0 ? lu : -lu;
+		if (fabs(sv) > lv)
+			sv = sv > 0 ? lv : -lv;
+		z->u += su;
+		z->v += sv;
+		if (home) {
+			/* a seed heading out of its cell (beyond one cell width)
+			 * converges to a point its own cell answers for */
+			double w = home->u1 - home->u0, h = home->v1 - home->v0;
+			if (z->u < home->u0 - w || z->u > home->u1 + w ||
+			    z->v < home->v0 - h || z->v > home->v1 + h)
+				return 1;
+		}
+	}
+	return 1;
+}
+
+/* ------------------------------------------------------------------ */
+/* critical-point sets                                                 */
+
+static int crit_dup(const struct ssurf *f, const struct crit *a,
+		    const struct crit *b)
+{
+	double du = fabs(a->u - b->u), dv = fabs(a->v - b->v);
+	if (f->wrap_u)
+		du = fmin(du, f->du - du);
+	if (f->wrap_v)
+		dv = fmin(dv, f->dv - dv);
+	return du <= 1e-7 * f->du && dv <= 1e-7 * f->dv;
+}
+
+/* Add z unless it duplicates a held point. Returns 1 added, 0 duplicate,
+ * PX_E_NOSPC. */
+static int crit_add(struct px_strack *t, struct ssurf *f, const struct crit *z)
+{
+	int i;
+	for (i = 0; i < f->nz; i++)
+		if (crit_dup(f, &f->z[i], z))
+			return 0;
+	if (f->nz >= f->cap)
+		return PX_E_NOSPC;
+	f->z[f->nz] = *z;
+	if (!f->z[f->nz].id) {
+		if (++t->next_id >= 0x7fffffffu)
+			t->next_id = 1;
+		f->z[f->nz].id = t->next_id;
+	}
+	f->nz++;
+	return 1;
+}
+
+/* Solve cell c at p from its seed grid. Returns 0 or PX_E_NOSPC. */
+static int follow(const struct ssurf *f, struct crit *z, px_vec3 p0,
+		  px_vec3 dp, px_vec3 p, struct crit *last);
+
+/*
+ * Solve cell c: Newton from its seed grid at ps, each root then followed
+ * from ps to p (a pair born where the path met the cell's region keeps
+ * moving for the rest of the step, possibly out of the cell). Returns 0
+ * or PX_E_NOSPC.
+ */
+static int cell_solve_at(struct px_strack *t, const struct scell *c,
+			 px_vec3 ps, px_vec3 p)
+{
+	struct ssurf *f = &t->sf[c->surf];
+	int n = t->opts.seeds, i, j, rc, same = px_v3_dist2(ps, p) == 0.0;
+	double lu = c->u1 - c->u0, lv = c->v1 - c->v0;
+	t->st.cell_solves++;
+	for (j = 0; j < n; j++)
+		for (i = 0; i < n; i++) {
+			struct crit z, last;
+			memset(&z, 0, sizeof(z));
+			z.u = c->u0 + lu * (i + 0.5) / n;
+			z.v = c->v0 + lv * (j + 0.5) / n;
+			if (snewton(f, &z, ps, 0.5 * lu, 0.5 * lv, c))
+				continue;
+			if (!same && follow(f, &z, ps, px_v3_sub(p, ps), p, &last))
+				continue;
+			rc = crit_add(t, f, &z);
+			if (rc < 0)
+				return rc;
+		}
+	return 0;
+}
+
+static int cell_solve(struct px_strack *t, const struct scell *c, px_vec3 p)
+{
+	return cell_solve_at(t, c, p, p);
+}
+
+static int surf_reinit(struct px_strack *t, struct ssurf *f, int si, px_vec3 p)
+{
+	int c, rc;
+	f->nz = 0;
+	for (c = 0; c < f->ncu * f->ncv; c++) {
+		const struct scell *cl = &t->cell[f->first_cell + c];
+		if (cl->surf != si)
+			continue;
+		rc = cell_solve(t, cl, p);
+		if (rc)
+			return rc;
+	}
+	return 0;
+}
+
+/* ------------------------------------------------------------------ */
+/* transition boxes: lazy tests                                        */
+
+/* Lower bound on the distance from p to a region cell's transition set. */
+static double region_radius(const struct scell *c, px_vec3 p)
+{
+	px_vec3 w;
+	double l, dp, rc, r = INFINITY;
+	int i;
+	if (c->always)
+		return 0.0;
+	if (c->nreg == 0)
+		return INFINITY;
+	w = px_v3_sub(p, c->sc);
+	l = px_v3_dot(w, c->nc);
+	dp = px_v3_norm(px_v3_sub(w, px_v3_scale(c->nc, l)));
+	/* d_perp - a |l| is sqrt(1 + a^2)-Lipschitz */
+	rc = fmax((dp - c->a * fabs(l) - c->rho) * c->ia, 0.0);
+	for (i = 0; i < c->nreg; i++) {
+		const struct sreg *g = &c->reg[i];
+		double ri;
+		if (g->wedge) {
+			px_vec3 we = px_v3_sub(p, g->sc);
+			ri = (fabs(px_v3_dot(we, g->b)) - g->a * fabs(px_v3_dot(we, g->n)) -
+			      g->rho) * g->ia;
+			ri = fmax(ri, 0.0);
+		} else {
+			ri = g->split ? fmax(g->lo - fabs(l), 0.0)
+				      : fmax(fmax(g->lo - l, l - g->hi), 0.0);
+		}
+		r = fmin(r, fmax(rc, ri));
+	}
+	return r;
+}
+
+/* ... and of a solve cell: its children's regions cover all of it. */
+static double cell_radius(const struct px_strack *t, const struct scell *c,
+			  px_vec3 p)
+{
+	const struct scell *ch = &t->rcell[c->child];
+	return fmin(fmin(region_radius(&ch[0], p), region_radius(&ch[1], p)),
+		    fmin(region_radius(&ch[2], p), region_radius(&ch[3], p)));
+}
+
+static void heap_set(struct px_strack *t, int pos, int ci)
+{
+	t->heap[pos] = ci;
+	t->cell[ci].hpos = pos;
+}
+
+static void heap_down(struct px_strack *t, int pos, int n)
+{
+	int ci = t->heap[pos];
+	double x = t->cell[ci].expiry;
+	for (;;) {
+		int c = 2 * pos + 1;
+		if (c >= n)
+			break;
+		if (c + 1 < n && t->cell[t->heap[c + 1]].expiry <
+				       t->cell[t->heap[c]].expiry)
+			c++;
+		if (!(t->cell[t->heap[c]].expiry < x))
+			break;
+		heap_set(t, pos, t->heap[c]);
+		pos = c;
+	}
+	heap_set(t, pos, ci);
+}
+
+static void heap_up(struct px_strack *t, int pos)
+{
+	int ci = t->heap[pos];
+	double x = t->cell[ci].expiry;
+	while (pos > 0) {
+		int par = (pos - 1) / 2;
+		if (!(x < t->cell[t->heap[par]].expiry))
+			break;
+		heap_set(t, pos, t->heap[par]);
+		pos = par;
+	}
+	heap_set(t, pos, ci);
+}
+
+static void heap_rebuild(struct px_strack *t, px_vec3 p)
+{
+	int i;
+	for (i = 0; i < t->n_cells; i++) {
+		t->cell[i].expiry = t->travel + cell_radius(t, &t->cell[i], p) *
+							(1.0 - 1e-9);
+		heap_set(t, i, i);
+	}
+	for (i = t->n_cells / 2 - 1; i >= 0; i--)
+		heap_down(t, i, t->n_cells);
+	t->heap_ok = 1;
+}
+
+/* Cells whose boxes the segment p0 -> p1 meets. Returns their count. */
+static int collect_cells(struct px_strack *t, px_vec3 p0, px_vec3 p1)
+{
+	int n = t->n_cells, np = 0, nh = 0, k;
+	double seg = px_v3_dist(p0, p1);
+	if (!t->heap_ok)
+		heap_rebuild(t, p0);
+	t->travel += seg;
+	while (n > 0 && t->cell[t->heap[0]].expiry <= t->travel) {
+		t->popped[np++] = t->heap[0];
+		n--;
+		if (n > 0) {
+			heap_set(t, 0, t->heap[n]);
+			heap_down(t, 0, n);
+		}
+	}
+	for (k = 0; k < np; k++) {
+		int ci = t->popped[k];
+		struct scell *c = &t->cell[ci];
+		double r1 = cell_radius(t, c, p1);
+		t->st.box_tests++;
+		/* a point of the segment within reach of the set is at least
+		 * r0 from p0 and r1 from p1: impossible when r0 + r1 > |seg| */
+		double r0 = r1 <= 0.0 || seg <= 0.0 ? 0.0 : cell_radius(t, c, p0);
+		if (r1 <= 0.0 || r0 + r1 <= seg) {
+			/* where along the segment the region can first be met */
+			double s0 = seg > 0.0 ? fmin(1.0, r0 / seg) : 1.0;
+			double s1 = seg > 0.0 ? fmax(s0, 1.0 - r1 / seg) : 1.0;
+			c->cross = r0 > 0.0 ? 0.5 * (s0 + s1) : 0.5 * s1;
+			c->mark = t->epoch;
+			t->hits[nh++] = ci;
+		}
+		c->expiry = t->travel + r1 * (1.0 - 1e-9);
+		heap_set(t, n, ci);
+		heap_up(t, n);
+		n++;
+	}
+	return nh;
+}
+
+/* ------------------------------------------------------------------ */
+/* answer                                                              */
+
+static int in_work(const struct px_strack *t, px_vec3 p)
+{
+	return px_aabb_contains(&t->work, p);
+}
+
+static void fill_dir(struct px_strack_result *r, px_vec3 p)
+{
+	px_vec3 d = px_v3_sub(p, r->point);
+	double n = px_v3_norm(d);
+	r->dist = n;
+	r->dir = n > 0.0 ? px_v3_scale(d, 1.0 / n) : px_v3(0, 0, 0);
+}
+
+static void count_crit(const struct px_strack *t, struct px_strack_result *r,
+		       int curve_crit)
+{
+	int i, j;
+	r->n_min = r->n_max = r->n_saddle = 0;
+	for (i = 0; i < t->n_surf; i++)
+		for (j = 0; j < t->sf[i].nz; j++) {
+			int ty = t->sf[i].z[j].type;
+			if (ty > 0)
+				r->n_min++;
+			else if (ty < 0)
+				r->n_max++;
+			else
+				r->n_saddle++;
+		}
+	r->n_crit = r->n_min + r->n_max + r->n_saddle + curve_crit;
+}
+
+static void answer(struct px_strack *t, px_vec3 p,
+		   const struct px_track_result *cr, struct px_strack_result *r)
+{
+	double best = INFINITY;
+	int kind = 0, i, j;
+	uint32_t id = 0;
+
+	if (cr->entity >= 0) {
+		best = cr->dist * cr->dist;
+		kind = 2;
+		r->point = cr->point;
+		if (cr->entity < t->n_curves) {
+			r->entity = cr->entity;
+			r->u = cr->u;
+			r->v = 0.0;
+			r->feature = PX_STRACK_CURVE;
+		} else {
+			const struct edge *e = &t->edge[cr->entity - t->n_curves];
+			r->entity = t->n_curves + e->surf;
+			r->u = e->dir ? e->t : cr->u;
+			r->v = e->dir ? cr->u : e->t;
+			r->feature = PX_STRACK_EDGE;
+		}
+	}
+	for (i = 0; i < t->n_surf; i++)
+		for (j = 0; j < t->sf[i].nz; j++) {
+			const struct crit *z = &t->sf[i].z[j];
+			double d2;
+			if (z->type <= 0)
+				continue;
+			d2 = px_v3_dist2(z->s, p);
+			if (d2 < best) {
+				best = d2;
+				kind = 1;
+				id = z->id;
+				r->point = z->s;
+				r->u = z->u;
+				r->v = z->v;
+				r->entity = t->n_curves + i;
+				r->feature = PX_STRACK_MIN;
+			}
+		}
+	for (i = 0; i < t->n_poles; i++) {
+		double d2 = px_v3_dist2(t->pole[i].q, p);
+		if (d2 < best) {
+			best = d2;
+			kind = 3;
+			id = (uint32_t)i;
+			r->point = t->pole[i].q;
+			r->u = t->pole[i].u;
+			r->v = t->pole[i].v;
+			r->entity = t->n_curves + t->pole[i].surf;
+			r->feature = PX_STRACK_POLE;
+		}
+	}
+	fill_dir(r, p);
+	count_crit(t, r, cr->n_crit);
+	r->jumped = kind != t->best_kind || (kind == 2 && cr->jumped) ||
+		    (kind != 2 && id != t->best_id);
+	t->best_kind = kind;
+	t->best_id = id;
+}
+
+static void answer_global(struct px_strack *t, px_vec3 p,
+			  struct px_strack_result *r)
+{
+	struct px_dist_result g;
+	px_dist_query(t->dist, p, &g);
+	r->point = g.point;
+	r->u = g.u;
+	r->v = g.v;
+	r->entity = g.entity;
+	r->feature = PX_STRACK_GLOBAL;
+	fill_dir(r, p);
+	count_crit(t, r, 0);
+	r->jumped = 1;
+	t->best_kind = 0;
+	r->source = PX_TRACK_GLOBAL;
+	t->st.fallbacks++;
+}
+
+static int reinit_all(struct px_strack *t, px_vec3 p)
+{
+	int i, rc = 0;
+	for (i = 0; i < t->n_surf; i++) {
+		int r2 = surf_reinit(t, &t->sf[i], i, p);
+		if (r2 && !rc)
+			rc = r2;
+	}
+	return rc;
+}
+
+static void verify(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
+{
+	struct px_dist_result g;
+	if (t->opts.verify_every <= 0 ||
+	    t->st.updates % (uint64_t)t->opts.verify_every != 0)
+		return;
+	if (px_dist_query(t->dist, p, &g))
+		return;
+	t->st.verifications++;
+	r->verified = 1;
+	if (r->dist > g.dist + 1e-9 * (t->scale + g.dist)) {
+		t->st.disagreements++;
+		t->st.reinits++;
+		if (reinit_all(t, p))
+			t->st.overflows++;
+		answer_global(t, p, r);
+		r->verified = 1;
+	}
+}
+
+static void result_clear(struct px_strack_result *r)
+{
+	memset(r, 0, sizeof(*r));
+	r->entity = -1;
+}
+
+/* The curve tracker's answer (none when the model has no curve and no
+ * open edge: closed in both directions or all poles). */
+static void curves_update(struct px_strack *t, px_vec3 p,
+			  struct px_track_result *cr, int reset)
+{
+	if (!t->ct) {
+		memset(cr, 0, sizeof(*cr));
+		cr->entity = -1;
+		return;
+	}
+	if (reset)
+		px_track_reset(t->ct, p, cr);
+	else
+		px_track_update(t->ct, p, cr);
+}
+
+static int full_reset(struct px_strack *t, px_vec3 p,
+		      struct px_strack_result *r)
+{
+	struct px_track_result cr;
+	int rc;
+	t->heap_ok = 0;
+	curves_update(t, p, &cr, 1);
+	rc = reinit_all(t, p);
+	r->source = PX_TRACK_REINIT;
+	if (rc) {
+		t->st.overflows++;
+		answer_global(t, p, r);
+	} else {
+		answer(t, p, &cr, r);
+		r->jumped = 1;
+		verify(t, p, r);
+	}
+	return PX_OK;
+}
+
+int px_strack_reset(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
+{
+	if (!t || !r)
+		return PX_E_INVAL;
+	if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
+		return PX_E_NAN;
+	result_clear(r);
+	t->st.updates++;
+	t->p = p;
+	t->init = 1;
+	t->best_kind = 0;
+	return full_reset(t, p, r);
+}
+
+/* Cell index (within the surface) holding (u, v). */
+static int cell_of(const struct ssurf *f, double u, double v)
+{
+	int i = bsearch_bounds(f->cu, f->ncu, u), j = bsearch_bounds(f->cv, f->ncv, v);
+	return j * f->ncu + i;
+}
+
+/* Follow one point from its state at p0 to p (predictor, Newton). */
+static int evolve(const struct ssurf *f, struct crit *z, px_vec3 dp,
+		  px_vec3 p)
+{
+	double a = px_v3_dot(z->su, dp), b = px_v3_dot(z->sv, dp);
+	double det = z->h11 * z->h22 - z->h12 * z->h12;
+	if (fabs(det) > 0.0) {
+		double su = (z->h22 * a - z->h12 * b) / det;
+		double sv = (-z->h12 * a + z->h11 * b) / det;
+		if (isfinite(su) && isfinite(sv) && fabs(su) <= 0.25 * f->du &&
+		    fabs(sv) <= 0.25 * f->dv) {
+			z->u += su;
+			z->v += sv;
+		}
+	}
+	return snewton(f, z, p, 0.125 * f->du, 0.125 * f->dv, NULL);
+}
+
+/*
+ * Follow z from p0 to p0 + dp, keeping its type (a point changes type only
+ * at a fold, where it dies). A long step that fails or changes the type
+ * is retried as a continuation in 4, then 16 sub-steps. Returns 0, or 1
+ * with *last the furthest point reached (to solve its cell again).
+ */
+static int follow(const struct ssurf *f, struct crit *z, px_vec3 p0,
+		  px_vec3 dp, px_vec3 p, struct crit *last)
+{
+	struct crit w = *z;
+	int ns, k;
+	if (!evolve(f, &w, dp, p) && w.type == z->type) {
+		*z = w;
+		return 0;
+	}
+	*last = *z;
+	for (ns = 4; ns <= 16; ns *= 4) {
+		px_vec3 sd = px_v3_scale(dp, 1.0 / ns);
+		w = *z;
+		for (k = 1; k <= ns; k++) {
+			px_vec3 pk = k == ns ? p : px_v3_add(p0, px_v3_scale(dp, (double)k / ns));
+			int ty = w.type;
+			if (evolve(f, &w, sd, pk) || w.type != ty)
+				break;
+			if (ns == 16)
+				*last = w;
+		}
+		if (k > ns) {
+			*z = w;
+			return 0;
+		}
+	}
+	return 1;
+}
+
+int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
+{
+	struct px_track_result cr;
+	px_vec3 p0, dp;
+	int i, j, nh, rc = 0;
+
+	if (!t || !r)
+		return PX_E_INVAL;
+	if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
+		return PX_E_NAN;
+	if (!t->init)
+		return px_strack_reset(t, p, r);
+	result_clear(r);
+	t->st.updates++;
+	p0 = t->p;
+	dp = px_v3_sub(p, p0);
+	t->p = p;
+	r->source = PX_TRACK_TRACKED;
+	if (++t->epoch == 0)
+		t->epoch = 1;
+	if (!in_work(t, p) || !in_work(t, p0)) {
+		t->st.outside++;
+		return full_reset(t, p, r);
+	}
+	curves_update(t, p, &cr, 0);
+	nh = collect_cells(t, p0, p);
+	for (i = 0; i < t->n_surf; i++) {
+		struct ssurf *f = &t->sf[i];
+		int n = f->nz;
+		memcpy(f->tmp, f->z, (size_t)n * sizeof(*f->z));
+		f->nz = 0;
+		for (j = 0; j < n; j++) {
+			struct crit z = f->tmp[j], last;
+			if (follow(f, &z, p0, dp, p, &last)) {
+				/* died at a fold (or left through an edge), or
+				 * Newton lost it: solve its cell and the cell
+				 * where it was last seen, so a survivor is found
+				 * again */
+				int q;
+				t->st.lost++;
+				r->died++;
+				for (q = 0; q < 2; q++) {
+					const struct crit *o = q ? &last : &f->tmp[j];
+					int ci = f->first_cell + cell_of(f, o->u, o->v);
+					if (t->cell[ci].mark != t->epoch && nh < t->n_cells) {
+						t->cell[ci].mark = t->epoch;
+						t->cell[ci].cross = 1.0;
+						t->hits[nh++] = ci;
+					}
+				}
+				continue;
+			}
+			rc = crit_add(t, f, &z);
+			if (rc < 0)
+				break;
+		}
+		if (rc < 0)
+			break;
+	}
+	{
+		int before = 0, after = 0;
+		for (i = 0; i < t->n_surf; i++)
+			before += t->sf[i].nz;
+		for (i = 0; i < nh && rc >= 0; i++) {
+			const struct scell *c = &t->cell[t->hits[i]];
+			rc = cell_solve(t, c, p);
+			/* a long step after the crossing: also solve where the
+			 * region was met and follow those roots to p */
+			if (rc >= 0 && (1.0 - c->cross) * px_v3_norm(dp) > 0.1 * c->rho)
+				rc = cell_solve_at(t, c, px_v3_add(p0, px_v3_scale(dp, c->cross)),
+						   p);
+		}
+		for (i = 0; i < t->n_surf; i++)
+			after += t->sf[i].nz;
+		/* new points only come from solved cells: births (pairs at
+		 * a focal sheet) and entries through an edge */
+		r->born = after - before;
+		t->st.born += (uint64_t)r->born;
+	}
+	r->cells_solved = nh;
+	if (rc < 0) {
+		t->st.overflows++;
+		t->st.reinits++;
+		if (reinit_all(t, p))
+			t->st.overflows++;
+		answer_global(t, p, r);
+		return PX_OK;
+	}
+	answer(t, p, &cr, r);
+	if (cr.source != PX_TRACK_TRACKED)
+		r->source = cr.source;
+	verify(t, p, r);
+	return PX_OK;
+}
+
+int px_strack_critical(const struct px_strack *t, int s, double *u, double *v,
+		       int *type, int cap)
+{
+	const struct ssurf *f;
+	int i;
+	if (!t || (cap > 0 && (!u || !v || !type)))
+		return PX_E_INVAL;
+	if (s < 0 || s >= t->n_surf)
+		return PX_E_RANGE;
+	f = &t->sf[s];
+	for (i = 0; i < f->nz && i < cap; i++) {
+		u[i] = f->z[i].u;
+		v[i] = f->z[i].v;
+		type[i] = f->z[i].type;
+	}
+	return f->nz;
+}
+
+void px_strack_get_stats(const struct px_strack *t, struct px_strack_stats *s)
+{
+	if (!s)
+		return;
+	if (!t)
+		memset(s, 0, sizeof(*s));
+	else
+		*s = t->st;
+}
+
+void px_strack_get_info(const struct px_strack *t, struct px_strack_info *info)
+{
+	if (!info)
+		return;
+	memset(info, 0, sizeof(*info));
+	if (!t)
+		return;
+	info->n_surfaces = t->n_surf;
+	info->n_curves = t->n_curves;
+	info->n_patches = t->n_patches;
+	info->n_cells = t->n_cells;
+	info->n_edges = t->n_edges;
+	info->n_poles = t->n_poles;
+	info->n_unbounded = t->n_unbounded;
+	info->work = t->work;
+}
+
+struct px_dist_model *px_strack_dist_model(struct px_strack *t)
+{
+	return t ? t->dist : NULL;
+}
+
+/* ------------------------------------------------------------------ */
+/* setup                                                               */
+
+void px_strack_opts_default(struct px_strack_opts *o)
+{
+	if (!o)
+		return;
+	memset(o, 0, sizeof(*o));
+	o->cells_per_span = 3;
+	o->seeds = 2;
+	o->samples = 6;
+	o->max_crit = 256;
+	o->work_margin = 1.0;
+	o->verify_every = 0;
+	o->dist = NULL;
+}
+
+/* Distinct knot values of one direction inside the domain, with both
+ * ends: the Bezier patch bounds. Returns the count. */
+static int span_bounds(const struct px_nurbs_surf *s, int dir, double a,
+		       double b, double *out)
+{
+	const double *U = s->knots[dir];
+	int i, n = 0;
+	out[n++] = a;
+	for (i = 0; i < s->n_knots[dir]; i++)
+		if (U[i] > out[n - 1] && U[i] < b)
+			out[n++] = U[i];
+	out[n++] = b;
+	return n;
+}
+
+/* Sample of the surface for the focal boxes: point, unit normal, the
+ * two principal curvatures (0 when the normal is undefined). */
+static void sample(const struct px_nurbs_surf *s, double u, double v, int su,
+		   int sv, px_vec3 *q, px_vec3 *nrm, double k[2], int *ok)
+{
+	struct px_nurbs_surf_derivs d;
+	px_vec3 n;
+	double E, F, G, L, M, N, det, H, K, disc, nn;
+	px_nurbs_surf_eval_side(s, u, v, su, sv, 2, &d);
+	*q = d.s;
+	n = px_v3_cross(d.su, d.sv);
+	nn = px_v3_norm(n);
+	*ok = 0;
+	k[0] = k[1] = 0.0;
+	*nrm = px_v3(0, 0, 0);
+	if (!(nn > 1e-14 * (px_v3_norm(d.su) * px_v3_norm(d.sv))) || !(nn > 0.0))
+		return;
+	n = px_v3_scale(n, 1.0 / nn);
+	E = px_v3_dot(d.su, d.su);
+	F = px_v3_dot(d.su, d.sv);
+	G = px_v3_dot(d.sv, d.sv);
+	L = px_v3_dot(d.suu, n);
+	M = px_v3_dot(d.suv, n);
+	N = px_v3_dot(d.svv, n);
+	det = E * G - F * F;
+	if (!(det > 0.0))
+		return;
+	K = (L * N - M * M) / det;
+	H = (E * N + G * L - 2.0 * F * M) / (2.0 * det);
+	/* umbilic: H^2 - K rounds below zero, clamp (equal curvatures) */
+	disc = H * H - K;
+	disc = disc > 0.0 ? sqrt(disc) : 0.0;
+	k[0] = H + disc;
+	k[1] = H - disc;
+	*nrm = n;
+	*ok = 1;
+}
+
+/* Transition regions of one cell from m x m samples (scratch pts, nrm,
+ * kk, okk). Sampling is not a proof: the cone and the height intervals
+ * are grown by margins for the variation between samples. */
+static void cell_regions(struct px_strack *t, struct scell *c,
+			 const struct ssurf *f, px_vec3 *pts, px_vec3 *nrm,
+			 double *kk, int *okk)
+{
+	int m = t->opts.samples, i, j, sh, q, nq = m * m, edge;
+	double sp = 0.0, rho = 0.0, cmin = 1.0, Lw = 0.0;
+	px_vec3 sc = px_v3(0, 0, 0), nc = px_v3(0, 0, 0);
+
+	c->nreg = 0;
+	c->always = 0;
+	for (j = 0; j < m; j++)
+		for (i = 0; i < m; i++) {
+			double u = c->u0 + (c->u1 - c->u0) * i / (m - 1);
+			double v = c->v0 + (c->v1 - c->v0) * j / (m - 1);
+			q = j * m + i;
+			sample(&f->s, u, v, i == m - 1 ? -1 : 1, j == m - 1 ? -1 : 1,
+			       &pts[q], &nrm[q], &kk[2 * q], &okk[q]);
+			if (!okk[q]) {
+				/* pole or degenerate point: the limit from inside */
+				double uu = u + (i == m - 1 ? -1e-7 : 1e-7) * (c->u1 - c->u0);
+				double vv = v + (j == m - 1 ? -1e-7 : 1e-7) * (c->v1 - c->v0);
+				px_vec3 q2;
+				sample(&f->s, uu, vv, 1, 1, &q2, &nrm[q], &kk[2 * q], &okk[q]);
+			}
+			if (!okk[q])
+				c->always = 1;
+			if (i > 0)
+				sp = fmax(sp, px_v3_dist(pts[q], pts[q - 1]));
+			if (j > 0)
+				sp = fmax(sp, px_v3_dist(pts[q], pts[q - m]));
+			sc = px_v3_add(sc, pts[q]);
+			nc = px_v3_add(nc, nrm[q]);
+			Lw = fmax(Lw, sqrt(px_aabb_max_dist2(&t->work, pts[q])));
+		}
+	if (c->always || !(px_v3_norm(nc) > 0.0)) {
+		c->always = 1;
+		t->n_unbounded++;
+		return;
+	}
+	sc = px_v3_scale(sc, 1.0 / nq);
+	nc = px_v3_scale(nc, 1.0 / px_v3_norm(nc));
+	for (q = 0; q < nq; q++) {
+		rho = fmax(rho, px_v3_dist(pts[q], sc));
+		cmin = fmin(cmin, px_v3_dot(nrm[q], nc));
+	}
+	{
+		double th = acos(fmax(-1.0, fmin(1.0, cmin)));
+		/* normals turn between samples by about a sample step of
+		 * curvature: grow the spread by a quarter and a margin */
+		th = 1.25 * th + 0.02;
+		if (th > 1.3) {
+			c->always = 1;
+			t->n_unbounded++;
+			return;
+		}
+		c->a = tan(th);
+		c->ia = 1.0 / sqrt(1.0 + c->a * c->a);
+		cmin = cos(th);
+	}
+	rho = 1.1 * rho + 0.5 * sp + 1e-9 * t->scale;
+	c->sc = sc;
+	c->nc = nc;
+	c->rho = rho * (1.0 + c->a);
+	for (sh = 0; sh < 2; sh++) {
+		double lmin = INFINITY, lmax = -INFINITY, kmax = 0.0, gap = 0.0;
+		int sg = 0, through = 0;
+		struct sreg g;
+		memset(&g, 0, sizeof(g));
+		for (q = 0; q < nq; q++) {
+			double k = kk[2 * q + sh];
+			int s = k > 0.0 ? 1 : (k < 0.0 ? -1 : 0);
+			kmax = fmax(kmax, fabs(k));
+			if (!s || (sg && s != sg) || fabs(k) * Lw < 1.0)
+				through = 1;
+			if (s)
+				sg = s;
+		}
+		if (through) {
+			/* the sheet reaches infinity here (or beyond the
+			 * working volume): |l| >= the smallest focal distance,
+			 * from the largest curvature grown for the samples */
+			if (!(kmax > 0.0))
+				continue; /* flat: no focal point at all */
+			g.split = 1;
+			g.lo = 1.0 / (1.25 * kmax + 1e-12 / t->scale) * cmin - c->rho;
+			g.hi = INFINITY;
+			t->n_unbounded++;
+		} else {
+			for (j = 0; j < m; j++)
+				for (i = 0; i < m; i++) {
+					double l;
+					q = j * m + i;
+					l = 1.0 / kk[2 * q + sh];
+					lmin = fmin(lmin, l);
+					lmax = fmax(lmax, l);
+					if (i > 0)
+						gap = fmax(gap, fabs(l - 1.0 / kk[2 * (q - 1) + sh]));
+					if (j > 0)
+						gap = fmax(gap, fabs(l - 1.0 / kk[2 * (q - m) + sh]));
+				}
+			g.split = 0;
+			/* the focal point's height on the central line is
+			 * between l cos(theta) - rho and l + rho */
+			lmin -= gap;
+			lmax += gap;
+			g.lo = (lmin > 0.0 ? lmin * cmin : lmin) - c->rho;
+			g.hi = (lmax > 0.0 ? lmax : lmax * cmin) + c->rho;
+		}
+		c->reg[c->nreg++] = g;
+	}
+	for (edge = 0; edge < 4; edge++) {
+		/* points cross an open edge on its normal lines */
+		struct sreg g;
+		px_vec3 e0, e1, tc, en = px_v3(0, 0, 0), ec = px_v3(0, 0, 0);
+		double rb = 0.0, rn = 0.0, sb = 0.0, cn = 1.0, nt;
+		int on;
+		if (edge == 0)
+			on = !f->wrap_u && c->u0 == f->u0;
+		else if (edge == 1)
+			on = !f->wrap_u && c->u1 == f->u1;
+		else if (edge == 2)
+			on = !f->wrap_v && c->v0 == f->v0;
+		else
+			on = !f->wrap_v && c->v1 == f->v1;
+		if (!on || c->nreg >= ST_NBOX)
+			continue;
+#define EQ(ii) (edge == 0 ? (ii) * m : edge == 1 ? (ii) * m + m - 1 \
+			  : edge == 2 ? (ii) : (m - 1) * m + (ii))
+		e0 = pts[EQ(0)];
+		e1 = pts[EQ(m - 1)];
+		for (i = 0; i < m; i++) {
+			ec = px_v3_add(ec, pts[EQ(i)]);
+			en = px_v3_add(en, nrm[EQ(i)]);
+		}
+		ec = px_v3_scale(ec, 1.0 / m);
+		tc = px_v3_sub(e1, e0);
+		nt = px_v3_norm(en);
+		memset(&g, 0, sizeof(g));
+		if (!(nt > 0.0) || !(px_v3_norm(tc) > 0.0)) {
+			g.lo = -INFINITY; /* collapsed or degenerate: the cone */
+			g.hi = INFINITY;
+			c->reg[c->nreg++] = g;
+			continue;
+		}
+		en = px_v3_scale(en, 1.0 / nt);
+		g.b = px_v3_cross(tc, en);
+		nt = px_v3_norm(g.b);
+		if (!(nt > 0.0)) {
+			g.lo = -INFINITY;
+			g.hi = INFINITY;
+			c->reg[c->nreg++] = g;
+			continue;
+		}
+		g.b = px_v3_scale(g.b, 1.0 / nt);
+		g.n = en;
+		g.sc = ec;
+		for (i = 0; i < m; i++) {
+			px_vec3 w = px_v3_sub(pts[EQ(i)], ec);
+			rb = fmax(rb, fabs(px_v3_dot(w, g.b)));
+			rn = fmax(rn, fabs(px_v3_dot(w, g.n)));
+			sb = fmax(sb, fabs(px_v3_dot(nrm[EQ(i)], g.b)));
+			cn = fmin(cn, px_v3_dot(nrm[EQ(i)], g.n));
+		}
+#undef EQ
+		{
+			/* margins for the turn of the normal between samples */
+			double thb = asin(fmin(1.0, sb)) * 1.25 + 0.02;
+			double thn = acos(fmax(-1.0, fmin(1.0, cn))) * 1.25 + 0.02;
+			if (thb > 1.3 || thn > 1.3) {
+				g.lo = -INFINITY;
+				g.hi = INFINITY;
+				c->reg[c->nreg++] = g;
+				continue;
+			}
+			g.a = sin(thb) / cos(thn);
+			rb = 1.1 * rb + 0.05 * sp + 1e-9 * t->scale;
+			rn = 1.1 * rn + 0.05 * sp + 1e-9 * t->scale;
+			g.rho = rb + g.a * rn;
+			g.ia = 1.0 / sqrt(1.0 + g.a * g.a);
+			g.wedge = 1;
+		}
+		c->reg[c->nreg++] = g;
+	}
+}
+
+void px_strack_free(struct px_strack *t)
+{
+	int i;
+	if (!t)
+		return;
+	px_dist_model_free(t->dist);
+	px_track_free(t->ct);
+	if (t->sf)
+		for (i = 0; i < t->n_surf; i++) {
+			free(t->sf[i].mem);
+			free(t->sf[i].pt);
+			free(t->sf[i].pool);
+			free(t->sf[i].pu);
+			free(t->sf[i].pv);
+			free(t->sf[i].cu);
+			free(t->sf[i].cv);
+			free(t->sf[i].z);
+			free(t->sf[i].tmp);
+		}
+	free(t->sf);
+	free(t->cell);
+	free(t->rcell);
+	free(t->edge);
+	free(t->pole);
+	free(t->heap);
+	free(t->popped);
+	free(t->hits);
+	free(t);
+}
+
+/* Copy a surface into owned memory. */
+static int surf_copy(struct ssurf *f, const struct px_nurbs_surf *s)
+{
+	size_t nu = (size_t)s->n_knots[0], nv = (size_t)s->n_knots[1];
+	size_t np = 4 * (size_t)s->n_ctrl[0] * (size_t)s->n_ctrl[1];
+	f->mem = malloc((nu + nv + np) * sizeof(double));
+	if (!f->mem)
+		return PX_E_NOMEM;
+	memcpy(f->mem, s->knots[0], nu * sizeof(double));
+	memcpy(f->mem + nu, s->knots[1], nv * sizeof(double));
+	memcpy(f->mem + nu + nv, s->pw, np * sizeof(double));
+	f->s = *s;
+	f->s.knots[0] = f->mem;
+	f->s.knots[1] = f->mem + nu;
+	f->s.pw = f->mem + nu + nv;
+	return PX_OK;
+}
+
+/* Power-form Bezier patches of a surface between the bounds ub x vb. */
+static int build_patches(struct ssurf *f, const double *ub, int nu,
+			 const double *vb, int nv)
+{
+	int p = f->s.degree[0], q = f->s.degree[1], np = (p + 1) * (q + 1);
+	int a, b, i, j, k, r;
+	size_t wl = PX_NURBS_SURF_WORK_LEN(p, q, f->s.n_ctrl[0], f->s.n_ctrl[1]);
+	double *work = malloc(wl * sizeof(double)), tmp[PX_NURBS_MAX_DEGREE + 1];
+	f->npu = nu - 1;
+	f->npv = nv - 1;
+	f->pt = calloc((size_t)(f->npu * f->npv), sizeof(*f->pt));
+	f->pool = calloc((size_t)(f->npu * f->npv) * 4 * (size_t)np, sizeof(double));
+	f->pu = malloc((size_t)nu * sizeof(double));
+	f->pv = malloc((size_t)nv * sizeof(double));
+	if (!work || !f->pt || !f->pool || !f->pu || !f->pv) {
+		free(work);
+		return PX_E_NOMEM;
+	}
+	memcpy(f->pu, ub, (size_t)nu * sizeof(double));
+	memcpy(f->pv, vb, (size_t)nv * sizeof(double));
+	for (b = 0; b < f->npv; b++)
+		for (a = 0; a < f->npu; a++) {
+			struct patch *pt = &f->pt[b * f->npu + a];
+			struct px_nurbs_surf sub;
+			double *c = f->pool + (size_t)(b * f->npu + a) * 4 * (size_t)np;
+			int rc = px_nurbs_surf_extract_work(&f->s, ub[a], ub[a + 1], vb[b],
+							    vb[b + 1], work, wl, &sub);
+			if (rc || sub.n_ctrl[0] != p + 1 || sub.n_ctrl[1] != q + 1) {
+				free(work);
+				return rc ? rc : PX_E_INVAL;
+			}
+			pt->u0 = ub[a];
+			pt->u1 = ub[a + 1];
+			pt->v0 = vb[b];
+			pt->v1 = vb[b + 1];
+			pt->iu = 1.0 / (pt->u1 - pt->u0);
+			pt->iv = 1.0 / (pt->v1 - pt->v0);
+			pt->p = p;
+			pt->q = q;
+			pt->c = c;
+			for (k = 0; k < 4; k++) {
+				double *ck = c + k * np;
+				for (j = 0; j <= q; j++)
+					for (i = 0; i <= p; i++)
+						ck[j * (p + 1) + i] = sub.pw[4 * (j * (p + 1) + i) + k];
+				/* Bernstein to power form along s, then along t */
+				for (j = 0; j <= q; j++) {
+					double *row = ck + j * (p + 1);
+					for (i = 0; i <= p; i++) {
+						double v = 0.0;
+						for (r = 0; r <= i; r++)
+							v += (((i - r) & 1) ? -1.0 : 1.0) *
+							     px_bern_binom(i, r) * row[r];
+						tmp[i] = px_bern_binom(p, i) * v;
+					}
+					memcpy(row, tmp, (size_t)(p + 1) * sizeof(double));
+				}
+				for (i = 0; i <= p; i++) {
+					for (j = 0; j <= q; j++) {
+						double v = 0.0;
+						for (r = 0; r <= j; r++)
+							v += (((j - r) & 1) ? -1.0 : 1.0) *
+							     px_bern_binom(j, r) * ck[r * (p + 1) + i];
+						tmp[j] = px_bern_binom(q, j) * v;
+					}
+					for (j = 0; j <= q; j++)
+						ck[j * (p + 1) + i] = tmp[j];
+				}
+			}
+		}
+	free(work);
+	return PX_OK;
+}
+
+int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
+		     const struct px_nurbs_surf *surfs, int n_surfs,
+		     const struct px_strack_opts *opts, struct px_strack **out)
+{
+	struct px_strack *t;
+	struct px_strack_opts o;
+	struct px_nurbs_curve *cc = NULL;
+	double **cpw = NULL, *ub = NULL, *vb = NULL;
+	px_vec3 *pts = NULL, *nrm = NULL;
+	double *kk = NULL;
+	int *okk = NULL;
+	int rc, i, j, k, max_knots = 0, cap_edges, n_cc = 0, cell_cap = 0;
+	px_aabb bounds;
+
+	if (!out || (n_curves > 0 && !curves) || !surfs || n_surfs <= 0 ||
+	    n_curves < 0)
+		return PX_E_INVAL;
+	*out = NULL;
+	if (opts)
+		o = *opts;
+	else
+		px_strack_opts_default(&o);
+	if (o.cells_per_span < 1 || o.cells_per_span > 16 || o.seeds < 1 ||
+	    o.seeds > 8 || o.samples < 2 || o.samples > 32 || o.max_crit < 2 ||
+	    o.max_crit > 1 << 20 || o.verify_every < 0 ||
+	    !(o.work_margin >= 0.0))
+		return PX_E_INVAL;
+	for (i = 0; i < n_surfs; i++) {
+		if (surfs[i].degree[0] < 1 || surfs[i].degree[1] < 1 ||
+		    surfs[i].degree[0] > PX_NURBS_MAX_DEGREE ||
+		    surfs[i].degree[1] > PX_NURBS_MAX_DEGREE)
+			return PX_E_RANGE;
+		if (!surfs[i].knots[0] || !surfs[i].knots[1] || !surfs[i].pw)
+			return PX_E_INVAL;
+		for (k = 0; k < 2; k++)
+			if (surfs[i].n_knots[k] > max_knots)
+				max_knots = surfs[i].n_knots[k];
+	}
+	t = calloc(1, sizeof(*t));
+	if (!t)
+		return PX_E_NOMEM;
+	t->opts = o;
+	t->n_curves = n_curves;
+	t->n_surf = n_surfs;
+	rc = px_dist_model_create(curves, n_curves, surfs, n_surfs, o.dist,
+				  &t->dist);
+	if (rc) {
+		free(t);
+		return rc;
+	}
+	t->sf = calloc((size_t)n_surfs, sizeof(*t->sf));
+	ub = calloc((size_t)max_knots + 2, sizeof(double));
+	vb = calloc((size_t)max_knots + 2, sizeof(double));
+	if (!t->sf || !ub || !vb) {
+		rc = PX_E_NOMEM;
+		goto fail;
+	}
+	/* surfaces, domains, cells */
+	bounds = px_aabb_empty();
+	for (i = 0; i < n_curves; i++) {
+		px_aabb hb = px_nurbs_curve_aabb(&curves[i]);
+		bounds = px_aabb_union(&bounds, &hb);
+	}
+	for (i = 0; i < n_surfs; i++) {
+		struct ssurf *f = &t->sf[i];
+		px_aabb hb = px_nurbs_surf_aabb(&surfs[i]);
+		int nu, nv;
+		bounds = px_aabb_union(&bounds, &hb);
+		rc = surf_copy(f, &surfs[i]);
+		if (rc)
+			goto fail;
+		px_nurbs_surf_domain(&f->s, &f->u0, &f->u1, &f->v0, &f->v1);
+		f->du = f->u1 - f->u0;
+		f->dv = f->v1 - f->v0;
+		{
+			double tol = 1e-12 * (1.0 + px_aabb_diagonal(&hb));
+			f->wrap_u = px_nurbs_surf_seam(&f->s, 0, tol, 1e-9) >= 1;
+			f->wrap_v = px_nurbs_surf_seam(&f->s, 1, tol, 1e-9) >= 1;
+		}
+		nu = span_bounds(&f->s, 0, f->u0, f->u1, ub);
+		nv = span_bounds(&f->s, 1, f->v0, f->v1, vb);
+		t->n_patches += (nu - 1) * (nv - 1);
+		rc = build_patches(f, ub, nu, vb, nv);
+		if (rc)
+			goto fail;
+		f->ncu = (nu - 1) * o.cells_per_span;
+		f->ncv = (nv - 1) * o.cells_per_span;
+		f->cu = calloc((size_t)f->ncu + 1, sizeof(double));
+		f->cv = calloc((size_t)f->ncv + 1, sizeof(double));
+		f->cap = o.max_crit;
+		f->z = calloc((size_t)f->cap, sizeof(*f->z));
+		f->tmp = calloc((size_t)f->cap, sizeof(*f->tmp));
+		if (!f->cu || !f->cv || !f->z || !f->tmp) {
+			rc = PX_E_NOMEM;
+			goto fail;
+		}
+		for (k = 0; k < nu - 1; k++)
+			for (j = 0; j < o.cells_per_span; j++)
+				f->cu[k * o.cells_per_span + j] =
+					ub[k] + (ub[k + 1] - ub[k]) * j / o.cells_per_span;
+		f->cu[f->ncu] = f->u1;
+		for (k = 0; k < nv - 1; k++)
+			for (j = 0; j < o.cells_per_span; j++)
+				f->cv[k * o.cells_per_span + j] =
+					vb[k] + (vb[k + 1] - vb[k]) * j / o.cells_per_span;
+		f->cv[f->ncv] = f->v1;
+		f->first_cell = cell_cap;
+		cell_cap += f->ncu * f->ncv;
+	}
+	t->scale = px_aabb_diagonal(&bounds);
+	if (!(t->scale > 0.0))
+		t->scale = 1.0;
+	{
+		double m = o.work_margin * t->scale;
+		t->work.min = px_v3_sub(bounds.min, px_v3(m, m, m));
+		t->work.max = px_v3_add(bounds.max, px_v3(m, m, m));
+	}
+	t->cell = calloc((size_t)cell_cap + 1, sizeof(*t->cell));
+	t->rcell = calloc(4 * (size_t)cell_cap + 1, sizeof(*t->rcell));
+	t->heap = calloc((size_t)cell_cap + 1, sizeof(int));
+	t->popped = calloc((size_t)cell_cap + 1, sizeof(int));
+	t->hits = calloc((size_t)cell_cap + 1, sizeof(int));
+	pts = calloc((size_t)(o.samples * o.samples), sizeof(*pts));
+	nrm = calloc((size_t)(o.samples * o.samples), sizeof(*nrm));
+	kk = calloc((size_t)(2 * o.samples * o.samples), sizeof(double));
+	okk = calloc((size_t)(o.samples * o.samples), sizeof(int));
+	if (!t->cell || !t->rcell || !t->heap || !t->popped || !t->hits ||
+	    !pts || !nrm ||
+	    !kk || !okk) {
+		rc = PX_E_NOMEM;
+		goto fail;
+	}
+	for (i = 0; i < n_surfs; i++) {
+		struct ssurf *f = &t->sf[i];
+		for (j = 0; j < f->ncv; j++)
+			for (k = 0; k < f->ncu; k++) {
+				struct scell *c = &t->cell[f->first_cell + j * f->ncu + k];
+				c->surf = i;
+				c->u0 = f->cu[k];
+				c->u1 = f->cu[k + 1];
+				c->v0 = f->cv[j];
+				c->v1 = f->cv[j + 1];
+				{
+					double um = 0.5 * (c->u0 + c->u1), vm = 0.5 * (c->v0 + c->v1);
+					int ch;
+					c->child = 4 * (f->first_cell + j * f->ncu + k);
+					for (ch = 0; ch < 4; ch++) {
+						struct scell *rg = &t->rcell[c->child + ch];
+						rg->surf = i;
+						rg->u0 = ch & 1 ? um : c->u0;
+						rg->u1 = ch & 1 ? c->u1 : um;
+						rg->v0 = ch & 2 ? vm : c->v0;
+						rg->v1 = ch & 2 ? c->v1 : vm;
+						cell_regions(t, rg, f, pts, nrm, kk, okk);
+						/* size scale of the solve cell */
+						c->rho = fmax(c->rho, 2.0 * rg->rho);
+					}
+				}
+			}
+	}
+	t->n_cells = cell_cap;
+
+	/* curve tracker: free curves, then open (uncollapsed) edges and
+	 * C0 creases as iso-curves; collapsed edges become poles */
+	cap_edges = 0;
+	for (i = 0; i < n_surfs; i++)
+		cap_edges += 4 + 2 * max_knots;
+	t->edge = calloc((size_t)cap_edges, sizeof(*t->edge));
+	t->pole = calloc((size_t)4 * n_surfs, sizeof(*t->pole));
+	cc = calloc((size_t)(n_curves + cap_edges), sizeof(*cc));
+	cpw = calloc((size_t)cap_edges, sizeof(*cpw));
+	if (!t->edge || !t->pole || !cc || !cpw) {
+		rc = PX_E_NOMEM;
+		goto fail;
+	}
+	for (i = 0; i < n_curves; i++)
+		cc[n_cc++] = curves[i];
+	for (i = 0; i < n_surfs; i++) {
+		struct ssurf *f = &t->sf[i];
+		double tol = 1e-12 * (1.0 + t->scale), brk[64];
+		int e, nb, d;
+		for (e = 0; e < 4; e++) {
+			int dir = e < 2 ? 1 : 0; /* curve direction */
+			double tv = e == 0 ? f->u0 : e == 1 ? f->u1 : e == 2 ? f->v0 : f->v1;
+			if ((e < 2 && f->wrap_u) || (e >= 2 && f->wrap_v))
+				continue;
+			if (px_nurbs_surf_edge_collapsed(&f->s, e, tol)) {
+				struct pole *pl = &t->pole[t->n_poles++];
+				f->pole[e] = 1;
+				pl->u = e < 2 ? tv : f->u0;
+				pl->v = e < 2 ? f->v0 : tv;
+				pl->q = px_nurbs_surf_point(&f->s, pl->u, pl->v);
+				pl->surf = i;
+				continue;
+			}
+			{
+				size_t len = 4 * (size_t)f->s.n_ctrl[dir];
+				struct edge *ed = &t->edge[t->n_edges];
+				cpw[t->n_edges] = malloc(len * sizeof(double));
+				if (!cpw[t->n_edges]) {
+					rc = PX_E_NOMEM;
+					goto fail;
+				}
+				rc = px_nurbs_surf_iso_curve(&f->s, dir, tv, cpw[t->n_edges],
+							     len, &cc[n_cc]);
+				if (rc) {
+					free(cpw[t->n_edges]);
+					cpw[t->n_edges] = NULL;
+					goto fail;
+				}
+				ed->surf = i;
+				ed->dir = dir;
+				ed->t = tv;
+				t->n_edges++;
+				n_cc++;
+			}
+		}
+		for (d = 0; d < 2; d++) {
+			/* creases across direction d: curves along the other */
+			nb = px_nurbs_surf_breaks(&f->s, d, brk, 64);
+			for (k = 0; k < nb && k < 64; k++) {
+				int dir = 1 - d;
+				size_t len = 4 * (size_t)f->s.n_ctrl[dir];
+				struct edge *ed = &t->edge[t->n_edges];
+				if (t->n_edges >= cap_edges)
+					break;
+				cpw[t->n_edges] = malloc(len * sizeof(double));
+				if (!cpw[t->n_edges]) {
+					rc = PX_E_NOMEM;
+					goto fail;
+				}
+				rc = px_nurbs_surf_iso_curve(&f->s, dir, brk[k], cpw[t->n_edges],
+							     len, &cc[n_cc]);
+				if (rc) {
+					free(cpw[t->n_edges]);
+					cpw[t->n_edges] = NULL;
+					goto fail;
+				}
+				ed->surf = i;
+				ed->dir = dir;
+				ed->t = brk[k];
+				t->n_edges++;
+				n_cc++;
+			}
+		}
+	}
+	if (n_cc > 0) {
+		struct px_track_opts to;
+		px_track_opts_default(&to);
+		to.work = t->work;
+		to.dist = o.dist;
+		rc = px_track_create(cc, n_cc, &to, &t->ct);
+		if (rc)
+			goto fail;
+	}
+	t->epoch = 1;
+	rc = PX_OK;
+	*out = t;
+	t = NULL;
+fail:
+	if (cpw)
+		for (i = 0; i < cap_edges; i++)
+			free(cpw[i]);
+	free(cpw);
+	free(cc);
+	free(ub);
+	free(vb);
+	free(pts);
+	free(nrm);
+	free(kk);
+	free(okk);
+	px_strack_free(t);
+	return rc;
+}

@@ -1,0 +1,190 @@
+/*
+ * px_strack.h - coherent tracking of the critical distances from a moving
+ * point to a model of NURBS surfaces and curves, the surface counterpart
+ * of px_track.h (Seong, Johnson and Cohen, lifted formulation, section 4).
+ *
+ * For every surface the tracker keeps all interior critical points of
+ * f(u, v) = |S(u, v) - p|^2 / 2 (minima, maxima, saddles, told apart by
+ * the Hessian H = I - l II, i.e. Su.Su + (S - p).Suu etc.):
+ *  - Evolution (section 4.2): each point moves by the predictor
+ *    d(u, v) = H^-1 (Su . dp, Sv . dp), then Newton on the gradient
+ *    ((S - p) . Su, (S - p) . Sv) = 0 with the new point held fixed.
+ *  - Transitions (section 4.3): pairs are born or die where p crosses a
+ *    focal sheet S + N / k_i (k_i the principal curvatures), and interior
+ *    points enter or leave through an edge where p crosses the normal
+ *    lines along that edge. Each Bezier patch is cut into (u, v) cells,
+ *    each of those into 2 x 2 region cells (a two-level hierarchy: the
+ *    regions of the small cells decide, the big cell is solved). At
+ *    setup every region cell gets, from samples, a cone that holds all its
+ *    normal lines (central normal line, spread and slope) and, per focal
+ *    sheet, the interval of heights l along it where the sheet lies; a
+ *    curvature that changes sign or nearly vanishes in the cell
+ *    (parabolic lines: the sheet goes through infinity) gives the
+ *    unbounded region |l| >= l_min instead of infinite coordinates, and
+ *    umbilics need no care (the principal curvatures come from a clamped
+ *    discriminant), so nothing is NaN. Cells on an open edge add a wedge
+ *    around the edge's normal lines. When the path of the point comes
+ *    within reach of a cell's regions, that cell is solved again at the
+ *    new point (Newton from a seed grid; evolved points are kept,
+ *    duplicates merged). Each cell carries a safe radius (a lower bound
+ *    on the distance of the point from its regions when last tested) and
+ *    a min-heap on the travelled path length names the cells due.
+ *  - Collapsed edges (poles): (S - p) . Sv vanishes along such an edge,
+ *    a spurious root set that attracts Newton; the tracker solves with
+ *    that equation divided by the distance to the edge and leaves the
+ *    pole itself to its own candidate.
+ *  - Evaluation: each Bezier patch is kept in power form (Horner in both
+ *    directions, rational derivatives up to order 2).
+ *  - Boundary candidates: the domain edges (not at a closed seam, not
+ *    collapsed) are tracked as curves by an internal px_track, with the
+ *    corners as their end points; collapsed edges are point candidates.
+ *    Free curves of the model go into the same curve tracker.
+ *  - Answer: the smallest of the surface minima and the curve tracker's
+ *    answer; jumped when the closest feature is not the continuation of
+ *    the last one.
+ *  - Never silent: verification every verify_every updates against
+ *    px_dist_query() on the whole model counts disagreements and
+ *    re-initialises; capacity overflow answers globally (counted).
+ *
+ * Entity indices follow px_dist.h: curves 0..n_curves-1, then surfaces.
+ *
+ * Memory and real-time rules: px_strack_create() allocates everything
+ * (cells, boxes, heap, critical-point arrays of fixed capacity, the
+ * curve tracker and the global-query model). px_strack_update() and the
+ * accessors never allocate, lock or print; every loop has a bound. One
+ * tracker follows one point; not for concurrent use.
+ */
+#ifndef PX_STRACK_H
+#define PX_STRACK_H
+
+#include <stdint.h>
+
+#include "px_base.h"
+#include "px_dist.h"
+#include "px_math.h"
+#include "px_nurbs.h"
+#include "px_track.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+struct px_strack_opts {
+	/* Cells per Bezier patch along u and along v (default 3, 1..16). */
+	int cells_per_span;
+	/* Newton seeds per cell and direction when a cell is solved
+	 * (default 2, 1..8). */
+	int seeds;
+	/* Samples per cell and direction for the transition regions at
+	 * setup (default 6, 2..32). */
+	int samples;
+	/* Interior critical points each surface can hold (default 256). */
+	int max_crit;
+	/* Working volume margin as a fraction of the model diagonal
+	 * (default 1.0); outside it the point re-initialises. */
+	double work_margin;
+	/* Compare with the global query every verify_every updates (0: off,
+	 * the default). */
+	int verify_every;
+	/* Options of the global-query model (NULL: defaults). */
+	const struct px_dist_opts *dist;
+};
+
+PX_API void px_strack_opts_default(struct px_strack_opts *o);
+
+/* Kind of the closest feature (px_strack_result.feature). */
+enum px_strack_feature {
+	PX_STRACK_MIN = 0,    /* interior minimum of a surface */
+	PX_STRACK_EDGE = 1,   /* on a surface edge or corner (u, v set) */
+	PX_STRACK_CURVE = 2,  /* on a free curve (u set) */
+	PX_STRACK_POLE = 3,   /* a collapsed surface edge */
+	PX_STRACK_GLOBAL = 4  /* answered by px_dist_query() */
+};
+
+struct px_strack_result {
+	double dist;
+	px_vec3 point;
+	double u, v;
+	int entity;        /* px_dist.h numbering */
+	int feature;       /* enum px_strack_feature */
+	px_vec3 dir;       /* unit, from point to the query (zero on it) */
+	int jumped;        /* closest feature changed this update */
+	int n_crit;        /* interior surface critical points + the curve
+			    * tracker's critical points */
+	int n_min, n_max, n_saddle; /* interior surface points by type */
+	int source;        /* enum px_track_source */
+	int cells_solved;  /* cells solved again this update */
+	/* interior points that appeared this update (born in pairs at a
+	 * focal sheet, or entered through an edge) and that ended (died in
+	 * pairs at a focal sheet, left through an edge, or lost by Newton:
+	 * their cell is solved again) */
+	int born, died;
+	int verified;
+};
+
+struct px_strack_stats {
+	uint64_t updates, reinits, outside, fallbacks, overflows;
+	uint64_t verifications, disagreements;
+	/* cells solved, cell region tests, points whose Newton failed (died
+	 * at a fold or left through an edge; their cell is solved again) */
+	uint64_t cell_solves, box_tests, lost;
+	uint64_t born;     /* interior points found by cell solves */
+};
+
+struct px_strack_info {
+	int n_surfaces, n_curves, n_patches, n_cells;
+	int n_edges;       /* edges tracked as curves */
+	int n_poles;       /* collapsed edges */
+	int n_unbounded;   /* focal sheets through infinity (|l| >= l_min)
+			    * and cells solved on every update (normals
+			    * too spread or undefined) */
+	px_aabb work;
+};
+
+struct px_strack;
+
+/*
+ * Prepare a tracker for n_surfs surfaces and n_curves curves (valid
+ * NURBS, copied; at least one surface). opts may be NULL. Setup only.
+ * Returns PX_OK, PX_E_INVAL, PX_E_RANGE (degree), PX_E_NOMEM or an error
+ * of px_dist_model_create() / px_track_create().
+ */
+PX_API int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
+			    const struct px_nurbs_surf *surfs, int n_surfs,
+			    const struct px_strack_opts *opts,
+			    struct px_strack **out);
+
+/* NULL is a no-op. */
+PX_API void px_strack_free(struct px_strack *t);
+
+/* Rebuild the state at p (every cell solved) and answer. Returns as
+ * px_strack_update(). @note RT-safe (bounded; costs more than a global
+ * query). */
+PX_API int px_strack_reset(struct px_strack *t, px_vec3 p,
+			   struct px_strack_result *r);
+
+/* Move the point to p and answer. Returns PX_OK, PX_E_INVAL (NULL) or
+ * PX_E_NAN (p not finite; state and r untouched). @note RT-safe. */
+PX_API int px_strack_update(struct px_strack *t, px_vec3 p,
+			    struct px_strack_result *r);
+
+/* Interior critical points of surface s (0-based among the surfaces):
+ * u[i], v[i], type[i] (+1 min, -1 max, 0 saddle), up to cap. Returns the
+ * number held or PX_E_INVAL / PX_E_RANGE. @note RT-safe. */
+PX_API int px_strack_critical(const struct px_strack *t, int s, double *u,
+			      double *v, int *type, int cap);
+
+PX_API void px_strack_get_stats(const struct px_strack *t,
+				struct px_strack_stats *s);
+PX_API void px_strack_get_info(const struct px_strack *t,
+			       struct px_strack_info *info);
+
+/* The whole-model global query the tracker verifies and falls back
+ * with (owned by it). @note RT-safe. */
+PX_API struct px_dist_model *px_strack_dist_model(struct px_strack *t);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

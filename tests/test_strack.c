@@ -1,0 +1,618 @@
+/*
+ * Coherent tracking of point-surface critical distances (px_strack)
+ * against references: the certified global query at every step, a
+ * brute-force dense sample (polished by Newton) at regular steps, and an
+ * independent count of interior critical points by dense Newton seeding,
+ * along smooth random paths and sums of sinusoids with steps from
+ * 0.01 % to 5 % of the model size, on a wavy bicubic patch, a concave
+ * fold, non-uniform knots, a collapsed edge and a multi-entity model. A
+ * naive tracker (Newton from last cycle's foot point) runs the same paths
+ * to show that the transitions matter.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "px_alloc_count.h"
+#include "px_arena.h"
+#include "px_dist.h"
+#include "px_nurbs.h"
+#include "px_strack.h"
+#include "px_test.h"
+
+static struct px_arena arena;
+static unsigned char arena_mem[1 << 20];
+
+static int mk_surf(struct px_nurbs_surf *s, int pu, int pv, int nu, int nv,
+		   const double *U, const double *V, const double *xyz,
+		   const double *w)
+{
+	struct px_nurbs_error err;
+	int rc = px_nurbs_surf_init(s, &arena, pu, pv, nu, nv, U, nu + pu + 1, V,
+				    nv + pv + 1, xyz, w, &err);
+	if (rc)
+		printf("surface: %s\n", err.msg);
+	return rc;
+}
+
+static void clamped(double *U, int n, int p, const double *inner)
+{
+	int i;
+	for (i = 0; i <= p; i++) {
+		U[i] = 0.0;
+		U[n + i] = 1.0;
+	}
+	for (i = p + 1; i < n; i++)
+		U[i] = inner ? inner[i - p - 1] : (double)(i - p) / (n - p);
+}
+
+/* wavy bicubic 7 x 7 over [-1, 1]^2; knots uniform or non-uniform */
+static int surf_wavy(struct px_nurbs_surf *s, double ox, double oy, double oz,
+		     int nonuni)
+{
+	static const double inner[] = {0.08, 0.2, 0.65};
+	double U[16], xyz[3 * 49];
+	int i, j, n = 7;
+	clamped(U, n, 3, nonuni ? inner : NULL);
+	for (j = 0; j < n; j++)
+		for (i = 0; i < n; i++) {
+			double x = -1 + 2.0 * i / (n - 1), y = -1 + 2.0 * j / (n - 1);
+			double *q = &xyz[3 * (j * n + i)];
+			q[0] = ox + x;
+			q[1] = oy + y + 0.1 * sin(3 * x);
+			q[2] = oz + 0.35 * sin(2.2 * x + 0.3) * cos(2.7 * y - 0.2);
+		}
+	return mk_surf(s, 3, 3, n, n, U, U, xyz, NULL);
+}
+
+/* concave fold: a sheet bent into a U (radius ~0.6) along v */
+static int surf_fold(struct px_nurbs_surf *s, double ox, double oy, double oz)
+{
+	double U[8], V[11], xyz[3 * 4 * 7];
+	int i, j, nu = 4, nv = 7;
+	clamped(U, nu, 3, NULL);
+	clamped(V, nv, 3, NULL);
+	for (j = 0; j < nv; j++)
+		for (i = 0; i < nu; i++) {
+			double a = M_PI * (1.15 + 0.7 * j / (nv - 1));
+			double *q = &xyz[3 * (j * nu + i)];
+			q[0] = ox + 0.8 * cos(a);
+			q[1] = oy - 1 + 2.0 * i / (nu - 1);
+			q[2] = oz + 0.8 * sin(a) + 0.9 + 0.1 * (i == 1) - 0.08 * (i == 2);
+		}
+	return mk_surf(s, 3, 3, nu, nv, U, V, xyz, NULL);
+}
+
+/* dome with the edge u = 0 collapsed to the apex */
+static int surf_dome(struct px_nurbs_surf *s, double ox, double oy, double oz)
+{
+	double U[7], V[9], xyz[3 * 4 * 5];
+	int i, j, nu = 4, nv = 5;
+	clamped(U, nu, 2, NULL);
+	clamped(V, nv, 3, NULL);
+	for (j = 0; j < nv; j++)
+		for (i = 0; i < nu; i++) {
+			double a = M_PI * (0.1 + 0.8 * j / (nv - 1)), r = 0.9 * i / (nu - 1);
+			double *q = &xyz[3 * (j * nu + i)];
+			q[0] = ox + r * cos(a) * 1.3;
+			q[1] = oy + r * sin(a);
+			q[2] = oz + 0.8 - 0.9 * r * r + 0.1 * r * (j == 2);
+		}
+	return mk_surf(s, 2, 3, nu, nv, U, V, xyz, NULL);
+}
+
+/* ---- references ------------------------------------------------------ */
+
+#define GR 40
+
+/* Brute force over one surface: the best samples of a dense grid
+ * polished by projected Newton (clamped to the domain). Squared distance. */
+static double brute_surf(const struct px_nurbs_surf *s, px_vec3 p)
+{
+	double u0, u1, v0, v1, best = INFINITY, bu[4], bv[4], bd[4];
+	int i, j, k, nb = 0;
+	px_nurbs_surf_domain(s, &u0, &u1, &v0, &v1);
+	for (j = 0; j <= GR; j++)
+		for (i = 0; i <= GR; i++) {
+			double u = u0 + (u1 - u0) * i / GR, v = v0 + (v1 - v0) * j / GR;
+			double d = px_v3_dist2(px_nurbs_surf_point(s, u, v), p);
+			if (nb < 4 || d < bd[nb - 1]) {
+				int q = nb < 4 ? nb++ : 3;
+				while (q > 0 && bd[q - 1] > d) {
+					bd[q] = bd[q - 1];
+					bu[q] = bu[q - 1];
+					bv[q] = bv[q - 1];
+					q--;
+				}
+				bd[q] = d;
+				bu[q] = u;
+				bv[q] = v;
+			}
+		}
+	for (k = 0; k < nb; k++) {
+		double u = bu[k], v = bv[k];
+		int it;
+		for (it = 0; it < 40; it++) {
+			struct px_nurbs_surf_derivs d;
+			px_vec3 w;
+			double g1, g2, a, b, c, det, su, sv, nu, nv;
+			px_nurbs_surf_eval(s, u, v, 2, &d);
+			w = px_v3_sub(d.s, p);
+			g1 = px_v3_dot(w, d.su);
+			g2 = px_v3_dot(w, d.sv);
+			a = px_v3_dot(d.su, d.su) + px_v3_dot(w, d.suu);
+			b = px_v3_dot(d.su, d.sv) + px_v3_dot(w, d.suv);
+			c = px_v3_dot(d.sv, d.sv) + px_v3_dot(w, d.svv);
+			det = a * c - b * b;
+			if (det > 0 && a > 0) {
+				su = -(c * g1 - b * g2) / det;
+				sv = -(-b * g1 + a * g2) / det;
+			} else {
+				/* not convex here: a gradient step */
+				double gg = g1 * g1 + g2 * g2, h = px_v3_dot(d.su, d.su) +
+								  px_v3_dot(d.sv, d.sv);
+				su = -g1 / (h + 1e-300);
+				sv = -g2 / (h + 1e-300);
+				(void)gg;
+			}
+			nu = fmin(fmax(u + su, u0), u1);
+			nv = fmin(fmax(v + sv, v0), v1);
+			if (fabs(nu - u) < 1e-15 && fabs(nv - v) < 1e-15)
+				break;
+			if (px_v3_dist2(px_nurbs_surf_point(s, nu, nv), p) >
+			    px_v3_dist2(px_nurbs_surf_point(s, u, v), p)) {
+				/* halve back along the step */
+				nu = 0.5 * (u + nu);
+				nv = 0.5 * (v + nv);
+			}
+			u = nu;
+			v = nv;
+		}
+		best = fmin(best, px_v3_dist2(px_nurbs_surf_point(s, u, v), p));
+	}
+	return best;
+}
+
+/* Independent count of interior critical points of |S - p|^2 by Newton
+ * from a dense seed grid; *amb set when a point is near-degenerate or
+ * near the boundary (the count is then not decisive). */
+/* Seed parameters along one direction: sd per knot span. */
+static int seeds_dir(const struct px_nurbs_surf *s, int dir, double a, double b,
+		     int sd, double *out, int cap)
+{
+	double kn[64];
+	int i, nk = 0, n = 0;
+	kn[nk++] = a;
+	for (i = 0; i < s->n_knots[dir] && nk < 63; i++)
+		if (s->knots[dir][i] > kn[nk - 1] && s->knots[dir][i] < b)
+			kn[nk++] = s->knots[dir][i];
+	kn[nk++] = b;
+	for (i = 0; i + 1 < nk; i++) {
+		int j;
+		for (j = 0; j < sd && n < cap; j++)
+			out[n++] = kn[i] + (kn[i + 1] - kn[i]) * (j + 0.5) / sd;
+	}
+	return n;
+}
+
+static double last_fu[512], last_fv[512];
+static int last_n;
+
+static int count_crit(const struct px_nurbs_surf *s, px_vec3 p, int *amb)
+{
+	double u0, u1, v0, v1, fu[512], fv[512], su_[256], sv_[256];
+	int i, j, n = 0, nsu, nsv, col[4];
+	last_n = 0;
+	px_nurbs_surf_domain(s, &u0, &u1, &v0, &v1);
+
+	for (i = 0; i < 4; i++)
+		col[i] = px_nurbs_surf_edge_collapsed(s, i, 1e-12);
+	nsu = seeds_dir(s, 0, u0, u1, 10, su_, 256);
+	nsv = seeds_dir(s, 1, v0, v1, 10, sv_, 256);
+	for (j = 0; j < nsv; j++)
+		for (i = 0; i < nsu; i++) {
+			double u = su_[i], v = sv_[j];
+			int it, ok = 0, q, outs = 0;
+			double det = 0.0, hn = 1.0;
+			for (it = 0; it < 30; it++) {
+				struct px_nurbs_surf_derivs d;
+				px_vec3 w;
+				double g1, g2, a, b, c, su, sv;
+				if (u < u0 || u > u1 || v < v0 || v > v1) {
+					/* overshoot: back to the edge, twice at most */
+					if (++outs > 2)
+						break;
+					u = fmin(fmax(u, u0), u1);
+					v = fmin(fmax(v, v0), v1);
+				}
+				px_nurbs_surf_eval(s, u, v, 2, &d);
+				w = px_v3_sub(d.s, p);
+				g1 = px_v3_dot(w, d.su);
+				g2 = px_v3_dot(w, d.sv);
+				a = px_v3_dot(d.su, d.su) + px_v3_dot(w, d.suu);
+				b = px_v3_dot(d.su, d.sv) + px_v3_dot(w, d.suv);
+				c = px_v3_dot(d.sv, d.sv) + px_v3_dot(w, d.svv);
+				det = a * c - b * b;
+				hn = a * a + c * c + 2 * b * b;
+				if (det == 0.0)
+					break;
+				su = -(c * g1 - b * g2) / det;
+				sv = -(-b * g1 + a * g2) / det;
+				su = fmax(fmin(su, 0.2 * (u1 - u0)), -0.2 * (u1 - u0));
+				sv = fmax(fmin(sv, 0.2 * (v1 - v0)), -0.2 * (v1 - v0));
+				u += su;
+				v += sv;
+				if (fabs(su) < 1e-12 * (u1 - u0) && fabs(sv) < 1e-12 * (v1 - v0)) {
+					ok = 1;
+					break;
+				}
+			}
+			if (!ok || u < u0 || u > u1 || v < v0 || v > v1)
+				continue;
+			/* Newton drawn onto a collapsed edge: (S - p) . Sv
+			 * vanishes along all of it; the pole is not an
+			 * interior critical point */
+			if ((col[0] && u - u0 < 1e-6 * (u1 - u0)) ||
+			    (col[1] && u1 - u < 1e-6 * (u1 - u0)) ||
+			    (col[2] && v - v0 < 1e-6 * (v1 - v0)) ||
+			    (col[3] && v1 - v < 1e-6 * (v1 - v0)))
+				continue;
+			for (q = 0; q < n; q++)
+				if (fabs(fu[q] - u) < 1e-6 * (u1 - u0) &&
+				    fabs(fv[q] - v) < 1e-6 * (v1 - v0))
+					break;
+			if (q < n || n >= 512)
+				continue;
+			fu[n] = u;
+			fv[n] = v;
+			last_fu[n] = u;
+			last_fv[n] = v;
+			n++;
+			last_n = n;
+			if (fabs(det) < 1e-3 * hn ||
+			    fmin(u - u0, u1 - u) < 1e-3 * (u1 - u0) ||
+			    fmin(v - v0, v1 - v) < 1e-3 * (v1 - v0))
+				*amb = 1;
+		}
+	return n;
+}
+
+/* Near-degenerate tracked points (born or dying this instant) or on the
+ * boundary make the count comparison not decisive too. */
+static int tracked_amb(const struct px_strack *t, int si,
+		       const struct px_nurbs_surf *s)
+{
+	double u[256], v[256], u0, u1, v0, v1;
+	int ty[256], n, i;
+	px_nurbs_surf_domain(s, &u0, &u1, &v0, &v1);
+	n = px_strack_critical(t, si, u, v, ty, 256);
+	for (i = 0; i < n && i < 256; i++)
+		if (fmin(u[i] - u0, u1 - u[i]) < 1e-3 * (u1 - u0) ||
+		    fmin(v[i] - v0, v1 - v[i]) < 1e-3 * (v1 - v0))
+			return 1;
+	return 0;
+}
+
+/* Naive tracker: Newton (projected, clamped) from last foot point. */
+struct naive {
+	int surf;
+	double u, v;
+};
+
+static double naive_step(const struct px_nurbs_surf *ss, struct naive *nv,
+			 px_vec3 p)
+{
+	const struct px_nurbs_surf *s = &ss[nv->surf];
+	double u0, u1, v0, v1;
+	int it;
+	px_nurbs_surf_domain(s, &u0, &u1, &v0, &v1);
+	for (it = 0; it < 8; it++) {
+		struct px_nurbs_surf_derivs d;
+		px_vec3 w;
+		double g1, g2, a, b, c, det;
+		px_nurbs_surf_eval(s, nv->u, nv->v, 2, &d);
+		w = px_v3_sub(d.s, p);
+		g1 = px_v3_dot(w, d.su);
+		g2 = px_v3_dot(w, d.sv);
+		a = px_v3_dot(d.su, d.su) + px_v3_dot(w, d.suu);
+		b = px_v3_dot(d.su, d.sv) + px_v3_dot(w, d.suv);
+		c = px_v3_dot(d.sv, d.sv) + px_v3_dot(w, d.svv);
+		det = a * c - b * b;
+		if (!(det > 0 && a > 0))
+			break;
+		nv->u = fmin(fmax(nv->u - (c * g1 - b * g2) / det, u0), u1);
+		nv->v = fmin(fmax(nv->v - (-b * g1 + a * g2) / det, v0), v1);
+	}
+	return px_v3_dist(px_nurbs_surf_point(s, nv->u, nv->v), p);
+}
+
+/* ---- trajectories ---------------------------------------------------- */
+
+#define NSTEP 300
+
+static void make_path(px_vec3 *q, int n, int kind, px_aabb box, double step)
+{
+	px_vec3 c = px_aabb_center(&box);
+	px_vec3 h = px_v3_scale(px_v3_sub(box.max, box.min), 0.5);
+	px_vec3 pos = c, vel = px_v3(px_rand_normal(), px_rand_normal(),
+				     px_rand_normal());
+	double amp[3][3], frq[3][3], ph[3][3], tt = 0;
+	int i, j, k;
+	for (i = 0; i < 3; i++)
+		for (j = 0; j < 3; j++) {
+			amp[i][j] = 0.2 + 0.25 * px_rand_unit();
+			frq[i][j] = 0.5 + 2.5 * px_rand_unit();
+			ph[i][j] = 2 * M_PI * px_rand_unit();
+		}
+	for (k = 0; k < n; k++) {
+		if (kind == 0) {
+			double nvv, *pp = &pos.x, *vv = &vel.x;
+			const double *cc = &c.x, *hh = &h.x;
+			vel = px_v3_add(px_v3_scale(vel, 0.95),
+					px_v3(0.3 * px_rand_normal(), 0.3 * px_rand_normal(),
+					      0.3 * px_rand_normal()));
+			nvv = px_v3_norm(vel);
+			pos = px_v3_add(pos, px_v3_scale(vel, step / nvv));
+			for (i = 0; i < 3; i++)
+				if (fabs(pp[i] - cc[i]) > hh[i]) {
+					pp[i] = cc[i] + (pp[i] > cc[i] ? hh[i] : -hh[i]);
+					vv[i] = -vv[i];
+				}
+		} else {
+			double v[3];
+			for (i = 0; i < 3; i++) {
+				v[i] = 0;
+				for (j = 0; j < 3; j++)
+					v[i] += amp[i][j] * sin(frq[i][j] * tt + ph[i][j]);
+			}
+			tt += step / (0.8 * fmax(h.x, h.y));
+			pos = px_v3_add(c, px_v3(v[0] * h.x, v[1] * h.y, v[2] * h.z));
+		}
+		q[k] = pos;
+	}
+}
+
+struct totals {
+	long steps, wrong, naive_wrong, brute_bad, brute_checks, count_checks,
+		count_bad, count_amb, jumps, cells, born, died;
+	uint64_t allocs;
+};
+
+/* Run the tracker along paths over the model; checks every step. */
+static void run_model(const char *name, const struct px_nurbs_curve *cs,
+		      int nc, const struct px_nurbs_surf *ss, int ns,
+		      struct totals *tot)
+{
+	static px_vec3 q[NSTEP];
+	static const double steps[] = {1e-4, 1e-3, 1e-2, 5e-2};
+	struct px_strack *t = NULL;
+	struct px_strack_opts o;
+	struct px_strack_stats st;
+	struct px_dist_model *ref = NULL;
+	struct px_dist_info di;
+	double size;
+	px_aabb box;
+	int kind, s, k, rc;
+	long wrong0 = tot->wrong, naive0 = tot->naive_wrong;
+
+	px_strack_opts_default(&o);
+	rc = px_strack_create(cs, nc, ss, ns, &o, &t);
+	PX_CHECK_MSG(rc == PX_OK, "%s: create: %s", name, px_strerror(rc));
+	if (rc)
+		return;
+	PX_CHECK_INT_EQ(px_dist_model_create(cs, nc, ss, ns, NULL, &ref), PX_OK);
+	px_dist_model_info(ref, &di);
+	box = di.bounds;
+	size = px_aabb_diagonal(&box);
+	box = px_aabb_inflate(&box, 0.25 * size);
+	for (kind = 0; kind < 2; kind++)
+		for (s = 0; s < 4; s++) {
+			struct px_strack_result r;
+			struct naive nv;
+			struct px_dist_result g;
+			make_path(q, NSTEP, kind, box, steps[s] * size);
+			px_strack_reset(t, q[0], &r);
+			px_dist_query(ref, q[0], &g);
+			nv.surf = g.entity >= nc ? g.entity - nc : 0;
+			nv.u = g.entity >= nc ? g.u : 0.5;
+			nv.v = g.entity >= nc ? g.v : 0.5;
+			for (k = 0; k < NSTEP; k++) {
+				uint64_t reg = px_alloc_region_begin();
+				double nd, tol;
+				px_strack_update(t, q[k], &r);
+				tot->allocs += px_alloc_region_end(reg);
+				px_dist_query(ref, q[k], &g);
+				tol = 1e-9 * (size + g.dist);
+				tot->steps++;
+				tot->jumps += r.jumped;
+				tot->cells += r.cells_solved;
+				tot->born += r.born;
+				tot->died += r.died;
+				if (fabs(r.dist - g.dist) > tol ||
+				    fabs(px_v3_dist(r.point, q[k]) - r.dist) > tol) {
+					if (tot->wrong - wrong0 < 3)
+						printf("  %s kind %d step %g k %d: tracked %.12g "
+						       "global %.12g (feature %d entity %d, u %g v %g; "
+						       "global u %g v %g) p %.17g %.17g %.17g\n",
+						       name, kind, steps[s], k, r.dist, g.dist,
+						       r.feature, r.entity, r.u, r.v, g.u, g.v, q[k].x, q[k].y, q[k].z);
+					tot->wrong++;
+				}
+				nd = naive_step(ss, &nv, q[k]);
+				if (nc == 0 && nd > g.dist + tol)
+					tot->naive_wrong++;
+				if (k % 30 == 0) {
+					/* brute force confirms the reference */
+					double bd = INFINITY;
+					int e;
+					for (e = 0; e < ns; e++)
+						bd = fmin(bd, brute_surf(&ss[e], q[k]));
+					tot->brute_checks++;
+					if (nc == 0 && sqrt(bd) < g.dist - 1e-7 * size)
+						tot->brute_bad++;
+				}
+				if (k % 50 == 0) {
+					int e;
+					for (e = 0; e < ns; e++) {
+						int amb = tracked_amb(t, e, &ss[e]);
+						int n = count_crit(&ss[e], q[k], &amb);
+						int m = px_strack_critical(t, e, NULL, NULL, NULL, 0);
+						tot->count_checks++;
+						if (amb) {
+							tot->count_amb++;
+						} else if (n != m) {
+							if (tot->count_bad < 5) {
+								double cu[64], cv[64];
+								int cty[64], qq, mm;
+								printf("  %s kind %d step %g k %d surf %d: "
+								       "tracked %d critical points, "
+								       "sampling %d:",
+								       name, kind, steps[s], k, e, m, n);
+								mm = px_strack_critical(t, e, cu, cv, cty, 64);
+								for (qq = 0; qq < mm && qq < 64; qq++)
+									printf(" (%.6g %.6g %d)", cu[qq], cv[qq], cty[qq]);
+								printf(" sampling:");
+								for (qq = 0; qq < last_n && qq < n; qq++)
+									printf(" (%.6g %.6g)", last_fu[qq], last_fv[qq]);
+								printf(" p %.17g %.17g %.17g\n", q[k].x, q[k].y, q[k].z);
+							}
+							tot->count_bad++;
+						}
+					}
+				}
+			}
+		}
+	px_strack_get_stats(t, &st);
+	printf("  %s: wrong %ld, naive wrong %ld; tracker: cell solves %llu "
+	       "box tests %llu reinit %llu outside %llu fallback %llu lost %llu\n",
+	       name, tot->wrong - wrong0, tot->naive_wrong - naive0,
+	       (unsigned long long)st.cell_solves, (unsigned long long)st.box_tests,
+	       (unsigned long long)st.reinits, (unsigned long long)st.outside,
+	       (unsigned long long)st.fallbacks, (unsigned long long)st.lost);
+	px_strack_free(t);
+	px_dist_model_free(ref);
+}
+
+static void report(const struct totals *tot)
+{
+	printf("  total: %ld steps, wrong %ld, naive wrong %ld, brute %ld/%ld bad, "
+	       "counts %ld checked %ld bad %ld ambiguous, jumps %ld, cells solved "
+	       "%ld, points born %ld died %ld, allocations %llu\n",
+	       tot->steps, tot->wrong, tot->naive_wrong, tot->brute_bad,
+	       tot->brute_checks, tot->count_checks, tot->count_bad,
+	       tot->count_amb, tot->jumps, tot->cells, tot->born, tot->died,
+	       (unsigned long long)tot->allocs);
+	/* the paths must cross focal sheets and edges many times */
+	PX_CHECK_MSG(tot->born >= 20 && tot->died >= 20,
+		     "too few transitions: born %ld died %ld", tot->born, tot->died);
+	PX_CHECK_INT_EQ(tot->wrong, 0);
+	PX_CHECK_INT_EQ(tot->brute_bad, 0);
+	PX_CHECK_INT_EQ(tot->count_bad, 0);
+	PX_CHECK_INT_EQ(tot->allocs, 0);
+	PX_CHECK_MSG(4 * (tot->count_checks - tot->count_amb) > tot->count_checks,
+		     "count checks mostly ambiguous: %ld of %ld", tot->count_amb,
+		     tot->count_checks);
+}
+
+static void test_wavy(void)
+{
+	struct px_nurbs_surf s;
+	struct totals tot;
+	memset(&tot, 0, sizeof(tot));
+	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
+	PX_CHECK_INT_EQ(surf_wavy(&s, 0, 0, 0, 0), PX_OK);
+	run_model("wavy", NULL, 0, &s, 1, &tot);
+	report(&tot);
+	PX_CHECK_MSG(tot.naive_wrong > 0, "naive tracker never wrong: paths too easy");
+}
+
+static void test_fold_nonuniform(void)
+{
+	struct px_nurbs_surf s[2];
+	struct totals tot;
+	memset(&tot, 0, sizeof(tot));
+	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
+	PX_CHECK_INT_EQ(surf_fold(&s[0], 0, 0, 0), PX_OK);
+	PX_CHECK_INT_EQ(surf_wavy(&s[1], 0, 0, 0, 1), PX_OK);
+	run_model("concave fold", NULL, 0, &s[0], 1, &tot);
+	run_model("non-uniform knots", NULL, 0, &s[1], 1, &tot);
+	report(&tot);
+}
+
+static void test_collapsed(void)
+{
+	struct px_nurbs_surf s;
+	struct px_strack *t = NULL;
+	struct px_strack_info info;
+	struct totals tot;
+	memset(&tot, 0, sizeof(tot));
+	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
+	PX_CHECK_INT_EQ(surf_dome(&s, 0, 0, 0), PX_OK);
+	PX_CHECK_INT_EQ(px_strack_create(NULL, 0, &s, 1, NULL, &t), PX_OK);
+	px_strack_get_info(t, &info);
+	PX_CHECK_INT_EQ(info.n_poles, 1);
+	PX_CHECK_INT_EQ(info.n_edges, 3);
+	px_strack_free(t);
+	run_model("collapsed edge", NULL, 0, &s, 1, &tot);
+	report(&tot);
+}
+
+static void test_multi(void)
+{
+	struct px_nurbs_surf s[3];
+	struct px_nurbs_curve c;
+	static const double U[] = {0, 0, 0, 0, 0.5, 1, 1, 1, 1};
+	double xyz[15];
+	int i;
+	struct totals tot;
+	memset(&tot, 0, sizeof(tot));
+	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
+	PX_CHECK_INT_EQ(surf_wavy(&s[0], 0, 0, 0, 0), PX_OK);
+	PX_CHECK_INT_EQ(surf_fold(&s[1], 2.4, 0.3, 0.2), PX_OK);
+	PX_CHECK_INT_EQ(surf_dome(&s[2], 0.5, 2.2, -0.3), PX_OK);
+	for (i = 0; i < 5; i++) {
+		xyz[3 * i] = 2.0 + 0.3 * i;
+		xyz[3 * i + 1] = 2.0 + 0.4 * sin(i);
+		xyz[3 * i + 2] = 0.5 * cos(1.3 * i);
+	}
+	PX_CHECK_INT_EQ(px_nurbs_curve_init(&c, &arena, 3, 5, U, 9, xyz, NULL, NULL),
+			PX_OK);
+	run_model("multi-entity", &c, 1, s, 3, &tot);
+	report(&tot);
+}
+
+static void test_errors(void)
+{
+	struct px_nurbs_surf s;
+	struct px_strack *t = NULL;
+	struct px_strack_result r;
+	struct px_strack_opts o;
+	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
+	PX_CHECK_INT_EQ(surf_wavy(&s, 0, 0, 0, 0), PX_OK);
+	PX_CHECK_INT_EQ(px_strack_create(NULL, 0, NULL, 0, NULL, &t), PX_E_INVAL);
+	PX_CHECK_INT_EQ(px_strack_create(NULL, 0, &s, 1, NULL, NULL), PX_E_INVAL);
+	px_strack_opts_default(&o);
+	o.seeds = 0;
+	PX_CHECK_INT_EQ(px_strack_create(NULL, 0, &s, 1, &o, &t), PX_E_INVAL);
+	PX_CHECK_INT_EQ(px_strack_create(NULL, 0, &s, 1, NULL, &t), PX_OK);
+	PX_CHECK_INT_EQ(px_strack_update(t, px_v3(NAN, 0, 0), &r), PX_E_NAN);
+	PX_CHECK_INT_EQ(px_strack_update(NULL, px_v3(0, 0, 0), &r), PX_E_INVAL);
+	PX_CHECK_INT_EQ(px_strack_update(t, px_v3(0.1, 0.2, 0.5), &r), PX_OK);
+	PX_CHECK(r.dist >= 0.0 && r.n_crit >= 1);
+	PX_CHECK_INT_EQ(px_strack_critical(t, 1, NULL, NULL, NULL, 0), PX_E_RANGE);
+	/* far outside the working volume: re-initialised, still right */
+	PX_CHECK_INT_EQ(px_strack_update(t, px_v3(50, 0, 0), &r), PX_OK);
+	PX_CHECK_INT_EQ(r.source, PX_TRACK_REINIT);
+	px_strack_free(t);
+	px_strack_free(NULL);
+}
+
+static const struct px_test tests[] = {
+	PX_T(test_wavy),
+	PX_T(test_fold_nonuniform),
+	PX_T(test_collapsed),
+	PX_T(test_multi),
+	PX_T(test_errors),
+};
+
+PX_TEST_MAIN(tests)
