@@ -387,7 +387,11 @@ static void test_penetration_convex(void)
 		px_model_set_pose(ma, Pa);
 		px_model_set_pose(mb, Pb);
 		memset(&r, 0, sizeof(r));
-		PX_CHECK_INT_EQ(px_pair_distance(ma, mb, NULL, &r), PX_OK);
+		{
+			uint64_t a0 = px_alloc_region_begin();
+			PX_CHECK_INT_EQ(px_pair_distance(ma, mb, NULL, &r), PX_OK);
+			PX_CHECK_INT_EQ(px_alloc_region_end(a0), 0);
+		}
 		if (!r.intersecting) {
 			PX_CHECK(r.distance > 0.0 && r.depth == 0.0);
 			px_model_free(ma);
