@@ -473,7 +473,7 @@ static int deepest(const struct px_model *x, const struct px_model *y,
 	if (!ry.is_signed || !(ry.distance < 0.0))
 		return 0;
 	step = fmax(-ry.distance, 1e-3 * scale);
-	for (it = 0; it < DEEP_ITERS && step > 1e-9 * scale; it++) {
+	for (it = 0; it < DEEP_ITERS && step > 1e-5 * scale; it++) {
 		px_vec3 target = px_v3_madd(rx.point, ry.direction, -step);
 		struct px_model_result nx;
 		if ((rc = px_model_query(x, target, &nx)) < 0)
@@ -905,6 +905,10 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 		scale = scale > 0.0 ? scale : 1.0;
 		for (side = 0; side < 2; side++) {
 			const struct px_model *x = side ? b : a, *y = side ? a : b;
+			/* every seed costs up to 2 DEEP_ITERS + 2 point
+			 * queries, and points deep inside a mesh are its most
+			 * expensive queries (many triangles nearly equidistant):
+			 * opt->starts trades time for the global hit rate */
 			for (j = -1; j < starts; j++) {
 				px_vec3 st = side ? best.pb : best.pa, pxx, qy, dir;
 				double dd;

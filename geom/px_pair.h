@@ -52,7 +52,7 @@
  * its centre). Other closed pairs (meshes, NURBS shells, the torus) get
  * the deepest point of either model inside the other by a local descent
  * of the signed point-to-model distance along the surface, from the
- * overlap found and from each seed (depth_approx = 1: a lower bound of
+ * overlap found and from each seed (opt->starts; depth_approx = 1: a lower bound of
  * the deepest point's depth, which for convex shapes is itself at most
  * the translational depth). Unsigned models (clouds, open meshes) have
  * no inside: touching reports distance 0 and depth 0.
