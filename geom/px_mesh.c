@@ -165,7 +165,8 @@ static double tri_as_segments(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
  * from the barycentric ratios, which lose accuracy on thin triangles.
  */
 /* n = (b - a) x (c - a), nn = |n|^2, needle: treat as segments. */
-static inline double tri_core(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
+static inline __attribute__((always_inline)) double
+tri_core(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
 			      px_vec3 n, double nn, int needle, px_vec3 *q,
 			      int *feature, int *sub, double *u, double *v)
 {
