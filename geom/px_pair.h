@@ -57,8 +57,12 @@
  * the translational depth). Unsigned models (clouds, open meshes) have
  * no inside: touching reports distance 0 and depth 0.
  *
- * Memory and real-time rules: no allocation; work bounded by
- * starts * max_iters point queries, each RT-safe. @note RT-safe.
+ * Memory and real-time rules: no allocation (GJK and EPA keep their
+ * simplex and polytope in fixed arrays on the stack, about 14 kB); work
+ * bounded by starts * max_iters point queries, plus for overlapping
+ * non-convex pairs 2 (starts + 1) (2 + 80) queries of the depth search
+ * (points deep inside a mesh are its slowest queries: budget for it, or
+ * lower starts), each RT-safe. @note RT-safe.
  */
 #ifndef PX_PAIR_H
 #define PX_PAIR_H
