@@ -371,6 +371,38 @@ int main(int argc, char **argv)
 				printf("  %-34s %d of %d results flagged possibly local\n", "", local, NP);
 			}
 		}
+		{
+			/* overlapping pairs: penetration depth out of the same call */
+			const struct {
+				const char *name;
+				struct px_model *a, *b;
+			} P[] = {{"overlap: cylinder / box (EPA)", ca, cb},
+				 {"overlap: mesh torus / sphere (deepest pt)", ma, mb}};
+			size_t k;
+			px_model_set_pose(ma, px_pose_identity()); /* moved above */
+			for (k = 0; k < sizeof(P) / sizeof(P[0]); k++) {
+				int pen = 0, approx = 0;
+				double dsum = 0;
+				memset(&r, 0, sizeof(r));
+				for (i = 0; i < NP; i++) {
+					px_pose Pb = px_pose_identity();
+					int64_t a;
+					double rr = k ? 0.1 : 0.06;
+					Pb.t = px_v3(rr * cos(4e-3 * i), rr * sin(4e-3 * i), 0.01);
+					px_quat_from_axis_angle(px_v3(1, 1, 0), 2e-3 * i, &Pb.q);
+					px_model_set_pose(P[k].b, Pb);
+					a = now_ns();
+					px_pair_distance(P[k].a, P[k].b, &o8, &r);
+					times[i] = (double)(now_ns() - a);
+					pen += r.intersecting && r.depth > 0.0;
+					approx += r.depth_approx;
+					dsum += r.depth;
+				}
+				print_stats(P[k].name, summarize(times, NP, overhead));
+				printf("  %-34s %d of %d with a depth (mean %.2f mm), %d approximate\n", "",
+				       pen, NP, 1e3 * dsum / NP, approx);
+			}
+		}
 		px_model_free(ma);
 		px_model_free(mb);
 		px_model_free(ca);

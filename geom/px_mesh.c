@@ -8,6 +8,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+#ifdef __SSE__
+#include <xmmintrin.h>
+#endif
+
 #include "model_internal.h"
 #include "px_mesh.h"
 
@@ -48,6 +52,22 @@ struct mtri {
 	px_vec3 b, c;
 } __attribute__((aligned(64)));
 
+/*
+ * Single-precision lower bound of a triangle's distance, one cache line
+ * per triangle, read before the exact data: with unit normal n and plane
+ * offset d, h = n . p - d is the distance to the plane; with the
+ * in-plane outward unit normals m[e] of the edges and their offsets, the
+ * largest m[e] . p - m[e][3] is at most the in-plane distance to the
+ * triangle (a convex polygon is the intersection of its edge half-planes),
+ * so h^2 + max(0, that)^2 <= the squared distance, exact in the face and
+ * edge regions. Degenerate triangles have all zeros (bound 0: never
+ * rejected). Rounding is absorbed by the query's slack (tri_lb).
+ */
+struct tlb {
+	float n[3], d;
+	float m[3][4];
+} __attribute__((aligned(64)));
+
 static float f_down(double x)
 {
 	float f = (float)x;
@@ -63,6 +83,7 @@ static float f_up(double x)
 struct mesh {
 	size_t nt, nv;
 	struct mtri *tri;    /* leaf order */
+	struct tlb *lb;      /* leaf order: float lower-bound data */
 	uint32_t *orig;      /* leaf -> input triangle */
 	uint32_t *leaf_of;   /* input -> leaf */
 	px_vec3 *fn;         /* face normal per leaf triangle (0 if degenerate) */
@@ -76,6 +97,7 @@ struct mesh {
 	int closed;
 	int depth;
 	px_aabb box;
+	double absmax;       /* largest |coordinate| of the vertices */
 	size_t bytes;
 	px_vec3 *hull;  /* distinct vertices, convex meshes only (support) */
 	size_t n_hull;
@@ -143,7 +165,8 @@ static double tri_as_segments(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
  * from the barycentric ratios, which lose accuracy on thin triangles.
  */
 /* n = (b - a) x (c - a), nn = |n|^2, needle: treat as segments. */
-static inline double tri_core(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
+static inline __attribute__((always_inline)) double
+tri_core(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
 			      px_vec3 n, double nn, int needle, px_vec3 *q,
 			      int *feature, int *sub, double *u, double *v)
 {
@@ -564,12 +587,59 @@ static inline void box4_d2(const struct node4 *nd, px_vec3 p, double d2[4])
 	}
 }
 
+/*
+ * The same four lower bounds in single precision, side by side (the
+ * compiler turns the loops into packed operations): half the work of the
+ * double version per node. Rounding p and the differences to float can
+ * overstate a gap by at most 2^-24 (2 |p| + |box|) per axis, so every gap
+ * is first reduced by slack = 2^-22 (|box| + |p|) (max norms, given by
+ * the caller), and the squared sum, itself rounded up to six times by
+ * 2^-24 relative, is scaled by 1 - 2^-18: the result stays a lower bound
+ * of the true squared distance, so pruning with it never loses the
+ * closest triangle. Callers use it only while |p| is far below the float
+ * range (mesh_closest falls back to box4_d2 otherwise).
+ */
+static inline void box4_d2f(const struct node4 *nd, const float pf[3],
+			    float slack, double d2[4])
+{
+	float s[4];
+	int j;
+#ifdef __SSE__
+	/* the same operations as below, four children per instruction (the
+	 * compiler does not vectorise the loops at -O2) */
+	__m128 sl = _mm_set1_ps(slack), z = _mm_setzero_ps(), acc = z;
+	int k;
+	for (k = 0; k < 3; k++) {
+		__m128 p = _mm_set1_ps(pf[k]);
+		__m128 a = _mm_sub_ps(_mm_load_ps(nd->lo[k]), p);
+		__m128 b = _mm_sub_ps(p, _mm_load_ps(nd->hi[k]));
+		__m128 g = _mm_max_ps(_mm_sub_ps(_mm_max_ps(a, b), sl), z);
+		acc = _mm_add_ps(acc, _mm_mul_ps(g, g));
+	}
+	_mm_storeu_ps(s, acc);
+#else
+	float g[3][4];
+	int k;
+	for (k = 0; k < 3; k++)
+		for (j = 0; j < 4; j++) {
+			float a = nd->lo[k][j] - pf[k], b = pf[k] - nd->hi[k][j];
+			float m = (a > b ? a : b) - slack;
+			g[k][j] = m > 0.0f ? m : 0.0f;
+		}
+	for (j = 0; j < 4; j++)
+		s[j] = g[0][j] * g[0][j] + g[1][j] * g[1][j] + g[2][j] * g[2][j];
+#endif
+	for (j = 0; j < 4; j++)
+		d2[j] = (double)s[j] * (1.0 - 0x1p-18);
+}
+
 static void mesh_free(void *impl)
 {
 	struct mesh *M = impl;
 	if (!M)
 		return;
 	free(M->tri);
+	free(M->lb);
 	free(M->orig);
 	free(M->leaf_of);
 	free(M->fn);
@@ -609,6 +679,46 @@ struct best {
 	int feature, sub;
 	double u, v;
 };
+
+/* Query point in single precision with the slack that covers the
+ * rounding of the float bounds (box4_d2f, tri_lb); use = 0 when p or the
+ * mesh is too far out for floats (then only exact tests are made). */
+struct pq {
+	float pf[3];
+	float slack_box, slack_tri;
+	int use;
+};
+
+static inline void pq_init(const struct mesh *M, px_vec3 p, struct pq *q)
+{
+	double pmax = fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z)));
+	q->use = pmax < 1e30 && M->absmax < 1e30;
+	q->pf[0] = (float)p.x;
+	q->pf[1] = (float)p.y;
+	q->pf[2] = (float)p.z;
+	q->slack_box = (float)(0x1p-22 * (M->absmax + pmax));
+	/* plane and edge values: unit vectors and offsets rounded to float
+	 * (2^-24 relative each), three products and sums, the rounded p:
+	 * together below 16 * 2^-24 (|p| + |mesh|); twice that here */
+	q->slack_tri = (float)(0x1p-19 * (M->absmax + pmax));
+}
+
+/* Lower bound of the squared distance to leaf triangle li (see struct
+ * tlb); only when q->use. */
+static inline double tri_lb(const struct tlb *L, const struct pq *q)
+{
+	const float *P = q->pf;
+	float h = L->n[0] * P[0] + L->n[1] * P[1] + L->n[2] * P[2] - L->d;
+	float e0 = L->m[0][0] * P[0] + L->m[0][1] * P[1] + L->m[0][2] * P[2] - L->m[0][3];
+	float e1 = L->m[1][0] * P[0] + L->m[1][1] * P[1] + L->m[1][2] * P[2] - L->m[1][3];
+	float e2 = L->m[2][0] * P[0] + L->m[2][1] * P[1] + L->m[2][2] * P[2] - L->m[2][3];
+	float e = e0 > e1 ? e0 : e1;
+	e = (e > e2 ? e : e2) - q->slack_tri;
+	h = (h < 0.0f ? -h : h) - q->slack_tri;
+	e = e > 0.0f ? e : 0.0f;
+	h = h > 0.0f ? h : 0.0f;
+	return (double)(h * h + e * e) * (1.0 - 0x1p-18);
+}
 
 static inline void test_tri(const struct mesh *M, size_t li, px_vec3 p,
 			    struct best *b)
@@ -695,6 +805,7 @@ static int mesh_closest(const void *impl, const struct px_model_query *qq,
 	int sp = 0, iters = 0, certified = 1;
 	struct best b;
 	px_vec3 p = qq->p;
+	struct pq pq;
 
 	b.d2 = isinf(qq->max_dist) ? INFINITY : qq->max_dist * qq->max_dist;
 	b.li = -1;
@@ -702,6 +813,7 @@ static int mesh_closest(const void *impl, const struct px_model_query *qq,
 	b.feature = PX_FEATURE_NONE;
 	b.sub = 0;
 	b.u = b.v = 0.0;
+	pq_init(M, p, &pq);
 	if (qq->hint >= 0 && (size_t)qq->hint < M->nt) {
 		test_tri(M, M->leaf_of[qq->hint], p, &b);
 		iters++;
@@ -722,11 +834,15 @@ static int mesh_closest(const void *impl, const struct px_model_query *qq,
 		if (st[sp].cnt > 0) {
 			uint32_t i;
 			for (i = st[sp].idx; i < st[sp].idx + st[sp].cnt; i++)
-				test_tri(M, i, p, &b);
+				if (!pq.use || !(tri_lb(&M->lb[i], &pq) > b.d2))
+					test_tri(M, i, p, &b);
 			continue;
 		}
 		nd = &M->n4[st[sp].idx];
-		box4_d2(nd, p, dc);
+		if (pq.use)
+			box4_d2f(nd, pq.pf, pq.slack_box, dc);
+		else
+			box4_d2(nd, p, dc);
 		/* children that can still win, nearest first */
 		for (j = 0; j < 4; j++) {
 			if (nd->idx[j] == EMPTY || dc[j] > b.d2)
@@ -749,7 +865,7 @@ static int mesh_closest(const void *impl, const struct px_model_query *qq,
 			/* start the memory fetch now: the node or the leaf's
 			 * triangles are needed within a few steps */
 			if (st[sp].cnt)
-				__builtin_prefetch(&M->tri[st[sp].idx]);
+				__builtin_prefetch(&M->lb[st[sp].idx]);
 			else
 				__builtin_prefetch(&M->n4[st[sp].idx]);
 			sp++;
@@ -1193,13 +1309,14 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 
 	/* reorder into leaf order */
 	M->tri = aligned_alloc(64, nt * sizeof(*M->tri));
+	M->lb = aligned_alloc(64, nt * sizeof(*M->lb));
 	M->orig = malloc(nt * sizeof(*M->orig));
 	M->leaf_of = malloc(nt * sizeof(*M->leaf_of));
 	M->fn = malloc(nt * sizeof(*M->fn));
 	M->en = malloc(3 * nt * sizeof(*M->en));
 	M->vnt = malloc(3 * nt * sizeof(*M->vnt));
 	M->degen = malloc(nt);
-	if (!M->tri || !M->orig || !M->leaf_of || !M->fn || !M->en || !M->vnt ||
+	if (!M->tri || !M->lb || !M->orig || !M->leaf_of || !M->fn || !M->en || !M->vnt ||
 	    !M->degen)
 		goto fail;
 	M->box = px_aabb_empty();
@@ -1220,12 +1337,34 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 		M->tri[i].c = P[2];
 		M->tri[i].n = px_v3_cross(px_v3_sub(P[1], P[0]), px_v3_sub(P[2], P[0]));
 		M->tri[i].inv_nn = deg[t] ? 0.0 : 1.0 / px_v3_norm2(M->tri[i].n);
+		memset(&M->lb[i], 0, sizeof(M->lb[i]));
+		if (!deg[t]) {
+			struct tlb *L = &M->lb[i];
+			double nl = sqrt(px_v3_norm2(M->tri[i].n));
+			px_vec3 nu = px_v3_scale(M->tri[i].n, 1.0 / nl);
+			L->n[0] = (float)nu.x;
+			L->n[1] = (float)nu.y;
+			L->n[2] = (float)nu.z;
+			L->d = (float)px_v3_dot(nu, P[0]);
+			for (k = 0; k < 3; k++) {
+				px_vec3 e = px_v3_sub(P[(k + 1) % 3], P[k]), mm;
+				if (px_v3_normalize(px_v3_cross(e, nu), px_v3(0, 0, 0), &mm) != PX_OK)
+					continue;
+				L->m[k][0] = (float)mm.x;
+				L->m[k][1] = (float)mm.y;
+				L->m[k][2] = (float)mm.z;
+				L->m[k][3] = (float)px_v3_dot(mm, P[k]);
+			}
+		}
 		M->orig[i] = t;
 		M->leaf_of[t] = (uint32_t)i;
 		M->fn[i] = fn[t];
 		M->degen[i] = deg[t];
 	}
-	M->bytes = sizeof(*M) + nt * (sizeof(struct mtri) + 2 * sizeof(uint32_t) +
+	M->absmax = fmax(fmax(fabs(M->box.min.x), fabs(M->box.max.x)),
+			 fmax(fmax(fabs(M->box.min.y), fabs(M->box.max.y)),
+			      fmax(fabs(M->box.min.z), fabs(M->box.max.z))));
+	M->bytes = sizeof(*M) + nt * (sizeof(struct mtri) + sizeof(struct tlb) + 2 * sizeof(uint32_t) +
 				      7 * sizeof(px_vec3) + 1) +
 		   M->n_n4 * sizeof(struct node4);
 	if (rep->convex) {

@@ -13,7 +13,12 @@
  * single precision rounded outwards, so they stay lower bounds), then
  * collapses it to four children per node for the queries. A query then needs no memory but a fixed array on
  * the call stack: it descends nearer child first and prunes every box
- * farther than the best triangle so far; the distance to a triangle is
+ * farther than the best triangle so far. Boxes, and then each
+ * triangle's plane and edge half-planes (one cache line per triangle),
+ * are first compared in single precision with a slack that covers the
+ * rounding (so they stay lower bounds and never prune the answer); only
+ * triangles that survive get the exact double-precision test. The
+ * distance to a triangle is
  * exact over all seven Voronoi regions (face, three edges, three
  * vertices), also for collapsed or needle triangles, which are treated
  * as the segments they are.
@@ -37,7 +42,7 @@
  * u, v = barycentric weights of v1 and v2 of the closest point,
  * iterations = nodes and triangles visited, certified = 1 (exact).
  *
- * Memory and real-time rules: building allocates (setup only) about 330
+ * Memory and real-time rules: building allocates (setup only) about 390
  * bytes per triangle; queries are RT-safe (no heap, bounded by the
  * triangle count, fixed stack of 3 PX_MESH_MAX_DEPTH + 4 entries).
  */

@@ -148,9 +148,9 @@ static int gjk_reduce(struct gjk_vert *S, int *n, px_vec3 *v, px_vec3 *pa,
 /* Returns 1 with the distance and witness points, 0 when intersecting,
  * negative when a model has no support function. */
 static int gjk(const struct px_model *a, const struct px_model *b, double *dist,
-	       px_vec3 *pa, px_vec3 *pb, int *iters)
+	       px_vec3 *pa, px_vec3 *pb, int *iters, struct gjk_vert S[4],
+	       int *n_out)
 {
-	struct gjk_vert S[4];
 	px_vec3 v, sa, sb;
 	int n = 1, it, rc;
 
@@ -185,6 +185,7 @@ static int gjk(const struct px_model *a, const struct px_model *b, double *dist,
 		S[n++] = nw;
 		if (gjk_reduce(S, &n, &v, pa, pb)) {
 			*iters = it + 1;
+			*n_out = n;
 			return 0;
 		}
 		/* no progress: rounding has taken over */
@@ -192,9 +193,306 @@ static int gjk(const struct px_model *a, const struct px_model *b, double *dist,
 			break;
 	}
 	*iters = it;
+	*n_out = n;
 	*dist = px_v3_norm(v);
 	if (*dist <= 1e-15 * (1.0 + px_v3_norm(*pa)))
 		return 0;
+	return 1;
+}
+
+/* ---- exact convex penetration: EPA ------------------------------------------
+ *
+ * Expanding polytope (van den Bergen 2001): when GJK ends with the origin
+ * inside A - B, the depth is the distance from the origin to the boundary
+ * of A - B, and translating B by depth * n (n the boundary normal there)
+ * separates the pair. The polytope starts as GJK's last simplex (blown up
+ * to a tetrahedron when the origin lies on a face, edge or vertex of it),
+ * always encloses the origin and lies inside A - B; each step takes the
+ * face nearest the origin, adds the support point along its normal, and
+ * replaces the faces that point sees by a fan from its horizon. The
+ * nearest face's distance is a lower bound of the depth and the support
+ * value along its normal an upper bound; the loop stops when they agree
+ * within a relative 1e-9 (curved shapes may run out of the fixed buffers
+ * first: then the upper bound is returned and the result is flagged).
+ * Fixed arrays on the stack: no allocation.
+ */
+
+#define EPA_MAX_V 64
+#define EPA_MAX_F 160
+#define EPA_MAX_E 96
+#define EPA_REL 1e-9
+
+struct epa_face {
+	int v[3];
+	px_vec3 n; /* unit outward normal */
+	double d;  /* n . v0: distance of the plane from the origin */
+	int alive;
+};
+
+static int epa_face_make(const struct gjk_vert *V, struct epa_face *f, int a,
+			 int b, int c)
+{
+	px_vec3 n = px_v3_cross(px_v3_sub(V[b].w, V[a].w), px_v3_sub(V[c].w, V[a].w));
+	double l = px_v3_norm(n);
+	f->v[0] = a;
+	f->v[1] = b;
+	f->v[2] = c;
+	f->alive = 1;
+	if (!(l > 0.0)) {
+		/* a sliver: never the nearest, still part of the hull */
+		f->n = px_v3(0, 0, 0);
+		f->d = INFINITY;
+		return 0;
+	}
+	f->n = px_v3_scale(n, 1.0 / l);
+	f->d = px_v3_dot(f->n, V[a].w);
+	return 1;
+}
+
+/* Grow a simplex that holds the origin (GJK ended on it) to a tetrahedron
+ * by support points along directions off its affine hull. */
+static int epa_blowup(const struct px_model *a, const struct px_model *b,
+		      struct gjk_vert *V, int *n, double scale)
+{
+	static const px_vec3 axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0},
+					{0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+	double eps = 1e-9 * scale;
+	while (*n < 4) {
+		px_vec3 dirs[6];
+		int nd = 0, k, added = 0;
+		if (*n == 1) {
+			for (k = 0; k < 6; k++)
+				dirs[nd++] = axes[k];
+		} else if (*n == 2) {
+			px_vec3 e = px_v3_sub(V[1].w, V[0].w), u, w;
+			int ax = fabs(e.x) < fabs(e.y) ? (fabs(e.x) < fabs(e.z) ? 0 : 2)
+						       : (fabs(e.y) < fabs(e.z) ? 1 : 2);
+			u = px_v3_cross(e, axes[2 * ax]);
+			w = px_v3_cross(e, u);
+			dirs[nd++] = u;
+			dirs[nd++] = px_v3_neg(u);
+			dirs[nd++] = w;
+			dirs[nd++] = px_v3_neg(w);
+		} else {
+			px_vec3 nn = px_v3_cross(px_v3_sub(V[1].w, V[0].w),
+						 px_v3_sub(V[2].w, V[0].w));
+			dirs[nd++] = nn;
+			dirs[nd++] = px_v3_neg(nn);
+		}
+		for (k = 0; k < nd && !added; k++) {
+			struct gjk_vert g;
+			double off;
+			if (px_v3_norm2(dirs[k]) == 0.0)
+				continue;
+			px_model_support(a, dirs[k], &g.a);
+			px_model_support(b, px_v3_neg(dirs[k]), &g.b);
+			g.w = px_v3_sub(g.a, g.b);
+			/* distance of g.w from the current affine hull */
+			if (*n == 1) {
+				off = px_v3_dist(g.w, V[0].w);
+			} else if (*n == 2) {
+				px_vec3 e = px_v3_sub(V[1].w, V[0].w);
+				off = px_v3_norm(px_v3_cross(e, px_v3_sub(g.w, V[0].w))) /
+				      fmax(px_v3_norm(e), 1e-300);
+			} else {
+				px_vec3 nn = px_v3_cross(px_v3_sub(V[1].w, V[0].w),
+							 px_v3_sub(V[2].w, V[0].w));
+				off = fabs(px_v3_dot(nn, px_v3_sub(g.w, V[0].w))) /
+				      fmax(px_v3_norm(nn), 1e-300);
+			}
+			if (off > eps) {
+				V[(*n)++] = g;
+				added = 1;
+			}
+		}
+		if (!added)
+			return 0; /* A - B is flat here: no depth */
+	}
+	return 1;
+}
+
+/* Depth, normal (translate B by depth * normal to separate) and the
+ * witness points (pa - pb = depth * normal). Returns 1 converged, 0 when
+ * the buffers ran out (upper bound returned), -1 when no polytope could
+ * be built (flat Minkowski difference: depth 0). */
+static int epa(const struct px_model *a, const struct px_model *b,
+	       const struct gjk_vert *S, int ns, double *depth, px_vec3 *normal,
+	       px_vec3 *pa, px_vec3 *pb, int *iters)
+{
+	struct gjk_vert V[EPA_MAX_V];
+	struct epa_face F[EPA_MAX_F];
+	int E[EPA_MAX_E][2];
+	int nv = ns, nf = 0, it, k, i, best = -1, conv = 0;
+	double scale = 0.0, upper = INFINITY;
+	px_vec3 up_n = px_v3(0, 0, 1);
+
+	for (k = 0; k < ns; k++) {
+		V[k] = S[k];
+		scale = fmax(scale, px_v3_norm(S[k].w));
+	}
+	scale = fmax(scale, 1e-300);
+	if (!epa_blowup(a, b, V, &nv, scale))
+		return -1;
+	{
+		/* outward winding: each face away from the opposite vertex */
+		static const int T[4][4] = {{1, 2, 3, 0}, {0, 3, 2, 1}, {0, 1, 3, 2}, {0, 2, 1, 3}};
+		for (k = 0; k < 4; k++) {
+			int x = T[k][0], y = T[k][1], z = T[k][2], o = T[k][3];
+			px_vec3 n = px_v3_cross(px_v3_sub(V[y].w, V[x].w),
+						px_v3_sub(V[z].w, V[x].w));
+			if (px_v3_dot(n, px_v3_sub(V[o].w, V[x].w)) > 0.0) {
+				int t = y;
+				y = z;
+				z = t;
+			}
+			epa_face_make(V, &F[nf++], x, y, z);
+		}
+	}
+	for (it = 0; it < 4 * EPA_MAX_V; it++) {
+		struct gjk_vert w;
+		double h;
+		int ne = 0, slot;
+		best = -1;
+		for (k = 0; k < nf; k++)
+			if (F[k].alive && (best < 0 || F[k].d < F[best].d))
+				best = k;
+		if (best < 0 || !isfinite(F[best].d))
+			return -1;
+		px_model_support(a, F[best].n, &w.a);
+		px_model_support(b, px_v3_neg(F[best].n), &w.b);
+		w.w = px_v3_sub(w.a, w.b);
+		h = px_v3_dot(F[best].n, w.w);
+		if (h < upper) {
+			upper = h;
+			up_n = F[best].n;
+		}
+		if (h - F[best].d <= EPA_REL * fmax(F[best].d, 1e-6 * scale)) {
+			conv = 1;
+			break;
+		}
+		if (nv >= EPA_MAX_V)
+			break;
+		/* faces seen from w: removed, their boundary is the horizon */
+		for (k = 0; k < nf; k++) {
+			if (!F[k].alive)
+				continue;
+			if (k != best &&
+			    !(isfinite(F[k].d) &&
+			      px_v3_dot(F[k].n, px_v3_sub(w.w, V[F[k].v[0]].w)) > 1e-12 * scale) &&
+			    !(!isfinite(F[k].d) &&
+			      px_v3_dot(px_v3_cross(px_v3_sub(V[F[k].v[1]].w, V[F[k].v[0]].w),
+						    px_v3_sub(V[F[k].v[2]].w, V[F[k].v[0]].w)),
+					px_v3_sub(w.w, V[F[k].v[0]].w)) > 0.0))
+				continue;
+			F[k].alive = 0;
+			for (i = 0; i < 3; i++) {
+				int x = F[k].v[i], y = F[k].v[(i + 1) % 3], j, found = -1;
+				for (j = 0; j < ne; j++)
+					if (E[j][0] == y && E[j][1] == x)
+						found = j;
+				if (found >= 0) {
+					E[found][0] = E[ne - 1][0];
+					E[found][1] = E[ne - 1][1];
+					ne--;
+				} else if (ne < EPA_MAX_E) {
+					E[ne][0] = x;
+					E[ne][1] = y;
+					ne++;
+				} else {
+					goto out; /* horizon too long for the buffer */
+				}
+			}
+		}
+		V[nv] = w;
+		slot = 0;
+		for (i = 0; i < ne; i++) {
+			while (slot < nf && F[slot].alive)
+				slot++;
+			if (slot == nf) {
+				if (nf == EPA_MAX_F)
+					goto out;
+				nf++;
+			}
+			epa_face_make(V, &F[slot], E[i][0], E[i][1], nv);
+		}
+		nv++;
+	}
+out:
+	*iters += it;
+	{
+		/* witness points from the nearest face when converged, else
+		 * from the best upper bound's direction */
+		px_vec3 q;
+		double u = 0, v = 0;
+		int f, sub;
+		if (conv) {
+			const struct epa_face *fb = &F[best];
+			px_tri_closest(px_v3_scale(fb->n, fb->d), V[fb->v[0]].w, V[fb->v[1]].w,
+				       V[fb->v[2]].w, &q, &f, &sub, &u, &v);
+			*depth = fb->d;
+			*normal = fb->n;
+			*pa = px_v3_add(px_v3_scale(V[fb->v[0]].a, 1.0 - u - v),
+					px_v3_add(px_v3_scale(V[fb->v[1]].a, u),
+						  px_v3_scale(V[fb->v[2]].a, v)));
+			*pb = px_v3_madd(*pa, fb->n, -fb->d);
+			return 1;
+		}
+		px_model_support(a, up_n, pa);
+		*depth = upper;
+		*normal = up_n;
+		*pb = px_v3_madd(*pa, up_n, -upper);
+		return 0;
+	}
+}
+
+/* ---- approximate penetration: deepest point ---------------------------------
+ *
+ * For closed models without an exact method: the point of x's surface
+ * deepest inside y (most negative signed distance to y), by projected
+ * descent from a start on x: step against y's distance gradient,
+ * project back onto x, keep the step when it went deeper (the step
+ * grows after a success and halves after a failure). A local search:
+ * results are flagged approximate. Returns 1 with *d (< 0) and the
+ * points when a point of x inside y was found, 0 when none, or an error.
+ */
+#define DEEP_ITERS 40
+
+static int deepest(const struct px_model *x, const struct px_model *y,
+		   px_vec3 start, double scale, double *d, px_vec3 *px_,
+		   px_vec3 *qy, px_vec3 *dir, int *iters)
+{
+	struct px_model_result rx, ry, t;
+	double step;
+	int it, rc;
+
+	if ((rc = px_model_query(x, start, &rx)) < 0)
+		return rc;
+	if ((rc = px_model_query(y, rx.point, &ry)) < 0)
+		return rc;
+	*iters += 2;
+	if (!ry.is_signed || !(ry.distance < 0.0))
+		return 0;
+	step = fmax(-ry.distance, 1e-3 * scale);
+	for (it = 0; it < DEEP_ITERS && step > 1e-5 * scale; it++) {
+		px_vec3 target = px_v3_madd(rx.point, ry.direction, -step);
+		struct px_model_result nx;
+		if ((rc = px_model_query(x, target, &nx)) < 0)
+			return rc;
+		if ((rc = px_model_query(y, nx.point, &t)) < 0)
+			return rc;
+		*iters += 2;
+		if (t.is_signed && t.distance < ry.distance - 1e-12 * scale) {
+			rx = nx;
+			ry = t;
+			step *= 1.5;
+		} else {
+			step *= 0.5;
+		}
+	}
+	*d = ry.distance;
+	*px_ = rx.point;
+	*qy = ry.point;
+	*dir = ry.direction;
 	return 1;
 }
 
@@ -432,6 +730,8 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 	if (!a || !b || !res || starts < 1 || starts > PX_PAIR_MAX_STARTS ||
 	    max_iters < 1 || !(tol >= 0.0))
 		return PX_E_INVAL;
+	res->depth = 0.0;
+	res->depth_approx = 0;
 
 	/* Exact paths. A sphere against anything: one point query of its
 	 * centre. Two convex models with support functions: GJK. */
@@ -461,7 +761,15 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 			if (q.distance == 0.0)
 				ps = px_v3_madd(c, q.direction, -pr.a);
 			res->intersecting = d <= 0.0;
-			res->distance = d > 0.0 ? d : 0.0;
+			res->distance = d;
+			if (d < 0.0) {
+				/* the sphere's point deepest in the other model:
+				 * moving the sphere by -d along direction frees it */
+				ps = px_v3_madd(c, q.direction, -pr.a);
+				res->depth = -d;
+				res->depth_approx = !q.is_signed && q.distance == 0.0;
+				res->normal = swap ? q.direction : px_v3_neg(q.direction);
+			}
 			res->point_a = swap ? po : ps;
 			res->point_b = swap ? ps : po;
 			res->index_a = swap ? q.index : 0;
@@ -478,7 +786,8 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 	    px_model_get_ops(a)->support && px_model_get_ops(b)->support) {
 		double d = 0.0;
 		px_vec3 pa, pb;
-		int its = 0, g = gjk(a, b, &d, &pa, &pb, &its);
+		struct gjk_vert S[4];
+		int its = 0, ns = 0, g = gjk(a, b, &d, &pa, &pb, &its, S, &ns);
 		if (g > 0) {
 			/* GJK's witness points are convex combinations of
 			 * support points, whose weights lose accuracy on the thin
@@ -507,8 +816,17 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 			goto done;
 		}
 		if (g == 0) {
+			double depth = 0.0;
+			px_vec3 nrm;
+			int e = epa(a, b, S, ns, &depth, &nrm, &pa, &pb, &its);
 			res->intersecting = 1;
 			res->distance = 0.0;
+			if (e >= 0 && depth > 0.0) {
+				res->depth = depth;
+				res->distance = -depth;
+				res->normal = nrm;
+				res->depth_approx = e == 0;
+			}
 			res->point_a = pa;
 			res->point_b = pb;
 			res->index_a = res->index_b = -1;
@@ -516,7 +834,7 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 			res->starts = 0;
 			res->converged = 1;
 			res->local_only = 0;
-			goto done;
+			goto done_n;
 		}
 	}
 	memset(&best, 0, sizeof(best));
@@ -576,6 +894,45 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 	res->point_b = best.pb;
 	res->index_a = best.ia;
 	res->index_b = best.ib;
+	if (best.intersecting) {
+		/* penetration: the deepest point of either model in the other,
+		 * from the overlap found and from every seed */
+		px_aabb ba = px_model_local_aabb(a), bb = px_model_local_aabb(b);
+		double scale = fmax(finite_box(&ba) ? px_aabb_diagonal(&ba) : 0.0,
+				    finite_box(&bb) ? px_aabb_diagonal(&bb) : 0.0);
+		double dmin = 0.0;
+		int side, j;
+		scale = scale > 0.0 ? scale : 1.0;
+		for (side = 0; side < 2; side++) {
+			const struct px_model *x = side ? b : a, *y = side ? a : b;
+			/* every seed costs up to 2 DEEP_ITERS + 2 point
+			 * queries, and points deep inside a mesh are its most
+			 * expensive queries (many triangles nearly equidistant):
+			 * opt->starts trades time for the global hit rate */
+			for (j = -1; j < starts; j++) {
+				px_vec3 st = side ? best.pb : best.pa, pxx, qy, dir;
+				double dd;
+				int g;
+				if (j >= 0 && (!seed_point(x, y, j, &st) || !px_v3_isfinite(st)))
+					break;
+				g = deepest(x, y, st, scale, &dd, &pxx, &qy, &dir, &total);
+				if (g < 0)
+					return g;
+				if (g == 0 || !(dd < dmin))
+					continue;
+				dmin = dd;
+				/* pa - pb = depth * normal (see px_pair.h) */
+				res->point_a = side ? qy : pxx;
+				res->point_b = side ? pxx : qy;
+				res->normal = side ? dir : px_v3_neg(dir);
+			}
+		}
+		if (dmin < 0.0) {
+			res->depth = -dmin;
+			res->distance = dmin;
+			res->depth_approx = 1;
+		}
+	}
 	res->iterations = total;
 	res->starts = n;
 	res->converged = best.converged;
@@ -585,6 +942,14 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 			     (px_model_caps(a) & PX_MODEL_CAP_CONVEX) &&
 			     (px_model_caps(b) & PX_MODEL_CAP_CONVEX)));
 done:
+	{
+		/* apart: the way B moves away from A */
+		px_vec3 dv = px_v3_sub(res->point_b, res->point_a);
+		if (res->depth == 0.0 &&
+		    px_v3_normalize(dv, px_v3(0, 0, 0), &res->normal) != PX_OK)
+			res->normal = px_v3(0, 0, 0);
+	}
+done_n:
 	res->local_a = px_pose_inverse_transform_point(px_model_pose(a), res->point_a);
 	res->local_b = px_pose_inverse_transform_point(px_model_pose(b), res->point_b);
 	res->valid = 1;

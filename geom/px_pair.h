@@ -41,11 +41,28 @@
  *
  * Intersection: when a projection lands inside a closed model (signed
  * distance <= 0) or the distance reaches 0, the models touch or overlap:
- * intersecting = 1 and distance = 0 (penetration depth between two
- * models is not computed here).
+ * intersecting = 1, and the penetration comes out of the same call:
+ * depth > 0, distance = -depth, and normal such that translating B by
+ * depth * normal (or A by -depth * normal) separates the pair, with
+ * point_a - point_b = depth * normal. Convex pairs with support functions
+ * get the exact depth (EPA on the Minkowski difference from GJK's final
+ * simplex, fixed buffers; depth_approx = 1 only if a curved pair runs
+ * out of them, then depth is an upper bound within about 1e-3). A sphere
+ * against any closed model is exact (radius minus the signed distance of
+ * its centre). Other closed pairs (meshes, NURBS shells, the torus) get
+ * the deepest point of either model inside the other by a local descent
+ * of the signed point-to-model distance along the surface, from the
+ * overlap found and from each seed (opt->starts; depth_approx = 1: a lower bound of
+ * the deepest point's depth, which for convex shapes is itself at most
+ * the translational depth). Unsigned models (clouds, open meshes) have
+ * no inside: touching reports distance 0 and depth 0.
  *
- * Memory and real-time rules: no allocation; work bounded by
- * starts * max_iters point queries, each RT-safe. @note RT-safe.
+ * Memory and real-time rules: no allocation (GJK and EPA keep their
+ * simplex and polytope in fixed arrays on the stack, about 14 kB); work
+ * bounded by starts * max_iters point queries, plus for overlapping
+ * non-convex pairs 2 (starts + 1) (2 + 80) queries of the depth search
+ * (points deep inside a mesh are its slowest queries: budget for it, or
+ * lower starts), each RT-safe. @note RT-safe.
  */
 #ifndef PX_PAIR_H
 #define PX_PAIR_H
@@ -71,7 +88,9 @@ struct px_pair_opts {
 };
 
 struct px_pair_result {
-	double distance;     /* >= 0; 0 when intersecting */
+	/* >= 0 apart; -depth when intersecting (0 when the depth is unknown
+	 * or zero) */
+	double distance;
 	px_vec3 point_a;     /* on A, world frame */
 	px_vec3 point_b;     /* on B, world frame */
 	int index_a, index_b; /* feature indices (px_model_result.index) */
@@ -86,6 +105,12 @@ struct px_pair_result {
 	 * after a successful call. */
 	px_vec3 local_a, local_b;
 	int valid;
+	/* Penetration (intersecting): depth >= 0 and the unit normal along
+	 * which B leaves A; apart: depth 0 and normal the unit vector from
+	 * point_a to point_b (zero when they coincide). */
+	double depth;
+	px_vec3 normal;
+	int depth_approx; /* 1: depth from a local search (see above) */
 };
 
 /*

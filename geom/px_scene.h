@@ -41,7 +41,9 @@ struct px_scene; /* opaque */
 /* One answer: which model, how far, where. */
 struct px_scene_hit {
 	int model;          /* id from px_scene_add() */
-	double distance;    /* signed for point queries on closed models */
+	/* signed: point queries on closed models, and tool queries whose
+	 * pair overlaps (-penetration depth, see px_pair.h) */
+	double distance;
 	px_vec3 point;      /* on the model (world) */
 	px_vec3 tool_point; /* on the tool (tool queries), else the query point */
 	int feature_index;  /* px_model_result.index of the model */

@@ -141,18 +141,21 @@ static void check_against_brute(struct px_model *m, int nq, double spread)
 		struct px_model_result r;
 		px_vec3 v[3];
 		double ref = brute(m, pl), dt;
+		/* tolerances scale with the mesh and its place (rounding of the
+		 * pose transform) */
+		double L = 1.0 + px_v3_norm(c) + px_v3_norm(h) + px_v3_norm(P.t);
 
 		PX_CHECK_INT_EQ(px_model_query(m, pw, &r), 1);
-		PX_CHECK_MSG(fabs(fabs(r.distance) - ref) <= 1e-12 * (1 + ref),
+		PX_CHECK_MSG(fabs(fabs(r.distance) - ref) <= 1e-12 * (1 + ref) + 1e-14 * L,
 			     "query %d: %.17g vs linear scan %.17g", i, fabs(r.distance), ref);
-		PX_CHECK_NEAR(px_v3_dist(pw, r.point), fabs(r.distance), 1e-12);
-		PX_CHECK_NEAR(px_v3_dist(px_v3_madd(r.point, r.direction, r.distance), pw), 0, 1e-9);
+		PX_CHECK_NEAR(px_v3_dist(pw, r.point), fabs(r.distance), 1e-12 * L);
+		PX_CHECK_NEAR(px_v3_dist(px_v3_madd(r.point, r.direction, r.distance), pw), 0, 1e-9 * L);
 		/* the reported triangle holds the reported point */
 		PX_CHECK(r.index >= 0 && (size_t)r.index < px_mesh_triangle_count(m));
 		px_mesh_triangle(m, (size_t)r.index, v);
 		dt = px_tri_closest(px_pose_inverse_transform_point(P, r.point), v[0], v[1],
 				    v[2], NULL, NULL, NULL, NULL, NULL);
-		PX_CHECK_NEAR(sqrt(dt), 0.0, 1e-9);
+		PX_CHECK_NEAR(sqrt(dt), 0.0, 1e-9 * L);
 		PX_CHECK(r.certified);
 	}
 }
@@ -218,6 +221,82 @@ static void test_closed_vs_brute(void)
 		px_model_free(m);
 	}
 	gen_free(&g);
+}
+
+/* The single-precision bounds must stay lower bounds at every scale:
+ * tiny meshes far from the origin (float spacing larger than the mesh),
+ * huge meshes, query points beyond the float range (exact path only),
+ * and two sheets 1e-7 apart, where the bounds of both are nearly equal. */
+static void test_scales_vs_brute(void)
+{
+	static const double sc[4][2] = {{1e-5, 1e3}, {1e4, 0.0}, {1.0, 50.0}, {1e-3, 0.0}};
+	struct gen_mesh g;
+	int k, i;
+	PX_CHECK_INT_EQ(gen_torus(1.0, 0.35, 24, 12, &g), 0);
+	for (k = 0; k < 4; k++) {
+		double *xyz = malloc(3 * g.nv * sizeof(double));
+		struct px_model *m;
+		size_t j;
+		for (j = 0; j < 3 * g.nv; j++)
+			xyz[j] = g.xyz[j] * sc[k][0] + sc[k][1];
+		PX_CHECK_INT_EQ(px_mesh_model(xyz, g.nv, g.tri, g.nt, NULL, NULL, &m), PX_OK);
+		check_against_brute(m, 150, 1.5);
+		PX_CHECK_INT_EQ(px_model_set_pose(m, rand_pose()), PX_OK);
+		check_against_brute(m, 100, 1.2);
+		PX_CHECK_INT_EQ(px_model_set_pose(m, px_pose_identity()), PX_OK);
+		for (i = 0; i < 20; i++) {
+			/* beyond the float range: the exact path alone */
+			px_vec3 p = px_v3_scale(rand_v(1.0), 1e35 / fmax(sc[k][0], 1e-3));
+			struct px_model_result r;
+			double ref = brute(m, p);
+			PX_CHECK_INT_EQ(px_model_query(m, p, &r), 1);
+			PX_CHECK_MSG(fabs(fabs(r.distance) - ref) <= 1e-12 * ref, "far %.17g vs %.17g",
+				     fabs(r.distance), ref);
+		}
+		px_model_free(m);
+		free(xyz);
+	}
+	gen_free(&g);
+	{
+		/* two parallel 20 x 20 sheets 1e-7 apart, one shifted by half
+		 * a cell */
+		enum { N = 20 };
+		double *xyz = malloc(2 * (N + 1) * (N + 1) * 3 * sizeof(double));
+		uint32_t *tri = malloc(2 * 2 * N * N * 3 * sizeof(uint32_t));
+		struct px_model *m;
+		size_t nv = 0, nt = 0;
+		int sh, a, b;
+		for (sh = 0; sh < 2; sh++) {
+			size_t base = nv;
+			for (b = 0; b <= N; b++)
+				for (a = 0; a <= N; a++) {
+					xyz[3 * nv] = a * 0.05 + sh * 0.025;
+					xyz[3 * nv + 1] = b * 0.05 + sh * 0.025;
+					xyz[3 * nv + 2] = 0.3 + sh * 1e-7;
+					nv++;
+				}
+			for (b = 0; b < N; b++)
+				for (a = 0; a < N; a++) {
+					uint32_t v0 = (uint32_t)(base + (size_t)b * (N + 1) + (size_t)a);
+					uint32_t q[6] = {v0, v0 + 1, v0 + N + 2, v0, v0 + N + 2, v0 + N + 1};
+					memcpy(tri + 3 * nt, q, sizeof(q));
+					nt += 2;
+				}
+		}
+		PX_CHECK_INT_EQ(px_mesh_model(xyz, nv, tri, nt, NULL, NULL, &m), PX_OK);
+		for (i = 0; i < 300; i++) {
+			px_vec3 p = px_v3(px_rand_range(-0.1, 1.1), px_rand_range(-0.1, 1.1),
+					  0.3 + px_rand_range(-1, 1) * (i % 2 ? 1e-6 : 0.2));
+			struct px_model_result r;
+			double ref = brute(m, p);
+			PX_CHECK_INT_EQ(px_model_query(m, p, &r), 1);
+			PX_CHECK_MSG(fabs(r.distance - ref) <= 1e-12 * (1 + ref),
+				     "sheets: %.17g vs %.17g", r.distance, ref);
+		}
+		px_model_free(m);
+		free(xyz);
+		free(tri);
+	}
 }
 
 /* ---- coherence -------------------------------------------------------------- */
@@ -824,6 +903,7 @@ static void test_no_alloc(void)
 static const struct px_test tests[] = {
 	PX_T(test_tri_closest),      PX_T(test_tri_regions),
 	PX_T(test_soup_vs_brute),    PX_T(test_closed_vs_brute),
+	PX_T(test_scales_vs_brute),
 	PX_T(test_coherent),         PX_T(test_cache), PX_T(test_convex_support),         PX_T(test_sign_box_exact),
 	PX_T(test_sign_sphere_torus), PX_T(test_sign_concave), PX_T(test_sign_tetra),
 	PX_T(test_open_and_bad_topology),

@@ -134,7 +134,7 @@ static void box_shell(struct px_nurbs_surf *s, px_vec3 h, int deg, double bulge,
 /* ---- independent inside test: ray parity on a tessellation ---------------- */
 
 #define TESS 48
-#define MAX_TRI (6 * 2 * TESS * TESS)
+#define MAX_TRI (12 * 2 * TESS * TESS) /* up to twelve surfaces */
 static px_vec3 tri[MAX_TRI][3];
 static int n_tri;
 
@@ -436,6 +436,86 @@ static void test_pillow(void)
 	PX_CHECK(st.inside > 100 && st.outside > 100);
 }
 
+/* Quarter q (0..3) of the surface of revolution of a straight profile
+ * from (rho0, z0) to (rho1, z1): a rational quadratic arc along u (90
+ * degrees from q * 90), linear along v. */
+static void quarter(struct px_nurbs_surf *s, int q, double rho0, double z0,
+		    double rho1, double z1)
+{
+	static const double ku[6] = {0, 0, 0, 1, 1, 1}, kv[4] = {0, 0, 1, 1};
+	const double r2 = sqrt(0.5), prof[2][2] = {{rho0, z0}, {rho1, z1}};
+	double xyz[3 * 6], w[6];
+	int i, j;
+	for (j = 0; j < 2; j++)
+		for (i = 0; i < 3; i++) {
+			int k = j * 3 + i, ci = 2 * q + i;
+			xyz[3 * k] = prof[j][0] * circ[ci][0];
+			xyz[3 * k + 1] = prof[j][0] * circ[ci][1];
+			xyz[3 * k + 2] = prof[j][1];
+			w[k] = circ[ci][2] ? 1.0 : r2;
+		}
+	PX_CHECK_INT_EQ(px_nurbs_surf_init(s, &arena, 2, 1, 3, 2, ku, 6, kv, 4, xyz, w, NULL),
+			PX_OK);
+}
+
+/* A capped cylinder of twelve patches (four quarters each for the side
+ * and the two caps): four patches meet at each of the eight rim
+ * vertices, the rims are curved edges between a side and a cap patch,
+ * four cap patches share the centre. Random points around the rim
+ * vertices, along the rims and the side seams at several scales, against
+ * the exact inside test, and a sample checked against ray parity on a
+ * dense tessellation as well. */
+static void test_capped_cylinder(void)
+{
+	struct px_nurbs_surf s[12];
+	struct px_model *m;
+	struct stats st = {0, 0};
+	const double r = 0.4, h = 0.6;
+	int q, i, agree = 0, compared = 0;
+	uint64_t a;
+	arena_reset();
+	for (q = 0; q < 4; q++) {
+		quarter(&s[q], q, r, -h, r, h);     /* side, outward */
+		quarter(&s[4 + q], q, r, h, 0, h);  /* top, +z */
+		quarter(&s[8 + q], q, 0, -h, r, -h); /* bottom, -z */
+	}
+	PX_CHECK_INT_EQ(px_nurbs_model_create(NULL, 0, s, 12, NULL, &m), PX_OK);
+	check_closed(m, M_PI * r * r * 2 * h, 1e-9);
+	tessellate(s, 12);
+	a = px_alloc_region_begin();
+	for (i = 0; i < 480; i++) {
+		double sc = i % 4 == 0 ? 1e-7 : i % 4 == 1 ? 1e-4 : i % 4 == 2 ? 1e-2 : 0.1;
+		double ang = i % 8 < 4 ? 0.5 * M_PI * (i % 8) : px_rand_range(0, 2 * M_PI);
+		double z = (i / 8) % 3 == 2 ? px_rand_range(-h, h) : ((i / 8) % 3 ? h : -h);
+		px_vec3 base = px_v3(r * cos(ang), r * sin(ang), z);
+		px_vec3 x = px_v3_madd(base, px_v3(px_rand_normal(), px_rand_normal(), px_rand_normal()), sc);
+		double rho = hypot(x.x, x.y);
+		int in = rho < r && fabs(x.z) < h;
+		/* (i / 8) % 3 == 2: along a side seam at a quarter angle, or
+		 * anywhere on the side; else a rim vertex or a rim point */
+		check_point(m, x, in, &st);
+		if (sc >= 1e-2 && px_model_query(m, x, &(struct px_model_result){0}) == 1) {
+			struct px_model_result ru;
+			px_model_query_ex(m, x, INFINITY, -1, PX_QUERY_UNSIGNED, &ru);
+			/* the tessellation's chords cut inside the curved side
+			 * by r (1 - cos(pi / 4 / TESS)): compare beyond that */
+			if (ru.distance > 2.0 * r * (1.0 - cos(M_PI / 4 / TESS)) + 1e-6) {
+				int pin = parity_inside(x);
+				if (pin >= 0) {
+					compared++;
+					agree += pin == in;
+				}
+			}
+		}
+	}
+	PX_CHECK_INT_EQ(px_alloc_region_end(a), 0);
+	px_model_free(m);
+	printf("    capped cylinder: %d inside, %d outside; ray parity agrees on %d of %d\n",
+	       st.inside, st.outside, agree, compared);
+	PX_CHECK(st.inside > 100 && st.outside > 100);
+	PX_CHECK(compared > 50 && agree == compared);
+}
+
 /* Bilinear quad with corners c0..c3 counterclockwise seen from the side
  * Su x Sv points to. */
 static void quad(struct px_nurbs_surf *s, px_vec3 c0, px_vec3 c1, px_vec3 c2, px_vec3 c3)
@@ -592,6 +672,7 @@ static const struct px_test tests[] = {
 	PX_T(test_box),
 	PX_T(test_pillow),
 	PX_T(test_l_prism),
+	PX_T(test_capped_cylinder),
 	PX_T(test_unsigned_cases),
 	PX_T(test_on_surface_and_pose),
 };
