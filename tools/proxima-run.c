@@ -24,17 +24,26 @@
  * PX_RUN_ALLOC_PROBE=1 in the environment makes cycle 10 allocate and
  * free once on purpose: the count is then 2 (a self-check for tests).
  *
- * Devices driven: simulated haptic and pose devices (haptic rendering or
- * mode none), and a CANopen arm on the in-process simulated CAN bus
- * (collision avoidance; the drives' side is stepped in the read phase as
- * another node on the bus). The `sim` section adds fault campaigns and
- * the avoidance demo's nominal task.
+ * Devices: the simulated haptic and pose devices are made here (they
+ * take the `sim` section's fault campaign); every other back end is
+ * opened through px_devcfg (hidapi, libusb, SocketCAN signals and CANopen
+ * drives, libgpiod, simulated lines), so the cycle sees only px_dev and
+ * the CANopen master, never a back end. Each cycle reads every pose
+ * device and e-stop line (a pressed one trips safe state), computes
+ * (haptic rendering on control.device, or avoidance on the CANopen arm),
+ * and writes the force, the drives' targets (held still without
+ * avoidance; quick stop in safe state), the enable relay (off in safe
+ * state) and the timing toggle. A CANopen arm on the in-process
+ * simulated bus gets its drives' side here, stepped in the read phase as
+ * another node on the bus would answer.
  *
- * Exit status: 0 ok, 1 invalid config or setup failure, 2 usage error or
- * a configuration this runner does not drive yet (hardware back ends).
+ * Exit status: 0 ok, 1 invalid config or setup failure (an absent device
+ * is named with the back end's reason), 2 usage error or --virtual-time
+ * with hardware.
  */
 #include <errno.h>
 #include <math.h>
+#include <poll.h>
 #include <pthread.h>
 #include <signal.h>
 #include <stdatomic.h>
@@ -42,6 +51,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -52,6 +63,7 @@
 #include "px_config.h"
 #include "px_control.h"
 #include "px_dev.h"
+#include "px_devcfg.h"
 #include "px_loop.h"
 #include "px_ring.h"
 #include "px_world.h"
@@ -75,9 +87,8 @@ static const char usage_text[] =
 	"                     plots go next to it as <stem>_time.svg and "
 	"<stem>_latency.svg\n"
 	"  --help             this text\n"
-	"Exit status: 0 ok, 1 invalid config or setup failure, 2 usage error "
-	"or\n"
-	"a configuration this runner does not drive.\n";
+	"Exit status: 0 ok, 1 invalid config or setup failure (e.g. a device\n"
+	"absent), 2 usage error or --virtual-time with hardware devices.\n";
 
 static int usage_error(const char *fmt, const char *arg)
 {
@@ -206,6 +217,7 @@ struct raw_sim {
 	size_t n_faults;
 	struct raw_nominal *nominal;
 	size_t n_nominal;
+	const char *spawn_arm; /* a socketcan device on transport unix */
 	const struct px_config *cfg_; /* not a key: context for the check */
 };
 
@@ -249,6 +261,50 @@ static const struct px_config_schema fault_schema = {
 	"fault", fault_keys, sizeof(fault_keys) / sizeof(fault_keys[0]),
 	fault_check};
 
+/* sim.spawn_arm: proxima-simarm plays drives 1..N (node i + 1 is joint
+ * i), all in one mode, at 100000 counts per rad, so the device's drive
+ * table must be exactly that. */
+static void spawn_arm_check(struct px_config_reader *r,
+			    const struct px_config_node *map,
+			    const struct raw_sim *sm)
+{
+	const struct px_config_node *at = px_config_node_get(map, "spawn_arm");
+	const struct px_config_device *d =
+		px_config_device_find(sm->cfg_, sm->spawn_arm);
+	const struct px_config_canopen *co;
+	size_t i;
+	if (!d) {
+		px_config_reader_error(r, at, "spawn_arm",
+				       "no device named '%s' in devices",
+				       sm->spawn_arm);
+		return;
+	}
+	co = &d->socketcan.canopen;
+	if (d->backend != PX_CONFIG_BACKEND_SOCKETCAN ||
+	    d->socketcan.transport != PX_CONFIG_CAN_UNIX || !co->present ||
+	    co->n_drives == 0) {
+		px_config_reader_error(r, at, "spawn_arm",
+				       "'%s' is not a socketcan device with "
+				       "transport unix and canopen drives",
+				       sm->spawn_arm);
+		return;
+	}
+	for (i = 0; i < co->n_drives; i++) {
+		const struct px_config_canopen_drive *v = &co->drives[i];
+		if (v->node_id != (int64_t)i + 1 || v->joint != (int64_t)i ||
+		    v->mode != co->drives[0].mode ||
+		    !v->has_counts_per_unit || v->counts_per_unit != 100000.0) {
+			px_config_reader_error(
+				r, at, "spawn_arm",
+				"proxima-simarm plays drives with node ids 1..N "
+				"on joints 0..N-1, one mode, counts_per_unit "
+				"100000; drives[%zu] of '%s' differs",
+				i, sm->spawn_arm);
+			return;
+		}
+	}
+}
+
 static void sim_check(struct px_config_reader *r,
 		      const struct px_config_node *map, void *obj)
 {
@@ -256,6 +312,8 @@ static void sim_check(struct px_config_reader *r,
 	const struct px_config_node *seq = px_config_node_get(map, "faults");
 	size_t i;
 	char where[48];
+	if (sm->spawn_arm)
+		spawn_arm_check(r, map, sm);
 	for (i = 0; i < sm->n_faults; i++) {
 		const struct raw_fault *f = &sm->faults[i];
 		const struct px_config_node *it =
@@ -311,6 +369,9 @@ static const struct px_config_key sim_keys[] = {
 	 .offset = offsetof(struct raw_sim, nominal), .sub = &nominal_schema,
 	 .elem = PX_CONFIG_T_SUB, .elem_size = sizeof(struct raw_nominal),
 	 .count_offset = offsetof(struct raw_sim, n_nominal), .max_count = 64},
+	{.name = "spawn_arm", .type = PX_CONFIG_T_STRING,
+	 .offset = offsetof(struct raw_sim, spawn_arm),
+	 .flags = PX_CONFIG_NONEMPTY},
 };
 static const struct px_config_schema sim_schema = {
 	"sim", sim_keys, sizeof(sim_keys) / sizeof(sim_keys[0]), sim_check};
@@ -347,6 +408,20 @@ struct app {
 	struct px_codec_buttons *buttons[MAX_DEVS];
 	struct px_codec_map codec[MAX_DEVS];
 	int n_dev;
+	/* devices opened through px_devcfg (every back end but the
+	 * simulated haptic/pose devices, which take the sim section's
+	 * faults): the handles own their devices */
+	struct px_devcfg *dcfg[MAX_DEVS];
+	int n_dcfg;
+	int dev_owned[MAX_DEVS]; /* dev[i] is freed by px_dev_free here */
+	struct px_dev *dio[MAX_DEVS]; /* digital I/O: e-stop, enable, timing */
+	int n_dio;
+	int estop_pressed, timing_level, hardware;
+	uint64_t estop_presses, estop_cycles, enable_errors;
+	int64_t estop_first_ns, safe_first_after_estop_ns;
+	uint64_t estop_first_cycle, safe_first_cycle_after_estop;
+	uint64_t safe_cycles_before_estop;
+	int safe_at_estop;      /* the loop was in safe state at the press */
 	int ctl_dev;          /* index of control.device, -1 none */
 	int rendering;        /* mode haptic */
 	struct px_force_cmd cmd;
@@ -383,12 +458,16 @@ struct app {
 	uint64_t faults_popped;
 	struct tele last;
 	int have_last;
-	/* avoidance: a CANopen arm on the in-process simulated CAN bus */
+	/* a CANopen arm: the master from px_devcfg on any transport; on the
+	 * in-process simulated bus the drives' side (arm) runs here too */
 	int avoiding;
+	const char *co_name;
 	struct px_can_sim *canbus;
-	struct px_can_bus *ep_master, *ep_arm;
+	struct px_can_bus *ep_arm;
 	struct px_canopen *co;
 	struct px_canopen_sim *arm;
+	uint64_t enabled_cycles, drive_problem_cycles;
+	pid_t arm_pid;          /* proxima-simarm spawned by sim.spawn_arm */
 	int arm_input;          /* loop input index of the drives' feedback */
 	int n_drives;
 	int drive_joint[PX_CANOPEN_MAX_DRIVES];
@@ -439,12 +518,13 @@ static int phase_read(struct px_loop *l, const struct px_loop_cycle *c,
 		a->heap_base = heap_count();
 		a->t0_ns = c->read_ns;
 	}
-	if (a->canbus) {
+	if (a->co) {
 		int64_t newest = 0;
 		int have = a->n_drives > 0;
-		/* the robot's side of the bus first, as another process would
-		 * have answered the last SYNC by now */
-		px_canopen_sim_step(a->arm, c->read_ns);
+		/* on the in-process bus, the robot's side first, as another
+		 * process would have answered the last SYNC by now */
+		if (a->arm)
+			px_canopen_sim_step(a->arm, c->read_ns);
 		px_canopen_rx(a->co, c->read_ns);
 		for (i = 0; i < a->n_drives; i++) {
 			struct px_canopen_drive_status ds;
@@ -463,10 +543,44 @@ static int phase_read(struct px_loop *l, const struct px_loop_cycle *c,
 			px_loop_input_stamp(l, a->arm_input, newest);
 		}
 		a->enabled = px_canopen_all_enabled(a->co);
+		if (a->enabled)
+			a->enabled_cycles++;
+		/* a drive lost (heartbeat timeout) or in fault: safe state,
+		 * held while the problem lasts */
+		if (px_canopen_first_problem(a->co) >= 0) {
+			a->drive_problem_cycles++;
+			px_loop_trip(l);
+		}
 	}
 	for (i = 0; i < a->n_dev; i++) {
-		int rc = px_dev_pose_read(a->dev[i], c->read_ns, &a->sample[i]);
+		int rc;
+		if (!(px_dev_caps(a->dev[i]) & PX_DEV_CAP_POSE))
+			continue;
+		rc = px_dev_pose_read(a->dev[i], c->read_ns, &a->sample[i]);
 		(void)rc; /* staleness reaches the watchdog through the stamp */
+	}
+	{
+		/* e-stop lines: a pressed (or unreadable) one trips the loop
+		 * inside px_dev_estop_read (px_dev_attach), every cycle it is
+		 * held, so safe state cannot be left while it is */
+		int any = 0;
+		for (i = 0; i < a->n_dio; i++) {
+			int p = 0;
+			int rc = px_dev_estop_read(a->dio[i], c->read_ns, &p);
+			if (rc != PX_E_UNSUPPORTED && p)
+				any = 1;
+		}
+		if (any && !a->estop_pressed) {
+			a->estop_presses++;
+			if (a->estop_first_ns < 0) {
+				a->estop_first_ns = c->read_ns;
+				a->estop_first_cycle = c->index;
+				a->safe_at_estop = c->safe;
+			}
+		}
+		if (any)
+			a->estop_cycles++;
+		a->estop_pressed = any;
 	}
 	if (a->ctl_dev >= 0) {
 		const struct px_pose_sample *s = &a->sample[a->ctl_dev];
@@ -582,9 +696,33 @@ static int phase_write(struct px_loop *l, const struct px_loop_cycle *c,
 		    PX_OK)
 			a->write_errors++;
 	}
-	if (a->canbus) {
+	if (a->n_dio) {
 		int i;
-		if (c->safe) /* hold where the arm is; drives to quick stop */
+		if (c->safe && a->estop_first_ns >= 0 &&
+		    a->safe_first_after_estop_ns < 0) {
+			a->safe_first_after_estop_ns = c->write_ns;
+			a->safe_first_cycle_after_estop = c->index;
+		}
+		if (c->safe && a->estop_first_ns < 0)
+			a->safe_cycles_before_estop++;
+		/* enable relay: on while the loop runs outside safe state;
+		 * timing line: toggles every cycle (scope probe) */
+		a->timing_level = !a->timing_level;
+		for (i = 0; i < a->n_dio; i++) {
+			int rc = px_dev_dio_write(a->dio[i], PX_DIO_ENABLE, !c->safe,
+						  c->write_ns);
+			if (rc != PX_OK && rc != PX_E_UNSUPPORTED)
+				a->enable_errors++;
+			(void)px_dev_dio_write(a->dio[i], PX_DIO_TIMING,
+					       a->timing_level, c->write_ns);
+		}
+	}
+	if (a->co) {
+		int i;
+		/* safe state: hold where the arm is, drives to quick stop;
+		 * without avoidance (an arm beside a haptic device) the
+		 * drives are enabled and hold still */
+		if (c->safe || !a->avoiding)
 			for (i = 0; i < PX_CONTROL_MAX_JOINTS; i++)
 				a->targets[i] = a->csp ? a->q[i] : 0.0;
 		if (px_canopen_tx(a->co, c->write_ns, a->targets,
@@ -736,79 +874,114 @@ static const struct px_codec_map *make_codec(int k, const struct px_config_codec
 	return m;
 }
 
-/* A CANopen arm on the in-process simulated CAN bus: the master (the
- * controller's side) on one endpoint, the simulated drives (the robot's
- * side, stepped in the read phase as if it were another process on the
- * bus) on the other. Returns 0 or 1 (said why). */
-static int make_can_arm(const struct px_config_device *d)
+/* A device through px_devcfg (every back end but the simulated
+ * haptic/pose devices): hidapi, libusb, SocketCAN signals and CANopen
+ * drives on any transport, libgpiod and simulated lines. A CANopen arm on
+ * the in-process simulated bus gets its drives' side here as well (the
+ * same drive table and PDO layouts as the master), stepped in the read
+ * phase. Returns 0 or 1 (said why, naming the device). */
+static int make_devcfg(int k)
 {
-	const struct px_config_canopen *c = &d->socketcan.canopen;
-	struct px_canopen_drive_cfg drv[PX_CANOPEN_MAX_DRIVES];
-	struct px_canopen_config mc;
-	struct px_canopen_sim_config sc;
-	struct px_can_sim_config bc;
-	char msg[256] = "";
-	size_t i;
-	int rc;
-	if (A.canbus) {
-		fprintf(stderr, "proxima-run: device '%s': one simulated CAN arm "
-				"per run\n",
-			d->name);
+	const struct px_config_device *d = &A.cfg->devices[k];
+	struct px_devcfg *h;
+	struct px_dev *dev;
+	struct px_canopen *co;
+	char msg[512] = "";
+	int rc, i;
+	rc = px_devcfg_open(A.cfg, d, NULL, &h, msg, sizeof(msg));
+	if (rc != PX_OK) {
+		fprintf(stderr, "proxima-run: %s\n",
+			msg[0] ? msg : px_strerror(rc));
+		if (d->backend != PX_CONFIG_BACKEND_SIM)
+			fprintf(stderr,
+				"proxima-run: is the hardware connected and "
+				"readable? build/bin/proxima-probe lists what "
+				"this machine has\n");
 		return 1;
 	}
-	memset(drv, 0, sizeof(drv));
-	for (i = 0; i < c->n_drives && i < PX_CANOPEN_MAX_DRIVES; i++) {
-		drv[i].node_id = (uint8_t)c->drives[i].node_id;
-		drv[i].mode = PX_CIA402_CSP + c->drives[i].mode;
-		drv[i].joint = (int)c->drives[i].joint;
-		A.drive_joint[i] = drv[i].joint;
-		drv[i].counts_per_unit = 100000.0; /* as proxima-simarm */
-		drv[i].rated_torque_n_m = 1.0;
-		if (drv[i].mode == PX_CIA402_CST) {
-			fprintf(stderr, "proxima-run: device '%s': drives in cst "
-					"take torques; avoidance commands csp or "
-					"csv\n",
-				d->name);
+	A.dcfg[A.n_dcfg++] = h;
+	dev = px_devcfg_dev(h);
+	if (dev) {
+		if (A.n_dev >= MAX_DEVS) {
+			fprintf(stderr, "proxima-run: more than %d devices\n",
+				MAX_DEVS);
 			return 1;
 		}
+		if (px_dev_caps(dev) & PX_DEV_CAP_DIO)
+			A.dio[A.n_dio++] = dev;
+		if ((px_dev_caps(dev) & PX_DEV_CAP_POSE) && A.ctl.device &&
+		    strcmp(A.ctl.device, d->name) == 0)
+			A.ctl_dev = A.n_dev;
+		A.dev[A.n_dev++] = dev;
 	}
-	A.n_drives = (int)i;
-	A.csp = A.n_drives > 0 && drv[0].mode == PX_CIA402_CSP;
-	px_can_sim_config_default(&bc);
-	rc = px_can_sim_create(&bc, &A.canbus);
-	if (rc == PX_OK)
-		rc = px_can_sim_endpoint(A.canbus, &A.ep_master);
-	if (rc == PX_OK)
-		rc = px_can_sim_endpoint(A.canbus, &A.ep_arm);
-	if (rc == PX_OK) {
-		px_canopen_config_default(&mc);
-		mc.sync = 1;
-		mc.heartbeat_period_ns = c->heartbeat_period_ns;
-		mc.heartbeat_timeout_ns = c->heartbeat_timeout_ns;
-		mc.drives = drv;
-		mc.n_drives = (size_t)A.n_drives;
-		rc = px_canopen_create(&mc, A.ep_master, &A.co, msg, sizeof(msg));
+	co = px_devcfg_canopen(h);
+	if (co) {
+		struct px_canopen_drive_cfg drv[PX_CANOPEN_MAX_DRIVES];
+		int n = px_devcfg_drives(h, drv, PX_CANOPEN_MAX_DRIVES);
+		if (A.co) {
+			fprintf(stderr,
+				"proxima-run: device '%s': a second CANopen "
+				"arm ('%s' is the first); one per run\n",
+				d->name, A.co_name);
+			return 1;
+		}
+		if (n < 0) {
+			fprintf(stderr, "proxima-run: device '%s': drives: %s\n",
+				d->name, px_strerror(n));
+			return 1;
+		}
+		A.co = co;
+		A.co_name = d->name;
+		A.n_drives = n;
+		for (i = 0; i < n; i++) {
+			A.drive_joint[i] = drv[i].joint;
+			if (drv[i].mode == PX_CIA402_CST) {
+				fprintf(stderr,
+					"proxima-run: device '%s': drives in cst "
+					"take torques; proxima-run commands csp "
+					"or csv\n",
+					d->name);
+				return 1;
+			}
+		}
+		A.csp = n > 0 && drv[0].mode == PX_CIA402_CSP;
+		A.canbus = px_devcfg_can_sim(h);
+		if (A.canbus) {
+			struct px_canopen_sim_config sc;
+			memset(&sc, 0, sizeof(sc));
+			sc.pdo = px_devcfg_pdo(h);
+			sc.drives = drv;
+			sc.n_drives = (size_t)n;
+			sc.heartbeat_period_ns = 100000000;
+			sc.inertia_kg_m2 = 0.01;
+			rc = px_can_sim_endpoint(A.canbus, &A.ep_arm);
+			if (rc == PX_OK)
+				rc = px_canopen_sim_create(&sc, A.ep_arm, &A.arm);
+			if (rc != PX_OK) {
+				fprintf(stderr,
+					"proxima-run: device '%s': simulated arm "
+					"on the in-process bus: %s\n",
+					d->name, px_strerror(rc));
+				return 1;
+			}
+		}
+		if (A.ctl.device && strcmp(A.ctl.device, d->name) == 0)
+			A.avoiding = A.ctl.mode == PX_CONTROL_MODE_AVOIDANCE;
 	}
-	if (rc == PX_OK) {
-		memset(&sc, 0, sizeof(sc));
-		sc.drives = drv;
-		sc.n_drives = (size_t)A.n_drives;
-		sc.heartbeat_period_ns = 100000000;
-		sc.inertia_kg_m2 = 0.01;
-		rc = px_canopen_sim_create(&sc, A.ep_arm, &A.arm);
-	}
-	if (rc != PX_OK) {
-		fprintf(stderr, "proxima-run: device '%s': %s\n", d->name,
-			msg[0] ? msg : px_strerror(rc));
-		return 1;
-	}
-	if (A.ctl.device && strcmp(A.ctl.device, d->name) == 0)
-		A.avoiding = A.ctl.mode == PX_CONTROL_MODE_AVOIDANCE;
 	return 0;
 }
 
-/* Create device k of the config. Returns 0, 1 (setup failed: said why)
- * or 2 (back end this runner does not drive). */
+/* A device that is not simulated in this process (hardware, or a CAN bus
+ * shared with another process) runs on the real clock only. */
+static int is_hardware(const struct px_config_device *d)
+{
+	return d->backend != PX_CONFIG_BACKEND_SIM &&
+	       !(d->backend == PX_CONFIG_BACKEND_SOCKETCAN &&
+		 d->socketcan.transport == PX_CONFIG_CAN_SIM);
+}
+
+/* Create device k of the config. Returns 0 or 1 (setup failed: said
+ * why). */
 static int make_device(int k)
 {
 	const struct px_config_device *d = &A.cfg->devices[k];
@@ -819,20 +992,8 @@ static int make_device(int k)
 	char msg[256] = "";
 	size_t i;
 	int rc;
-	if (d->backend == PX_CONFIG_BACKEND_SOCKETCAN &&
-	    d->socketcan.transport == PX_CONFIG_CAN_SIM &&
-	    d->socketcan.canopen.present)
-		return make_can_arm(d);
-	if (d->backend != PX_CONFIG_BACKEND_SIM) {
-		fprintf(stderr,
-			"proxima-run: device '%s': back end %s is not driven "
-			"by proxima-run in this version (only sim); check the "
-			"file with --check\n",
-			d->name, px_config_backend_names()[d->backend]);
-		return 2;
-	}
-	if (s->kind == PX_CONFIG_SIM_GPIO)
-		return 0; /* simulated lines: nothing in the cycle uses them */
+	if (d->backend != PX_CONFIG_BACKEND_SIM || s->kind == PX_CONFIG_SIM_GPIO)
+		return make_devcfg(k);
 	px_dev_config_default(&dc);
 	dc.name = d->name;
 	dc.stale_timeout_ns = d->stale_timeout_ns
@@ -909,8 +1070,108 @@ static int make_device(int k)
 	}
 	if (A.ctl.device && strcmp(A.ctl.device, d->name) == 0)
 		A.ctl_dev = A.n_dev;
+	A.dev_owned[A.n_dev] = 1;
 	A.n_dev++;
 	return 0;
+}
+
+/* sim.spawn_arm: start proxima-simarm (next to this program) as the
+ * drives' side of the unix-socket bus, as a second process, and wait
+ * until it has bound its socket. It gets SIGTERM when this process ends
+ * (teardown, or PR_SET_PDEATHSIG if this one dies). Returns 0 or 1. */
+static int spawn_arm(void)
+{
+	const struct px_config_device *d =
+		px_config_device_find(A.cfg, A.sim.spawn_arm);
+	const struct px_config_socketcan *c = &d->socketcan;
+	char exe[1024], local[160], n[16], line[256] = "";
+	const char *mode = c->canopen.drives[0].mode == PX_CONFIG_CIA402_CSV
+				   ? "csv"
+				   : "csp";
+	int fds[2];
+	ssize_t len = readlink("/proc/self/exe", exe, sizeof(exe) - 32);
+	char *slash;
+	size_t got = 0;
+	int64_t until;
+	if (len <= 0 || !(slash = memrchr(exe, '/', (size_t)len))) {
+		fprintf(stderr, "proxima-run: sim.spawn_arm: cannot find this "
+				"program's directory\n");
+		return 1;
+	}
+	strcpy(slash + 1, "proxima-simarm");
+	if (access(exe, X_OK) != 0) {
+		fprintf(stderr, "proxima-run: sim.spawn_arm: %s: %s (make builds "
+				"it)\n",
+			exe, strerror(errno));
+		return 1;
+	}
+	snprintf(local, sizeof(local), "%s.peer", c->socket_path);
+	snprintf(n, sizeof(n), "%zu", c->canopen.n_drives);
+	if (pipe(fds) != 0) {
+		fprintf(stderr, "proxima-run: sim.spawn_arm: pipe: %s\n",
+			strerror(errno));
+		return 1;
+	}
+	fflush(NULL);
+	A.arm_pid = fork();
+	if (A.arm_pid < 0) {
+		fprintf(stderr, "proxima-run: sim.spawn_arm: fork: %s\n",
+			strerror(errno));
+		close(fds[0]);
+		close(fds[1]);
+		return 1;
+	}
+	if (A.arm_pid == 0) {
+		/* the arm goes when the controller goes */
+		prctl(PR_SET_PDEATHSIG, SIGTERM);
+		dup2(fds[1], 1);
+		close(fds[0]);
+		close(fds[1]);
+		execl(exe, "proxima-simarm", "--unix", local, c->socket_path,
+		      "--drives", n, "--mode", mode, (char *)NULL);
+		fprintf(stderr, "proxima-run: sim.spawn_arm: %s: %s\n", exe,
+			strerror(errno));
+		_exit(127);
+	}
+	close(fds[1]);
+	/* its first line says the socket is bound: wait for it (5 s) */
+	until = mono_ns() + 5000000000;
+	while (got + 1 < sizeof(line) && !memchr(line, '\n', got)) {
+		struct pollfd p = {fds[0], POLLIN, 0};
+		int64_t left = until - mono_ns();
+		ssize_t r;
+		if (left <= 0 || poll(&p, 1, (int)(left / 1000000) + 1) <= 0)
+			break;
+		r = read(fds[0], line + got, sizeof(line) - 1 - got);
+		if (r <= 0)
+			break;
+		got += (size_t)r;
+		line[got] = '\0';
+	}
+	close(fds[0]);
+	if (!strstr(line, "drives on")) {
+		int st = 0;
+		kill(A.arm_pid, SIGTERM);
+		waitpid(A.arm_pid, &st, 0);
+		A.arm_pid = 0;
+		fprintf(stderr,
+			"proxima-run: sim.spawn_arm: %s did not start (exit "
+			"status %d)\n",
+			exe, WIFEXITED(st) ? WEXITSTATUS(st) : -1);
+		return 1;
+	}
+	fprintf(stderr, "proxima-run: spawned %s (pid %d): %zu drives on %s\n",
+		exe, (int)A.arm_pid, c->canopen.n_drives, c->socket_path);
+	return 0;
+}
+
+static void stop_arm(void)
+{
+	if (A.arm_pid > 0) {
+		kill(A.arm_pid, SIGTERM);
+		waitpid(A.arm_pid, NULL, 0);
+		A.arm_pid = 0;
+	}
 }
 
 static int report_config(int rc, const struct px_config_diag *diag)
@@ -933,6 +1194,8 @@ static int setup(void)
 	int i, rc;
 
 	A.ctl_dev = -1;
+	A.estop_first_ns = -1;
+	A.safe_first_after_estop_ns = -1;
 	A.clock0_ns = A.o.virtual_time ? 0 : mono_ns();
 	A.min_distance_m = INFINITY;
 	A.min_proxy_distance_m = INFINITY;
@@ -942,6 +1205,21 @@ static int setup(void)
 	if (rc != PX_OK)
 		return report_config(rc, &diag);
 	px_world_control_query(A.scene, &A.query);
+	for (i = 0; i < (int)cfg->n_devices; i++) {
+		if (!is_hardware(&cfg->devices[i]))
+			continue;
+		A.hardware = 1;
+		if (A.o.virtual_time) {
+			fprintf(stderr,
+				"proxima-run: device '%s' (%s): --virtual-time "
+				"drives simulated devices only; hardware and "
+				"buses shared with other processes run on the "
+				"real clock\n",
+				cfg->devices[i].name,
+				px_config_backend_names()[cfg->devices[i].backend]);
+			return 2;
+		}
+	}
 	for (i = 0; i < (int)cfg->n_devices && i < MAX_DEVS; i++) {
 		rc = make_device(i);
 		if (rc)
@@ -949,11 +1227,13 @@ static int setup(void)
 	}
 	if (A.ctl.mode == PX_CONTROL_MODE_AVOIDANCE && !A.avoiding) {
 		fprintf(stderr,
-			"proxima-run: control mode 'avoidance' is driven by "
-			"proxima-run only on a CANopen arm on the simulated CAN "
-			"bus (socketcan transport sim) in this version\n");
-		return 2;
+			"proxima-run: control mode 'avoidance' needs "
+			"control.device '%s' to be a socketcan device with "
+			"canopen drives\n",
+			A.ctl.device ? A.ctl.device : "");
+		return 1;
 	}
+
 	A.min_clearance_m = INFINITY;
 	A.min_scale = 1.0;
 	A.rendering = A.ctl.mode == PX_CONTROL_MODE_HAPTIC && A.ctl_dev >= 0;
@@ -1017,16 +1297,21 @@ static int setup(void)
 		if (rc >= 0 && A.rendering && i == A.ctl_dev)
 			rc = px_dev_force_attach(A.dev[i], A.loop, &A.cmd);
 		if (rc < 0) {
-			fprintf(stderr, "proxima-run: device '%s': %s\n",
-				px_dev_name(A.dev[i]), px_strerror(rc));
+			struct px_dev_status ds;
+			ds.last_msg[0] = '\0';
+			px_dev_status(A.dev[i], &ds);
+			fprintf(stderr, "proxima-run: device '%s': %s%s%s\n",
+				px_dev_name(A.dev[i]), px_strerror(rc),
+				ds.last_msg[0] ? ": " : "", ds.last_msg);
 			return 1;
 		}
 	}
-	if (A.avoiding) {
-		const struct px_config_device *d = px_config_device_find(cfg, A.ctl.device);
+	if (A.co) {
+		/* the drives' feedback (TPDO1) is a watched input like a pose */
+		const struct px_config_device *d = px_config_device_find(cfg, A.co_name);
 		int64_t tmo = d && d->stale_timeout_ns ? d->stale_timeout_ns
 						       : cfg->safety.watchdog.device_timeout_ns;
-		A.arm_input = px_loop_input_add(A.loop, A.ctl.device, tmo);
+		A.arm_input = px_loop_input_add(A.loop, A.co_name, tmo);
 		if (A.arm_input < 0) {
 			fprintf(stderr, "proxima-run: arm watchdog: %s\n",
 				px_strerror(A.arm_input));
@@ -1050,24 +1335,29 @@ static int setup(void)
 	if (A.o.duration_s > 0)
 		A.max_cycles = (uint64_t)ceil(A.o.duration_s * 1e9 /
 					      (double)cfg->loop.period_ns);
+	if (A.sim.spawn_arm && spawn_arm())
+		return 1;
 	return 0;
 }
 
 static void teardown(void)
 {
 	int i;
+	stop_arm();
 	px_loop_free(A.loop);
 	for (i = 0; i < A.n_dev; i++)
-		px_dev_free(A.dev[i]);
+		if (A.dev_owned[i])
+			px_dev_free(A.dev[i]);
 	for (i = 0; i < MAX_DEVS; i++) {
 		px_sim_csv_free(A.csv[i]);
 		free(A.fields[i][0]);
 		free(A.fields[i][1]);
 		free(A.buttons[i]);
 	}
-	px_canopen_free(A.co);
 	px_canopen_sim_free(A.arm);
-	px_can_sim_free(A.canbus);
+	px_can_bus_close(A.ep_arm);
+	for (i = 0; i < A.n_dcfg; i++)
+		px_devcfg_free(A.dcfg[i]); /* devices, master, buses */
 	px_world_free(A.scene);
 	px_arena_fini(&A.arena);
 	free(A.recs);
@@ -1367,6 +1657,77 @@ static void device_faults(struct dev_faults *df)
 
 static void json_campaign(FILE *f);
 
+/* What the safety layer and the e-stop did: presses seen, how long after
+ * the first press the loop was in safe state (ns, -1: never), state at
+ * the end. */
+static void json_safety(FILE *f, const struct px_loop_status *st)
+{
+	fprintf(f,
+		"  \"safe_at_end\": %d,\n  \"safe_cause\": \"%s\",\n"
+		"  \"estop_lines\": %d,\n  \"estop_presses\": %llu,\n"
+		"  \"estop_cycles\": %llu,\n  \"estop_to_safe_ns\": %lld,\n"
+		"  \"estop_to_safe_cycles\": %lld,\n"
+		"  \"safe_cycles_before_estop\": %llu,\n"
+		"  \"safe_at_estop\": %d,\n"
+		"  \"enable_write_errors\": %llu,\n",
+		st->safe, st->safe ? px_fault_cause_name(st->safe_cause) : "",
+		A.n_dio, (unsigned long long)A.estop_presses,
+		(unsigned long long)A.estop_cycles,
+		(long long)(A.estop_first_ns >= 0 && A.safe_first_after_estop_ns >= 0
+				    ? A.safe_first_after_estop_ns - A.estop_first_ns
+				    : -1),
+		(long long)(A.estop_first_ns >= 0 && A.safe_first_after_estop_ns >= 0
+				    ? (long long)(A.safe_first_cycle_after_estop -
+						  A.estop_first_cycle)
+				    : -1),
+		(unsigned long long)A.safe_cycles_before_estop, A.safe_at_estop,
+		(unsigned long long)A.enable_errors);
+}
+
+/* Every device's counters, and the CANopen drives' states. */
+static void json_devices(FILE *f)
+{
+	int i;
+	fputs("  \"devices\": [", f);
+	for (i = 0; i < A.n_dev; i++) {
+		struct px_dev_status s;
+		if (px_dev_status(A.dev[i], &s) != PX_OK)
+			continue;
+		fprintf(f, "%s\n    {\"name\": ", i ? "," : "");
+		json_string(f, s.name);
+		fprintf(f, ", \"backend\": ");
+		json_string(f, s.backend);
+		fprintf(f,
+			", \"state\": %d, \"reports\": %llu, \"samples\": %llu, "
+			"\"writes\": %llu, \"write_errors\": %llu, \"errors\": "
+			"%llu, \"last_error\": ",
+			s.state, (unsigned long long)s.reports,
+			(unsigned long long)s.samples, (unsigned long long)s.writes,
+			(unsigned long long)s.write_errors,
+			(unsigned long long)s.errors);
+		json_string(f, s.last_msg);
+		fputc('}', f);
+	}
+	fputs(A.n_dev ? "\n  ],\n" : "],\n", f);
+	fprintf(f,
+		"  \"drives_enabled_cycles\": %llu,\n"
+		"  \"drive_problem_cycles\": %llu,\n  \"drives\": [",
+		(unsigned long long)A.enabled_cycles,
+		(unsigned long long)A.drive_problem_cycles);
+	for (i = 0; A.co && i < A.n_drives; i++) {
+		struct px_canopen_drive_status ds;
+		if (px_canopen_drive_status(A.co, (size_t)i, &ds) != PX_OK)
+			continue;
+		fprintf(f,
+			"%s\n    {\"node_id\": %d, \"state\": \"%s\", "
+			"\"position\": %.9g, \"lost\": %d, \"emcy\": %llu}",
+			i ? "," : "", ds.node_id, px_cia402_state_name(ds.state),
+			json_num(ds.position), ds.lost,
+			(unsigned long long)ds.emcy_count);
+	}
+	fputs(A.co && A.n_drives ? "\n  ],\n" : "],\n", f);
+}
+
 static int write_json(const char *path, const struct px_loop_status *st,
 		      const struct px_stats_snapshot *lat,
 		      const struct px_stats_snapshot *cmp, double wall_s,
@@ -1423,6 +1784,8 @@ static int write_json(const char *path, const struct px_loop_status *st,
 		(unsigned long long)A.velocity_trips,
 		(unsigned long long)A.query_errors,
 		(unsigned long long)st->faults_dropped);
+	json_safety(f, st);
+	json_devices(f);
 	json_campaign(f);
 	fprintf(f,
 		"  \"allocations_after_setup\": %llu,\n"
@@ -1558,8 +1921,8 @@ static void print_summary(const struct px_loop_status *st,
 		       A.ctl.avoid.protective_distance_m * 1e3,
 		       A.ctl.avoid.influence_distance_m * 1e3, A.min_scale,
 		       (unsigned long long)A.stop_cycles);
-	else
-	printf("  distance          min %+.3f mm, max penetration %.3f mm, "
+	else if (A.ctl_dev >= 0)
+		printf("  distance          min %+.3f mm, max penetration %.3f mm, "
 	       "proxy min clearance %+.3f mm\n",
 	       json_num(A.min_distance_m) * 1e3, A.max_penetration_m * 1e3,
 	       json_num(A.min_proxy_distance_m) * 1e3);
@@ -1576,6 +1939,25 @@ static void print_summary(const struct px_loop_status *st,
 		printf(", query errors %llu (last: %s)",
 		       (unsigned long long)A.query_errors,
 		       px_strerror(A.last_query_err));
+	if (A.n_dio)
+		printf("\n  e-stop            %llu press%s, held %llu cycles%s",
+		       (unsigned long long)A.estop_presses,
+		       A.estop_presses == 1 ? "" : "es",
+		       (unsigned long long)A.estop_cycles,
+		       st->safe ? "; in safe state at the end" : "");
+	if (A.co) {
+		int i, n = 0;
+		for (i = 0; i < A.n_drives; i++) {
+			struct px_canopen_drive_status ds;
+			if (px_canopen_drive_status(A.co, (size_t)i, &ds) == PX_OK &&
+			    ds.state == PX_CIA402_OPERATION_ENABLED)
+				n++;
+		}
+		printf("\n  drives            %d on '%s', enabled in %llu cycles, "
+		       "%d in operation enabled at the end",
+		       A.n_drives, A.co_name, (unsigned long long)A.enabled_cycles,
+		       n);
+	}
 	printf("\n  allocations       %llu after setup (loop thread; setup made "
 	       "%llu)\n",
 	       (unsigned long long)atomic_load(&A.allocs),
@@ -1658,8 +2040,7 @@ int main(int argc, char **argv)
 		"%s\n",
 		A.o.config, px_world_count(A.scene),
 		px_world_count(A.scene) == 1 ? "" : "s",
-		A.n_dev + (A.canbus ? 1 : 0),
-		A.n_dev + (A.canbus ? 1 : 0) == 1 ? "" : "s",
+		(int)A.cfg->n_devices, A.cfg->n_devices == 1 ? "" : "s",
 		A.rendering ? (A.ctl.haptic.renderer == PX_CONTROL_PROXY
 				       ? "haptic proxy rendering"
 				       : "haptic penalty rendering")
