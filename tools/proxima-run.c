@@ -64,6 +64,7 @@
 #include "px_control.h"
 #include "px_dev.h"
 #include "px_devcfg.h"
+#include "px_gpio.h"
 #include "px_loop.h"
 #include "px_ring.h"
 #include "px_world.h"
@@ -86,6 +87,10 @@ static const char usage_text[] =
 	"CONFIG);\n"
 	"                     plots go next to it as <stem>_time.svg and "
 	"<stem>_latency.svg\n"
+	"  --fault K,DEV,START_S,DURATION_S[,PROBABILITY[,DELAY_S]]\n"
+	"                     inject fault kind K into device DEV (as an entry "
+	"of\n"
+	"                     sim.faults; DEV 'loop' for overrun); repeatable\n"
 	"  --help             this text\n"
 	"Exit status: 0 ok, 1 invalid config or setup failure (e.g. a device\n"
 	"absent), 2 usage error or --virtual-time with hardware devices.\n";
@@ -105,6 +110,8 @@ struct options {
 	double duration_s; /* 0 = until stopped */
 	const char *summary_json;
 	const char *telemetry; /* overrides telemetry.file */
+	const char *fault[64]; /* --fault specs, added to sim.faults */
+	int n_fault;
 };
 
 /* Value of an option given as "--opt VALUE" or "--opt=VALUE". */
@@ -159,6 +166,14 @@ static int parse_args(int argc, char **argv, struct options *o)
 			if (!v || !*v)
 				return usage_error("%s needs a file name", a);
 			o->summary_json = v;
+		} else if (!rest && matches(a, "--fault")) {
+			const char *v = opt_value(argc, argv, &i, "--fault");
+			if (!v || !*v)
+				return usage_error("%s needs KIND,DEVICE,START_S,"
+						   "DURATION_S", a);
+			if (o->n_fault == 64)
+				return usage_error("%s: at most 64", a);
+			o->fault[o->n_fault++] = v;
 		} else if (!rest && matches(a, "--telemetry")) {
 			const char *v = opt_value(argc, argv, &i, "--telemetry");
 			if (!v || !*v)
@@ -195,8 +210,15 @@ static uint64_t heap_count(void)
 
 /* Fault kinds a simulated haptic/pose device takes (enum px_sim_fault_kind
  * is index + 1). */
+/* Index + 1 is the px_sim fault kind (px_sim.h), up to estop; overrun
+ * is the runner's own (the compute phase takes delay_ns). */
 static const char *const fault_kind_names[] = {
-	"drop", "delay", "duplicate", "corrupt", "stuck", "nan", "unplug", NULL};
+	"drop", "delay", "duplicate", "corrupt", "stuck", "nan", "unplug",
+	"bus_off", "estop", "overrun", NULL};
+enum {
+	FK_DROP, FK_DELAY, FK_DUPLICATE, FK_CORRUPT, FK_STUCK, FK_NAN,
+	FK_UNPLUG, FK_BUS_OFF, FK_ESTOP, FK_OVERRUN
+};
 
 struct raw_fault {
 	const char *device;
@@ -225,13 +247,60 @@ static void fault_check(struct px_config_reader *r,
 			const struct px_config_node *map, void *obj)
 {
 	const struct raw_fault *f = obj;
-	int delay = f->kind + 1 == PX_SIM_FAULT_DELAY;
+	int delay = f->kind == FK_DELAY || f->kind == FK_OVERRUN;
 	if (delay && f->delay_ns <= 0)
 		px_config_reader_error(r, map, "delay_ns",
-				       "missing or zero for kind 'delay'");
+				       "missing or zero for kind '%s'",
+				       fault_kind_names[f->kind]);
 	if (!delay && f->delay_ns > 0)
 		px_config_reader_error(r, px_config_node_get(map, "delay_ns"),
-				       "delay_ns", "only for kind 'delay'");
+				       "delay_ns",
+				       "only for kinds 'delay' and 'overrun'");
+}
+
+/* Why fault f cannot be injected into its device (NULL: it can). What
+ * takes what: simulated haptic/pose devices their report faults,
+ * simulated lines the e-stop, a CANopen arm on the in-process simulated
+ * bus the bus's faults and drive 0's (estop: a drive fault, unplug: the
+ * drive falls silent), the pseudo-device 'loop' a compute overrun. */
+static const char *fault_misfit(const struct px_config *cfg,
+				const struct raw_fault *f, char *buf, size_t cap)
+{
+	const struct px_config_device *d = px_config_device_find(cfg, f->device);
+	if (f->kind == FK_OVERRUN)
+		return strcmp(f->device, "loop") == 0
+			       ? NULL
+			       : "kind 'overrun' makes the compute phase slow: "
+				 "its device is 'loop'";
+	if (!d && strcmp(f->device, "loop") == 0)
+		return "device 'loop' takes kind 'overrun' only";
+	if (!d) {
+		snprintf(buf, cap, "no device named '%s' in devices", f->device);
+		return buf;
+	}
+	if (d->backend == PX_CONFIG_BACKEND_SIM && d->sim.kind != PX_CONFIG_SIM_GPIO)
+		return f->kind <= FK_UNPLUG
+			       ? NULL
+			       : "a simulated haptic or pose device takes drop, "
+				 "delay, duplicate, corrupt, stuck, nan or unplug";
+	if (d->backend == PX_CONFIG_BACKEND_SIM)
+		return f->kind == FK_ESTOP ? NULL
+					   : "simulated lines take estop only";
+	if (d->backend == PX_CONFIG_BACKEND_SOCKETCAN &&
+	    d->socketcan.transport == PX_CONFIG_CAN_SIM &&
+	    d->socketcan.canopen.present)
+		return f->kind == FK_DROP || f->kind == FK_DUPLICATE ||
+				       f->kind == FK_CORRUPT ||
+				       f->kind == FK_BUS_OFF ||
+				       f->kind == FK_ESTOP || f->kind == FK_UNPLUG
+			       ? NULL
+			       : "a CANopen arm on the simulated bus takes drop, "
+				 "duplicate, corrupt, bus_off (the bus), estop "
+				 "(drive 0 faults) or unplug (drive 0 falls "
+				 "silent)";
+	snprintf(buf, cap, "'%s' is not a simulated device (faults are "
+		 "injected into simulated devices only)", f->device);
+	return buf;
 }
 
 static const struct px_config_key fault_keys[] = {
@@ -320,23 +389,15 @@ static void sim_check(struct px_config_reader *r,
 			seq && seq->kind == PX_CONFIG_NODE_SEQ && i < seq->len
 				? seq->items[i]
 				: map;
-		const struct px_config_device *d;
+		const char *why;
+		char buf[160];
 		if (!f->device)
 			continue;
-		d = px_config_device_find(sm->cfg_, f->device);
 		snprintf(where, sizeof(where), "faults[%zu].device", i);
-		if (!d)
+		why = fault_misfit(sm->cfg_, f, buf, sizeof(buf));
+		if (why)
 			px_config_reader_error(r, px_config_node_get(it, "device"),
-					       where,
-					       "no device named '%s' in devices",
-					       f->device);
-		else if (d->backend != PX_CONFIG_BACKEND_SIM ||
-			 d->sim.kind == PX_CONFIG_SIM_GPIO)
-			px_config_reader_error(r, px_config_node_get(it, "device"),
-					       where,
-					       "'%s' is not a simulated haptic or "
-					       "pose device",
-					       f->device);
+					       where, "%s", why);
 	}
 }
 
@@ -379,6 +440,7 @@ static const struct px_config_schema sim_schema = {
 /* ---- the application ----------------------------------------------- */
 
 #define MAX_DEVS 64
+#define TELE_JOINTS 6
 #define PLOT_MAX ((size_t)1 << 20)
 
 /* One telemetry record, pushed by the write phase every decimation-th
@@ -392,6 +454,9 @@ struct tele {
 	double penetration_m;
 	int64_t latency_ns, compute_ns;
 	int32_t contact, safe, queries, valid;
+	/* avoidance: speed scale and commanded joint velocities (the first
+	 * TELE_JOINTS joints) */
+	double scale, qdot[TELE_JOINTS];
 };
 
 struct app {
@@ -399,6 +464,7 @@ struct app {
 	struct px_config *cfg;
 	struct px_control_config ctl;
 	struct px_world *scene;
+	struct px_world_hints hints; /* coherent queries of the loop thread */
 	struct px_control_query query;
 	struct px_control_haptic haptic;
 	struct px_dev *dev[MAX_DEVS];
@@ -485,6 +551,18 @@ struct app {
 	int64_t clock0_ns;      /* loop clock at setup: fault windows start here */
 	struct px_fault *lfaults; /* loop faults seen, for the campaign report */
 	size_t n_lfaults, cap_lfaults;
+	struct raw_fault *all_faults; /* sim.faults + --fault (ours) */
+	int n_ov;               /* injected compute overruns (device loop) */
+	int64_t ov_start[MAX_CAMPAIGN], ov_end[MAX_CAMPAIGN], ov_ns[MAX_CAMPAIGN];
+	struct px_can_sim *fault_bus; /* in-process CAN bus with faults (ours) */
+	/* checks of every run: safe state per cycle (bit i: cycle i was in
+	 * safe state; runs of a known length), outputs that were not
+	 * finite, the first and last deadline (phase) */
+	uint8_t *safe_bits;
+	uint64_t safe_bits_n;
+	uint64_t nonfinite_outputs;
+	int64_t first_deadline_ns, last_deadline_ns;
+	int have_deadline;
 };
 
 static struct app A;
@@ -643,7 +721,7 @@ static int phase_compute(struct px_loop *l, const struct px_loop_cycle *c,
 {
 	struct app *a = user;
 	int64_t t = mono_ns();
-	(void)l;
+	int i;
 	a->have_out = 0;
 	if (a->avoiding)
 		avoid_compute(a, c);
@@ -673,6 +751,15 @@ static int phase_compute(struct px_loop *l, const struct px_loop_cycle *c,
 		}
 		a->have_out = 1;
 	}
+	for (i = 0; i < a->n_ov; i++)
+		if (c->deadline_ns >= a->ov_start[i] && c->deadline_ns < a->ov_end[i]) {
+			/* injected overrun: this compute takes ov_ns */
+			if (px_loop_vclock_advance(l, a->ov_ns[i]) == PX_E_STATE) {
+				int64_t until = mono_ns() + a->ov_ns[i];
+				while (mono_ns() < until)
+					;
+			}
+		}
 	if (a->alloc_probe && c->index == 10) {
 		/* self-check of the heap counter (PX_RUN_ALLOC_PROBE=1): one
 		 * deliberate allocation and release inside a cycle */
@@ -740,6 +827,24 @@ static int phase_write(struct px_loop *l, const struct px_loop_cycle *c,
 				a->stop_cycles++;
 		}
 	}
+	{
+		/* what went out this cycle: finite? in safe state? phase? */
+		int i, bad = 0;
+		for (i = 0; i < 3; i++)
+			bad |= !isfinite(a->cmd.force_n[i]) ||
+			       !isfinite(a->cmd.torque_n_m[i]);
+		for (i = 0; a->co && i < PX_CONTROL_MAX_JOINTS; i++)
+			bad |= !isfinite(a->targets[i]);
+		if (bad)
+			a->nonfinite_outputs++;
+		if (c->safe && c->index < a->safe_bits_n)
+			a->safe_bits[c->index >> 3] |= (uint8_t)(1u << (c->index & 7));
+		if (!a->have_deadline) {
+			a->first_deadline_ns = c->deadline_ns;
+			a->have_deadline = 1;
+		}
+		a->last_deadline_ns = c->deadline_ns;
+	}
 	f = sqrt(a->cmd.force_n[0] * a->cmd.force_n[0] +
 		 a->cmd.force_n[1] * a->cmd.force_n[1] +
 		 a->cmd.force_n[2] * a->cmd.force_n[2]);
@@ -783,8 +888,12 @@ static int phase_write(struct px_loop *l, const struct px_loop_cycle *c,
 					  : NAN;
 		r.latency_ns = c->wake_ns - c->deadline_ns;
 		r.compute_ns = a->compute_t0;
+		r.scale = 1.0;
 		if (a->avoiding && a->started) {
-			int k = a->aout.closest_capsule;
+			int k = a->aout.closest_capsule, j;
+			r.scale = c->safe ? 0.0 : a->aout.scale;
+			for (j = 0; j < TELE_JOINTS && j < a->ctl.chain.n_joints; j++)
+				r.qdot[j] = c->safe ? 0.0 : a->aout.qdot[j];
 			r.distance_m = a->aout.min_clearance_m;
 			r.penetration_m = 0;
 			r.queries = a->aout.point_queries;
@@ -874,6 +983,42 @@ static const struct px_codec_map *make_codec(int k, const struct px_config_codec
 	return m;
 }
 
+/* E-stop faults of simulated lines: the line pressed (physical level by
+ * its active_low) at each window's start and released at its end,
+ * queued at setup. Returns 0 or 1 (said why). */
+static int estop_faults(const struct px_config_device *d, struct px_dev *dev)
+{
+	const struct px_config_line_ref *e = &A.cfg->safety.estop;
+	int active_low = 0, found = 0;
+	size_t i;
+	for (i = 0; i < d->sim.n_lines; i++) {
+		const struct px_config_gpio_line *l = &d->sim.lines[i];
+		if ((e->present && !strcmp(e->device, d->name) &&
+		     !strcmp(e->line, l->name)) ||
+		    (!found && !strcmp(l->name, "estop"))) {
+			active_low = l->active_low;
+			found = 1;
+		}
+	}
+	for (i = 0; i < A.sim.n_faults; i++) {
+		const struct raw_fault *f = &A.sim.faults[i];
+		int64_t t0 = A.clock0_ns + f->start_ns;
+		if (strcmp(f->device, d->name) != 0 || f->kind != FK_ESTOP)
+			continue;
+		if (!found ||
+		    px_gpio_sim_drive(dev, PX_GPIO_ESTOP, !active_low, t0) != PX_OK ||
+		    px_gpio_sim_drive(dev, PX_GPIO_ESTOP, active_low,
+				      t0 + f->duration_ns) != PX_OK) {
+			fprintf(stderr,
+				"proxima-run: device '%s': cannot press its "
+				"e-stop line (%s)\n",
+				d->name, found ? "more than 64 pending levels" : "none");
+			return 1;
+		}
+	}
+	return 0;
+}
+
 /* A device through px_devcfg (every back end but the simulated
  * haptic/pose devices): hidapi, libusb, SocketCAN signals and CANopen
  * drives on any transport, libgpiod and simulated lines. A CANopen arm on
@@ -884,11 +1029,47 @@ static int make_devcfg(int k)
 {
 	const struct px_config_device *d = &A.cfg->devices[k];
 	struct px_devcfg *h;
+	struct px_devcfg_options opt;
 	struct px_dev *dev;
 	struct px_canopen *co;
+	static struct px_sim_fault busf[MAX_CAMPAIGN], armf[MAX_CAMPAIGN];
+	size_t nbus = 0, narm = 0, j;
 	char msg[512] = "";
 	int rc, i;
-	rc = px_devcfg_open(A.cfg, d, NULL, &h, msg, sizeof(msg));
+	memset(&opt, 0, sizeof(opt));
+	/* faults of a CANopen arm on the in-process bus: the bus's (a bus
+	 * of ours, given to px_devcfg) and drive 0's (the simulated arm) */
+	for (j = 0; j < A.sim.n_faults; j++) {
+		const struct raw_fault *f = &A.sim.faults[j];
+		struct px_sim_fault x;
+		if (strcmp(f->device, d->name) != 0 ||
+		    d->backend != PX_CONFIG_BACKEND_SOCKETCAN)
+			continue;
+		memset(&x, 0, sizeof(x));
+		x.kind = f->kind + 1;
+		x.start_ns = A.clock0_ns + f->start_ns;
+		x.duration_ns = f->duration_ns;
+		x.probability = f->probability;
+		if (f->kind == FK_ESTOP || f->kind == FK_UNPLUG)
+			armf[narm++] = x; /* delay_ns 0: drive index 0 */
+		else
+			busf[nbus++] = x;
+	}
+	if (nbus) {
+		struct px_can_sim_config bc;
+		px_can_sim_config_default(&bc);
+		bc.faults = busf;
+		bc.n_faults = nbus;
+		rc = px_can_sim_create(&bc, &A.fault_bus);
+		if (rc != PX_OK) {
+			fprintf(stderr, "proxima-run: device '%s': simulated bus: "
+					"%s\n",
+				d->name, px_strerror(rc));
+			return 1;
+		}
+		opt.can_sim = A.fault_bus;
+	}
+	rc = px_devcfg_open(A.cfg, d, &opt, &h, msg, sizeof(msg));
 	if (rc != PX_OK) {
 		fprintf(stderr, "proxima-run: %s\n",
 			msg[0] ? msg : px_strerror(rc));
@@ -909,6 +1090,8 @@ static int make_devcfg(int k)
 		}
 		if (px_dev_caps(dev) & PX_DEV_CAP_DIO)
 			A.dio[A.n_dio++] = dev;
+		if (d->backend == PX_CONFIG_BACKEND_SIM && estop_faults(d, dev))
+			return 1;
 		if ((px_dev_caps(dev) & PX_DEV_CAP_POSE) && A.ctl.device &&
 		    strcmp(A.ctl.device, d->name) == 0)
 			A.ctl_dev = A.n_dev;
@@ -954,6 +1137,8 @@ static int make_devcfg(int k)
 			sc.n_drives = (size_t)n;
 			sc.heartbeat_period_ns = 100000000;
 			sc.inertia_kg_m2 = 0.01;
+			sc.faults = narm ? armf : NULL;
+			sc.n_faults = narm;
 			rc = px_can_sim_endpoint(A.canbus, &A.ep_arm);
 			if (rc == PX_OK)
 				rc = px_canopen_sim_create(&sc, A.ep_arm, &A.arm);
@@ -1204,7 +1389,9 @@ static int setup(void)
 	rc = px_world_config_load(cfg, &A.scene, &diag);
 	if (rc != PX_OK)
 		return report_config(rc, &diag);
-	px_world_control_query(A.scene, &A.query);
+	/* the loop's queries follow a moving point (proxy, device, link
+	 * points): each model's search starts at last answer's feature */
+	px_world_control_query_coherent(A.scene, &A.hints, &A.query);
 	for (i = 0; i < (int)cfg->n_devices; i++) {
 		if (!is_hardware(&cfg->devices[i]))
 			continue;
@@ -1337,6 +1524,21 @@ static int setup(void)
 					      (double)cfg->loop.period_ns);
 	if (A.sim.spawn_arm && spawn_arm())
 		return 1;
+	for (i = 0; i < (int)A.sim.n_faults; i++) {
+		const struct raw_fault *f = &A.sim.faults[i];
+		if (f->kind != FK_OVERRUN)
+			continue;
+		A.ov_start[A.n_ov] = A.clock0_ns + f->start_ns;
+		A.ov_end[A.n_ov] = A.ov_start[A.n_ov] + f->duration_ns;
+		A.ov_ns[A.n_ov++] = f->delay_ns;
+	}
+	/* safe state per cycle, to check the reaction to every trip (runs
+	 * of a known length up to 2^26 cycles) */
+	if (A.max_cycles && A.max_cycles <= ((uint64_t)1 << 26)) {
+		A.safe_bits = calloc((size_t)(A.max_cycles + 7) / 8, 1);
+		if (A.safe_bits)
+			A.safe_bits_n = A.max_cycles;
+	}
 	return 0;
 }
 
@@ -1358,14 +1560,24 @@ static void teardown(void)
 	px_can_bus_close(A.ep_arm);
 	for (i = 0; i < A.n_dcfg; i++)
 		px_devcfg_free(A.dcfg[i]); /* devices, master, buses */
+	px_can_sim_free(A.fault_bus); /* after its endpoints */
 	px_world_free(A.scene);
 	px_arena_fini(&A.arena);
 	free(A.recs);
 	free(A.lfaults);
+	free(A.all_faults);
+	free(A.safe_bits);
 	px_config_free(A.cfg);
 }
 
 /* ---- outside the cycle: telemetry, faults, status ------------------ */
+
+/* Joints whose commanded velocity is recorded (CSV columns, plot). */
+static int avoid_joints(void)
+{
+	int n = A.ctl.chain.n_joints;
+	return n < TELE_JOINTS ? n : TELE_JOINTS;
+}
 
 static void drain(void)
 {
@@ -1392,7 +1604,7 @@ static void drain(void)
 		if (A.csv_f)
 			fprintf(A.csv_f,
 				"%.6f,%llu,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,"
-				"%.6g,%.6g,%.9g,%.9g,%d,%d,%lld,%lld,%d\n",
+				"%.6g,%.6g,%.9g,%.9g,%d,%d,%lld,%lld,%d",
 				r.t_s, (unsigned long long)r.cycle, r.dev_m[0],
 				r.dev_m[1], r.dev_m[2], r.proxy_m[0], r.proxy_m[1],
 				r.proxy_m[2], r.force_n[0], r.force_n[1],
@@ -1400,6 +1612,15 @@ static void drain(void)
 				r.penetration_m, r.contact, r.safe,
 				(long long)r.latency_ns, (long long)r.compute_ns,
 				r.queries);
+		if (A.csv_f) {
+			int j;
+			if (A.avoiding) {
+				fprintf(A.csv_f, ",%.6g", r.scale);
+				for (j = 0; j < avoid_joints(); j++)
+					fprintf(A.csv_f, ",%.6g", r.qdot[j]);
+			}
+			fputc('\n', A.csv_f);
+		}
 		/* The proxy must stay on the free side of closed models:
 		 * check each recorded proxy against the scene (not in the
 		 * cycle; the scene is only read). */
@@ -1555,7 +1776,46 @@ static int write_plots(const char *time_svg, const char *lat_svg)
 	static uint64_t lbins[PX_STATS_DEFAULT_BINS], cbins[PX_STATS_DEFAULT_BINS];
 	uint64_t lover = 0, cover = 0;
 	int nl, nc;
-	if (x && d && f && pen && fz) {
+	if (x && d && f && pen && fz && A.avoiding) {
+		static const char *const colors[TELE_JOINTS] = {
+			"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd",
+			"#8c564b"};
+		static const char *const names[TELE_JOINTS] = {
+			"joint 0", "joint 1", "joint 2", "joint 3", "joint 4",
+			"joint 5"};
+		double *qd[TELE_JOINTS] = {0};
+		struct tool_svg_series sq[TELE_JOINTS];
+		struct tool_svg_series sd[] = {{"clearance", d, "#1f77b4"},
+					       {"protective", pen, "#d62728"}};
+		struct tool_svg_series ss[] = {{"speed scale", f, "#2ca02c"}};
+		struct tool_svg_panel p[] = {{"clearance (mm)", sd, 2},
+					     {"speed scale", ss, 1},
+					     {"commanded velocity (rad/s)", sq, 0}};
+		int j, nj = avoid_joints(), ok = 1;
+		for (j = 0; j < nj; j++) {
+			qd[j] = calloc(n + 1, sizeof(double));
+			ok = ok && qd[j];
+			sq[j].name = names[j];
+			sq[j].y = qd[j];
+			sq[j].color = colors[j];
+		}
+		p[2].n_series = nj;
+		for (i = 0; ok && i < n; i++) {
+			x[i] = A.recs[i].t_s;
+			d[i] = A.recs[i].distance_m * 1e3;
+			pen[i] = A.ctl.avoid.protective_distance_m * 1e3;
+			f[i] = A.recs[i].scale;
+			for (j = 0; j < nj; j++)
+				qd[j][i] = A.recs[i].qdot[j];
+		}
+		if (ok)
+			rc = tool_svg_lines(time_svg,
+					    "proxima-run: clearance, speed scale "
+					    "and commanded joint velocity",
+					    "time (s)", x, n, p, 3);
+		for (j = 0; j < nj; j++)
+			free(qd[j]);
+	} else if (x && d && f && pen && fz) {
 		struct tool_svg_series sd[] = {{"distance", d, "#1f77b4"}};
 		struct tool_svg_series sf[] = {{"|F|", f, "#d62728"},
 					       {"Fz", fz, "#ff7f0e"}};
@@ -1656,6 +1916,38 @@ static void device_faults(struct dev_faults *df)
 }
 
 static void json_campaign(FILE *f);
+
+/* The slowest reaction to a trip: for every loop fault that put (or
+ * kept) the loop in safe state, the cycles from the one that saw it to
+ * the first in safe state (-1: no fault to check; 1000: none within the
+ * run). Needs the per-cycle record (runs of a known length) and the
+ * faults list (kept when faults are injected). */
+static int64_t trip_to_safe(uint64_t *checked)
+{
+	int64_t worst = -1;
+	size_t k;
+	*checked = 0;
+	if (!A.safe_bits)
+		return -1;
+	for (k = 0; k < A.n_lfaults; k++) {
+		const struct px_fault *lf = &A.lfaults[k];
+		int64_t d = 1000;
+		uint64_t c;
+		if (!lf->safe || lf->cycle >= A.safe_bits_n)
+			continue;
+		for (c = lf->cycle; c < A.safe_bits_n && c < lf->cycle + 1000; c++)
+			if (A.safe_bits[c >> 3] & (1u << (c & 7))) {
+				d = (int64_t)(c - lf->cycle);
+				break;
+			}
+		if (c == A.safe_bits_n && d == 1000)
+			continue; /* the run ended first */
+		(*checked)++;
+		if (d > worst)
+			worst = d;
+	}
+	return worst;
+}
 
 /* What the safety layer and the e-stop did: presses seen, how long after
  * the first press the loop was in safe state (ns, -1: never), state at
@@ -1786,17 +2078,41 @@ static int write_json(const char *path, const struct px_loop_status *st,
 		(unsigned long long)st->faults_dropped);
 	json_safety(f, st);
 	json_devices(f);
+	{
+		uint64_t checked;
+		int64_t worst = trip_to_safe(&checked);
+		int64_t span = A.have_deadline ? A.last_deadline_ns -
+							 A.first_deadline_ns
+					       : 0;
+		int64_t want = st->cycles
+				       ? ((int64_t)st->cycles - 1 +
+					  (int64_t)st->missed_periods) *
+						 st->period_ns
+				       : 0;
+		fprintf(f,
+			"  \"faults_injected\": %zu,\n  \"faults_popped\": %llu,\n"
+			"  \"watchdog_trips_checked\": %llu,\n"
+			"  \"max_trip_to_safe_cycles\": %lld,\n"
+			"  \"nonfinite_outputs\": %llu,\n"
+			"  \"phase_error_ns\": %lld,\n",
+			A.sim.n_faults, (unsigned long long)A.faults_popped,
+			(unsigned long long)checked, (long long)worst,
+			(unsigned long long)A.nonfinite_outputs,
+			(long long)(span - want));
+	}
 	json_campaign(f);
 	fprintf(f,
 		"  \"allocations_after_setup\": %llu,\n"
 		"  \"allocations_setup\": %llu,\n"
 		"  \"allocation_counter\": \"%s\",\n"
 		"  \"telemetry_records\": %llu,\n  \"telemetry_dropped\": %llu,\n"
+		"  \"telemetry_decimation\": %lld,\n"
 		"  \"realtime\": %d,\n  \"csv\": ",
 		(unsigned long long)atomic_load(&A.allocs),
 		(unsigned long long)A.setup_heap_calls, counter,
 		(unsigned long long)A.n_rows,
-		(unsigned long long)px_ring_dropped(A.ring), st->realtime);
+		(unsigned long long)px_ring_dropped(A.ring), (long long)A.decimation,
+		st->realtime);
 	if (A.csv_path[0])
 		json_string(f, A.csv_path);
 	else
@@ -1969,6 +2285,95 @@ static void print_summary(const struct px_loop_status *st,
 	print_campaign();
 }
 
+/* Parse --fault KIND,DEVICE,START_S,DURATION_S[,PROBABILITY[,DELAY_S]]
+ * into f. Returns NULL or why not. */
+static const char *parse_fault(const char *spec, struct raw_fault *f,
+			       char *dev, size_t dev_cap, char *buf, size_t cap)
+{
+	char tmp[256], *fld[7], *save = NULL, *t;
+	int n = 0, k;
+	double v[4] = {0, 0, 1, 0};
+	if (strlen(spec) >= sizeof(tmp))
+		return "too long";
+	strcpy(tmp, spec);
+	for (t = strtok_r(tmp, ",", &save); t && n < 7;
+	     t = strtok_r(NULL, ",", &save))
+		fld[n++] = t;
+	if (n < 4 || n > 6)
+		return "expected KIND,DEVICE,START_S,DURATION_S[,PROBABILITY[,"
+		       "DELAY_S]]";
+	memset(f, 0, sizeof(*f));
+	f->kind = -1;
+	for (k = 0; fault_kind_names[k]; k++)
+		if (strcmp(fld[0], fault_kind_names[k]) == 0)
+			f->kind = k;
+	if (f->kind < 0) {
+		snprintf(buf, cap, "unknown kind '%s' (drop, delay, duplicate, "
+			 "corrupt, stuck, nan, unplug, bus_off, estop, overrun)",
+			 fld[0]);
+		return buf;
+	}
+	snprintf(dev, dev_cap, "%s", fld[1]);
+	f->device = dev;
+	for (k = 2; k < n; k++) {
+		char *end;
+		errno = 0;
+		v[k - 2] = strtod(fld[k], &end);
+		if (end == fld[k] || *end || errno || !isfinite(v[k - 2]) ||
+		    v[k - 2] < 0 || v[k - 2] > 1e6) {
+			snprintf(buf, cap, "'%s' is not a number of seconds (or a "
+				 "probability)", fld[k]);
+			return buf;
+		}
+	}
+	if (v[1] <= 0 || v[2] <= 0 || v[2] > 1)
+		return "DURATION_S must be > 0 and PROBABILITY in (0, 1]";
+	f->start_ns = (int64_t)llround(v[0] * 1e9);
+	f->duration_ns = (int64_t)llround(v[1] * 1e9);
+	f->probability = v[2];
+	f->delay_ns = (int64_t)llround(v[3] * 1e9);
+	if ((f->kind == FK_DELAY || f->kind == FK_OVERRUN) != (f->delay_ns > 0))
+		return "DELAY_S is required for kinds delay and overrun, and only "
+		       "for them";
+	return NULL;
+}
+
+/* sim.faults plus the --fault ones, checked like the config's. Returns
+ * 0 or 2 (said why). */
+static int add_cli_faults(void)
+{
+	static char devs[64][64];
+	size_t n = A.sim.n_faults, i;
+	if (!A.o.n_fault)
+		return 0;
+	A.all_faults = calloc(n + (size_t)A.o.n_fault, sizeof(*A.all_faults));
+	if (!A.all_faults)
+		return 2;
+	if (n)
+		memcpy(A.all_faults, A.sim.faults, n * sizeof(*A.all_faults));
+	for (i = 0; i < (size_t)A.o.n_fault; i++) {
+		char buf[200];
+		const char *why = parse_fault(A.o.fault[i], &A.all_faults[n],
+					      devs[i], sizeof(devs[i]), buf,
+					      sizeof(buf));
+		if (!why)
+			why = fault_misfit(A.cfg, &A.all_faults[n], buf, sizeof(buf));
+		if (why) {
+			fprintf(stderr, "proxima-run: --fault %s: %s\n",
+				A.o.fault[i], why);
+			return 2;
+		}
+		n++;
+	}
+	if (n > MAX_CAMPAIGN) {
+		fprintf(stderr, "proxima-run: more than %d faults\n", MAX_CAMPAIGN);
+		return 2;
+	}
+	A.sim.faults = A.all_faults;
+	A.sim.n_faults = n;
+	return 0;
+}
+
 int main(int argc, char **argv)
 {
 	static struct px_config_diag diag;
@@ -2000,6 +2405,12 @@ int main(int argc, char **argv)
 	}
 	if (A.ctl.warning[0])
 		fprintf(stderr, "%s\n", A.ctl.warning);
+	rc = add_cli_faults();
+	if (rc) {
+		free(A.all_faults);
+		px_config_free(A.cfg);
+		return rc;
+	}
 	if (A.o.check) {
 		printf("%s: OK (%zu device%s, loop period %lld ns)\n", A.o.config,
 		       A.cfg->n_devices, A.cfg->n_devices == 1 ? "" : "s",
@@ -2028,7 +2439,16 @@ int main(int argc, char **argv)
 		fprintf(A.csv_f,
 			"t_s,cycle,x_m,y_m,z_m,proxy_x_m,proxy_y_m,proxy_z_m,"
 			"fx_n,fy_n,fz_n,force_n,distance_m,penetration_m,"
-			"contact,safe,wakeup_latency_ns,compute_ns,queries\n");
+			"contact,safe,wakeup_latency_ns,compute_ns,queries");
+		if (A.avoiding) {
+			/* distance_m is the clearance; x..z the closest link
+			 * point, proxy_* the obstacle point */
+			int j;
+			fprintf(A.csv_f, ",speed_scale");
+			for (j = 0; j < avoid_joints(); j++)
+				fprintf(A.csv_f, ",qdot%d_rad_per_s", j);
+		}
+		fputc('\n', A.csv_f);
 	}
 	A.alloc_probe = getenv("PX_RUN_ALLOC_PROBE") &&
 			strcmp(getenv("PX_RUN_ALLOC_PROBE"), "1") == 0;
