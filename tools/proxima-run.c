@@ -840,7 +840,9 @@ static int phase_write(struct px_loop *l, const struct px_loop_cycle *c,
 		if (c->safe && c->index < a->safe_bits_n)
 			a->safe_bits[c->index >> 3] |= (uint8_t)(1u << (c->index & 7));
 		if (!a->have_deadline) {
-			a->first_deadline_ns = c->deadline_ns;
+			/* periods skipped before the first cycle count too */
+			a->first_deadline_ns =
+				c->deadline_ns - (int64_t)c->missed * c->period_ns;
 			a->have_deadline = 1;
 		}
 		a->last_deadline_ns = c->deadline_ns;
