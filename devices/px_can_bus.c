@@ -43,6 +43,7 @@ struct px_can_bus {
 	size_t qcap, qhead, qn;
 	/* unix */
 	struct sockaddr_un peer;
+	int connected; /* connect()ed to peer (see unix_send) */
 	char local[sizeof(((struct sockaddr_un *)0)->sun_path)];
 	/* replay */
 	struct px_can_msg *recs;
@@ -395,13 +396,31 @@ static int unix_send(struct px_can_bus *b, const struct px_can_msg *m,
 {
 	size_t mtu = m->fd ? CANFD_MTU : CAN_MTU;
 	(void)now;
+	/* Connected, not sendto(): the kernel caps an unconnected datagram
+	 * receiver at net.unix.max_dgram_qlen (10) queued frames, fewer
+	 * than one SYNC's answers of a 6-drive arm; a receiver connected
+	 * back to its sender is limited only by its buffer. A peer not
+	 * there yet (ENOENT, ECONNREFUSED) or gone and rebound
+	 * (ECONNREFUSED, ENOTCONN) is connected again on the next send. */
+	if (!b->connected) {
+		if (connect(b->sock, (const struct sockaddr *)&b->peer,
+			    sizeof b->peer) != 0) {
+			b->last_errno = errno;
+			b->st.tx_dropped++;
+			return errno == ENOENT || errno == ECONNREFUSED ||
+					       errno == EAGAIN
+				       ? PX_E_AGAIN
+				       : PX_E_IO;
+		}
+		b->connected = 1;
+	}
 	/* struct can_frame is the first CAN_MTU bytes of canfd_frame with
 	 * the same field offsets: the frame goes out as SocketCAN has it. */
-	if (sendto(b->sock, &m->f, mtu, MSG_DONTWAIT,
-		   (const struct sockaddr *)&b->peer, sizeof b->peer) ==
-	    (ssize_t)mtu)
+	if (send(b->sock, &m->f, mtu, MSG_DONTWAIT) == (ssize_t)mtu)
 		return PX_OK;
 	b->last_errno = errno;
+	if (errno == ECONNREFUSED || errno == ENOTCONN)
+		b->connected = 0;
 	if (errno == EAGAIN || errno == ENOBUFS || errno == ECONNREFUSED ||
 	    errno == ENOENT) {
 		b->st.tx_dropped++; /* no peer yet, or it is not reading */

@@ -120,8 +120,8 @@ static double reported(const struct px_model_result *r)
 	return d;
 }
 
-int px_world_nearest(const struct px_world *s, px_vec3 p,
-		     double max_distance_m, struct px_world_hit *out)
+static int nearest(const struct px_world *s, px_vec3 p, double max_distance_m,
+		   struct px_world_hints *hints, struct px_world_hit *out)
 {
 	double lb[PX_WORLD_MAX_MODELS];
 	unsigned char done[PX_WORLD_MAX_MODELS];
@@ -163,12 +163,16 @@ int px_world_nearest(const struct px_world *s, px_vec3 p,
 		range = max_distance_m;
 		if ((!s->e[k].is_signed || lo > 0) && best >= 0 && best < range)
 			range = best;
-		rc = px_model_query_ex(s->e[k].m, p, range, -1, 0, &r);
+		rc = px_model_query_ex(s->e[k].m, p, range,
+				       hints ? hints->index[k] : -1,
+				       hints ? PX_QUERY_COHERENT : 0u, &r);
 		queried++;
 		if (rc < 0) {
 			out->models_queried = queried;
 			return rc;
 		}
+		if (hints && rc == 1)
+			hints->index[k] = r.index;
 		if (rc == 1) {
 			double d = reported(&r);
 			if (d < best && fabs(d) <= max_distance_m) {
@@ -183,11 +187,39 @@ int px_world_nearest(const struct px_world *s, px_vec3 p,
 	return out->model >= 0 ? 1 : 0;
 }
 
-static int scene_point(void *ctx, px_vec3 p_m, double max_distance_m,
-		       struct px_control_hit *out)
+int px_world_nearest(const struct px_world *s, px_vec3 p,
+		     double max_distance_m, struct px_world_hit *out)
 {
-	struct px_world_hit h;
-	int rc = px_world_nearest(ctx, p_m, max_distance_m, &h);
+	return nearest(s, p, max_distance_m, NULL, out);
+}
+
+void px_world_hints_reset(struct px_world_hints *h)
+{
+	size_t i;
+	if (!h)
+		return;
+	for (i = 0; i < PX_WORLD_MAX_MODELS; i++)
+		h->index[i] = -1;
+}
+
+int px_world_nearest_coherent(const struct px_world *s, px_vec3 p,
+			      double max_distance_m, struct px_world_hints *h,
+			      struct px_world_hit *out)
+{
+	if (!h) {
+		if (out) {
+			memset(out, 0, sizeof(*out));
+			out->model = -1;
+			out->distance_m = INFINITY;
+		}
+		return PX_E_INVAL;
+	}
+	return nearest(s, p, max_distance_m, h, out);
+}
+
+static int hit_to_control(int rc, const struct px_world_hit *h,
+			  struct px_control_hit *out)
+{
 	memset(out, 0, sizeof(*out));
 	if (rc < 0)
 		return rc;
@@ -196,11 +228,28 @@ static int scene_point(void *ctx, px_vec3 p_m, double max_distance_m,
 		out->distance_m = INFINITY;
 		return PX_OK;
 	}
-	out->two_sided = !h.r.is_signed;
-	out->distance_m = h.distance_m;
-	out->point_m = h.r.point;
-	out->normal = h.r.direction;
+	out->two_sided = !h->r.is_signed;
+	out->distance_m = h->distance_m;
+	out->point_m = h->r.point;
+	out->normal = h->r.direction;
 	return PX_OK;
+}
+
+static int scene_point(void *ctx, px_vec3 p_m, double max_distance_m,
+		       struct px_control_hit *out)
+{
+	struct px_world_hit h;
+	int rc = px_world_nearest(ctx, p_m, max_distance_m, &h);
+	return hit_to_control(rc, &h, out);
+}
+
+static int scene_point_coherent(void *ctx, px_vec3 p_m, double max_distance_m,
+				struct px_control_hit *out)
+{
+	struct px_world_hints *hints = ctx;
+	struct px_world_hit h;
+	int rc = nearest(hints->world_, p_m, max_distance_m, hints, &h);
+	return hit_to_control(rc, &h, out);
 }
 
 int px_world_control_query(const struct px_world *s, struct px_control_query *q)
@@ -211,5 +260,20 @@ int px_world_control_query(const struct px_world *s, struct px_control_query *q)
 	q->point = scene_point;
 	q->segment = NULL;
 	q->ctx = (void *)s;
+	return PX_OK;
+}
+
+int px_world_control_query_coherent(const struct px_world *s,
+				    struct px_world_hints *h,
+				    struct px_control_query *q)
+{
+	if (!s || !h || !q)
+		return PX_E_INVAL;
+	px_world_hints_reset(h);
+	h->world_ = s;
+	memset(q, 0, sizeof(*q));
+	q->point = scene_point_coherent;
+	q->segment = NULL;
+	q->ctx = h;
 	return PX_OK;
 }

@@ -19,6 +19,13 @@
  * cost one box test each. A point inside a model's box has bound
  * -infinity for closed models (it may be inside) and 0 for open ones.
  *
+ * Coherent queries. A point that moves a little between queries (a
+ * haptic proxy, a point on a robot link) finds its nearest feature near
+ * last time's: px_world_nearest_coherent() passes each model the feature
+ * it answered last (struct px_world_hints, caller-owned) as the start of
+ * its search (px_model_query_ex with PX_QUERY_COHERENT). The answer is
+ * the same global nearest surface; a stale hint only costs time.
+ *
  * As the control module's query (px_world_control_query): the hit is
  * the nearest answer with two_sided = the model is unsigned. Answers a
  * model does not certify (a bound cut its search short) report distance
@@ -104,6 +111,28 @@ struct px_world_hit {
 PX_API int px_world_nearest(const struct px_world *s, px_vec3 p,
 			    double max_distance_m, struct px_world_hit *out);
 
+/* Coherence state of one stream of queries: the feature index each
+ * model answered last (-1 none). Plain struct, caller-owned; used by one
+ * thread at a time. */
+struct px_world_hints {
+	int index[PX_WORLD_MAX_MODELS];
+	const struct px_world *world_; /* set by px_world_control_query_coherent */
+};
+
+/* Forget every hint (before first use, or after a jump). @note RT-safe. */
+PX_API void px_world_hints_reset(struct px_world_hints *h);
+
+/*
+ * As px_world_nearest(), each model's query starting from h's hint for
+ * it; h is updated with the answers. Same answer as px_world_nearest()
+ * for any hints. Returns as px_world_nearest() (PX_E_INVAL also for a
+ * NULL h). @note RT-safe.
+ */
+PX_API int px_world_nearest_coherent(const struct px_world *s, px_vec3 p,
+				     double max_distance_m,
+				     struct px_world_hints *h,
+				     struct px_world_hit *out);
+
 /*
  * Fill q so that the control module queries scene s (point callback;
  * segment left NULL: the control module's certified bisection over
@@ -112,6 +141,16 @@ PX_API int px_world_nearest(const struct px_world *s, px_vec3 p,
  */
 PX_API int px_world_control_query(const struct px_world *s,
 				  struct px_control_query *q);
+
+/*
+ * As px_world_control_query(), with coherent queries through h (reset
+ * here; it must outlive q's use, and one thread at a time uses q): for
+ * the loop's renderer or avoidance, whose queries follow a moving
+ * point. Returns PX_OK or PX_E_INVAL.
+ */
+PX_API int px_world_control_query_coherent(const struct px_world *s,
+					   struct px_world_hints *h,
+					   struct px_control_query *q);
 
 /* ---- configuration (setup time) --------------------------------- */
 

@@ -7,7 +7,9 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "mesh_gen.h"
 #include "px_alloc_count.h"
+#include "px_mesh.h"
 #include "px_config.h"
 #include "px_control.h"
 #include "px_model.h"
@@ -126,6 +128,87 @@ static void test_nearest_matches_brute_force(void)
 	}
 	printf("  broad phase: %.2f narrow-phase queries per point\n",
 	       (double)queried / (double)points);
+}
+
+/* Coherent queries along random walks (a moving probe, with jumps) give
+ * the plain query's answer whatever the hints, and allocate nothing, also
+ * through the control adapter. (The work figures are printed: with a
+ * best-first hierarchy the hint saves little.) */
+static void test_coherent_matches_plain(void)
+{
+	struct gen_mesh g;
+	struct px_world *s;
+	struct px_model *m;
+	static struct px_world_hints hints;
+	struct px_control_query q;
+	long it_plain = 0, it_coh = 0;
+	int round, k, i;
+	PX_CHECK_INT_EQ(px_world_create(8, &s), PX_OK);
+	for (i = 0; i < 2; i++) {
+		px_pose pose = px_pose_identity();
+		PX_CHECK_INT_EQ(gen_sphere(0.5 + 0.2 * i, 24 + 8 * i, 48, &g), 0);
+		PX_CHECK_INT_EQ(px_mesh_model(g.xyz, g.nv, g.tri, g.nt, NULL, NULL,
+					      &m), PX_OK);
+		gen_free(&g);
+		pose.t = px_v3(i ? 1.0 : -1.0, 0, 0);
+		PX_CHECK_INT_EQ(px_model_set_pose(m, pose), PX_OK);
+		PX_CHECK_INT_EQ(px_world_add(s, m, "ball"), i);
+	}
+	for (i = 0; i < 3; i++) {
+		struct px_prim pr;
+		memset(&pr, 0, sizeof(pr));
+		pr.type = PX_PRIM_BOX;
+		pr.a = pr.b = pr.c = 0.2;
+		PX_CHECK_INT_EQ(px_prim_model(&pr, &m), PX_OK);
+		PX_CHECK_INT_EQ(px_model_set_pose(m, random_pose(2.0)), PX_OK);
+		PX_CHECK_INT_EQ(px_world_add(s, m, NULL), i + 2);
+	}
+	for (round = 0; round < 20; round++) {
+		px_vec3 p = px_v3(px_rand_range(-2, 2), px_rand_range(-1, 1),
+				  px_rand_range(-1, 1));
+		uint64_t a;
+		px_world_hints_reset(&hints);
+		a = px_alloc_region_begin();
+		for (k = 0; k < 300; k++) {
+			struct px_world_hit h0, h1;
+			int r0, r1;
+			/* steps of a few mm, now and then a jump */
+			double step = px_rand_unit() < 0.02 ? 0.5 : 0.004;
+			p = px_v3_add(p, px_v3(step * px_rand_normal(),
+					       step * px_rand_normal(),
+					       step * px_rand_normal()));
+			r0 = px_world_nearest(s, p, INFINITY, &h0);
+			r1 = px_world_nearest_coherent(s, p, INFINITY, &hints, &h1);
+			PX_CHECK_INT_EQ(r1, r0);
+			PX_CHECK_NEAR(h1.distance_m, h0.distance_m, 1e-12);
+			if (h0.model >= 0 && h0.model < 2) {
+				it_plain += h0.r.iterations;
+				it_coh += h1.r.iterations;
+			}
+		}
+		PX_CHECK_INT_EQ(px_alloc_region_end(a), 0);
+	}
+	printf("  mesh work per query: plain %.1f, coherent %.1f\n",
+	       (double)it_plain / 6000.0, (double)it_coh / 6000.0);
+	/* the control adapter answers as the plain one */
+	PX_CHECK_INT_EQ(px_world_control_query_coherent(s, &hints, &q), PX_OK);
+	for (k = 0; k < 500; k++) {
+		px_vec3 p = px_v3(px_rand_range(-2, 2), px_rand_range(-1, 1),
+				  px_rand_range(-1, 1));
+		struct px_control_hit c;
+		struct px_world_hit h;
+		uint64_t a = px_alloc_region_begin();
+		PX_CHECK_INT_EQ(q.point(q.ctx, p, INFINITY, &c), PX_OK);
+		PX_CHECK_INT_EQ(px_alloc_region_end(a), 0);
+		PX_CHECK_INT_EQ(px_world_nearest(s, p, INFINITY, &h), 1);
+		PX_CHECK(c.valid);
+		PX_CHECK_NEAR(c.distance_m, h.distance_m, 1e-12);
+	}
+	PX_CHECK_INT_EQ(px_world_control_query_coherent(s, NULL, &q), PX_E_INVAL);
+	PX_CHECK_INT_EQ(px_world_nearest_coherent(s, px_v3(0, 0, 0), INFINITY,
+						  NULL, &(struct px_world_hit){0}),
+			PX_E_INVAL);
+	px_world_free(s);
 }
 
 static void test_broad_phase_skips_far_models(void)
@@ -490,6 +573,7 @@ static void test_schema_documented(void)
 static const struct px_test tests[] = {
 	PX_T(test_nearest_matches_brute_force),
 	PX_T(test_broad_phase_skips_far_models),
+	PX_T(test_coherent_matches_plain),
 	PX_T(test_control_adapter_never_overestimates),
 	PX_T(test_config_example_scene),
 	PX_T(test_config_scale),

@@ -24,17 +24,26 @@
  * PX_RUN_ALLOC_PROBE=1 in the environment makes cycle 10 allocate and
  * free once on purpose: the count is then 2 (a self-check for tests).
  *
- * Devices driven: simulated haptic and pose devices (haptic rendering or
- * mode none), and a CANopen arm on the in-process simulated CAN bus
- * (collision avoidance; the drives' side is stepped in the read phase as
- * another node on the bus). The `sim` section adds fault campaigns and
- * the avoidance demo's nominal task.
+ * Devices: the simulated haptic and pose devices are made here (they
+ * take the `sim` section's fault campaign); every other back end is
+ * opened through px_devcfg (hidapi, libusb, SocketCAN signals and CANopen
+ * drives, libgpiod, simulated lines), so the cycle sees only px_dev and
+ * the CANopen master, never a back end. Each cycle reads every pose
+ * device and e-stop line (a pressed one trips safe state), computes
+ * (haptic rendering on control.device, or avoidance on the CANopen arm),
+ * and writes the force, the drives' targets (held still without
+ * avoidance; quick stop in safe state), the enable relay (off in safe
+ * state) and the timing toggle. A CANopen arm on the in-process
+ * simulated bus gets its drives' side here, stepped in the read phase as
+ * another node on the bus would answer.
  *
- * Exit status: 0 ok, 1 invalid config or setup failure, 2 usage error or
- * a configuration this runner does not drive yet (hardware back ends).
+ * Exit status: 0 ok, 1 invalid config or setup failure (an absent device
+ * is named with the back end's reason), 2 usage error or --virtual-time
+ * with hardware.
  */
 #include <errno.h>
 #include <math.h>
+#include <poll.h>
 #include <pthread.h>
 #include <signal.h>
 #include <stdatomic.h>
@@ -42,6 +51,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -52,6 +63,8 @@
 #include "px_config.h"
 #include "px_control.h"
 #include "px_dev.h"
+#include "px_devcfg.h"
+#include "px_gpio.h"
 #include "px_loop.h"
 #include "px_ring.h"
 #include "px_world.h"
@@ -74,10 +87,13 @@ static const char usage_text[] =
 	"CONFIG);\n"
 	"                     plots go next to it as <stem>_time.svg and "
 	"<stem>_latency.svg\n"
+	"  --fault K,DEV,START_S,DURATION_S[,PROBABILITY[,DELAY_S]]\n"
+	"                     inject fault kind K into device DEV (as an entry "
+	"of\n"
+	"                     sim.faults; DEV 'loop' for overrun); repeatable\n"
 	"  --help             this text\n"
-	"Exit status: 0 ok, 1 invalid config or setup failure, 2 usage error "
-	"or\n"
-	"a configuration this runner does not drive.\n";
+	"Exit status: 0 ok, 1 invalid config or setup failure (e.g. a device\n"
+	"absent), 2 usage error or --virtual-time with hardware devices.\n";
 
 static int usage_error(const char *fmt, const char *arg)
 {
@@ -94,6 +110,8 @@ struct options {
 	double duration_s; /* 0 = until stopped */
 	const char *summary_json;
 	const char *telemetry; /* overrides telemetry.file */
+	const char *fault[64]; /* --fault specs, added to sim.faults */
+	int n_fault;
 };
 
 /* Value of an option given as "--opt VALUE" or "--opt=VALUE". */
@@ -148,6 +166,14 @@ static int parse_args(int argc, char **argv, struct options *o)
 			if (!v || !*v)
 				return usage_error("%s needs a file name", a);
 			o->summary_json = v;
+		} else if (!rest && matches(a, "--fault")) {
+			const char *v = opt_value(argc, argv, &i, "--fault");
+			if (!v || !*v)
+				return usage_error("%s needs KIND,DEVICE,START_S,"
+						   "DURATION_S", a);
+			if (o->n_fault == 64)
+				return usage_error("%s: at most 64", a);
+			o->fault[o->n_fault++] = v;
 		} else if (!rest && matches(a, "--telemetry")) {
 			const char *v = opt_value(argc, argv, &i, "--telemetry");
 			if (!v || !*v)
@@ -184,8 +210,15 @@ static uint64_t heap_count(void)
 
 /* Fault kinds a simulated haptic/pose device takes (enum px_sim_fault_kind
  * is index + 1). */
+/* Index + 1 is the px_sim fault kind (px_sim.h), up to estop; overrun
+ * is the runner's own (the compute phase takes delay_ns). */
 static const char *const fault_kind_names[] = {
-	"drop", "delay", "duplicate", "corrupt", "stuck", "nan", "unplug", NULL};
+	"drop", "delay", "duplicate", "corrupt", "stuck", "nan", "unplug",
+	"bus_off", "estop", "overrun", NULL};
+enum {
+	FK_DROP, FK_DELAY, FK_DUPLICATE, FK_CORRUPT, FK_STUCK, FK_NAN,
+	FK_UNPLUG, FK_BUS_OFF, FK_ESTOP, FK_OVERRUN
+};
 
 struct raw_fault {
 	const char *device;
@@ -206,6 +239,7 @@ struct raw_sim {
 	size_t n_faults;
 	struct raw_nominal *nominal;
 	size_t n_nominal;
+	const char *spawn_arm; /* a socketcan device on transport unix */
 	const struct px_config *cfg_; /* not a key: context for the check */
 };
 
@@ -213,13 +247,60 @@ static void fault_check(struct px_config_reader *r,
 			const struct px_config_node *map, void *obj)
 {
 	const struct raw_fault *f = obj;
-	int delay = f->kind + 1 == PX_SIM_FAULT_DELAY;
+	int delay = f->kind == FK_DELAY || f->kind == FK_OVERRUN;
 	if (delay && f->delay_ns <= 0)
 		px_config_reader_error(r, map, "delay_ns",
-				       "missing or zero for kind 'delay'");
+				       "missing or zero for kind '%s'",
+				       fault_kind_names[f->kind]);
 	if (!delay && f->delay_ns > 0)
 		px_config_reader_error(r, px_config_node_get(map, "delay_ns"),
-				       "delay_ns", "only for kind 'delay'");
+				       "delay_ns",
+				       "only for kinds 'delay' and 'overrun'");
+}
+
+/* Why fault f cannot be injected into its device (NULL: it can). What
+ * takes what: simulated haptic/pose devices their report faults,
+ * simulated lines the e-stop, a CANopen arm on the in-process simulated
+ * bus the bus's faults and drive 0's (estop: a drive fault, unplug: the
+ * drive falls silent), the pseudo-device 'loop' a compute overrun. */
+static const char *fault_misfit(const struct px_config *cfg,
+				const struct raw_fault *f, char *buf, size_t cap)
+{
+	const struct px_config_device *d = px_config_device_find(cfg, f->device);
+	if (f->kind == FK_OVERRUN)
+		return strcmp(f->device, "loop") == 0
+			       ? NULL
+			       : "kind 'overrun' makes the compute phase slow: "
+				 "its device is 'loop'";
+	if (!d && strcmp(f->device, "loop") == 0)
+		return "device 'loop' takes kind 'overrun' only";
+	if (!d) {
+		snprintf(buf, cap, "no device named '%s' in devices", f->device);
+		return buf;
+	}
+	if (d->backend == PX_CONFIG_BACKEND_SIM && d->sim.kind != PX_CONFIG_SIM_GPIO)
+		return f->kind <= FK_UNPLUG
+			       ? NULL
+			       : "a simulated haptic or pose device takes drop, "
+				 "delay, duplicate, corrupt, stuck, nan or unplug";
+	if (d->backend == PX_CONFIG_BACKEND_SIM)
+		return f->kind == FK_ESTOP ? NULL
+					   : "simulated lines take estop only";
+	if (d->backend == PX_CONFIG_BACKEND_SOCKETCAN &&
+	    d->socketcan.transport == PX_CONFIG_CAN_SIM &&
+	    d->socketcan.canopen.present)
+		return f->kind == FK_DROP || f->kind == FK_DUPLICATE ||
+				       f->kind == FK_CORRUPT ||
+				       f->kind == FK_BUS_OFF ||
+				       f->kind == FK_ESTOP || f->kind == FK_UNPLUG
+			       ? NULL
+			       : "a CANopen arm on the simulated bus takes drop, "
+				 "duplicate, corrupt, bus_off (the bus), estop "
+				 "(drive 0 faults) or unplug (drive 0 falls "
+				 "silent)";
+	snprintf(buf, cap, "'%s' is not a simulated device (faults are "
+		 "injected into simulated devices only)", f->device);
+	return buf;
 }
 
 static const struct px_config_key fault_keys[] = {
@@ -249,6 +330,50 @@ static const struct px_config_schema fault_schema = {
 	"fault", fault_keys, sizeof(fault_keys) / sizeof(fault_keys[0]),
 	fault_check};
 
+/* sim.spawn_arm: proxima-simarm plays drives 1..N (node i + 1 is joint
+ * i), all in one mode, at 100000 counts per rad, so the device's drive
+ * table must be exactly that. */
+static void spawn_arm_check(struct px_config_reader *r,
+			    const struct px_config_node *map,
+			    const struct raw_sim *sm)
+{
+	const struct px_config_node *at = px_config_node_get(map, "spawn_arm");
+	const struct px_config_device *d =
+		px_config_device_find(sm->cfg_, sm->spawn_arm);
+	const struct px_config_canopen *co;
+	size_t i;
+	if (!d) {
+		px_config_reader_error(r, at, "spawn_arm",
+				       "no device named '%s' in devices",
+				       sm->spawn_arm);
+		return;
+	}
+	co = &d->socketcan.canopen;
+	if (d->backend != PX_CONFIG_BACKEND_SOCKETCAN ||
+	    d->socketcan.transport != PX_CONFIG_CAN_UNIX || !co->present ||
+	    co->n_drives == 0) {
+		px_config_reader_error(r, at, "spawn_arm",
+				       "'%s' is not a socketcan device with "
+				       "transport unix and canopen drives",
+				       sm->spawn_arm);
+		return;
+	}
+	for (i = 0; i < co->n_drives; i++) {
+		const struct px_config_canopen_drive *v = &co->drives[i];
+		if (v->node_id != (int64_t)i + 1 || v->joint != (int64_t)i ||
+		    v->mode != co->drives[0].mode ||
+		    !v->has_counts_per_unit || v->counts_per_unit != 100000.0) {
+			px_config_reader_error(
+				r, at, "spawn_arm",
+				"proxima-simarm plays drives with node ids 1..N "
+				"on joints 0..N-1, one mode, counts_per_unit "
+				"100000; drives[%zu] of '%s' differs",
+				i, sm->spawn_arm);
+			return;
+		}
+	}
+}
+
 static void sim_check(struct px_config_reader *r,
 		      const struct px_config_node *map, void *obj)
 {
@@ -256,29 +381,23 @@ static void sim_check(struct px_config_reader *r,
 	const struct px_config_node *seq = px_config_node_get(map, "faults");
 	size_t i;
 	char where[48];
+	if (sm->spawn_arm)
+		spawn_arm_check(r, map, sm);
 	for (i = 0; i < sm->n_faults; i++) {
 		const struct raw_fault *f = &sm->faults[i];
 		const struct px_config_node *it =
 			seq && seq->kind == PX_CONFIG_NODE_SEQ && i < seq->len
 				? seq->items[i]
 				: map;
-		const struct px_config_device *d;
+		const char *why;
+		char buf[160];
 		if (!f->device)
 			continue;
-		d = px_config_device_find(sm->cfg_, f->device);
 		snprintf(where, sizeof(where), "faults[%zu].device", i);
-		if (!d)
+		why = fault_misfit(sm->cfg_, f, buf, sizeof(buf));
+		if (why)
 			px_config_reader_error(r, px_config_node_get(it, "device"),
-					       where,
-					       "no device named '%s' in devices",
-					       f->device);
-		else if (d->backend != PX_CONFIG_BACKEND_SIM ||
-			 d->sim.kind == PX_CONFIG_SIM_GPIO)
-			px_config_reader_error(r, px_config_node_get(it, "device"),
-					       where,
-					       "'%s' is not a simulated haptic or "
-					       "pose device",
-					       f->device);
+					       where, "%s", why);
 	}
 }
 
@@ -311,6 +430,9 @@ static const struct px_config_key sim_keys[] = {
 	 .offset = offsetof(struct raw_sim, nominal), .sub = &nominal_schema,
 	 .elem = PX_CONFIG_T_SUB, .elem_size = sizeof(struct raw_nominal),
 	 .count_offset = offsetof(struct raw_sim, n_nominal), .max_count = 64},
+	{.name = "spawn_arm", .type = PX_CONFIG_T_STRING,
+	 .offset = offsetof(struct raw_sim, spawn_arm),
+	 .flags = PX_CONFIG_NONEMPTY},
 };
 static const struct px_config_schema sim_schema = {
 	"sim", sim_keys, sizeof(sim_keys) / sizeof(sim_keys[0]), sim_check};
@@ -318,6 +440,7 @@ static const struct px_config_schema sim_schema = {
 /* ---- the application ----------------------------------------------- */
 
 #define MAX_DEVS 64
+#define TELE_JOINTS 6
 #define PLOT_MAX ((size_t)1 << 20)
 
 /* One telemetry record, pushed by the write phase every decimation-th
@@ -331,6 +454,9 @@ struct tele {
 	double penetration_m;
 	int64_t latency_ns, compute_ns;
 	int32_t contact, safe, queries, valid;
+	/* avoidance: speed scale and commanded joint velocities (the first
+	 * TELE_JOINTS joints) */
+	double scale, qdot[TELE_JOINTS];
 };
 
 struct app {
@@ -338,6 +464,7 @@ struct app {
 	struct px_config *cfg;
 	struct px_control_config ctl;
 	struct px_world *scene;
+	struct px_world_hints hints; /* coherent queries of the loop thread */
 	struct px_control_query query;
 	struct px_control_haptic haptic;
 	struct px_dev *dev[MAX_DEVS];
@@ -347,6 +474,20 @@ struct app {
 	struct px_codec_buttons *buttons[MAX_DEVS];
 	struct px_codec_map codec[MAX_DEVS];
 	int n_dev;
+	/* devices opened through px_devcfg (every back end but the
+	 * simulated haptic/pose devices, which take the sim section's
+	 * faults): the handles own their devices */
+	struct px_devcfg *dcfg[MAX_DEVS];
+	int n_dcfg;
+	int dev_owned[MAX_DEVS]; /* dev[i] is freed by px_dev_free here */
+	struct px_dev *dio[MAX_DEVS]; /* digital I/O: e-stop, enable, timing */
+	int n_dio;
+	int estop_pressed, timing_level, hardware;
+	uint64_t estop_presses, estop_cycles, enable_errors;
+	int64_t estop_first_ns, safe_first_after_estop_ns;
+	uint64_t estop_first_cycle, safe_first_cycle_after_estop;
+	uint64_t safe_cycles_before_estop;
+	int safe_at_estop;      /* the loop was in safe state at the press */
 	int ctl_dev;          /* index of control.device, -1 none */
 	int rendering;        /* mode haptic */
 	struct px_force_cmd cmd;
@@ -383,12 +524,16 @@ struct app {
 	uint64_t faults_popped;
 	struct tele last;
 	int have_last;
-	/* avoidance: a CANopen arm on the in-process simulated CAN bus */
+	/* a CANopen arm: the master from px_devcfg on any transport; on the
+	 * in-process simulated bus the drives' side (arm) runs here too */
 	int avoiding;
+	const char *co_name;
 	struct px_can_sim *canbus;
-	struct px_can_bus *ep_master, *ep_arm;
+	struct px_can_bus *ep_arm;
 	struct px_canopen *co;
 	struct px_canopen_sim *arm;
+	uint64_t enabled_cycles, drive_problem_cycles;
+	pid_t arm_pid;          /* proxima-simarm spawned by sim.spawn_arm */
 	int arm_input;          /* loop input index of the drives' feedback */
 	int n_drives;
 	int drive_joint[PX_CANOPEN_MAX_DRIVES];
@@ -406,6 +551,18 @@ struct app {
 	int64_t clock0_ns;      /* loop clock at setup: fault windows start here */
 	struct px_fault *lfaults; /* loop faults seen, for the campaign report */
 	size_t n_lfaults, cap_lfaults;
+	struct raw_fault *all_faults; /* sim.faults + --fault (ours) */
+	int n_ov;               /* injected compute overruns (device loop) */
+	int64_t ov_start[MAX_CAMPAIGN], ov_end[MAX_CAMPAIGN], ov_ns[MAX_CAMPAIGN];
+	struct px_can_sim *fault_bus; /* in-process CAN bus with faults (ours) */
+	/* checks of every run: safe state per cycle (bit i: cycle i was in
+	 * safe state; runs of a known length), outputs that were not
+	 * finite, the first and last deadline (phase) */
+	uint8_t *safe_bits;
+	uint64_t safe_bits_n;
+	uint64_t nonfinite_outputs;
+	int64_t first_deadline_ns, last_deadline_ns;
+	int have_deadline;
 };
 
 static struct app A;
@@ -439,12 +596,13 @@ static int phase_read(struct px_loop *l, const struct px_loop_cycle *c,
 		a->heap_base = heap_count();
 		a->t0_ns = c->read_ns;
 	}
-	if (a->canbus) {
+	if (a->co) {
 		int64_t newest = 0;
 		int have = a->n_drives > 0;
-		/* the robot's side of the bus first, as another process would
-		 * have answered the last SYNC by now */
-		px_canopen_sim_step(a->arm, c->read_ns);
+		/* on the in-process bus, the robot's side first, as another
+		 * process would have answered the last SYNC by now */
+		if (a->arm)
+			px_canopen_sim_step(a->arm, c->read_ns);
 		px_canopen_rx(a->co, c->read_ns);
 		for (i = 0; i < a->n_drives; i++) {
 			struct px_canopen_drive_status ds;
@@ -463,10 +621,44 @@ static int phase_read(struct px_loop *l, const struct px_loop_cycle *c,
 			px_loop_input_stamp(l, a->arm_input, newest);
 		}
 		a->enabled = px_canopen_all_enabled(a->co);
+		if (a->enabled)
+			a->enabled_cycles++;
+		/* a drive lost (heartbeat timeout) or in fault: safe state,
+		 * held while the problem lasts */
+		if (px_canopen_first_problem(a->co) >= 0) {
+			a->drive_problem_cycles++;
+			px_loop_trip(l);
+		}
 	}
 	for (i = 0; i < a->n_dev; i++) {
-		int rc = px_dev_pose_read(a->dev[i], c->read_ns, &a->sample[i]);
+		int rc;
+		if (!(px_dev_caps(a->dev[i]) & PX_DEV_CAP_POSE))
+			continue;
+		rc = px_dev_pose_read(a->dev[i], c->read_ns, &a->sample[i]);
 		(void)rc; /* staleness reaches the watchdog through the stamp */
+	}
+	{
+		/* e-stop lines: a pressed (or unreadable) one trips the loop
+		 * inside px_dev_estop_read (px_dev_attach), every cycle it is
+		 * held, so safe state cannot be left while it is */
+		int any = 0;
+		for (i = 0; i < a->n_dio; i++) {
+			int p = 0;
+			int rc = px_dev_estop_read(a->dio[i], c->read_ns, &p);
+			if (rc != PX_E_UNSUPPORTED && p)
+				any = 1;
+		}
+		if (any && !a->estop_pressed) {
+			a->estop_presses++;
+			if (a->estop_first_ns < 0) {
+				a->estop_first_ns = c->read_ns;
+				a->estop_first_cycle = c->index;
+				a->safe_at_estop = c->safe;
+			}
+		}
+		if (any)
+			a->estop_cycles++;
+		a->estop_pressed = any;
 	}
 	if (a->ctl_dev >= 0) {
 		const struct px_pose_sample *s = &a->sample[a->ctl_dev];
@@ -529,7 +721,7 @@ static int phase_compute(struct px_loop *l, const struct px_loop_cycle *c,
 {
 	struct app *a = user;
 	int64_t t = mono_ns();
-	(void)l;
+	int i;
 	a->have_out = 0;
 	if (a->avoiding)
 		avoid_compute(a, c);
@@ -559,6 +751,15 @@ static int phase_compute(struct px_loop *l, const struct px_loop_cycle *c,
 		}
 		a->have_out = 1;
 	}
+	for (i = 0; i < a->n_ov; i++)
+		if (c->deadline_ns >= a->ov_start[i] && c->deadline_ns < a->ov_end[i]) {
+			/* injected overrun: this compute takes ov_ns */
+			if (px_loop_vclock_advance(l, a->ov_ns[i]) == PX_E_STATE) {
+				int64_t until = mono_ns() + a->ov_ns[i];
+				while (mono_ns() < until)
+					;
+			}
+		}
 	if (a->alloc_probe && c->index == 10) {
 		/* self-check of the heap counter (PX_RUN_ALLOC_PROBE=1): one
 		 * deliberate allocation and release inside a cycle */
@@ -582,9 +783,33 @@ static int phase_write(struct px_loop *l, const struct px_loop_cycle *c,
 		    PX_OK)
 			a->write_errors++;
 	}
-	if (a->canbus) {
+	if (a->n_dio) {
 		int i;
-		if (c->safe) /* hold where the arm is; drives to quick stop */
+		if (c->safe && a->estop_first_ns >= 0 &&
+		    a->safe_first_after_estop_ns < 0) {
+			a->safe_first_after_estop_ns = c->write_ns;
+			a->safe_first_cycle_after_estop = c->index;
+		}
+		if (c->safe && a->estop_first_ns < 0)
+			a->safe_cycles_before_estop++;
+		/* enable relay: on while the loop runs outside safe state;
+		 * timing line: toggles every cycle (scope probe) */
+		a->timing_level = !a->timing_level;
+		for (i = 0; i < a->n_dio; i++) {
+			int rc = px_dev_dio_write(a->dio[i], PX_DIO_ENABLE, !c->safe,
+						  c->write_ns);
+			if (rc != PX_OK && rc != PX_E_UNSUPPORTED)
+				a->enable_errors++;
+			(void)px_dev_dio_write(a->dio[i], PX_DIO_TIMING,
+					       a->timing_level, c->write_ns);
+		}
+	}
+	if (a->co) {
+		int i;
+		/* safe state: hold where the arm is, drives to quick stop;
+		 * without avoidance (an arm beside a haptic device) the
+		 * drives are enabled and hold still */
+		if (c->safe || !a->avoiding)
 			for (i = 0; i < PX_CONTROL_MAX_JOINTS; i++)
 				a->targets[i] = a->csp ? a->q[i] : 0.0;
 		if (px_canopen_tx(a->co, c->write_ns, a->targets,
@@ -601,6 +826,26 @@ static int phase_write(struct px_loop *l, const struct px_loop_cycle *c,
 			if (a->aout.scale == 0)
 				a->stop_cycles++;
 		}
+	}
+	{
+		/* what went out this cycle: finite? in safe state? phase? */
+		int i, bad = 0;
+		for (i = 0; i < 3; i++)
+			bad |= !isfinite(a->cmd.force_n[i]) ||
+			       !isfinite(a->cmd.torque_n_m[i]);
+		for (i = 0; a->co && i < PX_CONTROL_MAX_JOINTS; i++)
+			bad |= !isfinite(a->targets[i]);
+		if (bad)
+			a->nonfinite_outputs++;
+		if (c->safe && c->index < a->safe_bits_n)
+			a->safe_bits[c->index >> 3] |= (uint8_t)(1u << (c->index & 7));
+		if (!a->have_deadline) {
+			/* periods skipped before the first cycle count too */
+			a->first_deadline_ns =
+				c->deadline_ns - (int64_t)c->missed * c->period_ns;
+			a->have_deadline = 1;
+		}
+		a->last_deadline_ns = c->deadline_ns;
 	}
 	f = sqrt(a->cmd.force_n[0] * a->cmd.force_n[0] +
 		 a->cmd.force_n[1] * a->cmd.force_n[1] +
@@ -645,8 +890,12 @@ static int phase_write(struct px_loop *l, const struct px_loop_cycle *c,
 					  : NAN;
 		r.latency_ns = c->wake_ns - c->deadline_ns;
 		r.compute_ns = a->compute_t0;
+		r.scale = 1.0;
 		if (a->avoiding && a->started) {
-			int k = a->aout.closest_capsule;
+			int k = a->aout.closest_capsule, j;
+			r.scale = c->safe ? 0.0 : a->aout.scale;
+			for (j = 0; j < TELE_JOINTS && j < a->ctl.chain.n_joints; j++)
+				r.qdot[j] = c->safe ? 0.0 : a->aout.qdot[j];
 			r.distance_m = a->aout.min_clearance_m;
 			r.penetration_m = 0;
 			r.queries = a->aout.point_queries;
@@ -736,79 +985,190 @@ static const struct px_codec_map *make_codec(int k, const struct px_config_codec
 	return m;
 }
 
-/* A CANopen arm on the in-process simulated CAN bus: the master (the
- * controller's side) on one endpoint, the simulated drives (the robot's
- * side, stepped in the read phase as if it were another process on the
- * bus) on the other. Returns 0 or 1 (said why). */
-static int make_can_arm(const struct px_config_device *d)
+/* E-stop faults of simulated lines: the line pressed (physical level by
+ * its active_low) at each window's start and released at its end,
+ * queued at setup. Returns 0 or 1 (said why). */
+static int estop_faults(const struct px_config_device *d, struct px_dev *dev)
 {
-	const struct px_config_canopen *c = &d->socketcan.canopen;
-	struct px_canopen_drive_cfg drv[PX_CANOPEN_MAX_DRIVES];
-	struct px_canopen_config mc;
-	struct px_canopen_sim_config sc;
-	struct px_can_sim_config bc;
-	char msg[256] = "";
+	const struct px_config_line_ref *e = &A.cfg->safety.estop;
+	int active_low = 0, found = 0;
 	size_t i;
-	int rc;
-	if (A.canbus) {
-		fprintf(stderr, "proxima-run: device '%s': one simulated CAN arm "
-				"per run\n",
-			d->name);
-		return 1;
+	for (i = 0; i < d->sim.n_lines; i++) {
+		const struct px_config_gpio_line *l = &d->sim.lines[i];
+		if ((e->present && !strcmp(e->device, d->name) &&
+		     !strcmp(e->line, l->name)) ||
+		    (!found && !strcmp(l->name, "estop"))) {
+			active_low = l->active_low;
+			found = 1;
+		}
 	}
-	memset(drv, 0, sizeof(drv));
-	for (i = 0; i < c->n_drives && i < PX_CANOPEN_MAX_DRIVES; i++) {
-		drv[i].node_id = (uint8_t)c->drives[i].node_id;
-		drv[i].mode = PX_CIA402_CSP + c->drives[i].mode;
-		drv[i].joint = (int)c->drives[i].joint;
-		A.drive_joint[i] = drv[i].joint;
-		drv[i].counts_per_unit = 100000.0; /* as proxima-simarm */
-		drv[i].rated_torque_n_m = 1.0;
-		if (drv[i].mode == PX_CIA402_CST) {
-			fprintf(stderr, "proxima-run: device '%s': drives in cst "
-					"take torques; avoidance commands csp or "
-					"csv\n",
-				d->name);
+	for (i = 0; i < A.sim.n_faults; i++) {
+		const struct raw_fault *f = &A.sim.faults[i];
+		int64_t t0 = A.clock0_ns + f->start_ns;
+		if (strcmp(f->device, d->name) != 0 || f->kind != FK_ESTOP)
+			continue;
+		if (!found ||
+		    px_gpio_sim_drive(dev, PX_GPIO_ESTOP, !active_low, t0) != PX_OK ||
+		    px_gpio_sim_drive(dev, PX_GPIO_ESTOP, active_low,
+				      t0 + f->duration_ns) != PX_OK) {
+			fprintf(stderr,
+				"proxima-run: device '%s': cannot press its "
+				"e-stop line (%s)\n",
+				d->name, found ? "more than 64 pending levels" : "none");
 			return 1;
 		}
 	}
-	A.n_drives = (int)i;
-	A.csp = A.n_drives > 0 && drv[0].mode == PX_CIA402_CSP;
-	px_can_sim_config_default(&bc);
-	rc = px_can_sim_create(&bc, &A.canbus);
-	if (rc == PX_OK)
-		rc = px_can_sim_endpoint(A.canbus, &A.ep_master);
-	if (rc == PX_OK)
-		rc = px_can_sim_endpoint(A.canbus, &A.ep_arm);
-	if (rc == PX_OK) {
-		px_canopen_config_default(&mc);
-		mc.sync = 1;
-		mc.heartbeat_period_ns = c->heartbeat_period_ns;
-		mc.heartbeat_timeout_ns = c->heartbeat_timeout_ns;
-		mc.drives = drv;
-		mc.n_drives = (size_t)A.n_drives;
-		rc = px_canopen_create(&mc, A.ep_master, &A.co, msg, sizeof(msg));
-	}
-	if (rc == PX_OK) {
-		memset(&sc, 0, sizeof(sc));
-		sc.drives = drv;
-		sc.n_drives = (size_t)A.n_drives;
-		sc.heartbeat_period_ns = 100000000;
-		sc.inertia_kg_m2 = 0.01;
-		rc = px_canopen_sim_create(&sc, A.ep_arm, &A.arm);
-	}
-	if (rc != PX_OK) {
-		fprintf(stderr, "proxima-run: device '%s': %s\n", d->name,
-			msg[0] ? msg : px_strerror(rc));
-		return 1;
-	}
-	if (A.ctl.device && strcmp(A.ctl.device, d->name) == 0)
-		A.avoiding = A.ctl.mode == PX_CONTROL_MODE_AVOIDANCE;
 	return 0;
 }
 
-/* Create device k of the config. Returns 0, 1 (setup failed: said why)
- * or 2 (back end this runner does not drive). */
+/* A device through px_devcfg (every back end but the simulated
+ * haptic/pose devices): hidapi, libusb, SocketCAN signals and CANopen
+ * drives on any transport, libgpiod and simulated lines. A CANopen arm on
+ * the in-process simulated bus gets its drives' side here as well (the
+ * same drive table and PDO layouts as the master), stepped in the read
+ * phase. Returns 0 or 1 (said why, naming the device). */
+static int make_devcfg(int k)
+{
+	const struct px_config_device *d = &A.cfg->devices[k];
+	struct px_devcfg *h;
+	struct px_devcfg_options opt;
+	struct px_dev *dev;
+	struct px_canopen *co;
+	static struct px_sim_fault busf[MAX_CAMPAIGN], armf[MAX_CAMPAIGN];
+	size_t nbus = 0, narm = 0, j;
+	char msg[512] = "";
+	int rc, i;
+	memset(&opt, 0, sizeof(opt));
+	/* faults of a CANopen arm on the in-process bus: the bus's (a bus
+	 * of ours, given to px_devcfg) and drive 0's (the simulated arm) */
+	for (j = 0; j < A.sim.n_faults; j++) {
+		const struct raw_fault *f = &A.sim.faults[j];
+		struct px_sim_fault x;
+		if (strcmp(f->device, d->name) != 0 ||
+		    d->backend != PX_CONFIG_BACKEND_SOCKETCAN)
+			continue;
+		memset(&x, 0, sizeof(x));
+		x.kind = f->kind + 1;
+		x.start_ns = A.clock0_ns + f->start_ns;
+		x.duration_ns = f->duration_ns;
+		x.probability = f->probability;
+		if (f->kind == FK_ESTOP || f->kind == FK_UNPLUG)
+			armf[narm++] = x; /* delay_ns 0: drive index 0 */
+		else
+			busf[nbus++] = x;
+	}
+	if (nbus) {
+		struct px_can_sim_config bc;
+		px_can_sim_config_default(&bc);
+		bc.faults = busf;
+		bc.n_faults = nbus;
+		rc = px_can_sim_create(&bc, &A.fault_bus);
+		if (rc != PX_OK) {
+			fprintf(stderr, "proxima-run: device '%s': simulated bus: "
+					"%s\n",
+				d->name, px_strerror(rc));
+			return 1;
+		}
+		opt.can_sim = A.fault_bus;
+	}
+	rc = px_devcfg_open(A.cfg, d, &opt, &h, msg, sizeof(msg));
+	if (rc != PX_OK) {
+		fprintf(stderr, "proxima-run: %s\n",
+			msg[0] ? msg : px_strerror(rc));
+		if (d->backend != PX_CONFIG_BACKEND_SIM)
+			fprintf(stderr,
+				"proxima-run: is the hardware connected and "
+				"readable? build/bin/proxima-probe lists what "
+				"this machine has\n");
+		return 1;
+	}
+	A.dcfg[A.n_dcfg++] = h;
+	dev = px_devcfg_dev(h);
+	if (dev) {
+		if (A.n_dev >= MAX_DEVS) {
+			fprintf(stderr, "proxima-run: more than %d devices\n",
+				MAX_DEVS);
+			return 1;
+		}
+		if (px_dev_caps(dev) & PX_DEV_CAP_DIO)
+			A.dio[A.n_dio++] = dev;
+		if (d->backend == PX_CONFIG_BACKEND_SIM && estop_faults(d, dev))
+			return 1;
+		if ((px_dev_caps(dev) & PX_DEV_CAP_POSE) && A.ctl.device &&
+		    strcmp(A.ctl.device, d->name) == 0)
+			A.ctl_dev = A.n_dev;
+		A.dev[A.n_dev++] = dev;
+	}
+	co = px_devcfg_canopen(h);
+	if (co) {
+		struct px_canopen_drive_cfg drv[PX_CANOPEN_MAX_DRIVES];
+		int n = px_devcfg_drives(h, drv, PX_CANOPEN_MAX_DRIVES);
+		if (A.co) {
+			fprintf(stderr,
+				"proxima-run: device '%s': a second CANopen "
+				"arm ('%s' is the first); one per run\n",
+				d->name, A.co_name);
+			return 1;
+		}
+		if (n < 0) {
+			fprintf(stderr, "proxima-run: device '%s': drives: %s\n",
+				d->name, px_strerror(n));
+			return 1;
+		}
+		A.co = co;
+		A.co_name = d->name;
+		A.n_drives = n;
+		for (i = 0; i < n; i++) {
+			A.drive_joint[i] = drv[i].joint;
+			if (drv[i].mode == PX_CIA402_CST) {
+				fprintf(stderr,
+					"proxima-run: device '%s': drives in cst "
+					"take torques; proxima-run commands csp "
+					"or csv\n",
+					d->name);
+				return 1;
+			}
+		}
+		A.csp = n > 0 && drv[0].mode == PX_CIA402_CSP;
+		A.canbus = px_devcfg_can_sim(h);
+		if (A.canbus) {
+			struct px_canopen_sim_config sc;
+			memset(&sc, 0, sizeof(sc));
+			sc.pdo = px_devcfg_pdo(h);
+			sc.drives = drv;
+			sc.n_drives = (size_t)n;
+			sc.heartbeat_period_ns = 100000000;
+			sc.inertia_kg_m2 = 0.01;
+			sc.faults = narm ? armf : NULL;
+			sc.n_faults = narm;
+			rc = px_can_sim_endpoint(A.canbus, &A.ep_arm);
+			if (rc == PX_OK)
+				rc = px_canopen_sim_create(&sc, A.ep_arm, &A.arm);
+			if (rc != PX_OK) {
+				fprintf(stderr,
+					"proxima-run: device '%s': simulated arm "
+					"on the in-process bus: %s\n",
+					d->name, px_strerror(rc));
+				return 1;
+			}
+		}
+		if (A.ctl.device && strcmp(A.ctl.device, d->name) == 0)
+			A.avoiding = A.ctl.mode == PX_CONTROL_MODE_AVOIDANCE;
+	}
+	return 0;
+}
+
+/* A device that is not simulated in this process (hardware, or a CAN bus
+ * shared with another process) runs on the real clock only. */
+static int is_hardware(const struct px_config_device *d)
+{
+	return d->backend != PX_CONFIG_BACKEND_SIM &&
+	       !(d->backend == PX_CONFIG_BACKEND_SOCKETCAN &&
+		 d->socketcan.transport == PX_CONFIG_CAN_SIM);
+}
+
+/* Create device k of the config. Returns 0 or 1 (setup failed: said
+ * why). */
 static int make_device(int k)
 {
 	const struct px_config_device *d = &A.cfg->devices[k];
@@ -819,20 +1179,8 @@ static int make_device(int k)
 	char msg[256] = "";
 	size_t i;
 	int rc;
-	if (d->backend == PX_CONFIG_BACKEND_SOCKETCAN &&
-	    d->socketcan.transport == PX_CONFIG_CAN_SIM &&
-	    d->socketcan.canopen.present)
-		return make_can_arm(d);
-	if (d->backend != PX_CONFIG_BACKEND_SIM) {
-		fprintf(stderr,
-			"proxima-run: device '%s': back end %s is not driven "
-			"by proxima-run in this version (only sim); check the "
-			"file with --check\n",
-			d->name, px_config_backend_names()[d->backend]);
-		return 2;
-	}
-	if (s->kind == PX_CONFIG_SIM_GPIO)
-		return 0; /* simulated lines: nothing in the cycle uses them */
+	if (d->backend != PX_CONFIG_BACKEND_SIM || s->kind == PX_CONFIG_SIM_GPIO)
+		return make_devcfg(k);
 	px_dev_config_default(&dc);
 	dc.name = d->name;
 	dc.stale_timeout_ns = d->stale_timeout_ns
@@ -909,8 +1257,108 @@ static int make_device(int k)
 	}
 	if (A.ctl.device && strcmp(A.ctl.device, d->name) == 0)
 		A.ctl_dev = A.n_dev;
+	A.dev_owned[A.n_dev] = 1;
 	A.n_dev++;
 	return 0;
+}
+
+/* sim.spawn_arm: start proxima-simarm (next to this program) as the
+ * drives' side of the unix-socket bus, as a second process, and wait
+ * until it has bound its socket. It gets SIGTERM when this process ends
+ * (teardown, or PR_SET_PDEATHSIG if this one dies). Returns 0 or 1. */
+static int spawn_arm(void)
+{
+	const struct px_config_device *d =
+		px_config_device_find(A.cfg, A.sim.spawn_arm);
+	const struct px_config_socketcan *c = &d->socketcan;
+	char exe[1024], local[160], n[16], line[256] = "";
+	const char *mode = c->canopen.drives[0].mode == PX_CONFIG_CIA402_CSV
+				   ? "csv"
+				   : "csp";
+	int fds[2];
+	ssize_t len = readlink("/proc/self/exe", exe, sizeof(exe) - 32);
+	char *slash;
+	size_t got = 0;
+	int64_t until;
+	if (len <= 0 || !(slash = memrchr(exe, '/', (size_t)len))) {
+		fprintf(stderr, "proxima-run: sim.spawn_arm: cannot find this "
+				"program's directory\n");
+		return 1;
+	}
+	strcpy(slash + 1, "proxima-simarm");
+	if (access(exe, X_OK) != 0) {
+		fprintf(stderr, "proxima-run: sim.spawn_arm: %s: %s (make builds "
+				"it)\n",
+			exe, strerror(errno));
+		return 1;
+	}
+	snprintf(local, sizeof(local), "%s.peer", c->socket_path);
+	snprintf(n, sizeof(n), "%zu", c->canopen.n_drives);
+	if (pipe(fds) != 0) {
+		fprintf(stderr, "proxima-run: sim.spawn_arm: pipe: %s\n",
+			strerror(errno));
+		return 1;
+	}
+	fflush(NULL);
+	A.arm_pid = fork();
+	if (A.arm_pid < 0) {
+		fprintf(stderr, "proxima-run: sim.spawn_arm: fork: %s\n",
+			strerror(errno));
+		close(fds[0]);
+		close(fds[1]);
+		return 1;
+	}
+	if (A.arm_pid == 0) {
+		/* the arm goes when the controller goes */
+		prctl(PR_SET_PDEATHSIG, SIGTERM);
+		dup2(fds[1], 1);
+		close(fds[0]);
+		close(fds[1]);
+		execl(exe, "proxima-simarm", "--unix", local, c->socket_path,
+		      "--drives", n, "--mode", mode, (char *)NULL);
+		fprintf(stderr, "proxima-run: sim.spawn_arm: %s: %s\n", exe,
+			strerror(errno));
+		_exit(127);
+	}
+	close(fds[1]);
+	/* its first line says the socket is bound: wait for it (5 s) */
+	until = mono_ns() + 5000000000;
+	while (got + 1 < sizeof(line) && !memchr(line, '\n', got)) {
+		struct pollfd p = {fds[0], POLLIN, 0};
+		int64_t left = until - mono_ns();
+		ssize_t r;
+		if (left <= 0 || poll(&p, 1, (int)(left / 1000000) + 1) <= 0)
+			break;
+		r = read(fds[0], line + got, sizeof(line) - 1 - got);
+		if (r <= 0)
+			break;
+		got += (size_t)r;
+		line[got] = '\0';
+	}
+	close(fds[0]);
+	if (!strstr(line, "drives on")) {
+		int st = 0;
+		kill(A.arm_pid, SIGTERM);
+		waitpid(A.arm_pid, &st, 0);
+		A.arm_pid = 0;
+		fprintf(stderr,
+			"proxima-run: sim.spawn_arm: %s did not start (exit "
+			"status %d)\n",
+			exe, WIFEXITED(st) ? WEXITSTATUS(st) : -1);
+		return 1;
+	}
+	fprintf(stderr, "proxima-run: spawned %s (pid %d): %zu drives on %s\n",
+		exe, (int)A.arm_pid, c->canopen.n_drives, c->socket_path);
+	return 0;
+}
+
+static void stop_arm(void)
+{
+	if (A.arm_pid > 0) {
+		kill(A.arm_pid, SIGTERM);
+		waitpid(A.arm_pid, NULL, 0);
+		A.arm_pid = 0;
+	}
 }
 
 static int report_config(int rc, const struct px_config_diag *diag)
@@ -933,6 +1381,8 @@ static int setup(void)
 	int i, rc;
 
 	A.ctl_dev = -1;
+	A.estop_first_ns = -1;
+	A.safe_first_after_estop_ns = -1;
 	A.clock0_ns = A.o.virtual_time ? 0 : mono_ns();
 	A.min_distance_m = INFINITY;
 	A.min_proxy_distance_m = INFINITY;
@@ -941,7 +1391,24 @@ static int setup(void)
 	rc = px_world_config_load(cfg, &A.scene, &diag);
 	if (rc != PX_OK)
 		return report_config(rc, &diag);
-	px_world_control_query(A.scene, &A.query);
+	/* the loop's queries follow a moving point (proxy, device, link
+	 * points): each model's search starts at last answer's feature */
+	px_world_control_query_coherent(A.scene, &A.hints, &A.query);
+	for (i = 0; i < (int)cfg->n_devices; i++) {
+		if (!is_hardware(&cfg->devices[i]))
+			continue;
+		A.hardware = 1;
+		if (A.o.virtual_time) {
+			fprintf(stderr,
+				"proxima-run: device '%s' (%s): --virtual-time "
+				"drives simulated devices only; hardware and "
+				"buses shared with other processes run on the "
+				"real clock\n",
+				cfg->devices[i].name,
+				px_config_backend_names()[cfg->devices[i].backend]);
+			return 2;
+		}
+	}
 	for (i = 0; i < (int)cfg->n_devices && i < MAX_DEVS; i++) {
 		rc = make_device(i);
 		if (rc)
@@ -949,11 +1416,13 @@ static int setup(void)
 	}
 	if (A.ctl.mode == PX_CONTROL_MODE_AVOIDANCE && !A.avoiding) {
 		fprintf(stderr,
-			"proxima-run: control mode 'avoidance' is driven by "
-			"proxima-run only on a CANopen arm on the simulated CAN "
-			"bus (socketcan transport sim) in this version\n");
-		return 2;
+			"proxima-run: control mode 'avoidance' needs "
+			"control.device '%s' to be a socketcan device with "
+			"canopen drives\n",
+			A.ctl.device ? A.ctl.device : "");
+		return 1;
 	}
+
 	A.min_clearance_m = INFINITY;
 	A.min_scale = 1.0;
 	A.rendering = A.ctl.mode == PX_CONTROL_MODE_HAPTIC && A.ctl_dev >= 0;
@@ -1017,16 +1486,21 @@ static int setup(void)
 		if (rc >= 0 && A.rendering && i == A.ctl_dev)
 			rc = px_dev_force_attach(A.dev[i], A.loop, &A.cmd);
 		if (rc < 0) {
-			fprintf(stderr, "proxima-run: device '%s': %s\n",
-				px_dev_name(A.dev[i]), px_strerror(rc));
+			struct px_dev_status ds;
+			ds.last_msg[0] = '\0';
+			px_dev_status(A.dev[i], &ds);
+			fprintf(stderr, "proxima-run: device '%s': %s%s%s\n",
+				px_dev_name(A.dev[i]), px_strerror(rc),
+				ds.last_msg[0] ? ": " : "", ds.last_msg);
 			return 1;
 		}
 	}
-	if (A.avoiding) {
-		const struct px_config_device *d = px_config_device_find(cfg, A.ctl.device);
+	if (A.co) {
+		/* the drives' feedback (TPDO1) is a watched input like a pose */
+		const struct px_config_device *d = px_config_device_find(cfg, A.co_name);
 		int64_t tmo = d && d->stale_timeout_ns ? d->stale_timeout_ns
 						       : cfg->safety.watchdog.device_timeout_ns;
-		A.arm_input = px_loop_input_add(A.loop, A.ctl.device, tmo);
+		A.arm_input = px_loop_input_add(A.loop, A.co_name, tmo);
 		if (A.arm_input < 0) {
 			fprintf(stderr, "proxima-run: arm watchdog: %s\n",
 				px_strerror(A.arm_input));
@@ -1050,32 +1524,62 @@ static int setup(void)
 	if (A.o.duration_s > 0)
 		A.max_cycles = (uint64_t)ceil(A.o.duration_s * 1e9 /
 					      (double)cfg->loop.period_ns);
+	if (A.sim.spawn_arm && spawn_arm())
+		return 1;
+	for (i = 0; i < (int)A.sim.n_faults; i++) {
+		const struct raw_fault *f = &A.sim.faults[i];
+		if (f->kind != FK_OVERRUN)
+			continue;
+		A.ov_start[A.n_ov] = A.clock0_ns + f->start_ns;
+		A.ov_end[A.n_ov] = A.ov_start[A.n_ov] + f->duration_ns;
+		A.ov_ns[A.n_ov++] = f->delay_ns;
+	}
+	/* safe state per cycle, to check the reaction to every trip (runs
+	 * of a known length up to 2^26 cycles) */
+	if (A.max_cycles && A.max_cycles <= ((uint64_t)1 << 26)) {
+		A.safe_bits = calloc((size_t)(A.max_cycles + 7) / 8, 1);
+		if (A.safe_bits)
+			A.safe_bits_n = A.max_cycles;
+	}
 	return 0;
 }
 
 static void teardown(void)
 {
 	int i;
+	stop_arm();
 	px_loop_free(A.loop);
 	for (i = 0; i < A.n_dev; i++)
-		px_dev_free(A.dev[i]);
+		if (A.dev_owned[i])
+			px_dev_free(A.dev[i]);
 	for (i = 0; i < MAX_DEVS; i++) {
 		px_sim_csv_free(A.csv[i]);
 		free(A.fields[i][0]);
 		free(A.fields[i][1]);
 		free(A.buttons[i]);
 	}
-	px_canopen_free(A.co);
 	px_canopen_sim_free(A.arm);
-	px_can_sim_free(A.canbus);
+	px_can_bus_close(A.ep_arm);
+	for (i = 0; i < A.n_dcfg; i++)
+		px_devcfg_free(A.dcfg[i]); /* devices, master, buses */
+	px_can_sim_free(A.fault_bus); /* after its endpoints */
 	px_world_free(A.scene);
 	px_arena_fini(&A.arena);
 	free(A.recs);
 	free(A.lfaults);
+	free(A.all_faults);
+	free(A.safe_bits);
 	px_config_free(A.cfg);
 }
 
 /* ---- outside the cycle: telemetry, faults, status ------------------ */
+
+/* Joints whose commanded velocity is recorded (CSV columns, plot). */
+static int avoid_joints(void)
+{
+	int n = A.ctl.chain.n_joints;
+	return n < TELE_JOINTS ? n : TELE_JOINTS;
+}
 
 static void drain(void)
 {
@@ -1102,7 +1606,7 @@ static void drain(void)
 		if (A.csv_f)
 			fprintf(A.csv_f,
 				"%.6f,%llu,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.6g,%.6g,"
-				"%.6g,%.6g,%.9g,%.9g,%d,%d,%lld,%lld,%d\n",
+				"%.6g,%.6g,%.9g,%.9g,%d,%d,%lld,%lld,%d",
 				r.t_s, (unsigned long long)r.cycle, r.dev_m[0],
 				r.dev_m[1], r.dev_m[2], r.proxy_m[0], r.proxy_m[1],
 				r.proxy_m[2], r.force_n[0], r.force_n[1],
@@ -1110,6 +1614,15 @@ static void drain(void)
 				r.penetration_m, r.contact, r.safe,
 				(long long)r.latency_ns, (long long)r.compute_ns,
 				r.queries);
+		if (A.csv_f) {
+			int j;
+			if (A.avoiding) {
+				fprintf(A.csv_f, ",%.6g", r.scale);
+				for (j = 0; j < avoid_joints(); j++)
+					fprintf(A.csv_f, ",%.6g", r.qdot[j]);
+			}
+			fputc('\n', A.csv_f);
+		}
 		/* The proxy must stay on the free side of closed models:
 		 * check each recorded proxy against the scene (not in the
 		 * cycle; the scene is only read). */
@@ -1265,7 +1778,46 @@ static int write_plots(const char *time_svg, const char *lat_svg)
 	static uint64_t lbins[PX_STATS_DEFAULT_BINS], cbins[PX_STATS_DEFAULT_BINS];
 	uint64_t lover = 0, cover = 0;
 	int nl, nc;
-	if (x && d && f && pen && fz) {
+	if (x && d && f && pen && fz && A.avoiding) {
+		static const char *const colors[TELE_JOINTS] = {
+			"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd",
+			"#8c564b"};
+		static const char *const names[TELE_JOINTS] = {
+			"joint 0", "joint 1", "joint 2", "joint 3", "joint 4",
+			"joint 5"};
+		double *qd[TELE_JOINTS] = {0};
+		struct tool_svg_series sq[TELE_JOINTS];
+		struct tool_svg_series sd[] = {{"clearance", d, "#1f77b4"},
+					       {"protective", pen, "#d62728"}};
+		struct tool_svg_series ss[] = {{"speed scale", f, "#2ca02c"}};
+		struct tool_svg_panel p[] = {{"clearance (mm)", sd, 2},
+					     {"speed scale", ss, 1},
+					     {"commanded velocity (rad/s)", sq, 0}};
+		int j, nj = avoid_joints(), ok = 1;
+		for (j = 0; j < nj; j++) {
+			qd[j] = calloc(n + 1, sizeof(double));
+			ok = ok && qd[j];
+			sq[j].name = names[j];
+			sq[j].y = qd[j];
+			sq[j].color = colors[j];
+		}
+		p[2].n_series = nj;
+		for (i = 0; ok && i < n; i++) {
+			x[i] = A.recs[i].t_s;
+			d[i] = A.recs[i].distance_m * 1e3;
+			pen[i] = A.ctl.avoid.protective_distance_m * 1e3;
+			f[i] = A.recs[i].scale;
+			for (j = 0; j < nj; j++)
+				qd[j][i] = A.recs[i].qdot[j];
+		}
+		if (ok)
+			rc = tool_svg_lines(time_svg,
+					    "proxima-run: clearance, speed scale "
+					    "and commanded joint velocity",
+					    "time (s)", x, n, p, 3);
+		for (j = 0; j < nj; j++)
+			free(qd[j]);
+	} else if (x && d && f && pen && fz) {
 		struct tool_svg_series sd[] = {{"distance", d, "#1f77b4"}};
 		struct tool_svg_series sf[] = {{"|F|", f, "#d62728"},
 					       {"Fz", fz, "#ff7f0e"}};
@@ -1367,6 +1919,109 @@ static void device_faults(struct dev_faults *df)
 
 static void json_campaign(FILE *f);
 
+/* The slowest reaction to a trip: for every loop fault that put (or
+ * kept) the loop in safe state, the cycles from the one that saw it to
+ * the first in safe state (-1: no fault to check; 1000: none within the
+ * run). Needs the per-cycle record (runs of a known length) and the
+ * faults list (kept when faults are injected). */
+static int64_t trip_to_safe(uint64_t *checked)
+{
+	int64_t worst = -1;
+	size_t k;
+	*checked = 0;
+	if (!A.safe_bits)
+		return -1;
+	for (k = 0; k < A.n_lfaults; k++) {
+		const struct px_fault *lf = &A.lfaults[k];
+		int64_t d = 1000;
+		uint64_t c;
+		if (!lf->safe || lf->cycle >= A.safe_bits_n)
+			continue;
+		for (c = lf->cycle; c < A.safe_bits_n && c < lf->cycle + 1000; c++)
+			if (A.safe_bits[c >> 3] & (1u << (c & 7))) {
+				d = (int64_t)(c - lf->cycle);
+				break;
+			}
+		if (c == A.safe_bits_n && d == 1000)
+			continue; /* the run ended first */
+		(*checked)++;
+		if (d > worst)
+			worst = d;
+	}
+	return worst;
+}
+
+/* What the safety layer and the e-stop did: presses seen, how long after
+ * the first press the loop was in safe state (ns, -1: never), state at
+ * the end. */
+static void json_safety(FILE *f, const struct px_loop_status *st)
+{
+	fprintf(f,
+		"  \"safe_at_end\": %d,\n  \"safe_cause\": \"%s\",\n"
+		"  \"estop_lines\": %d,\n  \"estop_presses\": %llu,\n"
+		"  \"estop_cycles\": %llu,\n  \"estop_to_safe_ns\": %lld,\n"
+		"  \"estop_to_safe_cycles\": %lld,\n"
+		"  \"safe_cycles_before_estop\": %llu,\n"
+		"  \"safe_at_estop\": %d,\n"
+		"  \"enable_write_errors\": %llu,\n",
+		st->safe, st->safe ? px_fault_cause_name(st->safe_cause) : "",
+		A.n_dio, (unsigned long long)A.estop_presses,
+		(unsigned long long)A.estop_cycles,
+		(long long)(A.estop_first_ns >= 0 && A.safe_first_after_estop_ns >= 0
+				    ? A.safe_first_after_estop_ns - A.estop_first_ns
+				    : -1),
+		(long long)(A.estop_first_ns >= 0 && A.safe_first_after_estop_ns >= 0
+				    ? (long long)(A.safe_first_cycle_after_estop -
+						  A.estop_first_cycle)
+				    : -1),
+		(unsigned long long)A.safe_cycles_before_estop, A.safe_at_estop,
+		(unsigned long long)A.enable_errors);
+}
+
+/* Every device's counters, and the CANopen drives' states. */
+static void json_devices(FILE *f)
+{
+	int i;
+	fputs("  \"devices\": [", f);
+	for (i = 0; i < A.n_dev; i++) {
+		struct px_dev_status s;
+		if (px_dev_status(A.dev[i], &s) != PX_OK)
+			continue;
+		fprintf(f, "%s\n    {\"name\": ", i ? "," : "");
+		json_string(f, s.name);
+		fprintf(f, ", \"backend\": ");
+		json_string(f, s.backend);
+		fprintf(f,
+			", \"state\": %d, \"reports\": %llu, \"samples\": %llu, "
+			"\"writes\": %llu, \"write_errors\": %llu, \"errors\": "
+			"%llu, \"last_error\": ",
+			s.state, (unsigned long long)s.reports,
+			(unsigned long long)s.samples, (unsigned long long)s.writes,
+			(unsigned long long)s.write_errors,
+			(unsigned long long)s.errors);
+		json_string(f, s.last_msg);
+		fputc('}', f);
+	}
+	fputs(A.n_dev ? "\n  ],\n" : "],\n", f);
+	fprintf(f,
+		"  \"drives_enabled_cycles\": %llu,\n"
+		"  \"drive_problem_cycles\": %llu,\n  \"drives\": [",
+		(unsigned long long)A.enabled_cycles,
+		(unsigned long long)A.drive_problem_cycles);
+	for (i = 0; A.co && i < A.n_drives; i++) {
+		struct px_canopen_drive_status ds;
+		if (px_canopen_drive_status(A.co, (size_t)i, &ds) != PX_OK)
+			continue;
+		fprintf(f,
+			"%s\n    {\"node_id\": %d, \"state\": \"%s\", "
+			"\"position\": %.9g, \"lost\": %d, \"emcy\": %llu}",
+			i ? "," : "", ds.node_id, px_cia402_state_name(ds.state),
+			json_num(ds.position), ds.lost,
+			(unsigned long long)ds.emcy_count);
+	}
+	fputs(A.co && A.n_drives ? "\n  ],\n" : "],\n", f);
+}
+
 static int write_json(const char *path, const struct px_loop_status *st,
 		      const struct px_stats_snapshot *lat,
 		      const struct px_stats_snapshot *cmp, double wall_s,
@@ -1423,17 +2078,43 @@ static int write_json(const char *path, const struct px_loop_status *st,
 		(unsigned long long)A.velocity_trips,
 		(unsigned long long)A.query_errors,
 		(unsigned long long)st->faults_dropped);
+	json_safety(f, st);
+	json_devices(f);
+	{
+		uint64_t checked;
+		int64_t worst = trip_to_safe(&checked);
+		int64_t span = A.have_deadline ? A.last_deadline_ns -
+							 A.first_deadline_ns
+					       : 0;
+		int64_t want = st->cycles
+				       ? ((int64_t)st->cycles - 1 +
+					  (int64_t)st->missed_periods) *
+						 st->period_ns
+				       : 0;
+		fprintf(f,
+			"  \"faults_injected\": %zu,\n  \"faults_popped\": %llu,\n"
+			"  \"watchdog_trips_checked\": %llu,\n"
+			"  \"max_trip_to_safe_cycles\": %lld,\n"
+			"  \"nonfinite_outputs\": %llu,\n"
+			"  \"phase_error_ns\": %lld,\n",
+			A.sim.n_faults, (unsigned long long)A.faults_popped,
+			(unsigned long long)checked, (long long)worst,
+			(unsigned long long)A.nonfinite_outputs,
+			(long long)(span - want));
+	}
 	json_campaign(f);
 	fprintf(f,
 		"  \"allocations_after_setup\": %llu,\n"
 		"  \"allocations_setup\": %llu,\n"
 		"  \"allocation_counter\": \"%s\",\n"
 		"  \"telemetry_records\": %llu,\n  \"telemetry_dropped\": %llu,\n"
+		"  \"telemetry_decimation\": %lld,\n"
 		"  \"realtime\": %d,\n  \"csv\": ",
 		(unsigned long long)atomic_load(&A.allocs),
 		(unsigned long long)A.setup_heap_calls, counter,
 		(unsigned long long)A.n_rows,
-		(unsigned long long)px_ring_dropped(A.ring), st->realtime);
+		(unsigned long long)px_ring_dropped(A.ring), (long long)A.decimation,
+		st->realtime);
 	if (A.csv_path[0])
 		json_string(f, A.csv_path);
 	else
@@ -1558,8 +2239,8 @@ static void print_summary(const struct px_loop_status *st,
 		       A.ctl.avoid.protective_distance_m * 1e3,
 		       A.ctl.avoid.influence_distance_m * 1e3, A.min_scale,
 		       (unsigned long long)A.stop_cycles);
-	else
-	printf("  distance          min %+.3f mm, max penetration %.3f mm, "
+	else if (A.ctl_dev >= 0)
+		printf("  distance          min %+.3f mm, max penetration %.3f mm, "
 	       "proxy min clearance %+.3f mm\n",
 	       json_num(A.min_distance_m) * 1e3, A.max_penetration_m * 1e3,
 	       json_num(A.min_proxy_distance_m) * 1e3);
@@ -1576,6 +2257,25 @@ static void print_summary(const struct px_loop_status *st,
 		printf(", query errors %llu (last: %s)",
 		       (unsigned long long)A.query_errors,
 		       px_strerror(A.last_query_err));
+	if (A.n_dio)
+		printf("\n  e-stop            %llu press%s, held %llu cycles%s",
+		       (unsigned long long)A.estop_presses,
+		       A.estop_presses == 1 ? "" : "es",
+		       (unsigned long long)A.estop_cycles,
+		       st->safe ? "; in safe state at the end" : "");
+	if (A.co) {
+		int i, n = 0;
+		for (i = 0; i < A.n_drives; i++) {
+			struct px_canopen_drive_status ds;
+			if (px_canopen_drive_status(A.co, (size_t)i, &ds) == PX_OK &&
+			    ds.state == PX_CIA402_OPERATION_ENABLED)
+				n++;
+		}
+		printf("\n  drives            %d on '%s', enabled in %llu cycles, "
+		       "%d in operation enabled at the end",
+		       A.n_drives, A.co_name, (unsigned long long)A.enabled_cycles,
+		       n);
+	}
 	printf("\n  allocations       %llu after setup (loop thread; setup made "
 	       "%llu)\n",
 	       (unsigned long long)atomic_load(&A.allocs),
@@ -1585,6 +2285,95 @@ static void print_summary(const struct px_loop_status *st,
 	       (unsigned long long)A.n_rows, (long long)A.decimation,
 	       (unsigned long long)px_ring_dropped(A.ring));
 	print_campaign();
+}
+
+/* Parse --fault KIND,DEVICE,START_S,DURATION_S[,PROBABILITY[,DELAY_S]]
+ * into f. Returns NULL or why not. */
+static const char *parse_fault(const char *spec, struct raw_fault *f,
+			       char *dev, size_t dev_cap, char *buf, size_t cap)
+{
+	char tmp[256], *fld[7], *save = NULL, *t;
+	int n = 0, k;
+	double v[4] = {0, 0, 1, 0};
+	if (strlen(spec) >= sizeof(tmp))
+		return "too long";
+	strcpy(tmp, spec);
+	for (t = strtok_r(tmp, ",", &save); t && n < 7;
+	     t = strtok_r(NULL, ",", &save))
+		fld[n++] = t;
+	if (n < 4 || n > 6)
+		return "expected KIND,DEVICE,START_S,DURATION_S[,PROBABILITY[,"
+		       "DELAY_S]]";
+	memset(f, 0, sizeof(*f));
+	f->kind = -1;
+	for (k = 0; fault_kind_names[k]; k++)
+		if (strcmp(fld[0], fault_kind_names[k]) == 0)
+			f->kind = k;
+	if (f->kind < 0) {
+		snprintf(buf, cap, "unknown kind '%s' (drop, delay, duplicate, "
+			 "corrupt, stuck, nan, unplug, bus_off, estop, overrun)",
+			 fld[0]);
+		return buf;
+	}
+	snprintf(dev, dev_cap, "%s", fld[1]);
+	f->device = dev;
+	for (k = 2; k < n; k++) {
+		char *end;
+		errno = 0;
+		v[k - 2] = strtod(fld[k], &end);
+		if (end == fld[k] || *end || errno || !isfinite(v[k - 2]) ||
+		    v[k - 2] < 0 || v[k - 2] > 1e6) {
+			snprintf(buf, cap, "'%s' is not a number of seconds (or a "
+				 "probability)", fld[k]);
+			return buf;
+		}
+	}
+	if (v[1] <= 0 || v[2] <= 0 || v[2] > 1)
+		return "DURATION_S must be > 0 and PROBABILITY in (0, 1]";
+	f->start_ns = (int64_t)llround(v[0] * 1e9);
+	f->duration_ns = (int64_t)llround(v[1] * 1e9);
+	f->probability = v[2];
+	f->delay_ns = (int64_t)llround(v[3] * 1e9);
+	if ((f->kind == FK_DELAY || f->kind == FK_OVERRUN) != (f->delay_ns > 0))
+		return "DELAY_S is required for kinds delay and overrun, and only "
+		       "for them";
+	return NULL;
+}
+
+/* sim.faults plus the --fault ones, checked like the config's. Returns
+ * 0 or 2 (said why). */
+static int add_cli_faults(void)
+{
+	static char devs[64][64];
+	size_t n = A.sim.n_faults, i;
+	if (!A.o.n_fault)
+		return 0;
+	A.all_faults = calloc(n + (size_t)A.o.n_fault, sizeof(*A.all_faults));
+	if (!A.all_faults)
+		return 2;
+	if (n)
+		memcpy(A.all_faults, A.sim.faults, n * sizeof(*A.all_faults));
+	for (i = 0; i < (size_t)A.o.n_fault; i++) {
+		char buf[200];
+		const char *why = parse_fault(A.o.fault[i], &A.all_faults[n],
+					      devs[i], sizeof(devs[i]), buf,
+					      sizeof(buf));
+		if (!why)
+			why = fault_misfit(A.cfg, &A.all_faults[n], buf, sizeof(buf));
+		if (why) {
+			fprintf(stderr, "proxima-run: --fault %s: %s\n",
+				A.o.fault[i], why);
+			return 2;
+		}
+		n++;
+	}
+	if (n > MAX_CAMPAIGN) {
+		fprintf(stderr, "proxima-run: more than %d faults\n", MAX_CAMPAIGN);
+		return 2;
+	}
+	A.sim.faults = A.all_faults;
+	A.sim.n_faults = n;
+	return 0;
 }
 
 int main(int argc, char **argv)
@@ -1618,6 +2407,12 @@ int main(int argc, char **argv)
 	}
 	if (A.ctl.warning[0])
 		fprintf(stderr, "%s\n", A.ctl.warning);
+	rc = add_cli_faults();
+	if (rc) {
+		free(A.all_faults);
+		px_config_free(A.cfg);
+		return rc;
+	}
 	if (A.o.check) {
 		printf("%s: OK (%zu device%s, loop period %lld ns)\n", A.o.config,
 		       A.cfg->n_devices, A.cfg->n_devices == 1 ? "" : "s",
@@ -1646,7 +2441,16 @@ int main(int argc, char **argv)
 		fprintf(A.csv_f,
 			"t_s,cycle,x_m,y_m,z_m,proxy_x_m,proxy_y_m,proxy_z_m,"
 			"fx_n,fy_n,fz_n,force_n,distance_m,penetration_m,"
-			"contact,safe,wakeup_latency_ns,compute_ns,queries\n");
+			"contact,safe,wakeup_latency_ns,compute_ns,queries");
+		if (A.avoiding) {
+			/* distance_m is the clearance; x..z the closest link
+			 * point, proxy_* the obstacle point */
+			int j;
+			fprintf(A.csv_f, ",speed_scale");
+			for (j = 0; j < avoid_joints(); j++)
+				fprintf(A.csv_f, ",qdot%d_rad_per_s", j);
+		}
+		fputc('\n', A.csv_f);
 	}
 	A.alloc_probe = getenv("PX_RUN_ALLOC_PROBE") &&
 			strcmp(getenv("PX_RUN_ALLOC_PROBE"), "1") == 0;
@@ -1658,8 +2462,7 @@ int main(int argc, char **argv)
 		"%s\n",
 		A.o.config, px_world_count(A.scene),
 		px_world_count(A.scene) == 1 ? "" : "s",
-		A.n_dev + (A.canbus ? 1 : 0),
-		A.n_dev + (A.canbus ? 1 : 0) == 1 ? "" : "s",
+		(int)A.cfg->n_devices, A.cfg->n_devices == 1 ? "" : "s",
 		A.rendering ? (A.ctl.haptic.renderer == PX_CONTROL_PROXY
 				       ? "haptic proxy rendering"
 				       : "haptic penalty rendering")

@@ -45,6 +45,16 @@ if ! env -u MAKEFLAGS -u MFLAGS ${MAKE:-make} -s --no-print-directory -C "$top" 
 	exit 1
 fi
 
+# The end-to-end scenario's HID device (guest_e2e.sh): a helper program
+# of the suite, not part of the library.
+if ! ${CC:-cc} -std=c11 -D_GNU_SOURCE -Wall -Wextra -Werror -O2 \
+	-o "$vmdir/uhid_feed" "$here/uhid_feed.c" -lm >"$vmdir/uhid_feed.log" 2>&1; then
+	cat "$vmdir/uhid_feed.log"
+	echo "FAIL VM suite: building tests/vm/uhid_feed.c failed"
+	summary 0 1 0
+	exit 1
+fi
+
 # What the guest runs, in order (paths in the guest).
 g=/px/build
 files="$build/tests/test_can=$g/tests/test_can
@@ -56,6 +66,7 @@ $build/tests/test_gpio=$g/tests/test_gpio
 $build/bin/proxima-probe=$g/bin/proxima-probe
 $build/bin/proxima-simarm=$g/bin/proxima-simarm
 $build/bin/proxima-run=$g/bin/proxima-run
+$vmdir/uhid_feed=$g/tests/uhid_feed
 $top/tests/run.sh=/px/tests/run.sh
 $top/tests/test_probe.sh=/px/tests/test_probe.sh"
 for a in $files; do
