@@ -368,7 +368,9 @@ int px_can_log_parse(const char *line, struct px_can_msg *m, int64_t *t_ns,
 		sec = sec * 10 + (*p++ - '0');
 		digits++;
 	}
-	if (!digits || *p++ != '.')
+	/* The time in ns must fit int64_t (seconds up to 9223372035, year
+	 * 2262): a larger value overflowed sec * 1e9 (found by fuzzing). */
+	if (!digits || *p++ != '.' || sec > INT64_MAX / 1000000000 - 1)
 		return PX_E_PARSE;
 	while (isdigit((unsigned char)*p)) {
 		if (fracdigits < 6) {
