@@ -241,6 +241,9 @@ help:
 	@echo '  sanitize   the test suite built with AddressSanitizer + UBSan'
 	@echo '  run        build, then run proxima-run on RUN_CONFIG for RUN_SECONDS (default config, 10 s)'
 	@echo '  fuzz       build fuzz/fuzz_*.c with libFuzzer, run each FUZZ_SECONDS=$(FUZZ_SECONDS) s'
+	@echo '  soak       SOAK_CYCLES=$(SOAK_CYCLES) loop cycles with faults in virtual time'
+	@echo '  memcheck   the tools under valgrind memcheck on sample inputs'
+	@echo '  stress     hostile geometry with the large cases (PX_STRESS=1)'
 	@echo '  install    library, headers, tools and proxima.pc under DESTDIR/PREFIX'
 	@echo '  uninstall  remove what install put there'
 	@echo '  deps       install the Debian packages building and testing need'
@@ -329,6 +332,22 @@ fuzz:
 	  exit 1; \
 	fi; \
 	echo "fuzz: no crash, leak or hang in $(FUZZ_SECONDS) s per target: $(FUZZ_RUN)"
+
+# ---- soak, memcheck, stress (reliability) ----------------------------------
+# `make soak`: tests/test_soak.c for SOAK_CYCLES cycles on the virtual
+# clock (make test runs 200000 of them). `make memcheck`: the tools under
+# valgrind on sample inputs (tests/memcheck.sh). `make stress`: the hostile
+# geometry tests with their large cases (PX_STRESS=1).
+SOAK_CYCLES ?= 10000000
+.PHONY: soak memcheck stress
+soak: $(BUILD)/tests/test_soak
+	PX_SOAK_CYCLES=$(SOAK_CYCLES) $(BUILD)/tests/test_soak
+
+memcheck: all
+	BUILD=$(BUILD) sh tests/memcheck.sh
+
+stress: $(BUILD)/tests/test_hostile
+	PX_STRESS=1 $(BUILD)/tests/test_hostile
 
 -include $(LIB_OBJ:.o=.d) $(TEST_SUPPORT_OBJ:.o=.d) $(TOOL_SUPPORT_OBJ:.o=.d)
 -include $(patsubst %.c,$(BUILD)/obj/%.d,$(TEST_SRC) $(TOOL_SRC) $(BENCH_SRC))
