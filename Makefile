@@ -344,6 +344,7 @@ soak: $(BUILD)/tests/test_soak
 	PX_SOAK_CYCLES=$(SOAK_CYCLES) $(BUILD)/tests/test_soak
 
 memcheck: all
+	@sh tools/install-deps.sh valgrind || echo "memcheck: could not install valgrind"
 	BUILD=$(BUILD) sh tests/memcheck.sh
 
 stress: $(BUILD)/tests/test_hostile
