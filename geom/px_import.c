@@ -383,58 +383,50 @@ static int ends_with_ci(const char *s, const char *ext)
 	return n >= m && strcasecmp(s + n - m, ext) == 0;
 }
 
-/* Next whitespace-separated word of an ASCII STL (cap > 1). */
-static int stl_word(FILE *f, char *w, size_t cap, long *line)
+/* Split a line into at most max whitespace-separated words (in place).
+ * Returns the word count, max + 1 when there are more. */
+static int stl_split(char *line, char **w, int max)
 {
-	return ply_token(f, w, cap, line);
+	int n = 0;
+	char *p = line;
+	for (;;) {
+		while (*p && isspace((unsigned char)*p))
+			p++;
+		if (!*p)
+			return n;
+		if (n == max)
+			return max + 1;
+		w[n++] = p;
+		while (*p && !isspace((unsigned char)*p))
+			p++;
+		if (*p)
+			*p++ = '\0';
+	}
 }
 
-static int stl_expect(FILE *f, const char *want, long *line, char *msg,
-		      size_t cap, const char *path)
+static int stl_is_number(const char *t)
 {
-	char w[64];
-	if (!stl_word(f, w, sizeof w, line)) {
-		snprintf(msg, cap, "%s:%ld: STL ends early, expected '%s'", path,
-			 *line, want);
-		return PX_E_PARSE;
-	}
-	if (strcasecmp(w, want) != 0) {
-		snprintf(msg, cap, "%s:%ld: expected '%s', found '%.32s'", path,
-			 *line, want, w);
-		return PX_E_PARSE;
-	}
-	return PX_OK;
+	char *end;
+	strtod(t, &end);
+	return end != t && *end == '\0';
 }
 
-static int stl_numbers(FILE *f, int n, long *line, char *msg, size_t cap,
-		       const char *path)
-{
-	char w[64], *end;
-	int i;
-	for (i = 0; i < n; i++) {
-		if (!stl_word(f, w, sizeof w, line)) {
-			snprintf(msg, cap, "%s:%ld: STL ends early, expected a number",
-				 path, *line);
-			return PX_E_PARSE;
-		}
-		strtod(w, &end);
-		if (end == w || *end) {
-			snprintf(msg, cap, "%s:%ld: not a number '%.32s'", path,
-				 *line, w);
-			return PX_E_PARSE;
-		}
-	}
-	return PX_OK;
-}
+/* The importer reads ASCII STL line by line, so the check does too:
+ * every statement on a line of its own. */
+enum { STL_SOLID, STL_FACET, STL_LOOP, STL_VERTEX, STL_ENDLOOP, STL_ENDFACET };
 
 static int stl_validate(const char *path, char *msg, size_t msg_cap)
 {
+	static const char *const want[] = {"'solid'", "'facet normal x y z' or 'endsolid'",
+					   "'outer loop'", "'vertex x y z'", "'endloop'",
+					   "'endfacet'"};
 	FILE *f = fopen(path, "rb");
 	unsigned char head[84];
-	char w[64];
-	long line = 1, size;
-	size_t got;
-	int rc = PX_E_PARSE, solids = 0;
+	char *line = NULL, *w[6];
+	size_t cap = 0, got;
+	ssize_t len;
+	long lineno = 0, size;
+	int rc = PX_E_PARSE, st = STL_SOLID, nv = 0, solids = 0, n;
 
 	if (!f) {
 		snprintf(msg, msg_cap, "%s: %s", path, strerror(errno));
@@ -447,73 +439,85 @@ static int stl_validate(const char *path, char *msg, size_t msg_cap)
 		return PX_E_IO;
 	}
 	if (got == sizeof head &&
-	    (unsigned long long)size ==
-		    84ull + 50ull * ply_uint(head + 80, 4, 0)) {
+	    (unsigned long long)size == 84ull + 50ull * ply_uint(head + 80, 4, 0)) {
 		fclose(f);
-		return ply_uint(head + 80, 4, 0) ? PX_OK : PX_E_PARSE;
+		if (ply_uint(head + 80, 4, 0) == 0) {
+			snprintf(msg, msg_cap, "%s: binary STL without triangles", path);
+			return PX_E_PARSE;
+		}
+		return PX_OK;
 	}
 	rewind(f);
-	for (;;) {
-		if (!stl_word(f, w, sizeof w, &line)) {
-			if (solids)
-				rc = PX_OK;
-			else
-				snprintf(msg, msg_cap,
-					 "%s: neither a binary STL (%ld bytes, not 84 + 50 "
-					 "per triangle) nor an ASCII one", path, size);
-			break;
+	while ((len = getline(&line, &cap, f)) >= 0) {
+		int ok;
+		lineno++;
+		if ((size_t)len != strlen(line)) {
+			snprintf(msg, msg_cap, "%s:%ld: NUL byte in an ASCII STL", path, lineno);
+			goto out;
 		}
-		if (strcasecmp(w, "solid") != 0) {
-			snprintf(msg, msg_cap, solids ? "%s:%ld: expected 'solid', found '%.32s'"
-					    : "%s:%ld: not an STL file (binary size "
-					      "does not match, no 'solid': '%.32s')",
-				 path, line, w);
-			break;
-		}
-		solids++;
-		/* the name runs to the end of the line */
-		{
-			int c;
-			while ((c = fgetc(f)) != EOF && c != '\n')
-				;
-			if (c == '\n')
-				line++;
-		}
-		for (;;) {
-			int k;
-			if (!stl_word(f, w, sizeof w, &line)) {
-				snprintf(msg, msg_cap, "%s:%ld: STL ends early, expected "
-					 "'facet' or 'endsolid'", path, line);
-				goto out;
+		n = stl_split(line, w, 5);
+		if (n == 0)
+			continue;
+		switch (st) {
+		case STL_SOLID:
+			ok = strcasecmp(w[0], "solid") == 0;
+			if (ok) {
+				st = STL_FACET;
+				solids++;
 			}
-			if (strcasecmp(w, "endsolid") == 0) {
-				int c;
-				while ((c = fgetc(f)) != EOF && c != '\n')
-					;
-				if (c == '\n')
-					line++;
+			break;
+		case STL_FACET:
+			if (strcasecmp(w[0], "endsolid") == 0) {
+				ok = 1;
+				st = STL_SOLID;
 				break;
 			}
-			if (strcasecmp(w, "facet") != 0) {
-				snprintf(msg, msg_cap, "%s:%ld: expected 'facet' or "
-					 "'endsolid', found '%.32s'", path, line, w);
-				goto out;
-			}
-			if (stl_expect(f, "normal", &line, msg, msg_cap, path) ||
-			    stl_numbers(f, 3, &line, msg, msg_cap, path) ||
-			    stl_expect(f, "outer", &line, msg, msg_cap, path) ||
-			    stl_expect(f, "loop", &line, msg, msg_cap, path))
-				goto out;
-			for (k = 0; k < 3; k++)
-				if (stl_expect(f, "vertex", &line, msg, msg_cap, path) ||
-				    stl_numbers(f, 3, &line, msg, msg_cap, path))
-					goto out;
-			if (stl_expect(f, "endloop", &line, msg, msg_cap, path) ||
-			    stl_expect(f, "endfacet", &line, msg, msg_cap, path))
-				goto out;
+			ok = n == 5 && strcasecmp(w[0], "facet") == 0 &&
+			     strcasecmp(w[1], "normal") == 0 && stl_is_number(w[2]) &&
+			     stl_is_number(w[3]) && stl_is_number(w[4]);
+			st = STL_LOOP;
+			break;
+		case STL_LOOP:
+			ok = n == 2 && strcasecmp(w[0], "outer") == 0 &&
+			     strcasecmp(w[1], "loop") == 0;
+			st = STL_VERTEX;
+			nv = 0;
+			break;
+		case STL_VERTEX:
+			ok = n == 4 && strcasecmp(w[0], "vertex") == 0 &&
+			     stl_is_number(w[1]) && stl_is_number(w[2]) &&
+			     stl_is_number(w[3]);
+			if (++nv == 3)
+				st = STL_ENDLOOP;
+			break;
+		case STL_ENDLOOP:
+			ok = n == 1 && strcasecmp(w[0], "endloop") == 0;
+			st = STL_ENDFACET;
+			break;
+		default:
+			ok = n == 1 && strcasecmp(w[0], "endfacet") == 0;
+			st = STL_FACET;
+			break;
+		}
+		if (!ok) {
+			if (lineno == 1 && solids == 0)
+				snprintf(msg, msg_cap, "%s: neither a binary STL (%ld bytes, "
+					 "not 84 + 50 per triangle) nor an ASCII one "
+					 "(no 'solid')", path, size);
+			else
+				snprintf(msg, msg_cap, "%s:%ld: expected %s", path, lineno,
+					 want[st == STL_LOOP && strcasecmp(w[0], "facet") != 0
+						      ? STL_FACET : st]);
+			goto out;
 		}
 	}
+	if (st != STL_SOLID || solids == 0)
+		snprintf(msg, msg_cap, "%s:%ld: ASCII STL ends early, expected %s", path,
+			 lineno, want[st]);
+	else
+		rc = PX_OK;
 out:
+	free(line);
 	fclose(f);
 	return rc;
 }
