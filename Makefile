@@ -273,6 +273,9 @@ help:
 FUZZ_CC      ?= clang
 FUZZ_SECONDS ?= 60
 FUZZ_TARGETS ?=
+# Extra libFuzzer flags, e.g. FUZZ_ARGS='-seed=1 -runs=20000' for a
+# repeatable pass (CI).
+FUZZ_ARGS    ?=
 FUZZ_DEB_PACKAGES := clang libclang-rt-dev
 FUZZ_SRC     := $(wildcard fuzz/fuzz_*.c)
 FUZZ_NAMES   := $(patsubst fuzz/fuzz_%.c,%,$(FUZZ_SRC))
@@ -322,7 +325,7 @@ fuzz:
 	  echo "== $$name: $(FUZZ_SECONDS) s"; \
 	  $(BUILD)/fuzz/$$name -max_total_time=$(FUZZ_SECONDS) -timeout=10 \
 	    -rss_limit_mb=2048 -artifact_prefix=$(BUILD)/fuzz/$$name- \
-	    -print_final_stats=1 $(BUILD)/fuzz/corpus-$$short \
+	    -print_final_stats=1 $(FUZZ_ARGS) $(BUILD)/fuzz/corpus-$$short \
 	    $$(test -d fuzz/corpus/$$short && echo fuzz/corpus/$$short) \
 	    > $(BUILD)/fuzz/$$name.log 2>&1 || failed="$$failed $$short"; \
 	  grep -E '^(stat::number_of_executed_units|stat::peak_rss_mb|#[0-9]+ +DONE)' $(BUILD)/fuzz/$$name.log | tr '\n' ' '; echo; \
