@@ -406,6 +406,11 @@ int px_can_log_parse(const char *line, struct px_can_msg *m, int64_t *t_ns,
 	if ((idlen != 3 && idlen != 8) || *p++ != '#')
 		return PX_E_PARSE;
 	if (idlen == 8) {
+		/* An error frame's id is the error flag and class bits only:
+		 * bits 30/31 would smuggle in the RTR and EFF flags, which the
+		 * formatter does not write back (found by fuzzing). */
+		if ((id & CAN_ERR_FLAG) && (id & ~(CAN_ERR_FLAG | CAN_ERR_MASK)))
+			return PX_E_PARSE;
 		if (id & CAN_ERR_FLAG)
 			m->f.can_id = id;
 		else if (id <= CAN_EFF_MASK)
