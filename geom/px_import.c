@@ -204,14 +204,50 @@ static int ply_token(FILE *f, char *tok, size_t cap, long *line)
 			(*line)++;
 	if (c == EOF)
 		return 0;
+	/* A NUL or control byte, or a token too long for tok, becomes '?' so
+	 * that the token fails every check instead of passing as its prefix
+	 * (the importer reads the whole token; found by fuzzing). */
 	do {
+		int bad = c == 0 || (c < 32) || c >= 127;
 		if (n + 1 < cap)
-			tok[n++] = (char)c;
+			tok[n++] = bad ? '?' : (char)c;
+		else
+			tok[cap - 2] = '?';
 	} while ((c = fgetc(f)) != EOF && !isspace(c));
 	if (c == '\n')
 		ungetc(c, f);
 	tok[n] = '\0';
 	return 1;
+}
+
+/* A decimal number as the importer's parser reads it: sign, digits with
+ * an optional point, optional exponent; or nan / inf. strtod() alone
+ * would also take hexadecimal floats. */
+static int num_ok(const char *t)
+{
+	int digits = 0;
+	if (*t == '+' || *t == '-')
+		t++;
+	if (strcasecmp(t, "nan") == 0 || strcasecmp(t, "inf") == 0 ||
+	    strcasecmp(t, "infinity") == 0)
+		return 1;
+	while (isdigit((unsigned char)*t))
+		t++, digits++;
+	if (*t == '.')
+		for (t++; isdigit((unsigned char)*t); t++)
+			digits++;
+	if (!digits)
+		return 0;
+	if (*t == 'e' || *t == 'E') {
+		t++;
+		if (*t == '+' || *t == '-')
+			t++;
+		if (!isdigit((unsigned char)*t))
+			return 0;
+		while (isdigit((unsigned char)*t))
+			t++;
+	}
+	return *t == '\0';
 }
 
 static int ply_validate(const char *path, char *msg, size_t msg_cap)
@@ -241,6 +277,11 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 			goto out;
 		}
 		lineno++;
+		if (!strchr(line, '\n') && !feof(f)) {
+			snprintf(msg, msg_cap, "%s:%ld: PLY header line too long or with a "
+				 "NUL byte", path, lineno);
+			goto out;
+		}
 		nw = sscanf(line, "%63s %63s %63s %63s", w[0], w[1], w[2], w[3]);
 		if (lineno == 1) {
 			if (nw < 1 || strcmp(w[0], "ply") != 0) {
@@ -324,8 +365,7 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 					for (t = 0; t < nitems; t++) {
 						if (!ply_token(f, tok, sizeof(tok), &lineno))
 							goto truncated;
-						strtod(tok, &end);
-						if (end == tok || *end) {
+						if (!num_ok(tok)) {
 							snprintf(msg, msg_cap, "%s:%ld: not a number '%s'",
 								 path, lineno, tok);
 							goto out;
@@ -406,9 +446,7 @@ static int stl_split(char *line, char **w, int max)
 
 static int stl_is_number(const char *t)
 {
-	char *end;
-	strtod(t, &end);
-	return end != t && *end == '\0';
+	return num_ok(t);
 }
 
 /* The importer reads ASCII STL line by line, so the check does too:
@@ -460,42 +498,42 @@ static int stl_validate(const char *path, char *msg, size_t msg_cap)
 			continue;
 		switch (st) {
 		case STL_SOLID:
-			ok = strcasecmp(w[0], "solid") == 0;
+			ok = strcmp(w[0], "solid") == 0;
 			if (ok) {
 				st = STL_FACET;
 				solids++;
 			}
 			break;
 		case STL_FACET:
-			if (strcasecmp(w[0], "endsolid") == 0) {
+			if (strcmp(w[0], "endsolid") == 0) {
 				ok = 1;
 				st = STL_SOLID;
 				break;
 			}
-			ok = n == 5 && strcasecmp(w[0], "facet") == 0 &&
-			     strcasecmp(w[1], "normal") == 0 && stl_is_number(w[2]) &&
+			ok = n == 5 && strcmp(w[0], "facet") == 0 &&
+			     strcmp(w[1], "normal") == 0 && stl_is_number(w[2]) &&
 			     stl_is_number(w[3]) && stl_is_number(w[4]);
 			st = STL_LOOP;
 			break;
 		case STL_LOOP:
-			ok = n == 2 && strcasecmp(w[0], "outer") == 0 &&
-			     strcasecmp(w[1], "loop") == 0;
+			ok = n == 2 && strcmp(w[0], "outer") == 0 &&
+			     strcmp(w[1], "loop") == 0;
 			st = STL_VERTEX;
 			nv = 0;
 			break;
 		case STL_VERTEX:
-			ok = n == 4 && strcasecmp(w[0], "vertex") == 0 &&
+			ok = n == 4 && strcmp(w[0], "vertex") == 0 &&
 			     stl_is_number(w[1]) && stl_is_number(w[2]) &&
 			     stl_is_number(w[3]);
 			if (++nv == 3)
 				st = STL_ENDLOOP;
 			break;
 		case STL_ENDLOOP:
-			ok = n == 1 && strcasecmp(w[0], "endloop") == 0;
+			ok = n == 1 && strcmp(w[0], "endloop") == 0;
 			st = STL_ENDFACET;
 			break;
 		default:
-			ok = n == 1 && strcasecmp(w[0], "endfacet") == 0;
+			ok = n == 1 && strcmp(w[0], "endfacet") == 0;
 			st = STL_FACET;
 			break;
 		}
@@ -506,7 +544,7 @@ static int stl_validate(const char *path, char *msg, size_t msg_cap)
 					 "(no 'solid')", path, size);
 			else
 				snprintf(msg, msg_cap, "%s:%ld: expected %s", path, lineno,
-					 want[st == STL_LOOP && strcasecmp(w[0], "facet") != 0
+					 want[st == STL_LOOP && strcmp(w[0], "facet") != 0
 						      ? STL_FACET : st]);
 			goto out;
 		}
