@@ -160,7 +160,15 @@ struct ply_prop {
 	int list;   /* 0: scalar */
 	int csize;  /* byte size of the count (lists) */
 	int size;   /* byte size of the value / list item */
+	int isint;  /* item type is an integer type */
+	int sgn;    /* ... a signed one */
 };
+
+static void ply_item_kind(const char *t, struct ply_prop *pp)
+{
+	pp->isint = strncmp(t, "float", 5) != 0 && strcmp(t, "double") != 0;
+	pp->sgn = t[0] != 'u';
+}
 
 struct ply_elem {
 	char name[64];
@@ -257,7 +265,7 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 	char line[512];
 	long lineno = 0;
 	FILE *f = fopen(path, "rb");
-	unsigned long long i;
+	unsigned long long i, n_vertex = 0;
 
 	if (!f) {
 		snprintf(msg, msg_cap, "%s: %s", path, strerror(errno));
@@ -327,8 +335,11 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 				pp->list = 1;
 				pp->csize = nw >= 4 ? ply_type_size(w[2]) : 0;
 				pp->size = nw >= 4 ? ply_type_size(w[3]) : 0;
+				if (nw >= 4)
+					ply_item_kind(w[3], pp);
 			} else {
 				pp->size = ply_type_size(w[1]);
+				ply_item_kind(w[1], pp);
 			}
 			if (!pp->size || (pp->list && !pp->csize)) {
 				snprintf(msg, msg_cap, "%s:%ld: bad PLY property type", path, lineno);
@@ -343,20 +354,27 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 		snprintf(msg, msg_cap, "%s: PLY header without format", path);
 		goto out;
 	}
-	/* body */
+	/* body; face lists must be polygons over existing vertices: the
+	 * importer's triangulation aborts the process on other indices
+	 * (found by fuzzing) */
+	for (k = 0; k < ne; k++)
+		if (strcmp(E[k].name, "vertex") == 0)
+			n_vertex = E[k].count;
 	for (k = 0; k < ne; k++)
 		for (i = 0; i < E[k].count; i++) {
 			int j;
 			for (j = 0; j < E[k].n_props; j++) {
 				const struct ply_prop *pp = &E[k].props[j];
 				unsigned long long nitems = 1, t;
+				int face = pp->list && strcmp(E[k].name, "face") == 0;
 				if (fmt == 0) {
 					char tok[64], *end;
 					if (pp->list) {
 						if (!ply_token(f, tok, sizeof(tok), &lineno))
 							goto truncated;
 						nitems = strtoull(tok, &end, 10);
-						if (*end || tok[0] == '-') {
+						if (*end || tok[0] == '-' || !tok[0] ||
+						    (face && nitems < 3)) {
 							snprintf(msg, msg_cap, "%s:%ld: bad list length '%s'",
 								 path, lineno, tok);
 							goto out;
@@ -370,6 +388,15 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 								 path, lineno, tok);
 							goto out;
 						}
+						if (face) {
+							unsigned long long vi = strtoull(tok, &end, 10);
+							if (*end || tok[0] == '-' || vi >= n_vertex) {
+								snprintf(msg, msg_cap, "%s:%ld: face %llu: "
+									 "vertex index '%s' not below %llu",
+									 path, lineno, i, tok, n_vertex);
+								goto out;
+							}
+						}
 					}
 				} else {
 					unsigned char b[8];
@@ -377,10 +404,29 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 						if (fread(b, 1, (size_t)pp->csize, f) != (size_t)pp->csize)
 							goto truncated;
 						nitems = ply_uint(b, pp->csize, fmt == 2);
+						if (face && nitems < 3) {
+							snprintf(msg, msg_cap, "%s: face %llu has %llu vertices",
+								 path, i, nitems);
+							goto out;
+						}
 					}
-					for (t = 0; t < nitems; t++)
+					for (t = 0; t < nitems; t++) {
+						unsigned long long v;
 						if (fread(b, 1, (size_t)pp->size, f) != (size_t)pp->size)
 							goto truncated;
+						if (!face)
+							continue;
+						v = ply_uint(b, pp->size, fmt == 2);
+						if (!pp->isint ||
+						    (pp->sgn && pp->size < 8 &&
+						     (v >> (8 * pp->size - 1)) & 1u) ||
+						    v >= n_vertex) {
+							snprintf(msg, msg_cap, "%s: face %llu: vertex index "
+								 "not an integer below %llu", path, i,
+								 n_vertex);
+							goto out;
+						}
+					}
 				}
 			}
 		}
@@ -430,14 +476,14 @@ static int stl_split(char *line, char **w, int max)
 	int n = 0;
 	char *p = line;
 	for (;;) {
-		while (*p && isspace((unsigned char)*p))
+		while (*p == ' ' || *p == '\t' || *p == '\r' || *p == '\n')
 			p++;
 		if (!*p)
 			return n;
 		if (n == max)
 			return max + 1;
 		w[n++] = p;
-		while (*p && !isspace((unsigned char)*p))
+		while (*p && *p != ' ' && *p != '\t' && *p != '\r' && *p != '\n')
 			p++;
 		if (*p)
 			*p++ = '\0';
