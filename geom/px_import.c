@@ -258,6 +258,18 @@ static int num_ok(const char *t)
 	return *t == '\0';
 }
 
+/* One element instance per line: its first value on a new line, the
+ * others on the same. Returns nonzero on a violation. */
+static int ply_line_check(int *first, long *line, const long *last, long now)
+{
+	if (*first) {
+		*first = 0;
+		*line = now;
+		return now <= *last;
+	}
+	return now != *line;
+}
+
 static int ply_validate(const char *path, char *msg, size_t msg_cap)
 {
 	struct ply_elem *E = NULL;
@@ -266,6 +278,8 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 	long lineno = 0;
 	FILE *f = fopen(path, "rb");
 	unsigned long long i, n_vertex = 0;
+	long inst_line = 0, inst_last = 0;
+	int inst_first = 1;
 
 	if (!f) {
 		snprintf(msg, msg_cap, "%s: %s", path, strerror(errno));
@@ -360,9 +374,14 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 	for (k = 0; k < ne; k++)
 		if (strcmp(E[k].name, "vertex") == 0)
 			n_vertex = E[k].count;
+	/* ASCII: the importer reads one element per line, so the check
+	 * wants each element's values on a line of their own (a row with a
+	 * value too many shifted the faces and aborted the importer). */
+	inst_last = lineno - 1;
 	for (k = 0; k < ne; k++)
 		for (i = 0; i < E[k].count; i++) {
 			int j;
+			inst_first = 1;
 			for (j = 0; j < E[k].n_props; j++) {
 				const struct ply_prop *pp = &E[k].props[j];
 				unsigned long long nitems = 1, t;
@@ -372,6 +391,9 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 					if (pp->list) {
 						if (!ply_token(f, tok, sizeof(tok), &lineno))
 							goto truncated;
+						if (ply_line_check(&inst_first, &inst_line, &inst_last,
+								   lineno))
+							goto rows;
 						nitems = strtoull(tok, &end, 10);
 						if (*end || tok[0] == '-' || !tok[0] ||
 						    (face && nitems < 3)) {
@@ -383,6 +405,9 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 					for (t = 0; t < nitems; t++) {
 						if (!ply_token(f, tok, sizeof(tok), &lineno))
 							goto truncated;
+						if (ply_line_check(&inst_first, &inst_line, &inst_last,
+								   lineno))
+							goto rows;
 						if (!num_ok(tok)) {
 							snprintf(msg, msg_cap, "%s:%ld: not a number '%s'",
 								 path, lineno, tok);
@@ -429,6 +454,8 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 					}
 				}
 			}
+			if (fmt == 0)
+				inst_last = inst_line;
 		}
 	if (fmt == 0) {
 		char tok[64];
@@ -441,6 +468,10 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 		goto out;
 	}
 	rc = PX_OK;
+	goto out;
+rows:
+	snprintf(msg, msg_cap, "%s:%ld: PLY element '%s' %llu: not one line of values",
+		 path, lineno, E[k].name, i);
 	goto out;
 truncated:
 	snprintf(msg, msg_cap, "%s: PLY data ends early (element '%s' %llu of %llu)", path,
@@ -537,6 +568,16 @@ static int stl_validate(const char *path, char *msg, size_t msg_cap)
 		lineno++;
 		if ((size_t)len != strlen(line)) {
 			snprintf(msg, msg_cap, "%s:%ld: NUL byte in an ASCII STL", path, lineno);
+			goto out;
+		}
+		if (len && line[len - 1] == '\n')
+			line[--len] = '\0';
+		if (len && line[len - 1] == '\r')
+			line[--len] = '\0';
+		if (strchr(line, '\r')) {
+			/* the importer ends lines there (found by fuzzing) */
+			snprintf(msg, msg_cap, "%s:%ld: carriage return inside a line",
+				 path, lineno);
 			goto out;
 		}
 		n = stl_split(line, w, 5);
