@@ -241,6 +241,9 @@ help:
 	@echo '  sanitize   the test suite built with AddressSanitizer + UBSan'
 	@echo '  run        build, then run proxima-run on RUN_CONFIG for RUN_SECONDS (default config, 10 s)'
 	@echo '  fuzz       build fuzz/fuzz_*.c with libFuzzer, run each FUZZ_SECONDS=$(FUZZ_SECONDS) s'
+	@echo '  soak       SOAK_CYCLES=$(SOAK_CYCLES) loop cycles with faults in virtual time'
+	@echo '  memcheck   the tools under valgrind memcheck on sample inputs'
+	@echo '  stress     hostile geometry with the large cases (PX_STRESS=1)'
 	@echo '  install    library, headers, tools and proxima.pc under DESTDIR/PREFIX'
 	@echo '  uninstall  remove what install put there'
 	@echo '  deps       install the Debian packages building and testing need'
@@ -255,37 +258,101 @@ help:
 	@echo '  PX_TEST_ONLY=<name> runs one test of a binary.'
 
 # ---- fuzzing (clang + libFuzzer) -----------------------------------------
-# Every fuzz/fuzz_<name>.c is built with the library sources into
-# $(BUILD)/fuzz/fuzz_<name> and run for FUZZ_SECONDS on a copy of its seed
-# corpus fuzz/corpus/<name>/ (new inputs and crash artifacts stay under
-# $(BUILD)/fuzz). Skipped, with a message, when FUZZ_CC cannot link
-# -fsanitize=fuzzer.
+# Every fuzz/fuzz_<name>.c is a libFuzzer target. `make fuzz` builds the
+# library once with clang's fuzzer instrumentation plus ASan and UBSan
+# ($(BUILD)/fuzz/obj), links each target into $(BUILD)/fuzz/fuzz_<name>
+# and runs it for FUZZ_SECONDS on a copy of its seed corpus
+# fuzz/corpus/<name>/ (new inputs stay in $(BUILD)/fuzz/corpus-<name>,
+# crash and hang artifacts in $(BUILD)/fuzz/). FUZZ_TARGETS=codec,can
+# picks targets. Fails when a target found something. Skipped, with a
+# message, when FUZZ_CC cannot link -fsanitize=fuzzer (the Debian
+# packages in FUZZ_DEB_PACKAGES are installed first when missing).
+# The same sources built with the normal compiler against fuzz/replay.c
+# ($(BUILD)/fuzz-replay/fuzz_<name>) replay fuzz/regress/<name>/ and the
+# seeds inside `make test` and `make sanitize`.
 FUZZ_CC      ?= clang
-FUZZ_SECONDS ?= 30
+FUZZ_SECONDS ?= 60
+FUZZ_TARGETS ?=
+# Extra libFuzzer flags, e.g. FUZZ_ARGS='-seed=1 -runs=20000' for a
+# repeatable pass (CI).
+FUZZ_ARGS    ?=
+FUZZ_DEB_PACKAGES := clang libclang-rt-dev
 FUZZ_SRC     := $(wildcard fuzz/fuzz_*.c)
+FUZZ_NAMES   := $(patsubst fuzz/fuzz_%.c,%,$(FUZZ_SRC))
+comma        := ,
+FUZZ_RUN     := $(if $(FUZZ_TARGETS),$(subst $(comma), ,$(FUZZ_TARGETS)),$(FUZZ_NAMES))
+FUZZ_BIN     := $(patsubst %,$(BUILD)/fuzz/fuzz_%,$(FUZZ_NAMES))
+FUZZ_LIB_OBJ := $(patsubst %.c,$(BUILD)/fuzz/obj/%.o,$(LIB_SRC))
+FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=undefined
 FUZZ_FLAGS   := -std=c11 -D_GNU_SOURCE $(WARN) $(INCS) -g -O1 \
-                -fno-omit-frame-pointer \
-                -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined
+                -Wno-unused-function -fno-omit-frame-pointer $(FUZZ_SAN)
+FUZZ_REPLAY_BIN := $(patsubst %,$(BUILD)/fuzz-replay/fuzz_%,$(FUZZ_NAMES))
 
-.PHONY: fuzz
+$(BUILD)/fuzz/obj/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(FUZZ_CC) $(FUZZ_FLAGS) -fsanitize=fuzzer-no-link -MMD -MP $(PKG_CFLAGS) -c $< -o $@
+
+$(BUILD)/fuzz/libproxima-fuzz.a: $(FUZZ_LIB_OBJ)
+	rm -f $@
+	ar rcs $@ $^
+
+$(BUILD)/fuzz/fuzz_%: $(BUILD)/fuzz/obj/fuzz/fuzz_%.o $(BUILD)/fuzz/libproxima-fuzz.a
+	$(FUZZ_CC) $(FUZZ_SAN) -fsanitize=fuzzer -o $@ $^ $(LIBS)
+
+$(BUILD)/fuzz-replay/fuzz_%: $(BUILD)/obj/fuzz/fuzz_%.o $(BUILD)/obj/fuzz/replay.o $(STATIC_LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_LDFLAGS) -o $@ $^ $(LIBS)
+
+# The replay programs are test programs: built by `tests`, run by `test`.
+tests: $(FUZZ_REPLAY_BIN)
+TEST_BIN += $(FUZZ_REPLAY_BIN)
+
+.PHONY: fuzz fuzz-build
+fuzz-build: $(FUZZ_BIN)
+
 fuzz:
+	@sh tools/install-deps.sh $(FUZZ_DEB_PACKAGES) || echo "fuzz: could not install $(FUZZ_DEB_PACKAGES)"
 	@if ! printf 'int LLVMFuzzerTestOneInput(const char *d, unsigned long n);\nint LLVMFuzzerTestOneInput(const char *d, unsigned long n) { (void)d; (void)n; return 0; }\n' | \
 	    $(FUZZ_CC) -x c -fsanitize=fuzzer - -o /dev/null >/dev/null 2>&1; then \
 	  echo "fuzz: skipped: '$(FUZZ_CC)' cannot link -fsanitize=fuzzer (install clang with libFuzzer)"; \
 	  exit 0; \
 	fi; \
-	set -e; mkdir -p $(BUILD)/fuzz; \
-	for src in $(FUZZ_SRC); do \
-	  name=$$(basename $$src .c); short=$${name#fuzz_}; \
-	  echo "== $$name: build"; \
-	  $(FUZZ_CC) $(FUZZ_FLAGS) $(PKG_CFLAGS) $$src $(LIB_SRC) -o $(BUILD)/fuzz/$$name $(LIBS); \
+	$(MAKE) --no-print-directory fuzz-build || exit 1; \
+	failed=""; \
+	for short in $(FUZZ_RUN); do \
+	  name=fuzz_$$short; \
 	  mkdir -p $(BUILD)/fuzz/corpus-$$short; \
 	  echo "== $$name: $(FUZZ_SECONDS) s"; \
 	  $(BUILD)/fuzz/$$name -max_total_time=$(FUZZ_SECONDS) -timeout=10 \
 	    -rss_limit_mb=2048 -artifact_prefix=$(BUILD)/fuzz/$$name- \
-	    -print_final_stats=1 $(BUILD)/fuzz/corpus-$$short \
-	    $$(test -d fuzz/corpus/$$short && echo fuzz/corpus/$$short); \
-	done
+	    -print_final_stats=1 $(FUZZ_ARGS) $(BUILD)/fuzz/corpus-$$short \
+	    $$(test -d fuzz/corpus/$$short && echo fuzz/corpus/$$short) \
+	    > $(BUILD)/fuzz/$$name.log 2>&1 || failed="$$failed $$short"; \
+	  grep -E '^(stat::number_of_executed_units|stat::peak_rss_mb|#[0-9]+ +DONE)' $(BUILD)/fuzz/$$name.log | tr '\n' ' '; echo; \
+	done; \
+	if [ -n "$$failed" ]; then \
+	  echo "fuzz: FOUND PROBLEMS in:$$failed (logs: $(BUILD)/fuzz/fuzz_<name>.log; artifacts: $(BUILD)/fuzz/fuzz_<name>-*)"; \
+	  exit 1; \
+	fi; \
+	echo "fuzz: no crash, leak or hang in $(FUZZ_SECONDS) s per target: $(FUZZ_RUN)"
+
+# ---- soak, memcheck, stress (reliability) ----------------------------------
+# `make soak`: tests/test_soak.c for SOAK_CYCLES cycles on the virtual
+# clock (make test runs 200000 of them). `make memcheck`: the tools under
+# valgrind on sample inputs (tests/memcheck.sh). `make stress`: the hostile
+# geometry tests with their large cases (PX_STRESS=1).
+SOAK_CYCLES ?= 10000000
+.PHONY: soak memcheck stress
+soak: $(BUILD)/tests/test_soak
+	PX_SOAK_CYCLES=$(SOAK_CYCLES) $(BUILD)/tests/test_soak
+
+memcheck: all
+	@sh tools/install-deps.sh valgrind || echo "memcheck: could not install valgrind"
+	BUILD=$(BUILD) sh tests/memcheck.sh
+
+stress: $(BUILD)/tests/test_hostile
+	PX_STRESS=1 $(BUILD)/tests/test_hostile
 
 -include $(LIB_OBJ:.o=.d) $(TEST_SUPPORT_OBJ:.o=.d) $(TOOL_SUPPORT_OBJ:.o=.d)
 -include $(patsubst %.c,$(BUILD)/obj/%.d,$(TEST_SRC) $(TOOL_SRC) $(BENCH_SRC))
+-include $(patsubst %.c,$(BUILD)/obj/%.d,$(FUZZ_SRC) fuzz/replay.c)

@@ -411,7 +411,9 @@ int px_can_log_parse(const char *line, struct px_can_msg *m, int64_t *t_ns,
 		sec = sec * 10 + (*p++ - '0');
 		digits++;
 	}
-	if (!digits || *p++ != '.')
+	/* The time in ns must fit int64_t (seconds up to 9223372035, year
+	 * 2262): a larger value overflowed sec * 1e9 (found by fuzzing). */
+	if (!digits || *p++ != '.' || sec > INT64_MAX / 1000000000 - 1)
 		return PX_E_PARSE;
 	while (isdigit((unsigned char)*p)) {
 		if (fracdigits < 6) {
@@ -447,6 +449,11 @@ int px_can_log_parse(const char *line, struct px_can_msg *m, int64_t *t_ns,
 	if ((idlen != 3 && idlen != 8) || *p++ != '#')
 		return PX_E_PARSE;
 	if (idlen == 8) {
+		/* An error frame's id is the error flag and class bits only:
+		 * bits 30/31 would smuggle in the RTR and EFF flags, which the
+		 * formatter does not write back (found by fuzzing). */
+		if ((id & CAN_ERR_FLAG) && (id & ~(CAN_ERR_FLAG | CAN_ERR_MASK)))
+			return PX_E_PARSE;
 		if (id & CAN_ERR_FLAG)
 			m->f.can_id = id;
 		else if (id <= CAN_EFF_MASK)

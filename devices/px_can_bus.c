@@ -827,9 +827,10 @@ int px_can_replay_open(const char *path, const char *iface,
 		       struct px_can_bus **out, char *msg, size_t cap)
 {
 	FILE *f;
-	char line[512], ifn[IFNAMSIZ + 8];
+	char *line = NULL, ifn[IFNAMSIZ + 8];
 	struct px_can_bus *b;
-	size_t capn = 0;
+	size_t capn = 0, lcap = 0;
+	ssize_t len;
 	int lineno = 0, rc = PX_OK;
 	if (msg && cap)
 		msg[0] = 0;
@@ -849,13 +850,17 @@ int px_can_replay_open(const char *path, const char *iface,
 		return PX_E_NOMEM;
 	}
 	b->fd_frames = 1;
-	while (fgets(line, sizeof line, f)) {
+	/* Whole lines: a fixed buffer split long lines into pieces that
+	 * were parsed as lines of their own (found by fuzzing). A NUL byte
+	 * inside a line is an error too, not the line's end. */
+	while ((len = getline(&line, &lcap, f)) >= 0) {
 		struct px_can_msg m;
 		int64_t t;
 		lineno++;
-		if (line[0] == '\n' || line[0] == '#' || line[0] == 0)
+		if (line[0] == '\n' || line[0] == '#' || len == 0)
 			continue;
-		if (px_can_log_parse(line, &m, &t, ifn, sizeof ifn) != PX_OK) {
+		if (strlen(line) != (size_t)len ||
+		    px_can_log_parse(line, &m, &t, ifn, sizeof ifn) != PX_OK) {
 			if (msg)
 				snprintf(msg, cap, "%s:%d: not a candump -l line "
 					 "\"(sec.usec) iface id#data\"", path,
@@ -886,6 +891,7 @@ int px_can_replay_open(const char *path, const char *iface,
 		b->rec_t[b->n_recs] = t;
 		b->n_recs++;
 	}
+	free(line);
 	fclose(f);
 	if (rc != PX_OK) {
 		px_can_bus_close(b);

@@ -5,8 +5,11 @@
 #ifndef PX_MODEL_INTERNAL_H
 #define PX_MODEL_INTERNAL_H
 
+#include <math.h>
 #include <stddef.h>
 #include <stdint.h>
+
+#include "px_math.h"
 
 /*
  * Read a mesh or point file with the Open Asset Import Library: all
@@ -33,5 +36,22 @@ void px__select_k(uint32_t *a, long n, long k, const double *key, int axis);
 /* Rewrite msg (cap bytes, NUL-terminated) as "<path>: <msg>", cut to
  * fit. Setup only. */
 void px__prefix_path(char *msg, size_t cap, const char *path);
+
+/* Farthest a query point may lie from a model's box (model units): the
+ * queries work with squared distances, which overflow past about 1e154. */
+#define PX__MAX_QUERY_REACH 1e150
+
+/* 1 when p lies farther than PX__MAX_QUERY_REACH from box b along some
+ * axis (an empty or infinite box never makes a point too far).
+ * RT-safe. */
+static inline int px__too_far(const px_aabb *b, px_vec3 p)
+{
+	return b->min.x - p.x > PX__MAX_QUERY_REACH ||
+	       p.x - b->max.x > PX__MAX_QUERY_REACH ||
+	       b->min.y - p.y > PX__MAX_QUERY_REACH ||
+	       p.y - b->max.y > PX__MAX_QUERY_REACH ||
+	       b->min.z - p.z > PX__MAX_QUERY_REACH ||
+	       p.z - b->max.z > PX__MAX_QUERY_REACH;
+}
 
 #endif

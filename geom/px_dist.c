@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "model_internal.h"
 #include "px_arena.h"
 #include "px_cpiece.h"
 #include "px_spiece.h"
@@ -1493,6 +1494,8 @@ int px_dist_query_ws(const struct px_dist_model *m, struct px_dist_ws *ws,
 		return PX_E_INVAL;
 	if (!px_v3_isfinite(p))
 		return PX_E_NAN;
+	if (px__too_far(&m->bounds, p))
+		return PX_E_RANGE; /* squared distances would overflow */
 	if (++ws->epoch == 0) {
 		/* Wrapped after 2^32 queries: clear once, then go on. */
 		memset(ws->stamp, 0, (size_t)m->n_pieces * sizeof(uint32_t));
@@ -1550,7 +1553,10 @@ int px_dist_query_ws(const struct px_dist_model *m, struct px_dist_ws *ws,
 	}
 	r->cells_visited = q.cells;
 	if (q.best_piece < 0)
-		return PX_E_STATE; /* unreachable: the wave meets every piece */
+		/* The wave meets every piece, so only overflowing squared
+		 * distances (a model spanning more than about 1e154) leave
+		 * no best sample. */
+		return PX_E_RANGE;
 
 	/* Start from the best sample, a point on the model, so that an
 	 * answer exists even if no solve improves on it. */
@@ -1660,6 +1666,8 @@ int px_dist_query_ws(const struct px_dist_model *m, struct px_dist_ws *ws,
 		}
 	}
 	r->dist = sqrt(best);
+	if (!isfinite(r->dist))
+		return PX_E_RANGE; /* overflow: see PX__MAX_QUERY_REACH */
 	r->gap = gap;
 	r->entity = m->pieces[r->piece].ent;
 	r->kind = m->ent[r->entity].kind;

@@ -163,7 +163,10 @@ PX_API int px_dist_entity_info(const struct px_dist_model *m, int entity,
 
 /*
  * Global minimum distance from p to the model. Returns PX_OK, PX_E_INVAL
- * (NULL) or PX_E_NAN (p not finite; r untouched). @note RT-safe.
+ * (NULL), PX_E_NAN (p not finite; r untouched) or PX_E_RANGE (p more
+ * than 1e150 model units outside the model's box, or a model so large
+ * that squared distances overflow: no answer rather than an infinite
+ * one). @note RT-safe.
  */
 PX_API int px_dist_query(struct px_dist_model *m, px_vec3 p,
 			 struct px_dist_result *r);

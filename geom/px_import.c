@@ -15,6 +15,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 
 #include <assimp/cimport.h>
@@ -159,7 +160,15 @@ struct ply_prop {
 	int list;   /* 0: scalar */
 	int csize;  /* byte size of the count (lists) */
 	int size;   /* byte size of the value / list item */
+	int isint;  /* item type is an integer type */
+	int sgn;    /* ... a signed one */
 };
+
+static void ply_item_kind(const char *t, struct ply_prop *pp)
+{
+	pp->isint = strncmp(t, "float", 5) != 0 && strcmp(t, "double") != 0;
+	pp->sgn = t[0] != 'u';
+}
 
 struct ply_elem {
 	char name[64];
@@ -203,14 +212,62 @@ static int ply_token(FILE *f, char *tok, size_t cap, long *line)
 			(*line)++;
 	if (c == EOF)
 		return 0;
+	/* A NUL or control byte, or a token too long for tok, becomes '?' so
+	 * that the token fails every check instead of passing as its prefix
+	 * (the importer reads the whole token; found by fuzzing). */
 	do {
+		int bad = c == 0 || (c < 32) || c >= 127;
 		if (n + 1 < cap)
-			tok[n++] = (char)c;
+			tok[n++] = bad ? '?' : (char)c;
+		else
+			tok[cap - 2] = '?';
 	} while ((c = fgetc(f)) != EOF && !isspace(c));
 	if (c == '\n')
 		ungetc(c, f);
 	tok[n] = '\0';
 	return 1;
+}
+
+/* A decimal number as the importer's parser reads it: sign, digits with
+ * an optional point, optional exponent; or nan / inf. strtod() alone
+ * would also take hexadecimal floats. */
+static int num_ok(const char *t)
+{
+	int digits = 0;
+	if (*t == '+' || *t == '-')
+		t++;
+	if (strcasecmp(t, "nan") == 0 || strcasecmp(t, "inf") == 0 ||
+	    strcasecmp(t, "infinity") == 0)
+		return 1;
+	while (isdigit((unsigned char)*t))
+		t++, digits++;
+	if (*t == '.')
+		for (t++; isdigit((unsigned char)*t); t++)
+			digits++;
+	if (!digits)
+		return 0;
+	if (*t == 'e' || *t == 'E') {
+		t++;
+		if (*t == '+' || *t == '-')
+			t++;
+		if (!isdigit((unsigned char)*t))
+			return 0;
+		while (isdigit((unsigned char)*t))
+			t++;
+	}
+	return *t == '\0';
+}
+
+/* One element instance per line: its first value on a new line, the
+ * others on the same. Returns nonzero on a violation. */
+static int ply_line_check(int *first, long *line, const long *last, long now)
+{
+	if (*first) {
+		*first = 0;
+		*line = now;
+		return now <= *last;
+	}
+	return now != *line;
 }
 
 static int ply_validate(const char *path, char *msg, size_t msg_cap)
@@ -220,7 +277,9 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 	char line[512];
 	long lineno = 0;
 	FILE *f = fopen(path, "rb");
-	unsigned long long i;
+	unsigned long long i, n_vertex = 0;
+	long inst_line = 0, inst_last = 0;
+	int inst_first = 1;
 
 	if (!f) {
 		snprintf(msg, msg_cap, "%s: %s", path, strerror(errno));
@@ -240,6 +299,11 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 			goto out;
 		}
 		lineno++;
+		if (!strchr(line, '\n') && !feof(f)) {
+			snprintf(msg, msg_cap, "%s:%ld: PLY header line too long or with a "
+				 "NUL byte", path, lineno);
+			goto out;
+		}
 		nw = sscanf(line, "%63s %63s %63s %63s", w[0], w[1], w[2], w[3]);
 		if (lineno == 1) {
 			if (nw < 1 || strcmp(w[0], "ply") != 0) {
@@ -285,8 +349,11 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 				pp->list = 1;
 				pp->csize = nw >= 4 ? ply_type_size(w[2]) : 0;
 				pp->size = nw >= 4 ? ply_type_size(w[3]) : 0;
+				if (nw >= 4)
+					ply_item_kind(w[3], pp);
 			} else {
 				pp->size = ply_type_size(w[1]);
+				ply_item_kind(w[1], pp);
 			}
 			if (!pp->size || (pp->list && !pp->csize)) {
 				snprintf(msg, msg_cap, "%s:%ld: bad PLY property type", path, lineno);
@@ -301,20 +368,35 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 		snprintf(msg, msg_cap, "%s: PLY header without format", path);
 		goto out;
 	}
-	/* body */
+	/* body; face lists must be polygons over existing vertices: the
+	 * importer's triangulation aborts the process on other indices
+	 * (found by fuzzing) */
+	for (k = 0; k < ne; k++)
+		if (strcmp(E[k].name, "vertex") == 0)
+			n_vertex = E[k].count;
+	/* ASCII: the importer reads one element per line, so the check
+	 * wants each element's values on a line of their own (a row with a
+	 * value too many shifted the faces and aborted the importer). */
+	inst_last = lineno - 1;
 	for (k = 0; k < ne; k++)
 		for (i = 0; i < E[k].count; i++) {
 			int j;
+			inst_first = 1;
 			for (j = 0; j < E[k].n_props; j++) {
 				const struct ply_prop *pp = &E[k].props[j];
 				unsigned long long nitems = 1, t;
+				int face = pp->list && strcmp(E[k].name, "face") == 0;
 				if (fmt == 0) {
 					char tok[64], *end;
 					if (pp->list) {
 						if (!ply_token(f, tok, sizeof(tok), &lineno))
 							goto truncated;
+						if (ply_line_check(&inst_first, &inst_line, &inst_last,
+								   lineno))
+							goto rows;
 						nitems = strtoull(tok, &end, 10);
-						if (*end || tok[0] == '-') {
+						if (*end || tok[0] == '-' || !tok[0] ||
+						    (face && nitems < 3)) {
 							snprintf(msg, msg_cap, "%s:%ld: bad list length '%s'",
 								 path, lineno, tok);
 							goto out;
@@ -323,11 +405,22 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 					for (t = 0; t < nitems; t++) {
 						if (!ply_token(f, tok, sizeof(tok), &lineno))
 							goto truncated;
-						strtod(tok, &end);
-						if (end == tok || *end) {
+						if (ply_line_check(&inst_first, &inst_line, &inst_last,
+								   lineno))
+							goto rows;
+						if (!num_ok(tok)) {
 							snprintf(msg, msg_cap, "%s:%ld: not a number '%s'",
 								 path, lineno, tok);
 							goto out;
+						}
+						if (face) {
+							unsigned long long vi = strtoull(tok, &end, 10);
+							if (*end || tok[0] == '-' || vi >= n_vertex) {
+								snprintf(msg, msg_cap, "%s:%ld: face %llu: "
+									 "vertex index '%s' not below %llu",
+									 path, lineno, i, tok, n_vertex);
+								goto out;
+							}
 						}
 					}
 				} else {
@@ -336,12 +429,33 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 						if (fread(b, 1, (size_t)pp->csize, f) != (size_t)pp->csize)
 							goto truncated;
 						nitems = ply_uint(b, pp->csize, fmt == 2);
+						if (face && nitems < 3) {
+							snprintf(msg, msg_cap, "%s: face %llu has %llu vertices",
+								 path, i, nitems);
+							goto out;
+						}
 					}
-					for (t = 0; t < nitems; t++)
+					for (t = 0; t < nitems; t++) {
+						unsigned long long v;
 						if (fread(b, 1, (size_t)pp->size, f) != (size_t)pp->size)
 							goto truncated;
+						if (!face)
+							continue;
+						v = ply_uint(b, pp->size, fmt == 2);
+						if (!pp->isint ||
+						    (pp->sgn && pp->size < 8 &&
+						     (v >> (8 * pp->size - 1)) & 1u) ||
+						    v >= n_vertex) {
+							snprintf(msg, msg_cap, "%s: face %llu: vertex index "
+								 "not an integer below %llu", path, i,
+								 n_vertex);
+							goto out;
+						}
+					}
 				}
 			}
+			if (fmt == 0)
+				inst_last = inst_line;
 		}
 	if (fmt == 0) {
 		char tok[64];
@@ -355,11 +469,180 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 	}
 	rc = PX_OK;
 	goto out;
+rows:
+	snprintf(msg, msg_cap, "%s:%ld: PLY element '%s' %llu: not one line of values",
+		 path, lineno, E[k].name, i);
+	goto out;
 truncated:
 	snprintf(msg, msg_cap, "%s: PLY data ends early (element '%s' %llu of %llu)", path,
 		 E[k].name, i, E[k].count);
 out:
 	free(E);
+	fclose(f);
+	return rc;
+}
+
+/* ---- strict STL structure check ---------------------------------------------
+ *
+ * The importer leaks the mesh it was building when an ASCII STL ends in
+ * the middle of a facet, and accepts odd layouts silently (found by
+ * fuzzing). Before importing a .stl file its structure is checked: a
+ * binary STL has exactly 84 + 50 * n bytes for the n triangles its
+ * header counts; anything else must be ASCII, "solid [name]" then facets
+ * "facet normal x y z / outer loop / vertex x y z (three) / endloop /
+ * endfacet", then "endsolid [name]" (several solids allowed), every
+ * number present and numeric.
+ */
+
+static int ends_with_ci(const char *s, const char *ext)
+{
+	size_t n = strlen(s), m = strlen(ext);
+	return n >= m && strcasecmp(s + n - m, ext) == 0;
+}
+
+/* Split a line into at most max whitespace-separated words (in place).
+ * Returns the word count, max + 1 when there are more. */
+static int stl_split(char *line, char **w, int max)
+{
+	int n = 0;
+	char *p = line;
+	for (;;) {
+		while (*p == ' ' || *p == '\t' || *p == '\r' || *p == '\n')
+			p++;
+		if (!*p)
+			return n;
+		if (n == max)
+			return max + 1;
+		w[n++] = p;
+		while (*p && *p != ' ' && *p != '\t' && *p != '\r' && *p != '\n')
+			p++;
+		if (*p)
+			*p++ = '\0';
+	}
+}
+
+static int stl_is_number(const char *t)
+{
+	return num_ok(t);
+}
+
+/* The importer reads ASCII STL line by line, so the check does too:
+ * every statement on a line of its own. */
+enum { STL_SOLID, STL_FACET, STL_LOOP, STL_VERTEX, STL_ENDLOOP, STL_ENDFACET };
+
+static int stl_validate(const char *path, char *msg, size_t msg_cap)
+{
+	static const char *const want[] = {"'solid'", "'facet normal x y z' or 'endsolid'",
+					   "'outer loop'", "'vertex x y z'", "'endloop'",
+					   "'endfacet'"};
+	FILE *f = fopen(path, "rb");
+	unsigned char head[84];
+	char *line = NULL, *w[6];
+	size_t cap = 0, got;
+	ssize_t len;
+	long lineno = 0, size;
+	int rc = PX_E_PARSE, st = STL_SOLID, nv = 0, solids = 0, n;
+
+	if (!f) {
+		snprintf(msg, msg_cap, "%s: %s", path, strerror(errno));
+		return PX_E_IO;
+	}
+	got = fread(head, 1, sizeof head, f);
+	if (fseek(f, 0, SEEK_END) != 0 || (size = ftell(f)) < 0) {
+		fclose(f);
+		snprintf(msg, msg_cap, "%s: cannot seek", path);
+		return PX_E_IO;
+	}
+	if (got == sizeof head &&
+	    (unsigned long long)size == 84ull + 50ull * ply_uint(head + 80, 4, 0)) {
+		fclose(f);
+		if (ply_uint(head + 80, 4, 0) == 0) {
+			snprintf(msg, msg_cap, "%s: binary STL without triangles", path);
+			return PX_E_PARSE;
+		}
+		return PX_OK;
+	}
+	rewind(f);
+	while ((len = getline(&line, &cap, f)) >= 0) {
+		int ok;
+		lineno++;
+		if ((size_t)len != strlen(line)) {
+			snprintf(msg, msg_cap, "%s:%ld: NUL byte in an ASCII STL", path, lineno);
+			goto out;
+		}
+		if (len && line[len - 1] == '\n')
+			line[--len] = '\0';
+		if (len && line[len - 1] == '\r')
+			line[--len] = '\0';
+		if (strchr(line, '\r')) {
+			/* the importer ends lines there (found by fuzzing) */
+			snprintf(msg, msg_cap, "%s:%ld: carriage return inside a line",
+				 path, lineno);
+			goto out;
+		}
+		n = stl_split(line, w, 5);
+		if (n == 0)
+			continue;
+		switch (st) {
+		case STL_SOLID:
+			ok = strcmp(w[0], "solid") == 0;
+			if (ok) {
+				st = STL_FACET;
+				solids++;
+			}
+			break;
+		case STL_FACET:
+			if (strcmp(w[0], "endsolid") == 0) {
+				ok = 1;
+				st = STL_SOLID;
+				break;
+			}
+			ok = n == 5 && strcmp(w[0], "facet") == 0 &&
+			     strcmp(w[1], "normal") == 0 && stl_is_number(w[2]) &&
+			     stl_is_number(w[3]) && stl_is_number(w[4]);
+			st = STL_LOOP;
+			break;
+		case STL_LOOP:
+			ok = n == 2 && strcmp(w[0], "outer") == 0 &&
+			     strcmp(w[1], "loop") == 0;
+			st = STL_VERTEX;
+			nv = 0;
+			break;
+		case STL_VERTEX:
+			ok = n == 4 && strcmp(w[0], "vertex") == 0 &&
+			     stl_is_number(w[1]) && stl_is_number(w[2]) &&
+			     stl_is_number(w[3]);
+			if (++nv == 3)
+				st = STL_ENDLOOP;
+			break;
+		case STL_ENDLOOP:
+			ok = n == 1 && strcmp(w[0], "endloop") == 0;
+			st = STL_ENDFACET;
+			break;
+		default:
+			ok = n == 1 && strcmp(w[0], "endfacet") == 0;
+			st = STL_FACET;
+			break;
+		}
+		if (!ok) {
+			if (lineno == 1 && solids == 0)
+				snprintf(msg, msg_cap, "%s: neither a binary STL (%ld bytes, "
+					 "not 84 + 50 per triangle) nor an ASCII one "
+					 "(no 'solid')", path, size);
+			else
+				snprintf(msg, msg_cap, "%s:%ld: expected %s", path, lineno,
+					 want[st == STL_LOOP && strcmp(w[0], "facet") != 0
+						      ? STL_FACET : st]);
+			goto out;
+		}
+	}
+	if (st != STL_SOLID || solids == 0)
+		snprintf(msg, msg_cap, "%s:%ld: ASCII STL ends early, expected %s", path,
+			 lineno, want[st]);
+	else
+		rc = PX_OK;
+out:
+	free(line);
 	fclose(f);
 	return rc;
 }
@@ -417,8 +700,15 @@ int px__import_file(const char *path, int want_tri, double **xyz,
 		return PX_E_IO;
 	}
 	fclose(f);
-	if (has_ply_magic(path)) {
+	/* A .ply name without the magic line goes to the check too: the
+	 * importer's PLY reader loops forever on some such headers (found
+	 * by fuzzing). */
+	if (has_ply_magic(path) || ends_with_ci(path, ".ply")) {
 		int rc = ply_validate(path, msg, msg_cap);
+		if (rc != PX_OK)
+			return rc;
+	} else if (ends_with_ci(path, ".stl")) {
+		int rc = stl_validate(path, msg, msg_cap);
 		if (rc != PX_OK)
 			return rc;
 	}

@@ -82,6 +82,11 @@ int px_model_query_ex(const struct px_model *m, px_vec3 p, double max_dist,
 	if (!px_v3_isfinite(p))
 		return PX_E_NAN;
 	q.p = px_pose_inverse_transform_point(m->pose, p);
+	/* Squared distances overflow past about 1e154: a point that far
+	 * from the model's box gets a clear error instead of an infinite
+	 * distance and an arbitrary closest point (every candidate ties). */
+	if (px__too_far(&m->local_box, q.p))
+		return PX_E_RANGE;
 	q.max_dist = max_dist;
 	q.hint = (flags & PX_QUERY_COHERENT) ? hint : -1;
 	q.flags = flags;
@@ -95,6 +100,8 @@ int px_model_query_ex(const struct px_model *m, px_vec3 p, double max_dist,
 		}
 		return rc;
 	}
+	if (!isfinite(out->distance))
+		return PX_E_RANGE; /* the model's own extent overflowed */
 	out->point = px_pose_transform_point(m->pose, out->point);
 	out->direction = px_pose_transform_vector(m->pose, out->direction);
 	return 1;
@@ -214,6 +221,8 @@ int px_model_query_cached(const struct px_model *m, px_vec3 p,
 		c->last_ = -1;
 	}
 	q.p = px_pose_inverse_transform_point(m->pose, p);
+	if (px__too_far(&m->local_box, q.p))
+		return PX_E_RANGE; /* as in px_model_query_ex() */
 	q.max_dist = INFINITY;
 	q.flags = 0u;
 	q.hint = -1;
@@ -235,6 +244,8 @@ int px_model_query_cached(const struct px_model *m, px_vec3 p,
 	rc = o->closest(m->impl, &q, out);
 	if (rc <= 0)
 		return rc < 0 ? rc : PX_E_DEGENERATE;
+	if (!isfinite(out->distance))
+		return PX_E_RANGE;
 	d = fabs(out->distance);
 	margin = c->margin_;
 	if (!(margin > 0.0))

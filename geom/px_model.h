@@ -181,7 +181,9 @@ PX_API px_pose px_model_pose(const struct px_model *m);
 /*
  * Closest point of the model to the world point p.
  * Returns 1 with *out filled (world frame); PX_E_INVAL for NULL
- * arguments, PX_E_NAN for a non-finite p. @note RT-safe.
+ * arguments, PX_E_NAN for a non-finite p, PX_E_RANGE when p lies more
+ * than 1e150 model units outside the model's box or the distance
+ * overflows (squared distances pass 1e300 there). @note RT-safe.
  */
 PX_API int px_model_query(const struct px_model *m, px_vec3 p,
 			  struct px_model_result *out);
@@ -194,7 +196,8 @@ PX_API int px_model_query(const struct px_model *m, px_vec3 p,
  * cycle's result (the last closest triangle or point), which gives the
  * search an immediate upper bound; any hint value is safe (a wrong one
  * only costs time). Returns 1, 0, PX_E_INVAL (NULL, max_dist < 0 or NaN),
- * PX_E_NAN (non-finite p), or an implementation's error. @note RT-safe.
+ * PX_E_NAN (non-finite p), PX_E_RANGE (as px_model_query()), or an
+ * implementation's error. @note RT-safe.
  */
 PX_API int px_model_query_ex(const struct px_model *m, px_vec3 p,
 			     double max_dist, int hint, unsigned flags,
