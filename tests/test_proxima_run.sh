@@ -359,6 +359,17 @@ for sl in 0 20; do
 done
 check "stuck_limit 0: a noiseless frozen sensor goes unseen" "$(num "$tmp/dst0.json" device_stuck) == 0"
 check "stuck_limit 20: the frozen sensor is caught" "$(num "$tmp/dst20.json" device_stuck) >= 1"
+# min_report_interval_ns: a device at rest sends the same report every
+# 1 ms; with the key above that period they count as duplicates.
+for mi in 0 5_000_000; do
+	absolute "$good" | sed 's/position_noise_m: .*/position_noise_m: 0/; s/amplitude_m: [0-9.]*/amplitude_m: 0/g' |
+		sed "/^  - name: haptic\$/a\    min_report_interval_ns: $mi" >"$tmp/dmr.yaml"
+	expect "device at rest, min_report_interval_ns $mi" 0 "$bin" "$tmp/dmr.yaml" --virtual-time \
+		--duration-s 1 --summary-json "$tmp/dmr$mi.json" --telemetry "$tmp/d.csv"
+done
+check "min_report_interval_ns 0 (half the report period): no duplicate" "$(num "$tmp/dmr0.json" device_duplicate) == 0"
+check "min_report_interval_ns 5 ms: the repeated reports are duplicates ($(num "$tmp/dmr5_000_000.json" device_duplicate))" \
+	"$(num "$tmp/dmr5_000_000.json" device_duplicate) > 100"
 sed '/^      kind: gpio$/a\      faults: [{kind: estop, start_ns: 1_000_000_000, duration_ns: 300_000_000}]' \
 	config/examples/can_avoid_sim.yaml >"$tmp/dge.yaml"
 expect "device-level e-stop on simulated lines" 0 "$bin" "$tmp/dge.yaml" --virtual-time --duration-s 2 \
