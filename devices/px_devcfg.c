@@ -49,6 +49,21 @@ static size_t conv_faults(const struct px_config_fault *f, size_t n,
 	return k;
 }
 
+/* The config's windows (conv_faults) plus the options' (already on the
+ * loop clock). Returns the count or PX_E_NOSPC. */
+static int sim_faults(const struct px_config_fault *f, size_t n,
+		      const struct px_devcfg_options *opt,
+		      struct px_sim_fault *o)
+{
+	size_t k = conv_faults(f, n, opt, o), i;
+	size_t extra = opt && opt->faults ? opt->n_faults : 0;
+	if (k + extra > PX_SIM_MAX_FAULTS)
+		return PX_E_NOSPC;
+	for (i = 0; i < extra; i++)
+		o[k++] = opt->faults[i];
+	return (int)k;
+}
+
 int px_devcfg_arm_faults(const struct px_config *cfg,
 			 const struct px_config_device *dc, int64_t clock0_ns,
 			 struct px_sim_fault *faults, size_t cap)
@@ -313,7 +328,12 @@ static int open_sim_haptic(struct px_devcfg *h, const struct px_config *cfg,
 			return rc;
 		dcfg->codec = &h->map;
 	}
-	hc.n_faults = conv_faults(s->faults, s->n_faults, opt, faults);
+	rc = sim_faults(s->faults, s->n_faults, opt, faults);
+	if (rc < 0)
+		return fail(msg, cap, cfg, dc, "sim.faults", rc,
+			    "more than %d fault windows (config and campaign)",
+			    PX_SIM_MAX_FAULTS);
+	hc.n_faults = (size_t)rc;
 	hc.faults = faults;
 	rc = px_sim_haptic_create(dcfg, &hc, &h->dev, why, sizeof(why));
 	if (rc != PX_OK)
@@ -700,6 +720,12 @@ int px_devcfg_open(const struct px_config *cfg,
 	if (!h)
 		return fail(msg, cap, cfg, dc, NULL, PX_E_NOMEM,
 			    "out of memory");
+	if (opt && opt->n_faults && dc->backend != PX_CONFIG_BACKEND_SIM) {
+		free(h);
+		return fail(msg, cap, cfg, dc, "faults", PX_E_INVAL,
+			    "fault windows in the options are for simulated "
+			    "devices only");
+	}
 	px_dev_config_default(&dcfg);
 	dcfg.name = dc->name;
 	dcfg.stale_timeout_ns = dc->stale_timeout_ns
@@ -718,11 +744,19 @@ int px_devcfg_open(const struct px_config *cfg,
 				      dc->sim.n_lines, &gc, msg, cap);
 			if (rc == PX_OK) {
 				struct px_sim_fault f[PX_SIM_MAX_FAULTS];
-				size_t n = conv_faults(dc->sim.faults,
-						       dc->sim.n_faults, opt, f);
-				rc = px_gpio_sim_create(&dcfg, &gc, f, n,
-							&h->dev, why,
-							sizeof(why));
+				int n = sim_faults(dc->sim.faults,
+						   dc->sim.n_faults, opt, f);
+				if (n < 0) {
+					rc = fail(msg, cap, cfg, dc,
+						  "sim.faults", n,
+						  "more than %d fault windows "
+						  "(config and campaign)",
+						  PX_SIM_MAX_FAULTS);
+					break;
+				}
+				rc = px_gpio_sim_create(&dcfg, &gc, f,
+							(size_t)n, &h->dev,
+							why, sizeof(why));
 				if (rc != PX_OK)
 					fail(msg, cap, cfg, dc, "sim.lines", rc,
 					     "%s", why);

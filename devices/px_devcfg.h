@@ -35,6 +35,8 @@
  *    pose, gpio); a simulated bus's (transport sim or unix) wrap each
  *    endpoint the device opens (px_can_fault_open(), seeded by the
  *    device index), so they hit what this device receives.
+ *    Faults in the options (a runner's campaign) are added to a
+ *    simulated device's own.
  *  - stuck_limit and min_report_interval_ns go to the device config.
  *
  * Errors: every failure leaves a one-line message naming the device, the
@@ -73,6 +75,14 @@ struct px_devcfg_options {
 	 * (start_ns from the start of the run) are moved by it. 0 for a
 	 * virtual clock starting at 0. */
 	int64_t clock0_ns;
+	/* More fault windows for a simulated device (sim haptic, pose or
+	 * gpio), e.g. a runner's fault campaign, added after the config's
+	 * own: on the loop clock already (not moved by clock0_ns), in the
+	 * kinds that device takes (px_sim.h, px_gpio.h: an estop window
+	 * presses a simulated e-stop line). Not owned; copied at open.
+	 * Given for any other back end: PX_E_INVAL naming "faults". */
+	const struct px_sim_fault *faults;
+	size_t n_faults;
 };
 
 /*

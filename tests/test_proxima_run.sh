@@ -139,7 +139,7 @@ for f in config/examples/*.yaml; do
 		rc=$?
 		if [ "$rc" -eq 0 ]; then
 			skp "$f: its hardware is present here (ran)"
-		elif [ "$rc" -eq 1 ] && grep -qE "^proxima-run: device '[a-z0-9_]+' \((hidapi|libusb|socketcan|gpiod), devices\[[0-9]\]\.[a-z_.]+\): .*(errno|not found|no HID|no USB|found)" "$tmp/err"; then
+		elif [ "$rc" -eq 1 ] && grep -qE "^proxima-run: device '[a-z0-9_]+' \((hidapi|libusb|socketcan|gpiod), devices\[[0-9]\]\.[a-z_.]+\): .*(errno|not found|no HID|no USB|found|no such network interface)" "$tmp/err"; then
 			ok "$f: absent hardware named with its reason (exit 1)"
 		else
 			sed 's/^/    /' "$tmp/err" | head -n 5
@@ -161,6 +161,8 @@ for f in config/examples/*.yaml; do
 		[ -s "$j" ] || { bad "$f: summary JSON written"; continue; }
 		pid=$(sed -n 's/^proxima-run: spawned .*proxima-simarm (pid \([0-9]*\)).*/\1/p' "$tmp/err")
 		check "$f: proxima-simarm spawned (pid $pid)" "\"$pid\" != \"\""
+		if grep -qF "layout from $tmp/$base.yaml" "$tmp/err"; then ok "$f: proxima-simarm took the config (--config)"
+		else bad "$f: proxima-simarm took the config (--config)"; fi
 		if [ -n "$pid" ] && ! kill -0 "$pid" 2>/dev/null; then ok "$f: the arm process is gone after the run"
 		else bad "$f: the arm process is gone after the run"; fi
 		check "$f: drives enabled over the socket ($(num "$j" drives_enabled_cycles) cycles)" \
@@ -321,14 +323,66 @@ sed 's/spawn_arm: arm/spawn_arm: nope/' config/examples/can_avoid.yaml >"$tmp/sp
 expect "--check: spawn_arm on an unknown device" 1 "$bin" --check "$tmp/spawn1.yaml"
 if grep -q "^$tmp/spawn1.yaml:[0-9]*:[0-9]*: sim.spawn_arm: no device named 'nope' in devices" "$tmp/err"; then
 	ok "spawn_arm error placed"; else bad "spawn_arm error placed"; fi
-sed 's/{node_id: 2, mode: csv, joint: 1, counts_per_unit: 100000}/{node_id: 2, mode: csv, joint: 1}/' \
+# proxima-simarm takes the drive table from the config: any table the
+# master takes is fine; an in-process bus (transport sim) is not reachable
+sed 's/{node_id: 2, mode: csv, joint: 1, counts_per_unit: 100000}/{node_id: 9, mode: csv, joint: 1}/' \
 	config/examples/can_avoid.yaml >"$tmp/spawn2.yaml"
-expect "--check: spawn_arm on drives proxima-simarm does not play" 1 "$bin" --check "$tmp/spawn2.yaml"
-if grep -q "sim.spawn_arm: .*drives\[1\] of 'arm' differs" "$tmp/err"; then
-	ok "spawn_arm drive mismatch named"; else bad "spawn_arm drive mismatch named"; fi
+expect "--check: spawn_arm on drives other than proxima-simarm's defaults" 0 "$bin" --check "$tmp/spawn2.yaml"
+sed 's/transport: unix/transport: sim/; /socket_path:/d' config/examples/can_avoid.yaml >"$tmp/spawn3.yaml"
+expect "--check: spawn_arm on an in-process bus" 1 "$bin" --check "$tmp/spawn3.yaml"
+if grep -q "sim.spawn_arm: 'arm' is not a socketcan device with transport unix and canopen drives" "$tmp/err"; then
+	ok "spawn_arm transport named"; else bad "spawn_arm transport named"; fi
+# can_sim.yaml maps its PDOs and numbers its drives unlike proxima-simarm's
+# defaults: its run above enabled the drives only because the arm read
+# the same file (--config); the arm process was started that way.
+if grep -q 'rpdo:' config/examples/can_sim.yaml && grep -q 'node_id: 11' config/examples/can_sim.yaml; then
+	ok "can_sim.yaml has a non-default PDO mapping and drive table"; else bad "can_sim.yaml has a non-default PDO mapping and drive table"; fi
 for k in nominal joint amplitude_rad_per_s frequency_hz phase_rad spawn_arm; do
 	grep -qF "\`$k\`" docs/config.md || { echo "    docs/config.md lacks \`$k\`"; bad "nominal keys documented"; }
 done
+
+# Device-level keys (devices[]: sim.faults, socketcan.faults with
+# node_id, stuck_limit) reach the devices proxima-run makes itself: each
+# shows in the summary's fault counts without any sim.faults campaign.
+absolute "$good" | sed '/^      kind: haptic$/a\      faults: [{kind: nan, start_ns: 1_000_000_000, duration_ns: 200_000_000}]' >"$tmp/dnan.yaml"
+expect "device-level nan fault run" 0 "$bin" "$tmp/dnan.yaml" --virtual-time --duration-s 2 \
+	--summary-json "$tmp/dnan.json" --telemetry "$tmp/d.csv"
+check "devices[].sim.faults nan counted ($(num "$tmp/dnan.json" device_non-finite))" \
+	"$(num "$tmp/dnan.json" device_non-finite) > 0 && $(num "$tmp/dnan.json" faults_injected) == 0"
+check "devices[].sim.faults nan trips safe state" "$(num "$tmp/dnan.json" safe_state_trips) >= 1"
+for sl in 0 20; do
+	absolute "$good" | sed 's/position_noise_m: .*/position_noise_m: 0/' |
+		sed '/^      kind: haptic$/a\      faults: [{kind: stuck, start_ns: 1_000_000_000, duration_ns: 200_000_000}]' |
+		sed "/^  - name: haptic\$/a\    stuck_limit: $sl" >"$tmp/dst$sl.yaml"
+	expect "device-level stuck fault, stuck_limit $sl" 0 "$bin" "$tmp/dst$sl.yaml" --virtual-time \
+		--duration-s 2 --summary-json "$tmp/dst$sl.json" --telemetry "$tmp/d.csv"
+done
+check "stuck_limit 0: a noiseless frozen sensor goes unseen" "$(num "$tmp/dst0.json" device_stuck) == 0"
+check "stuck_limit 20: the frozen sensor is caught" "$(num "$tmp/dst20.json" device_stuck) >= 1"
+# min_report_interval_ns: a device at rest sends the same report every
+# 1 ms; with the key above that period they count as duplicates.
+for mi in 0 5_000_000; do
+	absolute "$good" | sed 's/position_noise_m: .*/position_noise_m: 0/; s/amplitude_m: [0-9.]*/amplitude_m: 0/g' |
+		sed "/^  - name: haptic\$/a\    min_report_interval_ns: $mi" >"$tmp/dmr.yaml"
+	expect "device at rest, min_report_interval_ns $mi" 0 "$bin" "$tmp/dmr.yaml" --virtual-time \
+		--duration-s 1 --summary-json "$tmp/dmr$mi.json" --telemetry "$tmp/d.csv"
+done
+check "min_report_interval_ns 0 (half the report period): no duplicate" "$(num "$tmp/dmr0.json" device_duplicate) == 0"
+check "min_report_interval_ns 5 ms: the repeated reports are duplicates ($(num "$tmp/dmr5_000_000.json" device_duplicate))" \
+	"$(num "$tmp/dmr5_000_000.json" device_duplicate) > 100"
+sed '/^      kind: gpio$/a\      faults: [{kind: estop, start_ns: 1_000_000_000, duration_ns: 300_000_000}]' \
+	config/examples/can_avoid_sim.yaml >"$tmp/dge.yaml"
+expect "device-level e-stop on simulated lines" 0 "$bin" "$tmp/dge.yaml" --virtual-time --duration-s 2 \
+	--summary-json "$tmp/dge.json" --telemetry "$tmp/d.csv"
+check "devices[].sim.faults estop pressed ($(num "$tmp/dge.json" estop_presses))" \
+	"$(num "$tmp/dge.json" estop_presses) == 1 && $(num "$tmp/dge.json" safe_state_trips) >= 1"
+sed '/^      canopen:$/i\      faults: [{kind: estop, node_id: 2, start_ns: 1_000_000_000, duration_ns: 300_000_000}]' \
+	config/examples/can_avoid_sim.yaml >"$tmp/ddr.yaml"
+expect "device-level drive fault (node_id) on the in-process arm" 0 "$bin" "$tmp/ddr.yaml" --virtual-time \
+	--duration-s 2 --summary-json "$tmp/ddr.json" --telemetry "$tmp/d.csv"
+check "socketcan.faults node_id 2: the drive faulted ($(num "$tmp/ddr.json" drive_problem_cycles) cycles)" \
+	"$(num "$tmp/ddr.json" drive_problem_cycles) > 0 && $(num "$tmp/ddr.json" safe_state_trips) >= 1"
+check "the same run without it has no drive problem" "$(num "$tmp/can_avoid_sim.json" drive_problem_cycles) == 0"
 
 echo "$name: $pass passed, $fail failed, $skip skipped"
 [ "$fail" -eq 0 ]

@@ -25,10 +25,16 @@
  * free once on purpose: the count is then 2 (a self-check for tests).
  *
  * Devices: the simulated haptic and pose devices are made here (they
- * take the `sim` section's fault campaign); every other back end is
- * opened through px_devcfg (hidapi, libusb, SocketCAN signals and CANopen
- * drives, libgpiod, simulated lines), so the cycle sees only px_dev and
- * the CANopen master, never a back end. Each cycle reads every pose
+ * take their own devices[].sim.faults, stuck_limit and
+ * min_report_interval_ns, then the `sim` section's fault campaign); every
+ * other back end is opened through px_devcfg (hidapi, libusb, SocketCAN
+ * signals and CANopen drives, libgpiod, simulated lines; the campaign's
+ * e-stop presses go in as px_devcfg_options fault windows, its notes are
+ * printed), so the cycle sees only px_dev and the CANopen master, never
+ * a back end. Back-end headers still included: px_sim.h (the simulated
+ * haptic/pose device and the px_sim_fault windows), px_can.h and
+ * px_canopen.h (the in-process simulated bus and arm, and the CANopen
+ * master the avoidance cycle commands). Each cycle reads every pose
  * device and e-stop line (a pressed one trips safe state), computes
  * (haptic rendering on control.device, or avoidance on the CANopen arm),
  * and writes the force, the drives' targets (held still without
@@ -64,7 +70,6 @@
 #include "px_control.h"
 #include "px_dev.h"
 #include "px_devcfg.h"
-#include "px_gpio.h"
 #include "px_loop.h"
 #include "px_ring.h"
 #include "px_world.h"
@@ -330,9 +335,12 @@ static const struct px_config_schema fault_schema = {
 	"fault", fault_keys, sizeof(fault_keys) / sizeof(fault_keys[0]),
 	fault_check};
 
-/* sim.spawn_arm: proxima-simarm plays drives 1..N (node i + 1 is joint
- * i), all in one mode, at 100000 counts per rad, so the device's drive
- * table must be exactly that. */
+/* sim.spawn_arm: proxima-simarm takes the drive table, PDO mapping and
+ * drive faults from this config (--config FILE --device NAME), so any
+ * drive table the master takes will do; what still matters is that it
+ * can reach the device: a socketcan device on transport unix (another
+ * process cannot join an in-process bus; a kernel bus needs no spawned
+ * arm) with canopen drives. */
 static void spawn_arm_check(struct px_config_reader *r,
 			    const struct px_config_node *map,
 			    const struct raw_sim *sm)
@@ -341,7 +349,6 @@ static void spawn_arm_check(struct px_config_reader *r,
 	const struct px_config_device *d =
 		px_config_device_find(sm->cfg_, sm->spawn_arm);
 	const struct px_config_canopen *co;
-	size_t i;
 	if (!d) {
 		px_config_reader_error(r, at, "spawn_arm",
 				       "no device named '%s' in devices",
@@ -357,20 +364,6 @@ static void spawn_arm_check(struct px_config_reader *r,
 				       "transport unix and canopen drives",
 				       sm->spawn_arm);
 		return;
-	}
-	for (i = 0; i < co->n_drives; i++) {
-		const struct px_config_canopen_drive *v = &co->drives[i];
-		if (v->node_id != (int64_t)i + 1 || v->joint != (int64_t)i ||
-		    v->mode != co->drives[0].mode ||
-		    !v->has_counts_per_unit || v->counts_per_unit != 100000.0) {
-			px_config_reader_error(
-				r, at, "spawn_arm",
-				"proxima-simarm plays drives with node ids 1..N "
-				"on joints 0..N-1, one mode, counts_per_unit "
-				"100000; drives[%zu] of '%s' differs",
-				i, sm->spawn_arm);
-			return;
-		}
 	}
 }
 
@@ -985,42 +978,6 @@ static const struct px_codec_map *make_codec(int k, const struct px_config_codec
 	return m;
 }
 
-/* E-stop faults of simulated lines: the line pressed (physical level by
- * its active_low) at each window's start and released at its end,
- * queued at setup. Returns 0 or 1 (said why). */
-static int estop_faults(const struct px_config_device *d, struct px_dev *dev)
-{
-	const struct px_config_line_ref *e = &A.cfg->safety.estop;
-	int active_low = 0, found = 0;
-	size_t i;
-	for (i = 0; i < d->sim.n_lines; i++) {
-		const struct px_config_gpio_line *l = &d->sim.lines[i];
-		if ((e->present && !strcmp(e->device, d->name) &&
-		     !strcmp(e->line, l->name)) ||
-		    (!found && !strcmp(l->name, "estop"))) {
-			active_low = l->active_low;
-			found = 1;
-		}
-	}
-	for (i = 0; i < A.sim.n_faults; i++) {
-		const struct raw_fault *f = &A.sim.faults[i];
-		int64_t t0 = A.clock0_ns + f->start_ns;
-		if (strcmp(f->device, d->name) != 0 || f->kind != FK_ESTOP)
-			continue;
-		if (!found ||
-		    px_gpio_sim_drive(dev, PX_GPIO_ESTOP, !active_low, t0) != PX_OK ||
-		    px_gpio_sim_drive(dev, PX_GPIO_ESTOP, active_low,
-				      t0 + f->duration_ns) != PX_OK) {
-			fprintf(stderr,
-				"proxima-run: device '%s': cannot press its "
-				"e-stop line (%s)\n",
-				d->name, found ? "more than 64 pending levels" : "none");
-			return 1;
-		}
-	}
-	return 0;
-}
-
 /* A device through px_devcfg (every back end but the simulated
  * haptic/pose devices): hidapi, libusb, SocketCAN signals and CANopen
  * drives on any transport, libgpiod and simulated lines. A CANopen arm on
@@ -1035,10 +992,35 @@ static int make_devcfg(int k)
 	struct px_dev *dev;
 	struct px_canopen *co;
 	static struct px_sim_fault busf[MAX_CAMPAIGN], armf[MAX_CAMPAIGN];
-	size_t nbus = 0, narm = 0, j;
+	static struct px_sim_fault linef[PX_SIM_MAX_FAULTS];
+	size_t nbus = 0, narm = 0, nline = 0, j;
 	char msg[512] = "";
 	int rc, i;
 	memset(&opt, 0, sizeof(opt));
+	opt.clock0_ns = A.clock0_ns; /* the config's own fault windows */
+	/* the campaign's e-stop presses of simulated lines: fault windows
+	 * of the simulated GPIO device (px_devcfg applies them) */
+	for (j = 0; j < A.sim.n_faults; j++) {
+		const struct raw_fault *f = &A.sim.faults[j];
+		if (strcmp(f->device, d->name) != 0 ||
+		    d->backend != PX_CONFIG_BACKEND_SIM)
+			continue;
+		if (nline == PX_SIM_MAX_FAULTS) {
+			fprintf(stderr, "proxima-run: device '%s': more than %d "
+					"faults\n",
+				d->name, PX_SIM_MAX_FAULTS);
+			return 1;
+		}
+		memset(&linef[nline], 0, sizeof(linef[nline]));
+		linef[nline].kind = f->kind + 1;
+		linef[nline].start_ns = A.clock0_ns + f->start_ns;
+		linef[nline].duration_ns = f->duration_ns;
+		linef[nline].probability = f->probability;
+		linef[nline].delay_ns = f->delay_ns;
+		nline++;
+	}
+	opt.faults = nline ? linef : NULL;
+	opt.n_faults = nline;
 	/* faults of a CANopen arm on the in-process bus: the bus's (a bus
 	 * of ours, given to px_devcfg) and drive 0's (the simulated arm) */
 	for (j = 0; j < A.sim.n_faults; j++) {
@@ -1083,6 +1065,9 @@ static int make_devcfg(int k)
 		return 1;
 	}
 	A.dcfg[A.n_dcfg++] = h;
+	if (px_devcfg_notes(h)[0])
+		fprintf(stderr, "proxima-run: device '%s': note: %s\n", d->name,
+			px_devcfg_notes(h));
 	dev = px_devcfg_dev(h);
 	if (dev) {
 		if (A.n_dev >= MAX_DEVS) {
@@ -1092,8 +1077,6 @@ static int make_devcfg(int k)
 		}
 		if (px_dev_caps(dev) & PX_DEV_CAP_DIO)
 			A.dio[A.n_dio++] = dev;
-		if (d->backend == PX_CONFIG_BACKEND_SIM && estop_faults(d, dev))
-			return 1;
 		if ((px_dev_caps(dev) & PX_DEV_CAP_POSE) && A.ctl.device &&
 		    strcmp(A.ctl.device, d->name) == 0)
 			A.ctl_dev = A.n_dev;
@@ -1133,6 +1116,18 @@ static int make_devcfg(int k)
 		A.canbus = px_devcfg_can_sim(h);
 		if (A.canbus) {
 			struct px_canopen_sim_config sc;
+			/* the config's drive faults (node_id) as well */
+			int na = px_devcfg_arm_faults(A.cfg, d, A.clock0_ns,
+						      armf + narm,
+						      MAX_CAMPAIGN - narm);
+			if (na < 0) {
+				fprintf(stderr,
+					"proxima-run: device '%s': drive "
+					"faults: %s\n",
+					d->name, px_strerror(na));
+				return 1;
+			}
+			narm += (size_t)na;
 			memset(&sc, 0, sizeof(sc));
 			sc.pdo = px_devcfg_pdo(h);
 			sc.drives = drv;
@@ -1222,8 +1217,27 @@ static int make_device(int k)
 		sc.traj.csv = A.csv[k];
 	}
 	{
+		/* the device's own faults (devices[].sim.faults, timed from
+		 * the start of the run), then the campaign's (sim.faults) */
 		static struct px_sim_fault fl[PX_SIM_MAX_FAULTS];
 		size_t n = 0;
+		for (i = 0; i < s->n_faults; i++) {
+			const struct px_config_fault *f = &s->faults[i];
+			if (n == PX_SIM_MAX_FAULTS) {
+				fprintf(stderr,
+					"proxima-run: device '%s': more than %d "
+					"faults in devices[%d].sim.faults\n",
+					d->name, PX_SIM_MAX_FAULTS, k);
+				return 1;
+			}
+			memset(&fl[n], 0, sizeof(fl[n]));
+			fl[n].kind = f->kind + 1;
+			fl[n].start_ns = A.clock0_ns + f->start_ns;
+			fl[n].duration_ns = f->duration_ns;
+			fl[n].probability = f->probability;
+			fl[n].delay_ns = f->delay_ns;
+			n++;
+		}
 		for (i = 0; i < A.sim.n_faults; i++) {
 			const struct raw_fault *f = &A.sim.faults[i];
 			if (strcmp(f->device, d->name) != 0)
@@ -1249,6 +1263,9 @@ static int make_device(int k)
 	 * frozen sensor (the stuck fault), so let the device detect it. */
 	if (s->position_noise_m > 0)
 		dc.stuck_limit = 50;
+	if (d->stuck_limit > 0)
+		dc.stuck_limit = (uint32_t)d->stuck_limit;
+	dc.min_report_interval_ns = d->min_report_interval_ns;
 	rc = px_sim_haptic_create(&dc, &sc, &A.dev[A.n_dev], msg, sizeof(msg));
 	if (rc != PX_OK) {
 		fprintf(stderr, "proxima-run: device '%s': %s\n", d->name,
@@ -1271,10 +1288,7 @@ static int spawn_arm(void)
 	const struct px_config_device *d =
 		px_config_device_find(A.cfg, A.sim.spawn_arm);
 	const struct px_config_socketcan *c = &d->socketcan;
-	char exe[1024], local[160], n[16], line[256] = "";
-	const char *mode = c->canopen.drives[0].mode == PX_CONFIG_CIA402_CSV
-				   ? "csv"
-				   : "csp";
+	char exe[1024], line[256] = "";
 	int fds[2];
 	ssize_t len = readlink("/proc/self/exe", exe, sizeof(exe) - 32);
 	char *slash;
@@ -1292,8 +1306,6 @@ static int spawn_arm(void)
 			exe, strerror(errno));
 		return 1;
 	}
-	snprintf(local, sizeof(local), "%s.peer", c->socket_path);
-	snprintf(n, sizeof(n), "%zu", c->canopen.n_drives);
 	if (pipe(fds) != 0) {
 		fprintf(stderr, "proxima-run: sim.spawn_arm: pipe: %s\n",
 			strerror(errno));
@@ -1314,8 +1326,10 @@ static int spawn_arm(void)
 		dup2(fds[1], 1);
 		close(fds[0]);
 		close(fds[1]);
-		execl(exe, "proxima-simarm", "--unix", local, c->socket_path,
-		      "--drives", n, "--mode", mode, (char *)NULL);
+		/* the arm reads the same file: drives, PDO mapping, drive
+		 * faults, and the other end of socket_path */
+		execl(exe, "proxima-simarm", "--config", A.o.config, "--device",
+		      d->name, (char *)NULL);
 		fprintf(stderr, "proxima-run: sim.spawn_arm: %s: %s\n", exe,
 			strerror(errno));
 		_exit(127);
@@ -1336,7 +1350,7 @@ static int spawn_arm(void)
 		line[got] = '\0';
 	}
 	close(fds[0]);
-	if (!strstr(line, "drives on")) {
+	if (!strstr(line, "drives on") || !strstr(line, "layout from")) {
 		int st = 0;
 		kill(A.arm_pid, SIGTERM);
 		waitpid(A.arm_pid, &st, 0);
@@ -1347,8 +1361,11 @@ static int spawn_arm(void)
 			exe, WIFEXITED(st) ? WEXITSTATUS(st) : -1);
 		return 1;
 	}
-	fprintf(stderr, "proxima-run: spawned %s (pid %d): %zu drives on %s\n",
-		exe, (int)A.arm_pid, c->canopen.n_drives, c->socket_path);
+	fprintf(stderr,
+		"proxima-run: spawned %s (pid %d): %zu drives on %s, layout "
+		"from %s\n",
+		exe, (int)A.arm_pid, c->canopen.n_drives, c->socket_path,
+		A.o.config);
 	return 0;
 }
 
