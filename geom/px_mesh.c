@@ -596,8 +596,9 @@ static inline void box4_d2(const struct node4 *nd, px_vec3 p, double d2[4])
  * the caller), and the squared sum, itself rounded up to six times by
  * 2^-24 relative, is scaled by 1 - 2^-18: the result stays a lower bound
  * of the true squared distance, so pruning with it never loses the
- * closest triangle. Callers use it only while |p| is far below the float
- * range (mesh_closest falls back to box4_d2 otherwise).
+ * closest triangle. Callers use it only while |p| and the mesh stay below
+ * 1e18, so no square overflows the float range (mesh_closest falls back
+ * to box4_d2 otherwise).
  */
 static inline void box4_d2f(const struct node4 *nd, const float pf[3],
 			    float slack, double d2[4])
@@ -692,7 +693,10 @@ struct pq {
 static inline void pq_init(const struct mesh *M, px_vec3 p, struct pq *q)
 {
 	double pmax = fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z)));
-	q->use = pmax < 1e30 && M->absmax < 1e30;
+	/* Differences stay below 4e18 and their squares (and sums of three)
+	 * far below FLT_MAX; beyond that a float square overflows to inf,
+	 * which would prune the closest box or triangle. */
+	q->use = pmax < 1e18 && M->absmax < 1e18;
 	q->pf[0] = (float)p.x;
 	q->pf[1] = (float)p.y;
 	q->pf[2] = (float)p.z;
