@@ -330,6 +330,14 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 				snprintf(msg, msg_cap, "%s:%ld: too many PLY elements", path, lineno);
 				goto out;
 			}
+			/* the importer reads a name starting with a digit as the
+			 * element count (found by fuzzing: 'element 8888888face 1'
+			 * took gigabytes and minutes) */
+			if (!isalpha((unsigned char)w[1][0]) && w[1][0] != '_') {
+				snprintf(msg, msg_cap, "%s:%ld: PLY element name '%s' does "
+					 "not start with a letter", path, lineno, w[1]);
+				goto out;
+			}
 			snprintf(E[ne].name, sizeof(E[ne].name), "%s", w[1]);
 			E[ne].count = strtoull(w[2], &end, 10);
 			if (*end || w[2][0] == '-') {
