@@ -22,6 +22,19 @@
  * cycle; the loop goes to safe state); the reader then tries to reopen
  * every 200 ms and marks it running again when it is back (the loop
  * resumes after its re-arm).
+ * Replug without udevd: hidapi-libusb keeps one libusb context per
+ * process, and Debian's libusb learns of new devices only from udevd's
+ * events, so where none runs (containers, minimal guests) that context
+ * never sees a replugged device. So before each reopen attempt of the
+ * libusb build, when this back end holds no hidapi handle open (every
+ * HID device of the process is unplugged or freed; code that calls hidapi
+ * itself in the same process must not hold one either), the reader
+ * re-initialises hidapi (hid_exit + hid_init: a fresh context that scans
+ * sysfs again).
+ * While another HID device of the process stays open there, an unplugged
+ * one comes back only if udevd runs. All hidapi initialisation,
+ * enumeration, open and close go through one process-wide lock, never
+ * taken by the cycle.
  *
  * Memory: hidapi allocates inside its own calls on the reader/writer
  * threads and at open; the cycle side allocates nothing.
@@ -71,8 +84,9 @@ PX_API int px_hid_create(const struct px_dev_config *dcfg,
 			 char *msg, size_t cap);
 
 /* One line per HID device (VID:PID, usage page/usage, interface, path,
- * product) written to fn; for tools. Returns the device count, or a
- * negative error. Not for the cycle. */
+ * product) written to fn; for tools. fn is called with the back end's
+ * hidapi lock held, so it must not call px_hid functions. Returns the
+ * device count, or a negative error. Not for the cycle. */
 PX_API int px_hid_list(void (*fn)(void *user, const char *line), void *user);
 
 #ifdef __cplusplus

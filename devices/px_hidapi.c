@@ -41,12 +41,46 @@ struct hid {
 	struct px_param *out;
 };
 
-static pthread_once_t init_once = PTHREAD_ONCE_INIT;
-static int init_rc;
+/* hidapi's library state (for hidapi-libusb, its one libusb context) is
+ * process-wide: init, exit, enumerate, open and close all take this lock,
+ * and n_open counts the handles this file holds open, so that the context
+ * is only re-made when nothing uses it. */
+static pthread_mutex_t hid_lock = PTHREAD_MUTEX_INITIALIZER;
+static int init_done, init_rc, n_open;
 
-static void do_init(void)
+/* Call with hid_lock held. */
+static int lib_init_locked(void)
 {
-	init_rc = hid_init();
+	if (!init_done) {
+		init_rc = hid_init();
+		init_done = 1;
+	}
+	return init_rc;
+}
+
+/* Debian's libusb learns of new devices only from udevd's events; where
+ * none runs (containers, minimal guests) its context never sees a
+ * replugged device. A new context scans sysfs again, so before a reopen
+ * with hidapi-libusb, when no handle of the process uses the context,
+ * hid_exit + hid_init replace it. hidapi-hidraw enumerates sysfs on every
+ * call and needs none of this. Call with hid_lock held. */
+static void lib_refresh_locked(void)
+{
+	if (px_hid_driver() != PX_HID_LIBUSB || n_open != 0 || !init_done)
+		return;
+	hid_exit();
+	init_done = 0;
+	lib_init_locked();
+}
+
+static void close_handle(hid_device *h)
+{
+	if (!h)
+		return;
+	pthread_mutex_lock(&hid_lock);
+	hid_close(h);
+	n_open--;
+	pthread_mutex_unlock(&hid_lock);
 }
 
 int px_hid_driver(void)
@@ -67,6 +101,7 @@ static int count_devices(void)
 	for (p = all; p; p = p->next)
 		n++;
 	hid_free_enumeration(all);
+	pthread_mutex_unlock(&hid_lock);
 	return n;
 }
 
@@ -92,51 +127,91 @@ static int find_path(const struct hid *x, char *path, size_t cap)
 	return found ? PX_OK : PX_E_NOTFOUND;
 }
 
-/* Open (or reopen). Returns PX_OK or an error with msg filled. */
-static int hid_open_dev(struct hid *x, const char *nm, char *msg, size_t cap,
-			int *sys_errno)
+/* Find (by vid:pid) and open, under hid_lock; on failure *e is the
+ * open's errno and he (hcap wide chars) hidapi's text, copied while the
+ * lock still keeps it alive. */
+static int open_locked(struct hid *x, char *path, size_t cap, int *e,
+		       wchar_t *he, size_t hcap)
 {
-	char path[256];
-	int rc, e;
-	*sys_errno = 0;
+	const wchar_t *t;
+	int rc;
+	*e = 0;
 	if (x->cfg.has_vid_pid) {
-		rc = find_path(x, path, sizeof path);
-		if (rc == PX_E_INVAL) {
-			if (msg)
-				snprintf(msg, cap, "%s: serial '%s' is not "
-					 "valid text", nm, x->cfg.serial);
+		rc = find_path(x, path, cap);
+		if (rc != PX_OK)
 			return rc;
-		}
-		if (rc != PX_OK) {
-			if (msg)
-				snprintf(msg, cap,
-					 "%s: no HID device %04x:%04x%s%s found "
-					 "(%d HID devices present; "
-					 "proxima-probe lists them)",
-					 nm, x->cfg.vid, x->cfg.pid,
-					 x->cfg.serial ? " serial " : "",
-					 x->cfg.serial ? x->cfg.serial : "",
-					 count_devices());
-			return PX_E_NOTFOUND;
-		}
 	} else {
-		snprintf(path, sizeof path, "%s", x->path);
+		snprintf(path, cap, "%s", x->path);
 	}
 	errno = 0;
 	x->h = hid_open_path(path);
-	e = errno;
-	if (x->h) {
+	*e = errno;
+	if (!x->h) {
+		t = hid_error(NULL);
+		if (t) {
+			wcsncpy(he, t, hcap - 1);
+			he[hcap - 1] = 0;
+		}
+		if (*e == EACCES || *e == EPERM)
+			return PX_E_PERM;
+		return PX_E_IO;
+	}
+	n_open++;
+	return PX_OK;
+}
+
+/* Open (or reopen, refresh = 1: see lib_refresh_locked). Returns PX_OK
+ * or an error with msg filled. */
+static int hid_open_dev(struct hid *x, const char *nm, char *msg, size_t cap,
+			int *sys_errno, int refresh)
+{
+	char path[256];
+	wchar_t he[128];
+	int rc, e, ndev = 0;
+	*sys_errno = 0;
+	he[0] = 0;
+	pthread_mutex_lock(&hid_lock);
+	if (refresh)
+		lib_refresh_locked();
+	if (lib_init_locked() != 0) {
+		pthread_mutex_unlock(&hid_lock);
+		if (msg)
+			snprintf(msg, cap, "%s: hid_init failed: %ls", nm,
+				 hid_error(NULL) ? hid_error(NULL) : L"?");
+		return PX_E_IO;
+	}
+	rc = open_locked(x, path, sizeof path, &e, he, 128);
+	if (rc == PX_E_NOTFOUND && msg)
+		ndev = count_devices();
+	pthread_mutex_unlock(&hid_lock);
+	if (rc == PX_OK) {
 		snprintf(x->path, sizeof x->path, "%s", path);
 		return PX_OK;
 	}
+	if (rc == PX_E_INVAL) {
+		if (msg)
+			snprintf(msg, cap, "%s: serial '%s' is not valid text",
+				 nm, x->cfg.serial);
+		return rc;
+	}
+	if (rc == PX_E_NOTFOUND) {
+		if (msg)
+			snprintf(msg, cap,
+				 "%s: no HID device %04x:%04x%s%s found "
+				 "(%d HID devices present; "
+				 "proxima-probe lists them)",
+				 nm, x->cfg.vid, x->cfg.pid,
+				 x->cfg.serial ? " serial " : "",
+				 x->cfg.serial ? x->cfg.serial : "", ndev);
+		return PX_E_NOTFOUND;
+	}
 	*sys_errno = e;
 	if (msg) {
-		const wchar_t *he = hid_error(NULL);
 		snprintf(msg, cap, "%s: cannot open HID device %s (hidapi %s)%s%s"
 			 "%s%ls",
 			 nm, path, PX_HIDAPI_DRIVER,
 			 e ? ": " : "", e ? strerror(e) : "",
-			 he ? ": " : "", he ? he : L"");
+			 he[0] ? ": " : "", he);
 		if (e == EACCES || e == EPERM) {
 			size_t l = strlen(msg);
 			snprintf(msg + l, cap > l ? cap - l : 0,
@@ -172,7 +247,7 @@ static void *io_main(void *p)
 		if (!x->h) {
 			int se;
 			sleep_ns(REOPEN_NS);
-			if (hid_open_dev(x, px_dev_name(d), NULL, 0, &se) ==
+			if (hid_open_dev(x, px_dev_name(d), NULL, 0, &se, 1) ==
 			    PX_OK)
 				px_dev_set_state(d, PX_DEV_STATE_RUNNING,
 						 px_dev_mono_ns());
@@ -188,7 +263,7 @@ static void *io_main(void *p)
 				      "hid_read failed", px_dev_mono_ns());
 			px_dev_set_state(d, PX_DEV_STATE_UNPLUGGED,
 					 px_dev_mono_ns());
-			hid_close(x->h);
+			close_handle(x->h);
 			x->h = NULL;
 			continue;
 		}
@@ -254,8 +329,7 @@ static int hid_force(struct px_dev *d, const struct px_force_cmd *c,
 static void hid_destroy(struct px_dev *d)
 {
 	struct hid *x = px_dev_impl(d);
-	if (x->h)
-		hid_close(x->h);
+	close_handle(x->h);
 	x->h = NULL;
 }
 
@@ -307,13 +381,6 @@ int px_hid_create(const struct px_dev_config *dcfg,
 				 nm);
 		return PX_E_INVAL;
 	}
-	pthread_once(&init_once, do_init);
-	if (init_rc != 0) {
-		if (msg)
-			snprintf(msg, cap, "%s: hid_init failed: %ls", nm,
-				 hid_error(NULL) ? hid_error(NULL) : L"?");
-		return PX_E_IO;
-	}
 	memset(&tmp, 0, sizeof tmp);
 	tmp.cfg = *hc;
 	if (hc->serial) {
@@ -323,12 +390,12 @@ int px_hid_create(const struct px_dev_config *dcfg,
 	if (hc->path)
 		snprintf(tmp.path, sizeof tmp.path, "%s", hc->path);
 	tmp.cfg.path = NULL;
-	rc = hid_open_dev(&tmp, nm, msg, cap, &se);
+	rc = hid_open_dev(&tmp, nm, msg, cap, &se, 0);
 	if (rc != PX_OK)
 		return rc;
 	rc = px_dev_create(&hid_ops, dcfg, sizeof *x, out);
 	if (rc != PX_OK) {
-		hid_close(tmp.h);
+		close_handle(tmp.h);
 		if (msg)
 			snprintf(msg, cap, "%s: %s", nm, px_strerror(rc));
 		return rc;
@@ -356,9 +423,11 @@ int px_hid_list(void (*fn)(void *user, const char *line), void *user)
 	char line[512];
 	if (!fn)
 		return PX_E_INVAL;
-	pthread_once(&init_once, do_init);
-	if (init_rc != 0)
+	pthread_mutex_lock(&hid_lock);
+	if (lib_init_locked() != 0) {
+		pthread_mutex_unlock(&hid_lock);
 		return PX_E_IO;
+	}
 	all = hid_enumerate(0, 0);
 	for (p = all; p; p = p->next) {
 		snprintf(line, sizeof line,
@@ -372,5 +441,6 @@ int px_hid_list(void (*fn)(void *user, const char *line), void *user)
 		n++;
 	}
 	hid_free_enumeration(all);
+	pthread_mutex_unlock(&hid_lock);
 	return n;
 }

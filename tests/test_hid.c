@@ -251,10 +251,10 @@ static int write_file(const char *dir, const char *name, const char *v)
 }
 
 /* Unbind the gadget's UDC (an unplug) and bind it again (a replug). The
- * back end must report the device stale and unplugged, then, for hidraw,
- * reopen it and deliver reports again. hidapi-libusb keeps one libusb
- * context per process, which learns of a new device only from udevd: in
- * a system without udevd (the guest) it cannot see the replug. */
+ * back end must report the device stale and unplugged, then reopen it and
+ * deliver reports again, with either hidapi build. hidapi-libusb's libusb
+ * context learns of new devices only from udevd, which the guest does not
+ * run: this proves the back end's fresh context before a reopen. */
 static void gadget_unplug_replug(struct px_dev *d, const char *gdir,
 				 const char *udc, const char *hidg)
 {
@@ -274,8 +274,6 @@ static void gadget_unplug_replug(struct px_dev *d, const char *gdir,
 	PX_CHECK_INT_EQ(rc, PX_E_NODEV);
 	PX_CHECK(!s.valid && s.stale);
 	PX_CHECK_INT_EQ(write_file(gdir, "UDC", udc), 0);
-	if (px_hid_driver() == PX_HID_LIBUSB)
-		return;
 	for (i = 0; i < 500 && px_dev_state(d) != PX_DEV_STATE_RUNNING; i++)
 		wait_ms(10);
 	PX_CHECK_INT_EQ(px_dev_state(d), PX_DEV_STATE_RUNNING);
