@@ -324,6 +324,12 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 				snprintf(msg, msg_cap, "%s:%ld: unknown PLY format '%s'", path, lineno, w[1]);
 				goto out;
 			}
+			/* the importer crashed (SEGV) on a binary header with a
+			 * malformed version and no elements (found by fuzzing) */
+			if (nw != 3 || strcmp(w[2], "1.0") != 0) {
+				snprintf(msg, msg_cap, "%s:%ld: PLY format line must end with version 1.0", path, lineno);
+				goto out;
+			}
 		} else if (strcmp(w[0], "element") == 0 && nw >= 3) {
 			char *end;
 			if (ne == PLY_MAX_ELEMS) {
@@ -382,6 +388,10 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 	for (k = 0; k < ne; k++)
 		if (strcmp(E[k].name, "vertex") == 0)
 			n_vertex = E[k].count;
+	if (n_vertex == 0) {
+		snprintf(msg, msg_cap, "%s: PLY header declares no vertices", path);
+		goto out;
+	}
 	/* ASCII: the importer reads one element per line, so the check
 	 * wants each element's values on a line of their own (a row with a
 	 * value too many shifted the faces and aborted the importer). */
