@@ -94,4 +94,61 @@ struct mesh {
 	uint32_t ext[6];     /* vertices extreme along -x, +x, -y, +y, -z, +z */
 };
 
+/* ---- mesh-to-mesh distance (px_mesh_pair.c) ------------------------------ */
+
+/*
+ * Exact distance between triangles A and B (any shape, also collapsed or
+ * needle): the squared distance, a closest point on each, and *crossing
+ * = 1 when an edge of one passes through the other (then both points are
+ * that crossing point and the distance is 0). Separated triangles: the
+ * least of the nine edge-edge and six vertex-triangle distances.
+ * RT-safe.
+ */
+double px__tri_tri(const px_vec3 A[3], const px_vec3 B[3], px_vec3 *pa,
+		   px_vec3 *pb, int *crossing);
+
+/* Answer of px__mesh_pair(). */
+struct px__mesh_pair {
+	double distance;      /* >= 0: between the two surfaces */
+	px_vec3 point_a, point_b; /* world frame */
+	int tri_a, tri_b;     /* triangles (input order) */
+	int intersecting;     /* the surfaces touch or cross (distance 0) */
+	int nodes;            /* node pairs expanded */
+	int tri_tests;        /* exact triangle-pair distances computed */
+	int certified;        /* 0 only if the fixed stack ran out (cannot
+			       * happen with depths checked at setup) */
+};
+
+/*
+ * Exact distance between the surfaces of mesh models a and b at their
+ * poses, by a simultaneous depth-first traversal of both hierarchies.
+ * hint_a, hint_b: triangles (input order) of last cycle's closest pair,
+ * tested first as the starting bound (-1 for none; wrong hints only cost
+ * time). Returns PX_OK, PX_E_INVAL (NULL, or a model that is not a
+ * mesh). RT-safe: a fixed stack of MP_STACK entries (about 4 kB).
+ */
+int px__mesh_pair(const struct px_model *a, const struct px_model *b,
+		  int hint_a, int hint_b, struct px__mesh_pair *out);
+
+/*
+ * Lower-bounded search of mesh model m against any model o: visits the
+ * mesh's hierarchy nearest node first, bounds each node box from below
+ * by the distance of o to its centre (unsigned: 0 inside a closed o)
+ * minus its half diagonal, and calls tri(ctx, v, index, &d) for every
+ * triangle (world-frame vertices v, input index) whose box bound is
+ * below *best (minus a relative 1e-12); tri returns 0 or a negative
+ * error and sets d to the exact distance between the triangle and o (or
+ * INFINITY when it cannot tell: the search then reports it, see below).
+ * *best (in: an upper bound, e.g. a found distance; out: the least
+ * distance seen) and *best_tri are updated. Returns 1 when every node
+ * and triangle was either bounded out or measured exactly (the result is
+ * the global minimum), 0 when some triangle could not be measured or the
+ * point-query budget max_queries ran out, or a negative error. RT-safe.
+ */
+int px__mesh_vs_model(const struct px_model *m, const struct px_model *o,
+		      int (*tri)(void *ctx, const px_vec3 v[3], int index,
+				 double *d),
+		      void *ctx, int max_queries, double *best, int *best_tri,
+		      int *queries);
+
 #endif

@@ -1,0 +1,548 @@
+/*
+ * px_mesh_pair.c - exact distance between two posed triangle meshes, and
+ * a lower-bounded search of a mesh against any other model.
+ *
+ * Mesh against mesh: both hierarchies (mesh_internal.h: four-child float
+ * boxes, triangles in leaf order) are walked together, depth first,
+ * nearer pairs first, with the best triangle pair so far as the bound
+ * (the scheme of the bounding-volume-tree distance queries of Larsen,
+ * Gottschalk, Lin and Manocha, 1999). The work happens in A's model
+ * frame: a box of B becomes an oriented box there, and the lower bound
+ * of a box pair is the larger of two axis-aligned gaps: B's box, rotated
+ * into A's frame and enclosed by an axis-aligned box, against A's box;
+ * and the same from B's side. Each encloses the true box, so each gap is
+ * at most the true box distance, and the box distance is at most the
+ * distance of any two triangles inside. Triangle pairs are measured
+ * exactly (px__tri_tri). So the answer is the minimum over all triangle
+ * pairs, up to rounding (a gap is reduced by a slack of 1e-14 of the
+ * coordinate scale before it prunes).
+ *
+ * Memory and real-time rules: no allocation; a fixed stack of MP_STACK
+ * entries on the call stack. Every node pair is expanded at most once,
+ * so the work is bounded by the product of the node counts (and in
+ * practice a small multiple of the nodes near the closest pair).
+ */
+#include <math.h>
+#include <string.h>
+
+#include "mesh_internal.h"
+#include "px_mesh.h"
+#include "px_model.h"
+
+/* ---- triangle against triangle ------------------------------------------- */
+
+/*
+ * Closest points of segments p1q1 and p2q2 (squared distance). The line
+ * parameter comes from cross products: s = ((d1 x d2) . (d2 x r)) /
+ * |d1 x d2|^2 equals the usual (b f - c e) / (a e - b^2) by Lagrange's
+ * identity, but without the cancellation of a e - b^2 for nearly
+ * parallel segments (relative error eps / sin(angle) instead of
+ * eps / sin^2). Then the clamping order of Ericson (2005, 5.1.9), which
+ * is exact for any s in [0, 1].
+ */
+static double seg_seg(px_vec3 p1, px_vec3 q1, px_vec3 p2, px_vec3 q2,
+		      px_vec3 *c1, px_vec3 *c2)
+{
+	px_vec3 d1 = px_v3_sub(q1, p1), d2 = px_v3_sub(q2, p2), r = px_v3_sub(p1, p2);
+	double a = px_v3_norm2(d1), e = px_v3_norm2(d2), f = px_v3_dot(d2, r);
+	double s, t;
+
+	if (a <= 0.0 && e <= 0.0) {
+		s = t = 0.0;
+	} else if (a <= 0.0) {
+		s = 0.0;
+		t = f / e;
+		t = t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t);
+	} else {
+		double c = px_v3_dot(d1, r);
+		if (e <= 0.0) {
+			t = 0.0;
+			s = -c / a;
+			s = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
+		} else {
+			double b = px_v3_dot(d1, d2);
+			px_vec3 n = px_v3_cross(d1, d2);
+			double nn = px_v3_norm2(n);
+			s = 0.0;
+			if (nn > 0.0) {
+				s = px_v3_dot(n, px_v3_cross(d2, r)) / nn;
+				s = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
+			}
+			t = (b * s + f) / e;
+			if (t < 0.0) {
+				t = 0.0;
+				s = -c / a;
+				s = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
+			} else if (t > 1.0) {
+				t = 1.0;
+				s = (b - c) / a;
+				s = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
+			}
+		}
+	}
+	*c1 = px_v3_madd(p1, d1, s);
+	*c2 = px_v3_madd(p2, d2, t);
+	return px_v3_dist2(*c1, *c2);
+}
+
+/*
+ * Does segment pq pass through triangle T (normal n = (T1 - T0) x (T2 -
+ * T0))? Writes the crossing point. A segment lying in T's plane is left
+ * to the edge-edge and vertex-triangle distances, which are 0 for any
+ * coplanar contact.
+ */
+static int seg_crosses(px_vec3 p, px_vec3 q, const px_vec3 T[3], px_vec3 n,
+		       px_vec3 *x)
+{
+	double dp = px_v3_dot(n, px_v3_sub(p, T[0]));
+	double dq = px_v3_dot(n, px_v3_sub(q, T[0]));
+	px_vec3 y;
+	int k;
+
+	if ((dp > 0.0 && dq > 0.0) || (dp < 0.0 && dq < 0.0) || dp == dq)
+		return 0;
+	y = px_v3_madd(p, px_v3_sub(q, p), dp / (dp - dq));
+	/* inside: on the inner side of all three edges (the side n turns
+	 * them to) */
+	for (k = 0; k < 3; k++) {
+		px_vec3 e = px_v3_sub(T[(k + 1) % 3], T[k]);
+		if (px_v3_dot(px_v3_cross(e, px_v3_sub(y, T[k])), n) < 0.0)
+			return 0;
+	}
+	*x = y;
+	return 1;
+}
+
+double px__tri_tri(const px_vec3 A[3], const px_vec3 B[3], px_vec3 *pa,
+		   px_vec3 *pb, int *crossing)
+{
+	px_vec3 na = px_v3_cross(px_v3_sub(A[1], A[0]), px_v3_sub(A[2], A[0]));
+	px_vec3 nb = px_v3_cross(px_v3_sub(B[1], B[0]), px_v3_sub(B[2], B[0]));
+	px_vec3 x, c1, c2;
+	double best = INFINITY, d2;
+	int i, j;
+
+	*crossing = 0;
+	/* Two triangles that cross meet along a segment whose ends lie on
+	 * edges: some edge of one passes through the other. A degenerate
+	 * triangle (zero normal) is crossed only through its partner's
+	 * test, or touched, which the distances below see as 0. */
+	for (i = 0; i < 3; i++) {
+		if (px_v3_norm2(nb) > 0.0 && seg_crosses(A[i], A[(i + 1) % 3], B, nb, &x)) {
+			*pa = *pb = x;
+			*crossing = 1;
+			return 0.0;
+		}
+		if (px_v3_norm2(na) > 0.0 && seg_crosses(B[i], B[(i + 1) % 3], A, na, &x)) {
+			*pa = *pb = x;
+			*crossing = 1;
+			return 0.0;
+		}
+	}
+	/* Apart: the closest pair has a vertex or an edge-edge pair on it
+	 * (the minimum of a distance between two polygons is reached on a
+	 * boundary of one of them, and for two segments of boundary). */
+	for (i = 0; i < 3; i++)
+		for (j = 0; j < 3; j++) {
+			d2 = seg_seg(A[i], A[(i + 1) % 3], B[j], B[(j + 1) % 3], &c1, &c2);
+			if (d2 < best) {
+				best = d2;
+				*pa = c1;
+				*pb = c2;
+			}
+		}
+	for (i = 0; i < 3; i++) {
+		d2 = px_tri_closest(A[i], B[0], B[1], B[2], &c2, NULL, NULL, NULL, NULL);
+		if (d2 < best) {
+			best = d2;
+			*pa = A[i];
+			*pb = c2;
+		}
+		d2 = px_tri_closest(B[i], A[0], A[1], A[2], &c1, NULL, NULL, NULL, NULL);
+		if (d2 < best) {
+			best = d2;
+			*pa = c1;
+			*pb = B[i];
+		}
+	}
+	return best;
+}
+
+/* ---- mesh against mesh ---------------------------------------------------- */
+
+/* Deepest descent: each expansion replaces one entry by at most four,
+ * along a path of at most (binary depth / 2 + 1) four-child levels per
+ * mesh. */
+#define MP_STACK (3 * (PX_MESH_MAX_DEPTH + 4) + 4)
+#define ROOT_SLOT 4
+
+struct mp_ent {
+	uint32_t na, nb; /* parent node4 of each side (0 with ROOT_SLOT) */
+	uint8_t sa, sb;  /* child slot in the parent, ROOT_SLOT for the root */
+	double lb2;
+};
+
+struct mp_ctx {
+	const struct mesh *A, *B;
+	double R[3][3], Ra[3][3]; /* B frame -> A frame: p_A = R p_B + t */
+	px_vec3 t;
+	double slack;
+	double best2;
+	long la, lb;
+	px_vec3 pa, pb; /* A frame */
+	int crossing;
+	int nodes, tests;
+};
+
+static const struct mesh *mesh_of(const struct px_model *m)
+{
+	/* px_mesh_triangle_count() answers only for the mesh's own ops */
+	return px_mesh_triangle_count(m) > 0 ? px_model_impl(m) : NULL;
+}
+
+static void ref_get(const struct mesh *M, uint32_t node, int slot, px_vec3 *c,
+		    px_vec3 *h, uint32_t *idx, uint32_t *cnt)
+{
+	if (slot == ROOT_SLOT) {
+		*c = px_v3_scale(px_v3_add(M->box.min, M->box.max), 0.5);
+		*h = px_v3_scale(px_v3_sub(M->box.max, M->box.min), 0.5);
+		*idx = 0;
+		*cnt = 0;
+		return;
+	}
+	{
+		const struct node4 *nd = &M->n4[node];
+		double lo[3], hi[3];
+		int k;
+		for (k = 0; k < 3; k++) {
+			lo[k] = nd->lo[k][slot];
+			hi[k] = nd->hi[k][slot];
+		}
+		*c = px_v3(0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2]));
+		/* the half extents are rounded up so the box still encloses */
+		*h = px_v3(0.5 * (hi[0] - lo[0]), 0.5 * (hi[1] - lo[1]), 0.5 * (hi[2] - lo[2]));
+		*idx = nd->idx[slot];
+		*cnt = nd->cnt[slot];
+	}
+}
+
+static inline double gap_pos(double g)
+{
+	return g > 0.0 ? g : 0.0;
+}
+
+/* Lower bound of the squared distance between A's box (ca, ha: A frame)
+ * and B's box (cb, hb: B frame); see the top of the file. */
+static double box_lb2(const struct mp_ctx *X, px_vec3 ca, px_vec3 ha, px_vec3 cb,
+		      px_vec3 hb)
+{
+	double c[3] = {ca.x, ca.y, ca.z}, h[3] = {ha.x, ha.y, ha.z};
+	double d[3] = {cb.x, cb.y, cb.z}, e[3] = {hb.x, hb.y, hb.z};
+	double s1 = 0.0, s2 = 0.0, u[3];
+	int k;
+
+	for (k = 0; k < 3; k++) {
+		double cbk = X->R[k][0] * d[0] + X->R[k][1] * d[1] + X->R[k][2] * d[2] +
+			     px_v3_comp(X->t, k);
+		double ebk = X->Ra[k][0] * e[0] + X->Ra[k][1] * e[1] + X->Ra[k][2] * e[2];
+		double g = gap_pos(fabs(cbk - c[k]) - h[k] - ebk - X->slack);
+		s1 += g * g;
+		u[k] = c[k] - px_v3_comp(X->t, k);
+	}
+	for (k = 0; k < 3; k++) {
+		double cak = X->R[0][k] * u[0] + X->R[1][k] * u[1] + X->R[2][k] * u[2];
+		double eak = X->Ra[0][k] * h[0] + X->Ra[1][k] * h[1] + X->Ra[2][k] * h[2];
+		double g = gap_pos(fabs(cak - d[k]) - e[k] - eak - X->slack);
+		s2 += g * g;
+	}
+	return s1 > s2 ? s1 : s2;
+}
+
+static inline px_vec3 to_a(const struct mp_ctx *X, px_vec3 p)
+{
+	return px_v3(X->R[0][0] * p.x + X->R[0][1] * p.y + X->R[0][2] * p.z + X->t.x,
+		     X->R[1][0] * p.x + X->R[1][1] * p.y + X->R[1][2] * p.z + X->t.y,
+		     X->R[2][0] * p.x + X->R[2][1] * p.y + X->R[2][2] * p.z + X->t.z);
+}
+
+static void pair_test(struct mp_ctx *X, uint32_t ia, const px_vec3 V[3], uint32_t ib)
+{
+	const struct mtri *ta = &X->A->tri[ia];
+	px_vec3 T[3] = {ta->a, ta->b, ta->c}, pa, pb;
+	double d2;
+	int cr;
+
+	if (ta->inv_nn != 0.0 && X->best2 < INFINITY) {
+		/* B's triangle wholly on one side of A's plane and farther
+		 * than the best: its distance is at least the nearest vertex's
+		 * plane distance */
+		double h0 = px_v3_dot(ta->n, px_v3_sub(V[0], ta->a));
+		double h1 = px_v3_dot(ta->n, px_v3_sub(V[1], ta->a));
+		double h2 = px_v3_dot(ta->n, px_v3_sub(V[2], ta->a));
+		double m = INFINITY;
+		if (h0 > 0.0 && h1 > 0.0 && h2 > 0.0)
+			m = fmin(h0, fmin(h1, h2));
+		else if (h0 < 0.0 && h1 < 0.0 && h2 < 0.0)
+			m = -fmax(h0, fmax(h1, h2));
+		if (m < INFINITY) {
+			m = m * sqrt(ta->inv_nn) - X->slack;
+			if (m > 0.0 && m * m > X->best2)
+				return;
+		}
+	}
+	X->tests++;
+	d2 = px__tri_tri(T, V, &pa, &pb, &cr);
+	if (d2 < X->best2 || X->la < 0) {
+		X->best2 = d2;
+		X->la = (long)ia;
+		X->lb = (long)ib;
+		X->pa = pa;
+		X->pb = pb;
+		X->crossing = cr;
+	}
+}
+
+static void leaf_pair(struct mp_ctx *X, uint32_t ia, uint32_t na, uint32_t ib,
+		      uint32_t nb)
+{
+	uint32_t j, i;
+	for (j = ib; j < ib + nb; j++) {
+		const struct mtri *tb = &X->B->tri[j];
+		px_vec3 V[3] = {to_a(X, tb->a), to_a(X, tb->b), to_a(X, tb->c)};
+		px_vec3 lo = px_v3_min(V[0], px_v3_min(V[1], V[2]));
+		px_vec3 hi = px_v3_max(V[0], px_v3_max(V[1], V[2]));
+		for (i = ia; i < ia + na; i++) {
+			const struct mtri *ta = &X->A->tri[i];
+			px_vec3 alo = px_v3_min(ta->a, px_v3_min(ta->b, ta->c));
+			px_vec3 ahi = px_v3_max(ta->a, px_v3_max(ta->b, ta->c));
+			double gx = gap_pos(fmax(alo.x - hi.x, lo.x - ahi.x) - X->slack);
+			double gy = gap_pos(fmax(alo.y - hi.y, lo.y - ahi.y) - X->slack);
+			double gz = gap_pos(fmax(alo.z - hi.z, lo.z - ahi.z) - X->slack);
+			if (gx * gx + gy * gy + gz * gz > X->best2)
+				continue;
+			pair_test(X, i, V, j);
+			if (X->best2 == 0.0)
+				return;
+		}
+	}
+}
+
+static void mat_of(px_quat q, double R[3][3])
+{
+	px_mat3 m = px_quat_to_mat3(q);
+	memcpy(R, m.m, sizeof(m.m));
+}
+
+int px__mesh_pair(const struct px_model *a, const struct px_model *b,
+		  int hint_a, int hint_b, struct px__mesh_pair *out)
+{
+	const struct mesh *A = mesh_of(a), *B = mesh_of(b);
+	struct mp_ent st[MP_STACK];
+	struct mp_ctx X;
+	px_pose Pa, Pb;
+	double RA[3][3], RB[3][3];
+	int sp = 0, i, j, k, certified = 1;
+
+	if (!A || !B || !out)
+		return PX_E_INVAL;
+	Pa = px_model_pose(a);
+	Pb = px_model_pose(b);
+	mat_of(Pa.q, RA);
+	mat_of(Pb.q, RB);
+	memset(&X, 0, sizeof(X));
+	X.A = A;
+	X.B = B;
+	/* R = RA^T RB, t = RA^T (tB - tA) */
+	for (i = 0; i < 3; i++)
+		for (j = 0; j < 3; j++) {
+			double s = 0.0;
+			for (k = 0; k < 3; k++)
+				s += RA[k][i] * RB[k][j];
+			X.R[i][j] = s;
+			X.Ra[i][j] = fabs(s);
+		}
+	X.t = px_pose_inverse_transform_vector(Pa, px_v3_sub(Pb.t, Pa.t));
+	X.slack = 1e-14 * (A->absmax + B->absmax + px_v3_norm(X.t));
+	X.best2 = INFINITY;
+	X.la = X.lb = -1;
+	if (hint_a >= 0 && (size_t)hint_a < A->nt && hint_b >= 0 && (size_t)hint_b < B->nt) {
+		uint32_t la = A->leaf_of[hint_a], lb = B->leaf_of[hint_b];
+		const struct mtri *tb = &B->tri[lb];
+		px_vec3 V[3] = {to_a(&X, tb->a), to_a(&X, tb->b), to_a(&X, tb->c)};
+		pair_test(&X, la, V, lb);
+	}
+	st[0].na = st[0].nb = 0;
+	st[0].sa = st[0].sb = ROOT_SLOT;
+	st[0].lb2 = 0.0;
+	sp = 1;
+	while (sp > 0 && X.best2 > 0.0) {
+		struct mp_ent e = st[--sp];
+		px_vec3 ca, ha, cb, hb;
+		uint32_t ia, na, ib, nb;
+		const struct node4 *nd;
+		struct mp_ent kid[4];
+		int nk = 0, da;
+
+		if (e.lb2 > X.best2 || (e.lb2 == X.best2 && X.la >= 0))
+			continue;
+		ref_get(A, e.na, e.sa, &ca, &ha, &ia, &na);
+		ref_get(B, e.nb, e.sb, &cb, &hb, &ib, &nb);
+		X.nodes++;
+		if (na > 0 && nb > 0) {
+			leaf_pair(&X, ia, na, ib, nb);
+			continue;
+		}
+		/* split the inner node with the larger box (a leaf cannot be
+		 * split) */
+		da = na == 0 && (nb > 0 || px_v3_norm2(ha) >= px_v3_norm2(hb));
+		nd = da ? &A->n4[ia] : &B->n4[ib];
+		for (j = 0; j < 4; j++) {
+			px_vec3 cc, hc;
+			uint32_t ic, nc;
+			struct mp_ent c;
+			if (nd->idx[j] == EMPTY)
+				continue;
+			if (da) {
+				ref_get(A, ia, j, &cc, &hc, &ic, &nc);
+				c.lb2 = box_lb2(&X, cc, hc, cb, hb);
+				c.na = ia;
+				c.sa = (uint8_t)j;
+				c.nb = e.nb;
+				c.sb = e.sb;
+			} else {
+				ref_get(B, ib, j, &cc, &hc, &ic, &nc);
+				c.lb2 = box_lb2(&X, ca, ha, cc, hc);
+				c.na = e.na;
+				c.sa = e.sa;
+				c.nb = ib;
+				c.sb = (uint8_t)j;
+			}
+			if (c.lb2 > X.best2)
+				continue;
+			/* insertion by bound, farthest first */
+			for (k = nk; k > 0 && kid[k - 1].lb2 < c.lb2; k--)
+				kid[k] = kid[k - 1];
+			kid[k] = c;
+			nk++;
+		}
+		for (k = 0; k < nk; k++) {
+			if (sp >= MP_STACK) {
+				certified = 0;
+				continue;
+			}
+			st[sp++] = kid[k];
+		}
+	}
+	if (X.la < 0)
+		return PX_E_DEGENERATE; /* cannot happen: meshes have triangles */
+	out->distance = sqrt(X.best2);
+	out->point_a = px_pose_transform_point(Pa, X.pa);
+	out->point_b = px_pose_transform_point(Pa, X.pb);
+	out->tri_a = (int)A->orig[X.la];
+	out->tri_b = (int)B->orig[X.lb];
+	out->intersecting = X.best2 == 0.0;
+	out->nodes = X.nodes;
+	out->tri_tests = X.tests;
+	out->certified = certified;
+	return PX_OK;
+}
+
+/* ---- mesh against any model ------------------------------------------------ */
+
+struct mv_ent {
+	uint32_t node;
+	uint8_t slot;
+	double lb;
+};
+
+#define MV_STACK (3 * PX_MESH_MAX_DEPTH + 8)
+
+int px__mesh_vs_model(const struct px_model *m, const struct px_model *o,
+		      int (*tri)(void *ctx, const px_vec3 v[3], int index,
+				 double *d),
+		      void *ctx, int max_queries, double *best, int *best_tri,
+		      int *queries)
+{
+	const struct mesh *M = mesh_of(m);
+	struct mv_ent st[MV_STACK];
+	px_pose P;
+	int sp, exact = 1, rc, j, k;
+
+	if (!M || !o || !tri || !best || !best_tri || !queries)
+		return PX_E_INVAL;
+	P = px_model_pose(m);
+	st[0].node = 0;
+	st[0].slot = ROOT_SLOT;
+	st[0].lb = 0.0;
+	sp = 1;
+	while (sp > 0 && *best > 0.0) {
+		struct mv_ent e = st[--sp], kid[4];
+		px_vec3 c, h;
+		uint32_t idx, cnt;
+		const struct node4 *nd;
+		int nk = 0;
+
+		/* prune with a relative margin: bounds and distances carry
+		 * rounding, and a tie cannot improve the answer */
+		if (e.lb >= *best * (1.0 - 1e-12))
+			continue;
+		ref_get(M, e.node, e.slot, &c, &h, &idx, &cnt);
+		if (cnt > 0) {
+			uint32_t i;
+			for (i = idx; i < idx + cnt; i++) {
+				const struct mtri *t = &M->tri[i];
+				px_vec3 v[3] = {px_pose_transform_point(P, t->a),
+						px_pose_transform_point(P, t->b),
+						px_pose_transform_point(P, t->c)};
+				double d = INFINITY;
+				if ((rc = tri(ctx, v, (int)M->orig[i], &d)) < 0)
+					return rc;
+				if (!(d < INFINITY))
+					exact = 0;
+				else if (d < *best) {
+					*best = d;
+					*best_tri = (int)M->orig[i];
+				}
+			}
+			continue;
+		}
+		nd = &M->n4[idx];
+		for (j = 0; j < 4; j++) {
+			px_vec3 cc, hc;
+			uint32_t ic, nc;
+			struct px_model_result q;
+			struct mv_ent ch;
+			if (nd->idx[j] == EMPTY)
+				continue;
+			if (*queries >= max_queries)
+				return 0;
+			ref_get(M, idx, j, &cc, &hc, &ic, &nc);
+			rc = px_model_query_ex(o, px_pose_transform_point(P, cc), INFINITY, -1,
+					       0, &q);
+			(*queries)++;
+			if (rc < 0)
+				return rc;
+			if (rc == 0)
+				continue; /* nothing of o anywhere: cannot happen */
+			/* any point of the box is within |hc| of its centre;
+			 * inside a closed o the solid's distance is 0 */
+			ch.lb = fmax(q.distance, 0.0) - px_v3_norm(hc);
+			if (ch.lb >= *best * (1.0 - 1e-12))
+				continue;
+			ch.node = idx;
+			ch.slot = (uint8_t)j;
+			for (k = nk; k > 0 && kid[k - 1].lb < ch.lb; k--)
+				kid[k] = kid[k - 1];
+			kid[k] = ch;
+			nk++;
+		}
+		for (k = 0; k < nk; k++) {
+			if (sp >= MV_STACK) {
+				exact = 0;
+				continue;
+			}
+			st[sp++] = kid[k];
+		}
+	}
+	return exact;
+}

@@ -1,0 +1,408 @@
+/*
+ * Exact mesh-to-mesh distance (geom/px_mesh_pair.c).
+ *
+ * References, written independently of the library's routines: the
+ * triangle-triangle distance is checked against (1) the nine edge-edge
+ * distances by a plain parametric minimisation and the six vertex-face
+ * distances, with crossing decided by solving each edge against the
+ * other triangle's plane by Cramer's rule, and (2) dense sampling of
+ * each triangle measured exactly against the other (an upper bound that
+ * the answer may never exceed). Mesh pairs are compared with the
+ * minimum over all triangle pairs of reference (1).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mesh_gen.h"
+#include "mesh_internal.h"
+#include "px_alloc_count.h"
+#include "px_mesh.h"
+#include "px_pair.h"
+#include "px_test.h"
+
+static px_vec3 rand_pt(double s)
+{
+	return px_v3(px_rand_range(-s, s), px_rand_range(-s, s), px_rand_range(-s, s));
+}
+
+static px_pose rand_pose(px_vec3 t)
+{
+	px_pose P;
+	double w = px_rand_normal(), x = px_rand_normal(), y = px_rand_normal(),
+	       z = px_rand_normal(), n = sqrt(w * w + x * x + y * y + z * z);
+	P.q.w = w / n;
+	P.q.x = x / n;
+	P.q.y = y / n;
+	P.q.z = z / n;
+	P.t = t;
+	return P;
+}
+
+/* Segment-segment squared distance: minimum of the interior critical
+ * point (when inside the square) and the four boundary sides, each an
+ * exact point-segment distance. */
+static double ref_pt_seg(px_vec3 p, px_vec3 a, px_vec3 b)
+{
+	px_vec3 d = px_v3_sub(b, a);
+	double l = px_v3_norm2(d), t = l > 0 ? px_v3_dot(px_v3_sub(p, a), d) / l : 0;
+	t = t < 0 ? 0 : (t > 1 ? 1 : t);
+	return px_v3_dist2(p, px_v3_madd(a, d, t));
+}
+
+static double ref_seg_seg(px_vec3 p1, px_vec3 q1, px_vec3 p2, px_vec3 q2)
+{
+	px_vec3 d1 = px_v3_sub(q1, p1), d2 = px_v3_sub(q2, p2), r = px_v3_sub(p1, p2);
+	double a = px_v3_dot(d1, d1), b = px_v3_dot(d1, d2), e = px_v3_dot(d2, d2);
+	double c = px_v3_dot(d1, r), f = px_v3_dot(d2, r), den = a * e - b * b;
+	double best = fmin(fmin(ref_pt_seg(p1, p2, q2), ref_pt_seg(q1, p2, q2)),
+			   fmin(ref_pt_seg(p2, p1, q1), ref_pt_seg(q2, p1, q1)));
+	if (den > 1e-300) {
+		/* unconstrained minimum of |p1 + s d1 - p2 - t d2|^2 */
+		double s = (b * f - c * e) / den, t = (a * f - b * c) / den;
+		if (s > 0 && s < 1 && t > 0 && t < 1)
+			best = fmin(best, px_v3_dist2(px_v3_madd(p1, d1, s), px_v3_madd(p2, d2, t)));
+	}
+	return best;
+}
+
+/* Does segment pq meet triangle T? Solve p + s (q - p) = T0 + u e1 + v e2
+ * by Cramer's rule. */
+static int ref_seg_hits(px_vec3 p, px_vec3 q, const px_vec3 T[3])
+{
+	px_vec3 d = px_v3_sub(q, p), e1 = px_v3_sub(T[1], T[0]), e2 = px_v3_sub(T[2], T[0]);
+	px_vec3 r = px_v3_sub(p, T[0]);
+	/* columns (e1, e2, -d) */
+	px_vec3 md = px_v3_neg(d);
+	double det = px_v3_dot(e1, px_v3_cross(e2, md));
+	double u, v, s;
+	if (fabs(det) < 1e-14 * px_v3_norm(e1) * px_v3_norm(e2) * px_v3_norm(d))
+		return 0; /* parallel: left to the distances */
+	u = px_v3_dot(r, px_v3_cross(e2, md)) / det;
+	v = px_v3_dot(e1, px_v3_cross(r, md)) / det;
+	s = px_v3_dot(e1, px_v3_cross(e2, r)) / det;
+	return s >= 0 && s <= 1 && u >= 0 && v >= 0 && u + v <= 1;
+}
+
+static double ref_tri_tri(const px_vec3 A[3], const px_vec3 B[3], int *cross)
+{
+	double best = INFINITY;
+	int i, j;
+	*cross = 0;
+	for (i = 0; i < 3; i++)
+		if (ref_seg_hits(A[i], A[(i + 1) % 3], B) || ref_seg_hits(B[i], B[(i + 1) % 3], A))
+			*cross = 1;
+	for (i = 0; i < 3; i++) {
+		for (j = 0; j < 3; j++)
+			best = fmin(best, ref_seg_seg(A[i], A[(i + 1) % 3], B[j], B[(j + 1) % 3]));
+		best = fmin(best, px_tri_closest(A[i], B[0], B[1], B[2], NULL, NULL, NULL, NULL, NULL));
+		best = fmin(best, px_tri_closest(B[i], A[0], A[1], A[2], NULL, NULL, NULL, NULL, NULL));
+	}
+	return *cross ? 0.0 : best;
+}
+
+/* Upper bound by sampling: n x n barycentric grid of each triangle,
+ * measured exactly against the other. */
+static double sampled_tri_tri(const px_vec3 A[3], const px_vec3 B[3], int n)
+{
+	double best = INFINITY;
+	int i, j, s;
+	for (s = 0; s < 2; s++) {
+		const px_vec3 *X = s ? B : A, *Y = s ? A : B;
+		for (i = 0; i <= n; i++)
+			for (j = 0; i + j <= n; j++) {
+				double u = (double)i / n, v = (double)j / n;
+				px_vec3 p = px_v3_add(px_v3_scale(X[0], 1 - u - v),
+						      px_v3_add(px_v3_scale(X[1], u), px_v3_scale(X[2], v)));
+				best = fmin(best, px_tri_closest(p, Y[0], Y[1], Y[2], NULL, NULL, NULL, NULL,
+								 NULL));
+			}
+	}
+	return best;
+}
+
+/* Random triangle pairs of several kinds (see the switch). */
+static void make_pair(int kind, px_vec3 A[3], px_vec3 B[3])
+{
+	int i;
+	for (i = 0; i < 3; i++) {
+		A[i] = rand_pt(1);
+		B[i] = px_v3_add(rand_pt(1), px_v3(px_rand_range(-1.5, 1.5), 0, 0));
+	}
+	switch (kind) {
+	case 0: /* general */
+		break;
+	case 1: /* A collapsed to a point */
+		A[1] = A[2] = A[0];
+		break;
+	case 2: /* B collapsed to a segment (repeated vertex) */
+		B[2] = B[1];
+		break;
+	case 3: /* needle: third vertex nearly on the first edge */
+		A[2] = px_v3_add(px_v3_lerp(A[0], A[1], px_rand_range(-0.5, 1.5)),
+				 px_v3_scale(rand_pt(1), px_rand_unit() < 0.5 ? 1e-6 : 1e-13));
+		break;
+	case 4: { /* coplanar (z = 0), overlapping or not */
+		for (i = 0; i < 3; i++) {
+			A[i].z = 0;
+			B[i].z = 0;
+		}
+		break;
+	}
+	case 5: { /* touching: B's vertex placed on A's face */
+		double u = px_rand_unit(), v = px_rand_unit() * (1 - u);
+		px_vec3 n = px_v3_cross(px_v3_sub(A[1], A[0]), px_v3_sub(A[2], A[0]));
+		px_vec3 q = px_v3_add(px_v3_scale(A[0], 1 - u - v),
+				      px_v3_add(px_v3_scale(A[1], u), px_v3_scale(A[2], v)));
+		px_vec3 off = px_v3_sub(q, B[0]);
+		for (i = 0; i < 3; i++)
+			B[i] = px_v3_add(B[i], off);
+		/* the rest of B on the outer side */
+		for (i = 1; i < 3; i++)
+			if (px_v3_dot(n, px_v3_sub(B[i], q)) < 0)
+				B[i] = px_v3_madd(B[i], n, -2 * px_v3_dot(n, px_v3_sub(B[i], q)) /
+							      px_v3_norm2(n));
+		break;
+	}
+	case 6: { /* crossing: B's edge pierces A's interior */
+		double u = px_rand_range(0.1, 0.4), v = px_rand_range(0.1, 0.4);
+		px_vec3 n = px_v3_cross(px_v3_sub(A[1], A[0]), px_v3_sub(A[2], A[0]));
+		px_vec3 q = px_v3_add(px_v3_scale(A[0], 1 - u - v),
+				      px_v3_add(px_v3_scale(A[1], u), px_v3_scale(A[2], v)));
+		px_vec3 dir = px_v3_add(px_v3_scale(n, 1 / px_v3_norm(n)), px_v3_scale(rand_pt(1), 0.3));
+		B[0] = px_v3_madd(q, dir, px_rand_range(0.05, 1));
+		B[1] = px_v3_madd(q, dir, -px_rand_range(0.05, 1));
+		break;
+	}
+	case 7: /* nearly parallel edges a little apart */
+		B[0] = px_v3_add(A[0], px_v3(0, 0, 1e-3));
+		B[1] = px_v3_add(px_v3_madd(A[1], px_v3_sub(A[1], A[0]), 0.3),
+				 px_v3(1e-9, 0, 1e-3));
+		break;
+	default: /* far apart */
+		for (i = 0; i < 3; i++)
+			B[i] = px_v3_add(B[i], px_v3(10, 3, -2));
+		break;
+	}
+}
+
+static void test_tri_tri_vs_references(void)
+{
+	int trial, kind, crossings = 0, n = 0;
+	for (kind = 0; kind < 9; kind++)
+		for (trial = 0; trial < 300; trial++) {
+			px_vec3 A[3], B[3], pa, pb;
+			double d2, ref, samp;
+			int cr, rcr;
+			make_pair(kind, A, B);
+			d2 = px__tri_tri(A, B, &pa, &pb, &cr);
+			ref = ref_tri_tri(A, B, &rcr);
+			samp = sampled_tri_tri(A, B, trial % 10 == 0 ? 40 : 12);
+			n++;
+			crossings += cr;
+			/* the points are on the triangles and d2 is their distance
+			 * (on a sliver, plane projections are only good to about
+			 * eps / its angle: 1e-10 for the 1e-6 slivers here) */
+			double on = kind == 3 ? 1e-18 : 1e-22;
+			PX_CHECK_NEAR(px_v3_dist2(pa, pb), d2, 1e-12 * (1 + d2));
+			PX_CHECK_MSG(px_tri_closest(pa, A[0], A[1], A[2], NULL, NULL, NULL, NULL, NULL) < on,
+				     "kind %d: point_a off A by %.3g (cross %d)", kind,
+				     sqrt(px_tri_closest(pa, A[0], A[1], A[2], NULL, NULL, NULL, NULL, NULL)), cr);
+			PX_CHECK_MSG(px_tri_closest(pb, B[0], B[1], B[2], NULL, NULL, NULL, NULL, NULL) < on,
+				     "kind %d: point_b off B by %.3g (cross %d)", kind,
+				     sqrt(px_tri_closest(pb, B[0], B[1], B[2], NULL, NULL, NULL, NULL, NULL)), cr);
+			/* never above a sampled pair */
+			PX_CHECK_MSG(d2 <= samp * (1 + 1e-12) + 1e-28, "kind %d: %.17g above sample %.17g",
+				     kind, d2, samp);
+			/* equal to the feature reference, 0 when crossing */
+			if (rcr && !cr) {
+				/* the reference's inclusive tests call a grazing
+				 * touch a crossing: then the distance must be ~0 */
+				PX_CHECK_MSG(d2 < 1e-24, "kind %d: crossing missed, d2 %.3g", kind, d2);
+			} else {
+				PX_CHECK_MSG(fabs(sqrt(d2) - sqrt(ref)) <= 1e-9 * (sqrt(ref) + 1e-6),
+					     "kind %d trial %d: %.17g vs reference %.17g (cross %d/%d)", kind,
+					     trial, sqrt(d2), sqrt(ref), cr, rcr);
+			}
+			if (kind == 6)
+				PX_CHECK_MSG(cr && d2 == 0.0, "kind 6 not crossing: %d %.3g", cr, d2);
+			if (kind == 5)
+				PX_CHECK_MSG(d2 < 1e-24, "touching pair apart: %.3g", d2);
+		}
+	printf("    %d triangle pairs, %d crossing\n", n, crossings);
+}
+
+/* ---- meshes ---------------------------------------------------------------- */
+
+/* Random triangle soup of nt triangles in a cube of half size s. */
+static struct px_model *soup(int nt, double s)
+{
+	double *xyz = malloc(9 * (size_t)nt * sizeof(double));
+	uint32_t *tri = malloc(3 * (size_t)nt * sizeof(uint32_t));
+	struct px_model *m = NULL;
+	int i;
+	for (i = 0; i < nt; i++) {
+		px_vec3 c = rand_pt(s), p;
+		double r = px_rand_range(0.02, 0.4) * s;
+		int k;
+		for (k = 0; k < 3; k++) {
+			p = px_v3_add(c, rand_pt(r));
+			xyz[9 * i + 3 * k] = p.x;
+			xyz[9 * i + 3 * k + 1] = p.y;
+			xyz[9 * i + 3 * k + 2] = p.z;
+			tri[3 * i + k] = (uint32_t)(3 * i + k);
+		}
+	}
+	PX_CHECK_INT_EQ(px_mesh_model(xyz, 3 * (size_t)nt, tri, (size_t)nt, NULL, NULL, &m), PX_OK);
+	free(xyz);
+	free(tri);
+	return m;
+}
+
+static struct px_model *shape(int kind)
+{
+	struct gen_mesh g;
+	struct px_model *m = NULL;
+	double h[3] = {0.3, 0.5, 0.2};
+	switch (kind) {
+	case 0:
+		gen_torus(0.6, 0.2, 16, 8, &g);
+		break;
+	case 1:
+		gen_sphere(0.5, 8, 12, &g);
+		break;
+	case 2:
+		gen_box(h, 2, &g);
+		break;
+	default:
+		gen_lprism(0.4, 0.3, &g);
+		break;
+	}
+	PX_CHECK_INT_EQ(px_mesh_model(g.xyz, g.nv, g.tri, g.nt, NULL, NULL, &m), PX_OK);
+	gen_free(&g);
+	return m;
+}
+
+/* Minimum of the reference over all triangle pairs (world frame). */
+static double brute(const struct px_model *a, const struct px_model *b)
+{
+	size_t na = px_mesh_triangle_count(a), nb = px_mesh_triangle_count(b), i, j;
+	px_vec3 *A = malloc(3 * na * sizeof(px_vec3)), *B = malloc(3 * nb * sizeof(px_vec3));
+	double best = INFINITY;
+	int k, cr;
+	for (i = 0; i < na; i++) {
+		px_mesh_triangle(a, i, A + 3 * i);
+		for (k = 0; k < 3; k++)
+			A[3 * i + k] = px_pose_transform_point(px_model_pose(a), A[3 * i + k]);
+	}
+	for (j = 0; j < nb; j++) {
+		px_mesh_triangle(b, j, B + 3 * j);
+		for (k = 0; k < 3; k++)
+			B[3 * j + k] = px_pose_transform_point(px_model_pose(b), B[3 * j + k]);
+	}
+	for (i = 0; i < na && best > 0; i++)
+		for (j = 0; j < nb; j++)
+			best = fmin(best, ref_tri_tri(A + 3 * i, B + 3 * j, &cr));
+	free(A);
+	free(B);
+	return sqrt(best);
+}
+
+static void check_on_triangle(const struct px_model *m, int t, px_vec3 p)
+{
+	px_vec3 v[3];
+	int k;
+	PX_CHECK_INT_EQ(px_mesh_triangle(m, (size_t)t, v), PX_OK);
+	for (k = 0; k < 3; k++)
+		v[k] = px_pose_transform_point(px_model_pose(m), v[k]);
+	PX_CHECK_MSG(sqrt(px_tri_closest(p, v[0], v[1], v[2], NULL, NULL, NULL, NULL, NULL)) <
+			     1e-9,
+		     "point not on its triangle %d", t);
+}
+
+static void test_mesh_pair_vs_brute(void)
+{
+	int trial, zero = 0, n = 120;
+	for (trial = 0; trial < n; trial++) {
+		struct px_model *a = trial % 3 == 0 ? soup(px_rand_int(1, 120), 1.0) : shape(trial % 4);
+		struct px_model *b = trial % 2 == 0 ? soup(px_rand_int(1, 120), 0.7)
+						    : shape((trial / 4) % 4);
+		struct px__mesh_pair r, r2;
+		double ref;
+		px_vec3 dir = rand_pt(1);
+		dir = px_v3_scale(dir, 1.0 / px_v3_norm(dir));
+		px_model_set_pose(a, rand_pose(rand_pt(0.3)));
+		/* from deep overlap to well apart */
+		px_model_set_pose(b, rand_pose(px_v3_scale(dir, px_rand_range(0.0, 2.5))));
+		PX_CHECK_INT_EQ(px__mesh_pair(a, b, -1, -1, &r), PX_OK);
+		ref = brute(a, b);
+		zero += ref == 0.0;
+		PX_CHECK_MSG(fabs(r.distance - ref) <= 1e-9 * ref + 1e-12,
+			     "trial %d: %.17g vs brute force %.17g", trial, r.distance, ref);
+		PX_CHECK_INT_EQ(r.intersecting, r.distance == 0.0);
+		PX_CHECK(r.certified);
+		PX_CHECK_NEAR(px_v3_dist(r.point_a, r.point_b), r.distance, 1e-12);
+		check_on_triangle(a, r.tri_a, r.point_a);
+		check_on_triangle(b, r.tri_b, r.point_b);
+		/* any hints, right or wrong, give the same distance */
+		PX_CHECK_INT_EQ(px__mesh_pair(a, b, r.tri_a, r.tri_b, &r2), PX_OK);
+		PX_CHECK_NEAR(r2.distance, r.distance, 1e-15);
+		PX_CHECK_INT_EQ(px__mesh_pair(a, b, 0, (int)px_mesh_triangle_count(b) - 1, &r2), PX_OK);
+		PX_CHECK_NEAR(r2.distance, r.distance, 1e-15);
+		PX_CHECK_INT_EQ(px__mesh_pair(a, b, 1 << 30, -7, &r2), PX_OK);
+		PX_CHECK_NEAR(r2.distance, r.distance, 1e-15);
+		px_model_free(a);
+		px_model_free(b);
+	}
+	printf("    %d mesh pairs equal to brute force, %d touching or crossing\n", n, zero);
+}
+
+/* Boxes sliding face to face at tiny gaps: many parallel edges and
+ * coplanar faces, where rounding decides. */
+static void test_mesh_pair_parallel_faces(void)
+{
+	struct gen_mesh g;
+	struct px_model *a, *b;
+	double h[3] = {0.5, 0.5, 0.5};
+	int k;
+	gen_box(h, 3, &g);
+	PX_CHECK_INT_EQ(px_mesh_model(g.xyz, g.nv, g.tri, g.nt, NULL, NULL, &a), PX_OK);
+	PX_CHECK_INT_EQ(px_mesh_model(g.xyz, g.nv, g.tri, g.nt, NULL, NULL, &b), PX_OK);
+	gen_free(&g);
+	for (k = 0; k < 40; k++) {
+		px_pose P = px_pose_identity();
+		struct px__mesh_pair r;
+		double gap = k < 20 ? pow(10.0, -k * 0.5) : 0.0;
+		P.t = px_v3(1.0 + gap, px_rand_range(-0.9, 0.9), px_rand_range(-0.9, 0.9));
+		px_model_set_pose(b, P);
+		PX_CHECK_INT_EQ(px__mesh_pair(a, b, -1, -1, &r), PX_OK);
+		PX_CHECK_MSG(fabs(r.distance - gap) <= 1e-12, "gap %.3g: %.17g", gap, r.distance);
+		PX_CHECK_INT_EQ(r.intersecting, gap == 0.0);
+	}
+	px_model_free(a);
+	px_model_free(b);
+}
+
+static void test_mesh_pair_errors_and_alloc(void)
+{
+	struct px_model *a = shape(0), *b = shape(1);
+	struct px__mesh_pair r;
+	uint64_t reg;
+	int i;
+	PX_CHECK_INT_EQ(px__mesh_pair(NULL, b, -1, -1, &r), PX_E_INVAL);
+	PX_CHECK_INT_EQ(px__mesh_pair(a, b, -1, -1, NULL), PX_E_INVAL);
+	reg = px_alloc_region_begin();
+	for (i = 0; i < 50; i++) {
+		px_model_set_pose(b, rand_pose(rand_pt(1.5)));
+		PX_CHECK_INT_EQ(px__mesh_pair(a, b, i, i, &r), PX_OK);
+	}
+	PX_CHECK_INT_EQ(px_alloc_region_end(reg), 0);
+	px_model_free(a);
+	px_model_free(b);
+}
+
+static const struct px_test tests[] = {
+	PX_T(test_tri_tri_vs_references), PX_T(test_mesh_pair_vs_brute),
+	PX_T(test_mesh_pair_parallel_faces), PX_T(test_mesh_pair_errors_and_alloc)};
+PX_TEST_MAIN(tests)
