@@ -4,6 +4,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "mesh_internal.h"
 #include "px_mesh.h"
 #include "px_pair.h"
 #include "px_prim.h"
@@ -147,18 +148,44 @@ static int gjk_reduce(struct gjk_vert *S, int *n, px_vec3 *v, px_vec3 *pa,
 
 /* Returns 1 with the distance and witness points, 0 when intersecting,
  * negative when a model has no support function. */
-static int gjk(const struct px_model *a, const struct px_model *b, double *dist,
+/* A convex shape for GJK: a model with a support function, or a
+ * triangle (world-frame vertices) of a mesh. */
+struct shp {
+	const struct px_model *m;
+	const px_vec3 *v; /* 3 vertices, or NULL for m */
+};
+
+static int shp_support(const struct shp *s, px_vec3 d, px_vec3 *out)
+{
+	if (s->v) {
+		double h0 = px_v3_dot(s->v[0], d), h1 = px_v3_dot(s->v[1], d),
+		       h2 = px_v3_dot(s->v[2], d);
+		*out = h0 >= h1 ? (h0 >= h2 ? s->v[0] : s->v[2])
+				: (h1 >= h2 ? s->v[1] : s->v[2]);
+		return PX_OK;
+	}
+	return px_model_support(s->m, d, out);
+}
+
+static px_vec3 shp_centre(const struct shp *s)
+{
+	if (s->v)
+		return px_v3_scale(px_v3_add(s->v[0], px_v3_add(s->v[1], s->v[2])), 1.0 / 3.0);
+	return px_model_pose(s->m).t;
+}
+
+static int gjk(const struct shp *a, const struct shp *b, double *dist,
 	       px_vec3 *pa, px_vec3 *pb, int *iters, struct gjk_vert S[4],
 	       int *n_out)
 {
 	px_vec3 v, sa, sb;
 	int n = 1, it, rc;
 
-	v = px_v3_sub(px_model_pose(a).t, px_model_pose(b).t);
+	v = px_v3_sub(shp_centre(a), shp_centre(b));
 	if (px_v3_norm2(v) == 0.0)
 		v = px_v3(1, 0, 0);
-	if ((rc = px_model_support(a, px_v3_neg(v), &sa)) < 0 ||
-	    (rc = px_model_support(b, v, &sb)) < 0)
+	if ((rc = shp_support(a, px_v3_neg(v), &sa)) < 0 ||
+	    (rc = shp_support(b, v, &sb)) < 0)
 		return rc;
 	S[0].a = sa;
 	S[0].b = sb;
@@ -172,8 +199,8 @@ static int gjk(const struct px_model *a, const struct px_model *b, double *dist,
 		int k, dup = 0;
 		if (vv == 0.0)
 			break;
-		px_model_support(a, px_v3_neg(v), &nw.a);
-		px_model_support(b, v, &nw.b);
+		shp_support(a, px_v3_neg(v), &nw.a);
+		shp_support(b, v, &nw.b);
 		nw.w = px_v3_sub(nw.a, nw.b);
 		if (vv - px_v3_dot(v, nw.w) <= GJK_REL * vv)
 			break;
@@ -715,6 +742,170 @@ static int seed_point(const struct px_model *a, const struct px_model *b,
 	return 0;
 }
 
+/* ---- exact paths for meshes ------------------------------------------------ */
+
+/* World-frame vertices of triangle t of mesh m (seeds for the depth
+ * search). */
+static void tri_world(const struct px_model *m, int t, px_vec3 v[3])
+{
+	int k;
+	if (t < 0 || px_mesh_triangle(m, (size_t)t, v) != PX_OK) {
+		v[0] = v[1] = v[2] = px_model_pose(m).t;
+		return;
+	}
+	for (k = 0; k < 3; k++)
+		v[k] = px_pose_transform_point(px_model_pose(m), v[k]);
+}
+
+/*
+ * The surfaces are apart (best->d > 0), yet a closed model may hold the
+ * other whole: then the other's closest point lies inside it, which its
+ * signed distance tells. Marks best intersecting (that point as the
+ * overlap) and returns 1, else 0, or an error.
+ */
+static int contained(const struct px_model *a, const struct px_model *b,
+		     struct run *best, int *total)
+{
+	int side, rc;
+	for (side = 0; side < 2; side++) {
+		const struct px_model *x = side ? b : a;
+		px_vec3 p = side ? best->pa : best->pb; /* a point of the other */
+		struct px_model_result q;
+		if (!(px_model_caps(x) & PX_MODEL_CAP_SIGNED))
+			continue;
+		if ((rc = px_model_query(x, p, &q)) < 0)
+			return rc;
+		(*total)++;
+		if (q.is_signed && q.distance < 0.0) {
+			best->intersecting = 1;
+			best->d = 0.0;
+			if (side)
+				best->pb = q.point;
+			else
+				best->pa = q.point;
+			return 1;
+		}
+	}
+	return 0;
+}
+
+/* Mesh against a convex model with a support function: each triangle
+ * is itself convex, so GJK between the two is exact. */
+struct tv_ctx {
+	const struct px_model *o;
+	double best;
+	px_vec3 pt, po; /* on the triangle, on o */
+	px_vec3 tv[3];
+	int tri;
+	int iters;
+};
+
+static int tri_vs_convex(void *ctx, const px_vec3 v[3], int index, double *d)
+{
+	struct tv_ctx *c = ctx;
+	struct shp T = {NULL, v}, O = {c->o, NULL};
+	struct gjk_vert S[4];
+	double dist = 0.0;
+	px_vec3 pt = v[0], po = v[0];
+	int its = 0, ns = 0, g = gjk(&T, &O, &dist, &pt, &po, &its, S, &ns);
+
+	c->iters += its;
+	if (g < 0)
+		return g;
+	if (g == 0)
+		dist = 0.0;
+	if (dist < c->best) {
+		c->best = dist;
+		c->pt = pt;
+		c->po = po;
+		c->tv[0] = v[0];
+		c->tv[1] = v[1];
+		c->tv[2] = v[2];
+		c->tri = index;
+	}
+	/* GJK out of iterations: only an upper bound, which the search
+	 * must not take as exact */
+	*d = its >= GJK_MAX_ITERS ? INFINITY : dist;
+	return 0;
+}
+
+#define MESH_CONVEX_QUERIES 4096
+
+/*
+ * Exact distance of mesh m to convex model o (support function): the
+ * mesh hierarchy bounded from below by o's point queries
+ * (px__mesh_vs_model), each remaining triangle measured by GJK. The
+ * start bound is the triangle of hint (last cycle's) or of the mesh
+ * point nearest o's origin. Fills best (points polished by two exact
+ * projections) and returns 1 when proven global, 0 when the query
+ * budget ran out (best is then only the best found), or an error.
+ */
+static int mesh_vs_convex(const struct px_model *m, const struct px_model *o,
+			  int hint, struct run *best, int *total)
+{
+	struct tv_ctx c;
+	int rc, exact, queries = 0, bt = -1, j;
+	double bd;
+	px_vec3 v[3];
+	double dd;
+
+	memset(&c, 0, sizeof(c));
+	c.o = o;
+	c.best = INFINITY;
+	c.tri = -1;
+	if (hint < 0 || (size_t)hint >= px_mesh_triangle_count(m)) {
+		struct px_model_result q;
+		if ((rc = px_model_query_ex(m, px_model_pose(o).t, INFINITY, -1,
+					    PX_QUERY_UNSIGNED, &q)) < 0)
+			return rc;
+		(*total)++;
+		hint = q.index;
+	}
+	tri_world(m, hint, v);
+	if ((rc = tri_vs_convex(&c, v, hint, &dd)) < 0)
+		return rc;
+	bd = c.best;
+	bt = c.tri;
+	exact = px__mesh_vs_model(m, o, tri_vs_convex, &c, MESH_CONVEX_QUERIES, &bd, &bt,
+				  &queries);
+	*total += queries + c.iters;
+	if (exact < 0)
+		return exact;
+	best->converged = 1;
+	best->intersecting = c.best == 0.0;
+	best->d = c.best;
+	best->pa = c.pt;
+	best->pb = c.po;
+	best->ia = c.tri;
+	best->ib = -1;
+	for (j = 0; j < 2 && !best->intersecting; j++) {
+		/* GJK's witnesses are convex combinations of support points:
+		 * two exact projections put them on the surfaces (each can
+		 * only shorten the pair: both sets are convex) */
+		struct px_model_result q;
+		px_vec3 pt;
+		double d2;
+		if ((rc = px_model_query(o, best->pa, &q)) < 0)
+			return rc;
+		(*total)++;
+		if (q.is_signed && q.distance <= 0.0) {
+			best->intersecting = 1;
+			best->d = 0.0;
+			best->pb = best->pa;
+			break;
+		}
+		d2 = px_tri_closest(q.point, c.tv[0], c.tv[1], c.tv[2], &pt, NULL, NULL,
+				    NULL, NULL);
+		best->ib = q.index;
+		if (sqrt(d2) <= best->d) {
+			best->pb = q.point;
+			best->pa = pt;
+			best->d = sqrt(d2);
+		}
+	}
+	return exact;
+}
+
 int px_pair_distance(const struct px_model *a, const struct px_model *b,
 		     const struct px_pair_opts *opt, struct px_pair_result *res)
 {
@@ -724,8 +915,8 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 	double rel = opt && opt->rel_tol > 0.0 ? opt->rel_tol : 1e-9;
 	int coherent = opt && opt->coherent && res && res->valid;
 	struct run best, r;
-	int k, n = 0, total = 0, rc, have = 0;
-	px_vec3 seed;
+	int k, n = 0, total = 0, rc, have = 0, nxs = 0;
+	px_vec3 seed, xs[2][3];
 
 	if (!a || !b || !res || starts < 1 || starts > PX_PAIR_MAX_STARTS ||
 	    max_iters < 1 || !(tol >= 0.0))
@@ -787,7 +978,8 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 		double d = 0.0;
 		px_vec3 pa, pb;
 		struct gjk_vert S[4];
-		int its = 0, ns = 0, g = gjk(a, b, &d, &pa, &pb, &its, S, &ns);
+		struct shp sa = {a, NULL}, sb = {b, NULL};
+		int its = 0, ns = 0, g = gjk(&sa, &sb, &d, &pa, &pb, &its, S, &ns);
 		if (g > 0) {
 			/* GJK's witness points are convex combinations of
 			 * support points, whose weights lose accuracy on the thin
@@ -839,6 +1031,92 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 	}
 	memset(&best, 0, sizeof(best));
 	best.d = INFINITY;
+	if (px_mesh_triangle_count(a) > 0 && px_mesh_triangle_count(b) > 0) {
+		/* two meshes: exact, by both hierarchies at once */
+		struct px__mesh_pair mp;
+		rc = px__mesh_pair(a, b, coherent ? res->index_a : -1,
+				   coherent ? res->index_b : -1, &mp);
+		if (rc < 0)
+			return rc;
+		total = mp.nodes + mp.tri_tests;
+		best.d = mp.distance;
+		best.pa = mp.point_a;
+		best.pb = mp.point_b;
+		best.ia = mp.tri_a;
+		best.ib = mp.tri_b;
+		best.converged = 1;
+		best.intersecting = mp.intersecting;
+		if (!best.intersecting && (rc = contained(a, b, &best, &total)) < 0)
+			return rc;
+		if (best.intersecting) {
+			tri_world(a, best.ia, xs[0]);
+			tri_world(b, best.ib, xs[1]);
+			nxs = 3;
+			goto penetrate;
+		}
+		res->distance = best.d;
+		res->point_a = best.pa;
+		res->point_b = best.pb;
+		res->index_a = best.ia;
+		res->index_b = best.ib;
+		res->iterations = total;
+		res->starts = 0;
+		res->converged = 1;
+		res->intersecting = 0;
+		res->local_only = !mp.certified;
+		goto done;
+	}
+	{
+		/* a mesh against a convex model with a support function:
+		 * exact, by the mesh hierarchy and GJK per triangle */
+		int ma = px_mesh_triangle_count(a) > 0 && px_model_get_ops(b)->support;
+		int mb = !ma && px_mesh_triangle_count(b) > 0 && px_model_get_ops(a)->support;
+		if (ma || mb) {
+			const struct px_model *m = ma ? a : b, *o = ma ? b : a;
+			struct run mr;
+			int ex, mt;
+			memset(&mr, 0, sizeof(mr));
+			ex = mesh_vs_convex(m, o, coherent ? (ma ? res->index_a : res->index_b) : -1,
+					    &mr, &total);
+			if (ex < 0)
+				return ex;
+			mt = mr.ia; /* the mesh's triangle */
+			if (mb) {
+				/* the pair was measured mesh first */
+				px_vec3 t = mr.pa;
+				int ti = mr.ia;
+				mr.pa = mr.pb;
+				mr.pb = t;
+				mr.ia = mr.ib;
+				mr.ib = ti;
+			}
+			best = mr;
+			if (!best.intersecting && (rc = contained(a, b, &best, &total)) < 0)
+				return rc;
+			if (best.intersecting) {
+				tri_world(m, mt, xs[ma ? 0 : 1]);
+				xs[ma ? 1 : 0][0] = xs[ma ? 1 : 0][1] = xs[ma ? 1 : 0][2] =
+					ma ? best.pb : best.pa;
+				nxs = 3;
+				goto penetrate;
+			}
+			if (ex == 1) {
+				res->distance = best.d;
+				res->point_a = best.pa;
+				res->point_b = best.pb;
+				res->index_a = best.ia;
+				res->index_b = best.ib;
+				res->iterations = total;
+				res->starts = 0;
+				res->converged = 1;
+				res->intersecting = 0;
+				res->local_only = 0;
+				goto done;
+			}
+			/* budget out: projections may still do better */
+			have = 1;
+		}
+	}
 	for (k = coherent ? -1 : 0; n < starts; k++) {
 		if (k == -1) {
 			/* last pair, moved with the models */
@@ -889,6 +1167,7 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 		if (r.d < best.d || r.intersecting)
 			best = r;
 	}
+penetrate:
 	res->distance = best.d;
 	res->point_a = best.pa;
 	res->point_b = best.pb;
@@ -909,11 +1188,13 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 			 * queries, and points deep inside a mesh are its most
 			 * expensive queries (many triangles nearly equidistant):
 			 * opt->starts trades time for the global hit rate */
-			for (j = -1; j < starts; j++) {
+			for (j = -1 - nxs; j < starts; j++) {
 				px_vec3 st = side ? best.pb : best.pa, pxx, qy, dir;
 				double dd;
 				int g;
-				if (j >= 0 && (!seed_point(x, y, j, &st) || !px_v3_isfinite(st)))
+				if (j < -1)
+					st = xs[side][-2 - j]; /* the contact triangles' corners */
+				else if (j >= 0 && (!seed_point(x, y, j, &st) || !px_v3_isfinite(st)))
 					break;
 				g = deepest(x, y, st, scale, &dd, &pxx, &qy, &dir, &total);
 				if (g < 0)

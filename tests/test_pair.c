@@ -165,6 +165,10 @@ static void test_mesh_pairs_hit_rate(void)
 		PX_CHECK_MSG(r.distance >= ref - 1e-9, "below the true minimum: %.15g < %.15g",
 			     r.distance, ref);
 		PX_CHECK(!r.intersecting);
+		/* mesh pairs are exact now: equal within 1e-9 relative */
+		PX_CHECK_MSG(fabs(r.distance - ref) <= 1e-9 * ref, "mesh pair %.17g vs %.17g",
+			     r.distance, ref);
+		PX_CHECK(!r.local_only);
 		if (r.distance <= ref + 1e-6) {
 			hits++;
 			flagged_hits += r.local_only;
@@ -181,7 +185,7 @@ static void test_mesh_pairs_hit_rate(void)
 	printf("    mesh pairs: %d of %d global (%.1f %%), %d local minima (all flagged); "
 	       "%d global hits flagged as possibly local\n",
 	       hits, n, 100.0 * hits / n, misses, flagged_hits);
-	PX_CHECK_MSG(hits >= 0.97 * n, "global-hit rate %.3f", (double)hits / n);
+	PX_CHECK_MSG(hits == n, "global-hit rate %.3f", (double)hits / n);
 }
 
 static double seg_pt_dist(px_vec3 a, px_vec3 b, px_vec3 p)
@@ -622,12 +626,13 @@ static void test_coherent_and_alloc(void)
 		px_model_set_pose(b, Pb);
 		PX_CHECK_INT_EQ(px_pair_distance(a, b, &co, &rc), PX_OK);
 		PX_CHECK_INT_EQ(px_pair_distance(a, b, &fo, &rf), PX_OK);
-		PX_CHECK(rc.distance >= rf.distance - 1e-9 || rc.local_only);
-		agree += fabs(rc.distance - rf.distance) <= 1e-6;
-		PX_CHECK(rc.starts == 1);
+		/* mesh pairs are exact: coherent (hinted) and cold agree */
+		PX_CHECK(!rc.local_only && !rf.local_only);
+		agree += fabs(rc.distance - rf.distance) <= 1e-12;
+		PX_CHECK(rc.starts == 0);
 	}
 	PX_CHECK_INT_EQ(px_alloc_region_end(al), 0);
-	PX_CHECK_MSG(agree >= 190, "coherent agreed %d of 200", agree);
+	PX_CHECK_MSG(agree == 200, "coherent agreed %d of 200", agree);
 	PX_CHECK_INT_EQ(px_pair_distance(NULL, b, NULL, &rc), PX_E_INVAL);
 	fo.starts = PX_PAIR_MAX_STARTS + 1;
 	PX_CHECK_INT_EQ(px_pair_distance(a, b, &fo, &rc), PX_E_INVAL);
