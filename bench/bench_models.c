@@ -172,6 +172,40 @@ static struct fcl_out run_fcl(const char *argv0)
 	return o;
 }
 
+/* FCL's mesh-to-mesh distance on the pair workload (fcl_models pair). */
+struct fcl_pair_out {
+	int ok;
+	double median, p99, sum;
+};
+
+static struct fcl_pair_out run_fcl_pair(const char *argv0)
+{
+	struct fcl_pair_out o;
+	char path[4096], dir[4096], line[256];
+	const char *env = getenv("PX_BENCH_MODELS_FCL");
+	FILE *f;
+	memset(&o, 0, sizeof(o));
+	if (env && *env) {
+		snprintf(path, sizeof(path), "%s pair", env);
+	} else {
+		snprintf(dir, sizeof(dir), "%s", argv0);
+		snprintf(path, sizeof(path), "%s/fcl_models", dirname(dir));
+		if (access(path, X_OK) != 0)
+			return o;
+		snprintf(path + strlen(path), sizeof(path) - strlen(path), " pair");
+	}
+	f = popen(path, "r");
+	if (!f)
+		return o;
+	while (fgets(line, sizeof(line), f)) {
+		sscanf(line, "pair_median_ns %lf", &o.median);
+		sscanf(line, "pair_p99_ns %lf", &o.p99);
+		sscanf(line, "pair_sum %lf", &o.sum);
+	}
+	o.ok = pclose(f) == 0 && o.median > 0;
+	return o;
+}
+
 int main(int argc, char **argv)
 {
 	struct gen_mesh g;
@@ -329,16 +363,19 @@ int main(int argc, char **argv)
 	/* ---- model to model ---- */
 	{
 		struct gen_mesh g1, g2;
-		struct px_model *ma, *mb, *ca, *cb, *sp;
+		struct px_model *ma, *mb, *ca, *cb, *sp, *cl;
 		struct px_prim cyl = {PX_PRIM_CYLINDER, 0.05, 0.1, 0}, box = {PX_PRIM_BOX, 0.05, 0.08, 0.1};
 		struct px_prim sph = {PX_PRIM_SPHERE, 0.05, 0, 0};
 		struct px_pair_opts o1 = {1, 64, 1e-12, 1, 0}, o8 = {8, 64, 1e-12, 0, 0};
 		struct px_pair_result r;
-		const int NP = 2000;
+		const int NP = BM_PAIR_N;
+		double mesh_sum = 0.0, mesh_median = 0.0;
 		gen_torus(0.1, 0.03, 64, 32, &g1);
 		gen_sphere(0.08, 32, 64, &g2);
 		px_mesh_model(g1.xyz, g1.nv, g1.tri, g1.nt, NULL, NULL, &ma);
 		px_mesh_model(g2.xyz, g2.nv, g2.tri, g2.nt, NULL, NULL, &mb);
+		/* the sphere mesh's vertices as a scanned cloud */
+		px_cloud_model(g2.xyz, g2.nv, 0.0, NULL, &cl);
 		px_prim_model(&cyl, &ca);
 		px_prim_model(&box, &cb);
 		px_prim_model(&sph, &sp);
@@ -348,27 +385,53 @@ int main(int argc, char **argv)
 				const char *name;
 				struct px_model *a, *b;
 				const struct px_pair_opts *o;
-			} P[] = {{"mesh torus 4k tris / mesh sphere 4k, 8 starts", ma, mb, &o8},
-				 {"same, coherent, 1 start", ma, mb, &o1},
+			} P[] = {{"mesh torus 4k / mesh sphere 4k exact", ma, mb, &o8},
+				 {"same, coherent (last pair first)", ma, mb, &o1},
+				 {"mesh torus 4k / box (BVH + GJK)", ma, cb, &o8},
+				 {"same, coherent", ma, cb, &o1},
+				 {"mesh torus 4k / cloud 2k, 8 starts", ma, cl, &o8},
 				 {"sphere / mesh torus (exact)", sp, ma, &o8},
 				 {"cylinder / box (GJK)", ca, cb, &o8}};
 			size_t k;
 			for (k = 0; k < sizeof(P) / sizeof(P[0]); k++) {
 				int local = 0;
+				double sum = 0.0;
+				struct stats s;
 				memset(&r, 0, sizeof(r));
 				for (i = 0; i < NP; i++) {
 					px_pose Pb = px_pose_identity();
+					double tr[3], ax[3], ang;
 					int64_t a;
-					Pb.t = px_v3(0.25 * cos(4e-3 * i), 0.25 * sin(4e-3 * i), 0.02);
-					px_quat_from_axis_angle(px_v3(1, 1, 0), 2e-3 * i, &Pb.q);
+					bm_pair_pose(i, tr, ax, &ang);
+					Pb.t = px_v3(tr[0], tr[1], tr[2]);
+					px_quat_from_axis_angle(px_v3(ax[0], ax[1], ax[2]), ang, &Pb.q);
 					px_model_set_pose(P[k].b, Pb);
 					a = now_ns();
 					px_pair_distance(P[k].a, P[k].b, P[k].o, &r);
 					times[i] = (double)(now_ns() - a);
 					local += r.local_only;
+					sum += r.distance;
 				}
-				print_stats(P[k].name, summarize(times, NP, overhead));
+				s = summarize(times, NP, overhead);
+				print_stats(P[k].name, s);
 				printf("  %-34s %d of %d results flagged possibly local\n", "", local, NP);
+				if (k == 0) {
+					mesh_sum = sum;
+					mesh_median = s.median;
+				}
+			}
+		}
+		{
+			struct fcl_pair_out fp = run_fcl_pair(argv[0]);
+			if (!fp.ok) {
+				printf("  FCL mesh-mesh distance: reference program not built or failed: no "
+				       "comparison\n");
+			} else {
+				printf("  %-34s median %8.3f us  p99 %8.3f\n", "FCL 0.7 OBBRSS, same mesh pairs",
+				       fp.median / 1e3, fp.p99 / 1e3);
+				printf("  %-34s FCL / proxima median %.1fx; distance sums %.12g vs %.12g (%s)\n",
+				       "", fp.median / fmax(mesh_median, 1.0), fp.sum, mesh_sum,
+				       fabs(fp.sum - mesh_sum) <= 1e-6 * fabs(mesh_sum) ? "agree" : "DIFFER");
 			}
 		}
 		{
@@ -408,6 +471,7 @@ int main(int argc, char **argv)
 		px_model_free(ca);
 		px_model_free(cb);
 		px_model_free(sp);
+		px_model_free(cl);
 		gen_free(&g1);
 		gen_free(&g2);
 	}

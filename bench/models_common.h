@@ -62,4 +62,22 @@ static inline void bm_traj_point(int i, double p[3])
 	p[2] = rr * sin(v);
 }
 
+/* Model-to-model workload (bench_models' pair section and fcl_models
+ * "pair"): a 4,096-triangle torus (major 0.1, tube 0.03, 64 x 32 quads)
+ * at the origin and a 4,096-triangle sphere (radius 0.08, 32 x 64) moved
+ * through BM_PAIR_N poses along a circle of radius 0.25 at z = 0.02,
+ * 1 mm apart, turning about (1, 1, 0) by 2 mrad per pose. */
+#define BM_PAIR_N 2000
+
+static inline void bm_pair_pose(int i, double t[3], double axis[3],
+				double *angle)
+{
+	t[0] = 0.25 * cos(4e-3 * i);
+	t[1] = 0.25 * sin(4e-3 * i);
+	t[2] = 0.02;
+	axis[0] = axis[1] = 1.0 / sqrt(2.0);
+	axis[2] = 0.0;
+	*angle = 2e-3 * i;
+}
+
 #endif

@@ -86,16 +86,14 @@ static double seg_seg(px_vec3 p1, px_vec3 q1, px_vec3 p2, px_vec3 q2,
 }
 
 /*
- * Does segment pq pass through triangle T (normal n = (T1 - T0) x (T2 -
- * T0))? Writes the crossing point. A segment lying in T's plane is left
- * to the edge-edge and vertex-triangle distances, which are 0 for any
- * coplanar contact.
+ * Does edge pq of one triangle pass through triangle T (normal n = (T1 -
+ * T0) x (T2 - T0))? dp, dq: n . (p - T0) and n . (q - T0). Writes the
+ * crossing point. An edge lying in T's plane is left to the edge-edge
+ * and vertex-triangle distances, which are 0 for any coplanar contact.
  */
-static int seg_crosses(px_vec3 p, px_vec3 q, const px_vec3 T[3], px_vec3 n,
-		       px_vec3 *x)
+static int seg_crosses(px_vec3 p, px_vec3 q, double dp, double dq,
+		       const px_vec3 T[3], px_vec3 n, px_vec3 *x)
 {
-	double dp = px_v3_dot(n, px_v3_sub(p, T[0]));
-	double dq = px_v3_dot(n, px_v3_sub(q, T[0]));
 	px_vec3 y;
 	int k;
 
@@ -113,27 +111,64 @@ static int seg_crosses(px_vec3 p, px_vec3 q, const px_vec3 T[3], px_vec3 n,
 	return 1;
 }
 
+/* 1 when the triangle with normal n is a needle in the sense of the mesh
+ * module (NEEDLE_SIN2): its plane is then too ill-defined for face
+ * projections, and its edges are its distance. */
+static int needle(const px_vec3 T[3], px_vec3 n)
+{
+	double l0 = px_v3_dist2(T[0], T[1]), l1 = px_v3_dist2(T[1], T[2]),
+	       l2 = px_v3_dist2(T[2], T[0]);
+	double m = fmax(l0 * l1, fmax(l0 * l2, l1 * l2));
+	return !(px_v3_norm2(n) > NEEDLE_SIN2 * m);
+}
+
+/* Does the projection of p onto T's plane fall inside T (closed)? */
+static int projects_inside(px_vec3 p, const px_vec3 T[3], px_vec3 n)
+{
+	int k;
+	for (k = 0; k < 3; k++) {
+		px_vec3 e = px_v3_sub(T[(k + 1) % 3], T[k]);
+		if (px_v3_dot(px_v3_cross(e, px_v3_sub(p, T[k])), n) < 0.0)
+			return 0;
+	}
+	return 1;
+}
+
 double px__tri_tri(const px_vec3 A[3], const px_vec3 B[3], px_vec3 *pa,
 		   px_vec3 *pb, int *crossing)
 {
 	px_vec3 na = px_v3_cross(px_v3_sub(A[1], A[0]), px_v3_sub(A[2], A[0]));
 	px_vec3 nb = px_v3_cross(px_v3_sub(B[1], B[0]), px_v3_sub(B[2], B[0]));
 	px_vec3 x, c1, c2;
-	double best = INFINITY, d2;
-	int i, j;
+	double best = INFINITY, d2, ha[3], hb[3];
+	int i, j, fa = !needle(A, na), fb = !needle(B, nb);
+	int sep;
 
 	*crossing = 0;
+	for (i = 0; i < 3; i++) {
+		hb[i] = px_v3_dot(na, px_v3_sub(B[i], A[0])); /* B against A's plane */
+		ha[i] = px_v3_dot(nb, px_v3_sub(A[i], B[0]));
+	}
+	/* one triangle strictly on one side of the other's plane: no
+	 * crossing possible */
+	sep = (hb[0] > 0.0 && hb[1] > 0.0 && hb[2] > 0.0) ||
+	      (hb[0] < 0.0 && hb[1] < 0.0 && hb[2] < 0.0) ||
+	      (ha[0] > 0.0 && ha[1] > 0.0 && ha[2] > 0.0) ||
+	      (ha[0] < 0.0 && ha[1] < 0.0 && ha[2] < 0.0);
 	/* Two triangles that cross meet along a segment whose ends lie on
 	 * edges: some edge of one passes through the other. A degenerate
 	 * triangle (zero normal) is crossed only through its partner's
 	 * test, or touched, which the distances below see as 0. */
-	for (i = 0; i < 3; i++) {
-		if (px_v3_norm2(nb) > 0.0 && seg_crosses(A[i], A[(i + 1) % 3], B, nb, &x)) {
+	for (i = 0; i < 3 && !sep; i++) {
+		int i1 = (i + 1) % 3;
+		if (px_v3_norm2(nb) > 0.0 &&
+		    seg_crosses(A[i], A[i1], ha[i], ha[i1], B, nb, &x)) {
 			*pa = *pb = x;
 			*crossing = 1;
 			return 0.0;
 		}
-		if (px_v3_norm2(na) > 0.0 && seg_crosses(B[i], B[(i + 1) % 3], A, na, &x)) {
+		if (px_v3_norm2(na) > 0.0 &&
+		    seg_crosses(B[i], B[i1], hb[i], hb[i1], A, na, &x)) {
 			*pa = *pb = x;
 			*crossing = 1;
 			return 0.0;
@@ -141,7 +176,9 @@ double px__tri_tri(const px_vec3 A[3], const px_vec3 B[3], px_vec3 *pa,
 	}
 	/* Apart: the closest pair has a vertex or an edge-edge pair on it
 	 * (the minimum of a distance between two polygons is reached on a
-	 * boundary of one of them, and for two segments of boundary). */
+	 * boundary of one of them, and for two segments of boundary). A
+	 * vertex whose projection misses the other face is nearest to an
+	 * edge of it, which the edge pairs cover. */
 	for (i = 0; i < 3; i++)
 		for (j = 0; j < 3; j++) {
 			d2 = seg_seg(A[i], A[(i + 1) % 3], B[j], B[(j + 1) % 3], &c1, &c2);
@@ -152,17 +189,23 @@ double px__tri_tri(const px_vec3 A[3], const px_vec3 B[3], px_vec3 *pa,
 			}
 		}
 	for (i = 0; i < 3; i++) {
-		d2 = px_tri_closest(A[i], B[0], B[1], B[2], &c2, NULL, NULL, NULL, NULL);
-		if (d2 < best) {
-			best = d2;
-			*pa = A[i];
-			*pb = c2;
+		if (fb && ha[i] * ha[i] < best * px_v3_norm2(nb) &&
+		    projects_inside(A[i], B, nb)) {
+			d2 = px_tri_closest(A[i], B[0], B[1], B[2], &c2, NULL, NULL, NULL, NULL);
+			if (d2 < best) {
+				best = d2;
+				*pa = A[i];
+				*pb = c2;
+			}
 		}
-		d2 = px_tri_closest(B[i], A[0], A[1], A[2], &c1, NULL, NULL, NULL, NULL);
-		if (d2 < best) {
-			best = d2;
-			*pa = c1;
-			*pb = B[i];
+		if (fa && hb[i] * hb[i] < best * px_v3_norm2(na) &&
+		    projects_inside(B[i], A, na)) {
+			d2 = px_tri_closest(B[i], A[0], A[1], A[2], &c1, NULL, NULL, NULL, NULL);
+			if (d2 < best) {
+				best = d2;
+				*pa = c1;
+				*pb = B[i];
+			}
 		}
 	}
 	return best;
@@ -231,31 +274,71 @@ static inline double gap_pos(double g)
 	return g > 0.0 ? g : 0.0;
 }
 
-/* Lower bound of the squared distance between A's box (ca, ha: A frame)
- * and B's box (cb, hb: B frame); see the top of the file. */
-static double box_lb2(const struct mp_ctx *X, px_vec3 ca, px_vec3 ha, px_vec3 cb,
-		      px_vec3 hb)
+/* A node box seen from both frames: centre and half extents in A's
+ * frame and in B's frame (exact in its own mesh's frame, the enclosing
+ * axis-aligned box of the rotated box in the other). */
+struct bx {
+	double cA[3], eA[3], cB[3], eB[3];
+};
+
+static void bx_of_a(const struct mp_ctx *X, px_vec3 c, px_vec3 h, struct bx *o)
 {
-	double c[3] = {ca.x, ca.y, ca.z}, h[3] = {ha.x, ha.y, ha.z};
-	double d[3] = {cb.x, cb.y, cb.z}, e[3] = {hb.x, hb.y, hb.z};
-	double s1 = 0.0, s2 = 0.0, u[3];
+	double u[3] = {c.x - X->t.x, c.y - X->t.y, c.z - X->t.z};
+	int k;
+	o->cA[0] = c.x, o->cA[1] = c.y, o->cA[2] = c.z;
+	o->eA[0] = h.x, o->eA[1] = h.y, o->eA[2] = h.z;
+	for (k = 0; k < 3; k++) {
+		o->cB[k] = X->R[0][k] * u[0] + X->R[1][k] * u[1] + X->R[2][k] * u[2];
+		o->eB[k] = X->Ra[0][k] * h.x + X->Ra[1][k] * h.y + X->Ra[2][k] * h.z;
+	}
+}
+
+static void bx_of_b(const struct mp_ctx *X, px_vec3 c, px_vec3 h, struct bx *o)
+{
+	int k;
+	o->cB[0] = c.x, o->cB[1] = c.y, o->cB[2] = c.z;
+	o->eB[0] = h.x, o->eB[1] = h.y, o->eB[2] = h.z;
+	for (k = 0; k < 3; k++) {
+		o->cA[k] = X->R[k][0] * c.x + X->R[k][1] * c.y + X->R[k][2] * c.z +
+			   px_v3_comp(X->t, k);
+		o->eA[k] = X->Ra[k][0] * h.x + X->Ra[k][1] * h.y + X->Ra[k][2] * h.z;
+	}
+}
+
+/*
+ * Lower bound of the squared distance between box a of A and box b of
+ * B (see the top of the file): the axis-aligned gaps in A's frame and in
+ * B's frame, and the gap along the line of centres w, where the boxes
+ * project to intervals of half lengths sum |w_k| h_k (each box in its
+ * own frame) around centres |w| apart; that one is tight when the boxes
+ * face each other diagonally, where the axis-aligned gaps lose most.
+ */
+static double box_lb2(const struct mp_ctx *X, const struct bx *a, const struct bx *b)
+{
+	double s1 = 0.0, s2 = 0.0, ww = 0.0, ext = 0.0, w1 = 0.0;
 	int k;
 
 	for (k = 0; k < 3; k++) {
-		double cbk = X->R[k][0] * d[0] + X->R[k][1] * d[1] + X->R[k][2] * d[2] +
-			     px_v3_comp(X->t, k);
-		double ebk = X->Ra[k][0] * e[0] + X->Ra[k][1] * e[1] + X->Ra[k][2] * e[2];
-		double g = gap_pos(fabs(cbk - c[k]) - h[k] - ebk - X->slack);
-		s1 += g * g;
-		u[k] = c[k] - px_v3_comp(X->t, k);
+		double w = b->cA[k] - a->cA[k], wb = b->cB[k] - a->cB[k];
+		double g1 = gap_pos(fabs(w) - a->eA[k] - b->eA[k] - X->slack);
+		double g2 = gap_pos(fabs(wb) - a->eB[k] - b->eB[k] - X->slack);
+		s1 += g1 * g1;
+		s2 += g2 * g2;
+		ww += w * w;
+		w1 += fabs(w);
+		ext += fabs(w) * a->eA[k] + fabs(wb) * b->eB[k];
 	}
-	for (k = 0; k < 3; k++) {
-		double cak = X->R[0][k] * u[0] + X->R[1][k] * u[1] + X->R[2][k] * u[2];
-		double eak = X->Ra[0][k] * h[0] + X->Ra[1][k] * h[1] + X->Ra[2][k] * h[2];
-		double g = gap_pos(fabs(cak - d[k]) - e[k] - eak - X->slack);
-		s2 += g * g;
+	s1 = s1 > s2 ? s1 : s2;
+	/* (|w|^2 - ext) / |w| is the gap; the slack, scaled by |w|_1 >=
+	 * |w|, keeps it a lower bound under rounding */
+	ext += X->slack * w1;
+	if (ww > ext) {
+		double g = ww - ext;
+		g = g * g / ww;
+		if (g > s1)
+			s1 = g;
 	}
-	return s1 > s2 ? s1 : s2;
+	return s1;
 }
 
 static inline px_vec3 to_a(const struct mp_ctx *X, px_vec3 p)
@@ -263,6 +346,18 @@ static inline px_vec3 to_a(const struct mp_ctx *X, px_vec3 p)
 	return px_v3(X->R[0][0] * p.x + X->R[0][1] * p.y + X->R[0][2] * p.z + X->t.x,
 		     X->R[1][0] * p.x + X->R[1][1] * p.y + X->R[1][2] * p.z + X->t.y,
 		     X->R[2][0] * p.x + X->R[2][1] * p.y + X->R[2][2] * p.z + X->t.z);
+}
+
+static inline double mn3(double a, double b, double c)
+{
+	double m = a < b ? a : b;
+	return m < c ? m : c;
+}
+
+static inline double mx3(double a, double b, double c)
+{
+	double m = a > b ? a : b;
+	return m > c ? m : c;
 }
 
 static void pair_test(struct mp_ctx *X, uint32_t ia, const px_vec3 V[3], uint32_t ib)
@@ -281,9 +376,9 @@ static void pair_test(struct mp_ctx *X, uint32_t ia, const px_vec3 V[3], uint32_
 		double h2 = px_v3_dot(ta->n, px_v3_sub(V[2], ta->a));
 		double m = INFINITY;
 		if (h0 > 0.0 && h1 > 0.0 && h2 > 0.0)
-			m = fmin(h0, fmin(h1, h2));
+			m = mn3(h0, h1, h2);
 		else if (h0 < 0.0 && h1 < 0.0 && h2 < 0.0)
-			m = -fmax(h0, fmax(h1, h2));
+			m = -mx3(h0, h1, h2);
 		if (m < INFINITY) {
 			m = m * sqrt(ta->inv_nn) - X->slack;
 			if (m > 0.0 && m * m > X->best2)
@@ -302,25 +397,89 @@ static void pair_test(struct mp_ctx *X, uint32_t ia, const px_vec3 V[3], uint32_
 	}
 }
 
-static void leaf_pair(struct mp_ctx *X, uint32_t ia, uint32_t na, uint32_t ib,
-		      uint32_t nb)
+/* Lower bound of a triangle pair from its line of centres: the gap
+ * between the triangles' projections onto it (at most their distance).
+ * Returns 1 when that gap alone exceeds the best distance. */
+static inline int centres_apart(const struct mp_ctx *X, const px_vec3 T[3],
+				const px_vec3 V[3])
 {
+	px_vec3 ct = px_v3_add(T[0], px_v3_add(T[1], T[2]));
+	px_vec3 cv = px_v3_add(V[0], px_v3_add(V[1], V[2]));
+	px_vec3 u = px_v3_sub(cv, ct);
+	double uu = px_v3_norm2(u);
+	double g = mn3(px_v3_dot(u, V[0]), px_v3_dot(u, V[1]), px_v3_dot(u, V[2])) -
+		   mx3(px_v3_dot(u, T[0]), px_v3_dot(u, T[1]), px_v3_dot(u, T[2]));
+	if (!(g > 0.0) || !(uu > 0.0))
+		return 0;
+	g = g / sqrt(uu) - X->slack;
+	return g > 0.0 && g * g > X->best2;
+}
+
+/* A leaf of A with its triangles' boxes (A frame), set up once per
+ * leaf pair. */
+#define LEAF_MAX 16
+
+static void leaf_pair(struct mp_ctx *X, uint32_t ia, uint32_t na, uint32_t ib,
+		      uint32_t nb, px_vec3 cb, px_vec3 hb)
+{
+	double alo[LEAF_MAX][3], ahi[LEAF_MAX][3];
+	uint8_t near_b[LEAF_MAX];
+	px_vec3 cbA = to_a(X, cb);
+	double eb[3];
 	uint32_t j, i;
+	int k, any = 0;
+
+	na = na > LEAF_MAX ? LEAF_MAX : na; /* leaves hold at most 16 */
+	for (k = 0; k < 3; k++)
+		eb[k] = X->Ra[k][0] * hb.x + X->Ra[k][1] * hb.y + X->Ra[k][2] * hb.z;
+	for (i = 0; i < na; i++) {
+		const struct mtri *ta = &X->A->tri[ia + i];
+		double g2 = 0.0;
+		for (k = 0; k < 3; k++) {
+			double a = px_v3_comp(ta->a, k), b = px_v3_comp(ta->b, k),
+			       c = px_v3_comp(ta->c, k), cc = px_v3_comp(cbA, k), g;
+			alo[i][k] = mn3(a, b, c);
+			ahi[i][k] = mx3(a, b, c);
+			/* against B's leaf box (rotated into A's frame and
+			 * enclosed): a triangle of A farther than the best
+			 * from all of B's leaf is skipped for every B triangle */
+			g = alo[i][k] - (cc + eb[k]);
+			if (cc - eb[k] - ahi[i][k] > g)
+				g = cc - eb[k] - ahi[i][k];
+			g = gap_pos(g - X->slack);
+			g2 += g * g;
+		}
+		near_b[i] = !(g2 > X->best2);
+		any |= near_b[i];
+	}
+	if (!any)
+		return;
 	for (j = ib; j < ib + nb; j++) {
 		const struct mtri *tb = &X->B->tri[j];
 		px_vec3 V[3] = {to_a(X, tb->a), to_a(X, tb->b), to_a(X, tb->c)};
-		px_vec3 lo = px_v3_min(V[0], px_v3_min(V[1], V[2]));
-		px_vec3 hi = px_v3_max(V[0], px_v3_max(V[1], V[2]));
-		for (i = ia; i < ia + na; i++) {
-			const struct mtri *ta = &X->A->tri[i];
-			px_vec3 alo = px_v3_min(ta->a, px_v3_min(ta->b, ta->c));
-			px_vec3 ahi = px_v3_max(ta->a, px_v3_max(ta->b, ta->c));
-			double gx = gap_pos(fmax(alo.x - hi.x, lo.x - ahi.x) - X->slack);
-			double gy = gap_pos(fmax(alo.y - hi.y, lo.y - ahi.y) - X->slack);
-			double gz = gap_pos(fmax(alo.z - hi.z, lo.z - ahi.z) - X->slack);
-			if (gx * gx + gy * gy + gz * gz > X->best2)
+		double lo[3] = {mn3(V[0].x, V[1].x, V[2].x), mn3(V[0].y, V[1].y, V[2].y),
+				mn3(V[0].z, V[1].z, V[2].z)};
+		double hi[3] = {mx3(V[0].x, V[1].x, V[2].x), mx3(V[0].y, V[1].y, V[2].y),
+				mx3(V[0].z, V[1].z, V[2].z)};
+		for (i = 0; i < na; i++) {
+			const struct mtri *ta = &X->A->tri[ia + i];
+			px_vec3 T[3];
+			double g2 = 0.0;
+			if (!near_b[i])
 				continue;
-			pair_test(X, i, V, j);
+			for (k = 0; k < 3; k++) {
+				double a = alo[i][k] - hi[k], b = lo[k] - ahi[i][k];
+				double g = gap_pos((a > b ? a : b) - X->slack);
+				g2 += g * g;
+			}
+			if (g2 > X->best2)
+				continue;
+			T[0] = ta->a;
+			T[1] = ta->b;
+			T[2] = ta->c;
+			if (X->best2 < INFINITY && centres_apart(X, T, V))
+				continue;
+			pair_test(X, ia + i, V, j);
 			if (X->best2 == 0.0)
 				return;
 		}
@@ -381,6 +540,7 @@ int px__mesh_pair(const struct px_model *a, const struct px_model *b,
 		uint32_t ia, na, ib, nb;
 		const struct node4 *nd;
 		struct mp_ent kid[4];
+		struct bx fixed;
 		int nk = 0, da;
 
 		if (e.lb2 > X.best2 || (e.lb2 == X.best2 && X.la >= 0))
@@ -389,29 +549,36 @@ int px__mesh_pair(const struct px_model *a, const struct px_model *b,
 		ref_get(B, e.nb, e.sb, &cb, &hb, &ib, &nb);
 		X.nodes++;
 		if (na > 0 && nb > 0) {
-			leaf_pair(&X, ia, na, ib, nb);
+			leaf_pair(&X, ia, na, ib, nb, cb, hb);
 			continue;
 		}
 		/* split the inner node with the larger box (a leaf cannot be
 		 * split) */
 		da = na == 0 && (nb > 0 || px_v3_norm2(ha) >= px_v3_norm2(hb));
 		nd = da ? &A->n4[ia] : &B->n4[ib];
+		if (da)
+			bx_of_b(&X, cb, hb, &fixed);
+		else
+			bx_of_a(&X, ca, ha, &fixed);
 		for (j = 0; j < 4; j++) {
 			px_vec3 cc, hc;
 			uint32_t ic, nc;
 			struct mp_ent c;
+			struct bx kb;
 			if (nd->idx[j] == EMPTY)
 				continue;
 			if (da) {
 				ref_get(A, ia, j, &cc, &hc, &ic, &nc);
-				c.lb2 = box_lb2(&X, cc, hc, cb, hb);
+				bx_of_a(&X, cc, hc, &kb);
+				c.lb2 = box_lb2(&X, &kb, &fixed);
 				c.na = ia;
 				c.sa = (uint8_t)j;
 				c.nb = e.nb;
 				c.sb = e.sb;
 			} else {
 				ref_get(B, ib, j, &cc, &hc, &ic, &nc);
-				c.lb2 = box_lb2(&X, ca, ha, cc, hc);
+				bx_of_b(&X, cc, hc, &kb);
+				c.lb2 = box_lb2(&X, &fixed, &kb);
 				c.na = e.na;
 				c.sa = e.sa;
 				c.nb = ib;
