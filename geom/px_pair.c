@@ -879,12 +879,13 @@ static int mesh_vs_convex(const struct px_model *m, const struct px_model *o,
 	best->ia = c.tri;
 	best->ib = -1;
 	for (j = 0; j < 2 && !best->intersecting; j++) {
-		/* GJK's witnesses are convex combinations of support points:
-		 * two exact projections put them on the surfaces (each can
-		 * only shorten the pair: both sets are convex) */
+		/* GJK's witness on o is a convex combination of support
+		 * points, a chord point just inside a curved o: two exact
+		 * projections put the pair on the surfaces (the triangle's
+		 * witness is on it already; both sets are convex, so this
+		 * converges to the true pair) */
 		struct px_model_result q;
 		px_vec3 pt;
-		double d2;
 		if ((rc = px_model_query(o, best->pa, &q)) < 0)
 			return rc;
 		(*total)++;
@@ -894,14 +895,11 @@ static int mesh_vs_convex(const struct px_model *m, const struct px_model *o,
 			best->pb = best->pa;
 			break;
 		}
-		d2 = px_tri_closest(q.point, c.tv[0], c.tv[1], c.tv[2], &pt, NULL, NULL,
-				    NULL, NULL);
+		px_tri_closest(q.point, c.tv[0], c.tv[1], c.tv[2], &pt, NULL, NULL, NULL, NULL);
 		best->ib = q.index;
-		if (sqrt(d2) <= best->d) {
-			best->pb = q.point;
-			best->pa = pt;
-			best->d = sqrt(d2);
-		}
+		best->pb = q.point;
+		best->pa = pt;
+		best->d = px_v3_dist(pt, q.point);
 	}
 	return exact;
 }
