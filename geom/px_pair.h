@@ -21,19 +21,51 @@
  * other model, and any improvement is polished by another round of
  * projections (two such rounds; none in coherent mode with one start,
  * which is meant to be cheap). The result
- * says whether it is proven global: for two convex models alternating
- * projections converge to the global minimum (projections onto convex
- * sets), so convex pairs (px_model_caps() & PX_MODEL_CAP_CONVEX) that
- * converged are certified; every other result carries local_only = 1.
+ * says whether it is proven global (local_only, see below).
  *
- * Exact paths come first: a sphere primitive against any model is one
- * point query of its centre (exact, also for meshes and clouds); two
- * convex models that have support functions (convex primitives, convex
- * meshes) go through GJK on their Minkowski difference (the GJK of
- * libccd, which Debian ships, offers intersection and penetration but
- * no separation distance, so it is implemented here), its witness
- * points polished by two exact projections onto the surfaces. Both give
- * local_only = 0.
+ * Exact paths come first, in this order, all with local_only = 0:
+ * - a sphere primitive against any model: one point query of its
+ *   centre;
+ * - two convex models with support functions (convex primitives, convex
+ *   meshes): GJK on their Minkowski difference (the GJK of libccd, which
+ *   Debian ships, offers intersection and penetration but no separation
+ *   distance, so it is implemented here), its witness points polished by
+ *   two exact projections onto the surfaces;
+ * - two triangle meshes (any, closed or open, convex or not): the exact
+ *   minimum over all triangle pairs, by a simultaneous traversal of both
+ *   hierarchies (geom/px_mesh_pair.c: box pairs bounded below in both
+ *   frames and along the line of centres, exact triangle-triangle
+ *   distances with a crossing test); index_a/index_b are the triangles.
+ *   In coherent mode last cycle's triangle pair is the starting bound;
+ * - a mesh against a convex model with a support function (box,
+ *   capsule, cylinder, cone): the mesh hierarchy bounded below by the
+ *   other model's point queries (distance of a node box's centre minus
+ *   its half diagonal), each remaining triangle measured by GJK (exact to
+ *   a relative 1e-10), the pair then projected onto both surfaces. If
+ *   its budget of 4096 point queries runs out (very fine meshes close
+ *   to a large primitive) the best pair found joins the projections
+ *   below and the flag stays.
+ * Surfaces apart but one closed model holding the other whole (its
+ * signed distance at the other's closest point is negative) counts as
+ * intersecting.
+ *
+ * Everything else runs the projections. Then:
+ * - a mesh against a point cloud without radius is certified by the
+ *   mesh hierarchy bounded by the cloud's exact point queries; triangles
+ *   not bounded out are measured exactly against the cloud points near
+ *   them (collected within the best distance plus the piece's radius,
+ *   pieces split up to five times when more than 64 points are near),
+ *   which may also improve the answer. It stays flagged only when the
+ *   budget of 1024 cloud queries runs out or a piece still holds too
+ *   many near points after the splits;
+ * - two convex models that converged are certified (projections onto
+ *   convex sets converge to the global minimum).
+ * local_only = 1 remains exactly for: NURBS models against anything
+ * but a sphere; clouds against anything but a sphere or a mesh (and
+ * clouds with a radius against meshes); the torus primitive against
+ * anything but a sphere; the half-space against anything not convex
+ * (meshes that are not convex, clouds, NURBS, the torus); convex pairs
+ * whose projections did not converge; and the budget cases above.
  *
  * Coherent mode: the previous result's points (kept in the result, in
  * each model's own frame, so they follow the models' new poses) are the
@@ -58,11 +90,15 @@
  * no inside: touching reports distance 0 and depth 0.
  *
  * Memory and real-time rules: no allocation (GJK and EPA keep their
- * simplex and polytope in fixed arrays on the stack, about 14 kB); work
- * bounded by starts * max_iters point queries, plus for overlapping
- * non-convex pairs 2 (starts + 1) (2 + 80) queries of the depth search
- * (points deep inside a mesh are its slowest queries: budget for it, or
- * lower starts), each RT-safe. @note RT-safe.
+ * simplex and polytope in fixed arrays on the stack, about 14 kB; the
+ * mesh traversals a fixed stack of about 4 kB); work bounded by starts *
+ * max_iters point queries, by the node pairs of the two hierarchies for
+ * mesh pairs (in practice the node pairs near the closest pair: about a
+ * thousand for two 4k-triangle meshes 4 cm apart, half a millisecond),
+ * by the query budgets above for the mesh/convex and mesh/cloud paths,
+ * plus for overlapping non-convex pairs 2 (starts + 4) (2 + 80) queries
+ * of the depth search (points deep inside a mesh are its slowest
+ * queries: budget for it, or lower starts), each RT-safe. @note RT-safe.
  */
 #ifndef PX_PAIR_H
 #define PX_PAIR_H
@@ -94,12 +130,15 @@ struct px_pair_result {
 	px_vec3 point_a;     /* on A, world frame */
 	px_vec3 point_b;     /* on B, world frame */
 	int index_a, index_b; /* feature indices (px_model_result.index) */
-	int iterations;      /* point-to-model queries made */
+	/* work: point-to-model queries made (mesh pairs: node pairs
+	 * expanded plus triangle pairs measured; GJK steps included) */
+	int iterations;
 	int starts;          /* starts run */
 	int converged;       /* the best start met the tolerance */
 	int intersecting;
-	/* 1 unless the answer is proven global (both models convex and
-	 * converged, or intersecting). */
+	/* 0 when the answer is proven global (exact paths, certified
+	 * mesh/cloud pairs, converged convex pairs, intersecting); 1 when it
+	 * may be a local minimum (the cases listed at the top). */
 	int local_only;
 	/* Coherence state: the best pair in each model's own frame, valid
 	 * after a successful call. */
