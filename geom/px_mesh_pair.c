@@ -420,16 +420,47 @@ static inline int centres_apart(const struct mp_ctx *X, const px_vec3 T[3],
 #define LEAF_MAX 16
 
 static void leaf_pair(struct mp_ctx *X, uint32_t ia, uint32_t na, uint32_t ib,
-		      uint32_t nb, px_vec3 cb, px_vec3 hb)
+		      uint32_t nb, px_vec3 ca, px_vec3 ha, px_vec3 cb, px_vec3 hb)
 {
 	double alo[LEAF_MAX][3], ahi[LEAF_MAX][3];
+	px_vec3 VB[LEAF_MAX][3], ga = px_v3(0, 0, 0), gb = px_v3(0, 0, 0), u;
 	uint8_t near_b[LEAF_MAX];
 	px_vec3 cbA = to_a(X, cb);
-	double eb[3];
+	double eb[3], uu, mxa = -INFINITY, mnb = INFINITY;
 	uint32_t j, i;
 	int k, any = 0;
 
 	na = na > LEAF_MAX ? LEAF_MAX : na; /* leaves hold at most 16 */
+	nb = nb > LEAF_MAX ? LEAF_MAX : nb;
+	for (j = 0; j < nb; j++) {
+		const struct mtri *tb = &X->B->tri[ib + j];
+		VB[j][0] = to_a(X, tb->a);
+		VB[j][1] = to_a(X, tb->b);
+		VB[j][2] = to_a(X, tb->c);
+		gb = px_v3_add(gb, px_v3_add(VB[j][0], px_v3_add(VB[j][1], VB[j][2])));
+	}
+	for (i = 0; i < na; i++) {
+		const struct mtri *ta = &X->A->tri[ia + i];
+		ga = px_v3_add(ga, px_v3_add(ta->a, px_v3_add(ta->b, ta->c)));
+	}
+	if (X->best2 < INFINITY) {
+		/* the two leaves' vertices on their line of centres: a gap
+		 * there bounds every triangle pair of the leaves at once */
+		u = px_v3_sub(px_v3_scale(gb, 1.0 / (3.0 * nb)), px_v3_scale(ga, 1.0 / (3.0 * na)));
+		uu = px_v3_norm2(u);
+		for (i = 0; i < na; i++) {
+			const struct mtri *ta = &X->A->tri[ia + i];
+			mxa = fmax(mxa, mx3(px_v3_dot(u, ta->a), px_v3_dot(u, ta->b), px_v3_dot(u, ta->c)));
+		}
+		for (j = 0; j < nb; j++)
+			mnb = fmin(mnb, mn3(px_v3_dot(u, VB[j][0]), px_v3_dot(u, VB[j][1]),
+					    px_v3_dot(u, VB[j][2])));
+		if (mnb > mxa && uu > 0.0) {
+			double g = (mnb - mxa) / sqrt(uu) - X->slack;
+			if (g > 0.0 && g * g > X->best2)
+				return;
+		}
+	}
 	for (k = 0; k < 3; k++)
 		eb[k] = X->Ra[k][0] * hb.x + X->Ra[k][1] * hb.y + X->Ra[k][2] * hb.z;
 	for (i = 0; i < na; i++) {
@@ -440,9 +471,6 @@ static void leaf_pair(struct mp_ctx *X, uint32_t ia, uint32_t na, uint32_t ib,
 			       c = px_v3_comp(ta->c, k), cc = px_v3_comp(cbA, k), g;
 			alo[i][k] = mn3(a, b, c);
 			ahi[i][k] = mx3(a, b, c);
-			/* against B's leaf box (rotated into A's frame and
-			 * enclosed): a triangle of A farther than the best
-			 * from all of B's leaf is skipped for every B triangle */
 			g = alo[i][k] - (cc + eb[k]);
 			if (cc - eb[k] - ahi[i][k] > g)
 				g = cc - eb[k] - ahi[i][k];
@@ -454,13 +482,22 @@ static void leaf_pair(struct mp_ctx *X, uint32_t ia, uint32_t na, uint32_t ib,
 	}
 	if (!any)
 		return;
-	for (j = ib; j < ib + nb; j++) {
-		const struct mtri *tb = &X->B->tri[j];
-		px_vec3 V[3] = {to_a(X, tb->a), to_a(X, tb->b), to_a(X, tb->c)};
+	for (j = 0; j < nb; j++) {
+		const px_vec3 *V = VB[j];
 		double lo[3] = {mn3(V[0].x, V[1].x, V[2].x), mn3(V[0].y, V[1].y, V[2].y),
 				mn3(V[0].z, V[1].z, V[2].z)};
 		double hi[3] = {mx3(V[0].x, V[1].x, V[2].x), mx3(V[0].y, V[1].y, V[2].y),
 				mx3(V[0].z, V[1].z, V[2].z)};
+		double gb2 = 0.0;
+		for (k = 0; k < 3; k++) {
+			/* this triangle of B against A's whole leaf box */
+			double c = px_v3_comp(ca, k), h = px_v3_comp(ha, k);
+			double a = c - h - hi[k], b = lo[k] - c - h;
+			double g = gap_pos((a > b ? a : b) - X->slack);
+			gb2 += g * g;
+		}
+		if (gb2 > X->best2)
+			continue;
 		for (i = 0; i < na; i++) {
 			const struct mtri *ta = &X->A->tri[ia + i];
 			px_vec3 T[3];
@@ -479,7 +516,7 @@ static void leaf_pair(struct mp_ctx *X, uint32_t ia, uint32_t na, uint32_t ib,
 			T[2] = ta->c;
 			if (X->best2 < INFINITY && centres_apart(X, T, V))
 				continue;
-			pair_test(X, ia + i, V, j);
+			pair_test(X, ia + i, V, ib + j);
 			if (X->best2 == 0.0)
 				return;
 		}
@@ -549,7 +586,7 @@ int px__mesh_pair(const struct px_model *a, const struct px_model *b,
 		ref_get(B, e.nb, e.sb, &cb, &hb, &ib, &nb);
 		X.nodes++;
 		if (na > 0 && nb > 0) {
-			leaf_pair(&X, ia, na, ib, nb, cb, hb);
+			leaf_pair(&X, ia, na, ib, nb, ca, ha, cb, hb);
 			continue;
 		}
 		/* split the inner node with the larger box (a leaf cannot be

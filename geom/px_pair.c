@@ -98,8 +98,24 @@ static int gjk_reduce(struct gjk_vert *S, int *n, px_vec3 *v, px_vec3 *pa,
 			if (!(so != 0.0 && s / so > 1e-9))
 				inside = 0;
 		}
-		if (inside)
+		if (inside) {
+			/* the origin's weights give a common point of both
+			 * (the witnesses of the overlap) */
+			double tot = 0.0;
+			for (k = 0; k < 4; k++) {
+				const px_vec3 A = S[F[k][0]].w, B = S[F[k][1]].w, C = S[F[k][2]].w;
+				px_vec3 nk = px_v3_cross(px_v3_sub(B, A), px_v3_sub(C, A));
+				lam[k] = px_v3_dot(px_v3_neg(A), nk) / px_v3_dot(px_v3_sub(S[k].w, A), nk);
+				tot += lam[k];
+			}
+			*pa = px_v3(0, 0, 0);
+			*pb = px_v3(0, 0, 0);
+			for (k = 0; k < 4; k++) {
+				*pa = px_v3_madd(*pa, S[k].a, lam[k] / tot);
+				*pb = px_v3_madd(*pb, S[k].b, lam[k] / tot);
+			}
 			return 1;
+		}
 		for (k = 0; k < 4; k++) {
 			int f, sub;
 			double u, w, d2;
@@ -1005,7 +1021,8 @@ static int mesh_vs_convex(const struct px_model *m, const struct px_model *o,
 	best->intersecting = c.best == 0.0;
 	best->d = c.best;
 	best->pa = c.pt;
-	best->pb = c.po;
+	/* overlapping: GJK's common point, on the triangle and in o */
+	best->pb = best->intersecting ? c.pt : c.po;
 	best->ia = c.tri;
 	best->ib = -1;
 	for (j = 0; j < 2 && !best->intersecting; j++) {
