@@ -95,15 +95,13 @@ static void fzm_check(const struct px_model *m)
 }
 
 /*
- * The file at path read by px_model_load() with cloud radius radius_m
- * either loads (any kind) and passes fzm_check(), or fails with a
- * format error and a message naming the file; anything else aborts.
+ * The outcome of loading the file at path: rc PX_OK with model m, which
+ * must pass fzm_check() (then freed), or a format error, no model, and
+ * a message msg (cap bytes) naming the file; anything else aborts.
  */
-static inline int fzm_load_check(const char *path, double radius_m)
+static inline int fzm_outcome(int rc, struct px_model *m, const char *msg,
+			      size_t cap, const char *path)
 {
-	struct px_model *m = NULL;
-	char msg[512];
-	int rc = px_model_load(path, radius_m, &m, msg, sizeof msg);
 	if (rc == PX_OK) {
 		if (!m)
 			abort();
@@ -116,10 +114,20 @@ static inline int fzm_load_check(const char *path, double radius_m)
 	if (rc != PX_E_PARSE && rc != PX_E_NAN && rc != PX_E_RANGE &&
 	    rc != PX_E_INVAL && rc != PX_E_OVERFLOW)
 		abort();
-	fz_check_msg(msg, sizeof msg);
+	fz_check_msg(msg, cap);
 	if (!strstr(msg, path))
 		abort();
 	return 0;
+}
+
+/* The file at path read by px_model_load() with cloud radius radius_m
+ * (any kind of model), judged by fzm_outcome(). */
+static inline int fzm_load_check(const char *path, double radius_m)
+{
+	struct px_model *m = NULL;
+	char msg[512];
+	int rc = px_model_load(path, radius_m, &m, msg, sizeof msg);
+	return fzm_outcome(rc, m, msg, sizeof msg, path);
 }
 
 #endif
