@@ -105,7 +105,6 @@ static void test_config_errors(void)
 
 /* ---- through /dev/uhid ------------------------------------------------ */
 
-
 /* Wait (bounded) for a uhid event of type want; returns 0 or -1. */
 static int uhid_wait(int fd, uint32_t want, struct uhid_event *ev, int ms)
 {
