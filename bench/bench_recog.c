@@ -13,27 +13,8 @@
 #include "px_nurbs.h"
 #include "px_recog.h"
 
-static uint64_t rng = 0x9e3779b97f4a7c15ull;
-static double urand(void)
-{
-	rng ^= rng << 13;
-	rng ^= rng >> 7;
-	rng ^= rng << 17;
-	return (double)(rng >> 11) * 0x1.0p-53;
-}
-
-static int64_t now_ns(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
-}
-
-static int cmp_i64(const void *a, const void *b)
-{
-	int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
-	return (x > y) - (x < y);
-}
+#include "arc_gen.h"
+#include "bench_util.h"
 
 #define NQ 20000
 
@@ -58,37 +39,15 @@ static void time_queries(const char *name, const struct px_recog_shape *pr, int 
 	       (long long)t[NQ * 99 / 100], (long long)t[NQ - 1], sink / NQ);
 }
 
-/* Unit circle arc net in 2D: 2 nseg + 1 points, clamped knots. */
-static int arc2d(double sweep, int nseg, double *xy, double *w, double *U)
-{
-	int s, k = 0, i;
-	double h = sweep / nseg;
-	xy[0] = 1, xy[1] = 0, w[0] = 1;
-	for (s = 0; s < nseg; s++) {
-		double t0 = s * h, tm = t0 + h / 2;
-		xy[2 * (2 * s + 1)] = cos(tm) / cos(h / 2);
-		xy[2 * (2 * s + 1) + 1] = sin(tm) / cos(h / 2);
-		w[2 * s + 1] = cos(h / 2);
-		xy[2 * (2 * s + 2)] = cos(t0 + h);
-		xy[2 * (2 * s + 2) + 1] = sin(t0 + h);
-		w[2 * s + 2] = 1;
-	}
-	for (i = 0; i < 3; i++)
-		U[k++] = 0;
-	for (s = 1; s < nseg; s++)
-		U[k++] = (double)s / nseg, U[k++] = (double)s / nseg;
-	for (i = 0; i < 3; i++)
-		U[k++] = 1;
-	return 2 * nseg + 1;
-}
-
 static void bench_rev(const char *name, double hc, double rc, double r,
 		      double psweep, double sweep)
 {
 	static double pw[4 * 9 * 9];
 	double axy[18], aw[9], AU[12], pxy[18], pwt[9], PU[12];
-	int na = arc2d(sweep, (int)ceil(sweep / (M_PI / 2) - 1e-9), axy, aw, AU);
-	int np = arc2d(psweep, (int)ceil(psweep / (M_PI / 2) - 1e-9), pxy, pwt, PU);
+	int na = arc2d(0, sweep, (int)ceil(sweep / (M_PI / 2) - 1e-9), axy, aw,
+		       AU);
+	int np = arc2d(0, psweep, (int)ceil(psweep / (M_PI / 2) - 1e-9), pxy,
+		       pwt, PU);
 	struct px_nurbs_surf s;
 	struct px_recog_shape pr;
 	int i, j, rc_;
@@ -120,7 +79,7 @@ int main(void)
 	double xy[18], w[9], U[12], pw[36];
 	struct px_nurbs_curve c;
 	struct px_recog_shape pr;
-	int n = arc2d(2 * M_PI, 4, xy, w, U), i, rc;
+	int n = arc2d(0, 2 * M_PI, 4, xy, w, U), i, rc;
 	int64_t t0;
 	for (i = 0; i < n; i++) {
 		pw[4 * i] = xy[2 * i] * w[i];

@@ -28,6 +28,8 @@
 #include "px_ring.h"
 #include "px_stats.h"
 
+#include "bench_util.h"
+
 #define NBINS 5000 /* 1 us bins up to 5 ms */
 #define PERIOD_NS 1000000
 
@@ -37,13 +39,6 @@ struct hist {
 	int64_t min_ns, max_ns;
 	uint64_t n;
 };
-
-static int64_t now_ns(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
-}
 
 static void hist_init(struct hist *h)
 {

@@ -4,59 +4,7 @@
 #include <string.h>
 
 #include "internal.h"
-
-/* ---- key declaration helpers ------------------------------------- */
-
-#define RANGE (PX_CONFIG_HAS_MIN | PX_CONFIG_HAS_MAX)
-
-#define K_INT(T, f, nm, fl, lo, hi, def)                                    \
-	{.name = nm, .type = PX_CONFIG_T_INT64, .offset = offsetof(T, f),     \
-	 .flags = (fl) | RANGE, .imin = (lo), .imax = (hi), .idef = (def)}
-#define K_INTP(T, f, nm, fl, lo, hi, def, pres)                             \
-	{.name = nm, .type = PX_CONFIG_T_INT64, .offset = offsetof(T, f),     \
-	 .flags = (fl) | RANGE | PX_CONFIG_PRESENT, .imin = (lo), .imax = (hi), \
-	 .idef = (def), .present_offset = offsetof(T, pres)}
-#define K_DUR(T, f, nm, fl, lo, hi, def)                                    \
-	{.name = nm, .type = PX_CONFIG_T_DURATION, .offset = offsetof(T, f),  \
-	 .flags = (fl) | RANGE, .imin = (lo), .imax = (hi), .idef = (def)}
-#define K_DBL(T, f, nm, fl, lo, hi, def)                                    \
-	{.name = nm, .type = PX_CONFIG_T_DOUBLE, .offset = offsetof(T, f),    \
-	 .flags = (fl) | RANGE, .dmin = (lo), .dmax = (hi), .ddef = (def)}
-#define K_DBLP(T, f, nm, lo, hi, pres)                                      \
-	{.name = nm, .type = PX_CONFIG_T_DOUBLE, .offset = offsetof(T, f),    \
-	 .flags = RANGE | PX_CONFIG_PRESENT, .dmin = (lo), .dmax = (hi),      \
-	 .present_offset = offsetof(T, pres)}
-#define K_VEC(T, f, nm, n, lo, hi, def)                                     \
-	{.name = nm, .type = PX_CONFIG_T_DOUBLE, .offset = offsetof(T, f),    \
-	 .flags = RANGE, .dmin = (lo), .dmax = (hi), .ddef = (def),           \
-	 .fixed_count = (n)}
-#define K_BOOL(T, f, nm, def)                                               \
-	{.name = nm, .type = PX_CONFIG_T_BOOL, .offset = offsetof(T, f),      \
-	 .idef = (def)}
-#define K_STR(T, f, nm, fl)                                                 \
-	{.name = nm, .type = PX_CONFIG_T_STRING, .offset = offsetof(T, f),    \
-	 .flags = (fl) | PX_CONFIG_NONEMPTY}
-#define K_ENUM(T, f, nm, fl, nms, def)                                      \
-	{.name = nm, .type = PX_CONFIG_T_ENUM, .offset = offsetof(T, f),      \
-	 .flags = (fl), .names = (nms), .idef = (def)}
-#define K_SUB(T, f, nm, sch)                                                \
-	{.name = nm, .type = PX_CONFIG_T_SUB, .offset = offsetof(T, f),       \
-	 .sub = &(sch)}
-#define K_SUBP(T, f, nm, sch, pres)                                         \
-	{.name = nm, .type = PX_CONFIG_T_SUB, .offset = offsetof(T, f),       \
-	 .sub = &(sch), .flags = PX_CONFIG_PRESENT,                           \
-	 .present_offset = offsetof(T, pres)}
-#define K_SEQ(T, f, cnt, nm, fl, sch, ET, lo, hi)                           \
-	{.name = nm, .type = PX_CONFIG_T_SEQ, .offset = offsetof(T, f),       \
-	 .flags = (fl), .sub = &(sch), .elem = PX_CONFIG_T_SUB,               \
-	 .elem_size = sizeof(ET), .count_offset = offsetof(T, cnt),           \
-	 .min_count = (lo), .max_count = (hi)}
-#define K_MAP(T, f, nm)                                                     \
-	{.name = nm, .type = PX_CONFIG_T_MAP, .offset = offsetof(T, f)}
-
-#define SCHEMA(var, nm, keys, chk)                                          \
-	static const struct px_config_schema var = {                        \
-		nm, keys, sizeof(keys) / sizeof(keys[0]), chk}
+#include "schema_internal.h"
 
 #define NS_PER_S 1000000000LL
 #define BIG 1e12
@@ -522,8 +470,10 @@ static const struct px_config_key signal_keys[] = {
 	K_BOOL(struct px_config_can_signal, is_signed, "signed", 0),
 	K_DBL(struct px_config_can_signal, scale, "scale", 0, -BIG, BIG, 1.0),
 	K_DBL(struct px_config_can_signal, offset, "offset", 0, -BIG, BIG, 0.0),
-	K_DBLP(struct px_config_can_signal, min, "min", -BIG, BIG, has_min),
-	K_DBLP(struct px_config_can_signal, max, "max", -BIG, BIG, has_max),
+	K_DBLPD(struct px_config_can_signal, min, "min", 0, -BIG, BIG, 0,
+		has_min),
+	K_DBLPD(struct px_config_can_signal, max, "max", 0, -BIG, BIG, 0,
+		has_max),
 	K_ENUM(struct px_config_can_signal, axis, "axis", 0, signal_axis_names,
 	       PX_CONFIG_SIGNAL_AXIS_NONE),
 	K_BOOL(struct px_config_can_signal, is_float, "float", 0),
@@ -809,8 +759,7 @@ static void trajectory_check(struct px_config_reader *r,
 static const struct px_config_key trajectory_keys[] = {
 	K_ENUM(struct px_config_trajectory, kind, "kind", 0, traj_names,
 	       PX_CONFIG_TRAJ_HOLD),
-	K_VEC(struct px_config_trajectory, center_m, "center_m", 3, -100, 100,
-	      0),
+	K_VEC(struct px_config_trajectory, center_m, "center_m", 0, -100, 100),
 	K_SEQ(struct px_config_trajectory, sines, n_sines, "sines", 0,
 	      sine_schema, struct px_config_sine, 0, 32),
 	K_STR(struct px_config_trajectory, file, "file", 0),

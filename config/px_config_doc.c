@@ -517,6 +517,25 @@ static int grow(struct builder *b, void **arr, size_t *cap, size_t n,
 	return PX_OK;
 }
 
+/* The next node of a sequence or mapping, built into *child: 1, or 0 at
+ * the event of type end (the collection's end; -1: none expected), or
+ * an error code. */
+static int build_child(struct builder *b, int end, int depth,
+		       const struct px_config_node **child)
+{
+	yaml_event_t ev;
+	int rc = next_event(b, &ev);
+	if (rc)
+		return rc;
+	if ((int)ev.type == end) {
+		yaml_event_delete(&ev);
+		return 0;
+	}
+	rc = build(b, &ev, depth, child);
+	yaml_event_delete(&ev);
+	return rc ? rc : 1;
+}
+
 static int build_seq(struct builder *b, const yaml_event_t *start, int depth,
 		     const struct px_config_node **out)
 {
@@ -527,18 +546,9 @@ static int build_seq(struct builder *b, const yaml_event_t *start, int depth,
 	if (!n)
 		return PX_E_NOMEM;
 	for (;;) {
-		yaml_event_t ev;
 		const struct px_config_node *child;
-		rc = next_event(b, &ev);
-		if (rc)
-			break;
-		if (ev.type == YAML_SEQUENCE_END_EVENT) {
-			yaml_event_delete(&ev);
-			break;
-		}
-		rc = build(b, &ev, depth + 1, &child);
-		yaml_event_delete(&ev);
-		if (rc)
+		rc = build_child(b, YAML_SEQUENCE_END_EVENT, depth + 1, &child);
+		if (rc <= 0)
 			break;
 		rc = grow(b, (void **)&tmp, &cap, count, sizeof(*tmp));
 		if (rc)
@@ -636,18 +646,9 @@ static int build_map(struct builder *b, const yaml_event_t *start, int depth,
 	if (!n)
 		return PX_E_NOMEM;
 	for (;;) {
-		yaml_event_t ev;
 		const struct px_config_node *key, *value;
-		rc = next_event(b, &ev);
-		if (rc)
-			break;
-		if (ev.type == YAML_MAPPING_END_EVENT) {
-			yaml_event_delete(&ev);
-			break;
-		}
-		rc = build(b, &ev, depth + 1, &key);
-		yaml_event_delete(&ev);
-		if (rc)
+		rc = build_child(b, YAML_MAPPING_END_EVENT, depth + 1, &key);
+		if (rc <= 0)
 			break;
 		if (key->kind != PX_CONFIG_NODE_SCALAR) {
 			berr(b, key->line, key->column,
@@ -665,12 +666,8 @@ static int build_map(struct builder *b, const yaml_event_t *start, int depth,
 			rc = PX_E_PARSE;
 			break;
 		}
-		rc = next_event(b, &ev);
-		if (rc)
-			break;
-		rc = build(b, &ev, depth + 1, &value);
-		yaml_event_delete(&ev);
-		if (rc)
+		rc = build_child(b, -1, depth + 1, &value);
+		if (rc < 0)
 			break;
 		rc = grow(b, (void **)&tmp, &cap, count, sizeof(*tmp));
 		if (rc)

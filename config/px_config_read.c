@@ -225,24 +225,17 @@ static void make_c_locale(void)
 	c_locale = newlocale(LC_NUMERIC_MASK, "C", (locale_t)0);
 }
 
-/* Decimal floating point with '_' between digits; no inf/nan/hex. */
-static int parse_double(const char *s, size_t len, double *out)
+/* The digits of s from i on, a '_' allowed between two of them, copied
+ * without the '_' to buf at *o and counted in *mant; returns the index
+ * after them. */
+static size_t mantissa_digits(const char *s, size_t i, size_t len, char *buf,
+			      size_t *o, int *mant)
 {
-	char buf[MAX_NUMBER_CHARS];
-	size_t i = 0, o = 0;
-	int mant = 0, prev_digit = 0;
-	char *end;
-	double v;
-	if (len >= sizeof(buf))
-		return NUM_SYNTAX;
-#define EMIT(c) (buf[o++] = (c))
-	if (i < len && (s[i] == '+' || s[i] == '-'))
-		EMIT(s[i++]);
-	/* integer part */
+	int prev_digit = 0;
 	for (; i < len; i++) {
 		if (s[i] >= '0' && s[i] <= '9') {
-			EMIT(s[i]);
-			mant++;
+			buf[(*o)++] = s[i];
+			(*mant)++;
 			prev_digit = 1;
 		} else if (s[i] == '_' && prev_digit && i + 1 < len &&
 			   s[i + 1] >= '0' && s[i + 1] <= '9') {
@@ -251,21 +244,26 @@ static int parse_double(const char *s, size_t len, double *out)
 			break;
 		}
 	}
+	return i;
+}
+
+/* Decimal floating point with '_' between digits; no inf/nan/hex. */
+static int parse_double(const char *s, size_t len, double *out)
+{
+	char buf[MAX_NUMBER_CHARS];
+	size_t i = 0, o = 0;
+	int mant = 0;
+	char *end;
+	double v;
+	if (len >= sizeof(buf))
+		return NUM_SYNTAX;
+#define EMIT(c) (buf[o++] = (c))
+	if (i < len && (s[i] == '+' || s[i] == '-'))
+		EMIT(s[i++]);
+	i = mantissa_digits(s, i, len, buf, &o, &mant); /* integer part */
 	if (i < len && s[i] == '.') {
 		EMIT(s[i++]);
-		prev_digit = 0;
-		for (; i < len; i++) {
-			if (s[i] >= '0' && s[i] <= '9') {
-				EMIT(s[i]);
-				mant++;
-				prev_digit = 1;
-			} else if (s[i] == '_' && prev_digit && i + 1 < len &&
-				   s[i + 1] >= '0' && s[i + 1] <= '9') {
-				prev_digit = 0;
-			} else {
-				break;
-			}
-		}
+		i = mantissa_digits(s, i, len, buf, &o, &mant);
 	}
 	if (mant == 0)
 		return NUM_SYNTAX;

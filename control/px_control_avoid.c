@@ -265,6 +265,18 @@ static int count_segment(void *ctx, px_vec3 a, px_vec3 b, double maxd,
 	return k->q->segment(k->q->ctx, a, b, maxd, out);
 }
 
+/* cq: qry with each of its calls counted in k (k->n from 0). */
+static void counting_wrap(struct counting *k,
+			  const struct px_control_query *qry,
+			  struct px_control_query *cq)
+{
+	k->q = qry;
+	k->n = 0;
+	cq->point = count_point;
+	cq->segment = qry->segment ? count_segment : NULL;
+	cq->ctx = k;
+}
+
 static int check_caps(const struct px_control_chain *c)
 {
 	int i;
@@ -300,11 +312,7 @@ int px_control_chain_clearances(const struct px_control_chain *c,
 	rc = fk_full(c, q, frames, NULL, NULL);
 	if (rc)
 		return rc;
-	k.q = qry;
-	k.n = 0;
-	cq.point = count_point;
-	cq.segment = qry->segment ? count_segment : NULL;
-	cq.ctx = &k;
+	counting_wrap(&k, qry, &cq);
 	rc = clearances(c, p, &cq, frames, max_distance_m, out);
 	if (n_queries)
 		*n_queries = k.n;
@@ -360,11 +368,7 @@ int px_control_avoid_step(const struct px_control_chain *c,
 	rc = fk_full(c, q, frames, ax, org);
 	if (rc)
 		return rc;
-	k.q = qry;
-	k.n = 0;
-	cq.point = count_point;
-	cq.segment = qry->segment ? count_segment : NULL;
-	cq.ctx = &k;
+	counting_wrap(&k, qry, &cq);
 	rc = clearances(c, p, &cq, frames, p->influence_distance_m, out->caps);
 	out->point_queries = k.n;
 	if (rc < 0)

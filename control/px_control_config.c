@@ -10,49 +10,7 @@
 
 #include "internal.h"
 #include "px_config.h"
-
-#define RANGE (PX_CONFIG_HAS_MIN | PX_CONFIG_HAS_MAX)
-
-#define K_DBL(T, f, nm, fl, lo, hi, def)                                    \
-	{.name = nm, .type = PX_CONFIG_T_DOUBLE, .offset = offsetof(T, f),    \
-	 .flags = (fl) | RANGE, .dmin = (lo), .dmax = (hi), .ddef = (def)}
-/* Optional number whose absence means "take it from elsewhere"; the
- * placeholder default only has to lie in the range. */
-#define K_DBLP(T, f, nm, fl, lo, hi, pres)                                  \
-	{.name = nm, .type = PX_CONFIG_T_DOUBLE, .offset = offsetof(T, f),    \
-	 .flags = (fl) | RANGE | PX_CONFIG_PRESENT, .dmin = (lo), .dmax = (hi), \
-	 .ddef = (hi), .present_offset = offsetof(T, pres)}
-#define K_INT(T, f, nm, fl, lo, hi, def)                                    \
-	{.name = nm, .type = PX_CONFIG_T_INT64, .offset = offsetof(T, f),     \
-	 .flags = (fl) | RANGE, .imin = (lo), .imax = (hi), .idef = (def)}
-#define K_VEC(T, f, nm, fl, lo, hi)                                         \
-	{.name = nm, .type = PX_CONFIG_T_DOUBLE, .offset = offsetof(T, f),    \
-	 .flags = (fl) | RANGE, .dmin = (lo), .dmax = (hi), .fixed_count = 3}
-#define K_VECP(T, f, nm, lo, hi, pres)                                      \
-	{.name = nm, .type = PX_CONFIG_T_DOUBLE, .offset = offsetof(T, f),    \
-	 .flags = RANGE | PX_CONFIG_PRESENT, .dmin = (lo), .dmax = (hi),      \
-	 .fixed_count = 3, .present_offset = offsetof(T, pres)}
-#define K_STR(T, f, nm, fl)                                                 \
-	{.name = nm, .type = PX_CONFIG_T_STRING, .offset = offsetof(T, f),    \
-	 .flags = (fl) | PX_CONFIG_NONEMPTY}
-#define K_ENUM(T, f, nm, fl, nms, def)                                      \
-	{.name = nm, .type = PX_CONFIG_T_ENUM, .offset = offsetof(T, f),      \
-	 .flags = (fl), .names = (nms), .idef = (def)}
-#define K_SUB(T, f, nm, sch)                                                \
-	{.name = nm, .type = PX_CONFIG_T_SUB, .offset = offsetof(T, f),       \
-	 .sub = &(sch)}
-#define K_SUBP(T, f, nm, sch, pres)                                         \
-	{.name = nm, .type = PX_CONFIG_T_SUB, .offset = offsetof(T, f),       \
-	 .sub = &(sch), .flags = PX_CONFIG_PRESENT,                           \
-	 .present_offset = offsetof(T, pres)}
-#define K_SEQ(T, f, cnt, nm, fl, sch, ET, lo, hi)                           \
-	{.name = nm, .type = PX_CONFIG_T_SEQ, .offset = offsetof(T, f),       \
-	 .flags = (fl), .sub = &(sch), .elem = PX_CONFIG_T_SUB,               \
-	 .elem_size = sizeof(ET), .count_offset = offsetof(T, cnt),           \
-	 .min_count = (lo), .max_count = (hi)}
-#define SCHEMA(var, nm, keys, chk)                                          \
-	static const struct px_config_schema var = {                        \
-		nm, keys, sizeof(keys) / sizeof(keys[0]), chk}
+#include "schema_internal.h"
 
 #define BIG 1e6
 
@@ -171,7 +129,7 @@ static const struct px_config_key joint_keys[] = {
 	       PX_CONTROL_REVOLUTE),
 	K_SUBP(struct raw_joint, dh, "dh", dh_schema, has_dh),
 	K_SUBP(struct raw_joint, origin, "origin", pose_schema, has_origin),
-	K_VECP(struct raw_joint, axis, "axis", -BIG, BIG, has_axis),
+	K_VECPD(struct raw_joint, axis, "axis", 0, -BIG, BIG, 0, has_axis),
 };
 SCHEMA(joint_schema, "joint", joint_keys, joint_check);
 

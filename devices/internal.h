@@ -5,6 +5,7 @@
 #include <stdint.h>
 
 #include "px_can.h"
+#include "px_codec.h"
 #include "px_dev.h"
 #include "px_gpio.h"
 
@@ -12,6 +13,17 @@ struct px_loop;
 
 /* The loop a device was attached to (NULL none). */
 struct px_loop *px__dev_loop(const struct px_dev *d);
+
+/* The wrench of force command c in codec channel order: force, then
+ * torque; all 0 when c is not enabled. RT-safe. */
+void px__dev_force_wrench(const struct px_force_cmd *c,
+			  double w[PX_WRENCH__COUNT]);
+/* Output report of force command c through map m into buf (cap bytes):
+ * its length, or the negative px_codec_encode() code after recording
+ * PX_DEV_ERR_ENCODE on d at now. RT-safe. */
+int px__dev_encode_force(struct px_dev *d, const struct px_codec_map *m,
+			 const struct px_force_cmd *c, int64_t now,
+			 uint8_t *buf, size_t cap);
 
 /* Shared digital I/O logic of the GPIO back ends: roles, debounce of
  * the e-stop, fail-safe reporting and loop trips. */

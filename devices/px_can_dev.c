@@ -6,6 +6,7 @@
 #include <linux/can/error.h>
 
 #include "px_can.h"
+#include "internal.h"
 
 #define MAX_SIG 64
 #define MAX_OUT_IDS 8
@@ -175,16 +176,12 @@ static int cdev_force(struct px_dev *d, const struct px_force_cmd *cmd,
 		      int64_t now)
 {
 	struct cdev *c = px_dev_impl(d);
-	double w[PX_WRENCH__COUNT] = {0};
+	double w[PX_WRENCH__COUNT];
 	size_t j, i;
 	int k, rc = PX_OK;
 	if (!c->n_out)
 		return PX_E_UNSUPPORTED;
-	if (cmd->enable)
-		for (k = 0; k < 3; k++) {
-			w[k] = cmd->force_n[k];
-			w[3 + k] = cmd->torque_n_m[k];
-		}
+	px__dev_force_wrench(cmd, w);
 	for (j = 0; j < c->n_out; j++) {
 		struct px_can_msg m;
 		memset(&m, 0, sizeof m);

@@ -403,6 +403,20 @@ void px_canopen_config_default(struct px_canopen_config *c)
 	c->heartbeat_timeout_ns = 300000000;
 }
 
+/* Own copies of a config's PDO map (the default when it names none) and
+ * drive table, so the caller's may go away after create. */
+static void own_tables(const struct px_canopen_pdo_map *pdo_in,
+		       const struct px_canopen_drive_cfg *drives, size_t n,
+		       struct px_canopen_pdo_map *pdo,
+		       struct px_canopen_drive_cfg *drv)
+{
+	if (pdo_in)
+		*pdo = *pdo_in;
+	else
+		px_canopen_pdo_map_default(pdo);
+	memcpy(drv, drives, n * sizeof *drives);
+}
+
 int px_canopen_create(const struct px_canopen_config *c,
 		      struct px_can_bus *bus, struct px_canopen **out,
 		      char *msg, size_t cap)
@@ -446,12 +460,8 @@ int px_canopen_create(const struct px_canopen_config *c,
 	if (!co)
 		return PX_E_NOMEM;
 	co->cfg = *c;
-	if (c->pdo)
-		co->pdo = *c->pdo;
-	else
-		px_canopen_pdo_map_default(&co->pdo);
+	own_tables(c->pdo, c->drives, c->n_drives, &co->pdo, co->drv);
 	co->cfg.pdo = &co->pdo;
-	memcpy(co->drv, c->drives, c->n_drives * sizeof *c->drives);
 	co->cfg.drives = co->drv;
 	for (i = 0; i < c->n_drives; i++) {
 		co->st[i].node_id = c->drives[i].node_id;
@@ -708,12 +718,8 @@ int px_canopen_sim_create(const struct px_canopen_sim_config *c,
 	if (!s)
 		return PX_E_NOMEM;
 	s->cfg = *c;
-	if (c->pdo)
-		s->pdo = *c->pdo;
-	else
-		px_canopen_pdo_map_default(&s->pdo);
+	own_tables(c->pdo, c->drives, c->n_drives, &s->pdo, s->drv);
 	s->cfg.pdo = &s->pdo;
-	memcpy(s->drv, c->drives, c->n_drives * sizeof *c->drives);
 	s->cfg.drives = s->drv;
 	if (c->n_faults)
 		memcpy(s->faults, c->faults, c->n_faults * sizeof *c->faults);

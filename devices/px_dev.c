@@ -657,3 +657,31 @@ struct px_loop *px__dev_loop(const struct px_dev *d)
 {
 	return d ? d->loop : NULL;
 }
+
+void px__dev_force_wrench(const struct px_force_cmd *c,
+			  double w[PX_WRENCH__COUNT])
+{
+	int k;
+	for (k = 0; k < PX_WRENCH__COUNT; k++)
+		w[k] = 0.0;
+	if (c->enable)
+		for (k = 0; k < 3; k++) {
+			w[k] = c->force_n[k];
+			w[3 + k] = c->torque_n_m[k];
+		}
+}
+
+int px__dev_encode_force(struct px_dev *d, const struct px_codec_map *m,
+			 const struct px_force_cmd *c, int64_t now,
+			 uint8_t *buf, size_t cap)
+{
+	double w[PX_WRENCH__COUNT];
+	struct px_codec_diag diag;
+	int n;
+	px__dev_force_wrench(c, w);
+	n = px_codec_encode(m, w, buf, cap, NULL, &diag);
+	if (n < 0)
+		px_dev_record(d, PX_DEV_ERR_ENCODE, n, 0, diag.report_id,
+			      &diag, NULL, now);
+	return n;
+}

@@ -14,6 +14,7 @@
 #include "px_arena.h"
 #include "px_hid.h"
 #include "px_param.h"
+#include "internal.h"
 
 #ifndef PX_HIDAPI_DRIVER
 #define PX_HIDAPI_DRIVER "hidraw"
@@ -304,23 +305,13 @@ static int hid_force(struct px_dev *d, const struct px_force_cmd *c,
 {
 	struct hid *x = px_dev_impl(d);
 	const struct px_codec_map *m = px_dev_config(d)->codec;
-	double w[PX_WRENCH__COUNT] = {0};
-	struct px_codec_diag diag;
 	struct outrep o;
-	int n, k;
+	int n;
 	if (!m->n_outputs)
 		return PX_E_UNSUPPORTED;
-	if (c->enable)
-		for (k = 0; k < 3; k++) {
-			w[k] = c->force_n[k];
-			w[3 + k] = c->torque_n_m[k];
-		}
-	n = px_codec_encode(m, w, o.b, sizeof o.b, NULL, &diag);
-	if (n < 0) {
-		px_dev_record(d, PX_DEV_ERR_ENCODE, n, 0, diag.report_id,
-			      &diag, NULL, now);
+	n = px__dev_encode_force(d, m, c, now, o.b, sizeof o.b);
+	if (n < 0)
 		return n;
-	}
 	o.len = (size_t)n;
 	px_param_write(x->out, &o); /* the I/O thread sends it */
 	return PX_OK;

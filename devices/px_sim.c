@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "px_sim.h"
+#include "internal.h"
 
 #define REP_MAX 64
 #define QCAP 32          /* reports in flight (delay) */
@@ -545,24 +546,15 @@ static int sim_force(struct px_dev *d, const struct px_force_cmd *c,
 		     int64_t now)
 {
 	struct sim *s = px_dev_impl(d);
-	double w[PX_WRENCH__COUNT] = {0};
+	double w[PX_WRENCH__COUNT];
 	struct px_codec_diag diag;
 	uint8_t b[REP_MAX];
 	int n, k;
 	if (s->cfg.follow_hand)
 		return PX_E_UNSUPPORTED;
-	if (c->enable) {
-		for (k = 0; k < 3; k++) {
-			w[k] = c->force_n[k];
-			w[3 + k] = c->torque_n_m[k];
-		}
-	}
-	n = px_codec_encode(s->map, w, b, sizeof b, NULL, &diag);
-	if (n < 0) {
-		px_dev_record(d, PX_DEV_ERR_ENCODE, n, 0, diag.report_id,
-			      &diag, NULL, now);
+	n = px__dev_encode_force(d, s->map, c, now, b, sizeof b);
+	if (n < 0)
 		return n;
-	}
 	if (s->unplugged)
 		return PX_E_NODEV;
 	/* The device end: decode what was sent. */

@@ -13,6 +13,7 @@
 #include "px_arena.h"
 #include "px_param.h"
 #include "px_usb.h"
+#include "internal.h"
 
 #define MAX_XFER 16
 #define FRAME_MAX 1024
@@ -433,23 +434,13 @@ static int usb_force(struct px_dev *d, const struct px_force_cmd *c,
 {
 	struct usb *u = px_dev_impl(d);
 	const struct px_codec_map *m = px_dev_config(d)->codec;
-	double w[PX_WRENCH__COUNT] = {0};
-	struct px_codec_diag diag;
 	struct outframe o;
-	int n, k, off;
+	int n, off;
 	if (!m->n_outputs || !u->cfg.endpoint_out)
 		return PX_E_UNSUPPORTED;
-	if (c->enable)
-		for (k = 0; k < 3; k++) {
-			w[k] = c->force_n[k];
-			w[3 + k] = c->torque_n_m[k];
-		}
-	n = px_codec_encode(m, w, o.b, sizeof o.b, NULL, &diag);
-	if (n < 0) {
-		px_dev_record(d, PX_DEV_ERR_ENCODE, n, 0, diag.report_id,
-			      &diag, NULL, now);
+	n = px__dev_encode_force(d, m, c, now, o.b, sizeof o.b);
+	if (n < 0)
 		return n;
-	}
 	/* a vendor frame has no report id byte unless the map numbers
 	 * its reports */
 	off = px_codec_numbered(m) ? 0 : 1;

@@ -2,7 +2,8 @@
  * fuzz_model.h - what the file-format targets check on a model that
  * loaded: queries at points around its box answer finite distances equal
  * to a brute-force scan over every triangle (meshes) or point (clouds),
- * with the closest point at that distance.
+ * with the closest point at that distance; and the whole check of one
+ * model file read through px_model_load().
  */
 #ifndef PX_FUZZ_MODEL_H
 #define PX_FUZZ_MODEL_H
@@ -10,6 +11,7 @@
 #include "fuzz_util.h"
 
 #include "px_cloud.h"
+#include "px_load.h"
 #include "px_mesh.h"
 #include "px_model.h"
 
@@ -90,6 +92,42 @@ static void fzm_check(const struct px_model *m)
 		    !(fabs(px_v3_dist(p, r.point) - fabs(r.distance)) <= tol))
 			abort();
 	}
+}
+
+/*
+ * The outcome of loading the file at path: rc PX_OK with model m, which
+ * must pass fzm_check() (then freed), or a format error, no model, and
+ * a message msg (cap bytes) naming the file; anything else aborts.
+ */
+static inline int fzm_outcome(int rc, struct px_model *m, const char *msg,
+			      size_t cap, const char *path)
+{
+	if (rc == PX_OK) {
+		if (!m)
+			abort();
+		fzm_check(m);
+		px_model_free(m);
+		return 0;
+	}
+	if (m)
+		abort();
+	if (rc != PX_E_PARSE && rc != PX_E_NAN && rc != PX_E_RANGE &&
+	    rc != PX_E_INVAL && rc != PX_E_OVERFLOW)
+		abort();
+	fz_check_msg(msg, cap);
+	if (!strstr(msg, path))
+		abort();
+	return 0;
+}
+
+/* The file at path read by px_model_load() with cloud radius radius_m
+ * (any kind of model), judged by fzm_outcome(). */
+static inline int fzm_load_check(const char *path, double radius_m)
+{
+	struct px_model *m = NULL;
+	char msg[512];
+	int rc = px_model_load(path, radius_m, &m, msg, sizeof msg);
+	return fzm_outcome(rc, m, msg, sizeof msg, path);
 }
 
 #endif

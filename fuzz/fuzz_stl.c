@@ -14,21 +14,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	struct px_model *m = NULL;
 	const char *path = fz_file(".stl", data, size);
 	int rc = px_mesh_load(path, NULL, &rep, &m);
-	if (rc == PX_OK) {
-		if (!m || rep.n_triangles == 0 ||
-		    px_mesh_triangle_count(m) != rep.n_triangles)
-			abort();
-		fzm_check(m);
-		px_model_free(m);
-		return 0;
-	}
-	if (m)
+	if (rc == PX_OK && (!m || rep.n_triangles == 0 ||
+			    px_mesh_triangle_count(m) != rep.n_triangles))
 		abort();
-	if (rc != PX_E_PARSE && rc != PX_E_NAN && rc != PX_E_RANGE &&
-	    rc != PX_E_INVAL && rc != PX_E_OVERFLOW)
-		abort();
-	fz_check_msg(rep.message, sizeof rep.message);
-	if (!strstr(rep.message, path))
-		abort();
-	return 0;
+	return fzm_outcome(rc, m, rep.message, sizeof rep.message, path);
 }

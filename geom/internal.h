@@ -53,6 +53,27 @@ int px__nurbs_count_inside(const double *U, int n_knots, double a, double b);
 void px__nurbs_box_add(px_aabb *box, const double *pw);
 px_aabb px__nurbs_box_empty(void);
 
+/* Bytes of one arena allocation of n doubles including worst-case
+ * alignment padding; 0 on overflow. */
+size_t px__nurbs_padded(size_t n_doubles);
+
+/* Homogeneous control points P (4 per point) from xyz (3 per point) and
+ * weights w (NULL: all 1). */
+void px__nurbs_homogeneous(double *P, const double *xyz, const double *w,
+			   size_t count);
+
+/* 1 when every weight of the count homogeneous points pw is exactly 1. */
+int px__nurbs_unit_weights(const double *pw, size_t count);
+
+/* Binomial coefficient C(n, k), 0 <= k <= n <= 3: the derivative orders
+ * of the quotient rule. Inline: it sits in the evaluation loops. */
+static inline double px__nurbs_binom(int n, int k)
+{
+	static const double b[4][4] = {
+		{1, 0, 0, 0}, {1, 1, 0, 0}, {1, 2, 1, 0}, {1, 3, 3, 1}};
+	return b[n][k];
+}
+
 #endif
 
 /*

@@ -5,6 +5,7 @@
  */
 #include <math.h>
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -457,4 +458,33 @@ int px__nurbs_extract(int nd, const int *p, const int *n,
 			4 * (size_t)n_out[0] * sizeof(double));
 	*pw_out = work;
 	return PX_OK;
+}
+
+size_t px__nurbs_padded(size_t n_doubles)
+{
+	if (n_doubles > (SIZE_MAX - PX_ARENA_ALIGN) / sizeof(double))
+		return 0;
+	return n_doubles * sizeof(double) + PX_ARENA_ALIGN - 1;
+}
+
+void px__nurbs_homogeneous(double *P, const double *xyz, const double *w,
+			   size_t count)
+{
+	size_t i;
+	for (i = 0; i < count; i++) {
+		double wi = w ? w[i] : 1.0;
+		P[4 * i] = xyz[3 * i] * wi;
+		P[4 * i + 1] = xyz[3 * i + 1] * wi;
+		P[4 * i + 2] = xyz[3 * i + 2] * wi;
+		P[4 * i + 3] = wi;
+	}
+}
+
+int px__nurbs_unit_weights(const double *pw, size_t count)
+{
+	size_t i;
+	for (i = 0; i < count; i++)
+		if (pw[4 * i + 3] != 1.0)
+			return 0;
+	return 1;
 }

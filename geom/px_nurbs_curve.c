@@ -10,36 +10,16 @@
 #include "internal.h"
 #include "px_nurbs.h"
 
-static const double binom[4][4] = {
-	{1, 0, 0, 0}, {1, 1, 0, 0}, {1, 2, 1, 0}, {1, 3, 3, 1}};
-
-/* Bytes of one arena allocation including worst-case alignment padding. */
-static size_t padded(size_t n_doubles)
-{
-	if (n_doubles > (SIZE_MAX - PX_ARENA_ALIGN) / sizeof(double))
-		return 0;
-	return n_doubles * sizeof(double) + PX_ARENA_ALIGN - 1;
-}
-
 size_t px_nurbs_curve_bytes(int degree, int n_ctrl)
 {
 	size_t a, b;
 	if (degree < 0 || n_ctrl < 0)
 		return 0;
-	a = padded((size_t)n_ctrl + (size_t)degree + 1);
-	b = padded(4 * (size_t)n_ctrl);
+	a = px__nurbs_padded((size_t)n_ctrl + (size_t)degree + 1);
+	b = px__nurbs_padded(4 * (size_t)n_ctrl);
 	if (!a || !b)
 		return 0;
 	return a + b;
-}
-
-static int all_unit_weights(const double *pw, size_t count)
-{
-	size_t i;
-	for (i = 0; i < count; i++)
-		if (pw[4 * i + 3] != 1.0)
-			return 0;
-	return 1;
 }
 
 int px_nurbs_curve_validate(int degree, int n_ctrl, const double *knots,
@@ -61,7 +41,7 @@ int px_nurbs_curve_init(struct px_nurbs_curve *c, struct px_arena *a,
 			struct px_nurbs_error *err)
 {
 	double *U, *P;
-	int rc, i;
+	int rc;
 
 	if (!c || !a || !xyz) {
 		px__nurbs_err(err, PX_E_INVAL, PX_NURBS_FAULT_ARG, 0, -1, 0, 0,
@@ -84,19 +64,13 @@ int px_nurbs_curve_init(struct px_nurbs_curve *c, struct px_arena *a,
 		return PX_E_NOSPC;
 	}
 	memcpy(U, knots, (size_t)n_knots * sizeof(double));
-	for (i = 0; i < n_ctrl; i++) {
-		double wi = w ? w[i] : 1.0;
-		P[4 * i] = xyz[3 * i] * wi;
-		P[4 * i + 1] = xyz[3 * i + 1] * wi;
-		P[4 * i + 2] = xyz[3 * i + 2] * wi;
-		P[4 * i + 3] = wi;
-	}
+	px__nurbs_homogeneous(P, xyz, w, (size_t)n_ctrl);
 	c->degree = degree;
 	c->n_ctrl = n_ctrl;
 	c->n_knots = n_knots;
 	c->knots = U;
 	c->pw = P;
-	c->rational = !all_unit_weights(P, (size_t)n_ctrl);
+	c->rational = !px__nurbs_unit_weights(P, (size_t)n_ctrl);
 	return PX_OK;
 }
 
@@ -125,7 +99,7 @@ int px_nurbs_curve_view(struct px_nurbs_curve *c, int degree, int n_ctrl,
 	c->n_knots = n_knots;
 	c->knots = knots;
 	c->pw = pw;
-	c->rational = !all_unit_weights(pw, (size_t)n_ctrl);
+	c->rational = !px__nurbs_unit_weights(pw, (size_t)n_ctrl);
 	return PX_OK;
 }
 
@@ -178,7 +152,7 @@ static void curve_eval_core(const struct px_nurbs_curve *c, double u,
 		px_vec3 v = px_v3(A[kd][0], A[kd][1], A[kd][2]);
 		for (i = 1; i <= kd; i++)
 			v = px_v3_madd(v, ders[kd - i],
-				       -binom[kd][i] * A[i][3]);
+				       -px__nurbs_binom(kd, i) * A[i][3]);
 		ders[kd] = px_v3_scale(v, 1.0 / A[0][3]);
 	}
 }
@@ -339,7 +313,7 @@ int px_nurbs_curve_extract_work(const struct px_nurbs_curve *c, double a,
 size_t px_nurbs_curve_extract_bytes(const struct px_nurbs_curve *c)
 {
 	return px_nurbs_curve_bytes(c->degree, c->n_ctrl + c->degree) +
-	       padded(PX_NURBS_CURVE_WORK_LEN(c->degree, c->n_ctrl));
+	       px__nurbs_padded(PX_NURBS_CURVE_WORK_LEN(c->degree, c->n_ctrl));
 }
 
 int px_nurbs_curve_extract(const struct px_nurbs_curve *c, double a,

@@ -11,16 +11,6 @@
 #include "internal.h"
 #include "px_nurbs.h"
 
-static const double binom[4][4] = {
-	{1, 0, 0, 0}, {1, 1, 0, 0}, {1, 2, 1, 0}, {1, 3, 3, 1}};
-
-static size_t padded(size_t n_doubles)
-{
-	if (n_doubles > (SIZE_MAX - PX_ARENA_ALIGN) / sizeof(double))
-		return 0;
-	return n_doubles * sizeof(double) + PX_ARENA_ALIGN - 1;
-}
-
 size_t px_nurbs_surf_bytes(int degree_u, int degree_v, int n_u, int n_v)
 {
 	size_t a, b, c;
@@ -28,21 +18,12 @@ size_t px_nurbs_surf_bytes(int degree_u, int degree_v, int n_u, int n_v)
 		return 0;
 	if (n_v && (size_t)n_u > SIZE_MAX / 8 / (size_t)n_v)
 		return 0;
-	a = padded((size_t)n_u + (size_t)degree_u + 1);
-	b = padded((size_t)n_v + (size_t)degree_v + 1);
-	c = padded(4 * (size_t)n_u * (size_t)n_v);
+	a = px__nurbs_padded((size_t)n_u + (size_t)degree_u + 1);
+	b = px__nurbs_padded((size_t)n_v + (size_t)degree_v + 1);
+	c = px__nurbs_padded(4 * (size_t)n_u * (size_t)n_v);
 	if (!a || !b || !c)
 		return 0;
 	return a + b + c;
-}
-
-static int all_unit_weights(const double *pw, size_t count)
-{
-	size_t i;
-	for (i = 0; i < count; i++)
-		if (pw[4 * i + 3] != 1.0)
-			return 0;
-	return 1;
 }
 
 static int check_surf(int pu, int pv, int nu, int nv, const double *ku,
@@ -88,7 +69,7 @@ static void fill(struct px_nurbs_surf *s, int pu, int pv, int nu, int nv,
 	s->knots[0] = ku;
 	s->knots[1] = kv;
 	s->pw = pw;
-	s->rational = !all_unit_weights(pw, (size_t)nu * (size_t)nv);
+	s->rational = !px__nurbs_unit_weights(pw, (size_t)nu * (size_t)nv);
 }
 
 int px_nurbs_surf_init(struct px_nurbs_surf *s, struct px_arena *a,
@@ -99,7 +80,7 @@ int px_nurbs_surf_init(struct px_nurbs_surf *s, struct px_arena *a,
 		       struct px_nurbs_error *err)
 {
 	double *ku, *kv, *P;
-	size_t i, count;
+	size_t count;
 	int rc;
 
 	if (!s || !a || !xyz) {
@@ -128,13 +109,7 @@ int px_nurbs_surf_init(struct px_nurbs_surf *s, struct px_arena *a,
 	}
 	memcpy(ku, knots_u, (size_t)n_knots_u * sizeof(double));
 	memcpy(kv, knots_v, (size_t)n_knots_v * sizeof(double));
-	for (i = 0; i < count; i++) {
-		double wi = w ? w[i] : 1.0;
-		P[4 * i] = xyz[3 * i] * wi;
-		P[4 * i + 1] = xyz[3 * i + 1] * wi;
-		P[4 * i + 2] = xyz[3 * i + 2] * wi;
-		P[4 * i + 3] = wi;
-	}
+	px__nurbs_homogeneous(P, xyz, w, count);
 	fill(s, degree_u, degree_v, n_u, n_v, ku, kv, P);
 	return PX_OK;
 }
@@ -265,14 +240,16 @@ static void surf_eval_core(const struct px_nurbs_surf *s, double u, double v,
 			px_vec3 x = px_v3(A[k][l][0], A[k][l][1], A[k][l][2]);
 			for (j = 1; j <= l; j++)
 				x = px_v3_madd(x, S[k][l - j],
-					       -binom[l][j] * A[0][j][3]);
+					       -px__nurbs_binom(l, j) *
+						       A[0][j][3]);
 			for (i = 1; i <= k; i++) {
 				x = px_v3_madd(x, S[k - i][l],
-					       -binom[k][i] * A[i][0][3]);
+					       -px__nurbs_binom(k, i) *
+						       A[i][0][3]);
 				for (j = 1; j <= l; j++)
 					x = px_v3_madd(x, S[k - i][l - j],
-						       -binom[k][i] *
-							       binom[l][j] *
+						       -px__nurbs_binom(k, i) *
+							       px__nurbs_binom(l, j) *
 							       A[i][j][3]);
 			}
 			S[k][l] = px_v3_scale(x, 1.0 / A[0][0][3]);
@@ -606,7 +583,7 @@ size_t px_nurbs_surf_extract_bytes(const struct px_nurbs_surf *s)
 	return px_nurbs_surf_bytes(s->degree[0], s->degree[1],
 				   s->n_ctrl[0] + s->degree[0],
 				   s->n_ctrl[1] + s->degree[1]) +
-	       padded(PX_NURBS_SURF_WORK_LEN(s->degree[0], s->degree[1],
+	       px__nurbs_padded(PX_NURBS_SURF_WORK_LEN(s->degree[0], s->degree[1],
 					     s->n_ctrl[0], s->n_ctrl[1]));
 }
 

@@ -338,13 +338,65 @@ int px_scene_nearest(const struct px_scene *s, px_vec3 p, double max_dist,
 	return found;
 }
 
-int px_scene_within(const struct px_scene *s, px_vec3 p, double dist,
-		    struct px_scene_hit *hits, size_t cap, size_t *n_found)
-{
+/* Depth-first walk over the models in the leaves whose boxes lie within
+ * lim of a point p (b NULL) or of a box b, for the queries that want
+ * every model in range; on the caller's stack, no allocation. */
+struct leaf_walk {
 	struct {
 		uint32_t idx, cnt;
 	} st[STACK];
-	int sp = 0;
+	int sp;
+	uint32_t i, end; /* the leaf range being handed out */
+	px_vec3 p;
+	const px_aabb *b;
+	double lim;
+};
+
+static void walk_start(struct leaf_walk *w, px_vec3 p, const px_aabb *b,
+		       double lim)
+{
+	w->st[0].idx = 0;
+	w->st[0].cnt = 0;
+	w->sp = 1;
+	w->i = w->end = 0;
+	w->p = p;
+	w->b = b;
+	w->lim = lim;
+}
+
+/* The next model id of the walk, or -1 when it is over. */
+static int64_t walk_next(const struct px_scene *s, struct leaf_walk *w)
+{
+	while (w->i == w->end) {
+		const struct snode *nd;
+		int c;
+		if (w->sp == 0)
+			return -1;
+		w->sp--;
+		if (w->st[w->sp].cnt > 0) {
+			w->i = w->st[w->sp].idx;
+			w->end = w->i + w->st[w->sp].cnt;
+			continue;
+		}
+		nd = &s->nodes[w->st[w->sp].idx];
+		for (c = 0; c < 2; c++) {
+			double d = w->b ? box_box(nd, c, w->b)
+					 : box_dist(nd, c, w->p);
+			if (d > w->lim || w->sp >= STACK)
+				continue;
+			w->st[w->sp].idx = nd->idx[c];
+			w->st[w->sp].cnt = nd->cnt[c];
+			w->sp++;
+		}
+	}
+	return s->perm[w->i++];
+}
+
+int px_scene_within(const struct px_scene *s, px_vec3 p, double dist,
+		    struct px_scene_hit *hits, size_t cap, size_t *n_found)
+{
+	struct leaf_walk w;
+	int64_t id;
 	size_t n = 0;
 
 	if (n_found)
@@ -357,37 +409,17 @@ int px_scene_within(const struct px_scene *s, px_vec3 p, double dist,
 		return PX_E_STATE;
 	if (s->n == 0)
 		return 0;
-	st[sp].idx = 0;
-	st[sp].cnt = 0;
-	sp++;
-	while (sp > 0) {
-		const struct snode *nd;
-		int c;
-		sp--;
-		if (st[sp].cnt > 0) {
-			uint32_t i;
-			for (i = st[sp].idx; i < st[sp].idx + st[sp].cnt; i++) {
-				uint32_t id = s->perm[i];
-				struct px_model_result r;
-				double bound = box_contains(&s->box[id], p) ? INFINITY : dist;
-				int rc = px_model_query_ex(s->models[id], p, bound, -1, 0u, &r);
-				if (rc < 0)
-					return rc;
-				if (rc == 1 && r.distance <= dist) {
-					if (n < cap)
-						fill_point_hit(&hits[n], (int)id, p, &r);
-					n++;
-				}
-			}
-			continue;
-		}
-		nd = &s->nodes[st[sp].idx];
-		for (c = 0; c < 2; c++) {
-			if (box_dist(nd, c, p) > dist || sp >= STACK)
-				continue;
-			st[sp].idx = nd->idx[c];
-			st[sp].cnt = nd->cnt[c];
-			sp++;
+	walk_start(&w, p, NULL, dist);
+	while ((id = walk_next(s, &w)) >= 0) {
+		struct px_model_result r;
+		double bound = box_contains(&s->box[id], p) ? INFINITY : dist;
+		int rc = px_model_query_ex(s->models[id], p, bound, -1, 0u, &r);
+		if (rc < 0)
+			return rc;
+		if (rc == 1 && r.distance <= dist) {
+			if (n < cap)
+				fill_point_hit(&hits[n], (int)id, p, &r);
+			n++;
 		}
 	}
 	if (n_found)
@@ -399,10 +431,8 @@ int px_scene_tool(const struct px_scene *s, const struct px_model *tool,
 		  double max_dist, const struct px_pair_opts *opt,
 		  struct px_scene_hit *hits, size_t cap, size_t *n_found)
 {
-	struct {
-		uint32_t idx, cnt;
-	} st[STACK];
-	int sp = 0;
+	struct leaf_walk w;
+	int64_t id;
 	size_t n = 0;
 	px_aabb tb;
 
@@ -415,48 +445,28 @@ int px_scene_tool(const struct px_scene *s, const struct px_model *tool,
 	if (s->n == 0)
 		return 0;
 	tb = px_model_world_aabb(tool);
-	st[sp].idx = 0;
-	st[sp].cnt = 0;
-	sp++;
-	while (sp > 0) {
-		const struct snode *nd;
-		int c;
-		sp--;
-		if (st[sp].cnt > 0) {
-			uint32_t i;
-			for (i = st[sp].idx; i < st[sp].idx + st[sp].cnt; i++) {
-				uint32_t id = s->perm[i];
-				struct px_pair_result r;
-				int rc;
-				if (s->models[id] == tool)
-					continue;
-				memset(&r, 0, sizeof(r));
-				rc = px_pair_distance(tool, s->models[id], opt, &r);
-				if (rc < 0)
-					return rc;
-				if (r.distance <= max_dist) {
-					if (n < cap) {
-						struct px_scene_hit *h = &hits[n];
-						h->model = (int)id;
-						h->distance = r.distance;
-						h->point = r.point_b;
-						h->tool_point = r.point_a;
-						h->feature_index = r.index_b;
-						h->intersecting = r.intersecting;
-						h->local_only = r.local_only;
-					}
-					n++;
-				}
-			}
+	walk_start(&w, px_v3(0.0, 0.0, 0.0), &tb, max_dist);
+	while ((id = walk_next(s, &w)) >= 0) {
+		struct px_pair_result r;
+		int rc;
+		if (s->models[id] == tool)
 			continue;
-		}
-		nd = &s->nodes[st[sp].idx];
-		for (c = 0; c < 2; c++) {
-			if (box_box(nd, c, &tb) > max_dist || sp >= STACK)
-				continue;
-			st[sp].idx = nd->idx[c];
-			st[sp].cnt = nd->cnt[c];
-			sp++;
+		memset(&r, 0, sizeof(r));
+		rc = px_pair_distance(tool, s->models[id], opt, &r);
+		if (rc < 0)
+			return rc;
+		if (r.distance <= max_dist) {
+			if (n < cap) {
+				struct px_scene_hit *h = &hits[n];
+				h->model = (int)id;
+				h->distance = r.distance;
+				h->point = r.point_b;
+				h->tool_point = r.point_a;
+				h->feature_index = r.index_b;
+				h->intersecting = r.intersecting;
+				h->local_only = r.local_only;
+			}
+			n++;
 		}
 	}
 	if (n_found)

@@ -17,41 +17,9 @@
 #include "px_obj.h"
 #include "px_prim.h"
 #include "px_world.h"
+#include "schema_internal.h"
 
-#define RANGE (PX_CONFIG_HAS_MIN | PX_CONFIG_HAS_MAX)
 #define BIG 1e6
-
-#define K_DBL(T, f, nm, fl, lo, hi, def)                                    \
-	{.name = nm, .type = PX_CONFIG_T_DOUBLE, .offset = offsetof(T, f),    \
-	 .flags = (fl) | RANGE, .dmin = (lo), .dmax = (hi), .ddef = (def)}
-#define K_DBLP(T, f, nm, fl, lo, hi, pres)                                  \
-	{.name = nm, .type = PX_CONFIG_T_DOUBLE, .offset = offsetof(T, f),    \
-	 .flags = (fl) | RANGE | PX_CONFIG_PRESENT, .dmin = (lo), .dmax = (hi), \
-	 .ddef = (hi), .present_offset = offsetof(T, pres)}
-#define K_VEC(T, f, nm, fl, lo, hi)                                         \
-	{.name = nm, .type = PX_CONFIG_T_DOUBLE, .offset = offsetof(T, f),    \
-	 .flags = (fl) | RANGE, .dmin = (lo), .dmax = (hi), .fixed_count = 3}
-#define K_VECP(T, f, nm, fl, lo, hi, pres)                                  \
-	{.name = nm, .type = PX_CONFIG_T_DOUBLE, .offset = offsetof(T, f),    \
-	 .flags = (fl) | RANGE | PX_CONFIG_PRESENT, .dmin = (lo), .dmax = (hi), \
-	 .fixed_count = 3, .ddef = (hi), .present_offset = offsetof(T, pres)}
-#define K_STR(T, f, nm, fl)                                                 \
-	{.name = nm, .type = PX_CONFIG_T_STRING, .offset = offsetof(T, f),    \
-	 .flags = (fl) | PX_CONFIG_NONEMPTY}
-#define K_ENUM(T, f, nm, fl, nms, def)                                      \
-	{.name = nm, .type = PX_CONFIG_T_ENUM, .offset = offsetof(T, f),      \
-	 .flags = (fl), .names = (nms), .idef = (def)}
-#define K_SUB(T, f, nm, sch)                                                \
-	{.name = nm, .type = PX_CONFIG_T_SUB, .offset = offsetof(T, f),       \
-	 .sub = &(sch)}
-#define K_SEQ(T, f, cnt, nm, fl, sch, ET, lo, hi)                           \
-	{.name = nm, .type = PX_CONFIG_T_SEQ, .offset = offsetof(T, f),       \
-	 .flags = (fl), .sub = &(sch), .elem = PX_CONFIG_T_SUB,               \
-	 .elem_size = sizeof(ET), .count_offset = offsetof(T, cnt),           \
-	 .min_count = (lo), .max_count = (hi)}
-#define SCHEMA(var, nm, keys, chk)                                          \
-	static const struct px_config_schema var = {                        \
-		nm, keys, sizeof(keys) / sizeof(keys[0]), chk}
 
 enum file_kind { KIND_MESH = 0, KIND_NURBS = 1, KIND_CLOUD = 2 };
 static const char *const kind_names[] = {"mesh", "nurbs", "cloud", NULL};

@@ -60,3 +60,15 @@ void px_test_check_documented(const char *docs,
 {
 	walk(docs, s, 0, max_depth);
 }
+
+struct px_config *px_test_config_load(const char *yaml,
+				      struct px_config_diag *diag)
+{
+	struct px_config *c = NULL;
+	int rc = px_config_load_mem("t.yaml", yaml, strlen(yaml), &c, diag);
+	if (rc != PX_OK) {
+		px_config_diag_print(diag, stderr);
+		return NULL;
+	}
+	return c;
+}

@@ -18,4 +18,12 @@ char *px_test_read_text(const char *path);
 void px_test_check_documented(const char *docs,
 			      const struct px_config_schema *s, int max_depth);
 
+/*
+ * The YAML document yaml loaded as "t.yaml" with its diagnostics in
+ * *diag; NULL (diagnostics printed to stderr) when it does not load.
+ * The caller frees the config with px_config_free().
+ */
+struct px_config *px_test_config_load(const char *yaml,
+				      struct px_config_diag *diag);
+
 #endif

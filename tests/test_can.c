@@ -22,6 +22,7 @@
 #include "px_can.h"
 #include "px_loop.h"
 #include "px_test.h"
+#include "px_test_dev.h"
 
 /* Reference: Motorola signals as a big-endian bit stream. DBC's start
  * bit s (MSB) is stream position (s/8)*8 + 7 - s%8, and the signal's
@@ -412,12 +413,6 @@ static void test_sim_bus_order_faults_and_bus_off(void)
 	px_can_sim_free(s);
 }
 
-static void wait_ms(int ms)
-{
-	struct timespec ts = {0, ms * 1000000L};
-	nanosleep(&ts, NULL);
-}
-
 static void test_unix_bus_between_processes(void)
 {
 	char pa[64], pb[64];
@@ -441,12 +436,12 @@ static void test_unix_bus_between_processes(void)
 		for (k = 0; k < 4000 && n < 20; k++) {
 			struct px_can_msg r;
 			if (px_can_bus_recv(b, 0, &r) != PX_OK) {
-				wait_ms(1);
+				px_test_wait_ms(1);
 				continue;
 			}
 			r.f.can_id += 1;
 			while (px_can_bus_send(b, &r, 0) == PX_E_AGAIN)
-				wait_ms(1);
+				px_test_wait_ms(1);
 			n++;
 		}
 		px_can_bus_close(b);
@@ -463,12 +458,12 @@ static void test_unix_bus_between_processes(void)
 		for (tries = 0; tries < 2000; tries++) {
 			if (px_can_bus_send(a, &m, 0) == PX_OK)
 				break;
-			wait_ms(1);
+			px_test_wait_ms(1);
 		}
 		for (tries = 0; tries < 2000; tries++) {
 			if (px_can_bus_recv(a, 0, &m) == PX_OK)
 				break;
-			wait_ms(1);
+			px_test_wait_ms(1);
 		}
 		if (m.f.can_id == 0x101u + 2 * (uint32_t)i && m.fd == i % 2 &&
 		    m.f.data[0] == i && m.f.data[m.f.len - 1] == 0x5A &&
@@ -599,11 +594,11 @@ static void test_raw_on_vcan(void)
 			PX_CHECK(m.t_ns <= now + 1000000 && m.t_ns > now - 10000000000LL);
 			got++;
 		} else {
-			wait_ms(5);
+			px_test_wait_ms(5);
 		}
 	}
 	PX_CHECK_INT_EQ(got, 2);
-	wait_ms(20);
+	px_test_wait_ms(20);
 	PX_CHECK_INT_EQ(px_can_bus_recv(rx, 0, &m), PX_E_AGAIN); /* filtered */
 	px_can_bus_close(tx);
 	px_can_bus_close(rx);
@@ -646,7 +641,7 @@ static void test_error_frames_on_vcan(void)
 		PX_CHECK(write(s, &f[i], sizeof f[i]) == (ssize_t)sizeof f[i]);
 	for (i = 0; i < 200 && got < 2; i++) {
 		if (px_can_bus_recv(rx, 0, &m) != PX_OK) {
-			wait_ms(5);
+			px_test_wait_ms(5);
 			continue;
 		}
 		PX_CHECK(m.f.can_id & CAN_ERR_FLAG);

@@ -13,19 +13,9 @@
 #include "px_sim.h"
 #include "px_alloc_count.h"
 #include "px_test.h"
+#include "px_test_config.h"
 
 static struct px_config_diag g_diag;
-
-static struct px_config *load(const char *yaml)
-{
-	struct px_config *c = NULL;
-	int rc = px_config_load_mem("t.yaml", yaml, strlen(yaml), &c, &g_diag);
-	if (rc != PX_OK) {
-		px_config_diag_print(&g_diag, stderr);
-		return NULL;
-	}
-	return c;
-}
 
 static int is_simulated(const struct px_config_device *d)
 {
@@ -163,7 +153,7 @@ static void test_can_signal_axes(void)
 		"        - {name: st, id: 0x101, direction: input, start_bit: 32, length: 8}\n"
 		"        - {name: fy, id: 0x201, direction: output, start_bit: 0, length: 16, signed: true, scale: 0.01, axis: fy}\n"
 		"        - {name: tz, id: 0x201, direction: output, start_bit: 23, length: 16, byte_order: big, signed: true, scale: 0.001, axis: tz}\n";
-	struct px_config *cfg = load(y);
+	struct px_config *cfg = px_test_config_load(y, &g_diag);
 	struct px_can_sim *bus = NULL;
 	struct px_can_sim_config sc;
 	struct px_can_bus *peer = NULL;
@@ -249,7 +239,7 @@ static void test_canopen_drives(void)
 		"        drives:\n"
 		"          - {node_id: 3, mode: csp, joint: 1, counts_per_unit: 1000}\n"
 		"          - {node_id: 9, mode: csv, joint: 0, counts_per_unit: 20000, rated_torque_n_m: 4.5}\n";
-	struct px_config *cfg = load(y);
+	struct px_config *cfg = px_test_config_load(y, &g_diag);
 	struct px_devcfg *h = NULL;
 	struct px_canopen_drive_cfg dr[4];
 	struct px_canopen_sim_config sc;
@@ -329,7 +319,7 @@ static void test_gpio_roles(void)
 		"        - {name: stop_button, direction: input, active_low: true}\n"
 		"        - {name: relay, direction: output}\n"
 		"        - {name: timing, direction: output}\n";
-	struct px_config *cfg = load(y);
+	struct px_config *cfg = px_test_config_load(y, &g_diag);
 	struct px_devcfg *h = NULL;
 	struct px_dev *d;
 	char msg[512];
@@ -423,7 +413,8 @@ static void test_errors(void)
 	};
 	size_t i;
 	for (i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
-		struct px_config *cfg = load(cases[i].yaml);
+		struct px_config *cfg =
+			px_test_config_load(cases[i].yaml, &g_diag);
 		struct px_devcfg *h = NULL;
 		char msg[512];
 		int rc;
@@ -442,7 +433,8 @@ static void test_errors(void)
 	}
 	/* a device of another config, NULLs */
 	{
-		struct px_config *a = load(cases[0].yaml);
+		struct px_config *a =
+			px_test_config_load(cases[0].yaml, &g_diag);
 		struct px_devcfg *h = NULL;
 		char msg[128];
 		struct px_config_device other;

@@ -14,19 +14,9 @@
 #include "px_config.h"
 #include "px_devcfg.h"
 #include "px_test.h"
+#include "px_test_config.h"
 
 static struct px_config_diag g_diag;
-
-static struct px_config *load(const char *yaml)
-{
-	struct px_config *c = NULL;
-	int rc = px_config_load_mem("t.yaml", yaml, strlen(yaml), &c, &g_diag);
-	if (rc != PX_OK) {
-		px_config_diag_print(&g_diag, stderr);
-		return NULL;
-	}
-	return c;
-}
 
 /* The first diagnostic of a config that must not load. */
 static int load_fails_with(const char *yaml, const char *want)
@@ -86,7 +76,7 @@ static void test_can_sim_faults_from_config(void)
 		"      faults:\n"
 		"        - {kind: unplug, start_ns: 20000000, duration_ns: 10000000}\n"
 		"        - {kind: stuck, start_ns: 50000000, duration_ns: 20000000}\n";
-	struct px_config *cfg = load(y);
+	struct px_config *cfg = px_test_config_load(y, &g_diag);
 	struct px_can_sim_config sc;
 	struct px_can_sim *bus = NULL;
 	struct px_can_bus *robot = NULL;
@@ -179,7 +169,7 @@ static void test_can_unix_faults_from_config(void)
 		 "        - {kind: delay, start_ns: 10000000, duration_ns: 10000000, delay_ns: 5000000}\n"
 		 "        - {kind: duplicate, start_ns: 30000000, duration_ns: 10000000}\n",
 		 path);
-	cfg = load(y);
+	cfg = px_test_config_load(y, &g_diag);
 	PX_CHECK(cfg != NULL);
 	if (!cfg)
 		return;
@@ -233,7 +223,7 @@ static void test_sim_faults_from_config(void)
 		"      lines: [{name: estop, direction: input}]\n"
 		"      faults:\n"
 		"        - {kind: estop, start_ns: 5000000, duration_ns: 5000000}\n";
-	struct px_config *cfg = load(y);
+	struct px_config *cfg = px_test_config_load(y, &g_diag);
 	struct px_devcfg *h = NULL, *g = NULL;
 	struct px_pose_sample ps;
 	struct px_dev_status st;
@@ -332,7 +322,7 @@ static void test_fault_config_errors(void)
  * else the highest id no drive uses. */
 static int heartbeat_id(const char *yaml)
 {
-	struct px_config *cfg = load(yaml);
+	struct px_config *cfg = px_test_config_load(yaml, &g_diag);
 	struct px_devcfg *h = NULL;
 	struct px_can_bus *ep = NULL;
 	struct px_can_msg m;
@@ -402,7 +392,7 @@ static void test_arm_faults_from_config(void)
 		"      faults:\n"
 		"        - {kind: estop, node_id: 3, start_ns: 100000000, duration_ns: 50000000}\n"
 		"        - {kind: unplug, node_id: 9, start_ns: 200000000, duration_ns: 100000000}\n";
-	struct px_config *cfg = load(y);
+	struct px_config *cfg = px_test_config_load(y, &g_diag);
 	struct px_devcfg *h = NULL;
 	struct px_canopen_drive_cfg dr[4];
 	struct px_canopen_pdo_map pdo;
@@ -492,7 +482,7 @@ static void test_usb_no_hotplug_key(void)
 		"      pid: 0x5678\n"
 		"      endpoint_in: 0x81\n"
 		"      inputs: [{byte_offset: 0, axis: x}]\n";
-	struct px_config *cfg = load(y);
+	struct px_config *cfg = px_test_config_load(y, &g_diag);
 	PX_CHECK(cfg != NULL);
 	if (!cfg)
 		return;
@@ -646,7 +636,7 @@ static void test_bitrate_from_config(void)
 		"      interface: can0\n"
 		"      bitrate: 1000000\n"
 		"      restart_ms: 50\n" CAN_SIGNALS;
-	struct px_config *cfg = load(y);
+	struct px_config *cfg = px_test_config_load(y, &g_diag);
 	struct px_devcfg *h = NULL;
 	char msg[512];
 	int rc;

@@ -9,19 +9,9 @@
 #include "px_devcfg.h"
 #include "px_sim.h"
 #include "px_test.h"
+#include "px_test_config.h"
 
 static struct px_config_diag g_diag;
-
-static struct px_config *load(const char *yaml)
-{
-	struct px_config *c = NULL;
-	int rc = px_config_load_mem("t.yaml", yaml, strlen(yaml), &c, &g_diag);
-	if (rc != PX_OK) {
-		px_config_diag_print(&g_diag, stderr);
-		return NULL;
-	}
-	return c;
-}
 
 static const char yaml[] =
 	"version: 1\n"
@@ -61,7 +51,7 @@ static struct px_sim_fault window(int kind, int64_t start_ns,
  * option's (already on the loop clock) does not; both hit the device. */
 static void test_option_faults_added(void)
 {
-	struct px_config *cfg = load(yaml);
+	struct px_config *cfg = px_test_config_load(yaml, &g_diag);
 	struct px_devcfg *h = NULL, *g = NULL;
 	struct px_devcfg_options opt;
 	struct px_sim_fault hf, gf;
@@ -113,7 +103,7 @@ out:
 
 static void test_option_faults_refused(void)
 {
-	struct px_config *cfg = load(yaml);
+	struct px_config *cfg = px_test_config_load(yaml, &g_diag);
 	struct px_devcfg *h = NULL;
 	struct px_devcfg_options opt;
 	struct px_sim_fault f[PX_SIM_MAX_FAULTS];

@@ -13,6 +13,7 @@
 #include "px_gpio.h"
 #include "px_loop.h"
 #include "px_test.h"
+#include "px_test_dev.h"
 
 /* Reference: runs of equal raw level; the debounced level becomes a run's
  * level when the run lasted at least db (up to the next run or to q). */
@@ -451,18 +452,6 @@ static void test_gpiod_open_path(void)
 			PX_E_INVAL);
 }
 
-static int sysfs_write(const char *dir, const char *file, const char *v)
-{
-	char p[512];
-	FILE *f;
-	snprintf(p, sizeof p, "%s/%s", dir, file);
-	f = fopen(p, "w");
-	if (!f)
-		return -1;
-	fputs(v, f);
-	return fclose(f);
-}
-
 static int sysfs_read(const char *dir, const char *file)
 {
 	char p[512], b[16] = "";
@@ -504,7 +493,8 @@ static void test_gpiod_on_gpio_sim(void)
 	c.line[PX_GPIO_ESTOP].debounce_ns = 1000000;
 	c.line[PX_GPIO_ENABLE].offset = 1;
 	c.line[PX_GPIO_TIMING].present = 0;
-	PX_CHECK_INT_EQ(sysfs_write(dir, "sim_gpio0/pull", "pull-down"), 0);
+	PX_CHECK_INT_EQ(
+		px_test_write_file(dir, "sim_gpio0/pull", "pull-down"), 0);
 	px_dev_config_default(&dc);
 	dc.name = "io";
 	PX_CHECK_MSG(px_gpiod_create(&dc, &c, &d, &e, msg, sizeof msg) == PX_OK,
@@ -513,7 +503,8 @@ static void test_gpiod_on_gpio_sim(void)
 	PX_CHECK_INT_EQ(p, 0);
 	PX_CHECK_INT_EQ(px_dev_dio_write(d, PX_DIO_ENABLE, 1, mono()), PX_OK);
 	PX_CHECK_INT_EQ(sysfs_read(dir, "sim_gpio1/value"), 1);
-	PX_CHECK_INT_EQ(sysfs_write(dir, "sim_gpio0/pull", "pull-up"), 0);
+	PX_CHECK_INT_EQ(
+		px_test_write_file(dir, "sim_gpio0/pull", "pull-up"), 0);
 	for (i = 0; i < 500 && !p; i++) {
 		struct timespec ts = {0, 2000000};
 		nanosleep(&ts, NULL);
@@ -548,7 +539,8 @@ static void test_gpiod_by_name_on_gpio_sim(void)
 	c.line[PX_GPIO_ENABLE].line_name = "enable";
 	c.line[PX_GPIO_ENABLE].offset = 98;
 	c.line[PX_GPIO_TIMING].present = 0;
-	PX_CHECK_INT_EQ(sysfs_write(dir, "sim_gpio0/pull", "pull-down"), 0);
+	PX_CHECK_INT_EQ(
+		px_test_write_file(dir, "sim_gpio0/pull", "pull-down"), 0);
 	px_dev_config_default(&dc);
 	dc.name = "io";
 	PX_CHECK_MSG(px_gpiod_create(&dc, &c, &d, &e, msg, sizeof msg) == PX_OK,
@@ -557,8 +549,9 @@ static void test_gpiod_by_name_on_gpio_sim(void)
 	PX_CHECK_INT_EQ(sysfs_read(dir, "sim_gpio1/value"), 1);
 	for (k = 0; k < 3; k++) {
 		int want = k % 2 == 0;
-		PX_CHECK_INT_EQ(sysfs_write(dir, "sim_gpio0/pull",
-					    want ? "pull-up" : "pull-down"),
+		PX_CHECK_INT_EQ(px_test_write_file(dir, "sim_gpio0/pull",
+						   want ? "pull-up"
+							: "pull-down"),
 				0);
 		for (i = 0; i < 500 && p != want; i++) {
 			struct timespec ts = {0, 2000000};

@@ -16,6 +16,8 @@
 #include "px_dev.h"
 #include "px_hid.h"
 #include "px_test.h"
+#include "px_test_dev.h"
+#include "vm/haptic_rd.h"
 
 static void test_open_by_vid_pid_not_found(void)
 {
@@ -103,22 +105,6 @@ static void test_config_errors(void)
 
 /* ---- through /dev/uhid ------------------------------------------------ */
 
-/* Report 1: x, y, z int32 + 4 buttons (+4 pad bits); output report 2:
- * three int16: the built-in "haptic" map. */
-static const uint8_t haptic_rd[] = {
-	0x05, 0x01, 0x09, 0x08, 0xA1, 0x01,
-	0x85, 0x01, 0x09, 0x30, 0x09, 0x31, 0x09, 0x32,
-	0x17, 0x00, 0x00, 0x00, 0x80, 0x27, 0xFF, 0xFF, 0xFF, 0x7F,
-	0x75, 0x20, 0x95, 0x03, 0x81, 0x02,
-	0x05, 0x09, 0x19, 0x01, 0x29, 0x04, 0x15, 0x00, 0x25, 0x01,
-	0x75, 0x01, 0x95, 0x04, 0x81, 0x02, 0x75, 0x04, 0x95, 0x01,
-	0x81, 0x01,
-	0x85, 0x02, 0x06, 0x00, 0xFF, 0x09, 0x01,
-	0x16, 0x00, 0x80, 0x26, 0xFF, 0x7F, 0x75, 0x10, 0x95, 0x03,
-	0x91, 0x02,
-	0xC0,
-};
-
 /* Wait (bounded) for a uhid event of type want; returns 0 or -1. */
 static int uhid_wait(int fd, uint32_t want, struct uhid_event *ev, int ms)
 {
@@ -134,12 +120,6 @@ static int uhid_wait(int fd, uint32_t want, struct uhid_event *ev, int ms)
 			return 0;
 	}
 	return -1;
-}
-
-static void wait_ms(int ms)
-{
-	struct timespec ts = {ms / 1000, (ms % 1000) * 1000000L};
-	nanosleep(&ts, NULL);
 }
 
 static void test_uhid_device_roundtrip(void)
@@ -184,7 +164,7 @@ static void test_uhid_device_roundtrip(void)
 	for (i = 0; i < 50 && rc != PX_OK; i++) { /* node appears async */
 		rc = px_hid_create(&c, &h, &d, msg, sizeof msg);
 		if (rc != PX_OK)
-			wait_ms(100);
+			px_test_wait_ms(100);
 	}
 	PX_CHECK_MSG(rc == PX_OK, "%s", msg);
 	PX_CHECK_INT_EQ(px_dev_start(d), PX_OK);
@@ -206,7 +186,7 @@ static void test_uhid_device_roundtrip(void)
 		px_dev_pose_read(d, px_dev_mono_ns(), &s);
 		if (s.seq >= 1 && s.pos_m.x > 0.0199)
 			break;
-		wait_ms(10);
+		px_test_wait_ms(10);
 	}
 	PX_CHECK_NEAR(s.pos_m.x, 0.020, 1e-12);
 	PX_CHECK_NEAR(s.pos_m.y, -0.040, 1e-12);
@@ -227,7 +207,7 @@ static void test_uhid_device_roundtrip(void)
 	for (i = 0; i < 300; i++) {
 		if (px_dev_pose_read(d, px_dev_mono_ns(), &s) == PX_E_NODEV)
 			break;
-		wait_ms(10);
+		px_test_wait_ms(10);
 	}
 	PX_CHECK(!s.valid && s.stale);
 	px_dev_status(d, &st);
@@ -236,18 +216,6 @@ static void test_uhid_device_roundtrip(void)
 		     st.last_msg);
 	px_dev_free(d);
 	close(fd);
-}
-
-static int write_file(const char *dir, const char *name, const char *v)
-{
-	char p[512];
-	FILE *f;
-	snprintf(p, sizeof p, "%s/%s", dir, name);
-	f = fopen(p, "w");
-	if (!f)
-		return -1;
-	fputs(v, f);
-	return fclose(f);
 }
 
 /* Unbind the gadget's UDC (an unplug) and bind it again (a replug). The
@@ -263,30 +231,33 @@ static void gadget_unplug_replug(struct px_dev *d, const char *gdir,
 	struct px_pose_sample s;
 	struct px_dev_status st;
 	uint8_t rep[64];
-	int i, n, fd, rc = 0;
-	PX_CHECK_INT_EQ(write_file(gdir, "UDC", "\n"), 0);
-	for (i = 0; i < 500; i++) {
+	int64_t t_end;
+	int n, fd, rc = 0;
+	PX_CHECK_INT_EQ(px_test_write_file(gdir, "UDC", "\n"), 0);
+	for (t_end = px_test_deadline_ms(10000);;) {
 		rc = px_dev_pose_read(d, px_dev_mono_ns(), &s);
-		if (rc == PX_E_NODEV)
+		if (rc == PX_E_NODEV || px_test_past(t_end))
 			break;
-		wait_ms(10);
+		px_test_wait_ms(10);
 	}
 	PX_CHECK_INT_EQ(rc, PX_E_NODEV);
 	PX_CHECK(!s.valid && s.stale);
-	PX_CHECK_INT_EQ(write_file(gdir, "UDC", udc), 0);
-	for (i = 0; i < 500 && px_dev_state(d) != PX_DEV_STATE_RUNNING; i++)
-		wait_ms(10);
+	PX_CHECK_INT_EQ(px_test_write_file(gdir, "UDC", udc), 0);
+	/* re-enumeration on a loaded guest once took more than 5 s */
+	for (t_end = px_test_deadline_ms(30000);
+	     px_dev_state(d) != PX_DEV_STATE_RUNNING && !px_test_past(t_end);)
+		px_test_wait_ms(10);
 	PX_CHECK_INT_EQ(px_dev_state(d), PX_DEV_STATE_RUNNING);
 	fd = open(hidg, O_RDWR);
 	PX_CHECK_MSG(fd >= 0, "%s: %s", hidg, strerror(errno));
 	n = px_codec_encode_input(m, 1, a, 9, rep, sizeof rep);
-	for (i = 0; i < 300; i++) {
+	for (t_end = px_test_deadline_ms(10000);;) {
 		if (write(fd, rep, (size_t)n) != n)
-			wait_ms(5);
+			px_test_wait_ms(5);
 		px_dev_pose_read(d, px_dev_mono_ns(), &s);
-		if (s.valid && s.buttons == 9)
+		if ((s.valid && s.buttons == 9) || px_test_past(t_end))
 			break;
-		wait_ms(10);
+		px_test_wait_ms(10);
 	}
 	PX_CHECK(s.valid && !s.stale);
 	PX_CHECK_NEAR(s.pos_m.x, 0.007, 1e-12);
@@ -330,7 +301,7 @@ static void test_usb_hid_gadget(void)
 	for (i = 0; i < 50 && rc != PX_OK; i++) {
 		rc = px_hid_create(&c, &h, &d, msg, sizeof msg);
 		if (rc != PX_OK)
-			wait_ms(100);
+			px_test_wait_ms(100);
 	}
 	PX_CHECK_MSG(rc == PX_OK, "%s", msg);
 	PX_CHECK_INT_EQ(px_dev_start(d), PX_OK);
@@ -339,11 +310,11 @@ static void test_usb_hid_gadget(void)
 	n = px_codec_encode_input(m, 1, a, 3, rep, sizeof rep);
 	for (i = 0; i < 300; i++) {
 		if (write(fd, rep, (size_t)n) != n)
-			wait_ms(5);
+			px_test_wait_ms(5);
 		px_dev_pose_read(d, px_dev_mono_ns(), &s);
 		if (s.seq > 0)
 			break;
-		wait_ms(10);
+		px_test_wait_ms(10);
 	}
 	PX_CHECK(s.valid);
 	PX_CHECK_NEAR(s.pos_m.x, -0.004, 1e-12);

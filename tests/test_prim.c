@@ -19,6 +19,7 @@
 #include "px_model.h"
 #include "px_prim.h"
 #include "px_test.h"
+#include "px_test_geom.h"
 
 /* ---- independent references ------------------------------------------- */
 
@@ -149,21 +150,6 @@ static void sample(const struct px_prim *p, double d, struct samples *s)
 	}
 }
 
-static px_pose rand_pose(void)
-{
-	px_pose P;
-	px_quat q = {px_rand_normal(), px_rand_normal(), px_rand_normal(),
-		     px_rand_normal()};
-	double n = sqrt(px_quat_dot(q, q));
-	P.q.w = q.w / n;
-	P.q.x = q.x / n;
-	P.q.y = q.y / n;
-	P.q.z = q.z / n;
-	P.t = px_v3(px_rand_range(-2, 2), px_rand_range(-2, 2),
-		    px_rand_range(-2, 2));
-	return P;
-}
-
 static struct px_prim rand_prim(enum px_prim_type t)
 {
 	struct px_prim p = {t, 0, 0, 0};
@@ -212,7 +198,7 @@ static void check_type(enum px_prim_type t)
 	for (shape = 0; shape < 3; shape++) {
 		struct px_prim p = rand_prim(t);
 		struct px_model *m = NULL;
-		px_pose P = rand_pose();
+		px_pose P = px_test_rand_pose(2);
 		px_aabb box = px_prim_aabb(&p);
 		double ext = t == PX_PRIM_HALFSPACE ? 1.5 : 0.0;
 
@@ -366,7 +352,7 @@ static void test_interface(void)
 	struct px_prim sp = {PX_PRIM_SPHERE, 0.5, 0, 0};
 	struct px_model *m;
 	struct px_model_result r;
-	px_pose P = rand_pose();
+	px_pose P = px_test_rand_pose(2);
 	px_aabb wb;
 	px_obb ob;
 	uint64_t a;

@@ -5,6 +5,7 @@
 
 #include <stdio.h>
 
+#include "arc_gen.h"
 #include "px_alloc_count.h"
 #include "px_obj.h"
 #include "px_recog.h"
@@ -64,34 +65,6 @@ static void set_pw(double *pw, px_vec3 p, double w)
 	pw[1] = p.y * w;
 	pw[2] = p.z * w;
 	pw[3] = w;
-}
-
-/* 2D unit-circle arc from angle a0 over sweep in nseg rational quadratic
- * spans: xy (2 per point), w, n points, knots U on [0, 1] (clamped). */
-static int arc2d(double a0, double sweep, int nseg, double *xy, double *w,
-		 double *U)
-{
-	int s, k = 0, n = 2 * nseg + 1, i;
-	double h = sweep / nseg;
-	for (s = 0; s < nseg; s++) {
-		double t0 = a0 + s * h, tm = t0 + h / 2;
-		if (s == 0) {
-			xy[0] = cos(t0), xy[1] = sin(t0), w[0] = 1;
-		}
-		xy[2 * (2 * s + 1)] = cos(tm) / cos(h / 2);
-		xy[2 * (2 * s + 1) + 1] = sin(tm) / cos(h / 2);
-		w[2 * s + 1] = cos(h / 2);
-		xy[2 * (2 * s + 2)] = cos(t0 + h);
-		xy[2 * (2 * s + 2) + 1] = sin(t0 + h);
-		w[2 * s + 2] = 1;
-	}
-	for (i = 0; i < 3; i++)
-		U[k++] = 0;
-	for (s = 1; s < nseg; s++)
-		U[k++] = (double)s / nseg, U[k++] = (double)s / nseg;
-	for (i = 0; i < 3; i++)
-		U[k++] = 1;
-	return n;
 }
 
 static int view_curve(struct tcurve *t, int p, int n)
@@ -187,46 +160,86 @@ static int make_line(struct tcurve *t, const struct frame *f, int p, int n,
 
 /* ---- brute force references --------------------------------------------- */
 
-static double curve_brute(const struct px_nurbs_curve *c, px_vec3 p, double *ub)
+/* Distance from the query point to the point at t of a 1D path. */
+typedef double (*path_dist_fn)(const void *ctx, double t);
+
+/* Minimum of dist over [t0, t1]: n + 1 samples, then a ternary polish
+ * (iters steps) around up to 16 promising local minima of the samples
+ * (a seam or a symmetric query has several; at a centre all tie).
+ * *tbest (may be NULL) gets the parameter of the minimum. */
+static double path_brute(path_dist_fn dist, const void *ctx, double t0,
+			 double t1, int n, int iters, double *tbest)
 {
-	enum { N = 3000 };
-	double u0, u1, best = INFINITY, bu = 0, d[N + 1];
-	int i, it;
-	px_nurbs_curve_domain(c, &u0, &u1);
-	double dmin = INFINITY, dmax = 0;
-	int npol = 0;
-	for (i = 0; i <= N; i++) {
-		d[i] = px_v3_dist(p, px_nurbs_curve_point(c, u0 + (u1 - u0) * i / N));
+	double d[3001];
+	double best = INFINITY, bt = 0, dmin = INFINITY, dmax = 0;
+	int i, it, npol = 0;
+	if (n > 3000)
+		n = 3000;
+	for (i = 0; i <= n; i++) {
+		d[i] = dist(ctx, t0 + (t1 - t0) * i / n);
 		dmin = fmin(dmin, d[i]);
 		dmax = fmax(dmax, d[i]);
 	}
-	/* Polish around the promising local minima of the samples (a seam
-	 * or a symmetric query has several; at a centre all tie). */
-	for (i = 0; i <= N && npol < 16; i++) {
+	for (i = 0; i <= n && npol < 16; i++) {
 		double lo, hi, dm;
-		if ((i > 0 && d[i] > d[i - 1]) || (i < N && d[i] > d[i + 1]) ||
+		if ((i > 0 && d[i] > d[i - 1]) || (i < n && d[i] > d[i + 1]) ||
 		    d[i] > dmin + 0.05 * (dmax - dmin))
 			continue;
 		npol++;
-		lo = fmax(u0, u0 + (u1 - u0) * (i - 1) / N);
-		hi = fmin(u1, u0 + (u1 - u0) * (i + 1) / N);
-		for (it = 0; it < 200; it++) {
+		lo = fmax(t0, t0 + (t1 - t0) * (i - 1) / n);
+		hi = fmin(t1, t0 + (t1 - t0) * (i + 1) / n);
+		for (it = 0; it < iters; it++) {
 			double a = lo + (hi - lo) / 3, b = hi - (hi - lo) / 3;
-			if (px_v3_dist(p, px_nurbs_curve_point(c, a)) <
-			    px_v3_dist(p, px_nurbs_curve_point(c, b)))
+			if (dist(ctx, a) < dist(ctx, b))
 				hi = b;
 			else
 				lo = a;
 		}
-		dm = px_v3_dist(p, px_nurbs_curve_point(c, 0.5 * (lo + hi)));
+		dm = dist(ctx, 0.5 * (lo + hi));
 		if (d[i] < dm)
-			dm = d[i], lo = hi = u0 + (u1 - u0) * i / N;
+			dm = d[i], lo = hi = t0 + (t1 - t0) * i / n;
 		if (dm < best)
-			best = dm, bu = 0.5 * (lo + hi);
+			best = dm, bt = 0.5 * (lo + hi);
 	}
-	if (ub)
-		*ub = bu;
+	if (tbest)
+		*tbest = bt;
 	return best;
+}
+
+struct curve_path {
+	const struct px_nurbs_curve *c;
+	px_vec3 p;
+};
+
+static double curve_path_dist(const void *ctx, double u)
+{
+	const struct curve_path *q = ctx;
+	return px_v3_dist(q->p, px_nurbs_curve_point(q->c, u));
+}
+
+static double curve_brute(const struct px_nurbs_curve *c, px_vec3 p, double *ub)
+{
+	struct curve_path q = {c, p};
+	double u0, u1;
+	px_nurbs_curve_domain(c, &u0, &u1);
+	return path_brute(curve_path_dist, &q, u0, u1, 3000, 200, ub);
+}
+
+/* One boundary of a patch: u runs at v = fixed (along_u) or v runs at
+ * u = fixed. */
+struct edge_path {
+	const struct px_nurbs_surf *s;
+	px_vec3 p;
+	int along_u;
+	double fixed;
+};
+
+static double edge_path_dist(const void *ctx, double t)
+{
+	const struct edge_path *q = ctx;
+	return px_v3_dist(q->p, q->along_u
+					? px_nurbs_surf_point(q->s, t, q->fixed)
+					: px_nurbs_surf_point(q->s, q->fixed, t));
 }
 
 /* Dense samples plus ternary polish along one boundary of the patch
@@ -235,42 +248,15 @@ static double curve_brute(const struct px_nurbs_curve *c, px_vec3 p, double *ub)
  * pole. */
 static double surf_edge_brute(const struct px_nurbs_surf *s, px_vec3 p, int edge)
 {
-	enum { N = 400 };
-	double u0, u1, v0, v1, a0, a1, fixed, best = INFINITY, d[N + 1];
-	int i, it, along_u = edge < 2;
+	struct edge_path q;
+	double u0, u1, v0, v1;
 	px_nurbs_surf_domain(s, &u0, &u1, &v0, &v1);
-	a0 = along_u ? u0 : v0;
-	a1 = along_u ? u1 : v1;
-	fixed = edge == 0 ? v0 : edge == 1 ? v1 : edge == 2 ? u0 : u1;
-#define EPT(t) (along_u ? px_nurbs_surf_point(s, (t), fixed) : px_nurbs_surf_point(s, fixed, (t)))
-	double dmin = INFINITY, dmax = 0;
-	int npol = 0;
-	for (i = 0; i <= N; i++) {
-		d[i] = px_v3_dist(p, EPT(a0 + (a1 - a0) * i / N));
-		dmin = fmin(dmin, d[i]);
-		dmax = fmax(dmax, d[i]);
-	}
-	for (i = 0; i <= N && npol < 16; i++) {
-		double lo, hi, dm;
-		if ((i > 0 && d[i] > d[i - 1]) || (i < N && d[i] > d[i + 1]) ||
-		    d[i] > dmin + 0.05 * (dmax - dmin))
-			continue;
-		npol++;
-		lo = fmax(a0, a0 + (a1 - a0) * (i - 1) / N);
-		hi = fmin(a1, a0 + (a1 - a0) * (i + 1) / N);
-		for (it = 0; it < 120; it++) {
-			double a = lo + (hi - lo) / 3, b = hi - (hi - lo) / 3;
-			if (px_v3_dist(p, EPT(a)) < px_v3_dist(p, EPT(b)))
-				hi = b;
-			else
-				lo = a;
-		}
-		dm = fmin(d[i], px_v3_dist(p, EPT(0.5 * (lo + hi))));
-		if (dm < best)
-			best = dm;
-	}
-#undef EPT
-	return best;
+	q.s = s;
+	q.p = p;
+	q.along_u = edge < 2;
+	q.fixed = edge == 0 ? v0 : edge == 1 ? v1 : edge == 2 ? u0 : u1;
+	return q.along_u ? path_brute(edge_path_dist, &q, u0, u1, 400, 120, NULL)
+			 : path_brute(edge_path_dist, &q, v0, v1, 400, 120, NULL);
 }
 
 /* Damped Newton on |S - p|^2 / 2 from (*bu, *bv), clamped to the
@@ -883,7 +869,6 @@ static void test_surface_near_misses(void)
 			     trial, px_recog_kind_name(pr.kind));
 	}
 }
-
 
 /* Non-revolution surfaces whose rows are all exact circles: an oblique
  * circular cylinder (circles slide sideways) and a twisted band (rows

@@ -16,23 +16,9 @@
 #include "px_prim.h"
 #include "px_scene.h"
 #include "px_test.h"
+#include "px_test_geom.h"
 
 #define NM 40
-
-static px_pose rand_pose(double spread)
-{
-	px_pose P;
-	px_quat q = {px_rand_normal(), px_rand_normal(), px_rand_normal(),
-		     px_rand_normal()};
-	double n = sqrt(px_quat_dot(q, q));
-	P.q.w = q.w / n;
-	P.q.x = q.x / n;
-	P.q.y = q.y / n;
-	P.q.z = q.z / n;
-	P.t = px_v3(px_rand_range(-spread, spread), px_rand_range(-spread, spread),
-		    px_rand_range(-spread, spread));
-	return P;
-}
 
 static struct px_model *rand_model(int i)
 {
@@ -93,7 +79,7 @@ static void move_world(struct world *w)
 {
 	int i;
 	for (i = 0; i < NM; i++)
-		px_model_set_pose(w->m[i], rand_pose(3.0));
+		px_model_set_pose(w->m[i], px_test_rand_pose(3.0));
 	PX_CHECK_INT_EQ(px_scene_update(w->s), PX_OK);
 }
 
@@ -181,7 +167,7 @@ static void test_tool(void)
 			double lim = px_rand_range(0, 1.5);
 			int k, cnt = 0, rc;
 			size_t nf;
-			px_model_set_pose(tools[t], rand_pose(2.5));
+			px_model_set_pose(tools[t], px_test_rand_pose(2.5));
 			for (k = 0; k < w.n; k++) {
 				struct px_pair_result r;
 				memset(&r, 0, sizeof(r));

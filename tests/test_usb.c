@@ -14,6 +14,7 @@
 #include "px_sim.h"
 #include "px_usb.h"
 #include "px_test.h"
+#include "px_test_dev.h"
 
 static struct px_usb_config base_cfg(void)
 {
@@ -61,23 +62,11 @@ static void test_open_errors(void)
 	PX_CHECK_INT_EQ(px_usb_create(&c, &u, &d, msg, sizeof msg), PX_E_INVAL);
 }
 
-static void wait_ms(int ms)
-{
-	struct timespec ts = {ms / 1000, (ms % 1000) * 1000000L};
-	nanosleep(&ts, NULL);
-}
-
-static int write_file(const char *dir, const char *name, const char *v)
-{
-	char p[512];
-	FILE *f;
-	snprintf(p, sizeof p, "%s/%s", dir, name);
-	f = fopen(p, "w");
-	if (!f)
-		return -1;
-	fputs(v, f);
-	return fclose(f);
-}
+/* Bounds of the waits (see px_test_dev.h); a replug on a loaded guest
+ * once took more than 5 s. */
+#define FRAME_WAIT_MS 10000
+#define UNPLUG_WAIT_MS 10000
+#define REPLUG_WAIT_MS 30000
 
 /* no_hotplug 0: hotplug callbacks where libusb has them; 1: the 200 ms
  * reopen poll alone (the fallback for systems without udev). */
@@ -97,7 +86,8 @@ static void gadget_run(int no_hotplug)
 	char msg[300];
 	uint8_t rep[64];
 	double a[6] = {0.003, -0.002, 0.001, 0, 0, 0};
-	int fd, n, i, rc;
+	int64_t t_end;
+	int fd, n, rc;
 	if (!vp || !hidg || sscanf(vp, "%x:%x", &vid, &pid) != 2)
 		PX_SKIP("PX_TEST_USB_VIDPID/PX_TEST_HIDG not set: the VM suite "
 			"runs this on a USB HID gadget");
@@ -122,24 +112,24 @@ static void gadget_run(int no_hotplug)
 	PX_CHECK_MSG(fd >= 0, "%s: %s", hidg, strerror(errno));
 	n = px_codec_encode_input(m, 1, a, 5, rep, sizeof rep);
 	PX_CHECK_INT_EQ(n, 14);
-	for (i = 0; i < 300; i++) {
+	for (t_end = px_test_deadline_ms(FRAME_WAIT_MS);;) {
 		if (write(fd, rep, (size_t)n) != n)
-			wait_ms(5);
+			px_test_wait_ms(5);
 		px_dev_pose_read(d, px_dev_mono_ns(), &s);
-		if (s.seq > 0)
+		if (s.seq > 0 || px_test_past(t_end))
 			break;
-		wait_ms(10);
+		px_test_wait_ms(10);
 	}
 	PX_CHECK(s.valid);
 	PX_CHECK_NEAR(s.pos_m.x, 0.003, 1e-12);
 	PX_CHECK_INT_EQ(s.buttons, 5);
 	if (gdir && udc) {
-		PX_CHECK_INT_EQ(write_file(gdir, "UDC", "\n"), 0); /* unplug */
-		for (i = 0; i < 300; i++) {
+		PX_CHECK_INT_EQ(px_test_write_file(gdir, "UDC", "\n"), 0); /* unplug */
+		for (t_end = px_test_deadline_ms(UNPLUG_WAIT_MS);;) {
 			rc = px_dev_pose_read(d, px_dev_mono_ns(), &s);
-			if (rc == PX_E_NODEV)
+			if (rc == PX_E_NODEV || px_test_past(t_end))
 				break;
-			wait_ms(10);
+			px_test_wait_ms(10);
 		}
 		px_dev_status(d, &st);
 		PX_CHECK_MSG(!s.valid && s.stale,
@@ -147,14 +137,17 @@ static void gadget_run(int no_hotplug)
 			     "state %d, unplugs %d: %s",
 			     rc, s.valid, s.stale, px_dev_state(d),
 			     (int)st.unplugs, st.last_msg);
-		PX_CHECK_INT_EQ(write_file(gdir, "UDC", udc), 0); /* replug */
-		for (i = 0; i < 500; i++) {
+		PX_CHECK_INT_EQ(px_test_write_file(gdir, "UDC", udc), 0); /* replug */
+		for (t_end = px_test_deadline_ms(REPLUG_WAIT_MS);;) {
 			px_dev_pose_read(d, px_dev_mono_ns(), &s);
-			if (px_dev_state(d) == PX_DEV_STATE_RUNNING)
+			if (px_dev_state(d) == PX_DEV_STATE_RUNNING ||
+			    px_test_past(t_end))
 				break;
-			wait_ms(10);
+			px_test_wait_ms(10);
 		}
-		PX_CHECK_INT_EQ(px_dev_state(d), PX_DEV_STATE_RUNNING);
+		PX_CHECK_MSG(px_dev_state(d) == PX_DEV_STATE_RUNNING,
+			     "not running %d s after the replug: state %d",
+			     REPLUG_WAIT_MS / 1000, px_dev_state(d));
 		px_dev_status(d, &st);
 		PX_CHECK_INT_EQ(st.unplugs, 1);
 		PX_CHECK_INT_EQ(st.replugs, 1);

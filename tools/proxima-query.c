@@ -281,30 +281,19 @@ int main(int argc, char **argv)
 			rc = 2;
 			goto out;
 		}
-		if (track && ns > 0) {
+		rc = PX_OK;
+		if (track && ns > 0)
 			rc = px_strack_create(curves, nc, surfs, ns, NULL, &strk);
-			if (rc) {
-				fprintf(stderr, "%s: %s: cannot prepare the tracker: %s\n",
-					prog, model_path, px_strerror(rc));
-				rc = 1;
-				goto out;
-			}
-		} else if (track) {
+		else if (track)
 			rc = px_track_create(curves, nc, NULL, &trk);
-			if (rc) {
-				fprintf(stderr, "%s: %s: cannot prepare the tracker: %s\n",
-					prog, model_path, px_strerror(rc));
-				rc = 1;
-				goto out;
-			}
-		} else if (nc + ns > 0) {
+		else if (nc + ns > 0)
 			rc = px_dist_model_create(curves, nc, surfs, ns, NULL, &m);
-			if (rc) {
-				fprintf(stderr, "%s: %s: cannot prepare the model: %s\n",
-					prog, model_path, px_strerror(rc));
-				rc = 1;
-				goto out;
-			}
+		if (rc) {
+			fprintf(stderr, "%s: %s: cannot prepare the %s: %s\n", prog,
+				model_path, track ? "tracker" : "model",
+				px_strerror(rc));
+			rc = 1;
+			goto out;
 		}
 		if (obj->n_triangles > 0) {
 			/* The file's faces are a mesh of the same model. */
@@ -341,50 +330,40 @@ int main(int argc, char **argv)
 		goto out;
 	}
 	for (size_t k = 0; k < pts.n; k++) {
-		double dist = INFINITY, u = 0.0, v = 0.0;
-		px_vec3 cp = px_v3(0, 0, 0);
+		/* the output row: distance, closest point, parameters */
+		struct row {
+			double dist;
+			px_vec3 cp;
+			double u, v;
+		} o = {INFINITY, px_v3(0, 0, 0), 0.0, 0.0};
 		int64_t t0 = now_ns();
 		int qrc = 0;
 		if (trk) {
 			struct px_track_result tr;
 			qrc = px_track_update(trk, pts.p[k], &tr);
-			if (!qrc) {
-				dist = tr.dist;
-				cp = tr.point;
-				u = tr.u;
-				v = 0.0;
-			}
+			if (!qrc)
+				o = (struct row){tr.dist, tr.point, tr.u, 0.0};
 		}
 		if (strk) {
 			struct px_strack_result tr;
 			qrc = px_strack_update(strk, pts.p[k], &tr);
-			if (!qrc) {
-				dist = tr.dist;
-				cp = tr.point;
-				u = tr.u;
-				v = tr.v;
-			}
+			if (!qrc)
+				o = (struct row){tr.dist, tr.point, tr.u, tr.v};
 		}
 		if (m) {
 			struct px_dist_result r;
 			qrc = px_dist_query(m, pts.p[k], &r);
-			if (!qrc) {
-				dist = r.dist;
-				cp = r.point;
-				u = r.u;
-				v = r.v;
-			}
+			if (!qrc)
+				o = (struct row){r.dist, r.point, r.u, r.v};
 		}
 		if (mesh && !qrc) {
 			struct px_model_result r;
 			qrc = px_model_query_ex(mesh, pts.p[k], INFINITY, -1,
 						PX_QUERY_UNSIGNED, &r);
-			if (qrc == 1 && r.distance < dist) {
-				dist = r.distance;
-				cp = r.point;
-				u = r.index; /* triangle or point index */
-				v = 0.0;
-			}
+			/* u: the triangle or point index */
+			if (qrc == 1 && r.distance < o.dist)
+				o = (struct row){r.distance, r.point,
+						 (double)r.index, 0.0};
 			qrc = qrc < 0 ? qrc : 0;
 		}
 		times[k] = now_ns() - t0;
@@ -394,8 +373,8 @@ int main(int argc, char **argv)
 			rc = 1;
 			goto out;
 		}
-		printf("%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", dist, cp.x, cp.y,
-		       cp.z, u, v);
+		printf("%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", o.dist, o.cp.x,
+		       o.cp.y, o.cp.z, o.u, o.v);
 	}
 	if (fflush(stdout) || ferror(stdout)) {
 		fprintf(stderr, "%s: write error on standard output\n", prog);

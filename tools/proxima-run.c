@@ -559,6 +559,21 @@ struct app {
 };
 
 static struct app A;
+
+/* A campaign fault window (sim.faults) as a px_sim fault on the loop
+ * clock. */
+static struct px_sim_fault campaign_fault(const struct raw_fault *f)
+{
+	struct px_sim_fault x;
+	memset(&x, 0, sizeof(x));
+	x.kind = f->kind + 1;
+	x.start_ns = A.clock0_ns + f->start_ns;
+	x.duration_ns = f->duration_ns;
+	x.probability = f->probability;
+	x.delay_ns = f->delay_ns;
+	return x;
+}
+
 static volatile sig_atomic_t interrupted;
 
 static void on_signal(int sig)
@@ -1011,13 +1026,7 @@ static int make_devcfg(int k)
 				d->name, PX_SIM_MAX_FAULTS);
 			return 1;
 		}
-		memset(&linef[nline], 0, sizeof(linef[nline]));
-		linef[nline].kind = f->kind + 1;
-		linef[nline].start_ns = A.clock0_ns + f->start_ns;
-		linef[nline].duration_ns = f->duration_ns;
-		linef[nline].probability = f->probability;
-		linef[nline].delay_ns = f->delay_ns;
-		nline++;
+		linef[nline++] = campaign_fault(f);
 	}
 	opt.faults = nline ? linef : NULL;
 	opt.n_faults = nline;
@@ -1029,11 +1038,10 @@ static int make_devcfg(int k)
 		if (strcmp(f->device, d->name) != 0 ||
 		    d->backend != PX_CONFIG_BACKEND_SOCKETCAN)
 			continue;
-		memset(&x, 0, sizeof(x));
-		x.kind = f->kind + 1;
-		x.start_ns = A.clock0_ns + f->start_ns;
-		x.duration_ns = f->duration_ns;
-		x.probability = f->probability;
+		x = campaign_fault(f);
+		/* delay_ns is the simulated arm's drive index (drive 0);
+		 * this path gives the bus windows none either */
+		x.delay_ns = 0;
 		if (f->kind == FK_ESTOP || f->kind == FK_UNPLUG)
 			armf[narm++] = x; /* delay_ns 0: drive index 0 */
 		else
@@ -1249,12 +1257,7 @@ static int make_device(int k)
 					d->name, PX_SIM_MAX_FAULTS);
 				return 1;
 			}
-			fl[n].kind = f->kind + 1;
-			fl[n].start_ns = A.clock0_ns + f->start_ns;
-			fl[n].duration_ns = f->duration_ns;
-			fl[n].probability = f->probability;
-			fl[n].delay_ns = f->delay_ns;
-			n++;
+			fl[n++] = campaign_fault(f);
 		}
 		sc.faults = fl;
 		sc.n_faults = n;

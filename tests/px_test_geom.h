@@ -1,0 +1,14 @@
+/*
+ * px_test_geom.h - random geometry for the distance tests, drawn from
+ * the test's seeded stream (px_rand_*), so a failing seed replays.
+ */
+#ifndef PX_TEST_GEOM_H
+#define PX_TEST_GEOM_H
+
+#include "px_math.h"
+
+/* A pose with a uniformly random rotation (normalised Gaussian
+ * quaternion) and a translation uniform in [-spread, spread]^3. */
+px_pose px_test_rand_pose(double spread);
+
+#endif
