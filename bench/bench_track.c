@@ -10,6 +10,7 @@
  * Surfaces (px_strack) follow: a single wavy bicubic patch, a wavy
  * 16-patch bicubic, a concave fold, with cells solved per update.
  * BENCH_TRACK_DEPTH=d overrides the event-grid depth (default 4).
+ * BENCH_TRACK_CURVES_ONLY=1 stops after the curve models (profiling).
  * Prints figures only; nothing here is a pass/fail test.
  */
 #include <math.h>
@@ -435,6 +436,8 @@ int main(void)
 	circle(&c[2], 0.5, -2.5, 1.0);
 	knot(&c[3], 1.0, 1.0, 1.0);
 	run("multi-entity (4 curves)", c, 4);
+	if (getenv("BENCH_TRACK_CURVES_ONLY"))
+		return 0;
 	{
 		struct px_nurbs_surf sf[3];
 		printf("\npx_strack: surfaces, same columns (cells/u: cells solved "

@@ -59,7 +59,11 @@
 struct span {
 	double u0, u1, inv;
 	int deg;
+	int rat;        /* rational (w not constant 1) */
 	double pc[4][TRK_MAXD + 1]; /* power basis in t of x w, y w, z w, w */
+	/* the same in tau = u - u0 (derivatives come out in u directly);
+	 * zero-padded to degree 3 so low degrees share one unrolled path */
+	double pu[4][TRK_MAXD + 1];
 };
 
 struct leaf {
@@ -150,22 +154,40 @@ struct px_track {
 /* ------------------------------------------------------------------ */
 /* evaluation                                                          */
 
-static void span_eval(const struct span *s, double u, px_vec3 *c, px_vec3 *d1,
-		      px_vec3 *d2)
+/* C, C', C'' at u from the span's power-basis table: for degree <= 3 one
+ * unrolled Horner per coordinate (a few dozen flops), homogeneous
+ * quotient rule only for rational spans. */
+static inline void span_eval(const struct span *s, double u, px_vec3 *c,
+			     px_vec3 *d1, px_vec3 *d2)
 {
-	double t = (u - s->u0) * s->inv, h[4][3];
-	int k, j, p = s->deg;
+	double x = u - s->u0, h[4][3];
+	int k, j, p = s->deg, nk = s->rat ? 4 : 3;
 
-	for (k = 0; k < 4; k++) {
-		double v = s->pc[k][p], v1 = 0.0, v2 = 0.0;
-		for (j = p - 1; j >= 0; j--) {
-			v2 = v2 * t + 2.0 * v1;
-			v1 = v1 * t + v;
-			v = v * t + s->pc[k][j];
+	if (p <= 3) {
+		for (k = 0; k < nk; k++) {
+			const double *q = s->pu[k];
+			h[k][0] = ((q[3] * x + q[2]) * x + q[1]) * x + q[0];
+			h[k][1] = (3.0 * q[3] * x + 2.0 * q[2]) * x + q[1];
+			h[k][2] = 6.0 * q[3] * x + 2.0 * q[2];
 		}
-		h[k][0] = v;
-		h[k][1] = v1;
-		h[k][2] = v2;
+	} else {
+		for (k = 0; k < nk; k++) {
+			double v = s->pu[k][p], v1 = 0.0, v2 = 0.0;
+			for (j = p - 1; j >= 0; j--) {
+				v2 = v2 * x + 2.0 * v1;
+				v1 = v1 * x + v;
+				v = v * x + s->pu[k][j];
+			}
+			h[k][0] = v;
+			h[k][1] = v1;
+			h[k][2] = v2;
+		}
+	}
+	if (!s->rat) {
+		*c = px_v3(h[0][0], h[1][0], h[2][0]);
+		*d1 = px_v3(h[0][1], h[1][1], h[2][1]);
+		*d2 = px_v3(h[0][2], h[1][2], h[2][2]);
+		return;
 	}
 	{
 		double w = h[3][0], w1 = h[3][1], w2 = h[3][2], iw = 1.0 / w;
@@ -173,12 +195,11 @@ static void span_eval(const struct span *s, double u, px_vec3 *c, px_vec3 *d1,
 		px_vec3 C1 = px_v3((h[0][1] - w1 * C.x) * iw,
 				   (h[1][1] - w1 * C.y) * iw,
 				   (h[2][1] - w1 * C.z) * iw);
-		px_vec3 C2 = px_v3((h[0][2] - 2.0 * w1 * C1.x - w2 * C.x) * iw,
-				   (h[1][2] - 2.0 * w1 * C1.y - w2 * C.y) * iw,
-				   (h[2][2] - 2.0 * w1 * C1.z - w2 * C.z) * iw);
 		*c = C;
-		*d1 = px_v3_scale(C1, s->inv);
-		*d2 = px_v3_scale(C2, s->inv * s->inv);
+		*d1 = C1;
+		*d2 = px_v3((h[0][2] - 2.0 * w1 * C1.x - w2 * C.x) * iw,
+			    (h[1][2] - 2.0 * w1 * C1.y - w2 * C.y) * iw,
+			    (h[2][2] - 2.0 * w1 * C1.z - w2 * C.z) * iw);
 	}
 }
 
@@ -214,12 +235,32 @@ static inline double gco(const double *a, int n, int i, px_vec3 p)
 /* ------------------------------------------------------------------ */
 /* root isolation on one leaf                                          */
 
+/* Bernstein polynomial and its derivative at x by de Casteljau (exact
+ * enough near the ends, no library call): the last level's two values
+ * give f = (1-x) b0 + x b1 and f' = n (b1 - b0). */
+static inline double bern_val_d(const double *c, int n, double x, double *d)
+{
+	double b[TRK_NG + 1], y = 1.0 - x;
+	int i, k;
+	if (n == 0) {
+		*d = 0.0;
+		return c[0];
+	}
+	for (i = 0; i <= n; i++)
+		b[i] = c[i];
+	for (k = n; k > 1; k--)
+		for (i = 0; i < k; i++)
+			b[i] = y * b[i] + x * b[i + 1];
+	*d = n * (b[1] - b[0]);
+	return y * b[0] + x * b[1];
+}
+
 static double bern_root(const double *c, int n)
 {
 	double lo = 0.0, hi = 1.0, x = 0.5, flo = c[0];
 	int k;
 	for (k = 0; k < 100; k++) {
-		double d, f = px_bern_eval_d(c, n, x, &d), nx;
+		double d, f = bern_val_d(c, n, x, &d), nx;
 		if (f == 0.0)
 			return x;
 		if ((f < 0.0) == (flo < 0.0)) {
@@ -529,7 +570,7 @@ static int newton(const struct px_track *t, const struct ent *e, int type,
 		  double *unw, px_vec3 p, double lim, px_vec3 *c, px_vec3 *d1,
 		  double *D, double *u_out, int hint)
 {
-	double u, step, tol = 1e-8 * e->len, quick = 1e-6 * e->len;
+	double u, step, tol = 1e-8 * e->len, quick = 3e-5;
 	int k;
 	px_vec3 d2;
 	for (k = 0;; k++) {
@@ -560,16 +601,22 @@ static int newton(const struct px_track *t, const struct ent *e, int type,
 			return 1;
 		if (fabs(step) <= tol)
 			break;
-		if (fabs(step) <= quick && u + step >= sp->u0 &&
-		    u + step <= sp->u1) {
-			/* quadratic convergence: the error after this step is
-			 * O(step^2), below tol; move the point to first order
-			 * (its error is O(step^2) too) instead of evaluating
-			 * again */
+		if (fabs(step) <= quick * (sp->u1 - sp->u0) &&
+		    u + step >= sp->u0 && u + step <= sp->u1) {
+			/* quadratic convergence: the root error after this
+			 * step is O(step^2) (below 1e-9 of the span), so the
+			 * point is moved by its Taylor expansion instead of
+			 * another evaluation: second order in C (error
+			 * O(step^3), far below the answer tolerance), first
+			 * order in C' (only the next predictor uses it) */
+			px_vec3 pc;
 			*unw += step;
 			u += step;
-			*c = px_v3_add(*c, px_v3_scale(*d1, step));
+			*c = px_v3_add(*c, px_v3_scale(px_v3_add(*d1,
+					px_v3_scale(d2, 0.5 * step)), step));
 			*d1 = px_v3_add(*d1, px_v3_scale(d2, step));
+			pc = px_v3_sub(*c, p);
+			*D = px_v3_dot(pc, d2) + px_v3_dot(*d1, *d1);
 			break;
 		}
 		if (k >= TRK_NEWTON)
@@ -1609,6 +1656,18 @@ int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
 						     px_bern_binom(q, r) * hb[jj][r];
 					s->pc[jj][q] = px_bern_binom(p, q) * v;
 				}
+			{
+				double sc = 1.0;
+				for (q = 0; q <= p; q++) {
+					for (jj = 0; jj < 4; jj++)
+						s->pu[jj][q] = s->pc[jj][q] * sc;
+					sc *= s->inv;
+				}
+				s->rat = 0;
+				for (q = 0; q <= p; q++)
+					if (s->pc[3][q] != (q == 0 ? 1.0 : 0.0))
+						s->rat = 1;
+			}
 			t->n_spans++;
 		}
 		e->n_spans = t->n_spans - e->first_span;
