@@ -53,6 +53,14 @@ int px__nurbs_count_inside(const double *U, int n_knots, double a, double b);
 void px__nurbs_box_add(px_aabb *box, const double *pw);
 px_aabb px__nurbs_box_empty(void);
 
+/* ---- coherent tracking (px_track.c) ---- */
+
+struct px_track;
+/* Test hook: deliberately break the laziness proofs so tests can show
+ * they would catch it (bit 0: every root may rest, bit 1: resting minima
+ * are never woken). 0 restores normal operation. */
+void px__track_set_fault(struct px_track *t, int fault);
+
 #endif
 
 /*

@@ -35,6 +35,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "internal.h"
 #include "px_bern.h"
 
 #define TRK_MAXD PX_NURBS_MAX_DEGREE
@@ -96,6 +97,12 @@ struct zero {
 	uint32_t id;
 	px_vec3 c, d1;  /* point and C' at u (last evaluation) */
 	double D;       /* (C - p) . C'' + |C'|^2 there */
+	/* laziness: state of the last correction */
+	px_vec3 p;      /* query point then */
+	double trav;    /* path length travelled then */
+	double dist;    /* |c - p| then */
+	double until;   /* travel below which it provably stays in its leaf */
+	uint32_t ep;    /* update (epoch) of the last correction */
 };
 
 struct ent {
@@ -108,6 +115,8 @@ struct ent {
 	int first_cand, n_cand;
 	int stale;
 	int touched;
+	int full;       /* every root must be current (no laziness) */
+	uint32_t hit;   /* epoch in which a leaf of it was re-solved */
 };
 
 struct cand {
@@ -147,6 +156,7 @@ struct px_track {
 	px_vec3 p;
 	int init;
 	uint32_t epoch, next_id, best_id;
+	int fault;           /* test hook: px__track_set_fault() */
 	struct px_track_stats st;
 	size_t bytes;
 };
@@ -381,6 +391,37 @@ static int leaf_roots(const struct px_track *t, const struct leaf *l,
 /* ------------------------------------------------------------------ */
 /* entity state                                                        */
 
+/* Travel (path length) the point may still cover from p before a root
+ * of leaf l can leave it through an end: the end values of g are affine
+ * in p, so none changes sign within |value| / |p-gradient| (0 when an
+ * end value is too close to zero to tell). With no event inside the leaf
+ * (it is not re-solved) its roots keep their number and stay in it. */
+static double leaf_end_radius(const struct px_track *t, const struct leaf *l,
+			      px_vec3 p)
+{
+	const double *a = leaf_a(t, l), *ib = t->ipool + l->ioff;
+	double v0 = fabs(gco(a, l->n, 0, p)) - l->tol_g;
+	double v1 = fabs(gco(a, l->n, l->n, p)) - l->tol_g;
+	if (!(v0 > 0.0) || !(v1 > 0.0))
+		return 0.0;
+	v0 *= ib[0];
+	v1 *= ib[l->n];
+	return v0 < v1 ? v0 : v1;
+}
+
+/* Record a correction of z at p (now). */
+static void zero_stamp(const struct px_track *t, struct zero *z, px_vec3 p)
+{
+	z->p = p;
+	z->trav = t->travel;
+	z->dist = px_v3_dist(z->c, p);
+	z->ep = t->epoch;
+	z->until = t->opts.lazy
+			   ? t->travel + leaf_end_radius(t, &t->leaf[z->leaf], p) *
+						 (1.0 - 1e-9)
+			   : -1.0;
+}
+
 static void zero_eval(const struct px_track *t, const struct ent *e,
 		      struct zero *z, px_vec3 p)
 {
@@ -389,6 +430,7 @@ static void zero_eval(const struct px_track *t, const struct ent *e,
 	z->c = c;
 	z->d1 = d1;
 	z->D = px_v3_dot(px_v3_sub(c, p), d2) + px_v3_dot(d1, d1);
+	zero_stamp(t, z, p);
 }
 
 static int cmp_zero(const struct zero *a, const struct zero *b)
@@ -712,6 +754,7 @@ static int evolve(struct px_track *t, struct ent *e, struct zero *z,
 	z->c = c;
 	z->d1 = d1;
 	z->D = D;
+	zero_stamp(t, z, p);
 	return 0;
 }
 
@@ -781,16 +824,23 @@ static double definite_radius(const double *a, const double *ib, int m,
 		if (!s || (sg && s != sg))
 			return 0.0;
 		sg = s;
-		r = fmin(r, (fabs(v) - tol) * ib[i]);
+		{
+			double ri = ((v > 0.0 ? v : -v) - tol) * ib[i];
+			if (ri < r)
+				r = ri;
+		}
 	}
 	return r;
 }
 
 static double box_dist(const px_aabb *b, px_vec3 p)
 {
-	double dx = fmax(fmax(b->min.x - p.x, p.x - b->max.x), 0.0);
-	double dy = fmax(fmax(b->min.y - p.y, p.y - b->max.y), 0.0);
-	double dz = fmax(fmax(b->min.z - p.z, p.z - b->max.z), 0.0);
+	double dx = b->min.x - p.x > 0.0 ? b->min.x - p.x
+					: (p.x - b->max.x > 0.0 ? p.x - b->max.x : 0.0);
+	double dy = b->min.y - p.y > 0.0 ? b->min.y - p.y
+					: (p.y - b->max.y > 0.0 ? p.y - b->max.y : 0.0);
+	double dz = b->min.z - p.z > 0.0 ? b->min.z - p.z
+					: (p.z - b->max.z > 0.0 ? p.z - b->max.z : 0.0);
 	return sqrt(dx * dx + dy * dy + dz * dz);
 }
 
@@ -808,7 +858,7 @@ static double leaf_radius(const struct px_track *t, const struct leaf *l,
 	rb = box_dist(&l->box, p);
 	r = definite_radius(a, ib, n + 1, p, l->tol_g);
 	if (r > 0.0)
-		return fmax(r, rb);
+		return r > rb ? r : rb;
 	r = n >= 1 ? definite_radius(a + 4 * (n + 1), ib + n + 1, n, p,
 				     l->tol_d)
 		   : INFINITY;
@@ -817,10 +867,12 @@ static double leaf_radius(const struct px_track *t, const struct leaf *l,
 		int e = i ? n : 0;
 		if (!(l->flags & (i ? LF_EV1 : LF_EV0)))
 			continue;
-		v = gco(a, n, e, p);
-		r = fmin(r, fabs(v) > l->tol_g ? (fabs(v) - l->tol_g) * ib[e] : 0.0);
+		v = fabs(gco(a, n, e, p));
+		v = v > l->tol_g ? (v - l->tol_g) * ib[e] : 0.0;
+		if (v < r)
+			r = v;
 	}
-	return fmax(r, rb);
+	return r > rb ? r : rb;
 }
 
 static void heap_set(struct px_track *t, int pos, int li)
@@ -946,6 +998,105 @@ static int collect_events(struct px_track *t, px_vec3 p0, px_vec3 p1)
 /* ------------------------------------------------------------------ */
 /* answer                                                              */
 
+/* May root j of e (outside any re-solved leaf) skip its correction this
+ * update? Only when its leaf certificate holds (it is provably still in
+ * its leaf: no event there, end values of g kept their signs) and it is
+ * alone there (a neighbour converging onto its branch would otherwise go
+ * unseen by the duplicate check). */
+static int can_rest(const struct px_track *t, const struct ent *e, int j)
+{
+	const struct zero *z = &e->z[j];
+	if (t->fault & 1)
+		return 1;
+	if (!(t->travel < z->until))
+		return 0;
+	if (j > 0 && e->z[j - 1].leaf == z->leaf)
+		return 0;
+	if (j + 1 < e->nz && e->z[j + 1].leaf == z->leaf)
+		return 0;
+	return 1;
+}
+
+/* Correct every resting root of e at p. Returns 0 or 1 (anomaly). */
+static int catch_up(struct px_track *t, struct ent *e, px_vec3 p)
+{
+	int j;
+	for (j = 0; j < e->nz; j++) {
+		struct zero *z = &e->z[j];
+		if (z->ep == t->epoch)
+			continue;
+		if (evolve(t, e, z, z->p, px_v3_sub(p, z->p), p))
+			return 1;
+	}
+	return 0;
+}
+
+/*
+ * Correct the resting minima that could be the closest point. A critical
+ * distance is 1-Lipschitz in the query point along its branch (its
+ * gradient is the unit vector from the foot point), so after a path of
+ * length L since its last correction a minimum is at least dist - L
+ * away; best (the distance to a real curve point: a current minimum or a
+ * candidate) bounds the global minimum from above, and a minimum whose
+ * bound exceeds it cannot be the closest point. Maxima never answer and
+ * rest on their leaf certificates.
+ */
+static void wake_minima(struct px_track *t, px_vec3 p)
+{
+	double best2 = INFINITY, best;
+	int i, j;
+	for (i = 0; i < t->n_cand; i++) {
+		double d2 = px_v3_dist2(t->cand[i].q, p);
+		if (d2 < best2)
+			best2 = d2;
+	}
+	for (i = 0; i < t->n_ent; i++) {
+		const struct ent *e = &t->ent[i];
+		if (e->stale)
+			continue;
+		for (j = 0; j < e->nz; j++) {
+			const struct zero *z = &e->z[j];
+			double d2;
+			if (z->type < 0 || z->ep != t->epoch)
+				continue;
+			d2 = px_v3_dist2(z->c, p);
+			if (d2 < best2)
+				best2 = d2;
+		}
+	}
+	best = sqrt(best2);
+	for (i = 0; i < t->n_ent; i++) {
+		struct ent *e = &t->ent[i];
+		if (e->stale)
+			continue;
+		for (j = 0; j < e->nz; j++) {
+			struct zero *z = &e->z[j];
+			double lb, d;
+			int leaf0;
+			if (z->type < 0 || z->ep == t->epoch)
+				continue;
+			lb = z->dist - (t->travel - z->trav);
+			if (lb > best + 1e-9 * (best + t->scale) && !(t->fault & 2))
+				continue;
+			leaf0 = z->leaf;
+			if (evolve(t, e, z, z->p, px_v3_sub(p, z->p), p)) {
+				e->stale = 1;
+				break;
+			}
+			if (z->leaf != leaf0 && !e->full) {
+				e->full = 1;
+				if (catch_up(t, e, p)) {
+					e->stale = 1;
+					break;
+				}
+			}
+			d = px_v3_dist(z->c, p);
+			if (d < best)
+				best = d;
+		}
+	}
+}
+
 static int in_work(const struct px_track *t, px_vec3 p)
 {
 	return p.x >= t->work.min.x && p.x <= t->work.max.x &&
@@ -976,6 +1127,8 @@ static void answer(struct px_track *t, px_vec3 p, struct px_track_result *r)
 			if (z->type < 0)
 				continue;
 			nm++;
+			if (z->ep != t->epoch)
+				continue; /* resting: provably not the closest */
 			d2 = px_v3_dist2(z->c, p);
 			if (d2 < best) {
 				best = d2;
@@ -1105,7 +1258,7 @@ int px_track_reset(struct px_track *t, px_vec3 p, struct px_track_result *r)
 int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 {
 	int i, j, nh, rc = 0, fail = 0, added = 0;
-	px_vec3 p0, dp;
+	px_vec3 p0;
 
 	if (!t || !r)
 		return PX_E_INVAL;
@@ -1116,11 +1269,19 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 	result_clear(r);
 	t->st.updates++;
 	p0 = t->p;
-	dp = px_v3_sub(p, p0);
 	t->p = p;
 	r->source = PX_TRACK_TRACKED;
-	if (++t->epoch == 0)
+	if (++t->epoch == 0) {
+		/* wrapped: no stale mark or correction stamp may look current */
+		for (i = 0; i < t->n_leaves; i++)
+			t->leaf[i].mark = t->leaf[i].tested = 0;
+		for (i = 0; i < t->n_ent; i++) {
+			t->ent[i].hit = 0;
+			for (j = 0; j < t->ent[i].nz; j++)
+				t->ent[i].z[j].ep = 0;
+		}
 		t->epoch = 1;
+	}
 
 	if (!in_work(t, p) || !in_work(t, p0)) {
 		t->st.outside++;
@@ -1141,29 +1302,49 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 	r->leaves_solved = nh;
 	t->st.leaf_solves += (uint64_t)nh;
 
-	/* evolve every root outside the re-solved leaves */
+	for (i = 0; i < nh; i++)
+		t->ent[t->leaf[t->hits[i]].ent].hit = t->epoch;
+	/* evolve every root outside the re-solved leaves; in an entity
+	 * without re-solved leaves a root whose leaf certificate holds may
+	 * rest (can_rest) until the answer needs it */
 	for (i = 0; i < t->n_ent; i++) {
 		struct ent *e = &t->ent[i];
 		int w = 0;
 		e->nold = 0;
 		e->touched = 0;
+		e->full = !t->opts.lazy || e->hit == t->epoch;
 		if (e->stale)
 			continue;
 		for (j = 0; j < e->nz; j++) {
-			struct zero z = e->z[j];
-			if (t->leaf[z.leaf].mark == t->epoch) {
-				e->old[e->nold++] = z;
+			struct zero *zj = &e->z[j];
+			int leaf0;
+			if (t->leaf[zj->leaf].mark == t->epoch) {
+				e->old[e->nold++] = *zj;
 				e->touched = 1;
 				continue;
 			}
-			if (evolve(t, e, &z, p0, dp, p)) {
+			/* without a re-solved leaf nothing is dropped: w == j */
+			if (!e->full && can_rest(t, e, j)) {
+				w++;
+				continue;
+			}
+			leaf0 = zj->leaf;
+			if (w != j)
+				e->z[w] = *zj;
+			if (evolve(t, e, &e->z[w], e->z[w].p, px_v3_sub(p, e->z[w].p),
+				   p)) {
 				e->stale = 1;
 				break;
 			}
-			e->z[w++] = z;
+			if (e->z[w].leaf != leaf0)
+				e->full = 1;
+			w++;
 		}
-		if (!e->stale)
+		if (!e->stale) {
 			e->nz = w;
+			if (e->full && catch_up(t, e, p))
+				e->stale = 1;
+		}
 	}
 	/* re-solve the event leaves at the new point */
 	for (i = 0; i < nh; i++) {
@@ -1182,6 +1363,8 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 		added += n;
 		e->touched = 1;
 	}
+	if (!fail && t->opts.lazy)
+		wake_minima(t, p);
 	if (!fail) {
 		for (i = 0; i < t->n_ent; i++) {
 			struct ent *e = &t->ent[i];
@@ -1239,6 +1422,30 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 	return PX_OK;
 }
 
+/* Bring the resting roots of e up to date at the current point (for
+ * px_track_critical: the caller sees every root where it is now). */
+static void ent_refresh(struct px_track *t, struct ent *e)
+{
+	int j, rest = 0;
+	if (!t->init || e->stale)
+		return;
+	for (j = 0; j < e->nz; j++)
+		rest |= e->z[j].ep != t->epoch;
+	if (!rest)
+		return;
+	if (catch_up(t, e, t->p) || (sort_zeros(e), ent_check(t, e, t->p))) {
+		t->st.reinits++;
+		if (ent_reinit(t, e, t->p))
+			count_fail(t, PX_E_RANGE);
+	}
+}
+
+void px__track_set_fault(struct px_track *t, int fault)
+{
+	if (t)
+		t->fault = fault;
+}
+
 int px_track_critical(const struct px_track *t, int entity, double *u,
 		      int *type, int cap)
 {
@@ -1248,6 +1455,7 @@ int px_track_critical(const struct px_track *t, int entity, double *u,
 		return PX_E_INVAL;
 	if (entity < 0 || entity >= t->n_ent)
 		return PX_E_RANGE;
+	ent_refresh((struct px_track *)t, &t->ent[entity]);
 	e = &t->ent[entity];
 	for (i = 0; i < e->nz && i < cap; i++) {
 		u[i] = e->z[i].u;
@@ -1306,6 +1514,7 @@ void px_track_opts_default(struct px_track_opts *o)
 	o->box_depth = 4;
 	o->verify_every = 0;
 	o->dist = NULL;
+	o->lazy = 1;
 }
 
 struct split {

@@ -102,6 +102,12 @@ struct px_track_opts {
 	int verify_every;
 	/* Options of the global query model (NULL for its defaults). */
 	const struct px_dist_opts *dist;
+	/* Lazy correction (default 1): a critical point provably still in
+	 * its parameter leaf rests (is not corrected) while it cannot be the
+	 * closest point - maxima always, minima while their last distance
+	 * minus the path travelled since exceeds the current best. 0
+	 * corrects every critical point on every update. */
+	int lazy;
 };
 
 /* Defaults as documented above. */
