@@ -150,7 +150,7 @@ struct px_track {
 	 * length travelled stays below l->expiry (a safe radius around the
 	 * point of its last test); a min-heap on expiry makes the usual
 	 * update one comparison at the root */
-	int *heap, *popped;
+	int *heap;
 	double travel;
 	int heap_ok;
 	double *ipool;
@@ -914,6 +914,43 @@ static double leaf_radius(const struct px_track *t, const struct leaf *l,
 	return r > rb ? r : rb;
 }
 
+/*
+ * The exact test of leaf l along p0 -> p1 (*event: 1 when it may hold an
+ * event, as leaf_event()) and its safe radius at p1 (as leaf_radius()).
+ * The usual leaf - no root, coefficients of g of one sign along the
+ * whole step - is done in one pass over its coefficients.
+ */
+static double leaf_test(const struct px_track *t, const struct leaf *l,
+			px_vec3 p0, px_vec3 p1, int *event)
+{
+	const double *a = leaf_a(t, l), *ib = t->ipool + l->ioff;
+	int m = l->n + 1, i, sg = 0;
+	const double *bx = a + m, *by = bx + m, *bz = by + m;
+	double r = INFINITY, rb, tol = l->tol_g;
+	for (i = 0; i < m; i++) {
+		double v0 = a[i] - (p0.x * bx[i] + p0.y * by[i] + p0.z * bz[i]);
+		double v1 = a[i] - (p1.x * bx[i] + p1.y * by[i] + p1.z * bz[i]);
+		int s0 = v0 > tol ? 1 : (v0 < -tol ? -1 : 0);
+		int s1 = v1 > tol ? 1 : (v1 < -tol ? -1 : 0);
+		double ri;
+		if (!s0 || s1 != s0 || (sg && s0 != sg))
+			break;
+		sg = s0;
+		ri = ((v1 > 0.0 ? v1 : -v1) - tol) * ib[i];
+		if (ri < r)
+			r = ri;
+	}
+	if (i == m) {
+		*event = 0;
+		if (!l->boxed)
+			return INFINITY;
+		rb = box_dist(&l->box, p1);
+		return r > rb ? r : rb;
+	}
+	*event = leaf_event(t, l, p0, p1);
+	return leaf_radius(t, l, p1);
+}
+
 static void heap_set(struct px_track *t, int pos, int li)
 {
 	t->heap[pos] = li;
@@ -935,20 +972,6 @@ static void heap_down(struct px_track *t, int pos, int n)
 			break;
 		heap_set(t, pos, t->heap[c]);
 		pos = c;
-	}
-	heap_set(t, pos, li);
-}
-
-static void heap_up(struct px_track *t, int pos)
-{
-	int li = t->heap[pos];
-	double x = t->leaf[li].expiry;
-	while (pos > 0) {
-		int par = (pos - 1) / 2;
-		if (!(x < t->leaf[t->heap[par]].expiry))
-			break;
-		heap_set(t, pos, t->heap[par]);
-		pos = par;
 	}
 	heap_set(t, pos, li);
 }
@@ -986,24 +1009,22 @@ static int collect_events(struct px_track *t, px_vec3 p0, px_vec3 p1)
 	if (!t->heap_ok)
 		heap_rebuild(t, p0);
 	t->travel += px_v3_dist(p0, p1);
-	while (n > 0 && t->leaf[t->heap[0]].expiry <= t->travel) {
-		t->popped[np++] = t->heap[0];
-		n--;
-		if (n > 0) {
-			heap_set(t, 0, t->heap[n]);
-			heap_down(t, 0, n);
-		}
-	}
-	for (k = 0; k < np; k++) {
-		int li = t->popped[k];
+	/* Each due leaf at the root is tested, given its new expiry and
+	 * sifted down in place (one sift, no pop and push). A radius of 0
+	 * gives expiry == travel: due at the next update with any motion,
+	 * and the strict comparison ends this loop (bounded by n tests:
+	 * every tested leaf leaves with expiry >= travel). */
+	while (n > 0 && t->leaf[t->heap[0]].expiry < t->travel && np < n) {
+		int li = t->heap[0], ev;
 		struct leaf *l = &t->leaf[li];
+		double rad;
+		np++;
 		t->st.box_hits++;
-		if (leaf_event(t, l, p0, p1))
+		rad = leaf_test(t, l, p0, p1, &ev);
+		if (ev)
 			mark_leaf(t, li, &nh);
-		l->expiry = t->travel + leaf_radius(t, l, p1) * (1.0 - 1e-9);
-		heap_set(t, n, li);
-		heap_up(t, n);
-		n++;
+		l->expiry = t->travel + rad * (1.0 - 1e-9);
+		heap_down(t, 0, n);
 	}
 	for (k = 0; k < nh; k++) {
 		int li = t->hits[k], side;
@@ -1796,7 +1817,6 @@ void px_track_free(struct px_track *t)
 	free(t->gleaf);
 	free(t->hits);
 	free(t->heap);
-	free(t->popped);
 	free(t->ipool);
 	free(t);
 }
@@ -1953,10 +1973,9 @@ int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
 	t->cand = calloc((size_t)cand_cap + 1, sizeof(*t->cand));
 	t->hits = calloc((size_t)leaf_cap + 1, sizeof(int));
 	t->heap = calloc((size_t)leaf_cap + 1, sizeof(int));
-	t->popped = calloc((size_t)leaf_cap + 1, sizeof(int));
 	t->ipool = calloc((size_t)leaf_cap * (2 * TRK_NG + 2) + 1, sizeof(double));
 	if (!t->leaf || !t->pool || !t->cand || !t->hits || !t->heap ||
-	    !t->popped || !t->ipool) {
+	    !t->ipool) {
 		rc = PX_E_NOMEM;
 		goto fail;
 	}
