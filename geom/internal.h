@@ -56,10 +56,20 @@ px_aabb px__nurbs_box_empty(void);
 /* ---- coherent tracking (px_track.c) ---- */
 
 struct px_track;
-/* Test hook: deliberately break the laziness proofs so tests can show
- * they would catch it (bit 0: every root may rest, bit 1: resting minima
- * are never woken). 0 restores normal operation. */
+/* Test hook: deliberately break the proofs so tests can show they would
+ * catch it (bit 0: every root may rest, bit 1: resting minima are never
+ * woken, bit 2: every leaf's no-event radius is infinite, bit 3: every
+ * leaf-end radius is infinite). 0 restores normal operation. */
 void px__track_set_fault(struct px_track *t, int fault);
+
+/* Test hook: the certificate radius of leaf `leaf` at p (which 0: no
+ * event in the leaf while the point travels less; 1: its end values of
+ * f' keep their signs), with the leaf's entity, parameter interval and
+ * flags (bit 0: an end at a cusp, where g is divided). -1 for a bad
+ * leaf index. */
+double px__track_leaf_cert(const struct px_track *t, int leaf, px_vec3 p,
+			   int which, int *ent, double *u0, double *u1,
+			   unsigned *flags);
 
 #endif
 

@@ -404,6 +404,8 @@ static double leaf_end_radius(const struct px_track *t, const struct leaf *l,
 {
 	const double *a = leaf_a(t, l), *ib = t->ipool + l->ioff;
 	double v0 = fabs(gco(a, l->n, 0, p)) - l->tol_g;
+	if (t->fault & 8)
+		return INFINITY;
 	double v1 = fabs(gco(a, l->n, l->n, p)) - l->tol_g;
 	if (!(v0 > 0.0) || !(v1 > 0.0))
 		return 0.0;
@@ -892,7 +894,7 @@ static double leaf_radius(const struct px_track *t, const struct leaf *l,
 	const double *a = leaf_a(t, l), *ib = t->ipool + l->ioff;
 	double r, rb;
 	int n = l->n, i;
-	if (!l->boxed)
+	if (!l->boxed || (t->fault & 4))
 		return INFINITY;
 	rb = box_dist(&l->box, p);
 	r = definite_radius(a, ib, n + 1, p, l->tol_g);
@@ -942,7 +944,7 @@ static double leaf_test(const struct px_track *t, const struct leaf *l,
 	}
 	if (i == m) {
 		*event = 0;
-		if (!l->boxed)
+		if (!l->boxed || (t->fault & 4))
 			return INFINITY;
 		rb = box_dist(&l->box, p1);
 		return r > rb ? r : rb;
@@ -1136,7 +1138,7 @@ static void wake_minima(struct px_track *t, px_vec3 p)
 			if (z->type < 0 || z->ep == t->epoch)
 				continue;
 			lb = z->dist - (t->travel - z->trav);
-			if (lb > best + 1e-9 * (best + t->scale) && !(t->fault & 2))
+			if (lb > best + 1e-9 * (best + t->scale) || (t->fault & 2))
 				continue;
 			leaf0 = z->leaf;
 			if (evolve(t, e, z, z->p, px_v3_sub(p, z->p), p)) {
@@ -1184,6 +1186,8 @@ static void answer(struct px_track *t, px_vec3 p, struct px_track_result *r)
 		for (j = 0; j < e->nz; j++) {
 			const struct zero *z = &e->z[j];
 			double d2;
+			if (z->ep != t->epoch)
+				t->st.rested++;
 			if (z->type < 0)
 				continue;
 			nm++;
@@ -1502,8 +1506,25 @@ static void ent_refresh(struct px_track *t, struct ent *e)
 
 void px__track_set_fault(struct px_track *t, int fault)
 {
-	if (t)
+	if (t) {
 		t->fault = fault;
+		t->heap_ok = 0; /* radii of the new regime */
+	}
+}
+
+double px__track_leaf_cert(const struct px_track *t, int leaf, px_vec3 p,
+			   int which, int *ent, double *u0, double *u1,
+			   unsigned *flags)
+{
+	const struct leaf *l;
+	if (!t || leaf < 0 || leaf >= t->n_leaves)
+		return -1.0;
+	l = &t->leaf[leaf];
+	*ent = l->ent;
+	*u0 = l->u0;
+	*u1 = l->u1;
+	*flags = (l->flags & (LF_CUSP0 | LF_CUSP1)) ? 1u : 0u;
+	return which ? leaf_end_radius(t, l, p) : leaf_radius(t, l, p);
 }
 
 int px_track_critical(const struct px_track *t, int entity, double *u,

@@ -161,6 +161,8 @@ struct px_track_stats {
 	uint64_t box_hits;       /* leaves whose safe radius ran out (given
 				  * the exact segment test) */
 	uint64_t creations, annihilations; /* pairs */
+	uint64_t rested;         /* critical points left uncorrected in an
+				  * update (opts.lazy), summed over updates */
 };
 
 struct px_track_info {

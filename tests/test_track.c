@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "internal.h"
 #include "px_alloc_count.h"
 #include "px_arena.h"
 #include "px_dist.h"
@@ -20,6 +21,9 @@
 
 #define MAXC 64
 #define MAXE 8
+
+/* run_model() settings: lazy correction, deliberate faults (test hook) */
+static int g_lazy = 1, g_fault = 0;
 
 static struct px_arena arena;
 static unsigned char arena_mem[1 << 20];
@@ -410,10 +414,12 @@ static void run_model(const struct tcurve *tc, int ne, int n_steps,
 		cs[e] = tc[e].c;
 	px_track_opts_default(&o);
 	o.verify_every = verify_every;
+	o.lazy = g_lazy;
 	rc = px_track_create(cs, ne, &o, &t);
 	PX_CHECK_INT_EQ(rc, PX_OK);
 	if (rc)
 		return;
+	px__track_set_fault(t, g_fault);
 	rc = px_dist_model_create(cs, ne, NULL, 0, NULL, &ref);
 	PX_CHECK_INT_EQ(rc, PX_OK);
 	px_track_get_info(t, &info);
@@ -710,6 +716,196 @@ static void test_random_curves(void)
 	}
 }
 
+/* The model of the laziness tests: closed, open with breaks, cusp,
+ * rational, space curves. */
+static int lazy_model(struct tcurve *tc)
+{
+	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
+	return curve_blob(&tc[0], 0, 0) || curve_breaks(&tc[1], 2.5, 0.5) ||
+	       curve_cusp(&tc[2], -2.0, 2.0) || curve_circle(&tc[3], 0.5, -2.5, 1.0) ||
+	       curve_knot(&tc[4], 1.0, 1.0, 1.0);
+}
+
+/* Lazy correction on, nothing else looking: no verification and no
+ * px_track_critical() (which wakes every root) except at the first step,
+ * every answer against the global query. The same paths with laziness
+ * off must agree, and laziness must actually engage. */
+static void test_lazy_exact(void)
+{
+	struct tcurve tc[5];
+	struct run_stats rs;
+	PX_CHECK_INT_EQ(lazy_model(tc), 0);
+	memset(&rs, 0, sizeof(rs));
+	g_lazy = 1;
+	run_model(tc, 5, 1200, 1 << 30, &rs, 0);
+	check_run("lazy", &rs, 10);
+	PX_CHECK_MSG(rs.ts.rested > rs.ts.updates,
+		     "laziness never engaged: %llu rests in %llu updates",
+		     (unsigned long long)rs.ts.rested,
+		     (unsigned long long)rs.ts.updates);
+	memset(&rs, 0, sizeof(rs));
+	g_lazy = 0;
+	run_model(tc, 5, 600, 1 << 30, &rs, 0);
+	g_lazy = 1;
+	check_run("eager", &rs, 10);
+	PX_CHECK_INT_EQ((long)rs.ts.rested, 0);
+}
+
+/* The tests above can fail: break each proof on purpose and the same
+ * checks see wrong answers or wrong critical-point counts - or, when
+ * roots rest without their leaf certificate, the tracker's own structure
+ * checks catch the damage (re-initialisations far above a clean run). */
+static void test_lazy_faults_caught(void)
+{
+	static const int faults[] = {1 | 2, 4, 1};
+	static const char *names[] = {"fault: never woken", "fault: no events",
+				      "fault: rest always"};
+	struct tcurve tc[5];
+	struct run_stats rs;
+	uint64_t clean_reinits;
+	int f;
+	PX_CHECK_INT_EQ(lazy_model(tc), 0);
+	memset(&rs, 0, sizeof(rs));
+	run_model(tc, 5, 400, 40, &rs, 0);
+	check_run("clean", &rs, 10);
+	clean_reinits = rs.ts.reinits;
+	for (f = 0; f < 3; f++) {
+		memset(&rs, 0, sizeof(rs));
+		g_fault = faults[f];
+		run_model(tc, 5, 400, 40, &rs, 0);
+		g_fault = 0;
+		report(names[f], &rs);
+		if (faults[f] == 1)
+			PX_CHECK_MSG(rs.wrong + rs.count_bad + rs.brute_bad > 0 ||
+					     rs.ts.reinits > clean_reinits + 10,
+				     "%s went unnoticed", names[f]);
+		else
+			PX_CHECK_MSG(rs.wrong + rs.count_bad + rs.brute_bad > 0,
+				     "%s went unnoticed", names[f]);
+	}
+}
+
+/* Signs of f' at the samples of [u0, u1] (|f'| below tiny ignored):
+ * the number of sign changes. */
+static int sign_changes(const struct px_nurbs_curve *c, double u0, double u1,
+			px_vec3 q, int m, double tiny)
+{
+	int i, last = 0, n = 0;
+	for (i = 0; i <= m; i++) {
+		double u = u0 + (u1 - u0) * (1e-9 + (1.0 - 2e-9) * i / m);
+		double v = fprime(c, u, q);
+		if (fabs(v) <= tiny)
+			continue;
+		if (last && (v > 0) != (last > 0))
+			n++;
+		last = v > 0 ? 1 : -1;
+	}
+	return n;
+}
+
+/* Sign of f' just inside a leaf end (0 when too small to tell). */
+static int end_sign(const struct px_nurbs_curve *c, double u0, double u1,
+		    int side, px_vec3 q, double tiny)
+{
+	double u = side ? u1 - 1e-10 * (u1 - u0) : u0 + 1e-10 * (u1 - u0);
+	double v = fprime(c, u, q);
+	return fabs(v) <= tiny ? 0 : (v > 0 ? 1 : -1);
+}
+
+/*
+ * The leaf certificates against brute force: at random points, for every
+ * leaf, random points inside its no-event ball must see at most one sign
+ * change of f' over the leaf (no double root: no event), and inside its
+ * end ball the signs of f' at both leaf ends must stay. With a fault that
+ * makes the radii infinite the same sampling must find violations.
+ * Returns the violations found.
+ */
+static long cert_check(const struct tcurve *tc, int ne, int fault, int npts)
+{
+	struct px_nurbs_curve cs[MAXE];
+	struct px_track *t = NULL;
+	struct px_track_info info;
+	long bad = 0;
+	int e, k, li, j;
+	double size;
+	px_aabb box;
+	for (e = 0; e < ne; e++)
+		cs[e] = tc[e].c;
+	if (px_track_create(cs, ne, NULL, &t) != PX_OK) {
+		PX_CHECK_MSG(0, "create");
+		return 0;
+	}
+	px__track_set_fault(t, fault);
+	px_track_get_info(t, &info);
+	box = info.work;
+	size = px_aabb_diagonal(&box) / 3.0;
+	for (k = 0; k < npts; k++) {
+		px_vec3 p = px_v3(px_rand_range(-1.3, 1.3), px_rand_range(-1.3, 1.3),
+				  px_rand_range(-0.5, 0.5));
+		p = px_v3_add(p, px_aabb_center(&box));
+		for (li = 0; li < info.n_leaves; li++) {
+			int ent, which;
+			double u0, u1;
+			unsigned fl;
+			for (which = 0; which < 2; which++) {
+				double r = px__track_leaf_cert(t, li, p, which, &ent, &u0,
+							       &u1, &fl);
+				int s0, s1;
+				if (r <= 0.0 || fl)
+					continue;
+				if (r > 0.5 * size)
+					r = 0.5 * size;
+				s0 = end_sign(&cs[ent], u0, u1, 0, p, 1e-9);
+				s1 = end_sign(&cs[ent], u0, u1, 1, p, 1e-9);
+				for (j = 0; j < 6; j++) {
+					px_vec3 d = px_v3(px_rand_normal(), px_rand_normal(),
+							  px_rand_normal()), q;
+					double dn = px_v3_norm(d);
+					double rr = r * (j < 3 ? 0.999 : px_rand_unit());
+					if (!(dn > 0.0))
+						continue;
+					if (tc[ent].c.pw && px_rand_int(0, 1) == 0 &&
+					    fabs(p.z) < 1.0)
+						d.z = 0.0; /* stay in the plane sometimes */
+					dn = px_v3_norm(d);
+					if (!(dn > 0.0))
+						continue;
+					q = px_v3_add(p, px_v3_scale(d, rr / dn));
+					if (which == 0) {
+						if (sign_changes(&cs[ent], u0, u1, q, 200,
+								 1e-9) > 1)
+							bad++;
+					} else {
+						int a0 = end_sign(&cs[ent], u0, u1, 0, q, 1e-9);
+						int a1 = end_sign(&cs[ent], u0, u1, 1, q, 1e-9);
+						if ((s0 && a0 && a0 != s0) || (s1 && a1 && a1 != s1))
+							bad++;
+					}
+				}
+			}
+		}
+	}
+	px_track_free(t);
+	return bad;
+}
+
+static void test_certificates_brute(void)
+{
+	struct tcurve tc[5];
+	long bad, bad4, bad8;
+	PX_CHECK_INT_EQ(lazy_model(tc), 0);
+	/* cusp curve (index 2) has divided leaves: its other leaves still
+	 * count */
+	bad = cert_check(tc, 5, 0, 12);
+	bad4 = cert_check(tc, 5, 4, 6);
+	bad8 = cert_check(tc, 5, 8, 6);
+	printf("  certificates: %ld violations (faulted: no-event %ld, ends %ld)\n",
+	       bad, bad4, bad8);
+	PX_CHECK_MSG(bad == 0, "%ld certificate violations", bad);
+	PX_CHECK_MSG(bad4 > 0, "infinite no-event radii not caught");
+	PX_CHECK_MSG(bad8 > 0, "infinite end radii not caught");
+}
+
 static void test_errors(void)
 {
 	struct tcurve tc;
@@ -762,6 +958,7 @@ static const struct px_test tests[] = {
 	PX_T(test_space_closed),     PX_T(test_space_open),
 	PX_T(test_polygon),          PX_T(test_multi_entity),
 	PX_T(test_no_verification),  PX_T(test_random_curves),
-	PX_T(test_errors),
+	PX_T(test_errors),           PX_T(test_lazy_exact),
+	PX_T(test_lazy_faults_caught), PX_T(test_certificates_brute),
 };
 PX_TEST_MAIN(tests)
