@@ -139,12 +139,6 @@ struct px_track {
 	double *pool;
 	size_t pool_len;
 	struct cand *cand;
-	/* event grid: the finest octree level over the working volume;
-	 * cell (i, j, k) lists the leaves with an event cell there */
-	int gn;              /* cells per axis */
-	px_vec3 ginv;        /* cells per unit length */
-	int *gstart;         /* gn^3 + 1 offsets into gleaf */
-	int *gleaf;
 	int *hits;           /* scratch: leaves of this update */
 	/* lazy event tests: leaf l cannot have an event while the path
 	 * length travelled stays below l->expiry (a safe radius around the
@@ -1834,8 +1828,6 @@ void px_track_free(struct px_track *t)
 	free(t->leaf);
 	free(t->pool);
 	free(t->cand);
-	free(t->gstart);
-	free(t->gleaf);
 	free(t->hits);
 	free(t->heap);
 	free(t->ipool);
@@ -2191,16 +2183,11 @@ int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
 				e->n_sb++;
 	}
 
-	/* event cells: octree exclusion per leaf down to the grid level */
+	/* event cells: octree exclusion per leaf down to box_depth; their
+	 * union box per leaf bounds its safe radius */
 	{
 		struct cellbuf cb = {0};
-		long q, ncell;
-		int gn = 1 << o.box_depth, ax;
-		const double *wl = &t->work.min.x, *wh = &t->work.max.x;
-		double *gi = &t->ginv.x;
-		t->gn = gn;
-		for (ax = 0; ax < 3; ax++)
-			gi[ax] = wh[ax] > wl[ax] ? gn / (wh[ax] - wl[ax]) : 0.0;
+		long q;
 		for (i = 0; i < t->n_leaves; i++) {
 			long budget = 1L << 14, first = cb.n;
 			struct leaf *l = &t->leaf[i];
@@ -2220,71 +2207,17 @@ int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
 				t->n_boxed++;
 			}
 		}
-		ncell = (long)gn * gn * gn;
-		t->gstart = calloc((size_t)ncell + 1, sizeof(int));
-		if (!t->gstart) {
-			free(cb.p);
-			rc = PX_E_NOMEM;
-			goto fail;
-		}
-		/* two passes: count, then fill (a cell cut short by the budget
-		 * covers several grid cells) */
-		for (ax = 0; ax < 2; ax++) {
-			long total = 0;
-			if (ax == 1) {
-				for (q = 0; q < ncell; q++) {
-					int c = t->gstart[q];
-					t->gstart[q] = (int)total;
-					total += c;
-				}
-				t->gstart[ncell] = (int)total;
-				t->n_prim = (int)total;
-				t->gleaf = calloc((size_t)total + 1, sizeof(int));
-				if (!t->gleaf) {
-					free(cb.p);
-					rc = PX_E_NOMEM;
-					goto fail;
-				}
-				/* reuse gstart as fill cursors, restored below */
-			}
-			for (q = 0; q < cb.n; q++) {
-				int lo3[3], hi3[3], ii, jj, kk, d;
-				const double *bl = &cb.p[q].box.min.x, *bh = &cb.p[q].box.max.x;
-				for (d = 0; d < 3; d++) {
-					double x0 = (bl[d] - wl[d]) * gi[d] + 1e-6;
-					double x1 = (bh[d] - wl[d]) * gi[d] - 1e-6;
-					lo3[d] = x0 < 0 ? 0 : (x0 > gn - 1 ? gn - 1 : (int)x0);
-					hi3[d] = x1 < 0 ? 0 : (x1 > gn - 1 ? gn - 1 : (int)x1);
-				}
-				for (kk = lo3[2]; kk <= hi3[2]; kk++)
-					for (jj = lo3[1]; jj <= hi3[1]; jj++)
-						for (ii = lo3[0]; ii <= hi3[0]; ii++) {
-							int c = (kk * gn + jj) * gn + ii;
-							if (ax == 0)
-								t->gstart[c]++;
-							else
-								t->gleaf[t->gstart[c]++] = cb.p[q].leaf;
-						}
-			}
-			if (ax == 1) {
-				/* cursors ended at the next cell's start: shift back */
-				for (q = ncell; q > 0; q--)
-					t->gstart[q] = t->gstart[q - 1];
-				t->gstart[0] = 0;
-			}
-		}
+		t->n_prim = (int)cb.n;
 		free(cb.p);
 	}
 
 	t->bytes = sizeof(*t) + (size_t)t->n_ent * sizeof(*t->ent) +
 		   (size_t)t->n_ent * 2 * (size_t)o.max_crit * sizeof(struct zero) +
 		   (size_t)span_cap * sizeof(*t->span) +
-		   (size_t)leaf_cap * (sizeof(*t->leaf) + 4 * sizeof(int) +
+		   (size_t)leaf_cap * (sizeof(*t->leaf) + 2 * sizeof(int) +
 				       (2 * TRK_NG + 2) * sizeof(double)) +
 		   pool_cap * sizeof(double) +
-		   (size_t)(cand_cap + 1) * sizeof(*t->cand) +
-		   ((size_t)t->gn * t->gn * t->gn + 1 + (size_t)t->n_prim) *
-			   sizeof(int);
+		   (size_t)(cand_cap + 1) * sizeof(*t->cand);
 	t->epoch = 1;
 	free(spl);
 	free(work);

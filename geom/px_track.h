@@ -62,7 +62,7 @@
  * module).
  *
  * Memory and real-time rules: px_track_create() allocates everything
- * (spans, leaves, coefficient pool, event grid, per-entity critical-point
+ * (spans, leaves, coefficient pool, per-entity critical-point
  * arrays of fixed capacity, the global-query model) and may take long.
  * px_track_update() and the accessors never allocate, lock or print, and
  * every loop has a bound. One tracker follows one moving point; it must
@@ -167,7 +167,9 @@ struct px_track_stats {
 
 struct px_track_info {
 	int n_entities, n_spans, n_leaves, n_boxed_leaves;
-	int n_cells;             /* (grid cell, leaf) event entries */
+	int n_cells;             /* octree event cells over all leaves
+				  * (setup only: their union box per leaf
+				  * bounds its safe radius) */
 	int n_cusps, n_breaks;   /* detected cusps, C0/C1 breaks (all) */
 	px_aabb work;
 	size_t bytes;            /* tracker memory without the global model */
