@@ -15,10 +15,27 @@
  *  - Evolution (their Eq. 6): each critical point moves by the tangent
  *    predictor ds = (dp . C') / D, D = (C - p) . C'' + |C'|^2, then Newton
  *    on (C - p) . C' = 0 with the new point held fixed, staying inside its
- *    C1 stretch (across knot spans, wrapping at smooth closed seams). A
- *    Newton step below 1e-6 of the parameter range ends the iteration
- *    after one evaluation (quadratic convergence leaves an error far
- *    below the tolerance; the point is moved to first order).
+ *    C1 stretch (across knot spans, wrapping at smooth closed seams).
+ *    C, C', C'' come from per-span power-basis tables made at setup
+ *    (homogeneous for rational spans), so the usual update of a critical
+ *    point is the predictor, one evaluation and one Newton step: a step
+ *    below 3e-5 of its span is accepted without another evaluation
+ *    (quadratic convergence leaves a root error ~1e-9 of the span; the
+ *    point is moved by its second-order Taylor expansion).
+ *  - Lazy correction (opts.lazy, on by default): a critical point may
+ *    skip its correction while two proofs hold. (1) It is still in its
+ *    parameter leaf: the leaf had no event (it was not re-solved) and the
+ *    values of g at the leaf's two ends - affine in p - kept their signs
+ *    (|value| / |p-gradient| at its last correction bounds the travel for
+ *    that), and it is alone in that leaf. (2) It cannot be the closest
+ *    point: a critical distance is 1-Lipschitz in the query point along
+ *    its branch, so a minimum last corrected at distance d is at least
+ *    d - L away after a path of length L, and it rests only while that
+ *    exceeds the best current answer; maxima never answer. Whenever an
+ *    entity has a re-solved leaf or a root changes leaf, all its roots
+ *    are corrected first, so the structure checks and transitions always
+ *    see current data. px_track_critical() corrects resting roots before
+ *    reporting them.
  *  - Transitions: pairs appear or vanish only where the moving point
  *    crosses the transition set {p : g = 0 and dg/ds = 0} (the evolute of
  *    a planar curve, a ruled surface of polar lines for a space curve) or,
@@ -37,13 +54,14 @@
  *    |coefficient| / |its p-gradient| bounds it) - and a min-heap on the
  *    travelled path length names the leaves whose radius is used up;
  *    usually none, so an update costs one comparison at the heap root
- *    plus the evolution. A due leaf is tested exactly along the segment
+ *    plus the evolution (a due leaf is re-keyed in place at the root). A
+ *    due leaf is tested exactly along the segment
  *    p_old -> p_new (the coefficients are affine in the segment
  *    parameter, so sign-definite coefficients at both ends prove there is
  *    no event - the exact counterpart of the paper's line/box-diagonal
  *    stage), gets a new radius at p_new, and is re-solved with a
- *    certified Bernstein/Descartes root isolation at the new point. A region is grown while a root
- *    crosses its outer boundary, so created pairs that drift away from the
+ *    certified Bernstein/Descartes root isolation at the new point. A
+ *    region is grown while a root crosses its outer boundary, so created pairs that drift away from the
  *    crossing are found too. Creation and annihilation are counted by the
  *    change in the number of roots of the re-solved leaves.
  *  - Candidates: open-curve ends, C0 breaks, cusps and a cornered closed
