@@ -264,11 +264,29 @@ static inline double bern_val_d(const double *c, int n, double x, double *d)
 
 static double bern_root(const double *c, int n)
 {
-	double lo = 0.0, hi = 1.0, x = 0.5, flo = c[0];
-	int k;
+	double lo = 0.0, hi = 1.0, x = 0.5, flo = c[0], fe;
+	int k, i;
+	/* start where the control polygon crosses zero (it converges to
+	 * the curve quadratically under subdivision) */
+	for (i = 0; i < n; i++)
+		if ((c[i] < 0.0) != (c[i + 1] < 0.0)) {
+			x = (i + c[i] / (c[i] - c[i + 1])) / n;
+			break;
+		}
+	if (!(x > 0.0 && x < 1.0))
+		x = 0.5;
+	/* rounding level of an evaluation: below it f carries no sign
+	 * information and the iterate is as good as it gets */
+	{
+		double cm = 0.0;
+		for (i = 0; i <= n; i++)
+			if (fabs(c[i]) > cm)
+				cm = fabs(c[i]);
+		fe = 4.0 * (n + 1) * 2.2e-16 * cm;
+	}
 	for (k = 0; k < 100; k++) {
 		double d, f = bern_val_d(c, n, x, &d), nx;
-		if (f == 0.0)
+		if (fabs(f) <= fe)
 			return x;
 		if ((f < 0.0) == (flo < 0.0)) {
 			lo = x;
@@ -279,7 +297,10 @@ static double bern_root(const double *c, int n)
 		nx = (d != 0.0) ? x - f / d : 0.5 * (lo + hi);
 		if (!(nx > lo && nx < hi))
 			nx = 0.5 * (lo + hi);
-		if (fabs(nx - x) <= 1e-16 || hi - lo <= 1e-16)
+		/* a Newton step of 1e-14 leaves an error far below rounding;
+		 * smaller steps are rounding noise (waiting for an exact 0
+		 * step can take dozens of bisections) */
+		if (fabs(nx - x) <= 1e-14 || hi - lo <= 1e-16)
 			return nx;
 		x = nx;
 	}
