@@ -42,6 +42,7 @@
 #define TRK_NG (3 * TRK_MAXD)          /* coefficients of g: degree 3p-1 */
 #define TRK_DEPTH 52                    /* root isolation depth */
 #define TRK_NEWTON 10
+#define TRK_GROUP 8     /* leaves per group of the expiry scan */
 /* A Newton step below this fraction of its span is accepted without
  * another evaluation (the root error left is O(step^2), ~1e-9 span). */
 #define TRK_QUICK 3e-5
@@ -81,8 +82,6 @@ struct leaf {
 	int boxed;
 	uint32_t mark;  /* re-solved this update */
 	uint32_t tested; /* event test done this update */
-	double expiry;  /* travel after which the event test is due */
-	int hpos;       /* position in the expiry heap */
 	size_t ioff;    /* ipool: 1/|b_i| (n+1), 1/|db_i| (n) */
 };
 
@@ -141,12 +140,16 @@ struct px_track {
 	struct cand *cand;
 	int *hits;           /* scratch: leaves of this update */
 	/* lazy event tests: leaf l cannot have an event while the path
-	 * length travelled stays below l->expiry (a safe radius around the
-	 * point of its last test); a min-heap on expiry makes the usual
-	 * update one comparison at the root */
-	int *heap;
+	 * length travelled stays below expiry[l] (a safe radius around the
+	 * point of its last test); next_due (the smallest expiry) makes the
+	 * usual update one comparison, and an update with due leaves scans
+	 * the contiguous expiries once (cheaper than heap sifts as soon as
+	 * two or three leaves are due) */
+	double *expiry;
+	double *gdue;        /* smallest expiry of each group of TRK_GROUP */
+	double next_due;
 	double travel;
-	int heap_ok;
+	int heap_ok;         /* expiries valid */
 	double *ipool;
 	px_aabb work;
 	double scale;        /* model diagonal */
@@ -968,42 +971,22 @@ static double leaf_test(const struct px_track *t, const struct leaf *l,
 	return leaf_radius(t, l, p1);
 }
 
-static void heap_set(struct px_track *t, int pos, int li)
-{
-	t->heap[pos] = li;
-	t->leaf[li].hpos = pos;
-}
-
-static void heap_down(struct px_track *t, int pos, int n)
-{
-	int li = t->heap[pos];
-	double x = t->leaf[li].expiry;
-	for (;;) {
-		int c = 2 * pos + 1;
-		if (c >= n)
-			break;
-		if (c + 1 < n && t->leaf[t->heap[c + 1]].expiry <
-				       t->leaf[t->heap[c]].expiry)
-			c++;
-		if (!(t->leaf[t->heap[c]].expiry < x))
-			break;
-		heap_set(t, pos, t->heap[c]);
-		pos = c;
-	}
-	heap_set(t, pos, li);
-}
-
 /* Safe radii of all leaves at p (inside the working volume). */
 static void heap_rebuild(struct px_track *t, px_vec3 p)
 {
 	int i;
+	double nd = INFINITY;
 	for (i = 0; i < t->n_leaves; i++) {
-		t->leaf[i].expiry = t->travel + leaf_radius(t, &t->leaf[i], p) *
-							(1.0 - 1e-9);
-		heap_set(t, i, i);
+		double x = t->travel + leaf_radius(t, &t->leaf[i], p) * (1.0 - 1e-9);
+		t->expiry[i] = x;
+		if (i % TRK_GROUP == 0)
+			t->gdue[i / TRK_GROUP] = x;
+		else if (x < t->gdue[i / TRK_GROUP])
+			t->gdue[i / TRK_GROUP] = x;
+		if (x < nd)
+			nd = x;
 	}
-	for (i = t->n_leaves / 2 - 1; i >= 0; i--)
-		heap_down(t, i, t->n_leaves);
+	t->next_due = nd;
 	t->heap_ok = 1;
 }
 
@@ -1021,27 +1004,45 @@ static void mark_leaf(struct px_track *t, int li, int *nh)
  * (exactly, along the segment), then given a new radius at p1. */
 static int collect_events(struct px_track *t, px_vec3 p0, px_vec3 p1)
 {
-	int nh = 0, k, np = 0, n = t->n_leaves;
+	int nh = 0, k, n = t->n_leaves;
 
 	if (!t->heap_ok)
 		heap_rebuild(t, p0);
 	t->travel += px_v3_dist(p0, p1);
-	/* Each due leaf at the root is tested, given its new expiry and
-	 * sifted down in place (one sift, no pop and push). A radius of 0
-	 * gives expiry == travel: due at the next update with any motion,
-	 * and the strict comparison ends this loop (bounded by n tests:
-	 * every tested leaf leaves with expiry >= travel). */
-	while (n > 0 && t->leaf[t->heap[0]].expiry < t->travel && np < n) {
-		int li = t->heap[0], ev;
-		struct leaf *l = &t->leaf[li];
-		double rad;
-		np++;
-		t->st.box_hits++;
-		rad = leaf_test(t, l, p0, p1, &ev);
-		if (ev)
-			mark_leaf(t, li, &nh);
-		l->expiry = t->travel + rad * (1.0 - 1e-9);
-		heap_down(t, 0, n);
+	/* A due leaf is tested and gets its new expiry. A radius of 0 gives
+	 * expiry == travel: due at the next update with any motion (the
+	 * comparisons are strict). */
+	if (t->next_due < t->travel) {
+		double nd = INFINITY, tr = t->travel;
+		double *ex = t->expiry;
+		int g, ng = (n + TRK_GROUP - 1) / TRK_GROUP;
+		for (g = 0; g < ng; g++) {
+			int k1 = (g + 1) * TRK_GROUP < n ? (g + 1) * TRK_GROUP : n;
+			double gd = INFINITY;
+			if (!(t->gdue[g] < tr)) {
+				if (t->gdue[g] < nd)
+					nd = t->gdue[g];
+				continue;
+			}
+			for (k = g * TRK_GROUP; k < k1; k++) {
+				if (ex[k] < tr) {
+					struct leaf *l = &t->leaf[k];
+					int ev;
+					double rad;
+					t->st.box_hits++;
+					rad = leaf_test(t, l, p0, p1, &ev);
+					if (ev)
+						mark_leaf(t, k, &nh);
+					ex[k] = tr + rad * (1.0 - 1e-9);
+				}
+				if (ex[k] < gd)
+					gd = ex[k];
+			}
+			t->gdue[g] = gd;
+			if (gd < nd)
+				nd = gd;
+		}
+		t->next_due = nd;
 	}
 	for (k = 0; k < nh; k++) {
 		int li = t->hits[k], side;
@@ -1850,7 +1851,8 @@ void px_track_free(struct px_track *t)
 	free(t->pool);
 	free(t->cand);
 	free(t->hits);
-	free(t->heap);
+	free(t->expiry);
+	free(t->gdue);
 	free(t->ipool);
 	free(t);
 }
@@ -2006,9 +2008,10 @@ int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
 	t->pool = calloc(pool_cap ? pool_cap : 1, sizeof(double));
 	t->cand = calloc((size_t)cand_cap + 1, sizeof(*t->cand));
 	t->hits = calloc((size_t)leaf_cap + 1, sizeof(int));
-	t->heap = calloc((size_t)leaf_cap + 1, sizeof(int));
+	t->expiry = calloc((size_t)leaf_cap + 1, sizeof(double));
+	t->gdue = calloc((size_t)leaf_cap / TRK_GROUP + 2, sizeof(double));
 	t->ipool = calloc((size_t)leaf_cap * (2 * TRK_NG + 2) + 1, sizeof(double));
-	if (!t->leaf || !t->pool || !t->cand || !t->hits || !t->heap ||
+	if (!t->leaf || !t->pool || !t->cand || !t->hits || !t->expiry || !t->gdue ||
 	    !t->ipool) {
 		rc = PX_E_NOMEM;
 		goto fail;

@@ -51,17 +51,19 @@
  *    point may travel before the leaf can have an event: its distance
  *    to the box of its event cells, or the radius within which its
  *    coefficients provably keep their signs (each is affine in p, so
- *    |coefficient| / |its p-gradient| bounds it) - and a min-heap on the
- *    travelled path length names the leaves whose radius is used up;
- *    usually none, so an update costs one comparison at the heap root
- *    plus the evolution (a due leaf is re-keyed in place at the root). A
- *    due leaf is tested exactly along the segment
- *    p_old -> p_new (the coefficients are affine in the segment
- *    parameter, so sign-definite coefficients at both ends prove there is
- *    no event - the exact counterpart of the paper's line/box-diagonal
- *    stage), gets a new radius at p_new, and is re-solved with a
- *    certified Bernstein/Descartes root isolation at the new point. A
- *    region is grown while a root crosses its outer boundary, so created pairs that drift away from the
+ *    |coefficient| / |its p-gradient| bounds it) - and the smallest
+ *    expiry (travelled path length at which a radius is used up) names
+ *    the updates with due leaves; usually there are none, so an update
+ *    costs one comparison plus the evolution (otherwise one scan over
+ *    groups of 8 leaves, each with its smallest expiry, finds them). A
+ *    due leaf is tested exactly along the segment p_old -> p_new (the
+ *    coefficients are affine in the segment parameter, so sign-definite
+ *    coefficients at both ends prove there is no event - the exact
+ *    counterpart of the paper's line/box-diagonal stage), gets a new
+ *    radius at p_new, and is re-solved with a certified
+ *    Bernstein/Descartes root isolation at the new point. A region is
+ *    grown while a root crosses its outer boundary, so created pairs
+ *    that drift away from the
  *    crossing are found too. Creation and annihilation are counted by the
  *    change in the number of roots of the re-solved leaves.
  *  - Candidates: open-curve ends, C0 breaks, cusps and a cornered closed
