@@ -710,8 +710,8 @@ static int newton(const struct px_track *t, const struct ent *e, int type,
 static int evolve(struct px_track *t, struct ent *e, struct zero *z,
 		  px_vec3 p0, px_vec3 dp, px_vec3 p)
 {
-	double lim, unw, u = z->u, step, D = 0.0;
-	int li, guard, k, ok;
+	double lim, unw, u = z->u, step, D = 0.0, next = 0.0;
+	int li, guard, k, ok, have = 0;
 	px_vec3 c, d1;
 
 	{
@@ -743,7 +743,18 @@ static int evolve(struct px_track *t, struct ent *e, struct zero *z,
 					zero_stamp(t, z, p);
 					return 0;
 				}
+			} else if (isfinite(st)) {
+				/* the general iteration goes on from this
+				 * Newton step instead of evaluating ua again */
+				have = 1;
+				next = st;
 			}
+		}
+		if (have) {
+			lim = e->len / (e->n_leaves > 0 ? e->n_leaves : 1);
+			if (fabs(next) > lim)
+				next = next > 0 ? lim : -lim;
+			next += ua;
 		}
 	}
 	lim = e->len / (e->n_leaves > 0 ? e->n_leaves : 1);
@@ -752,7 +763,7 @@ static int evolve(struct px_track *t, struct ent *e, struct zero *z,
 		step = 0.0;
 	if (fabs(step) > lim)
 		step = step > 0 ? lim : -lim;
-	unw = z->u + step;
+	unw = have ? next : z->u + step;
 	ok = !newton(t, e, z->type, &unw, p, lim, &c, &d1, &D, &u,
 		     t->leaf[z->leaf].span);
 	if (!ok) {
