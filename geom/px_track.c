@@ -157,6 +157,7 @@ struct px_track {
 	int init;
 	uint32_t epoch, next_id, best_id;
 	int fault;           /* test hook: px__track_set_fault() */
+	int n_crit_cap;      /* critical points all entities can hold */
 	struct px_track_stats st;
 	size_t bytes;
 };
@@ -1133,7 +1134,7 @@ static int catch_up(struct px_track *t, struct ent *e, px_vec3 p)
 static void wake_minima(struct px_track *t, px_vec3 p)
 {
 	double best2 = INFINITY, best;
-	int i, j;
+	int i, j, round;
 	for (i = 0; i < t->n_cand; i++) {
 		double d2 = px_v3_dist2(t->cand[i].q, p);
 		if (d2 < best2)
@@ -1154,35 +1155,57 @@ static void wake_minima(struct px_track *t, px_vec3 p)
 		}
 	}
 	best = sqrt(best2);
-	for (i = 0; i < t->n_ent; i++) {
-		struct ent *e = &t->ent[i];
-		if (e->stale)
-			continue;
-		for (j = 0; j < e->nz; j++) {
-			struct zero *z = &e->z[j];
-			double lb, d;
-			int leaf0;
-			if (z->type < 0 || z->ep == t->epoch)
+	if (t->fault & 2)
+		return;
+	/* wake the resting minimum with the smallest bound first: it is
+	 * usually the closest point and then excludes the others (bounded:
+	 * each round corrects one root or ends) */
+	for (round = 0; round <= t->n_crit_cap; round++) {
+		struct ent *we = NULL;
+		struct zero *wz = NULL;
+		double wlb = INFINITY, d;
+		int leaf0;
+		for (i = 0; i < t->n_ent; i++) {
+			struct ent *e = &t->ent[i];
+			if (e->stale)
 				continue;
-			lb = z->dist - (t->travel - z->trav);
-			if (lb > best + 1e-9 * (best + t->scale) || (t->fault & 2))
-				continue;
-			leaf0 = z->leaf;
-			if (evolve(t, e, z, z->p, px_v3_sub(p, z->p), p)) {
-				e->stale = 1;
-				break;
-			}
-			if (z->leaf != leaf0 && !e->full) {
-				e->full = 1;
-				if (catch_up(t, e, p)) {
-					e->stale = 1;
-					break;
+			for (j = 0; j < e->nz; j++) {
+				struct zero *z = &e->z[j];
+				double lb;
+				if (z->type < 0 || z->ep == t->epoch)
+					continue;
+				lb = z->dist - (t->travel - z->trav);
+				if (lb < wlb) {
+					wlb = lb;
+					wz = z;
+					we = e;
 				}
 			}
-			d = px_v3_dist(z->c, p);
-			if (d < best)
-				best = d;
 		}
+		if (!wz || wlb > best + 1e-9 * (best + t->scale))
+			return;
+		leaf0 = wz->leaf;
+		if (evolve(t, we, wz, wz->p, px_v3_sub(p, wz->p), p)) {
+			we->stale = 1;
+			continue;
+		}
+		if (wz->leaf != leaf0 && !we->full) {
+			we->full = 1;
+			if (catch_up(t, we, p)) {
+				we->stale = 1;
+				continue;
+			}
+			/* caught-up minima may be closer */
+			for (j = 0; j < we->nz; j++)
+				if (we->z[j].type > 0) {
+					d = px_v3_dist(we->z[j].c, p);
+					if (d < best)
+						best = d;
+				}
+		}
+		d = px_v3_dist(wz->c, p);
+		if (d < best)
+			best = d;
 	}
 }
 
@@ -2254,6 +2277,7 @@ int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
 		   pool_cap * sizeof(double) +
 		   (size_t)(cand_cap + 1) * sizeof(*t->cand);
 	t->epoch = 1;
+	t->n_crit_cap = n_curves * o.max_crit;
 	free(spl);
 	free(work);
 	(void)j;
