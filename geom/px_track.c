@@ -158,6 +158,8 @@ struct px_track {
 	uint32_t epoch, next_id, best_id;
 	int fault;           /* test hook: px__track_set_fault() */
 	int n_crit_cap;      /* critical points all entities can hold */
+	int *rmin;           /* resting minima of this update: entity, index */
+	int n_rmin;
 	struct px_track_stats st;
 	size_t bytes;
 };
@@ -1160,26 +1162,24 @@ static void wake_minima(struct px_track *t, px_vec3 p)
 	/* wake the resting minimum with the smallest bound first: it is
 	 * usually the closest point and then excludes the others (bounded:
 	 * each round corrects one root or ends) */
-	for (round = 0; round <= t->n_crit_cap; round++) {
+	for (round = 0; round <= t->n_rmin; round++) {
 		struct ent *we = NULL;
 		struct zero *wz = NULL;
 		double wlb = INFINITY, d;
-		int leaf0;
-		for (i = 0; i < t->n_ent; i++) {
-			struct ent *e = &t->ent[i];
-			if (e->stale)
+		int leaf0, k;
+		/* the resting minima listed by the evolution pass (those of
+		 * an entity caught up since are current now) */
+		for (k = 0; k < t->n_rmin; k++) {
+			struct ent *e = &t->ent[t->rmin[2 * k]];
+			struct zero *z = &e->z[t->rmin[2 * k + 1]];
+			double lb;
+			if (e->stale || z->ep == t->epoch)
 				continue;
-			for (j = 0; j < e->nz; j++) {
-				struct zero *z = &e->z[j];
-				double lb;
-				if (z->type < 0 || z->ep == t->epoch)
-					continue;
-				lb = z->dist - (t->travel - z->trav);
-				if (lb < wlb) {
-					wlb = lb;
-					wz = z;
-					we = e;
-				}
+			lb = z->dist - (t->travel - z->trav);
+			if (lb < wlb) {
+				wlb = lb;
+				wz = z;
+				we = e;
 			}
 		}
 		if (!wz || wlb > best + 1e-9 * (best + t->scale))
@@ -1418,6 +1418,7 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 
 	for (i = 0; i < nh; i++)
 		t->ent[t->leaf[t->hits[i]].ent].hit = t->epoch;
+	t->n_rmin = 0;
 	/* evolve every root outside the re-solved leaves; in an entity
 	 * without re-solved leaves a root whose leaf certificate holds may
 	 * rest (can_rest) until the answer needs it */
@@ -1439,6 +1440,11 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 			}
 			/* without a re-solved leaf nothing is dropped: w == j */
 			if (!e->full && can_rest(t, e, j)) {
+				if (zj->type > 0) {
+					t->rmin[2 * t->n_rmin] = i;
+					t->rmin[2 * t->n_rmin + 1] = j;
+					t->n_rmin++;
+				}
 				w++;
 				continue;
 			}
@@ -1886,6 +1892,7 @@ void px_track_free(struct px_track *t)
 	free(t->cand);
 	free(t->hits);
 	free(t->expiry);
+	free(t->rmin);
 	free(t->gdue);
 	free(t->ipool);
 	free(t);
@@ -2278,6 +2285,11 @@ int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
 		   (size_t)(cand_cap + 1) * sizeof(*t->cand);
 	t->epoch = 1;
 	t->n_crit_cap = n_curves * o.max_crit;
+	t->rmin = calloc((size_t)t->n_crit_cap * 2 + 2, sizeof(int));
+	if (!t->rmin) {
+		rc = PX_E_NOMEM;
+		goto fail;
+	}
 	free(spl);
 	free(work);
 	(void)j;
