@@ -118,6 +118,7 @@ struct ent {
 	int stale;
 	int touched;
 	int full;       /* every root must be current (no laziness) */
+	int moved;      /* a root of it was corrected this update */
 	uint32_t hit;   /* epoch in which a leaf of it was re-solved */
 };
 
@@ -744,6 +745,7 @@ static int evolve(struct px_track *t, struct ent *e, struct zero *z,
 					z->d1 = d1;
 					z->D = D;
 					zero_stamp(t, z, p);
+					e->moved = 1;
 					return 0;
 				}
 			} else if (isfinite(st)) {
@@ -828,6 +830,7 @@ static int evolve(struct px_track *t, struct ent *e, struct zero *z,
 	z->d1 = d1;
 	z->D = D;
 	zero_stamp(t, z, p);
+	e->moved = 1;
 	return 0;
 }
 
@@ -1428,6 +1431,7 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 		e->nold = 0;
 		e->touched = 0;
 		e->full = !t->opts.lazy || e->hit == t->epoch;
+		e->moved = 0;
 		if (e->stale)
 			continue;
 		for (j = 0; j < e->nz; j++) {
@@ -1496,9 +1500,10 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 		}
 		for (i = 0; i < t->n_ent; i++) {
 			struct ent *e = &t->ent[i];
-			if (!e->stale && !e->touched) {
+			if (!e->stale && !e->touched && e->moved) {
 				/* evolved roots kept type and stretch; two
-				 * converging to one root shows as a duplicate */
+				 * converging to one root shows as a duplicate
+				 * (an entity whose roots all rest is unchanged) */
 				sort_zeros(e);
 				if (ent_dups(e))
 					e->stale = 1;
