@@ -230,9 +230,10 @@ PX_API int px_track_update(struct px_track *t, px_vec3 p,
 
 /*
  * The live critical points of an entity, sorted by parameter: u[i] and
- * type[i] (+1 minimum, -1 maximum), up to cap of them. Returns the
- * number held (may exceed cap) or PX_E_INVAL / PX_E_RANGE (entity).
- * @note RT-safe.
+ * type[i] (+1 minimum, -1 maximum), up to cap of them. Points resting
+ * under opts.lazy are corrected to the current point first (the tracker
+ * state changes, the answers do not). Returns the number held (may
+ * exceed cap) or PX_E_INVAL / PX_E_RANGE (entity). @note RT-safe.
  */
 PX_API int px_track_critical(const struct px_track *t, int entity, double *u,
 			     int *type, int cap);
