@@ -838,6 +838,7 @@ static long cert_check(const struct tcurve *tc, int ne, int fault, int npts)
 	int e, k, li, j, ng = 0, planar = 1, gi;
 	double size;
 	px_aabb box;
+	memset(cs, 0, sizeof(cs));
 	for (e = 0; e < ne; e++) {
 		px_aabb b = px_nurbs_curve_aabb(&tc[e].c);
 		cs[e] = tc[e].c;
