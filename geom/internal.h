@@ -74,7 +74,24 @@ static inline double px__nurbs_binom(int n, int k)
 	return b[n][k];
 }
 
-#endif
+/* ---- coherent tracking (px_track.c) ---- */
+
+struct px_track;
+/* Test hook: deliberately break the proofs so tests can show they would
+ * catch it (bit 0: every root may rest, bit 1: resting minima are never
+ * woken, bit 2: every leaf's no-event radius is infinite, bit 3: every
+ * leaf-end radius is infinite). 0 restores normal operation. */
+void px__track_set_fault(struct px_track *t, int fault);
+
+/* Test hook: the certificate radius of leaf `leaf` at p (which 0: no
+ * event in the leaf while the point travels less; 1: its end values of
+ * f' keep their signs), with the leaf's entity, parameter interval and
+ * flags (bit 0: an end at a cusp, where g is divided). -1 for a bad
+ * leaf index. */
+double px__track_leaf_cert(const struct px_track *t, int leaf, px_vec3 p,
+			   int which, int *ent, double *u0, double *u1,
+			   unsigned *flags);
+
 
 /*
  * Sub-block extraction shared by curves (nd = 1) and surfaces (nd = 2):
@@ -91,3 +108,5 @@ int px__nurbs_extract(int nd, const int *p, const int *n,
 
 /* Interior knot values of multiplicity >= p; returns the count. */
 int px__nurbs_breaks(const double *U, int p, int n, double *out, int cap);
+
+#endif

@@ -35,12 +35,17 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "internal.h"
 #include "px_bern.h"
 
 #define TRK_MAXD PX_NURBS_MAX_DEGREE
 #define TRK_NG (3 * TRK_MAXD)          /* coefficients of g: degree 3p-1 */
 #define TRK_DEPTH 52                    /* root isolation depth */
 #define TRK_NEWTON 10
+#define TRK_GROUP 8     /* leaves per group of the expiry scan */
+/* A Newton step below this fraction of its span is accepted without
+ * another evaluation (the root error left is O(step^2), ~1e-9 span). */
+#define TRK_QUICK 3e-5
 
 /* leaf flags */
 #define LF_EV0 0x1u   /* start is a break: a root crossing it is an event */
@@ -59,7 +64,11 @@
 struct span {
 	double u0, u1, inv;
 	int deg;
+	int rat;        /* rational (w not constant 1) */
 	double pc[4][TRK_MAXD + 1]; /* power basis in t of x w, y w, z w, w */
+	/* the same in tau = u - u0 (derivatives come out in u directly);
+	 * zero-padded to degree 3 so low degrees share one unrolled path */
+	double pu[4][TRK_MAXD + 1];
 };
 
 struct leaf {
@@ -73,8 +82,6 @@ struct leaf {
 	int boxed;
 	uint32_t mark;  /* re-solved this update */
 	uint32_t tested; /* event test done this update */
-	double expiry;  /* travel after which the event test is due */
-	int hpos;       /* position in the expiry heap */
 	size_t ioff;    /* ipool: 1/|b_i| (n+1), 1/|db_i| (n) */
 };
 
@@ -92,6 +99,12 @@ struct zero {
 	uint32_t id;
 	px_vec3 c, d1;  /* point and C' at u (last evaluation) */
 	double D;       /* (C - p) . C'' + |C'|^2 there */
+	/* laziness: state of the last correction */
+	px_vec3 p;      /* query point then */
+	double trav;    /* path length travelled then */
+	double dist;    /* |c - p| then */
+	double until;   /* travel below which it provably stays in its leaf */
+	uint32_t ep;    /* update (epoch) of the last correction */
 };
 
 struct ent {
@@ -104,6 +117,9 @@ struct ent {
 	int first_cand, n_cand;
 	int stale;
 	int touched;
+	int full;       /* every root must be current (no laziness) */
+	int moved;      /* a root of it was corrected this update */
+	uint32_t hit;   /* epoch in which a leaf of it was re-solved */
 };
 
 struct cand {
@@ -123,26 +139,28 @@ struct px_track {
 	double *pool;
 	size_t pool_len;
 	struct cand *cand;
-	/* event grid: the finest octree level over the working volume;
-	 * cell (i, j, k) lists the leaves with an event cell there */
-	int gn;              /* cells per axis */
-	px_vec3 ginv;        /* cells per unit length */
-	int *gstart;         /* gn^3 + 1 offsets into gleaf */
-	int *gleaf;
 	int *hits;           /* scratch: leaves of this update */
 	/* lazy event tests: leaf l cannot have an event while the path
-	 * length travelled stays below l->expiry (a safe radius around the
-	 * point of its last test); a min-heap on expiry makes the usual
-	 * update one comparison at the root */
-	int *heap, *popped;
+	 * length travelled stays below expiry[l] (a safe radius around the
+	 * point of its last test); next_due (the smallest expiry) makes the
+	 * usual update one comparison, and an update with due leaves scans
+	 * the contiguous expiries once (cheaper than heap sifts as soon as
+	 * two or three leaves are due) */
+	double *expiry;
+	double *gdue;        /* smallest expiry of each group of TRK_GROUP */
+	double next_due;
 	double travel;
-	int heap_ok;
+	int heap_ok;         /* expiries valid */
 	double *ipool;
 	px_aabb work;
 	double scale;        /* model diagonal */
 	px_vec3 p;
 	int init;
 	uint32_t epoch, next_id, best_id;
+	int fault;           /* test hook: px__track_set_fault() */
+	int n_crit_cap;      /* critical points all entities can hold */
+	int *rmin;           /* resting minima of this update: entity, index */
+	int n_rmin;
 	struct px_track_stats st;
 	size_t bytes;
 };
@@ -150,22 +168,40 @@ struct px_track {
 /* ------------------------------------------------------------------ */
 /* evaluation                                                          */
 
-static void span_eval(const struct span *s, double u, px_vec3 *c, px_vec3 *d1,
-		      px_vec3 *d2)
+/* C, C', C'' at u from the span's power-basis table: for degree <= 3 one
+ * unrolled Horner per coordinate (a few dozen flops), homogeneous
+ * quotient rule only for rational spans. */
+static inline void span_eval(const struct span *s, double u, px_vec3 *c,
+			     px_vec3 *d1, px_vec3 *d2)
 {
-	double t = (u - s->u0) * s->inv, h[4][3];
-	int k, j, p = s->deg;
+	double x = u - s->u0, h[4][3];
+	int k, j, p = s->deg, nk = s->rat ? 4 : 3;
 
-	for (k = 0; k < 4; k++) {
-		double v = s->pc[k][p], v1 = 0.0, v2 = 0.0;
-		for (j = p - 1; j >= 0; j--) {
-			v2 = v2 * t + 2.0 * v1;
-			v1 = v1 * t + v;
-			v = v * t + s->pc[k][j];
+	if (p <= 3) {
+		for (k = 0; k < nk; k++) {
+			const double *q = s->pu[k];
+			h[k][0] = ((q[3] * x + q[2]) * x + q[1]) * x + q[0];
+			h[k][1] = (3.0 * q[3] * x + 2.0 * q[2]) * x + q[1];
+			h[k][2] = 6.0 * q[3] * x + 2.0 * q[2];
 		}
-		h[k][0] = v;
-		h[k][1] = v1;
-		h[k][2] = v2;
+	} else {
+		for (k = 0; k < nk; k++) {
+			double v = s->pu[k][p], v1 = 0.0, v2 = 0.0;
+			for (j = p - 1; j >= 0; j--) {
+				v2 = v2 * x + 2.0 * v1;
+				v1 = v1 * x + v;
+				v = v * x + s->pu[k][j];
+			}
+			h[k][0] = v;
+			h[k][1] = v1;
+			h[k][2] = v2;
+		}
+	}
+	if (!s->rat) {
+		*c = px_v3(h[0][0], h[1][0], h[2][0]);
+		*d1 = px_v3(h[0][1], h[1][1], h[2][1]);
+		*d2 = px_v3(h[0][2], h[1][2], h[2][2]);
+		return;
 	}
 	{
 		double w = h[3][0], w1 = h[3][1], w2 = h[3][2], iw = 1.0 / w;
@@ -173,12 +209,11 @@ static void span_eval(const struct span *s, double u, px_vec3 *c, px_vec3 *d1,
 		px_vec3 C1 = px_v3((h[0][1] - w1 * C.x) * iw,
 				   (h[1][1] - w1 * C.y) * iw,
 				   (h[2][1] - w1 * C.z) * iw);
-		px_vec3 C2 = px_v3((h[0][2] - 2.0 * w1 * C1.x - w2 * C.x) * iw,
-				   (h[1][2] - 2.0 * w1 * C1.y - w2 * C.y) * iw,
-				   (h[2][2] - 2.0 * w1 * C1.z - w2 * C.z) * iw);
 		*c = C;
-		*d1 = px_v3_scale(C1, s->inv);
-		*d2 = px_v3_scale(C2, s->inv * s->inv);
+		*d1 = C1;
+		*d2 = px_v3((h[0][2] - 2.0 * w1 * C1.x - w2 * C.x) * iw,
+			    (h[1][2] - 2.0 * w1 * C1.y - w2 * C.y) * iw,
+			    (h[2][2] - 2.0 * w1 * C1.z - w2 * C.z) * iw);
 	}
 }
 
@@ -214,13 +249,51 @@ static inline double gco(const double *a, int n, int i, px_vec3 p)
 /* ------------------------------------------------------------------ */
 /* root isolation on one leaf                                          */
 
+/* Bernstein polynomial and its derivative at x by de Casteljau (exact
+ * enough near the ends, no library call): the last level's two values
+ * give f = (1-x) b0 + x b1 and f' = n (b1 - b0). */
+static inline double bern_val_d(const double *c, int n, double x, double *d)
+{
+	double b[TRK_NG + 1], y = 1.0 - x;
+	int i, k;
+	if (n == 0) {
+		*d = 0.0;
+		return c[0];
+	}
+	for (i = 0; i <= n; i++)
+		b[i] = c[i];
+	for (k = n; k > 1; k--)
+		for (i = 0; i < k; i++)
+			b[i] = y * b[i] + x * b[i + 1];
+	*d = n * (b[1] - b[0]);
+	return y * b[0] + x * b[1];
+}
+
 static double bern_root(const double *c, int n)
 {
-	double lo = 0.0, hi = 1.0, x = 0.5, flo = c[0];
-	int k;
+	double lo = 0.0, hi = 1.0, x = 0.5, flo = c[0], fe;
+	int k, i;
+	/* start where the control polygon crosses zero (it converges to
+	 * the curve quadratically under subdivision) */
+	for (i = 0; i < n; i++)
+		if ((c[i] < 0.0) != (c[i + 1] < 0.0)) {
+			x = (i + c[i] / (c[i] - c[i + 1])) / n;
+			break;
+		}
+	if (!(x > 0.0 && x < 1.0))
+		x = 0.5;
+	/* rounding level of an evaluation: below it f carries no sign
+	 * information and the iterate is as good as it gets */
+	{
+		double cm = 0.0;
+		for (i = 0; i <= n; i++)
+			if (fabs(c[i]) > cm)
+				cm = fabs(c[i]);
+		fe = 4.0 * (n + 1) * 2.2e-16 * cm;
+	}
 	for (k = 0; k < 100; k++) {
-		double d, f = px_bern_eval_d(c, n, x, &d), nx;
-		if (f == 0.0)
+		double d, f = bern_val_d(c, n, x, &d), nx;
+		if (fabs(f) <= fe)
 			return x;
 		if ((f < 0.0) == (flo < 0.0)) {
 			lo = x;
@@ -231,7 +304,10 @@ static double bern_root(const double *c, int n)
 		nx = (d != 0.0) ? x - f / d : 0.5 * (lo + hi);
 		if (!(nx > lo && nx < hi))
 			nx = 0.5 * (lo + hi);
-		if (fabs(nx - x) <= 1e-16 || hi - lo <= 1e-16)
+		/* a Newton step of 1e-14 leaves an error far below rounding;
+		 * smaller steps are rounding noise (waiting for an exact 0
+		 * step can take dozens of bisections) */
+		if (fabs(nx - x) <= 1e-14 || hi - lo <= 1e-16)
 			return nx;
 		x = nx;
 	}
@@ -340,6 +416,39 @@ static int leaf_roots(const struct px_track *t, const struct leaf *l,
 /* ------------------------------------------------------------------ */
 /* entity state                                                        */
 
+/* Travel (path length) the point may still cover from p before a root
+ * of leaf l can leave it through an end: the end values of g are affine
+ * in p, so none changes sign within |value| / |p-gradient| (0 when an
+ * end value is too close to zero to tell). With no event inside the leaf
+ * (it is not re-solved) its roots keep their number and stay in it. */
+static double leaf_end_radius(const struct px_track *t, const struct leaf *l,
+			      px_vec3 p)
+{
+	const double *a = leaf_a(t, l), *ib = t->ipool + l->ioff;
+	double v0 = fabs(gco(a, l->n, 0, p)) - l->tol_g;
+	if (t->fault & 8)
+		return INFINITY;
+	double v1 = fabs(gco(a, l->n, l->n, p)) - l->tol_g;
+	if (!(v0 > 0.0) || !(v1 > 0.0))
+		return 0.0;
+	v0 *= ib[0];
+	v1 *= ib[l->n];
+	return v0 < v1 ? v0 : v1;
+}
+
+/* Record a correction of z at p (now). */
+static void zero_stamp(const struct px_track *t, struct zero *z, px_vec3 p)
+{
+	z->p = p;
+	z->trav = t->travel;
+	z->dist = px_v3_dist(z->c, p);
+	z->ep = t->epoch;
+	z->until = t->opts.lazy
+			   ? t->travel + leaf_end_radius(t, &t->leaf[z->leaf], p) *
+						 (1.0 - 1e-9)
+			   : -1.0;
+}
+
 static void zero_eval(const struct px_track *t, const struct ent *e,
 		      struct zero *z, px_vec3 p)
 {
@@ -348,6 +457,7 @@ static void zero_eval(const struct px_track *t, const struct ent *e,
 	z->c = c;
 	z->d1 = d1;
 	z->D = px_v3_dot(px_v3_sub(c, p), d2) + px_v3_dot(d1, d1);
+	zero_stamp(t, z, p);
 }
 
 static int cmp_zero(const struct zero *a, const struct zero *b)
@@ -358,7 +468,11 @@ static int cmp_zero(const struct zero *a, const struct zero *b)
 static void sort_zeros(struct ent *e)
 {
 	int i, j;
-	for (i = 1; i < e->nz; i++) {
+	/* usually still sorted: one pass of comparisons, no copies */
+	for (i = 1; i < e->nz; i++)
+		if (e->z[i - 1].u > e->z[i].u)
+			break;
+	for (; i < e->nz; i++) {
 		struct zero z = e->z[i];
 		for (j = i; j > 0 && cmp_zero(&e->z[j - 1], &z); j--)
 			e->z[j] = e->z[j - 1];
@@ -529,7 +643,7 @@ static int newton(const struct px_track *t, const struct ent *e, int type,
 		  double *unw, px_vec3 p, double lim, px_vec3 *c, px_vec3 *d1,
 		  double *D, double *u_out, int hint)
 {
-	double u, step, tol = 1e-8 * e->len, quick = 1e-6 * e->len;
+	double u, step, tol = 1e-8 * e->len, quick = TRK_QUICK;
 	int k;
 	px_vec3 d2;
 	for (k = 0;; k++) {
@@ -560,16 +674,22 @@ static int newton(const struct px_track *t, const struct ent *e, int type,
 			return 1;
 		if (fabs(step) <= tol)
 			break;
-		if (fabs(step) <= quick && u + step >= sp->u0 &&
-		    u + step <= sp->u1) {
-			/* quadratic convergence: the error after this step is
-			 * O(step^2), below tol; move the point to first order
-			 * (its error is O(step^2) too) instead of evaluating
-			 * again */
+		if (fabs(step) <= quick * (sp->u1 - sp->u0) &&
+		    u + step >= sp->u0 && u + step <= sp->u1) {
+			/* quadratic convergence: the root error after this
+			 * step is O(step^2) (below 1e-9 of the span), so the
+			 * point is moved by its Taylor expansion instead of
+			 * another evaluation: second order in C (error
+			 * O(step^3), far below the answer tolerance), first
+			 * order in C' (only the next predictor uses it) */
+			px_vec3 pc;
 			*unw += step;
 			u += step;
-			*c = px_v3_add(*c, px_v3_scale(*d1, step));
+			*c = px_v3_add(*c, px_v3_scale(px_v3_add(*d1,
+					px_v3_scale(d2, 0.5 * step)), step));
 			*d1 = px_v3_add(*d1, px_v3_scale(d2, step));
+			pc = px_v3_sub(*c, p);
+			*D = px_v3_dot(pc, d2) + px_v3_dot(*d1, *d1);
 			break;
 		}
 		if (k >= TRK_NEWTON)
@@ -594,17 +714,61 @@ static int newton(const struct px_track *t, const struct ent *e, int type,
 static int evolve(struct px_track *t, struct ent *e, struct zero *z,
 		  px_vec3 p0, px_vec3 dp, px_vec3 p)
 {
-	double lim = e->len / (e->n_leaves > 0 ? e->n_leaves : 1);
-	double unw, u = z->u, step, D = 0.0;
-	int li, guard, k, ok;
+	double lim, unw, u = z->u, step, D = 0.0, next = 0.0;
+	int li, guard, k, ok, have = 0;
 	px_vec3 c, d1;
 
+	{
+		/* the usual case, in a few dozen flops: predictor, one
+		 * evaluation from the span table, one accepted Newton step,
+		 * all inside the root's leaf */
+		const struct leaf *l = &t->leaf[z->leaf];
+		const struct span *sp = &t->span[l->span];
+		double ua = z->u + px_v3_dot(dp, z->d1) / z->D, f1, st;
+		px_vec3 d2, pc;
+		if (ua >= l->u0 && ua <= l->u1) {
+			span_eval(sp, ua, &c, &d1, &d2);
+			pc = px_v3_sub(c, p);
+			f1 = px_v3_dot(pc, d1);
+			D = px_v3_dot(pc, d2) + px_v3_dot(d1, d1);
+			st = -f1 / D;
+			if (fabs(st) <= TRK_QUICK * (sp->u1 - sp->u0) &&
+			    ua + st >= l->u0 && ua + st <= l->u1) {
+				c = px_v3_add(c, px_v3_scale(px_v3_add(d1,
+						px_v3_scale(d2, 0.5 * st)), st));
+				d1 = px_v3_add(d1, px_v3_scale(d2, st));
+				pc = px_v3_sub(c, p);
+				D = px_v3_dot(pc, d2) + px_v3_dot(d1, d1);
+				if ((D > 0.0 ? 1 : -1) == z->type) {
+					z->u = ua + st;
+					z->c = c;
+					z->d1 = d1;
+					z->D = D;
+					zero_stamp(t, z, p);
+					e->moved = 1;
+					return 0;
+				}
+			} else if (isfinite(st)) {
+				/* the general iteration goes on from this
+				 * Newton step instead of evaluating ua again */
+				have = 1;
+				next = st;
+			}
+		}
+		if (have) {
+			lim = e->len / (e->n_leaves > 0 ? e->n_leaves : 1);
+			if (fabs(next) > lim)
+				next = next > 0 ? lim : -lim;
+			next += ua;
+		}
+	}
+	lim = e->len / (e->n_leaves > 0 ? e->n_leaves : 1);
 	step = (z->D != 0.0) ? px_v3_dot(dp, z->d1) / z->D : 0.0;
 	if (!isfinite(step))
 		step = 0.0;
 	if (fabs(step) > lim)
 		step = step > 0 ? lim : -lim;
-	unw = z->u + step;
+	unw = have ? next : z->u + step;
 	ok = !newton(t, e, z->type, &unw, p, lim, &c, &d1, &D, &u,
 		     t->leaf[z->leaf].span);
 	if (!ok) {
@@ -665,6 +829,8 @@ static int evolve(struct px_track *t, struct ent *e, struct zero *z,
 	z->c = c;
 	z->d1 = d1;
 	z->D = D;
+	zero_stamp(t, z, p);
+	e->moved = 1;
 	return 0;
 }
 
@@ -734,16 +900,23 @@ static double definite_radius(const double *a, const double *ib, int m,
 		if (!s || (sg && s != sg))
 			return 0.0;
 		sg = s;
-		r = fmin(r, (fabs(v) - tol) * ib[i]);
+		{
+			double ri = ((v > 0.0 ? v : -v) - tol) * ib[i];
+			if (ri < r)
+				r = ri;
+		}
 	}
 	return r;
 }
 
 static double box_dist(const px_aabb *b, px_vec3 p)
 {
-	double dx = fmax(fmax(b->min.x - p.x, p.x - b->max.x), 0.0);
-	double dy = fmax(fmax(b->min.y - p.y, p.y - b->max.y), 0.0);
-	double dz = fmax(fmax(b->min.z - p.z, p.z - b->max.z), 0.0);
+	double dx = b->min.x - p.x > 0.0 ? b->min.x - p.x
+					: (p.x - b->max.x > 0.0 ? p.x - b->max.x : 0.0);
+	double dy = b->min.y - p.y > 0.0 ? b->min.y - p.y
+					: (p.y - b->max.y > 0.0 ? p.y - b->max.y : 0.0);
+	double dz = b->min.z - p.z > 0.0 ? b->min.z - p.z
+					: (p.z - b->max.z > 0.0 ? p.z - b->max.z : 0.0);
 	return sqrt(dx * dx + dy * dy + dz * dz);
 }
 
@@ -756,12 +929,12 @@ static double leaf_radius(const struct px_track *t, const struct leaf *l,
 	const double *a = leaf_a(t, l), *ib = t->ipool + l->ioff;
 	double r, rb;
 	int n = l->n, i;
-	if (!l->boxed)
+	if (!l->boxed || (t->fault & 4))
 		return INFINITY;
 	rb = box_dist(&l->box, p);
 	r = definite_radius(a, ib, n + 1, p, l->tol_g);
 	if (r > 0.0)
-		return fmax(r, rb);
+		return r > rb ? r : rb;
 	r = n >= 1 ? definite_radius(a + 4 * (n + 1), ib + n + 1, n, p,
 				     l->tol_d)
 		   : INFINITY;
@@ -770,62 +943,67 @@ static double leaf_radius(const struct px_track *t, const struct leaf *l,
 		int e = i ? n : 0;
 		if (!(l->flags & (i ? LF_EV1 : LF_EV0)))
 			continue;
-		v = gco(a, n, e, p);
-		r = fmin(r, fabs(v) > l->tol_g ? (fabs(v) - l->tol_g) * ib[e] : 0.0);
+		v = fabs(gco(a, n, e, p));
+		v = v > l->tol_g ? (v - l->tol_g) * ib[e] : 0.0;
+		if (v < r)
+			r = v;
 	}
-	return fmax(r, rb);
+	return r > rb ? r : rb;
 }
 
-static void heap_set(struct px_track *t, int pos, int li)
+/*
+ * The exact test of leaf l along p0 -> p1 (*event: 1 when it may hold an
+ * event, as leaf_event()) and its safe radius at p1 (as leaf_radius()).
+ * The usual leaf - no root, coefficients of g of one sign along the
+ * whole step - is done in one pass over its coefficients.
+ */
+static double leaf_test(const struct px_track *t, const struct leaf *l,
+			px_vec3 p0, px_vec3 p1, int *event)
 {
-	t->heap[pos] = li;
-	t->leaf[li].hpos = pos;
-}
-
-static void heap_down(struct px_track *t, int pos, int n)
-{
-	int li = t->heap[pos];
-	double x = t->leaf[li].expiry;
-	for (;;) {
-		int c = 2 * pos + 1;
-		if (c >= n)
+	const double *a = leaf_a(t, l), *ib = t->ipool + l->ioff;
+	int m = l->n + 1, i, sg = 0;
+	const double *bx = a + m, *by = bx + m, *bz = by + m;
+	double r = INFINITY, rb, tol = l->tol_g;
+	for (i = 0; i < m; i++) {
+		double v0 = a[i] - (p0.x * bx[i] + p0.y * by[i] + p0.z * bz[i]);
+		double v1 = a[i] - (p1.x * bx[i] + p1.y * by[i] + p1.z * bz[i]);
+		int s0 = v0 > tol ? 1 : (v0 < -tol ? -1 : 0);
+		int s1 = v1 > tol ? 1 : (v1 < -tol ? -1 : 0);
+		double ri;
+		if (!s0 || s1 != s0 || (sg && s0 != sg))
 			break;
-		if (c + 1 < n && t->leaf[t->heap[c + 1]].expiry <
-				       t->leaf[t->heap[c]].expiry)
-			c++;
-		if (!(t->leaf[t->heap[c]].expiry < x))
-			break;
-		heap_set(t, pos, t->heap[c]);
-		pos = c;
+		sg = s0;
+		ri = ((v1 > 0.0 ? v1 : -v1) - tol) * ib[i];
+		if (ri < r)
+			r = ri;
 	}
-	heap_set(t, pos, li);
-}
-
-static void heap_up(struct px_track *t, int pos)
-{
-	int li = t->heap[pos];
-	double x = t->leaf[li].expiry;
-	while (pos > 0) {
-		int par = (pos - 1) / 2;
-		if (!(x < t->leaf[t->heap[par]].expiry))
-			break;
-		heap_set(t, pos, t->heap[par]);
-		pos = par;
+	if (i == m) {
+		*event = 0;
+		if (!l->boxed || (t->fault & 4))
+			return INFINITY;
+		rb = box_dist(&l->box, p1);
+		return r > rb ? r : rb;
 	}
-	heap_set(t, pos, li);
+	*event = leaf_event(t, l, p0, p1);
+	return leaf_radius(t, l, p1);
 }
 
 /* Safe radii of all leaves at p (inside the working volume). */
 static void heap_rebuild(struct px_track *t, px_vec3 p)
 {
 	int i;
+	double nd = INFINITY;
 	for (i = 0; i < t->n_leaves; i++) {
-		t->leaf[i].expiry = t->travel + leaf_radius(t, &t->leaf[i], p) *
-							(1.0 - 1e-9);
-		heap_set(t, i, i);
+		double x = t->travel + leaf_radius(t, &t->leaf[i], p) * (1.0 - 1e-9);
+		t->expiry[i] = x;
+		if (i % TRK_GROUP == 0)
+			t->gdue[i / TRK_GROUP] = x;
+		else if (x < t->gdue[i / TRK_GROUP])
+			t->gdue[i / TRK_GROUP] = x;
+		if (x < nd)
+			nd = x;
 	}
-	for (i = t->n_leaves / 2 - 1; i >= 0; i--)
-		heap_down(t, i, t->n_leaves);
+	t->next_due = nd;
 	t->heap_ok = 1;
 }
 
@@ -843,29 +1021,45 @@ static void mark_leaf(struct px_track *t, int li, int *nh)
  * (exactly, along the segment), then given a new radius at p1. */
 static int collect_events(struct px_track *t, px_vec3 p0, px_vec3 p1)
 {
-	int nh = 0, k, np = 0, n = t->n_leaves;
+	int nh = 0, k, n = t->n_leaves;
 
 	if (!t->heap_ok)
 		heap_rebuild(t, p0);
 	t->travel += px_v3_dist(p0, p1);
-	while (n > 0 && t->leaf[t->heap[0]].expiry <= t->travel) {
-		t->popped[np++] = t->heap[0];
-		n--;
-		if (n > 0) {
-			heap_set(t, 0, t->heap[n]);
-			heap_down(t, 0, n);
+	/* A due leaf is tested and gets its new expiry. A radius of 0 gives
+	 * expiry == travel: due at the next update with any motion (the
+	 * comparisons are strict). */
+	if (t->next_due < t->travel) {
+		double nd = INFINITY, tr = t->travel;
+		double *ex = t->expiry;
+		int g, ng = (n + TRK_GROUP - 1) / TRK_GROUP;
+		for (g = 0; g < ng; g++) {
+			int k1 = (g + 1) * TRK_GROUP < n ? (g + 1) * TRK_GROUP : n;
+			double gd = INFINITY;
+			if (!(t->gdue[g] < tr)) {
+				if (t->gdue[g] < nd)
+					nd = t->gdue[g];
+				continue;
+			}
+			for (k = g * TRK_GROUP; k < k1; k++) {
+				if (ex[k] < tr) {
+					struct leaf *l = &t->leaf[k];
+					int ev;
+					double rad;
+					t->st.box_hits++;
+					rad = leaf_test(t, l, p0, p1, &ev);
+					if (ev)
+						mark_leaf(t, k, &nh);
+					ex[k] = tr + rad * (1.0 - 1e-9);
+				}
+				if (ex[k] < gd)
+					gd = ex[k];
+			}
+			t->gdue[g] = gd;
+			if (gd < nd)
+				nd = gd;
 		}
-	}
-	for (k = 0; k < np; k++) {
-		int li = t->popped[k];
-		struct leaf *l = &t->leaf[li];
-		t->st.box_hits++;
-		if (leaf_event(t, l, p0, p1))
-			mark_leaf(t, li, &nh);
-		l->expiry = t->travel + leaf_radius(t, l, p1) * (1.0 - 1e-9);
-		heap_set(t, n, li);
-		heap_up(t, n);
-		n++;
+		t->next_due = nd;
 	}
 	for (k = 0; k < nh; k++) {
 		int li = t->hits[k], side;
@@ -899,6 +1093,125 @@ static int collect_events(struct px_track *t, px_vec3 p0, px_vec3 p1)
 /* ------------------------------------------------------------------ */
 /* answer                                                              */
 
+/* May root j of e (outside any re-solved leaf) skip its correction this
+ * update? Only when its leaf certificate holds (it is provably still in
+ * its leaf: no event there, end values of g kept their signs) and it is
+ * alone there (a neighbour converging onto its branch would otherwise go
+ * unseen by the duplicate check). */
+static int can_rest(const struct px_track *t, const struct ent *e, int j)
+{
+	const struct zero *z = &e->z[j];
+	if (t->fault & 1)
+		return 1;
+	if (!(t->travel < z->until))
+		return 0;
+	if (j > 0 && e->z[j - 1].leaf == z->leaf)
+		return 0;
+	if (j + 1 < e->nz && e->z[j + 1].leaf == z->leaf)
+		return 0;
+	return 1;
+}
+
+/* Correct every resting root of e at p. Returns 0 or 1 (anomaly). */
+static int catch_up(struct px_track *t, struct ent *e, px_vec3 p)
+{
+	int j;
+	for (j = 0; j < e->nz; j++) {
+		struct zero *z = &e->z[j];
+		if (z->ep == t->epoch)
+			continue;
+		if (evolve(t, e, z, z->p, px_v3_sub(p, z->p), p))
+			return 1;
+	}
+	return 0;
+}
+
+/*
+ * Correct the resting minima that could be the closest point. A critical
+ * distance is 1-Lipschitz in the query point along its branch (its
+ * gradient is the unit vector from the foot point), so after a path of
+ * length L since its last correction a minimum is at least dist - L
+ * away; best (the distance to a real curve point: a current minimum or a
+ * candidate) bounds the global minimum from above, and a minimum whose
+ * bound exceeds it cannot be the closest point. Maxima never answer and
+ * rest on their leaf certificates.
+ */
+static void wake_minima(struct px_track *t, px_vec3 p)
+{
+	double best2 = INFINITY, best;
+	int i, j, round;
+	for (i = 0; i < t->n_cand; i++) {
+		double d2 = px_v3_dist2(t->cand[i].q, p);
+		if (d2 < best2)
+			best2 = d2;
+	}
+	for (i = 0; i < t->n_ent; i++) {
+		const struct ent *e = &t->ent[i];
+		if (e->stale)
+			continue;
+		for (j = 0; j < e->nz; j++) {
+			const struct zero *z = &e->z[j];
+			double d2;
+			if (z->type < 0 || z->ep != t->epoch)
+				continue;
+			d2 = px_v3_dist2(z->c, p);
+			if (d2 < best2)
+				best2 = d2;
+		}
+	}
+	best = sqrt(best2);
+	if (t->fault & 2)
+		return;
+	/* wake the resting minimum with the smallest bound first: it is
+	 * usually the closest point and then excludes the others (bounded:
+	 * each round corrects one root or ends) */
+	for (round = 0; round <= t->n_rmin; round++) {
+		struct ent *we = NULL;
+		struct zero *wz = NULL;
+		double wlb = INFINITY, d;
+		int leaf0, k;
+		/* the resting minima listed by the evolution pass (those of
+		 * an entity caught up since are current now) */
+		for (k = 0; k < t->n_rmin; k++) {
+			struct ent *e = &t->ent[t->rmin[2 * k]];
+			struct zero *z = &e->z[t->rmin[2 * k + 1]];
+			double lb;
+			if (e->stale || z->ep == t->epoch)
+				continue;
+			lb = z->dist - (t->travel - z->trav);
+			if (lb < wlb) {
+				wlb = lb;
+				wz = z;
+				we = e;
+			}
+		}
+		if (!wz || wlb > best + 1e-9 * (best + t->scale))
+			return;
+		leaf0 = wz->leaf;
+		if (evolve(t, we, wz, wz->p, px_v3_sub(p, wz->p), p)) {
+			we->stale = 1;
+			continue;
+		}
+		if (wz->leaf != leaf0 && !we->full) {
+			we->full = 1;
+			if (catch_up(t, we, p)) {
+				we->stale = 1;
+				continue;
+			}
+			/* caught-up minima may be closer */
+			for (j = 0; j < we->nz; j++)
+				if (we->z[j].type > 0) {
+					d = px_v3_dist(we->z[j].c, p);
+					if (d < best)
+						best = d;
+				}
+		}
+		d = px_v3_dist(wz->c, p);
+		if (d < best)
+			best = d;
+	}
+}
+
 static int in_work(const struct px_track *t, px_vec3 p)
 {
 	return p.x >= t->work.min.x && p.x <= t->work.max.x &&
@@ -926,9 +1239,13 @@ static void answer(struct px_track *t, px_vec3 p, struct px_track_result *r)
 		for (j = 0; j < e->nz; j++) {
 			const struct zero *z = &e->z[j];
 			double d2;
+			if (z->ep != t->epoch)
+				t->st.rested++;
 			if (z->type < 0)
 				continue;
 			nm++;
+			if (z->ep != t->epoch)
+				continue; /* resting: provably not the closest */
 			d2 = px_v3_dist2(z->c, p);
 			if (d2 < best) {
 				best = d2;
@@ -1058,7 +1375,7 @@ int px_track_reset(struct px_track *t, px_vec3 p, struct px_track_result *r)
 int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 {
 	int i, j, nh, rc = 0, fail = 0, added = 0;
-	px_vec3 p0, dp;
+	px_vec3 p0;
 
 	if (!t || !r)
 		return PX_E_INVAL;
@@ -1069,11 +1386,19 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 	result_clear(r);
 	t->st.updates++;
 	p0 = t->p;
-	dp = px_v3_sub(p, p0);
 	t->p = p;
 	r->source = PX_TRACK_TRACKED;
-	if (++t->epoch == 0)
+	if (++t->epoch == 0) {
+		/* wrapped: no stale mark or correction stamp may look current */
+		for (i = 0; i < t->n_leaves; i++)
+			t->leaf[i].mark = t->leaf[i].tested = 0;
+		for (i = 0; i < t->n_ent; i++) {
+			t->ent[i].hit = 0;
+			for (j = 0; j < t->ent[i].nz; j++)
+				t->ent[i].z[j].ep = 0;
+		}
 		t->epoch = 1;
+	}
 
 	if (!in_work(t, p) || !in_work(t, p0)) {
 		t->st.outside++;
@@ -1094,29 +1419,56 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 	r->leaves_solved = nh;
 	t->st.leaf_solves += (uint64_t)nh;
 
-	/* evolve every root outside the re-solved leaves */
+	for (i = 0; i < nh; i++)
+		t->ent[t->leaf[t->hits[i]].ent].hit = t->epoch;
+	t->n_rmin = 0;
+	/* evolve every root outside the re-solved leaves; in an entity
+	 * without re-solved leaves a root whose leaf certificate holds may
+	 * rest (can_rest) until the answer needs it */
 	for (i = 0; i < t->n_ent; i++) {
 		struct ent *e = &t->ent[i];
 		int w = 0;
 		e->nold = 0;
 		e->touched = 0;
+		e->full = !t->opts.lazy || e->hit == t->epoch;
+		e->moved = 0;
 		if (e->stale)
 			continue;
 		for (j = 0; j < e->nz; j++) {
-			struct zero z = e->z[j];
-			if (t->leaf[z.leaf].mark == t->epoch) {
-				e->old[e->nold++] = z;
+			struct zero *zj = &e->z[j];
+			int leaf0;
+			if (t->leaf[zj->leaf].mark == t->epoch) {
+				e->old[e->nold++] = *zj;
 				e->touched = 1;
 				continue;
 			}
-			if (evolve(t, e, &z, p0, dp, p)) {
+			/* without a re-solved leaf nothing is dropped: w == j */
+			if (!e->full && can_rest(t, e, j)) {
+				if (zj->type > 0) {
+					t->rmin[2 * t->n_rmin] = i;
+					t->rmin[2 * t->n_rmin + 1] = j;
+					t->n_rmin++;
+				}
+				w++;
+				continue;
+			}
+			leaf0 = zj->leaf;
+			if (w != j)
+				e->z[w] = *zj;
+			if (evolve(t, e, &e->z[w], e->z[w].p, px_v3_sub(p, e->z[w].p),
+				   p)) {
 				e->stale = 1;
 				break;
 			}
-			e->z[w++] = z;
+			if (e->z[w].leaf != leaf0)
+				e->full = 1;
+			w++;
 		}
-		if (!e->stale)
+		if (!e->stale) {
 			e->nz = w;
+			if (e->full && catch_up(t, e, p))
+				e->stale = 1;
+		}
 	}
 	/* re-solve the event leaves at the new point */
 	for (i = 0; i < nh; i++) {
@@ -1135,6 +1487,8 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 		added += n;
 		e->touched = 1;
 	}
+	if (!fail && t->opts.lazy)
+		wake_minima(t, p);
 	if (!fail) {
 		for (i = 0; i < t->n_ent; i++) {
 			struct ent *e = &t->ent[i];
@@ -1146,9 +1500,10 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 		}
 		for (i = 0; i < t->n_ent; i++) {
 			struct ent *e = &t->ent[i];
-			if (!e->stale && !e->touched) {
+			if (!e->stale && !e->touched && e->moved) {
 				/* evolved roots kept type and stretch; two
-				 * converging to one root shows as a duplicate */
+				 * converging to one root shows as a duplicate
+				 * (an entity whose roots all rest is unchanged) */
 				sort_zeros(e);
 				if (ent_dups(e))
 					e->stale = 1;
@@ -1192,6 +1547,47 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 	return PX_OK;
 }
 
+/* Bring the resting roots of e up to date at the current point (for
+ * px_track_critical: the caller sees every root where it is now). */
+static void ent_refresh(struct px_track *t, struct ent *e)
+{
+	int j, rest = 0;
+	if (!t->init || e->stale)
+		return;
+	for (j = 0; j < e->nz; j++)
+		rest |= e->z[j].ep != t->epoch;
+	if (!rest)
+		return;
+	if (catch_up(t, e, t->p) || (sort_zeros(e), ent_check(t, e, t->p))) {
+		t->st.reinits++;
+		if (ent_reinit(t, e, t->p))
+			count_fail(t, PX_E_RANGE);
+	}
+}
+
+void px__track_set_fault(struct px_track *t, int fault)
+{
+	if (t) {
+		t->fault = fault;
+		t->heap_ok = 0; /* radii of the new regime */
+	}
+}
+
+double px__track_leaf_cert(const struct px_track *t, int leaf, px_vec3 p,
+			   int which, int *ent, double *u0, double *u1,
+			   unsigned *flags)
+{
+	const struct leaf *l;
+	if (!t || leaf < 0 || leaf >= t->n_leaves)
+		return -1.0;
+	l = &t->leaf[leaf];
+	*ent = l->ent;
+	*u0 = l->u0;
+	*u1 = l->u1;
+	*flags = (l->flags & (LF_CUSP0 | LF_CUSP1)) ? 1u : 0u;
+	return which ? leaf_end_radius(t, l, p) : leaf_radius(t, l, p);
+}
+
 int px_track_critical(const struct px_track *t, int entity, double *u,
 		      int *type, int cap)
 {
@@ -1201,6 +1597,7 @@ int px_track_critical(const struct px_track *t, int entity, double *u,
 		return PX_E_INVAL;
 	if (entity < 0 || entity >= t->n_ent)
 		return PX_E_RANGE;
+	ent_refresh((struct px_track *)t, &t->ent[entity]);
 	e = &t->ent[entity];
 	for (i = 0; i < e->nz && i < cap; i++) {
 		u[i] = e->z[i].u;
@@ -1259,6 +1656,7 @@ void px_track_opts_default(struct px_track_opts *o)
 	o->box_depth = 4;
 	o->verify_every = 0;
 	o->dist = NULL;
+	o->lazy = 1;
 }
 
 struct split {
@@ -1497,11 +1895,10 @@ void px_track_free(struct px_track *t)
 	free(t->leaf);
 	free(t->pool);
 	free(t->cand);
-	free(t->gstart);
-	free(t->gleaf);
 	free(t->hits);
-	free(t->heap);
-	free(t->popped);
+	free(t->expiry);
+	free(t->rmin);
+	free(t->gdue);
 	free(t->ipool);
 	free(t);
 }
@@ -1609,6 +2006,18 @@ int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
 						     px_bern_binom(q, r) * hb[jj][r];
 					s->pc[jj][q] = px_bern_binom(p, q) * v;
 				}
+			{
+				double sc = 1.0;
+				for (q = 0; q <= p; q++) {
+					for (jj = 0; jj < 4; jj++)
+						s->pu[jj][q] = s->pc[jj][q] * sc;
+					sc *= s->inv;
+				}
+				s->rat = 0;
+				for (q = 0; q <= p; q++)
+					if (s->pc[3][q] != (q == 0 ? 1.0 : 0.0))
+						s->rat = 1;
+			}
 			t->n_spans++;
 		}
 		e->n_spans = t->n_spans - e->first_span;
@@ -1645,11 +2054,11 @@ int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
 	t->pool = calloc(pool_cap ? pool_cap : 1, sizeof(double));
 	t->cand = calloc((size_t)cand_cap + 1, sizeof(*t->cand));
 	t->hits = calloc((size_t)leaf_cap + 1, sizeof(int));
-	t->heap = calloc((size_t)leaf_cap + 1, sizeof(int));
-	t->popped = calloc((size_t)leaf_cap + 1, sizeof(int));
+	t->expiry = calloc((size_t)leaf_cap + 1, sizeof(double));
+	t->gdue = calloc((size_t)leaf_cap / TRK_GROUP + 2, sizeof(double));
 	t->ipool = calloc((size_t)leaf_cap * (2 * TRK_NG + 2) + 1, sizeof(double));
-	if (!t->leaf || !t->pool || !t->cand || !t->hits || !t->heap ||
-	    !t->popped || !t->ipool) {
+	if (!t->leaf || !t->pool || !t->cand || !t->hits || !t->expiry || !t->gdue ||
+	    !t->ipool) {
 		rc = PX_E_NOMEM;
 		goto fail;
 	}
@@ -1844,16 +2253,11 @@ int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
 				e->n_sb++;
 	}
 
-	/* event cells: octree exclusion per leaf down to the grid level */
+	/* event cells: octree exclusion per leaf down to box_depth; their
+	 * union box per leaf bounds its safe radius */
 	{
 		struct cellbuf cb = {0};
-		long q, ncell;
-		int gn = 1 << o.box_depth, ax;
-		const double *wl = &t->work.min.x, *wh = &t->work.max.x;
-		double *gi = &t->ginv.x;
-		t->gn = gn;
-		for (ax = 0; ax < 3; ax++)
-			gi[ax] = wh[ax] > wl[ax] ? gn / (wh[ax] - wl[ax]) : 0.0;
+		long q;
 		for (i = 0; i < t->n_leaves; i++) {
 			long budget = 1L << 14, first = cb.n;
 			struct leaf *l = &t->leaf[i];
@@ -1873,72 +2277,24 @@ int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
 				t->n_boxed++;
 			}
 		}
-		ncell = (long)gn * gn * gn;
-		t->gstart = calloc((size_t)ncell + 1, sizeof(int));
-		if (!t->gstart) {
-			free(cb.p);
-			rc = PX_E_NOMEM;
-			goto fail;
-		}
-		/* two passes: count, then fill (a cell cut short by the budget
-		 * covers several grid cells) */
-		for (ax = 0; ax < 2; ax++) {
-			long total = 0;
-			if (ax == 1) {
-				for (q = 0; q < ncell; q++) {
-					int c = t->gstart[q];
-					t->gstart[q] = (int)total;
-					total += c;
-				}
-				t->gstart[ncell] = (int)total;
-				t->n_prim = (int)total;
-				t->gleaf = calloc((size_t)total + 1, sizeof(int));
-				if (!t->gleaf) {
-					free(cb.p);
-					rc = PX_E_NOMEM;
-					goto fail;
-				}
-				/* reuse gstart as fill cursors, restored below */
-			}
-			for (q = 0; q < cb.n; q++) {
-				int lo3[3], hi3[3], ii, jj, kk, d;
-				const double *bl = &cb.p[q].box.min.x, *bh = &cb.p[q].box.max.x;
-				for (d = 0; d < 3; d++) {
-					double x0 = (bl[d] - wl[d]) * gi[d] + 1e-6;
-					double x1 = (bh[d] - wl[d]) * gi[d] - 1e-6;
-					lo3[d] = x0 < 0 ? 0 : (x0 > gn - 1 ? gn - 1 : (int)x0);
-					hi3[d] = x1 < 0 ? 0 : (x1 > gn - 1 ? gn - 1 : (int)x1);
-				}
-				for (kk = lo3[2]; kk <= hi3[2]; kk++)
-					for (jj = lo3[1]; jj <= hi3[1]; jj++)
-						for (ii = lo3[0]; ii <= hi3[0]; ii++) {
-							int c = (kk * gn + jj) * gn + ii;
-							if (ax == 0)
-								t->gstart[c]++;
-							else
-								t->gleaf[t->gstart[c]++] = cb.p[q].leaf;
-						}
-			}
-			if (ax == 1) {
-				/* cursors ended at the next cell's start: shift back */
-				for (q = ncell; q > 0; q--)
-					t->gstart[q] = t->gstart[q - 1];
-				t->gstart[0] = 0;
-			}
-		}
+		t->n_prim = (int)cb.n;
 		free(cb.p);
 	}
 
 	t->bytes = sizeof(*t) + (size_t)t->n_ent * sizeof(*t->ent) +
 		   (size_t)t->n_ent * 2 * (size_t)o.max_crit * sizeof(struct zero) +
 		   (size_t)span_cap * sizeof(*t->span) +
-		   (size_t)leaf_cap * (sizeof(*t->leaf) + 4 * sizeof(int) +
+		   (size_t)leaf_cap * (sizeof(*t->leaf) + 2 * sizeof(int) +
 				       (2 * TRK_NG + 2) * sizeof(double)) +
 		   pool_cap * sizeof(double) +
-		   (size_t)(cand_cap + 1) * sizeof(*t->cand) +
-		   ((size_t)t->gn * t->gn * t->gn + 1 + (size_t)t->n_prim) *
-			   sizeof(int);
+		   (size_t)(cand_cap + 1) * sizeof(*t->cand);
 	t->epoch = 1;
+	t->n_crit_cap = n_curves * o.max_crit;
+	t->rmin = calloc((size_t)t->n_crit_cap * 2 + 2, sizeof(int));
+	if (!t->rmin) {
+		rc = PX_E_NOMEM;
+		goto fail;
+	}
 	free(spl);
 	free(work);
 	(void)j;

@@ -15,10 +15,27 @@
  *  - Evolution (their Eq. 6): each critical point moves by the tangent
  *    predictor ds = (dp . C') / D, D = (C - p) . C'' + |C'|^2, then Newton
  *    on (C - p) . C' = 0 with the new point held fixed, staying inside its
- *    C1 stretch (across knot spans, wrapping at smooth closed seams). A
- *    Newton step below 1e-6 of the parameter range ends the iteration
- *    after one evaluation (quadratic convergence leaves an error far
- *    below the tolerance; the point is moved to first order).
+ *    C1 stretch (across knot spans, wrapping at smooth closed seams).
+ *    C, C', C'' come from per-span power-basis tables made at setup
+ *    (homogeneous for rational spans), so the usual update of a critical
+ *    point is the predictor, one evaluation and one Newton step: a step
+ *    below 3e-5 of its span is accepted without another evaluation
+ *    (quadratic convergence leaves a root error ~1e-9 of the span; the
+ *    point is moved by its second-order Taylor expansion).
+ *  - Lazy correction (opts.lazy, on by default): a critical point may
+ *    skip its correction while two proofs hold. (1) It is still in its
+ *    parameter leaf: the leaf had no event (it was not re-solved) and the
+ *    values of g at the leaf's two ends - affine in p - kept their signs
+ *    (|value| / |p-gradient| at its last correction bounds the travel for
+ *    that), and it is alone in that leaf. (2) It cannot be the closest
+ *    point: a critical distance is 1-Lipschitz in the query point along
+ *    its branch, so a minimum last corrected at distance d is at least
+ *    d - L away after a path of length L, and it rests only while that
+ *    exceeds the best current answer; maxima never answer. Whenever an
+ *    entity has a re-solved leaf or a root changes leaf, all its roots
+ *    are corrected first, so the structure checks and transitions always
+ *    see current data. px_track_critical() corrects resting roots before
+ *    reporting them.
  *  - Transitions: pairs appear or vanish only where the moving point
  *    crosses the transition set {p : g = 0 and dg/ds = 0} (the evolute of
  *    a planar curve, a ruled surface of polar lines for a space curve) or,
@@ -34,16 +51,19 @@
  *    point may travel before the leaf can have an event: its distance
  *    to the box of its event cells, or the radius within which its
  *    coefficients provably keep their signs (each is affine in p, so
- *    |coefficient| / |its p-gradient| bounds it) - and a min-heap on the
- *    travelled path length names the leaves whose radius is used up;
- *    usually none, so an update costs one comparison at the heap root
- *    plus the evolution. A due leaf is tested exactly along the segment
- *    p_old -> p_new (the coefficients are affine in the segment
- *    parameter, so sign-definite coefficients at both ends prove there is
- *    no event - the exact counterpart of the paper's line/box-diagonal
- *    stage), gets a new radius at p_new, and is re-solved with a
- *    certified Bernstein/Descartes root isolation at the new point. A region is grown while a root
- *    crosses its outer boundary, so created pairs that drift away from the
+ *    |coefficient| / |its p-gradient| bounds it) - and the smallest
+ *    expiry (travelled path length at which a radius is used up) names
+ *    the updates with due leaves; usually there are none, so an update
+ *    costs one comparison plus the evolution (otherwise one scan over
+ *    groups of 8 leaves, each with its smallest expiry, finds them). A
+ *    due leaf is tested exactly along the segment p_old -> p_new (the
+ *    coefficients are affine in the segment parameter, so sign-definite
+ *    coefficients at both ends prove there is no event - the exact
+ *    counterpart of the paper's line/box-diagonal stage), gets a new
+ *    radius at p_new, and is re-solved with a certified
+ *    Bernstein/Descartes root isolation at the new point. A region is
+ *    grown while a root crosses its outer boundary, so created pairs
+ *    that drift away from the
  *    crossing are found too. Creation and annihilation are counted by the
  *    change in the number of roots of the re-solved leaves.
  *  - Candidates: open-curve ends, C0 breaks, cusps and a cornered closed
@@ -62,7 +82,7 @@
  * module).
  *
  * Memory and real-time rules: px_track_create() allocates everything
- * (spans, leaves, coefficient pool, event grid, per-entity critical-point
+ * (spans, leaves, coefficient pool, per-entity critical-point
  * arrays of fixed capacity, the global-query model) and may take long.
  * px_track_update() and the accessors never allocate, lock or print, and
  * every loop has a bound. One tracker follows one moving point; it must
@@ -102,6 +122,12 @@ struct px_track_opts {
 	int verify_every;
 	/* Options of the global query model (NULL for its defaults). */
 	const struct px_dist_opts *dist;
+	/* Lazy correction (default 1): a critical point provably still in
+	 * its parameter leaf rests (is not corrected) while it cannot be the
+	 * closest point - maxima always, minima while their last distance
+	 * minus the path travelled since exceeds the current best. 0
+	 * corrects every critical point on every update. */
+	int lazy;
 };
 
 /* Defaults as documented above. */
@@ -155,11 +181,15 @@ struct px_track_stats {
 	uint64_t box_hits;       /* leaves whose safe radius ran out (given
 				  * the exact segment test) */
 	uint64_t creations, annihilations; /* pairs */
+	uint64_t rested;         /* critical points left uncorrected in an
+				  * update (opts.lazy), summed over updates */
 };
 
 struct px_track_info {
 	int n_entities, n_spans, n_leaves, n_boxed_leaves;
-	int n_cells;             /* (grid cell, leaf) event entries */
+	int n_cells;             /* octree event cells over all leaves
+				  * (setup only: their union box per leaf
+				  * bounds its safe radius) */
 	int n_cusps, n_breaks;   /* detected cusps, C0/C1 breaks (all) */
 	px_aabb work;
 	size_t bytes;            /* tracker memory without the global model */
@@ -200,9 +230,10 @@ PX_API int px_track_update(struct px_track *t, px_vec3 p,
 
 /*
  * The live critical points of an entity, sorted by parameter: u[i] and
- * type[i] (+1 minimum, -1 maximum), up to cap of them. Returns the
- * number held (may exceed cap) or PX_E_INVAL / PX_E_RANGE (entity).
- * @note RT-safe.
+ * type[i] (+1 minimum, -1 maximum), up to cap of them. Points resting
+ * under opts.lazy are corrected to the current point first (the tracker
+ * state changes, the answers do not). Returns the number held (may
+ * exceed cap) or PX_E_INVAL / PX_E_RANGE (entity). @note RT-safe.
  */
 PX_API int px_track_critical(const struct px_track *t, int entity, double *u,
 			     int *type, int cap);

@@ -5,12 +5,16 @@
  * of critical points, along smooth random paths and sums of sinusoids
  * with steps from 0.01 % to 5 % of the model size. A naive tracker
  * (Newton from last cycle's foot point) runs the same paths to show
- * that the transitions matter.
+ * that the transitions matter. Lazy correction is checked with nothing
+ * waking the resting roots, against laziness off, with deliberately
+ * broken proofs (which must be caught), and its leaf certificates
+ * against brute-force sampling.
  */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
+#include "internal.h"
 #include "px_alloc_count.h"
 #include "px_arena.h"
 #include "px_dist.h"
@@ -20,6 +24,9 @@
 
 #define MAXC 64
 #define MAXE 8
+
+/* run_model() settings: lazy correction, deliberate faults (test hook) */
+static int g_lazy = 1, g_fault = 0;
 
 static struct px_arena arena;
 static unsigned char arena_mem[1 << 20];
@@ -410,10 +417,12 @@ static void run_model(const struct tcurve *tc, int ne, int n_steps,
 		cs[e] = tc[e].c;
 	px_track_opts_default(&o);
 	o.verify_every = verify_every;
+	o.lazy = g_lazy;
 	rc = px_track_create(cs, ne, &o, &t);
 	PX_CHECK_INT_EQ(rc, PX_OK);
 	if (rc)
 		return;
+	px__track_set_fault(t, g_fault);
 	rc = px_dist_model_create(cs, ne, NULL, 0, NULL, &ref);
 	PX_CHECK_INT_EQ(rc, PX_OK);
 	px_track_get_info(t, &info);
@@ -710,6 +719,239 @@ static void test_random_curves(void)
 	}
 }
 
+/* The model of the laziness tests: closed, open with breaks, cusp,
+ * rational, space curves. */
+static int lazy_model(struct tcurve *tc)
+{
+	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
+	return curve_blob(&tc[0], 0, 0) || curve_breaks(&tc[1], 2.5, 0.5) ||
+	       curve_cusp(&tc[2], -2.0, 2.0) || curve_circle(&tc[3], 0.5, -2.5, 1.0) ||
+	       curve_knot(&tc[4], 1.0, 1.0, 1.0);
+}
+
+/* Lazy correction on, nothing else looking: no verification and no
+ * px_track_critical() (which wakes every root) except at the first step,
+ * every answer against the global query. The same paths with laziness
+ * off must agree, and laziness must actually engage. */
+static void test_lazy_exact(void)
+{
+	struct tcurve tc[5];
+	struct run_stats rs;
+	PX_CHECK_INT_EQ(lazy_model(tc), 0);
+	memset(&rs, 0, sizeof(rs));
+	g_lazy = 1;
+	run_model(tc, 5, 1200, 1 << 30, &rs, 0);
+	check_run("lazy", &rs, 10);
+	PX_CHECK_MSG(rs.ts.rested > rs.ts.updates,
+		     "laziness never engaged: %llu rests in %llu updates",
+		     (unsigned long long)rs.ts.rested,
+		     (unsigned long long)rs.ts.updates);
+	memset(&rs, 0, sizeof(rs));
+	g_lazy = 0;
+	run_model(tc, 5, 600, 1 << 30, &rs, 0);
+	g_lazy = 1;
+	check_run("eager", &rs, 10);
+	PX_CHECK_INT_EQ((long)rs.ts.rested, 0);
+}
+
+/* The tests above can fail: break each proof on purpose and the same
+ * checks see wrong answers or wrong critical-point counts - or, when
+ * roots rest without their leaf certificate, the tracker's own structure
+ * checks catch the damage (re-initialisations far above a clean run). */
+static void test_lazy_faults_caught(void)
+{
+	static const int faults[] = {1 | 2, 4, 1};
+	static const char *names[] = {"fault: never woken", "fault: no events",
+				      "fault: rest always"};
+	struct tcurve tc[5];
+	struct run_stats rs;
+	uint64_t clean_reinits;
+	int f;
+	PX_CHECK_INT_EQ(lazy_model(tc), 0);
+	memset(&rs, 0, sizeof(rs));
+	run_model(tc, 5, 400, 40, &rs, 0);
+	check_run("clean", &rs, 10);
+	clean_reinits = rs.ts.reinits;
+	for (f = 0; f < 3; f++) {
+		memset(&rs, 0, sizeof(rs));
+		g_fault = faults[f];
+		run_model(tc, 5, 400, 40, &rs, 0);
+		g_fault = 0;
+		report(names[f], &rs);
+		if (faults[f] == 1)
+			PX_CHECK_MSG(rs.wrong + rs.count_bad + rs.brute_bad > 0 ||
+					     rs.ts.reinits > clean_reinits + 10,
+				     "%s went unnoticed", names[f]);
+		else
+			PX_CHECK_MSG(rs.wrong + rs.count_bad + rs.brute_bad > 0,
+				     "%s went unnoticed", names[f]);
+	}
+}
+
+/* Signs of f' at the samples of [u0, u1] (|f'| below tiny ignored):
+ * the number of sign changes. */
+static int sign_changes(const struct px_nurbs_curve *c, double u0, double u1,
+			px_vec3 q, int m, double tiny)
+{
+	int i, last = 0, n = 0;
+	for (i = 0; i <= m; i++) {
+		double u = u0 + (u1 - u0) * (1e-9 + (1.0 - 2e-9) * i / m);
+		double v = fprime(c, u, q);
+		if (fabs(v) <= tiny)
+			continue;
+		if (last && (v > 0) != (last > 0))
+			n++;
+		last = v > 0 ? 1 : -1;
+	}
+	return n;
+}
+
+/* Sign of f' just inside a leaf end (0 when too small to tell). */
+static int end_sign(const struct px_nurbs_curve *c, double u0, double u1,
+		    int side, px_vec3 q, double tiny)
+{
+	double u = side ? u1 - 1e-10 * (u1 - u0) : u0 + 1e-10 * (u1 - u0);
+	double v = fprime(c, u, q);
+	return fabs(v) <= tiny ? 0 : (v > 0 ? 1 : -1);
+}
+
+/*
+ * The leaf certificates against brute force. For every leaf, a grid over
+ * the working volume (its middle plane for planar curves) is scanned for
+ * points where f' has two or more sign changes on the leaf (two roots: on
+ * the far side of the leaf's transition set). At random points p, the
+ * leaf's no-event ball (radius from the tracker) must contain none of
+ * them, and random points inside it must see at most one sign change;
+ * inside its end ball the signs of f' at both leaf ends must stay. With
+ * a fault that makes the radii infinite the same checks must find
+ * violations. Returns the violations found.
+ */
+#define CG 20
+static long cert_check(const struct tcurve *tc, int ne, int fault, int npts)
+{
+	static px_vec3 grid[CG * CG * 8];
+	static unsigned char two[CG * CG * 8];
+	struct px_nurbs_curve cs[MAXE];
+	struct px_track *t = NULL;
+	struct px_track_info info;
+	long bad = 0;
+	int e, k, li, j, ng = 0, planar = 1, gi;
+	double size;
+	px_aabb box;
+	memset(cs, 0, sizeof(cs));
+	for (e = 0; e < ne; e++) {
+		px_aabb b = px_nurbs_curve_aabb(&tc[e].c);
+		cs[e] = tc[e].c;
+		if (b.max.z - b.min.z > 1e-12)
+			planar = 0;
+	}
+	if (px_track_create(cs, ne, NULL, &t) != PX_OK) {
+		PX_CHECK_MSG(0, "create");
+		return 0;
+	}
+	px__track_set_fault(t, fault);
+	px_track_get_info(t, &info);
+	box = info.work;
+	size = px_aabb_diagonal(&box) / 3.0;
+	{
+		int nz = planar ? 1 : 8, a, b, c, ncg = planar ? CG : CG / 2;
+		for (c = 0; c < nz; c++)
+			for (b = 0; b < ncg; b++)
+				for (a = 0; a < ncg; a++) {
+					px_vec3 q;
+					q.x = box.min.x + (box.max.x - box.min.x) * (a + 0.5) / ncg;
+					q.y = box.min.y + (box.max.y - box.min.y) * (b + 0.5) / ncg;
+					q.z = planar ? 0.5 * (box.min.z + box.max.z)
+						     : box.min.z + (box.max.z - box.min.z) *
+								       (c + 0.5) / nz;
+					grid[ng++] = q;
+				}
+	}
+	for (li = 0; li < info.n_leaves; li++) {
+		int ent;
+		double u0, u1, r0, r1;
+		unsigned fl;
+		px_vec3 p;
+		r0 = px__track_leaf_cert(t, li, px_v3(0, 0, 0), 0, &ent, &u0, &u1, &fl);
+		if (r0 < 0.0 || fl)
+			continue;
+		/* (the end-radius fault needs no grid) */
+		for (gi = 0; gi < ng; gi++)
+			two[gi] = fault != 8 &&
+				  sign_changes(&cs[ent], u0, u1, grid[gi], 24, 1e-9) > 1;
+		for (k = 0; k < npts; k++) {
+			int s0, s1;
+			p = px_v3(px_rand_range(box.min.x, box.max.x),
+				  px_rand_range(box.min.y, box.max.y),
+				  planar && px_rand_int(0, 1)
+					  ? 0.5 * (box.min.z + box.max.z)
+					  : px_rand_range(box.min.z, box.max.z));
+			r0 = px__track_leaf_cert(t, li, p, 0, &ent, &u0, &u1, &fl);
+			r1 = px__track_leaf_cert(t, li, p, 1, &ent, &u0, &u1, &fl);
+			if (r0 > 0.0) {
+				for (gi = 0; gi < ng; gi++)
+					if (two[gi] && px_v3_dist(grid[gi], p) < 0.999 * r0) {
+						bad++;
+						break;
+					}
+			}
+			s0 = end_sign(&cs[ent], u0, u1, 0, p, 1e-9);
+			s1 = end_sign(&cs[ent], u0, u1, 1, p, 1e-9);
+			for (j = 0; j < 4; j++) {
+				int which = j & 1;
+				double r = which ? r1 : r0, rr, dn;
+				px_vec3 d, q;
+				if (!(r > 0.0))
+					continue;
+				if (r > 0.5 * size)
+					r = 0.5 * size;
+				d = px_v3(px_rand_normal(), px_rand_normal(),
+					  planar && p.z == 0.5 * (box.min.z + box.max.z)
+						  ? 0.0 : px_rand_normal());
+				dn = px_v3_norm(d);
+				if (!(dn > 0.0))
+					continue;
+				rr = r * (j < 2 ? 0.999 : px_rand_unit());
+				q = px_v3_add(p, px_v3_scale(d, rr / dn));
+				if (!which) {
+					if (sign_changes(&cs[ent], u0, u1, q, 40, 1e-9) > 1)
+						bad++;
+				} else {
+					int a0 = end_sign(&cs[ent], u0, u1, 0, q, 1e-9);
+					int a1 = end_sign(&cs[ent], u0, u1, 1, q, 1e-9);
+					if ((s0 && a0 && a0 != s0) || (s1 && a1 && a1 != s1))
+						bad++;
+				}
+			}
+		}
+	}
+	px_track_free(t);
+	return bad;
+}
+
+static void test_certificates_brute(void)
+{
+	struct tcurve tc[5];
+	long bad = 0, bad4 = 0, bad8 = 0;
+	int e;
+	PX_CHECK_INT_EQ(lazy_model(tc), 0);
+	/* one curve at a time: blob, breaks, circle, knot (the cusp curve's
+	 * leaves at the cusp hold a divided g and are skipped) */
+	for (e = 0; e < 5; e++) {
+		if (e == 2)
+			continue;
+		bad += cert_check(&tc[e], 1, 0, 8);
+		if (e < 2)
+			bad4 += cert_check(&tc[e], 1, 4, 2);
+		bad8 += cert_check(&tc[e], 1, 8, 2);
+	}
+	printf("  certificates: %ld violations (faulted: no-event %ld, ends %ld)\n",
+	       bad, bad4, bad8);
+	PX_CHECK_MSG(bad == 0, "%ld certificate violations", bad);
+	PX_CHECK_MSG(bad4 > 0, "infinite no-event radii not caught");
+	PX_CHECK_MSG(bad8 > 0, "infinite end radii not caught");
+}
+
 static void test_errors(void)
 {
 	struct tcurve tc;
@@ -762,6 +1004,7 @@ static const struct px_test tests[] = {
 	PX_T(test_space_closed),     PX_T(test_space_open),
 	PX_T(test_polygon),          PX_T(test_multi_entity),
 	PX_T(test_no_verification),  PX_T(test_random_curves),
-	PX_T(test_errors),
+	PX_T(test_errors),           PX_T(test_lazy_exact),
+	PX_T(test_lazy_faults_caught), PX_T(test_certificates_brute),
 };
 PX_TEST_MAIN(tests)
