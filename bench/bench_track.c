@@ -419,6 +419,9 @@ int main(void)
 {
 	struct px_nurbs_curve c[6];
 	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
+	/* BENCH_TRACK_SURF_ONLY=1: the surface part alone (profiling) */
+	if (getenv("BENCH_TRACK_SURF_ONLY"))
+		goto surfaces;
 	printf("px_track: per-update ns vs cold px_dist_query on the same points "
 	       "(step in %% of the model diagonal; ratio = cold median / tracked "
 	       "median; wrong = answers differing from the global query)\n");
@@ -435,6 +438,7 @@ int main(void)
 	circle(&c[2], 0.5, -2.5, 1.0);
 	knot(&c[3], 1.0, 1.0, 1.0);
 	run("multi-entity (4 curves)", c, 4);
+surfaces:
 	{
 		struct px_nurbs_surf sf[3];
 		printf("\npx_strack: surfaces, same columns (cells/u: cells solved "

@@ -28,7 +28,6 @@
 #include "px_bern.h"
 
 #define ST_NEWTON 16
-#define ST_NBOX 4
 
 struct crit {
 	double u, v;
@@ -38,31 +37,42 @@ struct crit {
 	double h11, h12, h22;
 };
 
-/* Where a cell can have a transition: every normal line of the cell lies
- * in the double cone around its central normal line (apex spread rho,
- * slope a = tan of the largest normal deviation); a focal sheet lies on
- * those lines at a signed height l in an interval (bounded sheet) or at
- * |l| >= lo (a sheet through infinity: curvature crossing zero or too
- * small to matter); edge events anywhere on the lines. */
-struct sreg {
+/* Closed interval. */
+struct iv {
 	double lo, hi;
-	int split;      /* 1: |l| >= lo */
-	/* edge wedge (wedge = 1): the normal lines along an edge stay near
-	 * the plane through sc spanned by the edge chord and the normal n:
-	 * |w . b| <= rho + a |w . n| for w = x - sc */
-	int wedge;
-	px_vec3 sc, n, b;
-	double rho, a, ia;
+};
+
+/* Centre values on a cell side that the edge test needs. */
+struct cside {
+	px_vec3 s, su, sv;
+	int along;      /* 0: the side runs along u (v fixed), 1: along v */
+	double h;       /* half length of the side in its parameter */
+};
+
+/*
+ * Certificate data of a region cell: enclosures over the whole cell of
+ * S and its derivatives up to order 2 (from the Bezier net of the cell:
+ * the convex hull property for S, difference nets for the derivatives,
+ * interval arithmetic for the rational quotient rule), the first
+ * fundamental form entries Si.Sj, the centre values of S, Su, Sv and the
+ * sides on an open domain edge or a crease (less than C2 between
+ * patches), where points enter and leave.
+ */
+struct rcert {
+	struct iv S[3], Suu[3], Suv[3], Svv[3];
+	struct iv G11, G12, G22;
+	double m11, m12, m22;   /* sum over x, y, z of max |Sij| */
+	px_vec3 sc, suc, svc;
+	double hu, hv;          /* half widths of the cell in u, v */
+	int nside;
+	struct cside side[4];
 };
 
 struct scell {
 	double u0, u1, v0, v1;
 	int surf;
-	int always;     /* normals too spread for a cone: always solved */
-	px_vec3 sc, nc;
-	double rho, a, ia; /* ia = 1 / sqrt(1 + a^2) */
-	int nreg;
-	struct sreg reg[ST_NBOX];
+	double size;    /* diameter of the cell's box (solve cells) */
+	struct rcert cert; /* region cells */
 	double expiry;
 	int hpos;
 	uint32_t mark;
@@ -466,36 +476,157 @@ static int surf_reinit(struct px_strack *t, struct ssurf *f, int si, px_vec3 p)
 /* ------------------------------------------------------------------ */
 /* transition boxes: lazy tests                                        */
 
-/* Lower bound on the distance from p to a region cell's transition set. */
+static struct iv iv_mul(struct iv a, struct iv b)
+{
+	double p1 = a.lo * b.lo, p2 = a.lo * b.hi, p3 = a.hi * b.lo,
+	       p4 = a.hi * b.hi;
+	struct iv r;
+	r.lo = fmin(fmin(p1, p2), fmin(p3, p4));
+	r.hi = fmax(fmax(p1, p2), fmax(p3, p4));
+	return r;
+}
+
+static double iv_mag(struct iv a)
+{
+	return fmax(fabs(a.lo), fabs(a.hi));
+}
+
+/* Safety factor on certificate radii and relative padding of the
+ * enclosures for rounding. */
+#define ST_RSAFE (1.0 - 1e-9)
+#define ST_PAD 1e-12
+
+/*
+ * Certified radius of a region cell at p: no transition of the cell
+ * happens while the point stays in the cube |x - p|_inf <= r. A pair of
+ * critical points is born or dies only at a degenerate critical point,
+ * E = 0 and det H = 0 (the focal sheets, Seong-Johnson-Cohen section
+ * 4.3), and a point enters or leaves only through a side that is an open
+ * edge or a crease. For x in the cube and (u, v) in the cell:
+ *  - H_ij = Si.Sj + (S - x).Sij lies in [H_ij(p)] + [-r m_ij, r m_ij];
+ *  - E(u, v; x) lies in E(c; p) +- r |Su(c)|_1 + [H] * (cell half
+ *    widths) (mean value form about the centre c, dE/du = (H11, H12)).
+ * The cell is safe when E1 or E2 keeps its sign (no critical point at
+ * all), or when det H keeps its sign (no degenerate one: the points only
+ * move) and on every open side E1 or E2 keeps its sign. Each condition
+ * is monotone in r; the radius is the largest r that keeps one of them
+ * (closed forms: linear in r for E, quadratic for det H). Curvatures are
+ * never divided by, so parabolic lines and umbilics need no care.
+ */
+static double cert_radius(const struct rcert *c, px_vec3 p)
+{
+	const double *pp = &p.x;
+	struct iv h11, h12, h22;
+	double a11, b11, a22, b22, M11, M12, M22, m11 = c->m11, m12 = c->m12,
+	       m22 = c->m22, rE, rD, r, e1, e2, pad;
+	px_vec3 w;
+	int k;
+	h11 = c->G11;
+	h12 = c->G12;
+	h22 = c->G22;
+	for (k = 0; k < 3; k++) {
+		struct iv d;
+		d.lo = c->S[k].lo - pp[k];
+		d.hi = c->S[k].hi - pp[k];
+		struct iv x11 = iv_mul(d, c->Suu[k]), x12 = iv_mul(d, c->Suv[k]),
+			  x22 = iv_mul(d, c->Svv[k]);
+		h11.lo += x11.lo;
+		h11.hi += x11.hi;
+		h12.lo += x12.lo;
+		h12.hi += x12.hi;
+		h22.lo += x22.lo;
+		h22.hi += x22.hi;
+	}
+	/* rounding of the sums: pad by their magnitude */
+	pad = ST_PAD * (iv_mag(h11) + iv_mag(h12) + iv_mag(h22) +
+			(fabs(px_v3_dot(c->sc, c->sc)) + px_v3_dot(p, p)) *
+				(m11 + m12 + m22));
+	a11 = h11.lo - pad;
+	b11 = h11.hi + pad;
+	a22 = h22.lo - pad;
+	b22 = h22.hi + pad;
+	M11 = fmax(fabs(a11), fabs(b11));
+	M22 = fmax(fabs(a22), fabs(b22));
+	M12 = fmax(fabs(h12.lo), fabs(h12.hi)) + pad;
+	/* E test */
+	w = px_v3_sub(c->sc, p);
+	e1 = fabs(px_v3_dot(w, c->suc));
+	e2 = fabs(px_v3_dot(w, c->svc));
+	pad = ST_PAD * (px_v3_norm(w) + px_v3_norm(c->sc) + px_v3_norm(p)) *
+	      (px_v3_norm(c->suc) + px_v3_norm(c->svc));
+	{
+		double n1 = fabs(c->suc.x) + fabs(c->suc.y) + fabs(c->suc.z) +
+			    m11 * c->hu + m12 * c->hv;
+		double n2 = fabs(c->svc.x) + fabs(c->svc.y) + fabs(c->svc.z) +
+			    m12 * c->hu + m22 * c->hv;
+		double r1 = (e1 - pad - M11 * c->hu - M12 * c->hv) / n1;
+		double r2 = (e2 - pad - M12 * c->hu - M22 * c->hv) / n2;
+		rE = fmax(r1, r2);
+		if (!(rE > 0.0))
+			rE = 0.0;
+	}
+	/* det H test */
+	rD = 0.0;
+	{
+		double x = 0.0, y = 0.0, mx = m11, my = m22;
+		int definite = 0;
+		if (a11 > 0.0 && a22 > 0.0) {
+			x = a11;
+			y = a22;
+			definite = 1;
+		} else if (b11 < 0.0 && b22 < 0.0) {
+			x = -b11;
+			y = -b22;
+			definite = 1;
+		} else if (a11 > 0.0 && b22 < 0.0) {
+			rD = fmin(a11 / m11, -b22 / m22);
+		} else if (b11 < 0.0 && a22 > 0.0) {
+			rD = fmin(-b11 / m11, a22 / m22);
+		}
+		if (definite) {
+			/* f(r) = (x - r mx)(y - r my) - (M12 + r m12)^2 falls on
+			 * [0, min(x / mx, y / my)]: its first root */
+			double A = mx * my - m12 * m12;
+			double B = -(x * my + y * mx) - 2.0 * M12 * m12;
+			double C = x * y - M12 * M12;
+			double cap = fmin(x / mx, y / my);
+			if (C > 0.0) {
+				double disc = B * B - 4.0 * A * C;
+				double root = disc < 0.0 ? INFINITY
+							 : 2.0 * C / (-B + sqrt(disc));
+				rD = fmin(cap, root);
+			}
+		}
+		if (!(rD > 0.0))
+			rD = 0.0;
+	}
+	for (k = 0; k < c->nside && rD > rE; k++) {
+		/* open side: E restricted to it, mean value form along it */
+		const struct cside *sd = &c->side[k];
+		double d1 = sd->along ? M12 : M11, d2 = sd->along ? M22 : M12;
+		double q1 = sd->along ? m12 : m11, q2 = sd->along ? m22 : m12;
+		double f1, f2, r1, r2;
+		w = px_v3_sub(sd->s, p);
+		f1 = fabs(px_v3_dot(w, sd->su));
+		f2 = fabs(px_v3_dot(w, sd->sv));
+		r1 = (f1 - pad - d1 * sd->h) /
+		     (fabs(sd->su.x) + fabs(sd->su.y) + fabs(sd->su.z) + q1 * sd->h);
+		r2 = (f2 - pad - d2 * sd->h) /
+		     (fabs(sd->sv.x) + fabs(sd->sv.y) + fabs(sd->sv.z) + q2 * sd->h);
+		rD = fmin(rD, fmax(fmax(r1, r2), 0.0));
+	}
+	r = fmax(rE, rD) * ST_RSAFE;
+	return r > 0.0 ? r : 0.0;
+}
+
+/* Test hook: a factor on every certified radius (1: the proof; larger
+ * values make the bound non-conservative, for the tests that show the
+ * containment check can fail). */
+double px__strack_radius_scale = 1.0;
+
 static double region_radius(const struct scell *c, px_vec3 p)
 {
-	px_vec3 w;
-	double l, dp, rc, r = INFINITY;
-	int i;
-	if (c->always)
-		return 0.0;
-	if (c->nreg == 0)
-		return INFINITY;
-	w = px_v3_sub(p, c->sc);
-	l = px_v3_dot(w, c->nc);
-	dp = px_v3_norm(px_v3_sub(w, px_v3_scale(c->nc, l)));
-	/* d_perp - a |l| is sqrt(1 + a^2)-Lipschitz */
-	rc = fmax((dp - c->a * fabs(l) - c->rho) * c->ia, 0.0);
-	for (i = 0; i < c->nreg; i++) {
-		const struct sreg *g = &c->reg[i];
-		double ri;
-		if (g->wedge) {
-			px_vec3 we = px_v3_sub(p, g->sc);
-			ri = (fabs(px_v3_dot(we, g->b)) - g->a * fabs(px_v3_dot(we, g->n)) -
-			      g->rho) * g->ia;
-			ri = fmax(ri, 0.0);
-		} else {
-			ri = g->split ? fmax(g->lo - fabs(l), 0.0)
-				      : fmax(fmax(g->lo - l, l - g->hi), 0.0);
-		}
-		r = fmin(r, fmax(rc, ri));
-	}
-	return r;
+	return cert_radius(&c->cert, p) * px__strack_radius_scale;
 }
 
 /* ... and of a solve cell: its children's regions cover all of it. */
@@ -550,8 +681,7 @@ static void heap_rebuild(struct px_strack *t, px_vec3 p)
 {
 	int i;
 	for (i = 0; i < t->n_cells; i++) {
-		t->cell[i].expiry = t->travel + cell_radius(t, &t->cell[i], p) *
-							(1.0 - 1e-9);
+		t->cell[i].expiry = t->travel + cell_radius(t, &t->cell[i], p);
 		heap_set(t, i, i);
 	}
 	for (i = t->n_cells / 2 - 1; i >= 0; i--)
@@ -578,20 +708,23 @@ static int collect_cells(struct px_strack *t, px_vec3 p0, px_vec3 p1)
 	for (k = 0; k < np; k++) {
 		int ci = t->popped[k];
 		struct scell *c = &t->cell[ci];
+		/* the segment lies in the cube of half width dinf about p1
+		 * and in the cube of half width dinf / 2 about its middle */
+		double dinf = fmax(fmax(fabs(p1.x - p0.x), fabs(p1.y - p0.y)),
+				   fabs(p1.z - p0.z));
 		double r1 = cell_radius(t, c, p1);
 		t->st.box_tests++;
-		/* a point of the segment within reach of the set is at least
-		 * r0 from p0 and r1 from p1: impossible when r0 + r1 > |seg| */
-		double r0 = r1 <= 0.0 || seg <= 0.0 ? 0.0 : cell_radius(t, c, p0);
-		if (r1 <= 0.0 || r0 + r1 <= seg) {
+		if (r1 < dinf &&
+		    cell_radius(t, c, px_v3_scale(px_v3_add(p0, p1), 0.5)) < 0.5 * dinf) {
 			/* where along the segment the region can first be met */
-			double s0 = seg > 0.0 ? fmin(1.0, r0 / seg) : 1.0;
-			double s1 = seg > 0.0 ? fmax(s0, 1.0 - r1 / seg) : 1.0;
-			c->cross = r0 > 0.0 ? 0.5 * (s0 + s1) : 0.5 * s1;
+			double r0 = cell_radius(t, c, p0);
+			double s0 = fmin(1.0, r0 / dinf);
+			double s1 = fmax(s0, 1.0 - r1 / dinf);
+			c->cross = 0.5 * (s0 + s1);
 			c->mark = t->epoch;
 			t->hits[nh++] = ci;
 		}
-		c->expiry = t->travel + r1 * (1.0 - 1e-9);
+		c->expiry = t->travel + r1;
 		heap_set(t, n, ci);
 		heap_up(t, n);
 		n++;
@@ -929,7 +1062,7 @@ int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 			rc = cell_solve(t, c, p);
 			/* a long step after the crossing: also solve where the
 			 * region was met and follow those roots to p */
-			if (rc >= 0 && (1.0 - c->cross) * px_v3_norm(dp) > 0.1 * c->rho)
+			if (rc >= 0 && (1.0 - c->cross) * px_v3_norm(dp) > 0.05 * c->size)
 				rc = cell_solve_at(t, c, px_v3_add(p0, px_v3_scale(dp, c->cross)),
 						   p);
 		}
@@ -1038,230 +1171,195 @@ static int span_bounds(const struct px_nurbs_surf *s, int dir, double a,
 	return n;
 }
 
-/* Sample of the surface for the focal boxes: point, unit normal, the
- * two principal curvatures (0 when the normal is undefined). */
-static void sample(const struct px_nurbs_surf *s, double u, double v, int su,
-		   int sv, px_vec3 *q, px_vec3 *nrm, double k[2], int *ok)
+static struct iv iv_pt(double x)
 {
-	struct px_nurbs_surf_derivs d;
-	px_vec3 n;
-	double E, F, G, L, M, N, det, H, K, disc, nn;
-	px_nurbs_surf_eval_side(s, u, v, su, sv, 2, &d);
-	*q = d.s;
-	n = px_v3_cross(d.su, d.sv);
-	nn = px_v3_norm(n);
-	*ok = 0;
-	k[0] = k[1] = 0.0;
-	*nrm = px_v3(0, 0, 0);
-	if (!(nn > 1e-14 * (px_v3_norm(d.su) * px_v3_norm(d.sv))) || !(nn > 0.0))
-		return;
-	n = px_v3_scale(n, 1.0 / nn);
-	E = px_v3_dot(d.su, d.su);
-	F = px_v3_dot(d.su, d.sv);
-	G = px_v3_dot(d.sv, d.sv);
-	L = px_v3_dot(d.suu, n);
-	M = px_v3_dot(d.suv, n);
-	N = px_v3_dot(d.svv, n);
-	det = E * G - F * F;
-	if (!(det > 0.0))
-		return;
-	K = (L * N - M * M) / det;
-	H = (E * N + G * L - 2.0 * F * M) / (2.0 * det);
-	/* umbilic: H^2 - K rounds below zero, clamp (equal curvatures) */
-	disc = H * H - K;
-	disc = disc > 0.0 ? sqrt(disc) : 0.0;
-	k[0] = H + disc;
-	k[1] = H - disc;
-	*nrm = n;
-	*ok = 1;
+	struct iv r = {x, x};
+	return r;
 }
 
-/* Transition regions of one cell from m x m samples (scratch pts, nrm,
- * kk, okk). Sampling is not a proof: the cone and the height intervals
- * are grown by margins for the variation between samples. */
-static void cell_regions(struct px_strack *t, struct scell *c,
-			 const struct ssurf *f, px_vec3 *pts, px_vec3 *nrm,
-			 double *kk, int *okk)
+static struct iv iv_add(struct iv a, struct iv b)
 {
-	int m = t->opts.samples, i, j, sh, q, nq = m * m, edge;
-	double sp = 0.0, rho = 0.0, cmin = 1.0, Lw = 0.0;
-	px_vec3 sc = px_v3(0, 0, 0), nc = px_v3(0, 0, 0);
+	struct iv r = {a.lo + b.lo, a.hi + b.hi};
+	return r;
+}
 
-	c->nreg = 0;
-	c->always = 0;
-	for (j = 0; j < m; j++)
-		for (i = 0; i < m; i++) {
-			double u = c->u0 + (c->u1 - c->u0) * i / (m - 1);
-			double v = c->v0 + (c->v1 - c->v0) * j / (m - 1);
-			q = j * m + i;
-			sample(&f->s, u, v, i == m - 1 ? -1 : 1, j == m - 1 ? -1 : 1,
-			       &pts[q], &nrm[q], &kk[2 * q], &okk[q]);
-			if (!okk[q]) {
-				/* pole or degenerate point: the limit from inside */
-				double uu = u + (i == m - 1 ? -1e-7 : 1e-7) * (c->u1 - c->u0);
-				double vv = v + (j == m - 1 ? -1e-7 : 1e-7) * (c->v1 - c->v0);
-				px_vec3 q2;
-				sample(&f->s, uu, vv, 1, 1, &q2, &nrm[q], &kk[2 * q], &okk[q]);
-			}
-			if (!okk[q])
-				c->always = 1;
-			if (i > 0)
-				sp = fmax(sp, px_v3_dist(pts[q], pts[q - 1]));
-			if (j > 0)
-				sp = fmax(sp, px_v3_dist(pts[q], pts[q - m]));
-			sc = px_v3_add(sc, pts[q]);
-			nc = px_v3_add(nc, nrm[q]);
-			Lw = fmax(Lw, sqrt(px_aabb_max_dist2(&t->work, pts[q])));
-		}
-	if (c->always || !(px_v3_norm(nc) > 0.0)) {
-		c->always = 1;
-		t->n_unbounded++;
-		return;
-	}
-	sc = px_v3_scale(sc, 1.0 / nq);
-	nc = px_v3_scale(nc, 1.0 / px_v3_norm(nc));
-	for (q = 0; q < nq; q++) {
-		rho = fmax(rho, px_v3_dist(pts[q], sc));
-		cmin = fmin(cmin, px_v3_dot(nrm[q], nc));
-	}
-	{
-		double th = acos(fmax(-1.0, fmin(1.0, cmin)));
-		/* normals turn between samples by about a sample step of
-		 * curvature: grow the spread by a quarter and a margin */
-		th = 1.25 * th + 0.02;
-		if (th > 1.3) {
-			c->always = 1;
-			t->n_unbounded++;
-			return;
-		}
-		c->a = tan(th);
-		c->ia = 1.0 / sqrt(1.0 + c->a * c->a);
-		cmin = cos(th);
-	}
-	rho = 1.1 * rho + 0.5 * sp + 1e-9 * t->scale;
-	c->sc = sc;
-	c->nc = nc;
-	c->rho = rho * (1.0 + c->a);
-	for (sh = 0; sh < 2; sh++) {
-		double lmin = INFINITY, lmax = -INFINITY, kmax = 0.0, gap = 0.0;
-		int sg = 0, through = 0;
-		struct sreg g;
-		memset(&g, 0, sizeof(g));
-		for (q = 0; q < nq; q++) {
-			double k = kk[2 * q + sh];
-			int s = k > 0.0 ? 1 : (k < 0.0 ? -1 : 0);
-			kmax = fmax(kmax, fabs(k));
-			if (!s || (sg && s != sg) || fabs(k) * Lw < 1.0)
-				through = 1;
-			if (s)
-				sg = s;
-		}
-		if (through) {
-			/* the sheet reaches infinity here (or beyond the
-			 * working volume): |l| >= the smallest focal distance,
-			 * from the largest curvature grown for the samples */
-			if (!(kmax > 0.0))
-				continue; /* flat: no focal point at all */
-			g.split = 1;
-			g.lo = 1.0 / (1.25 * kmax + 1e-12 / t->scale) * cmin - c->rho;
-			g.hi = INFINITY;
-			t->n_unbounded++;
-		} else {
-			for (j = 0; j < m; j++)
-				for (i = 0; i < m; i++) {
-					double l;
-					q = j * m + i;
-					l = 1.0 / kk[2 * q + sh];
-					lmin = fmin(lmin, l);
-					lmax = fmax(lmax, l);
-					if (i > 0)
-						gap = fmax(gap, fabs(l - 1.0 / kk[2 * (q - 1) + sh]));
-					if (j > 0)
-						gap = fmax(gap, fabs(l - 1.0 / kk[2 * (q - m) + sh]));
+static struct iv iv_sub(struct iv a, struct iv b)
+{
+	struct iv r = {a.lo - b.hi, a.hi - b.lo};
+	return r;
+}
+
+static struct iv iv_scale(struct iv a, double k)
+{
+	struct iv r = {fmin(a.lo * k, a.hi * k), fmax(a.lo * k, a.hi * k)};
+	return r;
+}
+
+/* a / w for w > 0 */
+static struct iv iv_divw(struct iv a, struct iv w)
+{
+	struct iv iw = {1.0 / w.hi, 1.0 / w.lo};
+	return iv_mul(a, iw);
+}
+
+static struct iv iv_pad(struct iv a)
+{
+	double e = ST_PAD * (fabs(a.lo) + fabs(a.hi)) + 1e-300;
+	struct iv r = {a.lo - e, a.hi + e};
+	return r;
+}
+
+static void iv_grow(struct iv *a, double x)
+{
+	a->lo = fmin(a->lo, x);
+	a->hi = fmax(a->hi, x);
+}
+
+/*
+ * Enclosure of one homogeneous coordinate k (0..3) of a difference net of
+ * the Bezier net P ((p + 1) x (q + 1), u fastest, 4 per point): the
+ * derivative of order (a, b) in (u, v) is a Bezier patch whose control
+ * points are the forward differences times p!/(p - a)! q!/(q - b)!
+ * / (du^a dv^b); its range lies within their hull.
+ */
+static struct iv net_range(const double *P, int p, int q, int k, int a, int b,
+			   double du, double dv)
+{
+	struct iv r = {INFINITY, -INFINITY};
+	double f = 1.0;
+	int i, j, x, y;
+	if (a > p || b > q)
+		return iv_pt(0.0);
+	for (i = 0; i < a; i++)
+		f *= (double)(p - i) / du;
+	for (j = 0; j < b; j++)
+		f *= (double)(q - j) / dv;
+	for (j = 0; j + b <= q; j++)
+		for (i = 0; i + a <= p; i++) {
+			double d = 0.0;
+			for (y = 0; y <= b; y++)
+				for (x = 0; x <= a; x++) {
+					/* binomial signs of the forward differences */
+					double c = ((a - x + b - y) & 1) ? -1.0 : 1.0;
+					c *= (a == 2 && x == 1 ? 2.0 : 1.0) * (b == 2 && y == 1 ? 2.0 : 1.0);
+					d += c * P[4 * ((j + y) * (p + 1) + i + x) + k];
 				}
-			g.split = 0;
-			/* the focal point's height on the central line is
-			 * between l cos(theta) - rho and l + rho */
-			lmin -= gap;
-			lmax += gap;
-			g.lo = (lmin > 0.0 ? lmin * cmin : lmin) - c->rho;
-			g.hi = (lmax > 0.0 ? lmax : lmax * cmin) + c->rho;
+			iv_grow(&r, f * d);
 		}
-		c->reg[c->nreg++] = g;
+	return iv_pad(r);
+}
+
+/* Certificate data of region cell c (setup; work: extraction scratch). */
+static int cell_cert(struct px_strack *t, struct scell *c, const struct ssurf *f,
+		     double *work, size_t wl, const int side_open[4])
+{
+	struct rcert *ce = &c->cert;
+	struct px_nurbs_surf sub;
+	struct px_nurbs_surf_derivs d;
+	struct iv W, Wu, Wv, Wuu, Wuv, Wvv, Su[3], Sv[3];
+	double du = c->u1 - c->u0, dv = c->v1 - c->v0;
+	int p = f->s.degree[0], q = f->s.degree[1], k, i, rc;
+	rc = px_nurbs_surf_extract_work(&f->s, c->u0, c->u1, c->v0, c->v1, work,
+					wl, &sub);
+	if (rc)
+		return rc;
+	if (sub.n_ctrl[0] != p + 1 || sub.n_ctrl[1] != q + 1)
+		return PX_E_INVAL;
+	memset(ce, 0, sizeof(*ce));
+	W = net_range(sub.pw, p, q, 3, 0, 0, du, dv);
+	if (!(W.lo > 0.0))
+		return PX_E_INVAL;
+	Wu = net_range(sub.pw, p, q, 3, 1, 0, du, dv);
+	Wv = net_range(sub.pw, p, q, 3, 0, 1, du, dv);
+	Wuu = net_range(sub.pw, p, q, 3, 2, 0, du, dv);
+	Wuv = net_range(sub.pw, p, q, 3, 1, 1, du, dv);
+	Wvv = net_range(sub.pw, p, q, 3, 0, 2, du, dv);
+	for (k = 0; k < 3; k++) {
+		struct iv S = {INFINITY, -INFINITY};
+		/* the surface lies in the hull of its projected net */
+		for (i = 0; i < (p + 1) * (q + 1); i++)
+			iv_grow(&S, sub.pw[4 * i + k] / sub.pw[4 * i + 3]);
+		S = iv_pad(S);
+		ce->S[k] = S;
+		/* quotient rule on S = X / W, differentiated */
+		Su[k] = iv_pad(iv_divw(iv_sub(net_range(sub.pw, p, q, k, 1, 0, du, dv),
+					      iv_mul(S, Wu)), W));
+		Sv[k] = iv_pad(iv_divw(iv_sub(net_range(sub.pw, p, q, k, 0, 1, du, dv),
+					      iv_mul(S, Wv)), W));
+		ce->Suu[k] = iv_pad(iv_divw(
+			iv_sub(iv_sub(net_range(sub.pw, p, q, k, 2, 0, du, dv),
+				      iv_scale(iv_mul(Su[k], Wu), 2.0)),
+			       iv_mul(S, Wuu)), W));
+		ce->Svv[k] = iv_pad(iv_divw(
+			iv_sub(iv_sub(net_range(sub.pw, p, q, k, 0, 2, du, dv),
+				      iv_scale(iv_mul(Sv[k], Wv), 2.0)),
+			       iv_mul(S, Wvv)), W));
+		ce->Suv[k] = iv_pad(iv_divw(
+			iv_sub(iv_sub(iv_sub(net_range(sub.pw, p, q, k, 1, 1, du, dv),
+					     iv_mul(Su[k], Wv)),
+				      iv_mul(Sv[k], Wu)),
+			       iv_mul(S, Wuv)), W));
 	}
-	for (edge = 0; edge < 4; edge++) {
-		/* points cross an open edge on its normal lines */
-		struct sreg g;
-		px_vec3 e0, e1, tc, en = px_v3(0, 0, 0), ec = px_v3(0, 0, 0);
-		double rb = 0.0, rn = 0.0, sb = 0.0, cn = 1.0, nt;
-		int on;
-		if (edge == 0)
-			on = !f->wrap_u && c->u0 == f->u0;
-		else if (edge == 1)
-			on = !f->wrap_u && c->u1 == f->u1;
-		else if (edge == 2)
-			on = !f->wrap_v && c->v0 == f->v0;
-		else
-			on = !f->wrap_v && c->v1 == f->v1;
-		if (!on || c->nreg >= ST_NBOX)
-			continue;
-#define EQ(ii) (edge == 0 ? (ii) * m : edge == 1 ? (ii) * m + m - 1 \
-			  : edge == 2 ? (ii) : (m - 1) * m + (ii))
-		e0 = pts[EQ(0)];
-		e1 = pts[EQ(m - 1)];
-		for (i = 0; i < m; i++) {
-			ec = px_v3_add(ec, pts[EQ(i)]);
-			en = px_v3_add(en, nrm[EQ(i)]);
-		}
-		ec = px_v3_scale(ec, 1.0 / m);
-		tc = px_v3_sub(e1, e0);
-		nt = px_v3_norm(en);
-		memset(&g, 0, sizeof(g));
-		if (!(nt > 0.0) || !(px_v3_norm(tc) > 0.0)) {
-			g.lo = -INFINITY; /* collapsed or degenerate: the cone */
-			g.hi = INFINITY;
-			c->reg[c->nreg++] = g;
-			continue;
-		}
-		en = px_v3_scale(en, 1.0 / nt);
-		g.b = px_v3_cross(tc, en);
-		nt = px_v3_norm(g.b);
-		if (!(nt > 0.0)) {
-			g.lo = -INFINITY;
-			g.hi = INFINITY;
-			c->reg[c->nreg++] = g;
-			continue;
-		}
-		g.b = px_v3_scale(g.b, 1.0 / nt);
-		g.n = en;
-		g.sc = ec;
-		for (i = 0; i < m; i++) {
-			px_vec3 w = px_v3_sub(pts[EQ(i)], ec);
-			rb = fmax(rb, fabs(px_v3_dot(w, g.b)));
-			rn = fmax(rn, fabs(px_v3_dot(w, g.n)));
-			sb = fmax(sb, fabs(px_v3_dot(nrm[EQ(i)], g.b)));
-			cn = fmin(cn, px_v3_dot(nrm[EQ(i)], g.n));
-		}
-#undef EQ
-		{
-			/* margins for the turn of the normal between samples */
-			double thb = asin(fmin(1.0, sb)) * 1.25 + 0.02;
-			double thn = acos(fmax(-1.0, fmin(1.0, cn))) * 1.25 + 0.02;
-			if (thb > 1.3 || thn > 1.3) {
-				g.lo = -INFINITY;
-				g.hi = INFINITY;
-				c->reg[c->nreg++] = g;
-				continue;
-			}
-			g.a = sin(thb) / cos(thn);
-			rb = 1.1 * rb + 0.05 * sp + 1e-9 * t->scale;
-			rn = 1.1 * rn + 0.05 * sp + 1e-9 * t->scale;
-			g.rho = rb + g.a * rn;
-			g.ia = 1.0 / sqrt(1.0 + g.a * g.a);
-			g.wedge = 1;
-		}
-		c->reg[c->nreg++] = g;
+	ce->G11 = ce->G12 = ce->G22 = iv_pt(0.0);
+	for (k = 0; k < 3; k++) {
+		struct iv a = Su[k], b = Sv[k], sa = iv_mul(a, a), sb = iv_mul(b, b);
+		/* squares are not negative */
+		if (a.lo <= 0.0 && a.hi >= 0.0)
+			sa.lo = 0.0;
+		if (b.lo <= 0.0 && b.hi >= 0.0)
+			sb.lo = 0.0;
+		ce->G11 = iv_add(ce->G11, sa);
+		ce->G22 = iv_add(ce->G22, sb);
+		ce->G12 = iv_add(ce->G12, iv_mul(a, b));
+		ce->m11 += iv_mag(ce->Suu[k]);
+		ce->m12 += iv_mag(ce->Suv[k]);
+		ce->m22 += iv_mag(ce->Svv[k]);
 	}
+	ce->G11 = iv_pad(ce->G11);
+	ce->G12 = iv_pad(ce->G12);
+	ce->G22 = iv_pad(ce->G22);
+	ce->hu = 0.5 * du;
+	ce->hv = 0.5 * dv;
+	surf_eval2(f, 0.5 * (c->u0 + c->u1), 0.5 * (c->v0 + c->v1), &d);
+	ce->sc = d.s;
+	ce->suc = d.su;
+	ce->svc = d.sv;
+	for (k = 0; k < 4; k++) {
+		struct cside *sd;
+		double u, v;
+		if (!side_open[k])
+			continue;
+		sd = &ce->side[ce->nside++];
+		/* sides 0, 1: u = u0, u1 (along v); 2, 3: v = v0, v1 */
+		u = k == 0 ? c->u0 : k == 1 ? c->u1 : 0.5 * (c->u0 + c->u1);
+		v = k == 2 ? c->v0 : k == 3 ? c->v1 : 0.5 * (c->v0 + c->v1);
+		/* evaluate on the cell's own patch (one-sided at a crease) */
+		u = fmin(fmax(u, c->u0 + 1e-13 * du), c->u1 - 1e-13 * du);
+		v = fmin(fmax(v, c->v0 + 1e-13 * dv), c->v1 - 1e-13 * dv);
+		surf_eval2(f, u, v, &d);
+		sd->s = d.s;
+		sd->su = d.su;
+		sd->sv = d.sv;
+		sd->along = k < 2;
+		sd->h = k < 2 ? ce->hv : ce->hu;
+		/* the side point is off the exact side by 1e-13 of the cell:
+		 * cover it in the half length */
+		sd->h *= 1.0 + 1e-12;
+	}
+	(void)t;
+	return PX_OK;
+}
+
+/* 1 when x is a break of the surface along dir where it is less than
+ * C2 (knot multiplicity above degree - 2): points enter and leave a
+ * patch there as through an edge. */
+static int crease_at(const struct ssurf *f, int dir, double x)
+{
+	int i, m = 0;
+	for (i = 0; i < f->s.n_knots[dir]; i++)
+		if (f->s.knots[dir][i] == x)
+			m++;
+	return m > f->s.degree[dir] - 2;
 }
 
 void px_strack_free(struct px_strack *t)
@@ -1394,9 +1492,8 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	struct px_strack_opts o;
 	struct px_nurbs_curve *cc = NULL;
 	double **cpw = NULL, *ub = NULL, *vb = NULL;
-	px_vec3 *pts = NULL, *nrm = NULL;
-	double *kk = NULL;
-	int *okk = NULL;
+	double *work = NULL;
+	size_t wl = 0;
 	int rc, i, j, k, max_knots = 0, cap_edges, n_cc = 0, cell_cap = 0;
 	px_aabb bounds;
 
@@ -1508,13 +1605,16 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	t->heap = calloc((size_t)cell_cap + 1, sizeof(int));
 	t->popped = calloc((size_t)cell_cap + 1, sizeof(int));
 	t->hits = calloc((size_t)cell_cap + 1, sizeof(int));
-	pts = calloc((size_t)(o.samples * o.samples), sizeof(*pts));
-	nrm = calloc((size_t)(o.samples * o.samples), sizeof(*nrm));
-	kk = calloc((size_t)(2 * o.samples * o.samples), sizeof(double));
-	okk = calloc((size_t)(o.samples * o.samples), sizeof(int));
+	for (i = 0; i < n_surfs; i++) {
+		const struct px_nurbs_surf *sf = &t->sf[i].s;
+		size_t l = PX_NURBS_SURF_WORK_LEN(sf->degree[0], sf->degree[1],
+						  sf->n_ctrl[0], sf->n_ctrl[1]);
+		if (l > wl)
+			wl = l;
+	}
+	work = malloc(wl * sizeof(double));
 	if (!t->cell || !t->rcell || !t->heap || !t->popped || !t->hits ||
-	    !pts || !nrm ||
-	    !kk || !okk) {
+	    !work) {
 		rc = PX_E_NOMEM;
 		goto fail;
 	}
@@ -1531,18 +1631,37 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 				{
 					double um = 0.5 * (c->u0 + c->u1), vm = 0.5 * (c->v0 + c->v1);
 					int ch;
+					px_aabb cb = px_aabb_empty();
 					c->child = 4 * (f->first_cell + j * f->ncu + k);
 					for (ch = 0; ch < 4; ch++) {
 						struct scell *rg = &t->rcell[c->child + ch];
+						int open[4];
+						px_aabb rb;
 						rg->surf = i;
 						rg->u0 = ch & 1 ? um : c->u0;
 						rg->u1 = ch & 1 ? c->u1 : um;
 						rg->v0 = ch & 2 ? vm : c->v0;
 						rg->v1 = ch & 2 ? c->v1 : vm;
-						cell_regions(t, rg, f, pts, nrm, kk, okk);
-						/* size scale of the solve cell */
-						c->rho = fmax(c->rho, 2.0 * rg->rho);
+						open[0] = rg->u0 == f->u0 ? !f->wrap_u
+									  : crease_at(f, 0, rg->u0);
+						open[1] = rg->u1 == f->u1 ? !f->wrap_u
+									  : crease_at(f, 0, rg->u1);
+						open[2] = rg->v0 == f->v0 ? !f->wrap_v
+									  : crease_at(f, 1, rg->v0);
+						open[3] = rg->v1 == f->v1 ? !f->wrap_v
+									  : crease_at(f, 1, rg->v1);
+						rc = cell_cert(t, rg, f, work, wl, open);
+						if (rc)
+							goto fail;
+						rb.min = px_v3(rg->cert.S[0].lo, rg->cert.S[1].lo, rg->cert.S[2].lo);
+						rb.max = px_v3(rg->cert.S[0].hi, rg->cert.S[1].hi, rg->cert.S[2].hi);
+						cb = px_aabb_union(&cb, &rb);
+						/* no certificate even for a point on the
+						 * cell: a pole or a degenerate normal */
+						if (!(cert_radius(&rg->cert, rg->cert.sc) > 0.0))
+							t->n_unbounded++;
 					}
+					c->size = px_aabb_diagonal(&cb);
 				}
 			}
 	}
@@ -1653,10 +1772,7 @@ fail:
 	free(cc);
 	free(ub);
 	free(vb);
-	free(pts);
-	free(nrm);
-	free(kk);
-	free(okk);
+	free(work);
 	px_strack_free(t);
 	return rc;
 }
