@@ -29,6 +29,8 @@
 
 #define ST_NEWTON 16
 
+enum { ST_TRACK = 0, ST_LAG = 1, ST_REBUILD = 2 };
+
 struct crit {
 	double u, v;
 	int type;       /* +1 min, -1 max, 0 saddle */
@@ -72,6 +74,10 @@ struct scell {
 	double u0, u1, v0, v1;
 	int surf;
 	double size;    /* diameter of the cell's box (solve cells) */
+	/* on a collapsed edge: E2 vanishes along the pole, so no
+	 * certificate holds near its normal lines; solved whenever hit,
+	 * outside the budget (a fixed cost of the model) */
+	int always;
 	struct rcert cert; /* region cells */
 	double expiry;
 	int hpos;
@@ -137,6 +143,14 @@ struct px_strack {
 	px_vec3 p;
 	int init;
 	uint32_t epoch, next_id;
+	/* the tracked set is at p (ST_TRACK), or catching up with the query
+	 * point (ST_LAG), or being re-established at p (ST_REBUILD: rb_next
+	 * the next cell to solve; rb_started 0: start at the next point
+	 * inside the working volume) */
+	int mode, rb_started, rb_next;
+	double lag_len;
+	px_vec3 last_point, last_q; /* last answer and its query point */
+	int last_entity, have_last;
 	int best_kind;          /* 0 none, 1 surface min, 2 curve tracker, 3 pole */
 	uint32_t best_id;
 	struct px_strack_stats st;
@@ -689,13 +703,29 @@ static void heap_rebuild(struct px_strack *t, px_vec3 p)
 	t->heap_ok = 1;
 }
 
-/* Cells whose boxes the segment p0 -> p1 meets. Returns their count. */
-static int collect_cells(struct px_strack *t, px_vec3 p0, px_vec3 p1)
+/* Work units of a hit cell: one solve, two after a long step past the
+ * crossing (solved where the region was met too). */
+static int hit_work(const struct px_strack *t, int ci, double step)
 {
-	int n = t->n_cells, np = 0, nh = 0, k;
-	double seg = px_v3_dist(p0, p1);
+	const struct scell *c = &t->cell[ci];
+	if (c->always)
+		return 0;
+	return 1 + ((1.0 - c->cross) * step > 0.05 * c->size);
+}
+
+/*
+ * Cells whose certificates the segment p0 -> p1 may break. Returns their
+ * count, or -1 when their work exceeds budget (> 0): then nothing is
+ * committed (the popped cells stay due, the travel is unchanged).
+ */
+static int collect_cells(struct px_strack *t, px_vec3 p0, px_vec3 p1,
+			 int budget)
+{
+	int n = t->n_cells, np = 0, nh = 0, k, work = 0;
+	double seg = px_v3_dist(p0, p1), travel0;
 	if (!t->heap_ok)
 		heap_rebuild(t, p0);
+	travel0 = t->travel;
 	t->travel += seg;
 	while (n > 0 && t->cell[t->heap[0]].expiry <= t->travel) {
 		t->popped[np++] = t->heap[0];
@@ -723,9 +753,21 @@ static int collect_cells(struct px_strack *t, px_vec3 p0, px_vec3 p1)
 			c->cross = 0.5 * (s0 + s1);
 			c->mark = t->epoch;
 			t->hits[nh++] = ci;
+			work += hit_work(t, ci, seg);
 		}
 		c->expiry = t->travel + r1;
-		heap_set(t, n, ci);
+	}
+	if (budget > 0 && work > budget) {
+		/* undo: due again at the next test, from p0 */
+		for (k = 0; k < np; k++) {
+			t->cell[t->popped[k]].expiry = travel0;
+			t->cell[t->popped[k]].mark = 0;
+		}
+		t->travel = travel0;
+		nh = -1;
+	}
+	for (k = 0; k < np; k++) {
+		heap_set(t, n, t->popped[k]);
 		heap_up(t, n);
 		n++;
 	}
@@ -825,8 +867,17 @@ static void answer(struct px_strack *t, px_vec3 p,
 	count_crit(t, r, cr->n_crit);
 	r->jumped = kind != t->best_kind || (kind == 2 && cr->jumped) ||
 		    (kind != 2 && id != t->best_id);
+	if (t->best_kind == 0 && t->have_last)
+		/* after a global answer: judged as there */
+		r->jumped = r->entity != t->last_entity ||
+			    px_v3_dist(r->point, t->last_point) >
+				    4.0 * px_v3_dist(p, t->last_q) + 1e-9 * t->scale;
 	t->best_kind = kind;
 	t->best_id = id;
+	t->last_point = r->point;
+	t->last_q = p;
+	t->last_entity = r->entity;
+	t->have_last = 1;
 }
 
 static void answer_global(struct px_strack *t, px_vec3 p,
@@ -841,10 +892,18 @@ static void answer_global(struct px_strack *t, px_vec3 p,
 	r->feature = PX_STRACK_GLOBAL;
 	fill_dir(r, p);
 	count_crit(t, r, 0);
-	r->jumped = 1;
+	/* no feature identity here: a jump is a change of entity or a foot
+	 * point that moved far more than the query point */
+	r->jumped = !t->have_last || r->entity != t->last_entity ||
+		    px_v3_dist(r->point, t->last_point) >
+			    4.0 * px_v3_dist(p, t->last_q) + 1e-9 * t->scale;
 	t->best_kind = 0;
 	r->source = PX_TRACK_GLOBAL;
 	t->st.fallbacks++;
+	t->last_point = r->point;
+	t->last_q = p;
+	t->last_entity = r->entity;
+	t->have_last = 1;
 }
 
 static int reinit_all(struct px_strack *t, px_vec3 p)
@@ -857,6 +916,8 @@ static int reinit_all(struct px_strack *t, px_vec3 p)
 	}
 	return rc;
 }
+
+static void rebuild_start(struct px_strack *t);
 
 static void verify(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 {
@@ -871,8 +932,12 @@ static void verify(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 	if (r->dist > g.dist + 1e-9 * (t->scale + g.dist)) {
 		t->st.disagreements++;
 		t->st.reinits++;
-		if (reinit_all(t, p))
+		if (t->opts.max_solves > 0) {
+			/* re-established over the next updates */
+			rebuild_start(t);
+		} else if (reinit_all(t, p)) {
 			t->st.overflows++;
+		}
 		answer_global(t, p, r);
 		r->verified = 1;
 	}
@@ -931,6 +996,8 @@ int px_strack_reset(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 	t->p = p;
 	t->init = 1;
 	t->best_kind = 0;
+	t->have_last = 0;
+	t->mode = ST_TRACK;
 	return full_reset(t, p, r);
 }
 
@@ -994,32 +1061,26 @@ static int follow(const struct ssurf *f, struct crit *z, px_vec3 p0,
 	return 1;
 }
 
-int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
+/*
+ * Move the tracked set from p0 to p: collect the cells whose
+ * certificates the segment may break, follow every point, add the cells
+ * of lost points, solve them. Returns 0; 1 when the certified cells
+ * exceed the budget (checked before anything moves: the set stays at
+ * p0, consistent); 2 when the lost points' cells push the work over the
+ * budget (the set is then incomplete); PX_E_NOSPC.
+ */
+static int track_step(struct px_strack *t, px_vec3 p0, px_vec3 p,
+		      struct px_strack_result *r)
 {
-	struct px_track_result cr;
-	px_vec3 p0, dp;
-	int i, j, nh, rc = 0;
+	px_vec3 dp = px_v3_sub(p, p0);
+	double step = px_v3_norm(dp);
+	int i, j, nh, rc = 0, work = 0, budget = t->opts.max_solves;
 
-	if (!t || !r)
-		return PX_E_INVAL;
-	if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
-		return PX_E_NAN;
-	if (!t->init)
-		return px_strack_reset(t, p, r);
-	result_clear(r);
-	t->st.updates++;
-	p0 = t->p;
-	dp = px_v3_sub(p, p0);
-	t->p = p;
-	r->source = PX_TRACK_TRACKED;
-	if (++t->epoch == 0)
-		t->epoch = 1;
-	if (!in_work(t, p) || !in_work(t, p0)) {
-		t->st.outside++;
-		return full_reset(t, p, r);
+	nh = collect_cells(t, p0, p, budget);
+	if (nh < 0) {
+		t->st.over_budget++;
+		return 1;
 	}
-	curves_update(t, p, &cr, 0);
-	nh = collect_cells(t, p0, p);
 	for (i = 0; i < t->n_surf; i++) {
 		struct ssurf *f = &t->sf[i];
 		int n = f->nz;
@@ -1048,10 +1109,14 @@ int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 			}
 			rc = crit_add(t, f, &z);
 			if (rc < 0)
-				break;
+				return rc;
 		}
-		if (rc < 0)
-			break;
+	}
+	for (i = 0; i < nh; i++)
+		work += hit_work(t, t->hits[i], step);
+	if (budget > 0 && work > budget) {
+		t->st.over_budget++;
+		return 2;
 	}
 	{
 		int before = 0, after = 0;
@@ -1062,7 +1127,7 @@ int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 			rc = cell_solve(t, c, p);
 			/* a long step after the crossing: also solve where the
 			 * region was met and follow those roots to p */
-			if (rc >= 0 && (1.0 - c->cross) * px_v3_norm(dp) > 0.05 * c->size)
+			if (rc >= 0 && hit_work(t, t->hits[i], step) > 1)
 				rc = cell_solve_at(t, c, px_v3_add(p0, px_v3_scale(dp, c->cross)),
 						   p);
 		}
@@ -1073,15 +1138,175 @@ int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 		r->born = after - before;
 		t->st.born += (uint64_t)r->born;
 	}
-	r->cells_solved = nh;
-	if (rc < 0) {
-		t->st.overflows++;
-		t->st.reinits++;
-		if (reinit_all(t, p))
+	r->cells_solved = work;
+	return rc < 0 ? rc : 0;
+}
+
+/* Re-establish the critical points from scratch over the next updates,
+ * starting at the next point inside the working volume. */
+static void rebuild_start(struct px_strack *t)
+{
+	int i;
+	t->mode = ST_REBUILD;
+	t->rb_started = 0;
+	t->rb_next = 0;
+	t->heap_ok = 0;
+	for (i = 0; i < t->n_surf; i++)
+		t->sf[i].nz = 0;
+}
+
+/*
+ * One update while the tracked set is not at the query point (mode
+ * ST_REBUILD or ST_LAG); the answer is the global query's unless the set
+ * reaches p in this update and agrees with it.
+ *  - ST_REBUILD: a slice of cells is solved at the fixed point t->p
+ *    where the rebuild started, each cell's certificate taken there;
+ *    when all are, the set is complete at t->p: ST_LAG.
+ *  - ST_LAG: the set moves from t->p towards p by one tracked step of
+ *    length at most t->lag_len (doubled after a step within the budget,
+ *    quartered after one over it); on reaching p it answers again.
+ */
+static int catch_up(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
+{
+	struct px_track_result cr;
+	struct px_dist_result g;
+	int rc = 0;
+	t->st.rebuild_updates++;
+	curves_update(t, p, &cr, 0);
+	if (t->mode == ST_REBUILD) {
+		int slice = t->opts.max_solves > 1 ? t->opts.max_solves / 2 : 1;
+		if (!t->rb_started) {
+			if (!in_work(t, p)) {
+				t->st.outside++;
+				answer_global(t, p, r);
+				return PX_OK;
+			}
+			t->rb_started = 1;
+			t->p = p;
+			t->travel = 0.0;
+		}
+		while (slice-- > 0 && t->rb_next < t->n_cells && rc >= 0) {
+			struct scell *c = &t->cell[t->rb_next];
+			rc = cell_solve(t, c, t->p);
+			c->expiry = cell_radius(t, c, t->p);
+			heap_set(t, t->rb_next, t->rb_next);
+			t->rb_next++;
+			r->cells_solved++;
+		}
+		if (rc < 0) {
 			t->st.overflows++;
+			rebuild_start(t);
+		} else if (t->rb_next >= t->n_cells) {
+			int i;
+			for (i = t->n_cells / 2 - 1; i >= 0; i--)
+				heap_down(t, i, t->n_cells);
+			t->heap_ok = 1;
+			t->mode = ST_LAG;
+			t->lag_len = px_v3_dist(p, t->last_q) + 1e-6 * t->scale;
+		}
 		answer_global(t, p, r);
 		return PX_OK;
 	}
+	/* ST_LAG */
+	if (in_work(t, p)) {
+		double d = px_v3_dist(t->p, p);
+		px_vec3 q = d <= t->lag_len ? p
+					    : px_v3_add(t->p, px_v3_scale(px_v3_sub(p, t->p),
+									  t->lag_len / d));
+		rc = track_step(t, t->p, q, r);
+		if (rc == 1) {
+			t->lag_len *= 0.25;
+			if (t->lag_len < 1e-9 * t->scale)
+				rebuild_start(t);
+		} else if (rc) {
+			if (rc < 0)
+				t->st.overflows++;
+			rebuild_start(t);
+		} else {
+			t->p = q;
+			t->lag_len *= 2.0;
+			if (d <= t->lag_len * 0.5) {
+				/* caught up: checked against the global answer */
+				answer(t, p, &cr, r);
+				if (px_dist_query(t->dist, p, &g) == PX_OK) {
+					t->st.verifications++;
+					r->verified = 1;
+					if (fabs(r->dist - g.dist) <= 1e-9 * (t->scale + g.dist)) {
+						t->mode = ST_TRACK;
+						r->source = PX_TRACK_REINIT;
+						return PX_OK;
+					}
+					t->st.disagreements++;
+				}
+				rebuild_start(t);
+			}
+		}
+	} else {
+		t->st.outside++;
+	}
+	answer_global(t, p, r);
+	return PX_OK;
+}
+
+int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
+{
+	struct px_track_result cr;
+	px_vec3 p0;
+	int rc;
+
+	if (!t || !r)
+		return PX_E_INVAL;
+	if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
+		return PX_E_NAN;
+	if (!t->init)
+		return px_strack_reset(t, p, r);
+	result_clear(r);
+	t->st.updates++;
+	if (++t->epoch == 0)
+		t->epoch = 1;
+	if (t->mode != ST_TRACK)
+		return catch_up(t, p, r);
+	p0 = t->p;
+	r->source = PX_TRACK_TRACKED;
+	if (!in_work(t, p) || !in_work(t, p0)) {
+		if (t->opts.max_solves > 0) {
+			/* the set waits at p0 for the point to come back */
+			t->mode = ST_LAG;
+			t->lag_len = px_v3_dist(p0, p) + 1e-6 * t->scale;
+			return catch_up(t, p, r);
+		}
+		t->p = p;
+		t->st.outside++;
+		return full_reset(t, p, r);
+	}
+	curves_update(t, p, &cr, 0);
+	rc = track_step(t, p0, p, r);
+	if (rc == 1) {
+		/* over the budget before anything moved: answer globally,
+		 * the set catches up over the next updates */
+		t->mode = ST_LAG;
+		t->lag_len = 0.5 * px_v3_dist(p0, p);
+		answer_global(t, p, r);
+		return PX_OK;
+	}
+	if (rc) {
+		/* capacity, or lost points over the budget: the set is
+		 * re-established (over the next updates with a budget) */
+		if (rc < 0)
+			t->st.overflows++;
+		t->st.reinits++;
+		if (t->opts.max_solves > 0) {
+			rebuild_start(t);
+		} else {
+			t->p = p;
+			if (reinit_all(t, p))
+				t->st.overflows++;
+			t->heap_ok = 0;
+		}
+		answer_global(t, p, r);
+		return PX_OK;
+	}
+	t->p = p;
 	answer(t, p, &cr, r);
 	if (cr.source != PX_TRACK_TRACKED)
 		r->source = cr.source;
@@ -1153,6 +1378,7 @@ void px_strack_opts_default(struct px_strack_opts *o)
 	o->max_crit = 256;
 	o->work_margin = 1.0;
 	o->verify_every = 0;
+	o->max_solves = 4;
 	o->dist = NULL;
 }
 
@@ -1507,7 +1733,7 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 		px_strack_opts_default(&o);
 	if (o.cells_per_span < 1 || o.cells_per_span > 16 || o.seeds < 1 ||
 	    o.seeds > 8 || o.samples < 2 || o.samples > 32 || o.max_crit < 2 ||
-	    o.max_crit > 1 << 20 || o.verify_every < 0 ||
+	    o.max_crit > 1 << 20 || o.verify_every < 0 || o.max_solves < 0 ||
 	    !(o.work_margin >= 0.0))
 		return PX_E_INVAL;
 	for (i = 0; i < n_surfs; i++) {
@@ -1620,6 +1846,11 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	}
 	for (i = 0; i < n_surfs; i++) {
 		struct ssurf *f = &t->sf[i];
+		for (k = 0; k < 4; k++)
+			/* as for the poles below */
+			f->pole[k] = !((k < 2 && f->wrap_u) || (k >= 2 && f->wrap_v)) &&
+				     px_nurbs_surf_edge_collapsed(&f->s, k,
+								  1e-12 * (1.0 + t->scale));
 		for (j = 0; j < f->ncv; j++)
 			for (k = 0; k < f->ncu; k++) {
 				struct scell *c = &t->cell[f->first_cell + j * f->ncu + k];
@@ -1650,18 +1881,20 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 									  : crease_at(f, 1, rg->v0);
 						open[3] = rg->v1 == f->v1 ? !f->wrap_v
 									  : crease_at(f, 1, rg->v1);
+						if ((rg->u0 == f->u0 && f->pole[0]) ||
+						    (rg->u1 == f->u1 && f->pole[1]) ||
+						    (rg->v0 == f->v0 && f->pole[2]) ||
+						    (rg->v1 == f->v1 && f->pole[3]))
+							c->always = 1;
 						rc = cell_cert(t, rg, f, work, wl, open);
 						if (rc)
 							goto fail;
 						rb.min = px_v3(rg->cert.S[0].lo, rg->cert.S[1].lo, rg->cert.S[2].lo);
 						rb.max = px_v3(rg->cert.S[0].hi, rg->cert.S[1].hi, rg->cert.S[2].hi);
 						cb = px_aabb_union(&cb, &rb);
-						/* no certificate even for a point on the
-						 * cell: a pole or a degenerate normal */
-						if (!(cert_radius(&rg->cert, rg->cert.sc) > 0.0))
-							t->n_unbounded++;
 					}
 					c->size = px_aabb_diagonal(&cb);
+					t->n_unbounded += c->always;
 				}
 			}
 	}

@@ -86,6 +86,22 @@ struct px_strack_opts {
 	/* Compare with the global query every verify_every updates (0: off,
 	 * the default). */
 	int verify_every;
+	/* Bound on the transition work of one update, in cell solves
+	 * (default 4; 0: no bound). An update whose certificates name more
+	 * cells to solve (or whose critical points overflow max_crit) is
+	 * answered by the global query (px_dist_query(), exact) instead,
+	 * and the critical points are re-established over the following
+	 * updates: max_solves / 2 cells (at least 1) per update, each of
+	 * those answered by the global query too, then one tracked step
+	 * from where the rebuild started to the current point, checked
+	 * against the global answer before the tracker answers again.
+	 * Real-time meaning: an update costs at most about max_solves cell
+	 * solves plus the following of the live points, or one global query
+	 * plus max_solves / 2 cell solves (see stats.over_budget and
+	 * stats.rebuild_updates). Leaving the working volume starts such a
+	 * rebuild as well. With 0 these cases re-initialise at once (cost
+	 * of px_strack_reset()). */
+	int max_solves;
 	/* Options of the global-query model (NULL: defaults). */
 	const struct px_dist_opts *dist;
 };
@@ -129,6 +145,9 @@ struct px_strack_stats {
 	 * at a fold or left through an edge; their cell is solved again) */
 	uint64_t cell_solves, box_tests, lost;
 	uint64_t born;     /* interior points found by cell solves */
+	/* updates whose transition work exceeded max_solves; updates
+	 * answered globally while the set was re-established */
+	uint64_t over_budget, rebuild_updates;
 };
 
 struct px_strack_info {

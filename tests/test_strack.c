@@ -374,14 +374,16 @@ static void make_path(px_vec3 *q, int n, int kind, px_aabb box, double step)
 
 struct totals {
 	long steps, wrong, naive_wrong, brute_bad, brute_checks, count_checks,
-		count_bad, count_amb, jumps, cells, born, died;
+		count_bad, count_amb, jumps, cells, born, died, global;
+	uint64_t over_budget;
+	long budget_bad;
 	uint64_t allocs;
 };
 
 /* Run the tracker along paths over the model; checks every step. */
 static void run_model(const char *name, const struct px_nurbs_curve *cs,
 		      int nc, const struct px_nurbs_surf *ss, int ns,
-		      struct totals *tot)
+		      int max_solves, struct totals *tot)
 {
 	static px_vec3 q[NSTEP];
 	static const double steps[] = {1e-4, 1e-3, 1e-2, 5e-2};
@@ -396,6 +398,7 @@ static void run_model(const char *name, const struct px_nurbs_curve *cs,
 	long wrong0 = tot->wrong, naive0 = tot->naive_wrong;
 
 	px_strack_opts_default(&o);
+	o.max_solves = max_solves;
 	rc = px_strack_create(cs, nc, ss, ns, &o, &t);
 	PX_CHECK_MSG(rc == PX_OK, "%s: create: %s", name, px_strerror(rc));
 	if (rc)
@@ -451,7 +454,12 @@ static void run_model(const char *name, const struct px_nurbs_curve *cs,
 					if (nc == 0 && sqrt(bd) < g.dist - 1e-7 * size)
 						tot->brute_bad++;
 				}
-				if (k % 50 == 0) {
+				if (r.source == PX_TRACK_GLOBAL)
+					tot->global++;
+				if (max_solves > 0 && r.cells_solved > max_solves)
+					tot->budget_bad++;
+				/* answered globally: the set is still catching up */
+				if (k % 50 == 0 && r.source != PX_TRACK_GLOBAL) {
 					int e;
 					for (e = 0; e < ns; e++) {
 						int amb = tracked_amb(t, e, &ss[e]);
@@ -483,12 +491,16 @@ static void run_model(const char *name, const struct px_nurbs_curve *cs,
 			}
 		}
 	px_strack_get_stats(t, &st);
-	printf("  %s: wrong %ld, naive wrong %ld; tracker: cell solves %llu "
-	       "box tests %llu reinit %llu outside %llu fallback %llu lost %llu\n",
-	       name, tot->wrong - wrong0, tot->naive_wrong - naive0,
+	printf("  %s (max_solves %d): wrong %ld, naive wrong %ld; tracker: cell "
+	       "solves %llu box tests %llu reinit %llu outside %llu fallback %llu "
+	       "lost %llu over budget %llu rebuild updates %llu\n",
+	       name, max_solves, tot->wrong - wrong0, tot->naive_wrong - naive0,
 	       (unsigned long long)st.cell_solves, (unsigned long long)st.box_tests,
 	       (unsigned long long)st.reinits, (unsigned long long)st.outside,
-	       (unsigned long long)st.fallbacks, (unsigned long long)st.lost);
+	       (unsigned long long)st.fallbacks, (unsigned long long)st.lost,
+	       (unsigned long long)st.over_budget,
+	       (unsigned long long)st.rebuild_updates);
+	tot->over_budget += st.over_budget;
 	px_strack_free(t);
 	px_dist_model_free(ref);
 }
@@ -497,11 +509,12 @@ static void report(const struct totals *tot)
 {
 	printf("  total: %ld steps, wrong %ld, naive wrong %ld, brute %ld/%ld bad, "
 	       "counts %ld checked %ld bad %ld ambiguous, jumps %ld, cells solved "
-	       "%ld, points born %ld died %ld, allocations %llu\n",
+	       "%ld, points born %ld died %ld, answered globally %ld, "
+	       "allocations %llu\n",
 	       tot->steps, tot->wrong, tot->naive_wrong, tot->brute_bad,
 	       tot->brute_checks, tot->count_checks, tot->count_bad,
 	       tot->count_amb, tot->jumps, tot->cells, tot->born, tot->died,
-	       (unsigned long long)tot->allocs);
+	       tot->global, (unsigned long long)tot->allocs);
 	/* the paths must cross focal sheets and edges many times */
 	PX_CHECK_MSG(tot->born >= 20 && tot->died >= 20,
 		     "too few transitions: born %ld died %ld", tot->born, tot->died);
@@ -521,7 +534,7 @@ static void test_wavy(void)
 	memset(&tot, 0, sizeof(tot));
 	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
 	PX_CHECK_INT_EQ(surf_wavy(&s, 0, 0, 0, 0), PX_OK);
-	run_model("wavy", NULL, 0, &s, 1, &tot);
+	run_model("wavy", NULL, 0, &s, 1, 0, &tot);
 	report(&tot);
 	PX_CHECK_MSG(tot.naive_wrong > 0, "naive tracker never wrong: paths too easy");
 }
@@ -534,8 +547,8 @@ static void test_fold_nonuniform(void)
 	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
 	PX_CHECK_INT_EQ(surf_fold(&s[0], 0, 0, 0), PX_OK);
 	PX_CHECK_INT_EQ(surf_wavy(&s[1], 0, 0, 0, 1), PX_OK);
-	run_model("concave fold", NULL, 0, &s[0], 1, &tot);
-	run_model("non-uniform knots", NULL, 0, &s[1], 1, &tot);
+	run_model("concave fold", NULL, 0, &s[0], 1, 0, &tot);
+	run_model("non-uniform knots", NULL, 0, &s[1], 1, 0, &tot);
 	report(&tot);
 }
 
@@ -553,7 +566,7 @@ static void test_collapsed(void)
 	PX_CHECK_INT_EQ(info.n_poles, 1);
 	PX_CHECK_INT_EQ(info.n_edges, 3);
 	px_strack_free(t);
-	run_model("collapsed edge", NULL, 0, &s, 1, &tot);
+	run_model("collapsed edge", NULL, 0, &s, 1, 0, &tot);
 	report(&tot);
 }
 
@@ -577,8 +590,39 @@ static void test_multi(void)
 	}
 	PX_CHECK_INT_EQ(px_nurbs_curve_init(&c, &arena, 3, 5, U, 9, xyz, NULL, NULL),
 			PX_OK);
-	run_model("multi-entity", &c, 1, s, 3, &tot);
+	run_model("multi-entity", &c, 1, s, 3, 0, &tot);
 	report(&tot);
+}
+
+/* A bounded update: with a small budget of cell solves the answer stays
+ * exact at every step (global query while the set catches up or is
+ * rebuilt), no update solves more cells than the budget, and tracking
+ * resumes. */
+static void test_budget(void)
+{
+	struct px_nurbs_surf s[2];
+	struct totals tot;
+	memset(&tot, 0, sizeof(tot));
+	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
+	PX_CHECK_INT_EQ(surf_wavy(&s[0], 0, 0, 0, 0), PX_OK);
+	PX_CHECK_INT_EQ(surf_dome(&s[1], 0, 0, 0), PX_OK);
+	run_model("wavy", NULL, 0, &s[0], 1, 2, &tot);
+	run_model("collapsed edge", NULL, 0, &s[1], 1, 4, &tot);
+	printf("  total: %ld steps, wrong %ld, brute %ld/%ld bad, counts %ld "
+	       "checked %ld bad, answered globally %ld, over budget %llu, "
+	       "updates over the budget %ld, allocations %llu\n",
+	       tot.steps, tot.wrong, tot.brute_bad, tot.brute_checks,
+	       tot.count_checks, tot.count_bad, tot.global,
+	       (unsigned long long)tot.over_budget, tot.budget_bad,
+	       (unsigned long long)tot.allocs);
+	PX_CHECK_INT_EQ(tot.wrong, 0);
+	PX_CHECK_INT_EQ(tot.brute_bad, 0);
+	PX_CHECK_INT_EQ(tot.count_bad, 0);
+	PX_CHECK_INT_EQ(tot.allocs, 0);
+	PX_CHECK_INT_EQ(tot.budget_bad, 0);
+	PX_CHECK_MSG(tot.over_budget > 0, "the budget never bound: paths too easy");
+	PX_CHECK_MSG(tot.global > 0 && 2 * tot.global < tot.steps,
+		     "answered globally %ld of %ld", tot.global, tot.steps);
 }
 
 static void test_errors(void)
@@ -600,10 +644,31 @@ static void test_errors(void)
 	PX_CHECK_INT_EQ(px_strack_update(t, px_v3(0.1, 0.2, 0.5), &r), PX_OK);
 	PX_CHECK(r.dist >= 0.0 && r.n_crit >= 1);
 	PX_CHECK_INT_EQ(px_strack_critical(t, 1, NULL, NULL, NULL, 0), PX_E_RANGE);
-	/* far outside the working volume: re-initialised, still right */
+	/* far outside the working volume: answered globally (the set waits
+	 * inside), still right; back inside it is tracked again */
+	PX_CHECK_INT_EQ(px_strack_update(t, px_v3(50, 0, 0), &r), PX_OK);
+	PX_CHECK_INT_EQ(r.source, PX_TRACK_GLOBAL);
+	PX_CHECK(r.dist > 40.0);
+	{
+		int k, tracked = 0;
+		for (k = 0; k < 40; k++) {
+			PX_CHECK_INT_EQ(px_strack_update(t, px_v3(0.1, 0.2, 0.5 + 1e-3 * k), &r),
+					PX_OK);
+			tracked += r.source != PX_TRACK_GLOBAL;
+		}
+		PX_CHECK_MSG(tracked > 30, "tracked again: %d of 40", tracked);
+	}
+	px_strack_free(t);
+	/* without a budget: re-initialised at once */
+	o.seeds = 2;
+	o.max_solves = 0;
+	PX_CHECK_INT_EQ(px_strack_create(NULL, 0, &s, 1, &o, &t), PX_OK);
+	PX_CHECK_INT_EQ(px_strack_update(t, px_v3(0.1, 0.2, 0.5), &r), PX_OK);
 	PX_CHECK_INT_EQ(px_strack_update(t, px_v3(50, 0, 0), &r), PX_OK);
 	PX_CHECK_INT_EQ(r.source, PX_TRACK_REINIT);
 	px_strack_free(t);
+	o.max_solves = -1;
+	PX_CHECK_INT_EQ(px_strack_create(NULL, 0, &s, 1, &o, &t), PX_E_INVAL);
 	px_strack_free(NULL);
 }
 
@@ -612,6 +677,7 @@ static const struct px_test tests[] = {
 	PX_T(test_fold_nonuniform),
 	PX_T(test_collapsed),
 	PX_T(test_multi),
+	PX_T(test_budget),
 	PX_T(test_errors),
 };
 
