@@ -53,6 +53,20 @@ int px__nurbs_count_inside(const double *U, int n_knots, double a, double b);
 void px__nurbs_box_add(px_aabb *box, const double *pw);
 px_aabb px__nurbs_box_empty(void);
 
+/* ---- coherent surface tracking (px_strack.c), for its tests ---- */
+
+struct px_strack;
+
+/* Certified radius at p of the region cell of surface s holding (u, v):
+ * no transition of that cell while the point stays within this max-norm
+ * distance of p. -1 for bad arguments. */
+double px__strack_cert_radius(const struct px_strack *t, int s, double u,
+			      double v, px_vec3 p);
+/* Factor applied to every certified radius (1; the tests raise it to
+ * show that their containment check fails for a non-conservative
+ * bound). */
+extern double px__strack_radius_scale;
+
 #endif
 
 /*

@@ -25,6 +25,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "internal.h"
 #include "px_bern.h"
 
 #define ST_NEWTON 16
@@ -47,6 +48,7 @@ struct iv {
 /* Centre values on a cell side that the edge test needs. */
 struct cside {
 	px_vec3 s, su, sv;
+	double n1, n2;  /* |su|_1, |sv|_1 */
 	int along;      /* 0: the side runs along u (v fixed), 1: along v */
 	double h;       /* half length of the side in its parameter */
 };
@@ -64,7 +66,13 @@ struct rcert {
 	struct iv S[3], Suu[3], Suv[3], Svv[3];
 	struct iv G11, G12, G22;
 	double m11, m12, m22;   /* sum over x, y, z of max |Sij| */
+	/* the same in midpoint-radius form for the run-time test: with
+	 * w = S - x, H_ij lies in A_ij - x . B_ij +- (R_ij + |mid w| . Q_ij)
+	 * (entries 0: 11, 1: 12, 2: 22) */
+	px_vec3 smid, B[3], Q[3];
+	double A[3], R[3];
 	px_vec3 sc, suc, svc;
+	double n1, n2;          /* |suc|_1, |svc|_1 */
 	double hu, hv;          /* half widths of the cell in u, v */
 	int nside;
 	struct cside side[4];
@@ -527,62 +535,52 @@ static double iv_mag(struct iv a)
  * (closed forms: linear in r for E, quadratic for det H). Curvatures are
  * never divided by, so parabolic lines and umbilics need no care.
  */
+#define ST_MIN(a, b) ((a) < (b) ? (a) : (b))
+#define ST_MAX(a, b) ((a) > (b) ? (a) : (b))
+
 static double cert_radius(const struct rcert *c, px_vec3 p)
 {
-	const double *pp = &p.x;
-	struct iv h11, h12, h22;
-	double a11, b11, a22, b22, M11, M12, M22, m11 = c->m11, m12 = c->m12,
-	       m22 = c->m22, rE, rD, r, e1, e2, pad;
-	px_vec3 w;
+	double mid[3], rad[3], a11, b11, a22, b22, M11, M12, M22,
+	       m11 = c->m11, m12 = c->m12, m22 = c->m22, rE, rD, r, e1, e2, pad;
+	px_vec3 w, aw;
 	int k;
-	h11 = c->G11;
-	h12 = c->G12;
-	h22 = c->G22;
+	aw = px_v3_sub(c->smid, p);
+	aw = px_v3(fabs(aw.x), fabs(aw.y), fabs(aw.z));
 	for (k = 0; k < 3; k++) {
-		struct iv d;
-		d.lo = c->S[k].lo - pp[k];
-		d.hi = c->S[k].hi - pp[k];
-		struct iv x11 = iv_mul(d, c->Suu[k]), x12 = iv_mul(d, c->Suv[k]),
-			  x22 = iv_mul(d, c->Svv[k]);
-		h11.lo += x11.lo;
-		h11.hi += x11.hi;
-		h12.lo += x12.lo;
-		h12.hi += x12.hi;
-		h22.lo += x22.lo;
-		h22.hi += x22.hi;
+		mid[k] = c->A[k] - px_v3_dot(p, c->B[k]);
+		rad[k] = c->R[k] + px_v3_dot(aw, c->Q[k]);
 	}
 	/* rounding of the sums: pad by their magnitude */
-	pad = ST_PAD * (iv_mag(h11) + iv_mag(h12) + iv_mag(h22) +
-			(fabs(px_v3_dot(c->sc, c->sc)) + px_v3_dot(p, p)) *
-				(m11 + m12 + m22));
-	a11 = h11.lo - pad;
-	b11 = h11.hi + pad;
-	a22 = h22.lo - pad;
-	b22 = h22.hi + pad;
-	M11 = fmax(fabs(a11), fabs(b11));
-	M22 = fmax(fabs(a22), fabs(b22));
-	M12 = fmax(fabs(h12.lo), fabs(h12.hi)) + pad;
+	pad = ST_PAD * (fabs(mid[0]) + fabs(mid[1]) + fabs(mid[2]) + rad[0] + rad[1] +
+			rad[2] + (aw.x + aw.y + aw.z + fabs(p.x) + fabs(p.y) + fabs(p.z)) *
+					 (m11 + m12 + m22));
+	a11 = mid[0] - rad[0] - pad;
+	b11 = mid[0] + rad[0] + pad;
+	a22 = mid[2] - rad[2] - pad;
+	b22 = mid[2] + rad[2] + pad;
+	M11 = fabs(mid[0]) + rad[0] + pad;
+	M12 = fabs(mid[1]) + rad[1] + pad;
+	M22 = fabs(mid[2]) + rad[2] + pad;
 	/* E test */
 	w = px_v3_sub(c->sc, p);
 	e1 = fabs(px_v3_dot(w, c->suc));
 	e2 = fabs(px_v3_dot(w, c->svc));
-	pad = ST_PAD * (px_v3_norm(w) + px_v3_norm(c->sc) + px_v3_norm(p)) *
-	      (px_v3_norm(c->suc) + px_v3_norm(c->svc));
+	pad = ST_PAD * (fabs(w.x) + fabs(w.y) + fabs(w.z) + fabs(p.x) + fabs(p.y) +
+			fabs(p.z)) *
+	      (c->n1 + c->n2);
 	{
-		double n1 = fabs(c->suc.x) + fabs(c->suc.y) + fabs(c->suc.z) +
-			    m11 * c->hu + m12 * c->hv;
-		double n2 = fabs(c->svc.x) + fabs(c->svc.y) + fabs(c->svc.z) +
-			    m12 * c->hu + m22 * c->hv;
-		double r1 = (e1 - pad - M11 * c->hu - M12 * c->hv) / n1;
-		double r2 = (e2 - pad - M12 * c->hu - M22 * c->hv) / n2;
-		rE = fmax(r1, r2);
+		double r1 = (e1 - pad - M11 * c->hu - M12 * c->hv) /
+			    (c->n1 + m11 * c->hu + m12 * c->hv);
+		double r2 = (e2 - pad - M12 * c->hu - M22 * c->hv) /
+			    (c->n2 + m12 * c->hu + m22 * c->hv);
+		rE = r1 > r2 ? r1 : r2;
 		if (!(rE > 0.0))
 			rE = 0.0;
 	}
 	/* det H test */
 	rD = 0.0;
 	{
-		double x = 0.0, y = 0.0, mx = m11, my = m22;
+		double x = 0.0, y = 0.0;
 		int definite = 0;
 		if (a11 > 0.0 && a22 > 0.0) {
 			x = a11;
@@ -593,22 +591,22 @@ static double cert_radius(const struct rcert *c, px_vec3 p)
 			y = -b22;
 			definite = 1;
 		} else if (a11 > 0.0 && b22 < 0.0) {
-			rD = fmin(a11 / m11, -b22 / m22);
+			rD = ST_MIN(a11 / m11, -b22 / m22);
 		} else if (b11 < 0.0 && a22 > 0.0) {
-			rD = fmin(-b11 / m11, a22 / m22);
+			rD = ST_MIN(-b11 / m11, a22 / m22);
 		}
 		if (definite) {
-			/* f(r) = (x - r mx)(y - r my) - (M12 + r m12)^2 falls on
-			 * [0, min(x / mx, y / my)]: its first root */
-			double A = mx * my - m12 * m12;
-			double B = -(x * my + y * mx) - 2.0 * M12 * m12;
+			/* f(r) = (x - r m11)(y - r m22) - (M12 + r m12)^2 falls
+			 * on [0, min(x / m11, y / m22)]: its first root */
+			double A = m11 * m22 - m12 * m12;
+			double B = -(x * m22 + y * m11) - 2.0 * M12 * m12;
 			double C = x * y - M12 * M12;
-			double cap = fmin(x / mx, y / my);
+			double cap = ST_MIN(x / m11, y / m22);
 			if (C > 0.0) {
 				double disc = B * B - 4.0 * A * C;
 				double root = disc < 0.0 ? INFINITY
 							 : 2.0 * C / (-B + sqrt(disc));
-				rD = fmin(cap, root);
+				rD = ST_MIN(cap, root);
 			}
 		}
 		if (!(rD > 0.0))
@@ -623,19 +621,17 @@ static double cert_radius(const struct rcert *c, px_vec3 p)
 		w = px_v3_sub(sd->s, p);
 		f1 = fabs(px_v3_dot(w, sd->su));
 		f2 = fabs(px_v3_dot(w, sd->sv));
-		r1 = (f1 - pad - d1 * sd->h) /
-		     (fabs(sd->su.x) + fabs(sd->su.y) + fabs(sd->su.z) + q1 * sd->h);
-		r2 = (f2 - pad - d2 * sd->h) /
-		     (fabs(sd->sv.x) + fabs(sd->sv.y) + fabs(sd->sv.z) + q2 * sd->h);
-		rD = fmin(rD, fmax(fmax(r1, r2), 0.0));
+		r1 = (f1 - pad - d1 * sd->h) / (sd->n1 + q1 * sd->h);
+		r2 = (f2 - pad - d2 * sd->h) / (sd->n2 + q2 * sd->h);
+		r1 = r1 > r2 ? r1 : r2;
+		r1 = r1 > 0.0 ? r1 : 0.0;
+		rD = ST_MIN(rD, r1);
 	}
-	r = fmax(rE, rD) * ST_RSAFE;
+	r = (rE > rD ? rE : rD) * ST_RSAFE;
 	return r > 0.0 ? r : 0.0;
 }
 
-/* Test hook: a factor on every certified radius (1: the proof; larger
- * values make the bound non-conservative, for the tests that show the
- * containment check can fail). */
+/* Test hook (internal.h): a factor on every certified radius. */
 double px__strack_radius_scale = 1.0;
 
 static double region_radius(const struct scell *c, px_vec3 p)
@@ -1314,6 +1310,22 @@ int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 	return PX_OK;
 }
 
+double px__strack_cert_radius(const struct px_strack *t, int s, double u,
+			      double v, px_vec3 p)
+{
+	const struct ssurf *f;
+	const struct scell *c;
+	int ch;
+	if (!t || s < 0 || s >= t->n_surf)
+		return -1.0;
+	f = &t->sf[s];
+	if (u < f->u0 || u > f->u1 || v < f->v0 || v > f->v1)
+		return -1.0;
+	c = &t->cell[f->first_cell + cell_of(f, u, v)];
+	ch = (u >= 0.5 * (c->u0 + c->u1)) + 2 * (v >= 0.5 * (c->v0 + c->v1));
+	return region_radius(&t->rcell[c->child + ch], p);
+}
+
 int px_strack_critical(const struct px_strack *t, int s, double *u, double *v,
 		       int *type, int cap)
 {
@@ -1544,12 +1556,39 @@ static int cell_cert(struct px_strack *t, struct scell *c, const struct ssurf *f
 	ce->G11 = iv_pad(ce->G11);
 	ce->G12 = iv_pad(ce->G12);
 	ce->G22 = iv_pad(ce->G22);
+	{
+		/* midpoint-radius form: (S - x) . Sij with S = sm +- sr,
+		 * Sij = hm +- hr per coordinate lies in
+		 * (sm - x) . hm +- (|sm - x| . hr + sr . |hm| + sr . hr) */
+		const struct iv *G[3] = {&ce->G11, &ce->G12, &ce->G22};
+		const struct iv *D[3] = {ce->Suu, ce->Suv, ce->Svv};
+		double *sm = &ce->smid.x;
+		for (k = 0; k < 3; k++)
+			sm[k] = 0.5 * (ce->S[k].lo + ce->S[k].hi);
+		for (i = 0; i < 3; i++) {
+			double *b = &ce->B[i].x, *qq = &ce->Q[i].x;
+			ce->A[i] = 0.5 * (G[i]->lo + G[i]->hi);
+			ce->R[i] = 0.5 * (G[i]->hi - G[i]->lo);
+			for (k = 0; k < 3; k++) {
+				double hm = 0.5 * (D[i][k].lo + D[i][k].hi);
+				double hr = 0.5 * (D[i][k].hi - D[i][k].lo);
+				double sr = 0.5 * (ce->S[k].hi - ce->S[k].lo);
+				b[k] = hm;
+				qq[k] = hr;
+				ce->A[i] += sm[k] * hm;
+				ce->R[i] += sr * fabs(hm) + sr * hr;
+			}
+			ce->R[i] = iv_pad(iv_pt(ce->R[i])).hi;
+		}
+	}
 	ce->hu = 0.5 * du;
 	ce->hv = 0.5 * dv;
 	surf_eval2(f, 0.5 * (c->u0 + c->u1), 0.5 * (c->v0 + c->v1), &d);
 	ce->sc = d.s;
 	ce->suc = d.su;
 	ce->svc = d.sv;
+	ce->n1 = fabs(d.su.x) + fabs(d.su.y) + fabs(d.su.z);
+	ce->n2 = fabs(d.sv.x) + fabs(d.sv.y) + fabs(d.sv.z);
 	for (k = 0; k < 4; k++) {
 		struct cside *sd;
 		double u, v;
@@ -1566,6 +1605,8 @@ static int cell_cert(struct px_strack *t, struct scell *c, const struct ssurf *f
 		sd->s = d.s;
 		sd->su = d.su;
 		sd->sv = d.sv;
+		sd->n1 = fabs(d.su.x) + fabs(d.su.y) + fabs(d.su.z);
+		sd->n2 = fabs(d.sv.x) + fabs(d.sv.y) + fabs(d.sv.z);
 		sd->along = k < 2;
 		sd->h = k < 2 ? ce->hv : ce->hu;
 		/* the side point is off the exact side by 1e-13 of the cell:

@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "internal.h"
 #include "px_alloc_count.h"
 #include "px_arena.h"
 #include "px_dist.h"
@@ -594,6 +595,167 @@ static void test_multi(void)
 	report(&tot);
 }
 
+/* rational bicubic: a wavy patch with uneven weights */
+static int surf_rational(struct px_nurbs_surf *s)
+{
+	double U[8], xyz[3 * 16], w[16];
+	int i, j;
+	clamped(U, 4, 3, NULL);
+	for (j = 0; j < 4; j++)
+		for (i = 0; i < 4; i++) {
+			double *q = &xyz[3 * (j * 4 + i)];
+			q[0] = -1 + 2.0 * i / 3;
+			q[1] = -1 + 2.0 * j / 3;
+			q[2] = 0.6 * sin(1.7 * i + 0.4) * cos(1.3 * j - 0.3);
+			w[j * 4 + i] = 0.6 + 0.9 * ((i * 7 + j * 3) % 5) / 4.0;
+		}
+	return mk_surf(s, 3, 3, 4, 4, U, U, xyz, w);
+}
+
+/* octant of a sphere (rational quadratic, radius 0.8): umbilic
+ * everywhere, one focal point for the whole patch; its edge v = 1 is
+ * collapsed */
+static int surf_sphere(struct px_nurbs_surf *s)
+{
+	static const double U[] = {0, 0, 0, 1, 1, 1};
+	double xyz[27], w[9], h = sqrt(0.5);
+	static const double a[3][3] = {{1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+	int i, j;
+	for (j = 0; j < 3; j++)
+		for (i = 0; i < 3; i++) {
+			/* tensor product of two quarter circles */
+			double cx = a[i][0], cy = a[i][1], wi = i == 1 ? h : 1.0;
+			double z = j == 0 ? 0.0 : 1.0, r = j == 2 ? 0.0 : 1.0, wj = j == 1 ? h : 1.0;
+			double *q = &xyz[3 * (j * 3 + i)];
+			q[0] = 0.8 * cx * r;
+			q[1] = 0.8 * cy * r;
+			q[2] = 0.8 * z;
+			if (j == 1) {
+				q[0] = 0.8 * cx;
+				q[1] = 0.8 * cy;
+			}
+			w[j * 3 + i] = wi * wj;
+		}
+	return mk_surf(s, 2, 2, 3, 3, U, U, xyz, w);
+}
+
+/*
+ * The certified transition regions contain every focal point: for dense
+ * samples (u, v) with principal curvature k, the focal point F = S + N / k
+ * is where (u, v) is a degenerate critical point, and for (u, v) on an
+ * open edge every point of its normal line is where a critical point
+ * sits on the edge; so the certified radius r(p) of the cell holding
+ * (u, v) must stay below |p - F|_inf for points p around F. Returns the
+ * violations; *tight gets the largest r(p) / |p - F|_inf seen.
+ */
+static long focal_check(const struct px_strack *t, const struct px_nurbs_surf *s,
+			int si, double size, double *tight, long *checks)
+{
+	double u0, u1, v0, v1;
+	long bad = 0;
+	int i, j, k, q, G = 48;
+	px_nurbs_surf_domain(s, &u0, &u1, &v0, &v1);
+	for (j = 0; j <= G; j++)
+		for (i = 0; i <= G; i++) {
+			struct px_nurbs_surf_derivs d;
+			int edge = i == 0 || i == G || j == 0 || j == G;
+			/* jittered inside, exact on the edges */
+			double u = u0 + (u1 - u0) * (i + (i > 0 && i < G ? 0.5 * px_rand_unit() : 0.0)) / G;
+			double v = v0 + (v1 - v0) * (j + (j > 0 && j < G ? 0.5 * px_rand_unit() : 0.0)) / G;
+			double E, F, Gg, L, M, N, det, K, H, disc, kk[2], nn;
+			px_vec3 n, foc[4];
+			int nf = 0;
+			px_nurbs_surf_eval(s, u, v, 2, &d);
+			n = px_v3_cross(d.su, d.sv);
+			nn = px_v3_norm(n);
+			if (!(nn > 1e-9 * px_v3_norm(d.su) * px_v3_norm(d.sv)))
+				continue;
+			n = px_v3_scale(n, 1.0 / nn);
+			E = px_v3_dot(d.su, d.su);
+			F = px_v3_dot(d.su, d.sv);
+			Gg = px_v3_dot(d.sv, d.sv);
+			L = px_v3_dot(d.suu, n);
+			M = px_v3_dot(d.suv, n);
+			N = px_v3_dot(d.svv, n);
+			det = E * Gg - F * F;
+			K = (L * N - M * M) / det;
+			H = (E * N + Gg * L - 2.0 * F * M) / (2.0 * det);
+			disc = H * H - K > 0.0 ? sqrt(H * H - K) : 0.0;
+			kk[0] = H + disc;
+			kk[1] = H - disc;
+			for (k = 0; k < 2; k++)
+				if (fabs(kk[k]) > 0.1 / size)
+					foc[nf++] = px_v3_add(d.s, px_v3_scale(n, 1.0 / kk[k]));
+			if (edge) {
+				/* an edge point: points of its normal line */
+				foc[nf++] = px_v3_add(d.s, px_v3_scale(n, size * px_rand_range(-0.5, 0.5)));
+				foc[nf++] = d.s;
+			}
+			for (k = 0; k < nf; k++)
+				for (q = 0; q < 4; q++) {
+					/* around F, at distances from 0 to 0.3 size */
+					double a = q == 0 ? 0.0 : 0.3 * size * pow(px_rand_unit(), 3.0);
+					px_vec3 p = px_v3_add(foc[k], px_v3_scale(px_v3(px_rand_normal(),
+										       px_rand_normal(),
+										       px_rand_normal()),
+										 a));
+					px_vec3 e = px_v3_sub(p, foc[k]);
+					double dd = fmax(fmax(fabs(e.x), fabs(e.y)), fabs(e.z));
+					double r = px__strack_cert_radius(t, si, u, v, p);
+					(*checks)++;
+					if (r > dd) {
+						if (bad < 6 && px__strack_radius_scale == 1.0)
+							printf("    violation: u %.6g v %.6g focal %d of %d "
+							       "(edge %d) r %.6g distance %.6g\n",
+							       u, v, k, nf,
+							       edge, r, dd);
+						bad++;
+					}
+					if (dd > 0.0 && r / dd > *tight)
+						*tight = r / dd;
+				}
+		}
+	return bad;
+}
+
+static void test_focal_bounds(void)
+{
+	struct px_nurbs_surf s[6];
+	const char *names[6] = {"wavy", "non-uniform", "fold", "dome (pole)",
+				"rational", "sphere octant (umbilic)"};
+	int m;
+	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
+	PX_CHECK_INT_EQ(surf_wavy(&s[0], 0, 0, 0, 0), PX_OK);
+	PX_CHECK_INT_EQ(surf_wavy(&s[1], 0, 0, 0, 1), PX_OK);
+	PX_CHECK_INT_EQ(surf_fold(&s[2], 0, 0, 0), PX_OK);
+	PX_CHECK_INT_EQ(surf_dome(&s[3], 0, 0, 0), PX_OK);
+	PX_CHECK_INT_EQ(surf_rational(&s[4]), PX_OK);
+	PX_CHECK_INT_EQ(surf_sphere(&s[5]), PX_OK);
+	for (m = 0; m < 6; m++) {
+		struct px_strack *t = NULL;
+		double size, tight = 0.0, tight2 = 0.0;
+		long checks = 0, checks2 = 0, bad, bad2;
+		px_aabb b = px_nurbs_surf_aabb(&s[m]);
+		size = px_aabb_diagonal(&b);
+		PX_CHECK_INT_EQ(px_strack_create(NULL, 0, &s[m], 1, NULL, &t), PX_OK);
+		if (!t)
+			continue;
+		bad = focal_check(t, &s[m], 0, size, &tight, &checks);
+		/* the same check with the radii made 3 times too large must
+		 * see violations: it can fail */
+		px__strack_radius_scale = 3.0;
+		bad2 = focal_check(t, &s[m], 0, size, &tight2, &checks2);
+		px__strack_radius_scale = 1.0;
+		printf("  %s: %ld checks, %ld outside the certified regions (largest "
+		       "r / distance %.3f); radii x3: %ld outside\n",
+		       names[m], checks, bad, tight, bad2);
+		PX_CHECK_INT_EQ(bad, 0);
+		PX_CHECK_MSG(bad2 > 0, "%s: a non-conservative bound went unseen", names[m]);
+		PX_CHECK_MSG(!isnan(tight), "%s: NaN", names[m]);
+		px_strack_free(t);
+	}
+}
+
 /* A bounded update: with a small budget of cell solves the answer stays
  * exact at every step (global query while the set catches up or is
  * rebuilt), no update solves more cells than the budget, and tracking
@@ -678,6 +840,7 @@ static const struct px_test tests[] = {
 	PX_T(test_collapsed),
 	PX_T(test_multi),
 	PX_T(test_budget),
+	PX_T(test_focal_bounds),
 	PX_T(test_errors),
 };
 
