@@ -23,6 +23,7 @@
 #include "px_dist.h"
 #include "px_nurbs.h"
 #include "px_strack.h"
+#include "px_test_paths.h"
 #include "px_track.h"
 
 static uint64_t rng = 0x9e3779b97f4a7c15ull;
@@ -135,42 +136,8 @@ static int circle(struct px_nurbs_curve *c, double cx, double cy, double r)
 /* One trajectory of n points: kind 0 smooth random, 1 sinusoids. */
 static void make_path(px_vec3 *q, int n, int kind, px_aabb box, double step)
 {
-	px_vec3 c = px_aabb_center(&box);
-	px_vec3 h = px_v3_scale(px_v3_sub(box.max, box.min), 0.5);
-	px_vec3 pos = c, vel = px_v3(nrand(), nrand(), nrand());
-	double amp[3][3], frq[3][3], ph[3][3], tt = 0;
-	int i, j, k;
-	for (i = 0; i < 3; i++)
-		for (j = 0; j < 3; j++) {
-			amp[i][j] = 0.2 + 0.25 * urand();
-			frq[i][j] = 0.5 + 2.5 * urand();
-			ph[i][j] = 2 * M_PI * urand();
-		}
-	for (k = 0; k < n; k++) {
-		if (kind == 0) {
-			double nv, *pp = &pos.x, *vv = &vel.x;
-			const double *cc = &c.x, *hh = &h.x;
-			vel = px_v3_add(px_v3_scale(vel, 0.97),
-					px_v3(0.25 * nrand(), 0.25 * nrand(), 0.25 * nrand()));
-			nv = px_v3_norm(vel);
-			pos = px_v3_add(pos, px_v3_scale(vel, step / nv));
-			for (i = 0; i < 3; i++)
-				if (fabs(pp[i] - cc[i]) > hh[i]) {
-					pp[i] = cc[i] + (pp[i] > cc[i] ? hh[i] : -hh[i]);
-					vv[i] = -vv[i];
-				}
-		} else {
-			double v[3];
-			for (i = 0; i < 3; i++) {
-				v[i] = 0;
-				for (j = 0; j < 3; j++)
-					v[i] += amp[i][j] * sin(frq[i][j] * tt + ph[i][j]);
-			}
-			tt += step / (1.2 * fmax(h.x, h.y));
-			pos = px_v3_add(c, px_v3(v[0] * h.x, v[1] * h.y, v[2] * h.z));
-		}
-		q[k] = pos;
-	}
+	static const struct px_path_opts o = {urand, nrand, 0.97, 0.25, 1.2};
+	px_test_path(q, n, kind, box, step, &o);
 }
 
 static void run(const char *name, const struct px_nurbs_curve *cs, int nc)

@@ -20,6 +20,7 @@
 #include "px_nurbs.h"
 #include "px_strack.h"
 #include "px_test.h"
+#include "px_test_paths.h"
 
 static struct px_arena arena;
 static unsigned char arena_mem[1 << 20];
@@ -66,40 +67,49 @@ static int surf_wavy(struct px_nurbs_surf *s, double ox, double oy, double oz,
 	return mk_surf(s, 3, 3, n, n, U, U, xyz, NULL);
 }
 
-/* concave fold: a sheet bent into a U (radius ~0.6) along v */
-static int surf_fold(struct px_nurbs_surf *s, double ox, double oy, double oz)
+/* Clamped uniform surface of degree (pu, pv) with nu x nv control
+ * points pt(i, j) moved by o. */
+static int surf_grid(struct px_nurbs_surf *s, int pu, int pv, int nu, int nv,
+		     px_vec3 (*pt)(int i, int j, int nu, int nv), px_vec3 o)
 {
-	double U[8], V[11], xyz[3 * 4 * 7];
-	int i, j, nu = 4, nv = 7;
-	clamped(U, nu, 3, NULL);
-	clamped(V, nv, 3, NULL);
+	double U[16], V[16], xyz[3 * 64];
+	int i, j;
+	clamped(U, nu, pu, NULL);
+	clamped(V, nv, pv, NULL);
 	for (j = 0; j < nv; j++)
 		for (i = 0; i < nu; i++) {
-			double a = M_PI * (1.15 + 0.7 * j / (nv - 1));
-			double *q = &xyz[3 * (j * nu + i)];
-			q[0] = ox + 0.8 * cos(a);
-			q[1] = oy - 1 + 2.0 * i / (nu - 1);
-			q[2] = oz + 0.8 * sin(a) + 0.9 + 0.1 * (i == 1) - 0.08 * (i == 2);
+			px_vec3 q = px_v3_add(o, pt(i, j, nu, nv));
+			xyz[3 * (j * nu + i)] = q.x;
+			xyz[3 * (j * nu + i) + 1] = q.y;
+			xyz[3 * (j * nu + i) + 2] = q.z;
 		}
-	return mk_surf(s, 3, 3, nu, nv, U, V, xyz, NULL);
+	return mk_surf(s, pu, pv, nu, nv, U, V, xyz, NULL);
+}
+
+/* concave fold: a sheet bent into a U (radius ~0.6) along v */
+static px_vec3 fold_pt(int i, int j, int nu, int nv)
+{
+	double a = M_PI * (1.15 + 0.7 * j / (nv - 1));
+	return px_v3(0.8 * cos(a), -1 + 2.0 * i / (nu - 1),
+		     0.8 * sin(a) + 0.9 + 0.1 * (i == 1) - 0.08 * (i == 2));
+}
+
+static int surf_fold(struct px_nurbs_surf *s, double ox, double oy, double oz)
+{
+	return surf_grid(s, 3, 3, 4, 7, fold_pt, px_v3(ox, oy, oz));
 }
 
 /* dome with the edge u = 0 collapsed to the apex */
+static px_vec3 dome_pt(int i, int j, int nu, int nv)
+{
+	double a = M_PI * (0.1 + 0.8 * j / (nv - 1)), r = 0.9 * i / (nu - 1);
+	return px_v3(r * cos(a) * 1.3, r * sin(a),
+		     0.8 - 0.9 * r * r + 0.1 * r * (j == 2));
+}
+
 static int surf_dome(struct px_nurbs_surf *s, double ox, double oy, double oz)
 {
-	double U[7], V[9], xyz[3 * 4 * 5];
-	int i, j, nu = 4, nv = 5;
-	clamped(U, nu, 2, NULL);
-	clamped(V, nv, 3, NULL);
-	for (j = 0; j < nv; j++)
-		for (i = 0; i < nu; i++) {
-			double a = M_PI * (0.1 + 0.8 * j / (nv - 1)), r = 0.9 * i / (nu - 1);
-			double *q = &xyz[3 * (j * nu + i)];
-			q[0] = ox + r * cos(a) * 1.3;
-			q[1] = oy + r * sin(a);
-			q[2] = oz + 0.8 - 0.9 * r * r + 0.1 * r * (j == 2);
-		}
-	return mk_surf(s, 2, 3, nu, nv, U, V, xyz, NULL);
+	return surf_grid(s, 2, 3, 4, 5, dome_pt, px_v3(ox, oy, oz));
 }
 
 /* ---- references ------------------------------------------------------ */
@@ -333,44 +343,9 @@ static double naive_step(const struct px_nurbs_surf *ss, struct naive *nv,
 
 static void make_path(px_vec3 *q, int n, int kind, px_aabb box, double step)
 {
-	px_vec3 c = px_aabb_center(&box);
-	px_vec3 h = px_v3_scale(px_v3_sub(box.max, box.min), 0.5);
-	px_vec3 pos = c, vel = px_v3(px_rand_normal(), px_rand_normal(),
-				     px_rand_normal());
-	double amp[3][3], frq[3][3], ph[3][3], tt = 0;
-	int i, j, k;
-	for (i = 0; i < 3; i++)
-		for (j = 0; j < 3; j++) {
-			amp[i][j] = 0.2 + 0.25 * px_rand_unit();
-			frq[i][j] = 0.5 + 2.5 * px_rand_unit();
-			ph[i][j] = 2 * M_PI * px_rand_unit();
-		}
-	for (k = 0; k < n; k++) {
-		if (kind == 0) {
-			double nvv, *pp = &pos.x, *vv = &vel.x;
-			const double *cc = &c.x, *hh = &h.x;
-			vel = px_v3_add(px_v3_scale(vel, 0.95),
-					px_v3(0.3 * px_rand_normal(), 0.3 * px_rand_normal(),
-					      0.3 * px_rand_normal()));
-			nvv = px_v3_norm(vel);
-			pos = px_v3_add(pos, px_v3_scale(vel, step / nvv));
-			for (i = 0; i < 3; i++)
-				if (fabs(pp[i] - cc[i]) > hh[i]) {
-					pp[i] = cc[i] + (pp[i] > cc[i] ? hh[i] : -hh[i]);
-					vv[i] = -vv[i];
-				}
-		} else {
-			double v[3];
-			for (i = 0; i < 3; i++) {
-				v[i] = 0;
-				for (j = 0; j < 3; j++)
-					v[i] += amp[i][j] * sin(frq[i][j] * tt + ph[i][j]);
-			}
-			tt += step / (0.8 * fmax(h.x, h.y));
-			pos = px_v3_add(c, px_v3(v[0] * h.x, v[1] * h.y, v[2] * h.z));
-		}
-		q[k] = pos;
-	}
+	static const struct px_path_opts o = {px_rand_unit, px_rand_normal, 0.95,
+					      0.3, 0.8};
+	px_test_path(q, n, kind, box, step, &o);
 }
 
 struct totals {
