@@ -100,6 +100,7 @@ struct scell {
 struct patch {
 	double u0, u1, v0, v1, iu, iv;
 	int p, q;
+	int rat;         /* weights not all equal */
 	const double *c; /* 4 (p + 1)(q + 1) */
 };
 
@@ -134,6 +135,11 @@ struct px_strack {
 	struct px_strack_opts opts;
 	struct px_dist_model *dist;
 	struct px_track *ct;    /* free curves + edges */
+	/* boxes of half knot spans of every curve of ct: while the best
+	 * interior minimum is closer than all of them, ct is left out */
+	px_aabb *cbox;
+	int n_cbox, ct_ncrit;
+	px_vec3 ct_p;           /* where ct was last updated */
 	int n_curves, n_surf, n_edges, n_cells, n_poles, n_unbounded;
 	int n_patches;
 	struct ssurf *sf;
@@ -193,7 +199,7 @@ static void surf_eval2(const struct ssurf *f, double u, double v,
 	q = pt->q;
 	s = (u - pt->u0) * pt->iu;
 	t = (v - pt->v0) * pt->iv;
-	for (k = 0; k < 4; k++) {
+	for (k = 0; k < (pt->rat ? 4 : 3); k++) {
 		const double *c = pt->c + k * (p + 1) * (q + 1);
 		double V0 = 0, V1 = 0, V2 = 0, W0 = 0, W1 = 0, X0 = 0;
 		/* Horner in t over the rows a_j(s) and their s-derivatives:
@@ -219,6 +225,16 @@ static void surf_eval2(const struct ssurf *f, double u, double v,
 		h[k][3] = X0;
 		h[k][4] = W1;
 		h[k][5] = V2;
+	}
+	if (!pt->rat) {
+		/* polynomial (weights normalised to 1 at setup) */
+		d->s = px_v3(h[0][0], h[1][0], h[2][0]);
+		d->su = px_v3(h[0][1] * pt->iu, h[1][1] * pt->iu, h[2][1] * pt->iu);
+		d->sv = px_v3(h[0][2] * pt->iv, h[1][2] * pt->iv, h[2][2] * pt->iv);
+		d->suu = px_v3_scale(px_v3(h[0][3], h[1][3], h[2][3]), pt->iu * pt->iu);
+		d->suv = px_v3_scale(px_v3(h[0][4], h[1][4], h[2][4]), pt->iu * pt->iv);
+		d->svv = px_v3_scale(px_v3(h[0][5], h[1][5], h[2][5]), pt->iv * pt->iv);
+		return;
 	}
 	{
 		double w = h[3][0], iw = 1.0 / w, ws = h[3][1], wt = h[3][2],
@@ -959,6 +975,49 @@ static void curves_update(struct px_strack *t, px_vec3 p,
 		px_track_reset(t->ct, p, cr);
 	else
 		px_track_update(t->ct, p, cr);
+	t->ct_p = p;
+	t->ct_ncrit = cr->n_crit;
+}
+
+/*
+ * 1 when the curve tracker must answer this update: a curve or edge can
+ * be closest (some box of the curves is not farther than the best
+ * interior minimum or pole), or it was left out over more than 2 % of
+ * the model size (its next step stays of the length it is made for).
+ */
+static int curves_needed(const struct px_strack *t, px_vec3 p)
+{
+	double best = INFINITY, lim = 0.02 * t->scale;
+	int i, j;
+	if (!t->ct)
+		return 0;
+	if (px_v3_dist2(p, t->ct_p) > lim * lim)
+		return 1;
+	for (i = 0; i < t->n_surf; i++)
+		for (j = 0; j < t->sf[i].nz; j++) {
+			const struct crit *z = &t->sf[i].z[j];
+			double d2 = px_v3_dist2(z->s, p);
+			if (z->type > 0 && d2 < best)
+				best = d2;
+		}
+	for (i = 0; i < t->n_poles; i++) {
+		double d2 = px_v3_dist2(t->pole[i].q, p);
+		if (d2 < best)
+			best = d2;
+	}
+	if (!(best < INFINITY))
+		return 1;
+	/* a margin for the rounding of both sides */
+	best *= 1.0 + 1e-9;
+	for (i = 0; i < t->n_cbox; i++) {
+		const px_aabb *b = &t->cbox[i];
+		double dx = p.x < b->min.x ? b->min.x - p.x : p.x > b->max.x ? p.x - b->max.x : 0.0;
+		double dy = p.y < b->min.y ? b->min.y - p.y : p.y > b->max.y ? p.y - b->max.y : 0.0;
+		double dz = p.z < b->min.z ? b->min.z - p.z : p.z > b->max.z ? p.z - b->max.z : 0.0;
+		if (dx * dx + dy * dy + dz * dz <= best)
+			return 1;
+	}
+	return 0;
 }
 
 static int full_reset(struct px_strack *t, px_vec3 p,
@@ -1275,7 +1334,6 @@ int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 		t->st.outside++;
 		return full_reset(t, p, r);
 	}
-	curves_update(t, p, &cr, 0);
 	rc = track_step(t, p0, p, r);
 	if (rc == 1) {
 		/* over the budget before anything moved: answer globally,
@@ -1303,6 +1361,14 @@ int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 		return PX_OK;
 	}
 	t->p = p;
+	if (curves_needed(t, p)) {
+		curves_update(t, p, &cr, 0);
+	} else {
+		memset(&cr, 0, sizeof(cr));
+		cr.entity = -1;
+		cr.n_crit = t->ct_ncrit;
+		t->st.curve_skips++;
+	}
 	answer(t, p, &cr, r);
 	if (cr.source != PX_TRACK_TRACKED)
 		r->source = cr.source;
@@ -1656,6 +1722,7 @@ void px_strack_free(struct px_strack *t)
 	free(t->heap);
 	free(t->popped);
 	free(t->hits);
+	free(t->cbox);
 	free(t);
 }
 
@@ -1701,6 +1768,7 @@ static int build_patches(struct ssurf *f, const double *ub, int nu,
 		for (a = 0; a < f->npu; a++) {
 			struct patch *pt = &f->pt[b * f->npu + a];
 			struct px_nurbs_surf sub;
+			double pt_w;
 			double *c = f->pool + (size_t)(b * f->npu + a) * 4 * (size_t)np;
 			int rc = px_nurbs_surf_extract_work(&f->s, ub[a], ub[a + 1], vb[b],
 							    vb[b + 1], work, wl, &sub);
@@ -1717,11 +1785,24 @@ static int build_patches(struct ssurf *f, const double *ub, int nu,
 			pt->p = p;
 			pt->q = q;
 			pt->c = c;
+			{
+				/* equal weights: divide them out, evaluate as a
+				 * polynomial */
+				double w0 = sub.pw[3];
+				int m;
+				pt->rat = 0;
+				for (m = 0; m < np; m++)
+					if (sub.pw[4 * m + 3] != w0)
+						pt->rat = 1;
+				pt_w = pt->rat ? 1.0 : w0;
+			}
 			for (k = 0; k < 4; k++) {
 				double *ck = c + k * np;
 				for (j = 0; j <= q; j++)
 					for (i = 0; i <= p; i++)
-						ck[j * (p + 1) + i] = sub.pw[4 * (j * (p + 1) + i) + k];
+						ck[j * (p + 1) + i] =
+							k == 3 && !pt->rat ? 1.0
+									   : sub.pw[4 * (j * (p + 1) + i) + k] / pt_w;
 				/* Bernstein to power form along s, then along t */
 				for (j = 0; j <= q; j++) {
 					double *row = ck + j * (p + 1);
@@ -2027,6 +2108,41 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	}
 	if (n_cc > 0) {
 		struct px_track_opts to;
+		double *cw = NULL;
+		size_t cwl = 0;
+		int nb = 0;
+		for (i = 0; i < n_cc; i++) {
+			size_t l = PX_NURBS_CURVE_WORK_LEN(cc[i].degree, cc[i].n_ctrl);
+			cwl = l > cwl ? l : cwl;
+			nb += 2 * cc[i].n_knots;
+		}
+		t->cbox = calloc((size_t)nb, sizeof(*t->cbox));
+		cw = malloc(cwl * sizeof(double));
+		if (!t->cbox || !cw) {
+			free(cw);
+			rc = PX_E_NOMEM;
+			goto fail;
+		}
+		for (i = 0; i < n_cc && rc == PX_OK; i++) {
+			const double *U = cc[i].knots;
+			int p = cc[i].degree, n = cc[i].n_ctrl, h;
+			for (k = p; k < n && rc == PX_OK; k++) {
+				if (!(U[k + 1] > U[k]))
+					continue;
+				for (h = 0; h < 2 && rc == PX_OK; h++) {
+					double a = U[k] + 0.5 * h * (U[k + 1] - U[k]);
+					double b = h ? U[k + 1] : 0.5 * (U[k] + U[k + 1]);
+					px_aabb bx;
+					rc = px_nurbs_curve_sub_aabb(&cc[i], a, b, cw, cwl, &bx);
+					if (rc == PX_OK)
+						/* rounding of evaluated points */
+						t->cbox[t->n_cbox++] = px_aabb_inflate(&bx, 1e-12 * t->scale);
+				}
+			}
+		}
+		free(cw);
+		if (rc)
+			goto fail;
 		px_track_opts_default(&to);
 		to.work = t->work;
 		to.dist = o.dist;

@@ -148,6 +148,9 @@ struct px_strack_stats {
 	/* updates whose transition work exceeded max_solves; updates
 	 * answered globally while the set was re-established */
 	uint64_t over_budget, rebuild_updates;
+	/* updates that left the curve tracker out: every curve and edge
+	 * was proven farther than the best interior minimum */
+	uint64_t curve_skips;
 };
 
 struct px_strack_info {
