@@ -14,10 +14,10 @@
  * one comes from the solve of a cell whose transition region the path
  * came near.
  * Everything found is a verified zero of E (Newton converged), so the
- * tracked set can miss points but never holds a false one; a missed
- * minimum can only come from a transition region drawn too small (the
- * regions come from samples with margins, not from a proof), which the
- * optional verification would report.
+ * tracked set never holds a false point. The transition regions are
+ * proven (cert_radius()); what is left to Newton is finding the points
+ * of a cell that is solved again (seed grid per cell), which the optional
+ * verification would report if it failed.
  */
 #include "px_strack.h"
 
