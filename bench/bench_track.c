@@ -19,6 +19,10 @@
 #include <string.h>
 #include <time.h>
 
+#include <linux/perf_event.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 #include "px_arena.h"
 #include "px_dist.h"
 #include "px_nurbs.h"
@@ -287,20 +291,58 @@ static int fold_surf(struct px_nurbs_surf *s)
 
 #define NSSTEP 3000
 
+/* User-space instruction counter of this thread (perf events), for
+ * figures that do not depend on the load of the machine; -1 when the
+ * kernel refuses. */
+static int ins_fd = -2;
+
+static void ins_open(void)
+{
+	struct perf_event_attr a;
+	if (ins_fd != -2)
+		return;
+	memset(&a, 0, sizeof(a));
+	a.type = PERF_TYPE_HARDWARE;
+	a.size = sizeof(a);
+	a.config = PERF_COUNT_HW_INSTRUCTIONS;
+	a.exclude_kernel = 1;
+	a.exclude_hv = 1;
+	ins_fd = (int)syscall(SYS_perf_event_open, &a, 0, -1, -1, 0);
+	if (ins_fd < 0)
+		ins_fd = -1;
+}
+
+static int64_t ins_read(void)
+{
+	uint64_t v = 0;
+	if (ins_fd < 0 || read(ins_fd, &v, sizeof(v)) != (ssize_t)sizeof(v))
+		return -1;
+	return (int64_t)v;
+}
+
+/* Per path and step: what the summary and the targets line use. */
+struct surf_row {
+	int64_t med, p999, max, cold_med, ins_med, cold_ins_med, ins_max,
+		cold_ins_max;
+	long wrong;
+};
+
 static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 {
 	static px_vec3 q[NSSTEP];
-	static int64_t tt[NSSTEP], tg[NSSTEP];
+	static int64_t tt[NSSTEP], tg[NSSTEP], it[NSSTEP], ig[NSSTEP];
 	static const double steps[] = {1e-4, 1e-3, 1e-2, 5e-2};
+	struct surf_row row[2][4];
 	struct px_strack *t = NULL;
 	struct px_strack_info ti;
 	struct px_dist_model *ref = NULL;
 	struct px_dist_info di;
-	int64_t t0;
+	int64_t t0, ins0;
 	int kind, s, k, rc;
 	double size;
 	px_aabb box;
 
+	ins_open();
 	t0 = now_ns();
 	rc = px_strack_create(NULL, 0, ss, ns, NULL, &t);
 	if (rc) {
@@ -314,19 +356,24 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 	box = di.bounds;
 	size = px_aabb_diagonal(&box);
 	box = px_aabb_inflate(&box, 0.3 * size);
-	printf("%s: %d surfaces, %d patches, %d cells (%d sheets through "
-	       "infinity or unboxed), %d edge curves, setup %.1f ms\n",
+	/* instructions of an empty bracket, taken off every count */
+	ins0 = ins_read();
+	ins0 = ins_read() - ins0;
+	printf("%s: %d surfaces, %d patches, %d cells (%d solved whenever "
+	       "hit: pole cells), %d edge curves, setup %.1f ms\n",
 	       name, ti.n_surfaces, ti.n_patches, ti.n_cells, ti.n_unbounded,
 	       ti.n_edges, t0 / 1e6);
-	printf("  %-8s %-7s %8s %8s %8s | %8s %8s | %6s | %5s %7s %6s %5s\n",
-	       "path", "step", "med_ns", "p99_ns", "max_ns", "cold_med",
-	       "cold_p99", "ratio", "wrong", "cells/u", "tests", "crit");
+	printf("  %-8s %-7s %8s %8s %8s %8s | %8s %8s | %6s | %5s %7s %6s %5s | "
+	       "%5s %8s %8s %6s\n",
+	       "path", "step", "med_ns", "p99_ns", "p999_ns", "max_ns", "cold_med",
+	       "cold_p99", "ratio", "wrong", "cells/u", "tests", "crit", "glob%",
+	       "ins_med", "cins_med", "iratio");
 	for (kind = 0; kind < 2; kind++)
 		for (s = 0; s < 4; s++) {
 			struct px_strack_result r;
 			struct px_strack_stats a, b;
 			struct px_dist_result g;
-			long wrong = 0, crit = 0;
+			long wrong = 0, crit = 0, glob = 0;
 			make_path(q, NSSTEP, kind, box, steps[s] * size);
 			px_strack_reset(t, q[0], &r);
 			px_strack_get_stats(t, &a);
@@ -338,24 +385,105 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 				px_dist_query(ref, q[k], &g);
 				tg[k] = now_ns() - x;
 				crit += r.n_crit;
+				glob += r.source == PX_TRACK_GLOBAL;
 				if (fabs(r.dist - g.dist) > 1e-9 * (size + g.dist))
 					wrong++;
 			}
 			px_strack_get_stats(t, &b);
+			/* the same path again, counting instructions (the
+			 * tracker restarts from the same state) */
+			px_strack_reset(t, q[0], &r);
+			for (k = 0; k < NSSTEP; k++) {
+				int64_t x = ins_read();
+				px_strack_update(t, q[k], &r);
+				it[k] = ins_read() - x - ins0;
+				x = ins_read();
+				px_dist_query(ref, q[k], &g);
+				ig[k] = ins_read() - x - ins0;
+			}
 			qsort(tt, NSSTEP, sizeof(tt[0]), cmp_i64);
 			qsort(tg, NSSTEP, sizeof(tg[0]), cmp_i64);
-			printf("  %-8s %-7g %8lld %8lld %8lld | %8lld %8lld | %6.1f | %5ld "
-			       "%7.2f %6.2f %5.1f\n",
+			qsort(it, NSSTEP, sizeof(it[0]), cmp_i64);
+			qsort(ig, NSSTEP, sizeof(ig[0]), cmp_i64);
+			row[kind][s].med = tt[NSSTEP / 2];
+			row[kind][s].p999 = tt[NSSTEP * 999 / 1000];
+			row[kind][s].max = tt[NSSTEP - 1];
+			row[kind][s].cold_med = tg[NSSTEP / 2];
+			row[kind][s].ins_med = ins_fd >= 0 ? it[NSSTEP / 2] : -1;
+			row[kind][s].cold_ins_med = ins_fd >= 0 ? ig[NSSTEP / 2] : -1;
+			row[kind][s].ins_max = ins_fd >= 0 ? it[NSSTEP - 1] : -1;
+			row[kind][s].cold_ins_max = ins_fd >= 0 ? ig[NSSTEP - 1] : -1;
+			row[kind][s].wrong = wrong;
+			printf("  %-8s %-7g %8lld %8lld %8lld %8lld | %8lld %8lld | %6.1f | "
+			       "%5ld %7.2f %6.2f %5.1f | %5.1f %8lld %8lld %6.1f\n",
 			       kind ? "sines" : "random", steps[s] * 100.0,
 			       (long long)tt[NSSTEP / 2], (long long)tt[NSSTEP * 99 / 100],
+			       (long long)tt[NSSTEP * 999 / 1000],
 			       (long long)tt[NSSTEP - 1], (long long)tg[NSSTEP / 2],
 			       (long long)tg[NSSTEP * 99 / 100],
 			       (double)tg[NSSTEP / 2] / (double)(tt[NSSTEP / 2] ? tt[NSSTEP / 2] : 1),
 			       wrong,
 			       (double)(b.cell_solves - a.cell_solves) / NSSTEP,
 			       (double)(b.box_tests - a.box_tests) / NSSTEP,
-			       (double)crit / NSSTEP);
+			       (double)crit / NSSTEP, 100.0 * glob / NSSTEP,
+			       (long long)row[kind][s].ins_med,
+			       (long long)row[kind][s].cold_ins_med,
+			       row[kind][s].ins_med > 0
+				       ? (double)row[kind][s].cold_ins_med / row[kind][s].ins_med
+				       : 0.0);
 		}
+	{
+		/* per step size: medians of both paths and their ratios;
+		 * then the issue's targets, judged on these figures */
+		int med_ok = 1, max_ok = 1, ratio_ok = 1, iratio_ok = 1;
+		long wrong = 0;
+		int64_t worst_max = 0, worst_p999 = 0;
+		double worst_ratio = INFINITY, worst_iratio = INFINITY;
+		printf("  summary %s (random / sines):\n", name);
+		for (s = 0; s < 4; s++) {
+			double r0 = (double)row[0][s].cold_med / (double)(row[0][s].med ? row[0][s].med : 1);
+			double r1 = (double)row[1][s].cold_med / (double)(row[1][s].med ? row[1][s].med : 1);
+			double i0 = row[0][s].ins_med > 0 ? (double)row[0][s].cold_ins_med / row[0][s].ins_med : 0.0;
+			double i1 = row[1][s].ins_med > 0 ? (double)row[1][s].cold_ins_med / row[1][s].ins_med : 0.0;
+			printf("    step %-5g %%: median %6lld / %6lld ns, ratio %5.1f / %5.1f; "
+			       "median instructions %7lld / %7lld, ratio %5.1f / %5.1f; "
+			       "p99.9 %7lld / %7lld ns, max %8lld / %8lld ns; max "
+			       "instructions %7lld / %7lld (cold query %7lld / %7lld)\n",
+			       steps[s] * 100.0, (long long)row[0][s].med, (long long)row[1][s].med,
+			       r0, r1, (long long)row[0][s].ins_med, (long long)row[1][s].ins_med,
+			       i0, i1, (long long)row[0][s].p999, (long long)row[1][s].p999,
+			       (long long)row[0][s].max, (long long)row[1][s].max,
+			       (long long)row[0][s].ins_max, (long long)row[1][s].ins_max,
+			       (long long)row[0][s].cold_ins_max, (long long)row[1][s].cold_ins_max);
+			for (kind = 0; kind < 2; kind++) {
+				const struct surf_row *w = &row[kind][s];
+				double rr = kind ? r1 : r0, ii = kind ? i1 : i0;
+				if (w->med > 1500)
+					med_ok = 0;
+				if (w->max > 20000)
+					max_ok = 0;
+				if (rr < 10.0)
+					ratio_ok = 0;
+				if (ii < 10.0)
+					iratio_ok = 0;
+				wrong += w->wrong;
+				worst_max = w->max > worst_max ? w->max : worst_max;
+				worst_p999 = w->p999 > worst_p999 ? w->p999 : worst_p999;
+				worst_ratio = rr < worst_ratio ? rr : worst_ratio;
+				worst_iratio = ii < worst_iratio ? ii : worst_iratio;
+			}
+		}
+		printf("  targets %s: median <= 1.5 us %s; max <= 20 us %s (raw max "
+		       "%.1f us, p99.9 %.1f us; interrupts and other load on this "
+		       "machine are in the raw max); >= 10x cold query %s (worst "
+		       "ratio %.1f by time, %.1f by instructions); zero wrong %s "
+		       "(%ld)\n",
+		       name, med_ok ? "MET" : "NOT MET", max_ok ? "MET" : "NOT MET",
+		       worst_max / 1e3, worst_p999 / 1e3,
+		       ratio_ok ? "MET" : "NOT MET", worst_ratio, worst_iratio,
+		       wrong == 0 ? "MET" : "NOT MET", wrong);
+		(void)iratio_ok;
+	}
 	{
 		struct px_strack *tv = NULL;
 		struct px_strack_opts o;
@@ -371,10 +499,13 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 			for (k = 0; k < NSSTEP; k++)
 				px_strack_update(tv, q[k], &r);
 			px_strack_get_stats(tv, &st);
-			printf("  verification (every update, %llu checks): %llu "
-			       "disagreements\n",
+			printf("  verification (every tracked update, %llu checks): %llu "
+			       "disagreements; over budget %llu, updates answered "
+			       "globally while catching up %llu\n",
 			       (unsigned long long)st.verifications,
-			       (unsigned long long)st.disagreements);
+			       (unsigned long long)st.disagreements,
+			       (unsigned long long)st.over_budget,
+			       (unsigned long long)st.rebuild_updates);
 			px_strack_free(tv);
 		}
 	}
@@ -410,7 +541,11 @@ surfaces:
 		struct px_nurbs_surf sf[3];
 		printf("\npx_strack: surfaces, same columns (cells/u: cells solved "
 		       "per update; tests: cell tests per update; crit: live "
-		       "critical points)\n");
+		       "critical points; p999_ns: 99.9th percentile; glob%%: "
+		       "updates answered by the global query, over the budget or "
+		       "catching up; ins_med / cins_med: median user-space "
+		       "instructions of the update / the cold query, iratio their "
+		       "ratio: figures independent of the machine's load)\n");
 		if (wavy_surf(&sf[0], 4) == PX_OK)
 			run_surf("bicubic patch (wavy)", &sf[0], 1);
 		if (wavy_surf(&sf[1], 7) == PX_OK)

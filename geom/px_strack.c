@@ -162,6 +162,7 @@ struct px_strack {
 	 * the next cell to solve; rb_started 0: start at the next point
 	 * inside the working volume) */
 	int mode, rb_started, rb_next;
+	int lag_wait, lag_fails; /* ST_LAG: updates to wait, failures */
 	double lag_len;
 	px_vec3 last_point, last_q; /* last answer and its query point */
 	int last_entity, have_last;
@@ -766,6 +767,8 @@ static int collect_cells(struct px_strack *t, px_vec3 p0, px_vec3 p1,
 			c->mark = t->epoch;
 			t->hits[nh++] = ci;
 			work += hit_work(t, ci, seg);
+			if (budget > 0 && work > budget)
+				break; /* the rest is not looked at */
 		}
 		c->expiry = t->travel + r1;
 	}
@@ -1025,12 +1028,15 @@ static int full_reset(struct px_strack *t, px_vec3 p,
 {
 	struct px_track_result cr;
 	int rc;
-	t->heap_ok = 0;
 	curves_update(t, p, &cr, 1);
 	rc = reinit_all(t, p);
+	/* every cell's certificate here, not in the next update */
+	heap_rebuild(t, p);
 	r->source = PX_TRACK_REINIT;
 	if (rc) {
 		t->st.overflows++;
+		if (t->opts.max_solves > 0)
+			rebuild_start(t);
 		answer_global(t, p, r);
 	} else {
 		answer(t, p, &cr, r);
@@ -1258,12 +1264,16 @@ static int catch_up(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 			t->heap_ok = 1;
 			t->mode = ST_LAG;
 			t->lag_len = px_v3_dist(p, t->last_q) + 1e-6 * t->scale;
+			t->lag_wait = t->lag_fails = 0;
 		}
 		answer_global(t, p, r);
 		return PX_OK;
 	}
-	/* ST_LAG */
-	if (in_work(t, p)) {
+	/* ST_LAG: after a failed step, wait 1, 2, 4 .. 16 updates (answering
+	 * globally costs no more than that) */
+	if (t->lag_wait > 0) {
+		t->lag_wait--;
+	} else if (in_work(t, p)) {
 		double d = px_v3_dist(t->p, p);
 		px_vec3 q = d <= t->lag_len ? p
 					    : px_v3_add(t->p, px_v3_scale(px_v3_sub(p, t->p),
@@ -1271,6 +1281,8 @@ static int catch_up(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 		rc = track_step(t, t->p, q, r);
 		if (rc == 1) {
 			t->lag_len *= 0.25;
+			t->lag_fails = t->lag_fails < 4 ? t->lag_fails + 1 : 4;
+			t->lag_wait = (1 << t->lag_fails) - 1;
 			if (t->lag_len < 1e-9 * t->scale)
 				rebuild_start(t);
 		} else if (rc) {
@@ -1280,6 +1292,7 @@ static int catch_up(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 		} else {
 			t->p = q;
 			t->lag_len *= 2.0;
+			t->lag_fails = 0;
 			if (d <= t->lag_len * 0.5) {
 				/* caught up: checked against the global answer */
 				answer(t, p, &cr, r);
@@ -1328,6 +1341,7 @@ int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 			/* the set waits at p0 for the point to come back */
 			t->mode = ST_LAG;
 			t->lag_len = px_v3_dist(p0, p) + 1e-6 * t->scale;
+			t->lag_wait = t->lag_fails = 0;
 			return catch_up(t, p, r);
 		}
 		t->p = p;
@@ -1340,6 +1354,7 @@ int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 		 * the set catches up over the next updates */
 		t->mode = ST_LAG;
 		t->lag_len = 0.5 * px_v3_dist(p0, p);
+		t->lag_wait = t->lag_fails = 0;
 		answer_global(t, p, r);
 		return PX_OK;
 	}
@@ -1355,7 +1370,7 @@ int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 			t->p = p;
 			if (reinit_all(t, p))
 				t->st.overflows++;
-			t->heap_ok = 0;
+			heap_rebuild(t, p);
 		}
 		answer_global(t, p, r);
 		return PX_OK;
