@@ -468,16 +468,27 @@ static int follow(const struct ssurf *f, struct crit *z, px_vec3 p0,
  * moving for the rest of the step, possibly out of the cell). Returns 0
  * or PX_E_NOSPC.
  */
+static int no_root(const struct rcert *c, px_vec3 p);
+
 static int cell_solve_at(struct px_strack *t, const struct scell *c,
 			 px_vec3 ps, px_vec3 p)
 {
 	struct ssurf *f = &t->sf[c->surf];
 	int n = t->opts.seeds, i, j, rc, same = px_v3_dist2(ps, p) == 0.0;
+	int empty[4], ch;
 	double lu = c->u1 - c->u0, lv = c->v1 - c->v0;
 	t->st.cell_solves++;
+	/* region cells proven to hold no critical point at ps give no
+	 * seeds (a seed converges to a point near it) */
+	for (ch = 0; ch < 4; ch++)
+		empty[ch] = no_root(&t->rcell[c->child + ch].cert, ps);
+	if (empty[0] && empty[1] && empty[2] && empty[3])
+		return 0;
 	for (j = 0; j < n; j++)
 		for (i = 0; i < n; i++) {
 			struct crit z, last;
+			if (empty[(2 * i) / n + 2 * ((2 * j) / n)])
+				continue;
 			memset(&z, 0, sizeof(z));
 			z.u = c->u0 + lu * (i + 0.5) / n;
 			z.v = c->v0 + lv * (j + 0.5) / n;
@@ -646,6 +657,34 @@ static double cert_radius(const struct rcert *c, px_vec3 p)
 	}
 	r = (rE > rD ? rE : rD) * ST_RSAFE;
 	return r > 0.0 ? r : 0.0;
+}
+
+/* 1 when E is proven not to vanish on the cell for the point p: no
+ * critical point there (the E test of cert_radius() at r = 0). */
+static int no_root(const struct rcert *c, px_vec3 p)
+{
+	double mid[3], rad[3], e1, e2, pad;
+	px_vec3 w, aw;
+	int k;
+	aw = px_v3_sub(c->smid, p);
+	aw = px_v3(fabs(aw.x), fabs(aw.y), fabs(aw.z));
+	for (k = 0; k < 3; k++) {
+		mid[k] = fabs(c->A[k] - px_v3_dot(p, c->B[k]));
+		rad[k] = c->R[k] + px_v3_dot(aw, c->Q[k]);
+	}
+	pad = ST_PAD * (mid[0] + mid[1] + mid[2] + rad[0] + rad[1] + rad[2] +
+			(aw.x + aw.y + aw.z + fabs(p.x) + fabs(p.y) + fabs(p.z)) *
+				(c->m11 + c->m12 + c->m22));
+	for (k = 0; k < 3; k++)
+		mid[k] += rad[k] + pad;
+	w = px_v3_sub(c->sc, p);
+	e1 = fabs(px_v3_dot(w, c->suc));
+	e2 = fabs(px_v3_dot(w, c->svc));
+	pad = ST_PAD * (fabs(w.x) + fabs(w.y) + fabs(w.z) + fabs(p.x) + fabs(p.y) +
+			fabs(p.z)) *
+	      (c->n1 + c->n2);
+	return e1 - pad > mid[0] * c->hu + mid[1] * c->hv ||
+	       e2 - pad > mid[1] * c->hu + mid[2] * c->hv;
 }
 
 /* Test hook (internal.h): a factor on every certified radius. */
