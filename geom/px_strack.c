@@ -30,7 +30,7 @@
 
 #define ST_NEWTON 16
 
-enum { ST_TRACK = 0, ST_LAG = 1, ST_REBUILD = 2 };
+enum { ST_TRACK = 0, ST_LAG = 1, ST_REBUILD = 2, ST_PEND = 3 };
 
 struct crit {
 	double u, v;
@@ -150,6 +150,10 @@ struct px_strack {
 	struct edge *edge;
 	struct pole *pole;
 	int *heap, *popped, *hits;
+	/* solves owed to the set at p (mode ST_PEND): cell pend[i] solved
+	 * at pend_ps[i] and followed to p; pend_next the next one */
+	int *pend, n_pend, pend_next;
+	px_vec3 *pend_ps;
 	double travel;
 	int heap_ok;
 	px_aabb work;
@@ -162,8 +166,6 @@ struct px_strack {
 	 * the next cell to solve; rb_started 0: start at the next point
 	 * inside the working volume) */
 	int mode, rb_started, rb_next;
-	int lag_wait, lag_fails; /* ST_LAG: updates to wait, failures */
-	double lag_len;
 	px_vec3 last_point, last_q; /* last answer and its query point */
 	int last_entity, have_last;
 	int best_kind;          /* 0 none, 1 surface min, 2 curve tracker, 3 pole */
@@ -1161,26 +1163,38 @@ static int follow(const struct ssurf *f, struct crit *z, px_vec3 p0,
 	return 1;
 }
 
+/* Solve pending items from pend_next on, at most budget work units (0:
+ * all). Returns 0 or PX_E_NOSPC; *done the units solved. */
+static int pend_solve(struct px_strack *t, int budget, int *done)
+{
+	int rc = 0;
+	*done = 0;
+	while (t->pend_next < t->n_pend && rc >= 0 && (budget <= 0 || *done < budget)) {
+		const struct scell *c = &t->cell[t->pend[t->pend_next]];
+		rc = cell_solve_at(t, c, t->pend_ps[t->pend_next], t->p);
+		t->pend_next++;
+		(*done)++;
+	}
+	return rc < 0 ? rc : 0;
+}
+
 /*
- * Move the tracked set from p0 to p: collect the cells whose
- * certificates the segment may break, follow every point, add the cells
- * of lost points, solve them. Returns 0; 1 when the certified cells
- * exceed the budget (checked before anything moves: the set stays at
- * p0, consistent); 2 when the lost points' cells push the work over the
- * budget (the set is then incomplete); PX_E_NOSPC.
+ * Move the tracked set from p0 to p (t->p becomes p): collect the cells
+ * whose certificates the segment may break, follow every point, add the
+ * cells of lost points, and solve them (a hit after a long step also
+ * where its region was met, its roots followed to p). Returns 0; 1 when
+ * that work exceeds the budget: nothing is solved, the work is left
+ * pending (mode ST_PEND, solved over the next updates at p); PX_E_NOSPC.
  */
 static int track_step(struct px_strack *t, px_vec3 p0, px_vec3 p,
 		      struct px_strack_result *r)
 {
 	px_vec3 dp = px_v3_sub(p, p0);
 	double step = px_v3_norm(dp);
-	int i, j, nh, rc = 0, work = 0, budget = t->opts.max_solves;
+	int i, j, nh, rc = 0, before = 0, after = 0, done = 0,
+		      budget = t->opts.max_solves;
 
-	nh = collect_cells(t, p0, p, budget);
-	if (nh < 0) {
-		t->st.over_budget++;
-		return 1;
-	}
+	nh = collect_cells(t, p0, p, 0);
 	for (i = 0; i < t->n_surf; i++) {
 		struct ssurf *f = &t->sf[i];
 		int n = f->nz;
@@ -1212,34 +1226,40 @@ static int track_step(struct px_strack *t, px_vec3 p0, px_vec3 p,
 				return rc;
 		}
 	}
-	for (i = 0; i < nh; i++)
-		work += hit_work(t, t->hits[i], step);
-	if (budget > 0 && work > budget) {
-		t->st.over_budget++;
-		return 2;
-	}
-	{
-		int before = 0, after = 0;
-		for (i = 0; i < t->n_surf; i++)
-			before += t->sf[i].nz;
-		for (i = 0; i < nh && rc >= 0; i++) {
-			const struct scell *c = &t->cell[t->hits[i]];
-			rc = cell_solve(t, c, p);
-			/* a long step after the crossing: also solve where the
-			 * region was met and follow those roots to p */
-			if (rc >= 0 && hit_work(t, t->hits[i], step) > 1)
-				rc = cell_solve_at(t, c, px_v3_add(p0, px_v3_scale(dp, c->cross)),
-						   p);
+	t->p = p;
+	/* the work list: solve at p; after a long step past the crossing
+	 * also where the region was met (pole cells outside the budget) */
+	t->n_pend = t->pend_next = 0;
+	for (i = 0; i < nh; i++) {
+		int ci = t->hits[i];
+		const struct scell *c = &t->cell[ci];
+		t->pend[t->n_pend] = ci;
+		t->pend_ps[t->n_pend++] = p;
+		if (hit_work(t, ci, step) > 1) {
+			t->pend[t->n_pend] = ci;
+			t->pend_ps[t->n_pend++] = px_v3_add(p0, px_v3_scale(dp, c->cross));
 		}
-		for (i = 0; i < t->n_surf; i++)
-			after += t->sf[i].nz;
-		/* new points only come from solved cells: births (pairs at
-		 * a focal sheet) and entries through an edge */
-		r->born = after - before;
-		t->st.born += (uint64_t)r->born;
 	}
-	r->cells_solved = work;
-	return rc < 0 ? rc : 0;
+	for (i = 0; i < t->n_surf; i++)
+		before += t->sf[i].nz;
+	/* within the budget all of it; over it, the budget's worth now and
+	 * the rest over the next updates */
+	rc = pend_solve(t, budget, &done);
+	for (i = 0; i < t->n_surf; i++)
+		after += t->sf[i].nz;
+	/* new points only come from solved cells: births (pairs at a focal
+	 * sheet) and entries through an edge */
+	r->born = after - before;
+	t->st.born += (uint64_t)r->born;
+	r->cells_solved = done;
+	if (rc < 0)
+		return rc;
+	if (t->pend_next < t->n_pend) {
+		t->st.over_budget++;
+		t->mode = ST_PEND;
+		return 1;
+	}
+	return 0;
 }
 
 /* Re-establish the critical points from scratch over the next updates,
@@ -1256,15 +1276,19 @@ static void rebuild_start(struct px_strack *t)
 }
 
 /*
- * One update while the tracked set is not at the query point (mode
- * ST_REBUILD or ST_LAG); the answer is the global query's unless the set
- * reaches p in this update and agrees with it.
+ * One update while the tracked set is not at the query point; the answer
+ * is the global query's unless the set reaches p in this update and
+ * agrees with it.
+ *  - ST_PEND: the set is at t->p but owes cell solves there: up to the
+ *    budget of them now; when none is left: ST_LAG.
  *  - ST_REBUILD: a slice of cells is solved at the fixed point t->p
  *    where the rebuild started, each cell's certificate taken there;
  *    when all are, the set is complete at t->p: ST_LAG.
- *  - ST_LAG: the set moves from t->p towards p by one tracked step of
- *    length at most t->lag_len (doubled after a step within the budget,
- *    quartered after one over it); on reaching p it answers again.
+ *  - ST_LAG: the set moves from t->p to p by one tracked step; work
+ *    over the budget is left pending (ST_PEND) at p. It catches up when
+ *    the work of the distance travelled meanwhile fits the budget: while
+ *    the point moves with less work per update than the budget on
+ *    average.
  */
 static int catch_up(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 {
@@ -1273,6 +1297,25 @@ static int catch_up(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 	int rc = 0;
 	t->st.rebuild_updates++;
 	curves_update(t, p, &cr, 0);
+	if (t->mode == ST_PEND) {
+		int done = 0, i, before = 0, after = 0;
+		for (i = 0; i < t->n_surf; i++)
+			before += t->sf[i].nz;
+		rc = pend_solve(t, t->opts.max_solves > 0 ? t->opts.max_solves : 0, &done);
+		for (i = 0; i < t->n_surf; i++)
+			after += t->sf[i].nz;
+		r->born = after - before;
+		t->st.born += (uint64_t)r->born;
+		r->cells_solved = done;
+		if (rc < 0) {
+			t->st.overflows++;
+			rebuild_start(t);
+		} else if (t->pend_next >= t->n_pend) {
+			t->mode = ST_LAG;
+		}
+		answer_global(t, p, r);
+		return PX_OK;
+	}
 	if (t->mode == ST_REBUILD) {
 		int slice = t->opts.max_solves > 1 ? t->opts.max_solves / 2 : 1;
 		if (!t->rb_started) {
@@ -1302,51 +1345,30 @@ static int catch_up(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 				heap_down(t, i, t->n_cells);
 			t->heap_ok = 1;
 			t->mode = ST_LAG;
-			t->lag_len = px_v3_dist(p, t->last_q) + 1e-6 * t->scale;
-			t->lag_wait = t->lag_fails = 0;
 		}
 		answer_global(t, p, r);
 		return PX_OK;
 	}
-	/* ST_LAG: after a failed step, wait 1, 2, 4 .. 16 updates (answering
-	 * globally costs no more than that) */
-	if (t->lag_wait > 0) {
-		t->lag_wait--;
-	} else if (in_work(t, p)) {
-		double d = px_v3_dist(t->p, p);
-		px_vec3 q = d <= t->lag_len ? p
-					    : px_v3_add(t->p, px_v3_scale(px_v3_sub(p, t->p),
-									  t->lag_len / d));
-		rc = track_step(t, t->p, q, r);
-		if (rc == 1) {
-			t->lag_len *= 0.25;
-			t->lag_fails = t->lag_fails < 4 ? t->lag_fails + 1 : 4;
-			t->lag_wait = (1 << t->lag_fails) - 1;
-			if (t->lag_len < 1e-9 * t->scale)
-				rebuild_start(t);
-		} else if (rc) {
-			if (rc < 0)
-				t->st.overflows++;
+	/* ST_LAG */
+	if (in_work(t, p)) {
+		rc = track_step(t, t->p, p, r);
+		if (rc < 0) {
+			t->st.overflows++;
 			rebuild_start(t);
-		} else {
-			t->p = q;
-			t->lag_len *= 2.0;
-			t->lag_fails = 0;
-			if (d <= t->lag_len * 0.5) {
-				/* caught up: checked against the global answer */
-				answer(t, p, &cr, r);
-				if (px_dist_query(t->dist, p, &g) == PX_OK) {
-					t->st.verifications++;
-					r->verified = 1;
-					if (fabs(r->dist - g.dist) <= 1e-9 * (t->scale + g.dist)) {
-						t->mode = ST_TRACK;
-						r->source = PX_TRACK_REINIT;
-						return PX_OK;
-					}
-					t->st.disagreements++;
+		} else if (rc == 0) {
+			/* caught up: checked against the global answer */
+			answer(t, p, &cr, r);
+			if (px_dist_query(t->dist, p, &g) == PX_OK) {
+				t->st.verifications++;
+				r->verified = 1;
+				if (fabs(r->dist - g.dist) <= 1e-9 * (t->scale + g.dist)) {
+					t->mode = ST_TRACK;
+					r->source = PX_TRACK_REINIT;
+					return PX_OK;
 				}
-				rebuild_start(t);
+				t->st.disagreements++;
 			}
+			rebuild_start(t);
 		}
 	} else {
 		t->st.outside++;
@@ -1379,8 +1401,6 @@ int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 		if (t->opts.max_solves > 0) {
 			/* the set waits at p0 for the point to come back */
 			t->mode = ST_LAG;
-			t->lag_len = px_v3_dist(p0, p) + 1e-6 * t->scale;
-			t->lag_wait = t->lag_fails = 0;
 			return catch_up(t, p, r);
 		}
 		t->p = p;
@@ -1389,19 +1409,15 @@ int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 	}
 	rc = track_step(t, p0, p, r);
 	if (rc == 1) {
-		/* over the budget before anything moved: answer globally,
-		 * the set catches up over the next updates */
-		t->mode = ST_LAG;
-		t->lag_len = 0.5 * px_v3_dist(p0, p);
-		t->lag_wait = t->lag_fails = 0;
+		/* over the budget: answer globally; the rest of the solves
+		 * is done over the next updates, then the set catches up */
 		answer_global(t, p, r);
 		return PX_OK;
 	}
 	if (rc) {
-		/* capacity, or lost points over the budget: the set is
-		 * re-established (over the next updates with a budget) */
-		if (rc < 0)
-			t->st.overflows++;
+		/* capacity: the set is re-established (over the next
+		 * updates with a budget) */
+		t->st.overflows++;
 		t->st.reinits++;
 		if (t->opts.max_solves > 0) {
 			rebuild_start(t);
@@ -1414,7 +1430,6 @@ int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 		answer_global(t, p, r);
 		return PX_OK;
 	}
-	t->p = p;
 	if (curves_needed(t, p)) {
 		curves_update(t, p, &cr, 0);
 	} else {
@@ -1776,6 +1791,8 @@ void px_strack_free(struct px_strack *t)
 	free(t->heap);
 	free(t->popped);
 	free(t->hits);
+	free(t->pend);
+	free(t->pend_ps);
 	free(t->cbox);
 	free(t);
 }
@@ -2007,6 +2024,8 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	t->heap = calloc((size_t)cell_cap + 1, sizeof(int));
 	t->popped = calloc((size_t)cell_cap + 1, sizeof(int));
 	t->hits = calloc((size_t)cell_cap + 1, sizeof(int));
+	t->pend = calloc(2 * (size_t)cell_cap + 2, sizeof(int));
+	t->pend_ps = calloc(2 * (size_t)cell_cap + 2, sizeof(px_vec3));
 	for (i = 0; i < n_surfs; i++) {
 		const struct px_nurbs_surf *sf = &t->sf[i].s;
 		size_t l = PX_NURBS_SURF_WORK_LEN(sf->degree[0], sf->degree[1],
@@ -2016,7 +2035,7 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	}
 	work = malloc(wl * sizeof(double));
 	if (!t->cell || !t->rcell || !t->heap || !t->popped || !t->hits ||
-	    !work) {
+	    !t->pend || !t->pend_ps || !work) {
 		rc = PX_E_NOMEM;
 		goto fail;
 	}
