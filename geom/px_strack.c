@@ -749,7 +749,8 @@ static void heap_rebuild(struct px_strack *t, px_vec3 p)
 {
 	int i;
 	for (i = 0; i < t->n_cells; i++) {
-		t->cell[i].expiry = t->travel + cell_radius(t, &t->cell[i], p);
+		t->cell[i].expiry = t->travel + cell_radius(t, &t->cell[i], p) *
+							(1.0 - 1e-9);
 		heap_set(t, i, i);
 	}
 	for (i = t->n_cells / 2 - 1; i >= 0; i--)
