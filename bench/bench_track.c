@@ -24,10 +24,15 @@
 #include <string.h>
 #include <time.h>
 
+#include <linux/perf_event.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 #include "px_arena.h"
 #include "px_dist.h"
 #include "px_nurbs.h"
 #include "px_strack.h"
+#include "px_test_paths.h"
 #include "px_track.h"
 
 static uint64_t rng = 0x9e3779b97f4a7c15ull;
@@ -140,42 +145,8 @@ static int circle(struct px_nurbs_curve *c, double cx, double cy, double r)
 /* One trajectory of n points: kind 0 smooth random, 1 sinusoids. */
 static void make_path(px_vec3 *q, int n, int kind, px_aabb box, double step)
 {
-	px_vec3 c = px_aabb_center(&box);
-	px_vec3 h = px_v3_scale(px_v3_sub(box.max, box.min), 0.5);
-	px_vec3 pos = c, vel = px_v3(nrand(), nrand(), nrand());
-	double amp[3][3], frq[3][3], ph[3][3], tt = 0;
-	int i, j, k;
-	for (i = 0; i < 3; i++)
-		for (j = 0; j < 3; j++) {
-			amp[i][j] = 0.2 + 0.25 * urand();
-			frq[i][j] = 0.5 + 2.5 * urand();
-			ph[i][j] = 2 * M_PI * urand();
-		}
-	for (k = 0; k < n; k++) {
-		if (kind == 0) {
-			double nv, *pp = &pos.x, *vv = &vel.x;
-			const double *cc = &c.x, *hh = &h.x;
-			vel = px_v3_add(px_v3_scale(vel, 0.97),
-					px_v3(0.25 * nrand(), 0.25 * nrand(), 0.25 * nrand()));
-			nv = px_v3_norm(vel);
-			pos = px_v3_add(pos, px_v3_scale(vel, step / nv));
-			for (i = 0; i < 3; i++)
-				if (fabs(pp[i] - cc[i]) > hh[i]) {
-					pp[i] = cc[i] + (pp[i] > cc[i] ? hh[i] : -hh[i]);
-					vv[i] = -vv[i];
-				}
-		} else {
-			double v[3];
-			for (i = 0; i < 3; i++) {
-				v[i] = 0;
-				for (j = 0; j < 3; j++)
-					v[i] += amp[i][j] * sin(frq[i][j] * tt + ph[i][j]);
-			}
-			tt += step / (1.2 * fmax(h.x, h.y));
-			pos = px_v3_add(c, px_v3(v[0] * h.x, v[1] * h.y, v[2] * h.z));
-		}
-		q[k] = pos;
-	}
+	static const struct px_path_opts o = {urand, nrand, 0.97, 0.25, 1.2};
+	px_test_path(q, n, kind, box, step, &o);
 }
 
 /* Targets of the issue for a curve model, checked per model. */
@@ -380,20 +351,58 @@ static int fold_surf(struct px_nurbs_surf *s)
 
 #define NSSTEP 3000
 
+/* User-space instruction counter of this thread (perf events), for
+ * figures that do not depend on the load of the machine; -1 when the
+ * kernel refuses. */
+static int ins_fd = -2;
+
+static void ins_open(void)
+{
+	struct perf_event_attr a;
+	if (ins_fd != -2)
+		return;
+	memset(&a, 0, sizeof(a));
+	a.type = PERF_TYPE_HARDWARE;
+	a.size = sizeof(a);
+	a.config = PERF_COUNT_HW_INSTRUCTIONS;
+	a.exclude_kernel = 1;
+	a.exclude_hv = 1;
+	ins_fd = (int)syscall(SYS_perf_event_open, &a, 0, -1, -1, 0);
+	if (ins_fd < 0)
+		ins_fd = -1;
+}
+
+static int64_t ins_read(void)
+{
+	uint64_t v = 0;
+	if (ins_fd < 0 || read(ins_fd, &v, sizeof(v)) != (ssize_t)sizeof(v))
+		return -1;
+	return (int64_t)v;
+}
+
+/* Per path and step: what the summary and the targets line use. */
+struct surf_row {
+	int64_t med, p999, max, cold_med, ins_med, cold_ins_med, ins_max,
+		cold_ins_max;
+	long wrong;
+};
+
 static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 {
 	static px_vec3 q[NSSTEP];
-	static int64_t tt[NSSTEP], tg[NSSTEP];
+	static int64_t tt[NSSTEP], tg[NSSTEP], it[NSSTEP], ig[NSSTEP];
 	static const double steps[] = {1e-4, 1e-3, 1e-2, 5e-2};
+	struct surf_row row[2][4];
 	struct px_strack *t = NULL;
 	struct px_strack_info ti;
 	struct px_dist_model *ref = NULL;
 	struct px_dist_info di;
-	int64_t t0;
+	int64_t t0, ins0;
 	int kind, s, k, rc;
 	double size;
 	px_aabb box;
 
+	ins_open();
 	t0 = now_ns();
 	rc = px_strack_create(NULL, 0, ss, ns, NULL, &t);
 	if (rc) {
@@ -407,19 +416,24 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 	box = di.bounds;
 	size = px_aabb_diagonal(&box);
 	box = px_aabb_inflate(&box, 0.3 * size);
-	printf("%s: %d surfaces, %d patches, %d cells (%d sheets through "
-	       "infinity or unboxed), %d edge curves, setup %.1f ms\n",
+	/* instructions of an empty bracket, taken off every count */
+	ins0 = ins_read();
+	ins0 = ins_read() - ins0;
+	printf("%s: %d surfaces, %d patches, %d cells (%d solved whenever "
+	       "hit: pole cells), %d edge curves, setup %.1f ms\n",
 	       name, ti.n_surfaces, ti.n_patches, ti.n_cells, ti.n_unbounded,
 	       ti.n_edges, t0 / 1e6);
-	printf("  %-8s %-7s %8s %8s %8s | %8s %8s | %6s | %5s %7s %6s %5s\n",
-	       "path", "step", "med_ns", "p99_ns", "max_ns", "cold_med",
-	       "cold_p99", "ratio", "wrong", "cells/u", "tests", "crit");
+	printf("  %-8s %-7s %8s %8s %8s %8s | %8s %8s | %6s | %5s %7s %6s %5s | "
+	       "%5s %8s %8s %6s\n",
+	       "path", "step", "med_ns", "p99_ns", "p999_ns", "max_ns", "cold_med",
+	       "cold_p99", "ratio", "wrong", "cells/u", "tests", "crit", "glob%",
+	       "ins_med", "cins_med", "iratio");
 	for (kind = 0; kind < 2; kind++)
 		for (s = 0; s < 4; s++) {
 			struct px_strack_result r;
 			struct px_strack_stats a, b;
 			struct px_dist_result g;
-			long wrong = 0, crit = 0;
+			long wrong = 0, crit = 0, glob = 0;
 			make_path(q, NSSTEP, kind, box, steps[s] * size);
 			px_strack_reset(t, q[0], &r);
 			px_strack_get_stats(t, &a);
@@ -431,24 +445,110 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 				px_dist_query(ref, q[k], &g);
 				tg[k] = now_ns() - x;
 				crit += r.n_crit;
+				glob += r.source == PX_TRACK_GLOBAL;
 				if (fabs(r.dist - g.dist) > 1e-9 * (size + g.dist))
 					wrong++;
 			}
 			px_strack_get_stats(t, &b);
+			/* the same path again, counting instructions (the
+			 * tracker restarts from the same state) */
+			px_strack_reset(t, q[0], &r);
+			for (k = 0; k < NSSTEP; k++) {
+				int64_t x = ins_read();
+				px_strack_update(t, q[k], &r);
+				it[k] = ins_read() - x - ins0;
+				x = ins_read();
+				px_dist_query(ref, q[k], &g);
+				ig[k] = ins_read() - x - ins0;
+			}
 			qsort(tt, NSSTEP, sizeof(tt[0]), cmp_i64);
 			qsort(tg, NSSTEP, sizeof(tg[0]), cmp_i64);
-			printf("  %-8s %-7g %8lld %8lld %8lld | %8lld %8lld | %6.1f | %5ld "
-			       "%7.2f %6.2f %5.1f\n",
+			qsort(it, NSSTEP, sizeof(it[0]), cmp_i64);
+			qsort(ig, NSSTEP, sizeof(ig[0]), cmp_i64);
+			row[kind][s].med = tt[NSSTEP / 2];
+			row[kind][s].p999 = tt[NSSTEP * 999 / 1000];
+			row[kind][s].max = tt[NSSTEP - 1];
+			row[kind][s].cold_med = tg[NSSTEP / 2];
+			row[kind][s].ins_med = ins_fd >= 0 ? it[NSSTEP / 2] : -1;
+			row[kind][s].cold_ins_med = ins_fd >= 0 ? ig[NSSTEP / 2] : -1;
+			row[kind][s].ins_max = ins_fd >= 0 ? it[NSSTEP - 1] : -1;
+			row[kind][s].cold_ins_max = ins_fd >= 0 ? ig[NSSTEP - 1] : -1;
+			row[kind][s].wrong = wrong;
+			printf("  %-8s %-7g %8lld %8lld %8lld %8lld | %8lld %8lld | %6.1f | "
+			       "%5ld %7.2f %6.2f %5.1f | %5.1f %8lld %8lld %6.1f\n",
 			       kind ? "sines" : "random", steps[s] * 100.0,
 			       (long long)tt[NSSTEP / 2], (long long)tt[NSSTEP * 99 / 100],
+			       (long long)tt[NSSTEP * 999 / 1000],
 			       (long long)tt[NSSTEP - 1], (long long)tg[NSSTEP / 2],
 			       (long long)tg[NSSTEP * 99 / 100],
 			       (double)tg[NSSTEP / 2] / (double)(tt[NSSTEP / 2] ? tt[NSSTEP / 2] : 1),
 			       wrong,
 			       (double)(b.cell_solves - a.cell_solves) / NSSTEP,
 			       (double)(b.box_tests - a.box_tests) / NSSTEP,
-			       (double)crit / NSSTEP);
+			       (double)crit / NSSTEP, 100.0 * glob / NSSTEP,
+			       (long long)row[kind][s].ins_med,
+			       (long long)row[kind][s].cold_ins_med,
+			       row[kind][s].ins_med > 0
+				       ? (double)row[kind][s].cold_ins_med / row[kind][s].ins_med
+				       : 0.0);
 		}
+	{
+		/* per step size: medians of both paths and their ratios;
+		 * then the issue's targets, judged on these figures (met at
+		 * a step size when met on both paths) */
+		int med_ok[4], max_ok[4], ratio_ok[4], iratio_ok[4];
+		char lm[64], lx[64], lr[64], li[64];
+		long wrong = 0;
+		int64_t worst_max = 0, worst_p999 = 0;
+		printf("  summary %s (random / sines):\n", name);
+		for (s = 0; s < 4; s++) {
+			double r0 = (double)row[0][s].cold_med / (double)(row[0][s].med ? row[0][s].med : 1);
+			double r1 = (double)row[1][s].cold_med / (double)(row[1][s].med ? row[1][s].med : 1);
+			double i0 = row[0][s].ins_med > 0 ? (double)row[0][s].cold_ins_med / row[0][s].ins_med : 0.0;
+			double i1 = row[1][s].ins_med > 0 ? (double)row[1][s].cold_ins_med / row[1][s].ins_med : 0.0;
+			printf("    step %-5g %%: median %6lld / %6lld ns, ratio %5.1f / %5.1f; "
+			       "median instructions %7lld / %7lld, ratio %5.1f / %5.1f; "
+			       "p99.9 %7lld / %7lld ns, max %8lld / %8lld ns; max "
+			       "instructions %7lld / %7lld (cold query %7lld / %7lld)\n",
+			       steps[s] * 100.0, (long long)row[0][s].med, (long long)row[1][s].med,
+			       r0, r1, (long long)row[0][s].ins_med, (long long)row[1][s].ins_med,
+			       i0, i1, (long long)row[0][s].p999, (long long)row[1][s].p999,
+			       (long long)row[0][s].max, (long long)row[1][s].max,
+			       (long long)row[0][s].ins_max, (long long)row[1][s].ins_max,
+			       (long long)row[0][s].cold_ins_max, (long long)row[1][s].cold_ins_max);
+			med_ok[s] = row[0][s].med <= 1500 && row[1][s].med <= 1500;
+			max_ok[s] = row[0][s].max <= 20000 && row[1][s].max <= 20000;
+			ratio_ok[s] = r0 >= 10.0 && r1 >= 10.0;
+			iratio_ok[s] = i0 >= 10.0 && i1 >= 10.0;
+			for (kind = 0; kind < 2; kind++) {
+				const struct surf_row *w = &row[kind][s];
+				wrong += w->wrong;
+				worst_max = w->max > worst_max ? w->max : worst_max;
+				worst_p999 = w->p999 > worst_p999 ? w->p999 : worst_p999;
+			}
+		}
+		{
+			char *out[4] = {lm, lx, lr, li};
+			int *ok[4] = {med_ok, max_ok, ratio_ok, iratio_ok}, m;
+			for (m = 0; m < 4; m++) {
+				int n = 0;
+				out[m][0] = 0;
+				for (s = 0; s < 4; s++)
+					if (ok[m][s])
+						n += snprintf(out[m] + n, 64 - (size_t)n, "%s%g", n ? ", " : "",
+							      steps[s] * 100.0);
+				if (!n)
+					snprintf(out[m], 64, "none");
+			}
+		}
+		printf("  targets %s, steps (%%) where met on both paths: median <= "
+		       "1.5 us: %s; max <= 20 us: %s (raw max %.1f us, p99.9 %.1f us: "
+		       "interrupts and other load on this machine are in the raw "
+		       "max); >= 10x the cold query: %s by time, %s by "
+		       "instructions; zero wrong: %s (%ld)\n",
+		       name, lm, lx, worst_max / 1e3, worst_p999 / 1e3, lr, li,
+		       wrong == 0 ? "MET" : "NOT MET", wrong);
+	}
 	{
 		struct px_strack *tv = NULL;
 		struct px_strack_opts o;
@@ -464,10 +564,13 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 			for (k = 0; k < NSSTEP; k++)
 				px_strack_update(tv, q[k], &r);
 			px_strack_get_stats(tv, &st);
-			printf("  verification (every update, %llu checks): %llu "
-			       "disagreements\n",
+			printf("  verification (every tracked update, %llu checks): %llu "
+			       "disagreements; over budget %llu, updates answered "
+			       "globally while catching up %llu\n",
 			       (unsigned long long)st.verifications,
-			       (unsigned long long)st.disagreements);
+			       (unsigned long long)st.disagreements,
+			       (unsigned long long)st.over_budget,
+			       (unsigned long long)st.rebuild_updates);
 			px_strack_free(tv);
 		}
 	}
@@ -479,6 +582,9 @@ int main(void)
 {
 	struct px_nurbs_curve c[6];
 	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
+	/* BENCH_TRACK_SURF_ONLY=1: the surface part alone (profiling) */
+	if (getenv("BENCH_TRACK_SURF_ONLY"))
+		goto surfaces;
 	printf("px_track: per-update ns vs cold px_dist_query on the same points "
 	       "(step in %% of the model diagonal; ratio = cold median / tracked "
 	       "median; wrong = answers differing from the global query)\n");
@@ -503,11 +609,16 @@ int main(void)
 	       tgt_max_ok, TGT_RATIO, tgt_ratio_ok, tgt_wrong_ok);
 	if (getenv("BENCH_TRACK_CURVES_ONLY"))
 		return 0;
+surfaces:
 	{
 		struct px_nurbs_surf sf[3];
 		printf("\npx_strack: surfaces, same columns (cells/u: cells solved "
 		       "per update; tests: cell tests per update; crit: live "
-		       "critical points)\n");
+		       "critical points; p999_ns: 99.9th percentile; glob%%: "
+		       "updates answered by the global query, over the budget or "
+		       "catching up; ins_med / cins_med: median user-space "
+		       "instructions of the update / the cold query, iratio their "
+		       "ratio: figures independent of the machine's load)\n");
 		if (wavy_surf(&sf[0], 4) == PX_OK)
 			run_surf("bicubic patch (wavy)", &sf[0], 1);
 		if (wavy_surf(&sf[1], 7) == PX_OK)

@@ -92,6 +92,19 @@ double px__track_leaf_cert(const struct px_track *t, int leaf, px_vec3 p,
 			   int which, int *ent, double *u0, double *u1,
 			   unsigned *flags);
 
+/* ---- coherent surface tracking (px_strack.c), for its tests ---- */
+
+struct px_strack;
+
+/* Certified radius at p of the region cell of surface s holding (u, v):
+ * no transition of that cell while the point stays within this max-norm
+ * distance of p. -1 for bad arguments. */
+double px__strack_cert_radius(const struct px_strack *t, int s, double u,
+			      double v, px_vec3 p);
+/* Factor applied to every certified radius (1; the tests raise it to
+ * show that their containment check fails for a non-conservative
+ * bound). */
+extern double px__strack_radius_scale;
 
 /*
  * Sub-block extraction shared by curves (nd = 1) and surfaces (nd = 2):

@@ -14,10 +14,10 @@
  * one comes from the solve of a cell whose transition region the path
  * came near.
  * Everything found is a verified zero of E (Newton converged), so the
- * tracked set can miss points but never holds a false one; a missed
- * minimum can only come from a transition region drawn too small (the
- * regions come from samples with margins, not from a proof), which the
- * optional verification would report.
+ * tracked set never holds a false point. The transition regions are
+ * proven (cert_radius()); what is left to Newton is finding the points
+ * of a cell that is solved again (seed grid per cell), which the optional
+ * verification would report if it failed.
  */
 #include "px_strack.h"
 
@@ -25,10 +25,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "internal.h"
 #include "px_bern.h"
 
 #define ST_NEWTON 16
-#define ST_NBOX 4
+
+enum { ST_TRACK = 0, ST_LAG = 1, ST_REBUILD = 2, ST_PEND = 3 };
 
 struct crit {
 	double u, v;
@@ -38,31 +40,53 @@ struct crit {
 	double h11, h12, h22;
 };
 
-/* Where a cell can have a transition: every normal line of the cell lies
- * in the double cone around its central normal line (apex spread rho,
- * slope a = tan of the largest normal deviation); a focal sheet lies on
- * those lines at a signed height l in an interval (bounded sheet) or at
- * |l| >= lo (a sheet through infinity: curvature crossing zero or too
- * small to matter); edge events anywhere on the lines. */
-struct sreg {
+/* Closed interval. */
+struct iv {
 	double lo, hi;
-	int split;      /* 1: |l| >= lo */
-	/* edge wedge (wedge = 1): the normal lines along an edge stay near
-	 * the plane through sc spanned by the edge chord and the normal n:
-	 * |w . b| <= rho + a |w . n| for w = x - sc */
-	int wedge;
-	px_vec3 sc, n, b;
-	double rho, a, ia;
+};
+
+/* Centre values on a cell side that the edge test needs. */
+struct cside {
+	px_vec3 s, su, sv;
+	double n1, n2;  /* |su|_1, |sv|_1 */
+	int along;      /* 0: the side runs along u (v fixed), 1: along v */
+	double h;       /* half length of the side in its parameter */
+};
+
+/*
+ * Certificate data of a region cell: enclosures over the whole cell of
+ * S and its derivatives up to order 2 (from the Bezier net of the cell:
+ * the convex hull property for S, difference nets for the derivatives,
+ * interval arithmetic for the rational quotient rule), the first
+ * fundamental form entries Si.Sj, the centre values of S, Su, Sv and the
+ * sides on an open domain edge or a crease (less than C2 between
+ * patches), where points enter and leave.
+ */
+struct rcert {
+	struct iv S[3], Suu[3], Suv[3], Svv[3];
+	struct iv G11, G12, G22;
+	double m11, m12, m22;   /* sum over x, y, z of max |Sij| */
+	/* the same in midpoint-radius form for the run-time test: with
+	 * w = S - x, H_ij lies in A_ij - x . B_ij +- (R_ij + |mid w| . Q_ij)
+	 * (entries 0: 11, 1: 12, 2: 22) */
+	px_vec3 smid, B[3], Q[3];
+	double A[3], R[3];
+	px_vec3 sc, suc, svc;
+	double n1, n2;          /* |suc|_1, |svc|_1 */
+	double hu, hv;          /* half widths of the cell in u, v */
+	int nside;
+	struct cside side[4];
 };
 
 struct scell {
 	double u0, u1, v0, v1;
 	int surf;
-	int always;     /* normals too spread for a cone: always solved */
-	px_vec3 sc, nc;
-	double rho, a, ia; /* ia = 1 / sqrt(1 + a^2) */
-	int nreg;
-	struct sreg reg[ST_NBOX];
+	double size;    /* diameter of the cell's box (solve cells) */
+	/* on a collapsed edge: E2 vanishes along the pole, so no
+	 * certificate holds near its normal lines; solved whenever hit,
+	 * outside the budget (a fixed cost of the model) */
+	int always;
+	struct rcert cert; /* region cells */
 	double expiry;
 	int hpos;
 	uint32_t mark;
@@ -76,6 +100,7 @@ struct scell {
 struct patch {
 	double u0, u1, v0, v1, iu, iv;
 	int p, q;
+	int rat;         /* weights not all equal */
 	const double *c; /* 4 (p + 1)(q + 1) */
 };
 
@@ -110,6 +135,11 @@ struct px_strack {
 	struct px_strack_opts opts;
 	struct px_dist_model *dist;
 	struct px_track *ct;    /* free curves + edges */
+	/* boxes of half knot spans of every curve of ct: while the best
+	 * interior minimum is closer than all of them, ct is left out */
+	px_aabb *cbox;
+	int n_cbox, ct_ncrit;
+	px_vec3 ct_p;           /* where ct was last updated */
 	int n_curves, n_surf, n_edges, n_cells, n_poles, n_unbounded;
 	int n_patches;
 	struct ssurf *sf;
@@ -120,6 +150,10 @@ struct px_strack {
 	struct edge *edge;
 	struct pole *pole;
 	int *heap, *popped, *hits;
+	/* solves owed to the set at p (mode ST_PEND): cell pend[i] solved
+	 * at pend_ps[i] and followed to p; pend_next the next one */
+	int *pend, n_pend, pend_next;
+	px_vec3 *pend_ps;
 	double travel;
 	int heap_ok;
 	px_aabb work;
@@ -127,6 +161,13 @@ struct px_strack {
 	px_vec3 p;
 	int init;
 	uint32_t epoch, next_id;
+	/* the tracked set is at p (ST_TRACK), or catching up with the query
+	 * point (ST_LAG), or being re-established at p (ST_REBUILD: rb_next
+	 * the next cell to solve; rb_started 0: start at the next point
+	 * inside the working volume) */
+	int mode, rb_started, rb_next;
+	px_vec3 last_point, last_q; /* last answer and its query point */
+	int last_entity, have_last;
 	int best_kind;          /* 0 none, 1 surface min, 2 curve tracker, 3 pole */
 	uint32_t best_id;
 	struct px_strack_stats st;
@@ -161,7 +202,7 @@ static void surf_eval2(const struct ssurf *f, double u, double v,
 	q = pt->q;
 	s = (u - pt->u0) * pt->iu;
 	t = (v - pt->v0) * pt->iv;
-	for (k = 0; k < 4; k++) {
+	for (k = 0; k < (pt->rat ? 4 : 3); k++) {
 		const double *c = pt->c + k * (p + 1) * (q + 1);
 		double V0 = 0, V1 = 0, V2 = 0, W0 = 0, W1 = 0, X0 = 0;
 		/* Horner in t over the rows a_j(s) and their s-derivatives:
@@ -187,6 +228,16 @@ static void surf_eval2(const struct ssurf *f, double u, double v,
 		h[k][3] = X0;
 		h[k][4] = W1;
 		h[k][5] = V2;
+	}
+	if (!pt->rat) {
+		/* polynomial (weights normalised to 1 at setup) */
+		d->s = px_v3(h[0][0], h[1][0], h[2][0]);
+		d->su = px_v3(h[0][1] * pt->iu, h[1][1] * pt->iu, h[2][1] * pt->iu);
+		d->sv = px_v3(h[0][2] * pt->iv, h[1][2] * pt->iv, h[2][2] * pt->iv);
+		d->suu = px_v3_scale(px_v3(h[0][3], h[1][3], h[2][3]), pt->iu * pt->iu);
+		d->suv = px_v3_scale(px_v3(h[0][4], h[1][4], h[2][4]), pt->iu * pt->iv);
+		d->svv = px_v3_scale(px_v3(h[0][5], h[1][5], h[2][5]), pt->iv * pt->iv);
+		return;
 	}
 	{
 		double w = h[3][0], iw = 1.0 / w, ws = h[3][1], wt = h[3][2],
@@ -419,16 +470,27 @@ static int follow(const struct ssurf *f, struct crit *z, px_vec3 p0,
  * moving for the rest of the step, possibly out of the cell). Returns 0
  * or PX_E_NOSPC.
  */
+static int no_root(const struct rcert *c, px_vec3 p);
+
 static int cell_solve_at(struct px_strack *t, const struct scell *c,
 			 px_vec3 ps, px_vec3 p)
 {
 	struct ssurf *f = &t->sf[c->surf];
 	int n = t->opts.seeds, i, j, rc, same = px_v3_dist2(ps, p) == 0.0;
+	int empty[4], ch;
 	double lu = c->u1 - c->u0, lv = c->v1 - c->v0;
 	t->st.cell_solves++;
+	/* region cells proven to hold no critical point at ps give no
+	 * seeds (a seed converges to a point near it) */
+	for (ch = 0; ch < 4; ch++)
+		empty[ch] = no_root(&t->rcell[c->child + ch].cert, ps);
+	if (empty[0] && empty[1] && empty[2] && empty[3])
+		return 0;
 	for (j = 0; j < n; j++)
 		for (i = 0; i < n; i++) {
 			struct crit z, last;
+			if (empty[(2 * i) / n + 2 * ((2 * j) / n)])
+				continue;
 			memset(&z, 0, sizeof(z));
 			z.u = c->u0 + lu * (i + 0.5) / n;
 			z.v = c->v0 + lv * (j + 0.5) / n;
@@ -466,36 +528,173 @@ static int surf_reinit(struct px_strack *t, struct ssurf *f, int si, px_vec3 p)
 /* ------------------------------------------------------------------ */
 /* transition boxes: lazy tests                                        */
 
-/* Lower bound on the distance from p to a region cell's transition set. */
+static struct iv iv_mul(struct iv a, struct iv b)
+{
+	double p1 = a.lo * b.lo, p2 = a.lo * b.hi, p3 = a.hi * b.lo,
+	       p4 = a.hi * b.hi;
+	struct iv r;
+	r.lo = fmin(fmin(p1, p2), fmin(p3, p4));
+	r.hi = fmax(fmax(p1, p2), fmax(p3, p4));
+	return r;
+}
+
+static double iv_mag(struct iv a)
+{
+	return fmax(fabs(a.lo), fabs(a.hi));
+}
+
+/* Safety factor on certificate radii and relative padding of the
+ * enclosures for rounding. */
+#define ST_RSAFE (1.0 - 1e-9)
+#define ST_PAD 1e-12
+
+/*
+ * Certified radius of a region cell at p: no transition of the cell
+ * happens while the point stays in the cube |x - p|_inf <= r. A pair of
+ * critical points is born or dies only at a degenerate critical point,
+ * E = 0 and det H = 0 (the focal sheets, Seong-Johnson-Cohen section
+ * 4.3), and a point enters or leaves only through a side that is an open
+ * edge or a crease. For x in the cube and (u, v) in the cell:
+ *  - H_ij = Si.Sj + (S - x).Sij lies in [H_ij(p)] + [-r m_ij, r m_ij];
+ *  - E(u, v; x) lies in E(c; p) +- r |Su(c)|_1 + [H] * (cell half
+ *    widths) (mean value form about the centre c, dE/du = (H11, H12)).
+ * The cell is safe when E1 or E2 keeps its sign (no critical point at
+ * all), or when det H keeps its sign (no degenerate one: the points only
+ * move) and on every open side E1 or E2 keeps its sign. Each condition
+ * is monotone in r; the radius is the largest r that keeps one of them
+ * (closed forms: linear in r for E, quadratic for det H). Curvatures are
+ * never divided by, so parabolic lines and umbilics need no care.
+ */
+#define ST_MIN(a, b) ((a) < (b) ? (a) : (b))
+#define ST_MAX(a, b) ((a) > (b) ? (a) : (b))
+
+static double cert_radius(const struct rcert *c, px_vec3 p)
+{
+	double mid[3], rad[3], a11, b11, a22, b22, M11, M12, M22,
+	       m11 = c->m11, m12 = c->m12, m22 = c->m22, rE, rD, r, e1, e2, pad;
+	px_vec3 w, aw;
+	int k;
+	aw = px_v3_sub(c->smid, p);
+	aw = px_v3(fabs(aw.x), fabs(aw.y), fabs(aw.z));
+	for (k = 0; k < 3; k++) {
+		mid[k] = c->A[k] - px_v3_dot(p, c->B[k]);
+		rad[k] = c->R[k] + px_v3_dot(aw, c->Q[k]);
+	}
+	/* rounding of the sums: pad by their magnitude */
+	pad = ST_PAD * (fabs(mid[0]) + fabs(mid[1]) + fabs(mid[2]) + rad[0] + rad[1] +
+			rad[2] + (aw.x + aw.y + aw.z + fabs(p.x) + fabs(p.y) + fabs(p.z)) *
+					 (m11 + m12 + m22));
+	a11 = mid[0] - rad[0] - pad;
+	b11 = mid[0] + rad[0] + pad;
+	a22 = mid[2] - rad[2] - pad;
+	b22 = mid[2] + rad[2] + pad;
+	M11 = fabs(mid[0]) + rad[0] + pad;
+	M12 = fabs(mid[1]) + rad[1] + pad;
+	M22 = fabs(mid[2]) + rad[2] + pad;
+	/* E test */
+	w = px_v3_sub(c->sc, p);
+	e1 = fabs(px_v3_dot(w, c->suc));
+	e2 = fabs(px_v3_dot(w, c->svc));
+	pad = ST_PAD * (fabs(w.x) + fabs(w.y) + fabs(w.z) + fabs(p.x) + fabs(p.y) +
+			fabs(p.z)) *
+	      (c->n1 + c->n2);
+	{
+		double r1 = (e1 - pad - M11 * c->hu - M12 * c->hv) /
+			    (c->n1 + m11 * c->hu + m12 * c->hv);
+		double r2 = (e2 - pad - M12 * c->hu - M22 * c->hv) /
+			    (c->n2 + m12 * c->hu + m22 * c->hv);
+		rE = r1 > r2 ? r1 : r2;
+		if (!(rE > 0.0))
+			rE = 0.0;
+	}
+	/* det H test */
+	rD = 0.0;
+	{
+		double x = 0.0, y = 0.0;
+		int definite = 0;
+		if (a11 > 0.0 && a22 > 0.0) {
+			x = a11;
+			y = a22;
+			definite = 1;
+		} else if (b11 < 0.0 && b22 < 0.0) {
+			x = -b11;
+			y = -b22;
+			definite = 1;
+		} else if (a11 > 0.0 && b22 < 0.0) {
+			rD = ST_MIN(a11 / m11, -b22 / m22);
+		} else if (b11 < 0.0 && a22 > 0.0) {
+			rD = ST_MIN(-b11 / m11, a22 / m22);
+		}
+		if (definite) {
+			/* f(r) = (x - r m11)(y - r m22) - (M12 + r m12)^2 falls
+			 * on [0, min(x / m11, y / m22)]: its first root */
+			double A = m11 * m22 - m12 * m12;
+			double B = -(x * m22 + y * m11) - 2.0 * M12 * m12;
+			double C = x * y - M12 * M12;
+			double cap = ST_MIN(x / m11, y / m22);
+			if (C > 0.0) {
+				double disc = B * B - 4.0 * A * C;
+				double root = disc < 0.0 ? INFINITY
+							 : 2.0 * C / (-B + sqrt(disc));
+				rD = ST_MIN(cap, root);
+			}
+		}
+		if (!(rD > 0.0))
+			rD = 0.0;
+	}
+	for (k = 0; k < c->nside && rD > rE; k++) {
+		/* open side: E restricted to it, mean value form along it */
+		const struct cside *sd = &c->side[k];
+		double d1 = sd->along ? M12 : M11, d2 = sd->along ? M22 : M12;
+		double q1 = sd->along ? m12 : m11, q2 = sd->along ? m22 : m12;
+		double f1, f2, r1, r2;
+		w = px_v3_sub(sd->s, p);
+		f1 = fabs(px_v3_dot(w, sd->su));
+		f2 = fabs(px_v3_dot(w, sd->sv));
+		r1 = (f1 - pad - d1 * sd->h) / (sd->n1 + q1 * sd->h);
+		r2 = (f2 - pad - d2 * sd->h) / (sd->n2 + q2 * sd->h);
+		r1 = r1 > r2 ? r1 : r2;
+		r1 = r1 > 0.0 ? r1 : 0.0;
+		rD = ST_MIN(rD, r1);
+	}
+	r = (rE > rD ? rE : rD) * ST_RSAFE;
+	return r > 0.0 ? r : 0.0;
+}
+
+/* 1 when E is proven not to vanish on the cell for the point p: no
+ * critical point there (the E test of cert_radius() at r = 0). */
+static int no_root(const struct rcert *c, px_vec3 p)
+{
+	double mid[3], rad[3], e1, e2, pad;
+	px_vec3 w, aw;
+	int k;
+	aw = px_v3_sub(c->smid, p);
+	aw = px_v3(fabs(aw.x), fabs(aw.y), fabs(aw.z));
+	for (k = 0; k < 3; k++) {
+		mid[k] = fabs(c->A[k] - px_v3_dot(p, c->B[k]));
+		rad[k] = c->R[k] + px_v3_dot(aw, c->Q[k]);
+	}
+	pad = ST_PAD * (mid[0] + mid[1] + mid[2] + rad[0] + rad[1] + rad[2] +
+			(aw.x + aw.y + aw.z + fabs(p.x) + fabs(p.y) + fabs(p.z)) *
+				(c->m11 + c->m12 + c->m22));
+	for (k = 0; k < 3; k++)
+		mid[k] += rad[k] + pad;
+	w = px_v3_sub(c->sc, p);
+	e1 = fabs(px_v3_dot(w, c->suc));
+	e2 = fabs(px_v3_dot(w, c->svc));
+	pad = ST_PAD * (fabs(w.x) + fabs(w.y) + fabs(w.z) + fabs(p.x) + fabs(p.y) +
+			fabs(p.z)) *
+	      (c->n1 + c->n2);
+	return e1 - pad > mid[0] * c->hu + mid[1] * c->hv ||
+	       e2 - pad > mid[1] * c->hu + mid[2] * c->hv;
+}
+
+/* Test hook (internal.h): a factor on every certified radius. */
+double px__strack_radius_scale = 1.0;
+
 static double region_radius(const struct scell *c, px_vec3 p)
 {
-	px_vec3 w;
-	double l, dp, rc, r = INFINITY;
-	int i;
-	if (c->always)
-		return 0.0;
-	if (c->nreg == 0)
-		return INFINITY;
-	w = px_v3_sub(p, c->sc);
-	l = px_v3_dot(w, c->nc);
-	dp = px_v3_norm(px_v3_sub(w, px_v3_scale(c->nc, l)));
-	/* d_perp - a |l| is sqrt(1 + a^2)-Lipschitz */
-	rc = fmax((dp - c->a * fabs(l) - c->rho) * c->ia, 0.0);
-	for (i = 0; i < c->nreg; i++) {
-		const struct sreg *g = &c->reg[i];
-		double ri;
-		if (g->wedge) {
-			px_vec3 we = px_v3_sub(p, g->sc);
-			ri = (fabs(px_v3_dot(we, g->b)) - g->a * fabs(px_v3_dot(we, g->n)) -
-			      g->rho) * g->ia;
-			ri = fmax(ri, 0.0);
-		} else {
-			ri = g->split ? fmax(g->lo - fabs(l), 0.0)
-				      : fmax(fmax(g->lo - l, l - g->hi), 0.0);
-		}
-		r = fmin(r, fmax(rc, ri));
-	}
-	return r;
+	return cert_radius(&c->cert, p) * px__strack_radius_scale;
 }
 
 /* ... and of a solve cell: its children's regions cover all of it. */
@@ -559,13 +758,29 @@ static void heap_rebuild(struct px_strack *t, px_vec3 p)
 	t->heap_ok = 1;
 }
 
-/* Cells whose boxes the segment p0 -> p1 meets. Returns their count. */
-static int collect_cells(struct px_strack *t, px_vec3 p0, px_vec3 p1)
+/* Work units of a hit cell: one solve, two after a long step past the
+ * crossing (solved where the region was met too). */
+static int hit_work(const struct px_strack *t, int ci, double step)
 {
-	int n = t->n_cells, np = 0, nh = 0, k;
-	double seg = px_v3_dist(p0, p1);
+	const struct scell *c = &t->cell[ci];
+	if (c->always)
+		return 0;
+	return 1 + ((1.0 - c->cross) * step > 0.05 * c->size);
+}
+
+/*
+ * Cells whose certificates the segment p0 -> p1 may break. Returns their
+ * count, or -1 when their work exceeds budget (> 0): then nothing is
+ * committed (the popped cells stay due, the travel is unchanged).
+ */
+static int collect_cells(struct px_strack *t, px_vec3 p0, px_vec3 p1,
+			 int budget)
+{
+	int n = t->n_cells, np = 0, nh = 0, k, work = 0;
+	double seg = px_v3_dist(p0, p1), travel0;
 	if (!t->heap_ok)
 		heap_rebuild(t, p0);
+	travel0 = t->travel;
 	t->travel += seg;
 	while (n > 0 && t->cell[t->heap[0]].expiry <= t->travel) {
 		t->popped[np++] = t->heap[0];
@@ -578,21 +793,38 @@ static int collect_cells(struct px_strack *t, px_vec3 p0, px_vec3 p1)
 	for (k = 0; k < np; k++) {
 		int ci = t->popped[k];
 		struct scell *c = &t->cell[ci];
+		/* the segment lies in the cube of half width dinf about p1
+		 * and in the cube of half width dinf / 2 about its middle */
+		double dinf = fmax(fmax(fabs(p1.x - p0.x), fabs(p1.y - p0.y)),
+				   fabs(p1.z - p0.z));
 		double r1 = cell_radius(t, c, p1);
 		t->st.box_tests++;
-		/* a point of the segment within reach of the set is at least
-		 * r0 from p0 and r1 from p1: impossible when r0 + r1 > |seg| */
-		double r0 = r1 <= 0.0 || seg <= 0.0 ? 0.0 : cell_radius(t, c, p0);
-		if (r1 <= 0.0 || r0 + r1 <= seg) {
+		if (r1 < dinf &&
+		    cell_radius(t, c, px_v3_scale(px_v3_add(p0, p1), 0.5)) < 0.5 * dinf) {
 			/* where along the segment the region can first be met */
-			double s0 = seg > 0.0 ? fmin(1.0, r0 / seg) : 1.0;
-			double s1 = seg > 0.0 ? fmax(s0, 1.0 - r1 / seg) : 1.0;
-			c->cross = r0 > 0.0 ? 0.5 * (s0 + s1) : 0.5 * s1;
+			double r0 = cell_radius(t, c, p0);
+			double s0 = fmin(1.0, r0 / dinf);
+			double s1 = fmax(s0, 1.0 - r1 / dinf);
+			c->cross = 0.5 * (s0 + s1);
 			c->mark = t->epoch;
 			t->hits[nh++] = ci;
+			work += hit_work(t, ci, seg);
+			if (budget > 0 && work > budget)
+				break; /* the rest is not looked at */
 		}
-		c->expiry = t->travel + r1 * (1.0 - 1e-9);
-		heap_set(t, n, ci);
+		c->expiry = t->travel + r1;
+	}
+	if (budget > 0 && work > budget) {
+		/* undo: due again at the next test, from p0 */
+		for (k = 0; k < np; k++) {
+			t->cell[t->popped[k]].expiry = travel0;
+			t->cell[t->popped[k]].mark = 0;
+		}
+		t->travel = travel0;
+		nh = -1;
+	}
+	for (k = 0; k < np; k++) {
+		heap_set(t, n, t->popped[k]);
 		heap_up(t, n);
 		n++;
 	}
@@ -692,8 +924,17 @@ static void answer(struct px_strack *t, px_vec3 p,
 	count_crit(t, r, cr->n_crit);
 	r->jumped = kind != t->best_kind || (kind == 2 && cr->jumped) ||
 		    (kind != 2 && id != t->best_id);
+	if (t->best_kind == 0 && t->have_last)
+		/* after a global answer: judged as there */
+		r->jumped = r->entity != t->last_entity ||
+			    px_v3_dist(r->point, t->last_point) >
+				    4.0 * px_v3_dist(p, t->last_q) + 1e-9 * t->scale;
 	t->best_kind = kind;
 	t->best_id = id;
+	t->last_point = r->point;
+	t->last_q = p;
+	t->last_entity = r->entity;
+	t->have_last = 1;
 }
 
 static void answer_global(struct px_strack *t, px_vec3 p,
@@ -708,10 +949,18 @@ static void answer_global(struct px_strack *t, px_vec3 p,
 	r->feature = PX_STRACK_GLOBAL;
 	fill_dir(r, p);
 	count_crit(t, r, 0);
-	r->jumped = 1;
+	/* no feature identity here: a jump is a change of entity or a foot
+	 * point that moved far more than the query point */
+	r->jumped = !t->have_last || r->entity != t->last_entity ||
+		    px_v3_dist(r->point, t->last_point) >
+			    4.0 * px_v3_dist(p, t->last_q) + 1e-9 * t->scale;
 	t->best_kind = 0;
 	r->source = PX_TRACK_GLOBAL;
 	t->st.fallbacks++;
+	t->last_point = r->point;
+	t->last_q = p;
+	t->last_entity = r->entity;
+	t->have_last = 1;
 }
 
 static int reinit_all(struct px_strack *t, px_vec3 p)
@@ -724,6 +973,8 @@ static int reinit_all(struct px_strack *t, px_vec3 p)
 	}
 	return rc;
 }
+
+static void rebuild_start(struct px_strack *t);
 
 static void verify(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 {
@@ -738,8 +989,12 @@ static void verify(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 	if (r->dist > g.dist + 1e-9 * (t->scale + g.dist)) {
 		t->st.disagreements++;
 		t->st.reinits++;
-		if (reinit_all(t, p))
+		if (t->opts.max_solves > 0) {
+			/* re-established over the next updates */
+			rebuild_start(t);
+		} else if (reinit_all(t, p)) {
 			t->st.overflows++;
+		}
 		answer_global(t, p, r);
 		r->verified = 1;
 	}
@@ -765,6 +1020,49 @@ static void curves_update(struct px_strack *t, px_vec3 p,
 		px_track_reset(t->ct, p, cr);
 	else
 		px_track_update(t->ct, p, cr);
+	t->ct_p = p;
+	t->ct_ncrit = cr->n_crit;
+}
+
+/*
+ * 1 when the curve tracker must answer this update: a curve or edge can
+ * be closest (some box of the curves is not farther than the best
+ * interior minimum or pole), or it was left out over more than 2 % of
+ * the model size (its next step stays of the length it is made for).
+ */
+static int curves_needed(const struct px_strack *t, px_vec3 p)
+{
+	double best = INFINITY, lim = 0.02 * t->scale;
+	int i, j;
+	if (!t->ct)
+		return 0;
+	if (px_v3_dist2(p, t->ct_p) > lim * lim)
+		return 1;
+	for (i = 0; i < t->n_surf; i++)
+		for (j = 0; j < t->sf[i].nz; j++) {
+			const struct crit *z = &t->sf[i].z[j];
+			double d2 = px_v3_dist2(z->s, p);
+			if (z->type > 0 && d2 < best)
+				best = d2;
+		}
+	for (i = 0; i < t->n_poles; i++) {
+		double d2 = px_v3_dist2(t->pole[i].q, p);
+		if (d2 < best)
+			best = d2;
+	}
+	if (!(best < INFINITY))
+		return 1;
+	/* a margin for the rounding of both sides */
+	best *= 1.0 + 1e-9;
+	for (i = 0; i < t->n_cbox; i++) {
+		const px_aabb *b = &t->cbox[i];
+		double dx = p.x < b->min.x ? b->min.x - p.x : p.x > b->max.x ? p.x - b->max.x : 0.0;
+		double dy = p.y < b->min.y ? b->min.y - p.y : p.y > b->max.y ? p.y - b->max.y : 0.0;
+		double dz = p.z < b->min.z ? b->min.z - p.z : p.z > b->max.z ? p.z - b->max.z : 0.0;
+		if (dx * dx + dy * dy + dz * dz <= best)
+			return 1;
+	}
+	return 0;
 }
 
 static int full_reset(struct px_strack *t, px_vec3 p,
@@ -772,12 +1070,15 @@ static int full_reset(struct px_strack *t, px_vec3 p,
 {
 	struct px_track_result cr;
 	int rc;
-	t->heap_ok = 0;
 	curves_update(t, p, &cr, 1);
 	rc = reinit_all(t, p);
+	/* every cell's certificate here, not in the next update */
+	heap_rebuild(t, p);
 	r->source = PX_TRACK_REINIT;
 	if (rc) {
 		t->st.overflows++;
+		if (t->opts.max_solves > 0)
+			rebuild_start(t);
 		answer_global(t, p, r);
 	} else {
 		answer(t, p, &cr, r);
@@ -798,6 +1099,8 @@ int px_strack_reset(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 	t->p = p;
 	t->init = 1;
 	t->best_kind = 0;
+	t->have_last = 0;
+	t->mode = ST_TRACK;
 	return full_reset(t, p, r);
 }
 
@@ -861,32 +1164,38 @@ static int follow(const struct ssurf *f, struct crit *z, px_vec3 p0,
 	return 1;
 }
 
-int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
+/* Solve pending items from pend_next on, at most budget work units (0:
+ * all). Returns 0 or PX_E_NOSPC; *done the units solved. */
+static int pend_solve(struct px_strack *t, int budget, int *done)
 {
-	struct px_track_result cr;
-	px_vec3 p0, dp;
-	int i, j, nh, rc = 0;
-
-	if (!t || !r)
-		return PX_E_INVAL;
-	if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
-		return PX_E_NAN;
-	if (!t->init)
-		return px_strack_reset(t, p, r);
-	result_clear(r);
-	t->st.updates++;
-	p0 = t->p;
-	dp = px_v3_sub(p, p0);
-	t->p = p;
-	r->source = PX_TRACK_TRACKED;
-	if (++t->epoch == 0)
-		t->epoch = 1;
-	if (!in_work(t, p) || !in_work(t, p0)) {
-		t->st.outside++;
-		return full_reset(t, p, r);
+	int rc = 0;
+	*done = 0;
+	while (t->pend_next < t->n_pend && rc >= 0 && (budget <= 0 || *done < budget)) {
+		const struct scell *c = &t->cell[t->pend[t->pend_next]];
+		rc = cell_solve_at(t, c, t->pend_ps[t->pend_next], t->p);
+		t->pend_next++;
+		(*done)++;
 	}
-	curves_update(t, p, &cr, 0);
-	nh = collect_cells(t, p0, p);
+	return rc < 0 ? rc : 0;
+}
+
+/*
+ * Move the tracked set from p0 to p (t->p becomes p): collect the cells
+ * whose certificates the segment may break, follow every point, add the
+ * cells of lost points, and solve them (a hit after a long step also
+ * where its region was met, its roots followed to p). Returns 0; 1 when
+ * that work exceeds the budget: nothing is solved, the work is left
+ * pending (mode ST_PEND, solved over the next updates at p); PX_E_NOSPC.
+ */
+static int track_step(struct px_strack *t, px_vec3 p0, px_vec3 p,
+		      struct px_strack_result *r)
+{
+	px_vec3 dp = px_v3_sub(p, p0);
+	double step = px_v3_norm(dp);
+	int i, j, nh, rc = 0, before = 0, after = 0, done = 0,
+		      budget = t->opts.max_solves;
+
+	nh = collect_cells(t, p0, p, 0);
 	for (i = 0; i < t->n_surf; i++) {
 		struct ssurf *f = &t->sf[i];
 		int n = f->nz;
@@ -915,45 +1224,242 @@ int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 			}
 			rc = crit_add(t, f, &z);
 			if (rc < 0)
-				break;
+				return rc;
 		}
-		if (rc < 0)
-			break;
 	}
-	{
-		int before = 0, after = 0;
+	t->p = p;
+	/* the work list: solve at p; after a long step past the crossing
+	 * also where the region was met (pole cells outside the budget) */
+	t->n_pend = t->pend_next = 0;
+	for (i = 0; i < nh; i++) {
+		int ci = t->hits[i];
+		const struct scell *c = &t->cell[ci];
+		t->pend[t->n_pend] = ci;
+		t->pend_ps[t->n_pend++] = p;
+		if (hit_work(t, ci, step) > 1) {
+			t->pend[t->n_pend] = ci;
+			t->pend_ps[t->n_pend++] = px_v3_add(p0, px_v3_scale(dp, c->cross));
+		}
+	}
+	for (i = 0; i < t->n_surf; i++)
+		before += t->sf[i].nz;
+	/* within the budget all of it; over it, the budget's worth now and
+	 * the rest over the next updates */
+	rc = pend_solve(t, budget, &done);
+	for (i = 0; i < t->n_surf; i++)
+		after += t->sf[i].nz;
+	/* new points only come from solved cells: births (pairs at a focal
+	 * sheet) and entries through an edge */
+	r->born = after - before;
+	t->st.born += (uint64_t)r->born;
+	r->cells_solved = done;
+	if (rc < 0)
+		return rc;
+	if (t->pend_next < t->n_pend) {
+		t->st.over_budget++;
+		t->mode = ST_PEND;
+		return 1;
+	}
+	return 0;
+}
+
+/* Re-establish the critical points from scratch over the next updates,
+ * starting at the next point inside the working volume. */
+static void rebuild_start(struct px_strack *t)
+{
+	int i;
+	t->mode = ST_REBUILD;
+	t->rb_started = 0;
+	t->rb_next = 0;
+	t->heap_ok = 0;
+	for (i = 0; i < t->n_surf; i++)
+		t->sf[i].nz = 0;
+}
+
+/*
+ * One update while the tracked set is not at the query point; the answer
+ * is the global query's unless the set reaches p in this update and
+ * agrees with it.
+ *  - ST_PEND: the set is at t->p but owes cell solves there: up to the
+ *    budget of them now; when none is left: ST_LAG.
+ *  - ST_REBUILD: a slice of cells is solved at the fixed point t->p
+ *    where the rebuild started, each cell's certificate taken there;
+ *    when all are, the set is complete at t->p: ST_LAG.
+ *  - ST_LAG: the set moves from t->p to p by one tracked step; work
+ *    over the budget is left pending (ST_PEND) at p. It catches up when
+ *    the work of the distance travelled meanwhile fits the budget: while
+ *    the point moves with less work per update than the budget on
+ *    average.
+ */
+static int catch_up(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
+{
+	struct px_track_result cr;
+	struct px_dist_result g;
+	int rc = 0;
+	t->st.rebuild_updates++;
+	curves_update(t, p, &cr, 0);
+	if (t->mode == ST_PEND) {
+		int done = 0, i, before = 0, after = 0;
 		for (i = 0; i < t->n_surf; i++)
 			before += t->sf[i].nz;
-		for (i = 0; i < nh && rc >= 0; i++) {
-			const struct scell *c = &t->cell[t->hits[i]];
-			rc = cell_solve(t, c, p);
-			/* a long step after the crossing: also solve where the
-			 * region was met and follow those roots to p */
-			if (rc >= 0 && (1.0 - c->cross) * px_v3_norm(dp) > 0.1 * c->rho)
-				rc = cell_solve_at(t, c, px_v3_add(p0, px_v3_scale(dp, c->cross)),
-						   p);
-		}
+		rc = pend_solve(t, t->opts.max_solves > 0 ? t->opts.max_solves : 0, &done);
 		for (i = 0; i < t->n_surf; i++)
 			after += t->sf[i].nz;
-		/* new points only come from solved cells: births (pairs at
-		 * a focal sheet) and entries through an edge */
 		r->born = after - before;
 		t->st.born += (uint64_t)r->born;
-	}
-	r->cells_solved = nh;
-	if (rc < 0) {
-		t->st.overflows++;
-		t->st.reinits++;
-		if (reinit_all(t, p))
+		r->cells_solved = done;
+		if (rc < 0) {
 			t->st.overflows++;
+			rebuild_start(t);
+		} else if (t->pend_next >= t->n_pend) {
+			t->mode = ST_LAG;
+		}
 		answer_global(t, p, r);
 		return PX_OK;
+	}
+	if (t->mode == ST_REBUILD) {
+		int slice = t->opts.max_solves > 1 ? t->opts.max_solves / 2 : 1;
+		if (!t->rb_started) {
+			if (!in_work(t, p)) {
+				t->st.outside++;
+				answer_global(t, p, r);
+				return PX_OK;
+			}
+			t->rb_started = 1;
+			t->p = p;
+			t->travel = 0.0;
+		}
+		while (slice-- > 0 && t->rb_next < t->n_cells && rc >= 0) {
+			struct scell *c = &t->cell[t->rb_next];
+			rc = cell_solve(t, c, t->p);
+			c->expiry = cell_radius(t, c, t->p);
+			heap_set(t, t->rb_next, t->rb_next);
+			t->rb_next++;
+			r->cells_solved++;
+		}
+		if (rc < 0) {
+			t->st.overflows++;
+			rebuild_start(t);
+		} else if (t->rb_next >= t->n_cells) {
+			int i;
+			for (i = t->n_cells / 2 - 1; i >= 0; i--)
+				heap_down(t, i, t->n_cells);
+			t->heap_ok = 1;
+			t->mode = ST_LAG;
+		}
+		answer_global(t, p, r);
+		return PX_OK;
+	}
+	/* ST_LAG */
+	if (in_work(t, p)) {
+		rc = track_step(t, t->p, p, r);
+		if (rc < 0) {
+			t->st.overflows++;
+			rebuild_start(t);
+		} else if (rc == 0) {
+			/* caught up: checked against the global answer */
+			answer(t, p, &cr, r);
+			if (px_dist_query(t->dist, p, &g) == PX_OK) {
+				t->st.verifications++;
+				r->verified = 1;
+				if (fabs(r->dist - g.dist) <= 1e-9 * (t->scale + g.dist)) {
+					t->mode = ST_TRACK;
+					r->source = PX_TRACK_REINIT;
+					return PX_OK;
+				}
+				t->st.disagreements++;
+			}
+			rebuild_start(t);
+		}
+	} else {
+		t->st.outside++;
+	}
+	answer_global(t, p, r);
+	return PX_OK;
+}
+
+int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
+{
+	struct px_track_result cr;
+	px_vec3 p0;
+	int rc;
+
+	if (!t || !r)
+		return PX_E_INVAL;
+	if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
+		return PX_E_NAN;
+	if (!t->init)
+		return px_strack_reset(t, p, r);
+	result_clear(r);
+	t->st.updates++;
+	if (++t->epoch == 0)
+		t->epoch = 1;
+	if (t->mode != ST_TRACK)
+		return catch_up(t, p, r);
+	p0 = t->p;
+	r->source = PX_TRACK_TRACKED;
+	if (!in_work(t, p) || !in_work(t, p0)) {
+		if (t->opts.max_solves > 0) {
+			/* the set waits at p0 for the point to come back */
+			t->mode = ST_LAG;
+			return catch_up(t, p, r);
+		}
+		t->p = p;
+		t->st.outside++;
+		return full_reset(t, p, r);
+	}
+	rc = track_step(t, p0, p, r);
+	if (rc == 1) {
+		/* over the budget: answer globally; the rest of the solves
+		 * is done over the next updates, then the set catches up */
+		answer_global(t, p, r);
+		return PX_OK;
+	}
+	if (rc) {
+		/* capacity: the set is re-established (over the next
+		 * updates with a budget) */
+		t->st.overflows++;
+		t->st.reinits++;
+		if (t->opts.max_solves > 0) {
+			rebuild_start(t);
+		} else {
+			t->p = p;
+			if (reinit_all(t, p))
+				t->st.overflows++;
+			heap_rebuild(t, p);
+		}
+		answer_global(t, p, r);
+		return PX_OK;
+	}
+	if (curves_needed(t, p)) {
+		curves_update(t, p, &cr, 0);
+	} else {
+		memset(&cr, 0, sizeof(cr));
+		cr.entity = -1;
+		cr.n_crit = t->ct_ncrit;
+		t->st.curve_skips++;
 	}
 	answer(t, p, &cr, r);
 	if (cr.source != PX_TRACK_TRACKED)
 		r->source = cr.source;
 	verify(t, p, r);
 	return PX_OK;
+}
+
+double px__strack_cert_radius(const struct px_strack *t, int s, double u,
+			      double v, px_vec3 p)
+{
+	const struct ssurf *f;
+	const struct scell *c;
+	int ch;
+	if (!t || s < 0 || s >= t->n_surf)
+		return -1.0;
+	f = &t->sf[s];
+	if (u < f->u0 || u > f->u1 || v < f->v0 || v > f->v1)
+		return -1.0;
+	c = &t->cell[f->first_cell + cell_of(f, u, v)];
+	ch = (u >= 0.5 * (c->u0 + c->u1)) + 2 * (v >= 0.5 * (c->v0 + c->v1));
+	return region_radius(&t->rcell[c->child + ch], p);
 }
 
 int px_strack_critical(const struct px_strack *t, int s, double *u, double *v,
@@ -1020,6 +1526,7 @@ void px_strack_opts_default(struct px_strack_opts *o)
 	o->max_crit = 256;
 	o->work_margin = 1.0;
 	o->verify_every = 0;
+	o->max_solves = 4;
 	o->dist = NULL;
 }
 
@@ -1038,230 +1545,224 @@ static int span_bounds(const struct px_nurbs_surf *s, int dir, double a,
 	return n;
 }
 
-/* Sample of the surface for the focal boxes: point, unit normal, the
- * two principal curvatures (0 when the normal is undefined). */
-static void sample(const struct px_nurbs_surf *s, double u, double v, int su,
-		   int sv, px_vec3 *q, px_vec3 *nrm, double k[2], int *ok)
+static struct iv iv_pt(double x)
 {
-	struct px_nurbs_surf_derivs d;
-	px_vec3 n;
-	double E, F, G, L, M, N, det, H, K, disc, nn;
-	px_nurbs_surf_eval_side(s, u, v, su, sv, 2, &d);
-	*q = d.s;
-	n = px_v3_cross(d.su, d.sv);
-	nn = px_v3_norm(n);
-	*ok = 0;
-	k[0] = k[1] = 0.0;
-	*nrm = px_v3(0, 0, 0);
-	if (!(nn > 1e-14 * (px_v3_norm(d.su) * px_v3_norm(d.sv))) || !(nn > 0.0))
-		return;
-	n = px_v3_scale(n, 1.0 / nn);
-	E = px_v3_dot(d.su, d.su);
-	F = px_v3_dot(d.su, d.sv);
-	G = px_v3_dot(d.sv, d.sv);
-	L = px_v3_dot(d.suu, n);
-	M = px_v3_dot(d.suv, n);
-	N = px_v3_dot(d.svv, n);
-	det = E * G - F * F;
-	if (!(det > 0.0))
-		return;
-	K = (L * N - M * M) / det;
-	H = (E * N + G * L - 2.0 * F * M) / (2.0 * det);
-	/* umbilic: H^2 - K rounds below zero, clamp (equal curvatures) */
-	disc = H * H - K;
-	disc = disc > 0.0 ? sqrt(disc) : 0.0;
-	k[0] = H + disc;
-	k[1] = H - disc;
-	*nrm = n;
-	*ok = 1;
+	struct iv r = {x, x};
+	return r;
 }
 
-/* Transition regions of one cell from m x m samples (scratch pts, nrm,
- * kk, okk). Sampling is not a proof: the cone and the height intervals
- * are grown by margins for the variation between samples. */
-static void cell_regions(struct px_strack *t, struct scell *c,
-			 const struct ssurf *f, px_vec3 *pts, px_vec3 *nrm,
-			 double *kk, int *okk)
+static struct iv iv_add(struct iv a, struct iv b)
 {
-	int m = t->opts.samples, i, j, sh, q, nq = m * m, edge;
-	double sp = 0.0, rho = 0.0, cmin = 1.0, Lw = 0.0;
-	px_vec3 sc = px_v3(0, 0, 0), nc = px_v3(0, 0, 0);
+	struct iv r = {a.lo + b.lo, a.hi + b.hi};
+	return r;
+}
 
-	c->nreg = 0;
-	c->always = 0;
-	for (j = 0; j < m; j++)
-		for (i = 0; i < m; i++) {
-			double u = c->u0 + (c->u1 - c->u0) * i / (m - 1);
-			double v = c->v0 + (c->v1 - c->v0) * j / (m - 1);
-			q = j * m + i;
-			sample(&f->s, u, v, i == m - 1 ? -1 : 1, j == m - 1 ? -1 : 1,
-			       &pts[q], &nrm[q], &kk[2 * q], &okk[q]);
-			if (!okk[q]) {
-				/* pole or degenerate point: the limit from inside */
-				double uu = u + (i == m - 1 ? -1e-7 : 1e-7) * (c->u1 - c->u0);
-				double vv = v + (j == m - 1 ? -1e-7 : 1e-7) * (c->v1 - c->v0);
-				px_vec3 q2;
-				sample(&f->s, uu, vv, 1, 1, &q2, &nrm[q], &kk[2 * q], &okk[q]);
-			}
-			if (!okk[q])
-				c->always = 1;
-			if (i > 0)
-				sp = fmax(sp, px_v3_dist(pts[q], pts[q - 1]));
-			if (j > 0)
-				sp = fmax(sp, px_v3_dist(pts[q], pts[q - m]));
-			sc = px_v3_add(sc, pts[q]);
-			nc = px_v3_add(nc, nrm[q]);
-			Lw = fmax(Lw, sqrt(px_aabb_max_dist2(&t->work, pts[q])));
-		}
-	if (c->always || !(px_v3_norm(nc) > 0.0)) {
-		c->always = 1;
-		t->n_unbounded++;
-		return;
-	}
-	sc = px_v3_scale(sc, 1.0 / nq);
-	nc = px_v3_scale(nc, 1.0 / px_v3_norm(nc));
-	for (q = 0; q < nq; q++) {
-		rho = fmax(rho, px_v3_dist(pts[q], sc));
-		cmin = fmin(cmin, px_v3_dot(nrm[q], nc));
-	}
-	{
-		double th = acos(fmax(-1.0, fmin(1.0, cmin)));
-		/* normals turn between samples by about a sample step of
-		 * curvature: grow the spread by a quarter and a margin */
-		th = 1.25 * th + 0.02;
-		if (th > 1.3) {
-			c->always = 1;
-			t->n_unbounded++;
-			return;
-		}
-		c->a = tan(th);
-		c->ia = 1.0 / sqrt(1.0 + c->a * c->a);
-		cmin = cos(th);
-	}
-	rho = 1.1 * rho + 0.5 * sp + 1e-9 * t->scale;
-	c->sc = sc;
-	c->nc = nc;
-	c->rho = rho * (1.0 + c->a);
-	for (sh = 0; sh < 2; sh++) {
-		double lmin = INFINITY, lmax = -INFINITY, kmax = 0.0, gap = 0.0;
-		int sg = 0, through = 0;
-		struct sreg g;
-		memset(&g, 0, sizeof(g));
-		for (q = 0; q < nq; q++) {
-			double k = kk[2 * q + sh];
-			int s = k > 0.0 ? 1 : (k < 0.0 ? -1 : 0);
-			kmax = fmax(kmax, fabs(k));
-			if (!s || (sg && s != sg) || fabs(k) * Lw < 1.0)
-				through = 1;
-			if (s)
-				sg = s;
-		}
-		if (through) {
-			/* the sheet reaches infinity here (or beyond the
-			 * working volume): |l| >= the smallest focal distance,
-			 * from the largest curvature grown for the samples */
-			if (!(kmax > 0.0))
-				continue; /* flat: no focal point at all */
-			g.split = 1;
-			g.lo = 1.0 / (1.25 * kmax + 1e-12 / t->scale) * cmin - c->rho;
-			g.hi = INFINITY;
-			t->n_unbounded++;
-		} else {
-			for (j = 0; j < m; j++)
-				for (i = 0; i < m; i++) {
-					double l;
-					q = j * m + i;
-					l = 1.0 / kk[2 * q + sh];
-					lmin = fmin(lmin, l);
-					lmax = fmax(lmax, l);
-					if (i > 0)
-						gap = fmax(gap, fabs(l - 1.0 / kk[2 * (q - 1) + sh]));
-					if (j > 0)
-						gap = fmax(gap, fabs(l - 1.0 / kk[2 * (q - m) + sh]));
+static struct iv iv_sub(struct iv a, struct iv b)
+{
+	struct iv r = {a.lo - b.hi, a.hi - b.lo};
+	return r;
+}
+
+static struct iv iv_scale(struct iv a, double k)
+{
+	struct iv r = {fmin(a.lo * k, a.hi * k), fmax(a.lo * k, a.hi * k)};
+	return r;
+}
+
+/* a / w for w > 0 */
+static struct iv iv_divw(struct iv a, struct iv w)
+{
+	struct iv iw = {1.0 / w.hi, 1.0 / w.lo};
+	return iv_mul(a, iw);
+}
+
+static struct iv iv_pad(struct iv a)
+{
+	double e = ST_PAD * (fabs(a.lo) + fabs(a.hi)) + 1e-300;
+	struct iv r = {a.lo - e, a.hi + e};
+	return r;
+}
+
+static void iv_grow(struct iv *a, double x)
+{
+	a->lo = fmin(a->lo, x);
+	a->hi = fmax(a->hi, x);
+}
+
+/*
+ * Enclosure of one homogeneous coordinate k (0..3) of a difference net of
+ * the Bezier net P ((p + 1) x (q + 1), u fastest, 4 per point): the
+ * derivative of order (a, b) in (u, v) is a Bezier patch whose control
+ * points are the forward differences times p!/(p - a)! q!/(q - b)!
+ * / (du^a dv^b); its range lies within their hull.
+ */
+static struct iv net_range(const double *P, int p, int q, int k, int a, int b,
+			   double du, double dv)
+{
+	struct iv r = {INFINITY, -INFINITY};
+	double f = 1.0;
+	int i, j, x, y;
+	if (a > p || b > q)
+		return iv_pt(0.0);
+	for (i = 0; i < a; i++)
+		f *= (double)(p - i) / du;
+	for (j = 0; j < b; j++)
+		f *= (double)(q - j) / dv;
+	for (j = 0; j + b <= q; j++)
+		for (i = 0; i + a <= p; i++) {
+			double d = 0.0;
+			for (y = 0; y <= b; y++)
+				for (x = 0; x <= a; x++) {
+					/* binomial signs of the forward differences */
+					double c = ((a - x + b - y) & 1) ? -1.0 : 1.0;
+					c *= (a == 2 && x == 1 ? 2.0 : 1.0) * (b == 2 && y == 1 ? 2.0 : 1.0);
+					d += c * P[4 * ((j + y) * (p + 1) + i + x) + k];
 				}
-			g.split = 0;
-			/* the focal point's height on the central line is
-			 * between l cos(theta) - rho and l + rho */
-			lmin -= gap;
-			lmax += gap;
-			g.lo = (lmin > 0.0 ? lmin * cmin : lmin) - c->rho;
-			g.hi = (lmax > 0.0 ? lmax : lmax * cmin) + c->rho;
+			iv_grow(&r, f * d);
 		}
-		c->reg[c->nreg++] = g;
+	return iv_pad(r);
+}
+
+/* Certificate data of region cell c (setup; work: extraction scratch). */
+static int cell_cert(struct px_strack *t, struct scell *c, const struct ssurf *f,
+		     double *work, size_t wl, const int side_open[4])
+{
+	struct rcert *ce = &c->cert;
+	struct px_nurbs_surf sub;
+	struct px_nurbs_surf_derivs d;
+	struct iv W, Wu, Wv, Wuu, Wuv, Wvv, Su[3], Sv[3];
+	double du = c->u1 - c->u0, dv = c->v1 - c->v0;
+	int p = f->s.degree[0], q = f->s.degree[1], k, i, rc;
+	rc = px_nurbs_surf_extract_work(&f->s, c->u0, c->u1, c->v0, c->v1, work,
+					wl, &sub);
+	if (rc)
+		return rc;
+	if (sub.n_ctrl[0] != p + 1 || sub.n_ctrl[1] != q + 1)
+		return PX_E_INVAL;
+	memset(ce, 0, sizeof(*ce));
+	W = net_range(sub.pw, p, q, 3, 0, 0, du, dv);
+	if (!(W.lo > 0.0))
+		return PX_E_INVAL;
+	Wu = net_range(sub.pw, p, q, 3, 1, 0, du, dv);
+	Wv = net_range(sub.pw, p, q, 3, 0, 1, du, dv);
+	Wuu = net_range(sub.pw, p, q, 3, 2, 0, du, dv);
+	Wuv = net_range(sub.pw, p, q, 3, 1, 1, du, dv);
+	Wvv = net_range(sub.pw, p, q, 3, 0, 2, du, dv);
+	for (k = 0; k < 3; k++) {
+		struct iv S = {INFINITY, -INFINITY};
+		/* the surface lies in the hull of its projected net */
+		for (i = 0; i < (p + 1) * (q + 1); i++)
+			iv_grow(&S, sub.pw[4 * i + k] / sub.pw[4 * i + 3]);
+		S = iv_pad(S);
+		ce->S[k] = S;
+		/* quotient rule on S = X / W, differentiated */
+		Su[k] = iv_pad(iv_divw(iv_sub(net_range(sub.pw, p, q, k, 1, 0, du, dv),
+					      iv_mul(S, Wu)), W));
+		Sv[k] = iv_pad(iv_divw(iv_sub(net_range(sub.pw, p, q, k, 0, 1, du, dv),
+					      iv_mul(S, Wv)), W));
+		ce->Suu[k] = iv_pad(iv_divw(
+			iv_sub(iv_sub(net_range(sub.pw, p, q, k, 2, 0, du, dv),
+				      iv_scale(iv_mul(Su[k], Wu), 2.0)),
+			       iv_mul(S, Wuu)), W));
+		ce->Svv[k] = iv_pad(iv_divw(
+			iv_sub(iv_sub(net_range(sub.pw, p, q, k, 0, 2, du, dv),
+				      iv_scale(iv_mul(Sv[k], Wv), 2.0)),
+			       iv_mul(S, Wvv)), W));
+		ce->Suv[k] = iv_pad(iv_divw(
+			iv_sub(iv_sub(iv_sub(net_range(sub.pw, p, q, k, 1, 1, du, dv),
+					     iv_mul(Su[k], Wv)),
+				      iv_mul(Sv[k], Wu)),
+			       iv_mul(S, Wuv)), W));
 	}
-	for (edge = 0; edge < 4; edge++) {
-		/* points cross an open edge on its normal lines */
-		struct sreg g;
-		px_vec3 e0, e1, tc, en = px_v3(0, 0, 0), ec = px_v3(0, 0, 0);
-		double rb = 0.0, rn = 0.0, sb = 0.0, cn = 1.0, nt;
-		int on;
-		if (edge == 0)
-			on = !f->wrap_u && c->u0 == f->u0;
-		else if (edge == 1)
-			on = !f->wrap_u && c->u1 == f->u1;
-		else if (edge == 2)
-			on = !f->wrap_v && c->v0 == f->v0;
-		else
-			on = !f->wrap_v && c->v1 == f->v1;
-		if (!on || c->nreg >= ST_NBOX)
-			continue;
-#define EQ(ii) (edge == 0 ? (ii) * m : edge == 1 ? (ii) * m + m - 1 \
-			  : edge == 2 ? (ii) : (m - 1) * m + (ii))
-		e0 = pts[EQ(0)];
-		e1 = pts[EQ(m - 1)];
-		for (i = 0; i < m; i++) {
-			ec = px_v3_add(ec, pts[EQ(i)]);
-			en = px_v3_add(en, nrm[EQ(i)]);
-		}
-		ec = px_v3_scale(ec, 1.0 / m);
-		tc = px_v3_sub(e1, e0);
-		nt = px_v3_norm(en);
-		memset(&g, 0, sizeof(g));
-		if (!(nt > 0.0) || !(px_v3_norm(tc) > 0.0)) {
-			g.lo = -INFINITY; /* collapsed or degenerate: the cone */
-			g.hi = INFINITY;
-			c->reg[c->nreg++] = g;
-			continue;
-		}
-		en = px_v3_scale(en, 1.0 / nt);
-		g.b = px_v3_cross(tc, en);
-		nt = px_v3_norm(g.b);
-		if (!(nt > 0.0)) {
-			g.lo = -INFINITY;
-			g.hi = INFINITY;
-			c->reg[c->nreg++] = g;
-			continue;
-		}
-		g.b = px_v3_scale(g.b, 1.0 / nt);
-		g.n = en;
-		g.sc = ec;
-		for (i = 0; i < m; i++) {
-			px_vec3 w = px_v3_sub(pts[EQ(i)], ec);
-			rb = fmax(rb, fabs(px_v3_dot(w, g.b)));
-			rn = fmax(rn, fabs(px_v3_dot(w, g.n)));
-			sb = fmax(sb, fabs(px_v3_dot(nrm[EQ(i)], g.b)));
-			cn = fmin(cn, px_v3_dot(nrm[EQ(i)], g.n));
-		}
-#undef EQ
-		{
-			/* margins for the turn of the normal between samples */
-			double thb = asin(fmin(1.0, sb)) * 1.25 + 0.02;
-			double thn = acos(fmax(-1.0, fmin(1.0, cn))) * 1.25 + 0.02;
-			if (thb > 1.3 || thn > 1.3) {
-				g.lo = -INFINITY;
-				g.hi = INFINITY;
-				c->reg[c->nreg++] = g;
-				continue;
+	ce->G11 = ce->G12 = ce->G22 = iv_pt(0.0);
+	for (k = 0; k < 3; k++) {
+		struct iv a = Su[k], b = Sv[k], sa = iv_mul(a, a), sb = iv_mul(b, b);
+		/* squares are not negative */
+		if (a.lo <= 0.0 && a.hi >= 0.0)
+			sa.lo = 0.0;
+		if (b.lo <= 0.0 && b.hi >= 0.0)
+			sb.lo = 0.0;
+		ce->G11 = iv_add(ce->G11, sa);
+		ce->G22 = iv_add(ce->G22, sb);
+		ce->G12 = iv_add(ce->G12, iv_mul(a, b));
+		ce->m11 += iv_mag(ce->Suu[k]);
+		ce->m12 += iv_mag(ce->Suv[k]);
+		ce->m22 += iv_mag(ce->Svv[k]);
+	}
+	ce->G11 = iv_pad(ce->G11);
+	ce->G12 = iv_pad(ce->G12);
+	ce->G22 = iv_pad(ce->G22);
+	{
+		/* midpoint-radius form: (S - x) . Sij with S = sm +- sr,
+		 * Sij = hm +- hr per coordinate lies in
+		 * (sm - x) . hm +- (|sm - x| . hr + sr . |hm| + sr . hr) */
+		const struct iv *G[3] = {&ce->G11, &ce->G12, &ce->G22};
+		const struct iv *D[3] = {ce->Suu, ce->Suv, ce->Svv};
+		double *sm = &ce->smid.x;
+		for (k = 0; k < 3; k++)
+			sm[k] = 0.5 * (ce->S[k].lo + ce->S[k].hi);
+		for (i = 0; i < 3; i++) {
+			double *b = &ce->B[i].x, *qq = &ce->Q[i].x;
+			ce->A[i] = 0.5 * (G[i]->lo + G[i]->hi);
+			ce->R[i] = 0.5 * (G[i]->hi - G[i]->lo);
+			for (k = 0; k < 3; k++) {
+				double hm = 0.5 * (D[i][k].lo + D[i][k].hi);
+				double hr = 0.5 * (D[i][k].hi - D[i][k].lo);
+				double sr = 0.5 * (ce->S[k].hi - ce->S[k].lo);
+				b[k] = hm;
+				qq[k] = hr;
+				ce->A[i] += sm[k] * hm;
+				ce->R[i] += sr * fabs(hm) + sr * hr;
 			}
-			g.a = sin(thb) / cos(thn);
-			rb = 1.1 * rb + 0.05 * sp + 1e-9 * t->scale;
-			rn = 1.1 * rn + 0.05 * sp + 1e-9 * t->scale;
-			g.rho = rb + g.a * rn;
-			g.ia = 1.0 / sqrt(1.0 + g.a * g.a);
-			g.wedge = 1;
+			ce->R[i] = iv_pad(iv_pt(ce->R[i])).hi;
 		}
-		c->reg[c->nreg++] = g;
 	}
+	ce->hu = 0.5 * du;
+	ce->hv = 0.5 * dv;
+	surf_eval2(f, 0.5 * (c->u0 + c->u1), 0.5 * (c->v0 + c->v1), &d);
+	ce->sc = d.s;
+	ce->suc = d.su;
+	ce->svc = d.sv;
+	ce->n1 = fabs(d.su.x) + fabs(d.su.y) + fabs(d.su.z);
+	ce->n2 = fabs(d.sv.x) + fabs(d.sv.y) + fabs(d.sv.z);
+	for (k = 0; k < 4; k++) {
+		struct cside *sd;
+		double u, v;
+		if (!side_open[k])
+			continue;
+		sd = &ce->side[ce->nside++];
+		/* sides 0, 1: u = u0, u1 (along v); 2, 3: v = v0, v1 */
+		u = k == 0 ? c->u0 : k == 1 ? c->u1 : 0.5 * (c->u0 + c->u1);
+		v = k == 2 ? c->v0 : k == 3 ? c->v1 : 0.5 * (c->v0 + c->v1);
+		/* evaluate on the cell's own patch (one-sided at a crease) */
+		u = fmin(fmax(u, c->u0 + 1e-13 * du), c->u1 - 1e-13 * du);
+		v = fmin(fmax(v, c->v0 + 1e-13 * dv), c->v1 - 1e-13 * dv);
+		surf_eval2(f, u, v, &d);
+		sd->s = d.s;
+		sd->su = d.su;
+		sd->sv = d.sv;
+		sd->n1 = fabs(d.su.x) + fabs(d.su.y) + fabs(d.su.z);
+		sd->n2 = fabs(d.sv.x) + fabs(d.sv.y) + fabs(d.sv.z);
+		sd->along = k < 2;
+		sd->h = k < 2 ? ce->hv : ce->hu;
+		/* the side point is off the exact side by 1e-13 of the cell:
+		 * cover it in the half length */
+		sd->h *= 1.0 + 1e-12;
+	}
+	(void)t;
+	return PX_OK;
+}
+
+/* 1 when x is a break of the surface along dir where it is less than
+ * C2 (knot multiplicity above degree - 2): points enter and leave a
+ * patch there as through an edge. */
+static int crease_at(const struct ssurf *f, int dir, double x)
+{
+	int i, m = 0;
+	for (i = 0; i < f->s.n_knots[dir]; i++)
+		if (f->s.knots[dir][i] == x)
+			m++;
+	return m > f->s.degree[dir] - 2;
 }
 
 void px_strack_free(struct px_strack *t)
@@ -1291,6 +1792,9 @@ void px_strack_free(struct px_strack *t)
 	free(t->heap);
 	free(t->popped);
 	free(t->hits);
+	free(t->pend);
+	free(t->pend_ps);
+	free(t->cbox);
 	free(t);
 }
 
@@ -1336,6 +1840,7 @@ static int build_patches(struct ssurf *f, const double *ub, int nu,
 		for (a = 0; a < f->npu; a++) {
 			struct patch *pt = &f->pt[b * f->npu + a];
 			struct px_nurbs_surf sub;
+			double pt_w;
 			double *c = f->pool + (size_t)(b * f->npu + a) * 4 * (size_t)np;
 			int rc = px_nurbs_surf_extract_work(&f->s, ub[a], ub[a + 1], vb[b],
 							    vb[b + 1], work, wl, &sub);
@@ -1352,11 +1857,24 @@ static int build_patches(struct ssurf *f, const double *ub, int nu,
 			pt->p = p;
 			pt->q = q;
 			pt->c = c;
+			{
+				/* equal weights: divide them out, evaluate as a
+				 * polynomial */
+				double w0 = sub.pw[3];
+				int m;
+				pt->rat = 0;
+				for (m = 0; m < np; m++)
+					if (sub.pw[4 * m + 3] != w0)
+						pt->rat = 1;
+				pt_w = pt->rat ? 1.0 : w0;
+			}
 			for (k = 0; k < 4; k++) {
 				double *ck = c + k * np;
 				for (j = 0; j <= q; j++)
 					for (i = 0; i <= p; i++)
-						ck[j * (p + 1) + i] = sub.pw[4 * (j * (p + 1) + i) + k];
+						ck[j * (p + 1) + i] =
+							k == 3 && !pt->rat ? 1.0
+									   : sub.pw[4 * (j * (p + 1) + i) + k] / pt_w;
 				/* Bernstein to power form along s, then along t */
 				for (j = 0; j <= q; j++) {
 					double *row = ck + j * (p + 1);
@@ -1394,9 +1912,8 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	struct px_strack_opts o;
 	struct px_nurbs_curve *cc = NULL;
 	double **cpw = NULL, *ub = NULL, *vb = NULL;
-	px_vec3 *pts = NULL, *nrm = NULL;
-	double *kk = NULL;
-	int *okk = NULL;
+	double *work = NULL;
+	size_t wl = 0;
 	int rc, i, j, k, max_knots = 0, cap_edges, n_cc = 0, cell_cap = 0;
 	px_aabb bounds;
 
@@ -1410,7 +1927,7 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 		px_strack_opts_default(&o);
 	if (o.cells_per_span < 1 || o.cells_per_span > 16 || o.seeds < 1 ||
 	    o.seeds > 8 || o.samples < 2 || o.samples > 32 || o.max_crit < 2 ||
-	    o.max_crit > 1 << 20 || o.verify_every < 0 ||
+	    o.max_crit > 1 << 20 || o.verify_every < 0 || o.max_solves < 0 ||
 	    !(o.work_margin >= 0.0))
 		return PX_E_INVAL;
 	for (i = 0; i < n_surfs; i++) {
@@ -1508,18 +2025,28 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	t->heap = calloc((size_t)cell_cap + 1, sizeof(int));
 	t->popped = calloc((size_t)cell_cap + 1, sizeof(int));
 	t->hits = calloc((size_t)cell_cap + 1, sizeof(int));
-	pts = calloc((size_t)(o.samples * o.samples), sizeof(*pts));
-	nrm = calloc((size_t)(o.samples * o.samples), sizeof(*nrm));
-	kk = calloc((size_t)(2 * o.samples * o.samples), sizeof(double));
-	okk = calloc((size_t)(o.samples * o.samples), sizeof(int));
+	t->pend = calloc(2 * (size_t)cell_cap + 2, sizeof(int));
+	t->pend_ps = calloc(2 * (size_t)cell_cap + 2, sizeof(px_vec3));
+	for (i = 0; i < n_surfs; i++) {
+		const struct px_nurbs_surf *sf = &t->sf[i].s;
+		size_t l = PX_NURBS_SURF_WORK_LEN(sf->degree[0], sf->degree[1],
+						  sf->n_ctrl[0], sf->n_ctrl[1]);
+		if (l > wl)
+			wl = l;
+	}
+	work = malloc(wl * sizeof(double));
 	if (!t->cell || !t->rcell || !t->heap || !t->popped || !t->hits ||
-	    !pts || !nrm ||
-	    !kk || !okk) {
+	    !t->pend || !t->pend_ps || !work) {
 		rc = PX_E_NOMEM;
 		goto fail;
 	}
 	for (i = 0; i < n_surfs; i++) {
 		struct ssurf *f = &t->sf[i];
+		for (k = 0; k < 4; k++)
+			/* as for the poles below */
+			f->pole[k] = !((k < 2 && f->wrap_u) || (k >= 2 && f->wrap_v)) &&
+				     px_nurbs_surf_edge_collapsed(&f->s, k,
+								  1e-12 * (1.0 + t->scale));
 		for (j = 0; j < f->ncv; j++)
 			for (k = 0; k < f->ncu; k++) {
 				struct scell *c = &t->cell[f->first_cell + j * f->ncu + k];
@@ -1531,18 +2058,39 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 				{
 					double um = 0.5 * (c->u0 + c->u1), vm = 0.5 * (c->v0 + c->v1);
 					int ch;
+					px_aabb cb = px_aabb_empty();
 					c->child = 4 * (f->first_cell + j * f->ncu + k);
 					for (ch = 0; ch < 4; ch++) {
 						struct scell *rg = &t->rcell[c->child + ch];
+						int open[4];
+						px_aabb rb;
 						rg->surf = i;
 						rg->u0 = ch & 1 ? um : c->u0;
 						rg->u1 = ch & 1 ? c->u1 : um;
 						rg->v0 = ch & 2 ? vm : c->v0;
 						rg->v1 = ch & 2 ? c->v1 : vm;
-						cell_regions(t, rg, f, pts, nrm, kk, okk);
-						/* size scale of the solve cell */
-						c->rho = fmax(c->rho, 2.0 * rg->rho);
+						open[0] = rg->u0 == f->u0 ? !f->wrap_u
+									  : crease_at(f, 0, rg->u0);
+						open[1] = rg->u1 == f->u1 ? !f->wrap_u
+									  : crease_at(f, 0, rg->u1);
+						open[2] = rg->v0 == f->v0 ? !f->wrap_v
+									  : crease_at(f, 1, rg->v0);
+						open[3] = rg->v1 == f->v1 ? !f->wrap_v
+									  : crease_at(f, 1, rg->v1);
+						if ((rg->u0 == f->u0 && f->pole[0]) ||
+						    (rg->u1 == f->u1 && f->pole[1]) ||
+						    (rg->v0 == f->v0 && f->pole[2]) ||
+						    (rg->v1 == f->v1 && f->pole[3]))
+							c->always = 1;
+						rc = cell_cert(t, rg, f, work, wl, open);
+						if (rc)
+							goto fail;
+						rb.min = px_v3(rg->cert.S[0].lo, rg->cert.S[1].lo, rg->cert.S[2].lo);
+						rb.max = px_v3(rg->cert.S[0].hi, rg->cert.S[1].hi, rg->cert.S[2].hi);
+						cb = px_aabb_union(&cb, &rb);
 					}
+					c->size = px_aabb_diagonal(&cb);
+					t->n_unbounded += c->always;
 				}
 			}
 	}
@@ -1634,6 +2182,41 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	}
 	if (n_cc > 0) {
 		struct px_track_opts to;
+		double *cw = NULL;
+		size_t cwl = 0;
+		int nb = 0;
+		for (i = 0; i < n_cc; i++) {
+			size_t l = PX_NURBS_CURVE_WORK_LEN(cc[i].degree, cc[i].n_ctrl);
+			cwl = l > cwl ? l : cwl;
+			nb += 2 * cc[i].n_knots;
+		}
+		t->cbox = calloc((size_t)nb, sizeof(*t->cbox));
+		cw = malloc(cwl * sizeof(double));
+		if (!t->cbox || !cw) {
+			free(cw);
+			rc = PX_E_NOMEM;
+			goto fail;
+		}
+		for (i = 0; i < n_cc && rc == PX_OK; i++) {
+			const double *U = cc[i].knots;
+			int p = cc[i].degree, n = cc[i].n_ctrl, h;
+			for (k = p; k < n && rc == PX_OK; k++) {
+				if (!(U[k + 1] > U[k]))
+					continue;
+				for (h = 0; h < 2 && rc == PX_OK; h++) {
+					double a = U[k] + 0.5 * h * (U[k + 1] - U[k]);
+					double b = h ? U[k + 1] : 0.5 * (U[k] + U[k + 1]);
+					px_aabb bx;
+					rc = px_nurbs_curve_sub_aabb(&cc[i], a, b, cw, cwl, &bx);
+					if (rc == PX_OK)
+						/* rounding of evaluated points */
+						t->cbox[t->n_cbox++] = px_aabb_inflate(&bx, 1e-12 * t->scale);
+				}
+			}
+		}
+		free(cw);
+		if (rc)
+			goto fail;
 		px_track_opts_default(&to);
 		to.work = t->work;
 		to.dist = o.dist;
@@ -1653,10 +2236,7 @@ fail:
 	free(cc);
 	free(ub);
 	free(vb);
-	free(pts);
-	free(nrm);
-	free(kk);
-	free(okk);
+	free(work);
 	px_strack_free(t);
 	return rc;
 }

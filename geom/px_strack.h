@@ -10,25 +10,32 @@
  *    d(u, v) = H^-1 (Su . dp, Sv . dp), then Newton on the gradient
  *    ((S - p) . Su, (S - p) . Sv) = 0 with the new point held fixed.
  *  - Transitions (section 4.3): pairs are born or die where p crosses a
- *    focal sheet S + N / k_i (k_i the principal curvatures), and interior
- *    points enter or leave through an edge where p crosses the normal
- *    lines along that edge. Each Bezier patch is cut into (u, v) cells,
- *    each of those into 2 x 2 region cells (a two-level hierarchy: the
- *    regions of the small cells decide, the big cell is solved). At
- *    setup every region cell gets, from samples, a cone that holds all its
- *    normal lines (central normal line, spread and slope) and, per focal
- *    sheet, the interval of heights l along it where the sheet lies; a
- *    curvature that changes sign or nearly vanishes in the cell
- *    (parabolic lines: the sheet goes through infinity) gives the
- *    unbounded region |l| >= l_min instead of infinite coordinates, and
- *    umbilics need no care (the principal curvatures come from a clamped
- *    discriminant), so nothing is NaN. Cells on an open edge add a wedge
- *    around the edge's normal lines. When the path of the point comes
- *    within reach of a cell's regions, that cell is solved again at the
- *    new point (Newton from a seed grid; evolved points are kept,
- *    duplicates merged). Each cell carries a safe radius (a lower bound
- *    on the distance of the point from its regions when last tested) and
- *    a min-heap on the travelled path length names the cells due.
+ *    focal sheet S + N / k_i (k_i the principal curvatures): there a
+ *    critical point is degenerate, E = 0 and det H = 0. Interior points
+ *    enter or leave through an open edge (or a crease with less than C2
+ *    continuity), where E = 0 on that side. Each Bezier patch is cut into
+ *    (u, v) cells, each of those into 2 x 2 region cells. At setup every
+ *    region cell gets enclosures of S and its derivatives up to order 2
+ *    over the cell (from its Bezier net: convex hull for S, difference
+ *    nets for the derivatives, interval quotient rule when rational). At
+ *    run time these bound E and H over the cell for all points x of a
+ *    cube about p, and the cell is proven free of transitions while x
+ *    stays in the cube if E1 or E2 keeps its sign (no critical point
+ *    there at all) or det H keeps its sign and E is signed on every open
+ *    side. The largest such cube has a closed form (E: linear in the
+ *    half width; det H: quadratic). No curvature is ever divided by, so
+ *    parabolic lines (k = 0, the sheet through infinity) and umbilics give
+ *    no NaN. Each cell carries that radius; a min-heap on the travelled
+ *    path length names the cells due; a due cell is tested on the segment
+ *    of this update (the cube about its middle) and solved again at the
+ *    new point when the proof fails (Newton from a seed grid; evolved
+ *    points are kept, duplicates merged). Cells on a collapsed edge have
+ *    no proof near the pole's normal lines and are solved whenever hit.
+ *  - Bounded work: an update whose proven-hit cells exceed max_solves is
+ *    answered by the global query; the tracked set then catches up with
+ *    the point over the next updates in budgeted tracked steps (or is
+ *    rebuilt in slices of cells when that fails) and is checked against
+ *    the global answer before it answers again.
  *  - Collapsed edges (poles): (S - p) . Sv vanishes along such an edge,
  *    a spurious root set that attracts Newton; the tracker solves with
  *    that equation divided by the distance to the edge and leaves the
@@ -38,7 +45,10 @@
  *  - Boundary candidates: the domain edges (not at a closed seam, not
  *    collapsed) are tracked as curves by an internal px_track, with the
  *    corners as their end points; collapsed edges are point candidates.
- *    Free curves of the model go into the same curve tracker.
+ *    Free curves of the model go into the same curve tracker. It is left
+ *    out of an update while boxes of its curves' half spans prove them
+ *    all farther than the best interior minimum (and it is updated at
+ *    least every 2 % of the model size of travel).
  *  - Answer: the smallest of the surface minima and the curve tracker's
  *    answer; jumped when the closest feature is not the continuation of
  *    the last one.
@@ -75,17 +85,35 @@ struct px_strack_opts {
 	/* Newton seeds per cell and direction when a cell is solved
 	 * (default 2, 1..8). */
 	int seeds;
-	/* Samples per cell and direction for the transition regions at
-	 * setup (default 6, 2..32). */
+	/* Unused since the transition regions are proven instead of
+	 * sampled; still checked (2..32) so that old option sets stay
+	 * valid. */
 	int samples;
 	/* Interior critical points each surface can hold (default 256). */
 	int max_crit;
 	/* Working volume margin as a fraction of the model diagonal
-	 * (default 1.0); outside it the point re-initialises. */
+	 * (default 1.0); outside it the update answers globally and the set
+	 * waits (max_solves > 0) or re-initialises (max_solves = 0). */
 	double work_margin;
 	/* Compare with the global query every verify_every updates (0: off,
 	 * the default). */
 	int verify_every;
+	/* Bound on the transition work of one update, in cell solves
+	 * (default 4; 0: no bound). An update whose certificates name more
+	 * cells to solve (or whose critical points overflow max_crit) is
+	 * answered by the global query (px_dist_query(), exact) instead,
+	 * and the critical points are re-established over the following
+	 * updates: max_solves / 2 cells (at least 1) per update, each of
+	 * those answered by the global query too, then one tracked step
+	 * from where the rebuild started to the current point, checked
+	 * against the global answer before the tracker answers again.
+	 * Real-time meaning: an update costs at most about max_solves cell
+	 * solves plus the following of the live points, or one global query
+	 * plus max_solves / 2 cell solves (see stats.over_budget and
+	 * stats.rebuild_updates). Leaving the working volume starts such a
+	 * rebuild as well. With 0 these cases re-initialise at once (cost
+	 * of px_strack_reset()). */
+	int max_solves;
 	/* Options of the global-query model (NULL: defaults). */
 	const struct px_dist_opts *dist;
 };
@@ -113,7 +141,8 @@ struct px_strack_result {
 			    * tracker's critical points */
 	int n_min, n_max, n_saddle; /* interior surface points by type */
 	int source;        /* enum px_track_source */
-	int cells_solved;  /* cells solved again this update */
+	int cells_solved;  /* cell solves this update within the budget
+			    * (pole cells not counted) */
 	/* interior points that appeared this update (born in pairs at a
 	 * focal sheet, or entered through an edge) and that ended (died in
 	 * pairs at a focal sheet, left through an edge, or lost by Newton:
@@ -129,15 +158,20 @@ struct px_strack_stats {
 	 * at a fold or left through an edge; their cell is solved again) */
 	uint64_t cell_solves, box_tests, lost;
 	uint64_t born;     /* interior points found by cell solves */
+	/* updates whose transition work exceeded max_solves; updates
+	 * answered globally while the set was re-established */
+	uint64_t over_budget, rebuild_updates;
+	/* updates that left the curve tracker out: every curve and edge
+	 * was proven farther than the best interior minimum */
+	uint64_t curve_skips;
 };
 
 struct px_strack_info {
 	int n_surfaces, n_curves, n_patches, n_cells;
 	int n_edges;       /* edges tracked as curves */
 	int n_poles;       /* collapsed edges */
-	int n_unbounded;   /* focal sheets through infinity (|l| >= l_min)
-			    * and cells solved on every update (normals
-			    * too spread or undefined) */
+	int n_unbounded;   /* cells on a collapsed edge: solved whenever
+			    * hit, outside the work budget */
 	px_aabb work;
 };
 
@@ -164,7 +198,13 @@ PX_API int px_strack_reset(struct px_strack *t, px_vec3 p,
 			   struct px_strack_result *r);
 
 /* Move the point to p and answer. Returns PX_OK, PX_E_INVAL (NULL) or
- * PX_E_NAN (p not finite; state and r untouched). @note RT-safe. */
+ * PX_E_NAN (p not finite; state and r untouched). The answer is exact
+ * in every case: from the tracked set (source PX_TRACK_TRACKED or, the
+ * first after catching up, PX_TRACK_REINIT) or from px_dist_query()
+ * (PX_TRACK_GLOBAL: over the budget, catching up, outside the working
+ * volume); for those, jumped means a change of entity or a foot point
+ * that moved far more than the query point. n_crit counts the curve
+ * tracker's points as of its last update. @note RT-safe. */
 PX_API int px_strack_update(struct px_strack *t, px_vec3 p,
 			    struct px_strack_result *r);
 

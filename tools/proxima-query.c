@@ -446,6 +446,12 @@ int main(int argc, char **argv)
 				(unsigned long long)st.reinits,
 				(unsigned long long)st.outside,
 				(unsigned long long)st.fallbacks);
+			fprintf(stderr,
+				"strack_over_budget %llu catching_up %llu "
+				"curve_skips %llu\n",
+				(unsigned long long)st.over_budget,
+				(unsigned long long)st.rebuild_updates,
+				(unsigned long long)st.curve_skips);
 		}
 	}
 	rc = 0;
