@@ -92,6 +92,34 @@ struct mesh {
 	uint32_t *adj_start; /* n_hull + 1 offsets into adj (vertex graph) */
 	uint32_t *adj;
 	uint32_t ext[6];     /* vertices extreme along -x, +x, -y, +y, -z, +z */
+	/* Hint grid for cold queries: cubic cells over the box grown by a
+	 * margin, each holding the leaf index of the triangle closest to
+	 * the cell's centre (exact, computed at setup). Any triangle's
+	 * distance is an upper bound of the answer, and this one's is
+	 * within a cell diagonal of it, so the walk starts as a coherent
+	 * query does. Points outside the grid take the nearest cell.
+	 * grid == NULL: no grid (cold queries start unbounded). */
+	uint32_t *grid;      /* gdim[0] * gdim[1] * gdim[2] cells, x fastest */
+	int gdim[3];
+	px_vec3 gorg;        /* lower corner of cell (0, 0, 0) */
+	double gcell;        /* cell edge length */
+	double ginv;         /* 1 / gcell */
 };
+
+/* Leaf index of the hint triangle for p (the grid must exist).
+ * @note RT-safe. */
+static inline uint32_t px__mesh_grid_hint(const struct mesh *M, px_vec3 p)
+{
+	double f[3] = {(p.x - M->gorg.x) * M->ginv, (p.y - M->gorg.y) * M->ginv,
+		       (p.z - M->gorg.z) * M->ginv};
+	size_t c[3];
+	int k;
+	for (k = 0; k < 3; k++) {
+		/* clamp in double first: the cast is undefined out of range */
+		double hi = (double)(M->gdim[k] - 1);
+		c[k] = !(f[k] > 0.0) ? 0 : (f[k] >= hi ? (size_t)hi : (size_t)f[k]);
+	}
+	return M->grid[(c[2] * (size_t)M->gdim[1] + c[1]) * (size_t)M->gdim[0] + c[0]];
+}
 
 #endif
