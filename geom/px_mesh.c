@@ -8,25 +8,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#ifdef __SSE__
-#include <xmmintrin.h>
-#endif
-
 #include "mesh_internal.h"
 #include "model_internal.h"
 #include "px_mesh.h"
-
-static float f_down(double x)
-{
-	float f = (float)x;
-	return (double)f > x ? nextafterf(f, -INFINITY) : f;
-}
-
-static float f_up(double x)
-{
-	float f = (float)x;
-	return (double)f < x ? nextafterf(f, INFINITY) : f;
-}
 
 /* ---- point-triangle distance ------------------------------------------ */
 
@@ -264,6 +248,18 @@ struct build {
 	int depth;
 };
 
+/* Compares rather than fmin/fmax (library calls, a fifth of the build
+ * time): the coordinates are finite here. */
+static inline double mn(double a, double b)
+{
+	return a < b ? a : b;
+}
+
+static inline double mx(double a, double b)
+{
+	return a > b ? a : b;
+}
+
 static void range_box(const struct build *B, size_t s, size_t n, float lo[3],
 		      float hi[3])
 {
@@ -274,13 +270,13 @@ static void range_box(const struct build *B, size_t s, size_t n, float lo[3],
 	for (i = s; i < s + n; i++) {
 		size_t t = B->perm[i];
 		for (k = 0; k < 3; k++) {
-			l[k] = fmin(l[k], B->tlo[3 * t + k]);
-			h[k] = fmax(h[k], B->thi[3 * t + k]);
+			l[k] = mn(l[k], B->tlo[3 * t + k]);
+			h[k] = mx(h[k], B->thi[3 * t + k]);
 		}
 	}
 	for (k = 0; k < 3; k++) {
-		lo[k] = f_down(l[k]);
-		hi[k] = f_up(h[k]);
+		lo[k] = px__f_down(l[k]);
+		hi[k] = px__f_up(h[k]);
 	}
 }
 
@@ -333,8 +329,8 @@ static size_t sah_split(struct build *B, size_t s, size_t n, const double clo[3]
 			b = b < 0 ? 0 : (b >= SAH_BINS ? SAH_BINS - 1 : b);
 			cnt[b]++;
 			for (m = 0; m < 3; m++) {
-				blo[b][m] = fmin(blo[b][m], B->tlo[3 * t + m]);
-				bhi[b][m] = fmax(bhi[b][m], B->thi[3 * t + m]);
+				blo[b][m] = mn(blo[b][m], B->tlo[3 * t + m]);
+				bhi[b][m] = mx(bhi[b][m], B->thi[3 * t + m]);
 			}
 		}
 		for (m = 0; m < 3; m++) {
@@ -345,8 +341,8 @@ static size_t sah_split(struct build *B, size_t s, size_t n, const double clo[3]
 		for (j = 0; j < SAH_BINS - 1; j++) {
 			acc += cnt[j];
 			for (m = 0; m < 3; m++) {
-				llo[m] = fmin(llo[m], blo[j][m]);
-				lhi[m] = fmax(lhi[m], bhi[j][m]);
+				llo[m] = mn(llo[m], blo[j][m]);
+				lhi[m] = mx(lhi[m], bhi[j][m]);
 			}
 			lc[j] = acc;
 			la[j] = acc ? half_area(llo, lhi) : 0.0;
@@ -356,8 +352,8 @@ static size_t sah_split(struct build *B, size_t s, size_t n, const double clo[3]
 			double cost;
 			acc += cnt[j];
 			for (m = 0; m < 3; m++) {
-				rlo[m] = fmin(rlo[m], blo[j][m]);
-				rhi[m] = fmax(rhi[m], bhi[j][m]);
+				rlo[m] = mn(rlo[m], blo[j][m]);
+				rhi[m] = mx(rhi[m], bhi[j][m]);
 			}
 			if (lc[j - 1] == 0 || acc == 0)
 				continue;
@@ -398,28 +394,17 @@ static size_t sah_split(struct build *B, size_t s, size_t n, const double clo[3]
 static uint32_t build_node(struct build *B, size_t s, size_t n, int depth)
 {
 	uint32_t me = (uint32_t)B->n_nodes++;
-	double clo[3] = {INFINITY, INFINITY, INFINITY},
-	       chi[3] = {-INFINITY, -INFINITY, -INFINITY};
-	size_t i, half = 0, part[2][2];
-	int k, axis = 0, c;
+	double clo[3], chi[3];
+	size_t half = 0, part[2][2];
+	int c;
 
 	if (depth > B->depth)
 		B->depth = depth;
-	for (i = s; i < s + n; i++)
-		for (k = 0; k < 3; k++) {
-			double x = B->cen[3 * (size_t)B->perm[i] + k];
-			clo[k] = fmin(clo[k], x);
-			chi[k] = fmax(chi[k], x);
-		}
+	px__key_bounds(B->perm + s, n, B->cen, clo, chi);
 	if (depth + 2 + log2ceil(n) <= PX_MESH_MAX_DEPTH - 2)
 		half = sah_split(B, s, n, clo, chi);
-	if (half == 0) {
-		half = n / 2;
-		for (k = 1; k < 3; k++)
-			if (chi[k] - clo[k] > chi[axis] - clo[axis])
-				axis = k;
-		px__select_k(B->perm + s, (long)n, (long)half, B->cen, axis);
-	}
+	if (half == 0)
+		half = px__median_split(B->perm + s, n, B->cen, clo, chi);
 	part[0][0] = s;
 	part[0][1] = half;
 	part[1][0] = s + half;
@@ -440,8 +425,8 @@ static uint32_t build_node(struct build *B, size_t s, size_t n, int depth)
 	return me;
 }
 
-static uint32_t collapse(const struct node *bn, struct node4 *n4, size_t *n_n4,
-			 uint32_t b)
+uint32_t px__node4_collapse(const struct node *bn, struct node4 *n4,
+			    size_t *n_n4, uint32_t b)
 {
 	uint32_t me = (uint32_t)(*n_n4)++;
 	struct node4 *o = &n4[me];
@@ -484,76 +469,10 @@ static uint32_t collapse(const struct node *bn, struct node4 *n4, size_t *n_n4,
 	}
 	for (j = 0; j < s; j++)
 		if (n4[me].cnt[j] == 0) {
-			uint32_t ch = collapse(bn, n4, n_n4, n4[me].idx[j]);
+			uint32_t ch = px__node4_collapse(bn, n4, n_n4, n4[me].idx[j]);
 			n4[me].idx[j] = ch;
 		}
 	return me;
-}
-
-/* Squared distances from p to the four child boxes (+inf for absent
- * children, whose boxes are empty). */
-static inline void box4_d2(const struct node4 *nd, px_vec3 p, double d2[4])
-{
-	int j;
-	for (j = 0; j < 4; j++) {
-		double dx = (double)nd->lo[0][j] - p.x, ex = p.x - (double)nd->hi[0][j];
-		double dy = (double)nd->lo[1][j] - p.y, ey = p.y - (double)nd->hi[1][j];
-		double dz = (double)nd->lo[2][j] - p.z, ez = p.z - (double)nd->hi[2][j];
-		dx = dx > ex ? dx : ex;
-		dy = dy > ey ? dy : ey;
-		dz = dz > ez ? dz : ez;
-		dx = dx > 0.0 ? dx : 0.0;
-		dy = dy > 0.0 ? dy : 0.0;
-		dz = dz > 0.0 ? dz : 0.0;
-		d2[j] = dx * dx + dy * dy + dz * dz;
-	}
-}
-
-/*
- * The same four lower bounds in single precision, side by side (the
- * compiler turns the loops into packed operations): half the work of the
- * double version per node. Rounding p and the differences to float can
- * overstate a gap by at most 2^-24 (2 |p| + |box|) per axis, so every gap
- * is first reduced by slack = 2^-22 (|box| + |p|) (max norms, given by
- * the caller), and the squared sum, itself rounded up to six times by
- * 2^-24 relative, is scaled by 1 - 2^-18: the result stays a lower bound
- * of the true squared distance, so pruning with it never loses the
- * closest triangle. Callers use it only while |p| and the mesh stay below
- * 1e18, so no square overflows the float range (mesh_closest falls back
- * to box4_d2 otherwise).
- */
-static inline void box4_d2f(const struct node4 *nd, const float pf[3],
-			    float slack, double d2[4])
-{
-	float s[4];
-	int j;
-#ifdef __SSE__
-	/* the same operations as below, four children per instruction (the
-	 * compiler does not vectorise the loops at -O2) */
-	__m128 sl = _mm_set1_ps(slack), z = _mm_setzero_ps(), acc = z;
-	int k;
-	for (k = 0; k < 3; k++) {
-		__m128 p = _mm_set1_ps(pf[k]);
-		__m128 a = _mm_sub_ps(_mm_load_ps(nd->lo[k]), p);
-		__m128 b = _mm_sub_ps(p, _mm_load_ps(nd->hi[k]));
-		__m128 g = _mm_max_ps(_mm_sub_ps(_mm_max_ps(a, b), sl), z);
-		acc = _mm_add_ps(acc, _mm_mul_ps(g, g));
-	}
-	_mm_storeu_ps(s, acc);
-#else
-	float g[3][4];
-	int k;
-	for (k = 0; k < 3; k++)
-		for (j = 0; j < 4; j++) {
-			float a = nd->lo[k][j] - pf[k], b = pf[k] - nd->hi[k][j];
-			float m = (a > b ? a : b) - slack;
-			g[k][j] = m > 0.0f ? m : 0.0f;
-		}
-	for (j = 0; j < 4; j++)
-		s[j] = g[0][j] * g[0][j] + g[1][j] * g[1][j] + g[2][j] * g[2][j];
-#endif
-	for (j = 0; j < 4; j++)
-		d2[j] = (double)s[j] * (1.0 - 0x1p-18);
 }
 
 static void mesh_free(void *impl)
@@ -580,22 +499,6 @@ static void mesh_free(void *impl)
 
 /* ---- query --------------------------------------------------------------- */
 
-/* Plain compares rather than fmax(), which is an out-of-line libm call
- * (NaN rules) and was a fifth of the query time; no NaN reaches here. */
-static inline double gap(double lo, double hi, double x)
-{
-	double d = lo - x > x - hi ? lo - x : x - hi;
-	return d > 0.0 ? d : 0.0;
-}
-
-static inline double box_d2(const struct node *nd, int c, px_vec3 p)
-{
-	double dx = gap(nd->lo[c][0], nd->hi[c][0], p.x);
-	double dy = gap(nd->lo[c][1], nd->hi[c][1], p.y);
-	double dz = gap(nd->lo[c][2], nd->hi[c][2], p.z);
-	return dx * dx + dy * dy + dz * dz;
-}
-
 struct best {
 	double d2;
 	long li;
@@ -605,7 +508,7 @@ struct best {
 };
 
 /* Query point in single precision with the slack that covers the
- * rounding of the float bounds (box4_d2f, tri_lb); use = 0 when p or the
+ * rounding of the float bounds (px__box4_d2f, tri_lb); use = 0 when p or the
  * mesh is too far out for floats (then only exact tests are made). */
 struct pq {
 	float pf[3];
@@ -756,9 +659,9 @@ static void mesh_walk(const struct mesh *M, px_vec3 p, struct best *b,
 		}
 		nd = &M->n4[st[sp].idx];
 		if (pq.use)
-			box4_d2f(nd, pq.pf, pq.slack_box, dc);
+			px__box4_d2f(nd, pq.pf, pq.slack_box, dc);
 		else
-			box4_d2(nd, p, dc);
+			px__box4_d2(nd, p, dc);
 		/* children that can still win, nearest first */
 		for (j = 0; j < 4; j++) {
 			if (nd->idx[j] == EMPTY || dc[j] > b->d2)
@@ -882,7 +785,7 @@ static int mesh_collect(const void *impl, px_vec3 p, double radius, int *idx,
 			const struct node4 *nd = &M->n4[st[sp].idx];
 			double dc[4];
 			int c;
-			box4_d2(nd, p, dc);
+			px__box4_d2(nd, p, dc);
 			for (c = 0; c < 4; c++) {
 				if (nd->idx[c] == EMPTY || dc[c] > r2 || sp >= STACK4)
 					continue;
@@ -975,25 +878,16 @@ static const struct px_model_ops mesh_ops_convex = {
  * exact query starts from its neighbour's answer, which keeps the build
  * near the cost of coherent queries. Setup only.
  */
-static int grid_build(struct mesh *M, long budget)
+void px__grid_layout(px_aabb box, long cap, int d[3], px_vec3 *org, double *h_out)
 {
-	double ext[3] = {M->box.max.x - M->box.min.x, M->box.max.y - M->box.min.y,
-			 M->box.max.z - M->box.min.z};
+	double ext[3] = {box.max.x - box.min.x, box.max.y - box.min.y,
+			 box.max.z - box.min.z};
 	double len = fmax(ext[0], fmax(ext[1], ext[2])), margin, h, vol;
-	long cap = budget > 0 ? budget : 64L * 64 * 64;
-	int d[3], k, it, iz, jx, jy;
-	size_t ncell;
-	long prev = -1;
+	int k, it;
 
-	if (budget < 0)
-		return PX_OK;
-	/* measured on a 70k-triangle torus: one cell per 8 triangles gives
-	 * most of the gain of 30 times more cells at a fifth of the setup */
-	if ((double)cap > (double)(M->nt / 8))
-		cap = (long)(M->nt / 8);
 	if (cap < 1)
 		cap = 1;
-	/* a mesh collapsed to one point still gets a (one-cell) grid */
+	/* a model collapsed to one point still gets a (one-cell) grid */
 	margin = len > 0.0 ? 0.125 * len : 1.0;
 	vol = (ext[0] + 2 * margin) * (ext[1] + 2 * margin) * (ext[2] + 2 * margin);
 	h = cbrt(vol / (double)cap);
@@ -1008,8 +902,31 @@ static int grid_build(struct mesh *M, long budget)
 			break;
 		h *= 1.02;
 	}
-	if ((double)d[0] * d[1] * d[2] > (double)cap)
-		d[0] = d[1] = d[2] = 1, h = len + 2 * margin;
+	if ((double)d[0] * d[1] * d[2] > (double)cap) {
+		d[0] = d[1] = d[2] = 1;
+		h = len + 2 * margin;
+	}
+	*h_out = h;
+	*org = px_v3(0.5 * (box.min.x + box.max.x - d[0] * h),
+		     0.5 * (box.min.y + box.max.y - d[1] * h),
+		     0.5 * (box.min.z + box.max.z - d[2] * h));
+}
+
+static int grid_build(struct mesh *M, long budget)
+{
+	long cap = budget > 0 ? budget : 64L * 64 * 64;
+	int d[3], k, iz, jx, jy;
+	size_t ncell;
+	long prev = -1;
+	double h;
+
+	if (budget < 0)
+		return PX_OK;
+	/* measured on a 70k-triangle torus: one cell per 8 triangles gives
+	 * most of the gain of 30 times more cells at a fifth of the setup */
+	if ((double)cap > (double)(M->nt / 8))
+		cap = (long)(M->nt / 8);
+	px__grid_layout(M->box, cap, d, &M->gorg, &h);
 	ncell = (size_t)d[0] * (size_t)d[1] * (size_t)d[2];
 	M->grid = malloc(ncell * sizeof(*M->grid));
 	if (!M->grid)
@@ -1018,10 +935,6 @@ static int grid_build(struct mesh *M, long budget)
 		M->gdim[k] = d[k];
 	M->gcell = h;
 	M->ginv = 1.0 / h;
-	/* centred on the box */
-	M->gorg = px_v3(0.5 * (M->box.min.x + M->box.max.x - d[0] * h),
-			0.5 * (M->box.min.y + M->box.max.y - d[1] * h),
-			0.5 * (M->box.min.z + M->box.max.z - d[2] * h));
 	for (iz = 0; iz < d[2]; iz++)
 		for (jy = 0; jy < d[1]; jy++) {
 			int y = (iz & 1) ? d[1] - 1 - jy : jy;
@@ -1327,7 +1240,7 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 	if (!M->n4)
 		goto fail;
 	M->n_n4 = 0;
-	collapse(M->nodes, M->n4, &M->n_n4, 0);
+	px__node4_collapse(M->nodes, M->n4, &M->n_n4, 0);
 	free(M->nodes);
 	M->nodes = NULL;
 
