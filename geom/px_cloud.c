@@ -238,10 +238,18 @@ static void cloud_walk(const struct cloud *C, px_vec3 p, double *best_io,
 			st[sp].idx = nd->idx[j];
 			st[sp].cnt = nd->cnt[j];
 			st[sp].d2 = dc[j];
-			if (st[sp].cnt)
-				__builtin_prefetch(&C->pt[st[sp].idx]);
-			else
-				__builtin_prefetch(&C->n4[st[sp].idx]);
+			if (st[sp].cnt) {
+				/* up to 8 points of 24 bytes: three or four lines */
+				const char *q = (const char *)&C->pt[st[sp].idx];
+				__builtin_prefetch(q);
+				__builtin_prefetch(q + 64);
+				__builtin_prefetch(q + 128);
+				__builtin_prefetch(q + 191);
+			} else {
+				const char *q = (const char *)&C->n4[st[sp].idx];
+				__builtin_prefetch(q);
+				__builtin_prefetch(q + 64);
+			}
 			sp++;
 		}
 	}

@@ -683,10 +683,18 @@ static void mesh_walk(const struct mesh *M, px_vec3 p, struct best *b,
 			st[sp].d2 = dc[j];
 			/* start the memory fetch now: the node or the leaf's
 			 * triangles are needed within a few steps */
-			if (st[sp].cnt)
-				__builtin_prefetch(&M->lb[st[sp].idx]);
-			else
-				__builtin_prefetch(&M->n4[st[sp].idx]);
+			if (st[sp].cnt) {
+				/* one line per triangle */
+				const struct tlb *L = &M->lb[st[sp].idx];
+				uint32_t k;
+				for (k = 0; k < st[sp].cnt; k++)
+					__builtin_prefetch(L + k);
+			} else {
+				/* a node spans two lines */
+				const char *q = (const char *)&M->n4[st[sp].idx];
+				__builtin_prefetch(q);
+				__builtin_prefetch(q + 64);
+			}
 			sp++;
 		}
 	}
