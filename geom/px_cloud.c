@@ -19,6 +19,17 @@
 #define LEAF 8
 #define CSTACK4 (3 * PX_CLOUD_MAX_DEPTH + 4)
 
+/* A leaf's points lie between two parallel planes: lo <= n . x <= hi
+ * (n a float unit vector near the normal of the points' best-fit plane;
+ * lo, hi computed with that float n, rounded outwards). Scanned points
+ * sample surfaces, so a leaf is a thin patch and the slab bounds its
+ * distance far more tightly than its box when seen face-on. Leaves hold
+ * at least 4 points (median splits of more than 8), so first index / 4
+ * names a leaf. */
+struct slab {
+	float n[3], lo, hi;
+};
+
 /* The hierarchy has the mesh's layout (mesh_internal.h): a binary tree
  * built by median splits, with single-precision child boxes rounded
  * outwards, collapsed to four children per node for the queries. */
@@ -40,6 +51,7 @@ struct cloud {
 	int gdim[3];
 	px_vec3 gorg;
 	double gcell, ginv;
+	struct slab *slab; /* per leaf, at its first point's index / 4 */
 };
 
 static void rep_msg(struct px_cloud_report *rep, const char *fmt, ...)
@@ -64,6 +76,7 @@ static void cloud_free(void *impl)
 	free(C->leaf_of);
 	free(C->n4);
 	free(C->grid);
+	free(C->slab);
 	free(C);
 }
 
@@ -190,6 +203,9 @@ static void cloud_walk(const struct cloud *C, px_vec3 p, double *best_io,
 	int use = pmax < 1e18 && C->absmax < 1e18;
 	float pf[3] = {(float)p.x, (float)p.y, (float)p.z};
 	float slack = (float)(0x1p-22 * (C->absmax + pmax));
+	/* plane values: a float unit vector, products and sums, the rounded
+	 * p: below 16 * 2^-24 (|p| + |cloud|); twice that */
+	float slack_s = (float)(0x1p-19 * (C->absmax + pmax));
 
 	st[0].idx = 0;
 	st[0].cnt = 0;
@@ -206,6 +222,15 @@ static void cloud_walk(const struct cloud *C, px_vec3 p, double *best_io,
 		iters++;
 		if (st[sp].cnt > 0) {
 			uint32_t i;
+			if (use) {
+				/* the slab: rounding as in the mesh's tri_lb */
+				const struct slab *S = &C->slab[st[sp].idx / 4];
+				float h = S->n[0] * pf[0] + S->n[1] * pf[1] + S->n[2] * pf[2];
+				float g = S->lo - h > h - S->hi ? S->lo - h : h - S->hi;
+				g -= slack_s;
+				if (g > 0.0f && (double)(g * g) * (1.0 - 0x1p-18) > best)
+					continue;
+			}
 			for (i = st[sp].idx; i < st[sp].idx + st[sp].cnt; i++) {
 				double d2 = px_v3_dist2(p, C->pt[i]);
 				if (d2 < best || (d2 == best && bi < 0)) {
@@ -239,8 +264,9 @@ static void cloud_walk(const struct cloud *C, px_vec3 p, double *best_io,
 			st[sp].cnt = nd->cnt[j];
 			st[sp].d2 = dc[j];
 			if (st[sp].cnt) {
-				/* up to 8 points of 24 bytes: three or four lines */
+				/* the slab first, then up to 8 points of 24 bytes */
 				const char *q = (const char *)&C->pt[st[sp].idx];
+				__builtin_prefetch(&C->slab[st[sp].idx / 4]);
 				__builtin_prefetch(q);
 				__builtin_prefetch(q + 64);
 				__builtin_prefetch(q + 128);
@@ -374,6 +400,63 @@ static const struct px_model_ops cloud_ops = {
 static const struct px_model_ops cloud_ops_cache = {
 	"cloud", PX_MODEL_CLOUD, cloud_closest, cloud_aabb, cloud_bytes,
 	cloud_free, NULL, cloud_closest_among, cloud_collect};
+
+/* Slabs of the leaves of node4 tree node ni (struct slab). The normal:
+ * smallest-eigenvalue direction of the points' covariance by power
+ * iteration on trace - covariance (any unit vector gives a valid slab;
+ * a better one only a thinner). Setup only. */
+static void slab_leaf(struct cloud *C, uint32_t s, uint32_t n)
+{
+	struct slab *S = &C->slab[s / 4];
+	double m[3] = {0, 0, 0}, cv[3][3] = {{0}}, v[3] = {0.577, 0.577, 0.577}, t;
+	double lo = INFINITY, hi = -INFINITY;
+	uint32_t i;
+	int a, b, it;
+	for (i = s; i < s + n; i++) {
+		m[0] += C->pt[i].x / n;
+		m[1] += C->pt[i].y / n;
+		m[2] += C->pt[i].z / n;
+	}
+	for (i = s; i < s + n; i++) {
+		double d[3] = {C->pt[i].x - m[0], C->pt[i].y - m[1], C->pt[i].z - m[2]};
+		for (a = 0; a < 3; a++)
+			for (b = 0; b < 3; b++)
+				cv[a][b] += d[a] * d[b];
+	}
+	t = cv[0][0] + cv[1][1] + cv[2][2];
+	for (it = 0; it < 32 && t > 0.0; it++) {
+		double w[3], l;
+		for (a = 0; a < 3; a++)
+			w[a] = t * v[a] - (cv[a][0] * v[0] + cv[a][1] * v[1] + cv[a][2] * v[2]);
+		l = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+		if (!(l > 0.0) || !isfinite(l))
+			break;
+		for (a = 0; a < 3; a++)
+			v[a] = w[a] / l;
+	}
+	t = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+	for (a = 0; a < 3; a++)
+		S->n[a] = (float)(v[a] / t);
+	/* the offsets with the float normal itself, rounded outwards */
+	for (i = s; i < s + n; i++) {
+		double h = (double)S->n[0] * C->pt[i].x + (double)S->n[1] * C->pt[i].y +
+			   (double)S->n[2] * C->pt[i].z;
+		lo = h < lo ? h : lo;
+		hi = h > hi ? h : hi;
+	}
+	S->lo = px__f_down(lo - 1e-12 * fabs(lo));
+	S->hi = px__f_up(hi + 1e-12 * fabs(hi));
+}
+
+static void slab_build(struct cloud *C)
+{
+	size_t i;
+	int j;
+	for (i = 0; i < C->n_n4; i++)
+		for (j = 0; j < 4; j++)
+			if (C->n4[i].idx[j] != EMPTY && C->n4[i].cnt[j] > 0)
+				slab_leaf(C, C->n4[i].idx[j], C->n4[i].cnt[j]);
+}
 
 /* The hint grid (see struct cloud): one cell per 8 points, at most
  * 64^3; each cell's exact nearest point, found in a serpentine order
@@ -528,6 +611,11 @@ int px_cloud_model(const double *xyz, size_t n, double radius_m,
 			      fmax(fabs(C->box.min.z), fabs(C->box.max.z))));
 	C->bytes = sizeof(*C) + n * (sizeof(px_vec3) + 2 * sizeof(uint32_t)) +
 		   C->n_n4 * sizeof(struct node4);
+	C->slab = calloc(n / 4 + 1, sizeof(*C->slab));
+	if (!C->slab)
+		goto fail;
+	C->bytes += (n / 4 + 1) * sizeof(*C->slab);
+	slab_build(C);
 	if (grid_build(C) != PX_OK)
 		goto fail;
 	free(perm);
