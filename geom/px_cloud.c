@@ -19,15 +19,15 @@
 #define LEAF 8
 #define CSTACK4 (3 * PX_CLOUD_MAX_DEPTH + 4)
 
-/* A leaf's points lie between two parallel planes: lo <= n . x <= hi
- * (n a float unit vector near the normal of the points' best-fit plane;
- * lo, hi computed with that float n, rounded outwards). Scanned points
- * sample surfaces, so a leaf is a thin patch and the slab bounds its
- * distance far more tightly than its box when seen face-on. Leaves hold
- * at least 4 points (median splits of more than 8), so first index / 4
- * names a leaf. */
-struct slab {
-	float n[3], lo, hi;
+/* The points of each child of a four-wide node (a contiguous range of
+ * the leaf order) lie between two parallel planes: lo[j] <= n[.][j] . x
+ * <= hi[j] (n a float unit vector near the normal of the points'
+ * best-fit plane; lo, hi computed with that float n, rounded outwards).
+ * Scanned points sample surfaces, so a subtree is a thin curved patch,
+ * and seen face-on its slab bounds its distance far more tightly than
+ * its box. Per node, side by side as in struct node4. */
+struct nslab {
+	float n[3][4], lo[4], hi[4];
 };
 
 /* The hierarchy has the mesh's layout (mesh_internal.h): a binary tree
@@ -51,7 +51,7 @@ struct cloud {
 	int gdim[3];
 	px_vec3 gorg;
 	double gcell, ginv;
-	struct slab *slab; /* per leaf, at its first point's index / 4 */
+	struct nslab *ns;  /* per four-wide node, for its children */
 };
 
 static void rep_msg(struct px_cloud_report *rep, const char *fmt, ...)
@@ -76,7 +76,7 @@ static void cloud_free(void *impl)
 	free(C->leaf_of);
 	free(C->n4);
 	free(C->grid);
-	free(C->slab);
+	free(C->ns);
 	free(C);
 }
 
@@ -222,15 +222,6 @@ static void cloud_walk(const struct cloud *C, px_vec3 p, double *best_io,
 		iters++;
 		if (st[sp].cnt > 0) {
 			uint32_t i;
-			if (use) {
-				/* the slab: rounding as in the mesh's tri_lb */
-				const struct slab *S = &C->slab[st[sp].idx / 4];
-				float h = S->n[0] * pf[0] + S->n[1] * pf[1] + S->n[2] * pf[2];
-				float g = S->lo - h > h - S->hi ? S->lo - h : h - S->hi;
-				g -= slack_s;
-				if (g > 0.0f && (double)(g * g) * (1.0 - 0x1p-18) > best)
-					continue;
-			}
 			for (i = st[sp].idx; i < st[sp].idx + st[sp].cnt; i++) {
 				double d2 = px_v3_dist2(p, C->pt[i]);
 				if (d2 < best || (d2 == best && bi < 0)) {
@@ -241,10 +232,22 @@ static void cloud_walk(const struct cloud *C, px_vec3 p, double *best_io,
 			continue;
 		}
 		nd = &C->n4[st[sp].idx];
-		if (use)
+		if (use) {
+			const struct nslab *S = &C->ns[st[sp].idx];
 			px__box4_d2f(nd, pf, slack, dc);
-		else
+			/* the slabs: rounding as in the mesh's tri_lb */
+			for (j = 0; j < 4; j++) {
+				float h = S->n[0][j] * pf[0] + S->n[1][j] * pf[1] + S->n[2][j] * pf[2];
+				float g = S->lo[j] - h > h - S->hi[j] ? S->lo[j] - h : h - S->hi[j];
+				g -= slack_s;
+				if (g > 0.0f) {
+					double v = (double)(g * g) * (1.0 - 0x1p-18);
+					dc[j] = v > dc[j] ? v : dc[j];
+				}
+			}
+		} else {
 			px__box4_d2(nd, p, dc);
+		}
 		/* children that can still win, nearest first */
 		for (j = 0; j < 4; j++) {
 			if (nd->idx[j] == EMPTY || dc[j] > best)
@@ -264,9 +267,8 @@ static void cloud_walk(const struct cloud *C, px_vec3 p, double *best_io,
 			st[sp].cnt = nd->cnt[j];
 			st[sp].d2 = dc[j];
 			if (st[sp].cnt) {
-				/* the slab first, then up to 8 points of 24 bytes */
+				/* up to 8 points of 24 bytes: three or four lines */
 				const char *q = (const char *)&C->pt[st[sp].idx];
-				__builtin_prefetch(&C->slab[st[sp].idx / 4]);
 				__builtin_prefetch(q);
 				__builtin_prefetch(q + 64);
 				__builtin_prefetch(q + 128);
@@ -275,6 +277,7 @@ static void cloud_walk(const struct cloud *C, px_vec3 p, double *best_io,
 				const char *q = (const char *)&C->n4[st[sp].idx];
 				__builtin_prefetch(q);
 				__builtin_prefetch(q + 64);
+				__builtin_prefetch(&C->ns[st[sp].idx]);
 			}
 			sp++;
 		}
@@ -401,30 +404,29 @@ static const struct px_model_ops cloud_ops_cache = {
 	"cloud", PX_MODEL_CLOUD, cloud_closest, cloud_aabb, cloud_bytes,
 	cloud_free, NULL, cloud_closest_among, cloud_collect};
 
-/* Slabs of the leaves of node4 tree node ni (struct slab). The normal:
+/* Slab of the points [s, e) into child j of S. The normal: the
  * smallest-eigenvalue direction of the points' covariance by power
  * iteration on trace - covariance (any unit vector gives a valid slab;
  * a better one only a thinner). Setup only. */
-static void slab_leaf(struct cloud *C, uint32_t s, uint32_t n)
+static void slab_fit(const struct cloud *C, size_t s, size_t e, struct nslab *S, int j)
 {
-	struct slab *S = &C->slab[s / 4];
 	double m[3] = {0, 0, 0}, cv[3][3] = {{0}}, v[3] = {0.577, 0.577, 0.577}, t;
-	double lo = INFINITY, hi = -INFINITY;
-	uint32_t i;
+	double lo = INFINITY, hi = -INFINITY, cnt = (double)(e - s);
+	size_t i;
 	int a, b, it;
-	for (i = s; i < s + n; i++) {
-		m[0] += C->pt[i].x / n;
-		m[1] += C->pt[i].y / n;
-		m[2] += C->pt[i].z / n;
+	for (i = s; i < e; i++) {
+		m[0] += C->pt[i].x / cnt;
+		m[1] += C->pt[i].y / cnt;
+		m[2] += C->pt[i].z / cnt;
 	}
-	for (i = s; i < s + n; i++) {
+	for (i = s; i < e; i++) {
 		double d[3] = {C->pt[i].x - m[0], C->pt[i].y - m[1], C->pt[i].z - m[2]};
 		for (a = 0; a < 3; a++)
 			for (b = 0; b < 3; b++)
 				cv[a][b] += d[a] * d[b];
 	}
 	t = cv[0][0] + cv[1][1] + cv[2][2];
-	for (it = 0; it < 32 && t > 0.0; it++) {
+	for (it = 0; it < 32 && t > 0.0 && isfinite(t); it++) {
 		double w[3], l;
 		for (a = 0; a < 3; a++)
 			w[a] = t * v[a] - (cv[a][0] * v[0] + cv[a][1] * v[1] + cv[a][2] * v[2]);
@@ -436,26 +438,47 @@ static void slab_leaf(struct cloud *C, uint32_t s, uint32_t n)
 	}
 	t = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
 	for (a = 0; a < 3; a++)
-		S->n[a] = (float)(v[a] / t);
+		S->n[a][j] = (float)(v[a] / t);
 	/* the offsets with the float normal itself, rounded outwards */
-	for (i = s; i < s + n; i++) {
-		double h = (double)S->n[0] * C->pt[i].x + (double)S->n[1] * C->pt[i].y +
-			   (double)S->n[2] * C->pt[i].z;
+	for (i = s; i < e; i++) {
+		double h = (double)S->n[0][j] * C->pt[i].x + (double)S->n[1][j] * C->pt[i].y +
+			   (double)S->n[2][j] * C->pt[i].z;
 		lo = h < lo ? h : lo;
 		hi = h > hi ? h : hi;
 	}
-	S->lo = px__f_down(lo - 1e-12 * fabs(lo));
-	S->hi = px__f_up(hi + 1e-12 * fabs(hi));
+	S->lo[j] = px__f_down(lo - 1e-12 * fabs(lo));
+	S->hi[j] = px__f_up(hi + 1e-12 * fabs(hi));
 }
 
-static void slab_build(struct cloud *C)
+/* Slabs of node ni's children, recursively; returns the node's point
+ * range [*s, *e). Setup only. */
+static void slab_build(struct cloud *C, uint32_t ni, size_t *s_out, size_t *e_out)
 {
-	size_t i;
+	const struct node4 *nd = &C->n4[ni];
+	struct nslab *S = &C->ns[ni];
+	size_t s = (size_t)-1, e = 0;
 	int j;
-	for (i = 0; i < C->n_n4; i++)
-		for (j = 0; j < 4; j++)
-			if (C->n4[i].idx[j] != EMPTY && C->n4[i].cnt[j] > 0)
-				slab_leaf(C, C->n4[i].idx[j], C->n4[i].cnt[j]);
+	for (j = 0; j < 4; j++) {
+		size_t cs, ce;
+		/* absent children: a slab nothing is inside (never prunes
+		 * more than their empty box does) */
+		S->n[0][j] = S->n[1][j] = S->n[2][j] = 0.0f;
+		S->lo[j] = -INFINITY;
+		S->hi[j] = INFINITY;
+		if (nd->idx[j] == EMPTY)
+			continue;
+		if (nd->cnt[j] > 0) {
+			cs = nd->idx[j];
+			ce = cs + nd->cnt[j];
+		} else {
+			slab_build(C, nd->idx[j], &cs, &ce);
+		}
+		slab_fit(C, cs, ce, S, j);
+		s = cs < s ? cs : s;
+		e = ce > e ? ce : e;
+	}
+	*s_out = s;
+	*e_out = e;
 }
 
 /* The hint grid (see struct cloud): one cell per 8 points, at most
@@ -611,11 +634,14 @@ int px_cloud_model(const double *xyz, size_t n, double radius_m,
 			      fmax(fabs(C->box.min.z), fabs(C->box.max.z))));
 	C->bytes = sizeof(*C) + n * (sizeof(px_vec3) + 2 * sizeof(uint32_t)) +
 		   C->n_n4 * sizeof(struct node4);
-	C->slab = calloc(n / 4 + 1, sizeof(*C->slab));
-	if (!C->slab)
+	C->ns = malloc(C->n_n4 * sizeof(*C->ns));
+	if (!C->ns)
 		goto fail;
-	C->bytes += (n / 4 + 1) * sizeof(*C->slab);
-	slab_build(C);
+	C->bytes += C->n_n4 * sizeof(*C->ns);
+	{
+		size_t rs, re;
+		slab_build(C, 0, &rs, &re);
+	}
 	if (grid_build(C) != PX_OK)
 		goto fail;
 	free(perm);
