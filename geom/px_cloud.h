@@ -37,7 +37,7 @@
  * certified = 1 (exact).
  *
  * Memory and real-time rules: building allocates (setup only), about
- * 40 bytes per point (points, index maps, hierarchy, slabs, grid); queries are
+ * 45 bytes per point (points, index maps, hierarchy, slabs, grid); queries are
  * RT-safe (no heap, fixed stack of 3 PX_CLOUD_MAX_DEPTH + 4 entries on
  * the call stack).
  */

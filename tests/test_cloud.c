@@ -396,7 +396,50 @@ static void test_grid_hints(void)
 		}
 }
 
+/* The single-precision box and slab bounds must stay lower bounds at
+ * every scale: thin curved shells (where the slabs prune most), tiny
+ * clouds far from the origin (float spacing near the cloud's size), huge
+ * clouds, and query points beyond the float range (exact path only). */
+static void test_scales(void)
+{
+	int rep, i;
+	for (rep = 0; rep < 6; rep++) {
+		size_t n = (size_t)px_rand_int(500, 3000), k;
+		double *x = malloc(3 * n * sizeof(double));
+		double off = rep < 2 ? 0.0 : (rep < 4 ? 1e7 : -3e12), sc = rep % 2 ? 1e-3 : 1.0;
+		struct px_model *m;
+		if (rep >= 4)
+			sc = 1e9;
+		for (k = 0; k < n; k++) {
+			/* a sphere shell 1e-3 thick, as a scan would give */
+			double z = px_rand_range(-1, 1), ph = px_rand_range(0, 2 * M_PI);
+			double rr = sc * (1 + 1e-3 * px_rand_range(-0.5, 0.5)), s = sqrt(1 - z * z);
+			x[3 * k] = off + rr * s * cos(ph);
+			x[3 * k + 1] = -off + rr * s * sin(ph);
+			x[3 * k + 2] = off + rr * z;
+		}
+		PX_CHECK_INT_EQ(px_cloud_model(x, n, 0.0, NULL, &m), PX_OK);
+		for (i = 0; i < 200; i++) {
+			double f = i % 4 == 3 ? (i % 8 == 3 ? 1e3 : 1e20) : px_rand_range(0, 1.5);
+			px_vec3 d = px_v3(px_rand_normal(), px_rand_normal(), px_rand_normal());
+			px_vec3 p = px_v3_add(px_v3(off, -off, off), px_v3_scale(d, sc * f / px_v3_norm(d)));
+			struct px_model_result r;
+			double ref = scan(x, n, p);
+			PX_CHECK_INT_EQ(px_model_query_ex(m, p, INFINITY, -1, 0, &r), 1);
+			PX_CHECK_MSG(fabs(r.distance - ref) <= 1e-12 * (ref + fabs(off) + sc),
+				     "rep %d: %.17g vs scan %.17g", rep, r.distance, ref);
+			/* the same through the hint path */
+			PX_CHECK_INT_EQ(px_model_query_ex(m, p, INFINITY, px_rand_int(0, (int)n - 1),
+							  PX_QUERY_COHERENT, &r), 1);
+			PX_CHECK_MSG(fabs(r.distance - ref) <= 1e-12 * (ref + fabs(off) + sc),
+				     "rep %d (hint): %.17g vs scan %.17g", rep, r.distance, ref);
+		}
+		px_model_free(m);
+		free(x);
+	}
+}
+
 static const struct px_test tests[] = {
 	PX_T(test_vs_brute), PX_T(test_coherent_and_bounded), PX_T(test_cache), PX_T(test_invalid),
-	PX_T(test_files), PX_T(test_no_alloc), PX_T(test_grid_hints)};
+	PX_T(test_files), PX_T(test_no_alloc), PX_T(test_grid_hints), PX_T(test_scales)};
 PX_TEST_MAIN(tests)
