@@ -40,9 +40,9 @@
  * The answer stays exact: the hint only sets the starting bound. Cell
  * count: one per 8 triangles, at most 64^3 (1 MB) by default
  * (px_mesh_opts.grid_cells); building it costs about one cold query
- * per cell. On the 70k-triangle benchmark torus it saves about 6 % of
- * a cold query's instructions: most of a cold query's work is the proof
- * that no other triangle is closer, not the search for a good bound.
+ * per cell. On the 70k-triangle benchmark torus it saves a few percent
+ * of a cold query's instructions: most of a cold query's work is the
+ * proof that no other triangle is closer, not the search for a bound.
  *
  * Coherent queries (PX_QUERY_COHERENT with last cycle's triangle index as
  * hint) start from that triangle's distance as an upper bound, which
@@ -57,7 +57,7 @@
  * iterations = nodes and triangles visited, certified = 1 (exact).
  *
  * Memory and real-time rules: building allocates (setup only) about 390
- * bytes per triangle; queries are RT-safe (no heap, bounded by the
+ * bytes per triangle (the hint grid adds at most half a byte); queries are RT-safe (no heap, bounded by the
  * triangle count, fixed stack of 3 PX_MESH_MAX_DEPTH + 4 entries).
  */
 #ifndef PX_MESH_H
