@@ -550,22 +550,25 @@ static inline double tri_lb(const struct tlb *L, const struct pq *q)
 	return (double)(h * h + e * e) * (1.0 - 0x1p-18);
 }
 
-static inline void test_tri(const struct mesh *M, size_t li, px_vec3 p,
-			    struct best *b)
+/* plane_done: the caller's float bound (tri_lb) already compared the
+ * plane distance, so the double one here would repeat it. */
+static inline void test_tri_x(const struct mesh *M, size_t li, px_vec3 p,
+			      struct best *b, int plane_done)
 {
 	const struct mtri *t = &M->tri[li];
 	px_vec3 q;
 	int f, s;
 	double u, v, d2;
 
-	if (t->inv_nn != 0.0) {
+	if (!plane_done && t->inv_nn != 0.0) {
 		/* the distance to the plane is a lower bound */
 		double h = px_v3_dot(t->n, px_v3_sub(p, t->a));
 		if (h * h * t->inv_nn > b->d2)
 			return;
 	}
-	d2 = tri_core(p, t->a, t->b, t->c, t->n, t->inv_nn != 0.0 ? 1.0 / t->inv_nn : 0.0,
-		      t->inv_nn == 0.0, &q, &f, &s, &u, &v);
+	/* |n|^2 as px_tri_closest computes it (a product, not a division) */
+	d2 = tri_core(p, t->a, t->b, t->c, t->n, px_v3_norm2(t->n), t->inv_nn == 0.0, &q,
+		      &f, &s, &u, &v);
 	if (d2 < b->d2 ||
 	    (d2 == b->d2 && (b->li < 0 || (M->degen[b->li] && !M->degen[li])))) {
 		b->d2 = d2;
@@ -576,6 +579,12 @@ static inline void test_tri(const struct mesh *M, size_t li, px_vec3 p,
 		b->u = u;
 		b->v = v;
 	}
+}
+
+static inline void test_tri(const struct mesh *M, size_t li, px_vec3 p,
+			    struct best *b)
+{
+	test_tri_x(M, li, p, b, 0);
 }
 
 /* Fill a result from the best triangle: the sign from the pseudo-normal
@@ -653,8 +662,10 @@ static void mesh_walk(const struct mesh *M, px_vec3 p, struct best *b,
 		if (st[sp].cnt > 0) {
 			uint32_t i;
 			for (i = st[sp].idx; i < st[sp].idx + st[sp].cnt; i++)
-				if (!pq.use || !(tri_lb(&M->lb[i], &pq) > b->d2))
+				if (!pq.use)
 					test_tri(M, i, p, b);
+				else if (!(tri_lb(&M->lb[i], &pq) > b->d2))
+					test_tri_x(M, i, p, b, 1);
 			continue;
 		}
 		nd = &M->n4[st[sp].idx];
