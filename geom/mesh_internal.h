@@ -12,6 +12,12 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include <math.h>
+
+#ifdef __SSE__
+#include <xmmintrin.h>
+#endif
+
 #include "px_math.h"
 #include "px_mesh.h"
 
@@ -92,7 +98,134 @@ struct mesh {
 	uint32_t *adj_start; /* n_hull + 1 offsets into adj (vertex graph) */
 	uint32_t *adj;
 	uint32_t ext[6];     /* vertices extreme along -x, +x, -y, +y, -z, +z */
+	/* Hint grid for cold queries: cubic cells over the box grown by a
+	 * margin, each holding the leaf index of the triangle closest to
+	 * the cell's centre (exact, computed at setup). Any triangle's
+	 * distance is an upper bound of the answer, and this one's is
+	 * within a cell diagonal of it, so the walk starts as a coherent
+	 * query does. Points outside the grid take the nearest cell.
+	 * grid == NULL: no grid (cold queries start unbounded). */
+	uint32_t *grid;      /* gdim[0] * gdim[1] * gdim[2] cells, x fastest */
+	int gdim[3];
+	px_vec3 gorg;        /* lower corner of cell (0, 0, 0) */
+	double gcell;        /* cell edge length */
+	double ginv;         /* 1 / gcell */
 };
+
+/* Cell of a hint grid (gdim cells from corner org, 1 / cell size inv)
+ * holding p, points outside taking the nearest cell. @note RT-safe. */
+static inline size_t px__grid_cell(const int gdim[3], px_vec3 org, double inv,
+				   px_vec3 p)
+{
+	double f[3] = {(p.x - org.x) * inv, (p.y - org.y) * inv, (p.z - org.z) * inv};
+	size_t c[3];
+	int k;
+	for (k = 0; k < 3; k++) {
+		/* clamp in double first: the cast is undefined out of range */
+		double hi = (double)(gdim[k] - 1);
+		c[k] = !(f[k] > 0.0) ? 0 : (f[k] >= hi ? (size_t)hi : (size_t)f[k]);
+	}
+	return (c[2] * (size_t)gdim[1] + c[1]) * (size_t)gdim[0] + c[0];
+}
+
+/* Leaf index of the hint triangle for p (the grid must exist).
+ * @note RT-safe. */
+static inline uint32_t px__mesh_grid_hint(const struct mesh *M, px_vec3 p)
+{
+	return M->grid[px__grid_cell(M->gdim, M->gorg, M->ginv, p)];
+}
+
+/* Layout of a hint grid of at most cap cells (>= 1) over box grown by
+ * an eighth of its largest extent on every side: cubic cells of edge *h,
+ * d[3] per axis, centred on the box, corner *org. Setup only. */
+void px__grid_layout(px_aabb box, long cap, int d[3], px_vec3 *org, double *h);
+
+/* ---- shared with the point cloud's hierarchy (px_cloud.c) ---------- */
+
+/* Double to float rounded down / up (boxes stay lower bounds). */
+static inline float px__f_down(double x)
+{
+	float f = (float)x;
+	return (double)f > x ? nextafterf(f, -INFINITY) : f;
+}
+
+static inline float px__f_up(double x)
+{
+	float f = (float)x;
+	return (double)f < x ? nextafterf(f, INFINITY) : f;
+}
+
+/* Collapse the binary tree bn (root b) into four-wide nodes appended to
+ * n4 (room for as many as bn has); returns the index of the new node.
+ * Setup only. */
+uint32_t px__node4_collapse(const struct node *bn, struct node4 *n4,
+			    size_t *n_n4, uint32_t b);
+
+/* Squared distances from p to the four child boxes (+inf for absent
+ * children, whose boxes are empty). */
+static inline void px__box4_d2(const struct node4 *nd, px_vec3 p, double d2[4])
+{
+	int j;
+	for (j = 0; j < 4; j++) {
+		double dx = (double)nd->lo[0][j] - p.x, ex = p.x - (double)nd->hi[0][j];
+		double dy = (double)nd->lo[1][j] - p.y, ey = p.y - (double)nd->hi[1][j];
+		double dz = (double)nd->lo[2][j] - p.z, ez = p.z - (double)nd->hi[2][j];
+		dx = dx > ex ? dx : ex;
+		dy = dy > ey ? dy : ey;
+		dz = dz > ez ? dz : ez;
+		dx = dx > 0.0 ? dx : 0.0;
+		dy = dy > 0.0 ? dy : 0.0;
+		dz = dz > 0.0 ? dz : 0.0;
+		d2[j] = dx * dx + dy * dy + dz * dz;
+	}
+}
+
+/*
+ * The same four lower bounds in single precision, side by side (the
+ * compiler turns the loops into packed operations): half the work of the
+ * double version per node. Rounding p and the differences to float can
+ * overstate a gap by at most 2^-24 (2 |p| + |box|) per axis, so every gap
+ * is first reduced by slack = 2^-22 (|box| + |p|) (max norms, given by
+ * the caller), and the squared sum, itself rounded up to six times by
+ * 2^-24 relative, is scaled by 1 - 2^-18: the result stays a lower bound
+ * of the true squared distance, so pruning with it never loses the
+ * closest triangle. Callers use it only while |p| and the mesh stay below
+ * 1e18, so no square overflows the float range (callers fall back to
+ * px__box4_d2 otherwise).
+ */
+static inline void px__box4_d2f(const struct node4 *nd, const float pf[3],
+			    float slack, double d2[4])
+{
+	float s[4];
+	int j;
+#ifdef __SSE__
+	/* the same operations as below, four children per instruction (the
+	 * compiler does not vectorise the loops at -O2) */
+	__m128 sl = _mm_set1_ps(slack), z = _mm_setzero_ps(), acc = z;
+	int k;
+	for (k = 0; k < 3; k++) {
+		__m128 p = _mm_set1_ps(pf[k]);
+		__m128 a = _mm_sub_ps(_mm_load_ps(nd->lo[k]), p);
+		__m128 b = _mm_sub_ps(p, _mm_load_ps(nd->hi[k]));
+		__m128 g = _mm_max_ps(_mm_sub_ps(_mm_max_ps(a, b), sl), z);
+		acc = _mm_add_ps(acc, _mm_mul_ps(g, g));
+	}
+	_mm_storeu_ps(s, acc);
+#else
+	float g[3][4];
+	int k;
+	for (k = 0; k < 3; k++)
+		for (j = 0; j < 4; j++) {
+			float a = nd->lo[k][j] - pf[k], b = pf[k] - nd->hi[k][j];
+			float m = (a > b ? a : b) - slack;
+			g[k][j] = m > 0.0f ? m : 0.0f;
+		}
+	for (j = 0; j < 4; j++)
+		s[j] = g[0][j] * g[0][j] + g[1][j] * g[1][j] + g[2][j] * g[2][j];
+#endif
+	for (j = 0; j < 4; j++)
+		d2[j] = (double)s[j] * (1.0 - 0x1p-18);
+}
 
 /* ---- mesh-to-mesh distance (px_mesh_pair.c) ------------------------------ */
 

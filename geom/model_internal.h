@@ -33,6 +33,46 @@ int px__import_file(const char *path, int want_tri, double **xyz,
  */
 void px__select_k(uint32_t *a, long n, long k, const double *key, int axis);
 
+/* Bounds lo, hi of the keys (3 doubles each, finite) of the n elements
+ * perm[0..n). Setup only (hierarchy builds). */
+static inline void px__key_bounds(const uint32_t *perm, size_t n,
+				  const double *key, double lo[3], double hi[3])
+{
+	size_t i;
+	int k;
+	for (k = 0; k < 3; k++) {
+		lo[k] = INFINITY;
+		hi[k] = -INFINITY;
+	}
+	/* compares, not fmin/fmax (library calls): the keys are finite */
+	for (i = 0; i < n; i++)
+		for (k = 0; k < 3; k++) {
+			double x = key[3 * (size_t)perm[i] + k];
+			lo[k] = x < lo[k] ? x : lo[k];
+			hi[k] = x > hi[k] ? x : hi[k];
+		}
+}
+
+/* Median split of perm[0..n) along the widest axis of the key bounds
+ * lo, hi: afterwards the first n / 2 elements have keys at most those of
+ * the rest. Returns n / 2. Setup only. */
+static inline size_t px__median_split(uint32_t *perm, size_t n, const double *key,
+				      const double lo[3], const double hi[3])
+{
+	int k, axis = 0;
+	for (k = 1; k < 3; k++)
+		if (hi[k] - lo[k] > hi[axis] - lo[axis])
+			axis = k;
+	px__select_k(perm, (long)n, (long)(n / 2), key, axis);
+	return n / 2;
+}
+
+/* Point cloud hint grid (px_cloud.c), for tests: the input index of the
+ * point the grid names for p, and the centre of p's cell (clamped to the
+ * grid); -1 when m is not a cloud or has no grid. RT-safe. */
+struct px_model;
+long px__cloud_grid_hint(const struct px_model *m, px_vec3 p, px_vec3 *centre);
+
 /* Rewrite msg (cap bytes, NUL-terminated) as "<path>: <msg>", cut to
  * fit. Setup only. */
 void px__prefix_path(char *msg, size_t cap, const char *path);

@@ -12,30 +12,46 @@
 #include <strings.h>
 #include <sys/stat.h>
 
+#include "mesh_internal.h"
 #include "model_internal.h"
 #include "px_cloud.h"
 
 #define LEAF 8
-#define EMPTY 0xffffffffu
+#define CSTACK4 (3 * PX_CLOUD_MAX_DEPTH + 4)
 
-/* As in the mesh hierarchy: both children's boxes live in the parent;
- * cnt > 0 marks a leaf range, idx == EMPTY an absent child. */
-struct node {
-	double lo[2][3], hi[2][3];
-	uint32_t idx[2], cnt[2];
+/* The points of each child of a four-wide node (a contiguous range of
+ * the leaf order) lie between two parallel planes: lo[j] <= n[.][j] . x
+ * <= hi[j] (n a float unit vector near the normal of the points'
+ * best-fit plane; lo, hi computed with that float n, rounded outwards).
+ * Scanned points sample surfaces, so a subtree is a thin curved patch,
+ * and seen face-on its slab bounds its distance far more tightly than
+ * its box. Per node, side by side as in struct node4. */
+struct nslab {
+	float n[3][4], lo[4], hi[4];
 };
 
+/* The hierarchy has the mesh's layout (mesh_internal.h): a binary tree
+ * built by median splits, with single-precision child boxes rounded
+ * outwards, collapsed to four children per node for the queries. */
 struct cloud {
 	size_t n;
 	double radius;
 	px_vec3 *pt;       /* leaf order */
 	uint32_t *orig;    /* leaf -> input */
 	uint32_t *leaf_of; /* input -> leaf */
-	struct node *nodes;
-	size_t n_nodes;
+	struct node4 *n4;
+	size_t n_n4;
 	int depth;
 	px_aabb box;
+	double absmax;     /* largest |coordinate| of the points */
 	size_t bytes;
+	/* hint grid as for meshes (mesh_internal.h): leaf index of the
+	 * point nearest to each cell's centre; NULL = none */
+	uint32_t *grid;
+	int gdim[3];
+	px_vec3 gorg;
+	double gcell, ginv;
+	struct nslab *ns;  /* per four-wide node, for its children */
 };
 
 static void rep_msg(struct px_cloud_report *rep, const char *fmt, ...)
@@ -58,7 +74,9 @@ static void cloud_free(void *impl)
 	free(C->pt);
 	free(C->orig);
 	free(C->leaf_of);
-	free(C->nodes);
+	free(C->n4);
+	free(C->grid);
+	free(C->ns);
 	free(C);
 }
 
@@ -75,48 +93,42 @@ struct build {
 static void range_box(const struct build *B, size_t s, size_t n, double lo[3],
 		      double hi[3])
 {
-	size_t i;
+	px__key_bounds(B->perm + s, n, B->xyz, lo, hi);
+}
+
+static void store_box(struct node *nd, int c, const double lo[3], const double hi[3])
+{
 	int k;
 	for (k = 0; k < 3; k++) {
-		lo[k] = INFINITY;
-		hi[k] = -INFINITY;
+		nd->lo[c][k] = px__f_down(lo[k]);
+		nd->hi[c][k] = px__f_up(hi[k]);
 	}
-	for (i = s; i < s + n; i++)
-		for (k = 0; k < 3; k++) {
-			double x = B->xyz[3 * (size_t)B->perm[i] + k];
-			lo[k] = fmin(lo[k], x);
-			hi[k] = fmax(hi[k], x);
-		}
 }
 
 static uint32_t build_node(struct build *B, size_t s, size_t n, int depth,
 			   const double lo[3], const double hi[3])
 {
 	uint32_t me = (uint32_t)B->n_nodes++;
-	size_t part[2][2], half = n / 2;
-	int k, axis = 0, c;
+	size_t part[2][2], half;
+	int c;
 
 	if (depth > B->depth)
 		B->depth = depth;
-	for (k = 1; k < 3; k++)
-		if (hi[k] - lo[k] > hi[axis] - lo[axis])
-			axis = k;
-	px__select_k(B->perm + s, (long)n, (long)half, B->xyz, axis);
+	half = px__median_split(B->perm + s, n, B->xyz, lo, hi);
 	part[0][0] = s;
 	part[0][1] = half;
 	part[1][0] = s + half;
 	part[1][1] = n - half;
 	for (c = 0; c < 2; c++) {
 		struct node *nd = &B->nodes[me];
-		range_box(B, part[c][0], part[c][1], nd->lo[c], nd->hi[c]);
+		double clo[3], chi[3];
+		range_box(B, part[c][0], part[c][1], clo, chi);
+		store_box(nd, c, clo, chi);
 		if (part[c][1] <= LEAF) {
 			nd->idx[c] = (uint32_t)part[c][0];
 			nd->cnt[c] = (uint32_t)part[c][1];
 		} else {
-			double clo[3], chi[3];
 			uint32_t ch;
-			memcpy(clo, nd->lo[c], sizeof(clo));
-			memcpy(chi, nd->hi[c], sizeof(chi));
 			ch = build_node(B, part[c][0], part[c][1], depth + 1, clo, chi);
 			B->nodes[me].idx[c] = ch;
 			B->nodes[me].cnt[c] = 0;
@@ -126,22 +138,6 @@ static uint32_t build_node(struct build *B, size_t s, size_t n, int depth,
 }
 
 /* ---- query ------------------------------------------------------------------ */
-
-/* Plain compares rather than fmax(), which is an out-of-line libm call
- * (NaN rules) and was a fifth of the query time; no NaN reaches here. */
-static inline double gap(double lo, double hi, double x)
-{
-	double d = lo - x > x - hi ? lo - x : x - hi;
-	return d > 0.0 ? d : 0.0;
-}
-
-static inline double box_d2(const struct node *nd, int c, px_vec3 p)
-{
-	double dx = gap(nd->lo[c][0], nd->hi[c][0], p.x);
-	double dy = gap(nd->lo[c][1], nd->hi[c][1], p.y);
-	double dz = gap(nd->lo[c][2], nd->hi[c][2], p.z);
-	return dx * dx + dy * dy + dz * dz;
-}
 
 /* Fill a result from the nearest centre bi at squared distance best;
  * returns 0 when it lies beyond max_dist. */
@@ -188,40 +184,37 @@ static int cloud_finish(const struct cloud *C, const struct px_model_query *q,
 }
 
 
-static int cloud_closest(const void *impl, const struct px_model_query *q,
-			 struct px_model_result *r)
+/* The hierarchy walk: improves the nearest centre (*bi at squared
+ * distance *best, which may already be a bound from a hint). Boxes are
+ * compared in single precision with the slack that keeps them lower
+ * bounds (px__box4_d2f) while p and the cloud lie within 1e18, exactly
+ * otherwise. RT-safe. */
+static void cloud_walk(const struct cloud *C, px_vec3 p, double *best_io,
+		       long *bi_io, int *iters_io, int *certified_io)
 {
-	const struct cloud *C = impl;
 	struct {
 		uint32_t idx, cnt;
 		double d2;
-	} st[PX_CLOUD_MAX_DEPTH + 2];
-	int sp = 0, iters = 0, certified = 1;
-	px_vec3 p = q->p;
-	double best;
-	long bi = -1;
+	} st[CSTACK4];
+	int sp = 0, iters = *iters_io, certified = 1;
+	double best = *best_io;
+	long bi = *bi_io;
+	double pmax = fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z)));
+	int use = pmax < 1e18 && C->absmax < 1e18;
+	float pf[3] = {(float)p.x, (float)p.y, (float)p.z};
+	float slack = (float)(0x1p-22 * (C->absmax + pmax));
+	/* plane values: a float unit vector, products and sums, the rounded
+	 * p: below 16 * 2^-24 (|p| + |cloud|); twice that */
+	float slack_s = (float)(0x1p-19 * (C->absmax + pmax));
 
-	if (isinf(q->max_dist))
-		best = INFINITY;
-	else
-		best = (q->max_dist + C->radius) * (q->max_dist + C->radius);
-	if (q->hint >= 0 && (size_t)q->hint < C->n) {
-		uint32_t li = C->leaf_of[q->hint];
-		double d2 = px_v3_dist2(p, C->pt[li]);
-		if (d2 <= best) {
-			best = d2;
-			bi = (long)li;
-		}
-		iters++;
-	}
 	st[0].idx = 0;
 	st[0].cnt = 0;
 	st[0].d2 = 0.0;
 	sp = 1;
 	while (sp > 0) {
-		const struct node *nd;
-		double dc[2];
-		int near, c;
+		const struct node4 *nd;
+		double dc[4];
+		int ord[4], no = 0, j, c;
 
 		sp--;
 		if (st[sp].d2 > best || (st[sp].d2 == best && bi >= 0))
@@ -238,24 +231,92 @@ static int cloud_closest(const void *impl, const struct px_model_query *q,
 			}
 			continue;
 		}
-		nd = &C->nodes[st[sp].idx];
-		dc[0] = nd->idx[0] == EMPTY ? INFINITY : box_d2(nd, 0, p);
-		dc[1] = nd->idx[1] == EMPTY ? INFINITY : box_d2(nd, 1, p);
-		near = dc[1] < dc[0];
-		for (c = 0; c < 2; c++) {
-			int ch = c == 0 ? 1 - near : near;
-			if (dc[ch] > best)
+		nd = &C->n4[st[sp].idx];
+		if (use) {
+			const struct nslab *S = &C->ns[st[sp].idx];
+			px__box4_d2f(nd, pf, slack, dc);
+			/* the slabs: rounding as in the mesh's tri_lb */
+			for (j = 0; j < 4; j++) {
+				float h = S->n[0][j] * pf[0] + S->n[1][j] * pf[1] + S->n[2][j] * pf[2];
+				float g = S->lo[j] - h > h - S->hi[j] ? S->lo[j] - h : h - S->hi[j];
+				g -= slack_s;
+				if (g > 0.0f) {
+					double v = (double)(g * g) * (1.0 - 0x1p-18);
+					dc[j] = v > dc[j] ? v : dc[j];
+				}
+			}
+		} else {
+			px__box4_d2(nd, p, dc);
+		}
+		/* children that can still win, nearest first */
+		for (j = 0; j < 4; j++) {
+			if (nd->idx[j] == EMPTY || dc[j] > best)
 				continue;
-			if (sp >= PX_CLOUD_MAX_DEPTH + 2) {
+			for (c = no; c > 0 && dc[ord[c - 1]] > dc[j]; c--)
+				ord[c] = ord[c - 1];
+			ord[c] = j;
+			no++;
+		}
+		for (c = no - 1; c >= 0; c--) {
+			j = ord[c];
+			if (sp >= CSTACK4) {
 				certified = 0; /* cannot happen: depth checked at setup */
 				continue;
 			}
-			st[sp].idx = nd->idx[ch];
-			st[sp].cnt = nd->cnt[ch];
-			st[sp].d2 = dc[ch];
+			st[sp].idx = nd->idx[j];
+			st[sp].cnt = nd->cnt[j];
+			st[sp].d2 = dc[j];
+			if (st[sp].cnt) {
+				/* up to 8 points of 24 bytes: three or four lines */
+				const char *q = (const char *)&C->pt[st[sp].idx];
+				__builtin_prefetch(q);
+				__builtin_prefetch(q + 64);
+				__builtin_prefetch(q + 128);
+				__builtin_prefetch(q + 191);
+			} else {
+				const char *q = (const char *)&C->n4[st[sp].idx];
+				__builtin_prefetch(q);
+				__builtin_prefetch(q + 64);
+				__builtin_prefetch(&C->ns[st[sp].idx]);
+			}
 			sp++;
 		}
 	}
+	*best_io = best;
+	*bi_io = bi;
+	*iters_io = iters;
+	if (!certified)
+		*certified_io = 0;
+}
+
+static int cloud_closest(const void *impl, const struct px_model_query *q,
+			 struct px_model_result *r)
+{
+	const struct cloud *C = impl;
+	int iters = 0, certified = 1;
+	px_vec3 p = q->p;
+	double best;
+	long bi = -1;
+	uint32_t li = EMPTY;
+
+	if (isinf(q->max_dist))
+		best = INFINITY;
+	else
+		best = (q->max_dist + C->radius) * (q->max_dist + C->radius);
+	/* a starting bound: last cycle's point, else the grid's */
+	if (q->hint >= 0 && (size_t)q->hint < C->n)
+		li = C->leaf_of[q->hint];
+	else if (C->grid)
+		li = C->grid[px__grid_cell(C->gdim, C->gorg, C->ginv, p)];
+	if (li != EMPTY) {
+		double d2 = px_v3_dist2(p, C->pt[li]);
+		if (d2 <= best) {
+			best = d2;
+			bi = (long)li;
+		}
+		iters++;
+	}
+	cloud_walk(C, p, &best, &bi, &iters, &certified);
 	if (bi < 0)
 		return 0;
 	return cloud_finish(C, q, bi, best, iters, certified, r);
@@ -291,7 +352,7 @@ static int cloud_collect(const void *impl, px_vec3 p, double radius, int *idx,
 	const struct cloud *C = impl;
 	struct {
 		uint32_t idx, cnt;
-	} st[PX_CLOUD_MAX_DEPTH + 2];
+	} st[CSTACK4];
 	double r2 = radius * radius;
 	int sp = 0, n = 0;
 
@@ -309,11 +370,12 @@ static int cloud_collect(const void *impl, px_vec3 p, double radius, int *idx,
 					idx[n++] = (int)i;
 				}
 		} else {
-			const struct node *nd = &C->nodes[st[sp].idx];
+			const struct node4 *nd = &C->n4[st[sp].idx];
+			double dc[4];
 			int c;
-			for (c = 0; c < 2; c++) {
-				if (nd->idx[c] == EMPTY || box_d2(nd, c, p) > r2 ||
-				    sp >= PX_CLOUD_MAX_DEPTH + 2)
+			px__box4_d2(nd, p, dc);
+			for (c = 0; c < 4; c++) {
+				if (nd->idx[c] == EMPTY || dc[c] > r2 || sp >= CSTACK4)
 					continue;
 				st[sp].idx = nd->idx[c];
 				st[sp].cnt = nd->cnt[c];
@@ -342,12 +404,139 @@ static const struct px_model_ops cloud_ops_cache = {
 	"cloud", PX_MODEL_CLOUD, cloud_closest, cloud_aabb, cloud_bytes,
 	cloud_free, NULL, cloud_closest_among, cloud_collect};
 
+/* Slab of the points [s, e) into child j of S. The normal: the
+ * smallest-eigenvalue direction of the points' covariance by power
+ * iteration on trace - covariance (any unit vector gives a valid slab;
+ * a better one only a thinner). Setup only. */
+static void slab_fit(const struct cloud *C, size_t s, size_t e, struct nslab *S, int j)
+{
+	double m[3] = {0, 0, 0}, cv[3][3] = {{0}}, v[3] = {0.577, 0.577, 0.577}, t;
+	double lo = INFINITY, hi = -INFINITY, cnt = (double)(e - s);
+	size_t i;
+	int a, b, it;
+	for (i = s; i < e; i++) {
+		m[0] += C->pt[i].x / cnt;
+		m[1] += C->pt[i].y / cnt;
+		m[2] += C->pt[i].z / cnt;
+	}
+	for (i = s; i < e; i++) {
+		double d[3] = {C->pt[i].x - m[0], C->pt[i].y - m[1], C->pt[i].z - m[2]};
+		for (a = 0; a < 3; a++)
+			for (b = 0; b < 3; b++)
+				cv[a][b] += d[a] * d[b];
+	}
+	t = cv[0][0] + cv[1][1] + cv[2][2];
+	for (it = 0; it < 32 && t > 0.0 && isfinite(t); it++) {
+		double w[3], l;
+		for (a = 0; a < 3; a++)
+			w[a] = t * v[a] - (cv[a][0] * v[0] + cv[a][1] * v[1] + cv[a][2] * v[2]);
+		l = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+		if (!(l > 0.0) || !isfinite(l))
+			break;
+		for (a = 0; a < 3; a++)
+			v[a] = w[a] / l;
+	}
+	t = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+	for (a = 0; a < 3; a++)
+		S->n[a][j] = (float)(v[a] / t);
+	/* the offsets with the float normal itself, rounded outwards */
+	for (i = s; i < e; i++) {
+		double h = (double)S->n[0][j] * C->pt[i].x + (double)S->n[1][j] * C->pt[i].y +
+			   (double)S->n[2][j] * C->pt[i].z;
+		lo = h < lo ? h : lo;
+		hi = h > hi ? h : hi;
+	}
+	S->lo[j] = px__f_down(lo - 1e-12 * fabs(lo));
+	S->hi[j] = px__f_up(hi + 1e-12 * fabs(hi));
+}
+
+/* Slabs of node ni's children, recursively; returns the node's point
+ * range [*s, *e). Setup only. */
+static void slab_build(struct cloud *C, uint32_t ni, size_t *s_out, size_t *e_out)
+{
+	const struct node4 *nd = &C->n4[ni];
+	struct nslab *S = &C->ns[ni];
+	size_t s = (size_t)-1, e = 0;
+	int j;
+	for (j = 0; j < 4; j++) {
+		size_t cs, ce;
+		/* absent children: a slab nothing is inside (never prunes
+		 * more than their empty box does) */
+		S->n[0][j] = S->n[1][j] = S->n[2][j] = 0.0f;
+		S->lo[j] = -INFINITY;
+		S->hi[j] = INFINITY;
+		if (nd->idx[j] == EMPTY)
+			continue;
+		if (nd->cnt[j] > 0) {
+			cs = nd->idx[j];
+			ce = cs + nd->cnt[j];
+		} else {
+			slab_build(C, nd->idx[j], &cs, &ce);
+		}
+		slab_fit(C, cs, ce, S, j);
+		s = cs < s ? cs : s;
+		e = ce > e ? ce : e;
+	}
+	*s_out = s;
+	*e_out = e;
+}
+
+/* The hint grid (see struct cloud): one cell per 8 points, at most
+ * 64^3; each cell's exact nearest point, found in a serpentine order
+ * from its neighbour's. Setup only. */
+static int grid_build(struct cloud *C)
+{
+	long cap = (long)(C->n / 8);
+	int d[3], k, iz, jy, jx;
+	size_t ncell;
+	long prev = -1;
+	double h;
+
+	if (cap > 64L * 64 * 64)
+		cap = 64L * 64 * 64;
+	px__grid_layout(C->box, cap, d, &C->gorg, &h);
+	ncell = (size_t)d[0] * (size_t)d[1] * (size_t)d[2];
+	C->grid = malloc(ncell * sizeof(*C->grid));
+	if (!C->grid)
+		return PX_E_NOMEM;
+	for (k = 0; k < 3; k++)
+		C->gdim[k] = d[k];
+	C->gcell = h;
+	C->ginv = 1.0 / h;
+	for (iz = 0; iz < d[2]; iz++)
+		for (jy = 0; jy < d[1]; jy++) {
+			int y = (iz & 1) ? d[1] - 1 - jy : jy;
+			int back = ((iz * d[1] + jy) & 1) != 0;
+			for (jx = 0; jx < d[0]; jx++) {
+				int x = back ? d[0] - 1 - jx : jx;
+				px_vec3 c = px_v3(C->gorg.x + (x + 0.5) * h, C->gorg.y + (y + 0.5) * h,
+						  C->gorg.z + (iz + 0.5) * h);
+				double best = INFINITY;
+				long bi = -1;
+				int iters = 0, cert = 1;
+				if (prev >= 0) {
+					best = px_v3_dist2(c, C->pt[prev]);
+					bi = prev;
+				}
+				cloud_walk(C, c, &best, &bi, &iters, &cert);
+				if (bi < 0)
+					bi = prev >= 0 ? prev : 0;
+				prev = bi;
+				C->grid[((size_t)iz * (size_t)d[1] + (size_t)y) * (size_t)d[0] +
+					(size_t)x] = (uint32_t)bi;
+			}
+		}
+	C->bytes += ncell * sizeof(*C->grid);
+	return PX_OK;
+}
+
 int px_cloud_model(const double *xyz, size_t n, double radius_m,
 		   struct px_cloud_report *rep, struct px_model **out)
 {
 	struct px_cloud_report lrep;
 	struct cloud *C = NULL;
 	uint32_t *perm = NULL;
+	struct node *nodes = NULL;
 	struct build B;
 	size_t i;
 	int rc = PX_E_NOMEM, k;
@@ -384,23 +573,27 @@ int px_cloud_model(const double *xyz, size_t n, double radius_m,
 	C->n = n;
 	C->radius = radius_m;
 	perm = malloc(n * sizeof(*perm));
-	C->nodes = calloc(n / 2 + 2, sizeof(*C->nodes));
+	/* cache-line aligned: a 64-byte node then costs one line, not two */
+	nodes = aligned_alloc(64, (n / 2 + 2) * sizeof(*nodes));
 	C->pt = malloc(n * sizeof(*C->pt));
 	C->orig = malloc(n * sizeof(*C->orig));
 	C->leaf_of = malloc(n * sizeof(*C->leaf_of));
-	if (!perm || !C->nodes || !C->pt || !C->orig || !C->leaf_of)
+	if (!perm || !nodes || !C->pt || !C->orig || !C->leaf_of)
 		goto fail;
+	memset(nodes, 0, (n / 2 + 2) * sizeof(*nodes));
 	for (i = 0; i < n; i++)
 		perm[i] = (uint32_t)i;
 	B.perm = perm;
 	B.xyz = xyz;
-	B.nodes = C->nodes;
+	B.nodes = nodes;
 	B.n_nodes = 0;
 	B.depth = 0;
 	if (n <= LEAF) {
-		struct node *nd = &C->nodes[0];
+		struct node *nd = &nodes[0];
+		double lo[3], hi[3];
 		B.n_nodes = 1;
-		range_box(&B, 0, n, nd->lo[0], nd->hi[0]);
+		range_box(&B, 0, n, lo, hi);
+		store_box(nd, 0, lo, hi);
 		nd->idx[0] = 0;
 		nd->cnt[0] = (uint32_t)n;
 		for (k = 0; k < 3; k++) {
@@ -414,13 +607,19 @@ int px_cloud_model(const double *xyz, size_t n, double radius_m,
 		range_box(&B, 0, n, lo, hi);
 		build_node(&B, 0, n, 0, lo, hi);
 	}
-	C->n_nodes = B.n_nodes;
 	C->depth = B.depth + 1;
 	if (C->depth > PX_CLOUD_MAX_DEPTH) {
 		rep_msg(rep, "tree too deep (%d)", C->depth);
 		rc = PX_E_RANGE;
 		goto fail;
 	}
+	C->n4 = aligned_alloc(64, B.n_nodes * sizeof(*C->n4));
+	if (!C->n4)
+		goto fail;
+	C->n_n4 = 0;
+	px__node4_collapse(nodes, C->n4, &C->n_n4, 0);
+	free(nodes);
+	nodes = NULL;
 	C->box = px_aabb_empty();
 	for (i = 0; i < n; i++) {
 		uint32_t t = perm[i];
@@ -430,8 +629,21 @@ int px_cloud_model(const double *xyz, size_t n, double radius_m,
 		C->orig[i] = t;
 		C->leaf_of[t] = (uint32_t)i;
 	}
+	C->absmax = fmax(fmax(fabs(C->box.min.x), fabs(C->box.max.x)),
+			 fmax(fmax(fabs(C->box.min.y), fabs(C->box.max.y)),
+			      fmax(fabs(C->box.min.z), fabs(C->box.max.z))));
 	C->bytes = sizeof(*C) + n * (sizeof(px_vec3) + 2 * sizeof(uint32_t)) +
-		   C->n_nodes * sizeof(struct node);
+		   C->n_n4 * sizeof(struct node4);
+	C->ns = malloc(C->n_n4 * sizeof(*C->ns));
+	if (!C->ns)
+		goto fail;
+	C->bytes += C->n_n4 * sizeof(*C->ns);
+	{
+		size_t rs, re;
+		slab_build(C, 0, &rs, &re);
+	}
+	if (grid_build(C) != PX_OK)
+		goto fail;
 	free(perm);
 	rc = px_model_create(radius_m > 0.0 ? &cloud_ops : &cloud_ops_cache, C,
 			     PX_MODEL_CAP_EXACT | PX_MODEL_CAP_COHERENT |
@@ -444,6 +656,7 @@ fail:
 	if (rc == PX_E_NOMEM)
 		rep_msg(rep, "out of memory");
 	free(perm);
+	free(nodes);
 	cloud_free(C);
 	return rc;
 }
@@ -617,6 +830,25 @@ int px_cloud_load(const char *path, double radius_m,
 }
 
 /* ---- accessors ------------------------------------------------------------- */
+
+static const struct cloud *as_cloud(const struct px_model *m);
+
+long px__cloud_grid_hint(const struct px_model *m, px_vec3 p, px_vec3 *centre)
+{
+	const struct cloud *C = as_cloud(m);
+	size_t cell, x, y, z;
+	if (!C || !C->grid)
+		return -1;
+	cell = px__grid_cell(C->gdim, C->gorg, C->ginv, p);
+	x = cell % (size_t)C->gdim[0];
+	y = (cell / (size_t)C->gdim[0]) % (size_t)C->gdim[1];
+	z = cell / ((size_t)C->gdim[0] * (size_t)C->gdim[1]);
+	if (centre)
+		*centre = px_v3(C->gorg.x + ((double)x + 0.5) * C->gcell,
+				C->gorg.y + ((double)y + 0.5) * C->gcell,
+				C->gorg.z + ((double)z + 0.5) * C->gcell);
+	return (long)C->orig[C->grid[cell]];
+}
 
 static const struct cloud *as_cloud(const struct px_model *m)
 {

@@ -8,25 +8,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#ifdef __SSE__
-#include <xmmintrin.h>
-#endif
-
 #include "mesh_internal.h"
 #include "model_internal.h"
 #include "px_mesh.h"
-
-static float f_down(double x)
-{
-	float f = (float)x;
-	return (double)f > x ? nextafterf(f, -INFINITY) : f;
-}
-
-static float f_up(double x)
-{
-	float f = (float)x;
-	return (double)f < x ? nextafterf(f, INFINITY) : f;
-}
 
 /* ---- point-triangle distance ------------------------------------------ */
 
@@ -264,6 +248,18 @@ struct build {
 	int depth;
 };
 
+/* Compares rather than fmin/fmax (library calls, a fifth of the build
+ * time): the coordinates are finite here. */
+static inline double mn(double a, double b)
+{
+	return a < b ? a : b;
+}
+
+static inline double mx(double a, double b)
+{
+	return a > b ? a : b;
+}
+
 static void range_box(const struct build *B, size_t s, size_t n, float lo[3],
 		      float hi[3])
 {
@@ -274,13 +270,13 @@ static void range_box(const struct build *B, size_t s, size_t n, float lo[3],
 	for (i = s; i < s + n; i++) {
 		size_t t = B->perm[i];
 		for (k = 0; k < 3; k++) {
-			l[k] = fmin(l[k], B->tlo[3 * t + k]);
-			h[k] = fmax(h[k], B->thi[3 * t + k]);
+			l[k] = mn(l[k], B->tlo[3 * t + k]);
+			h[k] = mx(h[k], B->thi[3 * t + k]);
 		}
 	}
 	for (k = 0; k < 3; k++) {
-		lo[k] = f_down(l[k]);
-		hi[k] = f_up(h[k]);
+		lo[k] = px__f_down(l[k]);
+		hi[k] = px__f_up(h[k]);
 	}
 }
 
@@ -333,8 +329,8 @@ static size_t sah_split(struct build *B, size_t s, size_t n, const double clo[3]
 			b = b < 0 ? 0 : (b >= SAH_BINS ? SAH_BINS - 1 : b);
 			cnt[b]++;
 			for (m = 0; m < 3; m++) {
-				blo[b][m] = fmin(blo[b][m], B->tlo[3 * t + m]);
-				bhi[b][m] = fmax(bhi[b][m], B->thi[3 * t + m]);
+				blo[b][m] = mn(blo[b][m], B->tlo[3 * t + m]);
+				bhi[b][m] = mx(bhi[b][m], B->thi[3 * t + m]);
 			}
 		}
 		for (m = 0; m < 3; m++) {
@@ -345,8 +341,8 @@ static size_t sah_split(struct build *B, size_t s, size_t n, const double clo[3]
 		for (j = 0; j < SAH_BINS - 1; j++) {
 			acc += cnt[j];
 			for (m = 0; m < 3; m++) {
-				llo[m] = fmin(llo[m], blo[j][m]);
-				lhi[m] = fmax(lhi[m], bhi[j][m]);
+				llo[m] = mn(llo[m], blo[j][m]);
+				lhi[m] = mx(lhi[m], bhi[j][m]);
 			}
 			lc[j] = acc;
 			la[j] = acc ? half_area(llo, lhi) : 0.0;
@@ -356,8 +352,8 @@ static size_t sah_split(struct build *B, size_t s, size_t n, const double clo[3]
 			double cost;
 			acc += cnt[j];
 			for (m = 0; m < 3; m++) {
-				rlo[m] = fmin(rlo[m], blo[j][m]);
-				rhi[m] = fmax(rhi[m], bhi[j][m]);
+				rlo[m] = mn(rlo[m], blo[j][m]);
+				rhi[m] = mx(rhi[m], bhi[j][m]);
 			}
 			if (lc[j - 1] == 0 || acc == 0)
 				continue;
@@ -398,28 +394,17 @@ static size_t sah_split(struct build *B, size_t s, size_t n, const double clo[3]
 static uint32_t build_node(struct build *B, size_t s, size_t n, int depth)
 {
 	uint32_t me = (uint32_t)B->n_nodes++;
-	double clo[3] = {INFINITY, INFINITY, INFINITY},
-	       chi[3] = {-INFINITY, -INFINITY, -INFINITY};
-	size_t i, half = 0, part[2][2];
-	int k, axis = 0, c;
+	double clo[3], chi[3];
+	size_t half = 0, part[2][2];
+	int c;
 
 	if (depth > B->depth)
 		B->depth = depth;
-	for (i = s; i < s + n; i++)
-		for (k = 0; k < 3; k++) {
-			double x = B->cen[3 * (size_t)B->perm[i] + k];
-			clo[k] = fmin(clo[k], x);
-			chi[k] = fmax(chi[k], x);
-		}
+	px__key_bounds(B->perm + s, n, B->cen, clo, chi);
 	if (depth + 2 + log2ceil(n) <= PX_MESH_MAX_DEPTH - 2)
 		half = sah_split(B, s, n, clo, chi);
-	if (half == 0) {
-		half = n / 2;
-		for (k = 1; k < 3; k++)
-			if (chi[k] - clo[k] > chi[axis] - clo[axis])
-				axis = k;
-		px__select_k(B->perm + s, (long)n, (long)half, B->cen, axis);
-	}
+	if (half == 0)
+		half = px__median_split(B->perm + s, n, B->cen, clo, chi);
 	part[0][0] = s;
 	part[0][1] = half;
 	part[1][0] = s + half;
@@ -440,8 +425,8 @@ static uint32_t build_node(struct build *B, size_t s, size_t n, int depth)
 	return me;
 }
 
-static uint32_t collapse(const struct node *bn, struct node4 *n4, size_t *n_n4,
-			 uint32_t b)
+uint32_t px__node4_collapse(const struct node *bn, struct node4 *n4,
+			    size_t *n_n4, uint32_t b)
 {
 	uint32_t me = (uint32_t)(*n_n4)++;
 	struct node4 *o = &n4[me];
@@ -484,76 +469,10 @@ static uint32_t collapse(const struct node *bn, struct node4 *n4, size_t *n_n4,
 	}
 	for (j = 0; j < s; j++)
 		if (n4[me].cnt[j] == 0) {
-			uint32_t ch = collapse(bn, n4, n_n4, n4[me].idx[j]);
+			uint32_t ch = px__node4_collapse(bn, n4, n_n4, n4[me].idx[j]);
 			n4[me].idx[j] = ch;
 		}
 	return me;
-}
-
-/* Squared distances from p to the four child boxes (+inf for absent
- * children, whose boxes are empty). */
-static inline void box4_d2(const struct node4 *nd, px_vec3 p, double d2[4])
-{
-	int j;
-	for (j = 0; j < 4; j++) {
-		double dx = (double)nd->lo[0][j] - p.x, ex = p.x - (double)nd->hi[0][j];
-		double dy = (double)nd->lo[1][j] - p.y, ey = p.y - (double)nd->hi[1][j];
-		double dz = (double)nd->lo[2][j] - p.z, ez = p.z - (double)nd->hi[2][j];
-		dx = dx > ex ? dx : ex;
-		dy = dy > ey ? dy : ey;
-		dz = dz > ez ? dz : ez;
-		dx = dx > 0.0 ? dx : 0.0;
-		dy = dy > 0.0 ? dy : 0.0;
-		dz = dz > 0.0 ? dz : 0.0;
-		d2[j] = dx * dx + dy * dy + dz * dz;
-	}
-}
-
-/*
- * The same four lower bounds in single precision, side by side (the
- * compiler turns the loops into packed operations): half the work of the
- * double version per node. Rounding p and the differences to float can
- * overstate a gap by at most 2^-24 (2 |p| + |box|) per axis, so every gap
- * is first reduced by slack = 2^-22 (|box| + |p|) (max norms, given by
- * the caller), and the squared sum, itself rounded up to six times by
- * 2^-24 relative, is scaled by 1 - 2^-18: the result stays a lower bound
- * of the true squared distance, so pruning with it never loses the
- * closest triangle. Callers use it only while |p| and the mesh stay below
- * 1e18, so no square overflows the float range (mesh_closest falls back
- * to box4_d2 otherwise).
- */
-static inline void box4_d2f(const struct node4 *nd, const float pf[3],
-			    float slack, double d2[4])
-{
-	float s[4];
-	int j;
-#ifdef __SSE__
-	/* the same operations as below, four children per instruction (the
-	 * compiler does not vectorise the loops at -O2) */
-	__m128 sl = _mm_set1_ps(slack), z = _mm_setzero_ps(), acc = z;
-	int k;
-	for (k = 0; k < 3; k++) {
-		__m128 p = _mm_set1_ps(pf[k]);
-		__m128 a = _mm_sub_ps(_mm_load_ps(nd->lo[k]), p);
-		__m128 b = _mm_sub_ps(p, _mm_load_ps(nd->hi[k]));
-		__m128 g = _mm_max_ps(_mm_sub_ps(_mm_max_ps(a, b), sl), z);
-		acc = _mm_add_ps(acc, _mm_mul_ps(g, g));
-	}
-	_mm_storeu_ps(s, acc);
-#else
-	float g[3][4];
-	int k;
-	for (k = 0; k < 3; k++)
-		for (j = 0; j < 4; j++) {
-			float a = nd->lo[k][j] - pf[k], b = pf[k] - nd->hi[k][j];
-			float m = (a > b ? a : b) - slack;
-			g[k][j] = m > 0.0f ? m : 0.0f;
-		}
-	for (j = 0; j < 4; j++)
-		s[j] = g[0][j] * g[0][j] + g[1][j] * g[1][j] + g[2][j] * g[2][j];
-#endif
-	for (j = 0; j < 4; j++)
-		d2[j] = (double)s[j] * (1.0 - 0x1p-18);
 }
 
 static void mesh_free(void *impl)
@@ -574,26 +493,11 @@ static void mesh_free(void *impl)
 	free(M->hull);
 	free(M->adj_start);
 	free(M->adj);
+	free(M->grid);
 	free(M);
 }
 
 /* ---- query --------------------------------------------------------------- */
-
-/* Plain compares rather than fmax(), which is an out-of-line libm call
- * (NaN rules) and was a fifth of the query time; no NaN reaches here. */
-static inline double gap(double lo, double hi, double x)
-{
-	double d = lo - x > x - hi ? lo - x : x - hi;
-	return d > 0.0 ? d : 0.0;
-}
-
-static inline double box_d2(const struct node *nd, int c, px_vec3 p)
-{
-	double dx = gap(nd->lo[c][0], nd->hi[c][0], p.x);
-	double dy = gap(nd->lo[c][1], nd->hi[c][1], p.y);
-	double dz = gap(nd->lo[c][2], nd->hi[c][2], p.z);
-	return dx * dx + dy * dy + dz * dz;
-}
 
 struct best {
 	double d2;
@@ -604,7 +508,7 @@ struct best {
 };
 
 /* Query point in single precision with the slack that covers the
- * rounding of the float bounds (box4_d2f, tri_lb); use = 0 when p or the
+ * rounding of the float bounds (px__box4_d2f, tri_lb); use = 0 when p or the
  * mesh is too far out for floats (then only exact tests are made). */
 struct pq {
 	float pf[3];
@@ -646,22 +550,25 @@ static inline double tri_lb(const struct tlb *L, const struct pq *q)
 	return (double)(h * h + e * e) * (1.0 - 0x1p-18);
 }
 
-static inline void test_tri(const struct mesh *M, size_t li, px_vec3 p,
-			    struct best *b)
+/* plane_done: the caller's float bound (tri_lb) already compared the
+ * plane distance, so the double one here would repeat it. */
+static inline void test_tri_x(const struct mesh *M, size_t li, px_vec3 p,
+			      struct best *b, int plane_done)
 {
 	const struct mtri *t = &M->tri[li];
 	px_vec3 q;
 	int f, s;
 	double u, v, d2;
 
-	if (t->inv_nn != 0.0) {
+	if (!plane_done && t->inv_nn != 0.0) {
 		/* the distance to the plane is a lower bound */
 		double h = px_v3_dot(t->n, px_v3_sub(p, t->a));
 		if (h * h * t->inv_nn > b->d2)
 			return;
 	}
-	d2 = tri_core(p, t->a, t->b, t->c, t->n, t->inv_nn != 0.0 ? 1.0 / t->inv_nn : 0.0,
-		      t->inv_nn == 0.0, &q, &f, &s, &u, &v);
+	/* |n|^2 as px_tri_closest computes it (a product, not a division) */
+	d2 = tri_core(p, t->a, t->b, t->c, t->n, px_v3_norm2(t->n), t->inv_nn == 0.0, &q,
+		      &f, &s, &u, &v);
 	if (d2 < b->d2 ||
 	    (d2 == b->d2 && (b->li < 0 || (M->degen[b->li] && !M->degen[li])))) {
 		b->d2 = d2;
@@ -672,6 +579,12 @@ static inline void test_tri(const struct mesh *M, size_t li, px_vec3 p,
 		b->u = u;
 		b->v = v;
 	}
+}
+
+static inline void test_tri(const struct mesh *M, size_t li, px_vec3 p,
+			    struct best *b)
+{
+	test_tri_x(M, li, p, b, 0);
 }
 
 /* Fill a result from the best triangle: the sign from the pseudo-normal
@@ -720,30 +633,19 @@ static void mesh_finish(const struct mesh *M, px_vec3 p, const struct best *bp,
 }
 
 
-static int mesh_closest(const void *impl, const struct px_model_query *qq,
-			struct px_model_result *r)
+/* The hierarchy walk: improves *b (which may already hold a bound from
+ * a hint) to the exact closest triangle within its bound. RT-safe. */
+static void mesh_walk(const struct mesh *M, px_vec3 p, struct best *b,
+		      int *iters_io, int *certified_io)
 {
-	const struct mesh *M = impl;
 	struct {
 		uint32_t idx, cnt;
 		double d2;
 	} st[STACK4];
-	int sp = 0, iters = 0, certified = 1;
-	struct best b;
-	px_vec3 p = qq->p;
+	int sp = 0, iters = *iters_io, certified = 1;
 	struct pq pq;
 
-	b.d2 = isinf(qq->max_dist) ? INFINITY : qq->max_dist * qq->max_dist;
-	b.li = -1;
-	b.q = p;
-	b.feature = PX_FEATURE_NONE;
-	b.sub = 0;
-	b.u = b.v = 0.0;
 	pq_init(M, p, &pq);
-	if (qq->hint >= 0 && (size_t)qq->hint < M->nt) {
-		test_tri(M, M->leaf_of[qq->hint], p, &b);
-		iters++;
-	}
 	st[sp].idx = 0;
 	st[sp].cnt = 0;
 	st[sp].d2 = 0.0;
@@ -754,24 +656,26 @@ static int mesh_closest(const void *impl, const struct px_model_query *qq,
 		int ord[4], no = 0, j, c;
 
 		sp--;
-		if (st[sp].d2 > b.d2 || (st[sp].d2 == b.d2 && b.li >= 0))
+		if (st[sp].d2 > b->d2 || (st[sp].d2 == b->d2 && b->li >= 0))
 			continue;
 		iters++;
 		if (st[sp].cnt > 0) {
 			uint32_t i;
 			for (i = st[sp].idx; i < st[sp].idx + st[sp].cnt; i++)
-				if (!pq.use || !(tri_lb(&M->lb[i], &pq) > b.d2))
-					test_tri(M, i, p, &b);
+				if (!pq.use)
+					test_tri(M, i, p, b);
+				else if (!(tri_lb(&M->lb[i], &pq) > b->d2))
+					test_tri_x(M, i, p, b, 1);
 			continue;
 		}
 		nd = &M->n4[st[sp].idx];
 		if (pq.use)
-			box4_d2f(nd, pq.pf, pq.slack_box, dc);
+			px__box4_d2f(nd, pq.pf, pq.slack_box, dc);
 		else
-			box4_d2(nd, p, dc);
+			px__box4_d2(nd, p, dc);
 		/* children that can still win, nearest first */
 		for (j = 0; j < 4; j++) {
-			if (nd->idx[j] == EMPTY || dc[j] > b.d2)
+			if (nd->idx[j] == EMPTY || dc[j] > b->d2)
 				continue;
 			for (c = no; c > 0 && dc[ord[c - 1]] > dc[j]; c--)
 				ord[c] = ord[c - 1];
@@ -790,13 +694,54 @@ static int mesh_closest(const void *impl, const struct px_model_query *qq,
 			st[sp].d2 = dc[j];
 			/* start the memory fetch now: the node or the leaf's
 			 * triangles are needed within a few steps */
-			if (st[sp].cnt)
-				__builtin_prefetch(&M->lb[st[sp].idx]);
-			else
-				__builtin_prefetch(&M->n4[st[sp].idx]);
+			if (st[sp].cnt) {
+				/* one line per triangle */
+				const struct tlb *L = &M->lb[st[sp].idx];
+				uint32_t k;
+				for (k = 0; k < st[sp].cnt; k++)
+					__builtin_prefetch(L + k);
+			} else {
+				/* a node spans two lines */
+				const char *q = (const char *)&M->n4[st[sp].idx];
+				__builtin_prefetch(q);
+				__builtin_prefetch(q + 64);
+			}
 			sp++;
 		}
 	}
+	*iters_io = iters;
+	if (!certified)
+		*certified_io = 0;
+}
+
+static void best_init(struct best *b, px_vec3 p, double max_dist)
+{
+	b->d2 = isinf(max_dist) ? INFINITY : max_dist * max_dist;
+	b->li = -1;
+	b->q = p;
+	b->feature = PX_FEATURE_NONE;
+	b->sub = 0;
+	b->u = b->v = 0.0;
+}
+
+static int mesh_closest(const void *impl, const struct px_model_query *qq,
+			struct px_model_result *r)
+{
+	const struct mesh *M = impl;
+	int iters = 0, certified = 1;
+	struct best b;
+	px_vec3 p = qq->p;
+
+	best_init(&b, p, qq->max_dist);
+	/* a starting bound: last cycle's triangle, else the grid's */
+	if (qq->hint >= 0 && (size_t)qq->hint < M->nt) {
+		test_tri(M, M->leaf_of[qq->hint], p, &b);
+		iters++;
+	} else if (M->grid) {
+		test_tri(M, px__mesh_grid_hint(M, p), p, &b);
+		iters++;
+	}
+	mesh_walk(M, p, &b, &iters, &certified);
 	if (b.li < 0)
 		return 0;
 	mesh_finish(M, p, &b, qq->flags, iters, certified, r);
@@ -812,12 +757,7 @@ static int mesh_closest_among(const void *impl, const struct px_model_query *qq,
 	struct best b;
 	int i;
 
-	b.d2 = isinf(qq->max_dist) ? INFINITY : qq->max_dist * qq->max_dist;
-	b.li = -1;
-	b.q = qq->p;
-	b.feature = PX_FEATURE_NONE;
-	b.sub = 0;
-	b.u = b.v = 0.0;
+	best_init(&b, qq->p, qq->max_dist);
 	for (i = 0; i < n; i++)
 		if (idx[i] >= 0 && (size_t)idx[i] < M->nt)
 			test_tri(M, (size_t)idx[i], qq->p, &b);
@@ -864,7 +804,7 @@ static int mesh_collect(const void *impl, px_vec3 p, double radius, int *idx,
 			const struct node4 *nd = &M->n4[st[sp].idx];
 			double dc[4];
 			int c;
-			box4_d2(nd, p, dc);
+			px__box4_d2(nd, p, dc);
 			for (c = 0; c < 4; c++) {
 				if (nd->idx[c] == EMPTY || dc[c] > r2 || sp >= STACK4)
 					continue;
@@ -950,6 +890,95 @@ static const struct px_model_ops mesh_ops_convex = {
 
 /* ---- build ----------------------------------------------------------------- */
 
+/*
+ * The hint grid (struct mesh): cubic cells over the box grown by an
+ * eighth of its largest extent, as many as the budget allows (at most
+ * one per 8 triangles). Cells are filled in a serpentine order so that each
+ * exact query starts from its neighbour's answer, which keeps the build
+ * near the cost of coherent queries. Setup only.
+ */
+void px__grid_layout(px_aabb box, long cap, int d[3], px_vec3 *org, double *h_out)
+{
+	double ext[3] = {box.max.x - box.min.x, box.max.y - box.min.y,
+			 box.max.z - box.min.z};
+	double len = fmax(ext[0], fmax(ext[1], ext[2])), margin, h, vol;
+	int k, it;
+
+	if (cap < 1)
+		cap = 1;
+	/* a model collapsed to one point still gets a (one-cell) grid */
+	margin = len > 0.0 ? 0.125 * len : 1.0;
+	vol = (ext[0] + 2 * margin) * (ext[1] + 2 * margin) * (ext[2] + 2 * margin);
+	h = cbrt(vol / (double)cap);
+	for (it = 0;; it++) {
+		double cells = 1.0;
+		for (k = 0; k < 3; k++) {
+			double n = ceil((ext[k] + 2 * margin) / h);
+			d[k] = n < 1.0 ? 1 : (int)n;
+			cells *= d[k];
+		}
+		if (cells <= (double)cap || it > 200)
+			break;
+		h *= 1.02;
+	}
+	if ((double)d[0] * d[1] * d[2] > (double)cap) {
+		d[0] = d[1] = d[2] = 1;
+		h = len + 2 * margin;
+	}
+	*h_out = h;
+	*org = px_v3(0.5 * (box.min.x + box.max.x - d[0] * h),
+		     0.5 * (box.min.y + box.max.y - d[1] * h),
+		     0.5 * (box.min.z + box.max.z - d[2] * h));
+}
+
+static int grid_build(struct mesh *M, long budget)
+{
+	long cap = budget > 0 ? budget : 64L * 64 * 64;
+	int d[3], k, iz, jx, jy;
+	size_t ncell;
+	long prev = -1;
+	double h;
+
+	if (budget < 0)
+		return PX_OK;
+	/* measured on a 70k-triangle torus: one cell per 8 triangles gives
+	 * most of the gain of 30 times more cells at a fifth of the setup */
+	if ((double)cap > (double)(M->nt / 8))
+		cap = (long)(M->nt / 8);
+	px__grid_layout(M->box, cap, d, &M->gorg, &h);
+	ncell = (size_t)d[0] * (size_t)d[1] * (size_t)d[2];
+	M->grid = malloc(ncell * sizeof(*M->grid));
+	if (!M->grid)
+		return PX_E_NOMEM;
+	for (k = 0; k < 3; k++)
+		M->gdim[k] = d[k];
+	M->gcell = h;
+	M->ginv = 1.0 / h;
+	for (iz = 0; iz < d[2]; iz++)
+		for (jy = 0; jy < d[1]; jy++) {
+			int y = (iz & 1) ? d[1] - 1 - jy : jy;
+			int back = ((iz * d[1] + jy) & 1) != 0;
+			for (jx = 0; jx < d[0]; jx++) {
+				int x = back ? d[0] - 1 - jx : jx;
+				px_vec3 c = px_v3(M->gorg.x + (x + 0.5) * h, M->gorg.y + (y + 0.5) * h,
+						  M->gorg.z + (iz + 0.5) * h);
+				struct best b;
+				int iters = 0, cert = 1;
+				best_init(&b, c, INFINITY);
+				if (prev >= 0)
+					test_tri(M, (size_t)prev, c, &b);
+				mesh_walk(M, c, &b, &iters, &cert);
+				if (b.li < 0)
+					b.li = prev >= 0 ? prev : 0;
+				prev = b.li;
+				M->grid[((size_t)iz * (size_t)d[1] + (size_t)y) * (size_t)d[0] +
+					(size_t)x] = (uint32_t)b.li;
+			}
+		}
+	M->bytes += ncell * sizeof(*M->grid);
+	return PX_OK;
+}
+
 int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 		  size_t nt, const struct px_mesh_opts *opt,
 		  struct px_mesh_report *rep, struct px_model **out)
@@ -977,7 +1006,8 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 	rep->n_triangles = nt;
 	if (out)
 		*out = NULL;
-	if (!out || !xyz || !tri || nt == 0 || nv == 0 || leaf < 1 || leaf > 16) {
+	if (!out || !xyz || !tri || nt == 0 || nv == 0 || leaf < 1 || leaf > 16 ||
+	    (opt && opt->grid_cells > PX_MESH_MAX_GRID_CELLS)) {
 		rep_msg(rep, "%s", nt == 0 || nv == 0 ? "mesh has no triangles"
 						    : "invalid arguments");
 		return PX_E_INVAL;
@@ -1229,7 +1259,7 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 	if (!M->n4)
 		goto fail;
 	M->n_n4 = 0;
-	collapse(M->nodes, M->n4, &M->n_n4, 0);
+	px__node4_collapse(M->nodes, M->n4, &M->n_n4, 0);
 	free(M->nodes);
 	M->nodes = NULL;
 
@@ -1293,6 +1323,8 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 	M->bytes = sizeof(*M) + nt * (sizeof(struct mtri) + sizeof(struct tlb) + 2 * sizeof(uint32_t) +
 				      7 * sizeof(px_vec3) + 1) +
 		   M->n_n4 * sizeof(struct node4);
+	if (grid_build(M, opt ? opt->grid_cells : 0) != PX_OK)
+		goto fail;
 	if (rep->convex) {
 		size_t h = 0;
 		M->hull = malloc(rep->n_welded * sizeof(*M->hull));

@@ -30,6 +30,20 @@
  * non-manifold or inconsistently oriented meshes answer with unsigned
  * distances (result is_signed = 0) and say why in the report.
  *
+ * Cold queries (no hint) start from a hint grid built at setup: cubic
+ * cells over the mesh's box grown by an eighth of its largest extent on
+ * every side, each holding the triangle closest to the cell's centre
+ * (found by the exact query). Its distance is an upper bound of the
+ * answer within a cell diagonal of it (any triangle's distance bounds
+ * the answer; points outside the grid take the nearest cell), so the
+ * walk prunes nearly everything at once, as for a coherent query.
+ * The answer stays exact: the hint only sets the starting bound. Cell
+ * count: one per 8 triangles, at most 64^3 (1 MB) by default
+ * (px_mesh_opts.grid_cells); building it costs about one cold query
+ * per cell. On the 70k-triangle benchmark torus it saves a few percent
+ * of a cold query's instructions: most of a cold query's work is the
+ * proof that no other triangle is closer, not the search for a bound.
+ *
  * Coherent queries (PX_QUERY_COHERENT with last cycle's triangle index as
  * hint) start from that triangle's distance as an upper bound, which
  * prunes most of the hierarchy at once when the point moved little.
@@ -43,7 +57,7 @@
  * iterations = nodes and triangles visited, certified = 1 (exact).
  *
  * Memory and real-time rules: building allocates (setup only) about 390
- * bytes per triangle; queries are RT-safe (no heap, bounded by the
+ * bytes per triangle (the hint grid adds at most half a byte); queries are RT-safe (no heap, bounded by the
  * triangle count, fixed stack of 3 PX_MESH_MAX_DEPTH + 4 entries).
  */
 #ifndef PX_MESH_H
@@ -72,9 +86,18 @@ extern "C" {
 #define PX_MESH_REQUIRE_CLOSED 0x2u    /* open/non-manifold are errors */
 #define PX_MESH_NO_FLIP 0x4u           /* keep inward orientation (sign inverted) */
 
+/* Largest hint grid (cells of 4 bytes). */
+#define PX_MESH_MAX_GRID_CELLS (1L << 26)
+
 struct px_mesh_opts {
 	unsigned flags;     /* PX_MESH_* */
 	int leaf_size;      /* triangles per leaf, 1..16; 0 = 4 */
+	/* Hint-grid budget in cells (4 bytes each): 0 = the default of at
+	 * most 64^3 cells (1 MB); > 0 = at most this many (up to
+	 * PX_MESH_MAX_GRID_CELLS); < 0 = no grid. Either way the grid takes
+	 * at most one cell per 8 triangles (meshes under 16 triangles get
+	 * one cell). */
+	long grid_cells;
 };
 
 /* What setup found. message names the first problem and where it is. */

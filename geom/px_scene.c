@@ -118,21 +118,12 @@ static void range_box(const struct px_scene *s, size_t b, size_t n, double lo[3]
 static uint32_t build(struct px_scene *s, size_t b, size_t n)
 {
 	uint32_t me = (uint32_t)s->n_nodes++;
-	double clo[3] = {INFINITY, INFINITY, INFINITY},
-	       chi[3] = {-INFINITY, -INFINITY, -INFINITY};
-	size_t i, half = n / 2, part[2][2];
-	int k, axis = 0, c;
+	double clo[3], chi[3];
+	size_t half, part[2][2];
+	int c;
 
-	for (i = b; i < b + n; i++)
-		for (k = 0; k < 3; k++) {
-			double x = s->cen[3 * (size_t)s->perm[i] + k];
-			clo[k] = x < clo[k] ? x : clo[k];
-			chi[k] = x > chi[k] ? x : chi[k];
-		}
-	for (k = 1; k < 3; k++)
-		if (chi[k] - clo[k] > chi[axis] - clo[axis])
-			axis = k;
-	px__select_k(s->perm + b, (long)n, (long)half, s->cen, axis);
+	px__key_bounds(s->perm + b, n, s->cen, clo, chi);
+	half = px__median_split(s->perm + b, n, s->cen, clo, chi);
 	part[0][0] = b;
 	part[0][1] = half;
 	part[1][0] = b + half;

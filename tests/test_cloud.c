@@ -1,5 +1,6 @@
 /*
- * Point clouds: k-d tree against a linear scan, balls, coherence, files.
+ * Point clouds: k-d tree against a linear scan, balls, coherence, files,
+ * the hint grid of cold queries.
  */
 #include <math.h>
 #include <stdio.h>
@@ -7,6 +8,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "model_internal.h"
 #include "px_alloc_count.h"
 #include "px_cloud.h"
 #include "px_test.h"
@@ -329,7 +331,115 @@ static void test_no_alloc(void)
 	free(x);
 }
 
+static double scan(const double *x, size_t n, px_vec3 p)
+{
+	double best = INFINITY;
+	size_t k;
+	for (k = 0; k < n; k++) {
+		double d2 = px_v3_dist2(p, px_v3(x[3 * k], x[3 * k + 1], x[3 * k + 2]));
+		if (d2 < best)
+			best = d2;
+	}
+	return sqrt(best);
+}
+
+/* Cold queries (no hint) start from the grid's point for the query's
+ * cell: answers equal the scan inside, just outside and far outside the
+ * grid; the hint's distance is never below the answer and within twice
+ * the distance to the cell centre above it (the grid holds the exact
+ * nearest point of every centre); queries allocate nothing. */
+static void test_grid_hints(void)
+{
+	int kind, rep, i;
+	for (kind = 0; kind < 6; kind++)
+		for (rep = 0; rep < 2; rep++) {
+			size_t n = rep == 0 ? (size_t)px_rand_int(1, 40) : (size_t)px_rand_int(200, 4000);
+			double *x = make_cloud(n, kind);
+			struct px_model *m;
+			uint64_t a;
+			double sum = 0;
+			PX_CHECK_INT_EQ(px_cloud_model(x, n, 0.0, NULL, &m), PX_OK);
+			for (i = 0; i < 150; i++) {
+				double f = i % 3 == 0 ? 1.2 : (i % 3 == 1 ? 3.0 : 1e4);
+				px_vec3 p = px_v3(f * px_rand_range(-1.5, 1.5), f * px_rand_range(-1.5, 1.5),
+						  f * px_rand_range(-1.5, 1.5)),
+					c, h;
+				struct px_model_result r;
+				double ref = scan(x, n, p), dh, L = 1 + px_v3_norm(p);
+				long hi;
+				PX_CHECK_INT_EQ(px_model_query_ex(m, p, INFINITY, -1, 0, &r), 1);
+				PX_CHECK_MSG(fabs(r.distance - ref) <= 1e-12 * L,
+					     "kind %d n %zu: %.17g vs scan %.17g", kind, n, r.distance, ref);
+				hi = px__cloud_grid_hint(m, p, &c);
+				PX_CHECK(hi >= 0 && (size_t)hi < n);
+				if (hi < 0 || (size_t)hi >= n)
+					continue;
+				h = px_v3(x[3 * hi], x[3 * hi + 1], x[3 * hi + 2]);
+				dh = px_v3_dist(p, h);
+				PX_CHECK_MSG(dh >= ref - 1e-12 * L, "hint %.17g below exact %.17g", dh, ref);
+				PX_CHECK_MSG(dh <= ref + 2 * px_v3_dist(p, c) + 1e-12 * L,
+					     "hint %.17g, exact %.17g, %g from the cell centre", dh, ref,
+					     px_v3_dist(p, c));
+				/* at the centre itself the hint is the nearest point */
+				PX_CHECK_NEAR(px_v3_dist(c, h), scan(x, n, c), 1e-12 * (1 + px_v3_norm(c)));
+			}
+			a = px_alloc_region_begin();
+			for (i = 0; i < 300; i++) {
+				struct px_model_result r;
+				px_model_query(m, px_v3(3 * sin(i), 2 * cos(0.3 * i), sin(0.7 * i)), &r);
+				sum += r.distance;
+			}
+			PX_CHECK_INT_EQ(px_alloc_region_end(a), 0);
+			PX_CHECK(sum >= 0);
+			px_model_free(m);
+			free(x);
+		}
+}
+
+/* The single-precision box and slab bounds must stay lower bounds at
+ * every scale: thin curved shells (where the slabs prune most), tiny
+ * clouds far from the origin (float spacing near the cloud's size), huge
+ * clouds, and query points beyond the float range (exact path only). */
+static void test_scales(void)
+{
+	int rep, i;
+	for (rep = 0; rep < 6; rep++) {
+		size_t n = (size_t)px_rand_int(500, 3000), k;
+		double *x = malloc(3 * n * sizeof(double));
+		double off = rep < 2 ? 0.0 : (rep < 4 ? 1e7 : -3e12), sc = rep % 2 ? 1e-3 : 1.0;
+		struct px_model *m;
+		if (rep >= 4)
+			sc = 1e9;
+		for (k = 0; k < n; k++) {
+			/* a sphere shell 1e-3 thick, as a scan would give */
+			double z = px_rand_range(-1, 1), ph = px_rand_range(0, 2 * M_PI);
+			double rr = sc * (1 + 1e-3 * px_rand_range(-0.5, 0.5)), s = sqrt(1 - z * z);
+			x[3 * k] = off + rr * s * cos(ph);
+			x[3 * k + 1] = -off + rr * s * sin(ph);
+			x[3 * k + 2] = off + rr * z;
+		}
+		PX_CHECK_INT_EQ(px_cloud_model(x, n, 0.0, NULL, &m), PX_OK);
+		for (i = 0; i < 200; i++) {
+			double f = i % 4 == 3 ? (i % 8 == 3 ? 1e3 : 1e20) : px_rand_range(0, 1.5);
+			px_vec3 d = px_v3(px_rand_normal(), px_rand_normal(), px_rand_normal());
+			px_vec3 p = px_v3_add(px_v3(off, -off, off), px_v3_scale(d, sc * f / px_v3_norm(d)));
+			struct px_model_result r;
+			double ref = scan(x, n, p);
+			PX_CHECK_INT_EQ(px_model_query_ex(m, p, INFINITY, -1, 0, &r), 1);
+			PX_CHECK_MSG(fabs(r.distance - ref) <= 1e-12 * (ref + fabs(off) + sc),
+				     "rep %d: %.17g vs scan %.17g", rep, r.distance, ref);
+			/* the same through the hint path */
+			PX_CHECK_INT_EQ(px_model_query_ex(m, p, INFINITY, px_rand_int(0, (int)n - 1),
+							  PX_QUERY_COHERENT, &r), 1);
+			PX_CHECK_MSG(fabs(r.distance - ref) <= 1e-12 * (ref + fabs(off) + sc),
+				     "rep %d (hint): %.17g vs scan %.17g", rep, r.distance, ref);
+		}
+		px_model_free(m);
+		free(x);
+	}
+}
+
 static const struct px_test tests[] = {
 	PX_T(test_vs_brute), PX_T(test_coherent_and_bounded), PX_T(test_cache), PX_T(test_invalid),
-	PX_T(test_files), PX_T(test_no_alloc)};
+	PX_T(test_files), PX_T(test_no_alloc), PX_T(test_grid_hints), PX_T(test_scales)};
 PX_TEST_MAIN(tests)

@@ -205,7 +205,7 @@ static void test_closed_vs_brute(void)
 	struct gen_mesh g;
 	struct px_model *m;
 	struct px_mesh_report rp;
-	struct px_mesh_opts o = {0, 1};
+	struct px_mesh_opts o = {0, 1, 0};
 	int leaf;
 
 	PX_CHECK_INT_EQ(gen_torus(1.0, 0.35, 40, 24, &g), 0);
@@ -662,7 +662,7 @@ static void test_open_and_bad_topology(void)
 	struct gen_mesh g;
 	struct px_model *m;
 	struct px_mesh_report rp;
-	struct px_mesh_opts strict = {PX_MESH_REQUIRE_CLOSED, 0};
+	struct px_mesh_opts strict = {PX_MESH_REQUIRE_CLOSED, 0, 0};
 	struct px_model_result r;
 	uint32_t *t2;
 	size_t nt;
@@ -705,7 +705,7 @@ static void test_validation(void)
 	double xyz[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, NAN, 1, 1, 0};
 	uint32_t t_ok[] = {0, 1, 2}, t_nan[] = {0, 1, 2, 1, 3, 2},
 		 t_range[] = {0, 1, 2, 0, 1, 7}, t_deg[] = {0, 1, 2, 0, 1, 1};
-	struct px_mesh_opts strict = {PX_MESH_REJECT_DEGENERATE, 0};
+	struct px_mesh_opts strict = {PX_MESH_REJECT_DEGENERATE, 0, 0};
 	struct px_mesh_report rp;
 	struct px_model *m = (struct px_model *)1;
 
