@@ -7,6 +7,9 @@
 
 #include "px_math.h"
 
+/* A uniformly random unit quaternion (normalised Gaussian). */
+px_quat px_test_rand_quat(void);
+
 /* A pose with a uniformly random rotation (normalised Gaussian
  * quaternion) and a translation uniform in [-spread, spread]^3. */
 px_pose px_test_rand_pose(double spread);

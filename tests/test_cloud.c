@@ -12,20 +12,11 @@
 #include "px_alloc_count.h"
 #include "px_cloud.h"
 #include "px_test.h"
+#include "px_test_geom.h"
 
 static px_pose rand_pose(void)
 {
-	px_pose P;
-	px_quat q = {px_rand_normal(), px_rand_normal(), px_rand_normal(),
-		     px_rand_normal()};
-	double n = sqrt(px_quat_dot(q, q));
-	P.q.w = q.w / n;
-	P.q.x = q.x / n;
-	P.q.y = q.y / n;
-	P.q.z = q.z / n;
-	P.t = px_v3(px_rand_range(-2, 2), px_rand_range(-2, 2),
-		    px_rand_range(-2, 2));
-	return P;
+	return px_test_rand_pose(2);
 }
 
 /* Clouds of several shapes: uniform, clustered, on a plane, on a line,

@@ -19,20 +19,11 @@
 #include "px_mesh.h"
 #include "px_prim.h"
 #include "px_test.h"
+#include "px_test_geom.h"
 
 static px_pose rand_pose(void)
 {
-	px_pose P;
-	px_quat q = {px_rand_normal(), px_rand_normal(), px_rand_normal(),
-		     px_rand_normal()};
-	double n = sqrt(px_quat_dot(q, q));
-	P.q.w = q.w / n;
-	P.q.x = q.x / n;
-	P.q.y = q.y / n;
-	P.q.z = q.z / n;
-	P.t = px_v3(px_rand_range(-2, 2), px_rand_range(-2, 2),
-		    px_rand_range(-2, 2));
-	return P;
+	return px_test_rand_pose(2);
 }
 
 static px_vec3 rand_v(double s)

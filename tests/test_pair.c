@@ -20,17 +20,12 @@
 #include "px_pair.h"
 #include "px_prim.h"
 #include "px_test.h"
+#include "px_test_geom.h"
 
 static px_pose rand_rot_pose(px_vec3 t)
 {
 	px_pose P;
-	px_quat q = {px_rand_normal(), px_rand_normal(), px_rand_normal(),
-		     px_rand_normal()};
-	double n = sqrt(px_quat_dot(q, q));
-	P.q.w = q.w / n;
-	P.q.x = q.x / n;
-	P.q.y = q.y / n;
-	P.q.z = q.z / n;
+	P.q = px_test_rand_quat();
 	P.t = t;
 	return P;
 }
