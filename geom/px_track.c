@@ -120,6 +120,14 @@ struct ent {
 	int full;       /* every root must be current (no laziness) */
 	int moved;      /* a root of it was corrected this update */
 	uint32_t hit;   /* epoch in which a leaf of it was re-solved */
+	/* entity rest certificate: while the travelled path stays below
+	 * rest_until every root of it provably rests (each is alone in its
+	 * leaf and rest_until is below each leaf certificate) and none of
+	 * its minima can be the closest point, so an update passes the
+	 * entity with one comparison; -1 when not certified */
+	double rest_until;
+	int resting;    /* it rested whole in the last update */
+	int nmin;       /* minima among its roots (for the answer counts) */
 };
 
 struct cand {
@@ -161,6 +169,7 @@ struct px_track {
 	int n_crit_cap;      /* critical points all entities can hold */
 	int *rmin;           /* resting minima of this update: entity, index */
 	int n_rmin;
+	double best_now;     /* wake_minima: distance to a real curve point */
 	struct px_track_stats st;
 	size_t bytes;
 };
@@ -620,6 +629,8 @@ static int ent_check(const struct px_track *t, const struct ent *e, px_vec3 p)
 static int ent_reinit(struct px_track *t, struct ent *e, px_vec3 p)
 {
 	int i, rc;
+	e->rest_until = -1.0;
+	e->resting = 0;
 	memcpy(e->old, e->z, (size_t)e->nz * sizeof(*e->z));
 	e->nold = e->nz;
 	e->nz = 0;
@@ -1147,7 +1158,7 @@ static void wake_minima(struct px_track *t, px_vec3 p)
 	}
 	for (i = 0; i < t->n_ent; i++) {
 		const struct ent *e = &t->ent[i];
-		if (e->stale)
+		if (e->stale || e->resting)
 			continue;
 		for (j = 0; j < e->nz; j++) {
 			const struct zero *z = &e->z[j];
@@ -1160,6 +1171,7 @@ static void wake_minima(struct px_track *t, px_vec3 p)
 		}
 	}
 	best = sqrt(best2);
+	t->best_now = best;
 	if (t->fault & 2)
 		return;
 	/* wake the resting minimum with the smallest bound first: it is
@@ -1186,7 +1198,7 @@ static void wake_minima(struct px_track *t, px_vec3 p)
 			}
 		}
 		if (!wz || wlb > best + 1e-9 * (best + t->scale))
-			return;
+			break;
 		leaf0 = wz->leaf;
 		if (evolve(t, we, wz, wz->p, px_v3_sub(p, wz->p), p)) {
 			we->stale = 1;
@@ -1210,6 +1222,50 @@ static void wake_minima(struct px_track *t, px_vec3 p)
 		if (d < best)
 			best = d;
 	}
+	t->best_now = best;
+}
+
+/*
+ * Certify e to rest whole from now on (after its checks of this update).
+ * Each root must be alone in its leaf (can_rest) and rest_until stays
+ * below every leaf certificate. For the minima: the global distance d*
+ * is 1-Lipschitz and best is the distance to a real curve point, so
+ * after a further path L, d* <= best + L, while a minimum is at least
+ * lb - L away (lb its lower bound now); it cannot be the closest while
+ * lb - L > best + L, i.e. L < (lb - best) / 2 (with the same tolerance
+ * as wake_minima).
+ */
+static void ent_certify(struct px_track *t, struct ent *e)
+{
+	double until = INFINITY, lbmin = INFINITY, m;
+	int j, nmin = 0;
+	e->rest_until = -1.0;
+	for (j = 0; j < e->nz; j++) {
+		const struct zero *z = &e->z[j];
+		if (j > 0 && e->z[j - 1].leaf == z->leaf)
+			return;
+		if (!(z->until > t->travel))
+			return;
+		if (z->until < until)
+			until = z->until;
+		if (z->type > 0) {
+			double lb = z->dist - (t->travel - z->trav);
+			nmin++;
+			if (lb < lbmin)
+				lbmin = lb;
+		}
+	}
+	e->nmin = nmin;
+	if (nmin) {
+		m = lbmin - t->best_now -
+		    1e-9 * (t->best_now + t->scale);
+		if (!(m > 0.0))
+			return;
+		m = t->travel + 0.5 * m * (1.0 - 1e-9);
+		if (m < until)
+			until = m;
+	}
+	e->rest_until = (t->fault & 16) ? INFINITY : until;
 }
 
 static int in_work(const struct px_track *t, px_vec3 p)
@@ -1236,6 +1292,12 @@ static void answer(struct px_track *t, px_vec3 p, struct px_track_result *r)
 	for (i = 0; i < t->n_ent; i++) {
 		const struct ent *e = &t->ent[i];
 		nc += e->nz;
+		if (e->resting) {
+			/* rests whole: its minima provably not the closest */
+			t->st.rested += (uint64_t)e->nz;
+			nm += e->nmin;
+			continue;
+		}
 		for (j = 0; j < e->nz; j++) {
 			const struct zero *z = &e->z[j];
 			double d2;
@@ -1432,8 +1494,15 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 		e->touched = 0;
 		e->full = !t->opts.lazy || e->hit == t->epoch;
 		e->moved = 0;
+		e->resting = 0;
 		if (e->stale)
 			continue;
+		if (!e->full && t->travel < e->rest_until) {
+			e->resting = 1;
+			t->st.rested_entities++;
+			continue;
+		}
+		e->rest_until = -1.0;
 		for (j = 0; j < e->nz; j++) {
 			struct zero *zj = &e->z[j];
 			int leaf0;
@@ -1521,6 +1590,14 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 		if (rc)
 			fail = 1;
 	}
+	if (!fail && t->opts.lazy) {
+		for (i = 0; i < t->n_ent; i++) {
+			struct ent *e = &t->ent[i];
+			if (!e->resting && !e->stale &&
+			    e->hit != t->epoch && r->source == PX_TRACK_TRACKED)
+				ent_certify(t, e);
+		}
+	}
 	if (fail) {
 		count_fail(t, rc);
 		for (i = 0; i < t->n_ent; i++)
@@ -1554,6 +1631,8 @@ static void ent_refresh(struct px_track *t, struct ent *e)
 	int j, rest = 0;
 	if (!t->init || e->stale)
 		return;
+	e->rest_until = -1.0;
+	e->resting = 0;
 	for (j = 0; j < e->nz; j++)
 		rest |= e->z[j].ep != t->epoch;
 	if (!rest)

@@ -183,6 +183,8 @@ struct px_track_stats {
 	uint64_t creations, annihilations; /* pairs */
 	uint64_t rested;         /* critical points left uncorrected in an
 				  * update (opts.lazy), summed over updates */
+	uint64_t rested_entities; /* entities passed whole under their rest
+				   * certificate, summed over updates */
 };
 
 struct px_track_info {
