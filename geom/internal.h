@@ -81,7 +81,7 @@ struct px_track;
  * catch it (bit 0: every root may rest, bit 1: resting minima are never
  * woken, bit 2: every leaf's no-event radius is infinite, bit 3: every
  * leaf-end radius is infinite, bit 4: entity rest certificates never
- * expire). 0 restores normal operation. */
+ * expire, bit 5: they ignore the distance bound of their minima). 0 restores normal operation. */
 void px__track_set_fault(struct px_track *t, int fault);
 
 /* Test hook: the certificate radius of leaf `leaf` at p (which 0: no

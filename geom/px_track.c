@@ -1256,7 +1256,7 @@ static void ent_certify(struct px_track *t, struct ent *e)
 		}
 	}
 	e->nmin = nmin;
-	if (nmin) {
+	if (nmin && !(t->fault & 32)) {
 		m = lbmin - t->best_now -
 		    1e-9 * (t->best_now + t->scale);
 		if (!(m > 0.0))

@@ -518,7 +518,8 @@ static void report(const char *name, const struct run_stats *rs)
 	printf("  %s: %ld steps, wrong %ld, naive wrong %ld, brute %ld/%ld bad, "
 	       "counts %ld checked %ld bad %ld ambiguous, jumps %ld; tracker: "
 	       "reinit %llu outside %llu fallback %llu solves %llu created %llu "
-	       "annihilated %llu disagree %llu/%llu\n",
+	       "annihilated %llu disagree %llu/%llu rested %llu roots %llu "
+	       "entities\n",
 	       name, rs->steps, rs->wrong, rs->naive_wrong, rs->brute_bad,
 	       rs->brute_checked, rs->count_checked, rs->count_bad,
 	       rs->count_ambig, rs->jumps, (unsigned long long)rs->ts.reinits,
@@ -528,7 +529,9 @@ static void report(const char *name, const struct run_stats *rs)
 	       (unsigned long long)rs->ts.creations,
 	       (unsigned long long)rs->ts.annihilations,
 	       (unsigned long long)rs->ts.disagreements,
-	       (unsigned long long)rs->ts.verifications);
+	       (unsigned long long)rs->ts.verifications,
+	       (unsigned long long)rs->ts.rested,
+	       (unsigned long long)rs->ts.rested_entities);
 }
 
 static void check_run(const char *name, const struct run_stats *rs,
@@ -746,12 +749,18 @@ static void test_lazy_exact(void)
 		     "laziness never engaged: %llu rests in %llu updates",
 		     (unsigned long long)rs.ts.rested,
 		     (unsigned long long)rs.ts.updates);
+	/* whole entities are passed on their rest certificate */
+	PX_CHECK_MSG(rs.ts.rested_entities > rs.ts.updates / 4,
+		     "entity rest never engaged: %llu in %llu updates",
+		     (unsigned long long)rs.ts.rested_entities,
+		     (unsigned long long)rs.ts.updates);
 	memset(&rs, 0, sizeof(rs));
 	g_lazy = 0;
 	run_model(tc, 5, 600, 1 << 30, &rs, 0);
 	g_lazy = 1;
 	check_run("eager", &rs, 10);
 	PX_CHECK_INT_EQ((long)rs.ts.rested, 0);
+	PX_CHECK_INT_EQ((long)rs.ts.rested_entities, 0);
 }
 
 /* The tests above can fail: break each proof on purpose and the same
@@ -760,9 +769,11 @@ static void test_lazy_exact(void)
  * checks catch the damage (re-initialisations far above a clean run). */
 static void test_lazy_faults_caught(void)
 {
-	static const int faults[] = {1 | 2, 4, 1};
+	static const int faults[] = {1 | 2, 4, 1, 16, 32};
 	static const char *names[] = {"fault: never woken", "fault: no events",
-				      "fault: rest always"};
+				      "fault: rest always",
+				      "fault: entity rest never expires",
+				      "fault: entity rest without distance"};
 	struct tcurve tc[5];
 	struct run_stats rs;
 	uint64_t clean_reinits;
@@ -772,7 +783,7 @@ static void test_lazy_faults_caught(void)
 	run_model(tc, 5, 400, 40, &rs, 0);
 	check_run("clean", &rs, 10);
 	clean_reinits = rs.ts.reinits;
-	for (f = 0; f < 3; f++) {
+	for (f = 0; f < 5; f++) {
 		memset(&rs, 0, sizeof(rs));
 		g_fault = faults[f];
 		run_model(tc, 5, 400, 40, &rs, 0);
