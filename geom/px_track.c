@@ -127,6 +127,7 @@ struct ent {
 	 * entity with one comparison; -1 when not certified */
 	double rest_until;
 	int resting;    /* it rested whole in the last update */
+	int allrest;    /* every root of it rested in the evolution pass */
 	int nmin;       /* minima among its roots (for the answer counts) */
 };
 
@@ -1489,12 +1490,13 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 	 * rest (can_rest) until the answer needs it */
 	for (i = 0; i < t->n_ent; i++) {
 		struct ent *e = &t->ent[i];
-		int w = 0;
+		int w = 0, nrest = 0;
 		e->nold = 0;
 		e->touched = 0;
 		e->full = !t->opts.lazy || e->hit == t->epoch;
 		e->moved = 0;
 		e->resting = 0;
+		e->allrest = 0;
 		if (e->stale)
 			continue;
 		if (!e->full && t->travel < e->rest_until) {
@@ -1519,6 +1521,7 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 					t->n_rmin++;
 				}
 				w++;
+				nrest++;
 				continue;
 			}
 			leaf0 = zj->leaf;
@@ -1534,6 +1537,9 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 			w++;
 		}
 		if (!e->stale) {
+			/* a root corrected here moved the entity: w counts
+			 * the roots kept, nrest those that rested */
+			e->allrest = !e->full && nrest == w;
 			e->nz = w;
 			if (e->full && catch_up(t, e, p))
 				e->stale = 1;
@@ -1593,8 +1599,10 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 	if (!fail && t->opts.lazy) {
 		for (i = 0; i < t->n_ent; i++) {
 			struct ent *e = &t->ent[i];
-			if (!e->resting && !e->stale &&
-			    e->hit != t->epoch && r->source == PX_TRACK_TRACKED)
+			/* only entities whose roots all rested: one holding
+			 * a corrected root is near the answer or moving */
+			if (e->allrest && !e->stale &&
+			    r->source == PX_TRACK_TRACKED)
 				ent_certify(t, e);
 		}
 	}
