@@ -197,13 +197,14 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 	       "%zu bytes\n", name, nc, ti.n_spans, ti.n_leaves,
 	       ti.n_boxed_leaves, t0 / 1e6, ti.bytes);
 	printf("  %-8s %-7s %8s %8s %8s %8s %8s | %8s %8s | %6s | %5s %6s %6s %5s "
-	       "%5s %6s %6s\n",
+	       "%5s %6s %6s %6s\n",
 	       "path", "step", "med_ns", "p99_ns", "p999_ns", "max_ns", "max_m3",
 	       "cold_med", "cold_p99", "ratio", "wrong", "trans", "solves",
-	       "reini", "fallb", "tests", "rest");
+	       "reini", "fallb", "tests", "rest", "erest");
 	/* trans, solves, reini, fallb: counts per run of the path; tests:
 	 * leaves given the exact segment test per update; rest:
-	 * critical points left uncorrected per update (lazy); max_m3: the
+	 * critical points left uncorrected per update (lazy); erest: curves
+	 * passed whole on their rest certificate per update; max_m3: the
 	 * median over NRUN runs of each run's max (max_ns is the raw max of
 	 * all runs: on a shared machine it is dominated by interrupts) */
 	for (kind = 0; kind < 2; kind++)
@@ -241,7 +242,7 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 			ratio[kind][s] = (double)tg[n / 2] / (double)(tt[n / 2] ? tt[n / 2] : 1);
 			wrong_all += wrong;
 			printf("  %-8s %-7g %8lld %8lld %8lld %8lld %8lld | %8lld %8lld | "
-			       "%6.1f | %5ld %6llu %6llu %5llu %5llu %6.2f %6.2f\n",
+			       "%6.1f | %5ld %6llu %6llu %5llu %5llu %6.2f %6.2f %6.2f\n",
 			       kind ? "sines" : "random", steps[s] * 100.0,
 			       (long long)tt[n / 2], (long long)tt[n * 99 / 100],
 			       (long long)tt[n * 999 / 1000], (long long)tt[n - 1],
@@ -253,7 +254,8 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 			       (unsigned long long)(b.reinits - a.reinits) / NRUN,
 			       (unsigned long long)(b.fallbacks - a.fallbacks) / NRUN,
 			       (double)(b.box_hits - a.box_hits) / n,
-			       (double)(b.rested - a.rested) / n);
+			       (double)(b.rested - a.rested) / n,
+			       (double)(b.rested_entities - a.rested_entities) / n);
 			if (tt[n / 2] > TGT_MED_NS)
 				med_ok = 0;
 			if (tt[n - 1] > TGT_MAX_NS)
