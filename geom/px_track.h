@@ -35,7 +35,14 @@
  *    entity has a re-solved leaf or a root changes leaf, all its roots
  *    are corrected first, so the structure checks and transitions always
  *    see current data. px_track_critical() corrects resting roots before
- *    reporting them.
+ *    reporting them. An entity whose roots all rested in an update gets
+ *    one rest certificate: a travel bound below every leaf certificate of
+ *    its roots and below half the margin by which its minima exceed the
+ *    best answer (the global distance and each critical distance are
+ *    1-Lipschitz, so the margin shrinks at most twice as fast as the
+ *    path grows); until the path uses it up or one of its leaves has an
+ *    event, an update passes the entity with one comparison
+ *    (stats.rested_entities).
  *  - Transitions: pairs appear or vanish only where the moving point
  *    crosses the transition set {p : g = 0 and dg/ds = 0} (the evolute of
  *    a planar curve, a ruled surface of polar lines for a space curve) or,
