@@ -386,7 +386,8 @@ int main(int argc, char **argv)
 		struct px_model *ma, *mb, *ca, *cb, *sp, *cl;
 		struct px_prim cyl = {PX_PRIM_CYLINDER, 0.05, 0.1, 0}, box = {PX_PRIM_BOX, 0.05, 0.08, 0.1};
 		struct px_prim sph = {PX_PRIM_SPHERE, 0.05, 0, 0};
-		struct px_pair_opts o1 = {1, 64, 1e-12, 1, 0}, o8 = {8, 64, 1e-12, 0, 0};
+		struct px_pair_opts o1 = {1, 64, 1e-12, 1, 0, 0}, o8 = {8, 64, 1e-12, 0, 0, 0};
+		struct px_pair_opts o1l = {1, 64, 1e-12, 1, 0, 1};
 		struct px_pair_result r;
 		const int NP = BM_PAIR_N;
 		double mesh_sum = 0.0, mesh_median = 0.0;
@@ -407,6 +408,7 @@ int main(int argc, char **argv)
 				const struct px_pair_opts *o;
 			} P[] = {{"mesh torus 4k / mesh sphere 4k exact", ma, mb, &o8},
 				 {"same, coherent (last pair first)", ma, mb, &o1},
+				 {"same, coherent, local_ok (tracking)", ma, mb, &o1l},
 				 {"mesh torus 4k / box (BVH + GJK)", ma, cb, &o8},
 				 {"same, coherent", ma, cb, &o1},
 				 {"mesh torus 4k / cloud 2k, 8 starts", ma, cl, &o8},

@@ -1060,7 +1060,7 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 	double rel = opt && opt->rel_tol > 0.0 ? opt->rel_tol : 1e-9;
 	int coherent = opt && opt->coherent && res && res->valid;
 	struct run best, r;
-	int k, n = 0, total = 0, rc, have = 0, nxs = 0, cert = 0;
+	int k, n = 0, total = 0, rc, have = 0, nxs = 0, cert = 0, mesh_local;
 	px_vec3 seed, xs[2][3];
 
 	if (!a || !b || !res || starts < 1 || starts > PX_PAIR_MAX_STARTS ||
@@ -1176,7 +1176,11 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 	}
 	memset(&best, 0, sizeof(best));
 	best.d = INFINITY;
-	if (px_mesh_triangle_count(a) > 0 && px_mesh_triangle_count(b) > 0) {
+	/* two meshes, coherent and allowed local: last cycle's pair tracked
+	 * by the projections, no exact proof (px_pair.h, local_ok) */
+	mesh_local = coherent && opt->local_ok && px_mesh_triangle_count(a) > 0 &&
+		     px_mesh_triangle_count(b) > 0;
+	if (px_mesh_triangle_count(a) > 0 && px_mesh_triangle_count(b) > 0 && !mesh_local) {
 		/* two meshes: exact, by both hierarchies at once */
 		struct px__mesh_pair mp;
 		rc = px__mesh_pair(a, b, coherent ? res->index_a : -1,
@@ -1216,7 +1220,7 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 		 * exact, by the mesh hierarchy and GJK per triangle */
 		int ma = px_mesh_triangle_count(a) > 0 && px_model_get_ops(b)->support;
 		int mb = !ma && px_mesh_triangle_count(b) > 0 && px_model_get_ops(a)->support;
-		if (ma || mb) {
+		if ((ma || mb) && !mesh_local) {
 			const struct px_model *m = ma ? a : b, *o = ma ? b : a;
 			struct run mr;
 			int ex, mt;

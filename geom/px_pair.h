@@ -69,7 +69,10 @@
  *
  * Coherent mode: the previous result's points (kept in the result, in
  * each model's own frame, so they follow the models' new poses) are the
- * first start; with a slowly moving pair one or two steps suffice.
+ * first start; with a slowly moving pair one or two steps suffice. Two
+ * meshes stay exact in coherent mode unless opt->local_ok is set: then
+ * they take the projections from last cycle's pair (local_only = 1), a
+ * few microseconds instead of the exact proof's hundreds.
  *
  * Intersection: when a projection lands inside a closed model (signed
  * distance <= 0) or the distance reaches 0, the models touch or overlap:
@@ -124,6 +127,16 @@ struct px_pair_opts {
 	double tol;
 	int coherent;     /* start from the previous result's pair */
 	double rel_tol;
+	/* With coherent = 1 and a valid previous result: 1 lets a pair of
+	 * meshes skip the exact traversal (whose proof costs about a
+	 * thousand node pairs per call even with a perfect first bound) and
+	 * run the projections from last cycle's pair instead, answering
+	 * with local_only = 1 (also when one mesh is convex, which would
+	 * otherwise take the mesh/convex path; two convex meshes keep GJK,
+	 * which is exact and cheap). Use with starts = 1 for a cheap tracking
+	 * step; run a cold exact call now and then (or when the pair may
+	 * have jumped) to recover the global pair. 0 = always exact. */
+	int local_ok;
 };
 
 struct px_pair_result {

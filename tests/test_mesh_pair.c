@@ -622,7 +622,7 @@ static void test_pair_exact_paths_alloc(void)
 	struct px_prim bx = {PX_PRIM_BOX, 0.1, 0.2, 0.3}, cy = {PX_PRIM_CYLINDER, 0.1, 0.2, 0};
 	struct px_model *p1, *p2;
 	struct px_pair_result r;
-	struct px_pair_opts co = {1, 64, 1e-12, 1, 0};
+	struct px_pair_opts co = {1, 64, 1e-12, 1, 0, 0};
 	uint64_t reg;
 	int i;
 	PX_CHECK_INT_EQ(px_prim_model(&bx, &p1), PX_OK);
@@ -645,9 +645,61 @@ static void test_pair_exact_paths_alloc(void)
 	px_model_free(p2);
 }
 
+/* Along a smooth path: coherent exact calls equal cold ones at every step;
+ * local_ok = 1 takes the projections from last cycle's pair (local_only =
+ * 1, an upper bound realised by points on both surfaces) and only in
+ * coherent mode with a valid previous result; no allocation. */
+static void test_pair_coherent_local_ok(void)
+{
+	/* b a torus or a (convex) sphere mesh, which local_ok also takes
+	 * off the mesh/convex path; centre distance past contact */
+	int kb = px_rand_int(0, 1);
+	double R = kb ? 1.6 : 2.0;
+	struct px_model *a = shape(0), *b = shape(kb);
+	struct px_pair_result rc, rl, r0;
+	struct px_pair_opts ex = {1, 64, 1e-12, 1, 0, 0}, lo = {1, 64, 1e-12, 1, 0, 1};
+	struct px_model_result qa, qb;
+	double ph = px_rand_range(0.0, 6.283), w = px_rand_range(0.5, 2.0);
+	uint64_t reg;
+	int i, same = 0;
+	memset(&rc, 0, sizeof(rc));
+	memset(&rl, 0, sizeof(rl));
+	/* not coherent yet (res->valid = 0): local_ok is ignored */
+	px_model_set_pose(b, rand_pose(px_v3(R, 0.1, 0.2)));
+	PX_CHECK_INT_EQ(px_pair_distance(a, b, &lo, &rl), PX_OK);
+	PX_CHECK(!rl.local_only);
+	PX_CHECK_NEAR(rl.distance, brute(a, b), 1e-12);
+	reg = px_alloc_region_begin();
+	for (i = 0; i < 60; i++) {
+		double t = ph + 0.02 * i;
+		px_pose P = rand_pose(px_v3(R * cos(t), R * sin(t), 0.3 * sin(w * t)));
+		PX_CHECK_INT_EQ(px_quat_from_axis_angle(px_v3(0.3, 1, 0), 2.0 * t, &P.q), PX_OK);
+		px_model_set_pose(b, P);
+		PX_CHECK_INT_EQ(px_pair_distance(a, b, &ex, &rc), PX_OK);
+		PX_CHECK_INT_EQ(px_pair_distance(a, b, NULL, &r0), PX_OK);
+		PX_CHECK(!rc.local_only && !r0.local_only);
+		PX_CHECK_MSG(fabs(rc.distance - r0.distance) <= 1e-12 * r0.distance,
+			     "step %d: coherent %.17g cold %.17g", i, rc.distance, r0.distance);
+		PX_CHECK_INT_EQ(px_pair_distance(a, b, &lo, &rl), PX_OK);
+		PX_CHECK_MSG(rl.local_only && !rl.intersecting, "step %d: local_only %d intersecting %d d %.6g exact %.6g", i, rl.local_only, rl.intersecting, rl.distance, r0.distance);
+		PX_CHECK_MSG(rl.distance >= r0.distance * (1.0 - 1e-12),
+			     "step %d: local %.17g below exact %.17g", i, rl.distance, r0.distance);
+		PX_CHECK_NEAR(px_v3_dist(rl.point_a, rl.point_b), rl.distance, 1e-12);
+		PX_CHECK(px_model_query(a, rl.point_a, &qa) >= 0);
+		PX_CHECK(px_model_query(b, rl.point_b, &qb) >= 0);
+		PX_CHECK(fabs(qa.distance) < 1e-9 && fabs(qb.distance) < 1e-9);
+		same += rl.distance <= r0.distance * (1.0 + 1e-9);
+	}
+	PX_CHECK_INT_EQ(px_alloc_region_end(reg), 0);
+	/* a smooth path: the tracked pair is mostly the global one */
+	PX_CHECK_MSG(same >= 30, "local tracking global at %d of 60 steps", same);
+	px_model_free(a);
+	px_model_free(b);
+}
+
 static const struct px_test tests[] = {
 	PX_T(test_tri_tri_vs_references), PX_T(test_mesh_pair_vs_brute),
 	PX_T(test_mesh_pair_parallel_faces), PX_T(test_mesh_pair_errors_and_alloc),
 	PX_T(test_pair_mesh_vs_convex_primitives), PX_T(test_pair_mesh_in_mesh),
-	PX_T(test_pair_exact_paths_alloc)};
+	PX_T(test_pair_exact_paths_alloc), PX_T(test_pair_coherent_local_ok)};
 PX_TEST_MAIN(tests)

@@ -143,7 +143,7 @@ static void check_pair_result(const struct px_model *a, const struct px_model *b
 static void test_mesh_pairs_hit_rate(void)
 {
 	int trial, hits = 0, misses = 0, flagged_hits = 0, n = 240;
-	struct px_pair_opts o = {8, 64, 1e-12, 0, 0};
+	struct px_pair_opts o = {8, 64, 1e-12, 0, 0, 0};
 	for (trial = 0; trial < n; trial++) {
 		double ra, rb, ref, sep;
 		struct px_model *a = make_mesh(trial % 4, &ra);
@@ -612,7 +612,7 @@ static void test_coherent_and_alloc(void)
 	double ra, rb;
 	struct px_model *a = make_mesh(0, &ra), *b = make_mesh(1, &rb);
 	struct px_pair_result rc, rf;
-	struct px_pair_opts co = {1, 64, 1e-12, 1, 0}, fo = {8, 64, 1e-12, 0, 0};
+	struct px_pair_opts co = {1, 64, 1e-12, 1, 0, 0}, fo = {8, 64, 1e-12, 0, 0, 0};
 	uint64_t al;
 	int i, agree = 0;
 	memset(&rc, 0, sizeof(rc));
@@ -700,7 +700,7 @@ static void test_mesh_vs_cloud_certified(void)
 		{
 			/* a poor start (one start, one projection): the
 			 * certification must repair it or keep the flag */
-			struct px_pair_opts po = {1, 1, 1e-12, 1, 0};
+			struct px_pair_opts po = {1, 1, 1e-12, 1, 0, 0};
 			memset(&r, 0, sizeof(r));
 			/* coherent from a "last pair" on the far side of the
 			 * mesh: one projection, no neighbourhood steps */
