@@ -2,6 +2,7 @@
 
 #include <math.h>
 
+#include "px_mesh.h"
 #include "px_test.h"
 
 px_quat px_test_rand_quat(void)
@@ -24,4 +25,19 @@ px_pose px_test_rand_pose(double spread)
 		    px_rand_range(-spread, spread),
 		    px_rand_range(-spread, spread));
 	return P;
+}
+
+double px_test_mesh_brute(const struct px_model *m, px_vec3 p)
+{
+	size_t i, n = px_mesh_triangle_count(m);
+	double best = INFINITY;
+	for (i = 0; i < n; i++) {
+		px_vec3 v[3];
+		double d2;
+		px_mesh_triangle(m, i, v);
+		d2 = px_tri_closest(p, v[0], v[1], v[2], NULL, NULL, NULL, NULL, NULL);
+		if (d2 < best)
+			best = d2;
+	}
+	return sqrt(best);
 }

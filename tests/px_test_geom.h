@@ -14,4 +14,11 @@ px_quat px_test_rand_quat(void);
  * quaternion) and a translation uniform in [-spread, spread]^3. */
 px_pose px_test_rand_pose(double spread);
 
+struct px_model;
+
+/* Exact distance from p (model frame) to a mesh model by a scan over
+ * every triangle: the reference the hierarchy and grid tests compare
+ * with. */
+double px_test_mesh_brute(const struct px_model *m, px_vec3 p);
+
 #endif

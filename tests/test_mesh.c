@@ -103,19 +103,9 @@ static void test_tri_regions(void)
 
 /* ---- hierarchy against a linear scan -------------------------------------- */
 
-static double brute(const struct px_model *m, px_vec3 pl)
+static double brute(const struct px_model *m, px_vec3 p)
 {
-	size_t i, n = px_mesh_triangle_count(m);
-	double best = INFINITY;
-	for (i = 0; i < n; i++) {
-		px_vec3 v[3];
-		double d2;
-		px_mesh_triangle(m, i, v);
-		d2 = px_tri_closest(pl, v[0], v[1], v[2], NULL, NULL, NULL, NULL, NULL);
-		if (d2 < best)
-			best = d2;
-	}
-	return sqrt(best);
+	return px_test_mesh_brute(m, p);
 }
 
 static void check_against_brute(struct px_model *m, int nq, double spread)

@@ -21,6 +21,7 @@
 #include "px_alloc_count.h"
 #include "px_mesh.h"
 #include "px_test.h"
+#include "px_test_geom.h"
 
 static px_vec3 rand_v(double s)
 {
@@ -36,17 +37,7 @@ static const struct mesh *impl_of(const struct px_model *m)
 /* Exact distance by a scan over every triangle (model frame). */
 static double brute(const struct px_model *m, px_vec3 p)
 {
-	size_t i, n = px_mesh_triangle_count(m);
-	double best = INFINITY;
-	for (i = 0; i < n; i++) {
-		px_vec3 v[3];
-		double d2;
-		px_mesh_triangle(m, i, v);
-		d2 = px_tri_closest(p, v[0], v[1], v[2], NULL, NULL, NULL, NULL, NULL);
-		if (d2 < best)
-			best = d2;
-	}
-	return sqrt(best);
+	return px_test_mesh_brute(m, p);
 }
 
 static double leaf_dist(const struct mesh *M, uint32_t li, px_vec3 p)
