@@ -47,16 +47,14 @@ struct node4 {
 #define STACK4 (3 * PX_MESH_MAX_DEPTH + 4)
 
 /* Triangle with its (unnormalized) normal n = (b - a) x (c - a) and
- * 1 / |n|^2, for the plane-distance lower bound. */
+ * 1 / |n|^2 (0 for degenerate triangles), for the plane-distance lower
+ * bound: a value made on demand from the compact vertex data
+ * (px__mtri_get), not stored. */
 struct mtri {
-	/* first cache line: what the plane lower bound reads */
-	px_vec3 a;
+	px_vec3 a, b, c;
 	px_vec3 n;
 	double inv_nn;
-	double pad_;
-	/* second line: only for triangles the bound does not reject */
-	px_vec3 b, c;
-} __attribute__((aligned(64)));
+};
 
 /*
  * Single-precision lower bound of a triangle's distance, one cache line
@@ -76,7 +74,15 @@ struct tlb {
 
 struct mesh {
 	size_t nt, nv;
-	struct mtri *tri;    /* leaf order */
+	/* Exact triangles, compactly: the distinct vertices numbered in leaf
+	 * order (a leaf's triangles share their vertices' cache lines, and
+	 * neighbouring leaves mostly do too) and three indices per leaf
+	 * triangle - about 24 bytes a triangle where a stored triangle with
+	 * its normal took 128, which is what keeps a large mesh's query
+	 * data in cache. */
+	px_vec3 *vx;
+	uint32_t *tv;
+	size_t n_vx;
 	struct tlb *lb;      /* leaf order: float lower-bound data */
 	uint32_t *orig;      /* leaf -> input triangle */
 	uint32_t *leaf_of;   /* input -> leaf */
@@ -111,6 +117,20 @@ struct mesh {
 	double gcell;        /* cell edge length */
 	double ginv;         /* 1 / gcell */
 };
+
+/* Leaf triangle li as a struct mtri. The same operations as setup used,
+ * so n and inv_nn do not depend on where they are made. RT-safe. */
+static inline struct mtri px__mtri_get(const struct mesh *M, size_t li)
+{
+	const uint32_t *v = M->tv + 3 * li;
+	struct mtri t;
+	t.a = M->vx[v[0]];
+	t.b = M->vx[v[1]];
+	t.c = M->vx[v[2]];
+	t.n = px_v3_cross(px_v3_sub(t.b, t.a), px_v3_sub(t.c, t.a));
+	t.inv_nn = M->degen[li] ? 0.0 : 1.0 / px_v3_norm2(t.n);
+	return t;
+}
 
 /* Cell of a hint grid (gdim cells from corner org, 1 / cell size inv)
  * holding p, points outside taking the nearest cell. @note RT-safe. */

@@ -480,7 +480,8 @@ static void mesh_free(void *impl)
 	struct mesh *M = impl;
 	if (!M)
 		return;
-	free(M->tri);
+	free(M->vx);
+	free(M->tv);
 	free(M->lb);
 	free(M->orig);
 	free(M->leaf_of);
@@ -555,20 +556,23 @@ static inline double tri_lb(const struct tlb *L, const struct pq *q)
 static inline void test_tri_x(const struct mesh *M, size_t li, px_vec3 p,
 			      struct best *b, int plane_done)
 {
-	const struct mtri *t = &M->tri[li];
-	px_vec3 q;
-	int f, s;
-	double u, v, d2;
+	const uint32_t *vi = M->tv + 3 * li;
+	px_vec3 ta = M->vx[vi[0]], tb = M->vx[vi[1]], tc = M->vx[vi[2]], n, q;
+	int f, s, needle;
+	double u, v, d2, nn;
 
-	if (!plane_done && t->inv_nn != 0.0) {
+	n = px_v3_cross(px_v3_sub(tb, ta), px_v3_sub(tc, ta));
+	/* |n|^2 as px_tri_closest computes it (a product, not a division);
+	 * 1 / |n|^2 (px__mtri_get) is 0 exactly for these */
+	nn = px_v3_norm2(n);
+	needle = M->degen[li] || nn == INFINITY;
+	if (!plane_done && !needle) {
 		/* the distance to the plane is a lower bound */
-		double h = px_v3_dot(t->n, px_v3_sub(p, t->a));
-		if (h * h * t->inv_nn > b->d2)
+		double h = px_v3_dot(n, px_v3_sub(p, ta));
+		if (h * h * (1.0 / nn) > b->d2)
 			return;
 	}
-	/* |n|^2 as px_tri_closest computes it (a product, not a division) */
-	d2 = tri_core(p, t->a, t->b, t->c, t->n, px_v3_norm2(t->n), t->inv_nn == 0.0, &q,
-		      &f, &s, &u, &v);
+	d2 = tri_core(p, ta, tb, tc, n, nn, needle, &q, &f, &s, &u, &v);
 	if (d2 < b->d2 ||
 	    (d2 == b->d2 && (b->li < 0 || (M->degen[b->li] && !M->degen[li])))) {
 		b->d2 = d2;
@@ -660,12 +664,28 @@ static void mesh_walk(const struct mesh *M, px_vec3 p, struct best *b,
 			continue;
 		iters++;
 		if (st[sp].cnt > 0) {
-			uint32_t i;
-			for (i = st[sp].idx; i < st[sp].idx + st[sp].cnt; i++)
-				if (!pq.use)
-					test_tri(M, i, p, b);
-				else if (!(tri_lb(&M->lb[i], &pq) > b->d2))
-					test_tri_x(M, i, p, b, 1);
+			uint32_t i0 = st[sp].idx, n = st[sp].cnt, k;
+			double lb[16];
+			if (!pq.use) {
+				for (k = 0; k < n; k++)
+					test_tri(M, i0 + k, p, b);
+				continue;
+			}
+			/* all bounds of the leaf first, then the vertex fetches
+			 * of the triangles they keep at once, then the exact
+			 * tests: the fetches overlap instead of queueing */
+			for (k = 0; k < n; k++) {
+				lb[k] = tri_lb(&M->lb[i0 + k], &pq);
+				if (!(lb[k] > b->d2)) {
+					const uint32_t *v = M->tv + 3 * (i0 + k);
+					__builtin_prefetch(M->vx + v[0]);
+					__builtin_prefetch(M->vx + v[1]);
+					__builtin_prefetch(M->vx + v[2]);
+				}
+			}
+			for (k = 0; k < n; k++)
+				if (!(lb[k] > b->d2))
+					test_tri_x(M, i0 + k, p, b, 1);
 			continue;
 		}
 		nd = &M->n4[st[sp].idx];
@@ -700,6 +720,7 @@ static void mesh_walk(const struct mesh *M, px_vec3 p, struct best *b,
 				uint32_t k;
 				for (k = 0; k < st[sp].cnt; k++)
 					__builtin_prefetch(L + k);
+				__builtin_prefetch(M->tv + 3 * st[sp].idx);
 			} else {
 				/* a node spans two lines */
 				const char *q = (const char *)&M->n4[st[sp].idx];
@@ -787,7 +808,7 @@ static int mesh_collect(const void *impl, px_vec3 p, double radius, int *idx,
 		if (st[sp].cnt > 0) {
 			uint32_t i;
 			for (i = st[sp].idx; i < st[sp].idx + st[sp].cnt; i++) {
-				const struct mtri *t = &M->tri[i];
+				const struct mtri t_ = px__mtri_get(M, i), *t = &t_;
 				if (t->inv_nn != 0.0) {
 					double h = px_v3_dot(t->n, px_v3_sub(p, t->a));
 					if (h * h * t->inv_nn > r2)
@@ -985,7 +1006,7 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 {
 	struct px_mesh_report lrep;
 	struct mesh *M = NULL;
-	uint32_t *order = NULL, *canon = NULL, *perm = NULL;
+	uint32_t *order = NULL, *canon = NULL, *perm = NULL, *vmap = NULL;
 	struct edge *E = NULL;
 	size_t ne = 0, i, j;
 	int32_t *nb = NULL;
@@ -1264,7 +1285,8 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 	M->nodes = NULL;
 
 	/* reorder into leaf order */
-	M->tri = aligned_alloc(64, nt * sizeof(*M->tri));
+	M->vx = malloc(3 * nt * sizeof(*M->vx));
+	M->tv = malloc(3 * nt * sizeof(*M->tv));
 	M->lb = aligned_alloc(64, nt * sizeof(*M->lb));
 	M->orig = malloc(nt * sizeof(*M->orig));
 	M->leaf_of = malloc(nt * sizeof(*M->leaf_of));
@@ -1272,9 +1294,15 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 	M->en = malloc(3 * nt * sizeof(*M->en));
 	M->vnt = malloc(3 * nt * sizeof(*M->vnt));
 	M->degen = malloc(nt);
-	if (!M->tri || !M->lb || !M->orig || !M->leaf_of || !M->fn || !M->en || !M->vnt ||
+	if (!M->vx || !M->tv || !M->lb || !M->orig || !M->leaf_of || !M->fn || !M->en || !M->vnt ||
 	    !M->degen)
 		goto fail;
+	vmap = malloc(nv * sizeof(*vmap));
+	if (!vmap)
+		goto fail;
+	for (i = 0; i < nv; i++)
+		vmap[i] = UINT32_MAX;
+	M->n_vx = 0;
 	M->box = px_aabb_empty();
 	for (i = 0; i < nt; i++) {
 		uint32_t t = perm[i];
@@ -1288,16 +1316,21 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 						   ? px_v3_add(fn[t], fn[nb[3 * t + k]])
 						   : fn[t];
 		}
-		M->tri[i].a = P[0];
-		M->tri[i].b = P[1];
-		M->tri[i].c = P[2];
-		M->tri[i].n = px_v3_cross(px_v3_sub(P[1], P[0]), px_v3_sub(P[2], P[0]));
-		M->tri[i].inv_nn = deg[t] ? 0.0 : 1.0 / px_v3_norm2(M->tri[i].n);
+		for (k = 0; k < 3; k++) {
+			/* welded vertices numbered in order of first use */
+			uint32_t c = canon[tri[3 * t + k]];
+			if (vmap[c] == UINT32_MAX) {
+				vmap[c] = (uint32_t)M->n_vx;
+				M->vx[M->n_vx++] = P[k];
+			}
+			M->tv[3 * i + k] = vmap[c];
+		}
 		memset(&M->lb[i], 0, sizeof(M->lb[i]));
 		if (!deg[t]) {
 			struct tlb *L = &M->lb[i];
-			double nl = sqrt(px_v3_norm2(M->tri[i].n));
-			px_vec3 nu = px_v3_scale(M->tri[i].n, 1.0 / nl);
+			px_vec3 nrm = px_v3_cross(px_v3_sub(P[1], P[0]), px_v3_sub(P[2], P[0]));
+			double nl = sqrt(px_v3_norm2(nrm));
+			px_vec3 nu = px_v3_scale(nrm, 1.0 / nl);
 			L->n[0] = (float)nu.x;
 			L->n[1] = (float)nu.y;
 			L->n[2] = (float)nu.z;
@@ -1320,7 +1353,8 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 	M->absmax = fmax(fmax(fabs(M->box.min.x), fabs(M->box.max.x)),
 			 fmax(fmax(fabs(M->box.min.y), fabs(M->box.max.y)),
 			      fmax(fabs(M->box.min.z), fabs(M->box.max.z))));
-	M->bytes = sizeof(*M) + nt * (sizeof(struct mtri) + sizeof(struct tlb) + 2 * sizeof(uint32_t) +
+	M->bytes = sizeof(*M) + M->n_vx * sizeof(px_vec3) +
+		   nt * (3 * sizeof(uint32_t) + sizeof(struct tlb) + 2 * sizeof(uint32_t) +
 				      7 * sizeof(px_vec3) + 1) +
 		   M->n_n4 * sizeof(struct node4);
 	if (grid_build(M, opt ? opt->grid_cells : 0) != PX_OK)
@@ -1403,6 +1437,7 @@ done:
 	free(tlo);
 	free(thi);
 	free(deg);
+	free(vmap);
 	return rc;
 }
 
@@ -1425,13 +1460,13 @@ size_t px_mesh_triangle_count(const struct px_model *m)
 int px_mesh_triangle(const struct px_model *m, size_t i, px_vec3 v[3])
 {
 	const struct mesh *M = as_mesh(m);
-	const struct mtri *t;
+	const uint32_t *t;
 	if (!M || !v || i >= M->nt)
 		return PX_E_INVAL;
-	t = &M->tri[M->leaf_of[i]];
-	v[0] = t->a;
-	v[1] = t->b;
-	v[2] = t->c;
+	t = M->tv + 3 * (size_t)M->leaf_of[i];
+	v[0] = M->vx[t[0]];
+	v[1] = M->vx[t[1]];
+	v[2] = M->vx[t[2]];
 	return PX_OK;
 }
 

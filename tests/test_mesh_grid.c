@@ -42,7 +42,7 @@ static double brute(const struct px_model *m, px_vec3 p)
 
 static double leaf_dist(const struct mesh *M, uint32_t li, px_vec3 p)
 {
-	const struct mtri *t = &M->tri[li];
+	const struct mtri t_ = px__mtri_get(M, li), *t = &t_;
 	return sqrt(px_tri_closest(p, t->a, t->b, t->c, NULL, NULL, NULL, NULL, NULL));
 }
 
