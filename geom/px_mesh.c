@@ -954,13 +954,13 @@ void px__grid_layout(px_aabb box, long cap, int d[3], px_vec3 *org, double *h_ou
 
 static int grid_build(struct mesh *M, long budget)
 {
-	long cap = budget > 0 ? budget : 64L * 64 * 64;
+	long cap = budget;
 	int d[3], k, iz, jx, jy;
 	size_t ncell;
 	long prev = -1;
 	double h;
 
-	if (budget < 0)
+	if (budget <= 0)
 		return PX_OK;
 	/* measured on a 70k-triangle torus: one cell per 8 triangles gives
 	 * most of the gain of 30 times more cells at a fifth of the setup */

@@ -30,19 +30,20 @@
  * non-manifold or inconsistently oriented meshes answer with unsigned
  * distances (result is_signed = 0) and say why in the report.
  *
- * Cold queries (no hint) start from a hint grid built at setup: cubic
- * cells over the mesh's box grown by an eighth of its largest extent on
- * every side, each holding the triangle closest to the cell's centre
- * (found by the exact query). Its distance is an upper bound of the
- * answer within a cell diagonal of it (any triangle's distance bounds
- * the answer; points outside the grid take the nearest cell), so the
- * walk prunes nearly everything at once, as for a coherent query.
- * The answer stays exact: the hint only sets the starting bound. Cell
- * count: one per 8 triangles, at most 64^3 (1 MB) by default
- * (px_mesh_opts.grid_cells); building it costs about one cold query
- * per cell. On the 70k-triangle benchmark torus it saves a few percent
- * of a cold query's instructions: most of a cold query's work is the
- * proof that no other triangle is closer, not the search for a bound.
+ * Cold queries (no hint) walk the hierarchy from the root, nearest
+ * child first. An optional hint grid (px_mesh_opts.grid_cells > 0)
+ * gives them a first bound instead: cubic cells over the mesh's box
+ * grown by an eighth of its largest extent on every side, each holding
+ * the triangle closest to the cell's centre (found by the exact query;
+ * points outside the grid take the nearest cell), at most one cell per
+ * 8 triangles; building it costs about one cold query per cell. The
+ * answer is exact either way: the hint only sets the starting bound.
+ * It is off by default because it does not pay on the machines
+ * measured: on the 70k-triangle benchmark torus it saves a few percent
+ * of a cold query's instructions (most of the work is the proof that no
+ * other triangle is closer, not the search for a bound) but costs three
+ * dependent memory fetches (cell, hint indices, hint vertices) before
+ * the walk starts, about 10 % of the cold query's time.
  *
  * Coherent queries (PX_QUERY_COHERENT with last cycle's triangle index as
  * hint) start from that triangle's distance as an upper bound, which
@@ -56,9 +57,12 @@
  * u, v = barycentric weights of v1 and v2 of the closest point,
  * iterations = nodes and triangles visited, certified = 1 (exact).
  *
- * Memory and real-time rules: building allocates (setup only) about 390
- * bytes per triangle (the hint grid adds at most half a byte); queries are RT-safe (no heap, bounded by the
- * triangle count, fixed stack of 3 PX_MESH_MAX_DEPTH + 4 entries).
+ * Memory and real-time rules: building allocates (setup only) about 290
+ * bytes per triangle (of which a query reads about 110: nodes, float
+ * bounds, vertex indices and the welded vertices; the optional hint
+ * grid adds at most half a byte); queries are RT-safe (no heap, bounded
+ * by the triangle count, fixed stack of 3 PX_MESH_MAX_DEPTH + 4
+ * entries).
  */
 #ifndef PX_MESH_H
 #define PX_MESH_H
@@ -92,11 +96,10 @@ extern "C" {
 struct px_mesh_opts {
 	unsigned flags;     /* PX_MESH_* */
 	int leaf_size;      /* triangles per leaf, 1..16; 0 = 4 */
-	/* Hint-grid budget in cells (4 bytes each): 0 = the default of at
-	 * most 64^3 cells (1 MB); > 0 = at most this many (up to
-	 * PX_MESH_MAX_GRID_CELLS); < 0 = no grid. Either way the grid takes
-	 * at most one cell per 8 triangles (meshes under 16 triangles get
-	 * one cell). */
+	/* Hint-grid budget in cells (4 bytes each): > 0 = a grid of at
+	 * most this many cells (up to PX_MESH_MAX_GRID_CELLS, and at most
+	 * one cell per 8 triangles; meshes under 16 triangles get one
+	 * cell); 0 (the default) or < 0 = no grid. */
 	long grid_cells;
 };
 

@@ -1,6 +1,6 @@
 /*
- * The mesh hint grid: cold queries (no hint) start from the triangle the
- * grid names for the query's cell.
+ * The mesh hint grid (opt-in, px_mesh_opts.grid_cells > 0): cold queries
+ * (no hint) start from the triangle the grid names for the query's cell.
  *
  * References: a linear scan over every triangle. Checked: cold answers
  * equal the scan for points inside the grid, outside it and far outside
@@ -175,11 +175,11 @@ static void test_soups(void)
 			tri[3 * i + 2] = (uint32_t)(3 * i + 2);
 		}
 		PX_CHECK_INT_EQ(px_mesh_model(xyz, nv, tri, nt, &o, NULL, &m), PX_OK);
-		if (o.grid_cells < 0) {
+		if (o.grid_cells <= 0) {
 			PX_CHECK(impl_of(m)->grid == NULL);
 		} else {
 			const struct mesh *M = impl_of(m);
-			long cap = o.grid_cells ? o.grid_cells : 64L * 64 * 64;
+			long cap = o.grid_cells;
 			PX_CHECK(M->grid != NULL);
 			cells = (size_t)M->gdim[0] * (size_t)M->gdim[1] * (size_t)M->gdim[2];
 			PX_CHECK_MSG(cells >= 1 && cells <= (size_t)cap &&
@@ -215,13 +215,16 @@ static void test_shapes(void)
 		px_model_free(m);
 	}
 	gen_free(&g);
+	o.grid_cells = 1000;
 	/* a flat sheet (the box has no thickness) */
-	PX_CHECK_INT_EQ(px_mesh_model(xyz, 4, sheet, 2, NULL, NULL, &m), PX_OK);
+	PX_CHECK_INT_EQ(px_mesh_model(xyz, 4, sheet, 2, &o, NULL, &m), PX_OK);
+	PX_CHECK(impl_of(m)->grid != NULL);
 	check_cells(m, 100);
 	check_mesh(m, 100);
 	px_model_free(m);
 	/* everything collapsed to one point */
-	PX_CHECK_INT_EQ(px_mesh_model(pt, 3, one, 1, NULL, NULL, &m), PX_OK);
+	PX_CHECK_INT_EQ(px_mesh_model(pt, 3, one, 1, &o, NULL, &m), PX_OK);
+	PX_CHECK(impl_of(m)->grid != NULL);
 	check_cells(m, 10);
 	check_mesh(m, 30);
 	px_model_free(m);
@@ -236,9 +239,12 @@ static void test_wrong_hints_stay_exact(void)
 	struct mesh *M;
 	size_t n, i;
 	int q;
+	struct px_mesh_opts o;
 
+	memset(&o, 0, sizeof(o));
+	o.grid_cells = 64L * 64 * 64;
 	PX_CHECK_INT_EQ(gen_sphere(1.0, 16, 32, &g), 0);
-	PX_CHECK_INT_EQ(px_mesh_model(g.xyz, g.nv, g.tri, g.nt, NULL, NULL, &m), PX_OK);
+	PX_CHECK_INT_EQ(px_mesh_model(g.xyz, g.nv, g.tri, g.nt, &o, NULL, &m), PX_OK);
 	M = (struct mesh *)impl_of(m);
 	PX_CHECK(M->grid != NULL);
 	n = (size_t)M->gdim[0] * (size_t)M->gdim[1] * (size_t)M->gdim[2];
@@ -283,8 +289,11 @@ static void test_grid_no_alloc(void)
 	struct px_model_result r;
 	uint64_t a;
 	int i;
+	struct px_mesh_opts o;
+	memset(&o, 0, sizeof(o));
+	o.grid_cells = 64L * 64 * 64;
 	PX_CHECK_INT_EQ(gen_torus(1.0, 0.3, 80, 40, &g), 0);
-	PX_CHECK_INT_EQ(px_mesh_model(g.xyz, g.nv, g.tri, g.nt, NULL, NULL, &m), PX_OK);
+	PX_CHECK_INT_EQ(px_mesh_model(g.xyz, g.nv, g.tri, g.nt, &o, NULL, &m), PX_OK);
 	PX_CHECK(impl_of(m)->grid != NULL);
 	a = px_alloc_region_begin();
 	for (i = 0; i < 2000; i++) {
