@@ -61,15 +61,17 @@ struct mtri {
  * per triangle, read before the exact data: with unit normal n and plane
  * offset d, h = n . p - d is the distance to the plane; with the
  * in-plane outward unit normals m[e] of the edges and their offsets, the
- * largest m[e] . p - m[e][3] is at most the in-plane distance to the
+ * largest m[e] . p - (its offset) is at most the in-plane distance to the
  * triangle (a convex polygon is the intersection of its edge half-planes),
  * so h^2 + max(0, that)^2 <= the squared distance, exact in the face and
  * edge regions. Degenerate triangles have all zeros (bound 0: never
  * rejected). Rounding is absorbed by the query's slack (tri_lb).
  */
 struct tlb {
-	float n[3], d;
-	float m[3][4];
+	/* by component, so the four values come out side by side:
+	 * c[0..2][0] = n, c[3][0] = d; c[0..2][1 + e] = m[e], c[3][1 + e]
+	 * its offset */
+	float c[4][4];
 } __attribute__((aligned(64)));
 
 struct mesh {

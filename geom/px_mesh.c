@@ -539,12 +539,29 @@ static inline void pq_init(const struct mesh *M, px_vec3 p, struct pq *q)
 static inline double tri_lb(const struct tlb *L, const struct pq *q)
 {
 	const float *P = q->pf;
-	float h = L->n[0] * P[0] + L->n[1] * P[1] + L->n[2] * P[2] - L->d;
-	float e0 = L->m[0][0] * P[0] + L->m[0][1] * P[1] + L->m[0][2] * P[2] - L->m[0][3];
-	float e1 = L->m[1][0] * P[0] + L->m[1][1] * P[1] + L->m[1][2] * P[2] - L->m[1][3];
-	float e2 = L->m[2][0] * P[0] + L->m[2][1] * P[1] + L->m[2][2] * P[2] - L->m[2][3];
-	float e = e0 > e1 ? e0 : e1;
-	e = (e > e2 ? e : e2) - q->slack_tri;
+	float h, e;
+#ifdef __SSE__
+	/* the four values in one pass, in the scalar order of operations
+	 * (((x P0 + y P1) + z P2) - w), so the rounding argument holds */
+	__m128 v = _mm_sub_ps(
+		_mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_load_ps(L->c[0]), _mm_set1_ps(P[0])),
+				      _mm_mul_ps(_mm_load_ps(L->c[1]), _mm_set1_ps(P[1]))),
+			   _mm_mul_ps(_mm_load_ps(L->c[2]), _mm_set1_ps(P[2]))),
+		_mm_load_ps(L->c[3]));
+	__m128 s1 = _mm_shuffle_ps(v, v, _MM_SHUFFLE(3, 3, 2, 1)); /* e0 e1 e2 e2 */
+	__m128 mx = _mm_max_ps(s1, _mm_movehl_ps(s1, s1));        /* max(e0,e2) max(e1,e2) */
+	mx = _mm_max_ss(mx, _mm_shuffle_ps(mx, mx, _MM_SHUFFLE(1, 1, 1, 1)));
+	h = _mm_cvtss_f32(v);
+	e = _mm_cvtss_f32(mx) - q->slack_tri;
+#else
+	float v[4];
+	int j;
+	for (j = 0; j < 4; j++)
+		v[j] = L->c[0][j] * P[0] + L->c[1][j] * P[1] + L->c[2][j] * P[2] - L->c[3][j];
+	h = v[0];
+	e = v[1] > v[2] ? v[1] : v[2];
+	e = (e > v[3] ? e : v[3]) - q->slack_tri;
+#endif
 	h = (h < 0.0f ? -h : h) - q->slack_tri;
 	e = e > 0.0f ? e : 0.0f;
 	h = h > 0.0f ? h : 0.0f;
@@ -1331,18 +1348,18 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 			px_vec3 nrm = px_v3_cross(px_v3_sub(P[1], P[0]), px_v3_sub(P[2], P[0]));
 			double nl = sqrt(px_v3_norm2(nrm));
 			px_vec3 nu = px_v3_scale(nrm, 1.0 / nl);
-			L->n[0] = (float)nu.x;
-			L->n[1] = (float)nu.y;
-			L->n[2] = (float)nu.z;
-			L->d = (float)px_v3_dot(nu, P[0]);
+			L->c[0][0] = (float)nu.x;
+			L->c[1][0] = (float)nu.y;
+			L->c[2][0] = (float)nu.z;
+			L->c[3][0] = (float)px_v3_dot(nu, P[0]);
 			for (k = 0; k < 3; k++) {
 				px_vec3 e = px_v3_sub(P[(k + 1) % 3], P[k]), mm;
 				if (px_v3_normalize(px_v3_cross(e, nu), px_v3(0, 0, 0), &mm) != PX_OK)
 					continue;
-				L->m[k][0] = (float)mm.x;
-				L->m[k][1] = (float)mm.y;
-				L->m[k][2] = (float)mm.z;
-				L->m[k][3] = (float)px_v3_dot(mm, P[k]);
+				L->c[0][1 + k] = (float)mm.x;
+				L->c[1][1 + k] = (float)mm.y;
+				L->c[2][1 + k] = (float)mm.z;
+				L->c[3][1 + k] = (float)px_v3_dot(mm, P[k]);
 			}
 		}
 		M->orig[i] = t;
