@@ -597,6 +597,12 @@ static inline void test_tri_x(const struct mesh *M, size_t li, px_vec3 p,
 		b->q = q;
 		b->feature = f;
 		b->sub = s;
+		/* what mesh_finish reads if this stays the answer: fetched
+		 * while the walk goes on, not after it */
+		__builtin_prefetch(&M->orig[li]);
+		__builtin_prefetch(f == PX_FEATURE_FACE   ? &M->fn[li]
+				   : f == PX_FEATURE_EDGE ? &M->en[3 * li + (size_t)s]
+							  : &M->vnt[3 * li + (size_t)s]);
 		b->u = u;
 		b->v = v;
 	}
