@@ -88,6 +88,9 @@ DEB_PACKAGES += libudev-dev
 # Debian packages the benchmarks compare against (installed by `make bench`;
 # a benchmark whose reference is missing says so and still runs).
 BENCH_DEB_PACKAGES := rt-tests g++ libocct-modeling-algorithms-dev
+# (its headers include the Extrema and geometry headers of the data module,
+# which the algorithms package does not depend on)
+BENCH_DEB_PACKAGES += libocct-modeling-data-dev
 # bench_models compares with FCL through a C++ program (bench/fcl_models.cpp).
 BENCH_DEB_PACKAGES += libfcl-dev
 # config/: YAML loader.
