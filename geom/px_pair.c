@@ -190,12 +190,16 @@ static px_vec3 shp_centre(const struct shp *s)
 	return px_model_pose(s->m).t;
 }
 
+/* *vout (may be NULL): the point of A - B nearest the origin found;
+ * *lower (may be NULL): the best lower bound of the distance seen (the
+ * support plane's distance v . w / |v|), which certifies *dist. */
 static int gjk(const struct shp *a, const struct shp *b, double *dist,
 	       px_vec3 *pa, px_vec3 *pb, int *iters, struct gjk_vert S[4],
-	       int *n_out)
+	       int *n_out, px_vec3 *vout, double *lower)
 {
 	px_vec3 v, sa, sb;
 	int n = 1, it, rc;
+	double lb = 0.0;
 
 	v = px_v3_sub(shp_centre(a), shp_centre(b));
 	if (px_v3_norm2(v) == 0.0)
@@ -218,6 +222,8 @@ static int gjk(const struct shp *a, const struct shp *b, double *dist,
 		shp_support(a, px_v3_neg(v), &nw.a);
 		shp_support(b, v, &nw.b);
 		nw.w = px_v3_sub(nw.a, nw.b);
+		if (px_v3_dot(v, nw.w) > lb * sqrt(vv))
+			lb = px_v3_dot(v, nw.w) / sqrt(vv);
 		if (vv - px_v3_dot(v, nw.w) <= GJK_REL * vv)
 			break;
 		for (k = 0; k < n; k++)
@@ -238,6 +244,10 @@ static int gjk(const struct shp *a, const struct shp *b, double *dist,
 	*iters = it;
 	*n_out = n;
 	*dist = px_v3_norm(v);
+	if (vout)
+		*vout = v;
+	if (lower)
+		*lower = lb;
 	if (*dist <= 1e-15 * (1.0 + px_v3_norm(*pa)))
 		return 0;
 	return 1;
@@ -469,15 +479,51 @@ out:
 		double u = 0, v = 0;
 		int f, sub;
 		if (conv) {
+			/* A flat part of A - B is cut into coplanar faces that
+			 * tie on distance; the witnesses come from the one that
+			 * holds the foot of the origin (else they fall off the
+			 * surfaces: the foot's weights are then those of
+			 * another face's edge). */
 			const struct epa_face *fb = &F[best];
-			px_tri_closest(px_v3_scale(fb->n, fb->d), V[fb->v[0]].w, V[fb->v[1]].w,
-				       V[fb->v[2]].w, &q, &f, &sub, &u, &v);
+			px_vec3 foot = px_v3_scale(fb->n, fb->d);
+			double gap = INFINITY;
+			int pick = best;
+			for (k = 0; k < nf; k++) {
+				px_vec3 qk;
+				double g;
+				if (!F[k].alive || !isfinite(F[k].d) ||
+				    F[k].d - fb->d > EPA_REL * fmax(fb->d, 1e-6 * scale) ||
+				    px_v3_dot(F[k].n, fb->n) < 1.0 - 1e-9)
+					continue;
+				g = sqrt(px_tri_closest(foot, V[F[k].v[0]].w, V[F[k].v[1]].w,
+							V[F[k].v[2]].w, &qk, &f, &sub, &u, &v));
+				if (g < gap) {
+					gap = g;
+					pick = k;
+				}
+			}
+			px_tri_closest(foot, V[F[pick].v[0]].w, V[F[pick].v[1]].w, V[F[pick].v[2]].w,
+				       &q, &f, &sub, &u, &v);
 			*depth = fb->d;
 			*normal = fb->n;
-			*pa = px_v3_add(px_v3_scale(V[fb->v[0]].a, 1.0 - u - v),
-					px_v3_add(px_v3_scale(V[fb->v[1]].a, u),
-						  px_v3_scale(V[fb->v[2]].a, v)));
-			*pb = px_v3_madd(*pa, fb->n, -fb->d);
+			/* the same weights on both sides: each support point
+			 * lies on its model's supporting plane (to the
+			 * tolerance), so both witnesses lie on the surfaces */
+			*pa = px_v3_add(px_v3_scale(V[F[pick].v[0]].a, 1.0 - u - v),
+					px_v3_add(px_v3_scale(V[F[pick].v[1]].a, u),
+						  px_v3_scale(V[F[pick].v[2]].a, v)));
+			*pb = px_v3_add(px_v3_scale(V[F[pick].v[0]].b, 1.0 - u - v),
+					px_v3_add(px_v3_scale(V[F[pick].v[1]].b, u),
+						  px_v3_scale(V[F[pick].v[2]].b, v)));
+			{
+				/* the weights' point misses the foot by the
+				 * rounding of a curved hull (up to ~1e-7 of the
+				 * size): half the miss to each side, so that
+				 * pa - pb = depth * normal holds exactly */
+				px_vec3 miss = px_v3_scale(px_v3_sub(foot, px_v3_sub(*pa, *pb)), 0.5);
+				*pa = px_v3_add(*pa, miss);
+				*pb = px_v3_sub(*pb, miss);
+			}
 			return 1;
 		}
 		px_model_support(a, up_n, pa);
@@ -823,7 +869,7 @@ static int tri_vs_convex(void *ctx, const px_vec3 v[3], int index, double *d)
 	struct gjk_vert S[4];
 	double dist = 0.0;
 	px_vec3 pt = v[0], po = v[0];
-	int its = 0, ns = 0, g = gjk(&T, &O, &dist, &pt, &po, &its, S, &ns);
+	int its = 0, ns = 0, g = gjk(&T, &O, &dist, &pt, &po, &its, S, &ns, NULL, NULL);
 
 	c->iters += its;
 	if (g < 0)
@@ -1068,6 +1114,7 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 		return PX_E_INVAL;
 	res->depth = 0.0;
 	res->depth_approx = 0;
+	res->witness_gap = 0.0;
 
 	/* Exact paths. A sphere against anything: one point query of its
 	 * centre. Two convex models with support functions: GJK. */
@@ -1124,31 +1171,76 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 		px_vec3 pa, pb;
 		struct gjk_vert S[4];
 		struct shp sa = {a, NULL}, sb = {b, NULL};
-		int its = 0, ns = 0, g = gjk(&sa, &sb, &d, &pa, &pb, &its, S, &ns);
+		px_vec3 gv;
+		double lower = 0.0;
+		int its = 0, ns = 0,
+		    g = gjk(&sa, &sb, &d, &pa, &pb, &its, S, &ns, &gv, &lower);
 		if (g > 0) {
 			/* GJK's witness points are convex combinations of
 			 * support points, whose weights lose accuracy on the thin
-			 * simplices of smooth shapes: two exact projections put
-			 * them on the surfaces (each step can only shorten the
-			 * pair, and both models are convex). */
-			struct px_model_result qa, qb;
-			int j;
-			for (j = 0; j < 2; j++) {
-				if ((rc = px_model_query(b, pa, &qb)) < 0 ||
-				    (rc = px_model_query(a, qb.point, &qa)) < 0)
-					return rc;
-				pa = qa.point;
-				pb = qb.point;
+			 * simplices of smooth shapes (then they can sit far from
+			 * the contact though the distance |v| is right). Two
+			 * starts: those points, and the supports along the
+			 * separating direction v (the contact points themselves
+			 * on strictly convex shapes); each is put on the
+			 * surfaces by two exact projections (each step can only
+			 * shorten the pair, both models being convex), and the
+			 * shorter pair is kept. The distance is the lesser of
+			 * |v| and that pair's, certified by GJK's support plane
+			 * bound: converged = 0 when they differ by more than
+			 * 1e-8 of the distance plus 1e-9 of the coordinates
+			 * (a nanometre in a metre-sized scene). */
+			struct px_model_result qa, qb, ka, kb;
+			px_vec3 start[2] = {pa, pa};
+			double dk[2] = {INFINITY, INFINITY}, ctol;
+			int j, s, pick = 0;
+			if ((rc = px_model_support(a, px_v3_neg(gv), &start[1])) < 0)
+				return rc;
+			for (s = 0; s < 2; s++) {
+				px_vec3 x = start[s];
+				for (j = 0; j < 2; j++) {
+					if ((rc = px_model_query(b, x, &kb)) < 0 ||
+					    (rc = px_model_query(a, kb.point, &ka)) < 0)
+						return rc;
+					x = ka.point;
+				}
+				dk[s] = px_v3_dist(ka.point, kb.point);
+				if (s == 0 || dk[s] < dk[pick]) {
+					pick = s;
+					qa = ka;
+					qb = kb;
+				}
 			}
+			ctol = 1e-8 * dk[pick] + 1e-9 * (1.0 + px_v3_norm(qa.point));
+			/* not yet certified: more rounds from the better start
+			 * (slow near contact, where curved and flat parts meet) */
+			for (j = 0; j < 16 && dk[pick] - lower > ctol; j++) {
+				if ((rc = px_model_query(b, qa.point, &kb)) < 0 ||
+				    (rc = px_model_query(a, kb.point, &ka)) < 0)
+					return rc;
+				if (!(px_v3_dist(ka.point, kb.point) < dk[pick]))
+					break;
+				dk[pick] = px_v3_dist(ka.point, kb.point);
+				qa = ka;
+				qb = kb;
+				its++;
+			}
+			pa = qa.point;
+			pb = qb.point;
 			res->intersecting = qb.is_signed && qb.distance <= 0.0;
-			res->distance = res->intersecting ? 0.0 : px_v3_dist(pa, pb);
+			/* |v| is a point of A - B (an upper bound) and the
+			 * support plane a lower one: the distance is |v| when
+			 * they agree, whatever the witnesses' own gap */
+			res->distance = res->intersecting ? 0.0 : fmin(d, dk[pick]);
+			res->witness_gap = res->intersecting ? 0.0 : dk[pick] - res->distance;
 			res->point_a = pa;
 			res->point_b = pb;
 			res->index_a = qa.index;
 			res->index_b = qb.index;
-			res->iterations = its + 4;
+			res->iterations = its + 8;
 			res->starts = 0;
-			res->converged = its < GJK_MAX_ITERS;
+			res->converged = its < GJK_MAX_ITERS &&
+					 (res->intersecting || res->distance - lower <= ctol);
 			res->local_only = !res->converged;
 			goto done;
 		}

@@ -82,7 +82,9 @@
  * point_a - point_b = depth * normal. Convex pairs with support functions
  * get the exact depth (EPA on the Minkowski difference from GJK's final
  * simplex, fixed buffers; depth_approx = 1 only if a curved pair runs
- * out of them, then depth is an upper bound within about 1e-3). A sphere
+ * out of them, then depth is an upper bound within about 1e-3), with
+ * both witnesses on their surfaces (the deepest points; when converged,
+ * else point_a on A and point_b = point_a - depth * normal). A sphere
  * against any closed model is exact (radius minus the signed distance of
  * its centre). Other closed pairs (meshes, NURBS shells, the torus) get
  * the deepest point of either model inside the other by a local descent
@@ -166,6 +168,12 @@ struct px_pair_result {
 	double depth;
 	px_vec3 normal;
 	int depth_approx; /* 1: depth from a local search (see above) */
+	/* |point_a - point_b| - distance when apart (0 when the witness
+	 * points realise the distance, as they do but for convex pairs with
+	 * flat and curved parts in near contact, where GJK's distance is
+	 * certified while its witnesses, polished on the surfaces, may stay
+	 * a few micrometres longer) */
+	double witness_gap;
 };
 
 /*

@@ -365,7 +365,7 @@ static void test_penetration_convex(void)
 	 * cylinders and cones (curved): against a dense direction search,
 	 * and by moving B along the normal: depth + 1e-6 separates, depth -
 	 * 1e-3 does not. */
-	int trial, n_box = 0, n_curved = 0;
+	int trial, n_box = 0, n_curved = 0, n_gap = 0;
 	for (trial = 0; trial < 200; trial++) {
 		int curved = trial >= 120;
 		struct px_prim A = {PX_PRIM_BOX, px_rand_range(0.1, 0.5), px_rand_range(0.1, 0.5), px_rand_range(0.1, 0.5)};
@@ -402,6 +402,16 @@ static void test_penetration_convex(void)
 		PX_CHECK_NEAR(px_v3_norm(r.normal), 1.0, 1e-9);
 		PX_CHECK(px_v3_dist(px_v3_sub(r.point_a, r.point_b),
 				    px_v3_scale(r.normal, r.depth)) <= 1e-6);
+		if (!r.depth_approx) {
+			/* converged: the witnesses lie on their own surfaces
+			 * (px_pair.h) */
+			struct px_model_result qa, qb;
+			PX_CHECK(px_model_query(ma, r.point_a, &qa) >= 0);
+			PX_CHECK(px_model_query(mb, r.point_b, &qb) >= 0);
+			PX_CHECK_MSG(fabs(qa.distance) <= 1e-7 && fabs(qb.distance) <= 1e-7,
+				     "pair %d (curved %d, approx %d): witnesses %.3g and %.3g off their surfaces",
+				     trial, curved, r.depth_approx, qa.distance, qb.distance);
+		}
 		if (!curved) {
 			px_vec3 ax[15];
 			int i, j, k = 0;
@@ -450,6 +460,16 @@ static void test_penetration_convex(void)
 					     s2.distance <= 3e-6 + (r.depth_approx ? 5e-3 : 1e-8) * r.depth,
 				     "pair %d: moved by depth %.9g (approx %d): intersecting %d, distance %.3g",
 				     trial, r.depth, r.depth_approx, s2.intersecting, s2.distance);
+			/* near contact the distance is certified by GJK's
+			 * bounds, and the witnesses are on the surfaces, at
+			 * most witness_gap longer than it */
+			PX_CHECK_MSG(s2.converged && !s2.local_only && s2.witness_gap >= 0.0 &&
+					     fabs(px_v3_dist(s2.point_a, s2.point_b) -
+						  (s2.distance + s2.witness_gap)) <= 1e-12,
+				     "pair %d: converged %d, gap %.3g", trial, s2.converged,
+				     s2.witness_gap);
+			if (s2.witness_gap > 0.0)
+				n_gap++;
 			P2.t = px_v3_madd(Pb.t, r.normal, r.depth - 1e-3);
 			px_model_set_pose(mb, P2);
 			PX_CHECK_INT_EQ(px_pair_distance(ma, mb, NULL, &s2), PX_OK);
@@ -459,7 +479,8 @@ static void test_penetration_convex(void)
 		px_model_free(ma);
 		px_model_free(mb);
 	}
-	printf("    penetration: %d box pairs against SAT, %d curved pairs\n", n_box, n_curved);
+	printf("    penetration: %d box pairs against SAT, %d curved pairs; %d separated pairs "
+	       "with witnesses longer than the distance\n", n_box, n_curved, n_gap);
 	PX_CHECK(n_box > 20 && n_curved > 10);
 }
 
