@@ -11,7 +11,9 @@
  * 16-patch bicubic, a concave fold, with cells solved per update.
  * BENCH_TRACK_DEPTH=d overrides the event-grid depth (default 4).
  * BENCH_TRACK_CURVES_ONLY=1 stops after the curve models (profiling);
- * BENCH_TRACK_LAZY=0 turns lazy correction off. Each curve path runs
+ * BENCH_TRACK_LAZY=0 turns lazy correction off; BENCH_TRACK_MODEL=text runs
+ * only the curve models whose name holds text, BENCH_TRACK_STEP=0..3 only
+ * that step size (profiling). Each curve path runs
  * three times; a summary line per model gives the medians per step size
  * (worse path kind) and the ratio to the cold query, and a targets line
  * says which of the issue's curve targets are met.
@@ -174,6 +176,8 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 	double size;
 	px_aabb box;
 
+	if (getenv("BENCH_TRACK_MODEL") && !strstr(name, getenv("BENCH_TRACK_MODEL")))
+		return;
 	px_track_opts_default(&o);
 	if (getenv("BENCH_TRACK_DEPTH"))
 		o.box_depth = atoi(getenv("BENCH_TRACK_DEPTH"));
@@ -210,6 +214,11 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 	for (kind = 0; kind < 2; kind++)
 		for (s = 0; s < 4; s++) {
 			struct px_track_result r;
+			if (getenv("BENCH_TRACK_STEP") && atoi(getenv("BENCH_TRACK_STEP")) != s) {
+				med[kind][s] = 0;
+				ratio[kind][s] = 0.0;
+				continue;
+			}
 			struct px_track_stats a, b;
 			struct px_dist_result g;
 			int64_t rmax[NRUN], x3;
@@ -290,7 +299,7 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 		struct px_track_stats st;
 		struct px_track_result r;
 		o.verify_every = 1;
-		if (px_track_create(cs, nc, &o, &tv) == PX_OK) {
+		if (!getenv("BENCH_TRACK_STEP") && px_track_create(cs, nc, &o, &tv) == PX_OK) {
 			make_path(q, NSTEP, 0, box, 1e-2 * size);
 			for (k = 0; k < NSTEP; k++)
 				px_track_update(tv, q[k], &r);
