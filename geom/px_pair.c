@@ -7,6 +7,7 @@
 #include "mesh_internal.h"
 #include "px_mesh.h"
 #include "px_pair.h"
+#include "pair_internal.h"
 #include "px_prim.h"
 
 /* ---- exact convex distance: GJK ---------------------------------------------
@@ -1164,6 +1165,12 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 			goto done;
 		}
 	}
+	/* capsule against capsule or box: closed forms (pair_internal.h) */
+	rc = px__pair_closed(a, b, res);
+	if (rc < 0)
+		return rc;
+	if (rc == 1)
+		goto done;
 	if ((px_model_caps(a) & PX_MODEL_CAP_CONVEX) &&
 	    (px_model_caps(b) & PX_MODEL_CAP_CONVEX) &&
 	    px_model_get_ops(a)->support && px_model_get_ops(b)->support) {
