@@ -384,7 +384,8 @@ int main(int argc, char **argv)
 	/* ---- model to model ---- */
 	{
 		struct gen_mesh g1, g2;
-		struct px_model *ma, *mb, *ca, *cb, *sp, *cl;
+		struct px_model *ma, *mb, *ca, *cb, *sp, *cl, *k1, *k2;
+		struct px_prim cap1 = {PX_PRIM_CAPSULE, 0.04, 0.1, 0}, cap2 = {PX_PRIM_CAPSULE, 0.03, 0.08, 0};
 		struct px_prim cyl = {PX_PRIM_CYLINDER, 0.05, 0.1, 0}, box = {PX_PRIM_BOX, 0.05, 0.08, 0.1};
 		struct px_prim sph = {PX_PRIM_SPHERE, 0.05, 0, 0};
 		struct px_pair_opts o1 = {1, 64, 1e-12, 1, 0, 0}, o8 = {8, 64, 1e-12, 0, 0, 0};
@@ -401,6 +402,8 @@ int main(int argc, char **argv)
 		px_prim_model(&cyl, &ca);
 		px_prim_model(&box, &cb);
 		px_prim_model(&sph, &sp);
+		px_prim_model(&cap1, &k1);
+		px_prim_model(&cap2, &k2);
 		printf("model to model (%d poses on a circle, 1 mm apart):\n", NP);
 		{
 			const struct {
@@ -414,7 +417,9 @@ int main(int argc, char **argv)
 				 {"same, coherent", ma, cb, &o1},
 				 {"mesh torus 4k / cloud 2k, 8 starts", ma, cl, &o8},
 				 {"sphere / mesh torus (exact)", sp, ma, &o8},
-				 {"cylinder / box (GJK)", ca, cb, &o8}};
+				 {"cylinder / box (GJK)", ca, cb, &o8},
+				 {"capsule / capsule (closed form)", k1, k2, &o8},
+				 {"capsule / box (closed form)", k1, cb, &o8}};
 			size_t k;
 			for (k = 0; k < sizeof(P) / sizeof(P[0]); k++) {
 				int local = 0;
@@ -493,6 +498,8 @@ int main(int argc, char **argv)
 		px_model_free(mb);
 		px_model_free(ca);
 		px_model_free(cb);
+		px_model_free(k1);
+		px_model_free(k2);
 		px_model_free(sp);
 		px_model_free(cl);
 		gen_free(&g1);

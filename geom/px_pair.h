@@ -26,6 +26,11 @@
  * Exact paths come first, in this order, all with local_only = 0:
  * - a sphere primitive against any model: one point query of its
  *   centre;
+ * - a capsule against a capsule or a box: closed forms on the axis
+ *   segment (segment/segment and segment/box distances, each a convex
+ *   piecewise quadratic minimised exactly; geom/px_pair_prim.c), with
+ *   the depth, normal and witnesses of an overlap; only a capsule whose
+ *   axis meets the box goes on to GJK and EPA;
  * - two convex models with support functions (convex primitives, convex
  *   meshes): GJK on their Minkowski difference (the GJK of libccd, which
  *   Debian ships, offers intersection and penetration but no separation
