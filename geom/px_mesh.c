@@ -1308,7 +1308,8 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 	M->nodes = NULL;
 
 	/* reorder into leaf order */
-	M->vx = malloc(3 * nt * sizeof(*M->vx));
+	/* at most this many distinct vertices; trimmed once they are known */
+	M->vx = malloc((nv < 3 * nt ? nv : 3 * nt) * sizeof(*M->vx));
 	M->tv = malloc(3 * nt * sizeof(*M->tv));
 	M->lb = aligned_alloc(64, nt * sizeof(*M->lb));
 	M->orig = malloc(nt * sizeof(*M->orig));
@@ -1372,6 +1373,11 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 		M->leaf_of[t] = (uint32_t)i;
 		M->fn[i] = fn[t];
 		M->degen[i] = deg[t];
+	}
+	{
+		px_vec3 *vx = realloc(M->vx, M->n_vx * sizeof(*M->vx));
+		if (vx)
+			M->vx = vx;
 	}
 	M->absmax = fmax(fmax(fabs(M->box.min.x), fabs(M->box.max.x)),
 			 fmax(fmax(fabs(M->box.min.y), fabs(M->box.max.y)),
