@@ -415,6 +415,7 @@ int main(int argc, char **argv)
 				 {"same, coherent, local_ok (tracking)", ma, mb, &o1l},
 				 {"mesh torus 4k / box (BVH + GJK)", ma, cb, &o8},
 				 {"same, coherent", ma, cb, &o1},
+				 {"mesh torus 4k / capsule (closed form)", ma, k1, &o8},
 				 {"mesh torus 4k / cloud 2k, 8 starts", ma, cl, &o8},
 				 {"sphere / mesh torus (exact)", sp, ma, &o8},
 				 {"cylinder / box (GJK)", ca, cb, &o8},

@@ -35,6 +35,23 @@ double px__seg_box(px_vec3 p0, px_vec3 p1, const double h[3], double *t,
 		   px_vec3 *q);
 
 /*
+ * Closest points of segment p0-p1 and triangle v[0..2] (any shape, also
+ * collapsed): the segment parameter *s, the triangle point *q and the
+ * squared distance. The least over the segment's end points and its
+ * crossing of the triangle's plane against the triangle, and the
+ * triangle's edges against the segment: a disjoint pair has its closest
+ * points on one of these, and every candidate is a real pair of points.
+ * RT-safe.
+ */
+double px__seg_tri(px_vec3 p0, px_vec3 p1, const px_vec3 v[3], double *s,
+		   px_vec3 *q);
+
+/* When m is a capsule primitive: its world-frame axis e0-e1 and radius,
+ * returning 1; else 0. RT-safe. */
+int px__capsule_axis(const struct px_model *m, px_vec3 *e0, px_vec3 *e1,
+		     double *radius);
+
+/*
  * The pair in closed form when it is a capsule against a capsule, or a
  * capsule against a box whose axis segment stays outside the box (the
  * axis inside the box is left to EPA). Fills res (distance, points,

@@ -856,6 +856,9 @@ static int contained(const struct px_model *a, const struct px_model *b,
  * is itself convex, so GJK between the two is exact. */
 struct tv_ctx {
 	const struct px_model *o;
+	int capsule;        /* o is a capsule: axis c0-c1, radius cr */
+	px_vec3 c0, c1;
+	double cr;
 	double best;
 	px_vec3 pt, po; /* on the triangle, on o */
 	px_vec3 tv[3];
@@ -870,8 +873,24 @@ static int tri_vs_convex(void *ctx, const px_vec3 v[3], int index, double *d)
 	struct gjk_vert S[4];
 	double dist = 0.0;
 	px_vec3 pt = v[0], po = v[0];
-	int its = 0, ns = 0, g = gjk(&T, &O, &dist, &pt, &po, &its, S, &ns, NULL, NULL);
+	int its = 0, ns = 0, g;
 
+	if (c->capsule) {
+		/* closed form: the axis segment against the triangle */
+		double s, d2 = px__seg_tri(c->c0, c->c1, v, &s, &pt);
+		px_vec3 a = px_v3_lerp(c->c0, c->c1, s);
+		dist = sqrt(d2) - c->cr;
+		if (dist <= 0.0) {
+			dist = 0.0;
+			po = pt; /* the triangle point is in the capsule */
+		} else {
+			po = px_v3_madd(a, px_v3_sub(pt, a), c->cr / sqrt(d2));
+		}
+		its = 1;
+		g = 1;
+	} else {
+		g = gjk(&T, &O, &dist, &pt, &po, &its, S, &ns, NULL, NULL);
+	}
 	c->iters += its;
 	if (g < 0)
 		return g;
@@ -1044,6 +1063,7 @@ static int mesh_vs_convex(const struct px_model *m, const struct px_model *o,
 
 	memset(&c, 0, sizeof(c));
 	c.o = o;
+	c.capsule = px__capsule_axis(o, &c.c0, &c.c1, &c.cr);
 	c.best = INFINITY;
 	c.tri = -1;
 	if (hint < 0 || (size_t)hint >= px_mesh_triangle_count(m)) {

@@ -46,7 +46,9 @@
  *   capsule, cylinder, cone): the mesh hierarchy bounded below by the
  *   other model's point queries (distance of a node box's centre minus
  *   its half diagonal), each remaining triangle measured by GJK (exact to
- *   a relative 1e-10), the pair then projected onto both surfaces. If
+ *   a relative 1e-10; a capsule by the closed form of its axis against
+ *   the triangle, px_pair_prim.c), the pair then projected onto both
+ *   surfaces. If
  *   its budget of 4096 point queries runs out (very fine meshes close
  *   to a large primitive) the best pair found joins the projections
  *   below and the flag stays.

@@ -6,8 +6,10 @@
  * capsule or a box the segment's distance has a closed form.
  */
 #include <math.h>
+#include <stddef.h>
 
 #include "pair_internal.h"
+#include "px_mesh.h"
 #include "px_prim.h"
 
 static double clamp01(double x)
@@ -139,6 +141,51 @@ double px__seg_box(px_vec3 p0, px_vec3 p1, const double h[3], double *t,
 	return best;
 }
 
+double px__seg_tri(px_vec3 p0, px_vec3 p1, const px_vec3 v[3], double *s,
+		   px_vec3 *q)
+{
+	px_vec3 d = px_v3_sub(p1, p0), n, x;
+	double best, d2, hs0, hs1;
+	int k;
+
+	/* the end points */
+	best = px_tri_closest(p0, v[0], v[1], v[2], q, NULL, NULL, NULL, NULL);
+	*s = 0.0;
+	d2 = px_tri_closest(p1, v[0], v[1], v[2], &x, NULL, NULL, NULL, NULL);
+	if (d2 < best) {
+		best = d2;
+		*s = 1.0;
+		*q = x;
+	}
+	/* the crossing of the plane (a segment through the triangle meets
+	 * it there, at distance zero) */
+	n = px_v3_cross(px_v3_sub(v[1], v[0]), px_v3_sub(v[2], v[0]));
+	hs0 = px_v3_dot(n, px_v3_sub(p0, v[0]));
+	hs1 = px_v3_dot(n, px_v3_sub(p1, v[0]));
+	if ((hs0 < 0.0) != (hs1 < 0.0) && hs0 != hs1) {
+		double u = hs0 / (hs0 - hs1);
+		px_vec3 c = px_v3_madd(p0, d, u);
+		d2 = px_tri_closest(c, v[0], v[1], v[2], &x, NULL, NULL, NULL, NULL);
+		if (d2 < best) {
+			best = d2;
+			*s = u;
+			*q = x;
+		}
+	}
+	/* the edges */
+	for (k = 0; k < 3; k++) {
+		double a, b;
+		px_vec3 e0 = v[k], e1 = v[(k + 1) % 3];
+		d2 = px__seg_seg(p0, p1, e0, e1, &a, &b);
+		if (d2 < best) {
+			best = d2;
+			*s = a;
+			*q = px_v3_lerp(e0, e1, b);
+		}
+	}
+	return best;
+}
+
 /* World-frame axis segment of a capsule model. */
 static void capsule_axis(const struct px_model *m, const struct px_prim *c,
 			 px_vec3 *e0, px_vec3 *e1)
@@ -146,6 +193,17 @@ static void capsule_axis(const struct px_model *m, const struct px_prim *c,
 	px_pose P = px_model_pose(m);
 	*e0 = px_pose_transform_point(P, px_v3(0, 0, -c->b));
 	*e1 = px_pose_transform_point(P, px_v3(0, 0, c->b));
+}
+
+int px__capsule_axis(const struct px_model *m, px_vec3 *e0, px_vec3 *e1,
+		     double *radius)
+{
+	struct px_prim c;
+	if (px_prim_get(m, &c) != PX_OK || c.type != PX_PRIM_CAPSULE)
+		return 0;
+	capsule_axis(m, &c, e0, e1);
+	*radius = c.a;
+	return 1;
 }
 
 /* Fill res from the closest points ca (A's core) and cb (B's core) with

@@ -17,7 +17,9 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "mesh_gen.h"
 #include "pair_internal.h"
+#include "px_mesh.h"
 #include "px_alloc_count.h"
 #include "px_pair.h"
 #include "px_prim.h"
@@ -326,7 +328,135 @@ static void test_capsule_box_pairs(void)
 	PX_CHECK(n_over > 30 && n_apart > 100 && n_epa > 10);
 }
 
+struct stri {
+	px_vec3 p0, p1, v[3];
+};
+
+static double f_stri(const void *ctx, double u)
+{
+	const struct stri *T = ctx;
+	return sqrt(px_tri_closest(px_v3_lerp(T->p0, T->p1, u), T->v[0], T->v[1], T->v[2], NULL,
+				   NULL, NULL, NULL, NULL));
+}
+
+static void test_seg_tri(void)
+{
+	int i, hit = 0;
+	for (i = 0; i < 4000; i++) {
+		struct stri T;
+		double s, d2, ref, arg;
+		px_vec3 q;
+		int kind = i % 6;
+		T.v[0] = rand_v(1.0);
+		T.v[1] = rand_v(1.0);
+		T.v[2] = rand_v(1.0);
+		T.p0 = rand_v(1.5);
+		T.p1 = rand_v(1.5);
+		if (kind == 1) { /* through the triangle */
+			px_vec3 x = px_v3_add(px_v3_scale(T.v[0], 0.3),
+					      px_v3_add(px_v3_scale(T.v[1], 0.3), px_v3_scale(T.v[2], 0.4)));
+			px_vec3 d = rand_v(1.0);
+			T.p0 = px_v3_madd(x, d, -px_rand_unit());
+			T.p1 = px_v3_madd(x, d, px_rand_unit());
+		} else if (kind == 2) { /* in the triangle's plane */
+			T.p0 = px_v3_lerp(T.v[0], T.v[1], px_rand_range(-1, 2));
+			T.p1 = px_v3_lerp(T.v[0], T.v[2], px_rand_range(-1, 2));
+		} else if (kind == 3) { /* parallel to the plane, above it */
+			px_vec3 n, off;
+			px_v3_normalize(px_v3_cross(px_v3_sub(T.v[1], T.v[0]), px_v3_sub(T.v[2], T.v[0])),
+					px_v3(0, 0, 1), &n);
+			off = px_v3_scale(n, px_rand_range(0.01, 0.3));
+			T.p0 = px_v3_add(px_v3_lerp(T.v[0], T.v[1], px_rand_range(-1, 2)), off);
+			T.p1 = px_v3_add(px_v3_lerp(T.v[1], T.v[2], px_rand_range(-1, 2)), off);
+		} else if (kind == 4) { /* a collapsed triangle (a segment) */
+			T.v[2] = px_v3_lerp(T.v[0], T.v[1], px_rand_unit());
+		} else if (kind == 5) { /* the segment a point */
+			T.p1 = T.p0;
+		}
+		d2 = px__seg_tri(T.p0, T.p1, T.v, &s, &q);
+		ref = min_convex(f_stri, &T, &arg);
+		PX_CHECK(s >= 0.0 && s <= 1.0);
+		PX_CHECK_NEAR(px_v3_dist2(px_v3_lerp(T.p0, T.p1, s), q), d2, 1e-14);
+		/* q is a point of the triangle */
+		PX_CHECK(px_tri_closest(q, T.v[0], T.v[1], T.v[2], NULL, NULL, NULL, NULL, NULL) <=
+			 1e-24);
+		PX_CHECK_MSG(fabs(sqrt(d2) - ref) <= 1e-9, "case %d (kind %d): %.15g vs %.15g", i,
+			     kind, sqrt(d2), ref);
+		hit += d2 <= 1e-24;
+	}
+	printf("    4000 segment/triangle pairs, %d meeting\n", hit);
+	PX_CHECK(hit > 500);
+}
+
+/* A capsule against a closed mesh through px_pair_distance (the mesh
+ * hierarchy with the closed form per triangle) against a scan over
+ * every triangle with the brute-force segment minimisation. */
+static void test_capsule_mesh(void)
+{
+	struct gen_mesh g;
+	struct px_model *mm;
+	int trial, n_touch = 0, n_inside = 0;
+	PX_CHECK_INT_EQ(gen_torus(0.3, 0.1, 24, 12, &g), 0);
+	PX_CHECK_INT_EQ(px_mesh_model(g.xyz, g.nv, g.tri, g.nt, NULL, NULL, &mm), PX_OK);
+	for (trial = 0; trial < 80; trial++) {
+		struct px_prim c = {PX_PRIM_CAPSULE, px_rand_range(0.01, 0.08), px_rand_range(0.02, 0.3), 0};
+		px_pose Pc = px_test_rand_pose(0.5);
+		struct px_model *mc;
+		struct px_pair_result r;
+		struct stri T;
+		double ref = INFINITY, arg;
+		size_t i;
+		uint64_t a0;
+		PX_CHECK_INT_EQ(px_prim_model(&c, &mc), PX_OK);
+		px_model_set_pose(mc, Pc);
+		T.p0 = px_pose_transform_point(Pc, px_v3(0, 0, -c.b));
+		T.p1 = px_pose_transform_point(Pc, px_v3(0, 0, c.b));
+		for (i = 0; i < g.nt; i++) {
+			int k;
+			for (k = 0; k < 3; k++) {
+				const double *X = g.xyz + 3 * g.tri[3 * i + k];
+				T.v[k] = px_v3(X[0], X[1], X[2]);
+			}
+			ref = fmin(ref, min_convex(f_stri, &T, &arg));
+		}
+		ref -= c.a;
+		memset(&r, 0, sizeof(r));
+		a0 = px_alloc_region_begin();
+		PX_CHECK_INT_EQ(px_pair_distance(mm, mc, NULL, &r), PX_OK);
+		PX_CHECK_INT_EQ(px_alloc_region_end(a0), 0);
+		{
+			/* a capsule whose surface is apart from the torus's but
+			 * inside it is held whole: intersecting too */
+			struct px_model_result q;
+			PX_CHECK(px_model_query(mm, Pc.t, &q) >= 0);
+			if (ref > 1e-9 && q.distance < 0.0) {
+				PX_CHECK(r.intersecting);
+				n_inside++;
+				px_model_free(mc);
+				continue;
+			}
+		}
+		if (ref <= 1e-9) {
+			/* the surfaces touch or cross */
+			PX_CHECK(r.intersecting);
+			n_touch++;
+		} else {
+			PX_CHECK(!r.intersecting && !r.local_only);
+			PX_CHECK_MSG(fabs(r.distance - ref) <= 1e-9, "trial %d: %.15g vs %.15g", trial,
+				     r.distance, ref);
+			PX_CHECK_NEAR(px_v3_dist(r.point_a, r.point_b), r.distance, 1e-9);
+		}
+		px_model_free(mc);
+	}
+	printf("    80 capsules against a 576-triangle torus, %d touching, %d held inside\n", n_touch,
+	       n_inside);
+	px_model_free(mm);
+	gen_free(&g);
+}
+
 static const struct px_test tests[] = {
+	PX_T(test_seg_tri),
+	PX_T(test_capsule_mesh),
 	PX_T(test_seg_seg),
 	PX_T(test_seg_box),
 	PX_T(test_capsule_pairs),
