@@ -1037,7 +1037,7 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 	double *cen = NULL, *tlo = NULL, *thi = NULL;
 	uint8_t *deg = NULL, *used = NULL;
 	unsigned flags = opt ? opt->flags : 0u;
-	int leaf = (opt && opt->leaf_size) ? opt->leaf_size : 4;
+	int leaf = (opt && opt->leaf_size) ? opt->leaf_size : 6;
 	int rc = PX_E_NOMEM, k;
 	struct build B;
 
