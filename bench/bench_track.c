@@ -59,6 +59,15 @@ static int64_t now_ns(void)
 	return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
 }
 
+/* Thread CPU time: what an update costs without the time the thread
+ * spends preempted (the raw max on a shared machine is that time). */
+static int64_t cpu_ns(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+	return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+
 static int cmp_i64(const void *a, const void *b)
 {
 	int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
@@ -173,6 +182,7 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 	double ratio[2][4];
 	long wrong_all = 0;
 	int kind, s, k, rc, run_i, med_ok = 1, max_ok = 1, max3_ok = 1, ratio_ok = 1;
+	int64_t cmax_all = 0, mmax_all = 0;
 	double size;
 	px_aabb box;
 
@@ -201,16 +211,23 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 	       "%zu bytes\n", name, nc, ti.n_spans, ti.n_leaves,
 	       ti.n_boxed_leaves, t0 / 1e6, ti.bytes);
 	printf("  %-8s %-7s %8s %8s %8s %8s %8s | %8s %8s | %6s | %5s %6s %6s %5s "
-	       "%5s %6s %6s %6s\n",
+	       "%5s %6s %6s %6s %8s %8s\n",
 	       "path", "step", "med_ns", "p99_ns", "p999_ns", "max_ns", "max_m3",
 	       "cold_med", "cold_p99", "ratio", "wrong", "trans", "solves",
-	       "reini", "fallb", "tests", "rest", "erest");
+	       "reini", "fallb", "tests", "rest", "erest", "cpu_max", "max_min3");
 	/* trans, solves, reini, fallb: counts per run of the path; tests:
 	 * leaves given the exact segment test per update; rest:
 	 * critical points left uncorrected per update (lazy); erest: curves
 	 * passed whole on their rest certificate per update; max_m3: the
 	 * median over NRUN runs of each run's max (max_ns is the raw max of
-	 * all runs: on a shared machine it is dominated by interrupts) */
+	 * all runs: on a shared machine it is dominated by interrupts);
+	 * cpu_max: the max of one more run by thread CPU time (without the
+	 * time preempted, but with page faults, interrupts and a VM's
+	 * stolen time where the kernel charges them to the thread);
+	 * max_min3: the largest over the updates of each update's least
+	 * time in the NRUN runs (every run replays the same states, so the
+	 * work of an update repeats and an interrupt rarely does: the
+	 * worst case of the work itself) */
 	for (kind = 0; kind < 2; kind++)
 		for (s = 0; s < 4; s++) {
 			struct px_track_result r;
@@ -221,7 +238,7 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 			}
 			struct px_track_stats a, b;
 			struct px_dist_result g;
-			int64_t rmax[NRUN], x3;
+			int64_t rmax[NRUN], x3, cmax, mmax;
 			long wrong = 0;
 			int n = 0;
 			make_path(q, NSTEP, kind, box, steps[s] * size);
@@ -243,6 +260,33 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 				}
 			}
 			px_track_get_stats(t, &b);
+			/* once more, by thread CPU time: the max without
+			 * preemption */
+			cmax = 0;
+			px_track_reset(t, q[0], &r);
+			for (k = 0; k < NSTEP; k++) {
+				int64_t x = cpu_ns();
+				px_track_update(t, q[k], &r);
+				x = cpu_ns() - x;
+				if (x > cmax)
+					cmax = x;
+			}
+			if (cmax > cmax_all)
+				cmax_all = cmax;
+			/* each update's least time over the runs (the same
+			 * state every run: real work repeats, an interrupt does
+			 * not), then the largest of those */
+			mmax = 0;
+			for (k = 0; k < NSTEP; k++) {
+				int64_t m = tt[k];
+				for (run_i = 1; run_i < NRUN; run_i++)
+					if (tt[run_i * NSTEP + k] < m)
+						m = tt[run_i * NSTEP + k];
+				if (m > mmax)
+					mmax = m;
+			}
+			if (mmax > mmax_all)
+				mmax_all = mmax;
 			qsort(tt, (size_t)n, sizeof(tt[0]), cmp_i64);
 			qsort(tg, (size_t)n, sizeof(tg[0]), cmp_i64);
 			qsort(rmax, NRUN, sizeof(rmax[0]), cmp_i64);
@@ -251,7 +295,7 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 			ratio[kind][s] = (double)tg[n / 2] / (double)(tt[n / 2] ? tt[n / 2] : 1);
 			wrong_all += wrong;
 			printf("  %-8s %-7g %8lld %8lld %8lld %8lld %8lld | %8lld %8lld | "
-			       "%6.1f | %5ld %6llu %6llu %5llu %5llu %6.2f %6.2f %6.2f\n",
+			       "%6.1f | %5ld %6llu %6llu %5llu %5llu %6.2f %6.2f %6.2f %8lld %8lld\n",
 			       kind ? "sines" : "random", steps[s] * 100.0,
 			       (long long)tt[n / 2], (long long)tt[n * 99 / 100],
 			       (long long)tt[n * 999 / 1000], (long long)tt[n - 1],
@@ -264,7 +308,8 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 			       (unsigned long long)(b.fallbacks - a.fallbacks) / NRUN,
 			       (double)(b.box_hits - a.box_hits) / n,
 			       (double)(b.rested - a.rested) / n,
-			       (double)(b.rested_entities - a.rested_entities) / n);
+			       (double)(b.rested_entities - a.rested_entities) / n,
+			       (long long)cmax, (long long)mmax);
 			if (tt[n / 2] > TGT_MED_NS)
 				med_ok = 0;
 			if (tt[n - 1] > TGT_MAX_NS)
@@ -283,9 +328,13 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 		       rt, s < 3 ? " |" : "\n");
 	}
 	printf("  targets: median <= %d ns %s; max <= %d us %s (raw max), %s "
-	       "(median of %d runs' max); >= %.0fx cold %s; wrong 0 %s\n",
+	       "(median of %d runs' max), %s (thread CPU time, preemption "
+	       "excluded: max %.1f us), %s (worst update of its least of %d "
+	       "runs: %.1f us); >= %.0fx cold %s; wrong 0 %s\n",
 	       TGT_MED_NS, med_ok ? "MET" : "NOT MET", TGT_MAX_NS / 1000,
 	       max_ok ? "MET" : "NOT MET", max3_ok ? "MET" : "NOT MET", NRUN,
+	       cmax_all <= TGT_MAX_NS ? "MET" : "NOT MET", cmax_all / 1e3,
+	       mmax_all <= TGT_MAX_NS ? "MET" : "NOT MET", NRUN, mmax_all / 1e3,
 	       TGT_RATIO, ratio_ok ? "MET" : "NOT MET",
 	       wrong_all == 0 ? "MET" : "NOT MET");
 	tgt_models++;
