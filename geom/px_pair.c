@@ -1220,7 +1220,7 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 			struct px_model_result qa, qb, ka, kb;
 			px_vec3 start[2] = {pa, pa};
 			double dk[2] = {INFINITY, INFINITY}, ctol;
-			int j, s, pick = 0;
+			int j, s, pick = 0, extra = 0;
 			if ((rc = px_model_support(a, px_v3_neg(gv), &start[1])) < 0)
 				return rc;
 			for (s = 0; s < 2; s++) {
@@ -1250,7 +1250,7 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 				dk[pick] = px_v3_dist(ka.point, kb.point);
 				qa = ka;
 				qb = kb;
-				its++;
+				extra++;
 			}
 			pa = qa.point;
 			pb = qb.point;
@@ -1264,7 +1264,7 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 			res->point_b = pb;
 			res->index_a = qa.index;
 			res->index_b = qb.index;
-			res->iterations = its + 8;
+			res->iterations = its + 8 + 2 * extra;
 			res->starts = 0;
 			res->converged = its < GJK_MAX_ITERS &&
 					 (res->intersecting || res->distance - lower <= ctol);
