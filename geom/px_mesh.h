@@ -57,7 +57,7 @@
  * u, v = barycentric weights of v1 and v2 of the closest point,
  * iterations = nodes and triangles visited, certified = 1 (exact).
  *
- * Memory and real-time rules: building allocates (setup only) about 290
+ * Memory and real-time rules: building allocates (setup only) about 280
  * bytes per triangle (of which a query reads about 110: nodes, float
  * bounds, vertex indices and the welded vertices; the optional hint
  * grid adds at most half a byte); queries are RT-safe (no heap, bounded
