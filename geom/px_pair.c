@@ -1221,10 +1221,17 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 			px_vec3 start[2] = {pa, pa};
 			double dk[2] = {INFINITY, INFINITY}, ctol;
 			int j, s, pick = 0, extra = 0;
+			memset(&qa, 0, sizeof(qa));
+			memset(&qb, 0, sizeof(qb));
 			if ((rc = px_model_support(a, px_v3_neg(gv), &start[1])) < 0)
 				return rc;
 			for (s = 0; s < 2; s++) {
 				px_vec3 x = start[s];
+				/* the second start only where the first one's pair
+				 * is longer than |v| (its queries are the cost of
+				 * this path on a convex mesh) */
+				if (s == 1 && !(dk[0] - d > 1e-8 * dk[0] + 1e-9 * (1.0 + px_v3_norm(qa.point))))
+					break;
 				for (j = 0; j < 2; j++) {
 					if ((rc = px_model_query(b, x, &kb)) < 0 ||
 					    (rc = px_model_query(a, kb.point, &ka)) < 0)
@@ -1239,18 +1246,24 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 				}
 			}
 			ctol = 1e-8 * dk[pick] + 1e-9 * (1.0 + px_v3_norm(qa.point));
-			/* not yet certified: more rounds from the better start
-			 * (slow near contact, where curved and flat parts meet) */
-			for (j = 0; j < 16 && dk[pick] - lower > ctol; j++) {
+			/* witnesses still longer than |v|: a few more rounds from
+			 * the better start while they gain (slow near contact,
+			 * where curved and flat parts meet; the distance itself
+			 * is |v| either way) */
+			for (j = 0; j < 4 && dk[pick] - d > ctol; j++) {
+				double dn, gap = dk[pick] - d;
 				if ((rc = px_model_query(b, qa.point, &kb)) < 0 ||
 				    (rc = px_model_query(a, kb.point, &ka)) < 0)
 					return rc;
-				if (!(px_v3_dist(ka.point, kb.point) < dk[pick]))
+				dn = px_v3_dist(ka.point, kb.point);
+				if (!(dn < dk[pick]))
 					break;
-				dk[pick] = px_v3_dist(ka.point, kb.point);
+				dk[pick] = dn;
 				qa = ka;
 				qb = kb;
 				extra++;
+				if (dk[pick] - d > 0.75 * gap)
+					break; /* stalled: less than a quarter gained */
 			}
 			pa = qa.point;
 			pb = qb.point;
