@@ -584,9 +584,11 @@ static inline void test_tri_x(const struct mesh *M, size_t li, px_vec3 p,
 	nn = px_v3_norm2(n);
 	needle = M->degen[li] || nn == INFINITY;
 	if (!plane_done && !needle) {
-		/* the distance to the plane is a lower bound */
+		/* the distance to the plane is a lower bound (compared
+		 * without a division; the factor keeps rounding from ever
+		 * rejecting a triangle whose plane distance equals the bound) */
 		double h = px_v3_dot(n, px_v3_sub(p, ta));
-		if (h * h * (1.0 / nn) > b->d2)
+		if (h * h > b->d2 * nn * (1.0 + 1e-12))
 			return;
 	}
 	d2 = tri_core(p, ta, tb, tc, n, nn, needle, &q, &f, &s, &u, &v);
@@ -801,10 +803,21 @@ static int mesh_closest_among(const void *impl, const struct px_model_query *qq,
 	struct best b;
 	int i;
 
+	struct pq pq;
+
 	best_init(&b, qq->p, qq->max_dist);
-	for (i = 0; i < n; i++)
-		if (idx[i] >= 0 && (size_t)idx[i] < M->nt)
-			test_tri(M, (size_t)idx[i], qq->p, &b);
+	pq_init(M, qq->p, &pq);
+	for (i = 0; i < n; i++) {
+		size_t li = (size_t)idx[i];
+		if (idx[i] < 0 || li >= M->nt)
+			continue;
+		/* the float bound first, as the walk does: most of the set
+		 * is farther than the best so far */
+		if (!pq.use)
+			test_tri(M, li, qq->p, &b);
+		else if (!(tri_lb(&M->lb[li], &pq) > b.d2))
+			test_tri_x(M, li, qq->p, &b, 1);
+	}
 	if (b.li < 0)
 		return 0;
 	mesh_finish(M, qq->p, &b, qq->flags, n, 1, r);
@@ -822,7 +835,9 @@ static int mesh_collect(const void *impl, px_vec3 p, double radius, int *idx,
 	} st[STACK4];
 	double r2 = radius * radius;
 	int sp = 0, n = 0;
+	struct pq pq;
 
+	pq_init(M, p, &pq);
 	st[sp].idx = 0;
 	st[sp].cnt = 0;
 	sp++;
@@ -831,14 +846,11 @@ static int mesh_collect(const void *impl, px_vec3 p, double radius, int *idx,
 		if (st[sp].cnt > 0) {
 			uint32_t i;
 			for (i = st[sp].idx; i < st[sp].idx + st[sp].cnt; i++) {
-				const struct mtri t_ = px__mtri_get(M, i), *t = &t_;
-				if (t->inv_nn != 0.0) {
-					double h = px_v3_dot(t->n, px_v3_sub(p, t->a));
-					if (h * h * t->inv_nn > r2)
-						continue;
-				}
-				if (px_tri_closest(p, t->a, t->b, t->c, NULL, NULL, NULL, NULL,
-						   NULL) <= r2) {
+				const uint32_t *v = M->tv + 3 * i;
+				if (pq.use && tri_lb(&M->lb[i], &pq) > r2)
+					continue;
+				if (px_tri_closest(p, M->vx[v[0]], M->vx[v[1]], M->vx[v[2]], NULL,
+						   NULL, NULL, NULL, NULL) <= r2) {
 					if (n == cap)
 						return PX_E_NOSPC;
 					idx[n++] = (int)i;
