@@ -134,6 +134,21 @@ static inline struct mtri px__mtri_get(const struct mesh *M, size_t li)
 	return t;
 }
 
+/* The three vertices alone, where the normal is not needed. RT-safe. */
+struct mtri3 {
+	px_vec3 a, b, c;
+};
+
+static inline struct mtri3 px__tri3_get(const struct mesh *M, size_t li)
+{
+	const uint32_t *v = M->tv + 3 * li;
+	struct mtri3 t;
+	t.a = M->vx[v[0]];
+	t.b = M->vx[v[1]];
+	t.c = M->vx[v[2]];
+	return t;
+}
+
 /* Cell of a hint grid (gdim cells from corner org, 1 / cell size inv)
  * holding p, points outside taking the nearest cell. @note RT-safe. */
 static inline size_t px__grid_cell(const int gdim[3], px_vec3 org, double inv,

@@ -433,14 +433,14 @@ static void leaf_pair(struct mp_ctx *X, uint32_t ia, uint32_t na, uint32_t ib,
 	na = na > LEAF_MAX ? LEAF_MAX : na; /* leaves hold at most 16 */
 	nb = nb > LEAF_MAX ? LEAF_MAX : nb;
 	for (j = 0; j < nb; j++) {
-		const struct mtri tb_ = px__mtri_get(X->B, ib + j), *tb = &tb_;
+		const struct mtri3 tb_ = px__tri3_get(X->B, ib + j), *tb = &tb_;
 		VB[j][0] = to_a(X, tb->a);
 		VB[j][1] = to_a(X, tb->b);
 		VB[j][2] = to_a(X, tb->c);
 		gb = px_v3_add(gb, px_v3_add(VB[j][0], px_v3_add(VB[j][1], VB[j][2])));
 	}
 	for (i = 0; i < na; i++) {
-		const struct mtri ta_ = px__mtri_get(X->A, ia + i), *ta = &ta_;
+		const struct mtri3 ta_ = px__tri3_get(X->A, ia + i), *ta = &ta_;
 		ga = px_v3_add(ga, px_v3_add(ta->a, px_v3_add(ta->b, ta->c)));
 	}
 	if (X->best2 < INFINITY) {
@@ -449,7 +449,7 @@ static void leaf_pair(struct mp_ctx *X, uint32_t ia, uint32_t na, uint32_t ib,
 		u = px_v3_sub(px_v3_scale(gb, 1.0 / (3.0 * nb)), px_v3_scale(ga, 1.0 / (3.0 * na)));
 		uu = px_v3_norm2(u);
 		for (i = 0; i < na; i++) {
-			const struct mtri ta_ = px__mtri_get(X->A, ia + i), *ta = &ta_;
+			const struct mtri3 ta_ = px__tri3_get(X->A, ia + i), *ta = &ta_;
 			mxa = fmax(mxa, mx3(px_v3_dot(u, ta->a), px_v3_dot(u, ta->b), px_v3_dot(u, ta->c)));
 		}
 		for (j = 0; j < nb; j++)
@@ -464,7 +464,7 @@ static void leaf_pair(struct mp_ctx *X, uint32_t ia, uint32_t na, uint32_t ib,
 	for (k = 0; k < 3; k++)
 		eb[k] = X->Ra[k][0] * hb.x + X->Ra[k][1] * hb.y + X->Ra[k][2] * hb.z;
 	for (i = 0; i < na; i++) {
-		const struct mtri ta_ = px__mtri_get(X->A, ia + i), *ta = &ta_;
+		const struct mtri3 ta_ = px__tri3_get(X->A, ia + i), *ta = &ta_;
 		double g2 = 0.0;
 		for (k = 0; k < 3; k++) {
 			double a = px_v3_comp(ta->a, k), b = px_v3_comp(ta->b, k),
@@ -499,7 +499,7 @@ static void leaf_pair(struct mp_ctx *X, uint32_t ia, uint32_t na, uint32_t ib,
 		if (gb2 > X->best2)
 			continue;
 		for (i = 0; i < na; i++) {
-			const struct mtri ta_ = px__mtri_get(X->A, ia + i), *ta = &ta_;
+			const struct mtri3 ta_ = px__tri3_get(X->A, ia + i), *ta = &ta_;
 			px_vec3 T[3];
 			double g2 = 0.0;
 			if (!near_b[i])
@@ -563,7 +563,7 @@ int px__mesh_pair(const struct px_model *a, const struct px_model *b,
 	X.la = X.lb = -1;
 	if (hint_a >= 0 && (size_t)hint_a < A->nt && hint_b >= 0 && (size_t)hint_b < B->nt) {
 		uint32_t la = A->leaf_of[hint_a], lb = B->leaf_of[hint_b];
-		const struct mtri tb_ = px__mtri_get(B, lb), *tb = &tb_;
+		const struct mtri3 tb_ = px__tri3_get(B, lb), *tb = &tb_;
 		px_vec3 V[3] = {to_a(&X, tb->a), to_a(&X, tb->b), to_a(&X, tb->c)};
 		pair_test(&X, la, V, lb);
 	}
@@ -694,7 +694,7 @@ int px__mesh_vs_model(const struct px_model *m, const struct px_model *o,
 		if (cnt > 0) {
 			uint32_t i;
 			for (i = idx; i < idx + cnt; i++) {
-				const struct mtri t_ = px__mtri_get(M, i), *t = &t_;
+				const struct mtri3 t_ = px__tri3_get(M, i), *t = &t_;
 				px_vec3 v[3] = {px_pose_transform_point(P, t->a),
 						px_pose_transform_point(P, t->b),
 						px_pose_transform_point(P, t->c)};
