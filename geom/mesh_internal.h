@@ -120,21 +120,8 @@ struct mesh {
 	double ginv;         /* 1 / gcell */
 };
 
-/* Leaf triangle li as a struct mtri. The same operations as setup used,
- * so n and inv_nn do not depend on where they are made. RT-safe. */
-static inline struct mtri px__mtri_get(const struct mesh *M, size_t li)
-{
-	const uint32_t *v = M->tv + 3 * li;
-	struct mtri t;
-	t.a = M->vx[v[0]];
-	t.b = M->vx[v[1]];
-	t.c = M->vx[v[2]];
-	t.n = px_v3_cross(px_v3_sub(t.b, t.a), px_v3_sub(t.c, t.a));
-	t.inv_nn = M->degen[li] ? 0.0 : 1.0 / px_v3_norm2(t.n);
-	return t;
-}
-
-/* The three vertices alone, where the normal is not needed. RT-safe. */
+/* The three vertices of leaf triangle li, where the normal is not
+ * needed. RT-safe. */
 struct mtri3 {
 	px_vec3 a, b, c;
 };
@@ -146,6 +133,20 @@ static inline struct mtri3 px__tri3_get(const struct mesh *M, size_t li)
 	t.a = M->vx[v[0]];
 	t.b = M->vx[v[1]];
 	t.c = M->vx[v[2]];
+	return t;
+}
+
+/* Leaf triangle li as a struct mtri. The same operations as setup used,
+ * so n and inv_nn do not depend on where they are made. RT-safe. */
+static inline struct mtri px__mtri_get(const struct mesh *M, size_t li)
+{
+	struct mtri3 v = px__tri3_get(M, li);
+	struct mtri t;
+	t.a = v.a;
+	t.b = v.b;
+	t.c = v.c;
+	t.n = px_v3_cross(px_v3_sub(t.b, t.a), px_v3_sub(t.c, t.a));
+	t.inv_nn = M->degen[li] ? 0.0 : 1.0 / px_v3_norm2(t.n);
 	return t;
 }
 
