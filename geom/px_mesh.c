@@ -801,9 +801,8 @@ static int mesh_closest_among(const void *impl, const struct px_model_query *qq,
 {
 	const struct mesh *M = impl;
 	struct best b;
-	int i;
-
 	struct pq pq;
+	int i;
 
 	best_init(&b, qq->p, qq->max_dist);
 	pq_init(M, qq->p, &pq);

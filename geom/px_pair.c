@@ -216,16 +216,17 @@ static int gjk(const struct shp *a, const struct shp *b, double *dist,
 	v = S[0].w;
 	for (it = 0; it < GJK_MAX_ITERS; it++) {
 		struct gjk_vert nw;
-		double vv = px_v3_norm2(v);
+		double vv = px_v3_norm2(v), vw;
 		int k, dup = 0;
 		if (vv == 0.0)
 			break;
 		shp_support(a, px_v3_neg(v), &nw.a);
 		shp_support(b, v, &nw.b);
 		nw.w = px_v3_sub(nw.a, nw.b);
-		if (px_v3_dot(v, nw.w) > lb * sqrt(vv))
-			lb = px_v3_dot(v, nw.w) / sqrt(vv);
-		if (vv - px_v3_dot(v, nw.w) <= GJK_REL * vv)
+		vw = px_v3_dot(v, nw.w);
+		if (vw / sqrt(vv) > lb)
+			lb = vw / sqrt(vv);
+		if (vv - vw <= GJK_REL * vv)
 			break;
 		for (k = 0; k < n; k++)
 			if (S[k].w.x == nw.w.x && S[k].w.y == nw.w.y && S[k].w.z == nw.w.z)
@@ -489,22 +490,23 @@ out:
 			px_vec3 foot = px_v3_scale(fb->n, fb->d);
 			double gap = INFINITY;
 			int pick = best;
+			/* the nearest face itself passes the test, so pick and
+			 * its weights u, v are always set here */
 			for (k = 0; k < nf; k++) {
-				px_vec3 qk;
-				double g;
+				double g, uk, vk;
 				if (!F[k].alive || !isfinite(F[k].d) ||
 				    F[k].d - fb->d > EPA_REL * fmax(fb->d, 1e-6 * scale) ||
 				    px_v3_dot(F[k].n, fb->n) < 1.0 - 1e-9)
 					continue;
-				g = sqrt(px_tri_closest(foot, V[F[k].v[0]].w, V[F[k].v[1]].w,
-							V[F[k].v[2]].w, &qk, &f, &sub, &u, &v));
+				g = px_tri_closest(foot, V[F[k].v[0]].w, V[F[k].v[1]].w,
+						   V[F[k].v[2]].w, &q, &f, &sub, &uk, &vk);
 				if (g < gap) {
 					gap = g;
 					pick = k;
+					u = uk;
+					v = vk;
 				}
 			}
-			px_tri_closest(foot, V[F[pick].v[0]].w, V[F[pick].v[1]].w, V[F[pick].v[2]].w,
-				       &q, &f, &sub, &u, &v);
 			*depth = fb->d;
 			*normal = fb->n;
 			/* the same weights on both sides: each support point
@@ -1218,51 +1220,52 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 			 * 1e-8 of the distance plus 1e-9 of the coordinates
 			 * (a nanometre in a metre-sized scene). */
 			struct px_model_result qa, qb, ka, kb;
-			px_vec3 start[2] = {pa, pa};
-			double dk[2] = {INFINITY, INFINITY}, ctol;
-			int j, s, pick = 0, extra = 0;
+			px_vec3 x = pa;
+			double dq = INFINITY, ctol = 0.0;
+			int j, s, nq = 0;
 			memset(&qa, 0, sizeof(qa));
 			memset(&qb, 0, sizeof(qb));
-			if ((rc = px_model_support(a, px_v3_neg(gv), &start[1])) < 0)
-				return rc;
 			for (s = 0; s < 2; s++) {
-				px_vec3 x = start[s];
-				/* the second start only where the first one's pair
-				 * is longer than |v| (its queries are the cost of
-				 * this path on a convex mesh) */
-				if (s == 1 && !(dk[0] - d > 1e-8 * dk[0] + 1e-9 * (1.0 + px_v3_norm(qa.point))))
-					break;
+				if (s == 1) {
+					/* the second start only where the first one's
+					 * pair is longer than |v| (its queries are the
+					 * cost of this path on a convex mesh) */
+					if (!(dq - d > ctol))
+						break;
+					if ((rc = px_model_support(a, px_v3_neg(gv), &x)) < 0)
+						return rc;
+				}
 				for (j = 0; j < 2; j++) {
 					if ((rc = px_model_query(b, x, &kb)) < 0 ||
 					    (rc = px_model_query(a, kb.point, &ka)) < 0)
 						return rc;
 					x = ka.point;
+					nq += 2;
 				}
-				dk[s] = px_v3_dist(ka.point, kb.point);
-				if (s == 0 || dk[s] < dk[pick]) {
-					pick = s;
+				if (s == 0 || px_v3_dist(ka.point, kb.point) < dq) {
+					dq = px_v3_dist(ka.point, kb.point);
 					qa = ka;
 					qb = kb;
 				}
+				ctol = 1e-8 * dq + 1e-9 * (1.0 + px_v3_norm(qa.point));
 			}
-			ctol = 1e-8 * dk[pick] + 1e-9 * (1.0 + px_v3_norm(qa.point));
 			/* witnesses still longer than |v|: a few more rounds from
 			 * the better start while they gain (slow near contact,
 			 * where curved and flat parts meet; the distance itself
 			 * is |v| either way) */
-			for (j = 0; j < 4 && dk[pick] - d > ctol; j++) {
-				double dn, gap = dk[pick] - d;
+			for (j = 0; j < 4 && dq - d > ctol; j++) {
+				double dn, gap = dq - d;
 				if ((rc = px_model_query(b, qa.point, &kb)) < 0 ||
 				    (rc = px_model_query(a, kb.point, &ka)) < 0)
 					return rc;
+				nq += 2;
 				dn = px_v3_dist(ka.point, kb.point);
-				if (!(dn < dk[pick]))
+				if (!(dn < dq))
 					break;
-				dk[pick] = dn;
+				dq = dn;
 				qa = ka;
 				qb = kb;
-				extra++;
-				if (dk[pick] - d > 0.75 * gap)
+				if (dq - d > 0.75 * gap)
 					break; /* stalled: less than a quarter gained */
 			}
 			pa = qa.point;
@@ -1271,13 +1274,13 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 			/* |v| is a point of A - B (an upper bound) and the
 			 * support plane a lower one: the distance is |v| when
 			 * they agree, whatever the witnesses' own gap */
-			res->distance = res->intersecting ? 0.0 : fmin(d, dk[pick]);
-			res->witness_gap = res->intersecting ? 0.0 : dk[pick] - res->distance;
+			res->distance = res->intersecting ? 0.0 : fmin(d, dq);
+			res->witness_gap = res->intersecting ? 0.0 : dq - res->distance;
 			res->point_a = pa;
 			res->point_b = pb;
 			res->index_a = qa.index;
 			res->index_b = qb.index;
-			res->iterations = its + 8 + 2 * extra;
+			res->iterations = its + nq;
 			res->starts = 0;
 			res->converged = its < GJK_MAX_ITERS &&
 					 (res->intersecting || res->distance - lower <= ctol);

@@ -245,12 +245,13 @@ static int face_at(const struct px_model *m, px_vec3 x, int *index)
 	return 0;
 }
 
-/* Unit vector perpendicular to the segments' directions (cores that
- * cross: the pair leaves along it), else any perpendicular of u. */
-static px_vec3 cross_dir(px_vec3 u, px_vec3 w)
+/* x = u x w normalised: the unit vector perpendicular to the segments'
+ * directions u, w (cores that cross: the pair leaves along it), else any
+ * perpendicular of u. */
+static px_vec3 cross_dir(px_vec3 x, px_vec3 u)
 {
-	px_vec3 n = px_v3_cross(u, w), out;
-	if (px_v3_normalize(n, px_v3(0, 0, 0), &out) == PX_OK)
+	px_vec3 n, out;
+	if (px_v3_normalize(x, px_v3(0, 0, 0), &out) == PX_OK)
 		return out;
 	n = px_v3_cross(u, fabs(u.x) < 0.9 ? px_v3(1, 0, 0) : px_v3(0, 1, 0));
 	if (px_v3_normalize(n, px_v3(0, 0, 1), &out) != PX_OK)
@@ -300,8 +301,8 @@ int px__pair_closed(const struct px_model *a, const struct px_model *b,
 		 * rounding when the axes nearly meet); axes that meet: the
 		 * flat Minkowski difference of the segments holds the origin
 		 * and the pair leaves along its normal after ra + rb */
-		n = cross_dir(u, w);
 		x = px_v3_cross(u, w);
+		n = cross_dir(x, u);
 		interior = s > 0.0 && s < 1.0 && t > 0.0 && t < 1.0 &&
 			   px_v3_norm(x) > 1e-9 * px_v3_norm(u) * px_v3_norm(w);
 		if (px_v3_dot(n, px_v3_sub(cb, ca)) < 0.0)
@@ -310,14 +311,13 @@ int px__pair_closed(const struct px_model *a, const struct px_model *b,
 		     interior || px_v3_dist(ca, cb) <= 1e-12 * scale);
 	} else {
 		px_pose P = px_model_pose(b);
-		double h[3] = {pb.a, pb.b, pb.c}, t, d2;
+		double h[3] = {pb.a, pb.b, pb.c}, t, d2, sc = pa.a + pa.b + h[0] + h[1] + h[2];
 		px_vec3 q;
 		d2 = px__seg_box(px_pose_inverse_transform_point(P, a0),
 				 px_pose_inverse_transform_point(P, a1), h, &t, &q);
 		/* the axis meets the box (or is within rounding of it, where
 		 * the direction is lost): EPA measures the depth */
-		if (!(d2 > 1e-24 * (pa.a + pa.b + h[0] + h[1] + h[2]) *
-				(pa.a + pa.b + h[0] + h[1] + h[2])))
+		if (!(d2 > 1e-24 * sc * sc))
 			return 0;
 		fill(res, px_v3_lerp(a0, a1, t), px_pose_transform_point(P, q), pa.a, 0.0,
 		     px_v3(0, 0, 1), 0);
