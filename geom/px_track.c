@@ -46,6 +46,7 @@
 /* A Newton step below this fraction of its span is accepted without
  * another evaluation (the root error left is O(step^2), ~1e-9 span). */
 #define TRK_QUICK 3e-5
+#define TRK_QUICK_ITERS 3 /* Newton evaluations of the quick evolution */
 
 /* leaf flags */
 #define LF_EV0 0x1u   /* start is a break: a root crossing it is an event */
@@ -61,6 +62,15 @@
 #define K_C0 2
 #define K_CUSP 3
 
+/* Span evaluation in pairs of coordinates where the compiler has generic
+ * vectors (GCC, clang); the scalar form elsewhere. */
+#if defined(__GNUC__) && !defined(PX_TRACK_NO_VEC)
+#define TRK_VEC 1
+typedef double trk_v2 __attribute__((vector_size(16)));
+#else
+#define TRK_VEC 0
+#endif
+
 struct span {
 	double u0, u1, inv;
 	int deg;
@@ -69,6 +79,14 @@ struct span {
 	/* the same in tau = u - u0 (derivatives come out in u directly);
 	 * zero-padded to degree 3 so low degrees share one unrolled path */
 	double pu[4][TRK_MAXD + 1];
+#if TRK_VEC
+	/* degree <= 3 again, by coefficient with the four coordinates of a
+	 * coefficient in two vectors (x w, y w | z w, w) and the derivative
+	 * factors applied (value q0..q3; first derivative q1, 2 q2, 3 q3;
+	 * second 2 q2, 6 q3: the products the scalar form makes, so the
+	 * results are the same to the bit) */
+	trk_v2 hv[4][2], hd1[3][2], hd2[2][2];
+#endif
 };
 
 struct leaf {
@@ -171,6 +189,17 @@ struct px_track {
 	int *rmin;           /* resting minima of this update: entity, index */
 	int n_rmin;
 	double best_now;     /* wake_minima: distance to a real curve point */
+	/* hot certificate (armed by hot_arm after a tracked update): while
+	 * the travelled path stays below hot_until and no leaf has an event,
+	 * the answer is root hot_z of entity hot_ent, every other root rests
+	 * in its leaf and cannot be the closest point, so an update evolves
+	 * that one root and nothing else; hot_ent -1 when not armed */
+	int hot_ent, hot_z;
+	double hot_until, hot_other;
+	int hot_nc, hot_nm, hot_rest_ent;
+	int ans_z;           /* answer(): index of the answering root, -1 */
+	int ans_c;           /* answer(): answering candidate, -1 */
+	int hot_c;           /* hot: answering candidate (hot_z -1), -1 */
 	struct px_track_stats st;
 	size_t bytes;
 };
@@ -181,12 +210,37 @@ struct px_track {
 /* C, C', C'' at u from the span's power-basis table: for degree <= 3 one
  * unrolled Horner per coordinate (a few dozen flops), homogeneous
  * quotient rule only for rational spans. */
-static inline void span_eval(const struct span *s, double u, px_vec3 *c,
+static inline __attribute__((always_inline)) void span_eval(const struct span *s, double u, px_vec3 *c,
 			     px_vec3 *d1, px_vec3 *d2)
 {
 	double x = u - s->u0, h[4][3];
 	int k, j, p = s->deg, nk = s->rat ? 4 : 3;
 
+#if TRK_VEC
+	if (p <= 3) {
+		trk_v2 X = {x, x}, a0, a1, b0, b1, c0, c1;
+		a0 = ((s->hv[3][0] * X + s->hv[2][0]) * X + s->hv[1][0]) * X +
+		     s->hv[0][0];
+		a1 = ((s->hv[3][1] * X + s->hv[2][1]) * X + s->hv[1][1]) * X +
+		     s->hv[0][1];
+		b0 = (s->hd1[2][0] * X + s->hd1[1][0]) * X + s->hd1[0][0];
+		b1 = (s->hd1[2][1] * X + s->hd1[1][1]) * X + s->hd1[0][1];
+		c0 = s->hd2[1][0] * X + s->hd2[0][0];
+		c1 = s->hd2[1][1] * X + s->hd2[0][1];
+		if (!s->rat) {
+			*c = px_v3(a0[0], a0[1], a1[0]);
+			*d1 = px_v3(b0[0], b0[1], b1[0]);
+			*d2 = px_v3(c0[0], c0[1], c1[0]);
+			return;
+		}
+		h[0][0] = a0[0], h[1][0] = a0[1], h[2][0] = a1[0], h[3][0] = a1[1];
+		h[0][1] = b0[0], h[1][1] = b0[1], h[2][1] = b1[0], h[3][1] = b1[1];
+		h[0][2] = c0[0], h[1][2] = c0[1], h[2][2] = c1[0], h[3][2] = c1[1];
+		(void)k;
+		(void)j;
+		(void)nk;
+	} else
+#endif
 	if (p <= 3) {
 		for (k = 0; k < nk; k++) {
 			const double *q = s->pu[k];
@@ -717,6 +771,64 @@ static int newton(const struct px_track *t, const struct ent *e, int type,
 }
 
 /*
+ * The usual evolution of a root, in a few dozen flops: from the predicted
+ * parameter ua, up to iters Newton steps with p fixed (one evaluation
+ * each, from the span table) until one is small enough to be accepted,
+ * every iterate inside the given leaf, same type at the end. Writes
+ * nothing into z. Returns 0 (accepted: *u, *c, *d1, *D), 1 (not
+ * accepted: *ua is the last iterate, inside the leaf, and *st its finite
+ * Newton step) or 2 (nothing usable: ua outside the leaf, a non-finite
+ * step or the wrong type).
+ */
+static inline __attribute__((always_inline)) int
+quick_evolve(const struct px_track *t, const struct zero *z, int leaf,
+	     double ua, px_vec3 p, int iters, px_vec3 *c, px_vec3 *d1,
+	     double *D, double *u, double *ua_out, double *st_out)
+{
+	const struct leaf *l = &t->leaf[leaf];
+	const struct span *sp = &t->span[l->span];
+	double f1, st, Dn, quick = TRK_QUICK * (sp->u1 - sp->u0);
+	px_vec3 d2, pc, cc, dd;
+	int k;
+	*ua_out = ua;
+	if (!(ua >= l->u0 && ua <= l->u1))
+		return 2;
+	for (k = 1;; k++) {
+		span_eval(sp, ua, &cc, &dd, &d2);
+		pc = px_v3_sub(cc, p);
+		f1 = px_v3_dot(pc, dd);
+		Dn = px_v3_dot(pc, d2) + px_v3_dot(dd, dd);
+		st = -f1 / Dn;
+		if (fabs(st) <= quick && ua + st >= l->u0 && ua + st <= l->u1)
+			break;
+		*ua_out = ua;
+		*st_out = st;
+		if (!isfinite(st))
+			return 2;
+		if (k >= iters || !(ua + st >= l->u0 && ua + st <= l->u1))
+			return 1;
+		ua += st;
+	}
+	/* quadratic convergence: the root error after this step is
+	 * O(st^2) (below 1e-9 of the span), so the point is moved by its
+	 * Taylor expansion instead of another evaluation: second order in
+	 * C (error O(st^3), far below the answer tolerance), first order in
+	 * C' (only the next predictor uses it) */
+	cc = px_v3_add(cc, px_v3_scale(px_v3_add(dd, px_v3_scale(d2, 0.5 * st)),
+				       st));
+	dd = px_v3_add(dd, px_v3_scale(d2, st));
+	pc = px_v3_sub(cc, p);
+	Dn = px_v3_dot(pc, d2) + px_v3_dot(dd, dd);
+	if ((Dn > 0.0 ? 1 : -1) != z->type)
+		return 2;
+	*c = cc;
+	*d1 = dd;
+	*D = Dn;
+	*u = ua + st;
+	return 0;
+}
+
+/*
  * Evolve one root from p0 to p0 + dp: predictor (dp . C') / D (Eq. 6),
  * then Newton with the point held fixed. When that fails (a long step
  * near a fold), the same in four sub-steps along the segment. Then the
@@ -731,43 +843,25 @@ static int evolve(struct px_track *t, struct ent *e, struct zero *z,
 	px_vec3 c, d1;
 
 	{
-		/* the usual case, in a few dozen flops: predictor, one
-		 * evaluation from the span table, one accepted Newton step,
-		 * all inside the root's leaf */
-		const struct leaf *l = &t->leaf[z->leaf];
-		const struct span *sp = &t->span[l->span];
-		double ua = z->u + px_v3_dot(dp, z->d1) / z->D, f1, st;
-		px_vec3 d2, pc;
-		if (ua >= l->u0 && ua <= l->u1) {
-			span_eval(sp, ua, &c, &d1, &d2);
-			pc = px_v3_sub(c, p);
-			f1 = px_v3_dot(pc, d1);
-			D = px_v3_dot(pc, d2) + px_v3_dot(d1, d1);
-			st = -f1 / D;
-			if (fabs(st) <= TRK_QUICK * (sp->u1 - sp->u0) &&
-			    ua + st >= l->u0 && ua + st <= l->u1) {
-				c = px_v3_add(c, px_v3_scale(px_v3_add(d1,
-						px_v3_scale(d2, 0.5 * st)), st));
-				d1 = px_v3_add(d1, px_v3_scale(d2, st));
-				pc = px_v3_sub(c, p);
-				D = px_v3_dot(pc, d2) + px_v3_dot(d1, d1);
-				if ((D > 0.0 ? 1 : -1) == z->type) {
-					z->u = ua + st;
-					z->c = c;
-					z->d1 = d1;
-					z->D = D;
-					zero_stamp(t, z, p);
-					e->moved = 1;
-					return 0;
-				}
-			} else if (isfinite(st)) {
-				/* the general iteration goes on from this
-				 * Newton step instead of evaluating ua again */
-				have = 1;
-				next = st;
-			}
+		/* the usual case, in a few dozen flops */
+		double ua;
+		int q = quick_evolve(t, z, z->leaf,
+				     z->u + px_v3_dot(dp, z->d1) / z->D, p,
+				     TRK_QUICK_ITERS, &c, &d1, &D, &u, &ua,
+				     &next);
+		if (q == 0) {
+			z->u = u;
+			z->c = c;
+			z->d1 = d1;
+			z->D = D;
+			zero_stamp(t, z, p);
+			e->moved = 1;
+			return 0;
 		}
-		if (have) {
+		if (q == 1) {
+			/* the general iteration goes on from this Newton
+			 * step instead of evaluating ua again */
+			have = 1;
 			lim = e->len / (e->n_leaves > 0 ? e->n_leaves : 1);
 			if (fabs(next) > lim)
 				next = next > 0 ? lim : -lim;
@@ -1227,45 +1321,68 @@ static void wake_minima(struct px_track *t, px_vec3 p)
 }
 
 /*
- * Certify e to rest whole from now on (after its checks of this update).
- * Each root must be alone in its leaf (can_rest) and rest_until stays
- * below every leaf certificate. For the minima: the global distance d*
- * is 1-Lipschitz and best is the distance to a real curve point, so
- * after a further path L, d* <= best + L, while a minimum is at least
- * lb - L away (lb its lower bound now); it cannot be the closest while
- * lb - L > best + L, i.e. L < (lb - best) / 2 (with the same tolerance
- * as wake_minima).
+ * The certificate shared by resting roots: the travelled path below which
+ * every root of e but skip provably stays in its leaf (each leaf
+ * certificate; the caller checked that each is alone there) and no
+ * minimum of them can be the closest point. best is the distance to a
+ * real curve point followed continuously; the global distance d* is
+ * 1-Lipschitz, so after a further path L, d* <= best + L, while a
+ * minimum is at least lb - L away (lb its lower bound now); it cannot be
+ * the closest while lb - L > best + L, i.e. L < (lb - best) / 2 (with the
+ * same tolerance as wake_minima). With fix set, a root whose certificate
+ * ran out is corrected first, on a copy kept only when it stayed in its
+ * leaf. Lowers *until; returns 0, or 1 when there is no certificate.
  */
+static int cert_roots(struct px_track *t, struct ent *e, int skip,
+		      double best, int fix, double *until)
+{
+	double tol = 1e-9 * (best + t->scale), m;
+	int j, margin = !(t->fault & 32);
+	for (j = 0; j < e->nz; j++) {
+		struct zero *z = &e->z[j];
+		if (j == skip)
+			continue;
+		if (fix && (!(z->until > t->travel) ||
+			    (z->type > 0 &&
+			     !(z->dist - (t->travel - z->trav) - best - tol > 0.0)))) {
+			struct zero zc = *z;
+			if (evolve(t, e, &zc, zc.p, px_v3_sub(t->p, zc.p), t->p) ||
+			    zc.leaf != z->leaf)
+				return 1;
+			*z = zc;
+		}
+		if (!(z->until > t->travel))
+			return 1;
+		if (z->until < *until)
+			*until = z->until;
+		if (z->type > 0 && margin) {
+			m = z->dist - (t->travel - z->trav) - best - tol;
+			if (!(m > 0.0))
+				return 1;
+			m = t->travel + 0.5 * m * (1.0 - 1e-9);
+			if (m < *until)
+				*until = m;
+		}
+	}
+	return 0;
+}
+
+/* Certify e to rest whole from now on (after its checks of this update):
+ * each root alone in its leaf (can_rest), cert_roots against the best
+ * distance of this update. */
 static void ent_certify(struct px_track *t, struct ent *e)
 {
-	double until = INFINITY, lbmin = INFINITY, m;
+	double until = INFINITY;
 	int j, nmin = 0;
 	e->rest_until = -1.0;
 	for (j = 0; j < e->nz; j++) {
-		const struct zero *z = &e->z[j];
-		if (j > 0 && e->z[j - 1].leaf == z->leaf)
+		if (j > 0 && e->z[j - 1].leaf == e->z[j].leaf)
 			return;
-		if (!(z->until > t->travel))
-			return;
-		if (z->until < until)
-			until = z->until;
-		if (z->type > 0) {
-			double lb = z->dist - (t->travel - z->trav);
-			nmin++;
-			if (lb < lbmin)
-				lbmin = lb;
-		}
+		nmin += e->z[j].type > 0;
 	}
 	e->nmin = nmin;
-	if (nmin && !(t->fault & 32)) {
-		m = lbmin - t->best_now -
-		    1e-9 * (t->best_now + t->scale);
-		if (!(m > 0.0))
-			return;
-		m = t->travel + 0.5 * m * (1.0 - 1e-9);
-		if (m < until)
-			until = m;
-	}
+	if (cert_roots(t, e, -1, t->best_now, 0, &until))
+		return;
 	e->rest_until = (t->fault & 16) ? INFINITY : until;
 }
 
@@ -1290,6 +1407,8 @@ static void answer(struct px_track *t, px_vec3 p, struct px_track_result *r)
 	uint32_t id = 0;
 	int i, j, nc = 0, nm = 0;
 
+	t->ans_z = -1;
+	t->ans_c = -1;
 	for (i = 0; i < t->n_ent; i++) {
 		const struct ent *e = &t->ent[i];
 		nc += e->nz;
@@ -1317,6 +1436,8 @@ static void answer(struct px_track *t, px_vec3 p, struct px_track_result *r)
 				r->u = z->u;
 				r->entity = i;
 				r->feature = PX_TRACK_MIN;
+				t->ans_z = j;
+				t->ans_c = -1;
 			}
 		}
 	}
@@ -1329,6 +1450,8 @@ static void answer(struct px_track *t, px_vec3 p, struct px_track_result *r)
 			r->u = t->cand[i].u;
 			r->entity = t->cand[i].ent;
 			r->feature = t->cand[i].kind;
+			t->ans_z = -1;
+			t->ans_c = i;
 		}
 	}
 	fill_dir(r, p);
@@ -1336,6 +1459,193 @@ static void answer(struct px_track *t, px_vec3 p, struct px_track_result *r)
 	r->n_min = nm;
 	r->jumped = t->best_id != 0 && id != t->best_id;
 	t->best_id = id;
+}
+
+/*
+ * The hot certificate over entity E answered by its minimum a (or, a -1,
+ * by candidate hot_c), at the current point with best the distance of
+ * the answer (current): cert_roots over the other roots of E (each alone
+ * in its leaf, checked when armed) and over the other candidates (fixed
+ * points, 1-Lipschitz distances: the same margin), every other entity
+ * resting whole under its own certificate
+ * (hot_other, their smallest). With fix set (from the hot path) the roots
+ * whose certificates ran out are corrected and an entity whose rest ran
+ * out is certified again the same way. Returns 0 (hot_until set) or 1
+ * (no certificate: the full update runs).
+ */
+static int hot_cert(struct px_track *t, struct ent *E, int a, double best,
+		    int fix)
+{
+	double until, tol = 1e-9 * (best + t->scale), m;
+	int i;
+	if (fix && !(t->travel < t->hot_other)) {
+		double other = INFINITY;
+		for (i = 0; i < t->n_ent; i++) {
+			struct ent *e = &t->ent[i];
+			if (e == E)
+				continue;
+			if (!(t->travel < e->rest_until)) {
+				double u2 = INFINITY;
+				if ((t->fault & 16) ||
+				    cert_roots(t, e, -1, best, 1, &u2))
+					return 1;
+				e->rest_until = u2;
+			}
+			if (e->rest_until < other)
+				other = e->rest_until;
+		}
+		t->hot_other = other;
+	}
+	until = t->hot_other;
+	if (!(t->travel < until) || cert_roots(t, E, a, best, fix, &until))
+		return 1;
+	for (i = 0; i < t->n_cand; i++) {
+		if (i == t->hot_c)
+			continue;
+		m = px_v3_dist(t->cand[i].q, t->p) - best - tol;
+		if (!(m > 0.0))
+			return 1;
+		m = t->travel + 0.5 * m * (1.0 - 1e-9);
+		if (m < until)
+			until = m;
+	}
+	t->hot_until = (t->fault & 64) ? INFINITY : until;
+	return 0;
+}
+
+/*
+ * Arm the hot certificate after a tracked update answered by an interior
+ * minimum or a candidate. Every other entity must rest whole, and every
+ * root of the
+ * answer's entity must be alone in its leaf: with no event anywhere and
+ * every other root held in its leaf, the root Newton converges to inside
+ * the answering root's leaf is its continuation.
+ */
+static void hot_arm(struct px_track *t, const struct px_track_result *r)
+{
+	struct ent *E;
+	double other = INFINITY;
+	int a, i, j, nc = 0, nm = 0, nre = 0;
+
+	t->hot_ent = -1;
+	if (!t->opts.lazy || r->source != PX_TRACK_TRACKED ||
+	    (t->ans_z < 0) == (t->ans_c < 0) || r->entity < 0)
+		return;
+	E = &t->ent[r->entity];
+	a = t->ans_z;
+	if (E->stale || a >= E->nz || (a >= 0 && E->z[a].ep != t->epoch))
+		return;
+	for (i = 0; i < t->n_ent; i++) {
+		const struct ent *e = &t->ent[i];
+		nc += e->nz;
+		if (e == E)
+			continue;
+		if (e->stale || !(e->rest_until > t->travel))
+			return;
+		if (e->rest_until < other)
+			other = e->rest_until;
+		nm += e->nmin;
+		nre++;
+	}
+	for (j = 0; j < E->nz; j++) {
+		if (j > 0 && E->z[j - 1].leaf == E->z[j].leaf)
+			return;
+		nm += E->z[j].type > 0;
+	}
+	if (E->nz >= 2 && E->z[0].leaf == E->z[E->nz - 1].leaf)
+		return;
+	t->hot_other = other;
+	t->hot_c = t->ans_c;
+	if (hot_cert(t, E, a, r->dist, 0))
+		return;
+	t->hot_ent = r->entity;
+	t->hot_z = a;
+	t->hot_nc = nc;
+	t->hot_nm = nm;
+	t->hot_rest_ent = nre;
+}
+
+/*
+ * An update under the hot certificate (no leaf had an event on the way
+ * here): the answering root by quick_evolve, into a neighbouring leaf of
+ * the same stretch when that leaf holds no other root, then the
+ * certificate renewed in place when the path has used it up. Returns 0
+ * when answered, 1 when the full update must run (the state is then one
+ * it can start from: only corrections it would make itself were kept).
+ */
+static int hot_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
+{
+	struct ent *e = &t->ent[t->hot_ent];
+	struct zero *z;
+	px_vec3 c, d1;
+	double D, u, ua, st;
+	int li, j, q;
+	if (t->hot_z < 0) {
+		/* a candidate answers: a fixed point */
+		const struct cand *cd = &t->cand[t->hot_c];
+		if (!(t->travel < t->hot_until) &&
+		    hot_cert(t, e, -1, px_v3_dist(cd->q, p), 1))
+			return 1;
+		r->point = cd->q;
+		r->u = cd->u;
+		r->entity = cd->ent;
+		r->feature = cd->kind;
+		goto done;
+	}
+	z = &e->z[t->hot_z];
+	li = z->leaf;
+	q = quick_evolve(t, z, li, z->u + px_v3_dot(px_v3_sub(p, z->p), z->d1) / z->D,
+			 p, TRK_QUICK_ITERS, &c, &d1, &D, &u, &ua, &st);
+	if (q) {
+		/* the iteration left the leaf: on into the neighbour on that
+		 * side, unless a stretch boundary, a break or another root
+		 * is there */
+		const struct leaf *l = &t->leaf[li];
+		int side;
+		if (q == 1)
+			ua += st;
+		side = ua > l->u1;
+		if (!(ua < l->u0 || ua > l->u1) ||
+		    (l->flags & (side ? (LF_SB1 | LF_EV1) : (LF_SB0 | LF_EV0))))
+			return 1;
+		li += side ? 1 : -1;
+		if (li < e->first_leaf || li >= e->first_leaf + e->n_leaves ||
+		    (t->leaf[li].flags &
+		     (side ? (LF_SB0 | LF_EV0) : (LF_SB1 | LF_EV1))))
+			return 1;
+		for (j = 0; j < e->nz; j++)
+			if (e->z[j].leaf == li)
+				return 1;
+		if (quick_evolve(t, z, li, ua, p, TRK_QUICK_ITERS, &c, &d1, &D,
+				 &u, &ua, &st))
+			return 1;
+	}
+	z->u = u;
+	z->leaf = li;
+	z->c = c;
+	z->d1 = d1;
+	z->D = D;
+	z->p = p;
+	z->trav = t->travel;
+	z->ep = t->epoch;
+	/* its leaf certificate is not kept up here: the full update that
+	 * follows corrects it first */
+	z->until = -1.0;
+	z->dist = px_v3_dist(c, p);
+	if (!(t->travel < t->hot_until) && hot_cert(t, e, t->hot_z, z->dist, 1))
+		return 1;
+	r->point = c;
+	r->u = u;
+	r->entity = t->hot_ent;
+	r->feature = PX_TRACK_MIN;
+done:
+	fill_dir(r, p);
+	r->n_crit = t->hot_nc;
+	r->n_min = t->hot_nm;
+	t->st.hot++;
+	t->st.rested += (uint64_t)(t->hot_nc - (t->hot_z >= 0));
+	t->st.rested_entities += (uint64_t)t->hot_rest_ent;
+	return 0;
 }
 
 static void answer_global(struct px_track *t, px_vec3 p,
@@ -1421,6 +1731,7 @@ int px_track_reset(struct px_track *t, px_vec3 p, struct px_track_result *r)
 	t->p = p;
 	t->init = 1;
 	t->best_id = 0;
+	t->hot_ent = -1;
 	t->heap_ok = 0;
 	rc = reinit_all(t, p);
 	r->source = PX_TRACK_REINIT;
@@ -1464,6 +1775,7 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 	}
 
 	if (!in_work(t, p) || !in_work(t, p0)) {
+		t->hot_ent = -1;
 		t->st.outside++;
 		t->heap_ok = 0;
 		r->source = PX_TRACK_REINIT;
@@ -1479,6 +1791,15 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 	}
 
 	nh = collect_events(t, p0, p);
+	if (t->hot_ent >= 0) {
+		if (nh == 0 && !hot_update(t, p, r)) {
+			verify(t, p, r);
+			if (r->source != PX_TRACK_TRACKED)
+				t->hot_ent = -1;
+			return PX_OK;
+		}
+		t->hot_ent = -1;
+	}
 	r->leaves_solved = nh;
 	t->st.leaf_solves += (uint64_t)nh;
 
@@ -1599,9 +1920,10 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 	if (!fail && t->opts.lazy) {
 		for (i = 0; i < t->n_ent; i++) {
 			struct ent *e = &t->ent[i];
-			/* only entities whose roots all rested: one holding
-			 * a corrected root is near the answer or moving */
-			if (e->allrest && !e->stale &&
+			/* corrected roots too: their certificates were made
+			 * at this point (the hot path needs every entity
+			 * but the answer's resting whole) */
+			if (!e->resting && !e->stale &&
 			    r->source == PX_TRACK_TRACKED)
 				ent_certify(t, e);
 		}
@@ -1629,6 +1951,7 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 	answer(t, p, r);
 	r->leaves_solved = nh;
 	verify(t, p, r);
+	hot_arm(t, r);
 	return PX_OK;
 }
 
@@ -1639,6 +1962,7 @@ static void ent_refresh(struct px_track *t, struct ent *e)
 	int j, rest = 0;
 	if (!t->init || e->stale)
 		return;
+	t->hot_ent = -1; /* the roots are corrected and re-sorted here */
 	e->rest_until = -1.0;
 	e->resting = 0;
 	for (j = 0; j < e->nz; j++)
@@ -1657,6 +1981,7 @@ void px__track_set_fault(struct px_track *t, int fault)
 	if (t) {
 		t->fault = fault;
 		t->heap_ok = 0; /* radii of the new regime */
+		t->hot_ent = -1;
 	}
 }
 
@@ -2104,6 +2429,19 @@ int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
 				for (q = 0; q <= p; q++)
 					if (s->pc[3][q] != (q == 0 ? 1.0 : 0.0))
 						s->rat = 1;
+#if TRK_VEC
+				for (jj = 0; jj < 4; jj++) {
+					const double *w = s->pu[jj];
+					int m = jj / 2, l2 = jj % 2;
+					for (q = 0; q < 4; q++)
+						s->hv[q][m][l2] = w[q];
+					s->hd1[0][m][l2] = w[1];
+					s->hd1[1][m][l2] = 2.0 * w[2];
+					s->hd1[2][m][l2] = 3.0 * w[3];
+					s->hd2[0][m][l2] = 2.0 * w[2];
+					s->hd2[1][m][l2] = 6.0 * w[3];
+				}
+#endif
 			}
 			t->n_spans++;
 		}
@@ -2376,6 +2714,10 @@ int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
 		   pool_cap * sizeof(double) +
 		   (size_t)(cand_cap + 1) * sizeof(*t->cand);
 	t->epoch = 1;
+	t->hot_ent = -1;
+	t->ans_z = -1;
+	t->ans_c = -1;
+	t->hot_c = -1;
 	t->n_crit_cap = n_curves * o.max_crit;
 	t->rmin = calloc((size_t)t->n_crit_cap * 2 + 2, sizeof(int));
 	if (!t->rmin) {

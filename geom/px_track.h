@@ -43,6 +43,14 @@
  *    path grows); until the path uses it up or one of its leaves has an
  *    event, an update passes the entity with one comparison
  *    (stats.rested_entities).
+ *  - Hot path (opts.lazy): after an update answered by an interior
+ *    minimum, when every other entity rests whole and every other root
+ *    of the answer's entity rests under its leaf certificate and the
+ *    same distance margin (candidates too), one certificate covers them
+ *    all; until the path uses it up, a leaf has an event or the answering
+ *    root leaves the quick evolution (predictor, one evaluation, one
+ *    accepted Newton step inside its leaf), an update is that evolution
+ *    and nothing else (stats.hot).
  *  - Transitions: pairs appear or vanish only where the moving point
  *    crosses the transition set {p : g = 0 and dg/ds = 0} (the evolute of
  *    a planar curve, a ruled surface of polar lines for a space curve) or,
@@ -192,6 +200,9 @@ struct px_track_stats {
 				  * update (opts.lazy), summed over updates */
 	uint64_t rested_entities; /* entities passed whole under their rest
 				   * certificate, summed over updates */
+	uint64_t hot;            /* updates answered under the hot
+				  * certificate: only the answering root
+				  * evolved (opts.lazy) */
 };
 
 struct px_track_info {

@@ -519,7 +519,7 @@ static void report(const char *name, const struct run_stats *rs)
 	       "counts %ld checked %ld bad %ld ambiguous, jumps %ld; tracker: "
 	       "reinit %llu outside %llu fallback %llu solves %llu created %llu "
 	       "annihilated %llu disagree %llu/%llu rested %llu roots %llu "
-	       "entities\n",
+	       "entities, hot %llu\n",
 	       name, rs->steps, rs->wrong, rs->naive_wrong, rs->brute_bad,
 	       rs->brute_checked, rs->count_checked, rs->count_bad,
 	       rs->count_ambig, rs->jumps, (unsigned long long)rs->ts.reinits,
@@ -531,7 +531,8 @@ static void report(const char *name, const struct run_stats *rs)
 	       (unsigned long long)rs->ts.disagreements,
 	       (unsigned long long)rs->ts.verifications,
 	       (unsigned long long)rs->ts.rested,
-	       (unsigned long long)rs->ts.rested_entities);
+	       (unsigned long long)rs->ts.rested_entities,
+	       (unsigned long long)rs->ts.hot);
 }
 
 static void check_run(const char *name, const struct run_stats *rs,
@@ -754,6 +755,11 @@ static void test_lazy_exact(void)
 		     "entity rest never engaged: %llu in %llu updates",
 		     (unsigned long long)rs.ts.rested_entities,
 		     (unsigned long long)rs.ts.updates);
+	/* and the hot path answers a good share of the updates */
+	PX_CHECK_MSG(rs.ts.hot > rs.ts.updates / 10,
+		     "hot path never engaged: %llu in %llu updates",
+		     (unsigned long long)rs.ts.hot,
+		     (unsigned long long)rs.ts.updates);
 	memset(&rs, 0, sizeof(rs));
 	g_lazy = 0;
 	run_model(tc, 5, 600, 1 << 30, &rs, 0);
@@ -761,6 +767,7 @@ static void test_lazy_exact(void)
 	check_run("eager", &rs, 10);
 	PX_CHECK_INT_EQ((long)rs.ts.rested, 0);
 	PX_CHECK_INT_EQ((long)rs.ts.rested_entities, 0);
+	PX_CHECK_INT_EQ((long)rs.ts.hot, 0);
 }
 
 /* The tests above can fail: break each proof on purpose and the same
@@ -769,11 +776,12 @@ static void test_lazy_exact(void)
  * checks catch the damage (re-initialisations far above a clean run). */
 static void test_lazy_faults_caught(void)
 {
-	static const int faults[] = {1 | 2, 4, 1, 16, 32};
+	static const int faults[] = {1 | 2, 4, 1, 16, 32, 64};
 	static const char *names[] = {"fault: never woken", "fault: no events",
 				      "fault: rest always",
 				      "fault: entity rest never expires",
-				      "fault: entity rest without distance"};
+				      "fault: entity rest without distance",
+				      "fault: hot certificate never expires"};
 	struct tcurve tc[5];
 	struct run_stats rs;
 	uint64_t clean_reinits;
@@ -783,7 +791,7 @@ static void test_lazy_faults_caught(void)
 	run_model(tc, 5, 400, 40, &rs, 0);
 	check_run("clean", &rs, 10);
 	clean_reinits = rs.ts.reinits;
-	for (f = 0; f < 5; f++) {
+	for (f = 0; f < 6; f++) {
 		memset(&rs, 0, sizeof(rs));
 		g_fault = faults[f];
 		run_model(tc, 5, 400, 40, &rs, 0);
