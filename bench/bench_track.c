@@ -9,7 +9,8 @@
  * configuration); the comparison is made outside the timed call.
  * Surfaces (px_strack) follow: a single wavy bicubic patch, a wavy
  * 16-patch bicubic, a concave fold, with cells solved per update.
- * BENCH_TRACK_DEPTH=d overrides the event-grid depth (default 4).
+ * BENCH_TRACK_DEPTH=d overrides the event-grid depth (default 4),
+ * BENCH_TRACK_LEAVES=n the parameter leaves per span (default 4).
  * BENCH_TRACK_CURVES_ONLY=1 stops after the curve models (profiling);
  * BENCH_TRACK_LAZY=0 turns lazy correction off; BENCH_TRACK_MODEL=text runs
  * only the curve models whose name holds text, BENCH_TRACK_STEP=0..3 only
@@ -224,6 +225,8 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 		o.box_depth = atoi(getenv("BENCH_TRACK_DEPTH"));
 	if (getenv("BENCH_TRACK_LAZY"))
 		o.lazy = atoi(getenv("BENCH_TRACK_LAZY"));
+	if (getenv("BENCH_TRACK_LEAVES"))
+		o.leaves_per_span = atoi(getenv("BENCH_TRACK_LEAVES"));
 	t0 = now_ns();
 	rc = px_track_create(cs, nc, &o, &t);
 	if (rc) {

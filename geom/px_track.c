@@ -964,6 +964,73 @@ static int definite_seg(const double *a, int m, px_vec3 p0, px_vec3 p1,
 	return 1;
 }
 
+/* Signs of c0[0..m-1] and c1[0..m-1] all one, beyond tol. */
+static int definite2(const double *c0, const double *c1, int m, double tol)
+{
+	int i, pos = 0, neg = 0;
+	for (i = 0; i < m; i++) {
+		if (c0[i] > tol && c1[i] > tol)
+			pos = 1;
+		else if (c0[i] < -tol && c1[i] < -tol)
+			neg = 1;
+		else
+			return 0;
+	}
+	return !(pos && neg);
+}
+
+#define TRK_FINE_DEPTH 3
+/*
+ * The leaf's proof by pieces, where the whole-leaf proof failed: an event
+ * is a double root, g = dg/ds = 0 at one (s, point), so the leaf is free
+ * of events along p0 -> p1 when each piece of it in s is free of them:
+ * g of one sign there (no root) or dg/ds of one sign (one simple root at
+ * most). Both are Bernstein polynomials in s with coefficients affine in
+ * the point, so a piece's coefficients taken at p0 and at p1 (split the
+ * same way: subdivision is linear) of one sign prove it for the whole
+ * segment. Halves down to TRK_FINE_DEPTH levels; a piece still unproven
+ * there counts as an event (the leaf is solved again, as before).
+ * Saves most of the root isolations that the whole-leaf bound asked for
+ * without a transition.
+ */
+static int leaf_event_fine(const double *a, int n, px_vec3 p0, px_vec3 p1,
+			   double tol_g, double tol_d)
+{
+	struct piece {
+		double g0[TRK_NG + 1], g1[TRK_NG + 1], d0[TRK_NG], d1[TRK_NG];
+		int depth;
+	} st[TRK_FINE_DEPTH + 2];
+	const double *da = a + 4 * (n + 1);
+	int sp = 1, i;
+	for (i = 0; i <= n; i++) {
+		st[0].g0[i] = gco(a, n, i, p0);
+		st[0].g1[i] = gco(a, n, i, p1);
+	}
+	for (i = 0; i < n; i++) {
+		st[0].d0[i] = gco(da, n - 1, i, p0);
+		st[0].d1[i] = gco(da, n - 1, i, p1);
+	}
+	st[0].depth = 0;
+	while (sp > 0) {
+		struct piece *q = &st[sp - 1], *r;
+		if (definite2(q->g0, q->g1, n + 1, tol_g) ||
+		    definite2(q->d0, q->d1, n, tol_d)) {
+			sp--;
+			continue;
+		}
+		if (q->depth >= TRK_FINE_DEPTH)
+			return 1;
+		/* q becomes the left half, the right half goes above it */
+		r = &st[sp++];
+		px_bern_split(q->g0, n, 0.5, q->g0, r->g0);
+		px_bern_split(q->g1, n, 0.5, q->g1, r->g1);
+		px_bern_split(q->d0, n - 1, 0.5, q->d0, r->d0);
+		px_bern_split(q->d1, n - 1, 0.5, q->d1, r->d1);
+		r->depth = ++q->depth;
+	}
+	return 0;
+}
+
 /* May leaf l hold an event while the point runs p0 -> p1? */
 static int leaf_event(const struct px_track *t, const struct leaf *l,
 		      px_vec3 p0, px_vec3 p1)
@@ -987,7 +1054,9 @@ static int leaf_event(const struct px_track *t, const struct leaf *l,
 	}
 	if (n < 1)
 		return 0;
-	return !definite_seg(a + 4 * (n + 1), n, p0, p1, l->tol_d);
+	if (definite_seg(a + 4 * (n + 1), n, p0, p1, l->tol_d))
+		return 0;
+	return leaf_event_fine(a, n, p0, p1, l->tol_g, l->tol_d);
 }
 
 
@@ -1026,24 +1095,17 @@ static double box_dist(const px_aabb *b, px_vec3 p)
 	return sqrt(dx * dx + dy * dy + dz * dz);
 }
 
-/* Distance p may travel (inside the working volume) before leaf l can
- * have an event: the distance to its event cells, or the radius where
- * the exclusion of leaf_event() still holds. */
-static double leaf_radius(const struct px_track *t, const struct leaf *l,
-			  px_vec3 p)
+/* Radius within which dg/ds of leaf l keeps its sign around p (at most
+ * one simple root in the leaf: no event) and g keeps its sign at a break
+ * end of it (no root through it); 0 when not proven at p. */
+static double leaf_dradius(const struct px_track *t, const struct leaf *l,
+			   px_vec3 p)
 {
 	const double *a = leaf_a(t, l), *ib = t->ipool + l->ioff;
-	double r, rb;
 	int n = l->n, i;
-	if (!l->boxed || (t->fault & 4))
-		return INFINITY;
-	rb = box_dist(&l->box, p);
-	r = definite_radius(a, ib, n + 1, p, l->tol_g);
-	if (r > 0.0)
-		return r > rb ? r : rb;
-	r = n >= 1 ? definite_radius(a + 4 * (n + 1), ib + n + 1, n, p,
-				     l->tol_d)
-		   : INFINITY;
+	double r = n >= 1 ? definite_radius(a + 4 * (n + 1), ib + n + 1, n, p,
+					    l->tol_d)
+			  : INFINITY;
 	for (i = 0; i < 2 && r > 0.0; i++) {
 		double v;
 		int e = i ? n : 0;
@@ -1054,6 +1116,26 @@ static double leaf_radius(const struct px_track *t, const struct leaf *l,
 		if (v < r)
 			r = v;
 	}
+	return r;
+}
+
+/* Distance p may travel (inside the working volume) before leaf l can
+ * have an event: the distance to its event cells, or the radius where
+ * one of the two exclusions of leaf_event() still holds (g of one sign:
+ * no root at all; dg/ds of one sign: one simple root at most), whichever
+ * is largest. */
+static double leaf_radius(const struct px_track *t, const struct leaf *l,
+			  px_vec3 p)
+{
+	const double *a = leaf_a(t, l), *ib = t->ipool + l->ioff;
+	double r, rd, rb;
+	if (!l->boxed || (t->fault & 4))
+		return INFINITY;
+	rb = box_dist(&l->box, p);
+	r = definite_radius(a, ib, l->n + 1, p, l->tol_g);
+	rd = leaf_dradius(t, l, p);
+	if (rd > r)
+		r = rd;
 	return r > rb ? r : rb;
 }
 
@@ -1084,11 +1166,15 @@ static double leaf_test(const struct px_track *t, const struct leaf *l,
 			r = ri;
 	}
 	if (i == m) {
+		double rd;
 		*event = 0;
 		if (!l->boxed || (t->fault & 4))
 			return INFINITY;
 		rb = box_dist(&l->box, p1);
-		return r > rb ? r : rb;
+		if (rb > r)
+			r = rb;
+		rd = leaf_dradius(t, l, p1);
+		return rd > r ? rd : r;
 	}
 	*event = leaf_event(t, l, p0, p1);
 	return leaf_radius(t, l, p1);
