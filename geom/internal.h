@@ -106,6 +106,9 @@ double px__strack_cert_radius(const struct px_strack *t, int s, double u,
  * show that their containment check fails for a non-conservative
  * bound). */
 extern double px__strack_radius_scale;
+/* Test hook: 1 turns the surface tracker's hot path off, 2 makes its
+ * certificate never expire (a fault the tests must see). */
+void px__strack_set_hot_fault(struct px_strack *t, int fault);
 
 /*
  * Sub-block extraction shared by curves (nd = 1) and surfaces (nd = 2):

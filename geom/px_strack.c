@@ -170,6 +170,16 @@ struct px_strack {
 	int last_entity, have_last;
 	int best_kind;          /* 0 none, 1 surface min, 2 curve tracker, 3 pole */
 	uint32_t best_id;
+	int ans_s, ans_j;       /* answer(): the answering surface minimum */
+	/* hot path: every critical point but hot_j of surface hot_s rests at
+	 * its state of hot_p (track_step starts them there); while the path
+	 * stays below hot_until and no cell is due, an update follows that
+	 * one point alone; hot_s -1 when off */
+	int hot_s, hot_j;
+	px_vec3 hot_p;
+	double hot_until;
+	int hot_nmin, hot_nmax, hot_nsad, hot_ncrit, hot_ccrit;
+	int fault_hot;          /* test hook: 1 hot path off, 2 never expires */
 	struct px_strack_stats st;
 };
 
@@ -865,6 +875,26 @@ static void count_crit(const struct px_strack *t, struct px_strack_result *r,
 	r->n_crit = r->n_min + r->n_max + r->n_saddle + curve_crit;
 }
 
+/* The curve tracker's answer (a free curve or a surface edge) into r. */
+static void answer_curve(const struct px_strack *t,
+			 const struct px_track_result *cr,
+			 struct px_strack_result *r)
+{
+	r->point = cr->point;
+	if (cr->entity < t->n_curves) {
+		r->entity = cr->entity;
+		r->u = cr->u;
+		r->v = 0.0;
+		r->feature = PX_STRACK_CURVE;
+	} else {
+		const struct edge *e = &t->edge[cr->entity - t->n_curves];
+		r->entity = t->n_curves + e->surf;
+		r->u = e->dir ? e->t : cr->u;
+		r->v = e->dir ? cr->u : e->t;
+		r->feature = PX_STRACK_EDGE;
+	}
+}
+
 static void answer(struct px_strack *t, px_vec3 p,
 		   const struct px_track_result *cr, struct px_strack_result *r)
 {
@@ -872,22 +902,11 @@ static void answer(struct px_strack *t, px_vec3 p,
 	int kind = 0, i, j;
 	uint32_t id = 0;
 
+	t->ans_s = -1;
 	if (cr->entity >= 0) {
 		best = cr->dist * cr->dist;
 		kind = 2;
-		r->point = cr->point;
-		if (cr->entity < t->n_curves) {
-			r->entity = cr->entity;
-			r->u = cr->u;
-			r->v = 0.0;
-			r->feature = PX_STRACK_CURVE;
-		} else {
-			const struct edge *e = &t->edge[cr->entity - t->n_curves];
-			r->entity = t->n_curves + e->surf;
-			r->u = e->dir ? e->t : cr->u;
-			r->v = e->dir ? cr->u : e->t;
-			r->feature = PX_STRACK_EDGE;
-		}
+		answer_curve(t, cr, r);
 	}
 	for (i = 0; i < t->n_surf; i++)
 		for (j = 0; j < t->sf[i].nz; j++) {
@@ -905,6 +924,8 @@ static void answer(struct px_strack *t, px_vec3 p,
 				r->v = z->v;
 				r->entity = t->n_curves + i;
 				r->feature = PX_STRACK_MIN;
+				t->ans_s = i;
+				t->ans_j = j;
 			}
 		}
 	for (i = 0; i < t->n_poles; i++) {
@@ -966,6 +987,7 @@ static void answer_global(struct px_strack *t, px_vec3 p,
 static int reinit_all(struct px_strack *t, px_vec3 p)
 {
 	int i, rc = 0;
+	t->hot_s = -1;
 	for (i = 0; i < t->n_surf; i++) {
 		int r2 = surf_reinit(t, &t->sf[i], i, p);
 		if (r2 && !rc)
@@ -1101,6 +1123,7 @@ int px_strack_reset(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 	t->best_kind = 0;
 	t->have_last = 0;
 	t->mode = ST_TRACK;
+	t->hot_s = -1;
 	return full_reset(t, p, r);
 }
 
@@ -1188,14 +1211,15 @@ static int pend_solve(struct px_strack *t, int budget, int *done)
  * pending (mode ST_PEND, solved over the next updates at p); PX_E_NOSPC.
  */
 static int track_step(struct px_strack *t, px_vec3 p0, px_vec3 p,
-		      struct px_strack_result *r)
+		      struct px_strack_result *r, int nh_pre)
 {
 	px_vec3 dp = px_v3_sub(p, p0);
 	double step = px_v3_norm(dp);
 	int i, j, nh, rc = 0, before = 0, after = 0, done = 0,
 		      budget = t->opts.max_solves;
 
-	nh = collect_cells(t, p0, p, 0);
+	/* the cells of this step, unless the hot path collected them */
+	nh = nh_pre >= 0 ? nh_pre : collect_cells(t, p0, p, 0);
 	for (i = 0; i < t->n_surf; i++) {
 		struct ssurf *f = &t->sf[i];
 		int n = f->nz;
@@ -1203,7 +1227,11 @@ static int track_step(struct px_strack *t, px_vec3 p0, px_vec3 p,
 		f->nz = 0;
 		for (j = 0; j < n; j++) {
 			struct crit z = f->tmp[j], last;
-			if (follow(f, &z, p0, dp, p, &last)) {
+			/* a point that rested on the hot path starts where it
+			 * was last followed */
+			int rest = t->hot_s >= 0 && !(i == t->hot_s && j == t->hot_j);
+			px_vec3 q0 = rest ? t->hot_p : p0;
+			if (follow(f, &z, q0, px_v3_sub(p, q0), p, &last)) {
 				/* died at a fold (or left through an edge), or
 				 * Newton lost it: solve its cell and the cell
 				 * where it was last seen, so a survivor is found
@@ -1223,10 +1251,13 @@ static int track_step(struct px_strack *t, px_vec3 p0, px_vec3 p,
 				continue;
 			}
 			rc = crit_add(t, f, &z);
-			if (rc < 0)
+			if (rc < 0) {
+				t->hot_s = -1;
 				return rc;
+			}
 		}
 	}
+	t->hot_s = -1;
 	t->p = p;
 	/* the work list: solve at p; after a long step past the crossing
 	 * also where the region was met (pole cells outside the budget) */
@@ -1268,6 +1299,7 @@ static int track_step(struct px_strack *t, px_vec3 p0, px_vec3 p,
 static void rebuild_start(struct px_strack *t)
 {
 	int i;
+	t->hot_s = -1;
 	t->mode = ST_REBUILD;
 	t->rb_started = 0;
 	t->rb_next = 0;
@@ -1352,7 +1384,7 @@ static int catch_up(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 	}
 	/* ST_LAG */
 	if (in_work(t, p)) {
-		rc = track_step(t, t->p, p, r);
+		rc = track_step(t, t->p, p, r, -1);
 		if (rc < 0) {
 			t->st.overflows++;
 			rebuild_start(t);
@@ -1378,11 +1410,140 @@ static int catch_up(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 	return PX_OK;
 }
 
+/*
+ * Arm the hot path after a tracked update answered by surface minimum
+ * (ans_s, ans_j), with every point current at p. The global distance is
+ * 1-Lipschitz and best is that of a real surface point followed
+ * continuously, so after a further path L it is at most best + L, while
+ * another minimum, a pole or any curve or edge (bounded below by the
+ * distance to the boxes of its half spans) at distance d now is at least
+ * d - L away: none can answer while L < (d - best) / 2. While no cell is
+ * due the set of critical points keeps its count and types (the cell
+ * certificates), so the answering minimum is followed alone. The curve
+ * tracker is left out for at most 2 % of the size of travel, as
+ * curves_needed() does.
+ */
+static void hot_arm(struct px_strack *t, px_vec3 p,
+		    const struct px_strack_result *r)
+{
+	double best = r->dist, tol = 1e-9 * (best + t->scale), until, m;
+	int i, j;
+	int curve = r->feature == PX_STRACK_CURVE || r->feature == PX_STRACK_EDGE;
+	t->hot_s = -1;
+	if (t->mode != ST_TRACK || r->source != PX_TRACK_TRACKED ||
+	    (t->fault_hot & 1) ||
+	    !(curve ? t->best_kind == 2 && t->ct_p.x == p.x && t->ct_p.y == p.y &&
+			      t->ct_p.z == p.z
+		    : r->feature == PX_STRACK_MIN && t->ans_s >= 0))
+		return;
+	until = INFINITY;
+	for (i = 0; i < t->n_surf; i++)
+		for (j = 0; j < t->sf[i].nz; j++) {
+			const struct crit *z = &t->sf[i].z[j];
+			if (z->type <= 0 ||
+			    (!curve && i == t->ans_s && j == t->ans_j))
+				continue;
+			m = px_v3_dist(z->s, p) - best - tol;
+			if (!(m > 0.0))
+				return;
+			if (m < until)
+				until = m;
+		}
+	for (i = 0; i < t->n_poles; i++) {
+		m = px_v3_dist(t->pole[i].q, p) - best - tol;
+		if (!(m > 0.0))
+			return;
+		if (m < until)
+			until = m;
+	}
+	if (curve) {
+		/* the curve tracker answers: it runs every update (the least
+		 * distance to the curves is 1-Lipschitz too) */
+		until *= 0.5;
+	} else if (t->ct) {
+		double lim = 0.02 * t->scale - px_v3_dist(p, t->ct_p);
+		if (!(lim > 0.0))
+			return;
+		for (i = 0; i < t->n_cbox; i++) {
+			m = sqrt(px_aabb_dist2(&t->cbox[i], p)) - best - tol;
+			if (!(m > 0.0))
+				return;
+			if (m < until)
+				until = m;
+		}
+		until *= 0.5;
+		if (lim < until)
+			until = lim;
+	} else {
+		until *= 0.5;
+	}
+	t->hot_s = curve ? t->n_surf : t->ans_s;
+	t->hot_j = curve ? -1 : t->ans_j;
+	t->hot_p = p;
+	t->hot_until = (t->fault_hot & 2) ? INFINITY
+					   : t->travel + until * (1.0 - 1e-9);
+	t->hot_nmin = r->n_min;
+	t->hot_nmax = r->n_max;
+	t->hot_nsad = r->n_saddle;
+	t->hot_ncrit = r->n_crit;
+	t->hot_ccrit = t->ct_ncrit;
+}
+
+/* An update on the hot path (the certificate running, the due cells
+ * tested and none hit; the travelled path includes this step): the
+ * answering minimum followed by one predictor and Newton (on a copy,
+ * kept when it stays a minimum), or the curve tracker updated. Returns 0
+ * when answered, 1 when the full update must run (the point set is as
+ * it was). */
+static int hot_update(struct px_strack *t, px_vec3 p,
+		      struct px_strack_result *r)
+{
+	struct ssurf *f;
+	struct crit w;
+	if (t->hot_s == t->n_surf) {
+		/* the curve tracker answers (its own update, exact: no
+		 * surface minimum or pole can be closer) */
+		struct px_track_result cr;
+		curves_update(t, p, &cr, 0);
+		if (cr.entity < 0)
+			return 1; /* not expected: the full update decides */
+		t->p = p;
+		answer_curve(t, &cr, r);
+		r->source = cr.source;
+		r->jumped = cr.jumped;
+		r->n_crit = t->hot_ncrit - t->hot_ccrit + cr.n_crit;
+		goto done;
+	}
+	f = &t->sf[t->hot_s];
+	w = f->z[t->hot_j];
+	if (evolve(f, &w, px_v3_sub(p, t->p), p) || w.type != 1)
+		return 1;
+	f->z[t->hot_j] = w;
+	t->p = p;
+	r->source = PX_TRACK_TRACKED;
+	r->point = w.s;
+	r->u = w.u;
+	r->v = w.v;
+	r->entity = t->n_curves + t->hot_s;
+	r->feature = PX_STRACK_MIN;
+	r->n_crit = t->hot_ncrit;
+done:
+	fill_dir(r, p);
+	r->n_min = t->hot_nmin;
+	r->n_max = t->hot_nmax;
+	r->n_saddle = t->hot_nsad;
+	t->last_point = r->point;
+	t->last_q = p;
+	t->last_entity = r->entity;
+	t->st.hot++;
+	return 0;
+}
+
 int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 {
 	struct px_track_result cr;
 	px_vec3 p0;
-	int rc;
+	int rc, nh;
 
 	if (!t || !r)
 		return PX_E_INVAL;
@@ -1397,6 +1558,17 @@ int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 	if (t->mode != ST_TRACK)
 		return catch_up(t, p, r);
 	p0 = t->p;
+	nh = -1;
+	if (t->hot_s >= 0 && t->heap_ok && in_work(t, p) && in_work(t, p0) &&
+	    t->travel + px_v3_dist(p0, p) < t->hot_until) {
+		/* the due cells first (as track_step would): none hit and
+		 * the hot path answers */
+		nh = collect_cells(t, p0, p, 0);
+		if (nh == 0 && !hot_update(t, p, r)) {
+			verify(t, p, r);
+			return PX_OK;
+		}
+	}
 	r->source = PX_TRACK_TRACKED;
 	if (!in_work(t, p) || !in_work(t, p0)) {
 		if (t->opts.max_solves > 0) {
@@ -1408,7 +1580,7 @@ int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 		t->st.outside++;
 		return full_reset(t, p, r);
 	}
-	rc = track_step(t, p0, p, r);
+	rc = track_step(t, p0, p, r, nh);
 	if (rc == 1) {
 		/* over the budget: answer globally; the rest of the solves
 		 * is done over the next updates, then the set catches up */
@@ -1443,7 +1615,16 @@ int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 	if (cr.source != PX_TRACK_TRACKED)
 		r->source = cr.source;
 	verify(t, p, r);
+	hot_arm(t, p, r);
 	return PX_OK;
+}
+
+void px__strack_set_hot_fault(struct px_strack *t, int fault)
+{
+	if (t) {
+		t->fault_hot = fault;
+		t->hot_s = -1;
+	}
 }
 
 double px__strack_cert_radius(const struct px_strack *t, int s, double u,
@@ -1473,9 +1654,17 @@ int px_strack_critical(const struct px_strack *t, int s, double *u, double *v,
 		return PX_E_RANGE;
 	f = &t->sf[s];
 	for (i = 0; i < f->nz && i < cap; i++) {
-		u[i] = f->z[i].u;
-		v[i] = f->z[i].v;
-		type[i] = f->z[i].type;
+		struct crit w = f->z[i], last;
+		/* a point resting on the hot path, followed to the current
+		 * point on a copy (the state stays as the next update
+		 * expects it); as it was if that fails */
+		if (t->hot_s >= 0 && !(s == t->hot_s && i == t->hot_j) &&
+		    follow(f, &w, t->hot_p, px_v3_sub(t->p, t->hot_p), t->p,
+			   &last))
+			w = f->z[i];
+		u[i] = w.u;
+		v[i] = w.v;
+		type[i] = w.type;
 	}
 	return f->nz;
 }
@@ -2225,6 +2414,8 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 			goto fail;
 	}
 	t->epoch = 1;
+	t->hot_s = -1;
+	t->ans_s = -1;
 	rc = PX_OK;
 	*out = t;
 	t = NULL;

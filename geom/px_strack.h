@@ -52,6 +52,13 @@
  *  - Answer: the smallest of the surface minima and the curve tracker's
  *    answer; jumped when the closest feature is not the continuation of
  *    the last one.
+ *  - Hot path: after an update answered by a surface minimum, a
+ *    certificate from the distance margins of the other minima, the
+ *    poles and the curve boxes (all 1-Lipschitz: the margin shrinks at
+ *    most twice as fast as the path grows) lets the following updates,
+ *    while no cell is due, follow that minimum alone; the other points
+ *    rest and are followed from where they were at the next full update
+ *    (stats.hot).
  *  - Never silent: verification every verify_every updates against
  *    px_dist_query() on the whole model counts disagreements and
  *    re-initialises; capacity overflow answers globally (counted).
@@ -164,6 +171,8 @@ struct px_strack_stats {
 	/* updates that left the curve tracker out: every curve and edge
 	 * was proven farther than the best interior minimum */
 	uint64_t curve_skips;
+	/* updates on the hot path: the answering minimum followed alone */
+	uint64_t hot;
 };
 
 struct px_strack_info {

@@ -351,12 +351,15 @@ static void make_path(px_vec3 *q, int n, int kind, px_aabb box, double step)
 struct totals {
 	long steps, wrong, naive_wrong, brute_bad, brute_checks, count_checks,
 		count_bad, count_amb, jumps, cells, born, died, global;
-	uint64_t over_budget, curve_skips;
+	uint64_t over_budget, curve_skips, hot;
 	long budget_bad;
 	uint64_t allocs;
 };
 
 /* Run the tracker along paths over the model; checks every step. */
+/* surface tracker hot-path fault for run_model (test hook; 0 none) */
+static int g_hot_fault;
+
 static void run_model(const char *name, const struct px_nurbs_curve *cs,
 		      int nc, const struct px_nurbs_surf *ss, int ns,
 		      int max_solves, struct totals *tot)
@@ -379,6 +382,7 @@ static void run_model(const char *name, const struct px_nurbs_curve *cs,
 	PX_CHECK_MSG(rc == PX_OK, "%s: create: %s", name, px_strerror(rc));
 	if (rc)
 		return;
+	px__strack_set_hot_fault(t, g_hot_fault);
 	PX_CHECK_INT_EQ(px_dist_model_create(cs, nc, ss, ns, NULL, &ref), PX_OK);
 	px_dist_model_info(ref, &di);
 	box = di.bounds;
@@ -470,14 +474,16 @@ static void run_model(const char *name, const struct px_nurbs_curve *cs,
 	printf("  %s (max_solves %d): wrong %ld, naive wrong %ld; tracker: cell "
 	       "solves %llu box tests %llu reinit %llu outside %llu fallback %llu "
 	       "lost %llu over budget %llu rebuild updates %llu curve tracker "
-	       "left out %llu\n",
+	       "left out %llu hot %llu\n",
 	       name, max_solves, tot->wrong - wrong0, tot->naive_wrong - naive0,
 	       (unsigned long long)st.cell_solves, (unsigned long long)st.box_tests,
 	       (unsigned long long)st.reinits, (unsigned long long)st.outside,
 	       (unsigned long long)st.fallbacks, (unsigned long long)st.lost,
 	       (unsigned long long)st.over_budget,
 	       (unsigned long long)st.rebuild_updates,
-	       (unsigned long long)st.curve_skips);
+	       (unsigned long long)st.curve_skips,
+	       (unsigned long long)st.hot);
+	tot->hot += st.hot;
 	tot->over_budget += st.over_budget;
 	tot->curve_skips += st.curve_skips;
 	px_strack_free(t);
@@ -519,6 +525,11 @@ static void test_wavy(void)
 	run_model("wavy", NULL, 0, &s, 1, 0, &tot);
 	report(&tot);
 	PX_CHECK_MSG(tot.naive_wrong > 0, "naive tracker never wrong: paths too easy");
+	/* the hot path answers a good share of the updates (all of them
+	 * compared above) */
+	PX_CHECK_MSG(tot.hot * 4 > (uint64_t)tot.steps,
+		     "hot path rarely engaged: %llu of %ld updates",
+		     (unsigned long long)tot.hot, tot.steps);
 }
 
 static void test_fold_nonuniform(void)
@@ -532,6 +543,9 @@ static void test_fold_nonuniform(void)
 	run_model("concave fold", NULL, 0, &s[0], 1, 0, &tot);
 	run_model("non-uniform knots", NULL, 0, &s[1], 1, 0, &tot);
 	report(&tot);
+	PX_CHECK_MSG(tot.hot * 4 > (uint64_t)tot.steps,
+		     "hot path rarely engaged: %llu of %ld updates",
+		     (unsigned long long)tot.hot, tot.steps);
 }
 
 static void test_collapsed(void)
@@ -574,6 +588,90 @@ static void test_multi(void)
 			PX_OK);
 	run_model("multi-entity", &c, 1, s, 3, 0, &tot);
 	report(&tot);
+}
+
+/* a valley across x, flat along y */
+static px_vec3 valleys_pt(int i, int j, int nu, int nv)
+{
+	static const double z[7] = {1.2, 0.6, 0.1, 0.0, 0.1, 0.6, 1.2};
+	return px_v3(-1.5 + 3.0 * i / (nu - 1), -1 + 2.0 * j / (nv - 1), z[i]);
+}
+
+/*
+ * The closest point jumps between two minima that both live on: high
+ * above the bottom of a valley (beyond its focal point: two minima on the
+ * walls, a maximum at the bottom) the point moves slowly across the plane
+ * of symmetry, and the closest minimum changes sides with no transition
+ * anywhere. Only the hot path's distance margin sees it. Returns the
+ * wrong answers along the path.
+ */
+static long valleys_run(int fault, uint64_t *hot)
+{
+	struct px_nurbs_surf s;
+	struct px_strack *t = NULL;
+	struct px_dist_model *ref = NULL;
+	struct px_strack_result r;
+	struct px_strack_stats st;
+	long wrong = 0;
+	int k, n = 4000;
+	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
+	PX_CHECK_INT_EQ(surf_grid(&s, 3, 3, 7, 4, valleys_pt, px_v3(0, 0, 0)),
+			PX_OK);
+	PX_CHECK_INT_EQ(px_strack_create(NULL, 0, &s, 1, NULL, &t), PX_OK);
+	PX_CHECK_INT_EQ(px_dist_model_create(NULL, 0, &s, 1, NULL, &ref), PX_OK);
+	if (!t || !ref) {
+		px_strack_free(t);
+		px_dist_model_free(ref);
+		return 0;
+	}
+	px__strack_set_hot_fault(t, fault);
+	for (k = 0; k <= n; k++) {
+		/* back and forth across x = 0, 1e-4 of the size a step */
+		double x = 0.2 * sin(2.0 * M_PI * k / n);
+		px_vec3 p = px_v3(x, 0.1 * cos(2.0 * M_PI * k / n), 1.6);
+		struct px_dist_result g;
+		if (k == 0)
+			px_strack_reset(t, p, &r);
+		else
+			px_strack_update(t, p, &r);
+		px_dist_query(ref, p, &g);
+		if (fabs(r.dist - g.dist) > 1e-9 * (1.0 + g.dist))
+			wrong++;
+	}
+	px_strack_get_stats(t, &st);
+	*hot = st.hot;
+	px_strack_free(t);
+	px_dist_model_free(ref);
+	return wrong;
+}
+
+/* The hot path's certificate matters: with it never expiring the same
+ * paths see wrong answers; with the hot path off they are all right. */
+static void test_hot_fault(void)
+{
+	struct px_nurbs_surf s[2];
+	struct totals tot;
+	uint64_t hot;
+	long w;
+	/* the jump between two living minima */
+	w = valleys_run(0, &hot);
+	printf("  valley, closest point jumping sides: wrong %ld, hot %llu of 4000\n", w,
+	       (unsigned long long)hot);
+	PX_CHECK_INT_EQ(w, 0);
+	PX_CHECK_MSG(hot > 500, "hot path rarely engaged: %llu",
+		     (unsigned long long)hot);
+	w = valleys_run(2, &hot);
+	printf("  the same, hot certificate never expires: wrong %ld\n", w);
+	PX_CHECK_MSG(w > 0, "a hot path that never expires went unnoticed");
+	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
+	PX_CHECK_INT_EQ(surf_wavy(&s[0], 0, 0, 0, 0), PX_OK);
+	PX_CHECK_INT_EQ(surf_fold(&s[1], 0, 0, 0), PX_OK);
+	memset(&tot, 0, sizeof(tot));
+	g_hot_fault = 1;
+	run_model("hot path off", NULL, 0, s, 2, 0, &tot);
+	g_hot_fault = 0;
+	PX_CHECK_INT_EQ(tot.wrong, 0);
+	PX_CHECK_INT_EQ((long)tot.hot, 0);
 }
 
 /* rational bicubic: a wavy patch with uneven weights */
@@ -820,6 +918,7 @@ static const struct px_test tests[] = {
 	PX_T(test_fold_nonuniform),
 	PX_T(test_collapsed),
 	PX_T(test_multi),
+	PX_T(test_hot_fault),
 	PX_T(test_budget),
 	PX_T(test_focal_bounds),
 	PX_T(test_errors),
