@@ -86,7 +86,9 @@ void px__track_set_fault(struct px_track *t, int fault);
 
 /* Test hook: the certificate radius of leaf `leaf` at p (which 0: no
  * event in the leaf while the point travels less; 1: its end values of
- * f' keep their signs), with the leaf's entity, parameter interval and
+ * f' keep their signs; 2: no event, with the piecewise proof of a due
+ * leaf: no double root of f' in the leaf, though several simple roots
+ * may be; fault 128 makes it 4 times too large), with the leaf's entity, parameter interval and
  * flags (bit 0: an end at a cusp, where g is divided). -1 for a bad
  * leaf index. */
 double px__track_leaf_cert(const struct px_track *t, int leaf, px_vec3 p,

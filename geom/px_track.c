@@ -196,8 +196,10 @@ struct px_track {
 	 * that one root and nothing else; hot_ent -1 when not armed */
 	int hot_ent, hot_z;
 	double hot_until, hot_other;
-	int hot_nc, hot_nm, hot_rest_ent;
+	int hot_nc, hot_nm;
+	uint64_t hot_rested, hot_rest_ent; /* stats per hot update */
 	int ans_z;           /* answer(): index of the answering root, -1 */
+	int p_in;            /* p inside the working volume */
 	int ans_c;           /* answer(): answering candidate, -1 */
 	int hot_c;           /* hot: answering candidate (hot_z -1), -1 */
 	struct px_track_stats st;
@@ -979,6 +981,23 @@ static int definite2(const double *c0, const double *c1, int m, double tol)
 	return !(pos && neg);
 }
 
+/* Halves of a Bernstein polynomial of degree n: c becomes [0, 1/2], r
+ * gets [1/2, 1] (de Casteljau at the middle, in place). */
+static inline void bern_halves(double *c, int n, double *r)
+{
+	double w[TRK_NG + 1];
+	int i, k;
+	r[n] = c[n];
+	for (i = 0; i <= n; i++)
+		w[i] = c[i];
+	for (k = 1; k <= n; k++) {
+		for (i = 0; i <= n - k; i++)
+			w[i] = 0.5 * (w[i] + w[i + 1]);
+		c[k] = w[0];
+		r[n - k] = w[n - k];
+	}
+}
+
 #define TRK_FINE_DEPTH 3
 /*
  * The leaf's proof by pieces, where the whole-leaf proof failed: an event
@@ -993,15 +1012,24 @@ static int definite2(const double *c0, const double *c1, int m, double tol)
  * Saves most of the root isolations that the whole-leaf bound asked for
  * without a transition.
  */
-static int leaf_event_fine(const double *a, int n, px_vec3 p0, px_vec3 p1,
-			   double tol_g, double tol_d)
+static int leaf_event_fine(const double *a, const double *ib, int n,
+			   px_vec3 p0, px_vec3 p1, double tol_g, double tol_d,
+			   double *rad)
 {
 	struct piece {
 		double g0[TRK_NG + 1], g1[TRK_NG + 1], d0[TRK_NG], d1[TRK_NG];
 		int depth;
 	} st[TRK_FINE_DEPTH + 2];
 	const double *da = a + 4 * (n + 1);
+	double ig = INFINITY, id = INFINITY, r1 = INFINITY;
 	int sp = 1, i;
+	/* a piece's coefficients are convex combinations of the leaf's, so
+	 * their gradients in the point are no longer than the longest of the
+	 * leaf's: 1 / max |b| bounds how fast any of them changes */
+	for (i = 0; i <= n; i++)
+		ig = ib[i] < ig ? ib[i] : ig;
+	for (i = 0; i < n; i++)
+		id = ib[n + 1 + i] < id ? ib[n + 1 + i] : id;
 	for (i = 0; i <= n; i++) {
 		st[0].g0[i] = gco(a, n, i, p0);
 		st[0].g1[i] = gco(a, n, i, p1);
@@ -1011,10 +1039,29 @@ static int leaf_event_fine(const double *a, int n, px_vec3 p0, px_vec3 p1,
 		st[0].d1[i] = gco(da, n - 1, i, p1);
 	}
 	st[0].depth = 0;
+	*rad = 0.0;
 	while (sp > 0) {
 		struct piece *q = &st[sp - 1], *r;
-		if (definite2(q->g0, q->g1, n + 1, tol_g) ||
-		    definite2(q->d0, q->d1, n, tol_d)) {
+		int pg = definite2(q->g0, q->g1, n + 1, tol_g);
+		int pd = definite2(q->d0, q->d1, n, tol_d);
+		if (pg || pd) {
+			/* the piece's radius at p1: the exclusion that holds
+			 * (the larger when both do) */
+			double rg = 0.0, rd = 0.0, m = INFINITY;
+			if (pg) {
+				for (i = 0; i <= n; i++)
+					m = fabs(q->g1[i]) < m ? fabs(q->g1[i]) : m;
+				rg = (m - tol_g) * ig;
+			}
+			if (pd) {
+				m = INFINITY;
+				for (i = 0; i < n; i++)
+					m = fabs(q->d1[i]) < m ? fabs(q->d1[i]) : m;
+				rd = (m - tol_d) * id;
+			}
+			m = rg > rd ? rg : rd;
+			if (m < r1)
+				r1 = m;
 			sp--;
 			continue;
 		}
@@ -1022,21 +1069,23 @@ static int leaf_event_fine(const double *a, int n, px_vec3 p0, px_vec3 p1,
 			return 1;
 		/* q becomes the left half, the right half goes above it */
 		r = &st[sp++];
-		px_bern_split(q->g0, n, 0.5, q->g0, r->g0);
-		px_bern_split(q->g1, n, 0.5, q->g1, r->g1);
-		px_bern_split(q->d0, n - 1, 0.5, q->d0, r->d0);
-		px_bern_split(q->d1, n - 1, 0.5, q->d1, r->d1);
+		bern_halves(q->g0, n, r->g0);
+		bern_halves(q->g1, n, r->g1);
+		bern_halves(q->d0, n - 1, r->d0);
+		bern_halves(q->d1, n - 1, r->d1);
 		r->depth = ++q->depth;
 	}
+	*rad = r1 > 0.0 ? r1 : 0.0;
 	return 0;
 }
 
 /* May leaf l hold an event while the point runs p0 -> p1? */
 static int leaf_event(const struct px_track *t, const struct leaf *l,
-		      px_vec3 p0, px_vec3 p1)
+		      px_vec3 p0, px_vec3 p1, double *rfine)
 {
 	const double *a = leaf_a(t, l);
 	int n = l->n;
+	*rfine = 0.0;
 	if (definite_seg(a, n + 1, p0, p1, l->tol_g))
 		return 0;
 	if (l->flags & (LF_EV0 | LF_EV1)) {
@@ -1056,7 +1105,25 @@ static int leaf_event(const struct px_track *t, const struct leaf *l,
 		return 0;
 	if (definite_seg(a + 4 * (n + 1), n, p0, p1, l->tol_d))
 		return 0;
-	return leaf_event_fine(a, n, p0, p1, l->tol_g, l->tol_d);
+	if (leaf_event_fine(a, t->ipool + l->ioff, n, p0, p1, l->tol_g, l->tol_d,
+			    rfine))
+		return 1;
+	/* a break end's sign bounds it too (the whole-leaf radius holds
+	 * that term already) */
+	{
+		int i;
+		const double *ib = t->ipool + l->ioff;
+		for (i = 0; i < 2; i++) {
+			double v;
+			if (!(l->flags & (i ? LF_EV1 : LF_EV0)))
+				continue;
+			v = fabs(gco(a, n, i ? n : 0, p1));
+			v = v > l->tol_g ? (v - l->tol_g) * ib[i ? n : 0] : 0.0;
+			if (v < *rfine)
+				*rfine = v;
+		}
+	}
+	return 0;
 }
 
 
@@ -1176,8 +1243,12 @@ static double leaf_test(const struct px_track *t, const struct leaf *l,
 		rd = leaf_dradius(t, l, p1);
 		return rd > r ? rd : r;
 	}
-	*event = leaf_event(t, l, p0, p1);
-	return leaf_radius(t, l, p1);
+	{
+		double rf, rr;
+		*event = leaf_event(t, l, p0, p1, &rf);
+		rr = leaf_radius(t, l, p1);
+		return (t->fault & 4) || rf < rr ? rr : rf;
+	}
 }
 
 /* Safe radii of all leaves at p (inside the working volume). */
@@ -1648,7 +1719,8 @@ static void hot_arm(struct px_track *t, const struct px_track_result *r)
 	t->hot_z = a;
 	t->hot_nc = nc;
 	t->hot_nm = nm;
-	t->hot_rest_ent = nre;
+	t->hot_rest_ent = (uint64_t)nre;
+	t->hot_rested = (uint64_t)(nc - (a >= 0));
 }
 
 /*
@@ -1717,20 +1789,30 @@ static int hot_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 	/* its leaf certificate is not kept up here: the full update that
 	 * follows corrects it first */
 	z->until = -1.0;
-	z->dist = px_v3_dist(c, p);
-	if (!(t->travel < t->hot_until) && hot_cert(t, e, t->hot_z, z->dist, 1))
-		return 1;
+	{
+		/* the distance once, for the root and the answer */
+		px_vec3 d = px_v3_sub(p, c);
+		double n = sqrt(px_v3_dot(d, d));
+		z->dist = n;
+		if (!(t->travel < t->hot_until) &&
+		    hot_cert(t, e, t->hot_z, n, 1))
+			return 1;
+		r->dist = n;
+		r->dir = n > 0.0 ? px_v3_scale(d, 1.0 / n) : px_v3(0, 0, 0);
+	}
 	r->point = c;
 	r->u = u;
 	r->entity = t->hot_ent;
 	r->feature = PX_TRACK_MIN;
+	goto counts;
 done:
 	fill_dir(r, p);
+counts:
 	r->n_crit = t->hot_nc;
 	r->n_min = t->hot_nm;
 	t->st.hot++;
-	t->st.rested += (uint64_t)(t->hot_nc - (t->hot_z >= 0));
-	t->st.rested_entities += (uint64_t)t->hot_rest_ent;
+	t->st.rested += t->hot_rested;
+	t->st.rested_entities += t->hot_rest_ent;
 	return 0;
 }
 
@@ -1815,6 +1897,7 @@ int px_track_reset(struct px_track *t, px_vec3 p, struct px_track_result *r)
 	result_clear(r);
 	t->st.updates++;
 	t->p = p;
+	t->p_in = in_work(t, p);
 	t->init = 1;
 	t->best_id = 0;
 	t->hot_ent = -1;
@@ -1832,9 +1915,12 @@ int px_track_reset(struct px_track *t, px_vec3 p, struct px_track_result *r)
 	return PX_OK;
 }
 
+static __attribute__((noinline)) int update_full(struct px_track *t, px_vec3 p, int nh,
+		       struct px_track_result *r);
+
 int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 {
-	int i, j, nh, rc = 0, fail = 0, added = 0;
+	int i, j, nh, rc, in;
 	px_vec3 p0;
 
 	if (!t || !r)
@@ -1860,7 +1946,10 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 		t->epoch = 1;
 	}
 
-	if (!in_work(t, p) || !in_work(t, p0)) {
+	/* (whether p0 was inside was found by the last update) */
+	in = in_work(t, p);
+	if (!in || !t->p_in) {
+		t->p_in = in;
 		t->hot_ent = -1;
 		t->st.outside++;
 		t->heap_ok = 0;
@@ -1879,13 +1968,25 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 	nh = collect_events(t, p0, p);
 	if (t->hot_ent >= 0) {
 		if (nh == 0 && !hot_update(t, p, r)) {
-			verify(t, p, r);
-			if (r->source != PX_TRACK_TRACKED)
-				t->hot_ent = -1;
+			if (t->opts.verify_every > 0) {
+				verify(t, p, r);
+				if (r->source != PX_TRACK_TRACKED)
+					t->hot_ent = -1;
+			}
 			return PX_OK;
 		}
 		t->hot_ent = -1;
 	}
+	return update_full(t, p, nh, r);
+}
+
+/* The update beyond the hot path: evolution of every root that cannot
+ * rest, the re-solved leaves, the checks, the answer. */
+static __attribute__((noinline)) int update_full(struct px_track *t, px_vec3 p, int nh,
+		       struct px_track_result *r)
+{
+	int i, j, rc = 0, fail = 0, added = 0;
+
 	r->leaves_solved = nh;
 	t->st.leaf_solves += (uint64_t)nh;
 
@@ -2083,6 +2184,17 @@ double px__track_leaf_cert(const struct px_track *t, int leaf, px_vec3 p,
 	*u0 = l->u0;
 	*u1 = l->u1;
 	*flags = (l->flags & (LF_CUSP0 | LF_CUSP1)) ? 1u : 0u;
+	if (which == 2) {
+		/* the radius leaf_test() gives at the end of a step of
+		 * length 0: the larger of the whole-leaf one and the one
+		 * the piecewise proof gives (0 when that fails) */
+		double rf = 0.0, rr = leaf_radius(t, l, p);
+		if (leaf_event(t, l, p, p, &rf))
+			rf = 0.0;
+		if (t->fault & 128)
+			rf *= 4.0;
+		return rf > rr ? rf : rr;
+	}
 	return which ? leaf_end_radius(t, l, p) : leaf_radius(t, l, p);
 }
 

@@ -948,6 +948,103 @@ static long cert_check(const struct tcurve *tc, int ne, int fault, int npts)
 	return bad;
 }
 
+/* Sign of f' (0 below tiny) and the count of its sign changes over a
+ * leaf sampled at m + 1 points. */
+static int fp_changes(const struct px_nurbs_curve *c, double u0, double u1,
+		      px_vec3 q, int m)
+{
+	return sign_changes(c, u0, u1, q, m, 1e-9);
+}
+
+/*
+ * The no-event radius of a due leaf (piecewise proof, hook which 2)
+ * against brute force: along segments from p to random points inside the
+ * ball, sampled finely, the number of roots of f' in the leaf may change
+ * only by roots crossing an end of the leaf (a sign flip of f' there
+ * between two samples), never by a pair born or dying inside. Returns
+ * the violations.
+ */
+static long g_fine_used;
+static long fine_check(const struct tcurve *tc, int fault, int npts)
+{
+	struct px_nurbs_curve c = tc->c;
+	struct px_track *t = NULL;
+	struct px_track_info info;
+	long bad = 0;
+	int li, k, j, planar;
+	double size;
+	px_aabb box;
+	{
+		px_aabb b = px_nurbs_curve_aabb(&c);
+		planar = !(b.max.z - b.min.z > 1e-12);
+	}
+	if (px_track_create(&c, 1, NULL, &t) != PX_OK) {
+		PX_CHECK_MSG(0, "create");
+		return 0;
+	}
+	px__track_set_fault(t, fault);
+	px_track_get_info(t, &info);
+	box = info.work;
+	size = px_aabb_diagonal(&box) / 3.0;
+	for (li = 0; li < info.n_leaves; li++) {
+		int ent;
+		double u0, u1, r;
+		unsigned fl;
+		if (px__track_leaf_cert(t, li, px_v3(0, 0, 0), 2, &ent, &u0, &u1,
+					&fl) < 0.0 || fl)
+			continue;
+		for (k = 0, j = 0; k < 20000 && j < npts; k++) {
+			px_vec3 p = px_v3(px_rand_range(-0.5 * size, 0.5 * size),
+					  px_rand_range(-0.5 * size, 0.5 * size),
+					  planar ? 0.0 : px_rand_range(-0.5 * size, 0.5 * size));
+			px_vec3 d, q;
+			double dn;
+			int n_prev, e0, e1, ns = 60, s;
+			p = px_v3_add(p, px_aabb_center(&box));
+			if (planar)
+				p.z = 0.5 * (box.min.z + box.max.z);
+			r = px__track_leaf_cert(t, li, p, 2, &ent, &u0, &u1, &fl);
+			/* only where the pieces give the radius (rare at random
+			 * points: sampled until npts of them are found) */
+			if (!(r > 0.0) ||
+			    !(r > px__track_leaf_cert(t, li, p, 0, &ent, &u0, &u1, &fl)))
+				continue;
+			g_fine_used++;
+			if (r > 0.3 * size)
+				r = 0.3 * size;
+			d = px_v3(px_rand_normal(), px_rand_normal(),
+				  planar ? 0.0 : px_rand_normal());
+			dn = px_v3_norm(d);
+			if (!(dn > 0.0))
+				continue;
+			q = px_v3_add(p, px_v3_scale(d, 0.999 * r / dn));
+			j++;
+			n_prev = fp_changes(&c, u0, u1, p, 80);
+			e0 = end_sign(&c, u0, u1, 0, p, 1e-9);
+			e1 = end_sign(&c, u0, u1, 1, p, 1e-9);
+			for (s = 1; s <= ns; s++) {
+				px_vec3 x = px_v3_add(p, px_v3_scale(px_v3_sub(q, p),
+								     (double)s / ns));
+				int n = fp_changes(&c, u0, u1, x, 80);
+				int a0 = end_sign(&c, u0, u1, 0, x, 1e-9);
+				int a1 = end_sign(&c, u0, u1, 1, x, 1e-9);
+				int flips = (a0 && e0 && a0 != e0) + (a1 && e1 && a1 != e1);
+				if ((n > n_prev ? n - n_prev : n_prev - n) > flips) {
+					bad++;
+					break;
+				}
+				n_prev = n;
+				if (a0)
+					e0 = a0;
+				if (a1)
+					e1 = a1;
+			}
+		}
+	}
+	px_track_free(t);
+	return bad;
+}
+
 static void test_certificates_brute(void)
 {
 	struct tcurve tc[5];
@@ -966,6 +1063,19 @@ static void test_certificates_brute(void)
 	}
 	printf("  certificates: %ld violations (faulted: no-event %ld, ends %ld)\n",
 	       bad, bad4, bad8);
+	{
+		long fb = 0, fb4 = 0;
+		for (e = 0; e < 5; e++) {
+			if (e == 2)
+				continue;
+			fb += fine_check(&tc[e], 0, 40);
+			fb4 += fine_check(&tc[e], 128, 40);
+		}
+		printf("  due-leaf (piecewise) radii: %ld violations (made 4x "
+		       "larger: %ld), %ld balls walked\n", fb, fb4, g_fine_used);
+		PX_CHECK_MSG(fb == 0, "%ld piecewise radius violations", fb);
+		PX_CHECK_MSG(fb4 > 0, "piecewise radii 4x too large not caught");
+	}
 	PX_CHECK_MSG(bad == 0, "%ld certificate violations", bad);
 	PX_CHECK_MSG(bad4 > 0, "infinite no-event radii not caught");
 	PX_CHECK_MSG(bad8 > 0, "infinite end radii not caught");
