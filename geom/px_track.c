@@ -123,6 +123,10 @@ struct zero {
 	double dist;    /* |c - p| then */
 	double until;   /* travel below which it provably stays in its leaf */
 	uint32_t ep;    /* update (epoch) of the last correction */
+	/* cert_roots: travel below which its share of a rest or hot
+	 * certificate holds (leaf certificate and distance margin, as
+	 * proven when it was last computed) */
+	double hexp;
 };
 
 struct ent {
@@ -166,6 +170,7 @@ struct px_track {
 	double *pool;
 	size_t pool_len;
 	struct cand *cand;
+	double *cexp;        /* hot_cert: expiry of each candidate's margin */
 	int *hits;           /* scratch: leaves of this update */
 	/* lazy event tests: leaf l cannot have an event while the path
 	 * length travelled stays below expiry[l] (a safe radius around the
@@ -1493,12 +1498,19 @@ static void wake_minima(struct px_track *t, px_vec3 p)
 static int cert_roots(struct px_track *t, struct ent *e, int skip,
 		      double best, int fix, double *until)
 {
-	double tol = 1e-9 * (best + t->scale), m;
+	double tol = 1e-9 * (best + t->scale), m, x;
 	int j, margin = !(t->fault & 32);
 	for (j = 0; j < e->nz; j++) {
 		struct zero *z = &e->z[j];
 		if (j == skip)
 			continue;
+		/* renewing (fix): a root whose share still runs keeps it - a
+		 * proof made earlier stays a proof */
+		if (fix && z->hexp > t->travel) {
+			if (z->hexp < *until)
+				*until = z->hexp;
+			continue;
+		}
 		if (fix && (!(z->until > t->travel) ||
 			    (z->type > 0 &&
 			     !(z->dist - (t->travel - z->trav) - best - tol > 0.0)))) {
@@ -1510,16 +1522,18 @@ static int cert_roots(struct px_track *t, struct ent *e, int skip,
 		}
 		if (!(z->until > t->travel))
 			return 1;
-		if (z->until < *until)
-			*until = z->until;
+		x = z->until;
 		if (z->type > 0 && margin) {
 			m = z->dist - (t->travel - z->trav) - best - tol;
 			if (!(m > 0.0))
 				return 1;
 			m = t->travel + 0.5 * m * (1.0 - 1e-9);
-			if (m < *until)
-				*until = m;
+			if (m < x)
+				x = m;
 		}
+		z->hexp = x;
+		if (x < *until)
+			*until = x;
 	}
 	return 0;
 }
@@ -1659,12 +1673,14 @@ static int hot_cert(struct px_track *t, struct ent *E, int a, double best,
 	for (i = 0; i < t->n_cand; i++) {
 		if (i == t->hot_c)
 			continue;
-		m = px_v3_dist(t->cand[i].q, t->p) - best - tol;
-		if (!(m > 0.0))
-			return 1;
-		m = t->travel + 0.5 * m * (1.0 - 1e-9);
-		if (m < until)
-			until = m;
+		if (!fix || !(t->cexp[i] > t->travel)) {
+			m = px_v3_dist(t->cand[i].q, t->p) - best - tol;
+			if (!(m > 0.0))
+				return 1;
+			t->cexp[i] = t->travel + 0.5 * m * (1.0 - 1e-9);
+		}
+		if (t->cexp[i] < until)
+			until = t->cexp[i];
 	}
 	t->hot_until = (t->fault & 64) ? INFINITY : until;
 	return 0;
@@ -2505,6 +2521,7 @@ void px_track_free(struct px_track *t)
 	free(t->leaf);
 	free(t->pool);
 	free(t->cand);
+	free(t->cexp);
 	free(t->hits);
 	free(t->expiry);
 	free(t->rmin);
@@ -2676,11 +2693,13 @@ int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
 	t->leaf = calloc((size_t)leaf_cap, sizeof(*t->leaf));
 	t->pool = calloc(pool_cap ? pool_cap : 1, sizeof(double));
 	t->cand = calloc((size_t)cand_cap + 1, sizeof(*t->cand));
+	t->cexp = calloc((size_t)cand_cap + 1, sizeof(*t->cexp));
 	t->hits = calloc((size_t)leaf_cap + 1, sizeof(int));
 	t->expiry = calloc((size_t)leaf_cap + 1, sizeof(double));
 	t->gdue = calloc((size_t)leaf_cap / TRK_GROUP + 2, sizeof(double));
 	t->ipool = calloc((size_t)leaf_cap * (2 * TRK_NG + 2) + 1, sizeof(double));
-	if (!t->leaf || !t->pool || !t->cand || !t->hits || !t->expiry || !t->gdue ||
+	if (!t->leaf || !t->pool || !t->cand || !t->cexp || !t->hits ||
+	    !t->expiry || !t->gdue ||
 	    !t->ipool) {
 		rc = PX_E_NOMEM;
 		goto fail;
@@ -2910,7 +2929,7 @@ int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
 		   (size_t)leaf_cap * (sizeof(*t->leaf) + 2 * sizeof(int) +
 				       (2 * TRK_NG + 2) * sizeof(double)) +
 		   pool_cap * sizeof(double) +
-		   (size_t)(cand_cap + 1) * sizeof(*t->cand);
+		   (size_t)(cand_cap + 1) * (sizeof(*t->cand) + sizeof(double));
 	t->epoch = 1;
 	t->hot_ent = -1;
 	t->ans_z = -1;
