@@ -835,6 +835,20 @@ quick_evolve(const struct px_track *t, const struct zero *z, int leaf,
 	return 0;
 }
 
+/* A corrected root: its new state at p, stamped. */
+static void zero_commit(struct px_track *t, struct ent *e, struct zero *z,
+			double u, int leaf, px_vec3 c, px_vec3 d1, double D,
+			px_vec3 p)
+{
+	z->u = u;
+	z->leaf = leaf;
+	z->c = c;
+	z->d1 = d1;
+	z->D = D;
+	zero_stamp(t, z, p);
+	e->moved = 1;
+}
+
 /*
  * Evolve one root from p0 to p0 + dp: predictor (dp . C') / D (Eq. 6),
  * then Newton with the point held fixed. When that fails (a long step
@@ -857,12 +871,7 @@ static int evolve(struct px_track *t, struct ent *e, struct zero *z,
 				     TRK_QUICK_ITERS, &c, &d1, &D, &u, &ua,
 				     &next);
 		if (q == 0) {
-			z->u = u;
-			z->c = c;
-			z->d1 = d1;
-			z->D = D;
-			zero_stamp(t, z, p);
-			e->moved = 1;
+			zero_commit(t, e, z, u, z->leaf, c, d1, D, p);
 			return 0;
 		}
 		if (q == 1) {
@@ -937,13 +946,7 @@ static int evolve(struct px_track *t, struct ent *e, struct zero *z,
 	li += e->first_leaf;
 	if (t->leaf[li].mark == t->epoch)
 		return 1;
-	z->u = u;
-	z->leaf = li;
-	z->c = c;
-	z->d1 = d1;
-	z->D = D;
-	zero_stamp(t, z, p);
-	e->moved = 1;
+	zero_commit(t, e, z, u, li, c, d1, D, p);
 	return 0;
 }
 

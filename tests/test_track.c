@@ -845,6 +845,24 @@ static int end_sign(const struct px_nurbs_curve *c, double u0, double u1,
  * a fault that makes the radii infinite the same checks must find
  * violations. Returns the violations found.
  */
+/* A tracker for the certificate checks, with its working volume and a
+ * third of its diagonal (the model's size); NULL on failure (checked). */
+static struct px_track *cert_tracker(const struct px_nurbs_curve *cs, int ne,
+				     int fault, struct px_track_info *info,
+				     px_aabb *box, double *size)
+{
+	struct px_track *t = NULL;
+	if (px_track_create(cs, ne, NULL, &t) != PX_OK) {
+		PX_CHECK_MSG(0, "create");
+		return NULL;
+	}
+	px__track_set_fault(t, fault);
+	px_track_get_info(t, info);
+	*box = info->work;
+	*size = px_aabb_diagonal(box) / 3.0;
+	return t;
+}
+
 #define CG 20
 static long cert_check(const struct tcurve *tc, int ne, int fault, int npts)
 {
@@ -864,14 +882,9 @@ static long cert_check(const struct tcurve *tc, int ne, int fault, int npts)
 		if (b.max.z - b.min.z > 1e-12)
 			planar = 0;
 	}
-	if (px_track_create(cs, ne, NULL, &t) != PX_OK) {
-		PX_CHECK_MSG(0, "create");
+	t = cert_tracker(cs, ne, fault, &info, &box, &size);
+	if (!t)
 		return 0;
-	}
-	px__track_set_fault(t, fault);
-	px_track_get_info(t, &info);
-	box = info.work;
-	size = px_aabb_diagonal(&box) / 3.0;
 	{
 		int nz = planar ? 1 : 8, a, b, c, ncg = planar ? CG : CG / 2;
 		for (c = 0; c < nz; c++)
@@ -978,14 +991,9 @@ static long fine_check(const struct tcurve *tc, int fault, int npts)
 		px_aabb b = px_nurbs_curve_aabb(&c);
 		planar = !(b.max.z - b.min.z > 1e-12);
 	}
-	if (px_track_create(&c, 1, NULL, &t) != PX_OK) {
-		PX_CHECK_MSG(0, "create");
+	t = cert_tracker(&c, 1, fault, &info, &box, &size);
+	if (!t)
 		return 0;
-	}
-	px__track_set_fault(t, fault);
-	px_track_get_info(t, &info);
-	box = info.work;
-	size = px_aabb_diagonal(&box) / 3.0;
 	for (li = 0; li < info.n_leaves; li++) {
 		int ent;
 		double u0, u1, r;
