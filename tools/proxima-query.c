@@ -429,6 +429,11 @@ int main(int argc, char **argv)
 				(unsigned long long)st.reinits,
 				(unsigned long long)st.outside,
 				(unsigned long long)st.fallbacks);
+			fprintf(stderr,
+				"track_hot %llu rested %llu rested_entities %llu\n",
+				(unsigned long long)st.hot,
+				(unsigned long long)st.rested,
+				(unsigned long long)st.rested_entities);
 		}
 		if (strk) {
 			struct px_strack_stats st;
@@ -452,6 +457,8 @@ int main(int argc, char **argv)
 				(unsigned long long)st.over_budget,
 				(unsigned long long)st.rebuild_updates,
 				(unsigned long long)st.curve_skips);
+			fprintf(stderr, "strack_hot %llu\n",
+				(unsigned long long)st.hot);
 		}
 	}
 	rc = 0;
