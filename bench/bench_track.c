@@ -10,7 +10,8 @@
  * Surfaces (px_strack) follow: a single wavy bicubic patch, a wavy
  * 16-patch bicubic, a concave fold, with cells solved per update.
  * BENCH_TRACK_DEPTH=d overrides the event-grid depth (default 4),
- * BENCH_TRACK_LEAVES=n the parameter leaves per span (default 4).
+ * BENCH_TRACK_LEAVES=n the parameter leaves per span (default 4);
+ * BENCH_TRACK_WORST=1 prints what the worst update of each curve row did.
  * BENCH_TRACK_CURVES_ONLY=1 stops after the curve models (profiling);
  * BENCH_TRACK_LAZY=0 turns lazy correction off; BENCH_TRACK_MODEL=text runs
  * only the curve models whose name holds text, BENCH_TRACK_STEP=0..3 only
@@ -203,6 +204,9 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 {
 	static px_vec3 q[NSTEP];
 	static int64_t tt[NRUN * NSTEP], tg[NRUN * NSTEP];
+	/* BENCH_TRACK_WORST=1: what the worst update of each row did */
+	static int wk_solved[NSTEP], wk_src[NSTEP], wk_reinit[NSTEP], wk_tests[NSTEP];
+	int worst_env = getenv("BENCH_TRACK_WORST") != NULL;
 	static const double steps[] = {1e-4, 1e-3, 1e-2, 5e-2};
 	struct px_track *t = NULL;
 	struct px_track_opts o;
@@ -282,6 +286,7 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 			struct px_track_stats a, b;
 			struct px_dist_result g;
 			int64_t rmax[NRUN], x3, cmax, mmax;
+			int kworst = -1;
 			double bmean, cmean, net;
 			long wrong = 0;
 			int n = 0;
@@ -292,8 +297,18 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 				px_track_reset(t, q[0], &r);
 				for (k = 0; k < NSTEP; k++, n++) {
 					int64_t x = now_ns();
+					struct px_track_stats s0, s1;
+					if (run_i == 0 && worst_env)
+						px_track_get_stats(t, &s0);
 					px_track_update(t, q[k], &r);
 					tt[n] = now_ns() - x;
+					if (run_i == 0 && worst_env) {
+						px_track_get_stats(t, &s1);
+						wk_solved[k] = r.leaves_solved;
+						wk_src[k] = r.source;
+						wk_reinit[k] = (int)(s1.reinits - s0.reinits);
+						wk_tests[k] = (int)(s1.box_hits - s0.box_hits);
+					}
 					if (tt[n] > rmax[run_i])
 						rmax[run_i] = tt[n];
 					x = now_ns();
@@ -326,9 +341,17 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 				for (run_i = 1; run_i < NRUN; run_i++)
 					if (tt[run_i * NSTEP + k] < m)
 						m = tt[run_i * NSTEP + k];
-				if (m > mmax)
+				if (m > mmax) {
 					mmax = m;
+					kworst = k;
+				}
 			}
+			if (worst_env && kworst >= 0)
+				printf("  (worst update %d: %.1f us, leaves solved %d, "
+				       "leaf tests %d, entity re-initialisations %d, "
+				       "source %d)\n", kworst, mmax / 1e3,
+				       wk_solved[kworst], wk_tests[kworst],
+				       wk_reinit[kworst], wk_src[kworst]);
 			if (mmax > mmax_all)
 				mmax_all = mmax;
 			/* the whole path as one block, tracked then cold */

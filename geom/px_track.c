@@ -1922,6 +1922,10 @@ int px_track_reset(struct px_track *t, px_vec3 p, struct px_track_result *r)
 	t->hot_ent = -1;
 	t->heap_ok = 0;
 	rc = reinit_all(t, p);
+	/* the leaves' safe radii here too, so that the next update costs
+	 * what an update costs */
+	if (t->p_in)
+		heap_rebuild(t, p);
 	r->source = PX_TRACK_REINIT;
 	if (rc) {
 		count_fail(t, rc);
@@ -1974,6 +1978,10 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 		t->heap_ok = 0;
 		r->source = PX_TRACK_REINIT;
 		rc = reinit_all(t, p);
+		/* back inside: the radii at p in this update (a re-start
+		 * already), not in the next */
+		if (in)
+			heap_rebuild(t, p);
 		if (rc) {
 			count_fail(t, rc);
 			answer_global(t, p, r);
