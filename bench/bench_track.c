@@ -558,6 +558,8 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 {
 	static px_vec3 q[NSSTEP];
 	static int64_t tt[NSSTEP], tg[NSSTEP], it[NSSTEP], ig[NSSTEP], tw[NSSTEP];
+	static int sw_solved[NSSTEP], sw_tests[NSSTEP], sw_src[NSSTEP];
+	int worst_env = getenv("BENCH_TRACK_WORST") != NULL;
 	static const double steps[] = {1e-4, 1e-3, 1e-2, 5e-2};
 	struct surf_row row[2][4];
 	struct px_strack *t = NULL;
@@ -605,6 +607,7 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 			struct px_dist_result g;
 			long wrong = 0, crit = 0, glob = 0;
 			double bmean, cmean;
+			int kw = -1;
 			if (getenv("BENCH_TRACK_STEP") && atoi(getenv("BENCH_TRACK_STEP")) != s) {
 				memset(&row[kind][s], 0, sizeof(row[kind][s]));
 				continue;
@@ -614,8 +617,17 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 			px_strack_get_stats(t, &a);
 			for (k = 0; k < NSSTEP; k++) {
 				int64_t x = now_ns();
+				struct px_strack_stats s0, s1;
+				if (worst_env)
+					px_strack_get_stats(t, &s0);
 				px_strack_update(t, q[k], &r);
 				tt[k] = now_ns() - x;
+				if (worst_env) {
+					px_strack_get_stats(t, &s1);
+					sw_solved[k] = (int)(s1.cell_solves - s0.cell_solves);
+					sw_tests[k] = (int)(s1.box_tests - s0.box_tests);
+					sw_src[k] = r.source;
+				}
 				x = now_ns();
 				px_dist_query(ref, q[k], &g);
 				tg[k] = now_ns() - x;
@@ -644,8 +656,15 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 				}
 				row[kind][s].wmax = 0;
 				for (k = 0; k < NSSTEP; k++)
-					if (tw[k] > row[kind][s].wmax)
+					if (tw[k] > row[kind][s].wmax) {
 						row[kind][s].wmax = tw[k];
+						kw = k;
+					}
+				if (worst_env && kw >= 0)
+					printf("  (worst update %d: %.1f us, cells solved %d, "
+					       "cell tests %d, source %d)\n", kw,
+					       row[kind][s].wmax / 1e3, sw_solved[kw],
+					       sw_tests[kw], sw_src[kw]);
 			}
 			/* the same path again, counting instructions (the
 			 * tracker restarts from the same state) */
