@@ -399,6 +399,23 @@ static void bern_divide(double *c, int n, int end)
 	}
 }
 
+/* Halves of a Bernstein polynomial of degree n: c becomes [0, 1/2], r
+ * gets [1/2, 1] (de Casteljau at the middle, in place). */
+static inline void bern_halves(double *c, int n, double *r)
+{
+	double w[TRK_NG + 1];
+	int i, k;
+	r[n] = c[n];
+	for (i = 0; i <= n; i++)
+		w[i] = c[i];
+	for (k = 1; k <= n; k++) {
+		for (i = 0; i <= n - k; i++)
+			w[i] = 0.5 * (w[i] + w[i + 1]);
+		c[k] = w[0];
+		r[n - k] = w[n - k];
+	}
+}
+
 struct iso_item {
 	double c[TRK_NG + 1];
 	double min, max;
@@ -472,7 +489,8 @@ static int leaf_roots(const struct px_track *t, const struct leaf *l,
 			/* right half below the left one: roots come out sorted */
 			struct iso_item *r = &st[sp], *lf = &st[sp + 1];
 			double mid = 0.5 * (it.min + it.max);
-			px_bern_split(it.c, n, 0.5, lf->c, r->c);
+			memcpy(lf->c, it.c, (size_t)(n + 1) * sizeof(double));
+			bern_halves(lf->c, n, r->c);
 			r->min = mid;
 			r->max = it.max;
 			lf->min = it.min;
@@ -987,23 +1005,6 @@ static int definite2(const double *c0, const double *c1, int m, double tol)
 			return 0;
 	}
 	return !(pos && neg);
-}
-
-/* Halves of a Bernstein polynomial of degree n: c becomes [0, 1/2], r
- * gets [1/2, 1] (de Casteljau at the middle, in place). */
-static inline void bern_halves(double *c, int n, double *r)
-{
-	double w[TRK_NG + 1];
-	int i, k;
-	r[n] = c[n];
-	for (i = 0; i <= n; i++)
-		w[i] = c[i];
-	for (k = 1; k <= n; k++) {
-		for (i = 0; i <= n - k; i++)
-			w[i] = 0.5 * (w[i] + w[i + 1]);
-		c[k] = w[0];
-		r[n - k] = w[n - k];
-	}
 }
 
 #define TRK_FINE_DEPTH 3
