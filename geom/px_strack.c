@@ -176,6 +176,7 @@ struct px_strack {
 	 * stays below hot_until and no cell is due, an update follows that
 	 * one point alone; hot_s -1 when off */
 	int hot_s, hot_j;
+	int hot_curves;         /* the curve tracker runs with the minimum */
 	px_vec3 hot_p;
 	double hot_until;
 	int hot_nmin, hot_nmax, hot_nsad, hot_ncrit, hot_ccrit;
@@ -1461,22 +1462,31 @@ static void hot_arm(struct px_strack *t, px_vec3 p,
 		 * distance to the curves is 1-Lipschitz too) */
 		until *= 0.5;
 	} else if (t->ct) {
-		double lim = 0.02 * t->scale - px_v3_dist(p, t->ct_p);
-		if (!(lim > 0.0))
-			return;
-		for (i = 0; i < t->n_cbox; i++) {
+		/* the curves left out while their boxes are proven farther
+		 * (and for 2 % of the size at most, as curves_needed()), or
+		 * else updated along with the minimum every update */
+		double lim = 0.02 * t->scale - px_v3_dist(p, t->ct_p), uc = until;
+		int near = !(lim > 0.0);
+		for (i = 0; i < t->n_cbox && !near; i++) {
 			m = sqrt(px_aabb_dist2(&t->cbox[i], p)) - best - tol;
 			if (!(m > 0.0))
-				return;
-			if (m < until)
-				until = m;
+				near = 1;
+			else if (m < uc)
+				uc = m;
 		}
-		until *= 0.5;
-		if (lim < until)
-			until = lim;
+		t->hot_curves = near;
+		if (!near) {
+			until = 0.5 * uc;
+			if (lim < until)
+				until = lim;
+		} else {
+			until *= 0.5;
+		}
 	} else {
 		until *= 0.5;
 	}
+	if (curve || !t->ct)
+		t->hot_curves = 0;
 	t->hot_s = curve ? t->n_surf : t->ans_s;
 	t->hot_j = curve ? -1 : t->ans_j;
 	t->hot_p = p;
@@ -1521,12 +1531,31 @@ static int hot_update(struct px_strack *t, px_vec3 p,
 	f->z[t->hot_j] = w;
 	t->p = p;
 	r->source = PX_TRACK_TRACKED;
+	r->n_crit = t->hot_ncrit;
+	if (t->hot_curves) {
+		/* the curves could be closer: their tracker runs too and
+		 * the nearer of the two answers (both exact; the margin of
+		 * the other minima holds against either) */
+		struct px_track_result cr;
+		int kind;
+		curves_update(t, p, &cr, 0);
+		r->n_crit = t->hot_ncrit - t->hot_ccrit + cr.n_crit;
+		kind = cr.entity >= 0 && cr.dist * cr.dist < px_v3_dist2(w.s, p) ? 2 : 1;
+		if (kind == 2) {
+			answer_curve(t, &cr, r);
+			if (cr.source != PX_TRACK_TRACKED)
+				r->source = cr.source;
+		}
+		r->jumped = kind != t->best_kind || (kind == 2 && cr.jumped);
+		t->best_kind = kind;
+		if (kind == 2)
+			goto done;
+	}
 	r->point = w.s;
 	r->u = w.u;
 	r->v = w.v;
 	r->entity = t->n_curves + t->hot_s;
 	r->feature = PX_STRACK_MIN;
-	r->n_crit = t->hot_ncrit;
 done:
 	fill_dir(r, p);
 	r->n_min = t->hot_nmin;

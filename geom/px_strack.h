@@ -56,9 +56,11 @@
  *    certificate from the distance margins of the other minima, the
  *    poles and the curve boxes (all 1-Lipschitz: the margin shrinks at
  *    most twice as fast as the path grows) lets the following updates,
- *    while no cell is due, follow that minimum alone; the other points
- *    rest and are followed from where they were at the next full update
- *    (stats.hot).
+ *    while the due cells are proven free of transitions, follow that
+ *    minimum alone (with the curve tracker too when a curve box is not
+ *    proven farther; after an update answered by the curve tracker, that
+ *    tracker alone); the other points rest and are followed from where
+ *    they were at the next full update (stats.hot).
  *  - Never silent: verification every verify_every updates against
  *    px_dist_query() on the whole model counts disagreements and
  *    re-initialises; capacity overflow answers globally (counted).
