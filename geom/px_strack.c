@@ -1077,14 +1077,9 @@ static int curves_needed(const struct px_strack *t, px_vec3 p)
 		return 1;
 	/* a margin for the rounding of both sides */
 	best *= 1.0 + 1e-9;
-	for (i = 0; i < t->n_cbox; i++) {
-		const px_aabb *b = &t->cbox[i];
-		double dx = p.x < b->min.x ? b->min.x - p.x : p.x > b->max.x ? p.x - b->max.x : 0.0;
-		double dy = p.y < b->min.y ? b->min.y - p.y : p.y > b->max.y ? p.y - b->max.y : 0.0;
-		double dz = p.z < b->min.z ? b->min.z - p.z : p.z > b->max.z ? p.z - b->max.z : 0.0;
-		if (dx * dx + dy * dy + dz * dz <= best)
+	for (i = 0; i < t->n_cbox; i++)
+		if (px_aabb_dist2(&t->cbox[i], p) <= best)
 			return 1;
-	}
 	return 0;
 }
 
@@ -1427,7 +1422,7 @@ static int catch_up(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 static void hot_arm(struct px_strack *t, px_vec3 p,
 		    const struct px_strack_result *r)
 {
-	double best = r->dist, tol = 1e-9 * (best + t->scale), until, m;
+	double best = r->dist, tol = 1e-9 * (best + t->scale), until, m, lim;
 	int i, j;
 	int curve = r->feature == PX_STRACK_CURVE || r->feature == PX_STRACK_EDGE;
 	t->hot_s = -1;
@@ -1457,36 +1452,32 @@ static void hot_arm(struct px_strack *t, px_vec3 p,
 		if (m < until)
 			until = m;
 	}
-	if (curve) {
-		/* the curve tracker answers: it runs every update (the least
-		 * distance to the curves is 1-Lipschitz too) */
-		until *= 0.5;
-	} else if (t->ct) {
-		/* the curves left out while their boxes are proven farther
-		 * (and for 2 % of the size at most, as curves_needed()), or
-		 * else updated along with the minimum every update */
-		double lim = 0.02 * t->scale - px_v3_dist(p, t->ct_p), uc = until;
-		int near = !(lim > 0.0);
-		for (i = 0; i < t->n_cbox && !near; i++) {
+	/* when the curve tracker answers it runs every update (the least
+	 * distance to the curves is 1-Lipschitz too); else the curves are
+	 * left out while their boxes are proven farther (and for 2 % of the
+	 * size at most, as curves_needed()), or updated along with the
+	 * minimum every update */
+	t->hot_curves = 0;
+	lim = INFINITY;
+	if (!curve && t->ct) {
+		double uc = until;
+		lim = 0.02 * t->scale - px_v3_dist(p, t->ct_p);
+		t->hot_curves = !(lim > 0.0);
+		for (i = 0; i < t->n_cbox && !t->hot_curves; i++) {
 			m = sqrt(px_aabb_dist2(&t->cbox[i], p)) - best - tol;
 			if (!(m > 0.0))
-				near = 1;
+				t->hot_curves = 1;
 			else if (m < uc)
 				uc = m;
 		}
-		t->hot_curves = near;
-		if (!near) {
-			until = 0.5 * uc;
-			if (lim < until)
-				until = lim;
-		} else {
-			until *= 0.5;
-		}
-	} else {
-		until *= 0.5;
+		if (t->hot_curves)
+			lim = INFINITY;
+		else
+			until = uc;
 	}
-	if (curve || !t->ct)
-		t->hot_curves = 0;
+	until *= 0.5;
+	if (lim < until)
+		until = lim;
 	t->hot_s = curve ? t->n_surf : t->ans_s;
 	t->hot_j = curve ? -1 : t->ans_j;
 	t->hot_p = p;
@@ -1508,55 +1499,47 @@ static void hot_arm(struct px_strack *t, px_vec3 p,
 static int hot_update(struct px_strack *t, px_vec3 p,
 		      struct px_strack_result *r)
 {
-	struct ssurf *f;
+	struct ssurf *f = NULL;
 	struct crit w;
-	if (t->hot_s == t->n_surf) {
-		/* the curve tracker answers (its own update, exact: no
-		 * surface minimum or pole can be closer) */
-		struct px_track_result cr;
-		curves_update(t, p, &cr, 0);
-		if (cr.entity < 0)
-			return 1; /* not expected: the full update decides */
-		t->p = p;
-		answer_curve(t, &cr, r);
-		r->source = cr.source;
-		r->jumped = cr.jumped;
-		r->n_crit = t->hot_ncrit - t->hot_ccrit + cr.n_crit;
-		goto done;
+	struct px_track_result cr;
+	int use_min = t->hot_s < t->n_surf, kind = 1;
+	if (use_min) {
+		f = &t->sf[t->hot_s];
+		w = f->z[t->hot_j];
+		if (evolve(f, &w, px_v3_sub(p, t->p), p) || w.type != 1)
+			return 1;
 	}
-	f = &t->sf[t->hot_s];
-	w = f->z[t->hot_j];
-	if (evolve(f, &w, px_v3_sub(p, t->p), p) || w.type != 1)
-		return 1;
-	f->z[t->hot_j] = w;
+	r->n_crit = t->hot_ncrit;
+	if (!use_min || t->hot_curves) {
+		/* the curve tracker answers, or could (its own update,
+		 * exact); the margin of the other minima and the poles holds
+		 * against either answer, and the nearer answers */
+		curves_update(t, p, &cr, 0);
+		if (!use_min && cr.entity < 0)
+			return 1; /* not expected: the full update decides */
+		r->n_crit = t->hot_ncrit - t->hot_ccrit + cr.n_crit;
+		if (cr.entity >= 0 &&
+		    (!use_min || cr.dist * cr.dist < px_v3_dist2(w.s, p)))
+			kind = 2;
+	}
+	if (use_min)
+		f->z[t->hot_j] = w;
 	t->p = p;
 	r->source = PX_TRACK_TRACKED;
-	r->n_crit = t->hot_ncrit;
-	if (t->hot_curves) {
-		/* the curves could be closer: their tracker runs too and
-		 * the nearer of the two answers (both exact; the margin of
-		 * the other minima holds against either) */
-		struct px_track_result cr;
-		int kind;
-		curves_update(t, p, &cr, 0);
-		r->n_crit = t->hot_ncrit - t->hot_ccrit + cr.n_crit;
-		kind = cr.entity >= 0 && cr.dist * cr.dist < px_v3_dist2(w.s, p) ? 2 : 1;
-		if (kind == 2) {
-			answer_curve(t, &cr, r);
-			if (cr.source != PX_TRACK_TRACKED)
-				r->source = cr.source;
-		}
-		r->jumped = kind != t->best_kind || (kind == 2 && cr.jumped);
-		t->best_kind = kind;
-		if (kind == 2)
-			goto done;
+	if (kind == 2) {
+		answer_curve(t, &cr, r);
+		if (cr.source != PX_TRACK_TRACKED)
+			r->source = cr.source;
+		r->jumped = t->best_kind != 2 || cr.jumped;
+	} else {
+		r->point = w.s;
+		r->u = w.u;
+		r->v = w.v;
+		r->entity = t->n_curves + t->hot_s;
+		r->feature = PX_STRACK_MIN;
+		r->jumped = t->best_kind != 1;
 	}
-	r->point = w.s;
-	r->u = w.u;
-	r->v = w.v;
-	r->entity = t->n_curves + t->hot_s;
-	r->feature = PX_STRACK_MIN;
-done:
+	t->best_kind = kind;
 	fill_dir(r, p);
 	r->n_min = t->hot_nmin;
 	r->n_max = t->hot_nmax;

@@ -149,7 +149,6 @@ struct ent {
 	 * entity with one comparison; -1 when not certified */
 	double rest_until;
 	int resting;    /* it rested whole in the last update */
-	int allrest;    /* every root of it rested in the evolution pass */
 	int nmin;       /* minima among its roots (for the answer counts) */
 };
 
@@ -243,9 +242,6 @@ static inline __attribute__((always_inline)) void span_eval(const struct span *s
 		h[0][0] = a0[0], h[1][0] = a0[1], h[2][0] = a1[0], h[3][0] = a1[1];
 		h[0][1] = b0[0], h[1][1] = b0[1], h[2][1] = b1[0], h[3][1] = b1[1];
 		h[0][2] = c0[0], h[1][2] = c0[1], h[2][2] = c1[0], h[3][2] = c1[1];
-		(void)k;
-		(void)j;
-		(void)nk;
 	} else
 #endif
 	if (p <= 3) {
@@ -992,6 +988,26 @@ static int definite_seg(const double *a, int m, px_vec3 p0, px_vec3 p1,
 	return 1;
 }
 
+/* r, lowered to the radius within which g keeps its sign at each break
+ * end of leaf l around p (a root crossing a break is an event). */
+static double break_end_radius(const struct px_track *t, const struct leaf *l,
+			       px_vec3 p, double r)
+{
+	const double *a = leaf_a(t, l), *ib = t->ipool + l->ioff;
+	int n = l->n, i;
+	for (i = 0; i < 2 && r > 0.0; i++) {
+		double v;
+		int e = i ? n : 0;
+		if (!(l->flags & (i ? LF_EV1 : LF_EV0)))
+			continue;
+		v = fabs(gco(a, n, e, p));
+		v = v > l->tol_g ? (v - l->tol_g) * ib[e] : 0.0;
+		if (v < r)
+			r = v;
+	}
+	return r;
+}
+
 /* Signs of c0[0..m-1] and c1[0..m-1] all one, beyond tol. */
 static int definite2(const double *c0, const double *c1, int m, double tol)
 {
@@ -1119,19 +1135,7 @@ static int leaf_event(const struct px_track *t, const struct leaf *l,
 		return 1;
 	/* a break end's sign bounds it too (the whole-leaf radius holds
 	 * that term already) */
-	{
-		int i;
-		const double *ib = t->ipool + l->ioff;
-		for (i = 0; i < 2; i++) {
-			double v;
-			if (!(l->flags & (i ? LF_EV1 : LF_EV0)))
-				continue;
-			v = fabs(gco(a, n, i ? n : 0, p1));
-			v = v > l->tol_g ? (v - l->tol_g) * ib[i ? n : 0] : 0.0;
-			if (v < *rfine)
-				*rfine = v;
-		}
-	}
+	*rfine = break_end_radius(t, l, p1, *rfine);
 	return 0;
 }
 
@@ -1178,21 +1182,11 @@ static double leaf_dradius(const struct px_track *t, const struct leaf *l,
 			   px_vec3 p)
 {
 	const double *a = leaf_a(t, l), *ib = t->ipool + l->ioff;
-	int n = l->n, i;
+	int n = l->n;
 	double r = n >= 1 ? definite_radius(a + 4 * (n + 1), ib + n + 1, n, p,
 					    l->tol_d)
 			  : INFINITY;
-	for (i = 0; i < 2 && r > 0.0; i++) {
-		double v;
-		int e = i ? n : 0;
-		if (!(l->flags & (i ? LF_EV1 : LF_EV0)))
-			continue;
-		v = fabs(gco(a, n, e, p));
-		v = v > l->tol_g ? (v - l->tol_g) * ib[e] : 0.0;
-		if (v < r)
-			r = v;
-	}
-	return r;
+	return break_end_radius(t, l, p, r);
 }
 
 /* Distance p may travel (inside the working volume) before leaf l can
@@ -1542,19 +1536,30 @@ static int cert_roots(struct px_track *t, struct ent *e, int skip,
 	return 0;
 }
 
+/* Each root of e alone in its leaf (the roots sorted: neighbours
+ * compared); *nmin its minima. */
+static int ent_alone(const struct ent *e, int *nmin)
+{
+	int j, n = 0;
+	for (j = 0; j < e->nz; j++) {
+		if (j > 0 && e->z[j - 1].leaf == e->z[j].leaf)
+			return 0;
+		n += e->z[j].type > 0;
+	}
+	*nmin = n;
+	return 1;
+}
+
 /* Certify e to rest whole from now on (after its checks of this update):
  * each root alone in its leaf (can_rest), cert_roots against the best
  * distance of this update. */
 static void ent_certify(struct px_track *t, struct ent *e)
 {
 	double until = INFINITY;
-	int j, nmin = 0;
+	int nmin;
 	e->rest_until = -1.0;
-	for (j = 0; j < e->nz; j++) {
-		if (j > 0 && e->z[j - 1].leaf == e->z[j].leaf)
-			return;
-		nmin += e->z[j].type > 0;
-	}
+	if (!ent_alone(e, &nmin))
+		return;
 	e->nmin = nmin;
 	if (cert_roots(t, e, -1, t->best_now, 0, &until))
 		return;
@@ -1702,7 +1707,7 @@ static void hot_arm(struct px_track *t, const struct px_track_result *r)
 {
 	struct ent *E;
 	double other = INFINITY;
-	int a, i, j, nc = 0, nm = 0, nre = 0;
+	int a, i, ne, nc = 0, nm = 0, nre = 0;
 
 	t->hot_ent = -1;
 	if (!t->opts.lazy || r->source != PX_TRACK_TRACKED ||
@@ -1724,11 +1729,9 @@ static void hot_arm(struct px_track *t, const struct px_track_result *r)
 		nm += e->nmin;
 		nre++;
 	}
-	for (j = 0; j < E->nz; j++) {
-		if (j > 0 && E->z[j - 1].leaf == E->z[j].leaf)
-			return;
-		nm += E->z[j].type > 0;
-	}
+	if (!ent_alone(E, &ne))
+		return;
+	nm += ne;
 	if (E->nz >= 2 && E->z[0].leaf == E->z[E->nz - 1].leaf)
 		return;
 	t->hot_other = other;
@@ -2026,13 +2029,12 @@ static __attribute__((noinline)) int update_full(struct px_track *t, px_vec3 p, 
 	 * rest (can_rest) until the answer needs it */
 	for (i = 0; i < t->n_ent; i++) {
 		struct ent *e = &t->ent[i];
-		int w = 0, nrest = 0;
+		int w = 0;
 		e->nold = 0;
 		e->touched = 0;
 		e->full = !t->opts.lazy || e->hit == t->epoch;
 		e->moved = 0;
 		e->resting = 0;
-		e->allrest = 0;
 		if (e->stale)
 			continue;
 		if (!e->full && t->travel < e->rest_until) {
@@ -2057,7 +2059,6 @@ static __attribute__((noinline)) int update_full(struct px_track *t, px_vec3 p, 
 					t->n_rmin++;
 				}
 				w++;
-				nrest++;
 				continue;
 			}
 			leaf0 = zj->leaf;
@@ -2073,9 +2074,6 @@ static __attribute__((noinline)) int update_full(struct px_track *t, px_vec3 p, 
 			w++;
 		}
 		if (!e->stale) {
-			/* a root corrected here moved the entity: w counts
-			 * the roots kept, nrest those that rested */
-			e->allrest = !e->full && nrest == w;
 			e->nz = w;
 			if (e->full && catch_up(t, e, p))
 				e->stale = 1;
