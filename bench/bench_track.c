@@ -213,7 +213,7 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 	struct px_dist_model *ref = NULL;
 	struct px_track_info ti;
 	struct px_dist_info di;
-	int64_t t0, med[2][4];
+	int64_t t0, med[2][4], reset_ns;
 	double ratio[2][4];
 	int ok_med[2][4], ok_rt[2][4], ok_net[2][4], ok_bat[2][4], ok_m3[2][4];
 	long wrong_all = 0;
@@ -245,9 +245,28 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 	size = px_aabb_diagonal(&box);
 	box.min = px_v3_sub(box.min, px_v3(0.3 * size, 0.3 * size, 0.3 * size));
 	box.max = px_v3_add(box.max, px_v3(0.3 * size, 0.3 * size, 0.3 * size));
+	{
+		/* what a re-initialisation costs (every leaf solved, every
+		 * safe radius): the least of 20 at points spread over the
+		 * model's box */
+		struct px_track_result r0;
+		int64_t best = INT64_MAX;
+		int i;
+		for (i = 0; i < 20; i++) {
+			px_vec3 c = px_v3(box.min.x + (box.max.x - box.min.x) * urand(),
+					  box.min.y + (box.max.y - box.min.y) * urand(),
+					  box.min.z + (box.max.z - box.min.z) * urand());
+			int64_t x = now_ns();
+			px_track_reset(t, c, &r0);
+			x = now_ns() - x;
+			if (x < best)
+				best = x;
+		}
+		reset_ns = best;
+	}
 	printf("%s: %d curves, %d spans, %d leaves (%d boxed), setup %.1f ms, "
-	       "%zu bytes\n", name, nc, ti.n_spans, ti.n_leaves,
-	       ti.n_boxed_leaves, t0 / 1e6, ti.bytes);
+	       "%zu bytes, reset %.1f us\n", name, nc, ti.n_spans, ti.n_leaves,
+	       ti.n_boxed_leaves, t0 / 1e6, ti.bytes, reset_ns / 1e3);
 	printf("  %-8s %-7s %8s %8s %8s %8s %8s | %8s %8s | %6s | %5s %6s %6s %5s "
 	       "%5s %6s %6s %6s %8s %8s | %5s %5s | %6s %6s %5s\n",
 	       "path", "step", "med_ns", "p99_ns", "p999_ns", "max_ns", "max_m3",
@@ -319,6 +338,11 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 				}
 			}
 			px_track_get_stats(t, &b);
+			if (getenv("BENCH_TRACK_GOV"))
+				printf("  gov: tracked %.0f ns, cold %.0f ns, cold updates %llu, entered %llu, left %llu\n",
+				       b.tracked_ns, b.cold_ns, (unsigned long long)(b.cold - a.cold),
+				       (unsigned long long)(b.cold_entered - a.cold_entered),
+				       (unsigned long long)(b.cold_left - a.cold_left));
 			/* once more, by thread CPU time: the max without
 			 * preemption */
 			cmax = 0;

@@ -6,6 +6,7 @@
 #define PX_GEOM_INTERNAL_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "px_nurbs.h"
 
@@ -83,6 +84,8 @@ struct px_track;
  * leaf-end radius is infinite, bit 4: entity rest certificates never
  * expire, bit 5: they ignore the distance bound of their minima). 0 restores normal operation. */
 void px__track_set_fault(struct px_track *t, int fault);
+/* Test hook: the cold switch's clock (NULL: CLOCK_MONOTONIC). */
+void px__track_set_clock(struct px_track *t, int64_t (*fn)(void *), void *ctx);
 
 /* Test hook: the certificate radius of leaf `leaf` at p (which 0: no
  * event in the leaf while the point travels less; 1: its end values of

@@ -2419,6 +2419,9 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 		if (rc)
 			goto fail;
 		px_track_opts_default(&to);
+		/* the surface tracker decides what is followed; its curve
+		 * tracker must always track */
+		to.cold_switch = 0;
 		to.work = t->work;
 		to.dist = o.dist;
 		rc = px_track_create(cc, n_cc, &to, &t->ct);

@@ -35,6 +35,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "gov_internal.h"
 #include "internal.h"
 #include "px_bern.h"
 
@@ -208,6 +209,18 @@ struct px_track {
 	int hot_c;           /* hot: answering candidate (hot_z -1), -1 */
 	struct px_track_stats st;
 	size_t bytes;
+	/* cold switch (gov_internal.h) and the last answer, whose
+	 * continuation tells a cold answer's jumped */
+	struct px_gov gov;
+	px_vec3 cur_d1;      /* continued(): C' and D at the new answer */
+	double cur_D;
+	struct {
+		int ent, fixed; /* fixed: an end, break or cusp */
+		double u;
+		px_vec3 point, p; /* the closest point, the query point */
+		px_vec3 d1;       /* C' there (D > 0: known) */
+		double D;
+	} prev;
 };
 
 /* ------------------------------------------------------------------ */
@@ -1925,6 +1938,9 @@ int px_track_reset(struct px_track *t, px_vec3 p, struct px_track_result *r)
 	t->best_id = 0;
 	t->hot_ent = -1;
 	t->heap_ok = 0;
+	if (t->gov.cold)
+		t->st.cold_left++;
+	px__gov_restart(&t->gov);
 	rc = reinit_all(t, p);
 	/* the leaves' safe radii here too, so that the next update costs
 	 * what an update costs */
@@ -1945,10 +1961,100 @@ int px_track_reset(struct px_track *t, px_vec3 p, struct px_track_result *r)
 static __attribute__((noinline)) int update_full(struct px_track *t, px_vec3 p, int nh,
 		       struct px_track_result *r);
 
+/*
+ * Is the closest point (entity ent, parameter u, point) the continuation
+ * of the last answer kept in t->prev? Used where no critical point was
+ * followed: cold answers and the return from them. The same point (an
+ * end, a break, no motion) is; otherwise the answer must be a minimum of
+ * the same curve whose backward predictor (Eq. 6 from the new point to
+ * the last one) lands nearer the last parameter than half the parameter
+ * moved - on one branch the predictor's error is second order in the
+ * step, a jump to another branch lands it near the new parameter.
+ */
+static int continued(struct px_track *t, px_vec3 p, int ent, double u,
+		     px_vec3 point, double dist)
+{
+	const struct ent *e;
+	double D, ub, du, dub, duf = 0.0;
+	px_vec3 c, d1, d2;
+	t->cur_D = 0.0;
+	if (ent < 0 || ent >= t->n_ent)
+		return 0;
+	e = &t->ent[ent];
+	span_eval(find_span(t, e, u), u, &c, &d1, &d2);
+	D = px_v3_dot(px_v3_sub(c, p), d2) + px_v3_dot(d1, d1);
+	t->cur_d1 = d1;
+	t->cur_D = D;
+	if (t->prev.ent < 0 || ent != t->prev.ent)
+		return 0;
+	if (px_v3_dist(point, t->prev.point) <= 1e-9 * (t->scale + dist))
+		return 1;
+	if (t->prev.fixed || !(D > 0.0))
+		return 0;
+	ub = u + px_v3_dot(px_v3_sub(t->prev.p, p), d1) / D;
+	du = u - t->prev.u;
+	dub = ub - t->prev.u;
+	if (t->prev.D > 0.0)
+		/* and forward from the last answer (Eq. 6 itself) */
+		duf = t->prev.u + px_v3_dot(px_v3_sub(p, t->prev.p), t->prev.d1) /
+					  t->prev.D - u;
+	if (e->cyclic) {
+		/* the shorter way round the seam */
+		du = remainder(du, e->len);
+		dub = remainder(dub, e->len);
+		duf = remainder(duf, e->len);
+	}
+	return fabs(dub) <= 0.5 * fabs(du) && fabs(duf) <= 0.5 * fabs(du);
+}
+
+static void prev_keep(struct px_track *t, const struct px_track_result *r)
+{
+	t->prev.ent = r->entity;
+	t->prev.fixed = r->feature == PX_TRACK_END || r->feature == PX_TRACK_BREAK;
+	t->prev.u = r->u;
+	t->prev.point = r->point;
+	t->prev.p = t->p;
+	t->prev.d1 = t->cur_d1;
+	t->prev.D = t->cur_D;
+}
+
+/* An update answered cold (gov.cold): the global query alone; the
+ * critical points wait for the return. Returns 0 or the query's error
+ * (the caller then tracks instead). */
+static int cold_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
+{
+	struct px_dist_result g;
+	int timed = px__gov_timed(&t->gov), rc;
+	int64_t t0 = timed ? px__gov_now(&t->gov) : 0;
+	rc = px_dist_query(t->dist, p, &g);
+	if (timed)
+		px__gov_cold_sample(&t->gov, (double)(px__gov_now(&t->gov) - t0));
+	if (rc)
+		return rc;
+	result_clear(r);
+	t->st.updates++;
+	t->st.cold++;
+	r->dist = g.dist;
+	r->point = g.point;
+	r->u = g.u;
+	r->entity = g.entity;
+	r->dir = g.dir;
+	r->feature = PX_TRACK_FROM_GLOBAL;
+	r->n_crit = r->n_min = -1;
+	r->source = PX_TRACK_COLD;
+	r->jumped = !continued(t, p, g.entity, g.u, g.point, g.dist);
+	t->p = p;
+	prev_keep(t, r);
+	return 0;
+}
+
+static int track_update(struct px_track *t, px_vec3 p, int fresh,
+			struct px_track_result *r);
+
 int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 {
-	int i, j, nh, rc, in;
-	px_vec3 p0;
+	int64_t t0 = 0;
+	int timed, rc, fresh = 0;
 
 	if (!t || !r)
 		return PX_E_INVAL;
@@ -1956,6 +2062,43 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 		return PX_E_NAN;
 	if (!t->init)
 		return px_track_reset(t, p, r);
+	if (t->gov.on) {
+		px__gov_step(&t->gov, px_v3_dist(p, t->p));
+		if (t->gov.cold) {
+			if (!px__gov_leave(&t->gov)) {
+				if (cold_update(t, p, r) == 0)
+					return PX_OK;
+				/* no global answer here (far away): track */
+				px__gov_restart(&t->gov);
+			}
+			t->st.cold_left++;
+			fresh = 1;
+		}
+	}
+	timed = px__gov_timed(&t->gov);
+	if (timed)
+		t0 = px__gov_now(&t->gov);
+	rc = track_update(t, p, fresh, r);
+	if (timed && px__gov_tracked(&t->gov, (double)(px__gov_now(&t->gov) - t0))) {
+		/* cold from the next update on */
+		t->st.cold_entered++;
+		t->hot_ent = -1;
+		t->cur_D = 0.0;
+		prev_keep(t, r);
+	}
+	if (fresh && rc == PX_OK)
+		r->jumped = !continued(t, p, r->entity, r->u, r->point, r->dist);
+	return rc;
+}
+
+/* The tracked update; fresh: every critical point found again at p (the
+ * return from cold answers). */
+static int track_update(struct px_track *t, px_vec3 p, int fresh,
+			struct px_track_result *r)
+{
+	int i, j, nh, rc, in;
+	px_vec3 p0;
+
 	result_clear(r);
 	t->st.updates++;
 	p0 = t->p;
@@ -1975,10 +2118,11 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 
 	/* (whether p0 was inside was found by the last update) */
 	in = in_work(t, p);
-	if (!in || !t->p_in) {
+	if (!in || !t->p_in || fresh) {
+		if (!in || !t->p_in)
+			t->st.outside++;
 		t->p_in = in;
 		t->hot_ent = -1;
-		t->st.outside++;
 		t->heap_ok = 0;
 		r->source = PX_TRACK_REINIT;
 		rc = reinit_all(t, p);
@@ -2175,6 +2319,12 @@ static void ent_refresh(struct px_track *t, struct ent *e)
 	int j, rest = 0;
 	if (!t->init || e->stale)
 		return;
+	if (t->gov.cold) {
+		/* not followed while cold: found afresh at the point */
+		if (ent_reinit(t, e, t->p))
+			count_fail(t, PX_E_RANGE);
+		return;
+	}
 	t->hot_ent = -1; /* the roots are corrected and re-sorted here */
 	e->rest_until = -1.0;
 	e->resting = 0;
@@ -2196,6 +2346,12 @@ void px__track_set_fault(struct px_track *t, int fault)
 		t->heap_ok = 0; /* radii of the new regime */
 		t->hot_ent = -1;
 	}
+}
+
+void px__track_set_clock(struct px_track *t, int64_t (*fn)(void *), void *ctx)
+{
+	if (t)
+		px__gov_set_clock(&t->gov, fn, ctx);
 }
 
 double px__track_leaf_cert(const struct px_track *t, int leaf, px_vec3 p,
@@ -2251,6 +2407,8 @@ void px_track_get_stats(const struct px_track *t, struct px_track_stats *s)
 		return;
 	}
 	*s = t->st;
+	s->tracked_ns = t->gov.trk_ns;
+	s->cold_ns = t->gov.cold_ns;
 }
 
 void px_track_get_info(const struct px_track *t, struct px_track_info *info)
@@ -2293,6 +2451,7 @@ void px_track_opts_default(struct px_track_opts *o)
 	o->verify_every = 0;
 	o->dist = NULL;
 	o->lazy = 1;
+	o->cold_switch = 1;
 }
 
 struct split {
@@ -2950,6 +3109,17 @@ int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
 	if (!t->rmin) {
 		rc = PX_E_NOMEM;
 		goto fail;
+	}
+	t->prev.ent = -1;
+	{
+		/* the cold query's cost where a tool works: about the
+		 * model, not the whole working volume */
+		px_aabb cb = bounds;
+		double m = 0.3 * t->scale;
+		cb.min = px_v3_sub(cb.min, px_v3(m, m, m));
+		cb.max = px_v3_add(cb.max, px_v3(m, m, m));
+		px__gov_init(&t->gov, o.cold_switch != 0,
+			     o.cold_switch ? px__gov_calibrate(t->dist, cb) : 1.0);
 	}
 	free(spl);
 	free(work);

@@ -143,6 +143,15 @@ struct px_track_opts {
 	 * minus the path travelled since exceeds the current best. 0
 	 * corrects every critical point on every update. */
 	int lazy;
+	/* Cold switch (default 1): when the point moves so fast that
+	 * tracking costs more than the exact global query (one update in 16
+	 * is timed; tracked mean over 1.25 times the cold query's), updates
+	 * are answered by px_dist_query() (source PX_TRACK_COLD) until the
+	 * mean step has halved, then the critical points are found afresh
+	 * at the point (one re-initialisation) and tracking goes on. Both
+	 * answers are exact; this bounds the cost of fast motion by the
+	 * global query's. 0: always track. */
+	int cold_switch;
 };
 
 /* Defaults as documented above. */
@@ -152,7 +161,10 @@ PX_API void px_track_opts_default(struct px_track_opts *o);
 enum px_track_source {
 	PX_TRACK_TRACKED = 0, /* from the tracked critical points */
 	PX_TRACK_REINIT = 1,  /* state rebuilt at this point, then tracked */
-	PX_TRACK_GLOBAL = 2   /* fallback to px_dist_query() */
+	PX_TRACK_GLOBAL = 2,  /* fallback to px_dist_query() */
+	PX_TRACK_COLD = 3     /* px_dist_query() while it is the cheaper
+			       * exact answer (opts.cold_switch): n_crit and
+			       * n_min are -1 (not followed) */
 };
 
 /* Kind of the closest feature (px_track_result.feature). */
@@ -203,6 +215,11 @@ struct px_track_stats {
 	uint64_t hot;            /* updates answered under the hot
 				  * certificate: only the answering root
 				  * evolved (opts.lazy) */
+	uint64_t cold;           /* updates answered cold (cold_switch) */
+	uint64_t cold_entered, cold_left; /* switches to and from cold */
+	double tracked_ns, cold_ns; /* the cold switch's running means of a
+				     * tracked update and of the global
+				     * query (timed samples) */
 };
 
 struct px_track_info {

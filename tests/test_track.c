@@ -12,6 +12,7 @@
  */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
@@ -418,6 +419,9 @@ static void run_model(const struct tcurve *tc, int ne, int n_steps,
 	px_track_opts_default(&o);
 	o.verify_every = verify_every;
 	o.lazy = g_lazy;
+	/* the tracking itself is under test: never handed to the global
+	 * query for speed (test_cold_switch covers that) */
+	o.cold_switch = 0;
 	rc = px_track_create(cs, ne, &o, &t);
 	PX_CHECK_INT_EQ(rc, PX_OK);
 	if (rc)
@@ -1135,6 +1139,177 @@ static void test_errors(void)
 	px_track_free(t);
 }
 
+/* The cold switch's clock in these tests: every read advances by inc, so
+ * every timed region (tracked update or global query) measures inc. */
+struct fclock {
+	int64_t now, inc;
+};
+
+static int64_t fake_clock(void *ctx)
+{
+	struct fclock *c = ctx;
+	c->now += c->inc;
+	return c->now;
+}
+
+/*
+ * Cold switch: with tracked updates made to look 10 times the global
+ * query (the test clock), a fast path (2 % steps) goes cold; every answer
+ * stays exact, cold answers say n_crit -1, a closest point that jumps
+ * between two minima of one curve (as the always-tracking tracker sees
+ * it) is reported as jumped, nothing allocates. Then tracking made cheap
+ * and a slow path (0.01 %): the tracker comes back, finds the critical
+ * points afresh (the same counts as the always-tracking one) and stays.
+ * With cold_switch 0 nothing goes cold.
+ */
+static void test_cold_switch(void)
+{
+	struct tcurve tc[5];
+	struct px_nurbs_curve cs[5];
+	struct px_track *t = NULL, *t0 = NULL;
+	struct px_track_opts o;
+	struct px_dist_model *ref = NULL;
+	struct px_track_stats st, st0;
+	struct px_track_result r, r0;
+	struct px_dist_result g;
+	struct fclock fc = {0, 1};
+	px_aabb box;
+	double size;
+	int e, k, phase, rc;
+	long wrong = 0, cold = 0, bad_ncrit = 0, between = 0, missed = 0,
+	     false_jump = 0, count_checked = 0, count_bad = 0, late_cold = 0;
+	int prev_ent = -1, prev_feat = -1;
+	px_vec3 prev_pt = px_v3(0, 0, 0);
+
+	PX_CHECK_INT_EQ(lazy_model(tc), 0);
+	for (e = 0; e < 5; e++)
+		cs[e] = tc[e].c;
+	px_track_opts_default(&o);
+	PX_CHECK_INT_EQ(o.cold_switch, 1);
+	PX_CHECK_INT_EQ(px_track_create(cs, 5, &o, &t), PX_OK);
+	o.cold_switch = 0;
+	PX_CHECK_INT_EQ(px_track_create(cs, 5, &o, &t0), PX_OK);
+	PX_CHECK_INT_EQ(px_dist_model_create(cs, 5, NULL, 0, NULL, &ref), PX_OK);
+	if (!t || !t0 || !ref)
+		goto out;
+	px__track_set_clock(t, fake_clock, &fc);
+	px__track_set_clock(t0, fake_clock, &fc);
+	{
+		struct px_dist_info di;
+		px_dist_model_info(ref, &di);
+		box = di.bounds;
+	}
+	size = px_aabb_diagonal(&box);
+	box.min = px_v3_sub(box.min, px_v3(0.3 * size, 0.3 * size, 0.3 * size));
+	box.max = px_v3_add(box.max, px_v3(0.3 * size, 0.3 * size, 0.3 * size));
+	px_track_get_stats(t, &st);
+	PX_CHECK_MSG(st.cold_ns > 0.0, "no calibrated cold cost");
+
+	for (phase = 0; phase < 2; phase++) {
+		struct traj tr;
+		px_vec3 p;
+		traj_init(&tr, 0, box, (phase ? 1e-4 : 2e-2) * size);
+		p = traj_next(&tr);
+		if (phase == 0) {
+			px_track_reset(t, p, &r);
+			px_track_reset(t0, p, &r0);
+		}
+		px_track_get_stats(t, &st);
+		fc.inc = phase ? 1 : (int64_t)(10.0 * st.cold_ns) + 1;
+		for (k = 0; k < 1500; k++) {
+			uint64_t reg;
+			int rc0;
+			p = traj_next(&tr);
+			reg = px_alloc_region_begin();
+			rc = px_track_update(t, p, &r);
+			rc0 = px_track_update(t0, p, &r0);
+			if (px_alloc_region_end(reg) != 0) {
+				PX_CHECK_MSG(0, "update allocated");
+				goto out;
+			}
+			if (rc || rc0) {
+				PX_CHECK_INT_EQ(rc, PX_OK);
+				PX_CHECK_INT_EQ(rc0, PX_OK);
+				goto out;
+			}
+			px_dist_query(ref, p, &g);
+			if (fabs(r.dist - g.dist) > 1e-9 * (size + g.dist))
+				wrong++;
+			if (r.source == PX_TRACK_COLD) {
+				cold++;
+				if (r.n_crit != -1 || r.n_min != -1)
+					bad_ncrit++;
+				if (phase == 1 && k >= 1000)
+					late_cold++;
+				/* a jump between two minima of one curve */
+				if (r0.jumped && r0.feature == PX_TRACK_MIN &&
+				    prev_feat == PX_TRACK_MIN && r0.entity == prev_ent) {
+					between++;
+					missed += !r.jumped;
+					if (!r.jumped && getenv("PX_TEST_VERBOSE"))
+						printf("  missed: ent %d u %g, src0 %d, step %g, foot moved %g, crit0 %d\n",
+						       r.entity, r.u, r0.source, 2e-2 * size, px_v3_dist(r.point, prev_pt), r0.n_crit);
+				}
+				false_jump += r.jumped && !r0.jumped;
+			} else if (phase == 1 && k % 100 == 99) {
+				/* back to tracking: the same critical points as
+				 * the tracker that never left */
+				for (e = 0; e < 5; e++) {
+					double u[64], u0[64];
+					int ty[64], ty0[64];
+					int n = px_track_critical(t, e, u, ty, 64);
+					int n0 = px_track_critical(t0, e, u0, ty0, 64);
+					count_checked++;
+					count_bad += n != n0;
+				}
+			}
+			prev_ent = r0.entity;
+			prev_feat = r0.feature;
+			prev_pt = r.point;
+		}
+		px_track_get_stats(t, &st);
+		if (phase == 0) {
+			PX_CHECK_MSG(st.cold_entered >= 1 && cold > 500,
+				     "fast path never went cold: %ld cold updates, "
+				     "%llu switches", cold,
+				     (unsigned long long)st.cold_entered);
+		}
+	}
+	px_track_get_stats(t, &st);
+	px_track_get_stats(t0, &st0);
+	printf("  cold switch: %ld cold of %llu updates, entered %llu, left %llu, "
+	       "jumps between minima %ld (missed %ld), false jumps %ld, counts "
+	       "%ld/%ld bad, wrong %ld\n",
+	       cold, (unsigned long long)st.updates,
+	       (unsigned long long)st.cold_entered,
+	       (unsigned long long)st.cold_left, between, missed, false_jump,
+	       count_bad, count_checked, wrong);
+	PX_CHECK_INT_EQ(wrong, 0);
+	PX_CHECK_INT_EQ(bad_ncrit, 0);
+	PX_CHECK_MSG(st.cold == (uint64_t)cold, "stats.cold %llu, seen %ld",
+		     (unsigned long long)st.cold, cold);
+	PX_CHECK_MSG(st.cold_left >= 1, "never came back from cold");
+	PX_CHECK_INT_EQ(late_cold, 0);
+	PX_CHECK_MSG(between > 0, "the fast path never jumped between minima");
+	/* a jump seen from sampled answers alone: the rational circle's
+	 * evolute is its centre, and passing near it swings the foot point
+	 * round the circle in one step while the tracked ids change - such
+	 * steps are read as continuous (a few per run); a real switch
+	 * between two living minima is not */
+	PX_CHECK_MSG(missed * 5 <= between, "%ld of %ld jumps between minima "
+		     "not reported", missed, between);
+	PX_CHECK_MSG(false_jump * 20 < cold, "continuity not seen: %ld false "
+		     "jumps in %ld cold answers", false_jump, cold);
+	PX_CHECK_MSG(count_checked > 0, "no critical counts compared");
+	PX_CHECK_INT_EQ(count_bad, 0);
+	PX_CHECK_INT_EQ((long)st0.cold, 0);
+	PX_CHECK_INT_EQ((long)st0.cold_entered, 0);
+out:
+	px_track_free(t);
+	px_track_free(t0);
+	px_dist_model_free(ref);
+}
+
 static const struct px_test tests[] = {
 	PX_T(test_planar_closed_c2), PX_T(test_planar_open_c1_c0),
 	PX_T(test_planar_cusp),      PX_T(test_rational_circle),
@@ -1143,5 +1318,6 @@ static const struct px_test tests[] = {
 	PX_T(test_no_verification),  PX_T(test_random_curves),
 	PX_T(test_errors),           PX_T(test_lazy_exact),
 	PX_T(test_lazy_faults_caught), PX_T(test_certificates_brute),
+	PX_T(test_cold_switch),
 };
 PX_TEST_MAIN(tests)

@@ -434,6 +434,13 @@ int main(int argc, char **argv)
 				(unsigned long long)st.hot,
 				(unsigned long long)st.rested,
 				(unsigned long long)st.rested_entities);
+			fprintf(stderr,
+				"track_cold %llu entered %llu left %llu "
+				"tracked_ns %.0f cold_ns %.0f\n",
+				(unsigned long long)st.cold,
+				(unsigned long long)st.cold_entered,
+				(unsigned long long)st.cold_left, st.tracked_ns,
+				st.cold_ns);
 		}
 		if (strk) {
 			struct px_strack_stats st;

@@ -1,0 +1,113 @@
+/*
+ * gov_internal.h - the cost governor shared by the two trackers
+ * (px_track.c, px_strack.c): when the query point moves so fast that
+ * following every critical point costs more than the exact global query
+ * (events in most updates, leaves or cells re-solved every cycle), the
+ * tracker answers with that query instead ("cold" updates) and comes back
+ * to tracking, with a fresh set of critical points, once the steps have
+ * shrunk. Both ways are exact; only the cost differs.
+ *
+ * What is measured: one update in PX_GOV_EVERY is timed (two reads of
+ * CLOCK_MONOTONIC, about 40 ns on the machines measured, so about 3 ns an
+ * update on average), tracked or cold, and each kind keeps a running
+ * mean of its samples (the last 32 samples, 512 updates, weigh about two
+ * thirds: events come in bursts, and a burst alone should not send the
+ * tracker cold). A sample is first clipped to PX_GOV_CLIP times the
+ * other kind's mean, so that one interrupt or preemption (tens of
+ * microseconds on a shared machine) moves a mean by a bounded amount. The
+ * cold mean starts from a calibration made at setup. Switching:
+ *  - to cold when the tracked mean has at least PX_GOV_MIN_SAMPLES samples
+ *    since the last (re)start and exceeds PX_GOV_ENTER times the cold
+ *    mean;
+ *  - back to tracking when at least PX_GOV_MIN_COLD updates ran cold and
+ *    the running mean step length is below PX_GOV_LEAVE times what it was
+ *    when the tracker went cold (the tracked cost grows with the step, so
+ *    a step that has shrunk that much is where tracking paid before;
+ *    halved again, down to 1/16, each time tracking goes cold within
+ *    PX_GOV_BACK updates of such a return: a speed that swings by a
+ *    factor two is no reason to re-initialise every swing), or
+ *    as a probe after PX_GOV_PROBE cold updates, doubled each time a probe
+ *    goes cold again (up to PX_GOV_PROBE_MAX): the cost of tracking also
+ *    depends on where the point moves, not on its speed alone. A probe
+ *    decides again after PX_GOV_PROBE_SAMPLES samples.
+ * The return costs one re-initialisation (every leaf or cell solved at
+ * the new point); the thresholds keep a steady speed from switching
+ * back and forth.
+ *
+ * Memory and real-time rules: a plain struct inside the tracker, no
+ * allocation; every call is O(1) and lock-free. Tests replace the clock
+ * (px__gov_set_clock) to make the switching deterministic.
+ */
+#ifndef PX_GOV_INTERNAL_H
+#define PX_GOV_INTERNAL_H
+
+#include <stdint.h>
+
+#include "px_dist.h"
+#include "px_math.h"
+
+#define PX_GOV_EVERY 16        /* one update timed in this many */
+#define PX_GOV_CLIP 4.0        /* a sample is at most this times the other mean */
+#define PX_GOV_ENTER 1.5       /* tracked mean over cold mean to go cold */
+#define PX_GOV_LEAVE 0.5       /* step shrink factor to come back */
+#define PX_GOV_MIN_SAMPLES 32  /* timed tracked updates before going cold */
+#define PX_GOV_PROBE_SAMPLES 8 /* the same after a probe */
+#define PX_GOV_MIN_COLD 64     /* cold updates before coming back */
+#define PX_GOV_PROBE 1024      /* cold updates before a probe */
+#define PX_GOV_PROBE_MAX 16384
+#define PX_GOV_BACK 2048
+
+/* The clock: nanoseconds, monotonic. ctx is the tests' own. */
+typedef int64_t (*px_gov_clock_fn)(void *ctx);
+
+struct px_gov {
+	int on;           /* 0: always tracked */
+	int cold;         /* 1 while the global query answers */
+	uint32_t tick;    /* updates since the last timed one */
+	int n_trk;        /* tracked samples since the last (re)start */
+	uint32_t n_cold;  /* cold updates since going cold */
+	uint32_t probe;   /* cold updates before the next probe */
+	uint32_t n_back;  /* updates since the last return by step */
+	double leave;     /* step factor of the next return by step */
+	int probing;      /* tracking again as a probe */
+	double trk_ns, cold_ns;   /* running means */
+	double step, step_enter;  /* running mean step length; at going cold */
+	uint64_t entered, left;   /* switches, for the stats */
+	px_gov_clock_fn clock;
+	void *clock_ctx;
+};
+
+/* Start with a cold-query cost (ns) measured at setup; on: 0 or 1. */
+void px__gov_init(struct px_gov *g, int on, double cold_ns);
+
+/* Tracking (re)starts: tracked samples are gathered afresh. */
+void px__gov_restart(struct px_gov *g);
+
+/* Whether this update is one to time (advances the tick). */
+int px__gov_timed(struct px_gov *g);
+
+/* The clock now (ns). */
+int64_t px__gov_now(const struct px_gov *g);
+
+/* Every update's step length (the running mean the return looks at). */
+void px__gov_step(struct px_gov *g, double len);
+
+/* A timed tracked update took ns: returns 1 when the tracker should go
+ * cold from the next update on (g->cold is then set). */
+int px__gov_tracked(struct px_gov *g, double ns);
+
+/* A timed cold update took ns (the query alone). */
+void px__gov_cold_sample(struct px_gov *g, double ns);
+
+/* In cold mode, once per update: returns 1 when this update should go
+ * back to tracking (g->cold is then cleared). */
+int px__gov_leave(struct px_gov *g);
+
+/* Setup only: the cold query's cost (ns) at points spread over box,
+ * from the real clock. */
+double px__gov_calibrate(struct px_dist_model *m, px_aabb box);
+
+/* Tests: another clock (NULL: CLOCK_MONOTONIC). */
+void px__gov_set_clock(struct px_gov *g, px_gov_clock_fn fn, void *ctx);
+
+#endif
