@@ -11,7 +11,10 @@
  * 16-patch bicubic, a concave fold, with cells solved per update.
  * BENCH_TRACK_DEPTH=d overrides the event-grid depth (default 4),
  * BENCH_TRACK_LEAVES=n the parameter leaves per span (default 4);
- * BENCH_TRACK_WORST=1 prints what the worst update of each curve row did.
+ * BENCH_TRACK_WORST=1 prints what the worst update of each curve row did;
+ * BENCH_TRACK_GOV=1 what the cold switch saw and did per row (its means,
+ * cold updates, switches). The header line of each curve model gives the
+ * cost of a re-initialisation (reset: the least of 20).
  * BENCH_TRACK_CURVES_ONLY=1 stops after the curve models (profiling);
  * BENCH_TRACK_LAZY=0 turns lazy correction off; BENCH_TRACK_MODEL=text runs
  * only the curve models whose name holds text, BENCH_TRACK_STEP=0..3 only
