@@ -51,6 +51,11 @@
  *    root leaves the quick evolution (predictor, one evaluation, one
  *    accepted Newton step inside its leaf), an update is that evolution
  *    and nothing else (stats.hot).
+ *  - Cold switch (opts.cold_switch, on by default): when following every
+ *    critical point costs more than the exact global query (fast motion,
+ *    events in most updates; one update in 16 is timed), updates are
+ *    answered by px_dist_query() until the steps shrink (or a probe finds
+ *    tracking cheap again), then the critical points are found afresh.
  *  - Transitions: pairs appear or vanish only where the moving point
  *    crosses the transition set {p : g = 0 and dg/ds = 0} (the evolute of
  *    a planar curve, a ruled surface of polar lines for a space curve) or,
