@@ -83,14 +83,32 @@ void px__gov_init(struct px_gov *g, int on, double cold_ns);
 /* Tracking (re)starts: tracked samples are gathered afresh. */
 void px__gov_restart(struct px_gov *g);
 
-/* Whether this update is one to time (advances the tick). */
-int px__gov_timed(struct px_gov *g);
+/* Whether this update is one to time (advances the tick). Inline: every
+ * update calls it. */
+static inline int px__gov_timed(struct px_gov *g)
+{
+	if (!g->on)
+		return 0;
+	if (++g->tick < PX_GOV_EVERY)
+		return 0;
+	g->tick = 0;
+	return 1;
+}
 
 /* The clock now (ns). */
 int64_t px__gov_now(const struct px_gov *g);
 
-/* Every update's step length (the running mean the return looks at). */
-void px__gov_step(struct px_gov *g, double len);
+/* Every update's step length (the running mean the return looks at:
+ * the last 16 steps weigh about two thirds). Inline: every update calls
+ * it. */
+static inline void px__gov_step(struct px_gov *g, double len)
+{
+	if (!(len >= 0.0) || len > 1e300)
+		return;
+	g->step += 0.0625 * (len - g->step);
+	if (!g->cold && g->n_back < UINT32_MAX)
+		g->n_back++;
+}
 
 /* A timed tracked update took ns: returns 1 when the tracker should go
  * cold from the next update on (g->cold is then set). */

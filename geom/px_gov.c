@@ -8,7 +8,6 @@
 
 /* running means: the last 32 timed samples weigh about two thirds */
 #define GOV_ALPHA (1.0 / 32)
-#define GOV_STEP_ALPHA 0.0625
 
 static int64_t mono_ns(void *ctx)
 {
@@ -56,25 +55,6 @@ void px__gov_set_clock(struct px_gov *g, px_gov_clock_fn fn, void *ctx)
 int64_t px__gov_now(const struct px_gov *g)
 {
 	return g->clock(g->clock_ctx);
-}
-
-int px__gov_timed(struct px_gov *g)
-{
-	if (!g->on)
-		return 0;
-	if (++g->tick < PX_GOV_EVERY)
-		return 0;
-	g->tick = 0;
-	return 1;
-}
-
-void px__gov_step(struct px_gov *g, double len)
-{
-	if (!(len >= 0.0) || len > 1e300)
-		return;
-	g->step += GOV_STEP_ALPHA * (len - g->step);
-	if (!g->cold && g->n_back < UINT32_MAX)
-		g->n_back++;
 }
 
 static double clip(double x, double lim)

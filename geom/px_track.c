@@ -1297,14 +1297,16 @@ static void mark_leaf(struct px_track *t, int li, int *nh)
 /* Leaves that may hold an event along p0 -> p1, grown while a root
  * crosses the outer boundary of the region. Returns their count. Only
  * leaves whose safe radius the travelled path has used up are tested
- * (exactly, along the segment), then given a new radius at p1. */
-static int collect_events(struct px_track *t, px_vec3 p0, px_vec3 p1)
+ * (exactly, along the segment), then given a new radius at p1; len is
+ * |p1 - p0| (the update measured it once). */
+static int collect_events(struct px_track *t, px_vec3 p0, px_vec3 p1,
+			  double len)
 {
 	int nh = 0, k, n = t->n_leaves;
 
 	if (!t->heap_ok)
 		heap_rebuild(t, p0);
-	t->travel += px_v3_dist(p0, p1);
+	t->travel += len;
 	/* A due leaf is tested and gets its new expiry. A radius of 0 gives
 	 * expiry == travel: due at the next update with any motion (the
 	 * comparisons are strict). */
@@ -2048,13 +2050,14 @@ static int cold_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 	return 0;
 }
 
-static int track_update(struct px_track *t, px_vec3 p, int fresh,
+static int track_update(struct px_track *t, px_vec3 p, double len, int fresh,
 			struct px_track_result *r);
 
 int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 {
 	int64_t t0 = 0;
 	int timed, rc, fresh = 0;
+	double len;
 
 	if (!t || !r)
 		return PX_E_INVAL;
@@ -2062,8 +2065,10 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 		return PX_E_NAN;
 	if (!t->init)
 		return px_track_reset(t, p, r);
+	/* the step's length, for the travelled path and the cold switch */
+	len = px_v3_dist(t->p, p);
 	if (t->gov.on) {
-		px__gov_step(&t->gov, px_v3_dist(p, t->p));
+		px__gov_step(&t->gov, len);
 		if (t->gov.cold) {
 			if (!px__gov_leave(&t->gov)) {
 				if (cold_update(t, p, r) == 0)
@@ -2078,7 +2083,7 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 	timed = px__gov_timed(&t->gov);
 	if (timed)
 		t0 = px__gov_now(&t->gov);
-	rc = track_update(t, p, fresh, r);
+	rc = track_update(t, p, len, fresh, r);
 	if (timed && px__gov_tracked(&t->gov, (double)(px__gov_now(&t->gov) - t0))) {
 		/* cold from the next update on */
 		t->st.cold_entered++;
@@ -2091,9 +2096,9 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 	return rc;
 }
 
-/* The tracked update; fresh: every critical point found again at p (the
- * return from cold answers). */
-static int track_update(struct px_track *t, px_vec3 p, int fresh,
+/* The tracked update; len: |p - t->p|; fresh: every critical point found
+ * again at p (the return from cold answers). */
+static int track_update(struct px_track *t, px_vec3 p, double len, int fresh,
 			struct px_track_result *r)
 {
 	int i, j, nh, rc, in;
@@ -2140,7 +2145,7 @@ static int track_update(struct px_track *t, px_vec3 p, int fresh,
 		return PX_OK;
 	}
 
-	nh = collect_events(t, p0, p);
+	nh = collect_events(t, p0, p, len);
 	if (t->hot_ent >= 0) {
 		if (nh == 0 && !hot_update(t, p, r)) {
 			if (t->opts.verify_every > 0) {

@@ -398,6 +398,21 @@ struct run_stats {
 	struct px_track_stats ts;
 };
 
+/* The box the test paths run in: the model's bounds grown by a third of
+ * its diagonal on every side (paths reach beyond the model). Returns
+ * the diagonal. */
+static double path_box(struct px_dist_model *ref, px_aabb *box)
+{
+	struct px_dist_info di;
+	double size;
+	px_dist_model_info(ref, &di);
+	*box = di.bounds;
+	size = px_aabb_diagonal(box);
+	box->min = px_v3_sub(box->min, px_v3(0.3 * size, 0.3 * size, 0.3 * size));
+	box->max = px_v3_add(box->max, px_v3(0.3 * size, 0.3 * size, 0.3 * size));
+	return size;
+}
+
 /* Run trajectories over a model: every step checked against the global
  * query (wrong branch), every dense_every-th step against brute force and
  * the dense count. */
@@ -430,15 +445,7 @@ static void run_model(const struct tcurve *tc, int ne, int n_steps,
 	rc = px_dist_model_create(cs, ne, NULL, 0, NULL, &ref);
 	PX_CHECK_INT_EQ(rc, PX_OK);
 	px_track_get_info(t, &info);
-	{
-		struct px_dist_info di;
-		px_dist_model_info(ref, &di);
-		box = di.bounds;
-	}
-	size = px_aabb_diagonal(&box);
-	/* paths reach a third of the size beyond the model */
-	box.min = px_v3_sub(box.min, px_v3(0.3 * size, 0.3 * size, 0.3 * size));
-	box.max = px_v3_add(box.max, px_v3(0.3 * size, 0.3 * size, 0.3 * size));
+	size = path_box(ref, &box);
 
 	for (kind = 0; kind < 2; kind++)
 		for (s = 0; s < 4; s++) {
@@ -1194,14 +1201,7 @@ static void test_cold_switch(void)
 		goto out;
 	px__track_set_clock(t, fake_clock, &fc);
 	px__track_set_clock(t0, fake_clock, &fc);
-	{
-		struct px_dist_info di;
-		px_dist_model_info(ref, &di);
-		box = di.bounds;
-	}
-	size = px_aabb_diagonal(&box);
-	box.min = px_v3_sub(box.min, px_v3(0.3 * size, 0.3 * size, 0.3 * size));
-	box.max = px_v3_add(box.max, px_v3(0.3 * size, 0.3 * size, 0.3 * size));
+	size = path_box(ref, &box);
 	px_track_get_stats(t, &st);
 	PX_CHECK_MSG(st.cold_ns > 0.0, "no calibrated cold cost");
 
