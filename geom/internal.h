@@ -114,6 +114,8 @@ extern double px__strack_radius_scale;
 /* Test hook: 1 turns the surface tracker's hot path off, 2 makes its
  * certificate never expire (a fault the tests must see). */
 void px__strack_set_hot_fault(struct px_strack *t, int fault);
+/* Test hook: the cold switch's clock (NULL: CLOCK_MONOTONIC). */
+void px__strack_set_clock(struct px_strack *t, int64_t (*fn)(void *), void *ctx);
 
 /*
  * Sub-block extraction shared by curves (nd = 1) and surfaces (nd = 2):

@@ -25,6 +25,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "gov_internal.h"
 #include "internal.h"
 #include "px_bern.h"
 
@@ -181,6 +182,19 @@ struct px_strack {
 	double hot_until;
 	int hot_nmin, hot_nmax, hot_nsad, hot_ncrit, hot_ccrit;
 	int fault_hot;          /* test hook: 1 hot path off, 2 never expires */
+	/* cold switch (gov_internal.h): gov_q the last query point (step
+	 * lengths); ret_left > 0 while the set is re-established after
+	 * cold answers (those updates are not timed: the rebuild is the
+	 * return's cost, not tracking's); cprev the last answer when it is
+	 * an interior point of a surface (a cold answer's jumped follows it) */
+	struct px_gov gov;
+	px_vec3 gov_q;
+	int ret_left;
+	struct {
+		int ok, s;
+		double u, v;
+		px_vec3 q;
+	} cprev;
 	struct px_strack_stats st;
 };
 
@@ -1116,6 +1130,11 @@ int px_strack_reset(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 	t->st.updates++;
 	t->p = p;
 	t->init = 1;
+	if (t->gov.cold)
+		t->st.cold_left++;
+	px__gov_restart(&t->gov);
+	t->gov_q = p;
+	t->ret_left = 0;
 	t->best_kind = 0;
 	t->have_last = 0;
 	t->mode = ST_TRACK;
@@ -1551,18 +1570,13 @@ static int hot_update(struct px_strack *t, px_vec3 p,
 	return 0;
 }
 
-int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
+/* The tracked update (every mode but cold). */
+static int strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 {
 	struct px_track_result cr;
 	px_vec3 p0;
 	int rc, nh;
 
-	if (!t || !r)
-		return PX_E_INVAL;
-	if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
-		return PX_E_NAN;
-	if (!t->init)
-		return px_strack_reset(t, p, r);
 	result_clear(r);
 	t->st.updates++;
 	if (++t->epoch == 0)
@@ -1631,6 +1645,185 @@ int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 	return PX_OK;
 }
 
+/* ------------------------------------------------------------------ */
+/* cold switch                                                         */
+
+/* (u, v) off the open domain edges (a seam direction has none). */
+static int uv_inner(const struct ssurf *f, double u, double v)
+{
+	return (f->wrap_u || (u > f->u0 + 1e-9 * f->du && u < f->u1 - 1e-9 * f->du)) &&
+	       (f->wrap_v || (v > f->v0 + 1e-9 * f->dv && v < f->v1 - 1e-9 * f->dv));
+}
+
+/* Keep the answer r at p as the last one for the cold answers' jumped:
+ * an interior point of a surface is followed from there. */
+static void cold_keep(struct px_strack *t, px_vec3 p,
+		      const struct px_strack_result *r)
+{
+	int s = r->entity - t->n_curves;
+	t->cprev.ok = s >= 0 && s < t->n_surf &&
+		      (r->feature == PX_STRACK_MIN || r->feature == PX_STRACK_GLOBAL) &&
+		      uv_inner(&t->sf[s], r->u, r->v);
+	t->cprev.s = s;
+	t->cprev.u = r->u;
+	t->cprev.v = r->v;
+	t->cprev.q = p;
+	t->last_point = r->point;
+	t->last_q = p;
+	t->last_entity = r->entity;
+	t->have_last = 1;
+	t->best_kind = 0;
+}
+
+/*
+ * jumped for a cold answer g at p. Nothing was followed, so the last
+ * answer is: when it was an interior minimum of the same surface, that
+ * minimum is followed to p (predictor and Newton, in sub-steps when the
+ * step is long). Landing on g's point means g continues it; landing on
+ * another minimum means the closest point is now another one (a jump);
+ * losing it means it died at a fold (a jump when g is interior: the
+ * closest point left it discontinuously) or left through an edge (then
+ * judged as a global answer: a foot point that moved far more than the
+ * query point).
+ */
+static int cold_jumped(struct px_strack *t, px_vec3 p,
+		       const struct px_dist_result *g)
+{
+	const struct ssurf *f;
+	struct crit w, last, c;
+	px_vec3 gr;
+	double moved;
+	int far, s = g->entity - t->n_curves;
+	if (!t->have_last || g->entity != t->last_entity)
+		return 1;
+	moved = px_v3_dist(g->point, t->last_point);
+	if (moved <= 1e-9 * (t->scale + g->dist))
+		return 0;
+	far = moved > 4.0 * px_v3_dist(p, t->last_q) + 1e-9 * t->scale;
+	if (!t->cprev.ok || t->cprev.s != s || s < 0 || s >= t->n_surf)
+		return far;
+	f = &t->sf[s];
+	memset(&w, 0, sizeof(w));
+	w.u = t->cprev.u;
+	w.v = t->cprev.v;
+	crit_eval(f, &w, t->cprev.q, &gr);
+	w.type = crit_type(&w);
+	if (w.type != 1)
+		return far;
+	if (follow(f, &w, t->cprev.q, px_v3_sub(p, t->cprev.q), p, &last))
+		return uv_inner(f, g->u, g->v) ? 1 : far;
+	c.u = g->u;
+	c.v = g->v;
+	return !crit_dup(f, &w, &c);
+}
+
+/* An update answered cold: the global query alone. Returns 0 or the
+ * query's error (the caller then tracks again). */
+static int cold_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
+{
+	struct px_dist_result g;
+	int timed = px__gov_timed(&t->gov), rc;
+	int64_t t0 = timed ? px__gov_now(&t->gov) : 0;
+	rc = px_dist_query(t->dist, p, &g);
+	if (timed)
+		px__gov_cold_sample(&t->gov, (double)(px__gov_now(&t->gov) - t0));
+	if (rc)
+		return rc;
+	result_clear(r);
+	t->st.updates++;
+	t->st.cold++;
+	r->dist = g.dist;
+	r->point = g.point;
+	r->u = g.u;
+	r->v = g.v;
+	r->entity = g.entity;
+	r->dir = g.dir;
+	r->feature = PX_STRACK_GLOBAL;
+	r->n_crit = r->n_min = r->n_max = r->n_saddle = -1;
+	r->source = PX_TRACK_COLD;
+	r->jumped = cold_jumped(t, p, &g);
+	cold_keep(t, p, r);
+	return 0;
+}
+
+/* The tracker goes cold after the update that answered r at p: the set
+ * is dropped (it is not followed; px_strack_critical() holds none). */
+static void cold_enter(struct px_strack *t, px_vec3 p,
+		       const struct px_strack_result *r)
+{
+	int i;
+	t->st.cold_entered++;
+	t->hot_s = -1;
+	t->ret_left = 0;
+	for (i = 0; i < t->n_surf; i++)
+		t->sf[i].nz = 0;
+	cold_keep(t, p, r);
+}
+
+/* Back from cold answers at p: the curve tracker starts afresh at p and
+ * the surface set is re-established in slices (max_solves > 0, answered
+ * globally meanwhile) or at once. */
+static int cold_return(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
+{
+	struct px_track_result cr;
+	int slice = t->opts.max_solves > 1 ? t->opts.max_solves / 2 : 1;
+	t->st.cold_left++;
+	if (t->opts.max_solves > 0) {
+		curves_update(t, p, &cr, 1);
+		rebuild_start(t);
+		/* the rebuild's slices, then a margin for catching up */
+		t->ret_left = t->n_cells / slice + 2 * PX_GOV_MIN_COLD;
+		return strack_update(t, p, r);
+	}
+	result_clear(r);
+	t->st.updates++;
+	t->p = p;
+	t->mode = ST_TRACK;
+	t->hot_s = -1;
+	return full_reset(t, p, r);
+}
+
+int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
+{
+	int64_t t0 = 0;
+	int timed, rc;
+
+	if (!t || !r)
+		return PX_E_INVAL;
+	if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
+		return PX_E_NAN;
+	if (!t->init)
+		return px_strack_reset(t, p, r);
+	if (t->gov.on) {
+		px__gov_step(&t->gov, px_v3_dist(t->gov_q, p));
+		t->gov_q = p;
+		if (t->gov.cold) {
+			if (!px__gov_leave(&t->gov)) {
+				if (cold_update(t, p, r) == 0)
+					return PX_OK;
+				/* no global answer here: track again */
+				px__gov_restart(&t->gov);
+			}
+			return cold_return(t, p, r);
+		}
+	}
+	timed = t->ret_left == 0 && px__gov_timed(&t->gov);
+	if (timed)
+		t0 = px__gov_now(&t->gov);
+	rc = strack_update(t, p, r);
+	if (t->ret_left > 0 && (t->mode == ST_TRACK || --t->ret_left == 0))
+		t->ret_left = 0;
+	if (timed && px__gov_tracked(&t->gov, (double)(px__gov_now(&t->gov) - t0)))
+		cold_enter(t, p, r);
+	return rc;
+}
+
+void px__strack_set_clock(struct px_strack *t, int64_t (*fn)(void *), void *ctx)
+{
+	if (t)
+		px__gov_set_clock(&t->gov, fn, ctx);
+}
+
 void px__strack_set_hot_fault(struct px_strack *t, int fault)
 {
 	if (t) {
@@ -1685,10 +1878,13 @@ void px_strack_get_stats(const struct px_strack *t, struct px_strack_stats *s)
 {
 	if (!s)
 		return;
-	if (!t)
+	if (!t) {
 		memset(s, 0, sizeof(*s));
-	else
-		*s = t->st;
+		return;
+	}
+	*s = t->st;
+	s->tracked_ns = t->gov.trk_ns;
+	s->cold_ns = t->gov.cold_ns;
 }
 
 void px_strack_get_info(const struct px_strack *t, struct px_strack_info *info)
@@ -1729,6 +1925,7 @@ void px_strack_opts_default(struct px_strack_opts *o)
 	o->verify_every = 0;
 	o->max_solves = 4;
 	o->dist = NULL;
+	o->cold_switch = 1;
 }
 
 /* Distinct knot values of one direction inside the domain, with both
@@ -2431,6 +2628,16 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	t->epoch = 1;
 	t->hot_s = -1;
 	t->ans_s = -1;
+	{
+		/* the cold query's cost where a tool works: about the model
+		 * (as px_track does) */
+		px_aabb cb = bounds;
+		double m = 0.3 * t->scale;
+		cb.min = px_v3_sub(cb.min, px_v3(m, m, m));
+		cb.max = px_v3_add(cb.max, px_v3(m, m, m));
+		px__gov_init(&t->gov, o.cold_switch != 0,
+			     o.cold_switch ? px__gov_calibrate(t->dist, cb) : 1.0);
+	}
 	rc = PX_OK;
 	*out = t;
 	t = NULL;

@@ -61,6 +61,9 @@
  *    proven farther; after an update answered by the curve tracker, that
  *    tracker alone); the other points rest and are followed from where
  *    they were at the next full update (stats.hot).
+ *  - Fast motion (opts.cold_switch): while following the set costs more
+ *    than the global query, the global query answers (PX_TRACK_COLD);
+ *    the set is re-established when the steps have shrunk.
  *  - Never silent: verification every verify_every updates against
  *    px_dist_query() on the whole model counts disagreements and
  *    re-initialises; capacity overflow answers globally (counted).
@@ -125,6 +128,17 @@ struct px_strack_opts {
 	int max_solves;
 	/* Options of the global-query model (NULL: defaults). */
 	const struct px_dist_opts *dist;
+	/* Cold switch (default 1), as px_track_opts.cold_switch: when
+	 * tracking costs more than the exact global query (fast motion:
+	 * cells due and solved in most updates, the set catching up), the
+	 * updates are answered by px_dist_query() (source PX_TRACK_COLD)
+	 * until the mean step has halved (or as a probe after a while);
+	 * then the critical points are re-established in budgeted slices
+	 * as after an over-budget update (max_solves > 0; at once with 0),
+	 * the curve tracker started afresh at the point. Both answers are
+	 * exact; this bounds the cost of fast motion by the global
+	 * query's. 0: always track. */
+	int cold_switch;
 };
 
 PX_API void px_strack_opts_default(struct px_strack_opts *o);
@@ -159,6 +173,11 @@ struct px_strack_result {
 	int born, died;
 	int verified;
 };
+/* On cold answers (source PX_TRACK_COLD) n_crit, n_min, n_max and
+ * n_saddle are -1 (nothing followed) and feature is PX_STRACK_GLOBAL;
+ * jumped compares with the last answer: an interior minimum followed
+ * from there (predictor and Newton) must land on the new one, other
+ * features as for PX_TRACK_GLOBAL. */
 
 struct px_strack_stats {
 	uint64_t updates, reinits, outside, fallbacks, overflows;
@@ -175,6 +194,11 @@ struct px_strack_stats {
 	uint64_t curve_skips;
 	/* updates on the hot path: the answering minimum followed alone */
 	uint64_t hot;
+	/* cold switch: updates answered cold, switches to cold and back,
+	 * running mean cost (ns) of a timed tracked update (every mode but
+	 * cold) and of the cold query */
+	uint64_t cold, cold_entered, cold_left;
+	double tracked_ns, cold_ns;
 };
 
 struct px_strack_info {
@@ -213,7 +237,7 @@ PX_API int px_strack_reset(struct px_strack *t, px_vec3 p,
  * in every case: from the tracked set (source PX_TRACK_TRACKED or, the
  * first after catching up, PX_TRACK_REINIT) or from px_dist_query()
  * (PX_TRACK_GLOBAL: over the budget, catching up, outside the working
- * volume); for those, jumped means a change of entity or a foot point
+ * volume; PX_TRACK_COLD: fast motion, opts.cold_switch); for global ones, jumped means a change of entity or a foot point
  * that moved far more than the query point. n_crit counts the curve
  * tracker's points as of its last update. @note RT-safe. */
 PX_API int px_strack_update(struct px_strack *t, px_vec3 p,
