@@ -586,6 +586,7 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 	static px_vec3 q[NSSTEP];
 	static int64_t tt[NSSTEP], tg[NSSTEP], it[NSSTEP], ig[NSSTEP], tw[NSSTEP];
 	static int sw_solved[NSSTEP], sw_tests[NSSTEP], sw_src[NSSTEP];
+	static int64_t tc[NSSTEP];
 	int worst_env = getenv("BENCH_TRACK_WORST") != NULL;
 	static const double steps[] = {1e-4, 1e-3, 1e-2, 5e-2};
 	struct surf_row row[2][4];
@@ -632,7 +633,7 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 			struct px_strack_result r;
 			struct px_strack_stats a, b;
 			struct px_dist_result g;
-			long wrong = 0, crit = 0, glob = 0;
+			long wrong = 0, crit = 0, glob = 0, ncrit = 0, cold = 0;
 			double bmean, cmean;
 			int kw = -1;
 			if (getenv("BENCH_TRACK_STEP") && atoi(getenv("BENCH_TRACK_STEP")) != s) {
@@ -658,12 +659,26 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 				x = now_ns();
 				px_dist_query(ref, q[k], &g);
 				tg[k] = now_ns() - x;
-				crit += r.n_crit;
+				/* cold answers follow nothing (n_crit -1) */
+				if (r.source != PX_TRACK_COLD) {
+					crit += r.n_crit;
+					ncrit++;
+				}
 				glob += r.source == PX_TRACK_GLOBAL;
+				if (r.source == PX_TRACK_COLD)
+					tc[cold++] = tt[k];
 				if (fabs(r.dist - g.dist) > 1e-9 * (size + g.dist))
 					wrong++;
 			}
 			px_strack_get_stats(t, &b);
+			if (cold > 0)
+				qsort(tc, (size_t)cold, sizeof(tc[0]), cmp_i64);
+			if (getenv("BENCH_TRACK_GOV"))
+				printf("  gov: tracked %.0f ns, cold %.0f ns, cold updates %ld (median %lld ns), entered %llu, left %llu\n",
+				       b.tracked_ns, b.cold_ns, cold,
+				       cold > 0 ? (long long)tc[cold / 2] : 0LL,
+				       (unsigned long long)(b.cold_entered - a.cold_entered),
+				       (unsigned long long)(b.cold_left - a.cold_left));
 			{
 				/* the work's worst case: each update's least time
 				 * over this run and two more (the same states:
@@ -748,7 +763,7 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 			       wrong,
 			       (double)(b.cell_solves - a.cell_solves) / NSSTEP,
 			       (double)(b.box_tests - a.box_tests) / NSSTEP,
-			       (double)crit / NSSTEP, 100.0 * glob / NSSTEP,
+			       ncrit ? (double)crit / ncrit : 0.0, 100.0 * glob / NSSTEP,
 			       (long long)row[kind][s].ins_med,
 			       (long long)row[kind][s].cold_ins_med,
 			       row[kind][s].ins_med > 0

@@ -192,7 +192,7 @@ struct px_strack {
 	int ret_left;
 	struct {
 		int ok, s;
-		double u, v;
+		struct crit z;
 		px_vec3 q;
 	} cprev;
 	struct px_strack_stats st;
@@ -1655,18 +1655,39 @@ static int uv_inner(const struct ssurf *f, double u, double v)
 	       (f->wrap_v || (v > f->v0 + 1e-9 * f->dv && v < f->v1 - 1e-9 * f->dv));
 }
 
-/* Keep the answer r at p as the last one for the cold answers' jumped:
- * an interior point of a surface is followed from there. */
-static void cold_keep(struct px_strack *t, px_vec3 p,
-		      const struct px_strack_result *r)
+/* The answer r at p as a critical point, when it is an interior one of
+ * a surface that is a minimum there (the cold answers' jumped follows
+ * it): 1 with *z evaluated, else 0. One evaluation. */
+static int cold_crit(const struct px_strack *t, px_vec3 p,
+		     const struct px_strack_result *r, struct crit *z)
 {
+	const struct ssurf *f;
+	px_vec3 gr;
 	int s = r->entity - t->n_curves;
-	t->cprev.ok = s >= 0 && s < t->n_surf &&
-		      (r->feature == PX_STRACK_MIN || r->feature == PX_STRACK_GLOBAL) &&
-		      uv_inner(&t->sf[s], r->u, r->v);
-	t->cprev.s = s;
-	t->cprev.u = r->u;
-	t->cprev.v = r->v;
+	if (s < 0 || s >= t->n_surf ||
+	    (r->feature != PX_STRACK_MIN && r->feature != PX_STRACK_GLOBAL))
+		return 0;
+	f = &t->sf[s];
+	if (!uv_inner(f, r->u, r->v))
+		return 0;
+	memset(z, 0, sizeof(*z));
+	z->u = r->u;
+	z->v = r->v;
+	crit_eval(f, z, p, &gr);
+	z->type = crit_type(z);
+	return z->type == 1;
+}
+
+/* Keep the answer r at p (z: cold_crit()'s, ok its return) as the last
+ * one for the cold answers' jumped. */
+static void cold_keep(struct px_strack *t, px_vec3 p,
+		      const struct px_strack_result *r, const struct crit *z,
+		      int ok)
+{
+	t->cprev.ok = ok;
+	t->cprev.s = r->entity - t->n_curves;
+	if (ok)
+		t->cprev.z = *z;
 	t->cprev.q = p;
 	t->last_point = r->point;
 	t->last_q = p;
@@ -1675,25 +1696,54 @@ static void cold_keep(struct px_strack *t, px_vec3 p,
 	t->best_kind = 0;
 }
 
+/* Parameter offset a - b of surface f as a length in domain units (the
+ * shorter way round a seam). */
+static double uv_gap(const struct ssurf *f, double du, double dv)
+{
+	if (f->wrap_u)
+		du = remainder(du, f->du);
+	if (f->wrap_v)
+		dv = remainder(dv, f->dv);
+	return hypot(du / f->du, dv / f->dv);
+}
+
+/* The predictor (section 4.2) of z for a move dp: (su, sv). 0 when H is
+ * singular. */
+static int predict(const struct crit *z, px_vec3 dp, double *su, double *sv)
+{
+	double a = px_v3_dot(z->su, dp), b = px_v3_dot(z->sv, dp);
+	double det = z->h11 * z->h22 - z->h12 * z->h12;
+	if (!(fabs(det) > 0.0))
+		return 0;
+	*su = (z->h22 * a - z->h12 * b) / det;
+	*sv = (-z->h12 * a + z->h11 * b) / det;
+	return isfinite(*su) && isfinite(*sv);
+}
+
 /*
- * jumped for a cold answer g at p. Nothing was followed, so the last
- * answer is: when it was an interior minimum of the same surface, that
- * minimum is followed to p (predictor and Newton, in sub-steps when the
- * step is long). Landing on g's point means g continues it; landing on
- * another minimum means the closest point is now another one (a jump);
- * losing it means it died at a fold (a jump when g is interior: the
- * closest point left it discontinuously) or left through an edge (then
- * judged as a global answer: a foot point that moved far more than the
- * query point).
+ * jumped for a cold answer g at p (c: g as a critical point when c_ok).
+ * Nothing was followed, so the last answer decides, when it was an
+ * interior minimum of the same surface:
+ *  - both interior minima and the predictor, run forward from the last
+ *    one and backward from the new one, lands each within half the
+ *    parameter moved of the other: the same branch (on one branch its
+ *    error is second order in the step, a jump lands it far off);
+ *  - else the last minimum is followed to p (predictor and Newton, in
+ *    one step or four): landing on g means g continues it; on another minimum, the
+ *    closest point left a living minimum (a jump); losing it means it
+ *    died at a fold (a jump when g is interior) or left through an edge.
+ * Otherwise (edges, curves, poles) as a global answer: a foot point that
+ * moved far more than the query point.
  */
 static int cold_jumped(struct px_strack *t, px_vec3 p,
-		       const struct px_dist_result *g)
+		       const struct px_dist_result *g, const struct crit *c,
+		       int c_ok)
 {
 	const struct ssurf *f;
-	struct crit w, last, c;
-	px_vec3 gr;
-	double moved;
-	int far, s = g->entity - t->n_curves;
+	const struct crit *z = &t->cprev.z;
+	struct crit w;
+	double moved, du, dv, gap, su, sv;
+	int far, n, s = g->entity - t->n_curves;
 	if (!t->have_last || g->entity != t->last_entity)
 		return 1;
 	moved = px_v3_dist(g->point, t->last_point);
@@ -1703,18 +1753,31 @@ static int cold_jumped(struct px_strack *t, px_vec3 p,
 	if (!t->cprev.ok || t->cprev.s != s || s < 0 || s >= t->n_surf)
 		return far;
 	f = &t->sf[s];
-	memset(&w, 0, sizeof(w));
-	w.u = t->cprev.u;
-	w.v = t->cprev.v;
-	crit_eval(f, &w, t->cprev.q, &gr);
-	w.type = crit_type(&w);
-	if (w.type != 1)
-		return far;
-	if (follow(f, &w, t->cprev.q, px_v3_sub(p, t->cprev.q), p, &last))
-		return uv_inner(f, g->u, g->v) ? 1 : far;
-	c.u = g->u;
-	c.v = g->v;
-	return !crit_dup(f, &w, &c);
+	if (c_ok) {
+		du = c->u - z->u;
+		dv = c->v - z->v;
+		gap = uv_gap(f, du, dv);
+		if (predict(z, px_v3_sub(p, t->cprev.q), &su, &sv) &&
+		    uv_gap(f, du - su, dv - sv) <= 0.5 * gap &&
+		    predict(c, px_v3_sub(t->cprev.q, p), &su, &sv) &&
+		    uv_gap(f, du + su, dv + sv) <= 0.5 * gap)
+			return 0;
+	}
+	/* one step, else four (a long step near a focal point; bounded
+	 * work: at most five corrections) */
+	for (n = 1; n <= 4; n *= 4) {
+		px_vec3 dp = px_v3_scale(px_v3_sub(p, t->cprev.q), 1.0 / n);
+		int k;
+		w = *z;
+		for (k = 1; k <= n; k++) {
+			px_vec3 pk = k == n ? p : px_v3_add(t->cprev.q, px_v3_scale(dp, (double)k));
+			if (evolve(f, &w, dp, pk) || w.type != 1)
+				break;
+		}
+		if (k > n)
+			return uv_gap(f, w.u - g->u, w.v - g->v) > 1e-7;
+	}
+	return c_ok ? 1 : far;
 }
 
 /* An update answered cold: the global query alone. Returns 0 or the
@@ -1722,7 +1785,8 @@ static int cold_jumped(struct px_strack *t, px_vec3 p,
 static int cold_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 {
 	struct px_dist_result g;
-	int timed = px__gov_timed(&t->gov), rc;
+	struct crit c;
+	int timed = px__gov_timed(&t->gov), rc, ok;
 	int64_t t0 = timed ? px__gov_now(&t->gov) : 0;
 	rc = px_dist_query(t->dist, p, &g);
 	if (timed)
@@ -1741,8 +1805,9 @@ static int cold_update(struct px_strack *t, px_vec3 p, struct px_strack_result *
 	r->feature = PX_STRACK_GLOBAL;
 	r->n_crit = r->n_min = r->n_max = r->n_saddle = -1;
 	r->source = PX_TRACK_COLD;
-	r->jumped = cold_jumped(t, p, &g);
-	cold_keep(t, p, r);
+	ok = cold_crit(t, p, r, &c);
+	r->jumped = cold_jumped(t, p, &g, &c, ok);
+	cold_keep(t, p, r, &c, ok);
 	return 0;
 }
 
@@ -1751,13 +1816,14 @@ static int cold_update(struct px_strack *t, px_vec3 p, struct px_strack_result *
 static void cold_enter(struct px_strack *t, px_vec3 p,
 		       const struct px_strack_result *r)
 {
+	struct crit c;
 	int i;
 	t->st.cold_entered++;
 	t->hot_s = -1;
 	t->ret_left = 0;
 	for (i = 0; i < t->n_surf; i++)
 		t->sf[i].nz = 0;
-	cold_keep(t, p, r);
+	cold_keep(t, p, r, &c, cold_crit(t, p, r, &c));
 }
 
 /* Back from cold answers at p: the curve tracker starts afresh at p and

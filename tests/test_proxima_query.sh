@@ -96,6 +96,7 @@ done
 expect "--track --stats" 0 "$bin" --track --stats tests/data/circle.obj "$tmp/path.csv"
 err_has "--track stats: tracker counters" '^track_updates 3000 leaf_solves [0-9]+ created [0-9]+ annihilated [0-9]+ reinits [0-9]+ outside [0-9]+ fallbacks 0$'
 err_has "--track stats: hot-path counters" '^track_hot [1-9][0-9]* rested [0-9]+ rested_entities [0-9]+$'
+err_has "--track stats: cold-switch counters" '^track_cold [0-9]+ entered [0-9]+ left [0-9]+ tracked_ns [0-9]+ cold_ns [1-9][0-9]*$'
 # Surfaces (px_strack): the bicubic patch and the rational sphere (poles,
 # a closed seam) along the same paths; u and v must reproduce the point.
 for model in bicubic sphere; do
@@ -116,6 +117,7 @@ expect "--track --stats surface" 0 "$bin" --track --stats tests/data/bicubic.obj
 err_has "--track stats: surface tracker counters" '^strack_updates 3000 cell_solves [0-9]+ reinits [0-9]+ outside [0-9]+ fallbacks [0-9]+$'
 err_has "--track stats: surface budget counters" '^strack_over_budget [0-9]+ catching_up [0-9]+ curve_skips [0-9]+$'
 err_has "--track stats: surface hot-path counter" '^strack_hot [0-9]+$'
+err_has "--track stats: surface cold-switch counters" '^strack_cold [0-9]+ entered [0-9]+ left [0-9]+ tracked_ns [0-9]+ cold_ns [1-9][0-9]*$'
 expect "--track refuses faces clearly" 2 "$bin" --track tests/data/multi.obj "$tmp/pts.csv"
 err_has "--track with faces says why" 'free-form curves and surfaces only'
 printf '1,2,3\n4,nan,6\n' >"$tmp/nan.csv"

@@ -466,6 +466,13 @@ int main(int argc, char **argv)
 				(unsigned long long)st.curve_skips);
 			fprintf(stderr, "strack_hot %llu\n",
 				(unsigned long long)st.hot);
+			fprintf(stderr,
+				"strack_cold %llu entered %llu left %llu "
+				"tracked_ns %.0f cold_ns %.0f\n",
+				(unsigned long long)st.cold,
+				(unsigned long long)st.cold_entered,
+				(unsigned long long)st.cold_left, st.tracked_ns,
+				st.cold_ns);
 		}
 	}
 	rc = 0;
