@@ -150,7 +150,7 @@ struct px_track_opts {
 	int lazy;
 	/* Cold switch (default 1): when the point moves so fast that
 	 * tracking costs more than the exact global query (one update in 16
-	 * is timed; tracked mean over 1.25 times the cold query's), updates
+	 * is timed; tracked mean over 1.5 times the cold query's), updates
 	 * are answered by px_dist_query() (source PX_TRACK_COLD) until the
 	 * mean step has halved, then the critical points are found afresh
 	 * at the point (one re-initialisation) and tracking goes on. Both
