@@ -245,7 +245,10 @@ PX_API int px_strack_update(struct px_strack *t, px_vec3 p,
 
 /* Interior critical points of surface s (0-based among the surfaces):
  * u[i], v[i], type[i] (+1 min, -1 max, 0 saddle), up to cap. Returns the
- * number held or PX_E_INVAL / PX_E_RANGE. @note RT-safe. */
+ * number held or PX_E_INVAL / PX_E_RANGE. None are held while the
+ * answers are cold (source PX_TRACK_COLD); while the set catches up or
+ * is re-established (PX_TRACK_GLOBAL) they may be incomplete or lag the
+ * point. @note RT-safe. */
 PX_API int px_strack_critical(const struct px_strack *t, int s, double *u,
 			      double *v, int *type, int cap);
 
