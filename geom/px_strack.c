@@ -1729,9 +1729,10 @@ static int predict(const struct crit *z, px_vec3 dp, double *su, double *sv)
  *    parameter moved of the other: the same branch (on one branch its
  *    error is second order in the step, a jump lands it far off);
  *  - else the last minimum is followed to p (predictor and Newton, in
- *    one step or four): landing on g means g continues it; on another minimum, the
- *    closest point left a living minimum (a jump); losing it means it
- *    died at a fold (a jump when g is interior) or left through an edge.
+ *    one step or four): landing on g means g continues it; on another
+ *    minimum, the closest point left a living minimum (a jump); losing
+ *    it means it died at a fold (a jump when g is interior) or left
+ *    through an edge.
  * Otherwise (edges, curves, poles) as a global answer: a foot point that
  * moved far more than the query point.
  */

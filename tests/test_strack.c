@@ -955,7 +955,7 @@ struct cold_counts {
 
 static void cold_run(const char *name, const struct px_nurbs_curve *cs, int nc,
 		     const struct px_nurbs_surf *ss, int ns, const px_vec3 *fast,
-		     int n_fast, struct cold_counts *cc)
+		     int n_fast, int max_solves, struct cold_counts *cc)
 {
 	static px_vec3 q[1500];
 	struct px_strack *t = NULL, *t0 = NULL;
@@ -972,6 +972,8 @@ static void cold_run(const char *name, const struct px_nurbs_curve *cs, int nc,
 	memset(cc, 0, sizeof(*cc));
 	px_strack_opts_default(&o);
 	PX_CHECK_INT_EQ(o.cold_switch, 1);
+	/* max_solves > 0: the return rebuilds in slices; 0: at once */
+	o.max_solves = max_solves;
 	PX_CHECK_INT_EQ(px_strack_create(cs, nc, ss, ns, &o, &t), PX_OK);
 	o.cold_switch = 0;
 	o.max_solves = 0;
@@ -1101,7 +1103,7 @@ static void test_cold_switch(void)
 	struct px_nurbs_curve c;
 	static const double U[] = {0, 0, 0, 0, 0.5, 1, 1, 1, 1};
 	double xyz[15];
-	struct cold_counts a, b;
+	struct cold_counts a, b, a2;
 	long between, missed, cont, false_jump;
 	int i, k;
 
@@ -1118,7 +1120,7 @@ static void test_cold_switch(void)
 	}
 	PX_CHECK_INT_EQ(px_nurbs_curve_init(&c, &arena, 3, 5, U, 9, xyz, NULL, NULL),
 			PX_OK);
-	cold_run("mixed model", &c, 1, ss, 3, NULL, 0, &a);
+	cold_run("mixed model", &c, 1, ss, 3, NULL, 0, 4, &a);
 	/* high above a valley (beyond its focal point: a minimum on each
 	 * wall) the point swings across the plane of symmetry, 1-2 % of the
 	 * size a step: the closest point changes walls at every crossing */
@@ -1128,7 +1130,9 @@ static void test_cold_switch(void)
 	for (k = 0; k < 1200; k++)
 		fast[k] = px_v3(0.4 * sin(2.0 * M_PI * k / 37.0) + 0.05 * sin(0.11 * k),
 				0.3 * cos(2.0 * M_PI * k / 53.0), 0.8 + 1.0 * (0.5 + 0.5 * sin(0.05 * k)));
-	cold_run("valley", NULL, 0, ss, 1, fast, 1200, &b);
+	cold_run("valley", NULL, 0, ss, 1, fast, 1200, 4, &b);
+	/* the return at once (no budget): the same checks */
+	cold_run("valley, no budget", NULL, 0, ss, 1, fast, 1200, 0, &a2);
 	between = a.between + b.between;
 	missed = a.missed + b.missed;
 	cont = a.cont + b.cont;
