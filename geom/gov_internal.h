@@ -98,6 +98,11 @@ static inline int px__gov_timed(struct px_gov *g)
 /* The clock now (ns). */
 int64_t px__gov_now(const struct px_gov *g);
 
+/* A cold update's answer: px_dist_query() on m at p, timed as a cold
+ * sample when this update is one to time. Returns as px_dist_query(). */
+int px__gov_cold_query(struct px_gov *g, struct px_dist_model *m, px_vec3 p,
+		       struct px_dist_result *out);
+
 /* Every update's step length (the running mean the return looks at:
  * the last 16 steps weigh about two thirds). Inline: every update calls
  * it. */
@@ -114,8 +119,21 @@ static inline void px__gov_step(struct px_gov *g, double len)
  * cold from the next update on (g->cold is then set). */
 int px__gov_tracked(struct px_gov *g, double ns);
 
-/* A timed cold update took ns (the query alone). */
-void px__gov_cold_sample(struct px_gov *g, double ns);
+/* Around a tracked update: px__gov_start() returns the clock when this
+ * update is one to time, else PX_GOV_UNTIMED; px__gov_stop() hands the
+ * sample to px__gov_tracked() and returns 1 when the tracker goes cold
+ * from the next update on. Inline: every update calls them. */
+#define PX_GOV_UNTIMED INT64_MIN
+static inline int64_t px__gov_start(struct px_gov *g)
+{
+	return px__gov_timed(g) ? px__gov_now(g) : PX_GOV_UNTIMED;
+}
+
+static inline int px__gov_stop(struct px_gov *g, int64_t t0)
+{
+	return t0 != PX_GOV_UNTIMED &&
+	       px__gov_tracked(g, (double)(px__gov_now(g) - t0));
+}
 
 /* In cold mode, once per update: returns 1 when this update should go
  * back to tracking (g->cold is then cleared). */

@@ -104,7 +104,8 @@ int px__gov_tracked(struct px_gov *g, double ns)
 	return 0;
 }
 
-void px__gov_cold_sample(struct px_gov *g, double ns)
+/* A timed cold update took ns (the query alone). */
+static void cold_sample(struct px_gov *g, double ns)
 {
 	/* clipped by the tracked mean that sent the tracker here: a cold
 	 * mean inflated by an interrupt would keep it tracking too long */
@@ -112,6 +113,16 @@ void px__gov_cold_sample(struct px_gov *g, double ns)
 	g->cold_ns += GOV_ALPHA * (clip(ns, lim) - g->cold_ns);
 	if (!(g->cold_ns > 0.0))
 		g->cold_ns = 1.0;
+}
+
+int px__gov_cold_query(struct px_gov *g, struct px_dist_model *m, px_vec3 p,
+		       struct px_dist_result *out)
+{
+	int64_t t0 = px__gov_start(g);
+	int rc = px_dist_query(m, p, out);
+	if (t0 != PX_GOV_UNTIMED)
+		cold_sample(g, (double)(px__gov_now(g) - t0));
+	return rc;
 }
 
 int px__gov_leave(struct px_gov *g)

@@ -1787,11 +1787,7 @@ static int cold_update(struct px_strack *t, px_vec3 p, struct px_strack_result *
 {
 	struct px_dist_result g;
 	struct crit c;
-	int timed = px__gov_timed(&t->gov), rc, ok;
-	int64_t t0 = timed ? px__gov_now(&t->gov) : 0;
-	rc = px_dist_query(t->dist, p, &g);
-	if (timed)
-		px__gov_cold_sample(&t->gov, (double)(px__gov_now(&t->gov) - t0));
+	int ok, rc = px__gov_cold_query(&t->gov, t->dist, p, &g);
 	if (rc)
 		return rc;
 	result_clear(r);
@@ -1852,8 +1848,8 @@ static int cold_return(struct px_strack *t, px_vec3 p, struct px_strack_result *
 
 int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 {
-	int64_t t0 = 0;
-	int timed, rc;
+	int64_t t0;
+	int rc;
 
 	if (!t || !r)
 		return PX_E_INVAL;
@@ -1874,13 +1870,11 @@ int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 			return cold_return(t, p, r);
 		}
 	}
-	timed = t->ret_left == 0 && px__gov_timed(&t->gov);
-	if (timed)
-		t0 = px__gov_now(&t->gov);
+	t0 = t->ret_left == 0 ? px__gov_start(&t->gov) : PX_GOV_UNTIMED;
 	rc = strack_update(t, p, r);
 	if (t->ret_left > 0 && (t->mode == ST_TRACK || --t->ret_left == 0))
 		t->ret_left = 0;
-	if (timed && px__gov_tracked(&t->gov, (double)(px__gov_now(&t->gov) - t0)))
+	if (px__gov_stop(&t->gov, t0))
 		cold_enter(t, p, r);
 	return rc;
 }

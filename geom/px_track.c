@@ -2026,11 +2026,7 @@ static void prev_keep(struct px_track *t, const struct px_track_result *r)
 static int cold_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 {
 	struct px_dist_result g;
-	int timed = px__gov_timed(&t->gov), rc;
-	int64_t t0 = timed ? px__gov_now(&t->gov) : 0;
-	rc = px_dist_query(t->dist, p, &g);
-	if (timed)
-		px__gov_cold_sample(&t->gov, (double)(px__gov_now(&t->gov) - t0));
+	int rc = px__gov_cold_query(&t->gov, t->dist, p, &g);
 	if (rc)
 		return rc;
 	result_clear(r);
@@ -2055,8 +2051,8 @@ static int track_update(struct px_track *t, px_vec3 p, double len, int fresh,
 
 int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 {
-	int64_t t0 = 0;
-	int timed, rc, fresh = 0;
+	int64_t t0;
+	int rc, fresh = 0;
 	double len;
 
 	if (!t || !r)
@@ -2080,11 +2076,9 @@ int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 			fresh = 1;
 		}
 	}
-	timed = px__gov_timed(&t->gov);
-	if (timed)
-		t0 = px__gov_now(&t->gov);
+	t0 = px__gov_start(&t->gov);
 	rc = track_update(t, p, len, fresh, r);
-	if (timed && px__gov_tracked(&t->gov, (double)(px__gov_now(&t->gov) - t0))) {
+	if (px__gov_stop(&t->gov, t0)) {
 		/* cold from the next update on */
 		t->st.cold_entered++;
 		t->hot_ent = -1;
