@@ -65,6 +65,13 @@ double px_rand_range(double lo, double hi)
 	return lo + (hi - lo) * px_rand_unit();
 }
 
+int64_t px_test_clock_read(void *ctx)
+{
+	struct px_test_clock *c = ctx;
+	c->now += c->inc;
+	return c->now;
+}
+
 int px_rand_int(int lo, int hi)
 {
 	uint64_t span = (uint64_t)((int64_t)hi - lo) + 1;

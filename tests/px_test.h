@@ -99,4 +99,12 @@ int px_rand_int(int lo, int hi);           /* [lo, hi] inclusive */
 double px_rand_normal(void);
 uint64_t px_test_seed(void); /* seed of the running test */
 
+/* A clock for code that takes one as fn(ctx) -> ns (the trackers' cold
+ * switch): every read advances it by inc, so every timed region measures
+ * inc. Pass px_test_clock_read with a struct px_test_clock as ctx. */
+struct px_test_clock {
+	int64_t now, inc;
+};
+int64_t px_test_clock_read(void *ctx);
+
 #endif

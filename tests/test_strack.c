@@ -573,15 +573,13 @@ static void test_collapsed(void)
 	report(&tot);
 }
 
-static void test_multi(void)
+/* Three surfaces (wavy, a fold, a dome with a pole) and a free space
+ * curve, apart from each other (in the test arena, reset here). */
+static void mixed_model(struct px_nurbs_surf s[3], struct px_nurbs_curve *c)
 {
-	struct px_nurbs_surf s[3];
-	struct px_nurbs_curve c;
 	static const double U[] = {0, 0, 0, 0, 0.5, 1, 1, 1, 1};
 	double xyz[15];
 	int i;
-	struct totals tot;
-	memset(&tot, 0, sizeof(tot));
 	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
 	PX_CHECK_INT_EQ(surf_wavy(&s[0], 0, 0, 0, 0), PX_OK);
 	PX_CHECK_INT_EQ(surf_fold(&s[1], 2.4, 0.3, 0.2), PX_OK);
@@ -591,8 +589,17 @@ static void test_multi(void)
 		xyz[3 * i + 1] = 2.0 + 0.4 * sin(i);
 		xyz[3 * i + 2] = 0.5 * cos(1.3 * i);
 	}
-	PX_CHECK_INT_EQ(px_nurbs_curve_init(&c, &arena, 3, 5, U, 9, xyz, NULL, NULL),
+	PX_CHECK_INT_EQ(px_nurbs_curve_init(c, &arena, 3, 5, U, 9, xyz, NULL, NULL),
 			PX_OK);
+}
+
+static void test_multi(void)
+{
+	struct px_nurbs_surf s[3];
+	struct px_nurbs_curve c;
+	struct totals tot;
+	memset(&tot, 0, sizeof(tot));
+	mixed_model(s, &c);
 	run_model("multi-entity", &c, 1, s, 3, 0, &tot);
 	report(&tot);
 }
@@ -923,18 +930,6 @@ static void test_errors(void)
 	px_strack_free(NULL);
 }
 
-/* the cold switch's test clock: every read advances it by inc ns */
-struct fclock {
-	int64_t now, inc;
-};
-
-static int64_t fake_clock(void *ctx)
-{
-	struct fclock *c = ctx;
-	c->now += c->inc;
-	return c->now;
-}
-
 /*
  * The cold switch: with tracked updates made to look ten times the cost
  * of the global query (test clock), a fast path goes cold; every answer
@@ -964,7 +959,7 @@ static void cold_run(const char *name, const struct px_nurbs_curve *cs, int nc,
 	struct px_dist_info di;
 	struct px_strack_result r, r0;
 	struct px_dist_result g;
-	struct fclock fc = {0, 1};
+	struct px_test_clock fc = {0, 1};
 	px_aabb box;
 	double size;
 	int i, k, n, phase, rc, prev_ent = -1, prev_feat = -1;
@@ -981,8 +976,8 @@ static void cold_run(const char *name, const struct px_nurbs_curve *cs, int nc,
 	PX_CHECK_INT_EQ(px_dist_model_create(cs, nc, ss, ns, NULL, &ref), PX_OK);
 	if (!t || !t0 || !ref)
 		goto out;
-	px__strack_set_clock(t, fake_clock, &fc);
-	px__strack_set_clock(t0, fake_clock, &fc);
+	px__strack_set_clock(t, px_test_clock_read, &fc);
+	px__strack_set_clock(t0, px_test_clock_read, &fc);
 	px_dist_model_info(ref, &di);
 	box = di.bounds;
 	size = px_aabb_diagonal(&box);
@@ -1101,25 +1096,13 @@ static void test_cold_switch(void)
 	static px_vec3 fast[1200];
 	struct px_nurbs_surf ss[3];
 	struct px_nurbs_curve c;
-	static const double U[] = {0, 0, 0, 0, 0.5, 1, 1, 1, 1};
-	double xyz[15];
 	struct cold_counts a, b, a2;
 	long between, missed, cont, false_jump;
-	int i, k;
+	int k;
 
 	/* surfaces with edges, a pole and a free curve: the curve
 	 * tracker's restart too */
-	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
-	PX_CHECK_INT_EQ(surf_wavy(&ss[0], 0, 0, 0, 0), PX_OK);
-	PX_CHECK_INT_EQ(surf_fold(&ss[1], 2.4, 0.3, 0.2), PX_OK);
-	PX_CHECK_INT_EQ(surf_dome(&ss[2], 0.5, 2.2, -0.3), PX_OK);
-	for (i = 0; i < 5; i++) {
-		xyz[3 * i] = 2.0 + 0.3 * i;
-		xyz[3 * i + 1] = 2.0 + 0.4 * sin(i);
-		xyz[3 * i + 2] = 0.5 * cos(1.3 * i);
-	}
-	PX_CHECK_INT_EQ(px_nurbs_curve_init(&c, &arena, 3, 5, U, 9, xyz, NULL, NULL),
-			PX_OK);
+	mixed_model(ss, &c);
 	cold_run("mixed model", &c, 1, ss, 3, NULL, 0, 4, &a);
 	/* high above a valley (beyond its focal point: a minimum on each
 	 * wall) the point swings across the plane of symmetry, 1-2 % of the

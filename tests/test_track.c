@@ -1146,19 +1146,6 @@ static void test_errors(void)
 	px_track_free(t);
 }
 
-/* The cold switch's clock in these tests: every read advances by inc, so
- * every timed region (tracked update or global query) measures inc. */
-struct fclock {
-	int64_t now, inc;
-};
-
-static int64_t fake_clock(void *ctx)
-{
-	struct fclock *c = ctx;
-	c->now += c->inc;
-	return c->now;
-}
-
 /*
  * Cold switch: with tracked updates made to look 10 times the global
  * query (the test clock), a fast path (2 % steps) goes cold; every answer
@@ -1179,7 +1166,7 @@ static void test_cold_switch(void)
 	struct px_track_stats st, st0;
 	struct px_track_result r, r0;
 	struct px_dist_result g;
-	struct fclock fc = {0, 1};
+	struct px_test_clock fc = {0, 1};
 	px_aabb box;
 	double size;
 	int e, k, phase, rc;
@@ -1199,8 +1186,8 @@ static void test_cold_switch(void)
 	PX_CHECK_INT_EQ(px_dist_model_create(cs, 5, NULL, 0, NULL, &ref), PX_OK);
 	if (!t || !t0 || !ref)
 		goto out;
-	px__track_set_clock(t, fake_clock, &fc);
-	px__track_set_clock(t0, fake_clock, &fc);
+	px__track_set_clock(t, px_test_clock_read, &fc);
+	px__track_set_clock(t0, px_test_clock_read, &fc);
 	size = path_box(ref, &box);
 	px_track_get_stats(t, &st);
 	PX_CHECK_MSG(st.cold_ns > 0.0, "no calibrated cold cost");
