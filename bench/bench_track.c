@@ -54,6 +54,15 @@ static double urand(void)
 	return (double)(rng >> 11) * 0x1.0p-53;
 }
 
+/* A uniform point in box (coordinates drawn x, y, z in that order). */
+static px_vec3 box_urand(px_aabb box)
+{
+	double x = box.min.x + (box.max.x - box.min.x) * urand();
+	double y = box.min.y + (box.max.y - box.min.y) * urand();
+	double z = box.min.z + (box.max.z - box.min.z) * urand();
+	return px_v3(x, y, z);
+}
+
 static double nrand(void)
 {
 	double a = urand(), b = urand();
@@ -259,9 +268,7 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 		int64_t best = INT64_MAX;
 		int i;
 		for (i = 0; i < 20; i++) {
-			px_vec3 c = px_v3(box.min.x + (box.max.x - box.min.x) * urand(),
-					  box.min.y + (box.max.y - box.min.y) * urand(),
-					  box.min.z + (box.max.z - box.min.z) * urand());
+			px_vec3 c = box_urand(box);
 			int64_t x = now_ns();
 			px_track_reset(t, c, &r0);
 			x = now_ns() - x;
@@ -629,9 +636,7 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 		int64_t rs[20];
 		int i;
 		for (i = 0; i < 20; i++) {
-			px_vec3 c = px_v3(box.min.x + (box.max.x - box.min.x) * urand(),
-					  box.min.y + (box.max.y - box.min.y) * urand(),
-					  box.min.z + (box.max.z - box.min.z) * urand());
+			px_vec3 c = box_urand(box);
 			int64_t x = now_ns();
 			px_strack_reset(t, c, &r0);
 			rs[i] = now_ns() - x;

@@ -175,6 +175,16 @@ static int read_points(const char *path, struct points *pts)
 	return 0;
 }
 
+/* The cold switch's counters of either tracker (--track --stats). */
+static void print_cold(const char *name, uint64_t cold, uint64_t entered,
+		       uint64_t left, double tracked_ns, double cold_ns)
+{
+	fprintf(stderr, "%s_cold %llu entered %llu left %llu tracked_ns %.0f "
+		"cold_ns %.0f\n", name, (unsigned long long)cold,
+		(unsigned long long)entered, (unsigned long long)left,
+		tracked_ns, cold_ns);
+}
+
 static int cmp_i64(const void *a, const void *b)
 {
 	int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
@@ -434,13 +444,8 @@ int main(int argc, char **argv)
 				(unsigned long long)st.hot,
 				(unsigned long long)st.rested,
 				(unsigned long long)st.rested_entities);
-			fprintf(stderr,
-				"track_cold %llu entered %llu left %llu "
-				"tracked_ns %.0f cold_ns %.0f\n",
-				(unsigned long long)st.cold,
-				(unsigned long long)st.cold_entered,
-				(unsigned long long)st.cold_left, st.tracked_ns,
-				st.cold_ns);
+			print_cold("track", st.cold, st.cold_entered, st.cold_left,
+				   st.tracked_ns, st.cold_ns);
 		}
 		if (strk) {
 			struct px_strack_stats st;
@@ -466,13 +471,8 @@ int main(int argc, char **argv)
 				(unsigned long long)st.curve_skips);
 			fprintf(stderr, "strack_hot %llu\n",
 				(unsigned long long)st.hot);
-			fprintf(stderr,
-				"strack_cold %llu entered %llu left %llu "
-				"tracked_ns %.0f cold_ns %.0f\n",
-				(unsigned long long)st.cold,
-				(unsigned long long)st.cold_entered,
-				(unsigned long long)st.cold_left, st.tracked_ns,
-				st.cold_ns);
+			print_cold("strack", st.cold, st.cold_entered, st.cold_left,
+				   st.tracked_ns, st.cold_ns);
 		}
 	}
 	rc = 0;
