@@ -113,28 +113,90 @@ static void t_deriv_t(const double *c, int n, int m, double *out)
 				m * (c[i * (m + 1) + j + 1] - c[i * (m + 1) + j]);
 }
 
-/* Restriction to [s0, s1] x [t0, t1]. out may alias c. */
+/*
+ * De Casteljau on a tensor in place, a whole row of m + 1 coefficients
+ * per step along s (contiguous, so the compiler vectorises it) and one
+ * row at a time along t: no gathering of columns, no copies per line.
+ * Each keeps the arithmetic of px_bern_split() term for term (s * w_i +
+ * t * w_i+1, the left piece by the mirrored sweep), so results are the
+ * same to the bit.
+ */
+
+/* Keep [0, b] along s. */
+static void s_keep_left(double *c, int n, int m, double b)
+{
+	const int w = m + 1;
+	const double a = 1.0 - b;
+	int i, j, k;
+	for (k = 1; k <= n; k++)
+		for (i = n; i >= k; i--) {
+			double *ri = c + i * w;
+			const double *rp = ri - w;
+			for (j = 0; j < w; j++)
+				ri[j] = a * rp[j] + b * ri[j];
+		}
+}
+
+/* Keep [t, 1] along s. */
+static void s_keep_right(double *c, int n, int m, double t)
+{
+	const int w = m + 1;
+	const double a = 1.0 - t;
+	int i, j, k;
+	for (k = n; k > 0; k--)
+		for (i = 0; i < k; i++) {
+			double *ri = c + i * w;
+			const double *rn = ri + w;
+			for (j = 0; j < w; j++)
+				ri[j] = a * ri[j] + t * rn[j];
+		}
+}
+
+/* The same along t, row by row. */
+static void t_keep_left(double *c, int n, int m, double b)
+{
+	const double a = 1.0 - b;
+	int i, j, k;
+	for (i = 0; i <= n; i++) {
+		double *r = c + i * (m + 1);
+		for (k = 1; k <= m; k++)
+			for (j = m; j >= k; j--)
+				r[j] = a * r[j - 1] + b * r[j];
+	}
+}
+
+static void t_keep_right(double *c, int n, int m, double t)
+{
+	const double a = 1.0 - t;
+	int i, j, k;
+	for (i = 0; i <= n; i++) {
+		double *r = c + i * (m + 1);
+		for (k = m; k > 0; k--)
+			for (j = 0; j < k; j++)
+				r[j] = a * r[j] + t * r[j + 1];
+	}
+}
+
+/* Restriction to [s0, s1] x [t0, t1], as px_bern_restrict() per line:
+ * the left piece at the upper end, then the right piece of that at the
+ * lower end rescaled. out may alias c. */
 static void t_restrict(const double *c, int n, int m, double s0, double s1,
 		       double t0, double t1, double *out)
 {
-	double col[3 * MD + 2];
-	int i, j;
-
 	if (out != c)
 		memcpy(out, c, tsize(n, m) * sizeof(double));
-	/* Restrict along s first, then along t; each only if needed. */
-	if (s0 > 0.0 || s1 < 1.0)
-		for (j = 0; j <= m; j++) {
-			for (i = 0; i <= n; i++)
-				col[i] = out[i * (m + 1) + j];
-			px_bern_restrict(col, n, s0, s1, col);
-			for (i = 0; i <= n; i++)
-				out[i * (m + 1) + j] = col[i];
-		}
-	if (t0 > 0.0 || t1 < 1.0)
-		for (i = 0; i <= n; i++)
-			px_bern_restrict(out + i * (m + 1), m, t0, t1,
-					 out + i * (m + 1));
+	if (s1 < 1.0) {
+		s_keep_left(out, n, m, s1);
+		s0 = s0 / s1;
+	}
+	if (s0 > 0.0)
+		s_keep_right(out, n, m, s0);
+	if (t1 < 1.0) {
+		t_keep_left(out, n, m, t1);
+		t0 = t0 / t1;
+	}
+	if (t0 > 0.0)
+		t_keep_right(out, n, m, t0);
 }
 
 /*
@@ -633,28 +695,38 @@ done:
 	return 1;
 }
 
-/* Split a tensor at s = 1/2 (rows) or t = 1/2 (columns). */
+/* Split a tensor at s = 1/2 (rows) or t = 1/2 (columns): hi is the
+ * de Casteljau work array, lo takes the first entry of each level. */
 static void t_half_s(const double *c, int n, int m, double *lo, double *hi)
 {
-	double col[3 * MD + 2], l[3 * MD + 2], h[3 * MD + 2];
-	int i, j;
-	for (j = 0; j <= m; j++) {
-		for (i = 0; i <= n; i++)
-			col[i] = c[i * (m + 1) + j];
-		px_bern_split(col, n, 0.5, l, h);
-		for (i = 0; i <= n; i++) {
-			lo[i * (m + 1) + j] = l[i];
-			hi[i * (m + 1) + j] = h[i];
+	const int w = m + 1;
+	int i, j, k;
+	memcpy(hi, c, tsize(n, m) * sizeof(double));
+	memcpy(lo, c, (size_t)w * sizeof(double));
+	for (k = n; k > 0; k--) {
+		for (i = 0; i < k; i++) {
+			double *ri = hi + i * w;
+			const double *rn = ri + w;
+			for (j = 0; j < w; j++)
+				ri[j] = 0.5 * ri[j] + 0.5 * rn[j];
 		}
+		memcpy(lo + (n - k + 1) * w, hi, (size_t)w * sizeof(double));
 	}
 }
 
 static void t_half_t(const double *c, int n, int m, double *lo, double *hi)
 {
-	int i;
-	for (i = 0; i <= n; i++)
-		px_bern_split(c + i * (m + 1), m, 0.5, lo + i * (m + 1),
-			      hi + i * (m + 1));
+	int i, j, k;
+	memcpy(hi, c, tsize(n, m) * sizeof(double));
+	for (i = 0; i <= n; i++) {
+		double *h = hi + i * (m + 1), *l = lo + i * (m + 1);
+		l[0] = h[0];
+		for (k = m; k > 0; k--) {
+			for (j = 0; j < k; j++)
+				h[j] = 0.5 * h[j] + 0.5 * h[j + 1];
+			l[m - k + 1] = h[0];
+		}
+	}
 }
 
 /* min f_i / w_i, or min f_i when w is NULL (constant weight 1). */
