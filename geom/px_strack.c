@@ -157,6 +157,12 @@ struct px_strack {
 	px_vec3 *pend_ps;
 	double travel;
 	int heap_ok;
+	/* the due cells of the segment col_p0 -> col_p1 tested over several
+	 * updates (more of them than max_tests): popped from the heap
+	 * (heap_n cells left in it), col_k of the col_np tested, col_nh of
+	 * those hit (in hits) */
+	int col_on, col_np, col_k, col_nh, heap_n;
+	px_vec3 col_p0, col_p1;
 	px_aabb work;
 	double scale;
 	px_vec3 p;
@@ -781,6 +787,7 @@ static void heap_rebuild(struct px_strack *t, px_vec3 p)
 	for (i = t->n_cells / 2 - 1; i >= 0; i--)
 		heap_down(t, i, t->n_cells);
 	t->heap_ok = 1;
+	t->col_on = 0;
 }
 
 /* Work units of a hit cell: one solve, two after a long step past the
@@ -793,20 +800,22 @@ static int hit_work(const struct px_strack *t, int ci, double step)
 	return 1 + ((1.0 - c->cross) * step > 0.05 * c->size);
 }
 
-/*
- * Cells whose certificates the segment p0 -> p1 may break. Returns their
- * count, or -1 when their work exceeds budget (> 0): then nothing is
- * committed (the popped cells stay due, the travel is unchanged).
- */
-static int collect_cells(struct px_strack *t, px_vec3 p0, px_vec3 p1,
-			 int budget)
+/* The cell tests one update may make (0: no bound); only with a solve
+ * budget, without one every case re-initialises at once anyway. */
+static int tests_budget(const struct px_strack *t)
 {
-	int n = t->n_cells, np = 0, nh = 0, k, work = 0;
-	double seg = px_v3_dist(p0, p1), travel0;
+	return t->opts.max_solves > 0 ? t->opts.max_tests : 0;
+}
+
+/* Start collecting the cells whose certificates the segment p0 -> p1
+ * may break: the travel grows by the segment and the cells it makes due
+ * are taken out of the heap (popped), to be tested by col_test(). */
+static void col_begin(struct px_strack *t, px_vec3 p0, px_vec3 p1)
+{
+	int n = t->n_cells, np = 0;
 	if (!t->heap_ok)
 		heap_rebuild(t, p0);
-	travel0 = t->travel;
-	t->travel += seg;
+	t->travel += px_v3_dist(p0, p1);
 	while (n > 0 && t->cell[t->heap[0]].expiry <= t->travel) {
 		t->popped[np++] = t->heap[0];
 		n--;
@@ -815,45 +824,79 @@ static int collect_cells(struct px_strack *t, px_vec3 p0, px_vec3 p1,
 			heap_down(t, 0, n);
 		}
 	}
-	for (k = 0; k < np; k++) {
-		int ci = t->popped[k];
+	t->heap_n = n;
+	t->col_np = np;
+	t->col_k = 0;
+	t->col_nh = 0;
+	t->col_p0 = p0;
+	t->col_p1 = p1;
+	t->col_on = 1;
+}
+
+/* Test up to limit (0: all) more of the popped cells; each gets its
+ * next expiry, the hit ones go to hits. Returns 1 when all are tested. */
+static int col_test(struct px_strack *t, int limit)
+{
+	px_vec3 p0 = t->col_p0, p1 = t->col_p1;
+	px_vec3 mid = px_v3_scale(px_v3_add(p0, p1), 0.5);
+	/* the segment lies in the cube of half width dinf about p1 and in
+	 * the cube of half width dinf / 2 about its middle */
+	double dinf = fmax(fmax(fabs(p1.x - p0.x), fabs(p1.y - p0.y)),
+			   fabs(p1.z - p0.z));
+	int end = t->col_np;
+	if (limit > 0 && t->col_k + limit < end)
+		end = t->col_k + limit;
+	for (; t->col_k < end; t->col_k++) {
+		int ci = t->popped[t->col_k];
 		struct scell *c = &t->cell[ci];
-		/* the segment lies in the cube of half width dinf about p1
-		 * and in the cube of half width dinf / 2 about its middle */
-		double dinf = fmax(fmax(fabs(p1.x - p0.x), fabs(p1.y - p0.y)),
-				   fabs(p1.z - p0.z));
 		double r1 = cell_radius(t, c, p1);
 		t->st.box_tests++;
-		if (r1 < dinf &&
-		    cell_radius(t, c, px_v3_scale(px_v3_add(p0, p1), 0.5)) < 0.5 * dinf) {
+		if (r1 < dinf && cell_radius(t, c, mid) < 0.5 * dinf) {
 			/* where along the segment the region can first be met */
 			double r0 = cell_radius(t, c, p0);
 			double s0 = fmin(1.0, r0 / dinf);
 			double s1 = fmax(s0, 1.0 - r1 / dinf);
 			c->cross = 0.5 * (s0 + s1);
-			c->mark = t->epoch;
-			t->hits[nh++] = ci;
-			work += hit_work(t, ci, seg);
-			if (budget > 0 && work > budget)
-				break; /* the rest is not looked at */
+			t->hits[t->col_nh++] = ci;
 		}
 		c->expiry = t->travel + r1;
 	}
-	if (budget > 0 && work > budget) {
-		/* undo: due again at the next test, from p0 */
-		for (k = 0; k < np; k++) {
-			t->cell[t->popped[k]].expiry = travel0;
-			t->cell[t->popped[k]].mark = 0;
-		}
-		t->travel = travel0;
-		nh = -1;
-	}
-	for (k = 0; k < np; k++) {
+	return t->col_k >= t->col_np;
+}
+
+/* End the collection: the popped cells go back to the heap, the hit ones
+ * are marked with this update's epoch (track_step() adds the cells of
+ * lost points to them once). Returns the count of hits. */
+static int col_end(struct px_strack *t)
+{
+	int k, n = t->heap_n;
+	for (k = 0; k < t->col_np; k++) {
 		heap_set(t, n, t->popped[k]);
 		heap_up(t, n);
 		n++;
 	}
-	return nh;
+	for (k = 0; k < t->col_nh; k++)
+		t->cell[t->hits[k]].mark = t->epoch;
+	t->col_on = 0;
+	return t->col_nh;
+}
+
+/*
+ * Cells whose certificates the segment p0 -> p1 may break. Returns their
+ * count (in hits); -1 when more than max_tests cells are due: then that
+ * many are tested now and the collection goes on over the next updates
+ * (col_on; the tracked set stays at p0).
+ */
+static int collect_cells(struct px_strack *t, px_vec3 p0, px_vec3 p1)
+{
+	int lim = tests_budget(t);
+	col_begin(t, p0, p1);
+	if (lim > 0 && t->col_np > lim) {
+		col_test(t, lim);
+		return -1;
+	}
+	col_test(t, 0);
+	return col_end(t);
 }
 
 /* ------------------------------------------------------------------ */
@@ -1218,23 +1261,21 @@ static int pend_solve(struct px_strack *t, int budget, int *done)
 }
 
 /*
- * Move the tracked set from p0 to p (t->p becomes p): collect the cells
- * whose certificates the segment may break, follow every point, add the
- * cells of lost points, and solve them (a hit after a long step also
+ * Move the tracked set from p0 to p (t->p becomes p), the nh cells whose
+ * certificates the segment may break collected (collect_cells()): follow
+ * every point, add the cells of lost points, and solve them (a hit after a long step also
  * where its region was met, its roots followed to p). Returns 0; 1 when
  * that work exceeds the budget: nothing is solved, the work is left
  * pending (mode ST_PEND, solved over the next updates at p); PX_E_NOSPC.
  */
 static int track_step(struct px_strack *t, px_vec3 p0, px_vec3 p,
-		      struct px_strack_result *r, int nh_pre)
+		      struct px_strack_result *r, int nh)
 {
 	px_vec3 dp = px_v3_sub(p, p0);
 	double step = px_v3_norm(dp);
-	int i, j, nh, rc = 0, before = 0, after = 0, done = 0,
+	int i, j, rc = 0, before = 0, after = 0, done = 0,
 		      budget = t->opts.max_solves;
 
-	/* the cells of this step, unless the hot path collected them */
-	nh = nh_pre >= 0 ? nh_pre : collect_cells(t, p0, p, 0);
 	for (i = 0; i < t->n_surf; i++) {
 		struct ssurf *f = &t->sf[i];
 		int n = f->nz;
@@ -1319,6 +1360,7 @@ static void rebuild_start(struct px_strack *t)
 	t->rb_started = 0;
 	t->rb_next = 0;
 	t->heap_ok = 0;
+	t->col_on = 0;
 	for (i = 0; i < t->n_surf; i++)
 		t->sf[i].nz = 0;
 }
@@ -1332,10 +1374,12 @@ static void rebuild_start(struct px_strack *t)
  *  - ST_REBUILD: a slice of cells is solved at the fixed point t->p
  *    where the rebuild started, each cell's certificate taken there;
  *    when all are, the set is complete at t->p: ST_LAG.
- *  - ST_LAG: the set moves from t->p to p by one tracked step; work
- *    over the budget is left pending (ST_PEND) at p. It catches up when
- *    the work of the distance travelled meanwhile fits the budget: while
- *    the point moves with less work per update than the budget on
+ *  - ST_LAG: the set moves from t->p to p by one tracked step; solves
+ *    over the budget are left pending (ST_PEND) at p. When more than
+ *    max_tests cells are due, the step's end is held at that p and its
+ *    cells are tested max_tests per update first. It catches up when the
+ *    work of the distance travelled meanwhile fits the budgets: while
+ *    the point moves with less work per update than the budgets on
  *    average.
  */
 static int catch_up(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
@@ -1398,12 +1442,29 @@ static int catch_up(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 		return PX_OK;
 	}
 	/* ST_LAG */
-	if (in_work(t, p)) {
-		rc = track_step(t, t->p, p, r, -1);
+	if (t->col_on || in_work(t, p)) {
+		int nh;
+		px_vec3 p1;
+		if (t->col_on) {
+			if (!col_test(t, tests_budget(t))) {
+				answer_global(t, p, r);
+				return PX_OK;
+			}
+			nh = col_end(t);
+		} else {
+			nh = collect_cells(t, t->p, p);
+			if (nh < 0) {
+				answer_global(t, p, r);
+				return PX_OK;
+			}
+		}
+		/* the step ends where its collection started */
+		p1 = t->col_p1;
+		rc = track_step(t, t->p, p1, r, nh);
 		if (rc < 0) {
 			t->st.overflows++;
 			rebuild_start(t);
-		} else if (rc == 0) {
+		} else if (rc == 0 && p1.x == p.x && p1.y == p.y && p1.z == p.z) {
 			/* caught up: checked against the global answer */
 			answer(t, p, &cr, r);
 			if (px_dist_query(t->dist, p, &g) == PX_OK) {
@@ -1589,7 +1650,7 @@ static int strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result
 	    t->travel + px_v3_dist(p0, p) < t->hot_until) {
 		/* the due cells first (as track_step would): none hit and
 		 * the hot path answers */
-		nh = collect_cells(t, p0, p, 0);
+		nh = collect_cells(t, p0, p);
 		if (nh == 0 && !hot_update(t, p, r)) {
 			verify(t, p, r);
 			return PX_OK;
@@ -1605,6 +1666,16 @@ static int strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result
 		t->p = p;
 		t->st.outside++;
 		return full_reset(t, p, r);
+	}
+	if (nh < 0 && !t->col_on)
+		nh = collect_cells(t, p0, p);
+	if (t->col_on) {
+		/* more cells due than max_tests: tested over the next updates
+		 * (the set waits at p0), answered globally meanwhile */
+		t->st.over_budget++;
+		t->mode = ST_LAG;
+		answer_global(t, p, r);
+		return PX_OK;
 	}
 	rc = track_step(t, p0, p, r, nh);
 	if (rc == 1) {
@@ -1987,6 +2058,7 @@ void px_strack_opts_default(struct px_strack_opts *o)
 	o->max_solves = 4;
 	o->dist = NULL;
 	o->cold_switch = 1;
+	o->max_tests = 32;
 }
 
 /* Distinct knot values of one direction inside the domain, with both
@@ -2387,6 +2459,7 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	if (o.cells_per_span < 1 || o.cells_per_span > 16 || o.seeds < 1 ||
 	    o.seeds > 8 || o.samples < 2 || o.samples > 32 || o.max_crit < 2 ||
 	    o.max_crit > 1 << 20 || o.verify_every < 0 || o.max_solves < 0 ||
+	    o.max_tests < 0 ||
 	    !(o.work_margin >= 0.0))
 		return PX_E_INVAL;
 	for (i = 0; i < n_surfs; i++) {

@@ -139,6 +139,15 @@ struct px_strack_opts {
 	 * exact; this bounds the cost of fast motion by the global
 	 * query's. 0: always track. */
 	int cold_switch;
+	/* Bound on the cell tests of one update (default 32; 0: no bound;
+	 * unused with max_solves 0). A test is a few certificate radii
+	 * (about 0.3 us); a long step or a long lag makes many cells due at
+	 * once (every cell of the model after a long enough one). With more
+	 * due than this the update is answered by the global query, as over
+	 * max_solves, and the due cells are tested max_tests per update, the
+	 * set waiting where the step started, before the tracked step is
+	 * made (see stats.box_tests and stats.over_budget). */
+	int max_tests;
 };
 
 PX_API void px_strack_opts_default(struct px_strack_opts *o);

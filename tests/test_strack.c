@@ -403,10 +403,17 @@ static void run_model(const char *name, const struct px_nurbs_curve *cs,
 			nv.u = g.entity >= nc ? g.u : 0.5;
 			nv.v = g.entity >= nc ? g.v : 0.5;
 			for (k = 0; k < NSTEP; k++) {
-				uint64_t reg = px_alloc_region_begin();
+				uint64_t reg, tests0;
 				double nd, tol;
+				px_strack_get_stats(t, &st);
+				tests0 = st.box_tests;
+				reg = px_alloc_region_begin();
 				px_strack_update(t, q[k], &r);
 				tot->allocs += px_alloc_region_end(reg);
+				px_strack_get_stats(t, &st);
+				if (max_solves > 0 &&
+				    st.box_tests - tests0 > (uint64_t)o.max_tests)
+					tot->budget_bad++;
 				px_dist_query(ref, q[k], &g);
 				tol = 1e-9 * (size + g.dist);
 				tot->steps++;
@@ -883,6 +890,106 @@ static void test_budget(void)
 		     "answered globally %ld of %ld", tot.global, tot.steps);
 }
 
+/*
+ * The bound on cell tests (max_tests): a point that jumps across the
+ * model makes every cell due at once. With the bound no update tests
+ * more than max_tests cells, every answer is exact (global while the
+ * due cells are tested over several updates), and the set catches up
+ * within each slow leg with the critical points an independent count
+ * finds; without it the jumps test many more in one update.
+ */
+static void test_tests_budget(void)
+{
+	struct px_nurbs_surf s;
+	struct px_dist_model *ref = NULL;
+	struct px_dist_info di;
+	double size;
+	px_aabb box;
+	int bound;
+	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
+	PX_CHECK_INT_EQ(surf_wavy(&s, 0, 0, 0, 0), PX_OK);
+	PX_CHECK_INT_EQ(px_dist_model_create(NULL, 0, &s, 1, NULL, &ref), PX_OK);
+	px_dist_model_info(ref, &di);
+	size = px_aabb_diagonal(&di.bounds);
+	box = px_aabb_inflate(&di.bounds, 0.2 * size);
+	for (bound = 1; bound >= 0; bound--) {
+		struct px_strack *t = NULL;
+		struct px_strack_opts o;
+		struct px_strack_result r;
+		struct px_strack_stats st;
+		long wrong = 0, over = 0, legs_tracked = 0, counts = 0, counts_bad = 0;
+		uint64_t allocs = 0, most = 0;
+		int leg, k;
+		px_strack_opts_default(&o);
+		o.cold_switch = 0;
+		o.max_tests = bound ? 8 : 0;
+		PX_CHECK_INT_EQ(px_strack_create(NULL, 0, &s, 1, &o, &t), PX_OK);
+		if (!t)
+			break;
+		px_strack_reset(t, px_aabb_center(&box), &r);
+		for (leg = 0; leg < 8; leg++) {
+			px_vec3 a, d;
+			a.x = box.min.x + px_rand_unit() * (box.max.x - box.min.x);
+			a.y = box.min.y + px_rand_unit() * (box.max.y - box.min.y);
+			a.z = box.min.z + px_rand_unit() * (box.max.z - box.min.z);
+			d = px_v3(px_rand_normal(), px_rand_normal(), px_rand_normal());
+			d = px_v3_scale(d, 2e-4 * size / px_v3_norm(d));
+			for (k = 0; k < 150; k++) {
+				px_vec3 q = px_v3_add(a, px_v3_scale(d, k));
+				struct px_dist_result g;
+				struct px_strack_stats s0, s1;
+				uint64_t reg, n;
+				px_strack_get_stats(t, &s0);
+				reg = px_alloc_region_begin();
+				PX_CHECK_INT_EQ(px_strack_update(t, q, &r), PX_OK);
+				allocs += px_alloc_region_end(reg);
+				px_strack_get_stats(t, &s1);
+				n = s1.box_tests - s0.box_tests;
+				most = n > most ? n : most;
+				if (bound && n > (uint64_t)o.max_tests)
+					over++;
+				px_dist_query(ref, q, &g);
+				if (fabs(r.dist - g.dist) > 1e-9 * (size + g.dist) ||
+				    fabs(px_v3_dist(r.point, q) - r.dist) > 1e-9 * (size + g.dist))
+					wrong++;
+			}
+			/* the end of the leg: tracked again, the set complete */
+			if (r.source != PX_TRACK_GLOBAL) {
+				px_vec3 q = px_v3_add(a, px_v3_scale(d, k - 1));
+				int amb = tracked_amb(t, 0, &s);
+				int n = count_crit(&s, q, &amb);
+				legs_tracked++;
+				if (!amb) {
+					counts++;
+					counts_bad += n != px_strack_critical(t, 0, NULL, NULL, NULL, 0);
+				}
+			}
+		}
+		px_strack_get_stats(t, &st);
+		printf("  max_tests %d: most cell tests in one update %llu (over the "
+		       "bound %ld), wrong %ld, legs tracked again %ld of 8, counts "
+		       "%ld checked %ld bad, over budget %llu, allocations %llu\n",
+		       o.max_tests, (unsigned long long)most, over, wrong, legs_tracked,
+		       counts, counts_bad, (unsigned long long)st.over_budget,
+		       (unsigned long long)allocs);
+		PX_CHECK_INT_EQ(wrong, 0);
+		PX_CHECK_INT_EQ(allocs, 0);
+		PX_CHECK_INT_EQ(counts_bad, 0);
+		if (bound) {
+			PX_CHECK_INT_EQ(over, 0);
+			PX_CHECK_MSG(legs_tracked == 8,
+				     "tracked again after %ld of 8 jumps", legs_tracked);
+			PX_CHECK(counts > 0);
+		} else {
+			/* the jumps alone make many cells due: the bound bites */
+			PX_CHECK_MSG(most > 8, "without a bound at most %llu tests",
+				     (unsigned long long)most);
+		}
+		px_strack_free(t);
+	}
+	px_dist_model_free(ref);
+}
+
 static void test_errors(void)
 {
 	struct px_nurbs_surf s;
@@ -1141,6 +1248,7 @@ static const struct px_test tests[] = {
 	PX_T(test_multi),
 	PX_T(test_hot_fault),
 	PX_T(test_budget),
+	PX_T(test_tests_budget),
 	PX_T(test_focal_bounds),
 	PX_T(test_errors),
 	PX_T(test_cold_switch),
