@@ -31,7 +31,9 @@
  *    new point when the proof fails (Newton from a seed grid; evolved
  *    points are kept, duplicates merged). Cells on a collapsed edge have
  *    no proof near the pole's normal lines and are solved whenever hit.
- *  - Bounded work: an update whose proven-hit cells exceed max_solves is
+ *  - Bounded work: an update whose proven-hit cells exceed max_solves,
+ *    or whose due cells exceed max_tests (a long step: their tests then
+ *    go on max_tests per update), is
  *    answered by the global query; the tracked set then catches up with
  *    the point over the next updates in budgeted tracked steps (or is
  *    rebuilt in slices of cells when that fails) and is checked against
@@ -121,10 +123,10 @@ struct px_strack_opts {
 	 * against the global answer before the tracker answers again.
 	 * Real-time meaning: an update costs at most about max_solves cell
 	 * solves plus the following of the live points, or one global query
-	 * plus max_solves / 2 cell solves (see stats.over_budget and
-	 * stats.rebuild_updates). Leaving the working volume starts such a
-	 * rebuild as well. With 0 these cases re-initialise at once (cost
-	 * of px_strack_reset()). */
+	 * plus max_solves / 2 cell solves, and at most max_tests cell tests
+	 * (see stats.over_budget and stats.rebuild_updates). Leaving the
+	 * working volume starts such a rebuild as well. With 0 these cases
+	 * re-initialise at once (cost of px_strack_reset()). */
 	int max_solves;
 	/* Options of the global-query model (NULL: defaults). */
 	const struct px_dist_opts *dist;
