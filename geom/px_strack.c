@@ -899,6 +899,12 @@ static int collect_cells(struct px_strack *t, px_vec3 p0, px_vec3 p1)
 	return col_end(t);
 }
 
+/* The next max_tests of a collection in progress: as collect_cells(). */
+static int col_resume(struct px_strack *t)
+{
+	return col_test(t, tests_budget(t)) ? col_end(t) : -1;
+}
+
 /* ------------------------------------------------------------------ */
 /* answer                                                              */
 
@@ -1263,8 +1269,8 @@ static int pend_solve(struct px_strack *t, int budget, int *done)
 /*
  * Move the tracked set from p0 to p (t->p becomes p), the nh cells whose
  * certificates the segment may break collected (collect_cells()): follow
- * every point, add the cells of lost points, and solve them (a hit after a long step also
- * where its region was met, its roots followed to p). Returns 0; 1 when
+ * every point, add the cells of lost points, and solve them (a hit after
+ * a long step also where its region was met, its roots followed to p). Returns 0; 1 when
  * that work exceeds the budget: nothing is solved, the work is left
  * pending (mode ST_PEND, solved over the next updates at p); PX_E_NOSPC.
  */
@@ -1443,20 +1449,11 @@ static int catch_up(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 	}
 	/* ST_LAG */
 	if (t->col_on || in_work(t, p)) {
-		int nh;
+		int nh = t->col_on ? col_resume(t) : collect_cells(t, t->p, p);
 		px_vec3 p1;
-		if (t->col_on) {
-			if (!col_test(t, tests_budget(t))) {
-				answer_global(t, p, r);
-				return PX_OK;
-			}
-			nh = col_end(t);
-		} else {
-			nh = collect_cells(t, t->p, p);
-			if (nh < 0) {
-				answer_global(t, p, r);
-				return PX_OK;
-			}
+		if (nh < 0) {
+			answer_global(t, p, r);
+			return PX_OK;
 		}
 		/* the step ends where its collection started */
 		p1 = t->col_p1;

@@ -33,11 +33,11 @@
  *    no proof near the pole's normal lines and are solved whenever hit.
  *  - Bounded work: an update whose proven-hit cells exceed max_solves,
  *    or whose due cells exceed max_tests (a long step: their tests then
- *    go on max_tests per update), is
- *    answered by the global query; the tracked set then catches up with
- *    the point over the next updates in budgeted tracked steps (or is
- *    rebuilt in slices of cells when that fails) and is checked against
- *    the global answer before it answers again.
+ *    go on max_tests per update), is answered by the global query; the
+ *    tracked set then catches up with the point over the next updates in
+ *    budgeted tracked steps (or is rebuilt in slices of cells when that
+ *    fails) and is checked against the global answer before it answers
+ *    again.
  *  - Collapsed edges (poles): (S - p) . Sv vanishes along such an edge,
  *    a spurious root set that attracts Newton; the tracker solves with
  *    that equation divided by the distance to the edge and leaves the
@@ -142,8 +142,8 @@ struct px_strack_opts {
 	 * query's. 0: always track. */
 	int cold_switch;
 	/* Bound on the cell tests of one update (default 32; 0: no bound;
-	 * unused with max_solves 0). A test is a few certificate radii
-	 * (about 0.3 us); a long step or a long lag makes many cells due at
+	 * unused with max_solves 0). A test is up to 12 certificate
+	 * radii (0.3-0.7 us); a long step or a long lag makes many cells due at
 	 * once (every cell of the model after a long enough one). With more
 	 * due than this the update is answered by the global query, as over
 	 * max_solves, and the due cells are tested max_tests per update, the

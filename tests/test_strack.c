@@ -929,9 +929,9 @@ static void test_tests_budget(void)
 		px_strack_reset(t, px_aabb_center(&box), &r);
 		for (leg = 0; leg < 8; leg++) {
 			px_vec3 a, d;
-			a.x = box.min.x + px_rand_unit() * (box.max.x - box.min.x);
-			a.y = box.min.y + px_rand_unit() * (box.max.y - box.min.y);
-			a.z = box.min.z + px_rand_unit() * (box.max.z - box.min.z);
+			a.x = px_rand_range(box.min.x, box.max.x);
+			a.y = px_rand_range(box.min.y, box.max.y);
+			a.z = px_rand_range(box.min.z, box.max.z);
 			d = px_v3(px_rand_normal(), px_rand_normal(), px_rand_normal());
 			d = px_v3_scale(d, 2e-4 * size / px_v3_norm(d));
 			for (k = 0; k < 150; k++) {
