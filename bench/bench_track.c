@@ -3,7 +3,9 @@
  * moving-point trajectories (smooth random paths and sums of sinusoids,
  * steps of 0.01 %, 0.1 %, 1 % and 5 % of the model size), next to the
  * cold global query px_dist_query() on the same points in the same run
- * (ratio of medians), with the number of answers that differ from the
+ * (ratio of medians; each runs the whole path in its own pass, so that
+ * neither finds the branch predictor trained by the other at the same
+ * point), with the number of answers that differ from the
  * global one (must be 0), transitions, leaf re-solves and
  * re-initialisations. Verification inside the tracker is off (the loop
  * configuration); the comparison is made outside the timed call.
@@ -219,6 +221,7 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 {
 	static px_vec3 q[NSTEP];
 	static int64_t tt[NRUN * NSTEP], tg[NRUN * NSTEP];
+	static double dt[NSTEP];
 	/* BENCH_TRACK_WORST=1: what the worst update of each row did */
 	static int wk_solved[NSTEP], wk_src[NSTEP], wk_reinit[NSTEP], wk_tests[NSTEP];
 	int worst_env = getenv("BENCH_TRACK_WORST") != NULL;
@@ -324,7 +327,14 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 			int n = 0;
 			make_path(q, NSTEP, kind, box, steps[s] * size);
 			px_track_get_stats(t, &a);
+			/* the tracker and the cold query each run the whole path
+			 * on their own: interleaved at the same point, the
+			 * second call finds the branch predictor trained by the
+			 * first on the same data (measured: a cold-answered
+			 * update's median 531 ns against the reference's 350 ns
+			 * in that order, 440 against 491 in the other) */
 			for (run_i = 0; run_i < NRUN; run_i++) {
+				int n0 = n;
 				rmax[run_i] = 0;
 				px_track_reset(t, q[0], &r);
 				for (k = 0; k < NSTEP; k++, n++) {
@@ -343,10 +353,13 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 					}
 					if (tt[n] > rmax[run_i])
 						rmax[run_i] = tt[n];
-					x = now_ns();
+					dt[k] = r.dist;
+				}
+				for (k = 0, n = n0; k < NSTEP; k++, n++) {
+					int64_t x = now_ns();
 					px_dist_query(ref, q[k], &g);
 					tg[n] = now_ns() - x;
-					if (fabs(r.dist - g.dist) > 1e-9 * (size + g.dist))
+					if (fabs(dt[k] - g.dist) > 1e-9 * (size + g.dist))
 						wrong++;
 				}
 			}
@@ -597,6 +610,7 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 	static int64_t tt[NSSTEP], tg[NSSTEP], it[NSSTEP], ig[NSSTEP], tw[NSSTEP];
 	static int sw_solved[NSSTEP], sw_tests[NSSTEP], sw_src[NSSTEP];
 	static int64_t tc[NSSTEP], tgw[NSSTEP];
+	static double ds[NSSTEP];
 	int worst_env = getenv("BENCH_TRACK_WORST") != NULL;
 	static const double steps[] = {1e-4, 1e-3, 1e-2, 5e-2};
 	struct surf_row row[2][4];
@@ -683,9 +697,7 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 					sw_tests[k] = (int)(s1.box_tests - s0.box_tests);
 					sw_src[k] = r.source;
 				}
-				x = now_ns();
-				px_dist_query(ref, q[k], &g);
-				tg[k] = now_ns() - x;
+				ds[k] = r.dist;
 				/* cold answers follow nothing (n_crit -1) */
 				if (r.source != PX_TRACK_COLD) {
 					crit += r.n_crit;
@@ -694,7 +706,14 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 				glob += r.source == PX_TRACK_GLOBAL;
 				if (r.source == PX_TRACK_COLD)
 					tc[cold++] = tt[k];
-				if (fabs(r.dist - g.dist) > 1e-9 * (size + g.dist))
+			}
+			/* the cold query on its own pass (as for the curves:
+			 * not interleaved at the same point) */
+			for (k = 0; k < NSSTEP; k++) {
+				int64_t x = now_ns();
+				px_dist_query(ref, q[k], &g);
+				tg[k] = now_ns() - x;
+				if (fabs(ds[k] - g.dist) > 1e-9 * (size + g.dist))
 					wrong++;
 			}
 			px_strack_get_stats(t, &b);
@@ -723,8 +742,10 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 						x = now_ns() - x;
 						if (x < tw[k])
 							tw[k] = x;
-						/* the cold query's by the same measure */
-						x = now_ns();
+					}
+					/* the cold query's by the same measure */
+					for (k = 0; k < NSSTEP; k++) {
+						int64_t x = now_ns();
 						px_dist_query(ref, q[k], &g);
 						x = now_ns() - x;
 						if (x < tgw[k])
@@ -754,7 +775,9 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 				int64_t x = ins_read();
 				px_strack_update(t, q[k], &r);
 				it[k] = ins_read() - x - ins0;
-				x = ins_read();
+			}
+			for (k = 0; k < NSSTEP; k++) {
+				int64_t x = ins_read();
 				px_dist_query(ref, q[k], &g);
 				ig[k] = ins_read() - x - ins0;
 			}
