@@ -9,13 +9,20 @@
  *
  * What is measured: one update in PX_GOV_EVERY is timed (two reads of
  * CLOCK_MONOTONIC, about 40 ns on the machines measured, so about 3 ns an
- * update on average), tracked or cold, and each kind keeps a running
- * mean of its samples (the last 32 samples, 512 updates, weigh about two
- * thirds: events come in bursts, and a burst alone should not send the
- * tracker cold). A sample is first clipped to PX_GOV_CLIP times the
+ * update on average), tracked or cold, except while deciding (below), and
+ * each kind keeps a running mean of its samples (the last 32 samples, 512
+ * updates, weigh about two thirds: events come in bursts, and a burst
+ * alone should not send the tracker cold). A sample is first clipped to PX_GOV_CLIP times the
  * other kind's mean, so that one interrupt or preemption (tens of
  * microseconds on a shared machine) moves a mean by a bounded amount. The
- * cold mean starts from a calibration made at setup. Switching:
+ * cold mean starts from a calibration made at setup. After a (re)start
+ * (setup, reset, the return from cold, a probe) the first PX_GOV_WARM
+ * updates are not timed (the set and its certificates are being rebuilt)
+ * and then every tracked update is, until the decision's samples are in;
+ * the decision is made on their plain mean. A point that moves fast thus
+ * costs 48 expensive tracked updates before going cold, not 512 (each is
+ * up to several global queries; on a path whose speed swings, every
+ * swing pays it). Switching:
  *  - to cold when the tracked mean has at least PX_GOV_MIN_SAMPLES samples
  *    since the last (re)start and exceeds PX_GOV_ENTER times the cold
  *    mean;
@@ -56,6 +63,7 @@
 #define PX_GOV_PROBE 1024      /* cold updates before a probe */
 #define PX_GOV_PROBE_MAX 16384
 #define PX_GOV_BACK 2048
+#define PX_GOV_WARM 16         /* untimed updates after a (re)start */
 
 /* The clock: nanoseconds, monotonic. ctx is the tests' own. */
 typedef int64_t (*px_gov_clock_fn)(void *ctx);
@@ -70,6 +78,7 @@ struct px_gov {
 	uint32_t n_back;  /* updates since the last return by step */
 	double leave;     /* step factor of the next return by step */
 	int probing;      /* tracking again as a probe */
+	int skip;         /* updates left before timing (just restarted) */
 	double trk_ns, cold_ns;   /* running means */
 	double step, step_enter;  /* running mean step length; at going cold */
 	uint64_t entered, left;   /* switches, for the stats */
@@ -89,6 +98,17 @@ static inline int px__gov_timed(struct px_gov *g)
 {
 	if (!g->on)
 		return 0;
+	if (!g->cold && g->n_trk < (g->probing ? PX_GOV_PROBE_SAMPLES
+					       : PX_GOV_MIN_SAMPLES)) {
+		/* deciding: every update once the first PX_GOV_WARM after
+		 * a (re)start are past (they rebuild the set and its
+		 * certificates) */
+		if (g->skip > 0) {
+			g->skip--;
+			return 0;
+		}
+		return 1;
+	}
 	if (++g->tick < PX_GOV_EVERY)
 		return 0;
 	g->tick = 0;

@@ -31,6 +31,7 @@ void px__gov_init(struct px_gov *g, int on, double cold_ns)
 	g->entered = g->left = 0;
 	g->probe = PX_GOV_PROBE;
 	g->probing = 0;
+	g->skip = PX_GOV_WARM;
 	g->n_back = UINT32_MAX;
 	g->leave = PX_GOV_LEAVE;
 	g->clock = mono_ns;
@@ -44,6 +45,7 @@ void px__gov_restart(struct px_gov *g)
 	g->n_trk = 0;
 	g->trk_ns = 0.0;
 	g->tick = 0;
+	g->skip = PX_GOV_WARM;
 }
 
 void px__gov_set_clock(struct px_gov *g, px_gov_clock_fn fn, void *ctx)
@@ -72,11 +74,10 @@ int px__gov_tracked(struct px_gov *g, double ns)
 	ns = clip(ns, PX_GOV_CLIP * g->cold_ns);
 	if (g->n_trk < (1 << 30))
 		g->n_trk++;
-	/* the first sample is the mean (no bias towards zero); a probe
-	 * decides on the plain mean of its own samples */
-	if (g->n_trk == 1)
-		g->trk_ns = ns;
-	else if (g->probing)
+	/* the decision after a (re)start or probe is made on the plain
+	 * mean of its consecutive samples; the running mean goes on from
+	 * there */
+	if (g->n_trk <= need)
 		g->trk_ns += (ns - g->trk_ns) / g->n_trk;
 	else
 		g->trk_ns += GOV_ALPHA * (ns - g->trk_ns);

@@ -1151,7 +1151,8 @@ static void test_errors(void)
  * query (the test clock), a fast path (2 % steps) goes cold; every answer
  * stays exact, cold answers say n_crit -1, a closest point that jumps
  * between two minima of one curve (as the always-tracking tracker sees
- * it) is reported as jumped, nothing allocates. Then tracking made cheap
+ * it) is reported as jumped, nothing allocates; the switch is decided
+ * within 49 updates of the reset. Then tracking made cheap
  * and a slow path (0.01 %): the tracker comes back, finds the critical
  * points afresh (the same counts as the always-tracking one) and stays.
  * With cold_switch 0 nothing goes cold.
@@ -1171,7 +1172,8 @@ static void test_cold_switch(void)
 	double size;
 	int e, k, phase, rc;
 	long wrong = 0, cold = 0, bad_ncrit = 0, between = 0, missed = 0,
-	     false_jump = 0, count_checked = 0, count_bad = 0, late_cold = 0;
+	     false_jump = 0, count_checked = 0, count_bad = 0, late_cold = 0,
+	     first_cold = -1;
 	int prev_ent = -1, prev_feat = -1;
 	px_vec3 prev_pt = px_v3(0, 0, 0);
 
@@ -1223,6 +1225,8 @@ static void test_cold_switch(void)
 			if (fabs(r.dist - g.dist) > 1e-9 * (size + g.dist))
 				wrong++;
 			if (r.source == PX_TRACK_COLD) {
+				if (first_cold < 0)
+					first_cold = k;
 				cold++;
 				if (r.n_crit != -1 || r.n_min != -1)
 					bad_ncrit++;
@@ -1261,14 +1265,20 @@ static void test_cold_switch(void)
 				     "fast path never went cold: %ld cold updates, "
 				     "%llu switches", cold,
 				     (unsigned long long)st.cold_entered);
+			/* the decision after a reset: 16 untimed updates,
+			 * then 32 timed in a row (gov_internal.h), the
+			 * next update cold */
+			PX_CHECK_MSG(first_cold >= 0 && first_cold <= 16 + 32 + 1,
+				     "first cold answer at update %ld of the fast "
+				     "path", first_cold);
 		}
 	}
 	px_track_get_stats(t, &st);
 	px_track_get_stats(t0, &st0);
-	printf("  cold switch: %ld cold of %llu updates, entered %llu, left %llu, "
-	       "jumps between minima %ld (missed %ld), false jumps %ld, counts "
-	       "%ld/%ld bad, wrong %ld\n",
-	       cold, (unsigned long long)st.updates,
+	printf("  cold switch: %ld cold of %llu updates (the first at update "
+	       "%ld), entered %llu, left %llu, jumps between minima %ld (missed "
+	       "%ld), false jumps %ld, counts %ld/%ld bad, wrong %ld\n",
+	       cold, (unsigned long long)st.updates, first_cold,
 	       (unsigned long long)st.cold_entered,
 	       (unsigned long long)st.cold_left, between, missed, false_jump,
 	       count_bad, count_checked, wrong);
