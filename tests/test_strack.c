@@ -1241,6 +1241,99 @@ static void test_cold_switch(void)
 		     "%ld false jumps in %ld continued minima", false_jump, cont);
 }
 
+/*
+ * The return from cold answers rebuilds the set at the point in budgeted
+ * slices, and a cell proven empty by its certificates counts 1/8 of a
+ * solve: the rebuild of the 16-patch surface (144 cells, a few of them
+ * holding critical points) takes a few updates, not one per
+ * max_solves / 2 cells (72). The point is held still after the fast path,
+ * so the updates answered globally after the return are the rebuild's
+ * alone; every answer is exact, nothing allocates, and the set then holds
+ * the critical points of a tracker reset there.
+ */
+static void test_return_rebuild(void)
+{
+	static px_vec3 q[600];
+	struct px_nurbs_surf s;
+	struct px_strack *t = NULL, *t0 = NULL;
+	struct px_strack_opts o;
+	struct px_strack_result r;
+	struct px_strack_stats st;
+	struct px_strack_info ti;
+	struct px_dist_model *ref = NULL;
+	struct px_dist_info di;
+	struct px_test_clock fc = {0, 1};
+	px_aabb box;
+	double size;
+	long slice, wrong = 0;
+	int k, cold = 0, glob = 0, back = -1, n, n0;
+
+	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
+	PX_CHECK_INT_EQ(surf_wavy(&s, 0, 0, 0, 0), PX_OK);
+	px_strack_opts_default(&o);
+	slice = o.max_solves > 1 ? o.max_solves / 2 : 1;
+	PX_CHECK_INT_EQ(px_strack_create(NULL, 0, &s, 1, &o, &t), PX_OK);
+	o.cold_switch = 0;
+	PX_CHECK_INT_EQ(px_strack_create(NULL, 0, &s, 1, &o, &t0), PX_OK);
+	PX_CHECK_INT_EQ(px_dist_model_create(NULL, 0, &s, 1, NULL, &ref), PX_OK);
+	if (!t || !t0 || !ref)
+		goto out;
+	px__strack_set_clock(t, px_test_clock_read, &fc);
+	px_strack_get_info(t, &ti);
+	px_dist_model_info(ref, &di);
+	size = px_aabb_diagonal(&di.bounds);
+	box = px_aabb_inflate(&di.bounds, 0.25 * size);
+	make_path(q, 600, 0, box, 2e-2 * size);
+	px_strack_get_stats(t, &st);
+	fc.inc = (int64_t)(10.0 * st.cold_ns) + 1;
+	px_strack_reset(t, q[0], &r);
+	for (k = 1; k < 600; k++) {
+		PX_CHECK_INT_EQ(px_strack_update(t, q[k], &r), PX_OK);
+		cold += r.source == PX_TRACK_COLD;
+	}
+	PX_CHECK_MSG(cold > 300, "the fast path went cold for %d updates", cold);
+	/* held still, tracking cheap again: the return, its rebuild, then
+	 * the set answers */
+	fc.inc = 1;
+	for (k = 0; k < 400; k++) {
+		struct px_dist_result g;
+		uint64_t reg = px_alloc_region_begin();
+		int rc = px_strack_update(t, q[599], &r);
+		if (px_alloc_region_end(reg) != 0) {
+			PX_CHECK_MSG(0, "update allocated");
+			goto out;
+		}
+		PX_CHECK_INT_EQ(rc, PX_OK);
+		px_dist_query(ref, q[599], &g);
+		if (fabs(r.dist - g.dist) > 1e-9 * (size + g.dist))
+			wrong++;
+		if (r.source == PX_TRACK_COLD)
+			continue;
+		if (back < 0)
+			back = k;
+		if (r.source != PX_TRACK_GLOBAL)
+			break;
+		glob++;
+	}
+	px_strack_reset(t0, q[599], &r);
+	n = px_strack_critical(t, 0, NULL, NULL, NULL, 0);
+	n0 = px_strack_critical(t0, 0, NULL, NULL, NULL, 0);
+	printf("  return after %d still updates, then %d answered globally "
+	       "(%d cells, %ld solves per update), %d critical points (reset "
+	       "there: %d), wrong %ld\n", back, glob, ti.n_cells, slice, n, n0,
+	       wrong);
+	PX_CHECK_MSG(back >= 0 && k < 400, "never answered from the set again");
+	PX_CHECK_INT_EQ(wrong, 0);
+	PX_CHECK_MSG(glob >= 1 && glob <= ti.n_cells / slice / 2,
+		     "the rebuild answered globally for %d updates (%d cells)",
+		     glob, ti.n_cells);
+	PX_CHECK_INT_EQ(n, n0);
+out:
+	px_strack_free(t);
+	px_strack_free(t0);
+	px_dist_model_free(ref);
+}
+
 static const struct px_test tests[] = {
 	PX_T(test_wavy),
 	PX_T(test_fold_nonuniform),
@@ -1251,7 +1344,7 @@ static const struct px_test tests[] = {
 	PX_T(test_tests_budget),
 	PX_T(test_focal_bounds),
 	PX_T(test_errors),
-	PX_T(test_cold_switch),
+	PX_T(test_cold_switch), PX_T(test_return_rebuild),
 };
 
 PX_TEST_MAIN(tests)
