@@ -12,9 +12,10 @@
  * update on average), tracked or cold, except while deciding (below), and
  * each kind keeps a running mean of its samples (the last 32 samples, 512
  * updates, weigh about two thirds: events come in bursts, and a burst
- * alone should not send the tracker cold). A sample is first clipped to PX_GOV_CLIP times the
- * other kind's mean, so that one interrupt or preemption (tens of
- * microseconds on a shared machine) moves a mean by a bounded amount. The
+ * alone should not send the tracker cold). A sample is first clipped to
+ * PX_GOV_CLIP times the other kind's mean, so that one interrupt or
+ * preemption (tens of microseconds on a shared machine) moves a mean by
+ * a bounded amount. The
  * cold mean starts from a calibration made at setup. After a (re)start
  * (setup, reset, the return from cold, a probe) the first PX_GOV_WARM
  * updates are not timed (the set and its certificates are being rebuilt)
@@ -92,14 +93,19 @@ void px__gov_init(struct px_gov *g, int on, double cold_ns);
 /* Tracking (re)starts: tracked samples are gathered afresh. */
 void px__gov_restart(struct px_gov *g);
 
+/* Tracked samples the next decision is made on. */
+static inline int px__gov_need(const struct px_gov *g)
+{
+	return g->probing ? PX_GOV_PROBE_SAMPLES : PX_GOV_MIN_SAMPLES;
+}
+
 /* Whether this update is one to time (advances the tick). Inline: every
  * update calls it. */
 static inline int px__gov_timed(struct px_gov *g)
 {
 	if (!g->on)
 		return 0;
-	if (!g->cold && g->n_trk < (g->probing ? PX_GOV_PROBE_SAMPLES
-					       : PX_GOV_MIN_SAMPLES)) {
+	if (!g->cold && g->n_trk < px__gov_need(g)) {
 		/* deciding: every update once the first PX_GOV_WARM after
 		 * a (re)start are past (they rebuild the set and its
 		 * certificates) */

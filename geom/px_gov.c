@@ -19,19 +19,14 @@ static int64_t mono_ns(void *ctx)
 
 void px__gov_init(struct px_gov *g, int on, double cold_ns)
 {
+	px__gov_restart(g); /* cold, probing, the samples, the timing */
 	g->on = on;
-	g->cold = 0;
-	g->tick = 0;
-	g->n_trk = 0;
 	g->n_cold = 0;
-	g->trk_ns = 0.0;
 	g->cold_ns = cold_ns > 0.0 ? cold_ns : 1.0;
 	g->step = 0.0;
 	g->step_enter = 0.0;
 	g->entered = g->left = 0;
 	g->probe = PX_GOV_PROBE;
-	g->probing = 0;
-	g->skip = PX_GOV_WARM;
 	g->n_back = UINT32_MAX;
 	g->leave = PX_GOV_LEAVE;
 	g->clock = mono_ns;
@@ -68,7 +63,7 @@ static double clip(double x, double lim)
 
 int px__gov_tracked(struct px_gov *g, double ns)
 {
-	int need = g->probing ? PX_GOV_PROBE_SAMPLES : PX_GOV_MIN_SAMPLES;
+	int need = px__gov_need(g);
 	if (!g->on || g->cold)
 		return 0;
 	ns = clip(ns, PX_GOV_CLIP * g->cold_ns);

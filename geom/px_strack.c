@@ -491,16 +491,8 @@ static int crit_add(struct px_strack *t, struct ssurf *f, const struct crit *z)
 	return 1;
 }
 
-/* Solve cell c at p from its seed grid. Returns 0 or PX_E_NOSPC. */
 static int follow(const struct ssurf *f, struct crit *z, px_vec3 p0,
 		  px_vec3 dp, px_vec3 p, struct crit *last);
-
-/*
- * Solve cell c: Newton from its seed grid at ps, each root then followed
- * from ps to p (a pair born where the path met the cell's region keeps
- * moving for the rest of the step, possibly out of the cell). Returns 0
- * or PX_E_NOSPC.
- */
 static int no_root(const struct rcert *c, px_vec3 p);
 
 /*
@@ -526,7 +518,12 @@ static int cell_empty(const struct px_strack *t, const struct scell *c,
 	return empty[0] && empty[1] && empty[2] && empty[3];
 }
 
-/* As below; empty: cell_empty() at ps, or NULL to work it out. */
+/*
+ * Solve cell c: Newton from its seed grid at ps, each root then followed
+ * from ps to p (a pair born where the path met the cell's region keeps
+ * moving for the rest of the step, possibly out of the cell). empty:
+ * cell_empty() at ps, or NULL to work it out. Returns 0 or PX_E_NOSPC.
+ */
 static int cell_solve_at(struct px_strack *t, const struct scell *c,
 			 px_vec3 ps, px_vec3 p, const int *empty_in)
 {
@@ -561,6 +558,7 @@ static int cell_solve_at(struct px_strack *t, const struct scell *c,
 	return 0;
 }
 
+/* Solve cell c at p from its seed grid. Returns 0 or PX_E_NOSPC. */
 static int cell_solve(struct px_strack *t, const struct scell *c, px_vec3 p)
 {
 	return cell_solve_at(t, c, p, p, NULL);

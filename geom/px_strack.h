@@ -124,9 +124,9 @@ struct px_strack_opts {
 	 * re-established over the following updates: max_solves / 2 solves
 	 * (at least 1) per update - mostly cells proven empty, 8 of them
 	 * to a solve - each of those answered by the global query too,
-	 * then one tracked step
-	 * from where the rebuild started to the current point, checked
-	 * against the global answer before the tracker answers again.
+	 * then one tracked step from where the rebuild started to the
+	 * current point, checked against the global answer before the
+	 * tracker answers again.
 	 * Real-time meaning: an update costs at most about max_solves cell
 	 * solves plus the following of the live points, or one global query
 	 * plus max_solves / 2 cell solves, and at most max_tests cell tests
