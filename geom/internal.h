@@ -111,6 +111,15 @@ double px__strack_cert_radius(const struct px_strack *t, int s, double u,
  * show that their containment check fails for a non-conservative
  * bound). */
 extern double px__strack_radius_scale;
+/* The region cell of surface s holding (u, v): its bounds (u0, u1, v0,
+ * v1) in box; returns 1 when its certificates prove it free of critical
+ * points for the point p, 0 when not, -1 for bad arguments. */
+int px__strack_region(const struct px_strack *t, int s, double u, double v,
+		      px_vec3 p, double box[4]);
+/* The preconditioned emptiness test of the region certificates: 1 (the
+ * default) on, 0 off, 2 with its remainder terms dropped (unsound: a
+ * fault the tests must see). */
+extern int px__strack_precond;
 /* Test hook: 1 turns the surface tracker's hot path off, 2 makes its
  * certificate never expire (a fault the tests must see). */
 void px__strack_set_hot_fault(struct px_strack *t, int fault);

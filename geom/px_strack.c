@@ -637,10 +637,68 @@ static double iv_mag(struct iv a)
 #define ST_MIN(a, b) ((a) < (b) ? (a) : (b))
 #define ST_MAX(a, b) ((a) > (b) ? (a) : (b))
 
+/*
+ * The E test preconditioned (Krawczyk's exclusion): by the mean value
+ * theorem E(c + d) = E(c) + J d, each row of J the Hessian's at some point
+ * of the cell, so a zero at c + d gives d = -Y E(c) + (I - Y J) d for any
+ * Y; with Y the inverse of the midpoint of the Hessian's enclosure, a row
+ * i with |(Y E(c))_i| > h_i + sum_j |I - Y J|_ij h_j proves there is none.
+ * Unlike the plain test this sees where Newton from the centre would go:
+ * a cell beside a critical point (its E small in both components, the
+ * point just across a side) is proven empty when the step leads out of
+ * it. For x in the cube of radius r about p, E(c) moves by r |Su(c)|_1
+ * (resp. Sv) and J by r m_ij, so each row's test is linear in r: the
+ * largest r that keeps one of them. mid and rad: the Hessian enclosure
+ * at p (rad with its rounding pad), e1, e2: E(c) at p (signed), epad
+ * their rounding.
+ */
+/* Test hook (internal.h): 0 leaves the preconditioned test out, 2 drops
+ * its remainder terms (unsound). */
+int px__strack_precond = 1;
+
+static double pre_radius(const struct rcert *c, const double mid[3],
+			 const double rad_in[3], double e1, double e2, double epad)
+{
+	double det = mid[0] * mid[2] - mid[1] * mid[1], y[2][2], q[2][2], best = 0.0;
+	double rad[3] = {rad_in[0], rad_in[1], rad_in[2]};
+	int i;
+	if (!(fabs(det) > 0.0) || !px__strack_precond)
+		return 0.0;
+	if (px__strack_precond == 2)
+		rad[0] = rad[1] = rad[2] = 0.0;
+	y[0][0] = mid[2] / det;
+	y[0][1] = y[1][0] = -mid[1] / det;
+	y[1][1] = mid[0] / det;
+	if (!(isfinite(y[0][0]) && isfinite(y[0][1]) && isfinite(y[1][1])))
+		return 0.0;
+	/* I - Y mid, zero but for rounding */
+	q[0][0] = 1.0 - (y[0][0] * mid[0] + y[0][1] * mid[1]);
+	q[0][1] = -(y[0][0] * mid[1] + y[0][1] * mid[2]);
+	q[1][0] = -(y[1][0] * mid[0] + y[1][1] * mid[1]);
+	q[1][1] = 1.0 - (y[1][0] * mid[1] + y[1][1] * mid[2]);
+	for (i = 0; i < 2; i++) {
+		double a = fabs(y[i][0]), b = fabs(y[i][1]);
+		double ye = y[i][0] * e1 + y[i][1] * e2;
+		double num = fabs(ye) - (a + b) * epad -
+			     ST_PAD * (a * fabs(e1) + b * fabs(e2)) -
+			     (i ? c->hv : c->hu) -
+			     c->hu * (fabs(q[i][0]) + a * rad[0] + b * rad[1]) -
+			     c->hv * (fabs(q[i][1]) + a * rad[1] + b * rad[2]);
+		double den = a * c->n1 + b * c->n2 +
+			     c->hu * (a * c->m11 + b * c->m12) +
+			     c->hv * (a * c->m12 + b * c->m22);
+		double r = num / den;
+		if (r > best)
+			best = r;
+	}
+	return best;
+}
+
 static double cert_radius(const struct rcert *c, px_vec3 p)
 {
 	double mid[3], rad[3], a11, b11, a22, b22, M11, M12, M22,
-	       m11 = c->m11, m12 = c->m12, m22 = c->m22, rE, rD, r, e1, e2, pad;
+	       m11 = c->m11, m12 = c->m12, m22 = c->m22, rE, rD, r, e1, e2, pad,
+	       epad;
 	px_vec3 w, aw;
 	int k;
 	aw = px_v3_sub(c->smid, p);
@@ -662,15 +720,15 @@ static double cert_radius(const struct rcert *c, px_vec3 p)
 	M22 = fabs(mid[2]) + rad[2] + pad;
 	/* E test */
 	w = px_v3_sub(c->sc, p);
-	e1 = fabs(px_v3_dot(w, c->suc));
-	e2 = fabs(px_v3_dot(w, c->svc));
-	pad = ST_PAD * (fabs(w.x) + fabs(w.y) + fabs(w.z) + fabs(p.x) + fabs(p.y) +
-			fabs(p.z)) *
-	      (c->n1 + c->n2);
+	e1 = px_v3_dot(w, c->suc);
+	e2 = px_v3_dot(w, c->svc);
+	epad = ST_PAD * (fabs(w.x) + fabs(w.y) + fabs(w.z) + fabs(p.x) + fabs(p.y) +
+			 fabs(p.z)) *
+	       (c->n1 + c->n2);
 	{
-		double r1 = (e1 - pad - M11 * c->hu - M12 * c->hv) /
+		double r1 = (fabs(e1) - epad - M11 * c->hu - M12 * c->hv) /
 			    (c->n1 + m11 * c->hu + m12 * c->hv);
-		double r2 = (e2 - pad - M12 * c->hu - M22 * c->hv) /
+		double r2 = (fabs(e2) - epad - M12 * c->hu - M22 * c->hv) /
 			    (c->n2 + m12 * c->hu + m22 * c->hv);
 		rE = r1 > r2 ? r1 : r2;
 		if (!(rE > 0.0))
@@ -711,6 +769,14 @@ static double cert_radius(const struct rcert *c, px_vec3 p)
 		if (!(rD > 0.0))
 			rD = 0.0;
 	}
+	if (!(rE > 0.0) && !(rD > 0.0)) {
+		/* neither: the preconditioned E test (costs as much again,
+		 * so only here) */
+		double rp[3];
+		for (k = 0; k < 3; k++)
+			rp[k] = rad[k] + pad;
+		rE = pre_radius(c, mid, rp, e1, e2, epad);
+	}
 	for (k = 0; k < c->nside && rD > rE; k++) {
 		/* open side: E restricted to it, mean value form along it */
 		const struct cside *sd = &c->side[k];
@@ -720,8 +786,8 @@ static double cert_radius(const struct rcert *c, px_vec3 p)
 		w = px_v3_sub(sd->s, p);
 		f1 = fabs(px_v3_dot(w, sd->su));
 		f2 = fabs(px_v3_dot(w, sd->sv));
-		r1 = (f1 - pad - d1 * sd->h) / (sd->n1 + q1 * sd->h);
-		r2 = (f2 - pad - d2 * sd->h) / (sd->n2 + q2 * sd->h);
+		r1 = (f1 - epad - d1 * sd->h) / (sd->n1 + q1 * sd->h);
+		r2 = (f2 - epad - d2 * sd->h) / (sd->n2 + q2 * sd->h);
 		r1 = r1 > r2 ? r1 : r2;
 		r1 = r1 > 0.0 ? r1 : 0.0;
 		rD = ST_MIN(rD, r1);
@@ -731,31 +797,35 @@ static double cert_radius(const struct rcert *c, px_vec3 p)
 }
 
 /* 1 when E is proven not to vanish on the cell for the point p: no
- * critical point there (the E test of cert_radius() at r = 0). */
+ * critical point there (the E tests of cert_radius() at r = 0). */
 static int no_root(const struct rcert *c, px_vec3 p)
 {
-	double mid[3], rad[3], e1, e2, pad;
+	double mid[3], rad[3], mag[3], e1, e2, pad, epad;
 	px_vec3 w, aw;
 	int k;
 	aw = px_v3_sub(c->smid, p);
 	aw = px_v3(fabs(aw.x), fabs(aw.y), fabs(aw.z));
 	for (k = 0; k < 3; k++) {
-		mid[k] = fabs(c->A[k] - px_v3_dot(p, c->B[k]));
+		mid[k] = c->A[k] - px_v3_dot(p, c->B[k]);
 		rad[k] = c->R[k] + px_v3_dot(aw, c->Q[k]);
 	}
-	pad = ST_PAD * (mid[0] + mid[1] + mid[2] + rad[0] + rad[1] + rad[2] +
+	pad = ST_PAD * (fabs(mid[0]) + fabs(mid[1]) + fabs(mid[2]) + rad[0] +
+			rad[1] + rad[2] +
 			(aw.x + aw.y + aw.z + fabs(p.x) + fabs(p.y) + fabs(p.z)) *
 				(c->m11 + c->m12 + c->m22));
-	for (k = 0; k < 3; k++)
-		mid[k] += rad[k] + pad;
+	for (k = 0; k < 3; k++) {
+		rad[k] += pad;
+		mag[k] = fabs(mid[k]) + rad[k];
+	}
 	w = px_v3_sub(c->sc, p);
-	e1 = fabs(px_v3_dot(w, c->suc));
-	e2 = fabs(px_v3_dot(w, c->svc));
-	pad = ST_PAD * (fabs(w.x) + fabs(w.y) + fabs(w.z) + fabs(p.x) + fabs(p.y) +
-			fabs(p.z)) *
-	      (c->n1 + c->n2);
-	return e1 - pad > mid[0] * c->hu + mid[1] * c->hv ||
-	       e2 - pad > mid[1] * c->hu + mid[2] * c->hv;
+	e1 = px_v3_dot(w, c->suc);
+	e2 = px_v3_dot(w, c->svc);
+	epad = ST_PAD * (fabs(w.x) + fabs(w.y) + fabs(w.z) + fabs(p.x) + fabs(p.y) +
+			 fabs(p.z)) *
+	       (c->n1 + c->n2);
+	return fabs(e1) - epad > mag[0] * c->hu + mag[1] * c->hv ||
+	       fabs(e2) - epad > mag[1] * c->hu + mag[2] * c->hv ||
+	       pre_radius(c, mid, rad, e1, e2, epad) > 0.0;
 }
 
 /* Test hook (internal.h): a factor on every certified radius. */
@@ -2024,6 +2094,27 @@ double px__strack_cert_radius(const struct px_strack *t, int s, double u,
 	c = &t->cell[f->first_cell + cell_of(f, u, v)];
 	ch = (u >= 0.5 * (c->u0 + c->u1)) + 2 * (v >= 0.5 * (c->v0 + c->v1));
 	return region_radius(&t->rcell[c->child + ch], p);
+}
+
+int px__strack_region(const struct px_strack *t, int s, double u, double v,
+		       px_vec3 p, double box[4])
+{
+	const struct ssurf *f;
+	const struct scell *c, *g;
+	int ch;
+	if (!t || s < 0 || s >= t->n_surf)
+		return -1;
+	f = &t->sf[s];
+	if (u < f->u0 || u > f->u1 || v < f->v0 || v > f->v1)
+		return -1;
+	c = &t->cell[f->first_cell + cell_of(f, u, v)];
+	ch = (u >= 0.5 * (c->u0 + c->u1)) + 2 * (v >= 0.5 * (c->v0 + c->v1));
+	g = &t->rcell[c->child + ch];
+	box[0] = g->u0;
+	box[1] = g->u1;
+	box[2] = g->v0;
+	box[3] = g->v1;
+	return no_root(&g->cert, p);
 }
 
 int px_strack_critical(const struct px_strack *t, int s, double *u, double *v,
