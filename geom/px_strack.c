@@ -898,8 +898,9 @@ static void heap_rebuild(struct px_strack *t, px_vec3 p)
 	t->col_on = 0;
 }
 
-/* Work units of a hit cell: one solve, two after a long step past the
- * crossing (solved where the region was met too). */
+/* Work units of a hit cell: one solve; more than one after a long step
+ * past the crossing (solved where the region was met too, and its
+ * neighbours at the end). */
 static int hit_work(const struct px_strack *t, int ci, double step)
 {
 	const struct scell *c = &t->cell[ci];
@@ -1380,10 +1381,42 @@ static int pend_solve(struct px_strack *t, int budget, int *done)
 }
 
 /*
+ * Where along p0 -> p1 to solve hit cell c again after a long step: past
+ * the part of the segment its certificates leave open, so that a pair
+ * born there is found near where it was born (and followed to p1), not
+ * looked for after it may have left the cell. The certified radius at
+ * either end of the open part [a, b] clears a stretch of it; a few
+ * rounds from both ends narrow it down to where the transition can be.
+ * Returns b (the col_test() estimate when all of it is cleared).
+ */
+static double cross_at(const struct px_strack *t, const struct scell *c,
+		       px_vec3 p0, px_vec3 p1)
+{
+	px_vec3 dp = px_v3_sub(p1, p0);
+	double dinf = fmax(fmax(fabs(dp.x), fabs(dp.y)), fabs(dp.z));
+	double a = 0.0, b = 1.0;
+	int k;
+	if (!(dinf > 0.0))
+		return 1.0;
+	for (k = 0; k < 8 && b - a > 1e-3; k++) {
+		double ra = cell_radius(t, c, px_v3_add(p0, px_v3_scale(dp, a))) / dinf;
+		double rb = cell_radius(t, c, px_v3_add(p0, px_v3_scale(dp, b))) / dinf;
+		if (!(ra > 0.0) && !(rb > 0.0))
+			break;
+		a += ra;
+		b -= rb;
+		if (a >= b)
+			return c->cross;
+	}
+	return b;
+}
+
+/*
  * Move the tracked set from p0 to p (t->p becomes p), the nh cells whose
  * certificates the segment may break collected (collect_cells()): follow
  * every point, add the cells of lost points, and solve them (a hit after
- * a long step also where its region was met, its roots followed to p). Returns 0; 1 when
+ * a long step also past where its region was met, its roots followed to
+ * p, and its neighbours at p). Returns 0; 1 when
  * that work exceeds the budget: nothing is solved, the work is left
  * pending (mode ST_PEND, solved over the next updates at p); PX_E_NOSPC.
  */
@@ -1435,7 +1468,8 @@ static int track_step(struct px_strack *t, px_vec3 p0, px_vec3 p,
 	t->hot_s = -1;
 	t->p = p;
 	/* the work list: solve at p; after a long step past the crossing
-	 * also where the region was met (pole cells outside the budget) */
+	 * also past where the region was met, and the neighbours at p (pole
+	 * cells outside the budget) */
 	t->n_pend = t->pend_next = 0;
 	for (i = 0; i < nh; i++) {
 		int ci = t->hits[i];
@@ -1443,8 +1477,27 @@ static int track_step(struct px_strack *t, px_vec3 p0, px_vec3 p,
 		t->pend[t->n_pend] = ci;
 		t->pend_ps[t->n_pend++] = p;
 		if (hit_work(t, ci, step) > 1) {
+			const struct ssurf *f = &t->sf[c->surf];
+			int loc = ci - f->first_cell, cu = loc % f->ncu, cv = loc / f->ncu,
+			    du, dv;
 			t->pend[t->n_pend] = ci;
-			t->pend_ps[t->n_pend++] = px_v3_add(p0, px_v3_scale(dp, c->cross));
+			t->pend_ps[t->n_pend++] =
+				px_v3_add(p0, px_v3_scale(dp, cross_at(t, c, p0, p)));
+			/* after a long step a pair born in c may have moved on
+			 * into a neighbour whose own certificate holds (points
+			 * only move there): solved at p as well */
+			for (dv = -1; dv <= 1; dv++)
+				for (du = -1; du <= 1; du++) {
+					int nu = cu + du, nv = cv + dv, nc;
+					if (nu < 0 || nu >= f->ncu || nv < 0 || nv >= f->ncv)
+						continue;
+					nc = f->first_cell + nv * f->ncu + nu;
+					if (t->cell[nc].mark == t->epoch)
+						continue;
+					t->cell[nc].mark = t->epoch;
+					t->pend[t->n_pend] = nc;
+					t->pend_ps[t->n_pend++] = p;
+				}
 		}
 	}
 	for (i = 0; i < t->n_surf; i++)
@@ -2694,8 +2747,8 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	t->heap = calloc((size_t)cell_cap + 1, sizeof(int));
 	t->popped = calloc((size_t)cell_cap + 1, sizeof(int));
 	t->hits = calloc((size_t)cell_cap + 1, sizeof(int));
-	t->pend = calloc(2 * (size_t)cell_cap + 2, sizeof(int));
-	t->pend_ps = calloc(2 * (size_t)cell_cap + 2, sizeof(px_vec3));
+	t->pend = calloc(3 * (size_t)cell_cap + 2, sizeof(int));
+	t->pend_ps = calloc(3 * (size_t)cell_cap + 2, sizeof(px_vec3));
 	for (i = 0; i < n_surfs; i++) {
 		const struct px_nurbs_surf *sf = &t->sf[i].s;
 		size_t l = PX_NURBS_SURF_WORK_LEN(sf->degree[0], sf->degree[1],
