@@ -637,6 +637,10 @@ static double iv_mag(struct iv a)
 #define ST_MIN(a, b) ((a) < (b) ? (a) : (b))
 #define ST_MAX(a, b) ((a) > (b) ? (a) : (b))
 
+/* Test hook (internal.h): 0 leaves the preconditioned test out, 2 drops
+ * its remainder terms (unsound). */
+int px__strack_precond = 1;
+
 /*
  * The E test preconditioned (Krawczyk's exclusion): by the mean value
  * theorem E(c + d) = E(c) + J d, each row of J the Hessian's at some point
@@ -652,10 +656,6 @@ static double iv_mag(struct iv a)
  * at p (rad with its rounding pad), e1, e2: E(c) at p (signed), epad
  * their rounding.
  */
-/* Test hook (internal.h): 0 leaves the preconditioned test out, 2 drops
- * its remainder terms (unsound). */
-int px__strack_precond = 1;
-
 static double pre_radius(const struct rcert *c, const double mid[3],
 			 const double rad_in[3], double e1, double e2, double epad)
 {
