@@ -2133,36 +2133,37 @@ void px__strack_set_hot_fault(struct px_strack *t, int fault)
 	}
 }
 
-double px__strack_cert_radius(const struct px_strack *t, int s, double u,
-			      double v, px_vec3 p)
+/* The region cell of surface s holding (u, v), NULL for bad arguments
+ * (the test hooks below). */
+static const struct scell *region_at(const struct px_strack *t, int s,
+				     double u, double v)
 {
 	const struct ssurf *f;
 	const struct scell *c;
 	int ch;
 	if (!t || s < 0 || s >= t->n_surf)
-		return -1.0;
+		return NULL;
 	f = &t->sf[s];
 	if (u < f->u0 || u > f->u1 || v < f->v0 || v > f->v1)
-		return -1.0;
+		return NULL;
 	c = &t->cell[f->first_cell + cell_of(f, u, v)];
 	ch = (u >= 0.5 * (c->u0 + c->u1)) + 2 * (v >= 0.5 * (c->v0 + c->v1));
-	return region_radius(&t->rcell[c->child + ch], p);
+	return &t->rcell[c->child + ch];
+}
+
+double px__strack_cert_radius(const struct px_strack *t, int s, double u,
+			      double v, px_vec3 p)
+{
+	const struct scell *g = region_at(t, s, u, v);
+	return g ? region_radius(g, p) : -1.0;
 }
 
 int px__strack_region(const struct px_strack *t, int s, double u, double v,
 		       px_vec3 p, double box[4])
 {
-	const struct ssurf *f;
-	const struct scell *c, *g;
-	int ch;
-	if (!t || s < 0 || s >= t->n_surf)
+	const struct scell *g = region_at(t, s, u, v);
+	if (!g)
 		return -1;
-	f = &t->sf[s];
-	if (u < f->u0 || u > f->u1 || v < f->v0 || v > f->v1)
-		return -1;
-	c = &t->cell[f->first_cell + cell_of(f, u, v)];
-	ch = (u >= 0.5 * (c->u0 + c->u1)) + 2 * (v >= 0.5 * (c->v0 + c->v1));
-	g = &t->rcell[c->child + ch];
 	box[0] = g->u0;
 	box[1] = g->u1;
 	box[2] = g->v0;
