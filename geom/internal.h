@@ -120,6 +120,15 @@ int px__strack_region(const struct px_strack *t, int s, double u, double v,
  * default) on, 0 off, 2 with its remainder terms dropped (unsound: a
  * fault the tests must see). */
 extern int px__strack_precond;
+/* The region cell of surface s holding (u, v), bounds in box as above:
+ * bit 0 of the result set when its Hessian enclosure at p proves it
+ * holds at most one critical point, bit 1 + k the same for its quarter
+ * k (k & 1: upper half in u, k & 2: in v); -1 for bad arguments. */
+int px__strack_one(const struct px_strack *t, int s, double u, double v,
+		   px_vec3 p, double box[4]);
+/* 1 drops the Hessian enclosure's radius from that test (unsound: a
+ * fault the tests must see); 0 by default. */
+extern int px__strack_one_fault;
 /* Test hook: 1 turns the surface tracker's hot path off, 2 makes its
  * certificate never expire (a fault the tests must see). */
 void px__strack_set_hot_fault(struct px_strack *t, int fault);

@@ -148,6 +148,11 @@ struct px_strack {
 	/* transition regions are held by 2 x 2 children of each solve cell:
 	 * tighter cones and height intervals, the same seeds */
 	struct scell *rcell;
+	/* the quarters of each region cell (qcert[4 ri + k]): tried where
+	 * the region's own certificate proves nothing, which happens when
+	 * its enclosures are too wide for a critical point or a focal point
+	 * close by (the quarters' are about half as wide) */
+	struct rcert *qcert;
 	struct edge *edge;
 	struct pole *pole;
 	int *heap, *popped, *hits;
@@ -493,11 +498,34 @@ static int crit_add(struct px_strack *t, struct ssurf *f, const struct crit *z)
 
 static int follow(const struct ssurf *f, struct crit *z, px_vec3 p0,
 		  px_vec3 dp, px_vec3 p, struct crit *last);
+static int region_empty(const struct px_strack *t, int ri, px_vec3 p);
 static int no_root(const struct rcert *c, px_vec3 p);
+static int one_root(const struct rcert *c, px_vec3 p);
+
+/* 1 when f holds a point in the box b (u0, u1, v0, v1). */
+static int holds(const struct ssurf *f, const double b[4])
+{
+	int i;
+	for (i = 0; i < f->nz; i++)
+		if (f->z[i].u >= b[0] && f->z[i].u <= b[1] && f->z[i].v >= b[2] &&
+		    f->z[i].v <= b[3])
+			return 1;
+	return 0;
+}
+
+/* 1 when box b (with certificate c) needs no seeds at p: proven free of
+ * critical points, or (known: the held set is at p) its Hessian
+ * enclosure regular - at most one critical point in it - and a held
+ * point lies in it, which is then the only one. */
+static int box_done(const struct ssurf *f, const struct rcert *c,
+		    const double b[4], px_vec3 p, int known)
+{
+	return no_root(c, p) || (known && holds(f, b) && one_root(c, p));
+}
 
 /*
  * The work of cell solves, in ST_UNITS per solve: a cell whose four
- * region certificates prove it empty at the seed point costs those
+ * regions need no seeds at the seed point (cell_done()) costs those
  * checks alone (measured on the 16-patch bench surface: about 900
  * instructions, against about 7,000 for each Newton run from a seed and
  * 14,000 for following a root), one unit; any other solve ST_UNITS.
@@ -506,55 +534,122 @@ static int no_root(const struct rcert *c, px_vec3 p);
  */
 #define ST_UNITS 8
 
-/* Which of c's region cells are proven free of critical points at ps
- * (a seed converges to a point near it, so those give no seeds); 1 when
- * all four are. */
-static int cell_empty(const struct px_strack *t, const struct scell *c,
-		      px_vec3 ps, int empty[4])
+/* The box (u0, u1, v0, v1) of cell g (k < 0) or of its quarter k (k & 1:
+ * the upper half in u, k & 2: in v). */
+static void box_of(const struct scell *g, int k, double b[4])
 {
-	int ch;
-	for (ch = 0; ch < 4; ch++)
-		empty[ch] = no_root(&t->rcell[c->child + ch].cert, ps);
-	return empty[0] && empty[1] && empty[2] && empty[3];
+	double um = 0.5 * (g->u0 + g->u1), vm = 0.5 * (g->v0 + g->v1);
+	b[0] = k >= 0 && (k & 1) ? um : g->u0;
+	b[1] = k >= 0 && !(k & 1) ? um : g->u1;
+	b[2] = k >= 0 && (k & 2) ? vm : g->v0;
+	b[3] = k >= 0 && !(k & 2) ? vm : g->v1;
+}
+
+/* Which of c's region cells need no seeds at ps (box_done(), the region
+ * or each of its quarters; known: the held set is at ps; a seed
+ * converges to a point near it, so those give none); 1 when all four. */
+static int cell_done(const struct px_strack *t, const struct scell *c,
+		     px_vec3 ps, int known, int done[4])
+{
+	const struct ssurf *f = &t->sf[c->surf];
+	int ch, k;
+	for (ch = 0; ch < 4; ch++) {
+		int ri = c->child + ch;
+		const struct scell *g = &t->rcell[ri];
+		double b[4];
+		box_of(g, -1, b);
+		done[ch] = box_done(f, &g->cert, b, ps, known);
+		for (k = 0; k < 4 && !done[ch]; k++) {
+			box_of(g, k, b);
+			if (!box_done(f, &t->qcert[4 * ri + k], b, ps, known))
+				break;
+		}
+		done[ch] = done[ch] || k == 4;
+	}
+	return done[0] && done[1] && done[2] && done[3];
+}
+
+/* Newton from (u, v) of cell c at ps, the root followed to p and added.
+ * Returns 0 or PX_E_NOSPC. */
+static int seed_solve(struct px_strack *t, struct ssurf *f, const struct scell *c,
+		      double u, double v, px_vec3 ps, px_vec3 p)
+{
+	struct crit z, last;
+	memset(&z, 0, sizeof(z));
+	z.u = u;
+	z.v = v;
+	if (snewton(f, &z, ps, 0.5 * (c->u1 - c->u0), 0.5 * (c->v1 - c->v0), c))
+		return 0;
+	if (px_v3_dist2(ps, p) != 0.0 &&
+	    follow(f, &z, ps, px_v3_sub(p, ps), p, &last))
+		return 0;
+	return crit_add(t, f, &z) < 0 ? PX_E_NOSPC : 0;
 }
 
 /*
  * Solve cell c: Newton from its seed grid at ps, each root then followed
  * from ps to p (a pair born where the path met the cell's region keeps
  * moving for the rest of the step, possibly out of the cell). empty:
- * cell_empty() at ps, or NULL to work it out. Returns 0 or PX_E_NOSPC.
+ * cell_done() at ps, or NULL to work it out. The held set is at p (every
+ * caller), so where ps is p a region or quarter holding one of its
+ * points needs no seeds if it can hold only one. Returns 0 or
+ * PX_E_NOSPC.
  */
 static int cell_solve_at(struct px_strack *t, const struct scell *c,
 			 px_vec3 ps, px_vec3 p, const int *empty_in)
 {
 	struct ssurf *f = &t->sf[c->surf];
-	int n = t->opts.seeds, i, j, rc, same = px_v3_dist2(ps, p) == 0.0;
+	int n = t->opts.seeds, i, j, ch, rc, known = px_v3_dist2(ps, p) == 0.0;
 	int ebuf[4];
 	const int *empty = empty_in;
 	double lu = c->u1 - c->u0, lv = c->v1 - c->v0;
 	t->st.cell_solves++;
 	if (!empty) {
-		cell_empty(t, c, ps, ebuf);
+		cell_done(t, c, ps, known, ebuf);
 		empty = ebuf;
 	}
 	if (empty[0] && empty[1] && empty[2] && empty[3])
 		return 0;
-	for (j = 0; j < n; j++)
-		for (i = 0; i < n; i++) {
-			struct crit z, last;
-			if (empty[(2 * i) / n + 2 * ((2 * j) / n)])
+	for (ch = 0; ch < 4; ch++) {
+		/* Newton from the grid seeds of each region that may hold a
+		 * point, and from the centre of each of its quarters that
+		 * may and has no grid seed: where the quarters prove a
+		 * region's neighbourhood empty, a point in it is no longer
+		 * found from the seeds of the regions around */
+		const struct rcert *qc = &t->qcert[4 * (c->child + ch)];
+		int qn[4] = {0, 0, 0, 0}, qe[4], k;
+		if (empty[ch])
+			continue;
+		for (k = 0; k < 4; k++) {
+			double b[4];
+			box_of(&t->rcell[c->child + ch], k, b);
+			qe[k] = box_done(f, &qc[k], b, ps, known);
+		}
+		for (j = 0; j < n; j++)
+			for (i = 0; i < n; i++) {
+				double su = (i + 0.5) / n, sv = (j + 0.5) / n;
+				int ru = su >= 0.5, rv = sv >= 0.5;
+				if (ru + 2 * rv != ch)
+					continue;
+				k = (su - 0.5 * ru >= 0.25) + 2 * (sv - 0.5 * rv >= 0.25);
+				if (qe[k])
+					continue;
+				qn[k]++;
+				rc = seed_solve(t, f, c, c->u0 + lu * su, c->v0 + lv * sv, ps, p);
+				if (rc < 0)
+					return rc;
+			}
+		for (k = 0; k < 4; k++) {
+			double su, sv;
+			if (qe[k] || qn[k])
 				continue;
-			memset(&z, 0, sizeof(z));
-			z.u = c->u0 + lu * (i + 0.5) / n;
-			z.v = c->v0 + lv * (j + 0.5) / n;
-			if (snewton(f, &z, ps, 0.5 * lu, 0.5 * lv, c))
-				continue;
-			if (!same && follow(f, &z, ps, px_v3_sub(p, ps), p, &last))
-				continue;
-			rc = crit_add(t, f, &z);
+			su = 0.5 * (ch & 1) + 0.25 * (k & 1) + 0.125;
+			sv = 0.5 * (ch >> 1) + 0.25 * (k >> 1) + 0.125;
+			rc = seed_solve(t, f, c, c->u0 + lu * su, c->v0 + lv * sv, ps, p);
 			if (rc < 0)
 				return rc;
 		}
+	}
 	return 0;
 }
 
@@ -572,7 +667,7 @@ static int cell_solve_budget(struct px_strack *t, const struct scell *c,
 			     px_vec3 ps, px_vec3 p, int *units, int lim)
 {
 	int empty[4];
-	int cost = cell_empty(t, c, ps, empty) ? 1 : ST_UNITS;
+	int cost = cell_done(t, c, ps, px_v3_dist2(ps, p) == 0.0, empty) ? 1 : ST_UNITS;
 	if (lim > 0 && *units > 0 && *units + cost > lim)
 		return 1;
 	*units += cost;
@@ -796,12 +891,13 @@ static double cert_radius(const struct rcert *c, px_vec3 p)
 	return r > 0.0 ? r : 0.0;
 }
 
-/* 1 when E is proven not to vanish on the cell for the point p: no
- * critical point there (the E tests of cert_radius() at r = 0). */
-static int no_root(const struct rcert *c, px_vec3 p)
+/* The Hessian's enclosure over the cell for the point p, midpoint and
+ * radius (entries 11, 12, 22), the radius padded for rounding. */
+static void hess_at(const struct rcert *c, px_vec3 p, double mid[3],
+		    double rad[3])
 {
-	double mid[3], rad[3], mag[3], e1, e2, pad, epad;
-	px_vec3 w, aw;
+	double pad;
+	px_vec3 aw;
 	int k;
 	aw = px_v3_sub(c->smid, p);
 	aw = px_v3(fabs(aw.x), fabs(aw.y), fabs(aw.z));
@@ -813,10 +909,20 @@ static int no_root(const struct rcert *c, px_vec3 p)
 			rad[1] + rad[2] +
 			(aw.x + aw.y + aw.z + fabs(p.x) + fabs(p.y) + fabs(p.z)) *
 				(c->m11 + c->m12 + c->m22));
-	for (k = 0; k < 3; k++) {
+	for (k = 0; k < 3; k++)
 		rad[k] += pad;
+}
+
+/* 1 when E is proven not to vanish on the cell for the point p: no
+ * critical point there (the E tests of cert_radius() at r = 0). */
+static int no_root(const struct rcert *c, px_vec3 p)
+{
+	double mid[3], rad[3], mag[3], e1, e2, epad;
+	px_vec3 w;
+	int k;
+	hess_at(c, p, mid, rad);
+	for (k = 0; k < 3; k++)
 		mag[k] = fabs(mid[k]) + rad[k];
-	}
 	w = px_v3_sub(c->sc, p);
 	e1 = px_v3_dot(w, c->suc);
 	e2 = px_v3_dot(w, c->svc);
@@ -828,21 +934,76 @@ static int no_root(const struct rcert *c, px_vec3 p)
 	       pre_radius(c, mid, rad, e1, e2, epad) > 0.0;
 }
 
+/* Test hook (internal.h): 1 drops the Hessian enclosure's radius from
+ * one_root() (unsound: its test must see it). */
+int px__strack_one_fault = 0;
+
+/*
+ * 1 when every symmetric matrix in the Hessian's enclosure over the cell
+ * at p is regular (the det H test of cert_radius() at r = 0): then the
+ * cell holds at most one critical point, since E(a) - E(b) = M (a - b)
+ * with M the Hessian averaged along the segment, a matrix of the
+ * enclosure.
+ */
+static int one_root(const struct rcert *c, px_vec3 p)
+{
+	double mid[3], rad[3], lo[3], hi[3], m12;
+	int k;
+	hess_at(c, p, mid, rad);
+	for (k = 0; k < 3; k++) {
+		double r = px__strack_one_fault ? 0.0 : rad[k];
+		lo[k] = mid[k] - r;
+		hi[k] = mid[k] + r;
+	}
+	m12 = fmax(fabs(lo[1]), fabs(hi[1]));
+	/* definite: h11 h22 > h12^2 throughout (the product rounded down) */
+	if (lo[0] > 0.0 && lo[2] > 0.0)
+		return lo[0] * lo[2] * (1.0 - 1e-12) > m12 * m12;
+	if (hi[0] < 0.0 && hi[2] < 0.0)
+		return hi[0] * hi[2] * (1.0 - 1e-12) > m12 * m12;
+	/* h11 h22 < 0 <= h12^2 */
+	return (lo[0] > 0.0 && hi[2] < 0.0) || (hi[0] < 0.0 && lo[2] > 0.0);
+}
+
 /* Test hook (internal.h): a factor on every certified radius. */
 double px__strack_radius_scale = 1.0;
 
-static double region_radius(const struct scell *c, px_vec3 p)
+/*
+ * Certified radius of region cell ri at p; where its own certificate
+ * gives none, the least of its quarters' (each quarter free of
+ * degenerate critical points, or of any, and the open sides kept: so is
+ * their union, the interior sides between them being no way in or out).
+ */
+static double region_radius(const struct px_strack *t, int ri, px_vec3 p)
 {
-	return cert_radius(&c->cert, p) * px__strack_radius_scale;
+	double r = cert_radius(&t->rcell[ri].cert, p);
+	if (!(r > 0.0)) {
+		const struct rcert *q = &t->qcert[4 * ri];
+		int k;
+		r = INFINITY;
+		for (k = 0; k < 4 && r > 0.0; k++)
+			r = fmin(r, cert_radius(&q[k], p));
+	}
+	return r * px__strack_radius_scale;
+}
+
+/* 1 when region ri holds no critical point for p (its own E tests, or
+ * each of its quarters'). */
+static int region_empty(const struct px_strack *t, int ri, px_vec3 p)
+{
+	const struct rcert *q = &t->qcert[4 * ri];
+	return no_root(&t->rcell[ri].cert, p) ||
+	       (no_root(&q[0], p) && no_root(&q[1], p) && no_root(&q[2], p) &&
+		no_root(&q[3], p));
 }
 
 /* ... and of a solve cell: its children's regions cover all of it. */
 static double cell_radius(const struct px_strack *t, const struct scell *c,
 			  px_vec3 p)
 {
-	const struct scell *ch = &t->rcell[c->child];
-	return fmin(fmin(region_radius(&ch[0], p), region_radius(&ch[1], p)),
-		    fmin(region_radius(&ch[2], p), region_radius(&ch[3], p)));
+	int ri = c->child;
+	return fmin(fmin(region_radius(t, ri, p), region_radius(t, ri + 1, p)),
+		    fmin(region_radius(t, ri + 2, p), region_radius(t, ri + 3, p)));
 }
 
 static void heap_set(struct px_strack *t, int pos, int ci)
@@ -898,9 +1059,8 @@ static void heap_rebuild(struct px_strack *t, px_vec3 p)
 	t->col_on = 0;
 }
 
-/* Work units of a hit cell: one solve; more than one after a long step
- * past the crossing (solved where the region was met too, and its
- * neighbours at the end). */
+/* Solves of a hit cell itself: one; two after a long step past the
+ * crossing (solved where the region was met too); 0 for a pole cell. */
 static int hit_work(const struct px_strack *t, int ci, double step)
 {
 	const struct scell *c = &t->cell[ci];
@@ -1467,38 +1627,43 @@ static int track_step(struct px_strack *t, px_vec3 p0, px_vec3 p,
 	}
 	t->hot_s = -1;
 	t->p = p;
-	/* the work list: solve at p; after a long step past the crossing
-	 * also past where the region was met, and the neighbours at p (pole
-	 * cells outside the budget) */
+	/* the work list: solve at p, after a long step also past where the
+	 * region was met; and the neighbours at p (pole cells outside the
+	 * budget) */
 	t->n_pend = t->pend_next = 0;
 	for (i = 0; i < nh; i++) {
 		int ci = t->hits[i];
 		const struct scell *c = &t->cell[ci];
+		const struct ssurf *f = &t->sf[c->surf];
+		int loc = ci - f->first_cell, cu = loc % f->ncu, cv = loc / f->ncu,
+		    du, dv;
 		t->pend[t->n_pend] = ci;
 		t->pend_ps[t->n_pend++] = p;
 		if (hit_work(t, ci, step) > 1) {
-			const struct ssurf *f = &t->sf[c->surf];
-			int loc = ci - f->first_cell, cu = loc % f->ncu, cv = loc / f->ncu,
-			    du, dv;
 			t->pend[t->n_pend] = ci;
 			t->pend_ps[t->n_pend++] =
 				px_v3_add(p0, px_v3_scale(dp, cross_at(t, c, p0, p)));
-			/* after a long step a pair born in c may have moved on
-			 * into a neighbour whose own certificate holds (points
-			 * only move there): solved at p as well */
-			for (dv = -1; dv <= 1; dv++)
-				for (du = -1; du <= 1; du++) {
-					int nu = cu + du, nv = cv + dv, nc;
-					if (nu < 0 || nu >= f->ncu || nv < 0 || nv >= f->ncv)
-						continue;
-					nc = f->first_cell + nv * f->ncu + nu;
-					if (t->cell[nc].mark == t->epoch)
-						continue;
-					t->cell[nc].mark = t->epoch;
-					t->pend[t->n_pend] = nc;
-					t->pend_ps[t->n_pend++] = p;
-				}
 		}
+		/* a pair born in c may have moved on into a neighbour whose
+		 * own certificate holds (points only move there; near a focal
+		 * sheet they move fast); mostly cheap: a neighbour's regions
+		 * are proven empty or hold the one point they can */
+		for (dv = -1; dv <= 1; dv++)
+			for (du = -1; du <= 1; du++) {
+				int nu = cu + du, nv = cv + dv, nc;
+				if (f->wrap_u)
+					nu = (nu + f->ncu) % f->ncu;
+				if (f->wrap_v)
+					nv = (nv + f->ncv) % f->ncv;
+				if (nu < 0 || nu >= f->ncu || nv < 0 || nv >= f->ncv)
+					continue;
+				nc = f->first_cell + nv * f->ncu + nu;
+				if (t->cell[nc].mark == t->epoch)
+					continue;
+				t->cell[nc].mark = t->epoch;
+				t->pend[t->n_pend] = nc;
+				t->pend_ps[t->n_pend++] = p;
+			}
 	}
 	for (i = 0; i < t->n_surf; i++)
 		before += t->sf[i].nz;
@@ -2155,7 +2320,7 @@ double px__strack_cert_radius(const struct px_strack *t, int s, double u,
 			      double v, px_vec3 p)
 {
 	const struct scell *g = region_at(t, s, u, v);
-	return g ? region_radius(g, p) : -1.0;
+	return g ? region_radius(t, (int)(g - t->rcell), p) : -1.0;
 }
 
 int px__strack_region(const struct px_strack *t, int s, double u, double v,
@@ -2168,7 +2333,25 @@ int px__strack_region(const struct px_strack *t, int s, double u, double v,
 	box[1] = g->u1;
 	box[2] = g->v0;
 	box[3] = g->v1;
-	return no_root(&g->cert, p);
+	return region_empty(t, (int)(g - t->rcell), p);
+}
+
+int px__strack_one(const struct px_strack *t, int s, double u, double v,
+		   px_vec3 p, double box[4])
+{
+	const struct scell *g = region_at(t, s, u, v);
+	int ri, k, m;
+	if (!g)
+		return -1;
+	box[0] = g->u0;
+	box[1] = g->u1;
+	box[2] = g->v0;
+	box[3] = g->v1;
+	ri = (int)(g - t->rcell);
+	m = one_root(&g->cert, p);
+	for (k = 0; k < 4; k++)
+		m |= one_root(&t->qcert[4 * ri + k], p) << (k + 1);
+	return m;
 }
 
 int px_strack_critical(const struct px_strack *t, int s, double *u, double *v,
@@ -2487,6 +2670,41 @@ static int crease_at(const struct ssurf *f, int dir, double x)
 	return m > f->s.degree[dir] - 2;
 }
 
+/* Which sides of cell c are open domain edges or creases (u0, u1, v0,
+ * v1): where critical points enter and leave. */
+static void sides_open(const struct ssurf *f, const struct scell *c, int open[4])
+{
+	open[0] = c->u0 == f->u0 ? !f->wrap_u : crease_at(f, 0, c->u0);
+	open[1] = c->u1 == f->u1 ? !f->wrap_u : crease_at(f, 0, c->u1);
+	open[2] = c->v0 == f->v0 ? !f->wrap_v : crease_at(f, 1, c->v0);
+	open[3] = c->v1 == f->v1 ? !f->wrap_v : crease_at(f, 1, c->v1);
+}
+
+/* The certificates of the four quarters of region cell rg. */
+static int quarter_certs(struct px_strack *t, const struct scell *rg,
+			 const struct ssurf *f, double *work, size_t wl,
+			 struct rcert out[4])
+{
+	int k, rc, open[4];
+	for (k = 0; k < 4; k++) {
+		struct scell q;
+		double b[4];
+		memset(&q, 0, sizeof(q));
+		q.surf = rg->surf;
+		box_of(rg, k, b);
+		q.u0 = b[0];
+		q.u1 = b[1];
+		q.v0 = b[2];
+		q.v1 = b[3];
+		sides_open(f, &q, open);
+		rc = cell_cert(t, &q, f, work, wl, open);
+		if (rc)
+			return rc;
+		out[k] = q.cert;
+	}
+	return 0;
+}
+
 void px_strack_free(struct px_strack *t)
 {
 	int i;
@@ -2509,6 +2727,7 @@ void px_strack_free(struct px_strack *t)
 	free(t->sf);
 	free(t->cell);
 	free(t->rcell);
+	free(t->qcert);
 	free(t->edge);
 	free(t->pole);
 	free(t->heap);
@@ -2745,6 +2964,7 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	}
 	t->cell = calloc((size_t)cell_cap + 1, sizeof(*t->cell));
 	t->rcell = calloc(4 * (size_t)cell_cap + 1, sizeof(*t->rcell));
+	t->qcert = calloc(16 * (size_t)cell_cap + 1, sizeof(*t->qcert));
 	t->heap = calloc((size_t)cell_cap + 1, sizeof(int));
 	t->popped = calloc((size_t)cell_cap + 1, sizeof(int));
 	t->hits = calloc((size_t)cell_cap + 1, sizeof(int));
@@ -2758,7 +2978,7 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 			wl = l;
 	}
 	work = malloc(wl * sizeof(double));
-	if (!t->cell || !t->rcell || !t->heap || !t->popped || !t->hits ||
+	if (!t->cell || !t->rcell || !t->qcert || !t->heap || !t->popped || !t->hits ||
 	    !t->pend || !t->pend_ps || !work) {
 		rc = PX_E_NOMEM;
 		goto fail;
@@ -2792,20 +3012,17 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 						rg->u1 = ch & 1 ? c->u1 : um;
 						rg->v0 = ch & 2 ? vm : c->v0;
 						rg->v1 = ch & 2 ? c->v1 : vm;
-						open[0] = rg->u0 == f->u0 ? !f->wrap_u
-									  : crease_at(f, 0, rg->u0);
-						open[1] = rg->u1 == f->u1 ? !f->wrap_u
-									  : crease_at(f, 0, rg->u1);
-						open[2] = rg->v0 == f->v0 ? !f->wrap_v
-									  : crease_at(f, 1, rg->v0);
-						open[3] = rg->v1 == f->v1 ? !f->wrap_v
-									  : crease_at(f, 1, rg->v1);
+						sides_open(f, rg, open);
 						if ((rg->u0 == f->u0 && f->pole[0]) ||
 						    (rg->u1 == f->u1 && f->pole[1]) ||
 						    (rg->v0 == f->v0 && f->pole[2]) ||
 						    (rg->v1 == f->v1 && f->pole[3]))
 							c->always = 1;
 						rc = cell_cert(t, rg, f, work, wl, open);
+						if (rc)
+							goto fail;
+						rc = quarter_certs(t, rg, f, work, wl,
+								   &t->qcert[4 * (c->child + ch)]);
 						if (rc)
 							goto fail;
 						rb.min = px_v3(rg->cert.S[0].lo, rg->cert.S[1].lo, rg->cert.S[2].lo);

@@ -14,8 +14,10 @@
  *    critical point is degenerate, E = 0 and det H = 0. Interior points
  *    enter or leave through an open edge (or a crease with less than C2
  *    continuity), where E = 0 on that side. Each Bezier patch is cut into
- *    (u, v) cells, each of those into 2 x 2 region cells. At setup every
- *    region cell gets enclosures of S and its derivatives up to order 2
+ *    (u, v) cells, each of those into 2 x 2 region cells, each of those
+ *    into 2 x 2 quarters (tried where the region's own proof fails: their
+ *    enclosures are about half as wide). At setup every region cell and
+ *    quarter gets enclosures of S and its derivatives up to order 2
  *    over the cell (from its Bezier net: convex hull for S, difference
  *    nets for the derivatives, interval quotient rule when rational). At
  *    run time these bound E and H over the cell for all points x of a
@@ -28,8 +30,13 @@
  *    no NaN. Each cell carries that radius; a min-heap on the travelled
  *    path length names the cells due; a due cell is tested on the segment
  *    of this update (the cube about its middle) and solved again at the
- *    new point when the proof fails (Newton from a seed grid; evolved
- *    points are kept, duplicates merged). Cells on a collapsed edge have
+ *    new point when the proof fails, with its 8 neighbours (a pair born in
+ *    it may have moved on into one of them within the step). A solve
+ *    runs Newton from a seed grid, leaving out the regions and quarters
+ *    proven free of critical points and those that hold a tracked one
+ *    and can hold only one (every matrix of the Hessian's enclosure
+ *    regular: E is one-to-one there); evolved points are kept,
+ *    duplicates merged. Cells on a collapsed edge have
  *    no proof near the pole's normal lines and are solved whenever hit.
  *  - Bounded work: an update whose proven-hit cells exceed max_solves,
  *    or whose due cells exceed max_tests (a long step: their tests then
@@ -74,7 +81,8 @@
  *
  * Memory and real-time rules: px_strack_create() allocates everything
  * (cells, boxes, heap, critical-point arrays of fixed capacity, the
- * curve tracker and the global-query model). px_strack_update() and the
+ * curve tracker and the global-query model; the certificates take about
+ * 20 KB a cell, its 4 regions and 16 quarters). px_strack_update() and the
  * accessors never allocate, lock or print; every loop has a bound. One
  * tracker follows one point; not for concurrent use.
  */
