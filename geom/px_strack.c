@@ -589,36 +589,36 @@ static int seed_solve(struct px_strack *t, struct ssurf *f, const struct scell *
 /*
  * Solve cell c: Newton from its seed grid at ps, each root then followed
  * from ps to p (a pair born where the path met the cell's region keeps
- * moving for the rest of the step, possibly out of the cell). empty:
+ * moving for the rest of the step, possibly out of the cell). done_in:
  * cell_done() at ps, or NULL to work it out. The held set is at p (every
  * caller), so where ps is p a region or quarter holding one of its
  * points needs no seeds if it can hold only one. Returns 0 or
  * PX_E_NOSPC.
  */
 static int cell_solve_at(struct px_strack *t, const struct scell *c,
-			 px_vec3 ps, px_vec3 p, const int *empty_in)
+			 px_vec3 ps, px_vec3 p, const int *done_in)
 {
 	struct ssurf *f = &t->sf[c->surf];
 	int n = t->opts.seeds, i, j, ch, rc, known = px_v3_dist2(ps, p) == 0.0;
-	int ebuf[4];
-	const int *empty = empty_in;
+	int dbuf[4];
+	const int *done = done_in;
 	double lu = c->u1 - c->u0, lv = c->v1 - c->v0;
 	t->st.cell_solves++;
-	if (!empty) {
-		cell_done(t, c, ps, known, ebuf);
-		empty = ebuf;
+	if (!done) {
+		cell_done(t, c, ps, known, dbuf);
+		done = dbuf;
 	}
-	if (empty[0] && empty[1] && empty[2] && empty[3])
+	if (done[0] && done[1] && done[2] && done[3])
 		return 0;
 	for (ch = 0; ch < 4; ch++) {
 		/* Newton from the grid seeds of each region that may hold a
 		 * point, and from the centre of each of its quarters that
 		 * may and has no grid seed: where the quarters prove a
-		 * region's neighbourhood empty, a point in it is no longer
+		 * region's neighbourhood done, a point in it is no longer
 		 * found from the seeds of the regions around */
 		const struct rcert *qc = &t->qcert[4 * (c->child + ch)];
 		int qn[4] = {0, 0, 0, 0}, qe[4], k;
-		if (empty[ch])
+		if (done[ch])
 			continue;
 		for (k = 0; k < 4; k++) {
 			double b[4];
@@ -666,12 +666,12 @@ static int cell_solve(struct px_strack *t, const struct scell *c, px_vec3 p)
 static int cell_solve_budget(struct px_strack *t, const struct scell *c,
 			     px_vec3 ps, px_vec3 p, int *units, int lim)
 {
-	int empty[4];
-	int cost = cell_done(t, c, ps, px_v3_dist2(ps, p) == 0.0, empty) ? 1 : ST_UNITS;
+	int done[4];
+	int cost = cell_done(t, c, ps, px_v3_dist2(ps, p) == 0.0, done) ? 1 : ST_UNITS;
 	if (lim > 0 && *units > 0 && *units + cost > lim)
 		return 1;
 	*units += cost;
-	return cell_solve_at(t, c, ps, p, empty);
+	return cell_solve_at(t, c, ps, p, done);
 }
 
 static int surf_reinit(struct px_strack *t, struct ssurf *f, int si, px_vec3 p)
