@@ -545,11 +545,20 @@ static void box_of(const struct scell *g, int k, double b[4])
 	b[3] = k >= 0 && !(k & 2) ? vm : g->v1;
 }
 
-/* Which of c's region cells need no seeds at ps (box_done(), the region
- * or each of its quarters; known: the held set is at ps; a seed
- * converges to a point near it, so those give none); 1 when all four. */
+/* Which parts of a solve cell need no seeds (box_done()): region[ch]
+ * its region cells, quarter[ch][k] their quarters (worked out only where
+ * the region's own test fails). */
+struct cell_done {
+	int region[4];
+	int quarter[4][4];
+};
+
+/* cell_done for c at ps (known: the held set is at ps; a seed converges
+ * to a point near it, so those parts give none): a region needs none
+ * when its own test or each of its quarters' holds. 1 when no region
+ * needs seeds. */
 static int cell_done(const struct px_strack *t, const struct scell *c,
-		     px_vec3 ps, int known, int done[4])
+		     px_vec3 ps, int known, struct cell_done *d)
 {
 	const struct ssurf *f = &t->sf[c->surf];
 	int ch, k;
@@ -558,15 +567,17 @@ static int cell_done(const struct px_strack *t, const struct scell *c,
 		const struct scell *g = &t->rcell[ri];
 		double b[4];
 		box_of(g, -1, b);
-		done[ch] = box_done(f, &g->cert, b, ps, known);
-		for (k = 0; k < 4 && !done[ch]; k++) {
+		d->region[ch] = box_done(f, &g->cert, b, ps, known);
+		if (d->region[ch])
+			continue;
+		d->region[ch] = 1;
+		for (k = 0; k < 4; k++) {
 			box_of(g, k, b);
-			if (!box_done(f, &t->qcert[4 * ri + k], b, ps, known))
-				break;
+			d->quarter[ch][k] = box_done(f, &t->qcert[4 * ri + k], b, ps, known);
+			d->region[ch] = d->region[ch] && d->quarter[ch][k];
 		}
-		done[ch] = done[ch] || k == 4;
 	}
-	return done[0] && done[1] && done[2] && done[3];
+	return d->region[0] && d->region[1] && d->region[2] && d->region[3];
 }
 
 /* Newton from (u, v) of cell c at ps, the root followed to p and added.
@@ -596,35 +607,28 @@ static int seed_solve(struct px_strack *t, struct ssurf *f, const struct scell *
  * PX_E_NOSPC.
  */
 static int cell_solve_at(struct px_strack *t, const struct scell *c,
-			 px_vec3 ps, px_vec3 p, const int *done_in)
+			 px_vec3 ps, px_vec3 p, const struct cell_done *done_in)
 {
 	struct ssurf *f = &t->sf[c->surf];
-	int n = t->opts.seeds, i, j, ch, rc, known = px_v3_dist2(ps, p) == 0.0;
-	int dbuf[4];
-	const int *done = done_in;
+	int n = t->opts.seeds, i, j, ch, rc;
+	struct cell_done dbuf;
+	const struct cell_done *done = done_in;
 	double lu = c->u1 - c->u0, lv = c->v1 - c->v0;
 	t->st.cell_solves++;
 	if (!done) {
-		cell_done(t, c, ps, known, dbuf);
-		done = dbuf;
+		cell_done(t, c, ps, px_v3_dist2(ps, p) == 0.0, &dbuf);
+		done = &dbuf;
 	}
-	if (done[0] && done[1] && done[2] && done[3])
-		return 0;
 	for (ch = 0; ch < 4; ch++) {
 		/* Newton from the grid seeds of each region that may hold a
 		 * point, and from the centre of each of its quarters that
 		 * may and has no grid seed: where the quarters prove a
-		 * region's neighbourhood done, a point in it is no longer
+		 * region's neighbourhood empty, a point in it is no longer
 		 * found from the seeds of the regions around */
-		const struct rcert *qc = &t->qcert[4 * (c->child + ch)];
-		int qn[4] = {0, 0, 0, 0}, qe[4], k;
-		if (done[ch])
+		const int *qe = done->quarter[ch];
+		int qn[4] = {0, 0, 0, 0}, k;
+		if (done->region[ch])
 			continue;
-		for (k = 0; k < 4; k++) {
-			double b[4];
-			box_of(&t->rcell[c->child + ch], k, b);
-			qe[k] = box_done(f, &qc[k], b, ps, known);
-		}
 		for (j = 0; j < n; j++)
 			for (i = 0; i < n; i++) {
 				double su = (i + 0.5) / n, sv = (j + 0.5) / n;
@@ -666,12 +670,12 @@ static int cell_solve(struct px_strack *t, const struct scell *c, px_vec3 p)
 static int cell_solve_budget(struct px_strack *t, const struct scell *c,
 			     px_vec3 ps, px_vec3 p, int *units, int lim)
 {
-	int done[4];
-	int cost = cell_done(t, c, ps, px_v3_dist2(ps, p) == 0.0, done) ? 1 : ST_UNITS;
+	struct cell_done done;
+	int cost = cell_done(t, c, ps, px_v3_dist2(ps, p) == 0.0, &done) ? 1 : ST_UNITS;
 	if (lim > 0 && *units > 0 && *units + cost > lim)
 		return 1;
 	*units += cost;
-	return cell_solve_at(t, c, ps, p, done);
+	return cell_solve_at(t, c, ps, p, &done);
 }
 
 static int surf_reinit(struct px_strack *t, struct ssurf *f, int si, px_vec3 p)
@@ -789,12 +793,14 @@ static double pre_radius(const struct rcert *c, const double mid[3],
 	return best;
 }
 
-static double cert_radius(const struct rcert *c, px_vec3 p)
+/* The Hessian's enclosure over the cell for the point p, midpoint and
+ * radius (entries 11, 12, 22), the radius padded for rounding. Inline:
+ * cert_radius() runs in every cell test. */
+static inline void hess_at(const struct rcert *c, px_vec3 p, double mid[3],
+			   double rad[3])
 {
-	double mid[3], rad[3], a11, b11, a22, b22, M11, M12, M22,
-	       m11 = c->m11, m12 = c->m12, m22 = c->m22, rE, rD, r, e1, e2, pad,
-	       epad;
-	px_vec3 w, aw;
+	double pad;
+	px_vec3 aw;
 	int k;
 	aw = px_v3_sub(c->smid, p);
 	aw = px_v3(fabs(aw.x), fabs(aw.y), fabs(aw.z));
@@ -802,17 +808,28 @@ static double cert_radius(const struct rcert *c, px_vec3 p)
 		mid[k] = c->A[k] - px_v3_dot(p, c->B[k]);
 		rad[k] = c->R[k] + px_v3_dot(aw, c->Q[k]);
 	}
-	/* rounding of the sums: pad by their magnitude */
-	pad = ST_PAD * (fabs(mid[0]) + fabs(mid[1]) + fabs(mid[2]) + rad[0] + rad[1] +
-			rad[2] + (aw.x + aw.y + aw.z + fabs(p.x) + fabs(p.y) + fabs(p.z)) *
-					 (m11 + m12 + m22));
-	a11 = mid[0] - rad[0] - pad;
-	b11 = mid[0] + rad[0] + pad;
-	a22 = mid[2] - rad[2] - pad;
-	b22 = mid[2] + rad[2] + pad;
-	M11 = fabs(mid[0]) + rad[0] + pad;
-	M12 = fabs(mid[1]) + rad[1] + pad;
-	M22 = fabs(mid[2]) + rad[2] + pad;
+	pad = ST_PAD * (fabs(mid[0]) + fabs(mid[1]) + fabs(mid[2]) + rad[0] +
+			rad[1] + rad[2] +
+			(aw.x + aw.y + aw.z + fabs(p.x) + fabs(p.y) + fabs(p.z)) *
+				(c->m11 + c->m12 + c->m22));
+	for (k = 0; k < 3; k++)
+		rad[k] += pad;
+}
+
+static double cert_radius(const struct rcert *c, px_vec3 p)
+{
+	double mid[3], rad[3], a11, b11, a22, b22, M11, M12, M22,
+	       m11 = c->m11, m12 = c->m12, m22 = c->m22, rE, rD, r, e1, e2, epad;
+	px_vec3 w;
+	int k;
+	hess_at(c, p, mid, rad);
+	a11 = mid[0] - rad[0];
+	b11 = mid[0] + rad[0];
+	a22 = mid[2] - rad[2];
+	b22 = mid[2] + rad[2];
+	M11 = fabs(mid[0]) + rad[0];
+	M12 = fabs(mid[1]) + rad[1];
+	M22 = fabs(mid[2]) + rad[2];
 	/* E test */
 	w = px_v3_sub(c->sc, p);
 	e1 = px_v3_dot(w, c->suc);
@@ -867,10 +884,7 @@ static double cert_radius(const struct rcert *c, px_vec3 p)
 	if (!(rE > 0.0) && !(rD > 0.0)) {
 		/* neither: the preconditioned E test (costs as much again,
 		 * so only here) */
-		double rp[3];
-		for (k = 0; k < 3; k++)
-			rp[k] = rad[k] + pad;
-		rE = pre_radius(c, mid, rp, e1, e2, epad);
+		rE = pre_radius(c, mid, rad, e1, e2, epad);
 	}
 	for (k = 0; k < c->nside && rD > rE; k++) {
 		/* open side: E restricted to it, mean value form along it */
@@ -889,28 +903,6 @@ static double cert_radius(const struct rcert *c, px_vec3 p)
 	}
 	r = (rE > rD ? rE : rD) * ST_RSAFE;
 	return r > 0.0 ? r : 0.0;
-}
-
-/* The Hessian's enclosure over the cell for the point p, midpoint and
- * radius (entries 11, 12, 22), the radius padded for rounding. */
-static void hess_at(const struct rcert *c, px_vec3 p, double mid[3],
-		    double rad[3])
-{
-	double pad;
-	px_vec3 aw;
-	int k;
-	aw = px_v3_sub(c->smid, p);
-	aw = px_v3(fabs(aw.x), fabs(aw.y), fabs(aw.z));
-	for (k = 0; k < 3; k++) {
-		mid[k] = c->A[k] - px_v3_dot(p, c->B[k]);
-		rad[k] = c->R[k] + px_v3_dot(aw, c->Q[k]);
-	}
-	pad = ST_PAD * (fabs(mid[0]) + fabs(mid[1]) + fabs(mid[2]) + rad[0] +
-			rad[1] + rad[2] +
-			(aw.x + aw.y + aw.z + fabs(p.x) + fabs(p.y) + fabs(p.z)) *
-				(c->m11 + c->m12 + c->m22));
-	for (k = 0; k < 3; k++)
-		rad[k] += pad;
 }
 
 /* 1 when E is proven not to vanish on the cell for the point p: no
@@ -2329,10 +2321,7 @@ int px__strack_region(const struct px_strack *t, int s, double u, double v,
 	const struct scell *g = region_at(t, s, u, v);
 	if (!g)
 		return -1;
-	box[0] = g->u0;
-	box[1] = g->u1;
-	box[2] = g->v0;
-	box[3] = g->v1;
+	box_of(g, -1, box);
 	return region_empty(t, (int)(g - t->rcell), p);
 }
 
@@ -2343,10 +2332,7 @@ int px__strack_one(const struct px_strack *t, int s, double u, double v,
 	int ri, k, m;
 	if (!g)
 		return -1;
-	box[0] = g->u0;
-	box[1] = g->u1;
-	box[2] = g->v0;
-	box[3] = g->v1;
+	box_of(g, -1, box);
 	ri = (int)(g - t->rcell);
 	m = one_root(&g->cert, p);
 	for (k = 0; k < 4; k++)
