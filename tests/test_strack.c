@@ -924,19 +924,26 @@ static int near_points(const struct px_nurbs_surf *s, px_vec3 *pts, int n)
 	return m;
 }
 
-static void test_empty_regions(void)
+/* The five surfaces of the region tests (named in five_names). */
+static const char *const five_names[5] = {"wavy", "non-uniform", "fold",
+					  "rational", "sphere octant"};
+
+static void five_surfaces(struct px_nurbs_surf s[5])
 {
-	struct px_nurbs_surf s[5];
-	const char *names[5] = {"wavy", "non-uniform", "fold", "rational",
-				"sphere octant"};
-	long unsound = 0, more = 0;
-	int m;
 	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
 	PX_CHECK_INT_EQ(surf_wavy(&s[0], 0, 0, 0, 0), PX_OK);
 	PX_CHECK_INT_EQ(surf_wavy(&s[1], 0, 0, 0, 1), PX_OK);
 	PX_CHECK_INT_EQ(surf_fold(&s[2], 0, 0, 0), PX_OK);
 	PX_CHECK_INT_EQ(surf_rational(&s[3]), PX_OK);
 	PX_CHECK_INT_EQ(surf_sphere(&s[4]), PX_OK);
+}
+
+static void test_empty_regions(void)
+{
+	struct px_nurbs_surf s[5];
+	long unsound = 0, more = 0;
+	int m;
+	five_surfaces(s);
 	for (m = 0; m < 5; m++) {
 		struct px_strack *t = NULL;
 		long proven[3] = {0, 0, 0}, roots[3] = {0, 0, 0}, bad[3];
@@ -956,14 +963,14 @@ static void test_empty_regions(void)
 		printf("  %s: %ld critical points, %ld in regions proven empty; of their "
 		       "neighbours proven empty %ld (plain test alone %ld); remainder "
 		       "dropped: %ld violations\n",
-		       names[m], roots[0], bad[0], proven[0], proven[1], bad[2]);
+		       five_names[m], roots[0], bad[0], proven[0], proven[1], bad[2]);
 		PX_CHECK_INT_EQ(bad[0], 0);
 		PX_CHECK_INT_EQ(bad[1], 0);
-		PX_CHECK_MSG(roots[0] >= 60, "%s: too few critical points to check", names[m]);
+		PX_CHECK_MSG(roots[0] >= 60, "%s: too few critical points to check", five_names[m]);
 		/* with the quarters' tests too it may prove no more on one
 		 * surface, never fewer */
 		PX_CHECK_MSG(proven[0] >= proven[1], "%s: the preconditioned test "
-			     "proved fewer regions empty", names[m]);
+			     "proved fewer regions empty", five_names[m]);
 		more += proven[0] - proven[1];
 		unsound += bad[2];
 		px_strack_free(t);
@@ -1073,16 +1080,9 @@ static int focal_points(const struct px_nurbs_surf *s, px_vec3 *pts, int n)
 static void test_one_regions(void)
 {
 	struct px_nurbs_surf s[5];
-	const char *names[5] = {"wavy", "non-uniform", "fold", "rational",
-				"sphere octant"};
 	long unsound = 0, claimed_all = 0;
 	int m;
-	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
-	PX_CHECK_INT_EQ(surf_wavy(&s[0], 0, 0, 0, 0), PX_OK);
-	PX_CHECK_INT_EQ(surf_wavy(&s[1], 0, 0, 0, 1), PX_OK);
-	PX_CHECK_INT_EQ(surf_fold(&s[2], 0, 0, 0), PX_OK);
-	PX_CHECK_INT_EQ(surf_rational(&s[3]), PX_OK);
-	PX_CHECK_INT_EQ(surf_sphere(&s[4]), PX_OK);
+	five_surfaces(s);
 	for (m = 0; m < 5; m++) {
 		struct px_strack *t = NULL;
 		long claimed = 0, claimed_f = 0, bad, bad_f;
@@ -1099,7 +1099,7 @@ static void test_one_regions(void)
 		px__strack_one_fault = 0;
 		printf("  %s: %ld boxes claimed to hold one critical point, %ld "
 		       "holding two; radius dropped: %ld\n",
-		       names[m], claimed, bad, bad_f);
+		       five_names[m], claimed, bad, bad_f);
 		PX_CHECK_INT_EQ(bad, 0);
 		claimed_all += claimed;
 		unsound += bad_f;
