@@ -1620,8 +1620,8 @@ static int track_step(struct px_strack *t, px_vec3 p0, px_vec3 p,
 	t->hot_s = -1;
 	t->p = p;
 	/* the work list: solve at p, after a long step also past where the
-	 * region was met; and the neighbours at p (pole cells outside the
-	 * budget) */
+	 * region was met (not for pole cells: hit_work()); and the
+	 * neighbours at p */
 	t->n_pend = t->pend_next = 0;
 	for (i = 0; i < nh; i++) {
 		int ci = t->hits[i];
