@@ -129,6 +129,16 @@ int px__strack_one(const struct px_strack *t, int s, double u, double v,
 /* 1 drops the Hessian enclosure's radius from that test (unsound: a
  * fault the tests must see); 0 by default. */
 extern int px__strack_one_fault;
+/* The winding number of the gradient of the squared distance from p
+ * along the domain boundary of surface s, which the tracker compares
+ * with the index sum of its critical points (+1 minima and maxima, -1
+ * saddles) after a step that changed them: into *w; returns 1 when
+ * known, 0 when the boundary's sign tests fail at p (or the surface has
+ * a collapsed edge or a C0 line), -1 for bad arguments. */
+int px__strack_winding(const struct px_strack *t, int s, px_vec3 p, int *w);
+/* 1 negates that winding number (a fault the tests must see); 0 by
+ * default. */
+extern int px__strack_wind_fault;
 /* Test hook: 1 turns the surface tracker's hot path off, 2 makes its
  * certificate never expire (a fault the tests must see). */
 void px__strack_set_hot_fault(struct px_strack *t, int fault);

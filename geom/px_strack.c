@@ -95,6 +95,17 @@ struct scell {
 	int child;      /* solve cell: first of its 2 x 2 region cells */
 };
 
+/*
+ * A region cell's side on the open domain boundary, traversed
+ * counter-clockwise in (u, v): the region's certificate and the entry of
+ * that side in its side tests, the same for the two quarters along it
+ * (in the order traversed), and S, Su, Sv at the start, middle and end.
+ */
+struct wpiece {
+	int ri, side, qk[2], qside[2];
+	px_vec3 s[3], su[3], sv[3];
+};
+
 /* A Bezier patch of a surface in power form of its local (s, t) in
  * [0, 1]^2: coefficients of x w, y w, z w, w; c[k][j (p + 1) + i] is
  * the coefficient of s^i t^j. */
@@ -119,6 +130,11 @@ struct ssurf {
 	double *cu, *cv;        /* cell bounds along u (ncu + 1), v */
 	struct crit *z, *tmp;
 	int nz, cap;
+	/* the domain boundary for the index check (winding()): the region
+	 * sides on its open edges, counter-clockwise; none (nwp 0) with a
+	 * collapsed edge or a C0 line, or when every direction wraps */
+	struct wpiece *wp;
+	int nwp, wind_ok;
 };
 
 struct edge {
@@ -178,6 +194,9 @@ struct px_strack {
 	 * the next cell to solve; rb_started 0: start at the next point
 	 * inside the working volume) */
 	int mode, rb_started, rb_next;
+	/* the set's membership changed in the step in progress: its index
+	 * sums are checked when its solves are done (ix_check()) */
+	int ix_on;
 	px_vec3 last_point, last_q; /* last answer and its query point */
 	int last_entity, have_last;
 	int best_kind;          /* 0 none, 1 surface min, 2 curve tracker, 3 pole */
@@ -998,6 +1017,128 @@ static double cell_radius(const struct px_strack *t, const struct scell *c,
 		    fmin(region_radius(t, ri + 2, p), region_radius(t, ri + 3, p)));
 }
 
+/*
+ * Index check. A critical point's index is the sign of det H (+1 a
+ * minimum or maximum, -1 a saddle), and by degree theory the index sum
+ * of the critical points in the domain equals the winding number of
+ * E = (E1, E2) along the domain's boundary (Poincare-Hopf for the plane;
+ * a wrapped direction's seam sides cancel). Births and deaths keep the
+ * sum, a point crossing an open edge changes it and the winding number
+ * with it. A tracked set whose index sum differs from the winding number
+ * is incomplete: a point lost without its partner (a pair born in a step
+ * carried out of every solved cell, its other member meeting a tracked
+ * point and dying with it), or a point followed onto another's branch.
+ * The check sees an odd miss, never a missing pair.
+ *
+ * The winding number is exact when each boundary side keeps E in an open
+ * half plane (E1 or E2 of one sign on it: the open-side test of the
+ * certificates): then the angle turned along the side is the principal
+ * angle between its end values. Sides whose test fails are split into
+ * their quarters' sides; when one of those fails too the winding number
+ * is not known at p.
+ */
+
+/* Sign test of open side entry k of certificate c at p: 1 when E1 or E2
+ * keeps its sign on the side. */
+static int side_keeps(const struct rcert *c, int k, px_vec3 p)
+{
+	const struct cside *sd = &c->side[k];
+	double mid[3], rad[3], M11, M12, M22, epad, f1, f2;
+	px_vec3 w;
+	hess_at(c, p, mid, rad);
+	M11 = fabs(mid[0]) + rad[0];
+	M12 = fabs(mid[1]) + rad[1];
+	M22 = fabs(mid[2]) + rad[2];
+	w = px_v3_sub(sd->s, p);
+	epad = ST_PAD * (fabs(w.x) + fabs(w.y) + fabs(w.z) + fabs(p.x) + fabs(p.y) +
+			 fabs(p.z)) *
+	       (c->n1 + c->n2);
+	f1 = fabs(px_v3_dot(w, sd->su)) - epad - (sd->along ? M12 : M11) * sd->h;
+	f2 = fabs(px_v3_dot(w, sd->sv)) - epad - (sd->along ? M22 : M12) * sd->h;
+	return f1 > 0.0 || f2 > 0.0;
+}
+
+/* The angle E turns from point a to point b of piece w at p (principal
+ * value: E stays in a half plane between them). */
+static double piece_turn(const struct wpiece *w, int a, int b, px_vec3 p)
+{
+	px_vec3 da = px_v3_sub(w->s[a], p), db = px_v3_sub(w->s[b], p);
+	double a1 = px_v3_dot(da, w->su[a]), a2 = px_v3_dot(da, w->sv[a]);
+	double b1 = px_v3_dot(db, w->su[b]), b2 = px_v3_dot(db, w->sv[b]);
+	return atan2(a1 * b2 - a2 * b1, a1 * b1 + a2 * b2);
+}
+
+/* Test hook (internal.h): 1 turns every boundary piece the wrong way
+ * (the winding number negated: the check must see it). */
+int px__strack_wind_fault = 0;
+
+/* Winding number of E along f's boundary at p into *w: 1 when known,
+ * 0 when not (a side whose test fails, or no boundary to use). */
+static int winding(const struct px_strack *t, const struct ssurf *f,
+		   px_vec3 p, int *w)
+{
+	double sum = 0.0, x;
+	int i, k;
+	if (!f->wind_ok)
+		return 0;
+	for (i = 0; i < f->nwp; i++) {
+		const struct wpiece *wp = &f->wp[i];
+		if (side_keeps(&t->rcell[wp->ri].cert, wp->side, p)) {
+			sum += piece_turn(wp, 0, 2, p);
+			continue;
+		}
+		for (k = 0; k < 2; k++) {
+			if (!side_keeps(&t->qcert[4 * wp->ri + wp->qk[k]], wp->qside[k], p))
+				return 0;
+			sum += piece_turn(wp, k, k + 1, p);
+		}
+	}
+	if (px__strack_wind_fault)
+		sum = -sum;
+	x = sum / (2.0 * M_PI);
+	*w = (int)lround(x);
+	/* each turn is exact up to rounding: far from an integer means
+	 * a side's end value was zero to rounding */
+	return fabs(x - *w) < 1e-6;
+}
+
+static int crit_index(const struct crit *z)
+{
+	return z->type ? 1 : -1;
+}
+
+/* 1 when every surface whose winding number is known at p (the set's
+ * point) has a held set of that index sum. */
+static int ix_balanced(const struct px_strack *t, px_vec3 p)
+{
+	int i, k, w;
+	for (i = 0; i < t->n_surf; i++) {
+		const struct ssurf *f = &t->sf[i];
+		int sum = 0;
+		if (!winding(t, f, p, &w))
+			continue;
+		for (k = 0; k < f->nz; k++)
+			sum += crit_index(&f->z[k]);
+		if (sum != w)
+			return 0;
+	}
+	return 1;
+}
+
+/* The check owed by a step whose membership changed, once its solves
+ * are done: 0 when none is owed or it holds; 1 when it fails (counted:
+ * the caller re-establishes the set). */
+static int ix_check(struct px_strack *t)
+{
+	if (!t->ix_on || t->pend_next < t->n_pend)
+		return 0;
+	t->ix_on = 0;
+	if (ix_balanced(t, t->p))
+		return 0;
+	t->st.unbalanced++;
+	return 1;
+}
+
 static void heap_set(struct px_strack *t, int pos, int ci)
 {
 	t->heap[pos] = ci;
@@ -1599,6 +1740,7 @@ static int track_step(struct px_strack *t, px_vec3 p0, px_vec3 p,
 				int q;
 				t->st.lost++;
 				r->died++;
+				t->ix_on = 1;
 				for (q = 0; q < 2; q++) {
 					const struct crit *o = q ? &last : &f->tmp[j];
 					int ci = f->first_cell + cell_of(f, o->u, o->v);
@@ -1615,6 +1757,8 @@ static int track_step(struct px_strack *t, px_vec3 p0, px_vec3 p,
 				t->hot_s = -1;
 				return rc;
 			}
+			/* followed onto a held point's branch */
+			t->ix_on |= rc == 0;
 		}
 	}
 	t->hot_s = -1;
@@ -1668,6 +1812,7 @@ static int track_step(struct px_strack *t, px_vec3 p0, px_vec3 p,
 	 * sheet) and entries through an edge */
 	r->born = after - before;
 	t->st.born += (uint64_t)r->born;
+	t->ix_on |= r->born != 0;
 	r->cells_solved = done;
 	if (rc < 0)
 		return rc;
@@ -1676,7 +1821,7 @@ static int track_step(struct px_strack *t, px_vec3 p0, px_vec3 p,
 		t->mode = ST_PEND;
 		return 1;
 	}
-	return 0;
+	return ix_check(t) ? 2 : 0;
 }
 
 /* Re-establish the critical points from scratch over the next updates,
@@ -1690,6 +1835,7 @@ static void rebuild_start(struct px_strack *t)
 	t->rb_next = 0;
 	t->heap_ok = 0;
 	t->col_on = 0;
+	t->ix_on = 0;
 	for (i = 0; i < t->n_surf; i++)
 		t->sf[i].nz = 0;
 }
@@ -1727,12 +1873,15 @@ static int catch_up(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 			after += t->sf[i].nz;
 		r->born = after - before;
 		t->st.born += (uint64_t)r->born;
+		t->ix_on |= r->born != 0;
 		r->cells_solved = done;
 		if (rc < 0) {
 			t->st.overflows++;
 			rebuild_start(t);
 		} else if (t->pend_next >= t->n_pend) {
 			t->mode = ST_LAG;
+			if (ix_check(t))
+				rebuild_start(t);
 		}
 		answer_global(t, p, r);
 		return PX_OK;
@@ -1787,8 +1936,8 @@ static int catch_up(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 		/* the step ends where its collection started */
 		p1 = t->col_p1;
 		rc = track_step(t, t->p, p1, r, nh);
-		if (rc < 0) {
-			t->st.overflows++;
+		if (rc < 0 || rc == 2) {
+			t->st.overflows += rc < 0;
 			rebuild_start(t);
 		} else if (rc == 0 && p1.x == p.x && p1.y == p.y && p1.z == p.z) {
 			/* caught up: checked against the global answer */
@@ -2011,9 +2160,9 @@ static int strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result
 		return PX_OK;
 	}
 	if (rc) {
-		/* capacity: the set is re-established (over the next
-		 * updates with a budget) */
-		t->st.overflows++;
+		/* capacity, or the index check failed: the set is
+		 * re-established (over the next updates with a budget) */
+		t->st.overflows += rc < 0;
 		t->st.reinits++;
 		if (t->opts.max_solves > 0) {
 			rebuild_start(t);
@@ -2340,6 +2489,13 @@ int px__strack_one(const struct px_strack *t, int s, double u, double v,
 	return m;
 }
 
+int px__strack_winding(const struct px_strack *t, int s, px_vec3 p, int *w)
+{
+	if (!t || s < 0 || s >= t->n_surf || !w)
+		return -1;
+	return winding(t, &t->sf[s], p, w);
+}
+
 int px_strack_critical(const struct px_strack *t, int s, double *u, double *v,
 		       int *type, int cap)
 {
@@ -2656,6 +2812,21 @@ static int crease_at(const struct ssurf *f, int dir, double x)
 	return m > f->s.degree[dir] - 2;
 }
 
+/* 1 when knot x of direction dir is a C0 line of f (E jumps there). */
+static int c0_at(const struct ssurf *f, int dir, double x)
+{
+	int i, m = 0;
+	for (i = 0; i < f->s.n_knots[dir]; i++)
+		if (f->s.knots[dir][i] == x)
+			m++;
+	return m >= f->s.degree[dir];
+}
+
+static int has_pole(const struct ssurf *f)
+{
+	return f->pole[0] | f->pole[1] | f->pole[2] | f->pole[3];
+}
+
 /* Which sides of cell c are open domain edges or creases (u0, u1, v0,
  * v1): where critical points enter and leave. */
 static void sides_open(const struct ssurf *f, const struct scell *c, int open[4])
@@ -2691,6 +2862,83 @@ static int quarter_certs(struct px_strack *t, const struct scell *rg,
 	return 0;
 }
 
+/* The boundary pieces of surface si for winding() (after the region
+ * and quarter certificates are made). Returns 0 or PX_E_NOMEM. */
+static int wind_pieces(struct px_strack *t, int si)
+{
+	struct ssurf *f = &t->sf[si];
+	int nu = 2 * f->ncu, nv = 2 * f->ncv, e, n = 0, i, k;
+	f->wind_ok = 0;
+	f->nwp = 0;
+	if (has_pole(f))
+		return 0;
+	for (k = 0; k < 2; k++)
+		for (i = 0; i < f->s.n_knots[k]; i++) {
+			double x = f->s.knots[k][i];
+			if (x > (k ? f->v0 : f->u0) && x < (k ? f->v1 : f->u1) && c0_at(f, k, x))
+				return 0;
+		}
+	n = (f->wrap_v ? 0 : 2 * nu) + (f->wrap_u ? 0 : 2 * nv);
+	if (n > 0) {
+		f->wp = calloc((size_t)n, sizeof(*f->wp));
+		if (!f->wp)
+			return PX_E_NOMEM;
+	}
+	/* e 0: v = v0, u rising; 1: u = u1, v rising; 2: v = v1, u falling;
+	 * 3: u = u0, v falling (counter-clockwise) */
+	for (e = 0; e < 4; e++) {
+		int len = e & 1 ? nv : nu, side = (int[]){2, 1, 3, 0}[e];
+		/* the quarters along the side, in the order traversed */
+		static const int qk[4][2] = {{0, 1}, {1, 3}, {3, 2}, {2, 0}};
+		if ((e & 1) ? f->wrap_u : f->wrap_v)
+			continue;
+		for (i = 0; i < len; i++) {
+			int s2 = e >= 2 ? len - 1 - i : i;
+			int I = e == 0 ? s2 : e == 1 ? nu - 1 : e == 2 ? s2 : 0;
+			int J = e == 0 ? 0 : e == 1 ? s2 : e == 2 ? nv - 1 : s2;
+			int ri = 4 * (f->first_cell + (J / 2) * f->ncu + I / 2) + (I & 1) + 2 * (J & 1);
+			const struct scell *rg = &t->rcell[ri];
+			struct wpiece *w = &f->wp[f->nwp++];
+			int open[4], q, a;
+			double x0, x1;
+			sides_open(f, rg, open);
+			w->ri = ri;
+			w->side = 0;
+			for (a = 0; a < side; a++)
+				w->side += open[a];
+			for (q = 0; q < 2; q++) {
+				struct scell qc;
+				double b[4];
+				memset(&qc, 0, sizeof(qc));
+				box_of(rg, qk[e][q], b);
+				qc.u0 = b[0];
+				qc.u1 = b[1];
+				qc.v0 = b[2];
+				qc.v1 = b[3];
+				sides_open(f, &qc, open);
+				w->qk[q] = qk[e][q];
+				w->qside[q] = 0;
+				for (a = 0; a < side; a++)
+					w->qside[q] += open[a];
+			}
+			x0 = e & 1 ? (e == 1 ? rg->v0 : rg->v1) : (e == 0 ? rg->u0 : rg->u1);
+			x1 = e & 1 ? (e == 1 ? rg->v1 : rg->v0) : (e == 0 ? rg->u1 : rg->u0);
+			for (q = 0; q < 3; q++) {
+				struct px_nurbs_surf_derivs d;
+				double x = x0 + 0.5 * q * (x1 - x0);
+				double u = e & 1 ? (e == 1 ? f->u1 : f->u0) : x;
+				double v = e & 1 ? x : (e == 0 ? f->v0 : f->v1);
+				surf_eval2(f, u, v, &d);
+				w->s[q] = d.s;
+				w->su[q] = d.su;
+				w->sv[q] = d.sv;
+			}
+		}
+	}
+	f->wind_ok = 1;
+	return 0;
+}
+
 void px_strack_free(struct px_strack *t)
 {
 	int i;
@@ -2709,6 +2957,7 @@ void px_strack_free(struct px_strack *t)
 			free(t->sf[i].cv);
 			free(t->sf[i].z);
 			free(t->sf[i].tmp);
+			free(t->sf[i].wp);
 		}
 	free(t->sf);
 	free(t->cell);
@@ -3021,6 +3270,11 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 			}
 	}
 	t->n_cells = cell_cap;
+	for (i = 0; i < n_surfs; i++) {
+		rc = wind_pieces(t, i);
+		if (rc)
+			goto fail;
+	}
 
 	/* curve tracker: free curves, then open (uncollapsed) edges and
 	 * C0 creases as iso-curves; collapsed edges become poles */

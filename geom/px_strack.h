@@ -220,6 +220,11 @@ struct px_strack_stats {
 	/* updates that left the curve tracker out: every curve and edge
 	 * was proven farther than the best interior minimum */
 	uint64_t curve_skips;
+	/* steps after which the index sum of a surface's critical points
+	 * differed from the winding number of the gradient along its
+	 * boundary (a point missed): answered globally, the set
+	 * re-established */
+	uint64_t unbalanced;
 	/* updates on the hot path: the answering minimum followed alone */
 	uint64_t hot;
 	/* cold switch: updates answered cold, switches to cold and back,

@@ -208,6 +208,7 @@ static int seeds_dir(const struct px_nurbs_surf *s, int dir, double a, double b,
 }
 
 static double last_fu[512], last_fv[512];
+static int last_ix[512]; /* index: sign of det H */
 static int last_n;
 
 static int count_crit(const struct px_nurbs_surf *s, px_vec3 p, int *amb)
@@ -279,6 +280,7 @@ static int count_crit(const struct px_nurbs_surf *s, px_vec3 p, int *amb)
 			fv[n] = v;
 			last_fu[n] = u;
 			last_fv[n] = v;
+			last_ix[n] = det > 0.0 ? 1 : -1;
 			n++;
 			last_n = n;
 			if (fabs(det) < 1e-3 * hn ||
@@ -484,7 +486,7 @@ static void run_model(const char *name, const struct px_nurbs_curve *cs,
 	printf("  %s (max_solves %d): wrong %ld, naive wrong %ld; tracker: cell "
 	       "solves %llu box tests %llu reinit %llu outside %llu fallback %llu "
 	       "lost %llu over budget %llu rebuild updates %llu curve tracker "
-	       "left out %llu hot %llu\n",
+	       "left out %llu hot %llu unbalanced %llu\n",
 	       name, max_solves, tot->wrong - wrong0, tot->naive_wrong - naive0,
 	       (unsigned long long)st.cell_solves, (unsigned long long)st.box_tests,
 	       (unsigned long long)st.reinits, (unsigned long long)st.outside,
@@ -492,7 +494,7 @@ static void run_model(const char *name, const struct px_nurbs_curve *cs,
 	       (unsigned long long)st.over_budget,
 	       (unsigned long long)st.rebuild_updates,
 	       (unsigned long long)st.curve_skips,
-	       (unsigned long long)st.hot);
+	       (unsigned long long)st.hot, (unsigned long long)st.unbalanced);
 	tot->hot += st.hot;
 	tot->over_budget += st.over_budget;
 	tot->curve_skips += st.curve_skips;
@@ -1109,6 +1111,138 @@ static void test_one_regions(void)
 	PX_CHECK_MSG(unsound > 0, "the unsound variant went unseen: the check cannot fail");
 }
 
+/* The index check's winding number (px__strack_winding()) against the
+ * index sum of the dense Newton count, at query points near the
+ * surfaces, near their focal sheets and farther off: equal wherever it
+ * is known and the count is decisive; negated (a fault) the check sees
+ * it. */
+/* Index sum of the critical points that Newton reaches from a uniform
+ * g x g grid of seeds (count_crit()'s seeds are per span: a tight
+ * cluster of three can lose one); into *n their count. */
+static int index_dense(const struct px_nurbs_surf *s, px_vec3 p, int g, int *n)
+{
+	static double fu[4096], fv[4096];
+	double u0, u1, v0, v1;
+	int i, j, q, sum = 0;
+	*n = 0;
+	px_nurbs_surf_domain(s, &u0, &u1, &v0, &v1);
+	for (j = 0; j <= g; j++)
+		for (i = 0; i <= g; i++) {
+			double u = u0 + (u1 - u0) * i / g, v = v0 + (v1 - v0) * j / g, det = 0.0;
+			int it, ok = 0;
+			for (it = 0; it < 60 && !ok; it++) {
+				struct px_nurbs_surf_derivs d;
+				px_vec3 w;
+				double g1, g2, a, b, c, su, sv;
+				u = fmin(fmax(u, u0), u1);
+				v = fmin(fmax(v, v0), v1);
+				px_nurbs_surf_eval(s, u, v, 2, &d);
+				w = px_v3_sub(d.s, p);
+				g1 = px_v3_dot(w, d.su);
+				g2 = px_v3_dot(w, d.sv);
+				a = px_v3_dot(d.su, d.su) + px_v3_dot(w, d.suu);
+				b = px_v3_dot(d.su, d.sv) + px_v3_dot(w, d.suv);
+				c = px_v3_dot(d.sv, d.sv) + px_v3_dot(w, d.svv);
+				det = a * c - b * b;
+				if (det == 0.0)
+					break;
+				su = -(c * g1 - b * g2) / det;
+				sv = -(-b * g1 + a * g2) / det;
+				su = fmax(fmin(su, 0.1 * (u1 - u0)), -0.1 * (u1 - u0));
+				sv = fmax(fmin(sv, 0.1 * (v1 - v0)), -0.1 * (v1 - v0));
+				u += su;
+				v += sv;
+				ok = fabs(su) < 1e-13 * (u1 - u0) && fabs(sv) < 1e-13 * (v1 - v0);
+			}
+			if (!ok || u <= u0 || u >= u1 || v <= v0 || v >= v1)
+				continue;
+			for (q = 0; q < *n; q++)
+				if (fabs(fu[q] - u) < 1e-7 * (u1 - u0) &&
+				    fabs(fv[q] - v) < 1e-7 * (v1 - v0))
+					break;
+			if (q < *n || *n >= 4096)
+				continue;
+			fu[*n] = u;
+			fv[*n] = v;
+			(*n)++;
+			sum += det > 0.0 ? 1 : -1;
+		}
+	return sum;
+}
+
+static long wind_check(const struct px_strack *t, const struct px_nurbs_surf *s,
+		       const px_vec3 *pts, int npts, long *known)
+{
+	long bad = 0;
+	int k, i;
+	for (k = 0; k < npts; k++) {
+		int amb = 0, w, sum = 0;
+		count_crit(s, pts[k], &amb);
+		if (amb || px__strack_winding(t, 0, pts[k], &w) != 1)
+			continue;
+		(*known)++;
+		for (i = 0; i < last_n; i++)
+			sum += last_ix[i];
+		if (sum != w && !px__strack_wind_fault) {
+			/* a second opinion from a uniform grid of seeds */
+			int n2;
+			sum = index_dense(s, pts[k], 150, &n2);
+			if (n2 <= last_n) {
+				n2 = last_n;
+				sum = 0;
+				for (i = 0; i < last_n; i++)
+					sum += last_ix[i];
+			}
+		}
+		if (sum != w) {
+			if (bad < 4 && !px__strack_wind_fault)
+				printf("    winding %d, index sum %d of %d points at (%.6g, "
+				       "%.6g, %.6g)\n",
+				       w, sum, last_n, pts[k].x, pts[k].y, pts[k].z);
+			bad++;
+		}
+	}
+	return bad;
+}
+
+static void test_winding(void)
+{
+	struct px_nurbs_surf s[5];
+	long seen = 0, known_all = 0;
+	int m, k;
+	five_surfaces(s);
+	for (m = 0; m < 5; m++) {
+		struct px_strack *t = NULL;
+		long known = 0, known_f = 0, bad, bad_f;
+		px_vec3 pts[240];
+		px_aabb bb = px_nurbs_surf_aabb(&s[m]);
+		double size = px_aabb_diagonal(&bb);
+		int np = near_points(&s[m], pts, 80), w;
+		np += focal_points(&s[m], pts + np, 80);
+		for (k = 0; k < 80; k++)
+			pts[np++] = px_v3(px_rand_range(bb.min.x - size, bb.max.x + size),
+					  px_rand_range(bb.min.y - size, bb.max.y + size),
+					  px_rand_range(bb.min.z - size, bb.max.z + size));
+		PX_CHECK_INT_EQ(px_strack_create(NULL, 0, &s[m], 1, NULL, &t), PX_OK);
+		if (!t)
+			continue;
+		bad = wind_check(t, &s[m], pts, np, &known);
+		px__strack_wind_fault = 1;
+		bad_f = wind_check(t, &s[m], pts, np, &known_f);
+		px__strack_wind_fault = 0;
+		printf("  %s: winding number known at %ld of %d points, %ld differing "
+		       "from the index sum; negated: %ld\n",
+		       five_names[m], known, np, bad, bad_f);
+		PX_CHECK_INT_EQ(bad, 0);
+		PX_CHECK_INT_EQ(px__strack_winding(t, 1, pts[0], &w), -1);
+		known_all += known;
+		seen += bad_f;
+		px_strack_free(t);
+	}
+	PX_CHECK_MSG(known_all >= 400, "winding number known too rarely: %ld", known_all);
+	PX_CHECK_MSG(seen > 0, "the negated winding number went unseen: the check cannot fail");
+}
+
 /* A bounded update: with a small budget of cell solves the answer stays
  * exact at every step (global query while the set catches up or is
  * rebuilt), no update solves more cells than the budget, and tracking
@@ -1595,6 +1729,7 @@ static const struct px_test tests[] = {
 	PX_T(test_focal_bounds),
 	PX_T(test_empty_regions),
 	PX_T(test_one_regions),
+	PX_T(test_winding),
 	PX_T(test_errors),
 	PX_T(test_cold_switch), PX_T(test_return_rebuild),
 };
