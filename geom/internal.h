@@ -142,6 +142,10 @@ extern int px__strack_wind_fault;
 /* Test hook: 1 turns the surface tracker's hot path off, 2 makes its
  * certificate never expire (a fault the tests must see). */
 void px__strack_set_hot_fault(struct px_strack *t, int fault);
+/* Test hook: 1 makes a tracked step's cell solves drop every minimum
+ * they find (the set then misses points), 2 turns the index check off
+ * as well (faults the tests must see). */
+void px__strack_set_drop_fault(struct px_strack *t, int fault);
 /* Test hook: the cold switch's clock (NULL: CLOCK_MONOTONIC). */
 void px__strack_set_clock(struct px_strack *t, int64_t (*fn)(void *), void *ctx);
 

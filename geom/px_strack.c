@@ -212,6 +212,9 @@ struct px_strack {
 	double hot_until;
 	int hot_nmin, hot_nmax, hot_nsad, hot_ncrit, hot_ccrit;
 	int fault_hot;          /* test hook: 1 hot path off, 2 never expires */
+	/* test hook: 1 a step's solves drop the minima they find, 2 the
+	 * index check off too; pend_on: in a step's solves */
+	int fault_drop, pend_on;
 	/* cold switch (gov_internal.h): gov_q the last query point (step
 	 * lengths); ret_left > 0 while the set is re-established after
 	 * cold answers (those updates are not timed: the rebuild is the
@@ -605,6 +608,7 @@ static int seed_solve(struct px_strack *t, struct ssurf *f, const struct scell *
 		      double u, double v, px_vec3 ps, px_vec3 p)
 {
 	struct crit z, last;
+	int rc;
 	memset(&z, 0, sizeof(z));
 	z.u = u;
 	z.v = v;
@@ -613,7 +617,18 @@ static int seed_solve(struct px_strack *t, struct ssurf *f, const struct scell *
 	if (px_v3_dist2(ps, p) != 0.0 &&
 	    follow(f, &z, ps, px_v3_sub(p, ps), p, &last))
 		return 0;
-	return crit_add(t, f, &z) < 0 ? PX_E_NOSPC : 0;
+	if (t->fault_drop && t->pend_on && z.type == 1) {
+		/* the fault: the point is lost, the step's finding it is
+		 * not (as when a pair's other member is found) */
+		t->ix_on = 1;
+		return 0;
+	}
+	rc = crit_add(t, f, &z);
+	if (rc < 0)
+		return PX_E_NOSPC;
+	/* a point found: the set's membership changed */
+	t->ix_on |= rc;
+	return 0;
 }
 
 /*
@@ -1130,7 +1145,7 @@ static int ix_balanced(const struct px_strack *t, px_vec3 p)
  * the caller re-establishes the set). */
 static int ix_check(struct px_strack *t)
 {
-	if (!t->ix_on || t->pend_next < t->n_pend)
+	if (!t->ix_on || t->pend_next < t->n_pend || t->fault_drop == 2)
 		return 0;
 	t->ix_on = 0;
 	if (ix_balanced(t, t->p))
@@ -1659,6 +1674,7 @@ static int follow(const struct ssurf *f, struct crit *z, px_vec3 p0,
 static int pend_solve(struct px_strack *t, int budget, int *done)
 {
 	int rc = 0, units = 0;
+	t->pend_on = t->mode != ST_REBUILD;
 	while (t->pend_next < t->n_pend) {
 		const struct scell *c = &t->cell[t->pend[t->pend_next]];
 		rc = cell_solve_budget(t, c, t->pend_ps[t->pend_next], t->p,
@@ -1669,6 +1685,7 @@ static int pend_solve(struct px_strack *t, int budget, int *done)
 		if (rc < 0)
 			break;
 	}
+	t->pend_on = 0;
 	*done = (units + ST_UNITS - 1) / ST_UNITS;
 	return rc < 0 ? rc : 0;
 }
@@ -1721,6 +1738,7 @@ static int track_step(struct px_strack *t, px_vec3 p0, px_vec3 p,
 	int i, j, rc = 0, before = 0, after = 0, done = 0,
 		      budget = t->opts.max_solves;
 
+	t->ix_on = 0;
 	for (i = 0; i < t->n_surf; i++) {
 		struct ssurf *f = &t->sf[i];
 		int n = f->nz;
@@ -1782,8 +1800,9 @@ static int track_step(struct px_strack *t, px_vec3 p0, px_vec3 p,
 		}
 		/* a pair born in c may have moved on into a neighbour whose
 		 * own certificate holds (points only move there; near a focal
-		 * sheet they move fast); mostly cheap: a neighbour's regions
-		 * are proven empty or hold the one point they can */
+		 * sheet they move fast), both its members sometimes (the index
+		 * check does not see that); mostly cheap: a neighbour's
+		 * regions are proven empty or hold the one point they can */
 		for (dv = -1; dv <= 1; dv++)
 			for (du = -1; du <= 1; du++) {
 				int nu = cu + du, nv = cv + dv, nc;
@@ -1812,7 +1831,6 @@ static int track_step(struct px_strack *t, px_vec3 p0, px_vec3 p,
 	 * sheet) and entries through an edge */
 	r->born = after - before;
 	t->st.born += (uint64_t)r->born;
-	t->ix_on |= r->born != 0;
 	r->cells_solved = done;
 	if (rc < 0)
 		return rc;
@@ -1873,7 +1891,6 @@ static int catch_up(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 			after += t->sf[i].nz;
 		r->born = after - before;
 		t->st.born += (uint64_t)r->born;
-		t->ix_on |= r->born != 0;
 		r->cells_solved = done;
 		if (rc < 0) {
 			t->st.overflows++;
@@ -2423,6 +2440,12 @@ int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 	if (px__gov_stop(&t->gov, t0))
 		cold_enter(t, p, r);
 	return rc;
+}
+
+void px__strack_set_drop_fault(struct px_strack *t, int fault)
+{
+	if (t)
+		t->fault_drop = fault;
 }
 
 void px__strack_set_clock(struct px_strack *t, int64_t (*fn)(void *), void *ctx)

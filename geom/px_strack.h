@@ -38,6 +38,16 @@
  *    regular: E is one-to-one there); evolved points are kept,
  *    duplicates merged. Cells on a collapsed edge have
  *    no proof near the pole's normal lines and are solved whenever hit.
+ *  - Index check: after a step that found, lost or merged points, each
+ *    surface's index sum (+1 minima and maxima, -1 saddles) must equal
+ *    the winding number of E along its domain boundary (degree theory:
+ *    births and deaths keep the sum, edge crossings change both). The
+ *    winding number is exact where every boundary side keeps E1 or E2 of
+ *    one sign (the certificates' side test); a mismatch means a point was
+ *    missed (a pair born in a step whose one member was carried out of
+ *    the solved cells): the update is answered globally and the set
+ *    re-established (stats.unbalanced). It cannot see a pair missed
+ *    whole; surfaces with a collapsed edge or a C0 line are left out.
  *  - Bounded work: an update whose proven-hit cells exceed max_solves,
  *    or whose due cells exceed max_tests (a long step: their tests then
  *    go on max_tests per update), is answered by the global query; the
@@ -239,7 +249,8 @@ struct px_strack_info {
 	int n_edges;       /* edges tracked as curves */
 	int n_poles;       /* collapsed edges */
 	int n_unbounded;   /* cells on a collapsed edge: solved whenever
-			    * hit, outside the work budget */
+			    * hit (within the work budget, never more
+			    * than once a step) */
 	px_aabb work;
 };
 

@@ -1243,6 +1243,69 @@ static void test_winding(void)
 	PX_CHECK_MSG(seen > 0, "the negated winding number went unseen: the check cannot fail");
 }
 
+/* The index check at work: a fault makes the tracked steps drop every
+ * minimum their cell solves find (births, entries); the check must see
+ * the sets missing them (unbalanced) and answer those updates globally;
+ * with the check off too the dropped minima give wrong answers, so the
+ * check is what keeps them right. Wrong answers with the check on can
+ * only come from updates where the winding number is unknown. */
+static long drop_run(int fault, uint64_t *unbal, long *steps)
+{
+	struct px_nurbs_surf s;
+	struct px_strack *t = NULL;
+	struct px_dist_model *ref = NULL;
+	struct px_strack_result r;
+	struct px_strack_stats st;
+	long wrong = 0;
+	int k, n = 6000;
+	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
+	PX_CHECK_INT_EQ(surf_wavy(&s, 0, 0, 0, 0), PX_OK);
+	PX_CHECK_INT_EQ(px_strack_create(NULL, 0, &s, 1, NULL, &t), PX_OK);
+	PX_CHECK_INT_EQ(px_dist_model_create(NULL, 0, &s, 1, NULL, &ref), PX_OK);
+	if (!t || !ref) {
+		px_strack_free(t);
+		px_dist_model_free(ref);
+		return 0;
+	}
+	px__strack_set_drop_fault(t, fault);
+	for (k = 0; k <= n; k++) {
+		/* a Lissajous path over the sheet and through its focal
+		 * sheets, about 0.2 % of the size a step */
+		double a = 2.0 * M_PI * k / n;
+		px_vec3 p = px_v3(0.9 * sin(5.0 * a), 0.9 * sin(4.0 * a + 1.0),
+				  0.5 + 0.45 * sin(7.0 * a));
+		struct px_dist_result g;
+		if (k == 0)
+			px_strack_reset(t, p, &r);
+		else
+			px_strack_update(t, p, &r);
+		px_dist_query(ref, p, &g);
+		if (fabs(r.dist - g.dist) > 1e-9 * (1.0 + g.dist))
+			wrong++;
+	}
+	px_strack_get_stats(t, &st);
+	*unbal = st.unbalanced;
+	*steps = n;
+	px_strack_free(t);
+	px_dist_model_free(ref);
+	return wrong;
+}
+
+static void test_index_check(void)
+{
+	uint64_t u0, u1, u2;
+	long n, w0 = drop_run(0, &u0, &n), w1 = drop_run(1, &u1, &n),
+		w2 = drop_run(2, &u2, &n);
+	printf("  wavy, %ld steps: wrong %ld, unbalanced %llu; minima dropped: "
+	       "wrong %ld, unbalanced %llu; and the check off: wrong %ld\n",
+	       n, w0, (unsigned long long)u0, w1, (unsigned long long)u1, w2);
+	PX_CHECK_INT_EQ(w0, 0);
+	PX_CHECK_MSG(u1 > 0, "dropped minima went unseen by the index check");
+	PX_CHECK_MSG(w2 > 0, "dropped minima gave no wrong answer: the test proves nothing");
+	PX_CHECK_MSG(4 * w1 < w2, "the index check kept few answers right: %ld of %ld",
+		     w2 - w1, w2);
+}
+
 /* A bounded update: with a small budget of cell solves the answer stays
  * exact at every step (global query while the set catches up or is
  * rebuilt), no update solves more cells than the budget, and tracking
@@ -1730,6 +1793,7 @@ static const struct px_test tests[] = {
 	PX_T(test_empty_regions),
 	PX_T(test_one_regions),
 	PX_T(test_winding),
+	PX_T(test_index_check),
 	PX_T(test_errors),
 	PX_T(test_cold_switch), PX_T(test_return_rebuild),
 };
