@@ -131,8 +131,9 @@ struct ssurf {
 	struct crit *z, *tmp;
 	int nz, cap;
 	/* the domain boundary for the index check (winding()): the region
-	 * sides on its open edges, counter-clockwise; none (nwp 0) with a
-	 * collapsed edge or a C0 line, or when every direction wraps */
+	 * sides on its open edges, counter-clockwise (none when both
+	 * directions wrap: the sum is then 0); wind_ok 0, no check, with a
+	 * collapsed edge or a C0 line */
 	struct wpiece *wp;
 	int nwp, wind_ok;
 };
@@ -1043,7 +1044,8 @@ static double cell_radius(const struct px_strack *t, const struct scell *c,
  * is incomplete: a point lost without its partner (a pair born in a step
  * carried out of every solved cell, its other member meeting a tracked
  * point and dying with it), or a point followed onto another's branch.
- * The check sees an odd miss, never a missing pair.
+ * It sees every miss whose indices do not cancel, never a missing pair
+ * of a saddle and a minimum or maximum.
  *
  * The winding number is exact when each boundary side keeps E in an open
  * half plane (E1 or E2 of one sign on it: the open-side test of the
