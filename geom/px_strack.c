@@ -372,6 +372,11 @@ static int domain_fix(const struct ssurf *f, double *u, double *v)
 	return 0;
 }
 
+static int has_pole(const struct ssurf *f)
+{
+	return f->pole[0] | f->pole[1] | f->pole[2] | f->pole[3];
+}
+
 /*
  * Newton on E = 0 with p fixed from z->u, z->v; steps clamped to lu, lv.
  * Returns 0 with z evaluated at the root, 1 on failure (no convergence,
@@ -397,7 +402,7 @@ static int snewton(const struct ssurf *f, struct crit *z, px_vec3 p,
 		}
 		crit_eval(f, z, p, &g);
 		det = z->h11 * z->h22 - z->h12 * z->h12;
-		if (f->pole[0] | f->pole[1] | f->pole[2] | f->pole[3]) {
+		if (has_pole(f)) {
 			/* At a collapsed edge u = u0 the v-derivative vanishes,
 			 * so (S - p) . Sv = 0 holds along the whole edge: a
 			 * spurious root set that attracts Newton. Solve with
@@ -2830,26 +2835,8 @@ static int cell_cert(struct px_strack *t, struct scell *c, const struct ssurf *f
  * patch there as through an edge. */
 static int crease_at(const struct ssurf *f, int dir, double x)
 {
-	int i, m = 0;
-	for (i = 0; i < f->s.n_knots[dir]; i++)
-		if (f->s.knots[dir][i] == x)
-			m++;
-	return m > f->s.degree[dir] - 2;
-}
-
-/* 1 when knot x of direction dir is a C0 line of f (E jumps there). */
-static int c0_at(const struct ssurf *f, int dir, double x)
-{
-	int i, m = 0;
-	for (i = 0; i < f->s.n_knots[dir]; i++)
-		if (f->s.knots[dir][i] == x)
-			m++;
-	return m >= f->s.degree[dir];
-}
-
-static int has_pole(const struct ssurf *f)
-{
-	return f->pole[0] | f->pole[1] | f->pole[2] | f->pole[3];
+	return px__nurbs_mult(f->s.knots[dir], f->s.n_knots[dir], x) >
+	       f->s.degree[dir] - 2;
 }
 
 /* Which sides of cell c are open domain edges or creases (u0, u1, v0,
@@ -2862,6 +2849,31 @@ static void sides_open(const struct ssurf *f, const struct scell *c, int open[4]
 	open[3] = c->v1 == f->v1 ? !f->wrap_v : crease_at(f, 1, c->v1);
 }
 
+/* Quarter k of region cell rg as a cell of its own (bounds and
+ * surface; box_of()). */
+static void quarter_of(const struct scell *rg, int k, struct scell *q)
+{
+	double b[4];
+	memset(q, 0, sizeof(*q));
+	q->surf = rg->surf;
+	box_of(rg, k, b);
+	q->u0 = b[0];
+	q->u1 = b[1];
+	q->v0 = b[2];
+	q->v1 = b[3];
+}
+
+/* The entry of side k (sides_open()'s order) among c's side tests:
+ * cell_cert() keeps the open sides alone, in that order. */
+static int side_entry(const struct ssurf *f, const struct scell *c, int k)
+{
+	int open[4], a, n = 0;
+	sides_open(f, c, open);
+	for (a = 0; a < k; a++)
+		n += open[a];
+	return n;
+}
+
 /* The certificates of the four quarters of region cell rg. */
 static int quarter_certs(struct px_strack *t, const struct scell *rg,
 			 const struct ssurf *f, double *work, size_t wl,
@@ -2870,14 +2882,7 @@ static int quarter_certs(struct px_strack *t, const struct scell *rg,
 	int k, rc, open[4];
 	for (k = 0; k < 4; k++) {
 		struct scell q;
-		double b[4];
-		memset(&q, 0, sizeof(q));
-		q.surf = rg->surf;
-		box_of(rg, k, b);
-		q.u0 = b[0];
-		q.u1 = b[1];
-		q.v0 = b[2];
-		q.v1 = b[3];
+		quarter_of(rg, k, &q);
 		sides_open(f, &q, open);
 		rc = cell_cert(t, &q, f, work, wl, open);
 		if (rc)
@@ -2892,17 +2897,13 @@ static int quarter_certs(struct px_strack *t, const struct scell *rg,
 static int wind_pieces(struct px_strack *t, int si)
 {
 	struct ssurf *f = &t->sf[si];
-	int nu = 2 * f->ncu, nv = 2 * f->ncv, e, n = 0, i, k;
+	int nu = 2 * f->ncu, nv = 2 * f->ncv, e, n, i;
 	f->wind_ok = 0;
 	f->nwp = 0;
-	if (has_pole(f))
+	/* E jumps at a C0 line */
+	if (has_pole(f) || px_nurbs_surf_breaks(&f->s, 0, NULL, 0) > 0 ||
+	    px_nurbs_surf_breaks(&f->s, 1, NULL, 0) > 0)
 		return 0;
-	for (k = 0; k < 2; k++)
-		for (i = 0; i < f->s.n_knots[k]; i++) {
-			double x = f->s.knots[k][i];
-			if (x > (k ? f->v0 : f->u0) && x < (k ? f->v1 : f->u1) && c0_at(f, k, x))
-				return 0;
-		}
 	n = (f->wrap_v ? 0 : 2 * nu) + (f->wrap_u ? 0 : 2 * nv);
 	if (n > 0) {
 		f->wp = calloc((size_t)n, sizeof(*f->wp));
@@ -2924,27 +2925,15 @@ static int wind_pieces(struct px_strack *t, int si)
 			int ri = 4 * (f->first_cell + (J / 2) * f->ncu + I / 2) + (I & 1) + 2 * (J & 1);
 			const struct scell *rg = &t->rcell[ri];
 			struct wpiece *w = &f->wp[f->nwp++];
-			int open[4], q, a;
+			int q;
 			double x0, x1;
-			sides_open(f, rg, open);
 			w->ri = ri;
-			w->side = 0;
-			for (a = 0; a < side; a++)
-				w->side += open[a];
+			w->side = side_entry(f, rg, side);
 			for (q = 0; q < 2; q++) {
 				struct scell qc;
-				double b[4];
-				memset(&qc, 0, sizeof(qc));
-				box_of(rg, qk[e][q], b);
-				qc.u0 = b[0];
-				qc.u1 = b[1];
-				qc.v0 = b[2];
-				qc.v1 = b[3];
-				sides_open(f, &qc, open);
+				quarter_of(rg, qk[e][q], &qc);
 				w->qk[q] = qk[e][q];
-				w->qside[q] = 0;
-				for (a = 0; a < side; a++)
-					w->qside[q] += open[a];
+				w->qside[q] = side_entry(f, &qc, side);
 			}
 			x0 = e & 1 ? (e == 1 ? rg->v0 : rg->v1) : (e == 0 ? rg->u0 : rg->u1);
 			x1 = e & 1 ? (e == 1 ? rg->v1 : rg->v0) : (e == 0 ? rg->u1 : rg->u0);
