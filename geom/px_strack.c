@@ -856,6 +856,26 @@ static inline void hess_at(const struct rcert *c, px_vec3 p, double mid[3],
 		rad[k] += pad;
 }
 
+/* Rounding pad of E's components, w = S - p at the point where they
+ * are taken, for certificate c. */
+static inline double e_pad(const struct rcert *c, px_vec3 w, px_vec3 p)
+{
+	return ST_PAD *
+	       (fabs(w.x) + fabs(w.y) + fabs(w.z) + fabs(p.x) + fabs(p.y) + fabs(p.z)) *
+	       (c->n1 + c->n2);
+}
+
+/* Open side sd, w = S - p at its centre, M11, M12, M22 bounds of |H|
+ * over the cell: num[i] > 0 proves Ei keeps its sign along the side at
+ * p (mean value form along it); cert_radius() divides it by the rate at
+ * which it falls as the point moves. */
+static inline void side_num(const struct cside *sd, px_vec3 w, double epad,
+			    double M11, double M12, double M22, double num[2])
+{
+	num[0] = fabs(px_v3_dot(w, sd->su)) - epad - (sd->along ? M12 : M11) * sd->h;
+	num[1] = fabs(px_v3_dot(w, sd->sv)) - epad - (sd->along ? M22 : M12) * sd->h;
+}
+
 static double cert_radius(const struct rcert *c, px_vec3 p)
 {
 	double mid[3], rad[3], a11, b11, a22, b22, M11, M12, M22,
@@ -874,9 +894,7 @@ static double cert_radius(const struct rcert *c, px_vec3 p)
 	w = px_v3_sub(c->sc, p);
 	e1 = px_v3_dot(w, c->suc);
 	e2 = px_v3_dot(w, c->svc);
-	epad = ST_PAD * (fabs(w.x) + fabs(w.y) + fabs(w.z) + fabs(p.x) + fabs(p.y) +
-			 fabs(p.z)) *
-	       (c->n1 + c->n2);
+	epad = e_pad(c, w, p);
 	{
 		double r1 = (fabs(e1) - epad - M11 * c->hu - M12 * c->hv) /
 			    (c->n1 + m11 * c->hu + m12 * c->hv);
@@ -929,14 +947,11 @@ static double cert_radius(const struct rcert *c, px_vec3 p)
 	for (k = 0; k < c->nside && rD > rE; k++) {
 		/* open side: E restricted to it, mean value form along it */
 		const struct cside *sd = &c->side[k];
-		double d1 = sd->along ? M12 : M11, d2 = sd->along ? M22 : M12;
 		double q1 = sd->along ? m12 : m11, q2 = sd->along ? m22 : m12;
-		double f1, f2, r1, r2;
-		w = px_v3_sub(sd->s, p);
-		f1 = fabs(px_v3_dot(w, sd->su));
-		f2 = fabs(px_v3_dot(w, sd->sv));
-		r1 = (f1 - epad - d1 * sd->h) / (sd->n1 + q1 * sd->h);
-		r2 = (f2 - epad - d2 * sd->h) / (sd->n2 + q2 * sd->h);
+		double num[2], r1, r2;
+		side_num(sd, px_v3_sub(sd->s, p), epad, M11, M12, M22, num);
+		r1 = num[0] / (sd->n1 + q1 * sd->h);
+		r2 = num[1] / (sd->n2 + q2 * sd->h);
 		r1 = r1 > r2 ? r1 : r2;
 		r1 = r1 > 0.0 ? r1 : 0.0;
 		rD = ST_MIN(rD, r1);
@@ -958,9 +973,7 @@ static int no_root(const struct rcert *c, px_vec3 p)
 	w = px_v3_sub(c->sc, p);
 	e1 = px_v3_dot(w, c->suc);
 	e2 = px_v3_dot(w, c->svc);
-	epad = ST_PAD * (fabs(w.x) + fabs(w.y) + fabs(w.z) + fabs(p.x) + fabs(p.y) +
-			 fabs(p.z)) *
-	       (c->n1 + c->n2);
+	epad = e_pad(c, w, p);
 	return fabs(e1) - epad > mag[0] * c->hu + mag[1] * c->hv ||
 	       fabs(e2) - epad > mag[1] * c->hu + mag[2] * c->hv ||
 	       pre_radius(c, mid, rad, e1, e2, epad) > 0.0;
@@ -1065,19 +1078,12 @@ static double cell_radius(const struct px_strack *t, const struct scell *c,
 static int side_keeps(const struct rcert *c, int k, px_vec3 p)
 {
 	const struct cside *sd = &c->side[k];
-	double mid[3], rad[3], M11, M12, M22, epad, f1, f2;
-	px_vec3 w;
+	double mid[3], rad[3], num[2];
+	px_vec3 w = px_v3_sub(sd->s, p);
 	hess_at(c, p, mid, rad);
-	M11 = fabs(mid[0]) + rad[0];
-	M12 = fabs(mid[1]) + rad[1];
-	M22 = fabs(mid[2]) + rad[2];
-	w = px_v3_sub(sd->s, p);
-	epad = ST_PAD * (fabs(w.x) + fabs(w.y) + fabs(w.z) + fabs(p.x) + fabs(p.y) +
-			 fabs(p.z)) *
-	       (c->n1 + c->n2);
-	f1 = fabs(px_v3_dot(w, sd->su)) - epad - (sd->along ? M12 : M11) * sd->h;
-	f2 = fabs(px_v3_dot(w, sd->sv)) - epad - (sd->along ? M22 : M12) * sd->h;
-	return f1 > 0.0 || f2 > 0.0;
+	side_num(sd, w, e_pad(c, w, p), fabs(mid[0]) + rad[0], fabs(mid[1]) + rad[1],
+		 fabs(mid[2]) + rad[2], num);
+	return num[0] > 0.0 || num[1] > 0.0;
 }
 
 /* The angle E turns from point a to point b of piece w at p (principal
