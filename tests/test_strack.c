@@ -9,6 +9,7 @@
  * naive tracker (Newton from last cycle's foot point) runs the same paths
  * to show that the transitions matter.
  */
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -211,6 +212,53 @@ static double last_fu[512], last_fv[512];
 static int last_ix[512]; /* index: sign of det H */
 static int last_n;
 
+/*
+ * Newton on E = 0 for p from (*u, *v) over the domain of s: at most
+ * iters steps, each clamped to frac of the domain, put back
+ * onto the domain when it overshoots (more than max_outs times: fails).
+ * 1 when converged (a step below tol of the domain); *det and *hn the
+ * Hessian's determinant and squared norm at the last evaluation.
+ */
+static int crit_newton(const struct px_nurbs_surf *s, px_vec3 p, double *u,
+		       double *v, int iters, double frac, double tol, int max_outs,
+		       double *det, double *hn)
+{
+	double u0, u1, v0, v1;
+	int it, outs = 0;
+	px_nurbs_surf_domain(s, &u0, &u1, &v0, &v1);
+	for (it = 0; it < iters; it++) {
+		struct px_nurbs_surf_derivs d;
+		px_vec3 w;
+		double g1, g2, a, b, c, su, sv;
+		if (*u < u0 || *u > u1 || *v < v0 || *v > v1) {
+			if (++outs > max_outs)
+				return 0;
+			*u = fmin(fmax(*u, u0), u1);
+			*v = fmin(fmax(*v, v0), v1);
+		}
+		px_nurbs_surf_eval(s, *u, *v, 2, &d);
+		w = px_v3_sub(d.s, p);
+		g1 = px_v3_dot(w, d.su);
+		g2 = px_v3_dot(w, d.sv);
+		a = px_v3_dot(d.su, d.su) + px_v3_dot(w, d.suu);
+		b = px_v3_dot(d.su, d.sv) + px_v3_dot(w, d.suv);
+		c = px_v3_dot(d.sv, d.sv) + px_v3_dot(w, d.svv);
+		*det = a * c - b * b;
+		*hn = a * a + c * c + 2 * b * b;
+		if (*det == 0.0)
+			return 0;
+		su = -(c * g1 - b * g2) / *det;
+		sv = -(-b * g1 + a * g2) / *det;
+		su = fmax(fmin(su, frac * (u1 - u0)), -frac * (u1 - u0));
+		sv = fmax(fmin(sv, frac * (v1 - v0)), -frac * (v1 - v0));
+		*u += su;
+		*v += sv;
+		if (fabs(su) < tol * (u1 - u0) && fabs(sv) < tol * (v1 - v0))
+			return 1;
+	}
+	return 0;
+}
+
 static int count_crit(const struct px_nurbs_surf *s, px_vec3 p, int *amb)
 {
 	double u0, u1, v0, v1, fu[512], fv[512], su_[256], sv_[256];
@@ -225,41 +273,10 @@ static int count_crit(const struct px_nurbs_surf *s, px_vec3 p, int *amb)
 	for (j = 0; j < nsv; j++)
 		for (i = 0; i < nsu; i++) {
 			double u = su_[i], v = sv_[j];
-			int it, ok = 0, q, outs = 0;
+			int ok, q;
 			double det = 0.0, hn = 1.0;
-			for (it = 0; it < 30; it++) {
-				struct px_nurbs_surf_derivs d;
-				px_vec3 w;
-				double g1, g2, a, b, c, su, sv;
-				if (u < u0 || u > u1 || v < v0 || v > v1) {
-					/* overshoot: back to the edge, twice at most */
-					if (++outs > 2)
-						break;
-					u = fmin(fmax(u, u0), u1);
-					v = fmin(fmax(v, v0), v1);
-				}
-				px_nurbs_surf_eval(s, u, v, 2, &d);
-				w = px_v3_sub(d.s, p);
-				g1 = px_v3_dot(w, d.su);
-				g2 = px_v3_dot(w, d.sv);
-				a = px_v3_dot(d.su, d.su) + px_v3_dot(w, d.suu);
-				b = px_v3_dot(d.su, d.sv) + px_v3_dot(w, d.suv);
-				c = px_v3_dot(d.sv, d.sv) + px_v3_dot(w, d.svv);
-				det = a * c - b * b;
-				hn = a * a + c * c + 2 * b * b;
-				if (det == 0.0)
-					break;
-				su = -(c * g1 - b * g2) / det;
-				sv = -(-b * g1 + a * g2) / det;
-				su = fmax(fmin(su, 0.2 * (u1 - u0)), -0.2 * (u1 - u0));
-				sv = fmax(fmin(sv, 0.2 * (v1 - v0)), -0.2 * (v1 - v0));
-				u += su;
-				v += sv;
-				if (fabs(su) < 1e-12 * (u1 - u0) && fabs(sv) < 1e-12 * (v1 - v0)) {
-					ok = 1;
-					break;
-				}
-			}
+			/* overshoot: back to the edge, twice at most */
+			ok = crit_newton(s, p, &u, &v, 30, 0.2, 1e-12, 2, &det, &hn);
 			if (!ok || u < u0 || u > u1 || v < v0 || v > v1)
 				continue;
 			/* Newton drawn onto a collapsed edge: (S - p) . Sv
@@ -628,33 +645,34 @@ static px_vec3 valleys_pt(int i, int j, int nu, int nv)
  * anywhere. Only the hot path's distance margin sees it. Returns the
  * wrong answers along the path.
  */
-static long valleys_run(int fault, uint64_t *hot)
+/*
+ * Tracker on surface s (cold switch off: its clock would make the runs
+ * differ) along path(k, n), k = 0..n, with the fault set_fault(t, fault)
+ * set: the answers that differ from the global query; *st its stats.
+ */
+static long fault_run(const struct px_nurbs_surf *s,
+		      void (*set_fault)(struct px_strack *, int), int fault,
+		      px_vec3 (*path)(int k, int n), int n, struct px_strack_stats *st)
 {
-	struct px_nurbs_surf s;
 	struct px_strack *t = NULL;
 	struct px_dist_model *ref = NULL;
 	struct px_strack_result r;
-	struct px_strack_stats st;
 	struct px_strack_opts o;
 	long wrong = 0;
-	int k, n = 4000;
-	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
-	PX_CHECK_INT_EQ(surf_grid(&s, 3, 3, 7, 4, valleys_pt, px_v3(0, 0, 0)),
-			PX_OK);
+	int k;
+	memset(st, 0, sizeof(*st));
 	px_strack_opts_default(&o);
 	o.cold_switch = 0;
-	PX_CHECK_INT_EQ(px_strack_create(NULL, 0, &s, 1, &o, &t), PX_OK);
-	PX_CHECK_INT_EQ(px_dist_model_create(NULL, 0, &s, 1, NULL, &ref), PX_OK);
+	PX_CHECK_INT_EQ(px_strack_create(NULL, 0, s, 1, &o, &t), PX_OK);
+	PX_CHECK_INT_EQ(px_dist_model_create(NULL, 0, s, 1, NULL, &ref), PX_OK);
 	if (!t || !ref) {
 		px_strack_free(t);
 		px_dist_model_free(ref);
 		return 0;
 	}
-	px__strack_set_hot_fault(t, fault);
+	set_fault(t, fault);
 	for (k = 0; k <= n; k++) {
-		/* back and forth across x = 0, 1e-4 of the size a step */
-		double x = 0.2 * sin(2.0 * M_PI * k / n);
-		px_vec3 p = px_v3(x, 0.1 * cos(2.0 * M_PI * k / n), 1.6);
+		px_vec3 p = path(k, n);
 		struct px_dist_result g;
 		if (k == 0)
 			px_strack_reset(t, p, &r);
@@ -664,10 +682,29 @@ static long valleys_run(int fault, uint64_t *hot)
 		if (fabs(r.dist - g.dist) > 1e-9 * (1.0 + g.dist))
 			wrong++;
 	}
-	px_strack_get_stats(t, &st);
-	*hot = st.hot;
+	px_strack_get_stats(t, st);
 	px_strack_free(t);
 	px_dist_model_free(ref);
+	return wrong;
+}
+
+/* back and forth across x = 0, 1e-4 of the size a step */
+static px_vec3 valleys_path(int k, int n)
+{
+	double x = 0.2 * sin(2.0 * M_PI * k / n);
+	return px_v3(x, 0.1 * cos(2.0 * M_PI * k / n), 1.6);
+}
+
+static long valleys_run(int fault, uint64_t *hot)
+{
+	struct px_nurbs_surf s;
+	struct px_strack_stats st;
+	long wrong;
+	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
+	PX_CHECK_INT_EQ(surf_grid(&s, 3, 3, 7, 4, valleys_pt, px_v3(0, 0, 0)),
+			PX_OK);
+	wrong = fault_run(&s, px__strack_set_hot_fault, fault, valleys_path, 4000, &st);
+	*hot = st.hot;
 	return wrong;
 }
 
@@ -1128,32 +1165,9 @@ static int index_dense(const struct px_nurbs_surf *s, px_vec3 p, int g, int *n)
 	px_nurbs_surf_domain(s, &u0, &u1, &v0, &v1);
 	for (j = 0; j <= g; j++)
 		for (i = 0; i <= g; i++) {
-			double u = u0 + (u1 - u0) * i / g, v = v0 + (v1 - v0) * j / g, det = 0.0;
-			int it, ok = 0;
-			for (it = 0; it < 60 && !ok; it++) {
-				struct px_nurbs_surf_derivs d;
-				px_vec3 w;
-				double g1, g2, a, b, c, su, sv;
-				u = fmin(fmax(u, u0), u1);
-				v = fmin(fmax(v, v0), v1);
-				px_nurbs_surf_eval(s, u, v, 2, &d);
-				w = px_v3_sub(d.s, p);
-				g1 = px_v3_dot(w, d.su);
-				g2 = px_v3_dot(w, d.sv);
-				a = px_v3_dot(d.su, d.su) + px_v3_dot(w, d.suu);
-				b = px_v3_dot(d.su, d.sv) + px_v3_dot(w, d.suv);
-				c = px_v3_dot(d.sv, d.sv) + px_v3_dot(w, d.svv);
-				det = a * c - b * b;
-				if (det == 0.0)
-					break;
-				su = -(c * g1 - b * g2) / det;
-				sv = -(-b * g1 + a * g2) / det;
-				su = fmax(fmin(su, 0.1 * (u1 - u0)), -0.1 * (u1 - u0));
-				sv = fmax(fmin(sv, 0.1 * (v1 - v0)), -0.1 * (v1 - v0));
-				u += su;
-				v += sv;
-				ok = fabs(su) < 1e-13 * (u1 - u0) && fabs(sv) < 1e-13 * (v1 - v0);
-			}
+			double u = u0 + (u1 - u0) * i / g, v = v0 + (v1 - v0) * j / g, det = 0.0,
+			       hn;
+			int ok = crit_newton(s, p, &u, &v, 60, 0.1, 1e-13, INT_MAX, &det, &hn);
 			if (!ok || u <= u0 || u >= u1 || v <= v0 || v >= v1)
 				continue;
 			for (q = 0; q < *n; q++)
@@ -1249,49 +1263,25 @@ static void test_winding(void)
  * with the check off too the dropped minima give wrong answers, so the
  * check is what keeps them right. Wrong answers with the check on can
  * only come from updates where the winding number is unknown. */
+/* a Lissajous path over the wavy sheet and through its focal sheets,
+ * about 0.2 % of the size a step */
+static px_vec3 lissajous_path(int k, int n)
+{
+	double a = 2.0 * M_PI * k / n;
+	return px_v3(0.9 * sin(5.0 * a), 0.9 * sin(4.0 * a + 1.0),
+		     0.5 + 0.45 * sin(7.0 * a));
+}
+
 static long drop_run(int fault, uint64_t *unbal, long *steps)
 {
 	struct px_nurbs_surf s;
-	struct px_strack *t = NULL;
-	struct px_dist_model *ref = NULL;
-	struct px_strack_result r;
 	struct px_strack_stats st;
-	struct px_strack_opts o;
-	long wrong = 0;
-	int k, n = 6000;
+	long wrong;
 	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
 	PX_CHECK_INT_EQ(surf_wavy(&s, 0, 0, 0, 0), PX_OK);
-	/* the cold switch off: its clock would make the run differ */
-	px_strack_opts_default(&o);
-	o.cold_switch = 0;
-	PX_CHECK_INT_EQ(px_strack_create(NULL, 0, &s, 1, &o, &t), PX_OK);
-	PX_CHECK_INT_EQ(px_dist_model_create(NULL, 0, &s, 1, NULL, &ref), PX_OK);
-	if (!t || !ref) {
-		px_strack_free(t);
-		px_dist_model_free(ref);
-		return 0;
-	}
-	px__strack_set_drop_fault(t, fault);
-	for (k = 0; k <= n; k++) {
-		/* a Lissajous path over the sheet and through its focal
-		 * sheets, about 0.2 % of the size a step */
-		double a = 2.0 * M_PI * k / n;
-		px_vec3 p = px_v3(0.9 * sin(5.0 * a), 0.9 * sin(4.0 * a + 1.0),
-				  0.5 + 0.45 * sin(7.0 * a));
-		struct px_dist_result g;
-		if (k == 0)
-			px_strack_reset(t, p, &r);
-		else
-			px_strack_update(t, p, &r);
-		px_dist_query(ref, p, &g);
-		if (fabs(r.dist - g.dist) > 1e-9 * (1.0 + g.dist))
-			wrong++;
-	}
-	px_strack_get_stats(t, &st);
+	*steps = 6000;
+	wrong = fault_run(&s, px__strack_set_drop_fault, fault, lissajous_path, 6000, &st);
 	*unbal = st.unbalanced;
-	*steps = n;
-	px_strack_free(t);
-	px_dist_model_free(ref);
 	return wrong;
 }
 
