@@ -84,8 +84,8 @@ struct scell {
 	int surf;
 	double size;    /* diameter of the cell's box (solve cells) */
 	/* on a collapsed edge: E2 vanishes along the pole, so no
-	 * certificate holds near its normal lines; solved whenever hit,
-	 * outside the budget (a fixed cost of the model) */
+	 * certificate holds near its normal lines; solved whenever hit
+	 * (within the budget, as any cell; never past the crossing) */
 	int always;
 	struct rcert cert; /* region cells */
 	double expiry;

@@ -199,11 +199,10 @@ struct px_strack_result {
 			    * tracker's critical points */
 	int n_min, n_max, n_saddle; /* interior surface points by type */
 	int source;        /* enum px_track_source */
-	int cells_solved;  /* cell solves this update within the budget,
-			    * as max_solves counts them (a cell proven
-			    * empty is 1/8, the sum rounded up; pole cells
-			    * not counted); stats.cell_solves counts every
-			    * cell */
+	int cells_solved;  /* cell solves this update, as max_solves
+			    * counts them (a cell proven empty is 1/8, the
+			    * sum rounded up); stats.cell_solves counts
+			    * every cell */
 	/* interior points that appeared this update (born in pairs at a
 	 * focal sheet, or entered through an edge) and that ended (died in
 	 * pairs at a focal sheet, left through an edge, or lost by Newton:
