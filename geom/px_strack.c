@@ -179,6 +179,9 @@ struct px_strack {
 	px_vec3 *pend_ps;
 	double travel;
 	int heap_ok;
+	/* seeds of a cell solve with no region or quarter proven
+	 * (cell_seeds()), the work of ST_UNITS */
+	int full_seeds;
 	/* the due cells of the segment col_p0 -> col_p1 tested over several
 	 * updates (more of them than max_tests): popped from the heap
 	 * (heap_n cells left in it), col_k of the col_np tested, col_nh of
@@ -552,13 +555,17 @@ static int box_done(const struct ssurf *f, const struct rcert *c,
 }
 
 /*
- * The work of cell solves, in ST_UNITS per solve: a cell whose four
- * regions need no seeds at the seed point (cell_done()) costs those
- * checks alone (measured on the 16-patch bench surface: about 900
- * instructions, against about 7,000 for each Newton run from a seed and
- * 14,000 for following a root), one unit; any other solve ST_UNITS.
- * Budgets (max_solves) count solves, so a rebuild, mostly empty cells,
- * takes a few updates instead of one per max_solves / 2 cells.
+ * The work of cell solves, in ST_UNITS per full solve (every region and
+ * quarter seeded): the checks of a cell's regions and quarters
+ * (cell_done(); measured on the 16-patch bench surface: about 2,200
+ * instructions) are one unit, each Newton run from a seed (about 7,500,
+ * and 14,000 more where its root is followed) a share of the rest in
+ * proportion to the seeds run. Budgets (max_solves) count full solves, so
+ * a rebuild, mostly empty cells, takes a few updates instead of one per
+ * max_solves / 2 cells, and a cell near a focal sheet, where only the
+ * quarters the sheet passes through need seeds, costs a part of a solve:
+ * a path hovering there would otherwise go over the budget every step,
+ * by the checks of the hit cell's neighbours.
  */
 #define ST_UNITS 8
 
@@ -638,61 +645,83 @@ static int seed_solve(struct px_strack *t, struct ssurf *f, const struct scell *
 }
 
 /*
- * Solve cell c: Newton from its seed grid at ps, each root then followed
- * from ps to p (a pair born where the path met the cell's region keeps
- * moving for the rest of the step, possibly out of the cell). done_in:
- * cell_done() at ps, or NULL to work it out. The held set is at p (every
- * caller), so where ps is p a region or quarter holding one of its
- * points needs no seeds if it can hold only one. Returns 0 or
- * PX_E_NOSPC.
+ * The seeds of cell c's solve (done: cell_done() at the seed point):
+ * Newton from the grid seeds of each region that may hold a point, and
+ * from the centre of each of its quarters that may and has no grid seed
+ * (where the quarters prove a region's neighbourhood empty, a point in
+ * it is no longer found from the seeds of the regions around). Puts up
+ * to n * n + 16 of them in su, sv (cell-relative); returns their count.
+ */
+static int cell_seeds(int n, const struct cell_done *done, double *su,
+		      double *sv)
+{
+	int i, j, ch, k, ns = 0;
+	for (ch = 0; ch < 4; ch++) {
+		const int *qe = done->quarter[ch];
+		int qn[4] = {0, 0, 0, 0};
+		if (done->region[ch])
+			continue;
+		for (j = 0; j < n; j++)
+			for (i = 0; i < n; i++) {
+				double a = (i + 0.5) / n, b = (j + 0.5) / n;
+				int ru = a >= 0.5, rv = b >= 0.5;
+				if (ru + 2 * rv != ch)
+					continue;
+				k = (a - 0.5 * ru >= 0.25) + 2 * (b - 0.5 * rv >= 0.25);
+				if (qe[k])
+					continue;
+				qn[k]++;
+				su[ns] = a;
+				sv[ns++] = b;
+			}
+		for (k = 0; k < 4; k++) {
+			if (qe[k] || qn[k])
+				continue;
+			su[ns] = 0.5 * (ch & 1) + 0.25 * (k & 1) + 0.125;
+			sv[ns++] = 0.5 * (ch >> 1) + 0.25 * (k >> 1) + 0.125;
+		}
+	}
+	return ns;
+}
+
+/* Room for cell_seeds() at the largest seed grid (options: seeds <= 8). */
+#define ST_SEEDS_MAX (8 * 8 + 16)
+
+/* The units of a solve running ns seeds: 1 for the checks, rounded up
+ * to ST_UNITS for a full one. */
+static int solve_units(const struct px_strack *t, int ns)
+{
+	return 1 + (ns * (ST_UNITS - 1) + t->full_seeds - 1) / t->full_seeds;
+}
+
+/*
+ * Solve cell c: Newton from its seeds (cell_seeds()) at ps, each root
+ * then followed from ps to p (a pair born where the path met the cell's
+ * region keeps moving for the rest of the step, possibly out of the
+ * cell). done_in: cell_done() at ps, or NULL to work it out. The held
+ * set is at p (every caller), so where ps is p a region or quarter
+ * holding one of its points needs no seeds if it can hold only one.
+ * Returns 0 or PX_E_NOSPC.
  */
 static int cell_solve_at(struct px_strack *t, const struct scell *c,
 			 px_vec3 ps, px_vec3 p, const struct cell_done *done_in)
 {
 	struct ssurf *f = &t->sf[c->surf];
-	int n = t->opts.seeds, i, j, ch, rc;
 	struct cell_done dbuf;
 	const struct cell_done *done = done_in;
+	double su[ST_SEEDS_MAX], sv[ST_SEEDS_MAX];
 	double lu = c->u1 - c->u0, lv = c->v1 - c->v0;
+	int ns, i, rc;
 	t->st.cell_solves++;
 	if (!done) {
 		cell_done(t, c, ps, px_v3_dist2(ps, p) == 0.0, &dbuf);
 		done = &dbuf;
 	}
-	for (ch = 0; ch < 4; ch++) {
-		/* Newton from the grid seeds of each region that may hold a
-		 * point, and from the centre of each of its quarters that
-		 * may and has no grid seed: where the quarters prove a
-		 * region's neighbourhood empty, a point in it is no longer
-		 * found from the seeds of the regions around */
-		const int *qe = done->quarter[ch];
-		int qn[4] = {0, 0, 0, 0}, k;
-		if (done->region[ch])
-			continue;
-		for (j = 0; j < n; j++)
-			for (i = 0; i < n; i++) {
-				double su = (i + 0.5) / n, sv = (j + 0.5) / n;
-				int ru = su >= 0.5, rv = sv >= 0.5;
-				if (ru + 2 * rv != ch)
-					continue;
-				k = (su - 0.5 * ru >= 0.25) + 2 * (sv - 0.5 * rv >= 0.25);
-				if (qe[k])
-					continue;
-				qn[k]++;
-				rc = seed_solve(t, f, c, c->u0 + lu * su, c->v0 + lv * sv, ps, p);
-				if (rc < 0)
-					return rc;
-			}
-		for (k = 0; k < 4; k++) {
-			double su, sv;
-			if (qe[k] || qn[k])
-				continue;
-			su = 0.5 * (ch & 1) + 0.25 * (k & 1) + 0.125;
-			sv = 0.5 * (ch >> 1) + 0.25 * (k >> 1) + 0.125;
-			rc = seed_solve(t, f, c, c->u0 + lu * su, c->v0 + lv * sv, ps, p);
-			if (rc < 0)
-				return rc;
-		}
+	ns = cell_seeds(t->opts.seeds, done, su, sv);
+	for (i = 0; i < ns; i++) {
+		rc = seed_solve(t, f, c, c->u0 + lu * su[i], c->v0 + lv * sv[i], ps, p);
+		if (rc < 0)
+			return rc;
 	}
 	return 0;
 }
@@ -703,15 +732,17 @@ static int cell_solve(struct px_strack *t, const struct scell *c, px_vec3 p)
 	return cell_solve_at(t, c, p, p, NULL);
 }
 
-/* Solve c at ps (roots followed to p) if its work fits: *units (in
- * ST_UNITS per solve) grows by the cost unless that passes lim (lim <= 0:
- * no bound). Returns 0 solved, 1 left for later (nothing done),
- * PX_E_NOSPC. */
+/* Solve c at ps (roots followed to p) if its work fits: *units grows by
+ * the cost (solve_units()) unless that passes lim (lim <= 0: no bound).
+ * Returns 0 solved, 1 left for later (nothing done), PX_E_NOSPC. */
 static int cell_solve_budget(struct px_strack *t, const struct scell *c,
 			     px_vec3 ps, px_vec3 p, int *units, int lim)
 {
 	struct cell_done done;
-	int cost = cell_done(t, c, ps, px_v3_dist2(ps, p) == 0.0, &done) ? 1 : ST_UNITS;
+	double su[ST_SEEDS_MAX], sv[ST_SEEDS_MAX];
+	int cost;
+	cell_done(t, c, ps, px_v3_dist2(ps, p) == 0.0, &done);
+	cost = solve_units(t, cell_seeds(t->opts.seeds, &done, su, sv));
 	if (lim > 0 && *units > 0 && *units + cost > lim)
 		return 1;
 	*units += cost;
@@ -1682,7 +1713,7 @@ static int follow(const struct ssurf *f, struct crit *z, px_vec3 p0,
 }
 
 /* Solve pending items from pend_next on, at most budget solves (0: all;
- * a cell proven empty is 1 / ST_UNITS of one). Returns 0 or PX_E_NOSPC;
+ * counted in solve_units()). Returns 0 or PX_E_NOSPC;
  * *done the solves made (rounded up). */
 static int pend_solve(struct px_strack *t, int budget, int *done)
 {
@@ -3142,6 +3173,12 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	if (!t)
 		return PX_E_NOMEM;
 	t->opts = o;
+	{
+		struct cell_done none;
+		double su[ST_SEEDS_MAX], sv[ST_SEEDS_MAX];
+		memset(&none, 0, sizeof(none));
+		t->full_seeds = cell_seeds(o.seeds, &none, su, sv);
+	}
 	t->n_curves = n_curves;
 	t->n_surf = n_surfs;
 	rc = px_dist_model_create(curves, n_curves, surfs, n_surfs, o.dist,

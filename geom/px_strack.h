@@ -131,11 +131,14 @@ struct px_strack_opts {
 	 * the default). */
 	int verify_every;
 	/* Bound on the transition work of one update, in cell solves
-	 * (default 4; 0: no bound). A cell whose region certificates prove
-	 * it free of critical points where it is solved costs those checks
-	 * alone and counts 1/8 of a solve (measured: about 900
-	 * instructions against 7,000 or more for each Newton run from a
-	 * seed); a solve is never started past the bound. An update whose
+	 * (default 4; 0: no bound). A solve's work is counted by the seeds
+	 * it runs: a cell whose region certificates prove it free of
+	 * critical points where it is solved costs those checks alone and
+	 * counts 1/8 of a solve (measured: about 2,200 instructions
+	 * against 7,000 or more for each Newton run from a seed), one
+	 * whose certificates leave only some regions or quarters open
+	 * (near a focal sheet) 1/8 plus that share of the other 7/8; a
+	 * solve is never started past the bound. An update whose
 	 * certificates name more cells to solve (or whose critical points
 	 * overflow max_crit) is answered by the global query
 	 * (px_dist_query(), exact) instead, and the critical points are
@@ -200,8 +203,9 @@ struct px_strack_result {
 	int n_min, n_max, n_saddle; /* interior surface points by type */
 	int source;        /* enum px_track_source */
 	int cells_solved;  /* cell solves this update, as max_solves
-			    * counts them (a cell proven empty is 1/8, the
-			    * sum rounded up); stats.cell_solves counts
+			    * counts them (a cell proven empty is 1/8, one
+			    * partly proven a share more; the sum rounded
+			    * up); stats.cell_solves counts
 			    * every cell */
 	/* interior points that appeared this update (born in pairs at a
 	 * focal sheet, or entered through an edge) and that ended (died in

@@ -1431,6 +1431,92 @@ static void test_tests_budget(void)
 	px_dist_model_free(ref);
 }
 
+/*
+ * A point hovering close to a focal sheet: the cells the sheet passes
+ * through are hit in most steps, and only the regions or quarters the
+ * sheet crosses need seeds there. Such solves count that part of a full
+ * solve, so most steps fit the default budget (the hit cells' solves and
+ * their neighbours' checks) and are tracked; every answer exact.
+ */
+static void test_focal_hover(void)
+{
+	struct px_nurbs_surf s;
+	struct px_dist_model *ref = NULL;
+	struct px_dist_info di;
+	struct px_strack *t = NULL;
+	struct px_strack_opts o;
+	px_vec3 fp[24], pts[48];
+	px_aabb work;
+	long steps = 0, wrong = 0, global = 0, solved = 0;
+	uint64_t over = 0, allocs = 0, unbal = 0, rebuild = 0, tests = 0;
+	double size;
+	int nf, i, k, n = 0;
+	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
+	PX_CHECK_INT_EQ(surf_wavy(&s, 0, 0, 0, 0), PX_OK);
+	PX_CHECK_INT_EQ(px_dist_model_create(NULL, 0, &s, 1, NULL, &ref), PX_OK);
+	px_dist_model_info(ref, &di);
+	size = px_aabb_diagonal(&di.bounds);
+	work = px_aabb_inflate(&di.bounds, 0.9 * size);
+	/* those inside the working volume (1 diagonal about the model) */
+	nf = focal_points(&s, pts, 48);
+	for (i = 0; i < nf && n < 24; i++)
+		if (px_aabb_contains(&work, pts[i]))
+			fp[n++] = pts[i];
+	nf = n;
+	px_strack_opts_default(&o);
+	o.cold_switch = 0;
+	PX_CHECK_INT_EQ(px_strack_create(NULL, 0, &s, 1, &o, &t), PX_OK);
+	if (!t || !ref)
+		goto out;
+	for (i = 0; i < nf; i++) {
+		struct px_strack_result r;
+		struct px_strack_stats s0, s1;
+		px_strack_reset(t, fp[i], &r);
+		px_strack_get_stats(t, &s0);
+		for (k = 0; k < 400; k++) {
+			/* a Lissajous knot of radius 0.5 % of the model about the
+			 * focal point, steps about 0.04 % of it */
+			double a = 2.0 * M_PI * k / 400.0, rad = 5e-3 * size;
+			px_vec3 q = px_v3_add(fp[i], px_v3(rad * sin(3.0 * a),
+							   rad * sin(4.0 * a + 1.0),
+							   rad * sin(5.0 * a + 2.0)));
+			struct px_dist_result g;
+			uint64_t reg = px_alloc_region_begin();
+			PX_CHECK_INT_EQ(px_strack_update(t, q, &r), PX_OK);
+			allocs += px_alloc_region_end(reg);
+			px_dist_query(ref, q, &g);
+			steps++;
+			solved += r.cells_solved;
+			global += r.source == PX_TRACK_GLOBAL;
+			if (fabs(r.dist - g.dist) > 1e-9 * (size + g.dist))
+				wrong++;
+		}
+		px_strack_get_stats(t, &s1);
+		over += s1.over_budget - s0.over_budget;
+		unbal += s1.unbalanced - s0.unbalanced;
+		rebuild += s1.rebuild_updates - s0.rebuild_updates;
+		tests += s1.box_tests - s0.box_tests;
+	}
+	printf("  wavy, %d focal points, %ld steps: over budget %llu, answered "
+	       "globally %ld (rebuilding or catching up %llu, unbalanced %llu), "
+	       "cell tests %llu, cell solves %ld (as the budget counts them), "
+	       "wrong %ld, allocations %llu\n", nf, steps,
+	       (unsigned long long)over, global, (unsigned long long)rebuild,
+	       (unsigned long long)unbal, (unsigned long long)tests, solved, wrong,
+	       (unsigned long long)allocs);
+	PX_CHECK_MSG(nf >= 12, "only %d focal points", nf);
+	PX_CHECK_INT_EQ(wrong, 0);
+	PX_CHECK_INT_EQ(allocs, 0);
+	PX_CHECK_MSG(solved > steps / 4, "the path seldom met the focal sheet: "
+		     "%ld solves in %ld steps", solved, steps);
+	/* every step's solves at a full solve's cost: 30-50 % of these
+	 * steps went over the budget and were answered globally */
+	PX_CHECK_MSG(8 * global < steps, "answered globally %ld of %ld", global, steps);
+out:
+	px_strack_free(t);
+	px_dist_model_free(ref);
+}
+
 static void test_errors(void)
 {
 	struct px_nurbs_surf s;
@@ -1783,6 +1869,7 @@ static const struct px_test tests[] = {
 	PX_T(test_hot_fault),
 	PX_T(test_budget),
 	PX_T(test_tests_budget),
+	PX_T(test_focal_hover),
 	PX_T(test_focal_bounds),
 	PX_T(test_empty_regions),
 	PX_T(test_one_regions),
