@@ -174,9 +174,13 @@ struct px_strack {
 	struct pole *pole;
 	int *heap, *popped, *hits;
 	/* solves owed to the set at p (mode ST_PEND): cell pend[i] solved
-	 * at pend_ps[i] and followed to p; pend_next the next one */
+	 * at pend_ps[i] and followed to p; pend_next the next one. Where
+	 * pend_cross[i], pend_ps[i] is where the step began and the seed
+	 * point is still to be found along it (cross_at(), work counted in
+	 * the budget when the solve comes up) */
 	int *pend, n_pend, pend_next;
 	px_vec3 *pend_ps;
+	unsigned char *pend_cross;
 	double travel;
 	int heap_ok;
 	/* seeds of a cell solve with no region or quarter proven
@@ -1712,17 +1716,38 @@ static int follow(const struct ssurf *f, struct crit *z, px_vec3 p0,
 	return 1;
 }
 
+static double cross_at(const struct px_strack *t, const struct scell *c,
+		       px_vec3 p0, px_vec3 p1, int *rounds);
+
+/* Rounds of cross_at() at most. */
+#define ST_CROSS_ROUNDS 8
+
 /* Solve pending items from pend_next on, at most budget solves (0: all;
- * counted in solve_units()). Returns 0 or PX_E_NOSPC;
+ * counted in solve_units(), a seed point still to be found by its
+ * cross_at() rounds). Returns 0 or PX_E_NOSPC;
  * *done the solves made (rounded up). */
 static int pend_solve(struct px_strack *t, int budget, int *done)
 {
-	int rc = 0, units = 0;
+	int rc = 0, units = 0, lim = budget * ST_UNITS;
 	t->pend_on = t->mode != ST_REBUILD;
 	while (t->pend_next < t->n_pend) {
-		const struct scell *c = &t->cell[t->pend[t->pend_next]];
-		rc = cell_solve_budget(t, c, t->pend_ps[t->pend_next], t->p,
-				       &units, budget * ST_UNITS);
+		int i = t->pend_next;
+		const struct scell *c = &t->cell[t->pend[i]];
+		if (t->pend_cross[i]) {
+			/* its rounds (two cell radii each, about a check's
+			 * work) count as units, at most ST_CROSS_ROUNDS */
+			px_vec3 p0 = t->pend_ps[i];
+			int rounds = 0;
+			double s;
+			if (lim > 0 && units > 0 && units + ST_CROSS_ROUNDS > lim)
+				break;
+			s = cross_at(t, c, p0, t->p, &rounds);
+			t->pend_ps[i] = px_v3_add(p0, px_v3_scale(px_v3_sub(t->p, p0), s));
+			t->pend_cross[i] = 0;
+			t->st.cross_rounds += (uint64_t)rounds;
+			units += rounds;
+		}
+		rc = cell_solve_budget(t, c, t->pend_ps[i], t->p, &units, lim);
 		if (rc == 1)
 			break;
 		t->pend_next++;
@@ -1741,20 +1766,23 @@ static int pend_solve(struct px_strack *t, int budget, int *done)
  * looked for after it may have left the cell. The certified radius at
  * either end of the open part [a, b] clears a stretch of it; a few
  * rounds from both ends narrow it down to where the transition can be.
- * Returns b (the col_test() estimate when all of it is cleared).
+ * Returns b (the col_test() estimate when all of it is cleared); *rounds
+ * the rounds made.
  */
 static double cross_at(const struct px_strack *t, const struct scell *c,
-		       px_vec3 p0, px_vec3 p1)
+		       px_vec3 p0, px_vec3 p1, int *rounds)
 {
 	px_vec3 dp = px_v3_sub(p1, p0);
 	double dinf = fmax(fmax(fabs(dp.x), fabs(dp.y)), fabs(dp.z));
 	double a = 0.0, b = 1.0;
 	int k;
+	*rounds = 0;
 	if (!(dinf > 0.0))
 		return 1.0;
-	for (k = 0; k < 8 && b - a > 1e-3; k++) {
+	for (k = 0; k < ST_CROSS_ROUNDS && b - a > 1e-3; k++) {
 		double ra = cell_radius(t, c, px_v3_add(p0, px_v3_scale(dp, a))) / dinf;
 		double rb = cell_radius(t, c, px_v3_add(p0, px_v3_scale(dp, b))) / dinf;
+		*rounds = k + 1;
 		if (!(ra > 0.0) && !(rb > 0.0))
 			break;
 		a += ra;
@@ -1836,11 +1864,12 @@ static int track_step(struct px_strack *t, px_vec3 p0, px_vec3 p,
 		int loc = ci - f->first_cell, cu = loc % f->ncu, cv = loc / f->ncu,
 		    du, dv;
 		t->pend[t->n_pend] = ci;
+		t->pend_cross[t->n_pend] = 0;
 		t->pend_ps[t->n_pend++] = p;
 		if (hit_work(t, ci, step) > 1) {
 			t->pend[t->n_pend] = ci;
-			t->pend_ps[t->n_pend++] =
-				px_v3_add(p0, px_v3_scale(dp, cross_at(t, c, p0, p)));
+			t->pend_cross[t->n_pend] = 1;
+			t->pend_ps[t->n_pend++] = p0;
 		}
 		/* a pair born in c may have moved on into a neighbour whose
 		 * own certificate holds (points only move there; near a focal
@@ -1861,6 +1890,7 @@ static int track_step(struct px_strack *t, px_vec3 p0, px_vec3 p,
 					continue;
 				t->cell[nc].mark = t->epoch;
 				t->pend[t->n_pend] = nc;
+				t->pend_cross[t->n_pend] = 0;
 				t->pend_ps[t->n_pend++] = p;
 			}
 	}
@@ -3021,6 +3051,7 @@ void px_strack_free(struct px_strack *t)
 	free(t->hits);
 	free(t->pend);
 	free(t->pend_ps);
+	free(t->pend_cross);
 	free(t->cbox);
 	free(t);
 }
@@ -3262,6 +3293,7 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	t->hits = calloc((size_t)cell_cap + 1, sizeof(int));
 	t->pend = calloc(3 * (size_t)cell_cap + 2, sizeof(int));
 	t->pend_ps = calloc(3 * (size_t)cell_cap + 2, sizeof(px_vec3));
+	t->pend_cross = calloc(3 * (size_t)cell_cap + 2, 1);
 	for (i = 0; i < n_surfs; i++) {
 		const struct px_nurbs_surf *sf = &t->sf[i].s;
 		size_t l = PX_NURBS_SURF_WORK_LEN(sf->degree[0], sf->degree[1],
@@ -3271,7 +3303,7 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	}
 	work = malloc(wl * sizeof(double));
 	if (!t->cell || !t->rcell || !t->qcert || !t->heap || !t->popped || !t->hits ||
-	    !t->pend || !t->pend_ps || !work) {
+	    !t->pend || !t->pend_ps || !t->pend_cross || !work) {
 		rc = PX_E_NOMEM;
 		goto fail;
 	}

@@ -137,8 +137,10 @@ struct px_strack_opts {
 	 * counts 1/8 of a solve (measured: about 2,200 instructions
 	 * against 7,000 or more for each Newton run from a seed), one
 	 * whose certificates leave only some regions or quarters open
-	 * (near a focal sheet) 1/8 plus that share of the other 7/8; a
-	 * solve is never started past the bound. An update whose
+	 * (near a focal sheet) 1/8 plus that share of the other 7/8; after
+	 * a long step, finding where it met a hit cell's region (up to 8
+	 * rounds of certificate radii) 1/8 a round. A solve is never
+	 * started past the bound. An update whose
 	 * certificates name more cells to solve (or whose critical points
 	 * overflow max_crit) is answered by the global query
 	 * (px_dist_query(), exact) instead, and the critical points are
@@ -227,6 +229,10 @@ struct px_strack_stats {
 	 * at a fold or left through an edge; their cell is solved again) */
 	uint64_t cell_solves, box_tests, lost;
 	uint64_t born;     /* interior points found by cell solves */
+	/* rounds spent finding where a long step met a hit cell's region
+	 * (two certificate radii each; counted in max_solves as 1/8 of a
+	 * solve each) */
+	uint64_t cross_rounds;
 	/* updates whose transition work exceeded max_solves; updates
 	 * answered globally while the set was re-established */
 	uint64_t over_budget, rebuild_updates;
