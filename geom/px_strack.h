@@ -140,21 +140,22 @@ struct px_strack_opts {
 	 * (near a focal sheet) 1/8 plus that share of the other 7/8; after
 	 * a long step, finding where it met a hit cell's region (up to 8
 	 * rounds of certificate radii) 1/8 a round. A solve is never
-	 * started past the bound. An update whose
-	 * certificates name more cells to solve (or whose critical points
-	 * overflow max_crit) is answered by the global query
-	 * (px_dist_query(), exact) instead, and the critical points are
-	 * re-established over the following updates: max_solves / 2 solves
-	 * (at least 1) per update - mostly cells proven empty, 8 of them
-	 * to a solve - each of those answered by the global query too,
-	 * then one tracked step from where the rebuild started to the
-	 * current point, checked against the global answer before the
-	 * tracker answers again.
+	 * started past the bound. An update whose certificates name more
+	 * work than this does the bound's worth of it and is answered by
+	 * the global query (px_dist_query(), exact) instead; the rest is
+	 * done over the following updates (max_solves each, answered
+	 * globally too), then one tracked step takes the set from where it
+	 * waited to the current point, checked against the global answer
+	 * before the tracker answers again. Where the set is re-established
+	 * (its critical points overflow max_crit, a check fails, or the
+	 * point left the working volume: from its return) it is solved cell
+	 * by cell, max_solves / 2 solves (at least 1) per update - mostly
+	 * cells proven empty, 8 of them to a solve - each update answered
+	 * globally.
 	 * Real-time meaning: an update costs at most about max_solves cell
-	 * solves plus the following of the live points, or one global query
-	 * plus max_solves / 2 cell solves, and at most max_tests cell tests
-	 * (see stats.over_budget and stats.rebuild_updates). Leaving the
-	 * working volume starts such a rebuild as well. With 0 these cases
+	 * solves plus the following of the live points and max_tests cell
+	 * tests, and one global query where it is answered globally (see
+	 * stats.over_budget and stats.rebuild_updates). With 0 these cases
 	 * re-initialise at once (cost of px_strack_reset()). */
 	int max_solves;
 	/* Options of the global-query model (NULL: defaults). */
