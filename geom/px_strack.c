@@ -698,30 +698,17 @@ static int solve_units(const struct px_strack *t, int ns)
 	return 1 + (ns * (ST_UNITS - 1) + t->full_seeds - 1) / t->full_seeds;
 }
 
-/*
- * Solve cell c: Newton from its seeds (cell_seeds()) at ps, each root
- * then followed from ps to p (a pair born where the path met the cell's
- * region keeps moving for the rest of the step, possibly out of the
- * cell). done_in: cell_done() at ps, or NULL to work it out. The held
- * set is at p (every caller), so where ps is p a region or quarter
- * holding one of its points needs no seeds if it can hold only one.
- * Returns 0 or PX_E_NOSPC.
- */
-static int cell_solve_at(struct px_strack *t, const struct scell *c,
-			 px_vec3 ps, px_vec3 p, const struct cell_done *done_in)
+/* Newton from the ns seeds su, sv of cell c (cell-relative) at ps, each
+ * root then followed from ps to p (a pair born where the path met the
+ * cell's region keeps moving for the rest of the step, possibly out of
+ * the cell). Returns 0 or PX_E_NOSPC. */
+static int seeds_run(struct px_strack *t, const struct scell *c, px_vec3 ps,
+		     px_vec3 p, const double *su, const double *sv, int ns)
 {
 	struct ssurf *f = &t->sf[c->surf];
-	struct cell_done dbuf;
-	const struct cell_done *done = done_in;
-	double su[ST_SEEDS_MAX], sv[ST_SEEDS_MAX];
 	double lu = c->u1 - c->u0, lv = c->v1 - c->v0;
-	int ns, i, rc;
+	int i, rc;
 	t->st.cell_solves++;
-	if (!done) {
-		cell_done(t, c, ps, px_v3_dist2(ps, p) == 0.0, &dbuf);
-		done = &dbuf;
-	}
-	ns = cell_seeds(t->opts.seeds, done, su, sv);
 	for (i = 0; i < ns; i++) {
 		rc = seed_solve(t, f, c, c->u0 + lu * su[i], c->v0 + lv * sv[i], ps, p);
 		if (rc < 0)
@@ -730,10 +717,15 @@ static int cell_solve_at(struct px_strack *t, const struct scell *c,
 	return 0;
 }
 
-/* Solve cell c at p from its seed grid. Returns 0 or PX_E_NOSPC. */
+/* Solve cell c at p from its seeds (cell_seeds()); the held set is at p
+ * (every caller), so a region or quarter holding one of its points
+ * needs no seeds if it can hold only one. Returns 0 or PX_E_NOSPC. */
 static int cell_solve(struct px_strack *t, const struct scell *c, px_vec3 p)
 {
-	return cell_solve_at(t, c, p, p, NULL);
+	struct cell_done done;
+	double su[ST_SEEDS_MAX], sv[ST_SEEDS_MAX];
+	cell_done(t, c, p, 1, &done);
+	return seeds_run(t, c, p, p, su, sv, cell_seeds(t->opts.seeds, &done, su, sv));
 }
 
 /* Solve c at ps (roots followed to p) if its work fits: *units grows by
@@ -744,13 +736,14 @@ static int cell_solve_budget(struct px_strack *t, const struct scell *c,
 {
 	struct cell_done done;
 	double su[ST_SEEDS_MAX], sv[ST_SEEDS_MAX];
-	int cost;
+	int ns, cost;
 	cell_done(t, c, ps, px_v3_dist2(ps, p) == 0.0, &done);
-	cost = solve_units(t, cell_seeds(t->opts.seeds, &done, su, sv));
+	ns = cell_seeds(t->opts.seeds, &done, su, sv);
+	cost = solve_units(t, ns);
 	if (lim > 0 && *units > 0 && *units + cost > lim)
 		return 1;
 	*units += cost;
-	return cell_solve_at(t, c, ps, p, &done);
+	return seeds_run(t, c, ps, p, su, sv, ns);
 }
 
 static int surf_reinit(struct px_strack *t, struct ssurf *f, int si, px_vec3 p)
