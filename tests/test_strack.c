@@ -1467,7 +1467,8 @@ static void test_focal_hover(void)
 	px_dist_model_info(ref, &di);
 	size = px_aabb_diagonal(&di.bounds);
 	work = px_aabb_inflate(&di.bounds, 0.9 * size);
-	/* those inside the working volume (1 diagonal about the model) */
+	/* those inside the working volume (1 diagonal about the model),
+	 * with room for the knot */
 	nf = focal_points(&s, pts, 48);
 	for (i = 0; i < nf && n < 24; i++)
 		if (px_aabb_contains(&work, pts[i]))
