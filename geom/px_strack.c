@@ -1791,9 +1791,10 @@ static double cross_at(const struct px_strack *t, const struct scell *c,
  * certificates the segment may break collected (collect_cells()): follow
  * every point, add the cells of lost points, and solve them (a hit after
  * a long step also past where its region was met, its roots followed to
- * p, and its neighbours at p). Returns 0; 1 when
- * that work exceeds the budget: nothing is solved, the work is left
- * pending (mode ST_PEND, solved over the next updates at p); PX_E_NOSPC.
+ * p, and its neighbours at p). Returns 0; 1 when that work exceeds the
+ * budget: the budget's worth is done, the rest left pending (mode
+ * ST_PEND, solved over the next updates at p); 2 when the index check
+ * fails (ix_check()); PX_E_NOSPC.
  */
 static int track_step(struct px_strack *t, px_vec3 p0, px_vec3 p,
 		      struct px_strack_result *r, int nh)
