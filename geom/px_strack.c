@@ -594,9 +594,8 @@ struct cell_done {
 
 /* cell_done for c at ps (known: the held set is at ps; a seed converges
  * to a point near it, so those parts give none): a region needs none
- * when its own test or each of its quarters' holds. 1 when no region
- * needs seeds. */
-static int cell_done(const struct px_strack *t, const struct scell *c,
+ * when its own test or each of its quarters' holds. */
+static void cell_done(const struct px_strack *t, const struct scell *c,
 		     px_vec3 ps, int known, struct cell_done *d)
 {
 	const struct ssurf *f = &t->sf[c->surf];
@@ -616,7 +615,6 @@ static int cell_done(const struct px_strack *t, const struct scell *c,
 			d->region[ch] = d->region[ch] && d->quarter[ch][k];
 		}
 	}
-	return d->region[0] && d->region[1] && d->region[2] && d->region[3];
 }
 
 /* Newton from (u, v) of cell c at ps, the root followed to p and added.
