@@ -139,6 +139,10 @@ int px__strack_winding(const struct px_strack *t, int s, px_vec3 p, int *w);
 /* 1 negates that winding number (a fault the tests must see); 0 by
  * default. */
 extern int px__strack_wind_fault;
+/* Bit 0: a step solves the first ring of cells about each hit cell only,
+ * whatever the escape bound says (unsound: its test must see it); bit 1:
+ * no solve past where a long step met a hit cell's region. */
+extern int px__strack_ring_fault;
 /* Test hook: 1 turns the surface tracker's hot path off, 2 makes its
  * certificate never expire (a fault the tests must see). */
 void px__strack_set_hot_fault(struct px_strack *t, int fault);

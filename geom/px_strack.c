@@ -33,6 +33,10 @@
 
 enum { ST_TRACK = 0, ST_LAG = 1, ST_REBUILD = 2, ST_PEND = 3 };
 
+/* Pending items (struct px_strack's pend): a cell solve, one past where a
+ * long step met the cell's region, the escape bound of a ring. */
+enum { PK_SOLVE = 0, PK_CROSS = 1, PK_RING = 2 };
+
 struct crit {
 	double u, v;
 	int type;       /* +1 min, -1 max, 0 saddle */
@@ -93,6 +97,15 @@ struct scell {
 	uint32_t mark;
 	double cross;   /* hit: segment parameter where the region is met */
 	int child;      /* solve cell: first of its 2 x 2 region cells */
+	/* escape bound (ring_build()): dmark == epoch when dist is the
+	 * cell's ring (0: a source) */
+	uint32_t dmark;
+	int dist;
+	/* its K over the step of epoch kmark (ring_cell()): regions', and
+	 * quarters' (NAN where not worked out); its solve at p takes what
+	 * they prove at p from them (cell_done()) */
+	uint32_t kmark;
+	double kr[4], kq[16];
 };
 
 /*
@@ -136,6 +149,11 @@ struct ssurf {
 	 * collapsed edge or a C0 line */
 	struct wpiece *wp;
 	int nwp, wind_ok;
+	/* the ring of the escape bound in progress (ring_build()): rl_n
+	 * cells in ring_list, the next rl_next; its quarter layers' largest
+	 * K and least width */
+	int rl_n, rl_next;
+	double rl_kl[4], rl_wl[4];
 };
 
 struct edge {
@@ -175,12 +193,20 @@ struct px_strack {
 	int *heap, *popped, *hits;
 	/* solves owed to the set at p (mode ST_PEND): cell pend[i] solved
 	 * at pend_ps[i] and followed to p; pend_next the next one. Where
-	 * pend_cross[i], pend_ps[i] is where the step began and the seed
-	 * point is still to be found along it (cross_at(), work counted in
-	 * the budget when the solve comes up) */
-	int *pend, n_pend, pend_next;
+	 * pend_kind[i] is PK_CROSS, pend_ps[i] is where the step began and
+	 * the seed point is still to be found along it (cross_at(), work
+	 * counted in the budget when the solve comes up); PK_RING + k - 1:
+	 * the escape bound of ring k of surface pend[i] for the step from
+	 * pend_ps[i], the rings inside it needing pend_need[i] of
+	 * travel (ring_check()). pend_epoch: the epoch of the step (its
+	 * cells' marks); pend_nh its sources (hits 0..pend_nh). ring_list:
+	 * each surface's ring in progress, from its first cell on */
+	int *pend, n_pend, pend_next, pend_nh;
+	int *ring_list;
 	px_vec3 *pend_ps;
-	unsigned char *pend_cross;
+	double *pend_need;
+	unsigned char *pend_kind;
+	uint32_t pend_epoch;
 	double travel;
 	int heap_ok;
 	/* seeds of a cell solve with no region or quarter proven
@@ -593,28 +619,47 @@ struct cell_done {
 };
 
 /* cell_done for c at ps (known: the held set is at ps; a seed converges
- * to a point near it, so those parts give none): a region needs none
+ * to a point near it, so those parts give none); returns the
+ * certificate tests made (none where a ring's K covers them): a region
+ * needs none
  * when its own test or each of its quarters' holds. */
-static void cell_done(const struct px_strack *t, const struct scell *c,
+static int cell_done(const struct px_strack *t, const struct scell *c,
 		     px_vec3 ps, int known, struct cell_done *d)
 {
 	const struct ssurf *f = &t->sf[c->surf];
-	int ch, k;
+	/* K worked out over the step that ends at ps: 0, no critical point
+	 * in the piece at any point of it, so none at ps; finite, H regular
+	 * there throughout, so at most one at ps */
+	int sp = c->kmark == t->pend_epoch && t->pend_on && known &&
+		 px_v3_dist2(ps, t->p) == 0.0;
+	int ch, k, tests = 0;
 	for (ch = 0; ch < 4; ch++) {
 		int ri = c->child + ch;
 		const struct scell *g = &t->rcell[ri];
 		double b[4];
 		box_of(g, -1, b);
-		d->region[ch] = box_done(f, &g->cert, b, ps, known);
+		if (sp && c->kr[ch] < INFINITY) {
+			d->region[ch] = c->kr[ch] == 0.0 || holds(f, b);
+		} else {
+			d->region[ch] = box_done(f, &g->cert, b, ps, known);
+			tests++;
+		}
 		if (d->region[ch])
 			continue;
 		d->region[ch] = 1;
 		for (k = 0; k < 4; k++) {
+			double kq = sp ? c->kq[4 * ch + k] : NAN;
 			box_of(g, k, b);
-			d->quarter[ch][k] = box_done(f, &t->qcert[4 * ri + k], b, ps, known);
+			if (kq < INFINITY) {
+				d->quarter[ch][k] = kq == 0.0 || holds(f, b);
+			} else {
+				d->quarter[ch][k] = box_done(f, &t->qcert[4 * ri + k], b, ps, known);
+				tests++;
+			}
 			d->region[ch] = d->region[ch] && d->quarter[ch][k];
 		}
 	}
+	return tests;
 }
 
 /* Newton from (u, v) of cell c at ps, the root followed to p and added.
@@ -734,10 +779,10 @@ static int cell_solve_budget(struct px_strack *t, const struct scell *c,
 {
 	struct cell_done done;
 	double su[ST_SEEDS_MAX], sv[ST_SEEDS_MAX];
-	int ns, cost;
-	cell_done(t, c, ps, px_v3_dist2(ps, p) == 0.0, &done);
+	int ns, cost, tests = cell_done(t, c, ps, px_v3_dist2(ps, p) == 0.0, &done);
 	ns = cell_seeds(t->opts.seeds, &done, su, sv);
-	cost = solve_units(t, ns);
+	/* the checks' unit only where they were made */
+	cost = solve_units(t, ns) - (tests == 0);
 	if (lim > 0 && *units > 0 && *units + cost > lim)
 		return 1;
 	*units += cost;
@@ -1713,18 +1758,28 @@ static double cross_at(const struct px_strack *t, const struct scell *c,
 /* Rounds of cross_at() at most. */
 #define ST_CROSS_ROUNDS 8
 
+static int ring_check(struct px_strack *t, int i, int lim, int *units,
+		      int *spare);
+
 /* Solve pending items from pend_next on, at most budget solves (0: all;
  * counted in solve_units(), a seed point still to be found by its
- * cross_at() rounds). Returns 0 or PX_E_NOSPC;
- * *done the solves made (rounded up). */
+ * cross_at() rounds, an escape bound by the speeds it works out).
+ * Returns 0 or PX_E_NOSPC; *done the solves made (rounded up). */
 static int pend_solve(struct px_strack *t, int budget, int *done)
 {
-	int rc = 0, units = 0, lim = budget * ST_UNITS;
+	int rc = 0, units = 0, spare = 0, lim = budget * ST_UNITS;
 	t->pend_on = t->mode != ST_REBUILD;
 	while (t->pend_next < t->n_pend) {
 		int i = t->pend_next;
-		const struct scell *c = &t->cell[t->pend[i]];
-		if (t->pend_cross[i]) {
+		const struct scell *c;
+		if (t->pend_kind[i] >= PK_RING) {
+			if (ring_check(t, i, lim, &units, &spare))
+				break;
+			t->pend_next++;
+			continue;
+		}
+		c = &t->cell[t->pend[i]];
+		if (t->pend_kind[i] == PK_CROSS) {
 			/* its rounds (two cell radii each, about a check's
 			 * work) count as units, at most ST_CROSS_ROUNDS */
 			px_vec3 p0 = t->pend_ps[i];
@@ -1734,7 +1789,7 @@ static int pend_solve(struct px_strack *t, int budget, int *done)
 				break;
 			s = cross_at(t, c, p0, t->p, &rounds);
 			t->pend_ps[i] = px_v3_add(p0, px_v3_scale(px_v3_sub(t->p, p0), s));
-			t->pend_cross[i] = 0;
+			t->pend_kind[i] = PK_SOLVE;
 			t->st.cross_rounds += (uint64_t)rounds;
 			units += rounds;
 		}
@@ -1782,6 +1837,276 @@ static double cross_at(const struct px_strack *t, const struct scell *c,
 			return c->cross;
 	}
 	return b;
+}
+
+/*
+ * Escape bound. A critical point at p that no follow accounts for was,
+ * at some time of the step, in a source cell: a hit cell (pairs are born
+ * only where a certificate fails, and points enter only through the open
+ * sides of those) or the cell where a lost point was last seen. After it
+ * last left a source it moved through cells whose certificates hold, and
+ * there H d(u, v) = (Su . dx, Sv . dx) (differentiate E = 0), so
+ * |d(u, v)| <= K |dx| with K = sqrt(max Su.Su + max Sv.Sv) / sigma,
+ * sigma a lower bound on the singular values of every H in the piece's
+ * enclosure while x runs over the segment; where E is proven nonzero it
+ * does not pass at all (K = 0). Ring k is the cells at Chebyshev
+ * distance k from the sources (the cell grid, wrapped where the surface
+ * is); within it the quarters at distance j (in quarters) from rings
+ * 0..k-1 make layer j = 1..4, each one quarter thick: no two quarters of
+ * layers j - 1 and j + 1 touch. A point ending outside ring k crossed
+ * every layer of rings 1..k, each at K at most its largest and over at
+ * least its least quarter width w, so the step's travel |dp| is at least
+ * the sum of w / K over them. Rings are solved out to the first k where
+ * that sum exceeds |dp|. Near a focal sheet points move fast and one
+ * ring is not always enough; K is taken over the regions, and over the
+ * quarters of those that would spoil their layers (tighter enclosures
+ * near a fold).
+ */
+
+/* Test hook (internal.h): bit 0 solves the first ring only, bound or
+ * not; bit 1 leaves out the solves past where a long step met a hit
+ * cell's region (the bound alone must hold). */
+int px__strack_ring_fault = 0;
+
+/* Rings solved about a source at most; past them the whole surface. */
+#define ST_RINGS 3
+
+/* K of certificate c (above) while x runs over the cube of half width r
+ * about xm: 0 when E is proven nonzero, INFINITY when no bound. */
+static double cert_speed(const struct rcert *c, px_vec3 xm, double r)
+{
+	double mid[3], rad[3], rad0[3], e1, e2, epad, lo11, hi11, lo22, hi22, b,
+	       x, y, det, sig;
+	px_vec3 w;
+	hess_at(c, xm, mid, rad);
+	w = px_v3_sub(c->sc, xm);
+	e1 = px_v3_dot(w, c->suc);
+	e2 = px_v3_dot(w, c->svc);
+	epad = e_pad(c, w, xm);
+	memcpy(rad0, rad, sizeof(rad0));
+	rad[0] += r * c->m11;
+	rad[1] += r * c->m12;
+	rad[2] += r * c->m22;
+	b = fabs(mid[1]) + rad[1];
+	if (fabs(e1) - epad - r * c->n1 - (fabs(mid[0]) + rad[0]) * c->hu - b * c->hv > 0.0 ||
+	    fabs(e2) - epad - r * c->n2 - b * c->hu - (fabs(mid[2]) + rad[2]) * c->hv > 0.0)
+		return 0.0;
+	lo11 = mid[0] - rad[0];
+	hi11 = mid[0] + rad[0];
+	lo22 = mid[2] - rad[2];
+	hi22 = mid[2] + rad[2];
+	if ((lo11 > 0.0 && lo22 > 0.0) || (hi11 < 0.0 && hi22 < 0.0)) {
+		/* definite: the least eigenvalue grows with the diagonal and
+		 * falls with |h12|, so the corner (x, y, b) bounds it; the
+		 * product form avoids the cancellation of (x + y) / 2 - root */
+		x = lo11 > 0.0 ? lo11 : -hi11;
+		y = lo11 > 0.0 ? lo22 : -hi22;
+		det = x * y - b * b;
+		sig = det > 0.0 ? det / (0.5 * (x + y) + hypot(0.5 * (x - y), b)) : 0.0;
+	} else if (lo11 > 0.0 && hi22 < 0.0) {
+		/* indefinite: both |eigenvalues| >= the lesser |diagonal| */
+		sig = fmin(lo11, -hi22);
+	} else if (hi11 < 0.0 && lo22 > 0.0) {
+		sig = fmin(-hi11, lo22);
+	} else {
+		sig = 0.0;
+	}
+	if (!(sig > 0.0))
+		/* the preconditioned E test last: it costs as much again */
+		return pre_radius(c, mid, rad0, e1, e2, epad) > r ? 0.0 : INFINITY;
+	return sqrt(c->G11.hi + c->G22.hi) / sig * (1.0 + 1e-9);
+}
+
+static void pend_item(struct px_strack *t, int ci, int kind, px_vec3 ps,
+		      double need)
+{
+	t->pend[t->n_pend] = ci;
+	t->pend_kind[t->n_pend] = (unsigned char)kind;
+	t->pend_need[t->n_pend] = need;
+	t->pend_ps[t->n_pend++] = ps;
+}
+
+/* Pend cell ci of the step's solves at p, once. */
+static void pend_at(struct px_strack *t, int ci, px_vec3 p)
+{
+	if (t->cell[ci].mark == t->pend_epoch)
+		return;
+	t->cell[ci].mark = t->pend_epoch;
+	pend_item(t, ci, PK_SOLVE, p, 0.0);
+}
+
+/* Cell (cu + du, cv + dv) of f, wrapped; -1 off the domain. */
+static int cell_at(const struct ssurf *f, int cu, int cv, int du, int dv)
+{
+	int nu = cu + du, nv = cv + dv;
+	if (f->wrap_u)
+		nu = ((nu % f->ncu) + f->ncu) % f->ncu;
+	if (f->wrap_v)
+		nv = ((nv % f->ncv) + f->ncv) % f->ncv;
+	if (nu < 0 || nu >= f->ncu || nv < 0 || nv >= f->ncv)
+		return -1;
+	return f->first_cell + nv * f->ncu + nu;
+}
+
+/* Ring k of surface si: the cells at distance k from its sources (hits
+ * 0..pend_nh) get that distance and make its list (ring_list from the
+ * surface's first cell on; ring_check() pends their solves); its bound
+ * starts. */
+static void ring_build(struct px_strack *t, int si, int k)
+{
+	struct ssurf *f = &t->sf[si];
+	int i, du, dv;
+	f->rl_n = f->rl_next = 0;
+	for (i = 0; i < 4; i++) {
+		f->rl_kl[i] = 0.0;
+		f->rl_wl[i] = INFINITY;
+	}
+	for (i = 0; i < t->pend_nh; i++) {
+		int ci = t->hits[i], loc, cu, cv;
+		if (t->cell[ci].surf != si)
+			continue;
+		loc = ci - f->first_cell;
+		cu = loc % f->ncu;
+		cv = loc / f->ncu;
+		for (dv = -k; dv <= k; dv++)
+			for (du = -k; du <= k; du += (dv == -k || dv == k) ? 1 : 2 * k) {
+				int nc = cell_at(f, cu, cv, du, dv);
+				struct scell *c;
+				if (nc < 0)
+					continue;
+				c = &t->cell[nc];
+				/* nearer rings were built whole: unmarked here is
+				 * distance k */
+				if (c->dmark == t->pend_epoch)
+					continue;
+				c->dmark = t->pend_epoch;
+				c->dist = k;
+				t->ring_list[f->first_cell + f->rl_n++] = nc;
+			}
+	}
+}
+
+/* Distance in pieces (res a side) of piece (a, b) of a ring cell from the
+ * inner neighbours in (in[dv + 1][du + 1]); 1..res. */
+static int piece_dist(const int in[3][3], int res, int a, int b)
+{
+	int lo_u = a + 1, hi_u = res - a, lo_v = b + 1, hi_v = res - b, d = res;
+	if (in[1][0] && lo_u < d)
+		d = lo_u;
+	if (in[1][2] && hi_u < d)
+		d = hi_u;
+	if (in[0][1] && lo_v < d)
+		d = lo_v;
+	if (in[2][1] && hi_v < d)
+		d = hi_v;
+	if (in[0][0] && ST_MAX(lo_u, lo_v) < d)
+		d = ST_MAX(lo_u, lo_v);
+	if (in[0][2] && ST_MAX(hi_u, lo_v) < d)
+		d = ST_MAX(hi_u, lo_v);
+	if (in[2][0] && ST_MAX(lo_u, hi_v) < d)
+		d = ST_MAX(lo_u, hi_v);
+	if (in[2][2] && ST_MAX(hi_u, hi_v) < d)
+		d = ST_MAX(hi_u, hi_v);
+	return d;
+}
+
+/*
+ * Add ring cell ci of surface f to its ring's layers (quarter layers
+ * rl_kl, rl_wl): each region's K, or its quarters' where the region's
+ * could leave the four layers short of rem of travel. Returns the K
+ * worked out.
+ */
+static int ring_cell(struct px_strack *t, struct ssurf *f, int ci, px_vec3 xm,
+		     double r, double rem)
+{
+	struct scell *c = &t->cell[ci];
+	int loc = ci - f->first_cell, cu = loc % f->ncu, cv = loc / f->ncu, in[3][3],
+	    du, dv, a, b, n = 0;
+	double wq = 0.25 * fmin(c->u1 - c->u0, c->v1 - c->v0);
+	for (dv = -1; dv <= 1; dv++)
+		for (du = -1; du <= 1; du++) {
+			int nc = cell_at(f, cu, cv, du, dv);
+			in[dv + 1][du + 1] = nc >= 0 && t->cell[nc].dmark == t->pend_epoch &&
+					     t->cell[nc].dist < c->dist;
+		}
+	for (b = 0; b < 2; b++)
+		for (a = 0; a < 2; a++) {
+			int ri = c->child + a + 2 * b, d = piece_dist(in, 2, a, b), q;
+			double k = cert_speed(&t->rcell[ri].cert, xm, r);
+			n++;
+			c->kr[2 * b + a] = k;
+			for (q = 0; q < 4; q++)
+				c->kq[4 * (2 * b + a) + q] = NAN;
+			if (!(k * rem > 3.8 * wq)) {
+				/* both of its quarter layers get the region's: with
+				 * every piece so, the four layers take over rem */
+				f->rl_kl[2 * d - 2] = fmax(f->rl_kl[2 * d - 2], k);
+				f->rl_kl[2 * d - 1] = fmax(f->rl_kl[2 * d - 1], k);
+				f->rl_wl[2 * d - 2] = fmin(f->rl_wl[2 * d - 2], wq);
+				f->rl_wl[2 * d - 1] = fmin(f->rl_wl[2 * d - 1], wq);
+				continue;
+			}
+			for (q = 0; q < 4; q++) {
+				int l = piece_dist(in, 4, 2 * a + (q & 1), 2 * b + (q >> 1)) - 1;
+				k = cert_speed(&t->qcert[4 * ri + q], xm, r);
+				c->kq[4 * (2 * b + a) + q] = k;
+				n++;
+				f->rl_kl[l] = fmax(f->rl_kl[l], k);
+				f->rl_wl[l] = fmin(f->rl_wl[l], wq);
+			}
+		}
+	c->kmark = t->pend_epoch;
+	return n;
+}
+
+/* Units a ring cell's bound may take at most (4 regions and their 16
+ * quarters, 8 speeds a unit, about a check's work). */
+#define ST_RING_CELL_UNITS 3
+
+/*
+ * The escape bound of pending item i (ring k of surface pend[i], the step
+ * from pend_ps[i]; the rings inside it take pend_need[i] of travel): its
+ * cells' layers, then held (done) or ring k + 1 built and pended; past
+ * ST_RINGS the whole surface. *spare: speeds already counted in *units.
+ * Not continued past lim after other work; returns 1 when left for later
+ * (resumed at the next cell).
+ */
+static int ring_check(struct px_strack *t, int i, int lim, int *units,
+		      int *spare)
+{
+	int si = t->pend[i], k = t->pend_kind[i] - PK_RING + 1, j;
+	struct ssurf *f = &t->sf[si];
+	px_vec3 p0 = t->pend_ps[i], dp = px_v3_sub(t->p, p0),
+		xm = px_v3_scale(px_v3_add(p0, t->p), 0.5);
+	double r = 0.5 * fmax(fmax(fabs(dp.x), fabs(dp.y)), fabs(dp.z)),
+	       len = px_v3_norm(dp), need = t->pend_need[i];
+	while (f->rl_next < f->rl_n) {
+		int n, ci;
+		if (lim > 0 && *units > 0 && *units + ST_RING_CELL_UNITS > lim)
+			return 1;
+		ci = t->ring_list[f->first_cell + f->rl_next++];
+		n = ring_cell(t, f, ci, xm, r, len - need);
+		/* its solve after its K: they prove most of its checks */
+		pend_at(t, ci, t->p);
+		t->st.ring_speeds += (uint64_t)n;
+		for (*spare -= n; *spare < 0; *spare += 8)
+			++*units;
+	}
+	for (j = 0; j < 4; j++)
+		need += f->rl_kl[j] > 0.0 ? f->rl_wl[j] / f->rl_kl[j] : INFINITY;
+	/* held; or nothing to cross (no ring left in the domain), or no
+	 * motion (a point of a fixed x stays put) */
+	if (need > len || f->rl_n == 0 || !(len > 0.0))
+		return 0;
+	if (k < ST_RINGS) {
+		ring_build(t, si, k + 1);
+		pend_item(t, si, PK_RING + k, p0, need);
+		return 0;
+	}
+	t->st.ring_all++;
+	for (j = 0; j < f->ncu * f->ncv; j++)
+		pend_at(t, f->first_cell + j, t->p);
+	return 0;
 }
 
 /*
@@ -1847,45 +2172,40 @@ static int track_step(struct px_strack *t, px_vec3 p0, px_vec3 p,
 	t->p = p;
 	/* the work list: solve at p, after a long step also past where the
 	 * region was met (not for pole cells: hit_work()); and the
-	 * neighbours at p */
+	 * cells about it at p */
 	t->n_pend = t->pend_next = 0;
+	t->pend_epoch = t->epoch;
 	for (i = 0; i < nh; i++) {
 		int ci = t->hits[i];
-		const struct scell *c = &t->cell[ci];
-		const struct ssurf *f = &t->sf[c->surf];
-		int loc = ci - f->first_cell, cu = loc % f->ncu, cv = loc / f->ncu,
-		    du, dv;
-		t->pend[t->n_pend] = ci;
-		t->pend_cross[t->n_pend] = 0;
-		t->pend_ps[t->n_pend++] = p;
-		if (hit_work(t, ci, step) > 1) {
-			t->pend[t->n_pend] = ci;
-			t->pend_cross[t->n_pend] = 1;
-			t->pend_ps[t->n_pend++] = p0;
-		}
-		/* a pair born in c may have moved on into a neighbour whose
-		 * own certificate holds (points only move there; near a focal
-		 * sheet they move fast), both its members sometimes (the index
-		 * check does not see that); mostly cheap: a neighbour's
-		 * regions are proven empty or hold the one point they can */
-		for (dv = -1; dv <= 1; dv++)
-			for (du = -1; du <= 1; du++) {
-				int nu = cu + du, nv = cv + dv, nc;
-				if (f->wrap_u)
-					nu = (nu + f->ncu) % f->ncu;
-				if (f->wrap_v)
-					nv = (nv + f->ncv) % f->ncv;
-				if (nu < 0 || nu >= f->ncu || nv < 0 || nv >= f->ncv)
-					continue;
-				nc = f->first_cell + nv * f->ncu + nu;
-				if (t->cell[nc].mark == t->epoch)
-					continue;
-				t->cell[nc].mark = t->epoch;
-				t->pend[t->n_pend] = nc;
-				t->pend_cross[t->n_pend] = 0;
-				t->pend_ps[t->n_pend++] = p;
-			}
+		pend_item(t, ci, PK_SOLVE, p, 0.0);
+		if (hit_work(t, ci, step) > 1 && !(px__strack_ring_fault & 2))
+			pend_item(t, ci, PK_CROSS, p0, 0.0);
 	}
+	/* a pair born in a hit cell may have moved on into the cells about
+	 * it, both its members sometimes (the index check does not see
+	 * that): the rings of the escape bound (mostly cheap: their regions
+	 * are proven empty or hold the one point they can) */
+	t->pend_nh = nh;
+	for (i = 0; i < nh; i++) {
+		t->cell[t->hits[i]].dmark = t->epoch;
+		t->cell[t->hits[i]].dist = 0;
+	}
+	for (i = 0; i < t->n_surf && !(px__strack_ring_fault & 1); i++) {
+		ring_build(t, i, 1);
+		if (t->sf[i].rl_n > 0)
+			pend_item(t, i, PK_RING, p0, 0.0);
+	}
+	if (px__strack_ring_fault & 1)
+		for (i = 0; i < nh; i++) {
+			const struct ssurf *f = &t->sf[t->cell[t->hits[i]].surf];
+			int loc = t->hits[i] - f->first_cell, du, dv;
+			for (dv = -1; dv <= 1; dv++)
+				for (du = -1; du <= 1; du++) {
+					int nc = cell_at(f, loc % f->ncu, loc / f->ncu, du, dv);
+					if (nc >= 0)
+						pend_at(t, nc, p);
+				}
+		}
 	for (i = 0; i < t->n_surf; i++)
 		before += t->sf[i].nz;
 	/* within the budget all of it; over it, the budget's worth now and
@@ -3043,7 +3363,9 @@ void px_strack_free(struct px_strack *t)
 	free(t->hits);
 	free(t->pend);
 	free(t->pend_ps);
-	free(t->pend_cross);
+	free(t->pend_kind);
+	free(t->ring_list);
+	free(t->pend_need);
 	free(t->cbox);
 	free(t);
 }
@@ -3283,9 +3605,13 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	t->heap = calloc((size_t)cell_cap + 1, sizeof(int));
 	t->popped = calloc((size_t)cell_cap + 1, sizeof(int));
 	t->hits = calloc((size_t)cell_cap + 1, sizeof(int));
-	t->pend = calloc(3 * (size_t)cell_cap + 2, sizeof(int));
-	t->pend_ps = calloc(3 * (size_t)cell_cap + 2, sizeof(px_vec3));
-	t->pend_cross = calloc(3 * (size_t)cell_cap + 2, 1);
+	t->pend = calloc((2 + ST_RINGS) * (size_t)cell_cap + 2, sizeof(int));
+	/* each cell once, a crossing solve a hit, ST_RINGS bounds a
+	 * surface */
+	t->pend_ps = calloc((2 + ST_RINGS) * (size_t)cell_cap + 2, sizeof(px_vec3));
+	t->pend_need = calloc((2 + ST_RINGS) * (size_t)cell_cap + 2, sizeof(double));
+	t->pend_kind = calloc((2 + ST_RINGS) * (size_t)cell_cap + 2, 1);
+	t->ring_list = calloc((size_t)cell_cap + 1, sizeof(int));
 	for (i = 0; i < n_surfs; i++) {
 		const struct px_nurbs_surf *sf = &t->sf[i].s;
 		size_t l = PX_NURBS_SURF_WORK_LEN(sf->degree[0], sf->degree[1],
@@ -3295,7 +3621,8 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	}
 	work = malloc(wl * sizeof(double));
 	if (!t->cell || !t->rcell || !t->qcert || !t->heap || !t->popped || !t->hits ||
-	    !t->pend || !t->pend_ps || !t->pend_cross || !work) {
+	    !t->pend || !t->pend_ps || !t->pend_kind || !t->pend_need ||
+	    !t->ring_list || !work) {
 		rc = PX_E_NOMEM;
 		goto fail;
 	}

@@ -30,24 +30,35 @@
  *    no NaN. Each cell carries that radius; a min-heap on the travelled
  *    path length names the cells due; a due cell is tested on the segment
  *    of this update (the cube about its middle) and solved again at the
- *    new point when the proof fails, with its 8 neighbours (a pair born in
- *    it may have moved on into one of them within the step). A solve
- *    runs Newton from a seed grid, leaving out the regions and quarters
- *    proven free of critical points and those that hold a tracked one
- *    and can hold only one (every matrix of the Hessian's enclosure
- *    regular: E is one-to-one there); evolved points are kept,
- *    duplicates merged. Cells on a collapsed edge have
- *    no proof near the pole's normal lines and are solved whenever hit.
+ *    new point when the proof fails, with the rings of cells about it
+ *    that the escape bound names (below). A solve runs Newton from a
+ *    seed grid, leaving out the regions and quarters proven free of
+ *    critical points and those that hold a tracked one and can hold only
+ *    one (every matrix of the Hessian's enclosure regular: E is
+ *    one-to-one there); evolved points are kept, duplicates merged.
+ *    Cells on a collapsed edge have no proof near the pole's normal
+ *    lines and are solved whenever hit.
+ *  - Escape bound: a pair born in a hit cell may move on within the step
+ *    (fast near a focal sheet), both members out of it. Where the
+ *    certificates hold, d(u, v) = H^-1 (Su . dx, Sv . dx) is bounded by
+ *    K |dx| (K from the Hessian's enclosure over the step's segment: the
+ *    least singular value; 0 where E is proven nonzero); a point ending
+ *    outside the k rings of cells about the hit cells crossed each of
+ *    their quarter-wide layers, so the step's length is at least the sum
+ *    of width / K over them. The rings out to the first k where that sum
+ *    passes the step's length are solved (the same enclosures prove most
+ *    of their checks); past 3 rings the whole surface (stats.ring_all).
  *  - Index check: after a step that found, lost or merged points, each
  *    surface's index sum (+1 minima and maxima, -1 saddles) must equal
  *    the winding number of E along its domain boundary (degree theory:
  *    births and deaths keep the sum, edge crossings change both). The
  *    winding number is exact where every boundary side keeps E1 or E2 of
  *    one sign (the certificates' side test); a mismatch means a point was
- *    missed (a pair born in a step whose one member was carried out of
- *    the solved cells): the update is answered globally and the set
- *    re-established (stats.unbalanced). It cannot see a pair missed
- *    whole; surfaces with a collapsed edge or a C0 line are left out.
+ *    missed (a point followed onto another's branch, or a seed grid that
+ *    missed one of a cell's points): the update is answered globally and
+ *    the set re-established (stats.unbalanced). It cannot see a pair
+ *    missed whole (the escape bound's task where pairs are born);
+ *    surfaces with a collapsed edge or a C0 line are left out.
  *  - Bounded work: an update whose proven-hit cells exceed max_solves,
  *    or whose due cells exceed max_tests (a long step: their tests then
  *    go on max_tests per update), is answered by the global query; the
@@ -139,7 +150,9 @@ struct px_strack_opts {
 	 * whose certificates leave only some regions or quarters open
 	 * (near a focal sheet) 1/8 plus that share of the other 7/8; after
 	 * a long step, finding where it met a hit cell's region (up to 8
-	 * rounds of certificate radii) 1/8 a round. A solve is never
+	 * rounds of certificate radii) 1/8 a round; the escape bound 1/64 a
+	 * speed (a ring cell takes 4 to 20, and they spare its solve the
+	 * checks' 1/8 where they prove them). A solve is never
 	 * started past the bound. An update whose certificates name more
 	 * work than this does the bound's worth of it and is answered by
 	 * the global query (px_dist_query(), exact) instead; the rest is
@@ -234,6 +247,12 @@ struct px_strack_stats {
 	 * (two certificate radii each; counted in max_solves as 1/8 of a
 	 * solve each) */
 	uint64_t cross_rounds;
+	/* escape bounds (file comment) that 3 rings of cells about a
+	 * step's hit cells did not satisfy: the whole surface was solved */
+	uint64_t ring_all;
+	/* speeds K worked out for the escape bounds (counted in max_solves
+	 * as 1/64 of a solve each) */
+	uint64_t ring_speeds;
 	/* updates whose transition work exceeded max_solves; updates
 	 * answered globally while the set was re-established */
 	uint64_t over_budget, rebuild_updates;
