@@ -1546,7 +1546,7 @@ out:
 static long escape_run(int fault, long *checked, uint64_t *ring_all, long *wrong)
 {
 	static px_vec3 q[300];
-	static const double steps[] = {1e-2, 2e-2, 5e-2};
+	static const double steps[] = {1e-2, 2e-2, 3e-2, 5e-2};
 	struct px_nurbs_surf s;
 	struct px_dist_model *ref = NULL;
 	struct px_dist_info di;
@@ -1572,7 +1572,7 @@ static long escape_run(int fault, long *checked, uint64_t *ring_all, long *wrong
 	box = px_aabb_inflate(&di.bounds, 0.25 * size);
 	px__strack_ring_fault = fault;
 	for (kind = 0; kind < 2; kind++)
-		for (si = 0; si < 3; si++) {
+		for (si = 0; si < 4; si++) {
 			struct px_strack_result r;
 			make_path(q, 300, kind, box, steps[si] * size);
 			px_strack_reset(t, q[0], &r);
@@ -1583,8 +1583,8 @@ static long escape_run(int fault, long *checked, uint64_t *ring_all, long *wrong
 				px_dist_query(ref, q[k], &g);
 				if (fabs(r.dist - g.dist) > 1e-9 * (size + g.dist))
 					++*wrong;
-				/* every other step: the dense count is the cost */
-				if (r.source == PX_TRACK_GLOBAL || k % 2)
+				/* every third step: the dense count is the cost */
+				if (r.source == PX_TRACK_GLOBAL || k % 3)
 					continue;
 				amb = tracked_amb(t, 0, &s);
 				n = count_crit(&s, q[k], &amb);
@@ -1617,12 +1617,12 @@ static void test_escape(void)
 	 * (they find most fast pairs near their birth): the bound alone */
 	b0 = escape_run(2, &c0, &a0, &w0);
 	b1 = escape_run(3, &c1, &a1, &w1);
-	printf("  fine cells, steps 1 %%, 2 %% and 5 %%: counts short %ld of %ld (whole "
+	printf("  fine cells, steps 1 %% to 5 %%: counts short %ld of %ld (whole "
 	       "surface solved %llu times), wrong %ld; first ring only: short %ld "
 	       "of %ld, wrong %ld\n", b0, c0, (unsigned long long)a0, w0, b1, c1, w1);
 	PX_CHECK_INT_EQ(b0, 0);
 	PX_CHECK_INT_EQ(w0, 0);
-	/* seeds 1-10: short 1-9, wrong 2-16 */
+	/* seeds 1-39: short 1-9 and wrong 2-18 here, 0 and 0 above */
 	PX_CHECK_MSG(b1 + w1 > 0, "the first ring alone missed no point: the "
 		     "test does not reach the escape bound");
 	PX_CHECK_MSG(c0 > 600, "counts mostly not decisive: %ld", c0);
