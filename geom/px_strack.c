@@ -629,7 +629,8 @@ static int cell_done(const struct px_strack *t, const struct scell *c,
 	const struct ssurf *f = &t->sf[c->surf];
 	/* K worked out over the step that ends at ps: 0, no critical point
 	 * in the piece at any point of it, so none at ps; finite, H regular
-	 * there throughout, so at most one at ps */
+	 * there throughout, so at most one at ps (the held one if any;
+	 * without one the piece's own test at ps may still prove it empty) */
 	int sp = c->kmark == t->pend_epoch && t->pend_on && known &&
 		 px_v3_dist2(ps, t->p) == 0.0;
 	int ch, k, tests = 0;
@@ -638,8 +639,8 @@ static int cell_done(const struct px_strack *t, const struct scell *c,
 		const struct scell *g = &t->rcell[ri];
 		double b[4];
 		box_of(g, -1, b);
-		if (sp && c->kr[ch] < INFINITY) {
-			d->region[ch] = c->kr[ch] == 0.0 || holds(f, b);
+		if (sp && (c->kr[ch] == 0.0 || (c->kr[ch] < INFINITY && holds(f, b)))) {
+			d->region[ch] = 1;
 		} else {
 			d->region[ch] = box_done(f, &g->cert, b, ps, known);
 			tests++;
@@ -650,8 +651,8 @@ static int cell_done(const struct px_strack *t, const struct scell *c,
 		for (k = 0; k < 4; k++) {
 			double kq = sp ? c->kq[4 * ch + k] : NAN;
 			box_of(g, k, b);
-			if (kq < INFINITY) {
-				d->quarter[ch][k] = kq == 0.0 || holds(f, b);
+			if (kq == 0.0 || (kq < INFINITY && holds(f, b))) {
+				d->quarter[ch][k] = 1;
 			} else {
 				d->quarter[ch][k] = box_done(f, &t->qcert[4 * ri + k], b, ps, known);
 				tests++;
