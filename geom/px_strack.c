@@ -619,10 +619,9 @@ struct cell_done {
 };
 
 /* cell_done for c at ps (known: the held set is at ps; a seed converges
- * to a point near it, so those parts give none); returns the
- * certificate tests made (none where a ring's K covers them): a region
- * needs none
- * when its own test or each of its quarters' holds. */
+ * to a point near it, so those parts give none): a region needs none
+ * when its own test or each of its quarters' holds. Returns the
+ * certificate tests made (none where a ring's K covers them). */
 static int cell_done(const struct px_strack *t, const struct scell *c,
 		     px_vec3 ps, int known, struct cell_done *d)
 {
