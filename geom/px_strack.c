@@ -947,6 +947,22 @@ static inline void side_num(const struct cside *sd, px_vec3 w, double epad,
 	num[1] = fabs(px_v3_dot(w, sd->sv)) - epad - (sd->along ? M22 : M12) * sd->h;
 }
 
+/* The E test of cert_radius(): the largest r that keeps E1 or E2 of one
+ * sign over the cell for every x in the cube of half width r about p,
+ * e1, e2 (padded by epad) E at the cell's centre and M11, M12, M22
+ * bounds of |H| over the cell at p (0 when none). Inline, as hess_at():
+ * every cell test runs it. */
+static inline double e_radius(const struct rcert *c, double M11, double M12,
+			      double M22, double e1, double e2, double epad)
+{
+	double r1 = (fabs(e1) - epad - M11 * c->hu - M12 * c->hv) /
+		    (c->n1 + c->m11 * c->hu + c->m12 * c->hv);
+	double r2 = (fabs(e2) - epad - M12 * c->hu - M22 * c->hv) /
+		    (c->n2 + c->m12 * c->hu + c->m22 * c->hv);
+	double r = r1 > r2 ? r1 : r2;
+	return r > 0.0 ? r : 0.0;
+}
+
 static double cert_radius(const struct rcert *c, px_vec3 p)
 {
 	double mid[3], rad[3], a11, b11, a22, b22, M11, M12, M22,
@@ -966,15 +982,7 @@ static double cert_radius(const struct rcert *c, px_vec3 p)
 	e1 = px_v3_dot(w, c->suc);
 	e2 = px_v3_dot(w, c->svc);
 	epad = e_pad(c, w, p);
-	{
-		double r1 = (fabs(e1) - epad - M11 * c->hu - M12 * c->hv) /
-			    (c->n1 + m11 * c->hu + m12 * c->hv);
-		double r2 = (fabs(e2) - epad - M12 * c->hu - M22 * c->hv) /
-			    (c->n2 + m12 * c->hu + m22 * c->hv);
-		rE = r1 > r2 ? r1 : r2;
-		if (!(rE > 0.0))
-			rE = 0.0;
-	}
+	rE = e_radius(c, M11, M12, M22, e1, e2, epad);
 	/* det H test */
 	rD = 0.0;
 	{
@@ -1050,6 +1058,41 @@ static int no_root(const struct rcert *c, px_vec3 p)
 	       pre_radius(c, mid, rad, e1, e2, epad) > 0.0;
 }
 
+/*
+ * 1 when every symmetric matrix with entries 11, 12, 22 in [lo, hi] is
+ * regular, and then (sig not NULL) a lower bound on the absolute values
+ * of their eigenvalues into *sig. Definite (h11 h22 > h12^2 throughout,
+ * the product rounded down): the least eigenvalue grows with the
+ * diagonal and falls with |h12|, so the corner bounds it (the product
+ * form avoids the cancellation of (x + y) / 2 - root); h11 h22 < 0 <=
+ * h12^2: both |eigenvalues| are at least the lesser |diagonal|.
+ */
+static int sym_regular(const double lo[3], const double hi[3], double *sig)
+{
+	double b = fmax(fabs(lo[1]), fabs(hi[1])), x, y, det;
+	if ((lo[0] > 0.0 && lo[2] > 0.0) || (hi[0] < 0.0 && hi[2] < 0.0)) {
+		x = lo[0] > 0.0 ? lo[0] : -hi[0];
+		y = lo[0] > 0.0 ? lo[2] : -hi[2];
+		det = x * y * (1.0 - 1e-12) - b * b;
+		if (!(det > 0.0))
+			return 0;
+		if (sig)
+			*sig = det / (0.5 * (x + y) + hypot(0.5 * (x - y), b));
+		return 1;
+	}
+	if (lo[0] > 0.0 && hi[2] < 0.0) {
+		if (sig)
+			*sig = fmin(lo[0], -hi[2]);
+		return 1;
+	}
+	if (hi[0] < 0.0 && lo[2] > 0.0) {
+		if (sig)
+			*sig = fmin(-hi[0], lo[2]);
+		return 1;
+	}
+	return 0;
+}
+
 /* Test hook (internal.h): 1 drops the Hessian enclosure's radius from
  * one_root() (unsound: its test must see it). */
 int px__strack_one_fault = 0;
@@ -1063,7 +1106,7 @@ int px__strack_one_fault = 0;
  */
 static int one_root(const struct rcert *c, px_vec3 p)
 {
-	double mid[3], rad[3], lo[3], hi[3], m12;
+	double mid[3], rad[3], lo[3], hi[3];
 	int k;
 	hess_at(c, p, mid, rad);
 	for (k = 0; k < 3; k++) {
@@ -1071,14 +1114,7 @@ static int one_root(const struct rcert *c, px_vec3 p)
 		lo[k] = mid[k] - r;
 		hi[k] = mid[k] + r;
 	}
-	m12 = fmax(fabs(lo[1]), fabs(hi[1]));
-	/* definite: h11 h22 > h12^2 throughout (the product rounded down) */
-	if (lo[0] > 0.0 && lo[2] > 0.0)
-		return lo[0] * lo[2] * (1.0 - 1e-12) > m12 * m12;
-	if (hi[0] < 0.0 && hi[2] < 0.0)
-		return hi[0] * hi[2] * (1.0 - 1e-12) > m12 * m12;
-	/* h11 h22 < 0 <= h12^2 */
-	return (lo[0] > 0.0 && hi[2] < 0.0) || (hi[0] < 0.0 && lo[2] > 0.0);
+	return sym_regular(lo, hi, NULL);
 }
 
 /* Test hook (internal.h): a factor on every certified radius. */
@@ -1875,45 +1911,26 @@ int px__strack_ring_fault = 0;
  * about xm: 0 when E is proven nonzero, INFINITY when no bound. */
 static double cert_speed(const struct rcert *c, px_vec3 xm, double r)
 {
-	double mid[3], rad[3], rad0[3], e1, e2, epad, lo11, hi11, lo22, hi22, b,
-	       x, y, det, sig;
+	double mid[3], rad[3], lo[3], hi[3], e1, e2, epad, sig;
+	const double m[3] = {c->m11, c->m12, c->m22};
 	px_vec3 w;
+	int k;
 	hess_at(c, xm, mid, rad);
 	w = px_v3_sub(c->sc, xm);
 	e1 = px_v3_dot(w, c->suc);
 	e2 = px_v3_dot(w, c->svc);
 	epad = e_pad(c, w, xm);
-	memcpy(rad0, rad, sizeof(rad0));
-	rad[0] += r * c->m11;
-	rad[1] += r * c->m12;
-	rad[2] += r * c->m22;
-	b = fabs(mid[1]) + rad[1];
-	if (fabs(e1) - epad - r * c->n1 - (fabs(mid[0]) + rad[0]) * c->hu - b * c->hv > 0.0 ||
-	    fabs(e2) - epad - r * c->n2 - b * c->hu - (fabs(mid[2]) + rad[2]) * c->hv > 0.0)
+	/* cert_radius()'s E test over the cube */
+	if (e_radius(c, fabs(mid[0]) + rad[0], fabs(mid[1]) + rad[1],
+		     fabs(mid[2]) + rad[2], e1, e2, epad) * ST_RSAFE > r)
 		return 0.0;
-	lo11 = mid[0] - rad[0];
-	hi11 = mid[0] + rad[0];
-	lo22 = mid[2] - rad[2];
-	hi22 = mid[2] + rad[2];
-	if ((lo11 > 0.0 && lo22 > 0.0) || (hi11 < 0.0 && hi22 < 0.0)) {
-		/* definite: the least eigenvalue grows with the diagonal and
-		 * falls with |h12|, so the corner (x, y, b) bounds it; the
-		 * product form avoids the cancellation of (x + y) / 2 - root */
-		x = lo11 > 0.0 ? lo11 : -hi11;
-		y = lo11 > 0.0 ? lo22 : -hi22;
-		det = x * y - b * b;
-		sig = det > 0.0 ? det / (0.5 * (x + y) + hypot(0.5 * (x - y), b)) : 0.0;
-	} else if (lo11 > 0.0 && hi22 < 0.0) {
-		/* indefinite: both |eigenvalues| >= the lesser |diagonal| */
-		sig = fmin(lo11, -hi22);
-	} else if (hi11 < 0.0 && lo22 > 0.0) {
-		sig = fmin(-hi11, lo22);
-	} else {
-		sig = 0.0;
+	for (k = 0; k < 3; k++) {
+		lo[k] = mid[k] - rad[k] - r * m[k];
+		hi[k] = mid[k] + rad[k] + r * m[k];
 	}
-	if (!(sig > 0.0))
+	if (!sym_regular(lo, hi, &sig) || !(sig > 0.0))
 		/* the preconditioned E test last: it costs as much again */
-		return pre_radius(c, mid, rad0, e1, e2, epad) > r ? 0.0 : INFINITY;
+		return pre_radius(c, mid, rad, e1, e2, epad) > r ? 0.0 : INFINITY;
 	return sqrt(c->G11.hi + c->G22.hi) / sig * (1.0 + 1e-9);
 }
 
