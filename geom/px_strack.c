@@ -618,6 +618,16 @@ struct cell_done {
 	int quarter[4][4];
 };
 
+/* box_done() from the K of box b over the step that ends at the held
+ * set's point (NAN: none worked out): 0, no critical point in it at any
+ * point of the step, so none at its end; finite, H regular there
+ * throughout, so at most one, the held one if any (without one the
+ * box's own test is still to be made). */
+static int speed_done(const struct ssurf *f, double k, const double b[4])
+{
+	return k == 0.0 || (k < INFINITY && holds(f, b));
+}
+
 /* cell_done for c at ps (known: the held set is at ps; a seed converges
  * to a point near it, so those parts give none): a region needs none
  * when its own test or each of its quarters' holds. Returns the
@@ -626,10 +636,8 @@ static int cell_done(const struct px_strack *t, const struct scell *c,
 		     px_vec3 ps, int known, struct cell_done *d)
 {
 	const struct ssurf *f = &t->sf[c->surf];
-	/* K worked out over the step that ends at ps: 0, no critical point
-	 * in the piece at any point of it, so none at ps; finite, H regular
-	 * there throughout, so at most one at ps (the held one if any;
-	 * without one the piece's own test at ps may still prove it empty) */
+	/* the ring's K hold for ps: the end of the step they were worked
+	 * out for (speed_done()) */
 	int sp = c->kmark == t->pend_epoch && t->pend_on && known &&
 		 px_v3_dist2(ps, t->p) == 0.0;
 	int ch, k, tests = 0;
@@ -638,9 +646,8 @@ static int cell_done(const struct px_strack *t, const struct scell *c,
 		const struct scell *g = &t->rcell[ri];
 		double b[4];
 		box_of(g, -1, b);
-		if (sp && (c->kr[ch] == 0.0 || (c->kr[ch] < INFINITY && holds(f, b)))) {
-			d->region[ch] = 1;
-		} else {
+		d->region[ch] = speed_done(f, sp ? c->kr[ch] : NAN, b);
+		if (!d->region[ch]) {
 			d->region[ch] = box_done(f, &g->cert, b, ps, known);
 			tests++;
 		}
@@ -648,11 +655,9 @@ static int cell_done(const struct px_strack *t, const struct scell *c,
 			continue;
 		d->region[ch] = 1;
 		for (k = 0; k < 4; k++) {
-			double kq = sp ? c->kq[4 * ch + k] : NAN;
 			box_of(g, k, b);
-			if (kq == 0.0 || (kq < INFINITY && holds(f, b))) {
-				d->quarter[ch][k] = 1;
-			} else {
+			d->quarter[ch][k] = speed_done(f, sp ? c->kq[4 * ch + k] : NAN, b);
+			if (!d->quarter[ch][k]) {
 				d->quarter[ch][k] = box_done(f, &t->qcert[4 * ri + k], b, ps, known);
 				tests++;
 			}
@@ -2057,10 +2062,10 @@ static int ring_cell(struct px_strack *t, struct ssurf *f, int ci, px_vec3 xm,
 			if (!(k * rem > 3.8 * wq)) {
 				/* both of its quarter layers get the region's: with
 				 * every piece so, the four layers take over rem */
-				f->rl_kl[2 * d - 2] = fmax(f->rl_kl[2 * d - 2], k);
-				f->rl_kl[2 * d - 1] = fmax(f->rl_kl[2 * d - 1], k);
-				f->rl_wl[2 * d - 2] = fmin(f->rl_wl[2 * d - 2], wq);
-				f->rl_wl[2 * d - 1] = fmin(f->rl_wl[2 * d - 1], wq);
+				for (q = 2 * d - 2; q < 2 * d; q++) {
+					f->rl_kl[q] = fmax(f->rl_kl[q], k);
+					f->rl_wl[q] = fmin(f->rl_wl[q], wq);
+				}
 				continue;
 			}
 			for (q = 0; q < 4; q++) {
@@ -2207,22 +2212,18 @@ static int track_step(struct px_strack *t, px_vec3 p0, px_vec3 p,
 		t->cell[t->hits[i]].dmark = t->epoch;
 		t->cell[t->hits[i]].dist = 0;
 	}
-	for (i = 0; i < t->n_surf && !(px__strack_ring_fault & 1); i++) {
+	for (i = 0; i < t->n_surf; i++) {
+		const struct ssurf *f = &t->sf[i];
 		ring_build(t, i, 1);
-		if (t->sf[i].rl_n > 0)
-			pend_item(t, i, PK_RING, p0, 0.0);
-	}
-	if (px__strack_ring_fault & 1)
-		for (i = 0; i < nh; i++) {
-			const struct ssurf *f = &t->sf[t->cell[t->hits[i]].surf];
-			int loc = t->hits[i] - f->first_cell, du, dv;
-			for (dv = -1; dv <= 1; dv++)
-				for (du = -1; du <= 1; du++) {
-					int nc = cell_at(f, loc % f->ncu, loc / f->ncu, du, dv);
-					if (nc >= 0)
-						pend_at(t, nc, p);
-				}
+		if (!(px__strack_ring_fault & 1)) {
+			if (f->rl_n > 0)
+				pend_item(t, i, PK_RING, p0, 0.0);
+			continue;
 		}
+		/* the fault: the first ring solved, its bound not made */
+		for (j = 0; j < f->rl_n; j++)
+			pend_at(t, t->ring_list[f->first_cell + j], p);
+	}
 	for (i = 0; i < t->n_surf; i++)
 		before += t->sf[i].nz;
 	/* within the budget all of it; over it, the budget's worth now and
