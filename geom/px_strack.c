@@ -1171,11 +1171,10 @@ static double cell_radius(const struct px_strack *t, const struct scell *c,
  * a wrapped direction's seam sides cancel). Births and deaths keep the
  * sum, a point crossing an open edge changes it and the winding number
  * with it. A tracked set whose index sum differs from the winding number
- * is incomplete: a point lost without its partner (a pair born in a step
- * carried out of every solved cell, its other member meeting a tracked
- * point and dying with it), or a point followed onto another's branch.
- * It sees every miss whose indices do not cancel, never a missing pair
- * of a saddle and a minimum or maximum.
+ * is incomplete: a point a cell's seed grid missed, or a point followed
+ * onto another's branch. It sees every miss whose indices do not
+ * cancel, never a missing pair of a saddle and a minimum or maximum (the
+ * escape bound keeps pairs from being carried out of the solved cells).
  *
  * The winding number is exact when each boundary side keeps E in an open
  * half plane (E1 or E2 of one sign on it: the open-side test of the
@@ -2136,7 +2135,8 @@ static int ring_check(struct px_strack *t, int i, int lim, int *units,
  * certificates the segment may break collected (collect_cells()): follow
  * every point, add the cells of lost points, and solve them (a hit after
  * a long step also past where its region was met, its roots followed to
- * p, and its neighbours at p). Returns 0; 1 when that work exceeds the
+ * p) with the rings of cells about them that the escape bound names
+ * (ring_check()). Returns 0; 1 when that work exceeds the
  * budget: the budget's worth is done, the rest left pending (mode
  * ST_PEND, solved over the next updates at p); 2 when the index check
  * fails (ix_check()); PX_E_NOSPC.
@@ -3503,7 +3503,7 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	struct px_nurbs_curve *cc = NULL;
 	double **cpw = NULL, *ub = NULL, *vb = NULL;
 	double *work = NULL;
-	size_t wl = 0;
+	size_t wl = 0, npend;
 	int rc, i, j, k, max_knots = 0, cap_edges, n_cc = 0, cell_cap = 0;
 	px_aabb bounds;
 
@@ -3623,12 +3623,13 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	t->heap = calloc((size_t)cell_cap + 1, sizeof(int));
 	t->popped = calloc((size_t)cell_cap + 1, sizeof(int));
 	t->hits = calloc((size_t)cell_cap + 1, sizeof(int));
-	t->pend = calloc((2 + ST_RINGS) * (size_t)cell_cap + 2, sizeof(int));
-	/* each cell once, a crossing solve a hit, ST_RINGS bounds a
-	 * surface */
-	t->pend_ps = calloc((2 + ST_RINGS) * (size_t)cell_cap + 2, sizeof(px_vec3));
-	t->pend_need = calloc((2 + ST_RINGS) * (size_t)cell_cap + 2, sizeof(double));
-	t->pend_kind = calloc((2 + ST_RINGS) * (size_t)cell_cap + 2, 1);
+	/* pending items: each cell once, a crossing solve a hit, ST_RINGS
+	 * bounds a surface */
+	npend = (2 + ST_RINGS) * (size_t)cell_cap + 2;
+	t->pend = calloc(npend, sizeof(int));
+	t->pend_ps = calloc(npend, sizeof(px_vec3));
+	t->pend_need = calloc(npend, sizeof(double));
+	t->pend_kind = calloc(npend, 1);
 	t->ring_list = calloc((size_t)cell_cap + 1, sizeof(int));
 	for (i = 0; i < n_surfs; i++) {
 		const struct px_nurbs_surf *sf = &t->sf[i].s;
