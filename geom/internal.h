@@ -129,6 +129,17 @@ int px__strack_one(const struct px_strack *t, int s, double u, double v,
 /* 1 drops the Hessian enclosure's radius from that test (unsound: a
  * fault the tests must see); 0 by default. */
 extern int px__strack_one_fault;
+/* The contraction solve of the region cell of surface s holding (u, v)
+ * (bounds in box as above) and of its quarters at p: out[0] the
+ * region's, out[1 + k] quarter k's: -1 where its Hessian enclosure does
+ * not make x - Y E(x) a contraction, else 0 a critical point found (at
+ * fu, fv), 1 none there (proven), 2 undecided. Returns 0, -1 for bad
+ * arguments. */
+int px__strack_contract(const struct px_strack *t, int s, double u, double v,
+			px_vec3 p, double box[4], int out[5], double fu[5], double fv[5]);
+/* 1 drops the Hessian enclosure's radius from the contraction's rate
+ * (unsound: a fault the tests must see); 0 by default. */
+extern int px__strack_contract_fault;
 /* The winding number of the gradient of the squared distance from p
  * along the domain boundary of surface s, which the tracker compares
  * with the index sum of its critical points (+1 minima and maxima, -1

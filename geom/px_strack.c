@@ -16,8 +16,9 @@
  * Everything found is a verified zero of E (Newton converged), so the
  * tracked set never holds a false point. The transition regions are
  * proven (cert_radius()); what is left to Newton is finding the points
- * of a cell that is solved again (seed grid per cell), which the optional
- * verification would report if it failed.
+ * of a cell that is solved again (seed grid per cell) in the boxes where
+ * no contraction proves what they hold (contract_solve()), which the
+ * index check and the optional verification would report if it failed.
  */
 #include "px_strack.h"
 
@@ -30,6 +31,18 @@
 #include "px_bern.h"
 
 #define ST_NEWTON 16
+/* Safety factor on certificate radii and relative padding of the
+ * enclosures for rounding. */
+#define ST_RSAFE (1.0 - 1e-9)
+#define ST_PAD 1e-12
+/* Steps of contract_solve()'s iteration before it gives up, and the
+ * largest rate it runs with (0.75^64 ~ 1e-8: nearer 1 the iteration
+ * crawls, and seeds cost less) */
+#define ST_CONTRACT 64
+#define ST_RHO_MAX 0.75
+/* contract_solve() hands over to Newton this close (of the box's half
+ * widths) to the point */
+#define ST_POLISH 3e-2
 
 enum { ST_TRACK = 0, ST_LAG = 1, ST_REBUILD = 2, ST_PEND = 3 };
 
@@ -410,6 +423,17 @@ static int has_pole(const struct ssurf *f)
 	return f->pole[0] | f->pole[1] | f->pole[2] | f->pole[3];
 }
 
+/* Distance of (u, v) from the nearest collapsed edge, relative to the
+ * domain (1 when none is nearer): below 1e-9, a zero of E there is the
+ * pole, not an interior critical point (snewton() rejects it). */
+static double pole_gap(const struct ssurf *f, double u, double v)
+{
+	return fmin(fmin(f->pole[0] ? u - f->u0 : f->du, f->pole[1] ? f->u1 - u : f->du) /
+			    f->du,
+		    fmin(f->pole[2] ? v - f->v0 : f->dv, f->pole[3] ? f->v1 - v : f->dv) /
+			    f->dv);
+}
+
 /*
  * Newton on E = 0 with p fixed from z->u, z->v; steps clamped to lu, lv.
  * Returns 0 with z evaluated at the root, 1 on failure (no convergence,
@@ -466,9 +490,7 @@ static int snewton(const struct ssurf *f, struct crit *z, px_vec3 p,
 				av = 1.0 / dv1;
 				avp = av * av;
 			}
-			if (fmin(fmin(f->pole[0] ? du0 : 1.0, f->pole[1] ? du1 : 1.0) / f->du,
-				 fmin(f->pole[2] ? dv0 : 1.0, f->pole[3] ? dv1 : 1.0) / f->dv) <
-			    1e-9)
+			if (pole_gap(f, z->u, z->v) < 1e-9)
 				return 1;
 			g1 = g.x * av;
 			g2 = g.y * bu;
@@ -561,7 +583,15 @@ static int follow(const struct ssurf *f, struct crit *z, px_vec3 p0,
 		  px_vec3 dp, px_vec3 p, struct crit *last);
 static int region_empty(const struct px_strack *t, int ri, px_vec3 p);
 static int no_root(const struct rcert *c, px_vec3 p);
-static int one_root(const struct rcert *c, px_vec3 p);
+static inline void hess_at(const struct rcert *c, px_vec3 p, double mid[3],
+			   double rad[3]);
+static int no_root_h(const struct rcert *c, px_vec3 p, const double mid[3],
+		     const double rad[3]);
+static int one_root_h(const double mid[3], const double rad[3]);
+static int contract_h(const struct rcert *c, const double mid[3],
+		      const double rad_in[3], double y[2][2], double *rho);
+static int contract_rate(const struct rcert *c, px_vec3 p, double y[2][2],
+			 double *rho);
 
 /* 1 when f holds a point in the box b (u0, u1, v0, v1). */
 static int holds(const struct ssurf *f, const double b[4])
@@ -574,14 +604,30 @@ static int holds(const struct ssurf *f, const double b[4])
 	return 0;
 }
 
-/* 1 when box b (with certificate c) needs no seeds at p: proven free of
- * critical points, or (known: the held set is at p) its Hessian
- * enclosure regular - at most one critical point in it - and a held
- * point lies in it, which is then the only one. */
+/* What a solve at p does in a box: nothing (proven to hold no
+ * critical point, or none but a held one), contract_solve() (at most
+ * one, found or proven absent), its seeds (not proven). */
+enum { BOX_SEEDS = 0, BOX_DONE = 1, BOX_EXACT = 2 };
+
+/* The work of box b (with certificate c) at p (known: the held set is at
+ * p): done when proven free of critical points, or its Hessian enclosure
+ * regular - at most one critical point in it - and a held point lies in
+ * it, which is then the only one; exact when it holds none and the
+ * contraction of contract_rate() runs on it. */
 static int box_done(const struct ssurf *f, const struct rcert *c,
 		    const double b[4], px_vec3 p, int known)
 {
-	return no_root(c, p) || (known && holds(f, b) && one_root(c, p));
+	double y[2][2], rho, mid[3], rad[3];
+	int held;
+	hess_at(c, p, mid, rad);
+	if (no_root_h(c, p, mid, rad))
+		return BOX_DONE;
+	held = known && holds(f, b);
+	if (held && one_root_h(mid, rad))
+		return BOX_DONE;
+	if (!contract_h(c, mid, rad, y, &rho))
+		return BOX_SEEDS;
+	return held ? BOX_DONE : BOX_EXACT;
 }
 
 /*
@@ -610,9 +656,10 @@ static void box_of(const struct scell *g, int k, double b[4])
 	b[3] = k >= 0 && !(k & 2) ? vm : g->v1;
 }
 
-/* Which parts of a solve cell need no seeds (box_done()): region[ch]
- * its region cells, quarter[ch][k] their quarters (worked out only where
- * the region's own test fails). */
+/* Which parts of a solve cell need no seeds (box_done(): BOX_DONE, or
+ * BOX_EXACT, one start): region[ch] its region cells, quarter[ch][k]
+ * their quarters (worked out only where the region's own test leaves
+ * seeds). */
 struct cell_done {
 	int region[4];
 	int quarter[4][4];
@@ -640,7 +687,7 @@ static int cell_done(const struct px_strack *t, const struct scell *c,
 	 * out for (speed_done()) */
 	int sp = c->kmark == t->pend_epoch && t->pend_on && known &&
 		 px_v3_dist2(ps, t->p) == 0.0;
-	int ch, k, tests = 0;
+	int ch, k, tests = 0, all;
 	for (ch = 0; ch < 4; ch++) {
 		int ri = c->child + ch;
 		const struct scell *g = &t->rcell[ri];
@@ -653,7 +700,7 @@ static int cell_done(const struct px_strack *t, const struct scell *c,
 		}
 		if (d->region[ch])
 			continue;
-		d->region[ch] = 1;
+		all = 1;
 		for (k = 0; k < 4; k++) {
 			box_of(g, k, b);
 			d->quarter[ch][k] = speed_done(f, sp ? c->kq[4 * ch + k] : NAN, b);
@@ -661,23 +708,112 @@ static int cell_done(const struct px_strack *t, const struct scell *c,
 				d->quarter[ch][k] = box_done(f, &t->qcert[4 * ri + k], b, ps, known);
 				tests++;
 			}
-			d->region[ch] = d->region[ch] && d->quarter[ch][k];
+			all = all && d->quarter[ch][k] == BOX_DONE;
 		}
+		/* quarters all done, or some needing one start only: the
+		 * region's seeds are theirs */
+		d->region[ch] = all ? BOX_DONE : BOX_SEEDS;
 	}
 	return tests;
 }
 
-/* Newton from (u, v) of cell c at ps, the root followed to p and added.
- * Returns 0 or PX_E_NOSPC. */
+/* contract_solve()'s outcomes */
+enum { CS_FOUND = 0, CS_EMPTY = 1, CS_OPEN = 2 };
+
+/* 1 when z lies in box b, within Newton's tolerance. */
+static int in_box(const struct ssurf *f, const struct crit *z, const double b[4])
+{
+	double tu = 1e-9 * f->du, tv = 1e-9 * f->dv;
+	return z->u >= b[0] - tu && z->u <= b[1] + tu && z->v >= b[2] - tv &&
+	       z->v <= b[3] + tv;
+}
+
+/*
+ * The critical point of box b (certificate rc: contract_rate() holds) at
+ * p, into z. Newton from the box's centre first; where that goes
+ * elsewhere, x - Y E(x) iterated from the centre, each step put back
+ * onto the box (clamping does not move a point away from one in the
+ * box). If the box holds a point x*, |x_k - x*| <= rho^k (weighted norm,
+ * the centre within 1 of anything in the box), so the k-th step
+ * |g(x_k) - x_k| is at most (1 + rho) rho^k: a longer one proves the box
+ * empty; a short one is the iteration converging, which Newton finishes.
+ * Returns CS_FOUND, CS_EMPTY, or CS_OPEN when neither within
+ * ST_CONTRACT steps (rho near 1, or a point just outside the box).
+ */
+static int contract_solve(const struct ssurf *f, const struct rcert *rc,
+			  const double b[4], struct crit *z, px_vec3 p,
+			  const struct scell *home)
+{
+	double y[2][2], rho, lim = 1.0, hu = 0.5 * (b[1] - b[0]),
+	       hv = 0.5 * (b[3] - b[2]);
+	int k, polish = 2;
+	if (!contract_rate(rc, p, y, &rho))
+		return CS_OPEN;
+	z->u = b[0] + hu;
+	z->v = b[2] + hv;
+	for (k = 0; k < ST_CONTRACT; k++) {
+		px_vec3 g, w;
+		double du, dv, pu, pv, pad, step, r, u = z->u, v = z->v;
+		crit_eval(f, z, p, &g);
+		w = px_v3_sub(z->s, p);
+		/* E's rounding, as e_pad() */
+		pad = ST_PAD *
+		      (fabs(w.x) + fabs(w.y) + fabs(w.z) + fabs(p.x) + fabs(p.y) + fabs(p.z)) *
+		      (fabs(z->su.x) + fabs(z->su.y) + fabs(z->su.z) + fabs(z->sv.x) +
+		       fabs(z->sv.y) + fabs(z->sv.z));
+		du = -(y[0][0] * g.x + y[0][1] * g.y);
+		dv = -(y[1][0] * g.x + y[1][1] * g.y);
+		pu = (fabs(y[0][0]) + fabs(y[0][1])) * pad;
+		pv = (fabs(y[1][0]) + fabs(y[1][1])) * pad;
+		step = fmax((fabs(du) - pu) / hu, (fabs(dv) - pv) / hv);
+		if (step > (1.0 + rho) * (lim + 1e-9))
+			return CS_EMPTY;
+		/* a posteriori, from any x of the box: |x - x*| <= s / (1 - rho)
+		 * with s = |g(x) - x|, so x* = g(x*) lies within rho s / (1 -
+		 * rho) of g(x); outside the box there, none in it */
+		r = fmax((fabs(du) + pu) / hu, (fabs(dv) + pv) / hv) / (1.0 - rho);
+		if (fabs(u + du - (b[0] + hu)) - pu > hu * (1.0 + rho * r) * (1.0 + 1e-9) ||
+		    fabs(v + dv - (b[2] + hv)) - pv > hv * (1.0 + rho * r) * (1.0 + 1e-9))
+			return CS_EMPTY;
+		/* the box's zero, within r of x, on a collapsed edge: the
+		 * pole (a candidate of its own), no interior point */
+		if (has_pole(f) && pole_gap(f, u, v) + r * fmax(hu / f->du, hv / f->dv) < 1e-9)
+			return CS_EMPTY;
+		if (fabs(du) <= ST_POLISH * hu && fabs(dv) <= ST_POLISH * hv && polish > 0) {
+			/* twice at most: where Newton converges just outside the
+			 * box, the iteration's growing bound proves it empty */
+			polish--;
+			if (!snewton(f, z, p, hu, hv, home) && in_box(f, z, b))
+				return CS_FOUND;
+			z->u = u;
+			z->v = v;
+		}
+		z->u = fmin(fmax(u + du, b[0]), b[1]);
+		z->v = fmin(fmax(v + dv, b[2]), b[3]);
+		lim *= rho;
+	}
+	return CS_OPEN;
+}
+
+/* Newton from (u, v) of cell c at ps, or (rc not NULL) contract_solve()
+ * of box b with certificate rc, the root followed to p and added.
+ * Returns 0, 1 (contract_solve() undecided) or PX_E_NOSPC. */
 static int seed_solve(struct px_strack *t, struct ssurf *f, const struct scell *c,
-		      double u, double v, px_vec3 ps, px_vec3 p)
+		      double u, double v, px_vec3 ps, px_vec3 p,
+		      const struct rcert *rc, const double b[4])
 {
 	struct crit z, last;
-	int rc;
+	int rc_;
 	memset(&z, 0, sizeof(z));
 	z.u = u;
 	z.v = v;
-	if (snewton(f, &z, ps, 0.5 * (c->u1 - c->u0), 0.5 * (c->v1 - c->v0), c))
+	if (rc) {
+		rc_ = contract_solve(f, rc, b, &z, ps, c);
+		t->st.exact_solves++;
+		t->st.exact_open += rc_ == CS_OPEN;
+		if (rc_ != CS_FOUND)
+			return rc_ == CS_OPEN;
+	} else if (snewton(f, &z, ps, 0.5 * (c->u1 - c->u0), 0.5 * (c->v1 - c->v0), c))
 		return 0;
 	if (px_v3_dist2(ps, p) != 0.0 &&
 	    follow(f, &z, ps, px_v3_sub(p, ps), p, &last))
@@ -688,11 +824,11 @@ static int seed_solve(struct px_strack *t, struct ssurf *f, const struct scell *
 		t->ix_on = 1;
 		return 0;
 	}
-	rc = crit_add(t, f, &z);
-	if (rc < 0)
+	rc_ = crit_add(t, f, &z);
+	if (rc_ < 0)
 		return PX_E_NOSPC;
 	/* a point found: the set's membership changed */
-	t->ix_on |= rc;
+	t->ix_on |= rc_;
 	return 0;
 }
 
@@ -701,18 +837,27 @@ static int seed_solve(struct px_strack *t, struct ssurf *f, const struct scell *
  * Newton from the grid seeds of each region that may hold a point, and
  * from the centre of each of its quarters that may and has no grid seed
  * (where the quarters prove a region's neighbourhood empty, a point in
- * it is no longer found from the seeds of the regions around). Puts up
- * to n * n + 16 of them in su, sv (cell-relative); returns their count.
+ * it is no longer found from the seeds of the regions around); a region
+ * or quarter proven to hold exactly one point has its centre alone,
+ * solved by contract_solve() (sk: 5 ch for region ch, 5 ch + 1 + k for its
+ * quarter k; -1 a plain seed). Puts up to n * n + 16 of them in su, sv
+ * (cell-relative), sk; returns their count.
  */
 static int cell_seeds(int n, const struct cell_done *done, double *su,
-		      double *sv)
+		      double *sv, int *sk)
 {
 	int i, j, ch, k, ns = 0;
 	for (ch = 0; ch < 4; ch++) {
 		const int *qe = done->quarter[ch];
 		int qn[4] = {0, 0, 0, 0};
-		if (done->region[ch])
+		if (done->region[ch] == BOX_DONE)
 			continue;
+		if (done->region[ch] == BOX_EXACT) {
+			su[ns] = 0.5 * (ch & 1) + 0.25;
+			sv[ns] = 0.5 * (ch >> 1) + 0.25;
+			sk[ns++] = 5 * ch;
+			continue;
+		}
 		for (j = 0; j < n; j++)
 			for (i = 0; i < n; i++) {
 				double a = (i + 0.5) / n, b = (j + 0.5) / n;
@@ -720,17 +865,19 @@ static int cell_seeds(int n, const struct cell_done *done, double *su,
 				if (ru + 2 * rv != ch)
 					continue;
 				k = (a - 0.5 * ru >= 0.25) + 2 * (b - 0.5 * rv >= 0.25);
-				if (qe[k])
+				if (qe[k] != BOX_SEEDS)
 					continue;
 				qn[k]++;
 				su[ns] = a;
-				sv[ns++] = b;
+				sv[ns] = b;
+				sk[ns++] = -1;
 			}
 		for (k = 0; k < 4; k++) {
-			if (qe[k] || qn[k])
+			if (qe[k] == BOX_DONE || qn[k])
 				continue;
 			su[ns] = 0.5 * (ch & 1) + 0.25 * (k & 1) + 0.125;
-			sv[ns++] = 0.5 * (ch >> 1) + 0.25 * (k >> 1) + 0.125;
+			sv[ns] = 0.5 * (ch >> 1) + 0.25 * (k >> 1) + 0.125;
+			sk[ns++] = qe[k] == BOX_EXACT ? 5 * ch + 1 + k : -1;
 		}
 	}
 	return ns;
@@ -751,14 +898,32 @@ static int solve_units(const struct px_strack *t, int ns)
  * cell's region keeps moving for the rest of the step, possibly out of
  * the cell). Returns 0 or PX_E_NOSPC. */
 static int seeds_run(struct px_strack *t, const struct scell *c, px_vec3 ps,
-		     px_vec3 p, const double *su, const double *sv, int ns)
+		     px_vec3 p, const double *su, const double *sv, const int *sk,
+		     int ns)
 {
 	struct ssurf *f = &t->sf[c->surf];
 	double lu = c->u1 - c->u0, lv = c->v1 - c->v0;
-	int i, rc;
+	int i, k, rc;
 	t->st.cell_solves++;
 	for (i = 0; i < ns; i++) {
-		rc = seed_solve(t, f, c, c->u0 + lu * su[i], c->v0 + lv * sv[i], ps, p);
+		const struct rcert *xc = NULL;
+		double b[4];
+		if (sk[i] >= 0) {
+			int ri = c->child + sk[i] / 5, q = sk[i] % 5 - 1;
+			xc = q < 0 ? &t->rcell[ri].cert : &t->qcert[4 * ri + q];
+			box_of(&t->rcell[ri], q, b);
+		}
+		rc = seed_solve(t, f, c, c->u0 + lu * su[i], c->v0 + lv * sv[i], ps, p,
+				xc, b);
+		for (k = 0; rc == 1 && k < 4; k++) {
+			/* undecided: Newton from the box's quarters' centres,
+			 * as the seeds it stood for */
+			double qu = b[0] + (b[1] - b[0]) * (0.25 + 0.5 * (k & 1)),
+			       qv = b[2] + (b[3] - b[2]) * (0.25 + 0.5 * (k >> 1));
+			int r2 = seed_solve(t, f, c, qu, qv, ps, p, NULL, b);
+			if (r2 < 0)
+				return r2;
+		}
 		if (rc < 0)
 			return rc;
 	}
@@ -772,8 +937,10 @@ static int cell_solve(struct px_strack *t, const struct scell *c, px_vec3 p)
 {
 	struct cell_done done;
 	double su[ST_SEEDS_MAX], sv[ST_SEEDS_MAX];
+	int sk[ST_SEEDS_MAX];
 	cell_done(t, c, p, 1, &done);
-	return seeds_run(t, c, p, p, su, sv, cell_seeds(t->opts.seeds, &done, su, sv));
+	return seeds_run(t, c, p, p, su, sv, sk,
+			 cell_seeds(t->opts.seeds, &done, su, sv, sk));
 }
 
 /* Solve c at ps (roots followed to p) if its work fits: *units grows by
@@ -784,14 +951,15 @@ static int cell_solve_budget(struct px_strack *t, const struct scell *c,
 {
 	struct cell_done done;
 	double su[ST_SEEDS_MAX], sv[ST_SEEDS_MAX];
+	int sk[ST_SEEDS_MAX];
 	int ns, cost, tests = cell_done(t, c, ps, px_v3_dist2(ps, p) == 0.0, &done);
-	ns = cell_seeds(t->opts.seeds, &done, su, sv);
+	ns = cell_seeds(t->opts.seeds, &done, su, sv, sk);
 	/* the checks' unit only where they were made */
 	cost = solve_units(t, ns) - (tests == 0);
 	if (lim > 0 && *units > 0 && *units + cost > lim)
 		return 1;
 	*units += cost;
-	return seeds_run(t, c, ps, p, su, sv, ns);
+	return seeds_run(t, c, ps, p, su, sv, sk, ns);
 }
 
 static int surf_reinit(struct px_strack *t, struct ssurf *f, int si, px_vec3 p)
@@ -827,10 +995,6 @@ static double iv_mag(struct iv a)
 	return fmax(fabs(a.lo), fabs(a.hi));
 }
 
-/* Safety factor on certificate radii and relative padding of the
- * enclosures for rounding. */
-#define ST_RSAFE (1.0 - 1e-9)
-#define ST_PAD 1e-12
 
 /*
  * Certified radius of a region cell at p: no transition of the cell
@@ -871,34 +1035,45 @@ int px__strack_precond = 1;
  * at p (rad with its rounding pad), e1, e2: E(c) at p (signed), epad
  * their rounding.
  */
-static double pre_radius(const struct rcert *c, const double mid[3],
-			 const double rad_in[3], double e1, double e2, double epad)
+/* Y, the inverse of the symmetric mid (entries 11, 12, 22), and
+ * q = |I - Y mid| (zero but for rounding; padded by the rounding of the
+ * products): the preconditioner of the Krawczyk tests. 0 when mid is
+ * singular. */
+static int precond(const double mid[3], double y[2][2], double q[2][2])
 {
-	double det = mid[0] * mid[2] - mid[1] * mid[1], y[2][2], q[2][2], best = 0.0;
-	double rad[3] = {rad_in[0], rad_in[1], rad_in[2]};
-	int i;
-	if (!(fabs(det) > 0.0) || !px__strack_precond)
-		return 0.0;
-	if (px__strack_precond == 2)
-		rad[0] = rad[1] = rad[2] = 0.0;
+	double det = mid[0] * mid[2] - mid[1] * mid[1];
+	if (!(fabs(det) > 0.0))
+		return 0;
 	y[0][0] = mid[2] / det;
 	y[0][1] = y[1][0] = -mid[1] / det;
 	y[1][1] = mid[0] / det;
 	if (!(isfinite(y[0][0]) && isfinite(y[0][1]) && isfinite(y[1][1])))
+		return 0;
+	q[0][0] = fabs(1.0 - (y[0][0] * mid[0] + y[0][1] * mid[1])) + 1e-12;
+	q[0][1] = fabs(y[0][0] * mid[1] + y[0][1] * mid[2]) + 1e-12;
+	q[1][0] = fabs(y[1][0] * mid[0] + y[1][1] * mid[1]) + 1e-12;
+	q[1][1] = fabs(1.0 - (y[1][0] * mid[1] + y[1][1] * mid[2])) + 1e-12;
+	return 1;
+}
+
+static double pre_radius(const struct rcert *c, const double mid[3],
+			 const double rad_in[3], double e1, double e2, double epad)
+{
+	double y[2][2], q[2][2], best = 0.0;
+	double rad[3] = {rad_in[0], rad_in[1], rad_in[2]};
+	int i;
+	if (!px__strack_precond || !precond(mid, y, q))
 		return 0.0;
-	/* I - Y mid, zero but for rounding */
-	q[0][0] = 1.0 - (y[0][0] * mid[0] + y[0][1] * mid[1]);
-	q[0][1] = -(y[0][0] * mid[1] + y[0][1] * mid[2]);
-	q[1][0] = -(y[1][0] * mid[0] + y[1][1] * mid[1]);
-	q[1][1] = 1.0 - (y[1][0] * mid[1] + y[1][1] * mid[2]);
+	if (px__strack_precond == 2)
+		rad[0] = rad[1] = rad[2] = 0.0;
 	for (i = 0; i < 2; i++) {
 		double a = fabs(y[i][0]), b = fabs(y[i][1]);
 		double ye = y[i][0] * e1 + y[i][1] * e2;
 		double num = fabs(ye) - (a + b) * epad -
 			     ST_PAD * (a * fabs(e1) + b * fabs(e2)) -
 			     (i ? c->hv : c->hu) -
-			     c->hu * (fabs(q[i][0]) + a * rad[0] + b * rad[1]) -
-			     c->hv * (fabs(q[i][1]) + a * rad[1] + b * rad[2]);
+			     c->hu * (q[i][0] + a * rad[0] + b * rad[1]) -
+			     c->hv * (q[i][1] + a * rad[1] + b * rad[2]);
 		double den = a * c->n1 + b * c->n2 +
 			     c->hu * (a * c->m11 + b * c->m12) +
 			     c->hv * (a * c->m12 + b * c->m22);
@@ -1045,13 +1220,14 @@ static double cert_radius(const struct rcert *c, px_vec3 p)
 }
 
 /* 1 when E is proven not to vanish on the cell for the point p: no
- * critical point there (the E tests of cert_radius() at r = 0). */
-static int no_root(const struct rcert *c, px_vec3 p)
+ * critical point there (the E tests of cert_radius() at r = 0); mid and
+ * rad: hess_at() at p. */
+static int no_root_h(const struct rcert *c, px_vec3 p, const double mid[3],
+		     const double rad[3])
 {
-	double mid[3], rad[3], mag[3], e1, e2, epad;
+	double mag[3], e1, e2, epad;
 	px_vec3 w;
 	int k;
-	hess_at(c, p, mid, rad);
 	for (k = 0; k < 3; k++)
 		mag[k] = fabs(mid[k]) + rad[k];
 	w = px_v3_sub(c->sc, p);
@@ -1061,6 +1237,13 @@ static int no_root(const struct rcert *c, px_vec3 p)
 	return fabs(e1) - epad > mag[0] * c->hu + mag[1] * c->hv ||
 	       fabs(e2) - epad > mag[1] * c->hu + mag[2] * c->hv ||
 	       pre_radius(c, mid, rad, e1, e2, epad) > 0.0;
+}
+
+static int no_root(const struct rcert *c, px_vec3 p)
+{
+	double mid[3], rad[3];
+	hess_at(c, p, mid, rad);
+	return no_root_h(c, p, mid, rad);
 }
 
 /*
@@ -1107,19 +1290,66 @@ int px__strack_one_fault = 0;
  * at p is regular (the det H test of cert_radius() at r = 0): then the
  * cell holds at most one critical point, since E(a) - E(b) = M (a - b)
  * with M the Hessian averaged along the segment, a matrix of the
- * enclosure.
+ * enclosure. mid, rad: hess_at() at p.
  */
-static int one_root(const struct rcert *c, px_vec3 p)
+static int one_root_h(const double mid[3], const double rad[3])
 {
-	double mid[3], rad[3], lo[3], hi[3];
+	double lo[3], hi[3];
 	int k;
-	hess_at(c, p, mid, rad);
 	for (k = 0; k < 3; k++) {
 		double r = px__strack_one_fault ? 0.0 : rad[k];
 		lo[k] = mid[k] - r;
 		hi[k] = mid[k] + r;
 	}
 	return sym_regular(lo, hi, NULL);
+}
+
+static int one_root(const struct rcert *c, px_vec3 p)
+{
+	double mid[3], rad[3];
+	hess_at(c, p, mid, rad);
+	return one_root_h(mid, rad);
+}
+
+/* Test hook (internal.h): 1 drops the Hessian enclosure's radius from
+ * contract_rate() (unsound: its test must see it). */
+int px__strack_contract_fault = 0;
+
+/*
+ * 1 when x - Y E(x), Y the inverse of the Hessian enclosure's midpoint,
+ * contracts the cell at p (Krawczyk): by the mean value theorem
+ * g(x) - g(x') = (I - Y J)(x - x') with the rows of J in the enclosure,
+ * so in the norm weighted by the half widths the map shrinks distances
+ * by rho = max_i sum_j |I - Y [H]|_ij h_j / h_i, into *rho, when that is
+ * below 1. Every matrix of the enclosure is then regular: the cell holds
+ * at most one critical point, and contract_solve() finds it or proves
+ * there is none. mid, rad: hess_at() at p.
+ */
+static int contract_h(const struct rcert *c, const double mid[3],
+		      const double rad_in[3], double y[2][2], double *rho)
+{
+	double rad[3] = {rad_in[0], rad_in[1], rad_in[2]}, q[2][2], worst = 0.0;
+	int i;
+	if (px__strack_contract_fault)
+		rad[0] = rad[1] = rad[2] = 0.0;
+	if (!precond(mid, y, q))
+		return 0;
+	for (i = 0; i < 2; i++) {
+		double a = fabs(y[i][0]), b = fabs(y[i][1]);
+		double spread = c->hu * (q[i][0] + a * rad[0] + b * rad[1]) +
+				c->hv * (q[i][1] + a * rad[1] + b * rad[2]);
+		worst = fmax(worst, spread / (i ? c->hv : c->hu));
+	}
+	*rho = worst;
+	return worst < ST_RHO_MAX;
+}
+
+static int contract_rate(const struct rcert *c, px_vec3 p, double y[2][2],
+			 double *rho)
+{
+	double mid[3], rad[3];
+	hess_at(c, p, mid, rad);
+	return contract_h(c, mid, rad, y, rho);
 }
 
 /* Test hook (internal.h): a factor on every certified radius. */
@@ -2916,6 +3146,32 @@ int px__strack_one(const struct px_strack *t, int s, double u, double v,
 	return m;
 }
 
+int px__strack_contract(const struct px_strack *t, int s, double u, double v,
+			px_vec3 p, double box[4], int out[5], double fu[5], double fv[5])
+{
+	const struct scell *g = region_at(t, s, u, v), *home;
+	int ri, k;
+	if (!g)
+		return -1;
+	box_of(g, -1, box);
+	ri = (int)(g - t->rcell);
+	home = &t->cell[t->sf[s].first_cell + cell_of(&t->sf[s], u, v)];
+	for (k = -1; k < 4; k++) {
+		const struct rcert *c = k < 0 ? &g->cert : &t->qcert[4 * ri + k];
+		double y[2][2], rho, b[4];
+		struct crit z;
+		memset(&z, 0, sizeof(z));
+		box_of(g, k, b);
+		out[k + 1] = -1;
+		if (!contract_rate(c, p, y, &rho))
+			continue;
+		out[k + 1] = contract_solve(&t->sf[s], c, b, &z, p, home);
+		fu[k + 1] = z.u;
+		fv[k + 1] = z.v;
+	}
+	return 0;
+}
+
 int px__strack_winding(const struct px_strack *t, int s, px_vec3 p, int *w)
 {
 	if (!t || s < 0 || s >= t->n_surf || !w)
@@ -3539,8 +3795,9 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	{
 		struct cell_done none;
 		double su[ST_SEEDS_MAX], sv[ST_SEEDS_MAX];
+		int sk[ST_SEEDS_MAX];
 		memset(&none, 0, sizeof(none));
-		t->full_seeds = cell_seeds(o.seeds, &none, su, sv);
+		t->full_seeds = cell_seeds(o.seeds, &none, su, sv, sk);
 	}
 	t->n_curves = n_curves;
 	t->n_surf = n_surfs;

@@ -36,6 +36,12 @@
  *    critical points and those that hold a tracked one and can hold only
  *    one (every matrix of the Hessian's enclosure regular: E is
  *    one-to-one there); evolved points are kept, duplicates merged.
+ *    Where the enclosure makes x - Y E(x) (Y the inverse of its
+ *    midpoint) a contraction of a region or quarter (Krawczyk), that box
+ *    gets no seeds: the iteration from its centre, each step put back
+ *    into the box, converges to its one critical point if it has one,
+ *    and a step longer than the contraction allows proves it has none
+ *    (stats.exact_solves), so the solve is exact there.
  *    Cells on a collapsed edge have no proof near the pole's normal
  *    lines and are solved whenever hit.
  *  - Escape bound: a pair born in a hit cell may move on within the step
@@ -55,7 +61,7 @@
  *    winding number is exact where every boundary side keeps E1 or E2 of
  *    one sign (the certificates' side test); a mismatch means a point was
  *    missed (a point followed onto another's branch, or a seed grid that
- *    missed one of a cell's points): the update is answered globally and
+ *    missed one of a cell's points where no contraction holds): the update is answered globally and
  *    the set re-established (stats.unbalanced). It cannot see a pair
  *    missed whole (the escape bound's task where pairs are born);
  *    surfaces with a collapsed edge or a C0 line are left out.
@@ -243,6 +249,11 @@ struct px_strack_stats {
 	 * at a fold or left through an edge; their cell is solved again) */
 	uint64_t cell_solves, box_tests, lost;
 	uint64_t born;     /* interior points found by cell solves */
+	/* boxes of cell solves that hold at most one critical point and
+	 * none of the held ones, where x - Y E(x) contracts (Krawczyk): the
+	 * point found or proven absent from one start instead of seeds;
+	 * exact_open of them undecided (seeded after all) */
+	uint64_t exact_solves, exact_open;
 	/* rounds spent finding where a long step met a hit cell's region
 	 * (two certificate radii each; counted in max_solves as 1/8 of a
 	 * solve each) */

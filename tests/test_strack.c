@@ -1157,6 +1157,150 @@ static void test_one_regions(void)
 	PX_CHECK_MSG(unsound > 0, "the unsound variant went unseen: the check cannot fail");
 }
 
+/*
+ * Boxes (regions and their quarters) where x - Y E(x) contracts: the
+ * solve's contraction (px__strack_contract()) stands in for the box's
+ * seeds, so what it says must be so. A point found lies in the box and
+ * no second one does; "none" means the dense Newton count finds none in
+ * the box, nor Newton from a grid of starts inside it. At each query
+ * point the regions about the critical points of the dense count (where
+ * a point just outside a box makes the proof hard) and 24 others drawn
+ * at random. Returns the violations; *claims the boxes decided, *open
+ * those left undecided, *found those found to hold a point.
+ */
+static long contract_check(const struct px_strack *t, const struct px_nurbs_surf *s,
+			   const px_vec3 *pts, int npts, long *claims, long *open,
+			   long *found)
+{
+	static double rb[2048][4];
+	static char pick[2048];
+	double u0, u1, v0, v1, tu, tv;
+	long bad = 0;
+	int nr = 0, i, j, k, b, amb = 0;
+	px_nurbs_surf_domain(s, &u0, &u1, &v0, &v1);
+	tu = 1e-9 * (u1 - u0);
+	tv = 1e-9 * (v1 - v0);
+	/* the regions: the boxes met on a grid finer than any region */
+	for (j = 0; j < 96; j++)
+		for (i = 0; i < 96; i++) {
+			double box[4], fu[5], fv[5];
+			int out[5], q;
+			if (px__strack_contract(t, 0, u0 + (u1 - u0) * (i + 0.5) / 96,
+						v0 + (v1 - v0) * (j + 0.5) / 96, pts[0], box, out,
+						fu, fv) < 0)
+				continue;
+			for (q = 0; q < nr; q++)
+				if (rb[q][0] == box[0] && rb[q][2] == box[2])
+					break;
+			if (q == nr && nr < 2048)
+				memcpy(rb[nr++], box, sizeof(box));
+		}
+	for (k = 0; k < npts; k++) {
+		count_crit(s, pts[k], &amb);
+		memset(pick, 0, sizeof(pick));
+		for (i = 0; i < nr; i++)
+			for (j = 0; j < last_n && !pick[i]; j++)
+				pick[i] = fabs(last_fu[j] - 0.5 * (rb[i][0] + rb[i][1])) <=
+						  1.5 * (rb[i][1] - rb[i][0]) &&
+					  fabs(last_fv[j] - 0.5 * (rb[i][2] + rb[i][3])) <=
+						  1.5 * (rb[i][3] - rb[i][2]);
+		for (i = 0; i < 24 && nr > 0; i++)
+			pick[(int)(px_rand_unit() * nr) % nr] = 1;
+		for (i = 0; i < nr; i++) {
+			double box[4], fu[5], fv[5];
+			int out[5];
+			if (!pick[i])
+				continue;
+			px__strack_contract(t, 0, 0.5 * (rb[i][0] + rb[i][1]),
+					    0.5 * (rb[i][2] + rb[i][3]), pts[k], box, out, fu, fv);
+			for (b = 0; b < 5; b++) {
+				double um = 0.5 * (box[0] + box[1]), vm = 0.5 * (box[2] + box[3]);
+				double bu0 = box[0], bu1 = box[1], bv0 = box[2], bv1 = box[3];
+				int n = 0, q, g, ok = 1;
+				if (out[b] < 0)
+					continue;
+				if (out[b] == 2) {
+					(*open)++;
+					continue;
+				}
+				(*claims)++;
+				if (b > 0) {
+					q = b - 1;
+					bu0 = q & 1 ? um : box[0];
+					bu1 = q & 1 ? box[1] : um;
+					bv0 = q & 2 ? vm : box[2];
+					bv1 = q & 2 ? box[3] : vm;
+				}
+				for (q = 0; q < last_n; q++)
+					n += last_fu[q] >= bu0 - tu && last_fu[q] <= bu1 + tu &&
+					     last_fv[q] >= bv0 - tv && last_fv[q] <= bv1 + tv;
+				for (g = 0; n == 0 && out[b] == 1 && g < 16; g++) {
+					/* the dense count's seeds missed one? */
+					double u = bu0 + (bu1 - bu0) * (g % 4 + 0.5) / 4,
+					       v = bv0 + (bv1 - bv0) * (g / 4 + 0.5) / 4, det, hn;
+					if (crit_newton(s, pts[k], &u, &v, 30, 0.05, 1e-13, 0, &det,
+							&hn) &&
+					    u >= bu0 - tu && u <= bu1 + tu && v >= bv0 - tv &&
+					    v <= bv1 + tv)
+						n = 1;
+				}
+				if (out[b] == 0) {
+					(*found)++;
+					ok = n <= 1 && fu[b] >= bu0 - tu && fu[b] <= bu1 + tu &&
+					     fv[b] >= bv0 - tv && fv[b] <= bv1 + tv;
+				} else {
+					ok = n == 0;
+				}
+				if (!ok) {
+					if (bad < 4 && !px__strack_contract_fault)
+						printf("    violation: %s, %d critical points of the "
+						       "dense count in [%.6g, %.6g] x [%.6g, %.6g]\n",
+						       out[b] ? "proven empty" : "point found", n, bu0,
+						       bu1, bv0, bv1);
+					bad++;
+				}
+			}
+		}
+	}
+	return bad;
+}
+
+static void test_contract_regions(void)
+{
+	struct px_nurbs_surf s[5];
+	long unsound = 0, claims_all = 0, found_all = 0;
+	int m;
+	five_surfaces(s);
+	for (m = 0; m < 5; m++) {
+		struct px_strack *t = NULL;
+		long claims = 0, open = 0, found = 0, claims_f = 0, open_f = 0, found_f = 0,
+		     bad, bad_f;
+		px_vec3 pts[80];
+		int np = near_points(&s[m], pts, 40);
+		np += focal_points(&s[m], pts + np, 40);
+		PX_CHECK_INT_EQ(px_strack_create(NULL, 0, &s[m], 1, NULL, &t), PX_OK);
+		if (!t)
+			continue;
+		bad = contract_check(t, &s[m], pts, np, &claims, &open, &found);
+		/* the enclosure's radius dropped (unsound: must be seen) */
+		px__strack_contract_fault = 1;
+		bad_f = contract_check(t, &s[m], pts, np, &claims_f, &open_f, &found_f);
+		px__strack_contract_fault = 0;
+		printf("  %s: %ld boxes decided by the contraction (%ld holding a point), "
+		       "%ld undecided, %ld wrong; radius dropped: %ld wrong of %ld\n",
+		       five_names[m], claims, found, open, bad, bad_f, claims_f);
+		PX_CHECK_INT_EQ(bad, 0);
+		claims_all += claims;
+		found_all += found;
+		unsound += bad_f;
+		px_strack_free(t);
+	}
+	PX_CHECK_MSG(found_all >= 100, "too few boxes found to hold a point: %ld", found_all);
+	PX_CHECK_MSG(claims_all - found_all >= 100, "too few boxes proven empty: %ld",
+		     claims_all - found_all);
+	PX_CHECK_MSG(unsound > 0, "the unsound variant went unseen: the check cannot fail");
+}
+
 /* The index check's winding number (px__strack_winding()) against the
  * index sum of the dense Newton count, at query points near the
  * surfaces, near their focal sheets and farther off: equal wherever it
@@ -1985,6 +2129,7 @@ static const struct px_test tests[] = {
 	PX_T(test_focal_bounds),
 	PX_T(test_empty_regions),
 	PX_T(test_one_regions),
+	PX_T(test_contract_regions),
 	PX_T(test_winding),
 	PX_T(test_index_check),
 	PX_T(test_errors),
