@@ -252,8 +252,9 @@ struct px_strack_stats {
 	/* boxes of cell solves that hold at most one critical point and
 	 * none of the held ones, where x - Y E(x) contracts (Krawczyk): the
 	 * point found or proven absent from one start instead of seeds;
-	 * exact_open of them undecided (seeded after all) */
-	uint64_t exact_solves, exact_open;
+	 * exact_open of them undecided (seeded after all); Newton runs
+	 * from the seeds of the boxes where no contraction holds */
+	uint64_t exact_solves, exact_open, seed_runs;
 	/* rounds spent finding where a long step met a hit cell's region
 	 * (two certificate radii each; counted in max_solves as 1/8 of a
 	 * solve each) */
