@@ -656,10 +656,11 @@ static void box_of(const struct scell *g, int k, double b[4])
 	b[3] = k >= 0 && !(k & 2) ? vm : g->v1;
 }
 
-/* Which parts of a solve cell need no seeds (box_done(): BOX_DONE, or
- * BOX_EXACT, one start): region[ch] its region cells, quarter[ch][k]
- * their quarters (worked out only where the region's own test leaves
- * seeds). */
+/* What the parts of a solve cell need (box_done(): BOX_DONE nothing,
+ * BOX_EXACT contract_solve(), BOX_SEEDS seeds): region[ch] its region
+ * cells (BOX_SEEDS: as its quarters say), quarter[ch][k] their quarters
+ * (worked out only where the region's own test does not prove it
+ * done). */
 struct cell_done {
 	int region[4];
 	int quarter[4][4];
@@ -687,7 +688,7 @@ static int cell_done(const struct px_strack *t, const struct scell *c,
 	 * out for (speed_done()) */
 	int sp = c->kmark == t->pend_epoch && t->pend_on && known &&
 		 px_v3_dist2(ps, t->p) == 0.0;
-	int ch, k, tests = 0, all;
+	int ch, k, tests = 0, open, seeds;
 	for (ch = 0; ch < 4; ch++) {
 		int ri = c->child + ch;
 		const struct scell *g = &t->rcell[ri];
@@ -698,9 +699,9 @@ static int cell_done(const struct px_strack *t, const struct scell *c,
 			d->region[ch] = box_done(f, &g->cert, b, ps, known);
 			tests++;
 		}
-		if (d->region[ch])
+		if (d->region[ch] == BOX_DONE)
 			continue;
-		all = 1;
+		open = seeds = 0;
 		for (k = 0; k < 4; k++) {
 			box_of(g, k, b);
 			d->quarter[ch][k] = speed_done(f, sp ? c->kq[4 * ch + k] : NAN, b);
@@ -708,11 +709,16 @@ static int cell_done(const struct px_strack *t, const struct scell *c,
 				d->quarter[ch][k] = box_done(f, &t->qcert[4 * ri + k], b, ps, known);
 				tests++;
 			}
-			all = all && d->quarter[ch][k] == BOX_DONE;
+			open += d->quarter[ch][k] != BOX_DONE;
+			seeds += d->quarter[ch][k] == BOX_SEEDS;
 		}
-		/* quarters all done, or some needing one start only: the
-		 * region's seeds are theirs */
-		d->region[ch] = all ? BOX_DONE : BOX_SEEDS;
+		/* the quarters' tests first (a few hundred instructions each,
+		 * a contraction some thousands); the region's contraction
+		 * where they leave seeds or more than one to solve */
+		if (!open)
+			d->region[ch] = BOX_DONE;
+		else if (!(d->region[ch] == BOX_EXACT && (seeds || open > 1)))
+			d->region[ch] = BOX_SEEDS;
 	}
 	return tests;
 }
@@ -730,15 +736,15 @@ static int in_box(const struct ssurf *f, const struct crit *z, const double b[4]
 
 /*
  * The critical point of box b (certificate rc: contract_rate() holds) at
- * p, into z. Newton from the box's centre first; where that goes
- * elsewhere, x - Y E(x) iterated from the centre, each step put back
- * onto the box (clamping does not move a point away from one in the
+ * p, into z: x - Y E(x) iterated from the box's centre, each step put
+ * back onto the box (clamping does not move a point away from one in the
  * box). If the box holds a point x*, |x_k - x*| <= rho^k (weighted norm,
  * the centre within 1 of anything in the box), so the k-th step
  * |g(x_k) - x_k| is at most (1 + rho) rho^k: a longer one proves the box
- * empty; a short one is the iteration converging, which Newton finishes.
- * Returns CS_FOUND, CS_EMPTY, or CS_OPEN when neither within
- * ST_CONTRACT steps (rho near 1, or a point just outside the box).
+ * empty; a short one is the iteration converging, which Newton finishes
+ * (within ST_POLISH). Returns CS_FOUND, CS_EMPTY, or CS_OPEN when
+ * neither within ST_CONTRACT steps (rho near 1, or a point just outside
+ * the box).
  */
 static int contract_solve(const struct ssurf *f, const struct rcert *rc,
 			  const double b[4], struct crit *z, px_vec3 p,
