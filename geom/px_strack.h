@@ -152,7 +152,8 @@ struct px_strack_opts {
 	 * it runs: a cell whose region certificates prove it free of
 	 * critical points where it is solved costs those checks alone and
 	 * counts 1/8 of a solve (measured: about 2,200 instructions
-	 * against 7,000 or more for each Newton run from a seed), one
+	 * against 7,000 or more for each Newton run from a seed; a box's
+	 * contraction, stats.exact_solves, counts as one seed), one
 	 * whose certificates leave only some regions or quarters open
 	 * (near a focal sheet) 1/8 plus that share of the other 7/8; after
 	 * a long step, finding where it met a hit cell's region (up to 8
