@@ -1002,7 +1002,6 @@ static double iv_mag(struct iv a)
 	return fmax(fabs(a.lo), fabs(a.hi));
 }
 
-
 /*
  * Certified radius of a region cell at p: no transition of the cell
  * happens while the point stays in the cube |x - p|_inf <= r. A pair of
@@ -1027,21 +1026,6 @@ static double iv_mag(struct iv a)
  * its remainder terms (unsound). */
 int px__strack_precond = 1;
 
-/*
- * The E test preconditioned (Krawczyk's exclusion): by the mean value
- * theorem E(c + d) = E(c) + J d, each row of J the Hessian's at some point
- * of the cell, so a zero at c + d gives d = -Y E(c) + (I - Y J) d for any
- * Y; with Y the inverse of the midpoint of the Hessian's enclosure, a row
- * i with |(Y E(c))_i| > h_i + sum_j |I - Y J|_ij h_j proves there is none.
- * Unlike the plain test this sees where Newton from the centre would go:
- * a cell beside a critical point (its E small in both components, the
- * point just across a side) is proven empty when the step leads out of
- * it. For x in the cube of radius r about p, E(c) moves by r |Su(c)|_1
- * (resp. Sv) and J by r m_ij, so each row's test is linear in r: the
- * largest r that keeps one of them. mid and rad: the Hessian enclosure
- * at p (rad with its rounding pad), e1, e2: E(c) at p (signed), epad
- * their rounding.
- */
 /* Y, the inverse of the symmetric mid (entries 11, 12, 22), and
  * q = |I - Y mid| (zero but for rounding; padded by the rounding of the
  * products): the preconditioner of the Krawczyk tests. 0 when mid is
@@ -1063,6 +1047,21 @@ static int precond(const double mid[3], double y[2][2], double q[2][2])
 	return 1;
 }
 
+/*
+ * The E test preconditioned (Krawczyk's exclusion): by the mean value
+ * theorem E(c + d) = E(c) + J d, each row of J the Hessian's at some point
+ * of the cell, so a zero at c + d gives d = -Y E(c) + (I - Y J) d for any
+ * Y; with Y the inverse of the midpoint of the Hessian's enclosure, a row
+ * i with |(Y E(c))_i| > h_i + sum_j |I - Y J|_ij h_j proves there is none.
+ * Unlike the plain test this sees where Newton from the centre would go:
+ * a cell beside a critical point (its E small in both components, the
+ * point just across a side) is proven empty when the step leads out of
+ * it. For x in the cube of radius r about p, E(c) moves by r |Su(c)|_1
+ * (resp. Sv) and J by r m_ij, so each row's test is linear in r: the
+ * largest r that keeps one of them. mid and rad: the Hessian enclosure
+ * at p (rad with its rounding pad), e1, e2: E(c) at p (signed), epad
+ * their rounding.
+ */
 static double pre_radius(const struct rcert *c, const double mid[3],
 			 const double rad_in[3], double e1, double e2, double epad)
 {

@@ -61,8 +61,9 @@
  *    winding number is exact where every boundary side keeps E1 or E2 of
  *    one sign (the certificates' side test); a mismatch means a point was
  *    missed (a point followed onto another's branch, or a seed grid that
- *    missed one of a cell's points where no contraction holds): the update is answered globally and
- *    the set re-established (stats.unbalanced). It cannot see a pair
+ *    missed one of a cell's points where no contraction holds): the
+ *    update is answered globally and the set re-established
+ *    (stats.unbalanced). It cannot see a pair
  *    missed whole (the escape bound's task where pairs are born);
  *    surfaces with a collapsed edge or a C0 line are left out.
  *  - Bounded work: an update whose proven-hit cells exceed max_solves,
