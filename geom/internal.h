@@ -138,7 +138,8 @@ extern int px__strack_one_fault;
 int px__strack_contract(const struct px_strack *t, int s, double u, double v,
 			px_vec3 p, double box[4], int out[5], double fu[5], double fv[5]);
 /* 1 drops the Hessian enclosure's radius from the contraction's rate
- * (unsound: a fault the tests must see); 0 by default. */
+ * (unsound: a fault the tests must see); 2 leaves every contraction
+ * undecided (the solve falls back to seeds); 0 by default. */
 extern int px__strack_contract_fault;
 /* The winding number of the gradient of the squared distance from p
  * along the domain boundary of surface s, which the tracker compares

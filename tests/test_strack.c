@@ -372,6 +372,7 @@ struct totals {
 	long steps, wrong, naive_wrong, brute_bad, brute_checks, count_checks,
 		count_bad, count_amb, jumps, cells, born, died, global;
 	uint64_t over_budget, curve_skips, hot;
+	uint64_t exact, exact_open; /* boxes solved by contraction, undecided */
 	uint64_t rounds_most; /* most cross rounds in one update */
 	long budget_bad;
 	uint64_t allocs;
@@ -522,6 +523,8 @@ static void run_model(const char *name, const struct px_nurbs_curve *cs,
 	       (unsigned long long)st.curve_skips,
 	       (unsigned long long)st.hot, (unsigned long long)st.unbalanced);
 	tot->hot += st.hot;
+	tot->exact += st.exact_solves;
+	tot->exact_open += st.exact_open;
 	tot->over_budget += st.over_budget;
 	tot->curve_skips += st.curve_skips;
 	px_strack_free(t);
@@ -568,6 +571,17 @@ static void test_wavy(void)
 	PX_CHECK_MSG(tot.hot * 4 > (uint64_t)tot.steps,
 		     "hot path rarely engaged: %llu of %ld updates",
 		     (unsigned long long)tot.hot, tot.steps);
+	PX_CHECK_MSG(tot.exact > 0, "no box solved by its contraction");
+	/* every contraction undecided: the solves fall back to the boxes'
+	 * seeds, and the answers stay right */
+	memset(&tot, 0, sizeof(tot));
+	px__strack_contract_fault = 2;
+	run_model("wavy, contractions undecided", NULL, 0, &s, 1, 0, &tot);
+	px__strack_contract_fault = 0;
+	report(&tot);
+	PX_CHECK_MSG(tot.exact_open > 0 && tot.exact_open == tot.exact,
+		     "the fallback went unused: %llu of %llu undecided",
+		     (unsigned long long)tot.exact_open, (unsigned long long)tot.exact);
 }
 
 static void test_fold_nonuniform(void)
