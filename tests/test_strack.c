@@ -1041,6 +1041,18 @@ static void test_empty_regions(void)
 	PX_CHECK_MSG(unsound > 0, "the unsound variant went unseen: the check cannot fail");
 }
 
+/* Box b of a region's (u0, u1, v0, v1) as the hooks number them: 0 the
+ * region, 1 + q its quarter q (q & 1: upper half in u, q & 2: in v). */
+static void piece_box(const double box[4], int b, double out[4])
+{
+	double um = 0.5 * (box[0] + box[1]), vm = 0.5 * (box[2] + box[3]);
+	int q = b - 1;
+	out[0] = b > 0 && (q & 1) ? um : box[0];
+	out[1] = b > 0 && !(q & 1) ? um : box[1];
+	out[2] = b > 0 && (q & 2) ? vm : box[2];
+	out[3] = b > 0 && !(q & 2) ? vm : box[3];
+}
+
 /*
  * Boxes (regions and their quarters) whose Hessian enclosure proves they
  * hold at most one critical point - a solve seeds no Newton there when
@@ -1064,20 +1076,17 @@ static long one_check(const struct px_strack *t, const struct px_nurbs_surf *s,
 			double box[4];
 			int m = px__strack_one(t, 0, fu[i], fv[i], pts[k], box);
 			for (b = 0; m > 0 && b < 5; b++) {
-				/* b = 0 the region, b = 1 + q its quarter q */
-				double um = 0.5 * (box[0] + box[1]), vm = 0.5 * (box[2] + box[3]);
-				double bu0 = box[0], bu1 = box[1], bv0 = box[2], bv1 = box[3];
+				double pb[4], bu0, bu1, bv0, bv1;
 				if (!((m >> b) & 1))
 					continue;
-				if (b > 0) {
-					int q = b - 1;
-					bu0 = q & 1 ? um : box[0];
-					bu1 = q & 1 ? box[1] : um;
-					bv0 = q & 2 ? vm : box[2];
-					bv1 = q & 2 ? box[3] : vm;
-					if (fu[i] < bu0 || fu[i] > bu1 || fv[i] < bv0 || fv[i] > bv1)
-						continue;
-				}
+				piece_box(box, b, pb);
+				bu0 = pb[0];
+				bu1 = pb[1];
+				bv0 = pb[2];
+				bv1 = pb[3];
+				/* a quarter counts where it holds this point */
+				if (b > 0 && (fu[i] < bu0 || fu[i] > bu1 || fv[i] < bv0 || fv[i] > bv1))
+					continue;
 				(*claimed)++;
 				for (j = 0; j < n; j++)
 					if (j != i && fu[j] >= bu0 && fu[j] <= bu1 &&
@@ -1228,8 +1237,7 @@ static long contract_check(const struct px_strack *t, const struct px_nurbs_surf
 			px__strack_contract(t, 0, 0.5 * (rb[i][0] + rb[i][1]),
 					    0.5 * (rb[i][2] + rb[i][3]), pts[k], box, out, fu, fv);
 			for (b = 0; b < 5; b++) {
-				double um = 0.5 * (box[0] + box[1]), vm = 0.5 * (box[2] + box[3]);
-				double bu0 = box[0], bu1 = box[1], bv0 = box[2], bv1 = box[3];
+				double pb[4], bu0, bu1, bv0, bv1;
 				int n = 0, q, g, ok = 1;
 				if (out[b] < 0)
 					continue;
@@ -1238,13 +1246,11 @@ static long contract_check(const struct px_strack *t, const struct px_nurbs_surf
 					continue;
 				}
 				(*claims)++;
-				if (b > 0) {
-					q = b - 1;
-					bu0 = q & 1 ? um : box[0];
-					bu1 = q & 1 ? box[1] : um;
-					bv0 = q & 2 ? vm : box[2];
-					bv1 = q & 2 ? box[3] : vm;
-				}
+				piece_box(box, b, pb);
+				bu0 = pb[0];
+				bu1 = pb[1];
+				bv0 = pb[2];
+				bv1 = pb[3];
 				for (q = 0; q < last_n; q++)
 					n += last_fu[q] >= bu0 - tu && last_fu[q] <= bu1 + tu &&
 					     last_fv[q] >= bv0 - tv && last_fv[q] <= bv1 + tv;
