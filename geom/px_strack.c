@@ -819,9 +819,11 @@ static int seed_solve(struct px_strack *t, struct ssurf *f, const struct scell *
 		t->st.exact_open += rc_ == CS_OPEN;
 		if (rc_ != CS_FOUND)
 			return rc_ == CS_OPEN;
-	} else if (t->st.seed_runs++,
-		   snewton(f, &z, ps, 0.5 * (c->u1 - c->u0), 0.5 * (c->v1 - c->v0), c))
-		return 0;
+	} else {
+		t->st.seed_runs++;
+		if (snewton(f, &z, ps, 0.5 * (c->u1 - c->u0), 0.5 * (c->v1 - c->v0), c))
+			return 0;
+	}
 	if (px_v3_dist2(ps, p) != 0.0 &&
 	    follow(f, &z, ps, px_v3_sub(p, ps), p, &last))
 		return 0;
