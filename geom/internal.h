@@ -141,6 +141,17 @@ int px__strack_contract(const struct px_strack *t, int s, double u, double v,
  * (unsound: a fault the tests must see); 2 leaves every contraction
  * undecided (the solve falls back to seeds); 0 by default. */
 extern int px__strack_contract_fault;
+/* px_strack: the certificate made at update time for box (u0, u1, v0,
+ * v1) of surface s (inside one Bezier patch; sub_cert()) at p, as a
+ * solve's cut uses it: 1 proven free of critical points, 0 its one
+ * point found by the contraction (into fu, fv), 2 undecided; *regular 1
+ * when its Hessian enclosure is regular (at most one point). -1 for bad
+ * arguments or a box across patches. */
+int px__strack_sub(const struct px_strack *t, int s, const double box[4], px_vec3 p,
+		   int *regular, double *fu, double *fv);
+/* px_strack: 1 leaves every box no certificate decides uncut (Newton
+ * from its centre), the solve as it was before the run-time cuts. */
+extern int px__strack_sub_fault;
 /* The winding number of the gradient of the squared distance from p
  * along the domain boundary of surface s, which the tracker compares
  * with the index sum of its critical points (+1 minima and maxima, -1

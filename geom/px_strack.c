@@ -22,6 +22,7 @@
  */
 #include "px_strack.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -140,12 +141,15 @@ struct patch {
 	int p, q;
 	int rat;         /* weights not all equal */
 	const double *c; /* 4 (p + 1)(q + 1) */
+	/* its Bezier net, homogeneous, u fastest (4 per point): the run-time
+	 * certificates of sub-boxes are made from it (sub_cert()) */
+	const double *net;
 };
 
 struct ssurf {
 	struct px_nurbs_surf s;
 	struct patch *pt;       /* npu x npv, u fastest */
-	double *pool;
+	double *pool, *npool;   /* power forms, Bezier nets of the patches */
 	double *pu, *pv;        /* patch bounds (npu + 1, npv + 1) */
 	int npu, npv;
 	double *mem;            /* owned copy of knots and pw */
@@ -225,6 +229,9 @@ struct px_strack {
 	/* seeds of a cell solve with no region or quarter proven
 	 * (cell_seeds()), the work of ST_UNITS */
 	int full_seeds;
+	/* the sub-boxes' work in the solve in progress (sub_solve()), in
+	 * 1/ST_SUB_SEED of a seed */
+	int sub_work, sub_left;
 	/* the due cells of the segment col_p0 -> col_p1 tested over several
 	 * updates (more of them than max_tests): popped from the heap
 	 * (heap_n cells left in it), col_k of the col_np tested, col_nh of
@@ -842,23 +849,21 @@ static int seed_solve(struct px_strack *t, struct ssurf *f, const struct scell *
 }
 
 /*
- * The seeds of cell c's solve (done: cell_done() at the seed point):
- * Newton from the grid seeds of each region that may hold a point, and
- * from the centre of each of its quarters that may and has no grid seed
- * (where the quarters prove a region's neighbourhood empty, a point in
- * it is no longer found from the seeds of the regions around); a region
- * or quarter proven to hold exactly one point has its centre alone,
- * solved by contract_solve() (sk: 5 ch for region ch, 5 ch + 1 + k for its
- * quarter k; -1 a plain seed). Puts up to n * n + 16 of them in su, sv
- * (cell-relative), sk; returns their count.
+ * The work of cell c's solve (done: cell_done() at the seed point): a
+ * region or quarter proven to hold at most one point has its centre,
+ * solved by contract_solve() (sk: 5 ch for region ch, 5 ch + 1 + k for
+ * its quarter k); a quarter left open is cut into sub-boxes with
+ * certificates of their own (sub_solve(); sk: ST_SK_SUB plus its number
+ * as before). Puts up to 16 of them in su, sv (cell-relative, the
+ * boxes' centres), sk; returns their count.
  */
-static int cell_seeds(int n, const struct cell_done *done, double *su,
-		      double *sv, int *sk)
+#define ST_SK_SUB 32
+static int cell_seeds(const struct cell_done *done, double *su, double *sv,
+		      int *sk)
 {
-	int i, j, ch, k, ns = 0;
+	int ch, k, ns = 0;
 	for (ch = 0; ch < 4; ch++) {
 		const int *qe = done->quarter[ch];
-		int qn[4] = {0, 0, 0, 0};
 		if (done->region[ch] == BOX_DONE)
 			continue;
 		if (done->region[ch] == BOX_EXACT) {
@@ -867,33 +872,19 @@ static int cell_seeds(int n, const struct cell_done *done, double *su,
 			sk[ns++] = 5 * ch;
 			continue;
 		}
-		for (j = 0; j < n; j++)
-			for (i = 0; i < n; i++) {
-				double a = (i + 0.5) / n, b = (j + 0.5) / n;
-				int ru = a >= 0.5, rv = b >= 0.5;
-				if (ru + 2 * rv != ch)
-					continue;
-				k = (a - 0.5 * ru >= 0.25) + 2 * (b - 0.5 * rv >= 0.25);
-				if (qe[k] != BOX_SEEDS)
-					continue;
-				qn[k]++;
-				su[ns] = a;
-				sv[ns] = b;
-				sk[ns++] = -1;
-			}
 		for (k = 0; k < 4; k++) {
-			if (qe[k] == BOX_DONE || qn[k])
+			if (qe[k] == BOX_DONE)
 				continue;
 			su[ns] = 0.5 * (ch & 1) + 0.25 * (k & 1) + 0.125;
 			sv[ns] = 0.5 * (ch >> 1) + 0.25 * (k >> 1) + 0.125;
-			sk[ns++] = qe[k] == BOX_EXACT ? 5 * ch + 1 + k : -1;
+			sk[ns++] = (qe[k] == BOX_EXACT ? 0 : ST_SK_SUB) + 5 * ch + 1 + k;
 		}
 	}
 	return ns;
 }
 
-/* Room for cell_seeds() at the largest seed grid (options: seeds <= 8). */
-#define ST_SEEDS_MAX (8 * 8 + 16)
+/* Room for cell_seeds(): every quarter of the four regions. */
+#define ST_SEEDS_MAX 16
 
 /* The units of a solve running ns seeds: 1 for the checks, rounded up
  * to ST_UNITS for a full one. */
@@ -902,37 +893,169 @@ static int solve_units(const struct px_strack *t, int ns)
 	return 1 + (ns * (ST_UNITS - 1) + t->full_seeds - 1) / t->full_seeds;
 }
 
-/* Newton from the ns seeds su, sv of cell c (cell-relative) at ps, each
- * root then followed from ps to p (a pair born where the path met the
- * cell's region keeps moving for the rest of the step, possibly out of
- * the cell). Returns 0 or PX_E_NOSPC. */
+/* ------------------------------------------------------------------ */
+/* run-time subdivision of the boxes the setup certificates leave open */
+
+static int net_cert(const double *pw, int p, int q, double du, double dv,
+		    struct rcert *ce);
+static void cert_centre(const struct ssurf *f, double u0, double u1, double v0,
+			double v1, struct rcert *ce);
+
+/* Test hook (internal.h): 1 leaves every open box uncut (Newton from
+ * its centre, as before the cuts). */
+int px__strack_sub_fault = 0;
+
+/* Levels of sub-boxes below a region's quarter (or a box whose
+ * contraction stayed undecided): 4 + 16 certificates at most each. */
+#define ST_SUB_DEPTH 2
+
+/* The piece [a, b] of [0, 1] of the Bezier polygon of homogeneous
+ * points x[0..3], x[s..s + 3], ..., x[n s..], in place: de Casteljau at
+ * a keeping the right part, then at the image of b keeping the left
+ * (convex combinations only). */
+static void bez_piece(double *x, int s, int n, double a, double b)
+{
+	int r, i, k;
+	if (a > 0.0) {
+		for (r = 1; r <= n; r++)
+			for (i = 0; i <= n - r; i++)
+				for (k = 0; k < 4; k++)
+					x[i * s + k] = (1.0 - a) * x[i * s + k] + a * x[(i + 1) * s + k];
+		b = (b - a) / (1.0 - a);
+	}
+	if (b < 1.0)
+		for (r = 1; r <= n; r++)
+			for (i = n; i >= r; i--)
+				for (k = 0; k < 4; k++)
+					x[i * s + k] = (1.0 - b) * x[(i - 1) * s + k] + b * x[i * s + k];
+}
+
+/* Certificate of box b (u0, u1, v0, v1), inside one Bezier patch of f,
+ * at update time: its net cut from the patch's, then net_cert() and the
+ * centre values (no open sides: the tests of a solve do not use them).
+ * Returns 0 or PX_E_INVAL (weights). */
+static int sub_cert(const struct ssurf *f, const double b[4], struct rcert *ce)
+{
+	double net[4 * (PX_NURBS_MAX_DEGREE + 1) * (PX_NURBS_MAX_DEGREE + 1)];
+	double um = 0.5 * (b[0] + b[1]), vm = 0.5 * (b[2] + b[3]), s0, s1, t0, t1;
+	const struct patch *pt = &f->pt[bsearch_bounds(f->pv, f->npv, vm) * f->npu +
+					bsearch_bounds(f->pu, f->npu, um)];
+	int p = pt->p, q = pt->q, i, j, rc;
+	memcpy(net, pt->net, 4 * (size_t)((p + 1) * (q + 1)) * sizeof(double));
+	s0 = fmax((b[0] - pt->u0) * pt->iu, 0.0);
+	s1 = fmin((b[1] - pt->u0) * pt->iu, 1.0);
+	t0 = fmax((b[2] - pt->v0) * pt->iv, 0.0);
+	t1 = fmin((b[3] - pt->v0) * pt->iv, 1.0);
+	if (!(s0 < s1 && t0 < t1))
+		return PX_E_INVAL;
+	for (j = 0; j <= q; j++)
+		bez_piece(net + 4 * j * (p + 1), 4, p, s0, s1);
+	for (i = 0; i <= p; i++)
+		bez_piece(net + 4 * i, 4 * (p + 1), q, t0, t1);
+	rc = net_cert(net, p, q, b[1] - b[0], b[3] - b[2], ce);
+	if (rc)
+		return rc;
+	cert_centre(f, b[0], b[1], b[2], b[3], ce);
+	return PX_OK;
+}
+
+/* Quarter k of box b into q (k & 1: upper half in u, k & 2: in v). */
+static void box_quarter(const double b[4], int k, double q[4])
+{
+	double um = 0.5 * (b[0] + b[1]), vm = 0.5 * (b[2] + b[3]);
+	q[0] = (k & 1) ? um : b[0];
+	q[1] = (k & 1) ? b[1] : um;
+	q[2] = (k & 2) ? vm : b[2];
+	q[3] = (k & 2) ? b[3] : vm;
+}
+
+static int seed_solve(struct px_strack *t, struct ssurf *f, const struct scell *c,
+		      double u, double v, px_vec3 ps, px_vec3 p,
+		      const struct rcert *rc, const double b[4]);
+
+/* The work of a solve in sixteenths of a seed's Newton run: a
+ * certificate made at update time costs about 2.5 of them (measured on
+ * the 16-patch bench surface: 21,000 instructions, 15,000 of them its
+ * enclosures, against 7,500 for a Newton run). */
+#define ST_SUB_CERT 22
+#define ST_SUB_SEED 16
+
+/*
+ * Box b of cell c, left open by the certificates it has (setup's, or a
+ * contraction that stayed undecided), at ps (roots followed to p): its
+ * quarters get certificates of their own (sub_cert(), about half as
+ * wide) and are each done (proven empty, or holding a held point and
+ * no other), solved exactly (contract_solve()) or cut again, down to
+ * ST_SUB_DEPTH levels below the box; a piece still open there, or where
+ * the solve's allowance (t->sub_left) has no room for another cut, gets
+ * Newton from its centre. t->sub_work holds the work made or reserved:
+ * every open piece holds one seed's worth (the box's own is in it when
+ * this is called), a cut reserves its four certificates and a seed for
+ * each quarter and gives back what a quarter proven done does not use.
+ * The held set counts where it is at ps. Returns 0 or PX_E_NOSPC.
+ */
+static int sub_solve(struct px_strack *t, struct ssurf *f, const struct scell *c,
+		     const double b[4], int depth, px_vec3 ps, px_vec3 p)
+{
+	int known = px_v3_dist2(ps, p) == 0.0, k, r, cut = 4 * ST_SUB_CERT + 3 * ST_SUB_SEED;
+	if (depth > ST_SUB_DEPTH || t->sub_work + cut > t->sub_left ||
+	    px__strack_sub_fault) {
+		t->st.sub_open++;
+		return seed_solve(t, f, c, 0.5 * (b[0] + b[1]), 0.5 * (b[2] + b[3]), ps, p,
+				  NULL, b);
+	}
+	t->sub_work += cut;
+	for (k = 0; k < 4; k++) {
+		struct rcert rc;
+		double sb[4];
+		int w = BOX_SEEDS;
+		box_quarter(b, k, sb);
+		if (!sub_cert(f, sb, &rc)) {
+			t->st.sub_boxes++;
+			w = box_done(f, &rc, sb, ps, known);
+		}
+		if (w == BOX_DONE) {
+			t->sub_work -= ST_SUB_SEED;
+			continue;
+		}
+		/* a contraction takes the piece's seed; undecided (rare:
+		 * none in the tests), the piece goes on as an open one */
+		r = w == BOX_EXACT ? seed_solve(t, f, c, 0.0, 0.0, ps, p, &rc, sb) : 1;
+		if (r == 1)
+			r = sub_solve(t, f, c, sb, depth + 1, ps, p);
+		if (r < 0)
+			return r;
+	}
+	return 0;
+}
+
+/* The ns items of cell_seeds() for cell c at ps, each root found then
+ * followed from ps to p (a pair born where the path met the cell's
+ * region keeps moving for the rest of the step, possibly out of the
+ * cell); t->sub_work the subdivisions' work. Returns 0 or PX_E_NOSPC. */
 static int seeds_run(struct px_strack *t, const struct scell *c, px_vec3 ps,
 		     px_vec3 p, const double *su, const double *sv, const int *sk,
 		     int ns)
 {
 	struct ssurf *f = &t->sf[c->surf];
-	double lu = c->u1 - c->u0, lv = c->v1 - c->v0;
-	int i, k, rc;
+	int i, rc;
+	(void)su;
+	(void)sv;
 	t->st.cell_solves++;
+	/* every item holds one seed's worth; sub_solve() adds its cuts */
+	t->sub_work = ns * ST_SUB_SEED;
 	for (i = 0; i < ns; i++) {
-		const struct rcert *xc = NULL;
+		int n = sk[i] % ST_SK_SUB, ri = c->child + n / 5, q = n % 5 - 1;
 		double b[4];
-		if (sk[i] >= 0) {
-			int ri = c->child + sk[i] / 5, q = sk[i] % 5 - 1;
-			xc = q < 0 ? &t->rcell[ri].cert : &t->qcert[4 * ri + q];
-			box_of(&t->rcell[ri], q, b);
+		box_of(&t->rcell[ri], q, b);
+		rc = 1;
+		if (sk[i] < ST_SK_SUB) {
+			rc = seed_solve(t, f, c, 0.0, 0.0, ps, p,
+					q < 0 ? &t->rcell[ri].cert : &t->qcert[4 * ri + q], b);
 		}
-		rc = seed_solve(t, f, c, c->u0 + lu * su[i], c->v0 + lv * sv[i], ps, p,
-				xc, b);
-		for (k = 0; rc == 1 && k < 4; k++) {
-			/* undecided: Newton from the box's quarters' centres,
-			 * as the seeds it stood for */
-			double qu = b[0] + (b[1] - b[0]) * (0.25 + 0.5 * (k & 1)),
-			       qv = b[2] + (b[3] - b[2]) * (0.25 + 0.5 * (k >> 1));
-			int r2 = seed_solve(t, f, c, qu, qv, ps, p, NULL, b);
-			if (r2 < 0)
-				return r2;
-		}
+		/* open, or its contraction undecided: cut into sub-boxes */
+		if (rc == 1)
+			rc = sub_solve(t, f, c, b, 1, ps, p);
 		if (rc < 0)
 			return rc;
 	}
@@ -948,8 +1071,8 @@ static int cell_solve(struct px_strack *t, const struct scell *c, px_vec3 p)
 	double su[ST_SEEDS_MAX], sv[ST_SEEDS_MAX];
 	int sk[ST_SEEDS_MAX];
 	cell_done(t, c, p, 1, &done);
-	return seeds_run(t, c, p, p, su, sv, sk,
-			 cell_seeds(t->opts.seeds, &done, su, sv, sk));
+	t->sub_left = INT_MAX / 2;
+	return seeds_run(t, c, p, p, su, sv, sk, cell_seeds(&done, su, sv, sk));
 }
 
 /* Solve c at ps (roots followed to p) if its work fits: *units grows by
@@ -961,14 +1084,28 @@ static int cell_solve_budget(struct px_strack *t, const struct scell *c,
 	struct cell_done done;
 	double su[ST_SEEDS_MAX], sv[ST_SEEDS_MAX];
 	int sk[ST_SEEDS_MAX];
-	int ns, cost, tests = cell_done(t, c, ps, px_v3_dist2(ps, p) == 0.0, &done);
-	ns = cell_seeds(t->opts.seeds, &done, su, sv, sk);
+	int ns, cost, rc, more, tests = cell_done(t, c, ps, px_v3_dist2(ps, p) == 0.0, &done);
+	ns = cell_seeds(&done, su, sv, sk);
 	/* the checks' unit only where they were made */
 	cost = solve_units(t, ns) - (tests == 0);
 	if (lim > 0 && *units > 0 && *units + cost > lim)
 		return 1;
 	*units += cost;
-	return seeds_run(t, c, ps, p, su, sv, sk, ns);
+	/* the cuts of open boxes may use what the bound leaves (m more
+	 * seeds cost at most ceil(7 m / full_seeds) units more), up to
+	 * a full solve more: a cell's cuts must not take the work of
+	 * the other cells of the step (they would wait, the set lagging) */
+	more = lim > 0 ? (lim - *units) * t->full_seeds / (ST_UNITS - 1) : INT_MAX / 64;
+	if (more > t->full_seeds)
+		more = t->full_seeds;
+	t->sub_left = ST_SUB_SEED * (ns + more);
+	rc = seeds_run(t, c, ps, p, su, sv, sk, ns);
+	/* the sub-boxes' work past the one seed each item was counted as
+	 * (bounded: ST_SUB_DEPTH levels) */
+	more = (t->sub_work + ST_SUB_SEED - 1) / ST_SUB_SEED - ns;
+	if (more > 0)
+		*units += solve_units(t, ns + more) - solve_units(t, ns);
+	return rc;
 }
 
 static int surf_reinit(struct px_strack *t, struct ssurf *f, int si, px_vec3 p)
@@ -994,8 +1131,13 @@ static struct iv iv_mul(struct iv a, struct iv b)
 	double p1 = a.lo * b.lo, p2 = a.lo * b.hi, p3 = a.hi * b.lo,
 	       p4 = a.hi * b.hi;
 	struct iv r;
-	r.lo = fmin(fmin(p1, p2), fmin(p3, p4));
-	r.hi = fmax(fmax(p1, p2), fmax(p3, p4));
+	/* (no NaN here: plain comparisons, as fmin and fmax would give) */
+	r.lo = p1 < p2 ? p1 : p2;
+	r.lo = p3 < r.lo ? p3 : r.lo;
+	r.lo = p4 < r.lo ? p4 : r.lo;
+	r.hi = p1 > p2 ? p1 : p2;
+	r.hi = p3 > r.hi ? p3 : r.hi;
+	r.hi = p4 > r.hi ? p4 : r.hi;
 	return r;
 }
 
@@ -3181,6 +3323,41 @@ int px__strack_contract(const struct px_strack *t, int s, double u, double v,
 	return 0;
 }
 
+int px__strack_sub(const struct px_strack *t, int s, const double box[4], px_vec3 p,
+		   int *regular, double *fu, double *fv)
+{
+	const struct ssurf *f;
+	const struct scell *home;
+	struct rcert rc;
+	struct crit z;
+	double mid[3], rad[3], y[2][2], rho;
+	if (!t || s < 0 || s >= t->n_surf || !box || !regular || !fu || !fv)
+		return -1;
+	f = &t->sf[s];
+	if (!(box[0] >= f->u0 && box[1] <= f->u1 && box[2] >= f->v0 && box[3] <= f->v1) ||
+	    sub_cert(f, box, &rc))
+		return -1;
+	home = &t->cell[t->sf[s].first_cell +
+			cell_of(f, 0.5 * (box[0] + box[1]), 0.5 * (box[2] + box[3]))];
+	hess_at(&rc, p, mid, rad);
+	*regular = one_root_h(mid, rad);
+	if (no_root_h(&rc, p, mid, rad))
+		return 1;
+	if (!contract_h(&rc, mid, rad, y, &rho))
+		return 2;
+	memset(&z, 0, sizeof(z));
+	switch (contract_solve(f, &rc, box, &z, p, home)) {
+	case CS_FOUND:
+		*fu = z.u;
+		*fv = z.v;
+		return 0;
+	case CS_EMPTY:
+		return 1;
+	default:
+		return 2;
+	}
+}
+
 int px__strack_winding(const struct px_strack *t, int s, px_vec3 p, int *w)
 {
 	if (!t || s < 0 || s >= t->n_surf || !w)
@@ -3329,86 +3506,111 @@ static void iv_grow(struct iv *a, double x)
 }
 
 /*
- * Enclosure of one homogeneous coordinate k (0..3) of a difference net of
- * the Bezier net P ((p + 1) x (q + 1), u fastest, 4 per point): the
- * derivative of order (a, b) in (u, v) is a Bezier patch whose control
- * points are the forward differences times p!/(p - a)! q!/(q - b)!
- * / (du^a dv^b); its range lies within their hull.
+ * Enclosures of the homogeneous coordinates (k = 0..3) of the difference
+ * nets of the Bezier net P ((p + 1) x (q + 1), u fastest, 4 per point),
+ * all in one pass over the net: the derivative of order (a, b) in (u, v)
+ * is a Bezier patch whose control points are the forward differences
+ * times p!/(p - a)! q!/(q - b)! / (du^a dv^b); its range lies within
+ * their hull. r[0]: order (0, 0), r[1] (1, 0), r[2] (0, 1), r[3] (2, 0),
+ * r[4] (1, 1), r[5] (0, 2); an order above the degree is 0.
  */
-static struct iv net_range(const double *P, int p, int q, int k, int a, int b,
-			   double du, double dv)
+static void net_ranges(const double *P, int p, int q, double du, double dv,
+		       struct iv r[6][4])
 {
-	struct iv r = {INFINITY, -INFINITY};
-	double f = 1.0;
-	int i, j, x, y;
-	if (a > p || b > q)
-		return iv_pt(0.0);
-	for (i = 0; i < a; i++)
-		f *= (double)(p - i) / du;
-	for (j = 0; j < b; j++)
-		f *= (double)(q - j) / dv;
-	for (j = 0; j + b <= q; j++)
-		for (i = 0; i + a <= p; i++) {
-			double d = 0.0;
-			for (y = 0; y <= b; y++)
-				for (x = 0; x <= a; x++) {
-					/* binomial signs of the forward differences */
-					double c = ((a - x + b - y) & 1) ? -1.0 : 1.0;
-					c *= (a == 2 && x == 1 ? 2.0 : 1.0) * (b == 2 && y == 1 ? 2.0 : 1.0);
-					d += c * P[4 * ((j + y) * (p + 1) + i + x) + k];
-				}
-			iv_grow(&r, f * d);
+	static const int oa[6] = {0, 1, 0, 2, 1, 0}, ob[6] = {0, 0, 1, 0, 1, 2};
+	int i, j, k, o, n = p + 1;
+	for (o = 0; o < 6; o++)
+		for (k = 0; k < 4; k++) {
+			r[o][k].lo = INFINITY;
+			r[o][k].hi = -INFINITY;
 		}
-	return iv_pad(r);
+#define NR_AT(a, b) P[4 * ((b) * n + (a)) + k]
+	for (j = 0; j <= q; j++)
+		for (i = 0; i <= p; i++)
+			for (k = 0; k < 4; k++) {
+				double x = NR_AT(i, j);
+				/* the sums in the order of the signed binomial
+				 * terms (v outer, u inner) */
+				iv_grow(&r[0][k], x);
+				if (i < p)
+					iv_grow(&r[1][k], -x + NR_AT(i + 1, j));
+				if (j < q)
+					iv_grow(&r[2][k], -x + NR_AT(i, j + 1));
+				if (i + 1 < p)
+					iv_grow(&r[3][k], (x - 2.0 * NR_AT(i + 1, j)) + NR_AT(i + 2, j));
+				if (i < p && j < q)
+					iv_grow(&r[4][k], ((x - NR_AT(i + 1, j)) - NR_AT(i, j + 1)) +
+							      NR_AT(i + 1, j + 1));
+				if (j + 1 < q)
+					iv_grow(&r[5][k], (x - 2.0 * NR_AT(i, j + 1)) + NR_AT(i, j + 2));
+			}
+#undef NR_AT
+	for (o = 0; o < 6; o++) {
+		double f = 1.0;
+		for (i = 0; i < oa[o]; i++)
+			f *= (double)(p - i) / du;
+		for (j = 0; j < ob[o]; j++)
+			f *= (double)(q - j) / dv;
+		for (k = 0; k < 4; k++) {
+			struct iv *x = &r[o][k];
+			if (oa[o] > p || ob[o] > q) {
+				*x = iv_pt(0.0);
+				continue;
+			}
+			/* f > 0: rounding is monotone, so the scaled bounds are
+			 * the bounds of the scaled differences */
+			x->lo *= f;
+			x->hi *= f;
+			*x = iv_pad(*x);
+		}
+	}
 }
 
-/* Certificate data of region cell c (setup; work: extraction scratch). */
-static int cell_cert(struct px_strack *t, struct scell *c, const struct ssurf *f,
-		     double *work, size_t wl, const int side_open[4])
+/*
+ * The enclosures of certificate ce over a box of size du x dv from its
+ * Bezier net pw ((p + 1) x (q + 1) homogeneous points, u fastest): S and
+ * its derivatives up to order 2, the first fundamental form, the
+ * midpoint-radius form of H. Also run at update time on sub-boxes
+ * (sub_cert()): no allocation, bounded loops. Returns 0, or PX_E_INVAL
+ * where the weights are not positive.
+ */
+static int net_cert(const double *pw, int p, int q, double du, double dv,
+		    struct rcert *ce)
 {
-	struct rcert *ce = &c->cert;
-	struct px_nurbs_surf sub;
-	struct px_nurbs_surf_derivs d;
-	struct iv W, Wu, Wv, Wuu, Wuv, Wvv, Su[3], Sv[3];
-	double du = c->u1 - c->u0, dv = c->v1 - c->v0;
-	int p = f->s.degree[0], q = f->s.degree[1], k, i, rc;
-	rc = px_nurbs_surf_extract_work(&f->s, c->u0, c->u1, c->v0, c->v1, work,
-					wl, &sub);
-	if (rc)
-		return rc;
-	if (sub.n_ctrl[0] != p + 1 || sub.n_ctrl[1] != q + 1)
-		return PX_E_INVAL;
+	struct iv W, Wu, Wv, Wuu, Wuv, Wvv, Su[3], Sv[3], nr[6][4];
+	int k, i;
 	memset(ce, 0, sizeof(*ce));
-	W = net_range(sub.pw, p, q, 3, 0, 0, du, dv);
+	net_ranges(pw, p, q, du, dv, nr);
+	W = nr[0][3];
 	if (!(W.lo > 0.0))
 		return PX_E_INVAL;
-	Wu = net_range(sub.pw, p, q, 3, 1, 0, du, dv);
-	Wv = net_range(sub.pw, p, q, 3, 0, 1, du, dv);
-	Wuu = net_range(sub.pw, p, q, 3, 2, 0, du, dv);
-	Wuv = net_range(sub.pw, p, q, 3, 1, 1, du, dv);
-	Wvv = net_range(sub.pw, p, q, 3, 0, 2, du, dv);
+	Wu = nr[1][3];
+	Wv = nr[2][3];
+	Wuu = nr[3][3];
+	Wuv = nr[4][3];
+	Wvv = nr[5][3];
 	for (k = 0; k < 3; k++) {
 		struct iv S = {INFINITY, -INFINITY};
 		/* the surface lies in the hull of its projected net */
 		for (i = 0; i < (p + 1) * (q + 1); i++)
-			iv_grow(&S, sub.pw[4 * i + k] / sub.pw[4 * i + 3]);
+			iv_grow(&S, pw[4 * i + k] / pw[4 * i + 3]);
 		S = iv_pad(S);
 		ce->S[k] = S;
 		/* quotient rule on S = X / W, differentiated */
-		Su[k] = iv_pad(iv_divw(iv_sub(net_range(sub.pw, p, q, k, 1, 0, du, dv),
+		Su[k] = iv_pad(iv_divw(iv_sub(nr[1][k],
 					      iv_mul(S, Wu)), W));
-		Sv[k] = iv_pad(iv_divw(iv_sub(net_range(sub.pw, p, q, k, 0, 1, du, dv),
+		Sv[k] = iv_pad(iv_divw(iv_sub(nr[2][k],
 					      iv_mul(S, Wv)), W));
 		ce->Suu[k] = iv_pad(iv_divw(
-			iv_sub(iv_sub(net_range(sub.pw, p, q, k, 2, 0, du, dv),
+			iv_sub(iv_sub(nr[3][k],
 				      iv_scale(iv_mul(Su[k], Wu), 2.0)),
 			       iv_mul(S, Wuu)), W));
 		ce->Svv[k] = iv_pad(iv_divw(
-			iv_sub(iv_sub(net_range(sub.pw, p, q, k, 0, 2, du, dv),
+			iv_sub(iv_sub(nr[5][k],
 				      iv_scale(iv_mul(Sv[k], Wv), 2.0)),
 			       iv_mul(S, Wvv)), W));
 		ce->Suv[k] = iv_pad(iv_divw(
-			iv_sub(iv_sub(iv_sub(net_range(sub.pw, p, q, k, 1, 1, du, dv),
+			iv_sub(iv_sub(iv_sub(nr[4][k],
 					     iv_mul(Su[k], Wv)),
 				      iv_mul(Sv[k], Wu)),
 			       iv_mul(S, Wuv)), W));
@@ -3458,12 +3660,41 @@ static int cell_cert(struct px_strack *t, struct scell *c, const struct ssurf *f
 	}
 	ce->hu = 0.5 * du;
 	ce->hv = 0.5 * dv;
-	surf_eval2(f, 0.5 * (c->u0 + c->u1), 0.5 * (c->v0 + c->v1), &d);
+	return PX_OK;
+}
+
+/* The centre values of certificate ce of box (u0, u1, v0, v1). */
+static void cert_centre(const struct ssurf *f, double u0, double u1, double v0,
+			double v1, struct rcert *ce)
+{
+	struct px_nurbs_surf_derivs d;
+	surf_eval2(f, 0.5 * (u0 + u1), 0.5 * (v0 + v1), &d);
 	ce->sc = d.s;
 	ce->suc = d.su;
 	ce->svc = d.sv;
 	ce->n1 = fabs(d.su.x) + fabs(d.su.y) + fabs(d.su.z);
 	ce->n2 = fabs(d.sv.x) + fabs(d.sv.y) + fabs(d.sv.z);
+}
+
+/* Certificate data of region cell c (setup; work: extraction scratch). */
+static int cell_cert(struct px_strack *t, struct scell *c, const struct ssurf *f,
+		     double *work, size_t wl, const int side_open[4])
+{
+	struct rcert *ce = &c->cert;
+	struct px_nurbs_surf sub;
+	struct px_nurbs_surf_derivs d;
+	double du = c->u1 - c->u0, dv = c->v1 - c->v0;
+	int p = f->s.degree[0], q = f->s.degree[1], k, rc;
+	rc = px_nurbs_surf_extract_work(&f->s, c->u0, c->u1, c->v0, c->v1, work,
+					wl, &sub);
+	if (rc)
+		return rc;
+	if (sub.n_ctrl[0] != p + 1 || sub.n_ctrl[1] != q + 1)
+		return PX_E_INVAL;
+	rc = net_cert(sub.pw, p, q, du, dv, ce);
+	if (rc)
+		return rc;
+	cert_centre(f, c->u0, c->u1, c->v0, c->v1, ce);
 	for (k = 0; k < 4; k++) {
 		struct cside *sd;
 		double u, v;
@@ -3627,6 +3858,7 @@ void px_strack_free(struct px_strack *t)
 			free(t->sf[i].mem);
 			free(t->sf[i].pt);
 			free(t->sf[i].pool);
+			free(t->sf[i].npool);
 			free(t->sf[i].pu);
 			free(t->sf[i].pv);
 			free(t->sf[i].cu);
@@ -3683,9 +3915,10 @@ static int build_patches(struct ssurf *f, const double *ub, int nu,
 	f->npv = nv - 1;
 	f->pt = calloc((size_t)(f->npu * f->npv), sizeof(*f->pt));
 	f->pool = calloc((size_t)(f->npu * f->npv) * 4 * (size_t)np, sizeof(double));
+	f->npool = calloc((size_t)(f->npu * f->npv) * 4 * (size_t)np, sizeof(double));
 	f->pu = malloc((size_t)nu * sizeof(double));
 	f->pv = malloc((size_t)nv * sizeof(double));
-	if (!work || !f->pt || !f->pool || !f->pu || !f->pv) {
+	if (!work || !f->pt || !f->pool || !f->npool || !f->pu || !f->pv) {
 		free(work);
 		return PX_E_NOMEM;
 	}
@@ -3712,6 +3945,9 @@ static int build_patches(struct ssurf *f, const double *ub, int nu,
 			pt->p = p;
 			pt->q = q;
 			pt->c = c;
+			memcpy(f->npool + (size_t)(b * f->npu + a) * 4 * (size_t)np, sub.pw,
+			       4 * (size_t)np * sizeof(double));
+			pt->net = f->npool + (size_t)(b * f->npu + a) * 4 * (size_t)np;
 			{
 				/* equal weights: divide them out, evaluate as a
 				 * polynomial */
@@ -3806,7 +4042,7 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 		double su[ST_SEEDS_MAX], sv[ST_SEEDS_MAX];
 		int sk[ST_SEEDS_MAX];
 		memset(&none, 0, sizeof(none));
-		t->full_seeds = cell_seeds(o.seeds, &none, su, sv, sk);
+		t->full_seeds = cell_seeds(&none, su, sv, sk);
 	}
 	t->n_curves = n_curves;
 	t->n_surf = n_surfs;

@@ -41,7 +41,16 @@
  *    gets no seeds: the iteration from its centre, each step put back
  *    into the box, converges to its one critical point if it has one,
  *    and a step longer than the contraction allows proves it has none
- *    (stats.exact_solves), so the solve is exact there.
+ *    (stats.exact_solves), so the solve is exact there. A box these
+ *    setup certificates leave open (near a focal point the enclosures
+ *    over a whole quarter are too wide to contract) is cut in four, each
+ *    piece with a certificate made at update time from its own Bezier
+ *    net (cut from the patch's by de Casteljau: enclosures about as wide
+ *    as the piece, so they contract wherever H is regular), and each
+ *    piece is done, solved exactly or cut again, down to two levels;
+ *    Newton from its centre only in a piece still open there (within a
+ *    sixteenth of a quarter of a near-degenerate point, or where the
+ *    work bound leaves no room for a cut; stats.sub_boxes, sub_open).
  *    Cells on a collapsed edge have no proof near the pole's normal
  *    lines and are solved whenever hit.
  *  - Escape bound: a pair born in a hit cell may move on within the step
@@ -132,8 +141,10 @@ extern "C" {
 struct px_strack_opts {
 	/* Cells per Bezier patch along u and along v (default 3, 1..16). */
 	int cells_per_span;
-	/* Newton seeds per cell and direction when a cell is solved
-	 * (default 2, 1..8). */
+	/* Unused since the boxes the certificates leave open are cut
+	 * into pieces with certificates of their own instead of seeded on
+	 * a grid; still checked (1..8) so that old option sets stay
+	 * valid. */
 	int seeds;
 	/* Unused since the transition regions are proven instead of
 	 * sampled; still checked (2..32) so that old option sets stay
@@ -154,7 +165,10 @@ struct px_strack_opts {
 	 * critical points where it is solved costs those checks alone and
 	 * counts 1/8 of a solve (measured: about 2,200 instructions
 	 * against 7,000 or more for each Newton run from a seed; a box's
-	 * contraction, stats.exact_solves, counts as one seed), one
+	 * contraction, stats.exact_solves, counts as one seed, and the
+	 * cut of an open box four certificates made at update time (2.5
+	 * seeds each; a cut is made only where the bound leaves room for
+	 * it and a seed in each piece), one
 	 * whose certificates leave only some regions or quarters open
 	 * (near a focal sheet) 1/8 plus that share of the other 7/8; after
 	 * a long step, finding where it met a hit cell's region (up to 8
@@ -257,6 +271,12 @@ struct px_strack_stats {
 	 * exact_open of them undecided (seeded after all); Newton runs
 	 * from the seeds of the boxes where no contraction holds */
 	uint64_t exact_solves, exact_open, seed_runs;
+	/* boxes no certificate made at setup decides are cut in four, down
+	 * to two levels, each piece with a certificate made from its own
+	 * Bezier net (enclosures about as wide as the piece): sub_boxes of
+	 * those made, sub_open the pieces of the last level still
+	 * undecided (Newton from their centres) */
+	uint64_t sub_boxes, sub_open;
 	/* rounds spent finding where a long step met a hit cell's region
 	 * (two certificate radii each; counted in max_solves as 1/8 of a
 	 * solve each) */
