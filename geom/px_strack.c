@@ -95,6 +95,11 @@ struct rcert {
 	double hu, hv;          /* half widths of the cell in u, v */
 	int nside;
 	struct cside side[4];
+	/* polynomial patches (t3ok): bounds over the cell of |S_uuu|,
+	 * |S_uuv|, |S_uvv|, |S_vvv| per coordinate, from which the
+	 * certificates of its sub-boxes are made (taylor_cert()) */
+	double t3[4][3];
+	int t3ok;
 };
 
 struct scell {
@@ -900,6 +905,8 @@ static int net_cert(const double *pw, int p, int q, double du, double dv,
 		    struct rcert *ce);
 static void cert_centre(const struct ssurf *f, double u0, double u1, double v0,
 			double v1, struct rcert *ce);
+static void taylor_cert(const struct ssurf *f, const double b[4],
+			const struct rcert *top, struct rcert *ce);
 
 /* Test hook (internal.h): 1 leaves every open box uncut (Newton from
  * its centre, as before the cuts). */
@@ -973,18 +980,23 @@ static int seed_solve(struct px_strack *t, struct ssurf *f, const struct scell *
 		      double u, double v, px_vec3 ps, px_vec3 p,
 		      const struct rcert *rc, const double b[4]);
 
-/* The work of a solve in sixteenths of a seed's Newton run: a
- * certificate made at update time costs about 2.5 of them (measured on
- * the 16-patch bench surface: 21,000 instructions, 15,000 of them its
- * enclosures, against 7,500 for a Newton run). */
-#define ST_SUB_CERT 22
+/* The work of a solve in sixteenths of a seed's run: a certificate
+ * made at update time costs about 0.85 of one (measured on the 16-patch
+ * bench surface: 14,300 instructions, against 17,000 for a seed's
+ * Newton run with the following of its root). */
+#define ST_SUB_CERT 14
+/* the same from the centre values and the third-derivative bounds of a
+ * polynomial patch (taylor_cert(): a piece and its tests about 3,500
+ * instructions on the same paths) */
+#define ST_SUB_TAYLOR 3
 #define ST_SUB_SEED 16
 
 /*
- * Box b of cell c, left open by the certificates it has (setup's, or a
- * contraction that stayed undecided), at ps (roots followed to p): its
- * quarters get certificates of their own (sub_cert(), about half as
- * wide) and are each done (proven empty, or holding a held point and
+ * Box b of cell c, left open by the certificates it has (setup's, top,
+ * or a contraction that stayed undecided), at ps (roots followed to p):
+ * its quarters get certificates of their own (taylor_cert() from top's
+ * third-derivative bounds on a polynomial patch, sub_cert() from their
+ * Bezier nets on a rational one; about half as wide) and are each done (proven empty, or holding a held point and
  * no other), solved exactly (contract_solve()) or cut again, down to
  * ST_SUB_DEPTH levels below the box; a piece still open there, or where
  * the solve's allowance (t->sub_left) has no room for another cut, gets
@@ -995,9 +1007,11 @@ static int seed_solve(struct px_strack *t, struct ssurf *f, const struct scell *
  * The held set counts where it is at ps. Returns 0 or PX_E_NOSPC.
  */
 static int sub_solve(struct px_strack *t, struct ssurf *f, const struct scell *c,
-		     const double b[4], int depth, px_vec3 ps, px_vec3 p)
+		     const struct rcert *top, const double b[4], int depth, px_vec3 ps,
+		     px_vec3 p)
 {
-	int known = px_v3_dist2(ps, p) == 0.0, k, r, cut = 4 * ST_SUB_CERT + 3 * ST_SUB_SEED;
+	int known = px_v3_dist2(ps, p) == 0.0, k, r,
+	    cut = 4 * (top->t3ok ? ST_SUB_TAYLOR : ST_SUB_CERT) + 3 * ST_SUB_SEED;
 	if (depth > ST_SUB_DEPTH || t->sub_work + cut > t->sub_left ||
 	    px__strack_sub_fault) {
 		t->st.sub_open++;
@@ -1010,7 +1024,11 @@ static int sub_solve(struct px_strack *t, struct ssurf *f, const struct scell *c
 		double sb[4];
 		int w = BOX_SEEDS;
 		box_quarter(b, k, sb);
-		if (!sub_cert(f, sb, &rc)) {
+		if (top->t3ok) {
+			taylor_cert(f, sb, top, &rc);
+			t->st.sub_boxes++;
+			w = box_done(f, &rc, sb, ps, known);
+		} else if (!sub_cert(f, sb, &rc)) {
 			t->st.sub_boxes++;
 			w = box_done(f, &rc, sb, ps, known);
 		}
@@ -1022,7 +1040,7 @@ static int sub_solve(struct px_strack *t, struct ssurf *f, const struct scell *c
 		 * none in the tests), the piece goes on as an open one */
 		r = w == BOX_EXACT ? seed_solve(t, f, c, 0.0, 0.0, ps, p, &rc, sb) : 1;
 		if (r == 1)
-			r = sub_solve(t, f, c, sb, depth + 1, ps, p);
+			r = sub_solve(t, f, c, top, sb, depth + 1, ps, p);
 		if (r < 0)
 			return r;
 	}
@@ -1046,16 +1064,15 @@ static int seeds_run(struct px_strack *t, const struct scell *c, px_vec3 ps,
 	t->sub_work = ns * ST_SUB_SEED;
 	for (i = 0; i < ns; i++) {
 		int n = sk[i] % ST_SK_SUB, ri = c->child + n / 5, q = n % 5 - 1;
+		const struct rcert *xc = q < 0 ? &t->rcell[ri].cert : &t->qcert[4 * ri + q];
 		double b[4];
 		box_of(&t->rcell[ri], q, b);
 		rc = 1;
-		if (sk[i] < ST_SK_SUB) {
-			rc = seed_solve(t, f, c, 0.0, 0.0, ps, p,
-					q < 0 ? &t->rcell[ri].cert : &t->qcert[4 * ri + q], b);
-		}
+		if (sk[i] < ST_SK_SUB)
+			rc = seed_solve(t, f, c, 0.0, 0.0, ps, p, xc, b);
 		/* open, or its contraction undecided: cut into sub-boxes */
 		if (rc == 1)
-			rc = sub_solve(t, f, c, b, 1, ps, p);
+			rc = sub_solve(t, f, c, xc, b, 1, ps, p);
 		if (rc < 0)
 			return rc;
 	}
@@ -3327,15 +3344,33 @@ int px__strack_sub(const struct px_strack *t, int s, const double box[4], px_vec
 		   int *regular, double *fu, double *fv)
 {
 	const struct ssurf *f;
-	const struct scell *home;
+	const struct scell *home, *g;
+	const struct rcert *top;
 	struct rcert rc;
 	struct crit z;
-	double mid[3], rad[3], y[2][2], rho;
+	double mid[3], rad[3], y[2][2], rho, gb[4], qb[4];
+	int k, ri;
 	if (!t || s < 0 || s >= t->n_surf || !box || !regular || !fu || !fv)
 		return -1;
 	f = &t->sf[s];
-	if (!(box[0] >= f->u0 && box[1] <= f->u1 && box[2] >= f->v0 && box[3] <= f->v1) ||
-	    sub_cert(f, box, &rc))
+	g = region_at(t, s, 0.5 * (box[0] + box[1]), 0.5 * (box[2] + box[3]));
+	if (!g)
+		return -1;
+	/* the certificate a solve cuts the box from: its quarter's, or
+	 * its region's */
+	ri = (int)(g - t->rcell);
+	box_of(g, -1, gb);
+	if (!(box[0] >= gb[0] && box[1] <= gb[1] && box[2] >= gb[2] && box[3] <= gb[3]))
+		return -1;
+	top = &g->cert;
+	for (k = 0; k < 4; k++) {
+		box_of(g, k, qb);
+		if (box[0] >= qb[0] && box[1] <= qb[1] && box[2] >= qb[2] && box[3] <= qb[3])
+			top = &t->qcert[4 * ri + k];
+	}
+	if (top->t3ok)
+		taylor_cert(f, box, top, &rc);
+	else if (sub_cert(f, box, &rc))
 		return -1;
 	home = &t->cell[t->sf[s].first_cell +
 			cell_of(f, 0.5 * (box[0] + box[1]), 0.5 * (box[2] + box[3]))];
@@ -3501,8 +3536,10 @@ static struct iv iv_pad(struct iv a)
 
 static void iv_grow(struct iv *a, double x)
 {
-	a->lo = fmin(a->lo, x);
-	a->hi = fmax(a->hi, x);
+	/* as fmin and fmax (a NaN x leaves a as it is), without their
+	 * calls: run for every point of a net at update time too */
+	a->lo = x < a->lo ? x : a->lo;
+	a->hi = x > a->hi ? x : a->hi;
 }
 
 /*
@@ -3574,6 +3611,9 @@ static void net_ranges(const double *P, int p, int q, double du, double dv,
  * (sub_cert()): no allocation, bounded loops. Returns 0, or PX_E_INVAL
  * where the weights are not positive.
  */
+static void cert_fill(struct rcert *ce, const struct iv Su[3], const struct iv Sv[3],
+		      double du, double dv);
+
 static int net_cert(const double *pw, int p, int q, double du, double dv,
 		    struct rcert *ce)
 {
@@ -3615,7 +3655,19 @@ static int net_cert(const double *pw, int p, int q, double du, double dv,
 				      iv_mul(Sv[k], Wu)),
 			       iv_mul(S, Wuv)), W));
 	}
+	cert_fill(ce, Su, Sv, du, dv);
+	return PX_OK;
+}
+
+/* The rest of certificate ce from its enclosures of S, Su, Sv and the
+ * second derivatives over a box of size du x dv: the first fundamental
+ * form, the bounds m_ij and the midpoint-radius form of H. */
+static void cert_fill(struct rcert *ce, const struct iv Su[3], const struct iv Sv[3],
+		      double du, double dv)
+{
+	int k, i;
 	ce->G11 = ce->G12 = ce->G22 = iv_pt(0.0);
+	ce->m11 = ce->m12 = ce->m22 = 0.0;
 	for (k = 0; k < 3; k++) {
 		struct iv a = Su[k], b = Sv[k], sa = iv_mul(a, a), sb = iv_mul(b, b);
 		/* squares are not negative */
@@ -3660,7 +3712,104 @@ static int net_cert(const double *pw, int p, int q, double du, double dv,
 	}
 	ce->hu = 0.5 * du;
 	ce->hv = 0.5 * dv;
-	return PX_OK;
+}
+
+/*
+ * The third-derivative bounds of certificate ce (t3, t3ok) from the Bezier
+ * net pw of its box (du x dv), where the weights are all equal: the third
+ * difference nets, as net_ranges() does the lower ones. Rational nets
+ * get none (their sub-boxes are cut by sub_cert()).
+ */
+static void net_third(const double *pw, int p, int q, double du, double dv,
+		      struct rcert *ce)
+{
+	static const int oa[4] = {3, 2, 1, 0};
+	int i, j, k, o, n = p + 1;
+	double w0 = pw[3];
+	ce->t3ok = 0;
+	for (i = 0; i < (p + 1) * (q + 1); i++)
+		if (pw[4 * i + 3] != w0)
+			return;
+	for (o = 0; o < 4; o++) {
+		int a = oa[o], b = 3 - a, x, y;
+		double f = 1.0 / w0;
+		for (i = 0; i < a; i++)
+			f *= (double)(p - i) / du;
+		for (j = 0; j < b; j++)
+			f *= (double)(q - j) / dv;
+		for (k = 0; k < 3; k++) {
+			double m = 0.0;
+			if (a <= p && b <= q)
+				for (j = 0; j + b <= q; j++)
+					for (i = 0; i + a <= p; i++) {
+						double d = 0.0;
+						for (y = 0; y <= b; y++)
+							for (x = 0; x <= a; x++)
+								d += ((a - x + b - y) & 1 ? -1.0 : 1.0) *
+								     px_bern_binom(a, x) * px_bern_binom(b, y) *
+								     pw[4 * ((j + y) * n + i + x) + k];
+						m = fmax(m, fabs(d));
+					}
+			ce->t3[o][k] = iv_pad(iv_pt(m * f)).hi;
+		}
+	}
+	ce->t3ok = 1;
+}
+
+/*
+ * Certificate of sub-box b (u0, u1, v0, v1) of a box whose certificate
+ * top has third-derivative bounds (t3ok), at update time: the values at
+ * b's centre and the mean value theorem per coordinate, S_uu in
+ * S_uu(c) +- (|S_uuu| h_u + |S_uuv| h_v) and so on down to S; then
+ * cert_fill(). A fraction of sub_cert()'s cost (14,000 instructions),
+ * and about as wide as b; the parent's bounds hold for every piece of
+ * it.
+ */
+static void taylor_cert(const struct ssurf *f, const double b[4],
+			const struct rcert *top, struct rcert *ce)
+{
+	struct px_nurbs_surf_derivs d;
+	struct iv Su[3], Sv[3];
+	double hu = 0.5 * (b[1] - b[0]), hv = 0.5 * (b[3] - b[2]);
+	int k;
+	memset(ce, 0, sizeof(*ce));
+	surf_eval2(f, b[0] + hu, b[2] + hv, &d);
+	for (k = 0; k < 3; k++) {
+		const double *t = &top->t3[0][0];
+		double s = (&d.s.x)[k], su = (&d.su.x)[k], sv = (&d.sv.x)[k];
+		double suu = (&d.suu.x)[k], suv = (&d.suv.x)[k], svv = (&d.svv.x)[k];
+		double ruu = t[0 * 3 + k] * hu + t[1 * 3 + k] * hv;
+		double ruv = t[1 * 3 + k] * hu + t[2 * 3 + k] * hv;
+		double rvv = t[2 * 3 + k] * hu + t[3 * 3 + k] * hv;
+		struct iv x;
+		x.lo = suu - ruu;
+		x.hi = suu + ruu;
+		ce->Suu[k] = iv_pad(x);
+		x.lo = suv - ruv;
+		x.hi = suv + ruv;
+		ce->Suv[k] = iv_pad(x);
+		x.lo = svv - rvv;
+		x.hi = svv + rvv;
+		ce->Svv[k] = iv_pad(x);
+		ruu = iv_mag(ce->Suu[k]) * hu + iv_mag(ce->Suv[k]) * hv;
+		rvv = iv_mag(ce->Suv[k]) * hu + iv_mag(ce->Svv[k]) * hv;
+		x.lo = su - ruu;
+		x.hi = su + ruu;
+		Su[k] = iv_pad(x);
+		x.lo = sv - rvv;
+		x.hi = sv + rvv;
+		Sv[k] = iv_pad(x);
+		ruu = iv_mag(Su[k]) * hu + iv_mag(Sv[k]) * hv;
+		x.lo = s - ruu;
+		x.hi = s + ruu;
+		ce->S[k] = iv_pad(x);
+	}
+	cert_fill(ce, Su, Sv, 2.0 * hu, 2.0 * hv);
+	ce->sc = d.s;
+	ce->suc = d.su;
+	ce->svc = d.sv;
+	ce->n1 = fabs(d.su.x) + fabs(d.su.y) + fabs(d.su.z);
+	ce->n2 = fabs(d.sv.x) + fabs(d.sv.y) + fabs(d.sv.z);
 }
 
 /* The centre values of certificate ce of box (u0, u1, v0, v1). */
@@ -3694,6 +3843,7 @@ static int cell_cert(struct px_strack *t, struct scell *c, const struct ssurf *f
 	rc = net_cert(sub.pw, p, q, du, dv, ce);
 	if (rc)
 		return rc;
+	net_third(sub.pw, p, q, du, dv, ce);
 	cert_centre(f, c->u0, c->u1, c->v0, c->v1, ce);
 	for (k = 0; k < 4; k++) {
 		struct cside *sd;
