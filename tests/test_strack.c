@@ -1866,6 +1866,44 @@ static void test_focal_hover(void)
 	 * (seeds 1-4) */
 	PX_CHECK_MSG(4 * global < steps, "answered globally %ld of %ld", global, steps);
 	PX_CHECK_MSG(cuts > 0, "no box was cut near the focal points");
+	{
+		/* the same knots about the first 8 focal points with the
+		 * cuts and without (test hook: Newton from the centre of
+		 * every open box instead): the Newton runs from seeds they
+		 * leave */
+		uint64_t runs[2] = {0, 0};
+		long wrong2 = 0;
+		int f;
+		for (f = 0; f < 2; f++) {
+			px__strack_sub_fault = f;
+			for (i = 0; i < nf && i < 8; i++) {
+				struct px_strack_result r;
+				struct px_strack_stats s0, s1;
+				px_strack_reset(t, fp[i], &r);
+				px_strack_get_stats(t, &s0);
+				for (k = 0; k < 400; k++) {
+					double a = 2.0 * M_PI * k / 400.0, rad = 5e-3 * size;
+					px_vec3 q = px_v3_add(fp[i], px_v3(rad * sin(3.0 * a),
+									   rad * sin(4.0 * a + 1.0),
+									   rad * sin(5.0 * a + 2.0)));
+					struct px_dist_result g;
+					px_strack_update(t, q, &r);
+					px_dist_query(ref, q, &g);
+					if (fabs(r.dist - g.dist) > 1e-9 * (size + g.dist))
+						wrong2++;
+				}
+				px_strack_get_stats(t, &s1);
+				runs[f] += s1.seed_runs - s0.seed_runs;
+			}
+		}
+		px__strack_sub_fault = 0;
+		printf("  first 8 focal points: Newton runs from seeds %llu with the cuts, "
+		       "%llu without, wrong %ld\n", (unsigned long long)runs[0],
+		       (unsigned long long)runs[1], wrong2);
+		PX_CHECK_INT_EQ(wrong2, 0);
+		PX_CHECK_MSG(4 * runs[0] < runs[1], "the cuts left %llu of %llu Newton runs",
+			     (unsigned long long)runs[0], (unsigned long long)runs[1]);
+	}
 out:
 	px_strack_free(t);
 	px_dist_model_free(ref);
