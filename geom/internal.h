@@ -144,10 +144,11 @@ extern int px__strack_contract_fault;
 /* px_strack: the certificate made at update time for box (u0, u1, v0,
  * v1) of surface s (inside one region cell: taylor_cert() from its
  * quarter's or region's third-derivative bounds on a polynomial patch,
- * sub_cert() otherwise) at p, as a solve's cut uses it: 1 proven free of critical points, 0 its one
- * point found by the contraction (into fu, fv), 2 undecided; *regular 1
- * when its Hessian enclosure is regular (at most one point). -1 for bad
- * arguments or a box across region cells. */
+ * sub_cert() otherwise) at p, as a solve's cut uses it: 1 proven free
+ * of critical points, 0 its one point found by the contraction (into
+ * fu, fv), 2 undecided; *regular 1 when its Hessian enclosure is
+ * regular (at most one point). -1 for bad arguments or a box across
+ * region cells. */
 int px__strack_sub(const struct px_strack *t, int s, const double box[4], px_vec3 p,
 		   int *regular, double *fu, double *fv);
 /* px_strack: 1 leaves every box no certificate decides uncut (Newton

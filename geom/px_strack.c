@@ -859,12 +859,10 @@ static int seed_solve(struct px_strack *t, struct ssurf *f, const struct scell *
  * solved by contract_solve() (sk: 5 ch for region ch, 5 ch + 1 + k for
  * its quarter k); a quarter left open is cut into sub-boxes with
  * certificates of their own (sub_solve(); sk: ST_SK_SUB plus its number
- * as before). Puts up to 16 of them in su, sv (cell-relative, the
- * boxes' centres), sk; returns their count.
+ * as before). Puts up to 16 of them in sk; returns their count.
  */
 #define ST_SK_SUB 32
-static int cell_seeds(const struct cell_done *done, double *su, double *sv,
-		      int *sk)
+static int cell_seeds(const struct cell_done *done, int *sk)
 {
 	int ch, k, ns = 0;
 	for (ch = 0; ch < 4; ch++) {
@@ -872,16 +870,12 @@ static int cell_seeds(const struct cell_done *done, double *su, double *sv,
 		if (done->region[ch] == BOX_DONE)
 			continue;
 		if (done->region[ch] == BOX_EXACT) {
-			su[ns] = 0.5 * (ch & 1) + 0.25;
-			sv[ns] = 0.5 * (ch >> 1) + 0.25;
 			sk[ns++] = 5 * ch;
 			continue;
 		}
 		for (k = 0; k < 4; k++) {
 			if (qe[k] == BOX_DONE)
 				continue;
-			su[ns] = 0.5 * (ch & 1) + 0.25 * (k & 1) + 0.125;
-			sv[ns] = 0.5 * (ch >> 1) + 0.25 * (k >> 1) + 0.125;
 			sk[ns++] = (qe[k] == BOX_EXACT ? 0 : ST_SK_SUB) + 5 * ch + 1 + k;
 		}
 	}
@@ -996,8 +990,9 @@ static int seed_solve(struct px_strack *t, struct ssurf *f, const struct scell *
  * or a contraction that stayed undecided), at ps (roots followed to p):
  * its quarters get certificates of their own (taylor_cert() from top's
  * third-derivative bounds on a polynomial patch, sub_cert() from their
- * Bezier nets on a rational one; about half as wide) and are each done (proven empty, or holding a held point and
- * no other), solved exactly (contract_solve()) or cut again, down to
+ * Bezier nets on a rational one; about half as wide) and are each done
+ * (proven empty, or holding a held point and no other), solved exactly
+ * (contract_solve()) or cut again, down to
  * ST_SUB_DEPTH levels below the box; a piece still open there, or where
  * the solve's allowance (t->sub_left) has no room for another cut, gets
  * Newton from its centre. t->sub_work holds the work made or reserved:
@@ -1052,13 +1047,10 @@ static int sub_solve(struct px_strack *t, struct ssurf *f, const struct scell *c
  * region keeps moving for the rest of the step, possibly out of the
  * cell); t->sub_work the subdivisions' work. Returns 0 or PX_E_NOSPC. */
 static int seeds_run(struct px_strack *t, const struct scell *c, px_vec3 ps,
-		     px_vec3 p, const double *su, const double *sv, const int *sk,
-		     int ns)
+		     px_vec3 p, const int *sk, int ns)
 {
 	struct ssurf *f = &t->sf[c->surf];
 	int i, rc;
-	(void)su;
-	(void)sv;
 	t->st.cell_solves++;
 	/* every item holds one seed's worth; sub_solve() adds its cuts */
 	t->sub_work = ns * ST_SUB_SEED;
@@ -1085,11 +1077,10 @@ static int seeds_run(struct px_strack *t, const struct scell *c, px_vec3 ps,
 static int cell_solve(struct px_strack *t, const struct scell *c, px_vec3 p)
 {
 	struct cell_done done;
-	double su[ST_SEEDS_MAX], sv[ST_SEEDS_MAX];
 	int sk[ST_SEEDS_MAX];
 	cell_done(t, c, p, 1, &done);
 	t->sub_left = INT_MAX / 2;
-	return seeds_run(t, c, p, p, su, sv, sk, cell_seeds(&done, su, sv, sk));
+	return seeds_run(t, c, p, p, sk, cell_seeds(&done, sk));
 }
 
 /* Solve c at ps (roots followed to p) if its work fits: *units grows by
@@ -1099,10 +1090,9 @@ static int cell_solve_budget(struct px_strack *t, const struct scell *c,
 			     px_vec3 ps, px_vec3 p, int *units, int lim)
 {
 	struct cell_done done;
-	double su[ST_SEEDS_MAX], sv[ST_SEEDS_MAX];
 	int sk[ST_SEEDS_MAX];
 	int ns, cost, rc, more, tests = cell_done(t, c, ps, px_v3_dist2(ps, p) == 0.0, &done);
-	ns = cell_seeds(&done, su, sv, sk);
+	ns = cell_seeds(&done, sk);
 	/* the checks' unit only where they were made */
 	cost = solve_units(t, ns) - (tests == 0);
 	if (lim > 0 && *units > 0 && *units + cost > lim)
@@ -1110,13 +1100,13 @@ static int cell_solve_budget(struct px_strack *t, const struct scell *c,
 	*units += cost;
 	/* the cuts of open boxes may use what the bound leaves (m more
 	 * seeds cost at most ceil(7 m / full_seeds) units more), up to
-	 * a full solve more: a cell's cuts must not take the work of
+	 * half a full solve more: a cell's cuts must not take the work of
 	 * the other cells of the step (they would wait, the set lagging) */
 	more = lim > 0 ? (lim - *units) * t->full_seeds / (ST_UNITS - 1) : INT_MAX / 64;
-	if (more > t->full_seeds)
-		more = t->full_seeds;
+	if (more > t->full_seeds / 2)
+		more = t->full_seeds / 2;
 	t->sub_left = ST_SUB_SEED * (ns + more);
-	rc = seeds_run(t, c, ps, p, su, sv, sk, ns);
+	rc = seeds_run(t, c, ps, p, sk, ns);
 	/* the sub-boxes' work past the one seed each item was counted as
 	 * (bounded: ST_SUB_DEPTH levels) */
 	more = (t->sub_work + ST_SUB_SEED - 1) / ST_SUB_SEED - ns;
@@ -3603,6 +3593,9 @@ static void net_ranges(const double *P, int p, int q, double du, double dv,
 	}
 }
 
+static void cert_fill(struct rcert *ce, const struct iv Su[3], const struct iv Sv[3],
+		      double du, double dv);
+
 /*
  * The enclosures of certificate ce over a box of size du x dv from its
  * Bezier net pw ((p + 1) x (q + 1) homogeneous points, u fastest): S and
@@ -3611,9 +3604,6 @@ static void net_ranges(const double *P, int p, int q, double du, double dv,
  * (sub_cert()): no allocation, bounded loops. Returns 0, or PX_E_INVAL
  * where the weights are not positive.
  */
-static void cert_fill(struct rcert *ce, const struct iv Su[3], const struct iv Sv[3],
-		      double du, double dv);
-
 static int net_cert(const double *pw, int p, int q, double du, double dv,
 		    struct rcert *ce)
 {
@@ -4189,10 +4179,9 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	t->opts = o;
 	{
 		struct cell_done none;
-		double su[ST_SEEDS_MAX], sv[ST_SEEDS_MAX];
 		int sk[ST_SEEDS_MAX];
 		memset(&none, 0, sizeof(none));
-		t->full_seeds = cell_seeds(&none, su, sv, sk);
+		t->full_seeds = cell_seeds(&none, sk);
 	}
 	t->n_curves = n_curves;
 	t->n_surf = n_surfs;

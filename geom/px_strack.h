@@ -169,10 +169,11 @@ struct px_strack_opts {
 	 * counts 1/8 of a solve (measured: about 2,200 instructions
 	 * against 7,000 or more for each Newton run from a seed; a box's
 	 * contraction, stats.exact_solves, counts as one seed, and the
-	 * cut of an open box four certificates made at update time (0.2
-	 * of a seed each on a polynomial patch, 0.85 on a rational one; a cut is made only where the bound leaves room for
-	 * it and a seed in each piece), one
-	 * whose certificates leave only some regions or quarters open
+	 * cut of an open box four certificates made at update time, 0.2
+	 * of a seed each on a polynomial patch, 0.85 on a rational one; a
+	 * cut is made only where the bound leaves room for it and a seed
+	 * in each piece, up to half a full solve a cell), one whose
+	 * certificates leave only some regions or quarters open
 	 * (near a focal sheet) 1/8 plus that share of the other 7/8; after
 	 * a long step, finding where it met a hit cell's region (up to 8
 	 * rounds of certificate radii) 1/8 a round; the escape bound 1/64 a
@@ -275,10 +276,11 @@ struct px_strack_stats {
 	 * from the seeds of the boxes where no contraction holds */
 	uint64_t exact_solves, exact_open, seed_runs;
 	/* boxes no certificate made at setup decides are cut in four, down
-	 * to two levels, each piece with a certificate made from its own
-	 * Bezier net (enclosures about as wide as the piece): sub_boxes of
-	 * those made, sub_open the pieces of the last level still
-	 * undecided (Newton from their centres) */
+	 * to two levels, each piece with a certificate of its own made at
+	 * update time (enclosures about as wide as the piece): sub_boxes
+	 * of those made, sub_open the pieces left undecided (Newton from
+	 * their centres: at the last level, or where the work bound had no
+	 * room for a cut) */
 	uint64_t sub_boxes, sub_open;
 	/* rounds spent finding where a long step met a hit cell's region
 	 * (two certificate radii each; counted in max_solves as 1/8 of a

@@ -1329,9 +1329,9 @@ static void test_contract_regions(void)
  * random regions) are decided as a solve decides them, and every claim
  * is checked: proven empty, the dense count and Newton from a 2 x 2 grid
  * inside find none; found, the point lies in it and the dense count has
- * no second one there; regular, no two. *open_set counts the pieces of
- * quarters the setup certificates left undecided, *open_cut those of
- * them still undecided after the cut.
+ * no second one there; regular, no two. *open_set counts the
+ * second-level pieces of quarters whose setup certificate does not
+ * contract, *open_cut those of them still undecided after the cut.
  */
 static long sub_check(const struct px_strack *t, const struct px_nurbs_surf *s,
 		      const px_vec3 *pts, int npts, long *claims, long *found,
@@ -1470,7 +1470,8 @@ static void test_sub_boxes(void)
 		px__strack_contract_fault = 0;
 		px__strack_one_fault = 0;
 		printf("  %s: %ld pieces decided (%ld holding a point), %ld wrong; of %ld "
-		       "second-level pieces of quarters left open at setup %ld still open; "
+		       "second-level pieces of quarters whose setup certificate does not "
+		       "contract %ld still open; "
 		       "radii dropped: %ld wrong of %ld\n",
 		       five_names[m], claims, found, bad, oset, ocut, bad_f, c2);
 		PX_CHECK_INT_EQ(bad, 0);
@@ -1859,7 +1860,7 @@ static void test_focal_hover(void)
 	PX_CHECK_INT_EQ(allocs, 0);
 	PX_CHECK_MSG(solved > steps / 4, "the path seldom met the focal sheet: "
 		     "%ld solves in %ld steps", solved, steps);
-	/* default seed: 2.1 % (1.3 % before open boxes were cut, Newton
+	/* default seed: 1.8 % (1.3 % before open boxes were cut, Newton
 	 * from seeds there; 19 % with every piece's certificate cut from
 	 * its Bezier net, as on rational patches); before the budget
 	 * counted seeds, every step's solves at a full solve's cost: 31-48 %
