@@ -1191,25 +1191,20 @@ static void test_one_regions(void)
  * at random. Returns the violations; *claims the boxes decided, *open
  * those left undecided, *found those found to hold a point.
  */
-static long contract_check(const struct px_strack *t, const struct px_nurbs_surf *s,
-			   const px_vec3 *pts, int npts, long *claims, long *open,
-			   long *found)
+/* The region cells of surface 0 of t (up to 2048, into rb): the boxes
+ * met on a grid finer than any region. Returns their count. */
+static int region_boxes(const struct px_strack *t, const struct px_nurbs_surf *s,
+			px_vec3 p, double rb[][4])
 {
-	static double rb[2048][4];
-	static char pick[2048];
-	double u0, u1, v0, v1, tu, tv;
-	long bad = 0;
-	int nr = 0, i, j, k, b, amb = 0;
+	double u0, u1, v0, v1;
+	int nr = 0, i, j;
 	px_nurbs_surf_domain(s, &u0, &u1, &v0, &v1);
-	tu = 1e-9 * (u1 - u0);
-	tv = 1e-9 * (v1 - v0);
-	/* the regions: the boxes met on a grid finer than any region */
 	for (j = 0; j < 96; j++)
 		for (i = 0; i < 96; i++) {
 			double box[4], fu[5], fv[5];
 			int out[5], q;
 			if (px__strack_contract(t, 0, u0 + (u1 - u0) * (i + 0.5) / 96,
-						v0 + (v1 - v0) * (j + 0.5) / 96, pts[0], box, out,
+						v0 + (v1 - v0) * (j + 0.5) / 96, p, box, out,
 						fu, fv) < 0)
 				continue;
 			for (q = 0; q < nr; q++)
@@ -1218,17 +1213,41 @@ static long contract_check(const struct px_strack *t, const struct px_nurbs_surf
 			if (q == nr && nr < 2048)
 				memcpy(rb[nr++], box, sizeof(box));
 		}
+	return nr;
+}
+
+/* pick[i] set for the regions of rb about a critical point of the
+ * dense count just made (last_fu, last_fv) and for n random ones. */
+static void pick_regions(const double rb[][4], int nr, char *pick, int n)
+{
+	int i, j;
+	memset(pick, 0, (size_t)nr);
+	for (i = 0; i < nr; i++)
+		for (j = 0; j < last_n && !pick[i]; j++)
+			pick[i] = fabs(last_fu[j] - 0.5 * (rb[i][0] + rb[i][1])) <=
+					  1.5 * (rb[i][1] - rb[i][0]) &&
+				  fabs(last_fv[j] - 0.5 * (rb[i][2] + rb[i][3])) <=
+					  1.5 * (rb[i][3] - rb[i][2]);
+	for (i = 0; i < n && nr > 0; i++)
+		pick[(int)(px_rand_unit() * nr) % nr] = 1;
+}
+
+static long contract_check(const struct px_strack *t, const struct px_nurbs_surf *s,
+			   const px_vec3 *pts, int npts, long *claims, long *open,
+			   long *found)
+{
+	static double rb[2048][4];
+	static char pick[2048];
+	double u0, u1, v0, v1, tu, tv;
+	long bad = 0;
+	int nr, i, k, b, amb = 0;
+	px_nurbs_surf_domain(s, &u0, &u1, &v0, &v1);
+	tu = 1e-9 * (u1 - u0);
+	tv = 1e-9 * (v1 - v0);
+	nr = region_boxes(t, s, pts[0], rb);
 	for (k = 0; k < npts; k++) {
 		count_crit(s, pts[k], &amb);
-		memset(pick, 0, sizeof(pick));
-		for (i = 0; i < nr; i++)
-			for (j = 0; j < last_n && !pick[i]; j++)
-				pick[i] = fabs(last_fu[j] - 0.5 * (rb[i][0] + rb[i][1])) <=
-						  1.5 * (rb[i][1] - rb[i][0]) &&
-					  fabs(last_fv[j] - 0.5 * (rb[i][2] + rb[i][3])) <=
-						  1.5 * (rb[i][3] - rb[i][2]);
-		for (i = 0; i < 24 && nr > 0; i++)
-			pick[(int)(px_rand_unit() * nr) % nr] = 1;
+		pick_regions(rb, nr, pick, 24);
 		for (i = 0; i < nr; i++) {
 			double box[4], fu[5], fv[5];
 			int out[5];
@@ -1341,35 +1360,14 @@ static long sub_check(const struct px_strack *t, const struct px_nurbs_surf *s,
 	static char pick[2048];
 	double u0, u1, v0, v1, tu, tv;
 	long bad = 0;
-	int nr = 0, i, j, k, amb = 0;
+	int nr, i, k, amb = 0;
 	px_nurbs_surf_domain(s, &u0, &u1, &v0, &v1);
 	tu = 1e-9 * (u1 - u0);
 	tv = 1e-9 * (v1 - v0);
-	for (j = 0; j < 96; j++)
-		for (i = 0; i < 96; i++) {
-			double box[4], fu[5], fv[5];
-			int out[5], q;
-			if (px__strack_contract(t, 0, u0 + (u1 - u0) * (i + 0.5) / 96,
-						v0 + (v1 - v0) * (j + 0.5) / 96, pts[0], box, out,
-						fu, fv) < 0)
-				continue;
-			for (q = 0; q < nr; q++)
-				if (rb[q][0] == box[0] && rb[q][2] == box[2])
-					break;
-			if (q == nr && nr < 2048)
-				memcpy(rb[nr++], box, sizeof(box));
-		}
+	nr = region_boxes(t, s, pts[0], rb);
 	for (k = 0; k < npts; k++) {
 		count_crit(s, pts[k], &amb);
-		memset(pick, 0, sizeof(pick));
-		for (i = 0; i < nr; i++)
-			for (j = 0; j < last_n && !pick[i]; j++)
-				pick[i] = fabs(last_fu[j] - 0.5 * (rb[i][0] + rb[i][1])) <=
-						  1.5 * (rb[i][1] - rb[i][0]) &&
-					  fabs(last_fv[j] - 0.5 * (rb[i][2] + rb[i][3])) <=
-						  1.5 * (rb[i][3] - rb[i][2]);
-		for (i = 0; i < 8 && nr > 0; i++)
-			pick[(int)(px_rand_unit() * nr) % nr] = 1;
+		pick_regions(rb, nr, pick, 8);
 		for (i = 0; i < nr; i++) {
 			double box[4], fu[5], fv[5];
 			int out[5], qk, m;
