@@ -143,8 +143,8 @@ int px__strack_contract(const struct px_strack *t, int s, double u, double v,
 extern int px__strack_contract_fault;
 /* px_strack: the certificate made at update time for box (u0, u1, v0,
  * v1) of surface s (inside one region cell: taylor_cert() from its
- * quarter's or region's third-derivative bounds on a polynomial patch,
- * sub_cert() otherwise) at p, as a solve's cut uses it: 1 proven free
+ * quarter's or region's third-derivative bounds) at p, as a solve's cut
+ * uses it: 1 proven free
  * of critical points, 0 its one point found by the contraction (into
  * fu, fv), 2 undecided; *regular 1 when its Hessian enclosure is
  * regular (at most one point). -1 for bad arguments or a box across

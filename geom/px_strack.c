@@ -95,11 +95,10 @@ struct rcert {
 	double hu, hv;          /* half widths of the cell in u, v */
 	int nside;
 	struct cside side[4];
-	/* polynomial patches (t3ok): bounds over the cell of |S_uuu|,
-	 * |S_uuv|, |S_uvv|, |S_vvv| per coordinate, from which the
-	 * certificates of its sub-boxes are made (taylor_cert()) */
+	/* bounds over the cell of |S_uuu|, |S_uuv|, |S_uvv|, |S_vvv| per
+	 * coordinate, from which the certificates of its sub-boxes are made
+	 * (taylor_cert()) */
 	double t3[4][3];
-	int t3ok;
 };
 
 struct scell {
@@ -146,15 +145,12 @@ struct patch {
 	int p, q;
 	int rat;         /* weights not all equal */
 	const double *c; /* 4 (p + 1)(q + 1) */
-	/* its Bezier net, homogeneous, u fastest (4 per point): the run-time
-	 * certificates of sub-boxes are made from it (sub_cert()) */
-	const double *net;
 };
 
 struct ssurf {
 	struct px_nurbs_surf s;
 	struct patch *pt;       /* npu x npv, u fastest */
-	double *pool, *npool;   /* power forms, Bezier nets of the patches */
+	double *pool;
 	double *pu, *pv;        /* patch bounds (npu + 1, npv + 1) */
 	int npu, npv;
 	double *mem;            /* owned copy of knots and pw */
@@ -895,10 +891,6 @@ static int solve_units(const struct px_strack *t, int ns)
 /* ------------------------------------------------------------------ */
 /* run-time subdivision of the boxes the setup certificates leave open */
 
-static int net_cert(const double *pw, int p, int q, double du, double dv,
-		    struct rcert *ce);
-static void cert_centre(const struct ssurf *f, double u0, double u1, double v0,
-			double v1, struct rcert *ce);
 static void taylor_cert(const struct ssurf *f, const double b[4],
 			const struct rcert *top, struct rcert *ce);
 
@@ -909,56 +901,6 @@ int px__strack_sub_fault = 0;
 /* Levels of sub-boxes below a region's quarter (or a box whose
  * contraction stayed undecided): 4 + 16 certificates at most each. */
 #define ST_SUB_DEPTH 2
-
-/* The piece [a, b] of [0, 1] of the Bezier polygon of homogeneous
- * points x[0..3], x[s..s + 3], ..., x[n s..], in place: de Casteljau at
- * a keeping the right part, then at the image of b keeping the left
- * (convex combinations only). */
-static void bez_piece(double *x, int s, int n, double a, double b)
-{
-	int r, i, k;
-	if (a > 0.0) {
-		for (r = 1; r <= n; r++)
-			for (i = 0; i <= n - r; i++)
-				for (k = 0; k < 4; k++)
-					x[i * s + k] = (1.0 - a) * x[i * s + k] + a * x[(i + 1) * s + k];
-		b = (b - a) / (1.0 - a);
-	}
-	if (b < 1.0)
-		for (r = 1; r <= n; r++)
-			for (i = n; i >= r; i--)
-				for (k = 0; k < 4; k++)
-					x[i * s + k] = (1.0 - b) * x[(i - 1) * s + k] + b * x[i * s + k];
-}
-
-/* Certificate of box b (u0, u1, v0, v1), inside one Bezier patch of f,
- * at update time: its net cut from the patch's, then net_cert() and the
- * centre values (no open sides: the tests of a solve do not use them).
- * Returns 0 or PX_E_INVAL (weights). */
-static int sub_cert(const struct ssurf *f, const double b[4], struct rcert *ce)
-{
-	double net[4 * (PX_NURBS_MAX_DEGREE + 1) * (PX_NURBS_MAX_DEGREE + 1)];
-	double um = 0.5 * (b[0] + b[1]), vm = 0.5 * (b[2] + b[3]), s0, s1, t0, t1;
-	const struct patch *pt = &f->pt[bsearch_bounds(f->pv, f->npv, vm) * f->npu +
-					bsearch_bounds(f->pu, f->npu, um)];
-	int p = pt->p, q = pt->q, i, j, rc;
-	memcpy(net, pt->net, 4 * (size_t)((p + 1) * (q + 1)) * sizeof(double));
-	s0 = fmax((b[0] - pt->u0) * pt->iu, 0.0);
-	s1 = fmin((b[1] - pt->u0) * pt->iu, 1.0);
-	t0 = fmax((b[2] - pt->v0) * pt->iv, 0.0);
-	t1 = fmin((b[3] - pt->v0) * pt->iv, 1.0);
-	if (!(s0 < s1 && t0 < t1))
-		return PX_E_INVAL;
-	for (j = 0; j <= q; j++)
-		bez_piece(net + 4 * j * (p + 1), 4, p, s0, s1);
-	for (i = 0; i <= p; i++)
-		bez_piece(net + 4 * i, 4 * (p + 1), q, t0, t1);
-	rc = net_cert(net, p, q, b[1] - b[0], b[3] - b[2], ce);
-	if (rc)
-		return rc;
-	cert_centre(f, b[0], b[1], b[2], b[3], ce);
-	return PX_OK;
-}
 
 /* Quarter k of box b into q (k & 1: upper half in u, k & 2: in v). */
 static void box_quarter(const double b[4], int k, double q[4])
@@ -975,25 +917,21 @@ static int seed_solve(struct px_strack *t, struct ssurf *f, const struct scell *
 		      const struct rcert *rc, const double b[4]);
 
 /* The work of a solve in sixteenths of a seed's run: a certificate
- * made at update time costs about 0.85 of one (measured on the 16-patch
- * bench surface: 14,300 instructions, against 17,000 for a seed's
- * Newton run with the following of its root). */
-#define ST_SUB_CERT 14
-/* the same from the centre values and the third-derivative bounds of a
- * polynomial patch (taylor_cert(): a piece and its tests about 3,500
- * instructions on the same paths) */
-#define ST_SUB_TAYLOR 3
+ * made at update time (taylor_cert()) and its tests cost about 3/16 of
+ * one (measured on the 16-patch bench surface: 3,500 instructions,
+ * against 17,000 for a seed's Newton run with the following of its
+ * root). */
+#define ST_SUB_CERT 3
 #define ST_SUB_SEED 16
 
 /*
  * Box b of cell c, left open by the certificates it has (setup's, top,
  * or a contraction that stayed undecided), at ps (roots followed to p):
  * its quarters get certificates of their own (taylor_cert() from top's
- * third-derivative bounds on a polynomial patch, sub_cert() from their
- * Bezier nets on a rational one; about half as wide) and are each done
+ * third-derivative bounds; about half as wide) and are each done
  * (proven empty, or holding a held point and no other), solved exactly
- * (contract_solve()) or cut again, down to
- * ST_SUB_DEPTH levels below the box; a piece still open there, or where
+ * (contract_solve()) or cut again, down to ST_SUB_DEPTH levels below
+ * the box; a piece still open there, or where
  * the solve's allowance (t->sub_left) has no room for another cut, gets
  * Newton from its centre. t->sub_work holds the work made or reserved:
  * every open piece holds one seed's worth (the box's own is in it when
@@ -1006,7 +944,7 @@ static int sub_solve(struct px_strack *t, struct ssurf *f, const struct scell *c
 		     px_vec3 p)
 {
 	int known = px_v3_dist2(ps, p) == 0.0, k, r,
-	    cut = 4 * (top->t3ok ? ST_SUB_TAYLOR : ST_SUB_CERT) + 3 * ST_SUB_SEED;
+	    cut = 4 * ST_SUB_CERT + 3 * ST_SUB_SEED;
 	if (depth > ST_SUB_DEPTH || t->sub_work + cut > t->sub_left ||
 	    px__strack_sub_fault) {
 		t->st.sub_open++;
@@ -1017,16 +955,11 @@ static int sub_solve(struct px_strack *t, struct ssurf *f, const struct scell *c
 	for (k = 0; k < 4; k++) {
 		struct rcert rc;
 		double sb[4];
-		int w = BOX_SEEDS;
+		int w;
 		box_quarter(b, k, sb);
-		if (top->t3ok) {
-			taylor_cert(f, sb, top, &rc);
-			t->st.sub_boxes++;
-			w = box_done(f, &rc, sb, ps, known);
-		} else if (!sub_cert(f, sb, &rc)) {
-			t->st.sub_boxes++;
-			w = box_done(f, &rc, sb, ps, known);
-		}
+		taylor_cert(f, sb, top, &rc);
+		t->st.sub_boxes++;
+		w = box_done(f, &rc, sb, ps, known);
 		if (w == BOX_DONE) {
 			t->sub_work -= ST_SUB_SEED;
 			continue;
@@ -3358,10 +3291,7 @@ int px__strack_sub(const struct px_strack *t, int s, const double box[4], px_vec
 		if (box[0] >= qb[0] && box[1] <= qb[1] && box[2] >= qb[2] && box[3] <= qb[3])
 			top = &t->qcert[4 * ri + k];
 	}
-	if (top->t3ok)
-		taylor_cert(f, box, top, &rc);
-	else if (sub_cert(f, box, &rc))
-		return -1;
+	taylor_cert(f, box, top, &rc);
 	home = &t->cell[t->sf[s].first_cell +
 			cell_of(f, 0.5 * (box[0] + box[1]), 0.5 * (box[2] + box[3]))];
 	hess_at(&rc, p, mid, rad);
@@ -3595,14 +3525,16 @@ static void net_ranges(const double *P, int p, int q, double du, double dv,
 
 static void cert_fill(struct rcert *ce, const struct iv Su[3], const struct iv Sv[3],
 		      double du, double dv);
+static void net_ranges3(const double *P, int p, int q, double du, double dv,
+			struct iv r[4][4]);
 
 /*
  * The enclosures of certificate ce over a box of size du x dv from its
  * Bezier net pw ((p + 1) x (q + 1) homogeneous points, u fastest): S and
  * its derivatives up to order 2, the first fundamental form, the
- * midpoint-radius form of H. Also run at update time on sub-boxes
- * (sub_cert()): no allocation, bounded loops. Returns 0, or PX_E_INVAL
- * where the weights are not positive.
+ * midpoint-radius form of H, and the bounds of the third derivatives
+ * that the certificates of its sub-boxes are made from (taylor_cert()).
+ * Returns 0, or PX_E_INVAL where the weights are not positive.
  */
 static int net_cert(const double *pw, int p, int q, double du, double dv,
 		    struct rcert *ce)
@@ -3644,6 +3576,35 @@ static int net_cert(const double *pw, int p, int q, double du, double dv,
 					     iv_mul(Su[k], Wv)),
 				      iv_mul(Sv[k], Wu)),
 			       iv_mul(S, Wuv)), W));
+	}
+	{
+		/* third derivatives, for the certificates of sub-boxes
+		 * (taylor_cert()): X = S W differentiated three times */
+		struct iv n3[4][4], Wt[4];
+		net_ranges3(pw, p, q, du, dv, n3);
+		for (i = 0; i < 4; i++)
+			Wt[i] = n3[i][3];
+		for (k = 0; k < 3; k++) {
+			struct iv S = ce->S[k], T[4];
+			T[0] = iv_sub(iv_sub(iv_sub(n3[0][k], iv_scale(iv_mul(ce->Suu[k], Wu), 3.0)),
+					     iv_scale(iv_mul(Su[k], Wuu), 3.0)),
+				      iv_mul(S, Wt[0]));
+			T[1] = iv_sub(iv_sub(iv_sub(iv_sub(iv_sub(n3[1][k], iv_mul(ce->Suu[k], Wv)),
+						      iv_scale(iv_mul(ce->Suv[k], Wu), 2.0)),
+					       iv_scale(iv_mul(Su[k], Wuv), 2.0)),
+					iv_mul(Sv[k], Wuu)),
+				      iv_mul(S, Wt[1]));
+			T[2] = iv_sub(iv_sub(iv_sub(iv_sub(iv_sub(n3[2][k], iv_mul(ce->Svv[k], Wu)),
+						      iv_scale(iv_mul(ce->Suv[k], Wv), 2.0)),
+					       iv_scale(iv_mul(Sv[k], Wuv), 2.0)),
+					iv_mul(Su[k], Wvv)),
+				      iv_mul(S, Wt[2]));
+			T[3] = iv_sub(iv_sub(iv_sub(n3[3][k], iv_scale(iv_mul(ce->Svv[k], Wv), 3.0)),
+					     iv_scale(iv_mul(Sv[k], Wvv), 3.0)),
+				      iv_mul(S, Wt[3]));
+			for (i = 0; i < 4; i++)
+				ce->t3[i][k] = iv_mag(iv_pad(iv_divw(iv_pad(T[i]), W)));
+		}
 	}
 	cert_fill(ce, Su, Sv, du, dv);
 	return PX_OK;
@@ -3705,55 +3666,56 @@ static void cert_fill(struct rcert *ce, const struct iv Su[3], const struct iv S
 }
 
 /*
- * The third-derivative bounds of certificate ce (t3, t3ok) from the Bezier
- * net pw of its box (du x dv), where the weights are all equal: the third
- * difference nets, as net_ranges() does the lower ones. Rational nets
- * get none (their sub-boxes are cut by sub_cert()).
+ * Enclosures of the third difference nets of the Bezier net P (as
+ * net_ranges() the lower ones), every homogeneous coordinate: r[0] order
+ * (3, 0), r[1] (2, 1), r[2] (1, 2), r[3] (0, 3); an order above the
+ * degree is 0.
  */
-static void net_third(const double *pw, int p, int q, double du, double dv,
-		      struct rcert *ce)
+static void net_ranges3(const double *P, int p, int q, double du, double dv,
+			struct iv r[4][4])
 {
-	static const int oa[4] = {3, 2, 1, 0};
 	int i, j, k, o, n = p + 1;
-	double w0 = pw[3];
-	ce->t3ok = 0;
-	for (i = 0; i < (p + 1) * (q + 1); i++)
-		if (pw[4 * i + 3] != w0)
-			return;
 	for (o = 0; o < 4; o++) {
-		int a = oa[o], b = 3 - a, x, y;
-		double f = 1.0 / w0;
+		int a = 3 - o, b = o, x, y;
+		double f = 1.0;
 		for (i = 0; i < a; i++)
 			f *= (double)(p - i) / du;
 		for (j = 0; j < b; j++)
 			f *= (double)(q - j) / dv;
-		for (k = 0; k < 3; k++) {
-			double m = 0.0;
-			if (a <= p && b <= q)
-				for (j = 0; j + b <= q; j++)
-					for (i = 0; i + a <= p; i++) {
-						double d = 0.0;
-						for (y = 0; y <= b; y++)
-							for (x = 0; x <= a; x++)
-								d += ((a - x + b - y) & 1 ? -1.0 : 1.0) *
-								     px_bern_binom(a, x) * px_bern_binom(b, y) *
-								     pw[4 * ((j + y) * n + i + x) + k];
-						m = fmax(m, fabs(d));
-					}
-			ce->t3[o][k] = iv_pad(iv_pt(m * f)).hi;
+		for (k = 0; k < 4; k++) {
+			struct iv *z = &r[o][k];
+			if (a > p || b > q) {
+				*z = iv_pt(0.0);
+				continue;
+			}
+			z->lo = INFINITY;
+			z->hi = -INFINITY;
+			for (j = 0; j + b <= q; j++)
+				for (i = 0; i + a <= p; i++) {
+					double d = 0.0;
+					for (y = 0; y <= b; y++)
+						for (x = 0; x <= a; x++)
+							d += ((a - x + b - y) & 1 ? -1.0 : 1.0) *
+							     px_bern_binom(a, x) * px_bern_binom(b, y) *
+							     P[4 * ((j + y) * n + i + x) + k];
+					iv_grow(z, d);
+				}
+			z->lo *= f;
+			z->hi *= f;
+			*z = iv_pad(*z);
 		}
 	}
-	ce->t3ok = 1;
 }
 
 /*
- * Certificate of sub-box b (u0, u1, v0, v1) of a box whose certificate
- * top has third-derivative bounds (t3ok), at update time: the values at
- * b's centre and the mean value theorem per coordinate, S_uu in
- * S_uu(c) +- (|S_uuu| h_u + |S_uuv| h_v) and so on down to S; then
- * cert_fill(). A fraction of sub_cert()'s cost (14,000 instructions),
- * and about as wide as b; the parent's bounds hold for every piece of
- * it.
+ * Certificate of sub-box b (u0, u1, v0, v1) of the box of certificate
+ * top, at update time: the values at b's centre and the mean value
+ * theorem per coordinate, S_uu in S_uu(c) +- (|S_uuu| h_u + |S_uuv| h_v)
+ * and so on down to S, with top's third-derivative bounds (they hold
+ * over every piece of its box); then cert_fill(). About as wide as b:
+ * the width falls with the piece, which a hull of the box's own net
+ * cut down to it would give too, at a seventh of the cost (measured:
+ * 2,000 instructions against 14,000).
  */
 static void taylor_cert(const struct ssurf *f, const double b[4],
 			const struct rcert *top, struct rcert *ce)
@@ -3833,7 +3795,6 @@ static int cell_cert(struct px_strack *t, struct scell *c, const struct ssurf *f
 	rc = net_cert(sub.pw, p, q, du, dv, ce);
 	if (rc)
 		return rc;
-	net_third(sub.pw, p, q, du, dv, ce);
 	cert_centre(f, c->u0, c->u1, c->v0, c->v1, ce);
 	for (k = 0; k < 4; k++) {
 		struct cside *sd;
@@ -3998,7 +3959,6 @@ void px_strack_free(struct px_strack *t)
 			free(t->sf[i].mem);
 			free(t->sf[i].pt);
 			free(t->sf[i].pool);
-			free(t->sf[i].npool);
 			free(t->sf[i].pu);
 			free(t->sf[i].pv);
 			free(t->sf[i].cu);
@@ -4055,10 +4015,9 @@ static int build_patches(struct ssurf *f, const double *ub, int nu,
 	f->npv = nv - 1;
 	f->pt = calloc((size_t)(f->npu * f->npv), sizeof(*f->pt));
 	f->pool = calloc((size_t)(f->npu * f->npv) * 4 * (size_t)np, sizeof(double));
-	f->npool = calloc((size_t)(f->npu * f->npv) * 4 * (size_t)np, sizeof(double));
 	f->pu = malloc((size_t)nu * sizeof(double));
 	f->pv = malloc((size_t)nv * sizeof(double));
-	if (!work || !f->pt || !f->pool || !f->npool || !f->pu || !f->pv) {
+	if (!work || !f->pt || !f->pool || !f->pu || !f->pv) {
 		free(work);
 		return PX_E_NOMEM;
 	}
@@ -4085,9 +4044,6 @@ static int build_patches(struct ssurf *f, const double *ub, int nu,
 			pt->p = p;
 			pt->q = q;
 			pt->c = c;
-			memcpy(f->npool + (size_t)(b * f->npu + a) * 4 * (size_t)np, sub.pw,
-			       4 * (size_t)np * sizeof(double));
-			pt->net = f->npool + (size_t)(b * f->npu + a) * 4 * (size_t)np;
 			{
 				/* equal weights: divide them out, evaluate as a
 				 * polynomial */

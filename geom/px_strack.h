@@ -44,13 +44,12 @@
  *    (stats.exact_solves), so the solve is exact there. A box these
  *    setup certificates leave open (near a focal point the enclosures
  *    over a whole quarter are too wide to contract) is cut in four, each
- *    piece with a certificate made at update time - on a polynomial
- *    patch from the values at its centre and bounds of the third
- *    derivatives over the box made at setup (mean value theorem), on a
- *    rational one from its own Bezier net, cut from the patch's by de
- *    Casteljau: enclosures about as wide as the piece, so they contract
- *    wherever H is regular - and each piece is done, solved exactly or
- *    cut again, down to two levels;
+ *    piece with a certificate made at update time from the values at
+ *    its centre and bounds of the third derivatives over the box made
+ *    at setup (mean value theorem; the quotient rule where rational):
+ *    enclosures about as wide as the piece, so they contract wherever H
+ *    is regular. Each piece is done, solved exactly or cut again, down
+ *    to two levels;
  *    Newton from its centre only in a piece still open there (within a
  *    sixteenth of a quarter of a near-degenerate point, or where the
  *    work bound leaves no room for a cut; stats.sub_boxes, sub_open).
@@ -169,10 +168,10 @@ struct px_strack_opts {
 	 * counts 1/8 of a solve (measured: about 2,200 instructions
 	 * against 7,000 or more for each Newton run from a seed; a box's
 	 * contraction, stats.exact_solves, counts as one seed, and the
-	 * cut of an open box four certificates made at update time, 0.2
-	 * of a seed each on a polynomial patch, 0.85 on a rational one; a
-	 * cut is made only where the bound leaves room for it and a seed
-	 * in each piece, up to half a full solve a cell), one whose
+	 * cut of an open box four certificates made at update time, 3/16
+	 * of a seed each; a cut is made only where the bound leaves room
+	 * for it and a seed in each piece, up to half a full solve a
+	 * cell), one whose
 	 * certificates leave only some regions or quarters open
 	 * (near a focal sheet) 1/8 plus that share of the other 7/8; after
 	 * a long step, finding where it met a hit cell's region (up to 8

@@ -804,6 +804,23 @@ static int surf_sphere(struct px_nurbs_surf *s)
 	return mk_surf(s, 2, 2, 3, 3, U, U, xyz, w);
 }
 
+/* Rational patches (the quotient rule in every certificate, the cuts'
+ * third derivatives too): a rational bicubic and a sphere octant (its
+ * focal sheets collapse into the centre, every point there umbilic),
+ * along the same paths as the polynomial surfaces. */
+static void test_rational_track(void)
+{
+	struct px_nurbs_surf s[2];
+	struct totals tot;
+	memset(&tot, 0, sizeof(tot));
+	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
+	PX_CHECK_INT_EQ(surf_rational(&s[0]), PX_OK);
+	PX_CHECK_INT_EQ(surf_sphere(&s[1]), PX_OK);
+	run_model("rational bicubic", NULL, 0, &s[0], 1, 0, &tot);
+	run_model("sphere octant", NULL, 0, &s[1], 1, 0, &tot);
+	report(&tot);
+}
+
 /*
  * The certified transition regions contain every focal point: for dense
  * samples (u, v) with principal curvature k, the focal point F = S + N / k
@@ -2362,6 +2379,7 @@ static const struct px_test tests[] = {
 	PX_T(test_one_regions),
 	PX_T(test_contract_regions),
 	PX_T(test_sub_boxes),
+	PX_T(test_rational_track),
 	PX_T(test_winding),
 	PX_T(test_index_check),
 	PX_T(test_errors),
