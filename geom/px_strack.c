@@ -931,9 +931,9 @@ static int seed_solve(struct px_strack *t, struct ssurf *f, const struct scell *
  * third-derivative bounds; about half as wide) and are each done
  * (proven empty, or holding a held point and no other), solved exactly
  * (contract_solve()) or cut again, down to ST_SUB_DEPTH levels below
- * the box; a piece still open there, or where
- * the solve's allowance (t->sub_left) has no room for another cut, gets
- * Newton from its centre. t->sub_work holds the work made or reserved:
+ * the box; a piece still open there, or where the solve's allowance
+ * (t->sub_left) has no room for another cut, gets Newton from its
+ * centre. t->sub_work holds the work made or reserved:
  * every open piece holds one seed's worth (the box's own is in it when
  * this is called), a cut reserves its four certificates and a seed for
  * each quarter and gives back what a quarter proven done does not use.
