@@ -3529,6 +3529,237 @@ static void net_ranges3(const double *P, int p, int q, double du, double dv,
 			struct iv r[4][4]);
 
 /*
+ * Rational patches: the interval quotient rule on S = X / W counts the
+ * ranges of S, S_u, W, W_u ... as if independent, and its enclosures of
+ * the derivatives come out several times wider than the polynomial
+ * case's (certificate radii 0.25 against 0.81 on the same net with unit
+ * weights). The numerators of the derivatives over a power of W are
+ * polynomials, products of Bernstein tensor polynomials: their hulls
+ * are tight. Setup only (allocates).
+ */
+struct tpoly {
+	int m, n;       /* degrees in u, v */
+	double *c;      /* (m + 1) (n + 1), u fastest */
+	double mag;     /* bound on the rounding of its coefficients */
+};
+
+#define TP_LEN ((3 * PX_NURBS_MAX_DEGREE + 1) * (3 * PX_NURBS_MAX_DEGREE + 1))
+
+static void tp_net(const double *pw, int p, int q, int k, struct tpoly *o)
+{
+	int i;
+	o->m = p;
+	o->n = q;
+	o->mag = 0.0;
+	for (i = 0; i < (p + 1) * (q + 1); i++) {
+		o->c[i] = pw[4 * i + k];
+		o->mag = fmax(o->mag, 1e-16 * fabs(o->c[i]));
+	}
+}
+
+/* Derivative along u (dir 0, box width h) or v. */
+static void tp_d(const struct tpoly *a, int dir, double h, struct tpoly *o)
+{
+	int i, j, m = a->m, n = a->n;
+	double f = (dir ? n : m) / h;
+	o->m = dir ? m : m - 1;
+	o->n = dir ? n - 1 : n;
+	o->mag = 2.0 * f * a->mag;
+	for (j = 0; j <= o->n; j++)
+		for (i = 0; i <= o->m; i++) {
+			double x1 = dir ? a->c[(j + 1) * (m + 1) + i] : a->c[j * (m + 1) + i + 1];
+			o->c[j * (o->m + 1) + i] = f * (x1 - a->c[j * (m + 1) + i]);
+		}
+}
+
+/* o = a b (o not a or b). */
+static void tp_mul(const struct tpoly *a, const struct tpoly *b, struct tpoly *o)
+{
+	int i, j, x, y, M = a->m + b->m, N = a->n + b->n;
+	double amax = 0.0, bmax = 0.0;
+	o->m = M;
+	o->n = N;
+	for (i = 0; i < (M + 1) * (N + 1); i++)
+		o->c[i] = 0.0;
+	for (j = 0; j <= a->n; j++)
+		for (i = 0; i <= a->m; i++) {
+			double ca = a->c[j * (a->m + 1) + i] * px_bern_binom(a->m, i) *
+				    px_bern_binom(a->n, j);
+			amax = fmax(amax, fabs(a->c[j * (a->m + 1) + i]));
+			for (y = 0; y <= b->n; y++)
+				for (x = 0; x <= b->m; x++)
+					o->c[(j + y) * (M + 1) + i + x] +=
+						ca * b->c[y * (b->m + 1) + x] *
+						px_bern_binom(b->m, x) * px_bern_binom(b->n, y);
+		}
+	for (i = 0; i <= b->m * 0 + (b->m + 1) * (b->n + 1) - 1; i++)
+		bmax = fmax(bmax, fabs(b->c[i]));
+	for (j = 0; j <= N; j++)
+		for (i = 0; i <= M; i++)
+			o->c[j * (M + 1) + i] /= px_bern_binom(M, i) * px_bern_binom(N, j);
+	/* coefficients are convex combinations of the products */
+	o->mag = amax * b->mag + bmax * a->mag + 1e-15 * amax * bmax;
+}
+
+/* y += s a (the same degrees). */
+static void tp_axpy(struct tpoly *y, double s, const struct tpoly *a)
+{
+	int i;
+	for (i = 0; i < (y->m + 1) * (y->n + 1); i++)
+		y->c[i] += s * a->c[i];
+	y->mag += fabs(s) * a->mag + 1e-16 * fabs(s);
+}
+
+/* a raised to degrees (m, n) (not below its own), into o (not a;
+ * scratch: TP_LEN). */
+static void tp_elevate(const struct tpoly *a, int m, int n, struct tpoly *o,
+		       double *scratch)
+{
+	double *cur = scratch, *nxt = o->c, *sw;
+	int cm = a->m, cn = a->n, i, j;
+	memcpy(cur, a->c, (size_t)((cm + 1) * (cn + 1)) * sizeof(double));
+	for (; cm < m; cm++) {
+		for (j = 0; j <= cn; j++)
+			for (i = 0; i <= cm + 1; i++) {
+				double x = (double)i / (cm + 1);
+				double lo = i > 0 ? cur[j * (cm + 1) + i - 1] : 0.0;
+				double hi = i <= cm ? cur[j * (cm + 1) + i] : 0.0;
+				nxt[j * (cm + 2) + i] = x * lo + (1.0 - x) * hi;
+			}
+		sw = cur;
+		cur = nxt;
+		nxt = sw;
+	}
+	for (; cn < n; cn++) {
+		for (j = 0; j <= cn + 1; j++)
+			for (i = 0; i <= cm; i++) {
+				double x = (double)j / (cn + 1);
+				double lo = j > 0 ? cur[(j - 1) * (cm + 1) + i] : 0.0;
+				double hi = j <= cn ? cur[j * (cm + 1) + i] : 0.0;
+				nxt[j * (cm + 1) + i] = x * lo + (1.0 - x) * hi;
+			}
+		sw = cur;
+		cur = nxt;
+		nxt = sw;
+	}
+	if (cur != o->c)
+		memcpy(o->c, cur, (size_t)((cm + 1) * (cn + 1)) * sizeof(double));
+	o->m = cm;
+	o->n = cn;
+	/* convex combinations: no growth beyond a rounding each */
+	o->mag = a->mag * (1.0 + 1e-15 * (m + n));
+}
+
+/* The range of a / d over the box, d > 0 of a's degrees: a / d is a
+ * convex combination of the ratios of their Bernstein coefficients
+ * (weights d_i B_i / sum d_j B_j), so it lies within their hull. */
+static struct iv tp_ratio_range(const struct tpoly *a, const struct tpoly *d)
+{
+	struct iv r = {INFINITY, -INFINITY};
+	int i;
+	for (i = 0; i < (a->m + 1) * (a->n + 1); i++) {
+		double x = a->c[i] / d->c[i];
+		double e = (8.0 * a->mag + 1e-15 * fabs(a->c[i])) / d->c[i] +
+			   fabs(x) * (8.0 * d->mag / d->c[i] + 1e-15);
+		if (!(d->c[i] > 0.0)) {
+			r.lo = -INFINITY;
+			r.hi = INFINITY;
+			return r;
+		}
+		iv_grow(&r, x - e);
+		iv_grow(&r, x + e);
+	}
+	return iv_pad(r);
+}
+
+static struct iv iv_meet(struct iv a, struct iv b)
+{
+	struct iv r = {a.lo > b.lo ? a.lo : b.lo, a.hi < b.hi ? a.hi : b.hi};
+	return r.lo <= r.hi ? r : a;
+}
+
+/*
+ * Tighter enclosures of the derivatives of S = X / W for coordinate k
+ * of a rational net (degrees 2 or more): S_u = A_u / W^2 with
+ * A_u = X_u W - X W_u, S_uu = (X_uu W^2 - X W W_uu - 2 W_u A_u) / W^3,
+ * S_uv = ((X_uv W + X_u W_v - X_v W_u - X W_uv) W - 2 W_v A_u) / W^3, and
+ * so for v; each numerator's Bernstein hull over the hull of W's power.
+ * They are met with the interval quotient rule's (both hold). Returns 0
+ * or PX_E_NOMEM.
+ */
+static int rat_tight(const double *pw, int p, int q, double du, double dv, int k,
+		     struct iv *Su, struct iv *Sv, struct iv *Suu, struct iv *Suv,
+		     struct iv *Svv)
+{
+	enum { X, W, XU, XV, WU, WV, XUU, XUV, XVV, WUU, WUV, WVV, AU, AV, T1, T2, W2, W3,
+	       EL, SC, NP };
+	struct tpoly t[NP];
+	double *mem = malloc((size_t)NP * TP_LEN * sizeof(double));
+	int i;
+	if (!mem)
+		return PX_E_NOMEM;
+	for (i = 0; i < NP; i++)
+		t[i].c = mem + (size_t)i * TP_LEN;
+	tp_net(pw, p, q, k, &t[X]);
+	tp_net(pw, p, q, 3, &t[W]);
+	tp_d(&t[X], 0, du, &t[XU]);
+	tp_d(&t[X], 1, dv, &t[XV]);
+	tp_d(&t[W], 0, du, &t[WU]);
+	tp_d(&t[W], 1, dv, &t[WV]);
+	tp_d(&t[XU], 0, du, &t[XUU]);
+	tp_d(&t[XU], 1, dv, &t[XUV]);
+	tp_d(&t[XV], 1, dv, &t[XVV]);
+	tp_d(&t[WU], 0, du, &t[WUU]);
+	tp_d(&t[WU], 1, dv, &t[WUV]);
+	tp_d(&t[WV], 1, dv, &t[WVV]);
+	tp_mul(&t[W], &t[W], &t[W2]);
+	tp_mul(&t[W2], &t[W], &t[W3]);
+	/* A_u, A_v */
+	tp_mul(&t[XU], &t[W], &t[AU]);
+	tp_mul(&t[X], &t[WU], &t[T1]);
+	tp_axpy(&t[AU], -1.0, &t[T1]);
+	tp_mul(&t[XV], &t[W], &t[AV]);
+	tp_mul(&t[X], &t[WV], &t[T1]);
+	tp_axpy(&t[AV], -1.0, &t[T1]);
+	tp_elevate(&t[AU], 2 * p, 2 * q, &t[EL], t[SC].c);
+	*Su = iv_meet(*Su, tp_ratio_range(&t[EL], &t[W2]));
+	tp_elevate(&t[AV], 2 * p, 2 * q, &t[EL], t[SC].c);
+	*Sv = iv_meet(*Sv, tp_ratio_range(&t[EL], &t[W2]));
+	/* S_uu W^3: X_uu W^2 - (X W) W_uu - 2 W_u A_u */
+	tp_mul(&t[XUU], &t[W2], &t[T1]);
+	tp_mul(&t[X], &t[W], &t[XUU]);          /* X W (X_uu no longer needed) */
+	tp_mul(&t[XUU], &t[WUU], &t[T2]);
+	tp_axpy(&t[T1], -1.0, &t[T2]);
+	tp_mul(&t[WU], &t[AU], &t[T2]);
+	tp_axpy(&t[T1], -2.0, &t[T2]);
+	tp_elevate(&t[T1], 3 * p, 3 * q, &t[EL], t[SC].c);
+	*Suu = iv_meet(*Suu, tp_ratio_range(&t[EL], &t[W3]));
+	/* S_vv W^3: X_vv W^2 - (X W) W_vv - 2 W_v A_v */
+	tp_mul(&t[XVV], &t[W2], &t[T1]);
+	tp_mul(&t[XUU], &t[WVV], &t[T2]);
+	tp_axpy(&t[T1], -1.0, &t[T2]);
+	tp_mul(&t[WV], &t[AV], &t[T2]);
+	tp_axpy(&t[T1], -2.0, &t[T2]);
+	tp_elevate(&t[T1], 3 * p, 3 * q, &t[EL], t[SC].c);
+	*Svv = iv_meet(*Svv, tp_ratio_range(&t[EL], &t[W3]));
+	/* S_uv W^3: (X_uv W + X_u W_v - X_v W_u - X W_uv) W - 2 W_v A_u */
+	tp_mul(&t[XUV], &t[W], &t[T1]);
+	tp_mul(&t[XU], &t[WV], &t[T2]);
+	tp_axpy(&t[T1], 1.0, &t[T2]);
+	tp_mul(&t[XV], &t[WU], &t[T2]);
+	tp_axpy(&t[T1], -1.0, &t[T2]);
+	tp_mul(&t[X], &t[WUV], &t[T2]);
+	tp_axpy(&t[T1], -1.0, &t[T2]);
+	tp_mul(&t[T1], &t[W], &t[T2]);
+	tp_mul(&t[WV], &t[AU], &t[T1]);
+	tp_axpy(&t[T2], -2.0, &t[T1]);
+	tp_elevate(&t[T2], 3 * p, 3 * q, &t[EL], t[SC].c);
+	*Suv = iv_meet(*Suv, tp_ratio_range(&t[EL], &t[W3]));
+	free(mem);
+	return PX_OK;
+}
+
+/*
  * The enclosures of certificate ce over a box of size du x dv from its
  * Bezier net pw ((p + 1) x (q + 1) homogeneous points, u fastest): S and
  * its derivatives up to order 2, the first fundamental form, the
@@ -3540,8 +3771,10 @@ static int net_cert(const double *pw, int p, int q, double du, double dv,
 		    struct rcert *ce)
 {
 	struct iv W, Wu, Wv, Wuu, Wuv, Wvv, Su[3], Sv[3], nr[6][4];
-	int k, i;
+	int k, i, rational = 0;
 	memset(ce, 0, sizeof(*ce));
+	for (i = 1; i < (p + 1) * (q + 1); i++)
+		rational |= pw[4 * i + 3] != pw[3];
 	net_ranges(pw, p, q, du, dv, nr);
 	W = nr[0][3];
 	if (!(W.lo > 0.0))
@@ -3576,6 +3809,12 @@ static int net_cert(const double *pw, int p, int q, double du, double dv,
 					     iv_mul(Su[k], Wv)),
 				      iv_mul(Sv[k], Wu)),
 			       iv_mul(S, Wuv)), W));
+		if (rational && p >= 2 && q >= 2) {
+			int rc = rat_tight(pw, p, q, du, dv, k, &Su[k], &Sv[k], &ce->Suu[k],
+					   &ce->Suv[k], &ce->Svv[k]);
+			if (rc)
+				return rc;
+		}
 	}
 	{
 		/* third derivatives, for the certificates of sub-boxes
