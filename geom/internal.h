@@ -151,6 +151,10 @@ extern int px__strack_contract_fault;
  * region cells. */
 int px__strack_sub(const struct px_strack *t, int s, const double box[4], px_vec3 p,
 		   int *regular, double *fu, double *fv);
+/* px_strack: 1 shrinks the enclosures of a rational patch's derivatives
+ * from their numerators to a third of their width (unsound: a fault the
+ * focal test must see); read when certificates are made (create). */
+extern int px__strack_rat_fault;
 /* px_strack: 1 leaves every box no certificate decides uncut (Newton
  * from its centre), the solve as it was before the run-time cuts. */
 extern int px__strack_sub_fault;
