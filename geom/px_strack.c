@@ -3592,7 +3592,7 @@ static void tp_mul(const struct tpoly *a, const struct tpoly *b, struct tpoly *o
 						ca * b->c[y * (b->m + 1) + x] *
 						px_bern_binom(b->m, x) * px_bern_binom(b->n, y);
 		}
-	for (i = 0; i <= b->m * 0 + (b->m + 1) * (b->n + 1) - 1; i++)
+	for (i = 0; i < (b->m + 1) * (b->n + 1); i++)
 		bmax = fmax(bmax, fabs(b->c[i]));
 	for (j = 0; j <= N; j++)
 		for (i = 0; i <= M; i++)
@@ -3695,79 +3695,76 @@ static struct iv iv_meet(struct iv a, struct iv b)
  * A_u = X_u W - X W_u, S_uu = (X_uu W^2 - X W W_uu - 2 W_u A_u) / W^3,
  * S_uv = ((X_uv W + X_u W_v - X_v W_u - X W_uv) W - 2 W_v A_u) / W^3, and
  * so for v; each numerator's Bernstein hull over the hull of W's power.
- * They are met with the interval quotient rule's (both hold). Returns 0
- * or PX_E_NOMEM.
+ * They are met with the interval quotient rule's (both hold). mem:
+ * ST_RAT_POLYS * TP_LEN doubles.
  */
-static int rat_tight(const double *pw, int p, int q, double du, double dv, int k,
-		     struct iv *Su, struct iv *Sv, struct iv *Suu, struct iv *Suv,
-		     struct iv *Svv)
+enum {
+	R_X, R_W, R_XU, R_XV, R_WU, R_WV, R_XUU, R_XUV, R_XVV, R_WUU, R_WUV, R_WVV,
+	R_AU, R_AV, R_T1, R_T2, R_W2, R_W3, R_EL, R_SC, ST_RAT_POLYS
+};
+static void rat_tight(const double *pw, int p, int q, double du, double dv, int k,
+		      struct iv *Su, struct iv *Sv, struct iv *Suu, struct iv *Suv,
+		      struct iv *Svv, double *mem)
 {
-	enum { X, W, XU, XV, WU, WV, XUU, XUV, XVV, WUU, WUV, WVV, AU, AV, T1, T2, W2, W3,
-	       EL, SC, NP };
-	struct tpoly t[NP];
-	double *mem = malloc((size_t)NP * TP_LEN * sizeof(double));
+	struct tpoly t[ST_RAT_POLYS];
 	int i;
-	if (!mem)
-		return PX_E_NOMEM;
-	for (i = 0; i < NP; i++)
+	for (i = 0; i < ST_RAT_POLYS; i++)
 		t[i].c = mem + (size_t)i * TP_LEN;
-	tp_net(pw, p, q, k, &t[X]);
-	tp_net(pw, p, q, 3, &t[W]);
-	tp_d(&t[X], 0, du, &t[XU]);
-	tp_d(&t[X], 1, dv, &t[XV]);
-	tp_d(&t[W], 0, du, &t[WU]);
-	tp_d(&t[W], 1, dv, &t[WV]);
-	tp_d(&t[XU], 0, du, &t[XUU]);
-	tp_d(&t[XU], 1, dv, &t[XUV]);
-	tp_d(&t[XV], 1, dv, &t[XVV]);
-	tp_d(&t[WU], 0, du, &t[WUU]);
-	tp_d(&t[WU], 1, dv, &t[WUV]);
-	tp_d(&t[WV], 1, dv, &t[WVV]);
-	tp_mul(&t[W], &t[W], &t[W2]);
-	tp_mul(&t[W2], &t[W], &t[W3]);
+	tp_net(pw, p, q, k, &t[R_X]);
+	tp_net(pw, p, q, 3, &t[R_W]);
+	tp_d(&t[R_X], 0, du, &t[R_XU]);
+	tp_d(&t[R_X], 1, dv, &t[R_XV]);
+	tp_d(&t[R_W], 0, du, &t[R_WU]);
+	tp_d(&t[R_W], 1, dv, &t[R_WV]);
+	tp_d(&t[R_XU], 0, du, &t[R_XUU]);
+	tp_d(&t[R_XU], 1, dv, &t[R_XUV]);
+	tp_d(&t[R_XV], 1, dv, &t[R_XVV]);
+	tp_d(&t[R_WU], 0, du, &t[R_WUU]);
+	tp_d(&t[R_WU], 1, dv, &t[R_WUV]);
+	tp_d(&t[R_WV], 1, dv, &t[R_WVV]);
+	tp_mul(&t[R_W], &t[R_W], &t[R_W2]);
+	tp_mul(&t[R_W2], &t[R_W], &t[R_W3]);
 	/* A_u, A_v */
-	tp_mul(&t[XU], &t[W], &t[AU]);
-	tp_mul(&t[X], &t[WU], &t[T1]);
-	tp_axpy(&t[AU], -1.0, &t[T1]);
-	tp_mul(&t[XV], &t[W], &t[AV]);
-	tp_mul(&t[X], &t[WV], &t[T1]);
-	tp_axpy(&t[AV], -1.0, &t[T1]);
-	tp_elevate(&t[AU], 2 * p, 2 * q, &t[EL], t[SC].c);
-	*Su = iv_meet(*Su, tp_ratio_range(&t[EL], &t[W2]));
-	tp_elevate(&t[AV], 2 * p, 2 * q, &t[EL], t[SC].c);
-	*Sv = iv_meet(*Sv, tp_ratio_range(&t[EL], &t[W2]));
+	tp_mul(&t[R_XU], &t[R_W], &t[R_AU]);
+	tp_mul(&t[R_X], &t[R_WU], &t[R_T1]);
+	tp_axpy(&t[R_AU], -1.0, &t[R_T1]);
+	tp_mul(&t[R_XV], &t[R_W], &t[R_AV]);
+	tp_mul(&t[R_X], &t[R_WV], &t[R_T1]);
+	tp_axpy(&t[R_AV], -1.0, &t[R_T1]);
+	tp_elevate(&t[R_AU], 2 * p, 2 * q, &t[R_EL], t[R_SC].c);
+	*Su = iv_meet(*Su, tp_ratio_range(&t[R_EL], &t[R_W2]));
+	tp_elevate(&t[R_AV], 2 * p, 2 * q, &t[R_EL], t[R_SC].c);
+	*Sv = iv_meet(*Sv, tp_ratio_range(&t[R_EL], &t[R_W2]));
 	/* S_uu W^3: X_uu W^2 - (X W) W_uu - 2 W_u A_u */
-	tp_mul(&t[XUU], &t[W2], &t[T1]);
-	tp_mul(&t[X], &t[W], &t[XUU]);          /* X W (X_uu no longer needed) */
-	tp_mul(&t[XUU], &t[WUU], &t[T2]);
-	tp_axpy(&t[T1], -1.0, &t[T2]);
-	tp_mul(&t[WU], &t[AU], &t[T2]);
-	tp_axpy(&t[T1], -2.0, &t[T2]);
-	tp_elevate(&t[T1], 3 * p, 3 * q, &t[EL], t[SC].c);
-	*Suu = iv_meet(*Suu, tp_ratio_range(&t[EL], &t[W3]));
+	tp_mul(&t[R_XUU], &t[R_W2], &t[R_T1]);
+	tp_mul(&t[R_X], &t[R_W], &t[R_XUU]);          /* X W (X_uu no longer needed) */
+	tp_mul(&t[R_XUU], &t[R_WUU], &t[R_T2]);
+	tp_axpy(&t[R_T1], -1.0, &t[R_T2]);
+	tp_mul(&t[R_WU], &t[R_AU], &t[R_T2]);
+	tp_axpy(&t[R_T1], -2.0, &t[R_T2]);
+	tp_elevate(&t[R_T1], 3 * p, 3 * q, &t[R_EL], t[R_SC].c);
+	*Suu = iv_meet(*Suu, tp_ratio_range(&t[R_EL], &t[R_W3]));
 	/* S_vv W^3: X_vv W^2 - (X W) W_vv - 2 W_v A_v */
-	tp_mul(&t[XVV], &t[W2], &t[T1]);
-	tp_mul(&t[XUU], &t[WVV], &t[T2]);
-	tp_axpy(&t[T1], -1.0, &t[T2]);
-	tp_mul(&t[WV], &t[AV], &t[T2]);
-	tp_axpy(&t[T1], -2.0, &t[T2]);
-	tp_elevate(&t[T1], 3 * p, 3 * q, &t[EL], t[SC].c);
-	*Svv = iv_meet(*Svv, tp_ratio_range(&t[EL], &t[W3]));
+	tp_mul(&t[R_XVV], &t[R_W2], &t[R_T1]);
+	tp_mul(&t[R_XUU], &t[R_WVV], &t[R_T2]);
+	tp_axpy(&t[R_T1], -1.0, &t[R_T2]);
+	tp_mul(&t[R_WV], &t[R_AV], &t[R_T2]);
+	tp_axpy(&t[R_T1], -2.0, &t[R_T2]);
+	tp_elevate(&t[R_T1], 3 * p, 3 * q, &t[R_EL], t[R_SC].c);
+	*Svv = iv_meet(*Svv, tp_ratio_range(&t[R_EL], &t[R_W3]));
 	/* S_uv W^3: (X_uv W + X_u W_v - X_v W_u - X W_uv) W - 2 W_v A_u */
-	tp_mul(&t[XUV], &t[W], &t[T1]);
-	tp_mul(&t[XU], &t[WV], &t[T2]);
-	tp_axpy(&t[T1], 1.0, &t[T2]);
-	tp_mul(&t[XV], &t[WU], &t[T2]);
-	tp_axpy(&t[T1], -1.0, &t[T2]);
-	tp_mul(&t[X], &t[WUV], &t[T2]);
-	tp_axpy(&t[T1], -1.0, &t[T2]);
-	tp_mul(&t[T1], &t[W], &t[T2]);
-	tp_mul(&t[WV], &t[AU], &t[T1]);
-	tp_axpy(&t[T2], -2.0, &t[T1]);
-	tp_elevate(&t[T2], 3 * p, 3 * q, &t[EL], t[SC].c);
-	*Suv = iv_meet(*Suv, tp_ratio_range(&t[EL], &t[W3]));
-	free(mem);
-	return PX_OK;
+	tp_mul(&t[R_XUV], &t[R_W], &t[R_T1]);
+	tp_mul(&t[R_XU], &t[R_WV], &t[R_T2]);
+	tp_axpy(&t[R_T1], 1.0, &t[R_T2]);
+	tp_mul(&t[R_XV], &t[R_WU], &t[R_T2]);
+	tp_axpy(&t[R_T1], -1.0, &t[R_T2]);
+	tp_mul(&t[R_X], &t[R_WUV], &t[R_T2]);
+	tp_axpy(&t[R_T1], -1.0, &t[R_T2]);
+	tp_mul(&t[R_T1], &t[R_W], &t[R_T2]);
+	tp_mul(&t[R_WV], &t[R_AU], &t[R_T1]);
+	tp_axpy(&t[R_T2], -2.0, &t[R_T1]);
+	tp_elevate(&t[R_T2], 3 * p, 3 * q, &t[R_EL], t[R_SC].c);
+	*Suv = iv_meet(*Suv, tp_ratio_range(&t[R_EL], &t[R_W3]));
 }
 
 /*
@@ -3782,6 +3779,7 @@ static int net_cert(const double *pw, int p, int q, double du, double dv,
 		    struct rcert *ce)
 {
 	struct iv W, Wu, Wv, Wuu, Wuv, Wvv, Su[3], Sv[3], nr[6][4];
+	double *mem = NULL;
 	int k, i, rational = 0;
 	memset(ce, 0, sizeof(*ce));
 	for (i = 1; i < (p + 1) * (q + 1); i++)
@@ -3790,6 +3788,11 @@ static int net_cert(const double *pw, int p, int q, double du, double dv,
 	W = nr[0][3];
 	if (!(W.lo > 0.0))
 		return PX_E_INVAL;
+	if (rational && p >= 2 && q >= 2) {
+		mem = malloc((size_t)ST_RAT_POLYS * TP_LEN * sizeof(double));
+		if (!mem)
+			return PX_E_NOMEM;
+	}
 	Wu = nr[1][3];
 	Wv = nr[2][3];
 	Wuu = nr[3][3];
@@ -3820,13 +3823,11 @@ static int net_cert(const double *pw, int p, int q, double du, double dv,
 					     iv_mul(Su[k], Wv)),
 				      iv_mul(Sv[k], Wu)),
 			       iv_mul(S, Wuv)), W));
-		if (rational && p >= 2 && q >= 2) {
-			int rc = rat_tight(pw, p, q, du, dv, k, &Su[k], &Sv[k], &ce->Suu[k],
-					   &ce->Suv[k], &ce->Svv[k]);
-			if (rc)
-				return rc;
-		}
+		if (mem)
+			rat_tight(pw, p, q, du, dv, k, &Su[k], &Sv[k], &ce->Suu[k], &ce->Suv[k],
+				  &ce->Svv[k], mem);
 	}
+	free(mem);
 	{
 		/* third derivatives, for the certificates of sub-boxes
 		 * (taylor_cert()): X = S W differentiated three times */
