@@ -76,7 +76,8 @@ struct cside {
  * Certificate data of a region cell: enclosures over the whole cell of
  * S and its derivatives up to order 2 (from the Bezier net of the cell:
  * the convex hull property for S, difference nets for the derivatives,
- * interval arithmetic for the rational quotient rule), the first
+ * for rational cells the tighter of the interval quotient rule and the
+ * numerators' bounds, rat_tight()), the first
  * fundamental form entries Si.Sj, the centre values of S, Su, Sv and the
  * sides on an open domain edge or a crease (less than C2 between
  * patches), where points enter and leave.

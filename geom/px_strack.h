@@ -19,7 +19,9 @@
  *    enclosures are about half as wide). At setup every region cell and
  *    quarter gets enclosures of S and its derivatives up to order 2
  *    over the cell (from its Bezier net: convex hull for S, difference
- *    nets for the derivatives, interval quotient rule when rational). At
+ *    nets for the derivatives; when rational, the derivatives'
+ *    numerators over powers of W, bounded by the ratios of their
+ *    Bernstein coefficients, met with the interval quotient rule). At
  *    run time these bound E and H over the cell for all points x of a
  *    cube about p, and the cell is proven free of transitions while x
  *    stays in the cube if E1 or E2 keeps its sign (no critical point
