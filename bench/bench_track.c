@@ -547,6 +547,32 @@ static int wavy_surf(struct px_nurbs_surf *s, int n)
 				  NULL, NULL);
 }
 
+/* The 16-patch wavy sheet made rational: weights 0.6 to 1.5 over the
+ * net (the certificates' rational path, as a CAD model's cylinders and
+ * spheres take it). */
+static int rational_surf(struct px_nurbs_surf *s)
+{
+	double U[16], xyz[3 * 49], w[49];
+	int i, j, p = 3, n = 7;
+	for (i = 0; i <= p; i++) {
+		U[i] = 0.0;
+		U[n + i] = 1.0;
+	}
+	for (i = p + 1; i < n; i++)
+		U[i] = (double)(i - p) / (n - p);
+	for (j = 0; j < n; j++)
+		for (i = 0; i < n; i++) {
+			double x = -1 + 2.0 * i / (n - 1), y = -1 + 2.0 * j / (n - 1);
+			double *q = &xyz[3 * (j * n + i)];
+			q[0] = x;
+			q[1] = y + 0.1 * sin(3 * x);
+			q[2] = 0.35 * sin(2.2 * x + 0.3) * cos(2.7 * y - 0.2);
+			w[j * n + i] = 0.6 + 0.9 * ((i * 7 + j * 3) % 5) / 4.0;
+		}
+	return px_nurbs_surf_init(s, &arena, 3, 3, n, n, U, n + 4, U, n + 4, xyz,
+				  w, NULL);
+}
+
 static int fold_surf(struct px_nurbs_surf *s)
 {
 	static const double U[] = {0, 0, 0, 0, 1, 1, 1, 1};
@@ -967,7 +993,7 @@ int main(void)
 		return 0;
 surfaces:
 	{
-		struct px_nurbs_surf sf[3];
+		struct px_nurbs_surf sf[4];
 		printf("\npx_strack: surfaces, same columns (cells/u: cells solved "
 		       "per update; tests: cell tests per update; crit: live "
 		       "critical points; p999_ns: 99.9th percentile; glob%%: "
@@ -981,6 +1007,8 @@ surfaces:
 			run_surf("wavy bicubic, 16 patches", &sf[1], 1);
 		if (fold_surf(&sf[2]) == PX_OK)
 			run_surf("concave fold", &sf[2], 1);
+		if (rational_surf(&sf[3]) == PX_OK)
+			run_surf("rational wavy, 16 patches", &sf[3], 1);
 	}
 	return 0;
 }
