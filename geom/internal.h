@@ -155,6 +155,9 @@ int px__strack_sub(const struct px_strack *t, int s, const double box[4], px_vec
  * from their numerators to a third of their width (unsound: a fault the
  * focal test must see); read when certificates are made (create). */
 extern int px__strack_rat_fault;
+/* px_strack: 1 leaves the pieces out of a region's radius (a rational
+ * quarter without a radius of its own then has none). */
+extern int px__strack_piece_fault;
 /* px_strack: 1 leaves every box no certificate decides uncut (Newton
  * from its centre), the solve as it was before the run-time cuts. */
 extern int px__strack_sub_fault;

@@ -100,6 +100,7 @@ struct rcert {
 	 * coordinate, from which the certificates of its sub-boxes are made
 	 * (taylor_cert()) */
 	double t3[4][3];
+	int rat;        /* the net's weights differ */
 };
 
 struct scell {
@@ -1447,21 +1448,89 @@ static int contract_rate(const struct rcert *c, px_vec3 p, double y[2][2],
 /* Test hook (internal.h): a factor on every certified radius. */
 double px__strack_radius_scale = 1.0;
 
+static void sides_open(const struct ssurf *f, const struct scell *c, int open[4]);
+static void cert_sides(const struct ssurf *f, const struct scell *c, struct rcert *ce,
+		       const int side_open[4]);
+static void box_quarter(const double b[4], int k, double q[4]);
+
+/* Levels of pieces below a quarter whose certificate gives no radius
+ * (piece_radius()). */
+#define ST_PIECE_DEPTH 1
+
+/* Test hook (internal.h): 1 leaves the pieces out of region_radius(). */
+int px__strack_piece_fault = 0;
+
+/*
+ * Certified radius at p of piece b of surface s, its certificate made as
+ * a cut's (taylor_cert() from top, the certificate of a box holding it)
+ * with the side tests of the open sides it lies on; where it gives none,
+ * the least of its quarters', down to ST_PIECE_DEPTH levels. The union
+ * argument of region_radius() holds for the pieces as for quarters.
+ */
+static double piece_radius(const struct px_strack *t, int s, const struct rcert *top,
+			   const double b[4], int depth, px_vec3 p)
+{
+	const struct ssurf *f = &t->sf[s];
+	struct rcert rc;
+	struct scell pc;
+	int open[4], k;
+	double r;
+	memset(&pc, 0, sizeof(pc));
+	pc.surf = s;
+	pc.u0 = b[0];
+	pc.u1 = b[1];
+	pc.v0 = b[2];
+	pc.v1 = b[3];
+	taylor_cert(f, b, top, &rc);
+	sides_open(f, &pc, open);
+	cert_sides(f, &pc, &rc, open);
+	r = cert_radius(&rc, p);
+	if (r > 0.0 || depth >= ST_PIECE_DEPTH)
+		return r;
+	r = INFINITY;
+	for (k = 0; k < 4 && r > 0.0; k++) {
+		double sb[4];
+		box_quarter(b, k, sb);
+		r = fmin(r, piece_radius(t, s, top, sb, depth + 1, p));
+	}
+	return r;
+}
+
 /*
  * Certified radius of region cell ri at p; where its own certificate
  * gives none, the least of its quarters' (each quarter free of
  * degenerate critical points, or of any, and the open sides kept: so is
- * their union, the interior sides between them being no way in or out).
+ * their union, the interior sides between them being no way in or out),
+ * a rational quarter without one standing for by its four pieces'
+ * (piece_radius(): where the parametrization varies fast, as at a
+ * corner with weights far apart, the quarter's enclosures are too wide
+ * ever to hold, and its cell would be due, tested and solved in every
+ * update; on polynomial patches the pieces seldom hold where the
+ * quarter does not, near a focal sheet, and cost 4 % of the
+ * instructions of the 16-patch bench paths).
  */
 static double region_radius(const struct px_strack *t, int ri, px_vec3 p)
 {
 	double r = cert_radius(&t->rcell[ri].cert, p);
 	if (!(r > 0.0)) {
+		const struct scell *g = &t->rcell[ri];
 		const struct rcert *q = &t->qcert[4 * ri];
 		int k;
 		r = INFINITY;
-		for (k = 0; k < 4 && r > 0.0; k++)
-			r = fmin(r, cert_radius(&q[k], p));
+		for (k = 0; k < 4 && r > 0.0; k++) {
+			double rq = cert_radius(&q[k], p);
+			if (!(rq > 0.0) && q[k].rat && !px__strack_piece_fault) {
+				double b[4], sb[4];
+				int j;
+				box_of(g, k, b);
+				rq = INFINITY;
+				for (j = 0; j < 4 && rq > 0.0; j++) {
+					box_quarter(b, j, sb);
+					rq = fmin(rq, piece_radius(t, g->surf, &q[k], sb, 1, p));
+				}
+			}
+			r = fmin(r, rq);
+		}
 	}
 	return r * px__strack_radius_scale;
 }
@@ -3789,6 +3858,7 @@ static int net_cert(const double *pw, int p, int q, double du, double dv,
 	W = nr[0][3];
 	if (!(W.lo > 0.0))
 		return PX_E_INVAL;
+	ce->rat = rational;
 	if (rational && p >= 2 && q >= 2) {
 		mem = malloc((size_t)ST_RAT_POLYS * TP_LEN * sizeof(double));
 		if (!mem)
@@ -4035,9 +4105,8 @@ static int cell_cert(struct px_strack *t, struct scell *c, const struct ssurf *f
 {
 	struct rcert *ce = &c->cert;
 	struct px_nurbs_surf sub;
-	struct px_nurbs_surf_derivs d;
 	double du = c->u1 - c->u0, dv = c->v1 - c->v0;
-	int p = f->s.degree[0], q = f->s.degree[1], k, rc;
+	int p = f->s.degree[0], q = f->s.degree[1], rc;
 	rc = px_nurbs_surf_extract_work(&f->s, c->u0, c->u1, c->v0, c->v1, work,
 					wl, &sub);
 	if (rc)
@@ -4048,6 +4117,20 @@ static int cell_cert(struct px_strack *t, struct scell *c, const struct ssurf *f
 	if (rc)
 		return rc;
 	cert_centre(f, c->u0, c->u1, c->v0, c->v1, ce);
+	cert_sides(f, c, ce, side_open);
+	(void)t;
+	return PX_OK;
+}
+
+/* The side tests' data of certificate ce (hu, hv set) of box c for its
+ * open sides (side_open: u0, u1, v0, v1). */
+static void cert_sides(const struct ssurf *f, const struct scell *c, struct rcert *ce,
+		       const int side_open[4])
+{
+	struct px_nurbs_surf_derivs d;
+	double du = c->u1 - c->u0, dv = c->v1 - c->v0;
+	int k;
+	ce->nside = 0;
 	for (k = 0; k < 4; k++) {
 		struct cside *sd;
 		double u, v;
@@ -4072,8 +4155,6 @@ static int cell_cert(struct px_strack *t, struct scell *c, const struct ssurf *f
 		 * cover it in the half length */
 		sd->h *= 1.0 + 1e-12;
 	}
-	(void)t;
-	return PX_OK;
 }
 
 /* 1 when x is a break of the surface along dir where it is less than

@@ -38,6 +38,20 @@ static void seed_stream(uint64_t seed)
 		rng_[i] = splitmix(&x);
 }
 
+void px_rand_save(struct px_rand_state *st)
+{
+	int i;
+	for (i = 0; i < 4; i++)
+		st->s[i] = rng_[i];
+}
+
+void px_rand_restore(const struct px_rand_state *st)
+{
+	int i;
+	for (i = 0; i < 4; i++)
+		rng_[i] = st->s[i];
+}
+
 static uint64_t rotl(uint64_t x, int k)
 {
 	return (x << k) | (x >> (64 - k));

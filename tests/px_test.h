@@ -98,6 +98,13 @@ double px_rand_range(double lo, double hi); /* [lo, hi) */
 int px_rand_int(int lo, int hi);           /* [lo, hi] inclusive */
 double px_rand_normal(void);
 uint64_t px_test_seed(void); /* seed of the running test */
+/* The stream's state, saved and put back: a test can replay the same
+ * random inputs under two settings. */
+struct px_rand_state {
+	uint64_t s[4];
+};
+void px_rand_save(struct px_rand_state *st);
+void px_rand_restore(const struct px_rand_state *st);
 
 /* A clock for code that takes one as fn(ctx) -> ns (the trackers' cold
  * switch): every read advances it by inc, so every timed region measures

@@ -821,6 +821,27 @@ static void test_rational_track(void)
 	run_model("rational bicubic", NULL, 0, &s[0], 1, 0, &tot);
 	run_model("sphere octant", NULL, 0, &s[1], 1, 0, &tot);
 	report(&tot);
+	{
+		/* the quarters without a radius left without their pieces'
+		 * (test hook): the cells near the bicubic's corners, where
+		 * its weights are far apart, are solved far more often */
+		struct totals t0, t1;
+		struct px_rand_state rs;
+		memset(&t0, 0, sizeof(t0));
+		memset(&t1, 0, sizeof(t1));
+		/* the same paths both times */
+		px_rand_save(&rs);
+		run_model("rational bicubic", NULL, 0, &s[0], 1, 0, &t0);
+		px_rand_restore(&rs);
+		px__strack_piece_fault = 1;
+		run_model("rational bicubic, no pieces", NULL, 0, &s[0], 1, 0, &t1);
+		px__strack_piece_fault = 0;
+		printf("  cells solved %ld with the pieces, %ld without; wrong %ld, %ld\n",
+		       t0.cells, t1.cells, t0.wrong, t1.wrong);
+		PX_CHECK_INT_EQ(t0.wrong + t1.wrong, 0);
+		PX_CHECK_MSG(4 * t0.cells < 3 * t1.cells, "the pieces saved few solves: %ld of %ld",
+			     t0.cells, t1.cells);
+	}
 }
 
 /*
