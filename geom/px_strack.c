@@ -1457,7 +1457,8 @@ static void box_quarter(const double b[4], int k, double q[4]);
  * (piece_radius()). */
 #define ST_PIECE_DEPTH 1
 
-/* Test hook (internal.h): 1 leaves the pieces out of region_radius(). */
+/* Test hook (internal.h): 1 leaves the pieces out of the radii
+ * (region_radius_full(), cell_radius()). */
 int px__strack_piece_fault = 0;
 
 /*
@@ -1497,42 +1498,63 @@ static double piece_radius(const struct px_strack *t, int s, const struct rcert 
 }
 
 /*
+ * The radius of a rational region whose quarters left it none: each
+ * quarter without a radius stands for by its four pieces'
+ * (piece_radius()). Where the parametrization varies fast, as at a
+ * corner with weights far apart, a quarter's enclosures are too wide
+ * ever to hold, and its cell would be due, tested and solved in every
+ * update. On polynomial patches the pieces seldom hold where the
+ * quarter does not (near a focal sheet) and cost 4 % of the
+ * instructions of the 16-patch bench paths: not used there.
+ */
+static double region_pieces(const struct px_strack *t, int ri, px_vec3 p)
+{
+	const struct scell *g = &t->rcell[ri];
+	double r = INFINITY;
+	int k, j;
+	for (k = 0; k < 4 && r > 0.0; k++) {
+		const struct rcert *q = &t->qcert[4 * ri + k];
+		double b[4], sb[4], rq = cert_radius(q, p);
+		if (!(rq > 0.0)) {
+			box_of(g, k, b);
+			rq = INFINITY;
+			for (j = 0; j < 4 && rq > 0.0; j++) {
+				box_quarter(b, j, sb);
+				rq = fmin(rq, piece_radius(t, g->surf, q, sb, 1, p));
+			}
+		}
+		r = fmin(r, rq);
+	}
+	return r;
+}
+
+/*
  * Certified radius of region cell ri at p; where its own certificate
  * gives none, the least of its quarters' (each quarter free of
  * degenerate critical points, or of any, and the open sides kept: so is
- * their union, the interior sides between them being no way in or out),
- * a rational quarter without one standing for by its four pieces'
- * (piece_radius(): where the parametrization varies fast, as at a
- * corner with weights far apart, the quarter's enclosures are too wide
- * ever to hold, and its cell would be due, tested and solved in every
- * update; on polynomial patches the pieces seldom hold where the
- * quarter does not, near a focal sheet, and cost 4 % of the
- * instructions of the 16-patch bench paths).
+ * their union, the interior sides between them being no way in or out).
  */
 static double region_radius(const struct px_strack *t, int ri, px_vec3 p)
 {
 	double r = cert_radius(&t->rcell[ri].cert, p);
 	if (!(r > 0.0)) {
-		const struct scell *g = &t->rcell[ri];
 		const struct rcert *q = &t->qcert[4 * ri];
 		int k;
 		r = INFINITY;
-		for (k = 0; k < 4 && r > 0.0; k++) {
-			double rq = cert_radius(&q[k], p);
-			if (!(rq > 0.0) && q[k].rat && !px__strack_piece_fault) {
-				double b[4], sb[4];
-				int j;
-				box_of(g, k, b);
-				rq = INFINITY;
-				for (j = 0; j < 4 && rq > 0.0; j++) {
-					box_quarter(b, j, sb);
-					rq = fmin(rq, piece_radius(t, g->surf, &q[k], sb, 1, p));
-				}
-			}
-			r = fmin(r, rq);
-		}
+		for (k = 0; k < 4 && r > 0.0; k++)
+			r = fmin(r, cert_radius(&q[k], p));
 	}
 	return r * px__strack_radius_scale;
+}
+
+/* region_radius() with the pieces of a rational region's quarters that
+ * have none (region_pieces()). */
+static double region_radius_full(const struct px_strack *t, int ri, px_vec3 p)
+{
+	double r = region_radius(t, ri, p);
+	if (!(r > 0.0) && t->rcell[ri].cert.rat && !px__strack_piece_fault)
+		r = region_pieces(t, ri, p) * px__strack_radius_scale;
+	return r;
 }
 
 /* 1 when region ri holds no critical point for p (its own E tests, or
@@ -1546,12 +1568,28 @@ static int region_empty(const struct px_strack *t, int ri, px_vec3 p)
 }
 
 /* ... and of a solve cell: its children's regions cover all of it. */
+static __attribute__((noinline)) double cell_pieces(const struct px_strack *t,
+						    const struct scell *c, px_vec3 p);
+
 static double cell_radius(const struct px_strack *t, const struct scell *c,
 			  px_vec3 p)
 {
 	int ri = c->child;
-	return fmin(fmin(region_radius(t, ri, p), region_radius(t, ri + 1, p)),
-		    fmin(region_radius(t, ri + 2, p), region_radius(t, ri + 3, p)));
+	double r = fmin(fmin(region_radius(t, ri, p), region_radius(t, ri + 1, p)),
+			fmin(region_radius(t, ri + 2, p), region_radius(t, ri + 3, p)));
+	/* rational: quarters without a radius by their pieces (rarely run:
+	 * out of line, so that the usual test stays as lean as it was) */
+	if (!(r > 0.0) && t->rcell[ri].cert.rat && !px__strack_piece_fault)
+		r = cell_pieces(t, c, p);
+	return r;
+}
+
+static __attribute__((noinline)) double cell_pieces(const struct px_strack *t,
+						    const struct scell *c, px_vec3 p)
+{
+	int ri = c->child;
+	return fmin(fmin(region_radius_full(t, ri, p), region_radius_full(t, ri + 1, p)),
+		    fmin(region_radius_full(t, ri + 2, p), region_radius_full(t, ri + 3, p)));
 }
 
 /*
@@ -3279,7 +3317,7 @@ double px__strack_cert_radius(const struct px_strack *t, int s, double u,
 			      double v, px_vec3 p)
 {
 	const struct scell *g = region_at(t, s, u, v);
-	return g ? region_radius(t, (int)(g - t->rcell), p) : -1.0;
+	return g ? region_radius_full(t, (int)(g - t->rcell), p) : -1.0;
 }
 
 int px__strack_region(const struct px_strack *t, int s, double u, double v,
