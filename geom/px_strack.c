@@ -3680,33 +3680,57 @@ static void tp_d(const struct tpoly *a, int dir, double h, struct tpoly *o)
 		}
 }
 
-/* o = a b (o not a or b). */
-static void tp_mul(const struct tpoly *a, const struct tpoly *b, struct tpoly *o)
+/* Binomials C(n, k) for n up to the numerators' degrees. */
+#define TP_DEG (3 * PX_NURBS_MAX_DEGREE)
+struct tp_binom {
+	double c[TP_DEG + 1][TP_DEG + 1];
+};
+
+static void tp_binom_init(struct tp_binom *b)
 {
-	int i, j, x, y, M = a->m + b->m, N = a->n + b->n;
+	int n, k;
+	for (n = 0; n <= TP_DEG; n++) {
+		b->c[n][0] = b->c[n][n] = 1.0;
+		for (k = 1; k < n; k++)
+			b->c[n][k] = b->c[n - 1][k - 1] + b->c[n - 1][k];
+	}
+}
+
+/* o = a b (o not a or b; scratch: TP_LEN): the coefficients times their
+ * binomials convolve, then divided by the product's; each is a convex
+ * combination of the products a_i b_j (Vandermonde), so its rounding is
+ * at most a few units of the terms' count times amax bmax. */
+static void tp_mul(const struct tpoly *a, const struct tpoly *b, struct tpoly *o,
+		   const struct tp_binom *bc, double *scratch)
+{
+	int i, j, x, y, M = a->m + b->m, N = a->n + b->n, na = (a->m + 1) * (a->n + 1);
 	double amax = 0.0, bmax = 0.0;
 	o->m = M;
 	o->n = N;
 	for (i = 0; i < (M + 1) * (N + 1); i++)
 		o->c[i] = 0.0;
+	for (j = 0; j <= b->n; j++)
+		for (i = 0; i <= b->m; i++) {
+			double v = b->c[j * (b->m + 1) + i];
+			bmax = fmax(bmax, fabs(v));
+			scratch[j * (b->m + 1) + i] = v * bc->c[b->m][i] * bc->c[b->n][j];
+		}
 	for (j = 0; j <= a->n; j++)
 		for (i = 0; i <= a->m; i++) {
-			double ca = a->c[j * (a->m + 1) + i] * px_bern_binom(a->m, i) *
-				    px_bern_binom(a->n, j);
-			amax = fmax(amax, fabs(a->c[j * (a->m + 1) + i]));
-			for (y = 0; y <= b->n; y++)
+			double ca = a->c[j * (a->m + 1) + i];
+			amax = fmax(amax, fabs(ca));
+			ca *= bc->c[a->m][i] * bc->c[a->n][j];
+			for (y = 0; y <= b->n; y++) {
+				double *restrict row = o->c + (j + y) * (M + 1) + i;
+				const double *restrict bs = scratch + y * (b->m + 1);
 				for (x = 0; x <= b->m; x++)
-					o->c[(j + y) * (M + 1) + i + x] +=
-						ca * b->c[y * (b->m + 1) + x] *
-						px_bern_binom(b->m, x) * px_bern_binom(b->n, y);
+					row[x] += ca * bs[x];
+			}
 		}
-	for (i = 0; i < (b->m + 1) * (b->n + 1); i++)
-		bmax = fmax(bmax, fabs(b->c[i]));
 	for (j = 0; j <= N; j++)
 		for (i = 0; i <= M; i++)
-			o->c[j * (M + 1) + i] /= px_bern_binom(M, i) * px_bern_binom(N, j);
-	/* coefficients are convex combinations of the products */
-	o->mag = amax * b->mag + bmax * a->mag + 1e-15 * amax * bmax;
+			o->c[j * (M + 1) + i] /= bc->c[M][i] * bc->c[N][j];
+	o->mag = amax * b->mag + bmax * a->mag + 2.3e-16 * (na + 4) * amax * bmax;
 }
 
 /* y += s a (the same degrees). */
@@ -3798,81 +3822,86 @@ static struct iv iv_meet(struct iv a, struct iv b)
 }
 
 /*
- * Tighter enclosures of the derivatives of S = X / W for coordinate k
+ * Tighter enclosures of the derivatives of S = X / W for each coordinate
  * of a rational net (degrees 2 or more): S_u = A_u / W^2 with
  * A_u = X_u W - X W_u, S_uu = (X_uu W^2 - X W W_uu - 2 W_u A_u) / W^3,
  * S_uv = ((X_uv W + X_u W_v - X_v W_u - X W_uv) W - 2 W_v A_u) / W^3, and
- * so for v; each numerator's Bernstein hull over the hull of W's power.
- * They are met with the interval quotient rule's (both hold). mem:
- * ST_RAT_POLYS * TP_LEN doubles.
+ * so for v; each numerator raised to its power of W's degree and
+ * bounded by the ratios of their coefficients. They are met with the
+ * interval quotient rule's (both hold). mem: ST_RAT_POLYS * TP_LEN
+ * doubles; W's products once for the three coordinates.
  */
 enum {
 	R_X, R_W, R_XU, R_XV, R_WU, R_WV, R_XUU, R_XUV, R_XVV, R_WUU, R_WUV, R_WVV,
-	R_AU, R_AV, R_T1, R_T2, R_W2, R_W3, R_EL, R_SC, ST_RAT_POLYS
+	R_AU, R_AV, R_T1, R_T2, R_W2, R_W3, R_EL, R_SC, R_XW, ST_RAT_POLYS
 };
-static void rat_tight(const double *pw, int p, int q, double du, double dv, int k,
-		      struct iv *Su, struct iv *Sv, struct iv *Suu, struct iv *Suv,
-		      struct iv *Svv, double *mem)
+static void rat_tight(const double *pw, int p, int q, double du, double dv,
+		      struct iv Su[3], struct iv Sv[3], struct iv Suu[3], struct iv Suv[3],
+		      struct iv Svv[3], double *mem, const struct tp_binom *bc)
 {
 	struct tpoly t[ST_RAT_POLYS];
-	int i;
+	double *sc;
+	int i, k;
 	for (i = 0; i < ST_RAT_POLYS; i++)
 		t[i].c = mem + (size_t)i * TP_LEN;
-	tp_net(pw, p, q, k, &t[R_X]);
+	sc = t[R_SC].c;
 	tp_net(pw, p, q, 3, &t[R_W]);
-	tp_d(&t[R_X], 0, du, &t[R_XU]);
-	tp_d(&t[R_X], 1, dv, &t[R_XV]);
 	tp_d(&t[R_W], 0, du, &t[R_WU]);
 	tp_d(&t[R_W], 1, dv, &t[R_WV]);
-	tp_d(&t[R_XU], 0, du, &t[R_XUU]);
-	tp_d(&t[R_XU], 1, dv, &t[R_XUV]);
-	tp_d(&t[R_XV], 1, dv, &t[R_XVV]);
 	tp_d(&t[R_WU], 0, du, &t[R_WUU]);
 	tp_d(&t[R_WU], 1, dv, &t[R_WUV]);
 	tp_d(&t[R_WV], 1, dv, &t[R_WVV]);
-	tp_mul(&t[R_W], &t[R_W], &t[R_W2]);
-	tp_mul(&t[R_W2], &t[R_W], &t[R_W3]);
-	/* A_u, A_v */
-	tp_mul(&t[R_XU], &t[R_W], &t[R_AU]);
-	tp_mul(&t[R_X], &t[R_WU], &t[R_T1]);
-	tp_axpy(&t[R_AU], -1.0, &t[R_T1]);
-	tp_mul(&t[R_XV], &t[R_W], &t[R_AV]);
-	tp_mul(&t[R_X], &t[R_WV], &t[R_T1]);
-	tp_axpy(&t[R_AV], -1.0, &t[R_T1]);
-	tp_elevate(&t[R_AU], 2 * p, 2 * q, &t[R_EL], t[R_SC].c);
-	*Su = iv_meet(*Su, tp_ratio_range(&t[R_EL], &t[R_W2]));
-	tp_elevate(&t[R_AV], 2 * p, 2 * q, &t[R_EL], t[R_SC].c);
-	*Sv = iv_meet(*Sv, tp_ratio_range(&t[R_EL], &t[R_W2]));
-	/* S_uu W^3: X_uu W^2 - (X W) W_uu - 2 W_u A_u */
-	tp_mul(&t[R_XUU], &t[R_W2], &t[R_T1]);
-	tp_mul(&t[R_X], &t[R_W], &t[R_XUU]);          /* X W (X_uu no longer needed) */
-	tp_mul(&t[R_XUU], &t[R_WUU], &t[R_T2]);
-	tp_axpy(&t[R_T1], -1.0, &t[R_T2]);
-	tp_mul(&t[R_WU], &t[R_AU], &t[R_T2]);
-	tp_axpy(&t[R_T1], -2.0, &t[R_T2]);
-	tp_elevate(&t[R_T1], 3 * p, 3 * q, &t[R_EL], t[R_SC].c);
-	*Suu = iv_meet(*Suu, tp_ratio_range(&t[R_EL], &t[R_W3]));
-	/* S_vv W^3: X_vv W^2 - (X W) W_vv - 2 W_v A_v */
-	tp_mul(&t[R_XVV], &t[R_W2], &t[R_T1]);
-	tp_mul(&t[R_XUU], &t[R_WVV], &t[R_T2]);
-	tp_axpy(&t[R_T1], -1.0, &t[R_T2]);
-	tp_mul(&t[R_WV], &t[R_AV], &t[R_T2]);
-	tp_axpy(&t[R_T1], -2.0, &t[R_T2]);
-	tp_elevate(&t[R_T1], 3 * p, 3 * q, &t[R_EL], t[R_SC].c);
-	*Svv = iv_meet(*Svv, tp_ratio_range(&t[R_EL], &t[R_W3]));
-	/* S_uv W^3: (X_uv W + X_u W_v - X_v W_u - X W_uv) W - 2 W_v A_u */
-	tp_mul(&t[R_XUV], &t[R_W], &t[R_T1]);
-	tp_mul(&t[R_XU], &t[R_WV], &t[R_T2]);
-	tp_axpy(&t[R_T1], 1.0, &t[R_T2]);
-	tp_mul(&t[R_XV], &t[R_WU], &t[R_T2]);
-	tp_axpy(&t[R_T1], -1.0, &t[R_T2]);
-	tp_mul(&t[R_X], &t[R_WUV], &t[R_T2]);
-	tp_axpy(&t[R_T1], -1.0, &t[R_T2]);
-	tp_mul(&t[R_T1], &t[R_W], &t[R_T2]);
-	tp_mul(&t[R_WV], &t[R_AU], &t[R_T1]);
-	tp_axpy(&t[R_T2], -2.0, &t[R_T1]);
-	tp_elevate(&t[R_T2], 3 * p, 3 * q, &t[R_EL], t[R_SC].c);
-	*Suv = iv_meet(*Suv, tp_ratio_range(&t[R_EL], &t[R_W3]));
+	tp_mul(&t[R_W], &t[R_W], &t[R_W2], bc, sc);
+	tp_mul(&t[R_W2], &t[R_W], &t[R_W3], bc, sc);
+	for (k = 0; k < 3; k++) {
+		tp_net(pw, p, q, k, &t[R_X]);
+		tp_d(&t[R_X], 0, du, &t[R_XU]);
+		tp_d(&t[R_X], 1, dv, &t[R_XV]);
+		tp_d(&t[R_XU], 0, du, &t[R_XUU]);
+		tp_d(&t[R_XU], 1, dv, &t[R_XUV]);
+		tp_d(&t[R_XV], 1, dv, &t[R_XVV]);
+		/* A_u, A_v */
+		tp_mul(&t[R_XU], &t[R_W], &t[R_AU], bc, sc);
+		tp_mul(&t[R_X], &t[R_WU], &t[R_T1], bc, sc);
+		tp_axpy(&t[R_AU], -1.0, &t[R_T1]);
+		tp_mul(&t[R_XV], &t[R_W], &t[R_AV], bc, sc);
+		tp_mul(&t[R_X], &t[R_WV], &t[R_T1], bc, sc);
+		tp_axpy(&t[R_AV], -1.0, &t[R_T1]);
+		tp_elevate(&t[R_AU], 2 * p, 2 * q, &t[R_EL], sc);
+		Su[k] = iv_meet(Su[k], tp_ratio_range(&t[R_EL], &t[R_W2]));
+		tp_elevate(&t[R_AV], 2 * p, 2 * q, &t[R_EL], sc);
+		Sv[k] = iv_meet(Sv[k], tp_ratio_range(&t[R_EL], &t[R_W2]));
+		tp_mul(&t[R_X], &t[R_W], &t[R_XW], bc, sc);
+		/* S_uu W^3: X_uu W^2 - (X W) W_uu - 2 W_u A_u */
+		tp_mul(&t[R_XUU], &t[R_W2], &t[R_T1], bc, sc);
+		tp_mul(&t[R_XW], &t[R_WUU], &t[R_T2], bc, sc);
+		tp_axpy(&t[R_T1], -1.0, &t[R_T2]);
+		tp_mul(&t[R_WU], &t[R_AU], &t[R_T2], bc, sc);
+		tp_axpy(&t[R_T1], -2.0, &t[R_T2]);
+		tp_elevate(&t[R_T1], 3 * p, 3 * q, &t[R_EL], sc);
+		Suu[k] = iv_meet(Suu[k], tp_ratio_range(&t[R_EL], &t[R_W3]));
+		/* S_vv W^3: X_vv W^2 - (X W) W_vv - 2 W_v A_v */
+		tp_mul(&t[R_XVV], &t[R_W2], &t[R_T1], bc, sc);
+		tp_mul(&t[R_XW], &t[R_WVV], &t[R_T2], bc, sc);
+		tp_axpy(&t[R_T1], -1.0, &t[R_T2]);
+		tp_mul(&t[R_WV], &t[R_AV], &t[R_T2], bc, sc);
+		tp_axpy(&t[R_T1], -2.0, &t[R_T2]);
+		tp_elevate(&t[R_T1], 3 * p, 3 * q, &t[R_EL], sc);
+		Svv[k] = iv_meet(Svv[k], tp_ratio_range(&t[R_EL], &t[R_W3]));
+		/* S_uv W^3: (X_uv W + X_u W_v - X_v W_u - X W_uv) W - 2 W_v A_u */
+		tp_mul(&t[R_XUV], &t[R_W], &t[R_T1], bc, sc);
+		tp_mul(&t[R_XU], &t[R_WV], &t[R_T2], bc, sc);
+		tp_axpy(&t[R_T1], 1.0, &t[R_T2]);
+		tp_mul(&t[R_XV], &t[R_WU], &t[R_T2], bc, sc);
+		tp_axpy(&t[R_T1], -1.0, &t[R_T2]);
+		tp_mul(&t[R_X], &t[R_WUV], &t[R_T2], bc, sc);
+		tp_axpy(&t[R_T1], -1.0, &t[R_T2]);
+		tp_mul(&t[R_T1], &t[R_W], &t[R_T2], bc, sc);
+		tp_mul(&t[R_WV], &t[R_AU], &t[R_T1], bc, sc);
+		tp_axpy(&t[R_T2], -2.0, &t[R_T1]);
+		tp_elevate(&t[R_T2], 3 * p, 3 * q, &t[R_EL], sc);
+		Suv[k] = iv_meet(Suv[k], tp_ratio_range(&t[R_EL], &t[R_W3]));
+	}
 }
 
 /*
@@ -3898,9 +3927,11 @@ static int net_cert(const double *pw, int p, int q, double du, double dv,
 		return PX_E_INVAL;
 	ce->rat = rational;
 	if (rational && p >= 2 && q >= 2) {
-		mem = malloc((size_t)ST_RAT_POLYS * TP_LEN * sizeof(double));
+		mem = malloc((size_t)ST_RAT_POLYS * TP_LEN * sizeof(double) +
+			     sizeof(struct tp_binom));
 		if (!mem)
 			return PX_E_NOMEM;
+		tp_binom_init((struct tp_binom *)(mem + (size_t)ST_RAT_POLYS * TP_LEN));
 	}
 	Wu = nr[1][3];
 	Wv = nr[2][3];
@@ -3932,10 +3963,10 @@ static int net_cert(const double *pw, int p, int q, double du, double dv,
 					     iv_mul(Su[k], Wv)),
 				      iv_mul(Sv[k], Wu)),
 			       iv_mul(S, Wuv)), W));
-		if (mem)
-			rat_tight(pw, p, q, du, dv, k, &Su[k], &Sv[k], &ce->Suu[k], &ce->Suv[k],
-				  &ce->Svv[k], mem);
 	}
+	if (mem)
+		rat_tight(pw, p, q, du, dv, Su, Sv, ce->Suu, ce->Suv, ce->Svv, mem,
+			  (const struct tp_binom *)(mem + (size_t)ST_RAT_POLYS * TP_LEN));
 	free(mem);
 	{
 		/* third derivatives, for the certificates of sub-boxes
