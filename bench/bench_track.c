@@ -525,35 +525,14 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 
 /* ---- surfaces ------------------------------------------------------- */
 
-static int wavy_surf(struct px_nurbs_surf *s, int n)
-{
-	double U[16], xyz[3 * 49];
-	int i, j, p = 3;
-	for (i = 0; i <= p; i++) {
-		U[i] = 0.0;
-		U[n + i] = 1.0;
-	}
-	for (i = p + 1; i < n; i++)
-		U[i] = (double)(i - p) / (n - p);
-	for (j = 0; j < n; j++)
-		for (i = 0; i < n; i++) {
-			double x = -1 + 2.0 * i / (n - 1), y = -1 + 2.0 * j / (n - 1);
-			double *q = &xyz[3 * (j * n + i)];
-			q[0] = x;
-			q[1] = y + 0.1 * sin(3 * x);
-			q[2] = 0.35 * sin(2.2 * x + 0.3) * cos(2.7 * y - 0.2);
-		}
-	return px_nurbs_surf_init(s, &arena, 3, 3, n, n, U, n + 4, U, n + 4, xyz,
-				  NULL, NULL);
-}
-
-/* The 16-patch wavy sheet made rational: weights 0.6 to 1.5 over the
- * net (the certificates' rational path, as a CAD model's cylinders and
- * spheres take it). */
-static int rational_surf(struct px_nurbs_surf *s)
+/* The wavy sheet of n x n control points (clamped knots, uniform
+ * inside); rational: with weights 0.6 to 1.5 over the net (the
+ * certificates' rational path, as a CAD model's cylinders and spheres
+ * take it). */
+static int wavy_net(struct px_nurbs_surf *s, int n, int rational)
 {
 	double U[16], xyz[3 * 49], w[49];
-	int i, j, p = 3, n = 7;
+	int i, j, p = 3;
 	for (i = 0; i <= p; i++) {
 		U[i] = 0.0;
 		U[n + i] = 1.0;
@@ -570,7 +549,18 @@ static int rational_surf(struct px_nurbs_surf *s)
 			w[j * n + i] = 0.6 + 0.9 * ((i * 7 + j * 3) % 5) / 4.0;
 		}
 	return px_nurbs_surf_init(s, &arena, 3, 3, n, n, U, n + 4, U, n + 4, xyz,
-				  w, NULL);
+				  rational ? w : NULL, NULL);
+}
+
+static int wavy_surf(struct px_nurbs_surf *s, int n)
+{
+	return wavy_net(s, n, 0);
+}
+
+/* The 16-patch wavy sheet made rational. */
+static int rational_surf(struct px_nurbs_surf *s)
+{
+	return wavy_net(s, 7, 1);
 }
 
 static int fold_surf(struct px_nurbs_surf *s)

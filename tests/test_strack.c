@@ -1439,14 +1439,12 @@ static long sub_check(const struct px_strack *t, const struct px_nurbs_surf *s,
 			px__strack_contract(t, 0, 0.5 * (rb[i][0] + rb[i][1]),
 					    0.5 * (rb[i][2] + rb[i][3]), pts[k], box, out, fu, fv);
 			for (qk = 0; qk < 4; qk++) {
-				double qb[4], reg;
-				int qopen, qres, qrg;
+				double qb[4];
+				int qopen;
 				piece_box(box, qk + 1, qb);
 				/* the quarter as a solve sees it: decided by its
 				 * setup certificate's contraction, or open */
-				qres = px__strack_sub(t, 0, qb, pts[k], &qrg, &reg, &reg);
 				qopen = out[qk + 1] < 0 || out[qk + 1] == 2;
-				(void)qres;
 				/* level 1: 4 pieces, level 2: 16 */
 				for (m = 0; m < 20; m++) {
 					double pb[4], pu = 0.0, pv = 0.0;
@@ -1843,6 +1841,16 @@ static void test_tests_budget(void)
  * solve, so most steps fit the default budget (the hit cells' solves and
  * their neighbours' checks) and are tracked; every answer exact.
  */
+/* Step k of 400 of test_focal_hover()'s path about focal point c: a
+ * Lissajous knot of radius 0.5 % of the model size, steps about 0.04 %
+ * of it. */
+static px_vec3 hover_point(px_vec3 c, int k, double size)
+{
+	double a = 2.0 * M_PI * k / 400.0, rad = 5e-3 * size;
+	return px_v3_add(c, px_v3(rad * sin(3.0 * a), rad * sin(4.0 * a + 1.0),
+				  rad * sin(5.0 * a + 2.0)));
+}
+
 static void test_focal_hover(void)
 {
 	struct px_nurbs_surf s;
@@ -1881,12 +1889,7 @@ static void test_focal_hover(void)
 		px_strack_reset(t, fp[i], &r);
 		px_strack_get_stats(t, &s0);
 		for (k = 0; k < 400; k++) {
-			/* a Lissajous knot of radius 0.5 % of the model about the
-			 * focal point, steps about 0.04 % of it */
-			double a = 2.0 * M_PI * k / 400.0, rad = 5e-3 * size;
-			px_vec3 q = px_v3_add(fp[i], px_v3(rad * sin(3.0 * a),
-							   rad * sin(4.0 * a + 1.0),
-							   rad * sin(5.0 * a + 2.0)));
+			px_vec3 q = hover_point(fp[i], k, size);
 			struct px_dist_result g;
 			uint64_t reg = px_alloc_region_begin();
 			PX_CHECK_INT_EQ(px_strack_update(t, q, &r), PX_OK);
@@ -1944,10 +1947,7 @@ static void test_focal_hover(void)
 				px_strack_reset(t, fp[i], &r);
 				px_strack_get_stats(t, &s0);
 				for (k = 0; k < 400; k++) {
-					double a = 2.0 * M_PI * k / 400.0, rad = 5e-3 * size;
-					px_vec3 q = px_v3_add(fp[i], px_v3(rad * sin(3.0 * a),
-									   rad * sin(4.0 * a + 1.0),
-									   rad * sin(5.0 * a + 2.0)));
+					px_vec3 q = hover_point(fp[i], k, size);
 					struct px_dist_result g;
 					px_strack_update(t, q, &r);
 					px_dist_query(ref, q, &g);
