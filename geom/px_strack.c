@@ -1453,10 +1453,6 @@ static void cert_sides(const struct ssurf *f, const struct scell *c, struct rcer
 		       const int side_open[4]);
 static void box_quarter(const double b[4], int k, double q[4]);
 
-/* Levels of pieces below a quarter whose certificate gives no radius
- * (piece_radius()). */
-#define ST_PIECE_DEPTH 1
-
 /* Test hook (internal.h): 1 leaves the pieces out of the radii
  * (region_radius_full(), cell_radius()). */
 int px__strack_piece_fault = 0;
@@ -1464,18 +1460,17 @@ int px__strack_piece_fault = 0;
 /*
  * Certified radius at p of piece b of surface s, its certificate made as
  * a cut's (taylor_cert() from top, the certificate of a box holding it)
- * with the side tests of the open sides it lies on; where it gives none,
- * the least of its quarters', down to ST_PIECE_DEPTH levels. The union
- * argument of region_radius() holds for the pieces as for quarters.
+ * with the side tests of the open sides it lies on. The union argument
+ * of region_radius() holds for the pieces as for quarters (pieces of a
+ * second level gained nothing on the rational bench model).
  */
 static double piece_radius(const struct px_strack *t, int s, const struct rcert *top,
-			   const double b[4], int depth, px_vec3 p)
+			   const double b[4], px_vec3 p)
 {
 	const struct ssurf *f = &t->sf[s];
 	struct rcert rc;
 	struct scell pc;
-	int open[4], k;
-	double r;
+	int open[4];
 	memset(&pc, 0, sizeof(pc));
 	pc.surf = s;
 	pc.u0 = b[0];
@@ -1485,16 +1480,7 @@ static double piece_radius(const struct px_strack *t, int s, const struct rcert 
 	taylor_cert(f, b, top, &rc);
 	sides_open(f, &pc, open);
 	cert_sides(f, &pc, &rc, open);
-	r = cert_radius(&rc, p);
-	if (r > 0.0 || depth >= ST_PIECE_DEPTH)
-		return r;
-	r = INFINITY;
-	for (k = 0; k < 4 && r > 0.0; k++) {
-		double sb[4];
-		box_quarter(b, k, sb);
-		r = fmin(r, piece_radius(t, s, top, sb, depth + 1, p));
-	}
-	return r;
+	return cert_radius(&rc, p);
 }
 
 /*
@@ -1520,7 +1506,7 @@ static double region_pieces(const struct px_strack *t, int ri, px_vec3 p)
 			rq = INFINITY;
 			for (j = 0; j < 4 && rq > 0.0; j++) {
 				box_quarter(b, j, sb);
-				rq = fmin(rq, piece_radius(t, g->surf, q, sb, 1, p));
+				rq = fmin(rq, piece_radius(t, g->surf, q, sb, p));
 			}
 		}
 		r = fmin(r, rq);
@@ -1569,27 +1555,36 @@ static int region_empty(const struct px_strack *t, int ri, px_vec3 p)
 
 /* ... and of a solve cell: its children's regions cover all of it. */
 static __attribute__((noinline)) double cell_pieces(const struct px_strack *t,
-						    const struct scell *c, px_vec3 p);
+						    const struct scell *c, px_vec3 p, double r0,
+						    double r1, double r2, double r3);
 
 static double cell_radius(const struct px_strack *t, const struct scell *c,
 			  px_vec3 p)
 {
 	int ri = c->child;
-	double r = fmin(fmin(region_radius(t, ri, p), region_radius(t, ri + 1, p)),
-			fmin(region_radius(t, ri + 2, p), region_radius(t, ri + 3, p)));
+	double r0 = region_radius(t, ri, p), r1 = region_radius(t, ri + 1, p),
+	       r2 = region_radius(t, ri + 2, p), r3 = region_radius(t, ri + 3, p);
+	double r = fmin(fmin(r0, r1), fmin(r2, r3));
 	/* rational: quarters without a radius by their pieces (rarely run:
 	 * out of line, so that the usual test stays as lean as it was) */
 	if (!(r > 0.0) && t->rcell[ri].cert.rat && !px__strack_piece_fault)
-		r = cell_pieces(t, c, p);
+		r = cell_pieces(t, c, p, r0, r1, r2, r3);
 	return r;
 }
 
+/* cell_radius() where a region's radius (r0..r3) is none: by the
+ * pieces of its quarters (the others as they were). */
 static __attribute__((noinline)) double cell_pieces(const struct px_strack *t,
-						    const struct scell *c, px_vec3 p)
+						    const struct scell *c, px_vec3 p, double r0,
+						    double r1, double r2, double r3)
 {
-	int ri = c->child;
-	return fmin(fmin(region_radius_full(t, ri, p), region_radius_full(t, ri + 1, p)),
-		    fmin(region_radius_full(t, ri + 2, p), region_radius_full(t, ri + 3, p)));
+	const double r[4] = {r0, r1, r2, r3};
+	double m = INFINITY;
+	int i;
+	for (i = 0; i < 4; i++)
+		m = fmin(m, r[i] > 0.0 ? r[i]
+				       : region_pieces(t, c->child + i, p) * px__strack_radius_scale);
+	return m;
 }
 
 /*
@@ -3790,14 +3785,15 @@ static struct iv tp_ratio_range(const struct tpoly *a, const struct tpoly *d)
 	struct iv r = {INFINITY, -INFINITY};
 	int i;
 	for (i = 0; i < (a->m + 1) * (a->n + 1); i++) {
-		double x = a->c[i] / d->c[i];
-		double e = (8.0 * a->mag + 1e-15 * fabs(a->c[i])) / d->c[i] +
-			   fabs(x) * (8.0 * d->mag / d->c[i] + 1e-15);
+		double x, e;
 		if (!(d->c[i] > 0.0)) {
 			r.lo = -INFINITY;
 			r.hi = INFINITY;
 			return r;
 		}
+		x = a->c[i] / d->c[i];
+		e = (8.0 * a->mag + 1e-15 * fabs(a->c[i])) / d->c[i] +
+		    fabs(x) * (8.0 * d->mag / d->c[i] + 1e-15);
 		iv_grow(&r, x - e);
 		iv_grow(&r, x + e);
 	}
@@ -3819,6 +3815,24 @@ static struct iv iv_meet(struct iv a, struct iv b)
 		return r;
 	}
 	return r.lo <= r.hi ? r : a;
+}
+
+/* y += s a b (tmp: a product's room; as tp_mul() then tp_axpy()). */
+static void tp_muladd(struct tpoly *y, double s, const struct tpoly *a,
+		      const struct tpoly *b, struct tpoly *tmp, const struct tp_binom *bc,
+		      double *scratch)
+{
+	tp_mul(a, b, tmp, bc, scratch);
+	tp_axpy(y, s, tmp);
+}
+
+/* *x met with the range of num / den: num raised to den's degrees (into
+ * el), then the hull of the coefficients' ratios. */
+static void tp_bound(struct iv *x, const struct tpoly *num, const struct tpoly *den,
+		     struct tpoly *el, double *scratch)
+{
+	tp_elevate(num, den->m, den->n, el, scratch);
+	*x = iv_meet(*x, tp_ratio_range(el, den));
 }
 
 /*
@@ -3854,53 +3868,35 @@ static void rat_tight(const double *pw, int p, int q, double du, double dv,
 	tp_mul(&t[R_W], &t[R_W], &t[R_W2], bc, sc);
 	tp_mul(&t[R_W2], &t[R_W], &t[R_W3], bc, sc);
 	for (k = 0; k < 3; k++) {
+		int d;
 		tp_net(pw, p, q, k, &t[R_X]);
 		tp_d(&t[R_X], 0, du, &t[R_XU]);
 		tp_d(&t[R_X], 1, dv, &t[R_XV]);
 		tp_d(&t[R_XU], 0, du, &t[R_XUU]);
 		tp_d(&t[R_XU], 1, dv, &t[R_XUV]);
 		tp_d(&t[R_XV], 1, dv, &t[R_XVV]);
-		/* A_u, A_v */
-		tp_mul(&t[R_XU], &t[R_W], &t[R_AU], bc, sc);
-		tp_mul(&t[R_X], &t[R_WU], &t[R_T1], bc, sc);
-		tp_axpy(&t[R_AU], -1.0, &t[R_T1]);
-		tp_mul(&t[R_XV], &t[R_W], &t[R_AV], bc, sc);
-		tp_mul(&t[R_X], &t[R_WV], &t[R_T1], bc, sc);
-		tp_axpy(&t[R_AV], -1.0, &t[R_T1]);
-		tp_elevate(&t[R_AU], 2 * p, 2 * q, &t[R_EL], sc);
-		Su[k] = iv_meet(Su[k], tp_ratio_range(&t[R_EL], &t[R_W2]));
-		tp_elevate(&t[R_AV], 2 * p, 2 * q, &t[R_EL], sc);
-		Sv[k] = iv_meet(Sv[k], tp_ratio_range(&t[R_EL], &t[R_W2]));
 		tp_mul(&t[R_X], &t[R_W], &t[R_XW], bc, sc);
-		/* S_uu W^3: X_uu W^2 - (X W) W_uu - 2 W_u A_u */
-		tp_mul(&t[R_XUU], &t[R_W2], &t[R_T1], bc, sc);
-		tp_mul(&t[R_XW], &t[R_WUU], &t[R_T2], bc, sc);
-		tp_axpy(&t[R_T1], -1.0, &t[R_T2]);
-		tp_mul(&t[R_WU], &t[R_AU], &t[R_T2], bc, sc);
-		tp_axpy(&t[R_T1], -2.0, &t[R_T2]);
-		tp_elevate(&t[R_T1], 3 * p, 3 * q, &t[R_EL], sc);
-		Suu[k] = iv_meet(Suu[k], tp_ratio_range(&t[R_EL], &t[R_W3]));
-		/* S_vv W^3: X_vv W^2 - (X W) W_vv - 2 W_v A_v */
-		tp_mul(&t[R_XVV], &t[R_W2], &t[R_T1], bc, sc);
-		tp_mul(&t[R_XW], &t[R_WVV], &t[R_T2], bc, sc);
-		tp_axpy(&t[R_T1], -1.0, &t[R_T2]);
-		tp_mul(&t[R_WV], &t[R_AV], &t[R_T2], bc, sc);
-		tp_axpy(&t[R_T1], -2.0, &t[R_T2]);
-		tp_elevate(&t[R_T1], 3 * p, 3 * q, &t[R_EL], sc);
-		Svv[k] = iv_meet(Svv[k], tp_ratio_range(&t[R_EL], &t[R_W3]));
+		for (d = 0; d < 2; d++) {
+			/* A_d = X_d W - X W_d over W^2; S_dd W^3 = X_dd W^2 -
+			 * (X W) W_dd - 2 W_d A_d */
+			int xd = d ? R_XV : R_XU, wd = d ? R_WV : R_WU, ad = d ? R_AV : R_AU;
+			tp_mul(&t[xd], &t[R_W], &t[ad], bc, sc);
+			tp_muladd(&t[ad], -1.0, &t[R_X], &t[wd], &t[R_T1], bc, sc);
+			tp_bound(d ? &Sv[k] : &Su[k], &t[ad], &t[R_W2], &t[R_EL], sc);
+			tp_mul(&t[d ? R_XVV : R_XUU], &t[R_W2], &t[R_T1], bc, sc);
+			tp_muladd(&t[R_T1], -1.0, &t[R_XW], &t[d ? R_WVV : R_WUU], &t[R_T2], bc,
+				  sc);
+			tp_muladd(&t[R_T1], -2.0, &t[wd], &t[ad], &t[R_T2], bc, sc);
+			tp_bound(d ? &Svv[k] : &Suu[k], &t[R_T1], &t[R_W3], &t[R_EL], sc);
+		}
 		/* S_uv W^3: (X_uv W + X_u W_v - X_v W_u - X W_uv) W - 2 W_v A_u */
 		tp_mul(&t[R_XUV], &t[R_W], &t[R_T1], bc, sc);
-		tp_mul(&t[R_XU], &t[R_WV], &t[R_T2], bc, sc);
-		tp_axpy(&t[R_T1], 1.0, &t[R_T2]);
-		tp_mul(&t[R_XV], &t[R_WU], &t[R_T2], bc, sc);
-		tp_axpy(&t[R_T1], -1.0, &t[R_T2]);
-		tp_mul(&t[R_X], &t[R_WUV], &t[R_T2], bc, sc);
-		tp_axpy(&t[R_T1], -1.0, &t[R_T2]);
+		tp_muladd(&t[R_T1], 1.0, &t[R_XU], &t[R_WV], &t[R_T2], bc, sc);
+		tp_muladd(&t[R_T1], -1.0, &t[R_XV], &t[R_WU], &t[R_T2], bc, sc);
+		tp_muladd(&t[R_T1], -1.0, &t[R_X], &t[R_WUV], &t[R_T2], bc, sc);
 		tp_mul(&t[R_T1], &t[R_W], &t[R_T2], bc, sc);
-		tp_mul(&t[R_WV], &t[R_AU], &t[R_T1], bc, sc);
-		tp_axpy(&t[R_T2], -2.0, &t[R_T1]);
-		tp_elevate(&t[R_T2], 3 * p, 3 * q, &t[R_EL], sc);
-		Suv[k] = iv_meet(Suv[k], tp_ratio_range(&t[R_EL], &t[R_W3]));
+		tp_muladd(&t[R_T2], -2.0, &t[R_WV], &t[R_AU], &t[R_T1], bc, sc);
+		tp_bound(&Suv[k], &t[R_T2], &t[R_W3], &t[R_EL], sc);
 	}
 }
 
@@ -4098,6 +4094,16 @@ static void net_ranges3(const double *P, int p, int q, double du, double dv,
 	}
 }
 
+/* The centre values of certificate ce from the evaluation d there. */
+static void centre_set(struct rcert *ce, const struct px_nurbs_surf_derivs *d)
+{
+	ce->sc = d->s;
+	ce->suc = d->su;
+	ce->svc = d->sv;
+	ce->n1 = fabs(d->su.x) + fabs(d->su.y) + fabs(d->su.z);
+	ce->n2 = fabs(d->sv.x) + fabs(d->sv.y) + fabs(d->sv.z);
+}
+
 /*
  * Certificate of sub-box b (u0, u1, v0, v1) of the box of certificate
  * top, at update time: the values at b's centre and the mean value
@@ -4148,11 +4154,7 @@ static void taylor_cert(const struct ssurf *f, const double b[4],
 		ce->S[k] = iv_pad(x);
 	}
 	cert_fill(ce, Su, Sv, 2.0 * hu, 2.0 * hv);
-	ce->sc = d.s;
-	ce->suc = d.su;
-	ce->svc = d.sv;
-	ce->n1 = fabs(d.su.x) + fabs(d.su.y) + fabs(d.su.z);
-	ce->n2 = fabs(d.sv.x) + fabs(d.sv.y) + fabs(d.sv.z);
+	centre_set(ce, &d);
 }
 
 /* The centre values of certificate ce of box (u0, u1, v0, v1). */
@@ -4161,11 +4163,7 @@ static void cert_centre(const struct ssurf *f, double u0, double u1, double v0,
 {
 	struct px_nurbs_surf_derivs d;
 	surf_eval2(f, 0.5 * (u0 + u1), 0.5 * (v0 + v1), &d);
-	ce->sc = d.s;
-	ce->suc = d.su;
-	ce->svc = d.sv;
-	ce->n1 = fabs(d.su.x) + fabs(d.su.y) + fabs(d.su.z);
-	ce->n2 = fabs(d.sv.x) + fabs(d.sv.y) + fabs(d.sv.z);
+	centre_set(ce, &d);
 }
 
 /* Certificate data of region cell c (setup; work: extraction scratch). */
