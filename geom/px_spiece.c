@@ -1,5 +1,6 @@
 #include "px_spiece.h"
 
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -596,7 +597,7 @@ static int newton_f(struct qctx *x, const struct rect *r, int *iters,
 	double s = 0.5 * (r->s0 + r->s1), t = 0.5 * (r->t0 + r->t1);
 	double ks = sp->u1_ - sp->u0_, kt = sp->v1_ - sp->v0_;
 	double wmax = fmax(r->s1 - r->s0, r->t1 - r->t0), fcur;
-	int it;
+	int it, floor_steps = 0;
 
 	if (x->hint_s >= r->s0 && x->hint_s <= r->s1 && x->hint_t >= r->t0 &&
 	    x->hint_t <= r->t1) {
@@ -607,7 +608,7 @@ static int newton_f(struct qctx *x, const struct rect *r, int *iters,
 	for (it = 0; it < PX_SPIECE_MAX_ITERS; it++) {
 		px_vec3 su, sv, suu, suv, svv, d, S;
 		double gs, gt, a, b, c, det, ds, dt, al;
-		int k, out_s, out_t;
+		int k, out_s, out_t, newton_step = 1;
 
 		(*iters)++;
 		S = px_spiece_eval(sp, s, t, &su, &sv, &suu, &suv, &svv);
@@ -637,15 +638,18 @@ static int newton_f(struct qctx *x, const struct rect *r, int *iters,
 			goto done; /* a corner with descent pointing out */
 		if (out_s) {
 			ds = 0.0;
-			dt = c > 0.0 ? -gt / c : -copysign(wmax, gt);
+			newton_step = c > 0.0;
+			dt = newton_step ? -gt / c : -copysign(wmax, gt);
 		} else if (out_t) {
 			dt = 0.0;
-			ds = a > 0.0 ? -gs / a : -copysign(wmax, gs);
+			newton_step = a > 0.0;
+			ds = newton_step ? -gs / a : -copysign(wmax, gs);
 		} else if (a > 0.0 && det > 0.0) {
 			ds = -(c * gs - b * gt) / det;
 			dt = -(a * gt - b * gs) / det;
 		} else {
 			double g = sqrt(gs * gs + gt * gt);
+			newton_step = 0;
 			ds = -gs / g * wmax;
 			dt = -gt / g * wmax;
 		}
@@ -654,11 +658,38 @@ static int newton_f(struct qctx *x, const struct rect *r, int *iters,
 		 * search there would halve the step to nothing. */
 		if (fabs(ds) <= 1e-13 && fabs(dt) <= 1e-13)
 			goto done;
-		/* Sitting on the border and the step still pushed out through
-		 * it: give up, the caller subdivides, which is safe. */
-		if ((s <= r->s0 && ds < 0.0) || (s >= r->s1 && ds > 0.0) ||
-		    (t <= r->t0 && dt < 0.0) || (t >= r->t1 && dt > 0.0))
-			goto done;
+		/* Sitting on the border with the Newton step pushed out
+		 * through it while the gradient points in (the cross term):
+		 * the diagonal step, a descent direction whose components
+		 * point where the gradient's do, so inward. Giving up here
+		 * left the rectangle to be cut with no point to settle it
+		 * from. */
+		if (((s <= r->s0 && ds < 0.0) || (s >= r->s1 && ds > 0.0) ||
+		     (t <= r->t0 && dt < 0.0) || (t >= r->t1 && dt > 0.0))) {
+			if (!(a > 0.0 && c > 0.0))
+				goto done;
+			ds = out_s ? 0.0 : -gs / a;
+			dt = out_t ? 0.0 : -gt / c;
+			newton_step = 0;
+		}
+		/* A Newton step whose model decrease, -(g . step) / 2, is
+		 * below a few ulps of f cannot be judged by comparing f: f is
+		 * at its rounding floor and the line search would halve the
+		 * step at random, crawling (along a border, where the
+		 * gradient across it stays large, for the whole iteration
+		 * bound, subdividing towards the border at every level). The
+		 * model is right there (quadratic convergence): take it
+		 * whole, twice at most - after that the step is rounding
+		 * noise too and the point is as good as it gets. */
+		if (newton_step &&
+		    -(gs * ds + gt * dt) <= 8.0 * DBL_EPSILON * fcur) {
+			if (floor_steps++ >= 2)
+				goto done;
+			s = clampd(s + ds, r->s0, r->s1);
+			t = clampd(t + dt, r->t0, r->t1);
+			fcur = px_v3_dist2(spiece_point(sp, s, t), x->p);
+			continue;
+		}
 		for (al = 1.0, k = 0; k < 12; k++, al *= 0.5) {
 			double ns = clampd(s + al * ds, r->s0, r->s1);
 			double nt = clampd(t + al * dt, r->t0, r->t1);
@@ -867,6 +898,7 @@ struct mono {
 	double gu, gv;         /* (gu, gv) at the point */
 	double eps_gu, eps_gv; /* their rounding */
 	double gmax;           /* bound of |grad f| on the rectangle */
+	double gscale;         /* 2 / wmin^3: |grad f| <= gscale |G| */
 };
 
 /*
@@ -877,9 +909,18 @@ struct mono {
  *     mu |z - x*|^2 <= (G(z) - G(x*)) . (z - x*) = -G(x*) . (z - x*).
  * A component of G(x*) pointing out through a border x* lies on makes
  * its term <= 0 (z lies inside), so |z - x*| <= |G_rest| / mu = rho, and
- * f(z) >= f(x*) - rho * max |grad f|. When that is within the rounding
- * slack, x* (already considered) is as good as any interior minimum and
- * the rectangle is settled without subdividing around the border.
+ * f(z) >= f(x*) - rho * max |grad f|. Sharper, as for strongly convex
+ * functions: along y = x* + tau (z - x*), grad f = (2 / w^3) G(y) and
+ *     G(y) . (z - x*) >= G(x*) . (z - x*) >= -|G_rest| rho
+ * (monotonicity again, then the same sign argument), so
+ * f(z) >= f(x*) - (2 / wmin^3) |G_rest| rho: quadratic in |G_rest|, which
+ * near the border's constrained minimum is rounding. With the first bound
+ * alone, rounding in G times the whole gradient's size was more than the
+ * slack wherever the gradient across the border is large, and the
+ * rectangle was cut towards the border level after level. When the
+ * smaller bound is within the rounding slack, x* (already considered) is
+ * as good as any interior minimum and the rectangle is settled without
+ * subdividing around the border.
  */
 static int monotone_settles(const struct qctx *x, const struct rect *r,
 			    double s, double t, const struct mono *mo)
@@ -890,9 +931,10 @@ static int monotone_settles(const struct qctx *x, const struct rect *r,
 		    (t >= r->t1 && mo->gv < -mo->eps_gv);
 	double rs = out_s ? 0.0 : fabs(mo->gu) + mo->eps_gu;
 	double rt = out_t ? 0.0 : fabs(mo->gv) + mo->eps_gv;
-	double rho = sqrt(rs * rs + rt * rt) / mo->mu;
+	double g = sqrt(rs * rs + rt * rt), rho = g / mo->mu;
+	double drop = rho * (g * mo->gscale < mo->gmax ? g * mo->gscale : mo->gmax);
 
-	return rho * mo->gmax <= x->slack;
+	return drop <= x->slack;
 }
 
 int px_spiece_closest(const struct px_spiece *sp, px_vec3 p, double *best_d2,
@@ -1044,7 +1086,8 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 					rnd_g = point_rounding(sp, p, ngu, ngv);
 				mo.eps_gu = rnd_g;
 				mo.eps_gv = rnd_g;
-				mo.gmax = 2.0 * sqrt(mg * mg + mv * mv) / (wmin * wmin * wmin);
+				mo.gscale = 2.0 / (wmin * wmin * wmin);
+				mo.gmax = mo.gscale * sqrt(mg * mg + mv * mv);
 				if (monotone_settles(&x, &r, s, t, &mo))
 					continue;
 			}

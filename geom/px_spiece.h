@@ -24,8 +24,13 @@
  *    border or the patch edge), a projected Newton ends on the border
  *    with the gradient pointing out, and the monotonicity modulus bounds
  *    how far an interior zero could be from that point and how much
- *    lower it could be: within rounding, the rectangle is settled
- *    without subdividing towards the border.
+ *    lower it could be (by the square of the gradient's part along the
+ *    border over the modulus, as for strongly convex functions): within
+ *    rounding, the rectangle is settled without subdividing towards the
+ *    border. Newton takes a step whose predicted decrease is below f's
+ *    rounding whole (a line search cannot judge it), and where the
+ *    cross term pushes its step out through a border the gradient points
+ *    in through, the diagonal step instead.
  * Anything else is split in four, down to a depth and node bound; what
  * the bound cuts short is reported as uncertified with a gap.
  *
