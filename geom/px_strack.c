@@ -146,6 +146,7 @@ struct patch {
 	double u0, u1, v0, v1, iu, iv;
 	int p, q;
 	int rat;         /* weights not all equal */
+	double wratio;   /* largest weight over the smallest */
 	const double *c; /* 4 (p + 1)(q + 1) */
 };
 
@@ -4404,6 +4405,48 @@ static int surf_copy(struct ssurf *f, const struct px_nurbs_surf *s)
 }
 
 /* Power-form Bezier patches of a surface between the bounds ub x vb. */
+/*
+ * Cells per span along u (ncs_u, one per patch column) and v. A rational
+ * patch's derivative enclosures widen with the spread of its weights
+ * (the quotient rule over a cell where W changes by a factor: the
+ * bench's sheet with weights 0.6-1.5 had S_uu enclosed in [-130, 11]
+ * over a cell), and with them the certificates' radii fall to nothing;
+ * halving the cells narrows them about fourfold. So a span whose patches
+ * have weights more than ST_WRATIO_FINE apart gets twice the cells (at
+ * most 16): on that sheet instructions per update fell by half and the
+ * 99th percentile of the slow paths by a factor of three to four; the
+ * setup and memory of those cells grow fourfold. Polynomial patches
+ * keep cells_per_span.
+ */
+#define ST_WRATIO_FINE 1.5
+
+int px__strack_coarse = 0;
+
+static void span_cells(const struct ssurf *f, int cps, int *ncs_u, int *ncs_v)
+{
+	int a, b, fine = 2 * cps > 16 ? 16 : 2 * cps;
+	for (a = 0; a < f->npu; a++)
+		ncs_u[a] = cps;
+	for (b = 0; b < f->npv; b++)
+		ncs_v[b] = cps;
+	for (b = 0; b < f->npv; b++)
+		for (a = 0; a < f->npu; a++)
+			if (f->pt[b * f->npu + a].wratio > ST_WRATIO_FINE &&
+			    !px__strack_coarse) {
+				ncs_u[a] = fine;
+				ncs_v[b] = fine;
+			}
+}
+
+/* Cell bounds: each span [b[k], b[k + 1]] cut in ncs[k] equal parts. */
+static void span_bounds_fill(double *cb, const double *b, int nb, const int *ncs)
+{
+	int k, j, n = 0;
+	for (k = 0; k < nb - 1; k++)
+		for (j = 0; j < ncs[k]; j++)
+			cb[n++] = b[k] + (b[k + 1] - b[k]) * j / ncs[k];
+}
+
 static int build_patches(struct ssurf *f, const double *ub, int nu,
 			 const double *vb, int nv)
 {
@@ -4447,12 +4490,17 @@ static int build_patches(struct ssurf *f, const double *ub, int nu,
 			{
 				/* equal weights: divide them out, evaluate as a
 				 * polynomial */
-				double w0 = sub.pw[3];
+				double w0 = sub.pw[3], wlo = w0, whi = w0;
 				int m;
 				pt->rat = 0;
-				for (m = 0; m < np; m++)
-					if (sub.pw[4 * m + 3] != w0)
+				for (m = 0; m < np; m++) {
+					double w = sub.pw[4 * m + 3];
+					if (w != w0)
 						pt->rat = 1;
+					wlo = w < wlo ? w : wlo;
+					whi = w > whi ? w : whi;
+				}
+				pt->wratio = whi / wlo;
 				pt_w = pt->rat ? 1.0 : w0;
 			}
 			for (k = 0; k < 4; k++) {
@@ -4499,6 +4547,7 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	struct px_strack_opts o;
 	struct px_nurbs_curve *cc = NULL;
 	double **cpw = NULL, *ub = NULL, *vb = NULL;
+	int *ncs_u = NULL, *ncs_v = NULL;
 	double *work = NULL;
 	size_t wl = 0, npend;
 	int rc, i, j, k, max_knots = 0, cap_edges, n_cc = 0, cell_cap = 0;
@@ -4550,7 +4599,9 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	t->sf = calloc((size_t)n_surfs, sizeof(*t->sf));
 	ub = calloc((size_t)max_knots + 2, sizeof(double));
 	vb = calloc((size_t)max_knots + 2, sizeof(double));
-	if (!t->sf || !ub || !vb) {
+	ncs_u = calloc((size_t)max_knots + 2, sizeof(int));
+	ncs_v = calloc((size_t)max_knots + 2, sizeof(int));
+	if (!t->sf || !ub || !vb || !ncs_u || !ncs_v) {
 		rc = PX_E_NOMEM;
 		goto fail;
 	}
@@ -4582,8 +4633,11 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 		rc = build_patches(f, ub, nu, vb, nv);
 		if (rc)
 			goto fail;
-		f->ncu = (nu - 1) * o.cells_per_span;
-		f->ncv = (nv - 1) * o.cells_per_span;
+		span_cells(f, o.cells_per_span, ncs_u, ncs_v);
+		for (f->ncu = 0, k = 0; k < nu - 1; k++)
+			f->ncu += ncs_u[k];
+		for (f->ncv = 0, k = 0; k < nv - 1; k++)
+			f->ncv += ncs_v[k];
 		f->cu = calloc((size_t)f->ncu + 1, sizeof(double));
 		f->cv = calloc((size_t)f->ncv + 1, sizeof(double));
 		f->cap = o.max_crit;
@@ -4593,15 +4647,9 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 			rc = PX_E_NOMEM;
 			goto fail;
 		}
-		for (k = 0; k < nu - 1; k++)
-			for (j = 0; j < o.cells_per_span; j++)
-				f->cu[k * o.cells_per_span + j] =
-					ub[k] + (ub[k + 1] - ub[k]) * j / o.cells_per_span;
+		span_bounds_fill(f->cu, ub, nu, ncs_u);
 		f->cu[f->ncu] = f->u1;
-		for (k = 0; k < nv - 1; k++)
-			for (j = 0; j < o.cells_per_span; j++)
-				f->cv[k * o.cells_per_span + j] =
-					vb[k] + (vb[k + 1] - vb[k]) * j / o.cells_per_span;
+		span_bounds_fill(f->cv, vb, nv, ncs_v);
 		f->cv[f->ncv] = f->v1;
 		f->first_cell = cell_cap;
 		cell_cap += f->ncu * f->ncv;
@@ -4855,6 +4903,8 @@ fail:
 	free(cc);
 	free(ub);
 	free(vb);
+	free(ncs_u);
+	free(ncs_v);
 	free(work);
 	px_strack_free(t);
 	return rc;

@@ -143,7 +143,11 @@ extern "C" {
 #endif
 
 struct px_strack_opts {
-	/* Cells per Bezier patch along u and along v (default 3, 1..16). */
+	/* Cells per Bezier patch along u and along v (default 3, 1..16).
+	 * Spans of rational patches whose weights are more than a factor
+	 * 1.5 apart get twice as many (at most 16): their derivative
+	 * enclosures, and so the certificates, need the smaller cells
+	 * (px_strack_info.n_cells tells the total). */
 	int cells_per_span;
 	/* Unused since the boxes the certificates leave open are cut
 	 * into pieces with certificates of their own instead of seeded on

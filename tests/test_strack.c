@@ -822,25 +822,39 @@ static void test_rational_track(void)
 	run_model("sphere octant", NULL, 0, &s[1], 1, 0, &tot);
 	report(&tot);
 	{
-		/* the quarters without a radius left without their pieces'
-		 * (test hook): the cells near the bicubic's corners, where
-		 * its weights are far apart, are solved far more often */
-		struct totals t0, t1;
+		/* The same paths (replayed) three ways. On the cells of
+		 * cells_per_span alone (test hook), the quarters without a
+		 * radius left without their pieces' (test hook): the cells
+		 * near the bicubic's corners, where its weights are far
+		 * apart, are solved far more often. And the finer cells its
+		 * spans get by default (weights 0.6 to 1.5) against those. */
+		struct totals t0, t1, t2;
 		struct px_rand_state rs;
 		memset(&t0, 0, sizeof(t0));
 		memset(&t1, 0, sizeof(t1));
-		/* the same paths both times */
+		memset(&t2, 0, sizeof(t2));
 		px_rand_save(&rs);
-		run_model("rational bicubic", NULL, 0, &s[0], 1, 0, &t0);
+		px__strack_coarse = 1;
+		run_model("rational bicubic, coarse cells", NULL, 0, &s[0], 1, 0, &t0);
 		px_rand_restore(&rs);
 		px__strack_piece_fault = 1;
-		run_model("rational bicubic, no pieces", NULL, 0, &s[0], 1, 0, &t1);
+		run_model("rational bicubic, coarse cells, no pieces", NULL, 0, &s[0], 1, 0, &t1);
 		px__strack_piece_fault = 0;
-		printf("  cells solved %ld with the pieces, %ld without; wrong %ld, %ld\n",
-		       t0.cells, t1.cells, t0.wrong, t1.wrong);
-		PX_CHECK_INT_EQ(t0.wrong + t1.wrong, 0);
+		px__strack_coarse = 0;
+		px_rand_restore(&rs);
+		run_model("rational bicubic, finer cells", NULL, 0, &s[0], 1, 0, &t2);
+		printf("  cells solved %ld with the pieces, %ld without; %ld on the "
+		       "finer cells; hot updates %llu, %llu, %llu; wrong %ld, %ld, "
+		       "%ld\n", t0.cells, t1.cells, t2.cells,
+		       (unsigned long long)t0.hot, (unsigned long long)t1.hot,
+		       (unsigned long long)t2.hot, t0.wrong, t1.wrong, t2.wrong);
+		PX_CHECK_INT_EQ(t0.wrong + t1.wrong + t2.wrong, 0);
 		PX_CHECK_MSG(4 * t0.cells < 3 * t1.cells, "the pieces saved few solves: %ld of %ld",
 			     t0.cells, t1.cells);
+		PX_CHECK_MSG(t2.hot > t0.hot && t2.cells < t0.cells,
+			     "the finer cells: hot updates %llu against %llu, cells "
+			     "solved %ld against %ld", (unsigned long long)t2.hot,
+			     (unsigned long long)t0.hot, t2.cells, t0.cells);
 	}
 }
 
