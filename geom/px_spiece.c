@@ -664,8 +664,8 @@ static int newton_f(struct qctx *x, const struct rect *r, int *iters,
 		 * point where the gradient's do, so inward. Giving up here
 		 * left the rectangle to be cut with no point to settle it
 		 * from. */
-		if (((s <= r->s0 && ds < 0.0) || (s >= r->s1 && ds > 0.0) ||
-		     (t <= r->t0 && dt < 0.0) || (t >= r->t1 && dt > 0.0))) {
+		if ((s <= r->s0 && ds < 0.0) || (s >= r->s1 && ds > 0.0) ||
+		    (t <= r->t0 && dt < 0.0) || (t >= r->t1 && dt > 0.0)) {
 			if (!(a > 0.0 && c > 0.0))
 				goto done;
 			ds = out_s ? 0.0 : -gs / a;

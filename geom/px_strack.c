@@ -3850,6 +3850,19 @@ enum {
 	R_X, R_W, R_XU, R_XV, R_WU, R_WV, R_XUU, R_XUV, R_XVV, R_WUU, R_WUV, R_WVV,
 	R_AU, R_AV, R_T1, R_T2, R_W2, R_W3, R_EL, R_SC, R_XW, ST_RAT_POLYS
 };
+/* Coordinate k of the net and its derivatives to order 2 (du, dv: the
+ * cell's sides), into t[f], t[fu], ... */
+static void tp_jet(const double *pw, int p, int q, int k, double du, double dv,
+		   struct tpoly *t, int f, int fu, int fv, int fuu, int fuv, int fvv)
+{
+	tp_net(pw, p, q, k, &t[f]);
+	tp_d(&t[f], 0, du, &t[fu]);
+	tp_d(&t[f], 1, dv, &t[fv]);
+	tp_d(&t[fu], 0, du, &t[fuu]);
+	tp_d(&t[fu], 1, dv, &t[fuv]);
+	tp_d(&t[fv], 1, dv, &t[fvv]);
+}
+
 static void rat_tight(const double *pw, int p, int q, double du, double dv,
 		      struct iv Su[3], struct iv Sv[3], struct iv Suu[3], struct iv Suv[3],
 		      struct iv Svv[3], double *mem, const struct tp_binom *bc)
@@ -3860,22 +3873,12 @@ static void rat_tight(const double *pw, int p, int q, double du, double dv,
 	for (i = 0; i < ST_RAT_POLYS; i++)
 		t[i].c = mem + (size_t)i * TP_LEN;
 	sc = t[R_SC].c;
-	tp_net(pw, p, q, 3, &t[R_W]);
-	tp_d(&t[R_W], 0, du, &t[R_WU]);
-	tp_d(&t[R_W], 1, dv, &t[R_WV]);
-	tp_d(&t[R_WU], 0, du, &t[R_WUU]);
-	tp_d(&t[R_WU], 1, dv, &t[R_WUV]);
-	tp_d(&t[R_WV], 1, dv, &t[R_WVV]);
+	tp_jet(pw, p, q, 3, du, dv, t, R_W, R_WU, R_WV, R_WUU, R_WUV, R_WVV);
 	tp_mul(&t[R_W], &t[R_W], &t[R_W2], bc, sc);
 	tp_mul(&t[R_W2], &t[R_W], &t[R_W3], bc, sc);
 	for (k = 0; k < 3; k++) {
 		int d;
-		tp_net(pw, p, q, k, &t[R_X]);
-		tp_d(&t[R_X], 0, du, &t[R_XU]);
-		tp_d(&t[R_X], 1, dv, &t[R_XV]);
-		tp_d(&t[R_XU], 0, du, &t[R_XUU]);
-		tp_d(&t[R_XU], 1, dv, &t[R_XUV]);
-		tp_d(&t[R_XV], 1, dv, &t[R_XVV]);
+		tp_jet(pw, p, q, k, du, dv, t, R_X, R_XU, R_XV, R_XUU, R_XUV, R_XVV);
 		tp_mul(&t[R_X], &t[R_W], &t[R_XW], bc, sc);
 		for (d = 0; d < 2; d++) {
 			/* A_d = X_d W - X W_d over W^2; S_dd W^3 = X_dd W^2 -
