@@ -161,6 +161,10 @@ extern int px__strack_piece_fault;
 /* Test hook: rational spans keep cells_per_span (no finer cells where
  * the weights are far apart), read by px_strack_create(). */
 extern int px__strack_coarse;
+/* px_spiece: at most this many slots in a query's pool of parent
+ * tensors (-1: as many as fit), so tests can run the restriction from
+ * the root and compare. */
+extern int px__spiece_pool_cap;
 /* px_strack: 1 leaves every box no certificate decides uncut (Newton
  * from its centre), the solve as it was before the run-time cuts. */
 extern int px__strack_sub_fault;

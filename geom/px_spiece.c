@@ -4,6 +4,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "internal.h"
 #include "px_bern.h"
 
 #define MD PX_SPIECE_MAX_DEGREE
@@ -550,6 +551,10 @@ struct rect {
 	double s0, s1, t0, t1;
 	double lb; /* lower bound of f on the rectangle */
 	int depth;
+	/* Slot holding the parent's restricted tensors (-1: none), and
+	 * which quarter of the parent this is (bit 0: s high, bit 1: t
+	 * high). */
+	int parent, quad;
 };
 
 struct qctx {
@@ -726,40 +731,6 @@ done:
 	return 1;
 }
 
-/* Split a tensor at s = 1/2 (rows) or t = 1/2 (columns): hi is the
- * de Casteljau work array, lo takes the first entry of each level. */
-static void t_half_s(const double *c, int n, int m, double *lo, double *hi)
-{
-	const int w = m + 1;
-	int i, j, k;
-	memcpy(hi, c, tsize(n, m) * sizeof(double));
-	memcpy(lo, c, (size_t)w * sizeof(double));
-	for (k = n; k > 0; k--) {
-		for (i = 0; i < k; i++) {
-			double *ri = hi + i * w;
-			const double *rn = ri + w;
-			for (j = 0; j < w; j++)
-				ri[j] = 0.5 * ri[j] + 0.5 * rn[j];
-		}
-		memcpy(lo + (n - k + 1) * w, hi, (size_t)w * sizeof(double));
-	}
-}
-
-static void t_half_t(const double *c, int n, int m, double *lo, double *hi)
-{
-	int i, j, k;
-	memcpy(hi, c, tsize(n, m) * sizeof(double));
-	for (i = 0; i <= n; i++) {
-		double *h = hi + i * (m + 1), *l = lo + i * (m + 1);
-		l[0] = h[0];
-		for (k = m; k > 0; k--) {
-			for (j = 0; j < k; j++)
-				h[j] = 0.5 * h[j] + 0.5 * h[j + 1];
-			l[m - k + 1] = h[0];
-		}
-	}
-}
-
 /* min f_i / w_i, or min f_i when w is NULL (constant weight 1). */
 static double ratio_min(const double *f, const double *w, size_t k)
 {
@@ -773,32 +744,182 @@ static double ratio_min(const double *f, const double *w, size_t k)
 }
 
 /*
- * Lower bounds of the four quarters of r (order: s low/t low, s high/t
- * low, s low/t high, s high/t high): restrict F and W to r once, then
- * halve in s and in t, instead of restricting each quarter from scratch.
+ * Kernels of the subdivision. A tensor is stored row by row; "rows" is
+ * whichever parameter its rows run along (s at the root). Splitting
+ * along the rows is a de Casteljau sweep whose every level is one flat
+ * loop over contiguous memory (rows below the level, all their
+ * entries), which vectorises and has no per-row overhead; the other
+ * parameter is split by transposing first, so a rectangle's quarter is
+ * split, transpose, split, and its tensors come out with the other
+ * orientation (tracked per rectangle, see struct rect). Halving with
+ * 0.5 (a + b) is bit for bit 0.5 a + 0.5 b (scaling by 2 is exact), so
+ * the orientation changes no value.
  */
-static void children_lb(const double *F, const double *W, int fn, int fm,
-			const struct rect *r, struct rect ch[4])
-{
-	double pf[TMAX], pw[TMAX], fl[TMAX], fh[TMAX], wl[TMAX], wh[TMAX];
-	double a[TMAX], b[TMAX], c[TMAX], d[TMAX];
-	size_t k = tsize(fn, fm);
 
-	t_restrict(F, fn, fm, r->s0, r->s1, r->t0, r->t1, pf);
-	t_half_s(pf, fn, fm, fl, fh);
-	t_half_t(fl, fn, fm, a, b);
-	if (W) {
-		t_restrict(W, fn, fm, r->s0, r->s1, r->t0, r->t1, pw);
-		t_half_s(pw, fn, fm, wl, wh);
-		t_half_t(wl, fn, fm, c, d);
+/* Two doubles in one register (SSE2 on x86-64, NEON on arm64; scalar
+ * pairs elsewhere): GNU C vector extension, which GCC and Clang share. */
+typedef double v2d __attribute__((vector_size(16)));
+
+/* Along the rows (0..n, w wide): lo gets the half [0, 1/2] and hi the
+ * half [1/2, 1]; either may be NULL. Neither may alias c. */
+static void rows_half(const double *c, int n, int w, double *lo, double *hi)
+{
+	double work[TMAX];
+	double *h = hi ? hi : work;
+	const size_t W = (size_t)w;
+	int k;
+
+	memcpy(h, c, (size_t)(n + 1) * W * sizeof(double));
+	if (lo)
+		memcpy(lo, c, W * sizeof(double));
+	for (k = 1; k <= n; k++) {
+		const size_t e = (size_t)(n - k + 1) * W;
+		size_t i;
+		/* Two at a time: each pair is loaded before it is stored,
+		 * and what is read ahead (i + W >= i + 1) is not yet written,
+		 * so this is the scalar sweep's arithmetic exactly. */
+		for (i = 0; i + 2 <= e; i += 2) {
+			v2d a, b;
+			memcpy(&a, h + i, sizeof(a));
+			memcpy(&b, h + i + W, sizeof(b));
+			a = 0.5 * (a + b);
+			memcpy(h + i, &a, sizeof(a));
+		}
+		if (i < e)
+			h[i] = 0.5 * (h[i] + h[i + W]);
+		if (lo)
+			memcpy(lo + (size_t)k * W, h, W * sizeof(double));
 	}
-	ch[0].lb = ratio_min(a, W ? c : NULL, k);
-	ch[2].lb = ratio_min(b, W ? d : NULL, k);
-	t_half_t(fh, fn, fm, a, b);
-	if (W)
-		t_half_t(wh, fn, fm, c, d);
-	ch[1].lb = ratio_min(a, W ? c : NULL, k);
-	ch[3].lb = ratio_min(b, W ? d : NULL, k);
+}
+
+/* c (rows x cols) to out (cols x rows). */
+static void transpose(const double *c, int rows, int cols, double *out)
+{
+	int i, j;
+	for (i = 0; i < rows; i++)
+		for (j = 0; j < cols; j++)
+			out[j * rows + i] = c[i * cols + j];
+}
+
+/* The quarter of c (rows x cols) keeping half a (1: upper) along the
+ * rows and half b along the columns, into out (cols x rows). */
+static void t_quarter(const double *c, int rows, int cols, int a, int b,
+		      double *out)
+{
+	double h[TMAX], t[TMAX];
+	rows_half(c, rows - 1, cols, a ? NULL : h, a ? h : NULL);
+	transpose(h, rows, cols, t);
+	rows_half(t, cols - 1, rows, b ? NULL : out, b ? out : NULL);
+}
+
+/* Quarter number (bit 0: s high, bit 1: t high) of the half a along the
+ * rows and b along the columns, for a tensor of orientation o (0: rows
+ * along s). */
+static int quad_of(int o, int a, int b)
+{
+	return o ? (b | a << 1) : (a | b << 1);
+}
+
+/*
+ * Restricted tensors of split rectangles, kept for their children: the
+ * rectangle's gu and gv, and F and W already cut into its four quarters
+ * (their lower bounds needed them anyway). A child restricted from its
+ * parent needs one half split per direction instead of two full
+ * restrictions from the root (one to each end), and its F and W are
+ * copied, not recomputed. The pool is a fixed stack buffer cut into
+ * slots of the actual degrees' size; when it is full a child is
+ * restricted from the root as before (orientation 0), so the pool's
+ * size changes the cost, never the certificate.
+ */
+#define POOL_DOUBLES 8192
+int px__spiece_pool_cap = -1;
+#define POOL_SLOTS 64
+
+struct pool {
+	double mem[POOL_DOUBLES];
+	size_t ngu, ngv, nf;  /* tensor sizes */
+	size_t per;           /* doubles a slot: gu, gv, 4 F, 4 W */
+	int refs[POOL_SLOTS]; /* children still queued */
+	int orient[POOL_SLOTS]; /* of the slot's gu and gv */
+	int free_[POOL_SLOTS], nfree, fresh, nslots;
+};
+
+static void pool_init(struct pool *pl, size_t ngu, size_t ngv, size_t nf,
+		      int have_w)
+{
+	size_t n;
+	pl->ngu = ngu;
+	pl->ngv = ngv;
+	pl->nf = nf;
+	pl->per = ngu + ngv + 4 * nf * (have_w ? 2u : 1u);
+	n = POOL_DOUBLES / pl->per;
+	pl->nslots = n < POOL_SLOTS ? (int)n : POOL_SLOTS;
+	if (px__spiece_pool_cap >= 0 && pl->nslots > px__spiece_pool_cap)
+		pl->nslots = px__spiece_pool_cap;
+	pl->nfree = 0;
+	pl->fresh = 0;
+}
+
+static double *slot_gu(struct pool *pl, int k)
+{
+	return pl->mem + (size_t)k * pl->per;
+}
+static double *slot_gv(struct pool *pl, int k) { return slot_gu(pl, k) + pl->ngu; }
+/* Quarter q of F, and of W. */
+static double *slot_f(struct pool *pl, int k, int q)
+{
+	return slot_gv(pl, k) + pl->ngv + (size_t)q * pl->nf;
+}
+static double *slot_w(struct pool *pl, int k, int q) { return slot_f(pl, k, 4 + q); }
+
+/* A queued child leaves the heap: its parent's slot is freed with the
+ * last one. The data stays readable until the next pool_take(), which
+ * comes only after the popped rectangle has read what it needs. */
+static void pool_drop(struct pool *pl, int k)
+{
+	if (k >= 0 && --pl->refs[k] == 0)
+		pl->free_[pl->nfree++] = k;
+}
+
+static int pool_take(struct pool *pl)
+{
+	if (pl->nfree > 0)
+		return pl->free_[--pl->nfree];
+	return pl->fresh < pl->nslots ? pl->fresh++ : -1;
+}
+
+/*
+ * Lower bounds of the four quarters of a rectangle from F and W
+ * restricted to it (orientation o, pw NULL: constant weight), and the
+ * quarters themselves into the slot when there is one: halve along the
+ * rows, transpose, halve again.
+ */
+static void children_lb(const double *pf, const double *pw, int fn, int fm,
+			int o, struct pool *pl, int slot, struct rect ch[4])
+{
+	const int rows = (o ? fm : fn) + 1, cols = (o ? fn : fm) + 1;
+	const size_t k = tsize(fn, fm);
+	double half[2][2][TMAX], tr[TMAX], q[2][2][TMAX];
+	int a, b, c;
+
+	for (c = 0; c < (pw ? 2 : 1); c++)
+		rows_half(c ? pw : pf, rows - 1, cols, half[c][0], half[c][1]);
+	for (a = 0; a < 2; a++) {
+		for (c = 0; c < (pw ? 2 : 1); c++) {
+			transpose(half[c][a], rows, cols, tr);
+			rows_half(tr, cols - 1, rows, q[c][0], q[c][1]);
+		}
+		for (b = 0; b < 2; b++) {
+			int n = quad_of(o, a, b);
+			const double *w = pw ? q[1][b] : NULL;
+			ch[n].lb = ratio_min(q[0][b], w, k);
+			if (slot >= 0) {
+				memcpy(slot_f(pl, slot, n), q[0][b], k * sizeof(double));
+				if (w)
+					memcpy(slot_w(pl, slot, n), w, k * sizeof(double));
+			}
+		}
+	}
 }
 
 /* Min-heap of rectangles by lower bound: nearest first, so the best
@@ -956,6 +1077,7 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 	/* Each split replaces one rectangle by four: the heap never holds
 	 * more than 3 * nodes + 1. */
 	struct rect heap[3 * PX_SPIECE_MAX_NODES + 4];
+	struct pool pl;
 	struct qctx x;
 	double pp = px_v3_dot(p, p), lb_unresolved = INFINITY;
 	int hn = 0, k, have_gu = 0, have_gv = 0;
@@ -982,6 +1104,7 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 	x.improved = 0;
 	hit->iters = 0;
 	hit->nodes = 0;
+	hit->pool_misses = 0;
 	hit->certified = 1;
 	hit->gap = 0.0;
 	{
@@ -1000,7 +1123,7 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 		x.slack = 1e-13 * (r * r + px_v3_dot(sp->center_, sp->center_));
 	}
 	{
-		struct rect root = {0.0, 1.0, 0.0, 1.0, 0.0, 0};
+		struct rect root = {0.0, 1.0, 0.0, 1.0, 0.0, 0, -1, 0};
 		root.lb = rect_lb(F, sp->wconst_ ? NULL : sp->fw_, fn, fm, &root, rf, rw);
 		if (root.lb >= x.best - x.slack)
 			goto out;
@@ -1012,14 +1135,20 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 	 * every point is equally near (a sphere seen from its centre) could
 	 * not be settled by the F / W bound. */
 	consider(&x, 0.5, 0.5);
+	pool_init(&pl, ngu, ngv, nfs, !sp->wconst_);
 	while (hn > 0 && hit->nodes < PX_SPIECE_MAX_NODES) {
 		struct rect r = heap_pop(heap, &hn);
 		double ws = r.s1 - r.s0, wt = r.t1 - r.t0, mu = 0.0;
-		int certain = 0;
+		int certain = 0, up = r.parent;
+		/* Orientation of this rectangle's tensors: a quarter of its
+		 * parent's has the other one; from the root, rows along s. */
+		int o = up >= 0 ? !pl.orient[up] : 0;
 
+		pool_drop(&pl, up);
 		if (r.lb >= x.best - x.slack)
 			continue; /* the best dropped since it was queued */
 		hit->nodes++;
+		hit->pool_misses += up < 0 && r.depth > 0;
 		if (!have_gu) {
 			for (i = 0; i < ngu; i++)
 				GU[i] = sp->gua_[i] -
@@ -1028,7 +1157,11 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 			eps_gu = 1e-12 * max_abs(GU, ngu);
 			have_gu = 1;
 		}
-		t_restrict(GU, un, um, r.s0, r.s1, r.t0, r.t1, rg);
+		if (up >= 0)
+			t_quarter(slot_gu(&pl, up), (o ? un : um) + 1, (o ? um : un) + 1,
+				  o ? (r.quad & 1) : (r.quad & 2) != 0, o ? (r.quad & 2) != 0 : (r.quad & 1), rg);
+		else
+			t_restrict(GU, un, um, r.s0, r.s1, r.t0, r.t1, rg);
 		if (strict_sign(rg, ngu, eps_gu))
 			continue; /* df/ds never vanishes here */
 		if (!have_gv) {
@@ -1039,17 +1172,21 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 			eps_gv = 1e-12 * max_abs(GV, ngv);
 			have_gv = 1;
 		}
-		t_restrict(GV, vn, vm, r.s0, r.s1, r.t0, r.t1, rv);
+		if (up >= 0)
+			t_quarter(slot_gv(&pl, up), (o ? vn : vm) + 1, (o ? vm : vn) + 1,
+				  o ? (r.quad & 1) : (r.quad & 2) != 0, o ? (r.quad & 2) != 0 : (r.quad & 1), rv);
+		else
+			t_restrict(GV, vn, vm, r.s0, r.s1, r.t0, r.t1, rv);
 		if (strict_sign(rv, ngv, eps_gv))
 			continue; /* df/dt never vanishes here */
 		{
 			/* Bernstein bounds of the Jacobian of (gu, gv), in the
 			 * piece's local scale (d/ds = (1/ws) d/ds_sub). */
 			double a_lo, a_hi, b_lo, b_hi, c_lo, c_hi, d_lo, d_hi, off;
-			t_deriv_range(rg, un, um, 0, &a_lo, &a_hi);
-			t_deriv_range(rg, un, um, 1, &b_lo, &b_hi);
-			t_deriv_range(rv, vn, vm, 0, &c_lo, &c_hi);
-			t_deriv_range(rv, vn, vm, 1, &d_lo, &d_hi);
+			t_deriv_range(rg, o ? um : un, o ? un : um, o, &a_lo, &a_hi);
+			t_deriv_range(rg, o ? um : un, o ? un : um, !o, &b_lo, &b_hi);
+			t_deriv_range(rv, o ? vm : vn, o ? vn : vm, o, &c_lo, &c_hi);
+			t_deriv_range(rv, o ? vm : vn, o ? vn : vm, !o, &d_lo, &d_hi);
 			a_lo /= ws;
 			a_hi /= ws;
 			c_lo /= ws;
@@ -1101,14 +1238,52 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 		}
 		{
 			double sm = 0.5 * (r.s0 + r.s1), tm = 0.5 * (r.t0 + r.t1);
-			struct rect ch[4] = {{r.s0, sm, r.t0, tm, 0.0, r.depth + 1},
-					     {sm, r.s1, r.t0, tm, 0.0, r.depth + 1},
-					     {r.s0, sm, tm, r.t1, 0.0, r.depth + 1},
-					     {sm, r.s1, tm, r.t1, 0.0, r.depth + 1}};
-			children_lb(F, sp->wconst_ ? NULL : sp->fw_, fn, fm, &r, ch);
+			const double *W = sp->wconst_ ? NULL : sp->fw_;
+			struct rect ch[4] = {{r.s0, sm, r.t0, tm, 0.0, r.depth + 1, -1, 0},
+					     {sm, r.s1, r.t0, tm, 0.0, r.depth + 1, -1, 1},
+					     {r.s0, sm, tm, r.t1, 0.0, r.depth + 1, -1, 2},
+					     {sm, r.s1, tm, r.t1, 0.0, r.depth + 1, -1, 3}};
+			int kept = 0, slot = pool_take(&pl);
+			const double *pf = rf, *pw = rw;
+			/* This rectangle's F and W: its parent cut them out
+			 * already, or from the root. */
+			if (up >= 0) {
+				pf = slot_f(&pl, up, r.quad);
+				pw = W ? slot_w(&pl, up, r.quad) : NULL;
+			} else {
+				t_restrict(F, fn, fm, r.s0, r.s1, r.t0, r.t1, rf);
+				if (W)
+					t_restrict(W, fn, fm, r.s0, r.s1, r.t0, r.t1, rw);
+			}
+			/* The slot taken above may be the parent's, dropped
+			 * at the pop: its quarters are read before the
+			 * children's overwrite them only if it is not. */
+			if (slot == up && slot >= 0) {
+				memcpy(rf, pf, nfs * sizeof(double));
+				pf = rf;
+				if (W) {
+					memcpy(rw, pw, nfs * sizeof(double));
+					pw = rw;
+				}
+			}
+			children_lb(pf, W ? pw : NULL, fn, fm, o, &pl, slot, ch);
 			for (k = 0; k < 4; k++)
-				if (ch[k].lb < x.best - x.slack)
+				kept += ch[k].lb < x.best - x.slack;
+			if (slot >= 0 && !kept)
+				pl.free_[pl.nfree++] = slot;
+			else if (slot >= 0) {
+				memcpy(slot_gu(&pl, slot), rg, ngu * sizeof(double));
+				memcpy(slot_gv(&pl, slot), rv, ngv * sizeof(double));
+				pl.refs[slot] = kept;
+				pl.orient[slot] = o;
+			}
+			if (!kept)
+				slot = -1;
+			for (k = 0; k < 4; k++)
+				if (ch[k].lb < x.best - x.slack) {
+					ch[k].parent = slot;
 					heap_push(heap, &hn, ch[k]);
+				}
 		}
 	}
 	/* What the node bound left queued bounds what may have been missed. */

@@ -32,7 +32,12 @@
  *    cross term pushes its step out through a border the gradient points
  *    in through, the diagonal step instead.
  * Anything else is split in four, down to a depth and node bound; what
- * the bound cuts short is reported as uncertified with a gap.
+ * the bound cuts short is reported as uncertified with a gap. A split
+ * rectangle keeps its restricted tensors for its children (a fixed pool
+ * on the stack): a child's are one half split per direction from its
+ * parent's, each level of the sweep one flat loop, instead of two full
+ * restrictions from the whole patch per node (the cost near focal
+ * points, where dozens of rectangles stay open).
  *
  * Only interior critical points are searched here. Minima on the
  * boundary of a surface (and on C0 creases) are minima of the boundary
@@ -40,8 +45,9 @@
  *
  * Memory and real-time rules: a piece lives in caller memory: a small
  * struct plus px_spiece_doubles(p, q) doubles filled by px_spiece_init()
- * at setup. px_spiece_closest() uses fixed stack arrays (about 64 KiB,
- * see PX_SPIECE_MAX_DEGREE) and no heap; all loops are bounded.
+ * at setup. px_spiece_closest() uses fixed stack arrays (about 360 KiB:
+ * the rectangle heap, a pool of parent tensors and tensors sized for
+ * PX_SPIECE_MAX_DEGREE) and no heap; all loops are bounded.
  */
 #ifndef PX_SPIECE_H
 #define PX_SPIECE_H
@@ -56,8 +62,9 @@ extern "C" {
 #endif
 
 /* Same limit as the NURBS kernel. A query's stack arrays are sized for
- * it: about 64 KiB, whatever the actual degree (only the used part is
- * touched); real-time threads must have that much prefaulted stack. */
+ * it: about 360 KiB, whatever the actual degree (only the used part is
+ * touched); real-time threads must have that much prefaulted stack
+ * (px_rt's default prefaults 1 MiB). */
 #define PX_SPIECE_MAX_DEGREE 10
 #define PX_SPIECE_MAX_DEPTH 24
 #define PX_SPIECE_MAX_NODES 1024
@@ -89,6 +96,9 @@ struct px_spiece_hit {
 	double u, v;   /* global parameters */
 	px_vec3 point;
 	int iters, nodes;
+	/* Rectangles restricted from the whole patch because the query's
+	 * pool of parent tensors was full (cost only, see px_spiece.c). */
+	int pool_misses;
 	int certified; /* as px_cpiece_hit */
 	double gap;
 };

@@ -28,7 +28,9 @@ void px_rt_config_default(struct px_rt_config *cfg)
 	cfg->lock_memory = 1;
 	cfg->cpu = -1;
 	cfg->dma_latency = 0;
-	cfg->prefault_stack_bytes = 256u << 10;
+	/* A surface query alone takes about 360 KiB of stack (see
+	 * px_spiece.h), with the loop's frames above it. */
+	cfg->prefault_stack_bytes = 1u << 20;
 	cfg->prefault_heap_bytes = 0;
 }
 

@@ -85,7 +85,7 @@ struct px_rt_report {
 };
 
 /* Defaults: priority 80, lock memory, no pinning, no dma latency,
- * 256 KiB of stack and no heap prefault, stderr warnings. */
+ * 1 MiB of stack and no heap prefault, stderr warnings. */
 PX_API void px_rt_config_default(struct px_rt_config *cfg);
 
 /*

@@ -3,6 +3,7 @@
 #include <math.h>
 #include <stdio.h>
 
+#include "internal.h"
 #include "px_alloc_count.h"
 #include "px_bern.h"
 #include "px_cpiece.h"
@@ -401,6 +402,58 @@ static void test_packed_memory(void)
 	PX_CHECK_INT_EQ(px_spiece_doubles_hw(2, 2, NULL), 0);
 }
 
+/*
+ * A query keeps each split rectangle's tensors for its children (a
+ * quarter is one half split per direction, alternating orientation);
+ * with the pool capped at none or one slot, the children are restricted
+ * from the whole patch instead. Same answers and certificates, at every
+ * degree up to the limit (where few slots fit and the pool runs full on
+ * its own).
+ */
+static void test_pool_matches_root_restriction(void)
+{
+	enum { MD = PX_SPIECE_MAX_DEGREE };
+	static double hw[(MD + 1) * (MD + 1)][4];
+	int trial, misses[3] = {0, 0, 0}, deep = 0, high_misses = 0;
+	static const int caps[3] = {-1, 0, 1};
+	for (trial = 0; trial < 240; trial++) {
+		int p = px_rand_int(1, trial % 4 == 3 ? MD : 4);
+		int q = px_rand_int(1, trial % 4 == 3 ? MD : 4), c;
+		struct px_spiece sp;
+		struct px_spiece_hit h[3];
+		double d2[3];
+		px_vec3 x = px_v3(px_rand_range(-0.5, 1.5), px_rand_range(-0.5, 1.5),
+				  px_rand_range(-1.5, 1.5));
+		random_patch(hw, p, q, trial % 2);
+		PX_CHECK_INT_EQ(px_spiece_init(&sp, p, q, (const double(*)[4])hw, 0, 1, 0, 1, mem),
+				PX_OK);
+		for (c = 0; c < 3; c++) {
+			px__spiece_pool_cap = caps[c];
+			d2[c] = INFINITY;
+			px_spiece_closest(&sp, x, &d2[c], &h[c]);
+			misses[c] += h[c].pool_misses;
+		}
+		px__spiece_pool_cap = -1;
+		deep += h[0].nodes > 1;
+		if (p > 4 || q > 4)
+			high_misses += h[0].pool_misses;
+		for (c = 1; c < 3; c++) {
+			PX_CHECK_MSG(fabs(d2[c] - d2[0]) <= 1e-10 * (1.0 + d2[0]),
+				     "pool cap %d: d2 %.17g against %.17g with the pool (p %d q %d, "
+				     "rational %d, nodes %d / %d)", caps[c], d2[c], d2[0], p, q,
+				     trial % 2, h[c].nodes, h[0].nodes);
+			PX_CHECK_INT_EQ(h[c].certified, h[0].certified);
+		}
+	}
+	printf("    rectangles from the root: pool %d (degree > 4: %d), no pool %d, one slot %d; "
+	       "queries that split %d of 240\n", misses[0], high_misses, misses[1], misses[2], deep);
+	/* Both paths ran: with no pool every split child is restricted
+	 * from the root, with the pool (degree <= 4) none is. */
+	PX_CHECK(deep > 50);
+	PX_CHECK(misses[1] > misses[2] && misses[2] > misses[0] - high_misses);
+	PX_CHECK_INT_EQ(misses[0] - high_misses, 0);
+}
+
 static void test_query_allocates_nothing(void)
 {
 	double hw[16][4];
@@ -439,6 +492,7 @@ static const struct px_test tests[] = {
 	PX_T(test_symmetric_patch_split_lines),
 	PX_T(test_minimum_beside_piece_border),
 	PX_T(test_packed_memory),
+	PX_T(test_pool_matches_root_restriction),
 	PX_T(test_query_allocates_nothing),
 	PX_T(test_bad_input),
 };
