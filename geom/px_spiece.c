@@ -828,8 +828,10 @@ static int quad_of(int o, int a, int b)
  * restrictions from the root (one to each end), and its F and W are
  * copied, not recomputed. The pool is a fixed stack buffer cut into
  * slots of the actual degrees' size; when it is full a child is
- * restricted from the root as before (orientation 0), so the pool's
- * size changes the cost, never the certificate.
+ * restricted from the root as before (orientation 0). Both are the same
+ * restriction up to rounding, which the sign margins cover, so the
+ * pool's size changes the cost, not what is proved
+ * (test_pool_matches_root_restriction).
  */
 #define POOL_DOUBLES 8192
 int px__spiece_pool_cap = -1;
@@ -1157,6 +1159,8 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 			eps_gu = 1e-12 * max_abs(GU, ngu);
 			have_gu = 1;
 		}
+		/* The parent's tensors have orientation !o: rows along s
+		 * when o is 1, so its rows take the s half then. */
 		if (up >= 0)
 			t_quarter(slot_gu(&pl, up), (o ? un : um) + 1, (o ? um : un) + 1,
 				  o ? (r.quad & 1) : (r.quad & 2) != 0, o ? (r.quad & 2) != 0 : (r.quad & 1), rg);
