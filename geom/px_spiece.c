@@ -820,6 +820,15 @@ static int quad_of(int o, int a, int b)
 	return o ? (b | a << 1) : (a | b << 1);
 }
 
+/* The inverse: which halves along the rows (*a) and the columns (*b) of
+ * a tensor of orientation o make quarter quad. */
+static void quad_halves(int o, int quad, int *a, int *b)
+{
+	int s_hi = quad & 1, t_hi = (quad >> 1) & 1;
+	*a = o ? t_hi : s_hi;
+	*b = o ? s_hi : t_hi;
+}
+
 /*
  * Restricted tensors of split rectangles, kept for their children: the
  * rectangle's gu and gv, and F and W already cut into its four quarters
@@ -874,13 +883,18 @@ static double *slot_f(struct pool *pl, int k, int q)
 }
 static double *slot_w(struct pool *pl, int k, int q) { return slot_f(pl, k, 4 + q); }
 
-/* A queued child leaves the heap: its parent's slot is freed with the
- * last one. The data stays readable until the next pool_take(), which
- * comes only after the popped rectangle has read what it needs. */
+static void pool_give(struct pool *pl, int k)
+{
+	pl->free_[pl->nfree++] = k;
+}
+
+/* A child is done with its parent's slot: freed with the last one. The
+ * query drops a rectangle's parent only when the next rectangle is
+ * popped, so a slot taken while splitting is never the one being read. */
 static void pool_drop(struct pool *pl, int k)
 {
 	if (k >= 0 && --pl->refs[k] == 0)
-		pl->free_[pl->nfree++] = k;
+		pool_give(pl, k);
 }
 
 static int pool_take(struct pool *pl)
@@ -1082,7 +1096,7 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 	struct pool pl;
 	struct qctx x;
 	double pp = px_v3_dot(p, p), lb_unresolved = INFINITY;
-	int hn = 0, k, have_gu = 0, have_gv = 0;
+	int hn = 0, k, have_gu = 0, have_gv = 0, last_parent = -1;
 	double eps_gu = 0.0, eps_gv = 0.0;
 	/* Smallest weight: w on the patch is at least the smallest weight
 	 * coefficient (convex combination). */
@@ -1139,14 +1153,20 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 	consider(&x, 0.5, 0.5);
 	pool_init(&pl, ngu, ngv, nfs, !sp->wconst_);
 	while (hn > 0 && hit->nodes < PX_SPIECE_MAX_NODES) {
-		struct rect r = heap_pop(heap, &hn);
-		double ws = r.s1 - r.s0, wt = r.t1 - r.t0, mu = 0.0;
-		int certain = 0, up = r.parent;
+		struct rect r;
+		double ws, wt, mu = 0.0;
+		int certain = 0, up, o, ha = 0, hb = 0;
+
+		pool_drop(&pl, last_parent); /* the previous rectangle's */
+		r = heap_pop(heap, &hn);
+		ws = r.s1 - r.s0;
+		wt = r.t1 - r.t0;
+		up = last_parent = r.parent;
 		/* Orientation of this rectangle's tensors: a quarter of its
 		 * parent's has the other one; from the root, rows along s. */
-		int o = up >= 0 ? !pl.orient[up] : 0;
-
-		pool_drop(&pl, up);
+		o = up >= 0 ? !pl.orient[up] : 0;
+		if (up >= 0)
+			quad_halves(!o, r.quad, &ha, &hb);
 		if (r.lb >= x.best - x.slack)
 			continue; /* the best dropped since it was queued */
 		hit->nodes++;
@@ -1159,11 +1179,11 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 			eps_gu = 1e-12 * max_abs(GU, ngu);
 			have_gu = 1;
 		}
-		/* The parent's tensors have orientation !o: rows along s
-		 * when o is 1, so its rows take the s half then. */
+		/* The parent's tensors have orientation !o (rows along s
+		 * when o is 1). */
 		if (up >= 0)
 			t_quarter(slot_gu(&pl, up), (o ? un : um) + 1, (o ? um : un) + 1,
-				  o ? (r.quad & 1) : (r.quad & 2) != 0, o ? (r.quad & 2) != 0 : (r.quad & 1), rg);
+				  ha, hb, rg);
 		else
 			t_restrict(GU, un, um, r.s0, r.s1, r.t0, r.t1, rg);
 		if (strict_sign(rg, ngu, eps_gu))
@@ -1178,7 +1198,7 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 		}
 		if (up >= 0)
 			t_quarter(slot_gv(&pl, up), (o ? vn : vm) + 1, (o ? vm : vn) + 1,
-				  o ? (r.quad & 1) : (r.quad & 2) != 0, o ? (r.quad & 2) != 0 : (r.quad & 1), rv);
+				  ha, hb, rv);
 		else
 			t_restrict(GV, vn, vm, r.s0, r.s1, r.t0, r.t1, rv);
 		if (strict_sign(rv, ngv, eps_gv))
@@ -1259,22 +1279,11 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 				if (W)
 					t_restrict(W, fn, fm, r.s0, r.s1, r.t0, r.t1, rw);
 			}
-			/* The slot taken above may be the parent's, dropped
-			 * at the pop: its quarters are read before the
-			 * children's overwrite them only if it is not. */
-			if (slot == up && slot >= 0) {
-				memcpy(rf, pf, nfs * sizeof(double));
-				pf = rf;
-				if (W) {
-					memcpy(rw, pw, nfs * sizeof(double));
-					pw = rw;
-				}
-			}
 			children_lb(pf, W ? pw : NULL, fn, fm, o, &pl, slot, ch);
 			for (k = 0; k < 4; k++)
 				kept += ch[k].lb < x.best - x.slack;
 			if (slot >= 0 && !kept)
-				pl.free_[pl.nfree++] = slot;
+				pool_give(&pl, slot);
 			else if (slot >= 0) {
 				memcpy(slot_gu(&pl, slot), rg, ngu * sizeof(double));
 				memcpy(slot_gv(&pl, slot), rv, ngv * sizeof(double));
