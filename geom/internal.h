@@ -5,10 +5,20 @@
 #ifndef PX_GEOM_INTERNAL_H
 #define PX_GEOM_INTERNAL_H
 
+#include <math.h>
 #include <stddef.h>
 #include <stdint.h>
 
 #include "px_nurbs.h"
+
+/* x taken the shorter way round a period len > 0: in [-len/2, len/2]
+ * (remainder() without its exact-halfway rule, which nothing here needs;
+ * libm's costs about 120 instructions, and a cold update of the curve
+ * tracker calls it three times). */
+static inline double px__wrap_half(double x, double len)
+{
+	return x - len * floor(x / len + 0.5);
+}
 
 /* ---- NURBS (px_nurbs_basis.c) ---- */
 

@@ -3093,9 +3093,9 @@ static void cold_keep(struct px_strack *t, px_vec3 p,
 static double uv_gap(const struct ssurf *f, double du, double dv)
 {
 	if (f->wrap_u)
-		du = remainder(du, f->du);
+		du = px__wrap_half(du, f->du);
 	if (f->wrap_v)
-		dv = remainder(dv, f->dv);
+		dv = px__wrap_half(dv, f->dv);
 	return hypot(du / f->du, dv / f->dv);
 }
 

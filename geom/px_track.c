@@ -2002,9 +2002,9 @@ static int continued(struct px_track *t, px_vec3 p, int ent, double u,
 					  t->prev.D - u;
 	if (e->cyclic) {
 		/* the shorter way round the seam */
-		du = remainder(du, e->len);
-		dub = remainder(dub, e->len);
-		duf = remainder(duf, e->len);
+		du = px__wrap_half(du, e->len);
+		dub = px__wrap_half(dub, e->len);
+		duf = px__wrap_half(duf, e->len);
 	}
 	return fabs(dub) <= 0.5 * fabs(du) && fabs(duf) <= 0.5 * fabs(du);
 }

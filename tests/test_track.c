@@ -1309,6 +1309,69 @@ out:
 	px_dist_model_free(ref);
 }
 
+/*
+ * Cold answers carry jumped too, from the global answers alone: a point
+ * orbiting a circle (its foot point moves on continuously) crosses the
+ * curve's seam, where u wraps from the end of the domain to its start,
+ * several times while the tracker answers cold; none of those is a jump.
+ * Half way the point moves to the antipode: that one is.
+ */
+static void test_cold_seam(void)
+{
+	struct tcurve tc;
+	struct px_track *t = NULL;
+	struct px_track_stats st;
+	struct px_track_result r;
+	struct px_test_clock fc = {0, 1};
+	double a = 0.3, da, u_prev = 0.0;
+	long cold = 0, seams = 0, false_jump = 0, both = 0;
+	int k, prev_cold = 0, antipode_jumped = -1;
+
+	PX_CHECK_INT_EQ(curve_circle(&tc, 0.0, 0.0, 1.0), 0);
+	PX_CHECK_INT_EQ(px_track_create(&tc.c, 1, NULL, &t), PX_OK);
+	if (!t)
+		return;
+	px__track_set_clock(t, px_test_clock_read, &fc);
+	px_track_get_stats(t, &st);
+	/* every tracked update looks ten cold queries long: cold after the
+	 * decision's samples; the speed stays, so it stays cold (a probe
+	 * comes after 1024 cold updates, past this path) */
+	fc.inc = (int64_t)(10.0 * st.cold_ns) + 1;
+	/* about 2.4 % of the model's size a step: a turn in 140 */
+	da = 0.045;
+	px_track_reset(t, px_v3(1.5 * cos(a), 1.5 * sin(a), 0.0), &r);
+	for (k = 0; k < 900; k++) {
+		int anti = k == 450;
+		a += anti ? M_PI : da;
+		if (px_track_update(t, px_v3(1.5 * cos(a), 1.5 * sin(a), 0.1), &r) != PX_OK) {
+			PX_CHECK_MSG(0, "update %d failed", k);
+			break;
+		}
+		if (r.source == PX_TRACK_COLD) {
+			cold++;
+			if (prev_cold) {
+				both++;
+				if (anti)
+					antipode_jumped = r.jumped;
+				else {
+					false_jump += r.jumped;
+					seams += fabs(r.u - u_prev) > 0.5;
+				}
+			}
+		}
+		prev_cold = r.source == PX_TRACK_COLD;
+		u_prev = r.u;
+	}
+	printf("  cold seam: %ld cold answers, %ld after a cold one, seam "
+	       "crossings %ld, false jumps %ld, antipode jumped %d\n",
+	       cold, both, seams, false_jump, antipode_jumped);
+	PX_CHECK_MSG(cold >= 800, "only %ld cold answers", cold);
+	PX_CHECK_MSG(seams >= 4, "the seam crossed cold only %ld times", seams);
+	PX_CHECK_INT_EQ(false_jump, 0);
+	PX_CHECK_INT_EQ(antipode_jumped, 1);
+	px_track_free(t);
+}
+
 static const struct px_test tests[] = {
 	PX_T(test_planar_closed_c2), PX_T(test_planar_open_c1_c0),
 	PX_T(test_planar_cusp),      PX_T(test_rational_circle),
@@ -1317,6 +1380,6 @@ static const struct px_test tests[] = {
 	PX_T(test_no_verification),  PX_T(test_random_curves),
 	PX_T(test_errors),           PX_T(test_lazy_exact),
 	PX_T(test_lazy_faults_caught), PX_T(test_certificates_brute),
-	PX_T(test_cold_switch),
+	PX_T(test_cold_switch),      PX_T(test_cold_seam),
 };
 PX_TEST_MAIN(tests)
