@@ -231,32 +231,55 @@ static double max_abs(const double *c, size_t k)
 	return m;
 }
 
-/* Range of the coefficients of the derivative along s (dir 0) or t
- * (dir 1) of c (n, m), without storing them: the Jacobian bounds. */
-static void t_deriv_range(const double *c, int n, int m, int dir, double *lo,
-			  double *hi)
+/* Ranges of the coefficients of the derivatives of c (n + 1 rows of
+ * m + 1) along its rows (lo[0], hi[0]: differences between rows, times
+ * n) and along its columns (lo[1], hi[1], times m), without storing
+ * them: the Jacobian bounds. One pass for both, two independent chains
+ * per bound (the loop is bound by the latency of the min and max, not by
+ * the loads). */
+static void t_jac_range(const double *c, int n, int m, double lo[2],
+			double hi[2])
 {
-	double a = INFINITY, b = -INFINITY;
+	const int w = m + 1;
+	double ra = INFINITY, rb = -INFINITY, rc = INFINITY, rd = -INFINITY;
+	double ca = INFINITY, cb = -INFINITY, cc = INFINITY, cd = -INFINITY;
 	int i, j;
-	if (dir == 0) {
-		for (i = 0; i < n; i++)
-			for (j = 0; j <= m; j++) {
-				double d = c[(i + 1) * (m + 1) + j] - c[i * (m + 1) + j];
-				a = d < a ? d : a;
-				b = d > b ? d : b;
-			}
-		*lo = n * a;
-		*hi = n * b;
-	} else {
-		for (i = 0; i <= n; i++)
-			for (j = 0; j < m; j++) {
-				double d = c[i * (m + 1) + j + 1] - c[i * (m + 1) + j];
-				a = d < a ? d : a;
-				b = d > b ? d : b;
-			}
-		*lo = m * a;
-		*hi = m * b;
+	for (i = 0; i <= n; i++) {
+		const double *row = c + (size_t)i * (size_t)w;
+		const double *nxt = row + w;
+		for (j = 0; j + 1 < m; j += 2) {
+			double d0 = row[j + 1] - row[j], d1 = row[j + 2] - row[j + 1];
+			ca = d0 < ca ? d0 : ca;
+			cb = d0 > cb ? d0 : cb;
+			cc = d1 < cc ? d1 : cc;
+			cd = d1 > cd ? d1 : cd;
+		}
+		if (j < m) {
+			double d0 = row[j + 1] - row[j];
+			ca = d0 < ca ? d0 : ca;
+			cb = d0 > cb ? d0 : cb;
+		}
+		if (i == n)
+			break;
+		for (j = 0; j + 1 <= m; j += 2) {
+			double d0 = nxt[j] - row[j], d1 = nxt[j + 1] - row[j + 1];
+			ra = d0 < ra ? d0 : ra;
+			rb = d0 > rb ? d0 : rb;
+			rc = d1 < rc ? d1 : rc;
+			rd = d1 > rd ? d1 : rd;
+		}
+		if (j <= m) {
+			double d0 = nxt[j] - row[j];
+			ra = d0 < ra ? d0 : ra;
+			rb = d0 > rb ? d0 : rb;
+		}
 	}
+	/* (an order of the same values: only the sign of a zero bound can
+	 * differ, which no test below reads) */
+	lo[0] = n * (rc < ra ? rc : ra);
+	hi[0] = n * (rd > rb ? rd : rb);
+	lo[1] = m * (cc < ca ? cc : ca);
+	hi[1] = m * (cd > cb ? cd : cb);
 }
 
 /* ---- setup ------------------------------------------------------------------ */
@@ -1207,10 +1230,19 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 			/* Bernstein bounds of the Jacobian of (gu, gv), in the
 			 * piece's local scale (d/ds = (1/ws) d/ds_sub). */
 			double a_lo, a_hi, b_lo, b_hi, c_lo, c_hi, d_lo, d_hi, off;
-			t_deriv_range(rg, o ? um : un, o ? un : um, o, &a_lo, &a_hi);
-			t_deriv_range(rg, o ? um : un, o ? un : um, !o, &b_lo, &b_hi);
-			t_deriv_range(rv, o ? vm : vn, o ? vn : vm, o, &c_lo, &c_hi);
-			t_deriv_range(rv, o ? vm : vn, o ? vn : vm, !o, &d_lo, &d_hi);
+			double glo[2], ghi[2], vlo[2], vhi[2];
+			/* o: the rows run along t, so the s-derivative is
+			 * along the columns */
+			t_jac_range(rg, o ? um : un, o ? un : um, glo, ghi);
+			t_jac_range(rv, o ? vm : vn, o ? vn : vm, vlo, vhi);
+			a_lo = glo[o];
+			a_hi = ghi[o];
+			b_lo = glo[!o];
+			b_hi = ghi[!o];
+			c_lo = vlo[o];
+			c_hi = vhi[o];
+			d_lo = vlo[!o];
+			d_hi = vhi[!o];
 			a_lo /= ws;
 			a_hi /= ws;
 			c_lo /= ws;
