@@ -175,6 +175,16 @@ extern int px__strack_coarse;
  * tensors (-1: as many as fit), so tests can run the restriction from
  * the root and compare. */
 extern int px__spiece_pool_cap;
+/* px_spiece: 1 leaves the preconditioned monotonicity test out (a
+ * rectangle is then split where only it would prove one minimum). */
+extern int px__spiece_no_precond;
+/* px_spiece: the preconditioned monotonicity test on one rectangle, and
+ * the symmetric Jacobian part's least eigenvalue sampled there (see
+ * px_spiece.c). */
+struct px_spiece;
+int px__spiece_precond_probe(const struct px_spiece *sp, px_vec3 p, double s0,
+			     double s1, double t0, double t1, int o, int grid,
+			     double *mu, double *sampled);
 /* px_strack: 1 leaves every box no certificate decides uncut (Newton
  * from its centre), the solve as it was before the run-time cuts. */
 extern int px__strack_sub_fault;

@@ -282,6 +282,205 @@ static void t_jac_range(const double *c, int n, int m, double lo[2],
 	hi[1] = m * (cd > cb ? cd : cb);
 }
 
+/* Element (i, j), i along s, of a tensor of degrees (n, m) stored in
+ * orientation o (0: rows along s; 1: the transpose). */
+static inline double t_at(const double *c, int n, int m, int o, int i, int j)
+{
+	return o ? c[(size_t)j * (size_t)(n + 1) + (size_t)i]
+		 : c[(size_t)i * (size_t)(m + 1) + (size_t)j];
+}
+
+/* Degree elevation by one along the rows (dir 0) or the columns (dir 1)
+ * of x ((n + 1) rows of m + 1) into y ((n + 2) rows of m + 1, or n + 1
+ * rows of m + 2): y_i = (i x_i-1 + (N - i) x_i) / N, N the new degree. */
+static void t_elevate(const double *x, int n, int m, int dir, double *y)
+{
+	const size_t w = (size_t)(m + 1);
+	int i, j;
+	if (dir == 0) {
+		const double inv = 1.0 / (n + 1);
+		memcpy(y, x, w * sizeof(double));
+		for (i = 1; i <= n; i++) {
+			const double a = i * inv, b = 1.0 - a;
+			const double *x0 = x + (size_t)(i - 1) * w, *x1 = x0 + w;
+			double *yi = y + (size_t)i * w;
+			for (j = 0; j <= m; j++)
+				yi[j] = a * x0[j] + b * x1[j];
+		}
+		memcpy(y + (size_t)(n + 1) * w, x + (size_t)n * w, w * sizeof(double));
+	} else {
+		double a[3 * MD + 3];
+		const double inv = 1.0 / (m + 1);
+		for (j = 1; j <= m; j++)
+			a[j] = j * inv;
+		for (i = 0; i <= n; i++) {
+			const double *xi = x + (size_t)i * w;
+			double *yi = y + (size_t)i * (w + 1);
+			yi[0] = xi[0];
+			for (j = 1; j <= m; j++)
+				yi[j] = a[j] * xi[j - 1] + (1.0 - a[j]) * xi[j];
+			yi[m + 1] = xi[m];
+		}
+	}
+}
+
+/* The derivative of x (R rows of C, a Bernstein tensor of degree R - 1
+ * along its rows) along the rows, written back at the same degree (the
+ * difference tensor elevated once): i (x_i - x_i-1) + (n - i) (x_i+1 -
+ * x_i), n = R - 1. */
+static void d_rows(const double *x, int R, int C, double *out)
+{
+	const int n = R - 1;
+	int i, j;
+	for (j = 0; j < C; j++)
+		out[j] = n * (x[C + j] - x[j]);
+	for (i = 1; i < n; i++) {
+		const double *r = x + (size_t)i * (size_t)C;
+		double *o = out + (size_t)i * (size_t)C;
+		const double a = n - i, b = i;
+		for (j = 0; j < C; j++)
+			o[j] = a * (r[C + j] - r[j]) + b * (r[j] - r[j - C]);
+	}
+	for (j = 0; j < C; j++)
+		out[(size_t)n * C + j] = n * (x[(size_t)n * C + j] - x[(size_t)(n - 1) * C + j]);
+}
+
+/* The same along the columns (degree C - 1). */
+static void d_cols(const double *x, int R, int C, double *out)
+{
+	const int n = C - 1;
+	double wa[3 * MD + 3], wb[3 * MD + 3];
+	int i, j;
+	for (j = 1; j < n; j++) {
+		wa[j] = n - j;
+		wb[j] = j;
+	}
+	for (i = 0; i < R; i++) {
+		const double *r = x + (size_t)i * (size_t)C;
+		double *o = out + (size_t)i * (size_t)C;
+		double dl = r[1] - r[0];
+		o[0] = n * dl;
+		for (j = 1; j < n; j++) {
+			double dr = r[j + 1] - r[j];
+			o[j] = wa[j] * dr + wb[j] * dl;
+			dl = dr;
+		}
+		o[n] = n * dl;
+	}
+}
+
+/*
+ * The monotonicity test again, preconditioned, where the plain one
+ * failed with a positive diagonal. The symmetric part S of the Jacobian
+ * J of G = (gu, gv) (in the piece's scale: S11 in [a_lo, a_hi], S22 in
+ * [d_lo, d_hi], the off-diagonal in [o_lo, o_hi]) is positive definite
+ * on the rectangle iff K = M^T S M is, for any invertible M. The plain
+ * test bounds S11, S22 and the off-diagonal each on its own, so a cross
+ * term near the size of the diagonal (a skewed parametrization, a twist)
+ * fails it however small the rectangle. With M = L^-T from the Cholesky
+ * factor of S at the ranges' midpoints (columns m1 = (m11, 0), m2 =
+ * (m12, m22)), K is near the identity there, and its entries are formed
+ * as polynomials before their ranges are taken, so they vary only as S
+ * does over the rectangle:
+ *   K11 = m11^2 S11,
+ *   K22 = m2^T J m2 = D_m2 h,            h = m12 gu + m22 gv,
+ *   K12 = (m1^T J m2 + m2^T J m1) / 2 = m11 (D_m2 gu + dh/ds) / 2,
+ * D_m2 the derivative along m2 (scaled by the rectangle's widths). gu is
+ * elevated along s and gv along t to the common degree (un + 1, um), and
+ * each derivative is written back at that degree (d_rows(), d_cols()).
+ * The margins cover the coefficients' rounding rnd (point_rounding())
+ * through the differences and the sums. Returns 1 with *mu a modulus of
+ * S (v^T S v >= mu |v|^2: K's least eigenvalue bound over |M|_F^2), 0
+ * when K is not proven positive definite either. rg, rv in orientation
+ * o.
+ */
+static __attribute__((noinline)) int
+precond_monotone(const double *rg, const double *rv, int un, int um, int o,
+		 double ws, double wt, double a_lo, double a_hi, double d_lo,
+		 double d_hi, double o_lo, double o_hi, double rnd, double *mu)
+{
+	/* gv's degrees are gu's plus one along s and minus one along t
+	 * (both rational and polynomial patches) */
+	const int vn = un + 1, vm = um - 1, N = un + 1, Mx = um;
+	/* stored layout: R rows of C; the rows run along s when o = 0 */
+	const int R = (o ? Mx : N) + 1, C = (o ? N : Mx) + 1;
+	const size_t nk = (size_t)R * (size_t)C;
+	double eg[TMAX], h[TMAX], hr[TMAX], hc[TMAX], gr[TMAX], gc[TMAX];
+	double al = 0.5 * (a_lo + a_hi), de = 0.5 * (d_lo + d_hi),
+	       be = 0.5 * (o_lo + o_hi), l11, l21, l22, m11, m12, m22;
+	double k2 = INFINITY, k12 = 0.0, k1, lam, gmax = 0.0, vmax = 0.0;
+	double cr, cc, er, ec, fr, fc, hm, eh, nr2, nc2;
+	size_t k;
+	if (!(al > 0.0) || !(al * de > be * be))
+		return 0; /* S at the midpoint not definite: nor all of it */
+	l11 = sqrt(al);
+	l21 = be / l11;
+	l22 = sqrt(de - l21 * l21);
+	if (!(l22 > 0.0))
+		return 0;
+	m11 = 1.0 / l11;
+	m12 = -l21 / (l11 * l22);
+	m22 = 1.0 / l22;
+	/* gu along s, gv along t, in their stored orientation */
+	if (o) {
+		t_elevate(rg, um, un, 1, eg);
+		t_elevate(rv, vm, vn, 0, h);
+	} else {
+		t_elevate(rg, un, um, 0, eg);
+		t_elevate(rv, vn, vm, 1, h);
+	}
+	for (k = 0; k < nk; k++) {
+		double g = fabs(eg[k]), v = fabs(h[k]);
+		gmax = g > gmax ? g : gmax;
+		vmax = v > vmax ? v : vmax;
+		h[k] = m12 * eg[k] + m22 * h[k];
+	}
+	d_rows(h, R, C, hr);
+	d_cols(h, R, C, hc);
+	d_rows(eg, R, C, gr);
+	d_cols(eg, R, C, gc);
+	/* K22 = cr hr + cc hc, K12 = er hr + ec hc + fr gr + fc gc: the
+	 * derivatives along s carry 1 / ws, along t 1 / wt */
+	if (o) {
+		cr = m22 / wt;
+		cc = m12 / ws;
+		er = 0.0;
+		ec = 0.5 * m11 / ws;
+		fr = 0.5 * m11 * m22 / wt;
+		fc = 0.5 * m11 * m12 / ws;
+	} else {
+		cr = m12 / ws;
+		cc = m22 / wt;
+		er = 0.5 * m11 / ws;
+		ec = 0.0;
+		fr = 0.5 * m11 * m12 / ws;
+		fc = 0.5 * m11 * m22 / wt;
+	}
+	for (k = 0; k < nk; k++) {
+		double v2 = cr * hr[k] + cc * hc[k];
+		double v12 = fabs(er * hr[k] + ec * hc[k] + fr * gr[k] + fc * gc[k]);
+		k2 = v2 < k2 ? v2 : k2;
+		k12 = v12 > k12 ? v12 : k12;
+	}
+	/* Margins: a derivative coefficient is at most 2 n times its
+	 * tensor's largest (n its degree), and its error 2 n times the
+	 * tensor's; 1e-12 of those sizes covers the rounding of the sums,
+	 * rnd (with h's |m12| + |m22| times it) that of the coefficients */
+	nr2 = 2.0 * (R - 1);
+	nc2 = 2.0 * (C - 1);
+	hm = fabs(m12) * gmax + fabs(m22) * vmax;
+	eh = (fabs(m12) + fabs(m22)) * rnd;
+	k2 -= (fabs(cr) * nr2 + fabs(cc) * nc2) * (1e-12 * hm + eh);
+	k12 += (fabs(er) * nr2 + fabs(ec) * nc2) * (1e-12 * hm + eh) +
+	       (fabs(fr) * nr2 + fabs(fc) * nc2) * (1e-12 * gmax + rnd);
+	k1 = m11 * m11 * (a_lo - 2.0 * un * rnd / ws);
+	if (!(k1 > 0.0) || !(k2 > 0.0) || !(k1 * k2 > k12 * k12))
+		return 0;
+	lam = 0.5 * (k1 + k2) - sqrt(0.25 * (k1 - k2) * (k1 - k2) + k12 * k12);
+	*mu = lam / (m11 * m11 + m12 * m12 + m22 * m22);
+	return *mu > 0.0;
+}
+
 /* ---- setup ------------------------------------------------------------------ */
 
 int px_spiece_init(struct px_spiece *sp, int p, int q, const double (*hw)[4],
@@ -867,6 +1066,9 @@ static void quad_halves(int o, int quad, int *a, int *b)
  */
 #define POOL_DOUBLES 8192
 int px__spiece_pool_cap = -1;
+/* Test hook (internal.h): 1 leaves the preconditioned monotonicity test
+ * out (precond_monotone()). */
+int px__spiece_no_precond = 0;
 #define POOL_SLOTS 64
 
 struct pool {
@@ -1261,6 +1463,14 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 				     sqrt(0.25 * (a_lo - d_lo) * (a_lo - d_lo) + off * off);
 			} else if (a_hi < 0.0 && d_hi < 0.0 && a_hi * d_hi > off * off)
 				continue; /* at most one zero, and a maximum */
+			else if (a_lo > 0.0 && d_lo > 0.0 && !px__spiece_no_precond) {
+				if (rnd_g < 0.0)
+					rnd_g = point_rounding(sp, p, ngu, ngv);
+				certain = precond_monotone(rg, rv, un, um, o, ws, wt, a_lo,
+							   a_hi, d_lo, d_hi,
+							   0.5 * (b_lo + c_lo),
+							   0.5 * (b_hi + c_hi), rnd_g, &mu);
+			}
 		}
 		if (certain) {
 			double s = NAN, t = NAN;
@@ -1341,4 +1551,81 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 out:
 	*best_d2 = x.best;
 	return x.improved;
+}
+
+/*
+ * Test hook (internal.h): the preconditioned monotonicity test on the
+ * rectangle [s0, s1] x [t0, t1] (local coordinates) of sp for the point
+ * p, its tensors in orientation o, as the query makes it; and, apart
+ * from it, the least eigenvalue of the symmetric Jacobian part sampled
+ * on a grid x grid lattice of the rectangle from the whole patch's
+ * derivative tensors (no restriction, elevation or preconditioning).
+ * Returns -1 where the plain test decides (or the diagonal has no one
+ * sign), else precond_monotone()'s verdict with *mu.
+ */
+int px__spiece_precond_probe(const struct px_spiece *sp, px_vec3 p, double s0,
+			     double s1, double t0, double t1, int o, int grid,
+			     double *mu, double *sampled)
+{
+	const int un = sp->gun_, um = sp->gum_, vn = sp->gvn_, vm = sp->gvm_;
+	const size_t ngu = tsize(un, um), ngv = tsize(vn, vm);
+	static double GU[TMAX], GV[TMAX], rg[TMAX], rv[TMAX], tr[TMAX];
+	static double gs[TMAX], gt[TMAX], vs[TMAX], vt[TMAX];
+	double ws = s1 - s0, wt = t1 - t0, glo[2], ghi[2], vlo[2], vhi[2];
+	double a_lo, a_hi, b_lo, b_hi, c_lo, c_hi, d_lo, d_hi, off, least = INFINITY;
+	size_t i;
+	int j, k, rc;
+	for (i = 0; i < ngu; i++)
+		GU[i] = sp->gua_[i] - (p.x * sp->gub_[i] + p.y * sp->gub_[ngu + i] +
+				       p.z * sp->gub_[2 * ngu + i]);
+	for (i = 0; i < ngv; i++)
+		GV[i] = sp->gva_[i] - (p.x * sp->gvb_[i] + p.y * sp->gvb_[ngv + i] +
+				       p.z * sp->gvb_[2 * ngv + i]);
+	t_restrict(GU, un, um, s0, s1, t0, t1, rg);
+	t_restrict(GV, vn, vm, s0, s1, t0, t1, rv);
+	if (o) {
+		transpose(rg, un + 1, um + 1, tr);
+		memcpy(rg, tr, ngu * sizeof(double));
+		transpose(rv, vn + 1, vm + 1, tr);
+		memcpy(rv, tr, ngv * sizeof(double));
+	}
+	t_jac_range(rg, o ? um : un, o ? un : um, glo, ghi);
+	t_jac_range(rv, o ? vm : vn, o ? vn : vm, vlo, vhi);
+	a_lo = glo[o] / ws;
+	a_hi = ghi[o] / ws;
+	b_lo = glo[!o] / wt;
+	b_hi = ghi[!o] / wt;
+	c_lo = vlo[o] / ws;
+	c_hi = vhi[o] / ws;
+	d_lo = vlo[!o] / wt;
+	d_hi = vhi[!o] / wt;
+	off = 0.5 * fmax(fabs(b_lo + c_lo), fabs(b_hi + c_hi));
+	if (!(a_lo > 0.0 && d_lo > 0.0) || a_lo * d_lo > off * off)
+		return -1;
+	rc = precond_monotone(rg, rv, un, um, o, ws, wt, a_lo, a_hi, d_lo, d_hi,
+			      0.5 * (b_lo + c_lo), 0.5 * (b_hi + c_hi),
+			      point_rounding(sp, p, ngu, ngv), mu);
+	/* the derivative tensors of the whole patch, rows along s */
+	for (j = 0; j < un; j++)
+		for (k = 0; k <= um; k++)
+			gs[j * (um + 1) + k] = un * (GU[(j + 1) * (um + 1) + k] - GU[j * (um + 1) + k]);
+	for (j = 0; j <= un; j++)
+		for (k = 0; k < um; k++)
+			gt[j * um + k] = um * (GU[j * (um + 1) + k + 1] - GU[j * (um + 1) + k]);
+	for (j = 0; j < vn; j++)
+		for (k = 0; k <= vm; k++)
+			vs[j * (vm + 1) + k] = vn * (GV[(j + 1) * (vm + 1) + k] - GV[j * (vm + 1) + k]);
+	for (j = 0; j <= vn; j++)
+		for (k = 0; k < vm; k++)
+			vt[j * vm + k] = vm * (GV[j * (vm + 1) + k + 1] - GV[j * (vm + 1) + k]);
+	for (j = 0; j < grid; j++)
+		for (k = 0; k < grid; k++) {
+			double s = s0 + ws * j / (grid - 1), t = t0 + wt * k / (grid - 1);
+			double a = t_eval(gs, un - 1, um, s, t), d = t_eval(vt, vn, vm - 1, s, t);
+			double b = 0.5 * (t_eval(gt, un, um - 1, s, t) + t_eval(vs, vn - 1, vm, s, t));
+			double l = 0.5 * (a + d) - sqrt(0.25 * (a - d) * (a - d) + b * b);
+			least = l < least ? l : least;
+		}
+	*sampled = least;
+	return rc;
 }

@@ -19,7 +19,13 @@
  *  - at most one, and it is a minimum: Bernstein bounds of the Jacobian
  *    of (gu, gv) make its symmetric part positive definite, so (gu, gv)
  *    is strictly monotone on the rectangle; Newton started inside finds
- *    that single zero. Negative definite means a single maximum: dropped.
+ *    that single zero. Where a cross term near the size of the diagonal
+ *    defeats those bounds (a skewed parametrization, a twist), the same
+ *    test is made on M^T S M, M from the Cholesky factor of the symmetric
+ *    part S at the rectangle's middle, its entries formed as polynomials
+ *    before their ranges are taken (congruence keeps definiteness, and
+ *    the preconditioned entries vary only as S does). Negative definite
+ *    means a single maximum: dropped.
  *    When the minimum lies just outside the rectangle (beside a piece
  *    border or the patch edge), a projected Newton ends on the border
  *    with the gradient pointing out, and the monotonicity modulus bounds
