@@ -413,6 +413,22 @@ precond_monotone(const double *rg, const double *rv, int un, int um, int o,
 	size_t k;
 	if (!(al > 0.0) || !(al * de > be * be))
 		return 0; /* S at the midpoint not definite: nor all of it */
+	/* Where S is not definite at a corner (its value there: the corner
+	 * coefficients' differences) no M can prove it on the rectangle. */
+	for (k = 0; k < 4; k++) {
+		const int ei = k & 1, ej = k >> 1;
+		const int i0 = ei ? un - 1 : 0, j0 = ej ? um - 1 : 0;
+		const int iv = ei ? vn : 0, jv = ej ? vm : 0;
+		const int ig = ei ? un : 0, jg = ej ? um : 0;
+		const int i1 = ei ? vn - 1 : 0, j1 = ej ? vm - 1 : 0;
+		double s11 = un * (t_at(rg, un, um, o, i0 + 1, jg) - t_at(rg, un, um, o, i0, jg)) / ws;
+		double gut = um * (t_at(rg, un, um, o, ig, j0 + 1) - t_at(rg, un, um, o, ig, j0)) / wt;
+		double gvs = vn * (t_at(rv, vn, vm, o, i1 + 1, jv) - t_at(rv, vn, vm, o, i1, jv)) / ws;
+		double s22 = vm * (t_at(rv, vn, vm, o, iv, j1 + 1) - t_at(rv, vn, vm, o, iv, j1)) / wt;
+		double s12 = 0.5 * (gut + gvs);
+		if (!(s11 > 0.0) || !(s11 * s22 > s12 * s12))
+			return 0;
+	}
 	l11 = sqrt(al);
 	l21 = be / l11;
 	l22 = sqrt(de - l21 * l21);
