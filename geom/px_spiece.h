@@ -51,9 +51,10 @@
  *
  * Memory and real-time rules: a piece lives in caller memory: a small
  * struct plus px_spiece_doubles(p, q) doubles filled by px_spiece_init()
- * at setup. px_spiece_closest() uses fixed stack arrays (about 360 KiB:
- * the rectangle heap, a pool of parent tensors and tensors sized for
- * PX_SPIECE_MAX_DEGREE) and no heap; all loops are bounded.
+ * at setup. px_spiece_closest() uses fixed stack arrays (about 410 KiB
+ * deep: the rectangle heap, a pool of parent tensors and tensors sized
+ * for PX_SPIECE_MAX_DEGREE, 363 KiB, and the preconditioned test's 46
+ * KiB) and no heap; all loops are bounded.
  */
 #ifndef PX_SPIECE_H
 #define PX_SPIECE_H
@@ -68,8 +69,8 @@ extern "C" {
 #endif
 
 /* Same limit as the NURBS kernel. A query's stack arrays are sized for
- * it: about 360 KiB, whatever the actual degree (only the used part is
- * touched); real-time threads must have that much prefaulted stack
+ * it: about 410 KiB deep, whatever the actual degree (only the used part
+ * is touched); real-time threads must have that much prefaulted stack
  * (px_rt's default prefaults 1 MiB). */
 #define PX_SPIECE_MAX_DEGREE 10
 #define PX_SPIECE_MAX_DEPTH 24
