@@ -1868,8 +1868,9 @@ static int col_test(struct px_strack *t, int limit)
 	px_vec3 mid = px_v3_scale(px_v3_add(p0, p1), 0.5);
 	/* the segment lies in the cube of half width dinf about p1 and in
 	 * the cube of half width dinf / 2 about its middle */
-	double dinf = fmax(fmax(fabs(p1.x - p0.x), fabs(p1.y - p0.y)),
-			   fabs(p1.z - p0.z));
+	/* (the points are finite: plain comparisons, not fmax's calls) */
+	double dx = fabs(p1.x - p0.x), dy = fabs(p1.y - p0.y), dz = fabs(p1.z - p0.z);
+	double dinf = dx > dy ? (dx > dz ? dx : dz) : (dy > dz ? dy : dz);
 	int end = t->col_np;
 	if (limit > 0 && t->col_k + limit < end)
 		end = t->col_k + limit;
@@ -1937,7 +1938,10 @@ static int col_resume(struct px_strack *t)
 
 static int in_work(const struct px_strack *t, px_vec3 p)
 {
-	return px_aabb_contains(&t->work, p);
+	/* (px_aabb_contains() inline: twice in every update) */
+	const px_aabb *b = &t->work;
+	return p.x >= b->min.x && p.x <= b->max.x && p.y >= b->min.y &&
+	       p.y <= b->max.y && p.z >= b->min.z && p.z <= b->max.z;
 }
 
 static void fill_dir(struct px_strack_result *r, px_vec3 p)
