@@ -394,11 +394,20 @@ static void surf_eval2(const struct ssurf *f, double u, double v,
 	s = (u - pt->u0) * pt->iu;
 	t = (v - pt->v0) * pt->iv;
 #if ST_VEC
-	eval_pair(pt->c, pt->c + n, p, q, s, t, h[0], h[1]);
-	if (pt->rat)
-		eval_pair(pt->c + 2 * n, pt->c + 3 * n, p, q, s, t, h[2], h[3]);
-	else
-		eval_one(pt->c + 2 * n, p, q, s, t, h[2]);
+	if (p == 3 && q == 3) {
+		/* bicubic, the usual patch: the loops unrolled */
+		eval_pair(pt->c, pt->c + 16, 3, 3, s, t, h[0], h[1]);
+		if (pt->rat)
+			eval_pair(pt->c + 32, pt->c + 48, 3, 3, s, t, h[2], h[3]);
+		else
+			eval_one(pt->c + 32, 3, 3, s, t, h[2]);
+	} else {
+		eval_pair(pt->c, pt->c + n, p, q, s, t, h[0], h[1]);
+		if (pt->rat)
+			eval_pair(pt->c + 2 * n, pt->c + 3 * n, p, q, s, t, h[2], h[3]);
+		else
+			eval_one(pt->c + 2 * n, p, q, s, t, h[2]);
+	}
 #else
 	{
 		int k;
