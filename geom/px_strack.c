@@ -103,6 +103,14 @@ struct rcert {
 	int rat;        /* the net's weights differ */
 };
 
+/* The certificates of the four pieces of quarter key (4 ri + k), those
+ * made so far (bit j: piece j). */
+struct pcache {
+	int key;
+	unsigned filled;
+	struct rcert rc[4];
+};
+
 struct scell {
 	double u0, u1, v0, v1;
 	int surf;
@@ -209,6 +217,14 @@ struct px_strack {
 	 * its enclosures are too wide for a critical point or a focal point
 	 * close by (the quarters' are about half as wide) */
 	struct rcert *qcert;
+	/* the pieces' certificates of rational regions' quarters, made at
+	 * update time (piece_radius()) and kept, direct-mapped by quarter:
+	 * they do not depend on the point, and the cells about a point
+	 * near a focal sheet are tested again and again (up to three
+	 * radii a test); pcache_n a power of two, 0 without rational
+	 * regions */
+	struct pcache *pcache;
+	int pcache_n;
 	struct edge *edge;
 	struct pole *pole;
 	int *heap, *popped, *hits;
@@ -1536,22 +1552,33 @@ int px__strack_piece_fault = 0;
  * second level gained nothing on the rational bench model).
  */
 static double piece_radius(const struct px_strack *t, int s, const struct rcert *top,
-			   const double b[4], px_vec3 p)
+			   const double b[4], px_vec3 p, int key, int j)
 {
 	const struct ssurf *f = &t->sf[s];
-	struct rcert rc;
+	struct rcert own, *rcp = &own;
 	struct scell pc;
 	int open[4];
+	if (t->pcache_n > 0) {
+		struct pcache *e = &t->pcache[key & (t->pcache_n - 1)];
+		if (e->key != key) {
+			e->key = key;
+			e->filled = 0;
+		}
+		if (e->filled & (1u << j))
+			return cert_radius(&e->rc[j], p);
+		e->filled |= 1u << j; /* (made below) */
+		rcp = &e->rc[j];
+	}
 	memset(&pc, 0, sizeof(pc));
 	pc.surf = s;
 	pc.u0 = b[0];
 	pc.u1 = b[1];
 	pc.v0 = b[2];
 	pc.v1 = b[3];
-	taylor_cert(f, b, top, &rc);
+	taylor_cert(f, b, top, rcp);
 	sides_open(f, &pc, open);
-	cert_sides(f, &pc, &rc, open);
-	return cert_radius(&rc, p);
+	cert_sides(f, &pc, rcp, open);
+	return cert_radius(rcp, p);
 }
 
 /*
@@ -1577,7 +1604,7 @@ static double region_pieces(const struct px_strack *t, int ri, px_vec3 p)
 			rq = INFINITY;
 			for (j = 0; j < 4 && rq > 0.0; j++) {
 				box_quarter(b, j, sb);
-				rq = fmin(rq, piece_radius(t, g->surf, q, sb, p));
+				rq = fmin(rq, piece_radius(t, g->surf, q, sb, p, 4 * ri + k, j));
 			}
 		}
 		r = fmin(r, rq);
@@ -4449,6 +4476,7 @@ void px_strack_free(struct px_strack *t)
 	free(t->cell);
 	free(t->rcell);
 	free(t->qcert);
+	free(t->pcache);
 	free(t->edge);
 	free(t->pole);
 	free(t->heap);
@@ -4956,6 +4984,28 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 		rc = px_track_create(cc, n_cc, &to, &t->ct);
 		if (rc)
 			goto fail;
+	}
+	{
+		/* the piece cache where a region is rational: a slot for each
+		 * quarter of up to 64 such regions (about 3 KiB a slot),
+		 * fewer when the model has fewer */
+		int nrat = 0, n = 1;
+		for (i = 0; i < 4 * t->n_cells; i++)
+			nrat += t->rcell[i].cert.rat;
+		if (nrat > 0) {
+			while (n < 4 * nrat && n < 256)
+				n *= 2;
+			t->pcache = malloc((size_t)n * sizeof(*t->pcache));
+			if (!t->pcache) {
+				rc = PX_E_NOMEM;
+				goto fail;
+			}
+			for (i = 0; i < n; i++) {
+				t->pcache[i].key = -1;
+				t->pcache[i].filled = 0;
+			}
+			t->pcache_n = n;
+		}
 	}
 	t->epoch = 1;
 	t->hot_s = -1;
