@@ -111,6 +111,15 @@ struct pcache {
 	struct rcert rc[4];
 };
 
+/* The certificates of first-level sub-box key (4 (5 ri + q + 1) + k1)
+ * of a solve (rc[0]) and of its four quarters (rc[1 + k2]); bit i of
+ * filled: rc[i] made. */
+struct scache {
+	int key;
+	unsigned filled;
+	struct rcert rc[5];
+};
+
 struct scell {
 	double u0, u1, v0, v1;
 	int surf;
@@ -225,6 +234,11 @@ struct px_strack {
 	 * regions */
 	struct pcache *pcache;
 	int pcache_n;
+	/* the same for the boxes a solve cuts (sub_solve(): four quarters
+	 * of a region or quarter, and four of each of those), by the box
+	 * cut and its first-level quarter; scache_n a power of two */
+	struct scache *scache;
+	int scache_n;
 	struct edge *edge;
 	struct pole *pole;
 	int *heap, *popped, *hits;
@@ -1030,7 +1044,7 @@ static int seed_solve(struct px_strack *t, struct ssurf *f, const struct scell *
  */
 static int sub_solve(struct px_strack *t, struct ssurf *f, const struct scell *c,
 		     const struct rcert *top, const double b[4], int depth, px_vec3 ps,
-		     px_vec3 p)
+		     px_vec3 p, int top_id, int k1)
 {
 	int known = px_v3_dist2(ps, p) == 0.0, k, r,
 	    cut = 4 * ST_SUB_CERT + 3 * ST_SUB_SEED;
@@ -1042,22 +1056,38 @@ static int sub_solve(struct px_strack *t, struct ssurf *f, const struct scell *c
 	}
 	t->sub_work += cut;
 	for (k = 0; k < 4; k++) {
-		struct rcert rc;
+		struct rcert own, *rcp = &own;
 		double sb[4];
 		int w;
 		box_quarter(b, k, sb);
-		taylor_cert(f, sb, top, &rc);
+		if (t->scache_n > 0 && top_id >= 0 && depth <= 2) {
+			/* made before (the point does not enter a certificate) */
+			const int key = 4 * top_id + (depth == 1 ? k : k1),
+				  slot = depth == 1 ? 0 : 1 + k;
+			struct scache *e = &t->scache[key & (t->scache_n - 1)];
+			if (e->key != key) {
+				e->key = key;
+				e->filled = 0;
+			}
+			rcp = &e->rc[slot];
+			if (!(e->filled & (1u << slot))) {
+				taylor_cert(f, sb, top, rcp);
+				e->filled |= 1u << slot;
+			}
+		} else
+			taylor_cert(f, sb, top, rcp);
 		t->st.sub_boxes++;
-		w = box_done(f, &rc, sb, ps, known);
+		w = box_done(f, rcp, sb, ps, known);
 		if (w == BOX_DONE) {
 			t->sub_work -= ST_SUB_SEED;
 			continue;
 		}
 		/* a contraction takes the piece's seed; undecided (rare:
 		 * none in the tests), the piece goes on as an open one */
-		r = w == BOX_EXACT ? seed_solve(t, f, c, 0.0, 0.0, ps, p, &rc, sb) : 1;
+		r = w == BOX_EXACT ? seed_solve(t, f, c, 0.0, 0.0, ps, p, rcp, sb) : 1;
 		if (r == 1)
-			r = sub_solve(t, f, c, top, sb, depth + 1, ps, p);
+			r = sub_solve(t, f, c, top, sb, depth + 1, ps, p, top_id,
+				      depth == 1 ? k : k1);
 		if (r < 0)
 			return r;
 	}
@@ -1086,7 +1116,7 @@ static int seeds_run(struct px_strack *t, const struct scell *c, px_vec3 ps,
 			rc = seed_solve(t, f, c, 0.0, 0.0, ps, p, xc, b);
 		/* open, or its contraction undecided: cut into sub-boxes */
 		if (rc == 1)
-			rc = sub_solve(t, f, c, xc, b, 1, ps, p);
+			rc = sub_solve(t, f, c, xc, b, 1, ps, p, 5 * ri + q + 1, -1);
 		if (rc < 0)
 			return rc;
 	}
@@ -4477,6 +4507,7 @@ void px_strack_free(struct px_strack *t)
 	free(t->rcell);
 	free(t->qcert);
 	free(t->pcache);
+	free(t->scache);
 	free(t->edge);
 	free(t->pole);
 	free(t->heap);
@@ -5006,6 +5037,23 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 			}
 			t->pcache_n = n;
 		}
+	}
+	{
+		/* the cut cache: 128 slots (about 5.4 KiB each), fewer for
+		 * small models */
+		int n = 1;
+		while (n < 4 * t->n_cells && n < 128)
+			n *= 2;
+		t->scache = malloc((size_t)n * sizeof(*t->scache));
+		if (!t->scache) {
+			rc = PX_E_NOMEM;
+			goto fail;
+		}
+		for (i = 0; i < n; i++) {
+			t->scache[i].key = -1;
+			t->scache[i].filled = 0;
+		}
+		t->scache_n = n;
 	}
 	t->epoch = 1;
 	t->hot_s = -1;
