@@ -344,9 +344,12 @@ eval_one(const double *c, int p, int q, double s, double t, double h[6])
 {
 	double V0 = 0, V1 = 0, V2 = 0, W0 = 0, W1 = 0, X0 = 0;
 	int i, j;
+	/* (unrolled where the degrees are constants: the bicubic call) */
+#pragma GCC unroll 4
 	for (j = q; j >= 0; j--) {
 		const double *row = c + j * (p + 1);
 		double a = row[p], a1 = 0.0, a2 = 0.0;
+#pragma GCC unroll 4
 		for (i = p - 1; i >= 0; i--) {
 			a2 = a2 * s + 2.0 * a1;
 			a1 = a1 * s + a;
@@ -382,9 +385,11 @@ eval_pair(const double *c0, const double *c1, int p, int q, double s,
 	const st_v2 S = {s, s}, T = {t, t}, two = {2.0, 2.0};
 	st_v2 V0 = {0.0, 0.0}, V1 = V0, V2 = V0, W0 = V0, W1 = V0, X0 = V0;
 	int i, j;
+#pragma GCC unroll 4
 	for (j = q; j >= 0; j--) {
 		const double *r0 = c0 + j * (p + 1), *r1 = c1 + j * (p + 1);
 		st_v2 a = {r0[p], r1[p]}, a1 = {0.0, 0.0}, a2 = {0.0, 0.0};
+#pragma GCC unroll 4
 		for (i = p - 1; i >= 0; i--) {
 			const st_v2 ci = {r0[i], r1[i]};
 			a2 = a2 * S + two * a1;
