@@ -335,7 +335,6 @@ static int bsearch_bounds(const double *b, int n, double x)
 	return lo;
 }
 
-/* Point and derivatives up to order 2 from the patch holding (u, v). */
 /* H, H_s, H_t, H_ss, H_st, H_tt of one coordinate of a patch (power
  * basis, rows along t) at (s, t): Horner in t over the rows a_j(s) and
  * their s-derivatives (V = H, H_t, H_tt; W = H_s, H_st; X = H_ss). */
@@ -414,6 +413,7 @@ eval_pair(const double *c0, const double *c1, int p, int q, double s,
 #define ST_VEC 0
 #endif
 
+/* Point and derivatives up to order 2 from the patch holding (u, v). */
 static void surf_eval2(const struct ssurf *f, double u, double v,
 		       struct px_nurbs_surf_derivs *d)
 {
@@ -1066,6 +1066,7 @@ static int sub_solve(struct px_strack *t, struct ssurf *f, const struct scell *c
 		int w;
 		box_quarter(b, k, sb);
 		if (t->scache_n > 0 && top_id >= 0 && depth <= 2) {
+			/* (two levels a slot: ST_SUB_DEPTH's) */
 			/* made before (the point does not enter a certificate) */
 			const int key = 4 * top_id + (depth == 1 ? k : k1),
 				  slot = depth == 1 ? 0 : 1 + k;
@@ -5023,7 +5024,7 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	}
 	{
 		/* the piece cache where a region is rational: a slot for each
-		 * quarter of up to 64 such regions (about 3 KiB a slot),
+		 * quarter of up to 64 such regions (about 4.4 KiB a slot),
 		 * fewer when the model has fewer */
 		int nrat = 0, n = 1;
 		for (i = 0; i < 4 * t->n_cells; i++)
