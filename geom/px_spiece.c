@@ -1622,18 +1622,10 @@ int px__spiece_precond_probe(const struct px_spiece *sp, px_vec3 p, double s0,
 			      0.5 * (b_lo + c_lo), 0.5 * (b_hi + c_hi),
 			      point_rounding(sp, p, ngu, ngv), mu);
 	/* the derivative tensors of the whole patch, rows along s */
-	for (j = 0; j < un; j++)
-		for (k = 0; k <= um; k++)
-			gs[j * (um + 1) + k] = un * (GU[(j + 1) * (um + 1) + k] - GU[j * (um + 1) + k]);
-	for (j = 0; j <= un; j++)
-		for (k = 0; k < um; k++)
-			gt[j * um + k] = um * (GU[j * (um + 1) + k + 1] - GU[j * (um + 1) + k]);
-	for (j = 0; j < vn; j++)
-		for (k = 0; k <= vm; k++)
-			vs[j * (vm + 1) + k] = vn * (GV[(j + 1) * (vm + 1) + k] - GV[j * (vm + 1) + k]);
-	for (j = 0; j <= vn; j++)
-		for (k = 0; k < vm; k++)
-			vt[j * vm + k] = vm * (GV[j * (vm + 1) + k + 1] - GV[j * (vm + 1) + k]);
+	t_deriv_s(GU, un, um, gs);
+	t_deriv_t(GU, un, um, gt);
+	t_deriv_s(GV, vn, vm, vs);
+	t_deriv_t(GV, vn, vm, vt);
 	for (j = 0; j < grid; j++)
 		for (k = 0; k < grid; k++) {
 			double s = s0 + ws * j / (grid - 1), t = t0 + wt * k / (grid - 1);
