@@ -168,6 +168,7 @@ extern int px__strack_rat_fault;
 /* px_strack: 1 leaves the pieces out of a region's radius (a rational
  * quarter without a radius of its own then has none). */
 extern int px__strack_piece_fault;
+extern int px__strack_ct_fault;
 /* Test hook: rational spans keep cells_per_span (no finer cells where
  * the weights are far apart), read by px_strack_create(). */
 extern int px__strack_coarse;

@@ -214,6 +214,10 @@ struct px_strack {
 	px_aabb *cbox;
 	int n_cbox, ct_ncrit;
 	px_vec3 ct_p;           /* where ct was last updated */
+	/* the curves proven not closest within ct_rc of ct_q (straight
+	 * distance; ct_rc2 its square, -1 none): ct_note() */
+	px_vec3 ct_q;
+	double ct_rc, ct_rc2;
 	int n_curves, n_surf, n_edges, n_cells, n_poles, n_unbounded;
 	int n_patches;
 	struct ssurf *sf;
@@ -1576,6 +1580,10 @@ static void cert_sides(const struct ssurf *f, const struct scell *c, struct rcer
 		       const int side_open[4]);
 static void box_quarter(const double b[4], int k, double q[4]);
 
+/* Test hook (internal.h): 1 makes the curve tracker's certificate
+ * (ct_note()) unbounded (unsound: a curve that comes nearer is missed). */
+int px__strack_ct_fault = 0;
+
 /* Test hook (internal.h): 1 leaves the pieces out of the radii
  * (region_radius_full(), cell_radius()). */
 int px__strack_piece_fault = 0;
@@ -2214,6 +2222,26 @@ static void curves_update(struct px_strack *t, px_vec3 p,
 }
 
 /*
+ * The curve tracker's exact answer as a certificate for leaving it out:
+ * with dc its distance at q and best that of some surface point (a
+ * tracked minimum or a pole), at any x the curves are at least
+ * dc - |x - q| away and the closest point at most best + |x - q|, so no
+ * curve is closest while |x - q| < (dc - best) / 2. Where the boxes of
+ * the curves' half spans reach nearer than best (a point beside an edge,
+ * or far from the surface, its distance ball over the edges' boxes) they
+ * prove nothing, and the curve tracker ran every update.
+ */
+static void ct_note(struct px_strack *t, px_vec3 q, double dc, double best)
+{
+	double m = dc - best - 1e-9 * (best + t->scale);
+	t->ct_q = q;
+	t->ct_rc = m > 0.0 ? 0.5 * m * (1.0 - 1e-9) : -1.0;
+	t->ct_rc2 = m > 0.0 ? t->ct_rc * t->ct_rc : -1.0;
+	if (px__strack_ct_fault)
+		t->ct_rc = t->ct_rc2 = INFINITY;
+}
+
+/*
  * 1 when the curve tracker must answer this update: a curve or edge can
  * be closest (some box of the curves is not farther than the best
  * interior minimum or pole), or it was left out over more than 2 % of
@@ -2227,6 +2255,8 @@ static int curves_needed(const struct px_strack *t, px_vec3 p)
 		return 0;
 	if (px_v3_dist2(p, t->ct_p) > lim * lim)
 		return 1;
+	if (px_v3_dist2(p, t->ct_q) < t->ct_rc2)
+		return 0;
 	for (i = 0; i < t->n_surf; i++)
 		for (j = 0; j < t->sf[i].nz; j++) {
 			const struct crit *z = &t->sf[i].z[j];
@@ -2960,7 +2990,8 @@ static int catch_up(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 static void hot_arm(struct px_strack *t, px_vec3 p,
 		    const struct px_strack_result *r)
 {
-	double best = r->dist, tol = 1e-9 * (best + t->scale), until, m, lim;
+	double best = r->dist, tol = 1e-9 * (best + t->scale), until, m, lim,
+	       cc = INFINITY;
 	int i, j;
 	int curve = r->feature == PX_STRACK_CURVE || r->feature == PX_STRACK_EDGE;
 	t->hot_s = -1;
@@ -2992,9 +3023,10 @@ static void hot_arm(struct px_strack *t, px_vec3 p,
 	}
 	/* when the curve tracker answers it runs every update (the least
 	 * distance to the curves is 1-Lipschitz too); else the curves are
-	 * left out while their boxes are proven farther (and for 2 % of the
-	 * size at most, as curves_needed()), or updated along with the
-	 * minimum every update */
+	 * left out while the curve tracker's last answer proves them
+	 * farther (ct_note(): cc, already halved) or their boxes do (and
+	 * for 2 % of the size at most, as curves_needed()), or updated
+	 * along with the minimum every update */
 	t->hot_curves = 0;
 	lim = INFINITY;
 	if (!curve && t->ct) {
@@ -3008,6 +3040,18 @@ static void hot_arm(struct px_strack *t, px_vec3 p,
 			else if (m < uc)
 				uc = m;
 		}
+		if (t->hot_curves && lim > 0.0 && t->ct_rc > 0.0) {
+			/* the boxes prove nothing: the curve tracker's
+			 * answer may, when it does not cut the certificate
+			 * short (else the curves run with the minimum, and
+			 * hot_update() notes their answers) */
+			cc = t->ct_rc - px_v3_dist(p, t->ct_q);
+			if (cc >= 0.5 * fmin(until, 2.0 * lim)) {
+				t->hot_curves = 0;
+				uc = until;
+			} else
+				cc = INFINITY;
+		}
 		if (t->hot_curves)
 			lim = INFINITY;
 		else
@@ -3016,6 +3060,8 @@ static void hot_arm(struct px_strack *t, px_vec3 p,
 	until *= 0.5;
 	if (lim < until)
 		until = lim;
+	if (cc < until)
+		until = cc;
 	t->hot_s = curve ? t->n_surf : t->ans_s;
 	t->hot_j = curve ? -1 : t->ans_j;
 	t->hot_p = p;
@@ -3048,18 +3094,28 @@ static int hot_update(struct px_strack *t, px_vec3 p,
 			return 1;
 	}
 	r->n_crit = t->hot_ncrit;
-	if (!use_min || t->hot_curves) {
+	if (!use_min ||
+	    (t->hot_curves &&
+	     !(px_v3_dist2(p, t->ct_q) < t->ct_rc2 &&
+	       px_v3_dist2(p, t->ct_p) < 4e-4 * t->scale * t->scale))) {
 		/* the curve tracker answers, or could (its own update,
-		 * exact); the margin of the other minima and the poles holds
-		 * against either answer, and the nearer answers */
+		 * exact; left out while its last answer proves the curves
+		 * farther, ct_note(), for 2 % of the size at most); the
+		 * margin of the other minima and the poles holds against
+		 * either answer, and the nearer answers */
 		curves_update(t, p, &cr, 0);
 		if (!use_min && cr.entity < 0)
 			return 1; /* not expected: the full update decides */
-		r->n_crit = t->hot_ncrit - t->hot_ccrit + cr.n_crit;
 		if (cr.entity >= 0 &&
 		    (!use_min || cr.dist * cr.dist < px_v3_dist2(w.s, p)))
 			kind = 2;
+		if (use_min && kind == 1 && cr.entity >= 0)
+			ct_note(t, p, cr.dist, px_v3_dist(w.s, p));
+	} else if (t->hot_curves) {
+		t->st.curve_cert_skips++;
 	}
+	if (!use_min || t->hot_curves)
+		r->n_crit = t->hot_ncrit - t->hot_ccrit + t->ct_ncrit;
 	if (use_min)
 		f->z[t->hot_j] = w;
 	t->p = p;
@@ -3094,7 +3150,7 @@ static int strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result
 {
 	struct px_track_result cr;
 	px_vec3 p0;
-	int rc, nh;
+	int rc, nh, ran;
 
 	result_clear(r);
 	t->st.updates++;
@@ -3158,15 +3214,19 @@ static int strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result
 		answer_global(t, p, r);
 		return PX_OK;
 	}
-	if (curves_needed(t, p)) {
+	ran = curves_needed(t, p);
+	if (ran) {
 		curves_update(t, p, &cr, 0);
 	} else {
 		memset(&cr, 0, sizeof(cr));
 		cr.entity = -1;
 		cr.n_crit = t->ct_ncrit;
 		t->st.curve_skips++;
+		t->st.curve_cert_skips += px_v3_dist2(p, t->ct_q) < t->ct_rc2;
 	}
 	answer(t, p, &cr, r);
+	if (ran && cr.entity >= 0 && isfinite(r->dist))
+		ct_note(t, p, cr.dist, r->dist);
 	if (cr.source != PX_TRACK_TRACKED)
 		r->source = cr.source;
 	verify(t, p, r);

@@ -303,6 +303,11 @@ struct px_strack_stats {
 	/* updates that left the curve tracker out: every curve and edge
 	 * was proven farther than the best interior minimum */
 	uint64_t curve_skips;
+	/* updates (tracked or on the hot path) that left it out on its own
+	 * last answer instead: the curves' distance there, less the way
+	 * since, still beyond the best minimum's (where the boxes reach
+	 * nearer: beside an edge, or far from the surface) */
+	uint64_t curve_cert_skips;
 	/* steps after which the index sum of a surface's critical points
 	 * differed from the winding number of the gradient along its
 	 * boundary (a point missed): answered globally, the set

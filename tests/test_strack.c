@@ -762,6 +762,46 @@ static void test_hot_fault(void)
 	PX_CHECK_INT_EQ((long)tot.hot, 0);
 }
 
+static void ct_fault_set(struct px_strack *t, int fault)
+{
+	(void)t;
+	px__strack_ct_fault = fault;
+}
+
+/* over an edge of the wavy patch and back, the edge and an interior
+ * minimum taking turns as the closest: 1.4e-4 of the size a step */
+static px_vec3 edge_path(int k, int n)
+{
+	double a = 2.0 * M_PI * k / n;
+	return px_v3(1.0 + 0.25 * sin(3.0 * a), 0.2 + 0.3 * cos(a), 0.45);
+}
+
+/* The curve tracker is left out on its own last answer (its distance
+ * less the way since beyond the best minimum's) where the boxes of the
+ * edges reach nearer: every answer is still the global one, and with
+ * that certificate never running out the edge is missed. */
+static void test_curve_cert(void)
+{
+	struct px_nurbs_surf s;
+	struct px_strack_stats st;
+	long w;
+	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
+	PX_CHECK_INT_EQ(surf_wavy(&s, 0, 0, 0, 0), PX_OK);
+	w = fault_run(&s, ct_fault_set, 0, edge_path, 6000, &st);
+	printf("  over an edge and back: wrong %ld, hot %llu of 6000, curve tracker "
+	       "left out %llu (%llu on its own answer)\n",
+	       w, (unsigned long long)st.hot, (unsigned long long)st.curve_skips,
+	       (unsigned long long)st.curve_cert_skips);
+	PX_CHECK_INT_EQ(w, 0);
+	PX_CHECK_MSG(st.curve_cert_skips > 600,
+		     "curve tracker rarely left out on its answer: %llu",
+		     (unsigned long long)st.curve_cert_skips);
+	w = fault_run(&s, ct_fault_set, 1, edge_path, 6000, &st);
+	px__strack_ct_fault = 0;
+	printf("  the same, that certificate never running out: wrong %ld\n", w);
+	PX_CHECK_MSG(w > 0, "a curve certificate that never runs out went unnoticed");
+}
+
 /* rational bicubic: a wavy patch with uneven weights */
 static int surf_rational(struct px_nurbs_surf *s)
 {
@@ -2430,6 +2470,7 @@ static const struct px_test tests[] = {
 	PX_T(test_collapsed),
 	PX_T(test_multi),
 	PX_T(test_hot_fault),
+	PX_T(test_curve_cert),
 	PX_T(test_budget),
 	PX_T(test_tests_budget),
 	PX_T(test_focal_hover),
