@@ -97,8 +97,13 @@
  *    corners as their end points; collapsed edges are point candidates.
  *    Free curves of the model go into the same curve tracker. It is left
  *    out of an update while boxes of its curves' half spans prove them
- *    all farther than the best interior minimum (and it is updated at
- *    least every 2 % of the model size of travel).
+ *    all farther than the best interior minimum, or, where those boxes
+ *    reach nearer (beside an edge, or far from the surface), while its
+ *    own last answer does: the curves are at least dc - |x - q| from x
+ *    when dc was their distance at q, the closest point at most
+ *    best + |x - q|, so none is closest within (dc - best) / 2 of q
+ *    (stats.curve_cert_skips); it is updated at least every 2 % of the
+ *    model size of travel.
  *  - Answer: the smallest of the surface minima and the curve tracker's
  *    answer; jumped when the closest feature is not the continuation of
  *    the last one.
