@@ -1998,6 +1998,20 @@ static int col_end(struct px_strack *t)
 static int collect_cells(struct px_strack *t, px_vec3 p0, px_vec3 p1)
 {
 	int lim = tests_budget(t);
+	if (t->heap_ok && t->n_cells > 0) {
+		/* none due (most updates): what col_begin() and col_end()
+		 * would leave, without their passes */
+		double tr = t->travel + px_v3_dist(p0, p1);
+		if (t->cell[t->heap[0]].expiry > tr) {
+			t->travel = tr;
+			t->heap_n = t->n_cells;
+			t->col_np = t->col_k = t->col_nh = 0;
+			t->col_p0 = p0;
+			t->col_p1 = p1;
+			t->col_on = 0;
+			return 0;
+		}
+	}
 	col_begin(t, p0, p1);
 	if (lim > 0 && t->col_np > lim) {
 		col_test(t, lim);
