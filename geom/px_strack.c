@@ -262,7 +262,11 @@ struct px_strack {
 	double *pend_need;
 	unsigned char *pend_kind;
 	uint32_t pend_epoch;
-	double travel;
+	/* path length (the 1-Lipschitz certificates of the hot path); ctravel
+	 * the same path in the max norm (the cells' certificates are cubes:
+	 * a point whose max-norm path from p is below r stays in the cube of
+	 * half width r about p, and that path is often half the length) */
+	double travel, ctravel;
 	int heap_ok;
 	/* seeds of a cell solve with no region or quarter proven
 	 * (cell_seeds()), the work of ST_UNITS */
@@ -1887,7 +1891,7 @@ static void heap_rebuild(struct px_strack *t, px_vec3 p)
 {
 	int i;
 	for (i = 0; i < t->n_cells; i++) {
-		t->cell[i].expiry = t->travel + cell_radius(t, &t->cell[i], p) *
+		t->cell[i].expiry = t->ctravel + cell_radius(t, &t->cell[i], p) *
 							(1.0 - 1e-9);
 		heap_set(t, i, i);
 	}
@@ -1914,6 +1918,12 @@ static int tests_budget(const struct px_strack *t)
 	return t->opts.max_solves > 0 ? t->opts.max_tests : 0;
 }
 
+static inline double max_norm(px_vec3 d)
+{
+	double x = fabs(d.x), y = fabs(d.y), z = fabs(d.z);
+	return x > y ? (x > z ? x : z) : (y > z ? y : z);
+}
+
 /* Start collecting the cells whose certificates the segment p0 -> p1
  * may break: the travel grows by the segment and the cells it makes due
  * are taken out of the heap (popped), to be tested by col_test(). */
@@ -1923,7 +1933,8 @@ static void col_begin(struct px_strack *t, px_vec3 p0, px_vec3 p1)
 	if (!t->heap_ok)
 		heap_rebuild(t, p0);
 	t->travel += px_v3_dist(p0, p1);
-	while (n > 0 && t->cell[t->heap[0]].expiry <= t->travel) {
+	t->ctravel += max_norm(px_v3_sub(p1, p0));
+	while (n > 0 && t->cell[t->heap[0]].expiry <= t->ctravel) {
 		t->popped[np++] = t->heap[0];
 		n--;
 		if (n > 0) {
@@ -1967,7 +1978,7 @@ static int col_test(struct px_strack *t, int limit)
 			c->cross = 0.5 * (s0 + s1);
 			t->hits[t->col_nh++] = ci;
 		}
-		c->expiry = t->travel + r1;
+		c->expiry = t->ctravel + r1;
 	}
 	return t->col_k >= t->col_np;
 }
@@ -2001,9 +2012,10 @@ static int collect_cells(struct px_strack *t, px_vec3 p0, px_vec3 p1)
 	if (t->heap_ok && t->n_cells > 0) {
 		/* none due (most updates): what col_begin() and col_end()
 		 * would leave, without their passes */
-		double tr = t->travel + px_v3_dist(p0, p1);
-		if (t->cell[t->heap[0]].expiry > tr) {
-			t->travel = tr;
+		double ct = t->ctravel + max_norm(px_v3_sub(p1, p0));
+		if (t->cell[t->heap[0]].expiry > ct) {
+			t->travel += px_v3_dist(p0, p1);
+			t->ctravel = ct;
 			t->heap_n = t->n_cells;
 			t->col_np = t->col_k = t->col_nh = 0;
 			t->col_p0 = p0;
@@ -2923,7 +2935,7 @@ static int catch_up(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 			}
 			t->rb_started = 1;
 			t->p = p;
-			t->travel = 0.0;
+			t->travel = t->ctravel = 0.0;
 		}
 		int units = 0;
 		while (t->rb_next < t->n_cells && rc >= 0) {
