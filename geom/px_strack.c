@@ -94,6 +94,11 @@ struct rcert {
 	px_vec3 sc, suc, svc;
 	double n1, n2;          /* |suc|_1, |svc|_1 */
 	double hu, hv;          /* half widths of the cell in u, v */
+	/* the inverses cert_radius() multiplies by instead of dividing
+	 * (centre_set()): of the E test's
+	 * denominators n1 + m11 hu + m12 hv and n2 + m12 hu + m22 hv, and
+	 * of m11 and m22 */
+	double ie1, ie2, im11, im22;
 	int nside;
 	struct cside side[4];
 	/* bounds over the cell of |S_uuu|, |S_uuv|, |S_uvv|, |S_vvv| per
@@ -1358,10 +1363,8 @@ static inline void side_num(const struct cside *sd, px_vec3 w, double epad,
 static inline double e_radius(const struct rcert *c, double M11, double M12,
 			      double M22, double e1, double e2, double epad)
 {
-	double r1 = (fabs(e1) - epad - M11 * c->hu - M12 * c->hv) /
-		    (c->n1 + c->m11 * c->hu + c->m12 * c->hv);
-	double r2 = (fabs(e2) - epad - M12 * c->hu - M22 * c->hv) /
-		    (c->n2 + c->m12 * c->hu + c->m22 * c->hv);
+	double r1 = (fabs(e1) - epad - M11 * c->hu - M12 * c->hv) * c->ie1;
+	double r2 = (fabs(e2) - epad - M12 * c->hu - M22 * c->hv) * c->ie2;
 	double r = r1 > r2 ? r1 : r2;
 	return r > 0.0 ? r : 0.0;
 }
@@ -1400,9 +1403,9 @@ static double cert_radius(const struct rcert *c, px_vec3 p)
 			y = -b22;
 			definite = 1;
 		} else if (a11 > 0.0 && b22 < 0.0) {
-			rD = ST_MIN(a11 / m11, -b22 / m22);
+			rD = ST_MIN(a11 * c->im11, -b22 * c->im22);
 		} else if (b11 < 0.0 && a22 > 0.0) {
-			rD = ST_MIN(-b11 / m11, a22 / m22);
+			rD = ST_MIN(-b11 * c->im11, a22 * c->im22);
 		}
 		if (definite) {
 			/* f(r) = (x - r m11)(y - r m22) - (M12 + r m12)^2 falls
@@ -1410,7 +1413,7 @@ static double cert_radius(const struct rcert *c, px_vec3 p)
 			double A = m11 * m22 - m12 * m12;
 			double B = -(x * m22 + y * m11) - 2.0 * M12 * m12;
 			double C = x * y - M12 * M12;
-			double cap = ST_MIN(x / m11, y / m22);
+			double cap = ST_MIN(x * c->im11, y * c->im22);
 			if (C > 0.0) {
 				double disc = B * B - 4.0 * A * C;
 				double root = disc < 0.0 ? INFINITY
@@ -4329,6 +4332,11 @@ static void centre_set(struct rcert *ce, const struct px_nurbs_surf_derivs *d)
 	ce->svc = d->sv;
 	ce->n1 = fabs(d->su.x) + fabs(d->su.y) + fabs(d->su.z);
 	ce->n2 = fabs(d->sv.x) + fabs(d->sv.y) + fabs(d->sv.z);
+	/* (hu, hv and the m_ij are set: cert_fill() comes first) */
+	ce->ie1 = 1.0 / (ce->n1 + ce->m11 * ce->hu + ce->m12 * ce->hv);
+	ce->ie2 = 1.0 / (ce->n2 + ce->m12 * ce->hu + ce->m22 * ce->hv);
+	ce->im11 = 1.0 / ce->m11;
+	ce->im22 = 1.0 / ce->m22;
 }
 
 /*
