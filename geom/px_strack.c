@@ -1921,6 +1921,7 @@ static int tests_budget(const struct px_strack *t)
 	return t->opts.max_solves > 0 ? t->opts.max_tests : 0;
 }
 
+/* (the points are finite: plain comparisons, not fmax's calls) */
 static inline double max_norm(px_vec3 d)
 {
 	double x = fabs(d.x), y = fabs(d.y), z = fabs(d.z);
@@ -1962,9 +1963,7 @@ static int col_test(struct px_strack *t, int limit)
 	px_vec3 mid = px_v3_scale(px_v3_add(p0, p1), 0.5);
 	/* the segment lies in the cube of half width dinf about p1 and in
 	 * the cube of half width dinf / 2 about its middle */
-	/* (the points are finite: plain comparisons, not fmax's calls) */
-	double dx = fabs(p1.x - p0.x), dy = fabs(p1.y - p0.y), dz = fabs(p1.z - p0.z);
-	double dinf = dx > dy ? (dx > dz ? dx : dz) : (dy > dz ? dy : dz);
+	double dinf = max_norm(px_v3_sub(p1, p0));
 	int end = t->col_np;
 	if (limit > 0 && t->col_k + limit < end)
 		end = t->col_k + limit;
@@ -2012,22 +2011,12 @@ static int col_end(struct px_strack *t)
 static int collect_cells(struct px_strack *t, px_vec3 p0, px_vec3 p1)
 {
 	int lim = tests_budget(t);
-	if (t->heap_ok && t->n_cells > 0) {
-		/* none due (most updates): what col_begin() and col_end()
-		 * would leave, without their passes */
-		double ct = t->ctravel + max_norm(px_v3_sub(p1, p0));
-		if (t->cell[t->heap[0]].expiry > ct) {
-			t->travel += px_v3_dist(p0, p1);
-			t->ctravel = ct;
-			t->heap_n = t->n_cells;
-			t->col_np = t->col_k = t->col_nh = 0;
-			t->col_p0 = p0;
-			t->col_p1 = p1;
-			t->col_on = 0;
-			return 0;
-		}
-	}
 	col_begin(t, p0, p1);
+	if (t->col_np == 0) {
+		/* none due (most updates): nothing to test or put back */
+		t->col_on = 0;
+		return 0;
+	}
 	if (lim > 0 && t->col_np > lim) {
 		col_test(t, lim);
 		return -1;
@@ -2270,22 +2259,39 @@ static void ct_note(struct px_strack *t, px_vec3 q, double dc, double best)
 		t->ct_rc = t->ct_rc2 = INFINITY;
 }
 
+/* The curve tracker's last update more than 2 % of the model size from
+ * p: it must run before its step grows longer than it is made for. */
+static inline int ct_stale(const struct px_strack *t, px_vec3 p)
+{
+	double lim = 0.02 * t->scale;
+	return px_v3_dist2(p, t->ct_p) > lim * lim;
+}
+
+/* Its last answer still proves every curve farther than the closest
+ * point at p (ct_note()). */
+static inline int ct_proves(const struct px_strack *t, px_vec3 p)
+{
+	return px_v3_dist2(p, t->ct_q) < t->ct_rc2;
+}
+
 /*
  * 1 when the curve tracker must answer this update: a curve or edge can
  * be closest (some box of the curves is not farther than the best
  * interior minimum or pole), or it was left out over more than 2 % of
- * the model size (its next step stays of the length it is made for).
+ * the model size (its next step stays of the length it is made for);
+ * else 2 when its own last answer proves the curves farther, 0 when the
+ * boxes do (or there are no curves).
  */
 static int curves_needed(const struct px_strack *t, px_vec3 p)
 {
-	double best = INFINITY, lim = 0.02 * t->scale;
+	double best = INFINITY;
 	int i, j;
 	if (!t->ct)
 		return 0;
-	if (px_v3_dist2(p, t->ct_p) > lim * lim)
+	if (ct_stale(t, p))
 		return 1;
-	if (px_v3_dist2(p, t->ct_q) < t->ct_rc2)
-		return 0;
+	if (ct_proves(t, p))
+		return 2;
 	for (i = 0; i < t->n_surf; i++)
 		for (j = 0; j < t->sf[i].nz; j++) {
 			const struct crit *z = &t->sf[i].z[j];
@@ -2480,7 +2486,7 @@ static double cross_at(const struct px_strack *t, const struct scell *c,
 		       px_vec3 p0, px_vec3 p1, int *rounds)
 {
 	px_vec3 dp = px_v3_sub(p1, p0);
-	double dinf = fmax(fmax(fabs(dp.x), fabs(dp.y)), fabs(dp.z));
+	double dinf = max_norm(dp);
 	double a = 0.0, b = 1.0;
 	int k;
 	*rounds = 0;
@@ -2720,8 +2726,7 @@ static int ring_check(struct px_strack *t, int i, int lim, int *units,
 	struct ssurf *f = &t->sf[si];
 	px_vec3 p0 = t->pend_ps[i], dp = px_v3_sub(t->p, p0),
 		xm = px_v3_scale(px_v3_add(p0, t->p), 0.5);
-	double r = 0.5 * fmax(fmax(fabs(dp.x), fabs(dp.y)), fabs(dp.z)),
-	       len = px_v3_norm(dp), need = t->pend_need[i];
+	double r = 0.5 * max_norm(dp), len = px_v3_norm(dp), need = t->pend_need[i];
 	while (f->rl_next < f->rl_n) {
 		int n, ci;
 		if (lim > 0 && *units > 0 && *units + ST_RING_CELL_UNITS > lim)
@@ -3123,10 +3128,7 @@ static int hot_update(struct px_strack *t, px_vec3 p,
 			return 1;
 	}
 	r->n_crit = t->hot_ncrit;
-	if (!use_min ||
-	    (t->hot_curves &&
-	     !(px_v3_dist2(p, t->ct_q) < t->ct_rc2 &&
-	       px_v3_dist2(p, t->ct_p) < 4e-4 * t->scale * t->scale))) {
+	if (!use_min || (t->hot_curves && (ct_stale(t, p) || !ct_proves(t, p)))) {
 		/* the curve tracker answers, or could (its own update,
 		 * exact; left out while its last answer proves the curves
 		 * farther, ct_note(), for 2 % of the size at most); the
@@ -3244,17 +3246,17 @@ static int strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result
 		return PX_OK;
 	}
 	ran = curves_needed(t, p);
-	if (ran) {
+	if (ran == 1) {
 		curves_update(t, p, &cr, 0);
 	} else {
 		memset(&cr, 0, sizeof(cr));
 		cr.entity = -1;
 		cr.n_crit = t->ct_ncrit;
 		t->st.curve_skips++;
-		t->st.curve_cert_skips += px_v3_dist2(p, t->ct_q) < t->ct_rc2;
+		t->st.curve_cert_skips += ran == 2;
 	}
 	answer(t, p, &cr, r);
-	if (ran && cr.entity >= 0 && isfinite(r->dist))
+	if (ran == 1 && cr.entity >= 0 && isfinite(r->dist))
 		ct_note(t, p, cr.dist, r->dist);
 	if (cr.source != PX_TRACK_TRACKED)
 		r->source = cr.source;
