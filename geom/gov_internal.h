@@ -172,4 +172,8 @@ double px__gov_calibrate(struct px_dist_model *m, px_aabb box);
 /* Tests: another clock (NULL: CLOCK_MONOTONIC). */
 void px__gov_set_clock(struct px_gov *g, px_gov_clock_fn fn, void *ctx);
 
+/* The state of src into dst, dst's clock kept (benches: a path replayed
+ * from the same state). */
+void px__gov_copy(struct px_gov *dst, const struct px_gov *src);
+
 #endif

@@ -49,6 +49,15 @@ void px__gov_set_clock(struct px_gov *g, px_gov_clock_fn fn, void *ctx)
 	g->clock_ctx = ctx;
 }
 
+void px__gov_copy(struct px_gov *dst, const struct px_gov *src)
+{
+	px_gov_clock_fn fn = dst->clock;
+	void *ctx = dst->clock_ctx;
+	*dst = *src;
+	dst->clock = fn;
+	dst->clock_ctx = ctx;
+}
+
 int64_t px__gov_now(const struct px_gov *g)
 {
 	return g->clock(g->clock_ctx);

@@ -3445,21 +3445,27 @@ static void cold_enter(struct px_strack *t, px_vec3 p,
 
 /* Back from cold answers at p: the curve tracker starts afresh at p and
  * the surface set is re-established in slices (max_solves > 0, answered
- * globally meanwhile) or at once. */
+ * globally meanwhile) or at once. The curve tracker's restart has an
+ * update of its own: with the first slice and the global query, after a
+ * thousand cold updates had pushed the tracker's memory out of the
+ * caches, it was the worst update of the return. */
 static int cold_return(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 {
 	struct px_track_result cr;
 	int slice = t->opts.max_solves > 1 ? t->opts.max_solves / 2 : 1;
 	t->st.cold_left++;
+	result_clear(r);
+	t->st.updates++;
 	if (t->opts.max_solves > 0) {
 		curves_update(t, p, &cr, 1);
 		rebuild_start(t);
-		/* the rebuild's slices, then a margin for catching up */
-		t->ret_left = t->n_cells / slice + 2 * PX_GOV_MIN_COLD;
-		return strack_update(t, p, r);
+		/* this update, the rebuild's slices, then a margin for
+		 * catching up */
+		t->ret_left = 1 + t->n_cells / slice + 2 * PX_GOV_MIN_COLD;
+		t->st.rebuild_updates++;
+		answer_global(t, p, r);
+		return PX_OK;
 	}
-	result_clear(r);
-	t->st.updates++;
 	t->p = p;
 	t->mode = ST_TRACK;
 	t->hot_s = -1;
@@ -3509,6 +3515,16 @@ void px__strack_set_clock(struct px_strack *t, int64_t (*fn)(void *), void *ctx)
 {
 	if (t)
 		px__gov_set_clock(&t->gov, fn, ctx);
+}
+
+void px__strack_gov_copy(struct px_strack *t, struct px_gov *g, int load)
+{
+	if (!t || !g)
+		return;
+	if (load)
+		px__gov_copy(&t->gov, g);
+	else
+		*g = t->gov;
 }
 
 void px__strack_set_hot_fault(struct px_strack *t, int fault)

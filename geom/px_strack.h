@@ -220,7 +220,10 @@ struct px_strack_opts {
 	 * until the mean step has halved (or as a probe after a while);
 	 * then the critical points are re-established in budgeted slices
 	 * as after an over-budget update (max_solves > 0; at once with 0),
-	 * the curve tracker started afresh at the point. Both answers are
+	 * the curve tracker started afresh at the point (with max_solves >
+	 * 0 in an update of its own, answered globally, before the first
+	 * slice: after many cold updates its memory is out of the caches,
+	 * and the two together made the return's worst update). Both answers are
 	 * exact; this bounds the cost of fast motion by the global
 	 * query's. 0: always track. */
 	int cold_switch;

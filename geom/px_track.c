@@ -2353,6 +2353,16 @@ void px__track_set_clock(struct px_track *t, int64_t (*fn)(void *), void *ctx)
 		px__gov_set_clock(&t->gov, fn, ctx);
 }
 
+void px__track_gov_copy(struct px_track *t, struct px_gov *g, int load)
+{
+	if (!t || !g)
+		return;
+	if (load)
+		px__gov_copy(&t->gov, g);
+	else
+		*g = t->gov;
+}
+
 double px__track_leaf_cert(const struct px_track *t, int leaf, px_vec3 p,
 			   int which, int *ent, double *u0, double *u1,
 			   unsigned *flags)

@@ -2397,6 +2397,7 @@ static void test_return_rebuild(void)
 	double size;
 	long slice, wrong = 0;
 	int k, cold = 0, glob = 0, back = -1, n, n0;
+	int ret_solved = -1, ret_src = -1, next_solved = -1;
 
 	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
 	PX_CHECK_INT_EQ(surf_wavy(&s, 0, 0, 0, 0), PX_OK);
@@ -2439,8 +2440,13 @@ static void test_return_rebuild(void)
 			wrong++;
 		if (r.source == PX_TRACK_COLD)
 			continue;
-		if (back < 0)
+		if (back < 0) {
 			back = k;
+			ret_solved = r.cells_solved;
+			ret_src = r.source;
+		} else if (k == back + 1) {
+			next_solved = r.cells_solved;
+		}
 		if (r.source != PX_TRACK_GLOBAL)
 			break;
 		glob++;
@@ -2458,6 +2464,12 @@ static void test_return_rebuild(void)
 		     "the rebuild answered globally for %d updates (%d cells)",
 		     glob, ti.n_cells);
 	PX_CHECK_INT_EQ(n, n0);
+	/* the return restarts the curve tracker alone (answered globally);
+	 * the rebuild's first slice comes with the next update */
+	PX_CHECK_INT_EQ(ret_src, PX_TRACK_GLOBAL);
+	PX_CHECK_INT_EQ(ret_solved, 0);
+	PX_CHECK_MSG(next_solved > 0, "the update after the return solved %d cells",
+		     next_solved);
 out:
 	px_strack_free(t);
 	px_strack_free(t0);
