@@ -99,7 +99,7 @@ static int64_t cpu_ns(void)
  * switch at different updates and "each update's least time over the
  * runs" would compare different work. The first run records the
  * switch's clock readings and the runs after it replay them from the
- * same switch state (px__*_gov_copy): the same decisions at the same
+ * same switch state (px__gov_copy()): the same decisions at the same
  * updates. A replay that asks for more readings than were recorded
  * (or fewer) took another decision somewhere: counted in miss.
  */
@@ -135,22 +135,22 @@ static void rclock_record(void)
 	rclk.replay = 0;
 }
 
-/* The next replay; a run that did not use all of the readings before
- * it diverged too. */
-static void rclock_replay(void)
-{
-	if (rclk.replay && rclk.pos != rclk.n)
-		rclk.miss++;
-	rclk.pos = 0;
-	rclk.replay = 1;
-}
-
+/* The end of the runs: a replay that did not use all of the readings
+ * diverged too. Returns the divergences. */
 static long rclock_done(void)
 {
 	if (rclk.replay && rclk.pos != rclk.n)
 		rclk.miss++;
 	rclk.replay = 0;
 	return rclk.miss;
+}
+
+/* The next replay (the one before it ended as rclock_done() ends). */
+static void rclock_replay(void)
+{
+	rclock_done();
+	rclk.pos = 0;
+	rclk.replay = 1;
 }
 
 static int cmp_i64(const void *a, const void *b)
@@ -403,14 +403,14 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 			 * in that order, 440 against 491 in the other) */
 			/* the cold switch's decisions of the first run
 			 * replayed in the others (rclock) */
-			px__track_gov_copy(t, &gsave, 0);
+			gsave = *px__track_gov(t);
 			px__track_set_clock(t, rclock_read, &rclk);
 			rclock_record();
 			for (run_i = 0; run_i < NRUN; run_i++) {
 				int n0 = n;
 				rmax[run_i] = 0;
 				if (run_i > 0) {
-					px__track_gov_copy(t, &gsave, 1);
+					px__gov_copy(px__track_gov(t), &gsave);
 					rclock_replay();
 				}
 				px_track_reset(t, q[0], &r);
@@ -783,7 +783,7 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 			make_path(q, NSSTEP, kind, box, steps[s] * size);
 			/* the cold switch's decisions of this run replayed in
 			 * the two runs behind the work's worst (rclock) */
-			px__strack_gov_copy(t, &gsave, 0);
+			gsave = *px__strack_gov(t);
 			px__strack_set_clock(t, rclock_read, &rclk);
 			rclock_record();
 			px_strack_reset(t, q[0], &r);
@@ -839,7 +839,7 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 					tgw[k] = tg[k];
 				}
 				for (rr = 0; rr < 2; rr++) {
-					px__strack_gov_copy(t, &gsave, 1);
+					px__gov_copy(px__strack_gov(t), &gsave);
 					rclock_replay();
 					px_strack_reset(t, q[0], &r);
 					for (k = 0; k < NSSTEP; k++) {

@@ -97,10 +97,10 @@ void px__track_set_fault(struct px_track *t, int fault);
 /* Test hook: the cold switch's clock (NULL: CLOCK_MONOTONIC). */
 void px__track_set_clock(struct px_track *t, int64_t (*fn)(void *), void *ctx);
 struct px_gov;
-/* Bench hook: the cold switch's state copied out (load 0) or back in
- * (load 1; the clock in use is kept), so that a path run again from the
- * same state with the same clock readings takes the same decisions. */
-void px__track_gov_copy(struct px_track *t, struct px_gov *g, int load);
+/* Bench hook: the cold switch (gov_internal.h), whose state a bench
+ * copies out and back in (px__gov_copy()) so that a path run again from
+ * the same state with the same clock readings takes the same decisions. */
+struct px_gov *px__track_gov(struct px_track *t);
 
 /* Test hook: the certificate radius of leaf `leaf` at p (which 0: no
  * event in the leaf while the point travels less; 1: its end values of
@@ -217,8 +217,8 @@ void px__strack_set_hot_fault(struct px_strack *t, int fault);
 void px__strack_set_drop_fault(struct px_strack *t, int fault);
 /* Test hook: the cold switch's clock (NULL: CLOCK_MONOTONIC). */
 void px__strack_set_clock(struct px_strack *t, int64_t (*fn)(void *), void *ctx);
-/* Bench hook: as px__track_gov_copy(). */
-void px__strack_gov_copy(struct px_strack *t, struct px_gov *g, int load);
+/* Bench hook: as px__track_gov(). */
+struct px_gov *px__strack_gov(struct px_strack *t);
 
 /*
  * Sub-block extraction shared by curves (nd = 1) and surfaces (nd = 2):

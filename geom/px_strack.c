@@ -2872,6 +2872,12 @@ static int track_step(struct px_strack *t, px_vec3 p0, px_vec3 p,
 	return ix_check(t) ? 2 : 0;
 }
 
+/* Cells solved per update of a rebuild (max_solves > 0). */
+static int rebuild_slice(const struct px_strack *t)
+{
+	return t->opts.max_solves > 1 ? t->opts.max_solves / 2 : 1;
+}
+
 /* Re-establish the critical points from scratch over the next updates,
  * starting at the next point inside the working volume. */
 static void rebuild_start(struct px_strack *t)
@@ -2934,7 +2940,7 @@ static int catch_up(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 		return PX_OK;
 	}
 	if (t->mode == ST_REBUILD) {
-		int slice = t->opts.max_solves > 1 ? t->opts.max_solves / 2 : 1;
+		int slice = rebuild_slice(t);
 		if (!t->rb_started) {
 			if (!in_work(t, p)) {
 				t->st.outside++;
@@ -3452,7 +3458,7 @@ static void cold_enter(struct px_strack *t, px_vec3 p,
 static int cold_return(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 {
 	struct px_track_result cr;
-	int slice = t->opts.max_solves > 1 ? t->opts.max_solves / 2 : 1;
+	int slice = rebuild_slice(t);
 	t->st.cold_left++;
 	result_clear(r);
 	t->st.updates++;
@@ -3517,14 +3523,9 @@ void px__strack_set_clock(struct px_strack *t, int64_t (*fn)(void *), void *ctx)
 		px__gov_set_clock(&t->gov, fn, ctx);
 }
 
-void px__strack_gov_copy(struct px_strack *t, struct px_gov *g, int load)
+struct px_gov *px__strack_gov(struct px_strack *t)
 {
-	if (!t || !g)
-		return;
-	if (load)
-		px__gov_copy(&t->gov, g);
-	else
-		*g = t->gov;
+	return t ? &t->gov : NULL;
 }
 
 void px__strack_set_hot_fault(struct px_strack *t, int fault)

@@ -2353,14 +2353,9 @@ void px__track_set_clock(struct px_track *t, int64_t (*fn)(void *), void *ctx)
 		px__gov_set_clock(&t->gov, fn, ctx);
 }
 
-void px__track_gov_copy(struct px_track *t, struct px_gov *g, int load)
+struct px_gov *px__track_gov(struct px_track *t)
 {
-	if (!t || !g)
-		return;
-	if (load)
-		px__gov_copy(&t->gov, g);
-	else
-		*g = t->gov;
+	return t ? &t->gov : NULL;
 }
 
 double px__track_leaf_cert(const struct px_track *t, int leaf, px_vec3 p,
