@@ -208,6 +208,9 @@ extern int px__strack_wind_fault;
  * whatever the escape bound says (unsound: its test must see it); bit 1:
  * no solve past where a long step met a hit cell's region. */
 extern int px__strack_ring_fault;
+/* 1: a due cell keeps its certificate while the point is within twice
+ * the cube its last test proved (unsound: the tests must see it). */
+extern int px__strack_rekey_fault;
 /* Test hook: 1 turns the surface tracker's hot path off, 2 makes its
  * certificate never expire (a fault the tests must see). */
 void px__strack_set_hot_fault(struct px_strack *t, int fault);

@@ -135,7 +135,11 @@ struct scell {
 	int always;
 	struct rcert cert; /* region cells */
 	double expiry;
-	int hpos;
+	/* the cube the expiry is of: the certificate holds for every point
+	 * within max-norm distance crad of ctr (col_begin() checks a due
+	 * cell against it before a test) */
+	px_vec3 ctr;
+	double crad;
 	uint32_t mark;
 	double cross;   /* hit: segment parameter where the region is met */
 	int child;      /* solve cell: first of its 2 x 2 region cells */
@@ -210,6 +214,11 @@ struct pole {
 	int surf;
 };
 
+struct hent {
+	double key;
+	int ci;
+};
+
 struct px_strack {
 	struct px_strack_opts opts;
 	struct px_dist_model *dist;
@@ -250,7 +259,10 @@ struct px_strack {
 	int scache_n;
 	struct edge *edge;
 	struct pole *pole;
-	int *heap, *popped, *hits;
+	/* the expiry heap: each entry holds its cell's expiry (a compact
+	 * array: a sift reads no cell) */
+	struct hent *heap;
+	int *popped, *hits;
 	/* solves owed to the set at p (mode ST_PEND): cell pend[i] solved
 	 * at pend_ps[i] and followed to p; pend_next the next one. Where
 	 * pend_kind[i] is PK_CROSS, pend_ps[i] is where the step began and
@@ -1853,49 +1865,55 @@ static int ix_check(struct px_strack *t)
 
 static void heap_set(struct px_strack *t, int pos, int ci)
 {
-	t->heap[pos] = ci;
-	t->cell[ci].hpos = pos;
+	t->heap[pos].key = t->cell[ci].expiry;
+	t->heap[pos].ci = ci;
 }
 
 static void heap_down(struct px_strack *t, int pos, int n)
 {
-	int ci = t->heap[pos];
-	double x = t->cell[ci].expiry;
+	struct hent e = t->heap[pos];
 	for (;;) {
 		int c = 2 * pos + 1;
 		if (c >= n)
 			break;
-		if (c + 1 < n && t->cell[t->heap[c + 1]].expiry <
-				       t->cell[t->heap[c]].expiry)
+		if (c + 1 < n && t->heap[c + 1].key < t->heap[c].key)
 			c++;
-		if (!(t->cell[t->heap[c]].expiry < x))
+		if (!(t->heap[c].key < e.key))
 			break;
-		heap_set(t, pos, t->heap[c]);
+		t->heap[pos] = t->heap[c];
 		pos = c;
 	}
-	heap_set(t, pos, ci);
+	t->heap[pos] = e;
 }
 
 static void heap_up(struct px_strack *t, int pos)
 {
-	int ci = t->heap[pos];
-	double x = t->cell[ci].expiry;
+	struct hent e = t->heap[pos];
 	while (pos > 0) {
 		int par = (pos - 1) / 2;
-		if (!(x < t->cell[t->heap[par]].expiry))
+		if (!(e.key < t->heap[par].key))
 			break;
-		heap_set(t, pos, t->heap[par]);
+		t->heap[pos] = t->heap[par];
 		pos = par;
 	}
-	heap_set(t, pos, ci);
+	t->heap[pos] = e;
+}
+
+/* The cell's certificate was proven for the cube of half width r about
+ * p (max norm): due when the path from here could leave it. */
+static void cell_expire(struct px_strack *t, struct scell *c, px_vec3 p, double r)
+{
+	c->ctr = p;
+	c->crad = r;
+	c->expiry = t->ctravel + r;
 }
 
 static void heap_rebuild(struct px_strack *t, px_vec3 p)
 {
 	int i;
 	for (i = 0; i < t->n_cells; i++) {
-		t->cell[i].expiry = t->ctravel + cell_radius(t, &t->cell[i], p) *
-							(1.0 - 1e-9);
+		cell_expire(t, &t->cell[i], p,
+			    cell_radius(t, &t->cell[i], p) * (1.0 - 1e-9));
 		heap_set(t, i, i);
 	}
 	for (i = t->n_cells / 2 - 1; i >= 0; i--)
@@ -1928,9 +1946,22 @@ static inline double max_norm(px_vec3 d)
 	return x > y ? (x > z ? x : z) : (y > z ? y : z);
 }
 
+/* A due cell whose cube still holds the step's end with at least this
+ * share of its half width to spare is not tested again: the path wound
+ * about inside it (an expiry counts the path, not the way from the
+ * centre); a test there would prove a cube about as large. */
+#define ST_REKEY 0.25
+
 /* Start collecting the cells whose certificates the segment p0 -> p1
  * may break: the travel grows by the segment and the cells it makes due
- * are taken out of the heap (popped), to be tested by col_test(). */
+ * are taken out of the heap (popped), to be tested by col_test().
+ * A due cell whose cube still holds p1 well inside keeps it: p0 is in
+ * it too (every cell's expiry less the travel is at most its half width
+ * less the way of the point from its centre, by induction over the
+ * steps), so the cube holds the segment; its expiry becomes the travel
+ * plus what is left of the half width beyond p1, the same bound. */
+int px__strack_rekey_fault = 0;
+
 static void col_begin(struct px_strack *t, px_vec3 p0, px_vec3 p1)
 {
 	int n = t->n_cells, np = 0;
@@ -1938,11 +1969,21 @@ static void col_begin(struct px_strack *t, px_vec3 p0, px_vec3 p1)
 		heap_rebuild(t, p0);
 	t->travel += px_v3_dist(p0, p1);
 	t->ctravel += max_norm(px_v3_sub(p1, p0));
-	while (n > 0 && t->cell[t->heap[0]].expiry <= t->ctravel) {
-		t->popped[np++] = t->heap[0];
+	while (n > 0 && t->heap[0].key <= t->ctravel) {
+		struct scell *c = &t->cell[t->heap[0].ci];
+		double left = c->crad * (px__strack_rekey_fault ? 2.0 : 1.0) -
+			      max_norm(px_v3_sub(p1, c->ctr));
+		if (left > ST_REKEY * c->crad) {
+			/* (after it, expiry > ctravel: each cell once) */
+			c->expiry = t->heap[0].key = t->ctravel + left;
+			heap_down(t, 0, n);
+			t->st.rekeys++;
+			continue;
+		}
+		t->popped[np++] = t->heap[0].ci;
 		n--;
 		if (n > 0) {
-			heap_set(t, 0, t->heap[n]);
+			t->heap[0] = t->heap[n];
 			heap_down(t, 0, n);
 		}
 	}
@@ -1980,7 +2021,7 @@ static int col_test(struct px_strack *t, int limit)
 			c->cross = 0.5 * (s0 + s1);
 			t->hits[t->col_nh++] = ci;
 		}
-		c->expiry = t->ctravel + r1;
+		cell_expire(t, c, p1, r1);
 	}
 	return t->col_k >= t->col_np;
 }
@@ -2960,7 +3001,7 @@ static int catch_up(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 				rc = 0;
 				break;
 			}
-			c->expiry = cell_radius(t, c, t->p);
+			cell_expire(t, c, t->p, cell_radius(t, c, t->p));
 			heap_set(t, t->rb_next, t->rb_next);
 			t->rb_next++;
 		}
@@ -4921,7 +4962,7 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	t->cell = calloc((size_t)cell_cap + 1, sizeof(*t->cell));
 	t->rcell = calloc(4 * (size_t)cell_cap + 1, sizeof(*t->rcell));
 	t->qcert = calloc(16 * (size_t)cell_cap + 1, sizeof(*t->qcert));
-	t->heap = calloc((size_t)cell_cap + 1, sizeof(int));
+	t->heap = calloc((size_t)cell_cap + 1, sizeof(*t->heap));
 	t->popped = calloc((size_t)cell_cap + 1, sizeof(int));
 	t->hits = calloc((size_t)cell_cap + 1, sizeof(int));
 	/* pending items: each cell once, a crossing solve a hit, ST_RINGS

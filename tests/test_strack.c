@@ -373,6 +373,7 @@ struct totals {
 	long steps, wrong, naive_wrong, brute_bad, brute_checks, count_checks,
 		count_bad, count_amb, jumps, cells, born, died, global;
 	uint64_t over_budget, curve_skips, hot;
+	uint64_t rekeys, tests; /* due cells kept untested, cell tests */
 	uint64_t exact, exact_open; /* boxes solved by contraction, undecided */
 	uint64_t rounds_most; /* most cross rounds in one update */
 	long budget_bad;
@@ -526,6 +527,8 @@ static void run_model(const char *name, const struct px_nurbs_curve *cs,
 	       (unsigned long long)st.curve_skips,
 	       (unsigned long long)st.hot, (unsigned long long)st.unbalanced);
 	tot->hot += st.hot;
+	tot->rekeys += st.rekeys;
+	tot->tests += st.box_tests;
 	tot->exact += st.exact_solves;
 	tot->exact_open += st.exact_open;
 	tot->over_budget += st.over_budget;
@@ -585,6 +588,35 @@ static void test_wavy(void)
 	PX_CHECK_MSG(tot.exact_open > 0 && tot.exact_open == tot.exact,
 		     "the fallback went unused: %llu of %llu undecided",
 		     (unsigned long long)tot.exact_open, (unsigned long long)tot.exact);
+}
+
+/* A due cell is kept without a test while the point is still well
+ * inside the cube its last test proved (the random paths wind about):
+ * the answers and counts of run_model stay exact with it, and a cube
+ * taken twice as wide is seen. */
+static void test_rekey(void)
+{
+	struct px_nurbs_surf s[2];
+	struct totals tot, bad;
+	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
+	PX_CHECK_INT_EQ(surf_wavy(&s[0], 0, 0, 0, 0), PX_OK);
+	PX_CHECK_INT_EQ(surf_fold(&s[1], 0, 0, 0), PX_OK);
+	memset(&tot, 0, sizeof(tot));
+	run_model("wavy and fold", NULL, 0, s, 2, 0, &tot);
+	report(&tot);
+	printf("  due cells kept untested %llu, tested %llu\n",
+	       (unsigned long long)tot.rekeys, (unsigned long long)tot.tests);
+	PX_CHECK_MSG(tot.rekeys * 10 > tot.tests,
+		     "due cells rarely kept: %llu of %llu tests",
+		     (unsigned long long)tot.rekeys, (unsigned long long)tot.tests);
+	memset(&bad, 0, sizeof(bad));
+	px__strack_rekey_fault = 1;
+	run_model("wavy and fold, cubes twice as wide", NULL, 0, s, 2, 0, &bad);
+	px__strack_rekey_fault = 0;
+	printf("  cubes twice as wide: wrong %ld, counts short %ld of %ld\n",
+	       bad.wrong, bad.count_bad, bad.count_checks);
+	PX_CHECK_MSG(bad.wrong + bad.count_bad > 0,
+		     "certificates kept past their cubes went unnoticed");
 }
 
 static void test_fold_nonuniform(void)
@@ -2567,6 +2599,7 @@ out:
 
 static const struct px_test tests[] = {
 	PX_T(test_wavy),
+	PX_T(test_rekey),
 	PX_T(test_fold_nonuniform),
 	PX_T(test_collapsed),
 	PX_T(test_multi),
