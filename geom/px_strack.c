@@ -1677,11 +1677,13 @@ static double region_pieces(const struct px_strack *t, int ri, px_vec3 p)
 
 /*
  * Certified radius of region cell ri at p; where its own certificate
- * gives none, the least of its quarters' (each quarter free of
- * degenerate critical points, or of any, and the open sides kept: so is
- * their union, the interior sides between them being no way in or out).
+ * gives none, or less than need, the least of its quarters' (each
+ * quarter free of degenerate critical points, or of any, and the open
+ * sides kept: so is their union, the interior sides between them being
+ * no way in or out).
  */
-static double region_radius(const struct px_strack *t, int ri, px_vec3 p)
+static double region_radius_to(const struct px_strack *t, int ri, px_vec3 p,
+			       double need)
 {
 	double r = cert_radius(&t->rcell[ri].cert, p);
 	if (!(r > 0.0)) {
@@ -1690,8 +1692,24 @@ static double region_radius(const struct px_strack *t, int ri, px_vec3 p)
 		r = INFINITY;
 		for (k = 0; k < 4 && r > 0.0; k++)
 			r = fmin(r, cert_radius(&q[k], p));
+	} else if (r < need) {
+		/* short of what the caller needs: the quarters' enclosures
+		 * are about half as wide, and their least radius is as good
+		 * a proof for the region (the larger of the two stands) */
+		const struct rcert *q = &t->qcert[4 * ri];
+		double rq = INFINITY;
+		int k;
+		for (k = 0; k < 4 && rq > r; k++)
+			rq = fmin(rq, cert_radius(&q[k], p));
+		if (rq > r)
+			r = rq;
 	}
 	return r * px__strack_radius_scale;
+}
+
+static double region_radius(const struct px_strack *t, int ri, px_vec3 p)
+{
+	return region_radius_to(t, ri, p, 0.0);
 }
 
 /* region_radius() with the pieces of a rational region's quarters that
@@ -1719,18 +1737,26 @@ static __attribute__((noinline)) double cell_pieces(const struct px_strack *t,
 						    const struct scell *c, px_vec3 p, double r0,
 						    double r1, double r2, double r3);
 
-static double cell_radius(const struct px_strack *t, const struct scell *c,
-			  px_vec3 p)
+static double cell_radius_to(const struct px_strack *t, const struct scell *c,
+			     px_vec3 p, double need)
 {
 	int ri = c->child;
-	double r0 = region_radius(t, ri, p), r1 = region_radius(t, ri + 1, p),
-	       r2 = region_radius(t, ri + 2, p), r3 = region_radius(t, ri + 3, p);
+	double r0 = region_radius_to(t, ri, p, need),
+	       r1 = region_radius_to(t, ri + 1, p, need),
+	       r2 = region_radius_to(t, ri + 2, p, need),
+	       r3 = region_radius_to(t, ri + 3, p, need);
 	double r = fmin(fmin(r0, r1), fmin(r2, r3));
 	/* rational: quarters without a radius by their pieces (rarely run:
 	 * out of line, so that the usual test stays as lean as it was) */
 	if (!(r > 0.0) && t->rcell[ri].cert.rat && !px__strack_piece_fault)
 		r = cell_pieces(t, c, p, r0, r1, r2, r3);
 	return r;
+}
+
+static double cell_radius(const struct px_strack *t, const struct scell *c,
+			  px_vec3 p)
+{
+	return cell_radius_to(t, c, p, 0.0);
 }
 
 /* cell_radius() where a region's radius (r0..r3) is none: by the
@@ -2005,15 +2031,24 @@ static int col_test(struct px_strack *t, int limit)
 	/* the segment lies in the cube of half width dinf about p1 and in
 	 * the cube of half width dinf / 2 about its middle */
 	double dinf = max_norm(px_v3_sub(p1, p0));
+	/* A region whose radius falls short of clearing the segment is
+	 * given its quarters' too before the cell counts as hit: a hit cell
+	 * is solved, and with the quarters 30-50 % fewer cells are solved on
+	 * the bench paths at 0.1-1 % (3-9 % fewer instructions; the larger
+	 * radii also put the next test off). Not while catching up: the
+	 * segment then spans many updates' travel, most regions fall short
+	 * of it by far and the quarters' work was 17-38 % more at 5 %
+	 * steps. */
+	double fine = t->mode == ST_TRACK ? 1.0 : 0.0;
 	int end = t->col_np;
 	if (limit > 0 && t->col_k + limit < end)
 		end = t->col_k + limit;
 	for (; t->col_k < end; t->col_k++) {
 		int ci = t->popped[t->col_k];
 		struct scell *c = &t->cell[ci];
-		double r1 = cell_radius(t, c, p1);
+		double r1 = cell_radius_to(t, c, p1, fine * dinf);
 		t->st.box_tests++;
-		if (r1 < dinf && cell_radius(t, c, mid) < 0.5 * dinf) {
+		if (r1 < dinf && cell_radius_to(t, c, mid, fine * 0.5 * dinf) < 0.5 * dinf) {
 			/* where along the segment the region can first be met */
 			double r0 = cell_radius(t, c, p0);
 			double s0 = fmin(1.0, r0 / dinf);
