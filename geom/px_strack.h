@@ -34,9 +34,9 @@
  *    coordinate moves: it bounds the move from where the radius was
  *    taken in the cube's own norm, and is often half the Euclidean path;
  *    14-20 % fewer cell tests on the bench paths) names the cells due;
- *    a due cell whose cube still holds the new point with a quarter of
+ *    a due cell whose cube still holds the new point with a tenth of
  *    its half width to spare is kept without a test (the path wound
- *    about inside it: 42-48 % fewer tests on the bench's random paths
+ *    about inside it: about half the tests on the bench's random paths
  *    at 0.1 %), with an expiry of what is left; any other due cell
  *    is tested on the segment
  *    of this update (the cube about its middle) and solved again at the
