@@ -92,7 +92,10 @@ struct px_track;
  * catch it (bit 0: every root may rest, bit 1: resting minima are never
  * woken, bit 2: every leaf's no-event radius is infinite, bit 3: every
  * leaf-end radius is infinite, bit 4: entity rest certificates never
- * expire, bit 5: they ignore the distance bound of their minima). 0 restores normal operation. */
+ * expire, bit 5: they ignore the distance bound of their minima, bit 6:
+ * the hot certificate never expires, bit 8: a due leaf keeps its
+ * certificate while the point is within twice the ball its last test
+ * proved). 0 restores normal operation. */
 void px__track_set_fault(struct px_track *t, int fault);
 /* Test hook: the cold switch's clock (NULL: CLOCK_MONOTONIC). */
 void px__track_set_clock(struct px_track *t, int64_t (*fn)(void *), void *ctx);

@@ -48,6 +48,14 @@
  * another evaluation (the root error left is O(step^2), ~1e-9 span). */
 #define TRK_QUICK 3e-5
 #define TRK_QUICK_ITERS 3 /* Newton evaluations of the quick evolution */
+/* A due leaf whose ball still holds the new point with this share of its
+ * radius to spare keeps it (the path wound about inside it: an expiry
+ * counts the path, not the way from the centre). p0 is in the ball too:
+ * every leaf's expiry less the travel is at most its radius less the
+ * point's distance from the centre (by induction over the steps), so
+ * the ball, convex, holds the segment, and the expiry becomes the travel
+ * plus what is left beyond p1, the same bound. */
+#define TRK_REKEY 0.1
 
 /* leaf flags */
 #define LF_EV0 0x1u   /* start is a break: a root crossing it is an event */
@@ -179,6 +187,11 @@ struct px_track {
 	 * the contiguous expiries once (cheaper than heap sifts as soon as
 	 * two or three leaves are due) */
 	double *expiry;
+	/* the ball each expiry is of (centre, radius): a due leaf whose
+	 * ball still holds the new point well inside keeps it, without a
+	 * test (collect_events()) */
+	px_vec3 *ectr;
+	double *erad;
 	double *gdue;        /* smallest expiry of each group of TRK_GROUP */
 	double next_due;
 	double travel;
@@ -1273,8 +1286,11 @@ static void heap_rebuild(struct px_track *t, px_vec3 p)
 	int i;
 	double nd = INFINITY;
 	for (i = 0; i < t->n_leaves; i++) {
-		double x = t->travel + leaf_radius(t, &t->leaf[i], p) * (1.0 - 1e-9);
+		double rad = leaf_radius(t, &t->leaf[i], p) * (1.0 - 1e-9);
+		double x = t->travel + rad;
 		t->expiry[i] = x;
+		t->ectr[i] = p;
+		t->erad[i] = rad;
 		if (i % TRK_GROUP == 0)
 			t->gdue[i / TRK_GROUP] = x;
 		else if (x < t->gdue[i / TRK_GROUP])
@@ -1326,12 +1342,22 @@ static int collect_events(struct px_track *t, px_vec3 p0, px_vec3 p1,
 				if (ex[k] < tr) {
 					struct leaf *l = &t->leaf[k];
 					int ev;
-					double rad;
-					t->st.box_hits++;
-					rad = leaf_test(t, l, p0, p1, &ev);
-					if (ev)
-						mark_leaf(t, k, &nh);
-					ex[k] = tr + rad * (1.0 - 1e-9);
+					double rad, left;
+					left = t->erad[k] * ((t->fault & 256) ? 2.0 : 1.0) -
+					       px_v3_dist(p1, t->ectr[k]);
+					if (left > TRK_REKEY * t->erad[k]) {
+						ex[k] = tr + left;
+						t->st.rekeys++;
+					} else {
+						t->st.box_hits++;
+						rad = leaf_test(t, l, p0, p1, &ev);
+						if (ev)
+							mark_leaf(t, k, &nh);
+						rad *= 1.0 - 1e-9;
+						ex[k] = tr + rad;
+						t->ectr[k] = p1;
+						t->erad[k] = rad;
+					}
 				}
 				if (ex[k] < gd)
 					gd = ex[k];
@@ -2697,6 +2723,8 @@ void px_track_free(struct px_track *t)
 	free(t->cexp);
 	free(t->hits);
 	free(t->expiry);
+	free(t->ectr);
+	free(t->erad);
 	free(t->rmin);
 	free(t->gdue);
 	free(t->ipool);
@@ -2869,10 +2897,12 @@ int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
 	t->cexp = calloc((size_t)cand_cap + 1, sizeof(*t->cexp));
 	t->hits = calloc((size_t)leaf_cap + 1, sizeof(int));
 	t->expiry = calloc((size_t)leaf_cap + 1, sizeof(double));
+	t->ectr = calloc((size_t)leaf_cap + 1, sizeof(*t->ectr));
+	t->erad = calloc((size_t)leaf_cap + 1, sizeof(double));
 	t->gdue = calloc((size_t)leaf_cap / TRK_GROUP + 2, sizeof(double));
 	t->ipool = calloc((size_t)leaf_cap * (2 * TRK_NG + 2) + 1, sizeof(double));
 	if (!t->leaf || !t->pool || !t->cand || !t->cexp || !t->hits ||
-	    !t->expiry || !t->gdue ||
+	    !t->expiry || !t->ectr || !t->erad || !t->gdue ||
 	    !t->ipool) {
 		rc = PX_E_NOMEM;
 		goto fail;

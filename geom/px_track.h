@@ -212,6 +212,9 @@ struct px_track_stats {
 	uint64_t leaf_solves;
 	uint64_t box_hits;       /* leaves whose safe radius ran out (given
 				  * the exact segment test) */
+	uint64_t rekeys;         /* due leaves kept without the test: the
+				  * point still well inside the ball their
+				  * last test proved */
 	uint64_t creations, annihilations; /* pairs */
 	uint64_t rested;         /* critical points left uncorrected in an
 				  * update (opts.lazy), summed over updates */

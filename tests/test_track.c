@@ -766,6 +766,14 @@ static void test_lazy_exact(void)
 		     "entity rest never engaged: %llu in %llu updates",
 		     (unsigned long long)rs.ts.rested_entities,
 		     (unsigned long long)rs.ts.updates);
+	/* due leaves are kept without a test where the path winds about
+	 * inside their balls (the answers above are all compared) */
+	printf("  due leaves kept untested %llu, tested %llu\n",
+	       (unsigned long long)rs.ts.rekeys, (unsigned long long)rs.ts.box_hits);
+	PX_CHECK_MSG(rs.ts.rekeys * 20 > rs.ts.box_hits,
+		     "due leaves rarely kept: %llu of %llu tests",
+		     (unsigned long long)rs.ts.rekeys,
+		     (unsigned long long)rs.ts.box_hits);
 	/* and the hot path answers a good share of the updates */
 	PX_CHECK_MSG(rs.ts.hot > rs.ts.updates / 10,
 		     "hot path never engaged: %llu in %llu updates",
@@ -787,12 +795,13 @@ static void test_lazy_exact(void)
  * checks catch the damage (re-initialisations far above a clean run). */
 static void test_lazy_faults_caught(void)
 {
-	static const int faults[] = {1 | 2, 4, 1, 16, 32, 64};
+	static const int faults[] = {1 | 2, 4, 1, 16, 32, 64, 256};
 	static const char *names[] = {"fault: never woken", "fault: no events",
 				      "fault: rest always",
 				      "fault: entity rest never expires",
 				      "fault: entity rest without distance",
-				      "fault: hot certificate never expires"};
+				      "fault: hot certificate never expires",
+				      "fault: due leaves kept in twice their ball"};
 	struct tcurve tc[5];
 	struct run_stats rs;
 	uint64_t clean_reinits;
@@ -802,7 +811,7 @@ static void test_lazy_faults_caught(void)
 	run_model(tc, 5, 400, 40, &rs, 0);
 	check_run("clean", &rs, 10);
 	clean_reinits = rs.ts.reinits;
-	for (f = 0; f < 6; f++) {
+	for (f = 0; f < 7; f++) {
 		memset(&rs, 0, sizeof(rs));
 		g_fault = faults[f];
 		run_model(tc, 5, 400, 40, &rs, 0);
