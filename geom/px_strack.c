@@ -134,7 +134,6 @@ struct scell {
 	 * (within the budget, as any cell; never past the crossing) */
 	int always;
 	struct rcert cert; /* region cells */
-	double expiry;
 	uint32_t mark;
 	double cross;   /* hit: segment parameter where the region is met */
 	int child;      /* solve cell: first of its 2 x 2 region cells */
@@ -209,11 +208,6 @@ struct pole {
 	int surf;
 };
 
-struct hent {
-	double key;
-	int ci;
-};
-
 /* The cube a cell's expiry is of: its certificate holds for every point
  * within max-norm distance crad of ctr (col_begin() checks a due cell
  * against it before a test). By cell, in a compact array of its own:
@@ -263,9 +257,12 @@ struct px_strack {
 	int scache_n;
 	struct edge *edge;
 	struct pole *pole;
-	/* the expiry heap: each entry holds its cell's expiry (a compact
-	 * array: a sift reads no cell); cube: by cell */
-	struct hent *heap;
+	/* each cell's expiry (ex, by cell; the cube it is of in cube), the
+	 * least of each group of ST_GROUP cells and of all: an update with
+	 * cells due scans the groups once, the usual update compares one
+	 * number (a heap's sifts cost more as soon as cells are kept,
+	 * col_begin()) */
+	double *ex, *gdue, next_due;
 	struct cube *cube;
 	int *popped, *hits;
 	/* solves owed to the set at p (mode ST_PEND): cell pend[i] solved
@@ -289,7 +286,7 @@ struct px_strack {
 	 * a point whose max-norm path from p is below r stays in the cube of
 	 * half width r about p, and that path is often half the length) */
 	double travel, ctravel;
-	int heap_ok;
+	int ex_ok;              /* ex, gdue, next_due valid */
 	/* seeds of a cell solve with no region or quarter proven
 	 * (cell_seeds()), the work of ST_UNITS */
 	int full_seeds;
@@ -297,10 +294,10 @@ struct px_strack {
 	 * 1/ST_SUB_SEED of a seed */
 	int sub_work, sub_left;
 	/* the due cells of the segment col_p0 -> col_p1 tested over several
-	 * updates (more of them than max_tests): popped from the heap
-	 * (heap_n cells left in it), col_k of the col_np tested, col_nh of
-	 * those hit (in hits) */
-	int col_on, col_np, col_k, col_nh, heap_n;
+	 * updates (more of them than max_tests): taken out (popped, their
+	 * expiries infinite until tested), col_k of the col_np tested,
+	 * col_nh of those hit (in hits) */
+	int col_on, col_np, col_k, col_nh;
 	px_vec3 col_p0, col_p1;
 	px_aabb work;
 	double scale;
@@ -1894,40 +1891,23 @@ static int ix_check(struct px_strack *t)
 	return 1;
 }
 
-static void heap_set(struct px_strack *t, int pos, int ci)
-{
-	t->heap[pos].key = t->cell[ci].expiry;
-	t->heap[pos].ci = ci;
-}
+/* Cells per group of the expiry scan. */
+#define ST_GROUP 8
 
-static void heap_down(struct px_strack *t, int pos, int n)
+/* Every group's least expiry and the least of all, afresh. */
+static void groups_rebuild(struct px_strack *t)
 {
-	struct hent e = t->heap[pos];
-	for (;;) {
-		int c = 2 * pos + 1;
-		if (c >= n)
-			break;
-		if (c + 1 < n && t->heap[c + 1].key < t->heap[c].key)
-			c++;
-		if (!(t->heap[c].key < e.key))
-			break;
-		t->heap[pos] = t->heap[c];
-		pos = c;
+	int g, k, n = t->n_cells, ng = (n + ST_GROUP - 1) / ST_GROUP;
+	double nd = INFINITY;
+	for (g = 0; g < ng; g++) {
+		int k1 = (g + 1) * ST_GROUP < n ? (g + 1) * ST_GROUP : n;
+		double gm = INFINITY;
+		for (k = g * ST_GROUP; k < k1; k++)
+			gm = t->ex[k] < gm ? t->ex[k] : gm;
+		t->gdue[g] = gm;
+		nd = gm < nd ? gm : nd;
 	}
-	t->heap[pos] = e;
-}
-
-static void heap_up(struct px_strack *t, int pos)
-{
-	struct hent e = t->heap[pos];
-	while (pos > 0) {
-		int par = (pos - 1) / 2;
-		if (!(e.key < t->heap[par].key))
-			break;
-		t->heap[pos] = t->heap[par];
-		pos = par;
-	}
-	t->heap[pos] = e;
+	t->next_due = nd;
 }
 
 /* The cell's certificate was proven for the cube of half width r about
@@ -1937,20 +1917,17 @@ static void cell_expire(struct px_strack *t, struct scell *c, px_vec3 p, double 
 	struct cube *q = &t->cube[c - t->cell];
 	q->ctr = p;
 	q->crad = r;
-	c->expiry = t->ctravel + r;
+	t->ex[c - t->cell] = t->ctravel + r;
 }
 
-static void heap_rebuild(struct px_strack *t, px_vec3 p)
+static void expiries_rebuild(struct px_strack *t, px_vec3 p)
 {
 	int i;
-	for (i = 0; i < t->n_cells; i++) {
+	for (i = 0; i < t->n_cells; i++)
 		cell_expire(t, &t->cell[i], p,
 			    cell_radius(t, &t->cell[i], p) * (1.0 - 1e-9));
-		heap_set(t, i, i);
-	}
-	for (i = t->n_cells / 2 - 1; i >= 0; i--)
-		heap_down(t, i, t->n_cells);
-	t->heap_ok = 1;
+	groups_rebuild(t);
+	t->ex_ok = 1;
 	t->col_on = 0;
 }
 
@@ -1982,13 +1959,13 @@ static inline double max_norm(px_vec3 d)
  * share of its half width to spare is not tested again: the path wound
  * about inside it (an expiry counts the path, not the way from the
  * centre); a test there would prove a cube about as large. Keeping one
- * is a heap sift, so the share can be small (0.25 -> 0.1: 7-12 % fewer
- * tests on the random paths). */
+ * costs a comparison, so the share can be small (0.25 -> 0.1: 7-12 %
+ * fewer tests on the random paths). */
 #define ST_REKEY 0.1
 
 /* Start collecting the cells whose certificates the segment p0 -> p1
  * may break: the travel grows by the segment and the cells it makes due
- * are taken out of the heap (popped), to be tested by col_test().
+ * are taken out (popped), to be tested by col_test().
  * A due cell whose cube still holds p1 well inside keeps it: p0 is in
  * it too (every cell's expiry less the travel is at most its half width
  * less the way of the point from its centre, by induction over the
@@ -1998,33 +1975,43 @@ int px__strack_rekey_fault = 0;
 
 static void col_begin(struct px_strack *t, px_vec3 p0, px_vec3 p1)
 {
-	int n = t->n_cells, np = 0;
-	if (!t->heap_ok)
-		heap_rebuild(t, p0);
+	int np = 0;
+	if (!t->ex_ok)
+		expiries_rebuild(t, p0);
 	t->travel += px_v3_dist(p0, p1);
 	t->ctravel += max_norm(px_v3_sub(p1, p0));
-	while (n > 0 && t->heap[0].key <= t->ctravel) {
-		struct hent *h = &t->heap[0];
-		const struct cube *q = &t->cube[h->ci];
-		double left = q->crad * (px__strack_rekey_fault ? 2.0 : 1.0) -
-			      max_norm(px_v3_sub(p1, q->ctr));
-		if (left > ST_REKEY * q->crad) {
-			/* (after it, key > ctravel: each cell once; while a
-			 * cell is in the heap its entry's key is its expiry,
-			 * the cell's own is set again by its next test) */
-			h->key = t->ctravel + left;
-			heap_down(t, 0, n);
-			t->st.rekeys++;
-			continue;
+	if (t->next_due <= t->ctravel) {
+		double nd = INFINITY, tr = t->ctravel, *ex = t->ex;
+		int g, k, n = t->n_cells, ng = (n + ST_GROUP - 1) / ST_GROUP;
+		for (g = 0; g < ng; g++) {
+			int k1 = (g + 1) * ST_GROUP < n ? (g + 1) * ST_GROUP : n;
+			double gm = INFINITY;
+			if (!(t->gdue[g] <= tr)) {
+				nd = t->gdue[g] < nd ? t->gdue[g] : nd;
+				continue;
+			}
+			for (k = g * ST_GROUP; k < k1; k++) {
+				if (ex[k] <= tr) {
+					const struct cube *q = &t->cube[k];
+					double left = q->crad * (px__strack_rekey_fault ? 2.0 : 1.0) -
+						      max_norm(px_v3_sub(p1, q->ctr));
+					if (left > ST_REKEY * q->crad) {
+						ex[k] = tr + left;
+						t->st.rekeys++;
+					} else {
+						/* its next expiry comes with its
+						 * test (col_test(), col_end()) */
+						t->popped[np++] = k;
+						ex[k] = INFINITY;
+					}
+				}
+				gm = ex[k] < gm ? ex[k] : gm;
+			}
+			t->gdue[g] = gm;
+			nd = gm < nd ? gm : nd;
 		}
-		t->popped[np++] = t->heap[0].ci;
-		n--;
-		if (n > 0) {
-			t->heap[0] = t->heap[n];
-			heap_down(t, 0, n);
-		}
+		t->next_due = nd;
 	}
-	t->heap_n = n;
 	t->col_np = np;
 	t->col_k = 0;
 	t->col_nh = 0;
@@ -2072,16 +2059,19 @@ static int col_test(struct px_strack *t, int limit)
 	return t->col_k >= t->col_np;
 }
 
-/* End the collection: the popped cells go back to the heap, the hit ones
+/* End the collection: the popped cells' expiries count again, the hit ones
  * are marked with this update's epoch (track_step() adds the cells of
  * lost points to them once). Returns the count of hits. */
 static int col_end(struct px_strack *t)
 {
-	int k, n = t->heap_n;
+	int k;
 	for (k = 0; k < t->col_np; k++) {
-		heap_set(t, n, t->popped[k]);
-		heap_up(t, n);
-		n++;
+		int ci = t->popped[k], g = ci / ST_GROUP;
+		double x = t->ex[ci];
+		if (x < t->gdue[g])
+			t->gdue[g] = x;
+		if (x < t->next_due)
+			t->next_due = x;
 	}
 	for (k = 0; k < t->col_nh; k++)
 		t->cell[t->hits[k]].mark = t->epoch;
@@ -2409,7 +2399,7 @@ static int full_reset(struct px_strack *t, px_vec3 p,
 	curves_update(t, p, &cr, 1);
 	rc = reinit_all(t, p);
 	/* every cell's certificate here, not in the next update */
-	heap_rebuild(t, p);
+	expiries_rebuild(t, p);
 	r->source = PX_TRACK_REINIT;
 	if (rc) {
 		t->st.overflows++;
@@ -2974,7 +2964,7 @@ static void rebuild_start(struct px_strack *t)
 	t->mode = ST_REBUILD;
 	t->rb_started = 0;
 	t->rb_next = 0;
-	t->heap_ok = 0;
+	t->ex_ok = 0;
 	t->col_on = 0;
 	t->ix_on = 0;
 	for (i = 0; i < t->n_surf; i++)
@@ -3048,7 +3038,6 @@ static int catch_up(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 				break;
 			}
 			cell_expire(t, c, t->p, cell_radius(t, c, t->p));
-			heap_set(t, t->rb_next, t->rb_next);
 			t->rb_next++;
 		}
 		r->cells_solved = (units + ST_UNITS - 1) / ST_UNITS;
@@ -3056,10 +3045,8 @@ static int catch_up(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 			t->st.overflows++;
 			rebuild_start(t);
 		} else if (t->rb_next >= t->n_cells) {
-			int i;
-			for (i = t->n_cells / 2 - 1; i >= 0; i--)
-				heap_down(t, i, t->n_cells);
-			t->heap_ok = 1;
+			groups_rebuild(t);
+			t->ex_ok = 1;
 			t->mode = ST_LAG;
 		}
 		answer_global(t, p, r);
@@ -3284,7 +3271,7 @@ static int strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result
 		return catch_up(t, p, r);
 	p0 = t->p;
 	nh = -1;
-	if (t->hot_s >= 0 && t->heap_ok && in_work(t, p) && in_work(t, p0) &&
+	if (t->hot_s >= 0 && t->ex_ok && in_work(t, p) && in_work(t, p0) &&
 	    t->travel + px_v3_dist(p0, p) < t->hot_until) {
 		/* the due cells first (as track_step would): none hit and
 		 * the hot path answers */
@@ -3333,7 +3320,7 @@ static int strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result
 			t->p = p;
 			if (reinit_all(t, p))
 				t->st.overflows++;
-			heap_rebuild(t, p);
+			expiries_rebuild(t, p);
 		}
 		answer_global(t, p, r);
 		return PX_OK;
@@ -4716,7 +4703,8 @@ void px_strack_free(struct px_strack *t)
 	free(t->scache);
 	free(t->edge);
 	free(t->pole);
-	free(t->heap);
+	free(t->ex);
+	free(t->gdue);
 	free(t->cube);
 	free(t->popped);
 	free(t->hits);
@@ -5009,7 +4997,8 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	t->cell = calloc((size_t)cell_cap + 1, sizeof(*t->cell));
 	t->rcell = calloc(4 * (size_t)cell_cap + 1, sizeof(*t->rcell));
 	t->qcert = calloc(16 * (size_t)cell_cap + 1, sizeof(*t->qcert));
-	t->heap = calloc((size_t)cell_cap + 1, sizeof(*t->heap));
+	t->ex = calloc((size_t)cell_cap + 1, sizeof(*t->ex));
+	t->gdue = calloc((size_t)cell_cap / ST_GROUP + 2, sizeof(*t->gdue));
 	t->cube = calloc((size_t)cell_cap + 1, sizeof(*t->cube));
 	t->popped = calloc((size_t)cell_cap + 1, sizeof(int));
 	t->hits = calloc((size_t)cell_cap + 1, sizeof(int));
@@ -5029,7 +5018,7 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 			wl = l;
 	}
 	work = malloc(wl * sizeof(double));
-	if (!t->cell || !t->rcell || !t->qcert || !t->heap || !t->cube || !t->popped || !t->hits ||
+	if (!t->cell || !t->rcell || !t->qcert || !t->ex || !t->gdue || !t->cube || !t->popped || !t->hits ||
 	    !t->pend || !t->pend_ps || !t->pend_kind || !t->pend_need ||
 	    !t->ring_list || !work) {
 		rc = PX_E_NOMEM;

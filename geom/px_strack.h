@@ -29,11 +29,13 @@
  *    side. The largest such cube has a closed form (E: linear in the
  *    half width; det H: quadratic). No curvature is ever divided by, so
  *    parabolic lines (k = 0, the sheet through infinity) and umbilics give
- *    no NaN. Each cell carries that radius; a min-heap on the travelled
+ *    no NaN. Each cell carries that radius; its expiry on the travelled
  *    path length in the max norm (the sum of the steps' largest
  *    coordinate moves: it bounds the move from where the radius was
  *    taken in the cube's own norm, and is often half the Euclidean path;
- *    14-20 % fewer cell tests on the bench paths) names the cells due;
+ *    14-20 % fewer cell tests on the bench paths; the least of all and
+ *    of each group of 8 cells kept, so that the usual update compares
+ *    one number) names the cells due;
  *    a due cell whose cube still holds the new point with a tenth of
  *    its half width to spare is kept without a test (the path wound
  *    about inside it: about half the tests on the bench's random paths
