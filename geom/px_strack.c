@@ -1963,6 +1963,9 @@ static inline double max_norm(px_vec3 d)
  * fewer tests on the random paths). */
 #define ST_REKEY 0.1
 
+/* Test hook (internal.h): 1 takes the cubes twice as wide. */
+int px__strack_rekey_fault = 0;
+
 /* Start collecting the cells whose certificates the segment p0 -> p1
  * may break: the travel grows by the segment and the cells it makes due
  * are taken out (popped), to be tested by col_test().
@@ -1971,8 +1974,6 @@ static inline double max_norm(px_vec3 d)
  * less the way of the point from its centre, by induction over the
  * steps), so the cube holds the segment; its expiry becomes the travel
  * plus what is left of the half width beyond p1, the same bound. */
-int px__strack_rekey_fault = 0;
-
 static void col_begin(struct px_strack *t, px_vec3 p0, px_vec3 p1)
 {
 	int np = 0;
