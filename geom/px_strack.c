@@ -2032,8 +2032,8 @@ static int col_test(struct px_strack *t, int limit)
 	double dinf = max_norm(px_v3_sub(p1, p0));
 	/* A region whose radius falls short of clearing the segment is
 	 * given its quarters' too before the cell counts as hit: a hit cell
-	 * is solved, and with the quarters 30-50 % fewer cells are solved on
-	 * the bench paths at 0.1-1 % (3-9 % fewer instructions; the larger
+	 * is solved, and with the quarters 25-35 % fewer cells are solved on
+	 * most bench paths at 0.1-1 % (3-9 % fewer instructions; the larger
 	 * radii also put the next test off). Not while catching up: the
 	 * segment then spans many updates' travel, most regions fall short
 	 * of it by far and the quarters' work was 17-38 % more at 5 %
