@@ -14,6 +14,10 @@
  * BENCH_TRACK_DEPTH=d overrides the event-grid depth (default 4),
  * BENCH_TRACK_LEAVES=n the parameter leaves per span (default 4);
  * BENCH_TRACK_WORST=1 prints what the worst update of each curve row did;
+ * BENCH_TRACK_CLASSES=1 prints for each surface row the median time of
+ * the updates by their work (0, 1, 2, 3, 4 or more cell tests, answered
+ * other than by tracking, cells solved): which of them sets the median
+ * (both read the stats inside the timed call: tens of ns each update);
  * BENCH_TRACK_GOV=1 what the cold switch saw and did per row (its means,
  * cold updates and their median, switches). The header line of each
  * model gives the cost of a re-initialisation (reset: the least of 20;
@@ -709,7 +713,8 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 	static int sw_solved[NSSTEP], sw_tests[NSSTEP], sw_src[NSSTEP];
 	static int64_t tc[NSSTEP], tgw[NSSTEP];
 	static double ds[NSSTEP];
-	int worst_env = getenv("BENCH_TRACK_WORST") != NULL;
+	int worst_env = getenv("BENCH_TRACK_WORST") != NULL ||
+			getenv("BENCH_TRACK_CLASSES") != NULL;
 	static const double steps[] = {1e-4, 1e-3, 1e-2, 5e-2};
 	struct surf_row row[2][4];
 	struct px_strack *t = NULL;
@@ -810,6 +815,29 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 				glob += r.source == PX_TRACK_GLOBAL;
 				if (r.source == PX_TRACK_COLD)
 					tc[cold++] = tt[k];
+			}
+			if (getenv("BENCH_TRACK_CLASSES")) {
+				static const char *cname[8] = {"0 tests", "1 test", "2 tests",
+							       "3 tests", "4 tests", ">4 tests",
+							       "not tracked", "solves"};
+				static int64_t cv[8][NSSTEP];
+				int cn[8] = {0}, c;
+				for (k = 1; k < NSSTEP; k++) {
+					c = sw_solved[k] ? 7
+					    : sw_src[k] != PX_TRACK_TRACKED ? 6
+					    : sw_tests[k] > 4 ? 5 : sw_tests[k];
+					cv[c][cn[c]++] = tt[k];
+				}
+				printf("  classes %s %g %%, updates and median ns:",
+				       kind ? "sines" : "random", steps[s] * 100);
+				for (c = 0; c < 8; c++) {
+					if (!cn[c])
+						continue;
+					qsort(cv[c], (size_t)cn[c], sizeof(int64_t), cmp_i64);
+					printf(" [%s %d: %lld]", cname[c], cn[c],
+					       (long long)cv[c][cn[c] / 2]);
+				}
+				printf("\n");
 			}
 			/* the cold query on its own pass (as for the curves:
 			 * not interleaved at the same point) */
