@@ -32,6 +32,9 @@
 #include "px_bern.h"
 
 #define ST_NEWTON 16
+/* Newton's last step on a polynomial surface where the Hessian is well
+ * conditioned (snewton()): this share of a patch's span */
+#define ST_QUICK 3e-5
 /* Safety factor on certificate radii and relative padding of the
  * enclosures for rounding. */
 #define ST_RSAFE (1.0 - 1e-9)
@@ -179,6 +182,7 @@ struct ssurf {
 	double *mem;            /* owned copy of knots and pw */
 	double u0, u1, v0, v1, du, dv;
 	int wrap_u, wrap_v;
+	int poly;               /* every patch polynomial (snewton()) */
 	int pole[4];            /* edge collapsed: u0, u1, v0, v1 */
 	int first_cell, ncu, ncv;
 	double *cu, *cv;        /* cell bounds along u (ncu + 1), v */
@@ -578,6 +582,22 @@ static double pole_gap(const struct ssurf *f, double u, double v)
 }
 
 /*
+ * The Hessian at z far from singular: its eigenvalues within a factor 10
+ * of each other in size. Newton then converges quadratically from a step
+ * away, the error left O(step^2 / span) (a near-fold point, where one
+ * eigenvalue goes to 0, converges linearly and a short step says
+ * little); on a rational patch the parametrization's own speed changes
+ * too fast for the constant to be small (weights far apart).
+ */
+static inline int well_posed(const struct crit *z)
+{
+	double d = z->h11 - z->h22, tr = z->h11 + z->h22;
+	double disc = sqrt(d * d + 4.0 * z->h12 * z->h12);
+	double a = fabs(tr + disc), b = fabs(tr - disc);
+	return a < b ? a >= 0.1 * b : b >= 0.1 * a;
+}
+
+/*
  * Newton on E = 0 with p fixed from z->u, z->v; steps clamped to lu, lv.
  * Returns 0 with z evaluated at the root, 1 on failure (no convergence,
  * singular Hessian, the domain left through an open edge).
@@ -587,6 +607,7 @@ static int snewton(const struct ssurf *f, struct crit *z, px_vec3 p,
 {
 	double tu = 1e-11 * f->du, tv = 1e-11 * f->dv;
 	double qu = 1e-6 * f->du, qv = 1e-6 * f->dv;
+	double qu1 = ST_QUICK * f->du / f->npu, qv1 = ST_QUICK * f->dv / f->npv;
 	int k, outs = 0;
 	for (k = 0; k < ST_NEWTON; k++) {
 		px_vec3 g;
@@ -658,8 +679,11 @@ static int snewton(const struct ssurf *f, struct crit *z, px_vec3 p,
 			z->type = crit_type(z);
 			return 0;
 		}
-		if (fabs(su) <= qu && fabs(sv) <= qv && z->u + su >= f->u0 &&
-		    z->u + su <= f->u1 && z->v + sv >= f->v0 && z->v + sv <= f->v1) {
+		if (((fabs(su) <= qu && fabs(sv) <= qv) ||
+		     (f->poly && fabs(su) <= qu1 && fabs(sv) <= qv1 &&
+		      well_posed(z))) &&
+		    z->u + su >= f->u0 && z->u + su <= f->u1 && z->v + sv >= f->v0 &&
+		    z->v + sv <= f->v1) {
 			/* quadratic convergence: after this step the error is
 			 * O(step^2), far below the tolerance; move the point to
 			 * first order instead of evaluating again */
@@ -4799,6 +4823,7 @@ static int build_patches(struct ssurf *f, const double *ub, int nu,
 	}
 	memcpy(f->pu, ub, (size_t)nu * sizeof(double));
 	memcpy(f->pv, vb, (size_t)nv * sizeof(double));
+	f->poly = 1;
 	for (b = 0; b < f->npv; b++)
 		for (a = 0; a < f->npu; a++) {
 			struct patch *pt = &f->pt[b * f->npu + a];
@@ -4835,6 +4860,8 @@ static int build_patches(struct ssurf *f, const double *ub, int nu,
 				}
 				pt->wratio = whi / wlo;
 				pt_w = pt->rat ? 1.0 : w0;
+				if (pt->rat)
+					f->poly = 0;
 			}
 			for (k = 0; k < 4; k++) {
 				double *ck = c + k * np;
