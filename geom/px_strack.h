@@ -136,7 +136,7 @@
  * Entity indices follow px_dist.h: curves 0..n_curves-1, then surfaces.
  *
  * Memory and real-time rules: px_strack_create() allocates everything
- * (cells, boxes, heap, critical-point arrays of fixed capacity, the
+ * (cells, boxes, expiries, critical-point arrays of fixed capacity, the
  * curve tracker and the global-query model; the certificates take about
  * 20 KB a cell, its 4 regions and 16 quarters). px_strack_update() and the
  * accessors never allocate, lock or print; every loop has a bound. One
