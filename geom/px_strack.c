@@ -182,7 +182,10 @@ struct ssurf {
 	double *mem;            /* owned copy of knots and pw */
 	double u0, u1, v0, v1, du, dv;
 	int wrap_u, wrap_v;
-	int poly;               /* every patch polynomial (snewton()) */
+	/* snewton()'s quick last step where the Hessian is well
+	 * conditioned: ST_QUICK of a patch's span when every patch is
+	 * polynomial, else 0 (only the general 1e-6 of the domain) */
+	double quick_u, quick_v;
 	int pole[4];            /* edge collapsed: u0, u1, v0, v1 */
 	int first_cell, ncu, ncv;
 	double *cu, *cv;        /* cell bounds along u (ncu + 1), v */
@@ -607,7 +610,6 @@ static int snewton(const struct ssurf *f, struct crit *z, px_vec3 p,
 {
 	double tu = 1e-11 * f->du, tv = 1e-11 * f->dv;
 	double qu = 1e-6 * f->du, qv = 1e-6 * f->dv;
-	double qu1 = ST_QUICK * f->du / f->npu, qv1 = ST_QUICK * f->dv / f->npv;
 	int k, outs = 0;
 	for (k = 0; k < ST_NEWTON; k++) {
 		px_vec3 g;
@@ -680,7 +682,7 @@ static int snewton(const struct ssurf *f, struct crit *z, px_vec3 p,
 			return 0;
 		}
 		if (((fabs(su) <= qu && fabs(sv) <= qv) ||
-		     (f->poly && fabs(su) <= qu1 && fabs(sv) <= qv1 &&
+		     (fabs(su) <= f->quick_u && fabs(sv) <= f->quick_v &&
 		      well_posed(z))) &&
 		    z->u + su >= f->u0 && z->u + su <= f->u1 && z->v + sv >= f->v0 &&
 		    z->v + sv <= f->v1) {
@@ -1711,17 +1713,12 @@ static double region_pieces(const struct px_strack *t, int ri, px_vec3 p)
 static double region_radius_to(const struct px_strack *t, int ri, px_vec3 p,
 			       double need)
 {
+	/* (cert_radius() is never negative: none is r == 0) */
 	double r = cert_radius(&t->rcell[ri].cert, p);
-	if (!(r > 0.0)) {
-		const struct rcert *q = &t->qcert[4 * ri];
-		int k;
-		r = INFINITY;
-		for (k = 0; k < 4 && r > 0.0; k++)
-			r = fmin(r, cert_radius(&q[k], p));
-	} else if (r < need) {
-		/* short of what the caller needs: the quarters' enclosures
-		 * are about half as wide, and their least radius is as good
-		 * a proof for the region (the larger of the two stands) */
+	if (!(r > 0.0) || r < need) {
+		/* the quarters' enclosures are about half as wide, and their
+		 * least radius is as good a proof for the region (the larger
+		 * of the two stands); the loop stops once it cannot be */
 		const struct rcert *q = &t->qcert[4 * ri];
 		double rq = INFINITY;
 		int k;
@@ -4823,7 +4820,8 @@ static int build_patches(struct ssurf *f, const double *ub, int nu,
 	}
 	memcpy(f->pu, ub, (size_t)nu * sizeof(double));
 	memcpy(f->pv, vb, (size_t)nv * sizeof(double));
-	f->poly = 1;
+	f->quick_u = ST_QUICK * f->du / f->npu;
+	f->quick_v = ST_QUICK * f->dv / f->npv;
 	for (b = 0; b < f->npv; b++)
 		for (a = 0; a < f->npu; a++) {
 			struct patch *pt = &f->pt[b * f->npu + a];
@@ -4861,7 +4859,7 @@ static int build_patches(struct ssurf *f, const double *ub, int nu,
 				pt->wratio = whi / wlo;
 				pt_w = pt->rat ? 1.0 : w0;
 				if (pt->rat)
-					f->poly = 0;
+					f->quick_u = f->quick_v = 0.0;
 			}
 			for (k = 0; k < 4; k++) {
 				double *ck = c + k * np;
