@@ -214,6 +214,10 @@ extern int px__strack_ring_fault;
 /* 1: a due cell keeps its certificate while the point is within twice
  * the cube its last test proved (unsound: the tests must see it). */
 extern int px__strack_rekey_fault;
+/* 1: surface trackers made while it is set evaluate their bicubics
+ * with the portable two-lane code, not the AVX2/FMA one (the tests
+ * compare the two). */
+extern int px__strack_no_fma;
 /* Test hook: 1 turns the surface tracker's hot path off, 2 makes its
  * certificate never expire (a fault the tests must see). */
 void px__strack_set_hot_fault(struct px_strack *t, int fault);
