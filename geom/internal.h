@@ -214,6 +214,10 @@ extern int px__strack_ring_fault;
 /* 1: a due cell keeps its certificate while the point is within twice
  * the cube its last test proved (unsound: the tests must see it). */
 extern int px__strack_rekey_fault;
+/* 1: surfaces made while it is set take Newton's quick last step
+ * (snewton()) up to a thousand times as far, whatever the Hessian and
+ * the weights (unsound: the tests must see it). */
+extern int px__strack_quick_fault;
 /* 1: surface trackers made while it is set evaluate their bicubics
  * with the portable two-lane code, not the AVX2/FMA one (the tests
  * compare the two). */

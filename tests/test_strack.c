@@ -929,6 +929,23 @@ static void test_rational_track(void)
 			     "solved %ld against %ld", (unsigned long long)t2.hot,
 			     (unsigned long long)t0.hot, t2.cells, t0.cells);
 	}
+	{
+		/* Newton's quick last step is taken here too (weights 0.6
+		 * to 1.5, well-conditioned Hessians): one a thousand times
+		 * as long, on any Hessian, is seen */
+		struct totals bad;
+		struct px_rand_state rs;
+		memset(&bad, 0, sizeof(bad));
+		px_rand_save(&rs);
+		px__strack_quick_fault = 1;
+		run_model("rational bicubic, loose quick step", NULL, 0, &s[0], 1, 0, &bad);
+		px__strack_quick_fault = 0;
+		px_rand_restore(&rs);
+		printf("  loose quick step: wrong %ld, counts bad %ld of %ld\n", bad.wrong,
+		       bad.count_bad, bad.count_checks);
+		PX_CHECK_MSG(bad.wrong + bad.count_bad > 0,
+			     "a quick step a thousand times too long went unnoticed");
+	}
 }
 
 /*
