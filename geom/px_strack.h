@@ -138,7 +138,9 @@
  * Memory and real-time rules: px_strack_create() allocates everything
  * (cells, boxes, expiries, critical-point arrays of fixed capacity, the
  * curve tracker and the global-query model; the certificates take about
- * 20 KB a cell, its 4 regions and 16 quarters). px_strack_update() and the
+ * 20 KB a cell, its 4 regions and 16 quarters; a bicubic patch keeps an
+ * interleaved copy of its coefficients, 512 bytes, for the AVX2/FMA
+ * evaluation where the processor has it). px_strack_update() and the
  * accessors never allocate, lock or print; every loop has a bound. One
  * tracker follows one point; not for concurrent use.
  */
