@@ -460,7 +460,7 @@ eval_pair(const double *c0, const double *c1, int p, int q, double s,
 
 /* All four coordinates of a bicubic at once (x, y, z, w in the lanes of
  * one 256-bit vector, fused multiply-adds) where the processor has
- * AVX2 and FMA (checked at setup: px__strack_fma()); eval_one()'s
+ * AVX2 and FMA (checked at setup: have_fma()); eval_one()'s
  * Horner scheme, each multiply-add rounded once. About a third of the
  * instructions of the two-lane form, and the evaluation is most of a
  * hot update. */
@@ -500,7 +500,7 @@ eval4_bicubic(const double *c4, double s, double t, double h[6][4])
 
 int px__strack_no_fma = 0;
 
-static int px__strack_fma(void)
+static int have_fma(void)
 {
 	return !px__strack_no_fma && __builtin_cpu_supports("avx2") &&
 	       __builtin_cpu_supports("fma");
@@ -508,7 +508,7 @@ static int px__strack_fma(void)
 #else
 #define ST_FMA 0
 int px__strack_no_fma = 0;
-static int px__strack_fma(void)
+static int have_fma(void)
 {
 	return 0;
 }
@@ -4909,7 +4909,7 @@ static int build_patches(struct ssurf *f, const double *ub, int nu,
 	f->pt = calloc((size_t)(f->npu * f->npv), sizeof(*f->pt));
 	f->pool = calloc((size_t)(f->npu * f->npv) * 4 * (size_t)np, sizeof(double));
 	f->pool4 = NULL;
-	if (p == 3 && q == 3 && px__strack_fma()) {
+	if (p == 3 && q == 3 && have_fma()) {
 		/* 512 bytes a patch: a multiple of the alignment */
 		f->pool4 = aligned_alloc(64, (size_t)(f->npu * f->npv) * 64 * sizeof(double));
 		if (!f->pool4) {
