@@ -1522,6 +1522,39 @@ static void wake_minima(struct px_track *t, px_vec3 p)
 }
 
 /*
+ * A resting root's leaf certificate (z->until) renewed at t->p without
+ * correcting the root, when its distance share still holds. Sound where
+ * the certificate held at the previous update (renewals come at the
+ * first update past the least expiry, hot_cert()): from there to t->p
+ * the path is one straight step, along which the leaf's end values of g
+ * (affine in p) are linear, so where each has at t->p the sign it had at
+ * the root's last correction z->p it kept that sign the whole way and no
+ * root left the leaf; the new certificate is leaf_end_radius() at t->p.
+ * Returns 1 when renewed, 0 when the root must be corrected (an end
+ * value changed sign or is too close to zero to tell).
+ */
+static int renew_until(struct px_track *t, struct zero *z)
+{
+	const struct leaf *l = &t->leaf[z->leaf];
+	const double *a = leaf_a(t, l);
+	double r, g0 = gco(a, l->n, 0, t->p), g1 = gco(a, l->n, l->n, t->p);
+	if (!t->opts.lazy)
+		return 0;
+	if (!(t->fault & 512)) {
+		double h0 = gco(a, l->n, 0, z->p), h1 = gco(a, l->n, l->n, z->p);
+		if (!(fabs(h0) > l->tol_g) || !(fabs(h1) > l->tol_g) || !(g0 * h0 > 0.0) ||
+		    !(g1 * h1 > 0.0))
+			return 0;
+	}
+	r = leaf_end_radius(t, l, t->p);
+	if (!(r > 0.0))
+		return 0;
+	z->until = t->travel + r * (1.0 - 1e-9);
+	t->st.renewals++;
+	return 1;
+}
+
+/*
  * The certificate shared by resting roots: the travelled path below which
  * every root of e but skip provably stays in its leaf (each leaf
  * certificate; the caller checked that each is alone there) and no
@@ -1552,7 +1585,10 @@ static int cert_roots(struct px_track *t, struct ent *e, int skip,
 		}
 		if (fix && (!(z->until > t->travel) ||
 			    (z->type > 0 &&
-			     !(z->dist - (t->travel - z->trav) - best - tol > 0.0)))) {
+			     !(z->dist - (t->travel - z->trav) - best - tol > 0.0))) &&
+		    !(z->until <= t->travel &&
+		      (z->type < 0 || z->dist - (t->travel - z->trav) - best - tol > 0.0) &&
+		      renew_until(t, z))) {
 			struct zero zc = *z;
 			if (evolve(t, e, &zc, zc.p, px_v3_sub(t->p, zc.p), t->p) ||
 			    zc.leaf != z->leaf)

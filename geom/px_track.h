@@ -215,6 +215,9 @@ struct px_track_stats {
 	uint64_t rekeys;         /* due leaves kept without the test: the
 				  * point still well inside the ball their
 				  * last test proved */
+	uint64_t renewals;       /* resting roots' leaf certificates renewed
+				  * without correcting them (their leaf's
+				  * end values kept their signs) */
 	uint64_t creations, annihilations; /* pairs */
 	uint64_t rested;         /* critical points left uncorrected in an
 				  * update (opts.lazy), summed over updates */
