@@ -50,7 +50,12 @@
  *    all; until the path uses it up, a leaf has an event or the answering
  *    root leaves the quick evolution (predictor, one evaluation, one
  *    accepted Newton step inside its leaf), an update is that evolution
- *    and nothing else (stats.hot).
+ *    and nothing else (stats.hot). When the path uses up a resting
+ *    root's leaf certificate, the certificate is taken again at the new
+ *    point without correcting the root where the leaf's end values have
+ *    the signs they had at its last correction (the step since the
+ *    certificate held is straight, the end values linear along it;
+ *    stats.renewals).
  *  - Cold switch (opts.cold_switch, on by default): when following every
  *    critical point costs more than the exact global query (fast motion,
  *    events in most updates; one update in 16 is timed), updates are
