@@ -702,6 +702,9 @@ static int64_t ins_read(void)
 struct surf_row {
 	int64_t med, p999, max, cold_med, ins_med, cold_ins_med, ins_max,
 		cold_ins_max, wmax, cwmax;
+	/* medians of each update's and each cold query's least time over
+	 * the three runs (interrupts and a busy machine mostly fall out) */
+	int64_t med3, cold_med3;
 	long wrong;
 	double net, bat; /* ratio of medians net of the clock; of block means */
 };
@@ -711,7 +714,7 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 	static px_vec3 q[NSSTEP];
 	static int64_t tt[NSSTEP], tg[NSSTEP], it[NSSTEP], ig[NSSTEP], tw[NSSTEP];
 	static int sw_solved[NSSTEP], sw_tests[NSSTEP], sw_src[NSSTEP];
-	static int64_t tc[NSSTEP], tgw[NSSTEP];
+	static int64_t tc[NSSTEP], tgw[NSSTEP], tsort[NSSTEP];
 	static double ds[NSSTEP];
 	int worst_env = getenv("BENCH_TRACK_WORST") != NULL ||
 			getenv("BENCH_TRACK_CLASSES") != NULL;
@@ -902,6 +905,12 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 						row[kind][s].wmax = tw[k];
 						kw = k;
 					}
+				memcpy(tsort, tw, sizeof(tsort));
+				qsort(tsort, NSSTEP, sizeof(tsort[0]), cmp_i64);
+				row[kind][s].med3 = tsort[NSSTEP / 2];
+				memcpy(tsort, tgw, sizeof(tsort));
+				qsort(tsort, NSSTEP, sizeof(tsort[0]), cmp_i64);
+				row[kind][s].cold_med3 = tsort[NSSTEP / 2];
 				if (worst_env && kw >= 0)
 					printf("  (worst update %d: %.1f us, cells solved %d, "
 					       "cell tests %d, source %d)\n", kw,
@@ -979,8 +988,8 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 		 * then the issue's targets, judged on these figures (met at
 		 * a step size when met on both paths) */
 		int med_ok[4], max_ok[4], ratio_ok[4], iratio_ok[4], wmax_ok[4];
-		int net_ok[4], bat_ok[4];
-		char lm[64], lx[64], lr[64], li[64], lw[64], ln[64], lb[64];
+		int net_ok[4], bat_ok[4], m3_ok[4];
+		char lm[64], lx[64], lr[64], li[64], lw[64], ln[64], lb[64], l3[64];
 		long wrong = 0;
 		int64_t worst_max = 0, worst_p999 = 0, worst_w = 0, worst_cw = 0;
 		printf("  summary %s (random / sines):\n", name);
@@ -989,16 +998,23 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 			double r1 = (double)row[1][s].cold_med / (double)(row[1][s].med ? row[1][s].med : 1);
 			double i0 = row[0][s].ins_med > 0 ? (double)row[0][s].cold_ins_med / row[0][s].ins_med : 0.0;
 			double i1 = row[1][s].ins_med > 0 ? (double)row[1][s].cold_ins_med / row[1][s].ins_med : 0.0;
+			double m0 = row[0][s].med3 > 0 ? (double)row[0][s].cold_med3 / row[0][s].med3 : 0.0;
+			double m1 = row[1][s].med3 > 0 ? (double)row[1][s].cold_med3 / row[1][s].med3 : 0.0;
 			printf("    step %-5g %%: median %6lld / %6lld ns, ratio %5.1f / %5.1f; "
 			       "median instructions %7lld / %7lld, ratio %5.1f / %5.1f; "
 			       "p99.9 %7lld / %7lld ns, max %8lld / %8lld ns; max "
-			       "instructions %7lld / %7lld (cold query %7lld / %7lld)\n",
+			       "instructions %7lld / %7lld (cold query %7lld / %7lld); "
+			       "least-of-3 medians %6lld / %6lld ns against the cold "
+			       "query's %6lld / %6lld, ratio %5.1f / %5.1f\n",
 			       steps[s] * 100.0, (long long)row[0][s].med, (long long)row[1][s].med,
 			       r0, r1, (long long)row[0][s].ins_med, (long long)row[1][s].ins_med,
 			       i0, i1, (long long)row[0][s].p999, (long long)row[1][s].p999,
 			       (long long)row[0][s].max, (long long)row[1][s].max,
 			       (long long)row[0][s].ins_max, (long long)row[1][s].ins_max,
-			       (long long)row[0][s].cold_ins_max, (long long)row[1][s].cold_ins_max);
+			       (long long)row[0][s].cold_ins_max, (long long)row[1][s].cold_ins_max,
+			       (long long)row[0][s].med3, (long long)row[1][s].med3,
+			       (long long)row[0][s].cold_med3, (long long)row[1][s].cold_med3,
+			       m0, m1);
 			med_ok[s] = row[0][s].med <= 1500 && row[1][s].med <= 1500;
 			max_ok[s] = row[0][s].max <= 20000 && row[1][s].max <= 20000;
 			wmax_ok[s] = row[0][s].wmax <= 20000 && row[1][s].wmax <= 20000;
@@ -1006,6 +1022,7 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 			iratio_ok[s] = i0 >= 10.0 && i1 >= 10.0;
 			net_ok[s] = row[0][s].net >= 10.0 && row[1][s].net >= 10.0;
 			bat_ok[s] = row[0][s].bat >= 10.0 && row[1][s].bat >= 10.0;
+			m3_ok[s] = m0 >= 10.0 && m1 >= 10.0;
 			for (kind = 0; kind < 2; kind++) {
 				const struct surf_row *w = &row[kind][s];
 				wrong += w->wrong;
@@ -1016,10 +1033,10 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 			}
 		}
 		{
-			char *out[7] = {lm, lx, lr, li, lw, ln, lb};
-			int *ok[7] = {med_ok, max_ok, ratio_ok, iratio_ok, wmax_ok,
-				      net_ok, bat_ok}, m;
-			for (m = 0; m < 7; m++) {
+			char *out[8] = {lm, lx, lr, li, lw, ln, lb, l3};
+			int *ok[8] = {med_ok, max_ok, ratio_ok, iratio_ok, wmax_ok,
+				      net_ok, bat_ok, m3_ok}, m;
+			for (m = 0; m < 8; m++) {
 				int n = 0;
 				out[m][0] = 0;
 				for (s = 0; s < 4; s++)
@@ -1037,10 +1054,10 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 		       "%.1f us; the cold query's the same way %.1f us); >= 10x "
 		       "the cold query: %s by time, %s by "
 		       "instructions, %s by medians net of the clock, %s by block "
-		       "means; zero wrong: %s (%ld)\n",
+		       "means, %s by least-of-3 medians; zero wrong: %s (%ld)\n",
 		       name, lm, lx, worst_max / 1e3, worst_p999 / 1e3, lw, worst_w / 1e3,
 		       worst_cw / 1e3, lr,
-		       li, ln, lb, wrong == 0 ? "MET" : "NOT MET", wrong);
+		       li, ln, lb, l3, wrong == 0 ? "MET" : "NOT MET", wrong);
 	}
 	{
 		struct px_strack *tv = NULL;
