@@ -398,11 +398,12 @@ static size_t cloud_bytes(const void *impl)
 }
 
 static const struct px_model_ops cloud_ops = {
-	"cloud", PX_MODEL_CLOUD, cloud_closest, cloud_aabb, cloud_bytes,
-	cloud_free, NULL, NULL, NULL};
+	.name = "cloud", .kind = PX_MODEL_CLOUD, .closest = cloud_closest,
+	.aabb = cloud_aabb, .memory_bytes = cloud_bytes, .free = cloud_free};
 static const struct px_model_ops cloud_ops_cache = {
-	"cloud", PX_MODEL_CLOUD, cloud_closest, cloud_aabb, cloud_bytes,
-	cloud_free, NULL, cloud_closest_among, cloud_collect};
+	.name = "cloud", .kind = PX_MODEL_CLOUD, .closest = cloud_closest,
+	.aabb = cloud_aabb, .memory_bytes = cloud_bytes, .free = cloud_free,
+	.closest_among = cloud_closest_among, .collect = cloud_collect};
 
 /* Slab of the points [s, e) into child j of S. The normal: the
  * smallest-eigenvalue direction of the points' covariance by power

@@ -937,11 +937,14 @@ static px_vec3 mesh_support(const void *impl, px_vec3 d)
 }
 
 static const struct px_model_ops mesh_ops = {
-	"mesh", PX_MODEL_MESH, mesh_closest, mesh_aabb, mesh_bytes, mesh_free, NULL,
-	mesh_closest_among, mesh_collect};
+	.name = "mesh", .kind = PX_MODEL_MESH, .closest = mesh_closest,
+	.aabb = mesh_aabb, .memory_bytes = mesh_bytes, .free = mesh_free,
+	.closest_among = mesh_closest_among, .collect = mesh_collect};
 static const struct px_model_ops mesh_ops_convex = {
-	"mesh", PX_MODEL_MESH, mesh_closest, mesh_aabb, mesh_bytes, mesh_free,
-	mesh_support, mesh_closest_among, mesh_collect};
+	.name = "mesh", .kind = PX_MODEL_MESH, .closest = mesh_closest,
+	.aabb = mesh_aabb, .memory_bytes = mesh_bytes, .free = mesh_free,
+	.support = mesh_support, .closest_among = mesh_closest_among,
+	.collect = mesh_collect};
 
 /* ---- build ----------------------------------------------------------------- */
 

@@ -328,3 +328,120 @@ void px__prefix_path(char *msg, size_t cap, const char *path)
 	/* what is left of the message after the prefix, NUL included */
 	snprintf(msg + lp + 2, cap - lp - 2, "%s", tmp);
 }
+
+/* ---- tracked streams ------------------------------------------------ */
+
+struct px_model_stream {
+	const struct px_model *m;
+	void *state;
+	uint64_t queries;
+};
+
+void px_model_stream_opts_default(struct px_model_stream_opts *o)
+{
+	if (!o)
+		return;
+	memset(o, 0, sizeof(*o));
+	o->verify_every = 0;
+	o->max_solves = 4;
+	o->cold_switch = 1;
+}
+
+int px_model_stream_create(const struct px_model *m,
+			   const struct px_model_stream_opts *o,
+			   struct px_model_stream **out)
+{
+	struct px_model_stream_opts d;
+	struct px_model_stream *s;
+	int rc;
+
+	if (out)
+		*out = NULL;
+	if (!m || !out)
+		return PX_E_INVAL;
+	if (!o) {
+		px_model_stream_opts_default(&d);
+		o = &d;
+	}
+	if (o->verify_every < 0 || o->max_solves < 0 ||
+	    (o->cold_switch != 0 && o->cold_switch != 1))
+		return PX_E_INVAL;
+	if (!m->ops->stream_create || !m->ops->stream_query ||
+	    !m->ops->stream_free)
+		return PX_E_UNSUPPORTED;
+	s = calloc(1, sizeof(*s));
+	if (!s)
+		return PX_E_NOMEM;
+	s->m = m;
+	rc = m->ops->stream_create(m->impl, o, &s->state);
+	if (rc != PX_OK) {
+		free(s);
+		return rc;
+	}
+	*out = s;
+	return PX_OK;
+}
+
+void px_model_stream_free(struct px_model_stream *s)
+{
+	if (!s)
+		return;
+	if (s->state)
+		s->m->ops->stream_free(s->state);
+	free(s);
+}
+
+int px_model_stream_query(struct px_model_stream *s, px_vec3 p,
+			  double max_dist, unsigned flags,
+			  struct px_model_result *out,
+			  struct px_model_stream_note *note)
+{
+	struct px_model_stream_note nn;
+	struct px_model_query q;
+	const struct px_model *m;
+	int rc;
+
+	if (!note)
+		note = &nn;
+	memset(note, 0, sizeof(*note));
+	if (!s || !out || !(max_dist >= 0.0))
+		return PX_E_INVAL;
+	if (!px_v3_isfinite(p))
+		return PX_E_NAN;
+	m = s->m;
+	q.p = px_pose_inverse_transform_point(m->pose, p);
+	if (px__too_far(&m->local_box, q.p))
+		return PX_E_RANGE;
+	q.max_dist = max_dist;
+	q.hint = -1;
+	q.flags = flags & ~PX_QUERY_COHERENT;
+	rc = m->ops->stream_query(m->impl, s->state, &q, out, note);
+	if (rc < 0)
+		return rc;
+	s->queries++;
+	if (rc == 0) {
+		out->distance = INFINITY;
+		out->index = -1;
+		out->sub = -1;
+		out->feature = PX_FEATURE_NONE;
+		return 0;
+	}
+	if (!isfinite(out->distance))
+		return PX_E_RANGE;
+	out->point = px_pose_transform_point(m->pose, out->point);
+	out->direction = px_pose_transform_vector(m->pose, out->direction);
+	return 1;
+}
+
+void px_model_stream_get_stats(const struct px_model_stream *s,
+			       struct px_model_stream_stats *st)
+{
+	if (!st)
+		return;
+	memset(st, 0, sizeof(*st));
+	if (!s)
+		return;
+	if (s->m->ops->stream_stats)
+		s->m->ops->stream_stats(s->state, st);
+	st->queries = s->queries;
+}

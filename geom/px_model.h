@@ -38,6 +38,7 @@
 #define PX_MODEL_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "px_base.h"
 #include "px_math.h"
@@ -112,6 +113,46 @@ struct px_model_result {
 	double gap;        /* how much closer the true answer may be (>= 0) */
 };
 
+/* ---- tracked streams: declarations the ops table needs (API below) ---- */
+
+/* Options of a tracked stream (px_model_stream_opts_default()). */
+struct px_model_stream_opts {
+	/* Compare the tracked answer with the global query every
+	 * verify_every answers (0: never, the default in a loop); a
+	 * disagreement re-initialises the tracked set and is counted. */
+	int verify_every;
+	/* Transition work of one answer, in cell solves (surfaces; default
+	 * 4, 0: unbounded): more is answered by the global query and caught
+	 * up over the following answers (px_strack_opts.max_solves). */
+	int max_solves;
+	/* 1 (default): while the point moves so fast that following its
+	 * critical points costs more than the global query, answer with
+	 * the global query (px_track_opts.cold_switch). */
+	int cold_switch;
+};
+
+/* How one stream answer came about. */
+struct px_model_stream_note {
+	int source;  /* enum px_track_source (px_track.h) */
+	int jumped;  /* the closest point jumped (another branch, entity or
+		      * feature: a haptic renderer must not smooth across) */
+	int n_crit;  /* live critical points followed; -1 while cold */
+};
+
+/* Counters of a stream since its creation. */
+struct px_model_stream_stats {
+	uint64_t queries;       /* answered (in range or not) */
+	uint64_t tracked;       /* from the tracked critical points */
+	uint64_t hot;           /* of which by the answering point alone */
+	uint64_t global;        /* by the global query: over the work
+				 * budget, catching up, re-initialised,
+				 * outside the working volume */
+	uint64_t cold;          /* by the global query, motion too fast */
+	uint64_t jumps;         /* answers whose closest point jumped */
+	uint64_t reinits;       /* tracked set rebuilt (anomalies, capacity) */
+	uint64_t verifications, disagreements;
+};
+
 /*
  * One representation's implementation. Every function receives the impl
  * pointer given to px_model_create(). All but free must be RT-safe.
@@ -150,6 +191,22 @@ struct px_model_ops {
 			     const int *idx, int n, struct px_model_result *r);
 	int (*collect)(const void *impl, px_vec3 p, double radius, int *idx,
 		       int cap);
+	/* Optional tracked streams (see px_model_stream_create(); all four
+	 * or none; NULL otherwise). stream_create builds the state of one
+	 * moving point (setup: may allocate); stream_query answers as
+	 * closest does, in the model frame, and fills note; stream_stats
+	 * adds the state's counters; stream_free releases it. Query and
+	 * stats must be RT-safe. */
+	int (*stream_create)(const void *impl,
+			     const struct px_model_stream_opts *o,
+			     void **state);
+	int (*stream_query)(const void *impl, void *state,
+			    const struct px_model_query *q,
+			    struct px_model_result *r,
+			    struct px_model_stream_note *note);
+	void (*stream_stats)(const void *state,
+			     struct px_model_stream_stats *s);
+	void (*stream_free)(void *state);
 };
 
 struct px_model; /* opaque handle */
@@ -251,6 +308,61 @@ PX_API int px_model_query_cached(const struct px_model *m, px_vec3 p,
 /* Queries answered and refills made through c. @note RT-safe. */
 PX_API unsigned long px_model_cache_queries(const struct px_model_cache *c);
 PX_API unsigned long px_model_cache_refills(const struct px_model_cache *c);
+
+/* ---- tracked streams -----------------------------------------------------
+ *
+ * A point that moves a little each cycle (a haptic proxy, a tool tip)
+ * can be followed instead of searched for: a stream keeps every critical
+ * distance of the model from that point and detects where pairs of them
+ * are born or die as the point moves (NURBS models: px_strack for
+ * surfaces, px_track for curves alone), so most answers cost a fraction
+ * of a global query, and each is still the exact global closest point
+ * (the same as px_model_query_ex(); where the tracked set cannot prove
+ * it, the global query answers). The stream follows the point in the
+ * model frame: the model's pose may change between answers.
+ *
+ * Memory and real-time rules: px_model_stream_create() allocates all of
+ * the stream's memory (setup; for NURBS surfaces it may take a few
+ * hundred milliseconds and some megabytes); px_model_stream_query() and
+ * px_model_stream_get_stats() are RT-safe. One stream belongs to one
+ * thread; several streams may follow one model.
+ */
+struct px_model_stream;
+
+/* Defaults: verify_every 0, max_solves 4, cold_switch 1. */
+PX_API void px_model_stream_opts_default(struct px_model_stream_opts *o);
+
+/*
+ * A stream following one point through model m (m must outlive it);
+ * o may be NULL for defaults. Setup only. Returns PX_OK, PX_E_INVAL (NULL
+ * m or out, bad options), PX_E_UNSUPPORTED (the representation cannot
+ * track: use px_model_query_ex() with hints or a px_model_cache),
+ * PX_E_NOMEM, or the tracker's errors.
+ */
+PX_API int px_model_stream_create(const struct px_model *m,
+				  const struct px_model_stream_opts *o,
+				  struct px_model_stream **out);
+
+/* NULL is a no-op. Setup only. */
+PX_API void px_model_stream_free(struct px_model_stream *s);
+
+/*
+ * Move the stream's point to p (world frame) and answer as
+ * px_model_query_ex() (no hint: the stream is its own coherence):
+ * returns 1 with out filled, 0 when the closest point is farther than
+ * max_dist (the point is followed all the same), PX_E_INVAL (NULL,
+ * max_dist < 0 or NaN), PX_E_NAN (p not finite: the stream is left as
+ * it was), PX_E_RANGE, or an implementation's error. note (may be NULL)
+ * says how the answer came about. @note RT-safe.
+ */
+PX_API int px_model_stream_query(struct px_model_stream *s, px_vec3 p,
+				 double max_dist, unsigned flags,
+				 struct px_model_result *out,
+				 struct px_model_stream_note *note);
+
+/* The stream's counters (zeroed for NULL). @note RT-safe. */
+PX_API void px_model_stream_get_stats(const struct px_model_stream *s,
+				      struct px_model_stream_stats *st);
 
 /* Bounding box in the model frame / in the world frame (the model-frame
  * box transformed by the current pose). Empty box for NULL.

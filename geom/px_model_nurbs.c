@@ -12,6 +12,8 @@
 
 #include "px_dist.h"
 #include "px_model.h"
+#include "px_strack.h"
+#include "px_track.h"
 
 /* Queries take a const model and may come from several threads at once;
  * each borrows one of these workspaces without waiting (a query that
@@ -36,6 +38,11 @@ struct nurbs_impl {
 	double on_tol;    /* rounding level: closer counts as on the surface */
 	int edge_samples;
 	char why[160];
+	/* the inputs, kept for tracked streams (px_model_stream_create) */
+	struct px_nurbs_curve *kc;
+	struct px_nurbs_surf *ks;
+	int n_kc, n_ks;
+	double *kmem;
 };
 
 /* ---- signed distance for closed surface shells ---------------------------
@@ -508,6 +515,82 @@ static int sgn_query(const struct nurbs_impl *n, int k,
 	return s < 0.0 ? -1 : 1;
 }
 
+/* Take one of the workspaces without waiting; NURBS_WS when all are
+ * taken. */
+static int ws_take(struct nurbs_impl *n)
+{
+	int k;
+	for (k = 0; k < NURBS_WS; k++)
+		if (!atomic_flag_test_and_set_explicit(&n->busy[k],
+						       memory_order_acquire))
+			break;
+	return k;
+}
+
+static void ws_give(struct nurbs_impl *n, int k)
+{
+	atomic_flag_clear_explicit(&n->busy[k], memory_order_release);
+}
+
+/* The model's answer from the unsigned one d (the global query's or a
+ * stream's): the sign on closed shells (workspace slot k, or one taken
+ * here when k < 0), the on-surface direction, the fields. Returns 1, 0
+ * (beyond q->max_dist) or PX_E_BUSY. */
+static int nurbs_answer(struct nurbs_impl *n, int k,
+			const struct px_model_query *q,
+			const struct px_dist_result *d,
+			struct px_model_result *r)
+{
+	int sg = 1, own = 0;
+	int want_sign = n->closed && !(q->flags & PX_QUERY_UNSIGNED);
+
+	if (d->dist > q->max_dist)
+		return 0;
+	/* Within rounding of the surface the side is noise: outside. */
+	if (want_sign && d->dist > n->on_tol) {
+		if (k < 0) {
+			k = ws_take(n);
+			if (k == NURBS_WS)
+				return PX_E_BUSY;
+			own = 1;
+		}
+		sg = sgn_query(n, k, d);
+		if (own)
+			ws_give(n, k);
+	}
+	memset(r, 0, sizeof(*r));
+	r->distance = d->dist;
+	r->point = d->point;
+	r->direction = d->dir;
+	if (d->dist == 0.0) {
+		/* On the model: any unit vector satisfies query = point +
+		 * 0 * direction; keep the contract of a unit direction, the
+		 * outward normal where a closed shell has one. */
+		px_vec3 nn = px_v3(0, 0, 0);
+		if (want_sign)
+			nn = px_v3_scale(sgn_unit(sgn_normal(&n->ss[d->entity].s,
+							     d->u, d->v)),
+					 n->orient);
+		r->direction = px_v3_norm(nn) > 0.5 ? nn : px_v3(0.0, 0.0, 1.0);
+	} else if (sg < 0) {
+		/* Inside: query = point + (-dist) * direction, direction
+		 * pointing out of the solid. */
+		r->distance = -d->dist;
+		r->direction = px_v3_scale(d->dir, -1.0);
+		r->inside = 1;
+	}
+	r->index = d->entity;
+	r->sub = d->piece;
+	r->feature = d->kind == PX_DIST_CURVE ? PX_FEATURE_CURVE : PX_FEATURE_SURFACE;
+	r->u = d->u;
+	r->v = d->v;
+	r->is_signed = want_sign;
+	r->iterations = d->iters;
+	r->certified = d->certified;
+	r->gap = d->gap;
+	return 1;
+}
+
 static int nurbs_closest(const void *impl, const struct px_model_query *q,
 			 struct px_model_result *r)
 {
@@ -515,55 +598,205 @@ static int nurbs_closest(const void *impl, const struct px_model_query *q,
 	 * const; taking a workspace is the one write a query makes. */
 	struct nurbs_impl *n = (struct nurbs_impl *)(uintptr_t)impl;
 	struct px_dist_result d;
-	int k, rc, sg = 1;
-	int want_sign = n->closed && !(q->flags & PX_QUERY_UNSIGNED);
+	int k, rc;
 
-	for (k = 0; k < NURBS_WS; k++)
-		if (!atomic_flag_test_and_set_explicit(&n->busy[k],
-						       memory_order_acquire))
-			break;
+	k = ws_take(n);
 	if (k == NURBS_WS)
 		return PX_E_BUSY;
 	rc = px_dist_query_ws(n->dm, n->ws[k], q->p, &d);
-	/* Within rounding of the surface the side is noise: outside. */
-	if (rc == PX_OK && want_sign && d.dist > n->on_tol && d.dist <= q->max_dist)
-		sg = sgn_query(n, k, &d);
-	atomic_flag_clear_explicit(&n->busy[k], memory_order_release);
-	if (rc < 0)
-		return rc;
-	if (d.dist > q->max_dist)
-		return 0;
-	memset(r, 0, sizeof(*r));
-	r->distance = d.dist;
-	r->point = d.point;
-	r->direction = d.dir;
-	if (d.dist == 0.0) {
-		/* On the model: any unit vector satisfies query = point +
-		 * 0 * direction; keep the contract of a unit direction, the
-		 * outward normal where a closed shell has one. */
-		px_vec3 nn = px_v3(0, 0, 0);
-		if (want_sign)
-			nn = px_v3_scale(sgn_unit(sgn_normal(&n->ss[d.entity].s,
-							     d.u, d.v)),
-					 n->orient);
-		r->direction = px_v3_norm(nn) > 0.5 ? nn : px_v3(0.0, 0.0, 1.0);
-	} else if (sg < 0) {
-		/* Inside: query = point + (-dist) * direction, direction
-		 * pointing out of the solid. */
-		r->distance = -d.dist;
-		r->direction = px_v3_scale(d.dir, -1.0);
-		r->inside = 1;
+	if (rc == PX_OK)
+		rc = nurbs_answer(n, k, q, &d, r);
+	ws_give(n, k);
+	return rc;
+}
+
+/* ---- tracked streams ------------------------------------------------------
+ *
+ * A stream is a px_strack over the model's surfaces and curves (a
+ * px_track when there are curves alone), built from the inputs kept at
+ * creation; its answers are exact (every critical distance followed, or
+ * the global query where that cannot be proven), so they go through the
+ * same signing as the global query's. Entity numbering is px_dist.h's
+ * in both, as the model's own index. */
+
+struct nurbs_stream {
+	struct px_strack *st;
+	struct px_track *tr;
+	int n_curves;
+	uint64_t tracked, global, cold, jumps;
+};
+
+static void stream_free(void *state)
+{
+	struct nurbs_stream *s = state;
+	if (!s)
+		return;
+	px_strack_free(s->st);
+	px_track_free(s->tr);
+	free(s);
+}
+
+static int stream_create(const void *impl, const struct px_model_stream_opts *o,
+			 void **state)
+{
+	const struct nurbs_impl *n = impl;
+	struct nurbs_stream *s;
+	int rc;
+
+	*state = NULL;
+	s = calloc(1, sizeof(*s));
+	if (!s)
+		return PX_E_NOMEM;
+	s->n_curves = n->n_kc;
+	if (n->n_ks > 0) {
+		struct px_strack_opts so;
+		px_strack_opts_default(&so);
+		so.verify_every = o->verify_every;
+		so.max_solves = o->max_solves;
+		so.cold_switch = o->cold_switch;
+		rc = px_strack_create(n->kc, n->n_kc, n->ks, n->n_ks, &so, &s->st);
+	} else {
+		struct px_track_opts to;
+		px_track_opts_default(&to);
+		to.verify_every = o->verify_every;
+		to.cold_switch = o->cold_switch;
+		rc = px_track_create(n->kc, n->n_kc, &to, &s->tr);
 	}
-	r->index = d.entity;
-	r->sub = d.piece;
-	r->feature = d.kind == PX_DIST_CURVE ? PX_FEATURE_CURVE : PX_FEATURE_SURFACE;
-	r->u = d.u;
-	r->v = d.v;
-	r->is_signed = want_sign;
-	r->iterations = d.iters;
-	r->certified = d.certified;
-	r->gap = d.gap;
-	return 1;
+	if (rc != PX_OK) {
+		stream_free(s);
+		return rc;
+	}
+	*state = s;
+	return PX_OK;
+}
+
+static void stream_count(struct nurbs_stream *s, int source, int jumped)
+{
+	if (source == PX_TRACK_COLD)
+		s->cold++;
+	else if (source == PX_TRACK_GLOBAL || source == PX_TRACK_REINIT)
+		s->global++;
+	else
+		s->tracked++;
+	s->jumps += jumped != 0;
+}
+
+static int stream_query(const void *impl, void *state,
+			const struct px_model_query *q, struct px_model_result *r,
+			struct px_model_stream_note *note)
+{
+	struct nurbs_impl *n = (struct nurbs_impl *)(uintptr_t)impl;
+	struct nurbs_stream *s = state;
+	struct px_dist_result d;
+	int rc;
+
+	memset(&d, 0, sizeof(d));
+	if (s->st) {
+		struct px_strack_result sr;
+		rc = px_strack_update(s->st, q->p, &sr);
+		if (rc != PX_OK)
+			return rc;
+		d.dist = sr.dist;
+		d.point = sr.point;
+		d.dir = sr.dir;
+		d.u = sr.u;
+		d.v = sr.v;
+		d.entity = sr.entity;
+		note->source = sr.source;
+		note->jumped = sr.jumped;
+		note->n_crit = sr.n_crit;
+	} else {
+		struct px_track_result tr;
+		rc = px_track_update(s->tr, q->p, &tr);
+		if (rc != PX_OK)
+			return rc;
+		d.dist = tr.dist;
+		d.point = tr.point;
+		d.dir = tr.dir;
+		d.u = tr.u;
+		d.entity = tr.entity;
+		note->source = tr.source;
+		note->jumped = tr.jumped;
+		note->n_crit = tr.n_crit;
+	}
+	stream_count(s, note->source, note->jumped);
+	d.kind = d.entity < s->n_curves ? PX_DIST_CURVE : PX_DIST_SURFACE;
+	d.piece = -1;
+	d.certified = 1;
+	return nurbs_answer(n, -1, q, &d, r);
+}
+
+static void stream_stats(const void *state, struct px_model_stream_stats *st)
+{
+	const struct nurbs_stream *s = state;
+	st->tracked = s->tracked;
+	st->global = s->global;
+	st->cold = s->cold;
+	st->jumps = s->jumps;
+	if (s->st) {
+		struct px_strack_stats ss;
+		px_strack_get_stats(s->st, &ss);
+		st->hot = ss.hot;
+		st->reinits = ss.reinits;
+		st->verifications = ss.verifications;
+		st->disagreements = ss.disagreements;
+	} else {
+		struct px_track_stats ts;
+		px_track_get_stats(s->tr, &ts);
+		st->hot = ts.hot;
+		st->reinits = ts.reinits;
+		st->verifications = ts.verifications;
+		st->disagreements = ts.disagreements;
+	}
+}
+
+/* Copies of the inputs in one block (the caller's arrays may go). */
+static int keep_inputs(struct nurbs_impl *n, const struct px_nurbs_curve *curves,
+		       int nc, const struct px_nurbs_surf *surfs, int ns)
+{
+	size_t total = 0, at = 0;
+	int i;
+	for (i = 0; i < nc; i++)
+		total += 4 * (size_t)curves[i].n_ctrl + (size_t)curves[i].n_knots;
+	for (i = 0; i < ns; i++)
+		total += 4 * (size_t)surfs[i].n_ctrl[0] * (size_t)surfs[i].n_ctrl[1] +
+			 (size_t)surfs[i].n_knots[0] + (size_t)surfs[i].n_knots[1];
+	n->kc = calloc((size_t)nc + 1, sizeof(*n->kc));
+	n->ks = calloc((size_t)ns + 1, sizeof(*n->ks));
+	n->kmem = malloc((total + 1) * sizeof(double));
+	if (!n->kc || !n->ks || !n->kmem)
+		return PX_E_NOMEM;
+	for (i = 0; i < nc; i++) {
+		const struct px_nurbs_curve *c = &curves[i];
+		size_t npw = 4 * (size_t)c->n_ctrl, nk = (size_t)c->n_knots;
+		n->kc[i] = *c;
+		memcpy(n->kmem + at, c->pw, npw * sizeof(double));
+		n->kc[i].pw = n->kmem + at;
+		at += npw;
+		memcpy(n->kmem + at, c->knots, nk * sizeof(double));
+		n->kc[i].knots = n->kmem + at;
+		at += nk;
+	}
+	for (i = 0; i < ns; i++) {
+		const struct px_nurbs_surf *f = &surfs[i];
+		size_t npw = 4 * (size_t)f->n_ctrl[0] * (size_t)f->n_ctrl[1];
+		int d;
+		n->ks[i] = *f;
+		memcpy(n->kmem + at, f->pw, npw * sizeof(double));
+		n->ks[i].pw = n->kmem + at;
+		at += npw;
+		for (d = 0; d < 2; d++) {
+			size_t nk = (size_t)f->n_knots[d];
+			memcpy(n->kmem + at, f->knots[d], nk * sizeof(double));
+			n->ks[i].knots[d] = n->kmem + at;
+			at += nk;
+		}
+	}
+	n->n_kc = nc;
+	n->n_ks = ns;
+	n->bytes += ((size_t)nc + 1) * sizeof(*n->kc) +
+		    ((size_t)ns + 1) * sizeof(*n->ks) + (total + 1) * sizeof(double);
+	return PX_OK;
 }
 
 static px_aabb nurbs_aabb(const void *impl)
@@ -589,6 +822,9 @@ static void nurbs_free(void *impl)
 		free((void *)(uintptr_t)n->ss[i].s.pw);
 	}
 	free(n->ss);
+	free(n->kc);
+	free(n->ks);
+	free(n->kmem);
 	for (k = 0; k < NURBS_WS; k++)
 		px_dist_ws_free(n->ws[k]);
 	px_dist_model_free(n->dm);
@@ -602,6 +838,10 @@ static const struct px_model_ops nurbs_ops = {
 	.aabb = nurbs_aabb,
 	.memory_bytes = nurbs_bytes,
 	.free = nurbs_free,
+	.stream_create = stream_create,
+	.stream_query = stream_query,
+	.stream_stats = stream_stats,
+	.stream_free = stream_free,
 };
 
 int px_nurbs_model_create(const struct px_nurbs_curve *curves, int n_curves,
@@ -631,6 +871,11 @@ int px_nurbs_model_create(const struct px_nurbs_curve *curves, int n_curves,
 	n->box = info.bounds;
 	n->bytes = sizeof(*n) + info.bytes +
 		   NURBS_WS * (size_t)info.n_pieces * (sizeof(uint32_t) + 16);
+	rc = keep_inputs(n, curves, n_curves, surfs, n_surfs);
+	if (rc != PX_OK) {
+		nurbs_free(n);
+		return rc;
+	}
 	if (n_curves > 0) {
 		snprintf(n->why, sizeof(n->why),
 			 "the model has curves: only surface shells are signed");

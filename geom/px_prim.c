@@ -372,14 +372,15 @@ static px_vec3 prim_support(const void *impl, px_vec3 d)
 }
 
 static const struct px_model_ops prim_ops = {
-	"primitive", PX_MODEL_PRIMITIVE, prim_closest, prim_aabb, prim_bytes,
-	prim_free, prim_support, NULL, NULL};
+	.name = "primitive", .kind = PX_MODEL_PRIMITIVE, .closest = prim_closest,
+	.aabb = prim_aabb, .memory_bytes = prim_bytes, .free = prim_free,
+	.support = prim_support};
 
 /* Torus and half-space have no support function (not convex, or not
  * bounded). */
 static const struct px_model_ops prim_ops_nosupport = {
-	"primitive", PX_MODEL_PRIMITIVE, prim_closest, prim_aabb, prim_bytes,
-	prim_free, NULL, NULL, NULL};
+	.name = "primitive", .kind = PX_MODEL_PRIMITIVE, .closest = prim_closest,
+	.aabb = prim_aabb, .memory_bytes = prim_bytes, .free = prim_free};
 
 int px_prim_get(const struct px_model *m, struct px_prim *out)
 {

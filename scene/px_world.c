@@ -120,14 +120,23 @@ static double reported(const struct px_model_result *r)
 	return d;
 }
 
+struct px_world_tracking {
+	const struct px_world *w;
+	struct px_world_hints hints;
+	size_t n;      /* models when made: streams[0..n) */
+	int last;      /* model of the last answer, -1 none */
+	struct px_model_stream *st[];
+};
+
 static int nearest(const struct px_world *s, px_vec3 p, double max_distance_m,
-		   struct px_world_hints *hints, struct px_world_hit *out)
+		   struct px_world_hints *hints, struct px_world_tracking *trk,
+		   struct px_world_hit *out)
 {
 	double lb[PX_WORLD_MAX_MODELS];
 	unsigned char done[PX_WORLD_MAX_MODELS];
 	double best = INFINITY;
 	size_t i, n;
-	int queried = 0;
+	int queried = 0, jumped = 0;
 	if (!out)
 		return PX_E_INVAL;
 	memset(out, 0, sizeof(*out));
@@ -163,9 +172,17 @@ static int nearest(const struct px_world *s, px_vec3 p, double max_distance_m,
 		range = max_distance_m;
 		if ((!s->e[k].is_signed || lo > 0) && best >= 0 && best < range)
 			range = best;
-		rc = px_model_query_ex(s->e[k].m, p, range,
-				       hints ? hints->index[k] : -1,
-				       hints ? PX_QUERY_COHERENT : 0u, &r);
+		if (trk && k < trk->n && trk->st[k]) {
+			struct px_model_stream_note note;
+			rc = px_model_stream_query(trk->st[k], p, range, 0u, &r,
+						   &note);
+			if (rc == 1 && note.jumped && (int)k == trk->last)
+				jumped = 1;
+		} else {
+			rc = px_model_query_ex(s->e[k].m, p, range,
+					       hints ? hints->index[k] : -1,
+					       hints ? PX_QUERY_COHERENT : 0u, &r);
+		}
 		queried++;
 		if (rc < 0) {
 			out->models_queried = queried;
@@ -184,13 +201,21 @@ static int nearest(const struct px_world *s, px_vec3 p, double max_distance_m,
 		}
 	}
 	out->models_queried = queried;
+	if (trk) {
+		/* a change of model is a jump; within the last model, its
+		 * stream's word (models without a stream: changes of model
+		 * only); coming into or out of range is none */
+		out->jumped = out->model >= 0 && trk->last >= 0 &&
+			      (out->model != trk->last || jumped);
+		trk->last = out->model;
+	}
 	return out->model >= 0 ? 1 : 0;
 }
 
 int px_world_nearest(const struct px_world *s, px_vec3 p,
 		     double max_distance_m, struct px_world_hit *out)
 {
-	return nearest(s, p, max_distance_m, NULL, out);
+	return nearest(s, p, max_distance_m, NULL, NULL, out);
 }
 
 void px_world_hints_reset(struct px_world_hints *h)
@@ -214,7 +239,7 @@ int px_world_nearest_coherent(const struct px_world *s, px_vec3 p,
 		}
 		return PX_E_INVAL;
 	}
-	return nearest(s, p, max_distance_m, h, out);
+	return nearest(s, p, max_distance_m, h, NULL, out);
 }
 
 static int hit_to_control(int rc, const struct px_world_hit *h,
@@ -248,7 +273,7 @@ static int scene_point_coherent(void *ctx, px_vec3 p_m, double max_distance_m,
 {
 	struct px_world_hints *hints = ctx;
 	struct px_world_hit h;
-	int rc = nearest(hints->world_, p_m, max_distance_m, hints, &h);
+	int rc = nearest(hints->world_, p_m, max_distance_m, hints, NULL, &h);
 	return hit_to_control(rc, &h, out);
 }
 
@@ -275,5 +300,117 @@ int px_world_control_query_coherent(const struct px_world *s,
 	q->point = scene_point_coherent;
 	q->segment = NULL;
 	q->ctx = h;
+	return PX_OK;
+}
+
+/* ---- tracked queries ------------------------------------------------ */
+
+int px_world_tracking_create(const struct px_world *s,
+			     const struct px_model_stream_opts *o,
+			     struct px_world_tracking **out)
+{
+	struct px_world_tracking *t;
+	size_t i;
+	if (out)
+		*out = NULL;
+	if (!s || !out)
+		return PX_E_INVAL;
+	t = calloc(1, sizeof(*t) + (s->n + 1) * sizeof(t->st[0]));
+	if (!t)
+		return PX_E_NOMEM;
+	t->w = s;
+	t->n = s->n;
+	t->last = -1;
+	px_world_hints_reset(&t->hints);
+	t->hints.world_ = s;
+	for (i = 0; i < s->n; i++) {
+		int rc = px_model_stream_create(s->e[i].m, o, &t->st[i]);
+		if (rc == PX_E_UNSUPPORTED) {
+			t->st[i] = NULL;
+			continue;
+		}
+		if (rc != PX_OK) {
+			px_world_tracking_free(t);
+			return rc;
+		}
+	}
+	*out = t;
+	return PX_OK;
+}
+
+void px_world_tracking_free(struct px_world_tracking *t)
+{
+	size_t i;
+	if (!t)
+		return;
+	for (i = 0; i < t->n; i++)
+		px_model_stream_free(t->st[i]);
+	free(t);
+}
+
+int px_world_nearest_tracked(const struct px_world *s, px_vec3 p,
+			     double max_distance_m, struct px_world_tracking *t,
+			     struct px_world_hit *out)
+{
+	if (!t || t->w != s) {
+		if (out) {
+			memset(out, 0, sizeof(*out));
+			out->model = -1;
+			out->distance_m = INFINITY;
+		}
+		return PX_E_INVAL;
+	}
+	return nearest(s, p, max_distance_m, &t->hints, t, out);
+}
+
+int px_world_tracking_stats(const struct px_world_tracking *t,
+			    struct px_model_stream_stats *sum)
+{
+	size_t i;
+	int n = 0;
+	if (sum)
+		memset(sum, 0, sizeof(*sum));
+	if (!t)
+		return 0;
+	for (i = 0; i < t->n; i++) {
+		struct px_model_stream_stats st;
+		if (!t->st[i])
+			continue;
+		n++;
+		if (!sum)
+			continue;
+		px_model_stream_get_stats(t->st[i], &st);
+		sum->queries += st.queries;
+		sum->tracked += st.tracked;
+		sum->hot += st.hot;
+		sum->global += st.global;
+		sum->cold += st.cold;
+		sum->jumps += st.jumps;
+		sum->reinits += st.reinits;
+		sum->verifications += st.verifications;
+		sum->disagreements += st.disagreements;
+	}
+	return n;
+}
+
+static int scene_point_tracked(void *ctx, px_vec3 p_m, double max_distance_m,
+			       struct px_control_hit *out)
+{
+	struct px_world_tracking *t = ctx;
+	struct px_world_hit h;
+	int rc = nearest(t->w, p_m, max_distance_m, &t->hints, t, &h);
+	return hit_to_control(rc, &h, out);
+}
+
+int px_world_control_query_tracked(const struct px_world *s,
+				   struct px_world_tracking *t,
+				   struct px_control_query *q)
+{
+	if (!s || !t || t->w != s || !q)
+		return PX_E_INVAL;
+	memset(q, 0, sizeof(*q));
+	q->point = scene_point_tracked;
+	q->segment = NULL;
+	q->ctx = t;
 	return PX_OK;
 }

@@ -99,6 +99,10 @@ struct px_world_hit {
 	/* r.distance, lowered by r.gap when not certified (see above) */
 	double distance_m;
 	int models_queried;          /* narrow-phase queries made */
+	/* Tracked queries only (px_world_nearest_tracked), 0 otherwise:
+	 * the closest point jumped since the last answer (another model,
+	 * or another branch of the same model's distance). */
+	int jumped;
 };
 
 /*
@@ -151,6 +155,67 @@ PX_API int px_world_control_query(const struct px_world *s,
 PX_API int px_world_control_query_coherent(const struct px_world *s,
 					   struct px_world_hints *h,
 					   struct px_control_query *q);
+
+/* ---- tracked queries ----------------------------------------------
+ *
+ * One moving point (a haptic proxy or tool tip) followed through the
+ * scene: every model that can track (NURBS models: px_model.h's
+ * streams) gets a stream that follows the point's critical distances
+ * instead of searching from scratch, the others are queried with
+ * coherence hints. Answers are the same exact nearest surface as
+ * px_world_nearest(); a model the broad phase passes over is not
+ * followed that time and catches up when next asked (a longer step
+ * costs more work, never a wrong answer).
+ *
+ * Memory and real-time rules: px_world_tracking_create() allocates every
+ * stream (setup; NURBS surfaces take some milliseconds and megabytes
+ * each); the queries and the statistics are RT-safe. One thread uses a
+ * tracking state; the world must outlive it and keep its models (models
+ * added later are queried with hints).
+ */
+struct px_world_tracking;
+struct px_model_stream_opts;
+struct px_model_stream_stats;
+
+/*
+ * Streams for the models of s (o: px_model_stream_opts, NULL for the
+ * defaults: verification off, as in a loop). Models whose representation
+ * cannot track are not an error. Returns PX_OK, PX_E_INVAL, PX_E_NOMEM
+ * or a stream's error (then *out is NULL).
+ */
+PX_API int px_world_tracking_create(const struct px_world *s,
+				    const struct px_model_stream_opts *o,
+				    struct px_world_tracking **out);
+
+/* NULL is a no-op. Setup only. */
+PX_API void px_world_tracking_free(struct px_world_tracking *t);
+
+/*
+ * As px_world_nearest(), following the point through t (made for s):
+ * out->jumped says whether the closest point jumped. Returns as
+ * px_world_nearest() (PX_E_INVAL also for a NULL t or one made for
+ * another world). @note RT-safe.
+ */
+PX_API int px_world_nearest_tracked(const struct px_world *s, px_vec3 p,
+				    double max_distance_m,
+				    struct px_world_tracking *t,
+				    struct px_world_hit *out);
+
+/*
+ * Counters of t's streams, summed (zeroed for NULL); returns the number
+ * of models followed by a stream. @note RT-safe.
+ */
+PX_API int px_world_tracking_stats(const struct px_world_tracking *t,
+				   struct px_model_stream_stats *sum);
+
+/*
+ * As px_world_control_query_coherent(), with tracked queries through t:
+ * the renderer's queries follow one moving point. Returns PX_OK or
+ * PX_E_INVAL.
+ */
+PX_API int px_world_control_query_tracked(const struct px_world *s,
+					  struct px_world_tracking *t,
+					  struct px_control_query *q);
 
 /* ---- configuration (setup time) --------------------------------- */
 

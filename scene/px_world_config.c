@@ -189,6 +189,45 @@ static int scaled_closest(const void *impl, const struct px_model_query *q,
 	return rc;
 }
 
+/* Streams through the wrapper follow the point in the inner model's
+ * frame (inner models without streams say PX_E_UNSUPPORTED). */
+static int scaled_stream_create(const void *impl,
+				const struct px_model_stream_opts *o,
+				void **state)
+{
+	const struct scaled *w = impl;
+	return px_model_stream_create(w->inner, o,
+				      (struct px_model_stream **)state);
+}
+
+static int scaled_stream_query(const void *impl, void *state,
+			       const struct px_model_query *q,
+			       struct px_model_result *r,
+			       struct px_model_stream_note *note)
+{
+	const struct scaled *w = impl;
+	double md = isinf(q->max_dist) ? q->max_dist : q->max_dist / w->s;
+	int rc = px_model_stream_query(state, px_v3_scale(q->p, 1 / w->s), md,
+				       q->flags, r, note);
+	if (rc == 1) {
+		r->distance *= w->s;
+		r->gap *= w->s;
+		r->point = px_v3_scale(r->point, w->s);
+	}
+	return rc;
+}
+
+static void scaled_stream_stats(const void *state,
+				struct px_model_stream_stats *st)
+{
+	px_model_stream_get_stats(state, st);
+}
+
+static void scaled_stream_free(void *state)
+{
+	px_model_stream_free(state);
+}
+
 static px_aabb scaled_aabb(const void *impl)
 {
 	const struct scaled *w = impl;
@@ -216,7 +255,11 @@ static void scaled_free(void *impl)
 
 #define SCALED_OPS(k)                                                       \
 	{.name = "scaled", .kind = k, .closest = scaled_closest,              \
-	 .aabb = scaled_aabb, .memory_bytes = scaled_bytes, .free = scaled_free}
+	 .aabb = scaled_aabb, .memory_bytes = scaled_bytes, .free = scaled_free, \
+	 .stream_create = scaled_stream_create,                               \
+	 .stream_query = scaled_stream_query,                                 \
+	 .stream_stats = scaled_stream_stats,                                 \
+	 .stream_free = scaled_stream_free}
 static const struct px_model_ops scaled_ops[] = {
 	SCALED_OPS(PX_MODEL_CUSTOM),    SCALED_OPS(PX_MODEL_PRIMITIVE),
 	SCALED_OPS(PX_MODEL_MESH),      SCALED_OPS(PX_MODEL_CLOUD),

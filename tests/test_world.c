@@ -2,6 +2,7 @@
  * broad phase, the control adapter's no-overestimate contract, scale,
  * config loading and its errors, no allocation in queries. */
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -555,6 +556,162 @@ static void test_proxy_leaves_the_end_of_a_face(void)
 	px_world_free(s);
 }
 
+/* Tracked queries (px_world_nearest_tracked) along smooth paths through a
+ * scene of NURBS models (a scaled terrain, a closed rational sphere -
+ * signed -, a curve-only circle: px_strack and px_track streams) and a
+ * mesh: every answer equals the plain global one, the streams do the
+ * work (tracked answers, hot path), a model moved between queries is
+ * followed, jumps of the closest point are reported, and nothing is
+ * allocated once the streams are made. */
+static void test_tracked_matches_plain(void)
+{
+	static struct px_config_diag diag;
+	struct px_world *s, *other;
+	struct px_world_tracking *t;
+	struct px_model_stream_opts so;
+	struct px_model_stream_stats st;
+	struct px_control_query q;
+	char text[4096], cwd[400];
+	px_vec3 prev_p = px_v3(0, 0, 0), prev_pt = px_v3(0, 0, 0);
+	int prev_model = -1, k, pass, real_jumps = 0, missed = 0, reported = 0;
+	long stream_answers = 0;
+	uint64_t a;
+
+	PX_CHECK(getcwd(cwd, sizeof(cwd)) != NULL);
+	snprintf(text, sizeof(text),
+		 "scene:\n  models:\n"
+		 "    - {name: terrain, file: %s/config/examples/scenes/terrain.obj,"
+		 " kind: nurbs, scale: 1.25, pose: {xyz_m: [0.0, 0.0, 0.005]}}\n"
+		 "    - {name: ball, file: %s/tests/data/sphere.obj, kind: nurbs,"
+		 " scale: 0.015, pose: {xyz_m: [-0.04, 0.03, 0.0]}}\n"
+		 "    - {name: ring, file: %s/tests/data/circle.obj, kind: nurbs,"
+		 " scale: 0.01, pose: {xyz_m: [0.03, -0.04, 0.01],"
+		 " rpy_rad: [0.4, 0.0, 0.0]}}\n"
+		 "    - {name: knob, file: %s/config/examples/scenes/knob.stl,"
+		 " kind: mesh, pose: {xyz_m: [-0.03, -0.05, 0.0]}}\n",
+		 cwd, cwd, cwd, cwd);
+	if (load(text, &s, &diag) != PX_OK) {
+		px_config_diag_print(&diag, stdout);
+		PX_CHECK(0);
+		return;
+	}
+	px_model_stream_opts_default(&so);
+	so.verify_every = 7;
+	PX_CHECK_INT_EQ(px_world_tracking_create(s, &so, &t), PX_OK);
+	/* three NURBS models follow with streams, the mesh with hints */
+	PX_CHECK_INT_EQ(px_world_tracking_stats(t, &st), 3);
+	/* the closed sphere is signed, also behind the scale */
+	{
+		struct px_world_hit h;
+		PX_CHECK_INT_EQ(px_world_nearest(s, px_v3(-0.04, 0.03, 0.0), 1.0,
+						 &h),
+				1);
+		PX_CHECK_INT_EQ(h.model, 1);
+		PX_CHECK(h.r.is_signed && h.distance_m < -0.02);
+	}
+	a = px_alloc_region_begin();
+	for (pass = 0; pass < 2; pass++) {
+		for (k = 0; k < 6000; k++) {
+			double tt = (double)k / 1000.0 + 0.37 * pass;
+			struct px_world_hit h0, h1;
+			int r0, r1;
+			px_vec3 p = px_v3(0.09 * sin(0.9 * tt + 0.3 * pass),
+					  0.08 * sin(1.3 * tt + 1.0),
+					  0.012 + 0.025 * sin(2.1 * tt));
+			if (pass == 1 && k >= 2000 && k < 4000) {
+				/* the ball moves under the point */
+				px_pose pose = px_pose_identity();
+				pose.t = px_v3(-0.04 + 0.02 * sin(3.0 * tt), 0.03,
+					       0.0);
+				PX_CHECK_INT_EQ(px_world_set_pose(s, 1, pose), PX_OK);
+			}
+			r0 = px_world_nearest(s, p, 1.0, &h0);
+			r1 = px_world_nearest_tracked(s, p, 1.0, t, &h1);
+			PX_CHECK_INT_EQ(r1, r0);
+			PX_CHECK_NEAR(h1.distance_m, h0.distance_m, 1e-9);
+			if (fabs(h1.distance_m - h0.distance_m) > 1e-9)
+				printf("  step %d pass %d: model %d %.12g vs %d %.12g\n",
+				       k, pass, h1.model, h1.distance_m, h0.model,
+				       h0.distance_m);
+			if (h1.model != h0.model)
+				/* only a tie may name another model */
+				PX_CHECK_NEAR(h1.distance_m, h0.distance_m, 1e-12);
+			else
+				PX_CHECK(px_v3_dist(h1.r.point, h0.r.point) < 1e-6);
+			PX_CHECK_INT_EQ(h1.r.is_signed, h0.r.is_signed);
+			if (h1.model >= 0 && h1.model < 3)
+				stream_answers++;
+			/* a closest point moving far more than the query
+			 * point, within one model, or another model, is a
+			 * jump the answer must report */
+			if (k > 0 && h1.model >= 0 && prev_model >= 0) {
+				double dq = px_v3_dist(p, prev_p);
+				double dx = px_v3_dist(h1.r.point, prev_pt);
+				int real = h1.model != prev_model ||
+					   dx > 50.0 * dq + 1e-6;
+				real_jumps += real;
+				missed += real && !h1.jumped;
+				reported += h1.jumped;
+			}
+			prev_p = p;
+			prev_pt = h1.r.point;
+			prev_model = h1.model;
+		}
+	}
+	PX_CHECK_INT_EQ(px_alloc_region_end(a), 0);
+	PX_CHECK_INT_EQ(px_world_tracking_stats(t, &st), 3);
+	printf("  tracked scene: %ld stream answers of 12000; streams: %llu "
+	       "queries, %llu tracked (%llu hot), %llu global, %llu cold, "
+	       "%llu verified, %llu disagreements; jumps %d real, %d missed, "
+	       "%d reported\n",
+	       stream_answers, (unsigned long long)st.queries,
+	       (unsigned long long)st.tracked, (unsigned long long)st.hot,
+	       (unsigned long long)st.global, (unsigned long long)st.cold,
+	       (unsigned long long)st.verifications,
+	       (unsigned long long)st.disagreements, real_jumps, missed,
+	       reported);
+	PX_CHECK(stream_answers > 3000);
+	/* the streams, not a global query behind them, answered */
+	PX_CHECK(st.tracked > st.queries / 2);
+	PX_CHECK(st.hot > st.tracked / 4);
+	PX_CHECK(st.verifications > 100);
+	PX_CHECK_INT_EQ((long)st.disagreements, 0);
+	PX_CHECK(real_jumps > 0);
+	PX_CHECK_INT_EQ(missed, 0);
+
+	/* the control adapter answers as the plain one */
+	PX_CHECK_INT_EQ(px_world_control_query_tracked(s, t, &q), PX_OK);
+	for (k = 0; k < 300; k++) {
+		px_vec3 p = px_v3(0.05 * cos(k * 0.01), 0.05 * sin(k * 0.01), 0.01);
+		struct px_control_hit c;
+		struct px_world_hit h;
+		PX_CHECK_INT_EQ(q.point(q.ctx, p, 1.0, &c), PX_OK);
+		PX_CHECK_INT_EQ(px_world_nearest(s, p, 1.0, &h), 1);
+		PX_CHECK(c.valid);
+		PX_CHECK_NEAR(c.distance_m, h.distance_m, 1e-9);
+	}
+	/* bad input: a NaN point leaves the streams as they were; a
+	 * tracking state of another world is refused */
+	{
+		struct px_world_hit h;
+		PX_CHECK_INT_EQ(px_world_nearest_tracked(s, px_v3(NAN, 0, 0), 1.0,
+							 t, &h),
+				PX_E_NAN);
+		PX_CHECK_INT_EQ(px_world_create(1, &other), PX_OK);
+		PX_CHECK_INT_EQ(px_world_nearest_tracked(other, px_v3(0, 0, 0),
+							 1.0, t, &h),
+				PX_E_INVAL);
+		PX_CHECK_INT_EQ(px_world_nearest_tracked(s, px_v3(0, 0, 0), 1.0,
+							 NULL, &h),
+				PX_E_INVAL);
+		PX_CHECK_INT_EQ(px_world_control_query_tracked(other, t, &q),
+				PX_E_INVAL);
+		px_world_free(other);
+	}
+	px_world_tracking_free(t);
+	px_world_free(s);
+}
+
 static void test_schema_documented(void)
 {
 	char why[200];
@@ -579,6 +736,7 @@ static const struct px_test tests[] = {
 	PX_T(test_config_scale),
 	PX_T(test_config_errors),
 	PX_T(test_proxy_leaves_the_end_of_a_face),
+	PX_T(test_tracked_matches_plain),
 	PX_T(test_schema_documented),
 };
 PX_TEST_MAIN(tests)
