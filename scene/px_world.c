@@ -21,6 +21,8 @@ struct px_world_entry {
 
 struct px_world {
 	size_t cap, n;
+	bool track_on;
+	struct px_model_stream_opts track_opts;
 	struct px_world_entry e[];
 };
 
@@ -35,6 +37,8 @@ int px_world_create(size_t capacity, struct px_world **out)
 	if (!s)
 		return PX_E_NOMEM;
 	s->cap = capacity;
+	s->track_on = true;
+	px_model_stream_opts_default(&s->track_opts);
 	*out = s;
 	return PX_OK;
 }
@@ -305,6 +309,32 @@ int px_world_control_query_coherent(const struct px_world *s,
 
 /* ---- tracked queries ------------------------------------------------ */
 
+int px_world_set_tracking(struct px_world *s, bool enabled,
+			  const struct px_model_stream_opts *o)
+{
+	if (!s)
+		return PX_E_INVAL;
+	if (o && (o->verify_every < 0 || o->max_solves < 0 ||
+		  (o->cold_switch != 0 && o->cold_switch != 1)))
+		return PX_E_INVAL;
+	s->track_on = enabled;
+	if (o)
+		s->track_opts = *o;
+	else
+		px_model_stream_opts_default(&s->track_opts);
+	return PX_OK;
+}
+
+int px_world_get_tracking(const struct px_world *s,
+			  struct px_model_stream_opts *o)
+{
+	if (!s)
+		return PX_E_INVAL;
+	if (o)
+		*o = s->track_opts;
+	return s->track_on ? 1 : 0;
+}
+
 int px_world_tracking_create(const struct px_world *s,
 			     const struct px_model_stream_opts *o,
 			     struct px_world_tracking **out)
@@ -315,6 +345,8 @@ int px_world_tracking_create(const struct px_world *s,
 		*out = NULL;
 	if (!s || !out)
 		return PX_E_INVAL;
+	if (!o)
+		o = &s->track_opts;
 	t = calloc(1, sizeof(*t) + (s->n + 1) * sizeof(t->st[0]));
 	if (!t)
 		return PX_E_NOMEM;

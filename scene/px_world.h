@@ -179,7 +179,8 @@ struct px_model_stream_stats;
 
 /*
  * Streams for the models of s (o: px_model_stream_opts, NULL for the
- * defaults: verification off, as in a loop). Models whose representation
+ * scene's own, px_world_get_tracking(): by default verification off, as
+ * in a loop). Models whose representation
  * cannot track are not an error. Returns PX_OK, PX_E_INVAL, PX_E_NOMEM
  * or a stream's error (then *out is NULL).
  */
@@ -207,6 +208,18 @@ PX_API int px_world_nearest_tracked(const struct px_world *s, px_vec3 p,
  */
 PX_API int px_world_tracking_stats(const struct px_world_tracking *t,
 				   struct px_model_stream_stats *sum);
+
+/*
+ * The scene's tracking settings (the config's scene.tracking; a new
+ * world: enabled, defaults): whether a loop should follow its point with
+ * tracked queries, and the streams' options. set: setup only, o NULL for
+ * the defaults; PX_OK or PX_E_INVAL. get: 1 when enabled, 0 when not,
+ * PX_E_INVAL; o (may be NULL) gets the options.
+ */
+PX_API int px_world_set_tracking(struct px_world *s, bool enabled,
+				 const struct px_model_stream_opts *o);
+PX_API int px_world_get_tracking(const struct px_world *s,
+				 struct px_model_stream_opts *o);
 
 /*
  * As px_world_control_query_coherent(), with tracked queries through t:

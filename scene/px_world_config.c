@@ -55,11 +55,19 @@ struct raw_prim {
 		tube_radius_m;
 };
 
+struct raw_tracking {
+	bool enabled;
+	int64_t verify_every;
+	int64_t max_solves;
+	bool cold_switch;
+};
+
 struct raw_scene {
 	struct raw_model *models;
 	size_t n_models;
 	struct raw_prim *prims;
 	size_t n_prims;
+	struct raw_tracking tracking;
 	/* not keys: context for the check */
 	const struct px_config *cfg_;
 	const struct px_config_diag *diag_;
@@ -152,11 +160,20 @@ SCHEMA(prim_schema, "primitive", prim_keys, prim_check);
 static void scene_check(struct px_config_reader *r,
 			const struct px_config_node *map, void *obj);
 
+static const struct px_config_key tracking_keys[] = {
+	K_BOOL(struct raw_tracking, enabled, "enabled", 1),
+	K_INT(struct raw_tracking, verify_every, "verify_every", 0, 0, 1000000, 0),
+	K_INT(struct raw_tracking, max_solves, "max_solves", 0, 0, 1000, 4),
+	K_BOOL(struct raw_tracking, cold_switch, "cold_switch", 1),
+};
+SCHEMA(tracking_schema, "tracking", tracking_keys, NULL);
+
 static const struct px_config_key scene_keys[] = {
 	K_SEQ(struct raw_scene, models, n_models, "models", 0, model_schema,
 	      struct raw_model, 0, PX_WORLD_MAX_MODELS),
 	K_SEQ(struct raw_scene, prims, n_prims, "primitives", 0, prim_schema,
 	      struct raw_prim, 0, PX_WORLD_MAX_MODELS),
+	K_SUB(struct raw_scene, tracking, "tracking", tracking_schema),
 };
 SCHEMA(scene_schema, "scene", scene_keys, scene_check);
 
@@ -519,6 +536,14 @@ int px_world_config_load(const struct px_config *cfg, struct px_world **out,
 	if (rc != PX_OK) {
 		px_world_free(raw.scene_);
 		return rc;
+	}
+	{
+		struct px_model_stream_opts o;
+		px_model_stream_opts_default(&o);
+		o.verify_every = (int)raw.tracking.verify_every;
+		o.max_solves = (int)raw.tracking.max_solves;
+		o.cold_switch = raw.tracking.cold_switch ? 1 : 0;
+		px_world_set_tracking(raw.scene_, raw.tracking.enabled, &o);
 	}
 	*out = raw.scene_;
 	return PX_OK;

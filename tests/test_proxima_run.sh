@@ -237,6 +237,38 @@ expect "penalty renderer run" 0 "$bin" "$tmp/penalty.yaml" --virtual-time --dura
 check "penalty: force within the clamp" "$(num "$tmp/pen.json" max_force_n) <= $(num "$tmp/pen.json" force_clamp_n) + 1e-9"
 check "penalty: contact happened" "$(num "$tmp/pen.json" contact_cycles) > 0"
 
+# Tracked queries (scene.tracking, on by default in haptic mode) change
+# the cost, not the answers: the same run with tracking off gives the same
+# telemetry within rounding; the streams answered, mostly from their
+# tracked sets, and checked against the global query at every answer
+# (verify_every: 1) never disagreed.
+check "tracking on by default: streams answered" \
+	"$(sub "$tmp/haptic_sim.json" tracking streams) >= 1 && $(sub "$tmp/haptic_sim.json" tracking queries) > 3000"
+check "tracking on by default: mostly tracked" \
+	"$(sub "$tmp/haptic_sim.json" tracking tracked) > $(sub "$tmp/haptic_sim.json" tracking queries) / 2"
+if "$bin" "$good" --virtual-time --duration-s 0.5 --telemetry "$tmp/tr.csv" 2>/dev/null |
+	grep -qE '^  tracking          [0-9]+ streams?: [0-9]+ answers, [0-9.]+ % tracked'; then
+	ok "summary has the tracking line"; else bad "summary has the tracking line"; fi
+absolute "$good" | sed 's/^  primitives:/  tracking: {enabled: false}\n  primitives:/' >"$tmp/notrack.yaml"
+absolute "$good" | sed 's/^  primitives:/  tracking: {verify_every: 1}\n  primitives:/' >"$tmp/verify.yaml"
+expect "run with tracking off" 0 "$bin" "$tmp/notrack.yaml" --virtual-time --duration-s 3 \
+	--summary-json "$tmp/notrack.json" --telemetry "$tmp/notrack.csv"
+check "tracking off: no stream" "$(sub "$tmp/notrack.json" tracking streams) == 0"
+# columns 3-14 (device, proxy, force, distance, penetration) agree to
+# the CSV's six significant digits (a last digit may round either way)
+if [ "$(wc -l <"$tmp/notrack.csv")" -eq "$(wc -l <"$tmp/haptic_sim.csv")" ] &&
+	paste -d, "$tmp/haptic_sim.csv" "$tmp/notrack.csv" | awk -F, -v n=19 '
+	NR > 1 { for (i = 3; i <= 14; i++) { d = $i - $(i + n); if (d < 0) d = -d
+		a = $i < 0 ? -$i : $i
+		if (d > 1e-9 + 1e-5 * a) { print "    line " NR " column " i ": " $i " vs " $(i + n); bad = 1; exit } } }
+	END { exit bad }'; then
+	ok "tracked and untracked runs give the same telemetry"; else bad "tracked and untracked runs give the same telemetry"; fi
+expect "run verifying every tracked answer" 0 "$bin" "$tmp/verify.yaml" --virtual-time --duration-s 3 \
+	--summary-json "$tmp/verify.json"
+check "verify_every 1: verified ($(sub "$tmp/verify.json" tracking verifications)), no disagreement" \
+	"$(sub "$tmp/verify.json" tracking verifications) > 1000 && $(sub "$tmp/verify.json" tracking disagreements) == 0"
+check "verify_every 1: no allocation after setup" "$(num "$tmp/verify.json" allocations_after_setup) == 0"
+
 # Safety: a velocity limit below the hand's speed trips safe state; from
 # then on every force sent is zero (no auto re-arm).
 absolute "$good" | sed 's/velocity_limit_m_per_s: .*/velocity_limit_m_per_s: 0.05/' >"$tmp/slow.yaml"

@@ -458,6 +458,9 @@ struct app {
 	struct px_control_config ctl;
 	struct px_world *scene;
 	struct px_world_hints hints; /* coherent queries of the loop thread */
+	/* haptic mode, scene.tracking on: the renderer's queries follow one
+	 * point through tracked streams (NULL otherwise) */
+	struct px_world_tracking *tracking;
 	struct px_control_query query;
 	struct px_control_haptic haptic;
 	struct px_dev *dev[MAX_DEVS];
@@ -1414,6 +1417,23 @@ static int setup(void)
 	/* the loop's queries follow a moving point (proxy, device, link
 	 * points): each model's search starts at last answer's feature */
 	px_world_control_query_coherent(A.scene, &A.hints, &A.query);
+	/* a haptic renderer's queries follow one point (the proxy, or the
+	 * device point): NURBS models follow it with tracked streams, the
+	 * exact answer at a fraction of the global query's cost
+	 * (scene.tracking); an arm's link points are many points, and stay
+	 * with the hints */
+	if (A.ctl.mode == PX_CONTROL_MODE_HAPTIC &&
+	    px_world_get_tracking(A.scene, NULL) == 1) {
+		rc = px_world_tracking_create(A.scene, NULL, &A.tracking);
+		if (rc != PX_OK) {
+			fprintf(stderr,
+				"proxima-run: %s: scene.tracking: cannot make the "
+				"tracked streams: %s\n",
+				A.o.config, px_strerror(rc));
+			return 1;
+		}
+		px_world_control_query_tracked(A.scene, A.tracking, &A.query);
+	}
 	for (i = 0; i < (int)cfg->n_devices; i++) {
 		if (!is_hardware(&cfg->devices[i]))
 			continue;
@@ -1583,6 +1603,7 @@ static void teardown(void)
 	for (i = 0; i < A.n_dcfg; i++)
 		px_devcfg_free(A.dcfg[i]); /* devices, master, buses */
 	px_can_sim_free(A.fault_bus); /* after its endpoints */
+	px_world_tracking_free(A.tracking); /* before its world */
 	px_world_free(A.scene);
 	px_arena_fini(&A.arena);
 	free(A.recs);
@@ -2068,6 +2089,24 @@ static int write_json(const char *path, const struct px_loop_status *st,
 		(unsigned long long)st->missed_periods);
 	json_stats(f, "wakeup_latency_ns", lat, 0);
 	json_stats(f, "compute_ns", cmp, 0);
+	{
+		struct px_model_stream_stats ts;
+		int ns = px_world_tracking_stats(A.tracking, &ts);
+		fprintf(f,
+			"  \"tracking\": {\"enabled\": %s, \"streams\": %d, "
+			"\"queries\": %llu, \"tracked\": %llu, \"hot\": %llu, "
+			"\"global\": %llu, \"cold\": %llu, \"jumps\": %llu, "
+			"\"reinits\": %llu, \"verifications\": %llu, "
+			"\"disagreements\": %llu},\n",
+			A.tracking ? "true" : "false", ns,
+			(unsigned long long)ts.queries,
+			(unsigned long long)ts.tracked,
+			(unsigned long long)ts.hot, (unsigned long long)ts.global,
+			(unsigned long long)ts.cold, (unsigned long long)ts.jumps,
+			(unsigned long long)ts.reinits,
+			(unsigned long long)ts.verifications,
+			(unsigned long long)ts.disagreements);
+	}
 	fprintf(f,
 		"  \"max_force_n\": %.9g,\n  \"force_clamp_n\": %.9g,\n"
 		"  \"min_distance_m\": %.9g,\n  \"max_penetration_m\": %.9g,\n"
@@ -2295,6 +2334,20 @@ static void print_summary(const struct px_loop_status *st,
 		       "%d in operation enabled at the end",
 		       A.n_drives, A.co_name, (unsigned long long)A.enabled_cycles,
 		       n);
+	}
+	if (A.tracking) {
+		struct px_model_stream_stats ts;
+		int ns = px_world_tracking_stats(A.tracking, &ts);
+		double q = ts.queries ? (double)ts.queries : 1.0;
+		printf("\n  tracking          %d stream%s: %llu answers, %.1f %% "
+		       "tracked (%.1f %% hot), %.1f %% global, %.1f %% cold, "
+		       "%llu jumps, %llu verified, %llu disagreements",
+		       ns, ns == 1 ? "" : "s", (unsigned long long)ts.queries,
+		       100.0 * (double)ts.tracked / q, 100.0 * (double)ts.hot / q,
+		       100.0 * (double)ts.global / q, 100.0 * (double)ts.cold / q,
+		       (unsigned long long)ts.jumps,
+		       (unsigned long long)ts.verifications,
+		       (unsigned long long)ts.disagreements);
 	}
 	printf("\n  allocations       %llu after setup (loop thread; setup made "
 	       "%llu)\n",
