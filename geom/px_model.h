@@ -25,6 +25,11 @@
  * point out), and on the surface it is the outward normal where one is
  * defined.
  *
+ * Representations that can follow a moving point (NURBS) also hand out
+ * tracked streams (px_model_stream_create(), below): per-point state made
+ * at setup whose answers are the same as a query's, at a fraction of the
+ * cost when the point moves a little between them.
+ *
  * Memory and real-time rules: creating a model (px_model_create and the
  * per-representation constructors) is setup-time and allocates; the
  * handle owns its implementation and px_model_free() releases both.

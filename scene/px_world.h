@@ -26,6 +26,12 @@
  * its search (px_model_query_ex with PX_QUERY_COHERENT). The answer is
  * the same global nearest surface; a stale hint only costs time.
  *
+ * Tracked queries. px_world_nearest_tracked() follows one moving point
+ * with a stream per NURBS model (px_model.h: every critical distance
+ * followed, pairs born and dying detected) and hints for the rest: the
+ * same exact answer at a fraction of the cost, and a word on whether the
+ * closest point jumped. The loop's haptic renderer uses it.
+ *
  * As the control module's query (px_world_control_query): the hit is
  * the nearest answer with two_sided = the model is unsigned. Answers a
  * model does not certify (a bound cut its search short) report distance
