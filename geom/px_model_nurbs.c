@@ -338,11 +338,11 @@ static int sgn_edges_at(const struct sgn_surf *g, double u, double v, double eps
 	       (v - g->v0 <= ev) << 2 | (g->v1 - v <= ev) << 3;
 }
 
-static int sgn_setup(struct nurbs_impl *n, const struct px_nurbs_surf *surfs,
-		     int ns, const struct px_dist_opts *opts)
+/* The sign tables of the model's kept surfaces (n->ks, n->n_ks). */
+static int sgn_setup(struct nurbs_impl *n, const struct px_dist_opts *opts)
 {
 	double diag, tol, vol3 = 0.0;
-	int i, e, k, rc;
+	int i, e, k, rc, ns = n->n_ks;
 
 	diag = px_v3_norm(px_v3_sub(n->box.max, n->box.min));
 	tol = SIGN_TOL_REL * diag;
@@ -354,27 +354,20 @@ static int sgn_setup(struct nurbs_impl *n, const struct px_nurbs_surf *surfs,
 	n->n_ss = ns;
 	for (i = 0; i < ns; i++) {
 		struct sgn_surf *g = &n->ss[i];
-		const struct px_nurbs_surf *s = &surfs[i];
-		size_t npw = 4 * (size_t)s->n_ctrl[0] * s->n_ctrl[1];
-		size_t nk0 = (size_t)s->n_knots[0], nk1 = (size_t)s->n_knots[1];
+		/* the model's kept copy (keep_inputs()): only the breaks are
+		 * this table's own */
+		const struct px_nurbs_surf *s = &n->ks[i];
 		int nb0 = px_nurbs_surf_breaks(s, 0, NULL, 0);
 		int nb1 = px_nurbs_surf_breaks(s, 1, NULL, 0);
-		double *mem = malloc((npw + nk0 + nk1 + (size_t)nb0 + (size_t)nb1 + 1) *
-				     sizeof(double));
+		double *mem = malloc(((size_t)nb0 + (size_t)nb1 + 1) * sizeof(double));
 		if (!mem)
 			return PX_E_NOMEM;
 		g->s = *s;
-		memcpy(mem, s->pw, npw * sizeof(double));
-		memcpy(mem + npw, s->knots[0], nk0 * sizeof(double));
-		memcpy(mem + npw + nk0, s->knots[1], nk1 * sizeof(double));
-		g->s.pw = mem;
-		g->s.knots[0] = mem + npw;
-		g->s.knots[1] = mem + npw + nk0;
-		g->brk[0] = mem + npw + nk0 + nk1;
+		g->brk[0] = mem;
 		g->brk[1] = g->brk[0] + nb0;
 		g->n_brk[0] = px_nurbs_surf_breaks(s, 0, g->brk[0], nb0);
 		g->n_brk[1] = px_nurbs_surf_breaks(s, 1, g->brk[1], nb1);
-		n->bytes += (npw + nk0 + nk1 + (size_t)nb0 + (size_t)nb1) * sizeof(double);
+		n->bytes += ((size_t)nb0 + (size_t)nb1) * sizeof(double);
 		px_nurbs_surf_domain(&g->s, &g->u0, &g->u1, &g->v0, &g->v1);
 		g->closed_u = px_nurbs_surf_closed(&g->s, 0, tol);
 		g->closed_v = px_nurbs_surf_closed(&g->s, 1, tol);
@@ -819,7 +812,7 @@ static void nurbs_free(void *impl)
 		for (k = 0; k < NURBS_WS; k++)
 			px_dist_ws_free(n->ss[i].ws[k]);
 		px_dist_model_free(n->ss[i].dm);
-		free((void *)(uintptr_t)n->ss[i].s.pw);
+		free(n->ss[i].brk[0]);
 	}
 	free(n->ss);
 	free(n->kc);
@@ -880,7 +873,7 @@ int px_nurbs_model_create(const struct px_nurbs_curve *curves, int n_curves,
 		snprintf(n->why, sizeof(n->why),
 			 "the model has curves: only surface shells are signed");
 	} else {
-		rc = sgn_setup(n, surfs, n_surfs, opts);
+		rc = sgn_setup(n, opts);
 		if (rc != PX_OK) {
 			nurbs_free(n);
 			return rc;
