@@ -71,26 +71,34 @@ px_pose px_model_pose(const struct px_model *m)
 	return m ? m->pose : px_pose_identity();
 }
 
-int px_model_query_ex(const struct px_model *m, px_vec3 p, double max_dist,
-		      int hint, unsigned flags, struct px_model_result *out)
+/* The query in m's frame (q->hint and q->flags left to the caller).
+ * Returns PX_OK or the error of a bad point. */
+static int query_in(const struct px_model *m, px_vec3 p, double max_dist,
+		    struct px_model_query *q)
 {
-	struct px_model_query q;
-	int rc;
-
-	if (!m || !out || !(max_dist >= 0.0))
-		return PX_E_INVAL;
 	if (!px_v3_isfinite(p))
 		return PX_E_NAN;
-	q.p = px_pose_inverse_transform_point(m->pose, p);
+	q->p = px_pose_inverse_transform_point(m->pose, p);
 	/* Squared distances overflow past about 1e154: a point that far
 	 * from the model's box gets a clear error instead of an infinite
 	 * distance and an arbitrary closest point (every candidate ties). */
-	if (px__too_far(&m->local_box, q.p))
+	if (px__too_far(&m->local_box, q->p))
 		return PX_E_RANGE;
-	q.max_dist = max_dist;
-	q.hint = (flags & PX_QUERY_COHERENT) ? hint : -1;
-	q.flags = flags;
-	rc = m->ops->closest(m->impl, &q, out);
+	q->max_dist = max_dist;
+	return PX_OK;
+}
+
+static void to_world(const struct px_model *m, struct px_model_result *out)
+{
+	out->point = px_pose_transform_point(m->pose, out->point);
+	out->direction = px_pose_transform_vector(m->pose, out->direction);
+}
+
+/* An implementation's answer rc (model frame) as the API gives it:
+ * nothing in range spelled out, the point and direction in the world. */
+static int answer_out(const struct px_model *m, int rc,
+		      struct px_model_result *out)
+{
 	if (rc <= 0) {
 		if (rc == 0) {
 			out->distance = INFINITY;
@@ -102,9 +110,24 @@ int px_model_query_ex(const struct px_model *m, px_vec3 p, double max_dist,
 	}
 	if (!isfinite(out->distance))
 		return PX_E_RANGE; /* the model's own extent overflowed */
-	out->point = px_pose_transform_point(m->pose, out->point);
-	out->direction = px_pose_transform_vector(m->pose, out->direction);
+	to_world(m, out);
 	return 1;
+}
+
+int px_model_query_ex(const struct px_model *m, px_vec3 p, double max_dist,
+		      int hint, unsigned flags, struct px_model_result *out)
+{
+	struct px_model_query q;
+	int rc;
+
+	if (!m || !out || !(max_dist >= 0.0))
+		return PX_E_INVAL;
+	rc = query_in(m, p, max_dist, &q);
+	if (rc != PX_OK)
+		return rc;
+	q.hint = (flags & PX_QUERY_COHERENT) ? hint : -1;
+	q.flags = flags;
+	return answer_out(m, m->ops->closest(m->impl, &q, out), out);
 }
 
 int px_model_query(const struct px_model *m, px_vec3 p,
@@ -189,12 +212,6 @@ void px_model_cache_init(struct px_model_cache *c, double margin_m)
 	c->margin_ = margin_m > 0.0 && isfinite(margin_m) ? margin_m : 0.0;
 }
 
-static void to_world(const struct px_model *m, struct px_model_result *out)
-{
-	out->point = px_pose_transform_point(m->pose, out->point);
-	out->direction = px_pose_transform_vector(m->pose, out->direction);
-}
-
 int px_model_query_cached(const struct px_model *m, px_vec3 p,
 			  struct px_model_cache *c, struct px_model_result *out)
 {
@@ -220,10 +237,9 @@ int px_model_query_cached(const struct px_model *m, px_vec3 p,
 		c->n_ = -1;
 		c->last_ = -1;
 	}
-	q.p = px_pose_inverse_transform_point(m->pose, p);
-	if (px__too_far(&m->local_box, q.p))
-		return PX_E_RANGE; /* as in px_model_query_ex() */
-	q.max_dist = INFINITY;
+	rc = query_in(m, p, INFINITY, &q);
+	if (rc != PX_OK)
+		return rc;
 	q.flags = 0u;
 	q.hint = -1;
 	if (c->n_ > 0) {
@@ -406,31 +422,16 @@ int px_model_stream_query(struct px_model_stream *s, px_vec3 p,
 	memset(note, 0, sizeof(*note));
 	if (!s || !out || !(max_dist >= 0.0))
 		return PX_E_INVAL;
-	if (!px_v3_isfinite(p))
-		return PX_E_NAN;
 	m = s->m;
-	q.p = px_pose_inverse_transform_point(m->pose, p);
-	if (px__too_far(&m->local_box, q.p))
-		return PX_E_RANGE;
-	q.max_dist = max_dist;
+	rc = query_in(m, p, max_dist, &q);
+	if (rc != PX_OK)
+		return rc;
 	q.hint = -1;
 	q.flags = flags & ~PX_QUERY_COHERENT;
 	rc = m->ops->stream_query(m->impl, s->state, &q, out, note);
-	if (rc < 0)
-		return rc;
-	s->queries++;
-	if (rc == 0) {
-		out->distance = INFINITY;
-		out->index = -1;
-		out->sub = -1;
-		out->feature = PX_FEATURE_NONE;
-		return 0;
-	}
-	if (!isfinite(out->distance))
-		return PX_E_RANGE;
-	out->point = px_pose_transform_point(m->pose, out->point);
-	out->direction = px_pose_transform_vector(m->pose, out->direction);
-	return 1;
+	if (rc >= 0)
+		s->queries++;
+	return answer_out(m, rc, out);
 }
 
 void px_model_stream_get_stats(const struct px_model_stream *s,
