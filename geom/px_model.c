@@ -363,6 +363,14 @@ void px_model_stream_opts_default(struct px_model_stream_opts *o)
 	o->cold_switch = 1;
 }
 
+int px_model_stream_opts_check(const struct px_model_stream_opts *o)
+{
+	if (!o || o->verify_every < 0 || o->max_solves < 0 ||
+	    (o->cold_switch != 0 && o->cold_switch != 1))
+		return PX_E_INVAL;
+	return PX_OK;
+}
+
 int px_model_stream_create(const struct px_model *m,
 			   const struct px_model_stream_opts *o,
 			   struct px_model_stream **out)
@@ -379,8 +387,7 @@ int px_model_stream_create(const struct px_model *m,
 		px_model_stream_opts_default(&d);
 		o = &d;
 	}
-	if (o->verify_every < 0 || o->max_solves < 0 ||
-	    (o->cold_switch != 0 && o->cold_switch != 1))
+	if (px_model_stream_opts_check(o) != PX_OK)
 		return PX_E_INVAL;
 	if (!m->ops->stream_create || !m->ops->stream_query ||
 	    !m->ops->stream_free)

@@ -337,6 +337,10 @@ struct px_model_stream;
 /* Defaults: verify_every 0, max_solves 4, cold_switch 1. */
 PX_API void px_model_stream_opts_default(struct px_model_stream_opts *o);
 
+/* PX_OK when o holds options a stream takes (verify_every >= 0,
+ * max_solves >= 0, cold_switch 0 or 1), else PX_E_INVAL (also NULL). */
+PX_API int px_model_stream_opts_check(const struct px_model_stream_opts *o);
+
 /*
  * A stream following one point through model m (m must outlive it);
  * o may be NULL for defaults. Setup only. Returns PX_OK, PX_E_INVAL (NULL

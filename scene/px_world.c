@@ -124,6 +124,14 @@ static double reported(const struct px_model_result *r)
 	return d;
 }
 
+/* An answer that names no model (before a search, or refused). */
+static void no_hit(struct px_world_hit *out)
+{
+	memset(out, 0, sizeof(*out));
+	out->model = -1;
+	out->distance_m = INFINITY;
+}
+
 struct px_world_tracking {
 	const struct px_world *w;
 	struct px_world_hints hints;
@@ -143,9 +151,7 @@ static int nearest(const struct px_world *s, px_vec3 p, double max_distance_m,
 	int queried = 0, jumped = 0;
 	if (!out)
 		return PX_E_INVAL;
-	memset(out, 0, sizeof(*out));
-	out->model = -1;
-	out->distance_m = INFINITY;
+	no_hit(out);
 	out->r.distance = INFINITY;
 	out->r.index = -1;
 	if (!s || !(max_distance_m >= 0))
@@ -236,11 +242,8 @@ int px_world_nearest_coherent(const struct px_world *s, px_vec3 p,
 			      struct px_world_hit *out)
 {
 	if (!h) {
-		if (out) {
-			memset(out, 0, sizeof(*out));
-			out->model = -1;
-			out->distance_m = INFINITY;
-		}
+		if (out)
+			no_hit(out);
 		return PX_E_INVAL;
 	}
 	return nearest(s, p, max_distance_m, h, NULL, out);
@@ -314,8 +317,7 @@ int px_world_set_tracking(struct px_world *s, bool enabled,
 {
 	if (!s)
 		return PX_E_INVAL;
-	if (o && (o->verify_every < 0 || o->max_solves < 0 ||
-		  (o->cold_switch != 0 && o->cold_switch != 1)))
+	if (o && px_model_stream_opts_check(o) != PX_OK)
 		return PX_E_INVAL;
 	s->track_on = enabled;
 	if (o)
@@ -385,11 +387,8 @@ int px_world_nearest_tracked(const struct px_world *s, px_vec3 p,
 			     struct px_world_hit *out)
 {
 	if (!t || t->w != s) {
-		if (out) {
-			memset(out, 0, sizeof(*out));
-			out->model = -1;
-			out->distance_m = INFINITY;
-		}
+		if (out)
+			no_hit(out);
 		return PX_E_INVAL;
 	}
 	return nearest(s, p, max_distance_m, &t->hints, t, out);
