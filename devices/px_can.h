@@ -214,9 +214,17 @@ PX_API int px_can_fault_open(struct px_can_bus *inner,
 			     size_t n_faults, uint64_t seed,
 			     struct px_can_bus **out, char *msg, size_t cap);
 
-/* Simulated bus over a UNIX datagram socket bound at local_path (an
- * existing socket file there is replaced), sending to peer_path.
- * Returns PX_OK, PX_E_INVAL (path too long), PX_E_IO with msg. */
+/* Simulated bus over a UNIX datagram socket bound at local_path,
+ * sending to peer_path. What is at local_path already decides: nothing,
+ * or a stale socket (nobody bound to it: a datagram connect is refused),
+ * which is removed, then bound; a socket in use by another process is
+ * refused (PX_E_BUSY); anything that is not a socket (regular file,
+ * directory, symbolic link, device, FIFO) is left untouched and refused
+ * (PX_E_INVAL), msg naming the path and what it is. px_can_bus_close()
+ * removes the socket file only while it is still the one this call
+ * bound (same device and inode), never another process's.
+ * Returns PX_OK, PX_E_INVAL (path too long or empty, not a socket),
+ * PX_E_BUSY (in use), PX_E_PERM, PX_E_IO, PX_E_NOMEM; msg says why. */
 PX_API int px_can_unix_open(const char *local_path, const char *peer_path,
 			    struct px_can_bus **out, char *msg, size_t cap);
 

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/un.h>
 #include <time.h>
 #include <unistd.h>
@@ -45,6 +46,8 @@ struct px_can_bus {
 	struct sockaddr_un peer;
 	int connected; /* connect()ed to peer (see unix_send) */
 	char local[sizeof(((struct sockaddr_un *)0)->sun_path)];
+	dev_t local_dev; /* the socket file this bus bound (close removes */
+	ino_t local_ino; /* it only while it is still that file) */
 	/* replay */
 	struct px_can_msg *recs;
 	int64_t *rec_t;
@@ -339,12 +342,97 @@ static int fault_recv(struct px_can_bus *b, int64_t now, struct px_can_msg *m)
 
 /* ---- UNIX datagram simulation ------------------------------------------- */
 
+/* What a file type is, for the refusal below. */
+static const char *file_kind(mode_t m)
+{
+	return S_ISREG(m)    ? "a regular file"
+	       : S_ISDIR(m)  ? "a directory"
+	       : S_ISLNK(m)  ? "a symbolic link"
+	       : S_ISCHR(m)  ? "a character device"
+	       : S_ISBLK(m)  ? "a block device"
+	       : S_ISFIFO(m) ? "a FIFO"
+			     : "not a regular file";
+}
+
+/* Make local_path free to bind without taking anything the caller did
+ * not mean: nothing there is fine; a socket nobody is bound to (left by
+ * a process that died: a datagram connect is refused) is removed;
+ * anything else stays where it is and is refused: a live socket (two
+ * runs on one path would steal frames from each other, and the first to
+ * exit would delete the other's socket), a socket of another type, and
+ * every file that is not a socket (a config typo must never delete a
+ * file). The check and the bind are not one atomic step: two processes
+ * starting in the same instant can still both see a stale socket, and
+ * then one of them fails to bind (EADDRINUSE) or binds the other's
+ * fresh path; close() removes only the file its own bind made. */
+static int unix_claim(const char *path, char *msg, size_t cap)
+{
+	struct stat st;
+	struct sockaddr_un a;
+	int s, e, rc;
+	if (lstat(path, &st) != 0) {
+		e = errno;
+		if (e == ENOENT)
+			return PX_OK;
+		if (msg)
+			snprintf(msg, cap, "%s: %s", path, strerror(e));
+		return e == EACCES ? PX_E_PERM : PX_E_IO;
+	}
+	if (!S_ISSOCK(st.st_mode)) {
+		if (msg)
+			snprintf(msg, cap, "%s exists and is %s, not a socket: "
+				 "refusing to remove it", path,
+				 file_kind(st.st_mode));
+		return PX_E_INVAL;
+	}
+	s = socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+	if (s < 0) {
+		e = errno;
+		if (msg)
+			snprintf(msg, cap, "socket(AF_UNIX, SOCK_DGRAM): %s",
+				 strerror(e));
+		return PX_E_IO;
+	}
+	memset(&a, 0, sizeof a);
+	a.sun_family = AF_UNIX;
+	snprintf(a.sun_path, sizeof a.sun_path, "%s", path);
+	rc = connect(s, (struct sockaddr *)&a, sizeof a);
+	e = errno;
+	close(s);
+	if (rc == 0) {
+		if (msg)
+			snprintf(msg, cap, "%s is in use: another process is "
+				 "bound to it (a second run on the same "
+				 "socket_path?): refusing to take it over",
+				 path);
+		return PX_E_BUSY;
+	}
+	if (e == ECONNREFUSED) {
+		/* stale: nobody will ever read it */
+		if (unlink(path) != 0 && errno != ENOENT) {
+			e = errno;
+			if (msg)
+				snprintf(msg, cap, "%s: stale socket, cannot "
+					 "remove it: %s", path, strerror(e));
+			return e == EACCES || e == EPERM ? PX_E_PERM : PX_E_IO;
+		}
+		return PX_OK;
+	}
+	if (msg)
+		snprintf(msg, cap, "%s is a socket that cannot be checked (%s): "
+			 "refusing to remove it", path,
+			 e == EPROTOTYPE ? "not a datagram socket"
+					 : strerror(e));
+	return e == EACCES ? PX_E_PERM : PX_E_BUSY;
+}
+
 int px_can_unix_open(const char *local_path, const char *peer_path,
 		     struct px_can_bus **out, char *msg, size_t cap)
 {
 	struct px_can_bus *b;
 	struct sockaddr_un a;
-	int e;
+	struct stat st;
+	int e, rc;
 	if (msg && cap)
 		msg[0] = 0;
 	if (!local_path || !peer_path || !out)
@@ -357,6 +445,14 @@ int px_can_unix_open(const char *local_path, const char *peer_path,
 				 "bytes", sizeof a.sun_path - 1);
 		return PX_E_INVAL;
 	}
+	if (!local_path[0]) {
+		if (msg)
+			snprintf(msg, cap, "empty UNIX socket path");
+		return PX_E_INVAL;
+	}
+	rc = unix_claim(local_path, msg, cap);
+	if (rc != PX_OK)
+		return rc;
 	b = bus_new(K_UNIX);
 	if (!b)
 		return PX_E_NOMEM;
@@ -373,17 +469,27 @@ int px_can_unix_open(const char *local_path, const char *peer_path,
 	memset(&a, 0, sizeof a);
 	a.sun_family = AF_UNIX;
 	snprintf(a.sun_path, sizeof a.sun_path, "%s", local_path);
-	unlink(local_path);
 	if (bind(b->sock, (struct sockaddr *)&a, sizeof a) != 0) {
 		e = errno;
 		if (msg)
-			snprintf(msg, cap, "bind(%s): %s", local_path,
-				 strerror(e));
+			snprintf(msg, cap, "bind(%s): %s%s", local_path,
+				 strerror(e),
+				 e == EADDRINUSE ? " (another process took "
+						   "it meanwhile)"
+						 : "");
 		close(b->sock);
 		free(b);
-		return e == EACCES ? PX_E_PERM : PX_E_IO;
+		return e == EACCES ? PX_E_PERM
+		       : e == EADDRINUSE ? PX_E_BUSY
+					 : PX_E_IO;
 	}
-	snprintf(b->local, sizeof b->local, "%s", local_path);
+	/* the file this bind made: close() removes it only while it is
+	 * still this one (another process may have replaced it) */
+	if (lstat(local_path, &st) == 0 && S_ISSOCK(st.st_mode)) {
+		snprintf(b->local, sizeof b->local, "%s", local_path);
+		b->local_dev = st.st_dev;
+		b->local_ino = st.st_ino;
+	}
 	memset(&b->peer, 0, sizeof b->peer);
 	b->peer.sun_family = AF_UNIX;
 	snprintf(b->peer.sun_path, sizeof b->peer.sun_path, "%s", peer_path);
@@ -1004,10 +1110,16 @@ void px_can_bus_close(struct px_can_bus *b)
 		for (i = 0; i < b->sim->n_eps; i++)
 			if (b->sim->eps[i] == b)
 				b->sim->eps[i] = NULL;
+	if (b->kind == K_UNIX && b->local[0]) {
+		/* only the socket file this bus bound: never one another
+		 * process has put there since */
+		struct stat st;
+		if (lstat(b->local, &st) == 0 && S_ISSOCK(st.st_mode) &&
+		    st.st_dev == b->local_dev && st.st_ino == b->local_ino)
+			unlink(b->local);
+	}
 	if (b->sock >= 0)
 		close(b->sock);
-	if (b->kind == K_UNIX && b->local[0])
-		unlink(b->local);
 	free(b->q);
 	free(b->recs);
 	free(b->rec_t);

@@ -1,6 +1,7 @@
 /* CAN: signal codec against an independent DBC reference, error frames,
  * candump log lines, simulated buses (in-process with faults, UNIX
- * datagrams between two processes), replay, the raw back end's open
+ * datagrams between two processes; what a socket path may take over
+ * and remove), replay, the raw back end's open
  * path, and the CAN pose/force device. Where AF_CAN and vcan0 exist (the
  * VM suite) the raw back end is exercised on vcan0. */
 #include <errno.h>
@@ -11,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/un.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -499,6 +501,150 @@ static void test_unix_bus_between_processes(void)
 	}
 }
 
+/* A plain datagram socket bound at path (a stand-in for another
+ * process's bus end), -1 on failure. */
+static int bind_raw(const char *path)
+{
+	struct sockaddr_un ad;
+	int s = socket(AF_UNIX, SOCK_DGRAM, 0);
+	memset(&ad, 0, sizeof ad);
+	ad.sun_family = AF_UNIX;
+	snprintf(ad.sun_path, sizeof ad.sun_path, "%s", path);
+	if (s >= 0 && bind(s, (struct sockaddr *)&ad, sizeof ad) != 0) {
+		close(s);
+		s = -1;
+	}
+	return s;
+}
+
+static int is_socket(const char *path)
+{
+	struct stat st;
+	return lstat(path, &st) == 0 && S_ISSOCK(st.st_mode);
+}
+
+/* The file at path holds exactly text. */
+static int holds(const char *path, const char *text)
+{
+	char buf[256];
+	FILE *f = fopen(path, "r");
+	size_t n;
+	if (!f)
+		return 0;
+	n = fread(buf, 1, sizeof buf, f);
+	fclose(f);
+	return n == strlen(text) && memcmp(buf, text, n) == 0;
+}
+
+/* A socket path never costs the caller a file it did not mean: what is
+ * not a socket is refused and left as it was, a live socket (another
+ * bus bound there) is refused and keeps working, a stale one is taken
+ * over, and close removes only the socket file its own open bound. */
+static void test_unix_path_claims(void)
+{
+	char dir[64], path[128], file[128], link_[128], peer[128];
+	char msg[300];
+	struct px_can_bus *a, *b;
+	struct px_can_msg m;
+	struct stat st;
+	int raw;
+	FILE *f;
+	snprintf(dir, sizeof dir, "/tmp/pxcan-claim-%d", (int)getpid());
+	PX_CHECK(mkdir(dir, 0700) == 0);
+	snprintf(path, sizeof path, "%s/bus.sock", dir);
+	snprintf(peer, sizeof peer, "%s/bus.sock.peer", dir);
+	snprintf(file, sizeof file, "%s/victim.txt", dir);
+	snprintf(link_, sizeof link_, "%s/link.sock", dir);
+
+	/* a regular file: refused by name and kind, unchanged */
+	f = fopen(path, "w");
+	PX_CHECK(f != NULL);
+	if (f) {
+		fputs("precious\n", f);
+		fclose(f);
+	}
+	PX_CHECK_INT_EQ(px_can_unix_open(path, peer, &a, msg, sizeof msg),
+			PX_E_INVAL);
+	PX_CHECK(a == NULL);
+	PX_CHECK_MSG(strstr(msg, path) &&
+			     strstr(msg, "exists and is a regular file, not a "
+					 "socket: refusing to remove it"),
+		     "message: %s", msg);
+	PX_CHECK(holds(path, "precious\n"));
+	unlink(path);
+
+	/* a directory: refused, still there */
+	PX_CHECK(mkdir(path, 0700) == 0);
+	PX_CHECK_INT_EQ(px_can_unix_open(path, peer, &a, msg, sizeof msg),
+			PX_E_INVAL);
+	PX_CHECK_MSG(strstr(msg, "is a directory, not a socket"), "message: %s",
+		     msg);
+	PX_CHECK(stat(path, &st) == 0 && S_ISDIR(st.st_mode));
+	rmdir(path);
+
+	/* a symbolic link to a file: the link and its target survive */
+	f = fopen(file, "w");
+	if (f) {
+		fputs("target\n", f);
+		fclose(f);
+	}
+	PX_CHECK(symlink(file, link_) == 0);
+	PX_CHECK_INT_EQ(px_can_unix_open(link_, peer, &a, msg, sizeof msg),
+			PX_E_INVAL);
+	PX_CHECK_MSG(strstr(msg, "is a symbolic link, not a socket"),
+		     "message: %s", msg);
+	PX_CHECK(lstat(link_, &st) == 0 && S_ISLNK(st.st_mode));
+	PX_CHECK(holds(file, "target\n"));
+	unlink(link_);
+	unlink(file);
+
+	/* a live socket: refused; its owner still bound and reachable */
+	raw = bind_raw(path);
+	PX_CHECK(raw >= 0);
+	PX_CHECK_INT_EQ(px_can_unix_open(path, peer, &a, msg, sizeof msg),
+			PX_E_BUSY);
+	PX_CHECK_MSG(strstr(msg, path) && strstr(msg, "in use"), "message: %s",
+		     msg);
+	PX_CHECK(is_socket(path));
+	PX_CHECK_INT_EQ(px_can_unix_open(peer, path, &b, msg, sizeof msg),
+			PX_OK);
+	m = frame(0x123, 2, 7);
+	PX_CHECK_INT_EQ(px_can_bus_send(b, &m, 0), PX_OK);
+	{
+		uint8_t buf[100];
+		PX_CHECK_INT_EQ(recv(raw, buf, sizeof buf, MSG_DONTWAIT), CAN_MTU);
+	}
+	px_can_bus_close(b);
+	PX_CHECK(!is_socket(peer)); /* b removed its own file */
+
+	/* stale (its owner gone, the file left): taken over */
+	close(raw);
+	PX_CHECK(is_socket(path));
+	PX_CHECK_INT_EQ(px_can_unix_open(path, peer, &a, msg, sizeof msg),
+			PX_OK);
+	/* a second open on the same path is refused; the first's socket
+	 * survives the refusal and the second's close */
+	PX_CHECK_INT_EQ(px_can_unix_open(path, peer, &b, msg, sizeof msg),
+			PX_E_BUSY);
+	PX_CHECK(b == NULL);
+	px_can_bus_close(b);
+	PX_CHECK(is_socket(path));
+	px_can_bus_close(a);
+	PX_CHECK(!is_socket(path)); /* its own: removed at close */
+
+	/* the path replaced behind a bus's back: close leaves the new one */
+	PX_CHECK_INT_EQ(px_can_unix_open(path, peer, &a, msg, sizeof msg),
+			PX_OK);
+	unlink(path);
+	raw = bind_raw(path);
+	PX_CHECK(raw >= 0);
+	px_can_bus_close(a);
+	PX_CHECK(is_socket(path));
+	close(raw);
+	unlink(path);
+	PX_CHECK(rmdir(dir) == 0);
+}
+
 static void test_raw_open_path(void)
 {
 	struct px_can_raw_config c;
@@ -952,6 +1098,7 @@ static const struct px_test tests[] = {
 	PX_T(test_candump_lines),
 	PX_T(test_sim_bus_order_faults_and_bus_off),
 	PX_T(test_unix_bus_between_processes),
+	PX_T(test_unix_path_claims),
 	PX_T(test_raw_open_path),
 	PX_T(test_raw_on_vcan),
 	PX_T(test_error_frames_on_vcan),
