@@ -7,6 +7,7 @@
 
 #include "px_base.h"
 #include "px_arena.h"
+#include "px_file.h"
 #include "px_math.h"
 #include "px_nurbs.h"
 #include "px_obj.h"

@@ -15,6 +15,7 @@
 #include "mesh_internal.h"
 #include "model_internal.h"
 #include "px_cloud.h"
+#include "px_file.h"
 
 #define LEAF 8
 #define CSTACK4 (3 * PX_CLOUD_MAX_DEPTH + 4)
@@ -568,6 +569,22 @@ int px_cloud_model(const double *xyz, size_t n, double radius_m,
 				xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
 			return PX_E_NAN;
 		}
+	/* The extent, the hint grid's cells and every squared distance of a
+	 * query within reach stay finite only for coordinates and radius
+	 * within PX_CLOUD_MAX_COORD (points near 1e308 overflowed the
+	 * extent to infinity and the grid's cell counts with it). */
+	if (radius_m > PX_CLOUD_MAX_COORD) {
+		rep_msg(rep, "point radius %g beyond %g", radius_m, PX_CLOUD_MAX_COORD);
+		return PX_E_RANGE;
+	}
+	for (i = 0; i < n; i++)
+		for (k = 0; k < 3; k++)
+			if (fabs(xyz[3 * i + (size_t)k]) > PX_CLOUD_MAX_COORD) {
+				rep_msg(rep, "point %zu: coordinate %c = %g beyond +-%g "
+					"(squared distances would overflow)", i, "xyz"[k],
+					xyz[3 * i + (size_t)k], PX_CLOUD_MAX_COORD);
+				return PX_E_RANGE;
+			}
 	C = calloc(1, sizeof(*C));
 	if (!C)
 		goto fail;
@@ -667,27 +684,33 @@ fail:
 static int is_sep(int c)
 {
 	return c == ' ' || c == '\t' || c == ',' || c == ';' || c == '\r' ||
-	       c == '\n' || c == '\0';
+	       c == '\0';
 }
 
 /*
- * Parse one line: up to 3 numbers (more columns ignored). Returns the
- * count of numbers read at the start of the line (0..3), and in *bad_col
+ * Parse one line: up to 3 numbers (more columns ignored), separated by
+ * blanks or by one ',' or ';' with optional blanks around it. Returns
+ * the count of numbers read at the start of the line (0..3); *bad_col is
  * the 1-based column of the first field that is not a number (0 if all
- * of the first three parsed).
+ * of the first three parsed) and *empty the 1-based number of a field
+ * that is empty ("1,,2": two separators, or one at either end), which
+ * would otherwise shift the columns.
  */
-static int parse_line(const char *s, double v[3], int *bad_col)
+static int parse_line(const char *s, double v[3], int *bad_col, int *empty)
 {
 	const char *p = s;
 	int k = 0;
 	*bad_col = 0;
-	while (k < 3) {
+	*empty = 0;
+	while (*p == ' ' || *p == '\t')
+		p++;
+	while (k < 3 && *p) {
 		char *end;
-		while (*p == ' ' || *p == '\t' || *p == ',' || *p == ';' || *p == '\r')
-			p++;
-		if (*p == '\0' || *p == '\n')
-			break;
-		errno = 0;
+		if (*p == ',' || *p == ';') {
+			*bad_col = (int)(p - s) + 1;
+			*empty = k + 1;
+			return k;
+		}
 		v[k] = strtod(p, &end);
 		if (end == p || !is_sep((unsigned char)*end)) {
 			*bad_col = (int)(p - s) + 1;
@@ -695,6 +718,18 @@ static int parse_line(const char *s, double v[3], int *bad_col)
 		}
 		p = end;
 		k++;
+		while (*p == ' ' || *p == '\t' || *p == '\r')
+			p++;
+		if (*p == ',' || *p == ';') {
+			const char *sep = p++;
+			while (*p == ' ' || *p == '\t' || *p == '\r')
+				p++;
+			if (!*p && k < 3) {
+				*bad_col = (int)(sep - s) + 2;
+				*empty = k + 1;
+				return k;
+			}
+		}
 	}
 	return k;
 }
@@ -702,39 +737,43 @@ static int parse_line(const char *s, double v[3], int *bad_col)
 static int load_text(const char *path, double **xyz_out, size_t *n_out,
 		     struct px_cloud_report *rep)
 {
-	FILE *f = fopen(path, "r");
-	char *line = NULL;
-	size_t cap = 0, n = 0, vcap = 0;
-	ssize_t len;
+	char *data = NULL, *cur, *line;
+	size_t n = 0, vcap = 0, len = 0;
 	long lineno = 0;
 	double *xyz = NULL;
-	int seen_data = 0, rc = PX_OK;
+	int seen_data = 0, rc;
 
-	if (!f) {
-		int e = errno;
-		rep_msg(rep, "%s: %s", path, strerror(e));
-		return e == ENOENT ? PX_E_NOTFOUND : PX_E_IO;
-	}
-	while ((len = getline(&line, &cap, f)) >= 0) {
+	rc = px_file_read(path, PX_FILE_MODEL_MAX_BYTES, PX_FILE_TEXT,
+			  "point cloud", &data, &len, rep->message,
+			  sizeof(rep->message));
+	if (rc != PX_OK)
+		return rc;
+	cur = data;
+	while ((line = px_file_next_line(&cur)) != NULL) {
 		const char *s = line;
 		double v[3];
-		int k, bad;
+		int k, bad, empty;
 		lineno++;
 		while (*s == ' ' || *s == '\t')
 			s++;
-		if (*s == '\0' || *s == '\n' || *s == '\r' || *s == '#' ||
-		    (s[0] == '/' && s[1] == '/'))
+		if (*s == '\0' || *s == '#' || (s[0] == '/' && s[1] == '/'))
 			continue;
-		k = parse_line(line, v, &bad);
+		k = parse_line(line, v, &bad, &empty);
 		if (k < 3) {
-			/* a header of names before the first point is fine */
-			if (!seen_data && k == 0 && isalpha((unsigned char)*s)) {
+			/* a header of names before the first point is fine; a
+			 * line whose first field reads as a number (NaN and inf
+			 * included) is data */
+			if (!seen_data && k == 0 && !empty && isalpha((unsigned char)*s)) {
 				seen_data = 1;
 				continue;
 			}
 			rep->line = lineno;
-			if (bad)
-				rep_msg(rep, "%s:%ld:%d: not a number", path, lineno, bad);
+			if (empty)
+				rep_msg(rep, "%s:%ld:%d: field %d is empty", path, lineno,
+					bad, empty);
+			else if (bad)
+				rep_msg(rep, "%s:%ld:%d: field %d: not a number", path,
+					lineno, bad, k + 1);
 			else
 				rep_msg(rep, "%s:%ld: %d numbers, a point needs 3", path,
 					lineno, k);
@@ -743,15 +782,26 @@ static int load_text(const char *path, double **xyz_out, size_t *n_out,
 		}
 		if (!(isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]))) {
 			rep->line = lineno;
-			rep_msg(rep, "%s:%ld: non-finite coordinate", path, lineno);
+			rep_msg(rep, "%s:%ld: field %d: non-finite coordinate", path, lineno,
+				!isfinite(v[0]) ? 1 : !isfinite(v[1]) ? 2 : 3);
 			rc = PX_E_NAN;
 			goto out;
 		}
+		for (k = 0; k < 3; k++)
+			if (fabs(v[k]) > PX_CLOUD_MAX_COORD) {
+				rep->line = lineno;
+				rep_msg(rep, "%s:%ld: field %d: coordinate %g beyond +-%g "
+					"(squared distances would overflow)", path, lineno,
+					k + 1, v[k], PX_CLOUD_MAX_COORD);
+				rc = PX_E_RANGE;
+				goto out;
+			}
 		seen_data = 1;
 		if (n == vcap) {
 			size_t nc = vcap ? 2 * vcap : 4096;
 			double *q = realloc(xyz, 3 * nc * sizeof(double));
 			if (!q) {
+				rep_msg(rep, "%s: out of memory", path);
 				rc = PX_E_NOMEM;
 				goto out;
 			}
@@ -761,16 +811,12 @@ static int load_text(const char *path, double **xyz_out, size_t *n_out,
 		memcpy(xyz + 3 * n, v, sizeof(v));
 		n++;
 	}
-	if (ferror(f)) {
-		rep_msg(rep, "%s: read error", path);
-		rc = PX_E_IO;
-	} else if (n == 0) {
+	if (n == 0) {
 		rep_msg(rep, "%s: no points in the file", path);
 		rc = PX_E_PARSE;
 	}
 out:
-	free(line);
-	fclose(f);
+	free(data);
 	if (rc != PX_OK) {
 		free(xyz);
 		return rc;

@@ -56,6 +56,10 @@ extern "C" {
 
 #define PX_CLOUD_MAX_DEPTH 48
 #define PX_CLOUD_MAX_POINTS ((size_t)1 << 31)
+/* Largest |coordinate| and radius a cloud takes (model units): the
+ * extent, the hint grid and the squared distances of every query within
+ * the models' reach (px_model.h, 1e150 beyond the box) stay finite. */
+#define PX_CLOUD_MAX_COORD 1e150
 
 struct px_cloud_report {
 	size_t n_points;
@@ -66,9 +70,10 @@ struct px_cloud_report {
 /*
  * Build a cloud model from n points (xyz, 3 doubles each; copied) with
  * ball radius radius_m >= 0. rep may be NULL.
- * Returns PX_OK; PX_E_INVAL (NULL, n = 0), PX_E_RANGE (radius negative
- * or not finite, too many points), PX_E_NAN (a non-finite coordinate:
- * rep->message names the point), PX_E_NOMEM. Setup only.
+ * Returns PX_OK; PX_E_INVAL (NULL, n = 0), PX_E_RANGE (radius negative,
+ * not finite or beyond PX_CLOUD_MAX_COORD, a coordinate beyond
+ * +-PX_CLOUD_MAX_COORD, too many points), PX_E_NAN (a non-finite
+ * coordinate: rep->message names the point), PX_E_NOMEM. Setup only.
  */
 PX_API int px_cloud_model(const double *xyz, size_t n, double radius_m,
 			  struct px_cloud_report *rep, struct px_model **out);

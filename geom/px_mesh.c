@@ -968,6 +968,11 @@ void px__grid_layout(px_aabb box, long cap, int d[3], px_vec3 *org, double *h_ou
 	margin = len > 0.0 ? 0.125 * len : 1.0;
 	vol = (ext[0] + 2 * margin) * (ext[1] + 2 * margin) * (ext[2] + 2 * margin);
 	h = cbrt(vol / (double)cap);
+	/* a model wider than about 1e102 overflows the volume, not its
+	 * cube root */
+	if (!isfinite(h))
+		h = cbrt(ext[0] + 2 * margin) * cbrt(ext[1] + 2 * margin) *
+		    cbrt(ext[2] + 2 * margin) / cbrt((double)cap);
 	for (it = 0;; it++) {
 		double cells = 1.0;
 		for (k = 0; k < 3; k++) {
