@@ -24,6 +24,7 @@
 
 #include "model_internal.h"
 #include "px_base.h"
+#include "px_file.h"
 
 struct acc {
 	double *xyz;
@@ -157,6 +158,7 @@ static void walk(struct acc *A, const struct aiScene *s,
 #define PLY_MAX_ELEMS 16
 
 struct ply_prop {
+	char name[64];
 	int list;   /* 0: scalar */
 	int csize;  /* byte size of the count (lists) */
 	int size;   /* byte size of the value / list item */
@@ -200,6 +202,30 @@ static unsigned long long ply_uint(const unsigned char *b, int size, int big)
 	for (i = 0; i < size; i++)
 		v |= (unsigned long long)b[big ? size - 1 - i : i] << (8 * i);
 	return v;
+}
+
+/* A binary scalar as a double: floats widened, integers exact (every
+ * PLY integer type fits a double's 53 bits). */
+static double ply_value(const unsigned char *b, const struct ply_prop *pp, int big)
+{
+	unsigned long long u = ply_uint(b, pp->size, big);
+	if (!pp->isint) {
+		if (pp->size == 4) {
+			uint32_t w = (uint32_t)u;
+			float f;
+			memcpy(&f, &w, sizeof f);
+			return f;
+		} else {
+			uint64_t w = u;
+			double d;
+			memcpy(&d, &w, sizeof d);
+			return d;
+		}
+	}
+	if (pp->sgn && ((u >> (8 * pp->size - 1)) & 1u))
+		return -(double)((~u + 1u) &
+				 (pp->size < 8 ? (1ull << (8 * pp->size)) - 1u : ~0ull));
+	return (double)u;
 }
 
 /* Next whitespace-separated token of an ASCII body; counts lines. */
@@ -270,26 +296,27 @@ static int ply_line_check(int *first, long *line, const long *last, long now)
 	return now != *line;
 }
 
-static int ply_validate(const char *path, char *msg, size_t msg_cap)
+/* Check the PLY of size bytes at f (see above) and read its vertices'
+ * x, y, z exactly as doubles into *xyz (malloc'ed, 3 per vertex, *nv of
+ * them), which the caller frees. */
+static int ply_validate(const char *path, FILE *f, size_t size, double **xyz,
+			size_t *nv, char *msg, size_t msg_cap)
 {
 	struct ply_elem *E = NULL;
-	int ne = 0, fmt = -1, rc = PX_E_PARSE, k;
+	int ne = 0, fmt = -1, rc = PX_E_PARSE, k, vk = -1, ax[3] = {-1, -1, -1};
+	long vline = 0;
 	char line[512];
 	long lineno = 0;
-	FILE *f = fopen(path, "rb");
 	unsigned long long i, n_vertex = 0;
 	long inst_line = 0, inst_last = 0;
 	int inst_first = 1;
+	double *V = NULL;
 
-	if (!f) {
-		snprintf(msg, msg_cap, "%s: %s", path, strerror(errno));
-		return PX_E_IO;
-	}
+	*xyz = NULL;
+	*nv = 0;
 	E = calloc(PLY_MAX_ELEMS, sizeof(*E));
-	if (!E) {
-		fclose(f);
+	if (!E)
 		return PX_E_NOMEM;
-	}
 	/* header */
 	for (;;) {
 		char w[4][64];
@@ -345,6 +372,10 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 				goto out;
 			}
 			snprintf(E[ne].name, sizeof(E[ne].name), "%s", w[1]);
+			if (strcmp(w[1], "vertex") == 0 && vk < 0) {
+				vk = ne;
+				vline = lineno;
+			}
 			E[ne].count = strtoull(w[2], &end, 10);
 			if (*end || w[2][0] == '-') {
 				snprintf(msg, msg_cap, "%s:%ld: bad element count '%s'", path, lineno, w[2]);
@@ -363,11 +394,16 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 				pp->list = 1;
 				pp->csize = nw >= 4 ? ply_type_size(w[2]) : 0;
 				pp->size = nw >= 4 ? ply_type_size(w[3]) : 0;
-				if (nw >= 4)
+				if (nw >= 4) {
 					ply_item_kind(w[3], pp);
+				}
 			} else {
 				pp->size = ply_type_size(w[1]);
 				ply_item_kind(w[1], pp);
+				snprintf(pp->name, sizeof(pp->name), "%s", w[2]);
+				if (ne - 1 == vk && !w[2][1] && w[2][0] >= 'x' &&
+				    w[2][0] <= 'z' && ax[w[2][0] - 'x'] < 0)
+					ax[w[2][0] - 'x'] = el->n_props - 1;
 			}
 			if (!pp->size || (pp->list && !pp->csize)) {
 				snprintf(msg, msg_cap, "%s:%ld: bad PLY property type", path, lineno);
@@ -385,11 +421,32 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 	/* body; face lists must be polygons over existing vertices: the
 	 * importer's triangulation aborts the process on other indices
 	 * (found by fuzzing) */
-	for (k = 0; k < ne; k++)
-		if (strcmp(E[k].name, "vertex") == 0)
-			n_vertex = E[k].count;
+	if (vk >= 0)
+		n_vertex = E[vk].count;
 	if (n_vertex == 0) {
 		snprintf(msg, msg_cap, "%s: PLY header declares no vertices", path);
+		goto out;
+	}
+	/* a vertex without x, y or z loaded as 0 there: every point of a
+	 * cloud without z on the plane z = 0 */
+	for (k = 0; k < 3; k++)
+		if (ax[k] < 0) {
+			snprintf(msg, msg_cap, "%s:%ld: PLY element 'vertex' has no "
+				 "scalar property '%c'", path, vline, "xyz"[k]);
+			goto out;
+		}
+	/* every vertex takes at least a byte a property (two in ASCII): a
+	 * count the file cannot hold is refused before the allocation */
+	if (n_vertex > size / (unsigned long long)E[vk].n_props) {
+		snprintf(msg, msg_cap, "%s:%ld: PLY header declares %llu vertices, "
+			 "more than its %zu bytes can hold", path, vline, n_vertex, size);
+		goto out;
+	}
+	V = malloc((size_t)n_vertex * 3 * sizeof(*V));
+	if (!V) {
+		snprintf(msg, msg_cap, "%s: out of memory for %llu vertices", path,
+			 n_vertex);
+		rc = PX_E_NOMEM;
 		goto out;
 	}
 	/* ASCII: the importer reads one element per line, so the check
@@ -398,7 +455,7 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 	inst_last = lineno - 1;
 	for (k = 0; k < ne; k++)
 		for (i = 0; i < E[k].count; i++) {
-			int j;
+			int j, a;
 			inst_first = 1;
 			for (j = 0; j < E[k].n_props; j++) {
 				const struct ply_prop *pp = &E[k].props[j];
@@ -431,6 +488,10 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 								 path, lineno, tok);
 							goto out;
 						}
+						if (k == vk && !pp->list)
+							for (a = 0; a < 3; a++)
+								if (ax[a] == j)
+									V[3 * i + (size_t)a] = strtod(tok, NULL);
 						if (face) {
 							unsigned long long vi = strtoull(tok, &end, 10);
 							if (*end || tok[0] == '-' || vi >= n_vertex) {
@@ -457,6 +518,11 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 						unsigned long long v;
 						if (fread(b, 1, (size_t)pp->size, f) != (size_t)pp->size)
 							goto truncated;
+						if (k == vk && !pp->list)
+							for (a = 0; a < 3; a++)
+								if (ax[a] == j)
+									V[3 * i + (size_t)a] =
+										ply_value(b, pp, fmt == 2);
 						if (!face)
 							continue;
 						v = ply_uint(b, pp->size, fmt == 2);
@@ -486,6 +552,9 @@ static int ply_validate(const char *path, char *msg, size_t msg_cap)
 		goto out;
 	}
 	rc = PX_OK;
+	*xyz = V;
+	*nv = (size_t)n_vertex;
+	V = NULL;
 	goto out;
 rows:
 	snprintf(msg, msg_cap, "%s:%ld: PLY element '%s' %llu: not one line of values",
@@ -495,8 +564,8 @@ truncated:
 	snprintf(msg, msg_cap, "%s: PLY data ends early (element '%s' %llu of %llu)", path,
 		 E[k].name, i, E[k].count);
 out:
+	free(V);
 	free(E);
-	fclose(f);
 	return rc;
 }
 
@@ -548,39 +617,49 @@ static int stl_is_number(const char *t)
  * every statement on a line of its own. */
 enum { STL_SOLID, STL_FACET, STL_LOOP, STL_VERTEX, STL_ENDLOOP, STL_ENDFACET };
 
-static int stl_validate(const char *path, char *msg, size_t msg_cap)
+/* The STL of size bytes at data (f reads the same bytes). */
+static int stl_validate(const char *path, const char *data, size_t size, FILE *f,
+			char *msg, size_t msg_cap)
 {
 	static const char *const want[] = {"'solid'", "'facet normal x y z' or 'endsolid'",
 					   "'outer loop'", "'vertex x y z'", "'endloop'",
 					   "'endfacet'"};
-	FILE *f = fopen(path, "rb");
-	unsigned char head[84];
 	char *line = NULL, *w[6];
-	size_t cap = 0, got;
+	size_t cap = 0;
 	ssize_t len;
-	long lineno = 0, size;
+	long lineno = 0, nul_line, nul_col;
 	int rc = PX_E_PARSE, st = STL_SOLID, nv = 0, solids = 0, n;
+	int nul = px_file_find_nul(data, size, &nul_line, &nul_col);
 
-	if (!f) {
-		snprintf(msg, msg_cap, "%s: %s", path, strerror(errno));
-		return PX_E_IO;
-	}
-	got = fread(head, 1, sizeof head, f);
-	if (fseek(f, 0, SEEK_END) != 0 || (size = ftell(f)) < 0) {
-		fclose(f);
-		snprintf(msg, msg_cap, "%s: cannot seek", path);
-		return PX_E_IO;
-	}
-	if (got == sizeof head &&
-	    (unsigned long long)size == 84ull + 50ull * ply_uint(head + 80, 4, 0)) {
-		fclose(f);
-		if (ply_uint(head + 80, 4, 0) == 0) {
-			snprintf(msg, msg_cap, "%s: binary STL without triangles", path);
+	if (size >= 84) {
+		unsigned long long count = ply_uint((const unsigned char *)data + 80, 4, 0);
+		unsigned long long need = 84ull + 50ull * count;
+		if (size == need) {
+			if (count == 0) {
+				snprintf(msg, msg_cap, "%s: binary STL without triangles", path);
+				return PX_E_PARSE;
+			}
+			return PX_OK;
+		}
+		/* not ASCII (a NUL byte, or no 'solid' to begin with): a binary
+		 * STL whose count and size disagree, truncated or padded */
+		if (nul || strncmp(data, "solid", 5) != 0) {
+			char why[96];
+			if (strncmp(data, "solid", 5) != 0)
+				snprintf(why, sizeof why, "; not an ASCII STL either (no 'solid')");
+			else
+				snprintf(why, sizeof why, "; not an ASCII STL either (NUL byte "
+					 "at %ld:%ld)", nul_line, nul_col);
+			snprintf(msg, msg_cap, "%s: binary STL: header says %llu triangles "
+				 "(needs %llu bytes), file has %zu bytes%s", path, count,
+				 need, size, why);
 			return PX_E_PARSE;
 		}
-		return PX_OK;
+	} else if (nul || strncmp(data, "solid", 5) != 0) {
+		snprintf(msg, msg_cap, "%s: %zu bytes: shorter than a binary STL's 84-byte "
+			 "header, and not an ASCII STL (no 'solid')", path, size);
+		return PX_E_PARSE;
 	}
-	rewind(f);
 	while ((len = getline(&line, &cap, f)) >= 0) {
 		int ok;
 		lineno++;
@@ -644,7 +723,7 @@ static int stl_validate(const char *path, char *msg, size_t msg_cap)
 		}
 		if (!ok) {
 			if (lineno == 1 && solids == 0)
-				snprintf(msg, msg_cap, "%s: neither a binary STL (%ld bytes, "
+				snprintf(msg, msg_cap, "%s: neither a binary STL (%zu bytes, "
 					 "not 84 + 50 per triangle) nor an ASCII one "
 					 "(no 'solid')", path, size);
 			else
@@ -661,20 +740,64 @@ static int stl_validate(const char *path, char *msg, size_t msg_cap)
 		rc = PX_OK;
 out:
 	free(line);
-	fclose(f);
 	return rc;
 }
 
-static int has_ply_magic(const char *path)
+static int has_ply_magic(const char *b, size_t n)
 {
-	char b[4] = {0};
-	FILE *f = fopen(path, "rb");
-	size_t n;
+	return n >= 4 && memcmp(b, "ply", 3) == 0 && (b[3] == '\n' || b[3] == '\r');
+}
+
+/* A reader over the file's bytes for the structure checks (fmemopen
+ * wants at least one byte; an empty file never gets that far). */
+static FILE *mem_stream(const char *path, char *data, size_t len, char *msg,
+			size_t msg_cap)
+{
+	FILE *f = len ? fmemopen(data, len, "rb") : NULL;
 	if (!f)
-		return 0;
-	n = fread(b, 1, 4, f);
-	fclose(f);
-	return n == 4 && memcmp(b, "ply", 3) == 0 && (b[3] == '\n' || b[3] == '\r');
+		snprintf(msg, msg_cap, "%s: %s", path,
+			 len ? strerror(errno) : "empty file");
+	return f;
+}
+
+/* A mesh from the importer passes through single-precision floats: the
+ * PLY's own values (read exactly by the check) must not move by more
+ * than PX_IMPORT_FLOAT_TOL of the model's largest extent, or the mesh is
+ * refused rather than answered off (a model far from its origin, as
+ * survey coordinates are, loses its small digits). */
+#define PX_IMPORT_FLOAT_TOL 1e-5
+
+static int float_loss_check(const char *path, const double *v, size_t nv,
+			    char *msg, size_t msg_cap)
+{
+	double lo[3] = {INFINITY, INFINITY, INFINITY};
+	double hi[3] = {-INFINITY, -INFINITY, -INFINITY}, ext = 0.0, tol;
+	size_t i;
+	int k;
+	for (i = 0; i < nv; i++)
+		for (k = 0; k < 3; k++) {
+			double x = v[3 * i + (size_t)k];
+			lo[k] = x < lo[k] ? x : lo[k];
+			hi[k] = x > hi[k] ? x : hi[k];
+		}
+	for (k = 0; k < 3; k++)
+		ext = fmax(ext, hi[k] - lo[k]);
+	tol = PX_IMPORT_FLOAT_TOL * ext;
+	for (i = 0; i < nv; i++)
+		for (k = 0; k < 3; k++) {
+			double x = v[3 * i + (size_t)k], lost;
+			if (!isfinite(x) || fabs(x) > 3.0e38)
+				continue; /* left to the mesh's own range checks */
+			lost = fabs(x - (double)(float)x);
+			if (lost > tol) {
+				snprintf(msg, msg_cap, "%s: PLY vertex %zu: %c = %.17g loses %g "
+					 "in the importer's single precision, more than %g "
+					 "(%g of the model's extent %g)", path, i, "xyz"[k], x,
+					 lost, tol, PX_IMPORT_FLOAT_TOL, ext);
+				return PX_E_RANGE;
+			}
+		}
+	return PX_OK;
 }
 
 int px__import_file(const char *path, int want_tri, double **xyz,
@@ -683,11 +806,13 @@ int px__import_file(const char *path, int want_tri, double **xyz,
 {
 	const struct aiScene *s;
 	struct acc A;
-	struct stat st;
 	struct aiMatrix4x4 I;
 	unsigned char *seen;
 	unsigned i;
-	FILE *f;
+	char *data = NULL, hint[16] = "";
+	size_t len = 0;
+	const char *dot, *slash;
+	int rc;
 
 	memset(&A, 0, sizeof(A));
 	A.want_tri = want_tri;
@@ -703,34 +828,74 @@ int px__import_file(const char *path, int want_tri, double **xyz,
 		*tri = NULL;
 	if (nt)
 		*nt = 0;
-	if (stat(path, &st) != 0) {
-		int e = errno;
-		snprintf(msg, msg_cap, "%s: %s", path, strerror(e));
-		return e == ENOENT ? PX_E_NOTFOUND : PX_E_IO;
+	/* read once, with the limit: the checks and the importer see the
+	 * same bytes, and a pipe or /dev/zero cannot grow without bound */
+	rc = px_file_read(path, PX_FILE_MODEL_MAX_BYTES, 0, "model", &data, &len,
+			  msg, msg_cap);
+	if (rc != PX_OK)
+		return rc;
+	if (len == 0) {
+		snprintf(msg, msg_cap, "%s: empty file", path);
+		free(data);
+		return PX_E_PARSE;
 	}
-	if (S_ISDIR(st.st_mode)) {
-		snprintf(msg, msg_cap, "%s: is a directory", path);
-		return PX_E_IO;
-	}
-	f = fopen(path, "rb");
-	if (!f) {
-		snprintf(msg, msg_cap, "%s: %s", path, strerror(errno));
-		return PX_E_IO;
-	}
-	fclose(f);
 	/* A .ply name without the magic line goes to the check too: the
 	 * importer's PLY reader loops forever on some such headers (found
 	 * by fuzzing). */
-	if (has_ply_magic(path) || ends_with_ci(path, ".ply")) {
-		int rc = ply_validate(path, msg, msg_cap);
-		if (rc != PX_OK)
+	if (has_ply_magic(data, len) || ends_with_ci(path, ".ply")) {
+		double *pv = NULL;
+		size_t pn = 0;
+		FILE *f = mem_stream(path, data, len, msg, msg_cap);
+		if (!f) {
+			free(data);
+			return PX_E_IO;
+		}
+		rc = ply_validate(path, f, len, &pv, &pn, msg, msg_cap);
+		fclose(f);
+		if (rc == PX_OK && !want_tri) {
+			/* points: the file's own values, doubles kept exact */
+			free(data);
+			*xyz = pv;
+			*nv = pn;
+			if (n_skipped)
+				*n_skipped = 0;
+			return PX_OK;
+		}
+		if (rc == PX_OK)
+			rc = float_loss_check(path, pv, pn, msg, msg_cap);
+		free(pv);
+		if (rc != PX_OK) {
+			free(data);
 			return rc;
+		}
+		snprintf(hint, sizeof hint, "ply");
 	} else if (ends_with_ci(path, ".stl")) {
-		int rc = stl_validate(path, msg, msg_cap);
-		if (rc != PX_OK)
+		FILE *f = mem_stream(path, data, len, msg, msg_cap);
+		if (!f) {
+			free(data);
+			return PX_E_IO;
+		}
+		rc = stl_validate(path, data, len, f, msg, msg_cap);
+		fclose(f);
+		if (rc != PX_OK) {
+			free(data);
 			return rc;
+		}
 	}
-	s = aiImportFile(path, aiProcess_Triangulate);
+	if (!hint[0]) {
+		dot = strrchr(path, '.');
+		slash = strrchr(path, '/');
+		if (dot && (!slash || dot > slash) && strlen(dot + 1) < sizeof hint)
+			snprintf(hint, sizeof hint, "%s", dot + 1);
+	}
+	if (len > 0xffffffffu) {
+		snprintf(msg, msg_cap, "%s: %zu bytes, more than the importer takes", path,
+			 len);
+		free(data);
+		return PX_E_RANGE;
+	}
+	s = aiImportFileFromMemory(data, (unsigned)len, aiProcess_Triangulate, hint);
+	free(data);
 	if (!s) {
 		snprintf(msg, msg_cap, "%s: %s", path, aiGetErrorString());
 		return PX_E_PARSE;
