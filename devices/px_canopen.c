@@ -3,6 +3,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "px_canopen.h"
 #include "px_codec.h"
@@ -390,6 +391,8 @@ struct px_canopen {
 	int64_t t0, last_hb;
 	/* a node announced boot-up or pre-operational: start it (again) */
 	int need_start[PX_CANOPEN_MAX_DRIVES];
+	/* when each drive's statusword last came (0 never) */
+	int64_t sw_ns[PX_CANOPEN_MAX_DRIVES];
 };
 
 void px_canopen_config_default(struct px_canopen_config *c)
@@ -531,6 +534,7 @@ int px_canopen_rx(struct px_canopen *co, int64_t now)
 					s->statusword = (uint16_t)v[e];
 					s->state = px_cia402_state_of(
 						s->statusword);
+					co->sw_ns[d] = m.t_ns ? m.t_ns : 1;
 					break;
 				case 0x6064:
 					s->position = (double)v[e] /
@@ -563,6 +567,44 @@ int px_canopen_rx(struct px_canopen *co, int64_t now)
 			s->lost = now - since > co->cfg.heartbeat_timeout_ns;
 		}
 	return n;
+}
+
+/* Drive i's RPDO: its controlword as set, modes of operation, target
+ * raw (in the mode's units). */
+static int send_rpdo(struct px_canopen *co, size_t i, int32_t raw, int64_t now)
+{
+	const struct px_canopen_pdo *p = &co->pdo.rpdo;
+	const struct px_canopen_drive_cfg *c = &co->drv[i];
+	int64_t v[PX_CANOPEN_MAX_MAP];
+	uint8_t b[8];
+	size_t e;
+	for (e = 0; e < p->n; e++) {
+		uint16_t ix = p->e[e].index;
+		v[e] = ix == 0x6040   ? co->st[i].controlword
+		       : ix == 0x6060 ? c->mode
+				      : fit(raw, p->e[e].bits, 1);
+	}
+	memset(b, 0, sizeof b);
+	px_canopen_pdo_pack(p, v, b, sizeof b);
+	return send_frame(co->bus, 0x200u + c->node_id, b,
+			  (int)px_canopen_pdo_bytes(p), now);
+}
+
+/* SYNC when enabled, and the heartbeat when due. */
+static int sync_and_heartbeat(struct px_canopen *co, int64_t now)
+{
+	uint8_t b[1];
+	int rc = PX_OK;
+	if (co->cfg.sync && send_frame(co->bus, 0x080, b, 0, now) == PX_E_IO)
+		rc = PX_E_IO;
+	if (co->cfg.heartbeat_period_ns > 0 &&
+	    (co->last_hb == 0 ||
+	     now - co->last_hb >= co->cfg.heartbeat_period_ns)) {
+		b[0] = 0x05; /* operational */
+		send_frame(co->bus, 0x700u + co->cfg.own_node_id, b, 1, now);
+		co->last_hb = now ? now : 1;
+	}
+	return rc;
 }
 
 int px_canopen_tx(struct px_canopen *co, int64_t now, const double *targets,
@@ -606,34 +648,132 @@ int px_canopen_tx(struct px_canopen *co, int64_t now, const double *targets,
 			raw = to_i32(t / c->rated_torque_n_m * 1000.0);
 		else
 			raw = to_i32(t * c->counts_per_unit);
-		{
-			const struct px_canopen_pdo *p = &co->pdo.rpdo;
-			int64_t v[PX_CANOPEN_MAX_MAP];
-			size_t e;
-			for (e = 0; e < p->n; e++) {
-				uint16_t ix = p->e[e].index;
-				v[e] = ix == 0x6040   ? s->controlword
-				       : ix == 0x6060 ? c->mode
-						      : fit(raw, p->e[e].bits, 1);
-			}
-			memset(b, 0, sizeof b);
-			px_canopen_pdo_pack(p, v, b, sizeof b);
-			r = send_frame(co->bus, 0x200u + c->node_id, b,
-				       (int)px_canopen_pdo_bytes(p), now);
-		}
+		r = send_rpdo(co, i, raw, now);
 		if (r == PX_E_IO)
 			rc = PX_E_IO;
 	}
-	if (co->cfg.sync && send_frame(co->bus, 0x080, b, 0, now) == PX_E_IO)
-		rc = PX_E_IO;
-	if (co->cfg.heartbeat_period_ns > 0 &&
-	    (co->last_hb == 0 ||
-	     now - co->last_hb >= co->cfg.heartbeat_period_ns)) {
-		b[0] = 0x05; /* operational */
-		send_frame(co->bus, 0x700u + co->cfg.own_node_id, b, 1, now);
-		co->last_hb = now ? now : 1;
+	r = sync_and_heartbeat(co, now);
+	return rc < 0 ? rc : r;
+}
+
+/* ---- safe stop ------------------------------------------------------------ */
+
+void px_canopen_stop_config_default(struct px_canopen_stop_config *c)
+{
+	if (!c)
+		return;
+	memset(c, 0, sizeof *c);
+	c->timeout_ns = 500000000;
+	c->max_rounds = 1000;
+	c->period_ns = 1000000;
+	c->quick_stop_ns = 20000000;
+}
+
+static int64_t sleep_period(void *user, int64_t now, int64_t period_ns)
+{
+	struct timespec ts;
+	(void)user;
+	(void)now;
+	ts.tv_sec = (time_t)(period_ns / 1000000000);
+	ts.tv_nsec = (long)(period_ns % 1000000000);
+	nanosleep(&ts, NULL);
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+
+/* Power stage off as the drive itself reports it. */
+static int disabled_state(int state)
+{
+	return state == PX_CIA402_SWITCH_ON_DISABLED ||
+	       state == PX_CIA402_NOT_READY || state == PX_CIA402_FAULT;
+}
+
+int px_canopen_safe_stop(struct px_canopen *co, int64_t now_ns,
+			 const struct px_canopen_stop_config *cfg,
+			 struct px_canopen_stop_result *res)
+{
+	struct px_canopen_stop_config c;
+	int64_t qs_since[PX_CANOPEN_MAX_DRIVES];
+	int64_t t0 = now_ns, sent0 = 0;
+	uint32_t round;
+	size_t i;
+	int io = 0;
+	if (res) {
+		memset(res, 0, sizeof *res);
+		res->first_unconfirmed = -1;
 	}
-	return rc;
+	if (!co)
+		return PX_E_INVAL;
+	if (cfg)
+		c = *cfg;
+	else
+		px_canopen_stop_config_default(&c);
+	if (c.timeout_ns < 0 || c.period_ns <= 0 || c.quick_stop_ns < 0)
+		return PX_E_INVAL;
+	if (!c.wait)
+		c.wait = sleep_period;
+	for (i = 0; i < co->cfg.n_drives; i++)
+		qs_since[i] = INT64_MIN;
+	for (round = 0;; round++) {
+		size_t ok = 0, faulted = 0;
+		int first = -1;
+		if (px_canopen_rx(co, now_ns) == PX_E_IO)
+			io = 1; /* kept trying within the bound */
+		/* confirmed: a statusword sent after our first command says
+		 * the power stage is off */
+		for (i = 0; i < co->cfg.n_drives; i++) {
+			const struct px_canopen_drive_status *s = &co->st[i];
+			if (round > 0 && co->sw_ns[i] > sent0 && !s->lost &&
+			    disabled_state(s->state)) {
+				ok++;
+				faulted += s->state == PX_CIA402_FAULT;
+			} else if (first < 0) {
+				first = (int)i;
+			}
+		}
+		if (res) {
+			res->drives = co->cfg.n_drives;
+			res->disabled = ok;
+			res->faulted = faulted;
+			res->first_unconfirmed = first;
+			res->rounds = round;
+			res->elapsed_ns = now_ns - t0;
+		}
+		if (ok == co->cfg.n_drives)
+			return PX_OK;
+		if (round >= c.max_rounds || now_ns - t0 >= c.timeout_ns)
+			return io ? PX_E_IO : PX_E_TIMEOUT;
+		if (round == 0)
+			sent0 = now_ns - 1;
+		/* quick stop from operation enabled, held quick_stop_ns so
+		 * the drive decelerates on its own ramp, then disable
+		 * voltage; anything else straight to disable voltage (no
+		 * fault reset: a faulted drive stays off) */
+		for (i = 0; i < co->cfg.n_drives; i++) {
+			struct px_canopen_drive_status *s = &co->st[i];
+			const struct px_canopen_drive_cfg *d = &co->drv[i];
+			int32_t hold = 0;
+			if (s->state == PX_CIA402_OPERATION_ENABLED ||
+			    (s->state == PX_CIA402_QUICK_STOP_ACTIVE &&
+			     (qs_since[i] == INT64_MIN ||
+			      now_ns - qs_since[i] < c.quick_stop_ns))) {
+				if (qs_since[i] == INT64_MIN)
+					qs_since[i] = now_ns;
+				s->controlword = PX_CIA402_CW_QUICK_STOP;
+			} else {
+				s->controlword = PX_CIA402_CW_DISABLE_VOLTAGE;
+			}
+			/* a position drive is told to stay where it is, the
+			 * others zero velocity or torque */
+			if (d->mode == PX_CIA402_CSP)
+				hold = to_i32(s->position * d->counts_per_unit);
+			if (send_rpdo(co, i, hold, now_ns) == PX_E_IO)
+				io = 1;
+		}
+		if (sync_and_heartbeat(co, now_ns) == PX_E_IO)
+			io = 1;
+		now_ns = c.wait(c.user, now_ns, c.period_ns);
+	}
 }
 
 int px_canopen_all_enabled(const struct px_canopen *co)

@@ -206,6 +206,59 @@ PX_API int px_canopen_first_problem(const struct px_canopen *co);
 PX_API int px_canopen_drive_status(const struct px_canopen *co, size_t i,
 				   struct px_canopen_drive_status *st);
 
+/* ---- safe stop --------------------------------------------------------------- */
+
+/*
+ * How px_canopen_safe_stop() waits. Rounds of one command each to every
+ * drive (and SYNC) are period_ns apart; between them wait() lets the
+ * time pass and returns the new now (on the clock of now_ns): NULL
+ * sleeps on CLOCK_MONOTONIC, the clock now_ns must then be on. A
+ * virtual clock, or a simulated arm stepped on the same thread, plugs in
+ * here (step the arm, advance the clock). The wait is bounded twice:
+ * timeout_ns of that clock and max_rounds rounds, whichever comes first.
+ */
+struct px_canopen_stop_config {
+	int64_t timeout_ns;     /* default 500 ms */
+	uint32_t max_rounds;    /* default 1000 */
+	int64_t period_ns;      /* default 1 ms, > 0 */
+	/* A drive found in operation enabled gets quick stop for this long
+	 * (it decelerates on its own quick-stop ramp) before disable
+	 * voltage; default 20 ms. */
+	int64_t quick_stop_ns;
+	int64_t (*wait)(void *user, int64_t now_ns, int64_t period_ns);
+	void *user;
+};
+
+struct px_canopen_stop_result {
+	size_t drives;
+	size_t disabled;        /* confirmed with the power stage off */
+	size_t faulted;         /* of those, in fault (off, not reset) */
+	int first_unconfirmed;  /* drive index, -1 when all confirmed */
+	uint32_t rounds;
+	int64_t elapsed_ns;
+};
+
+PX_API void px_canopen_stop_config_default(struct px_canopen_stop_config *c);
+
+/*
+ * Take every drive to standstill with its power stage off (CiA 402): a
+ * drive in operation enabled gets quick stop (controlword 0x0002) for
+ * quick_stop_ns, then disable voltage (0x0000); a drive in any other
+ * state disable voltage at once; a drive in fault is left in fault (no
+ * reset). CSP drives are sent their last position as target, the
+ * others zero. A drive counts as confirmed when a statusword it sent
+ * after the first command says switch on disabled, not ready to switch
+ * on or fault, and its heartbeat is not lost. cfg NULL: the defaults.
+ * res (may be NULL) says how many drives confirmed and the first that
+ * did not. Shutdown time, not for the cycle (it waits). Returns PX_OK
+ * when every drive confirmed, PX_E_TIMEOUT when the bound passed first,
+ * PX_E_IO when frames could not be sent or received and the bound
+ * passed, PX_E_INVAL.
+ */
+PX_API int px_canopen_safe_stop(struct px_canopen *co, int64_t now_ns,
+				const struct px_canopen_stop_config *cfg,
+				struct px_canopen_stop_result *res);
+
 /* ---- simulated arm (the drives' side) -------------------------------------- */
 
 struct px_canopen_sim;

@@ -17,7 +17,7 @@
 enum {
 	C_REPORTS, C_SAMPLES, C_DECODE, C_NONFINITE, C_DUP, C_STUCK,
 	C_UNPLUG, C_REPLUG, C_WRITES, C_WERR, C_IOERR, C_BUSERR, C_ERRORS,
-	C__COUNT
+	C_SAFE, C_SAFE_ERR, C__COUNT
 };
 
 /* The last-error record, copied through a seqlock as 64-bit words. */
@@ -38,6 +38,13 @@ struct px_dev {
 	void *impl;
 	_Atomic int state;
 	int started;
+	/* an output was written since the last confirmed safe output (any
+	 * thread reads it: px_dev_status) */
+	_Atomic int dirty;
+	/* loop clock of the newest cycle call, for the safe output that
+	 * stop/free send (a simulated device lives on the virtual clock;
+	 * the loop itself may be gone by then) */
+	_Atomic int64_t last_now_ns;
 
 	/* feeding thread */
 	double axis[PX_AXIS__COUNT];
@@ -69,6 +76,19 @@ int64_t px_dev_mono_ns(void)
 	struct timespec ts;
 	clock_gettime(CLOCK_MONOTONIC, &ts);
 	return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+
+static void seen(struct px_dev *d, int64_t now_ns)
+{
+	atomic_store_explicit(&d->last_now_ns, now_ns, memory_order_relaxed);
+}
+
+/* When a safe output is sent from stop/free: just after the newest
+ * cycle call on its clock, else CLOCK_MONOTONIC. */
+static int64_t dev_now(struct px_dev *d)
+{
+	int64_t t = atomic_load_explicit(&d->last_now_ns, memory_order_relaxed);
+	return t == INT64_MIN ? px_dev_mono_ns() : t;
 }
 
 static void inc(struct px_dev *d, int c)
@@ -130,6 +150,8 @@ int px_dev_create(const struct px_dev_ops *ops,
 		return rc;
 	}
 	atomic_init(&d->state, PX_DEV_STATE_CLOSED);
+	atomic_init(&d->dirty, 0);
+	atomic_init(&d->last_now_ns, INT64_MIN);
 	atomic_init(&d->eseq, 0);
 	atomic_flag_clear(&d->ebusy);
 	for (i = 0; i < C__COUNT; i++)
@@ -147,6 +169,10 @@ void px_dev_free(struct px_dev *d)
 {
 	if (!d)
 		return;
+	/* Belt and braces: whoever frees a device that was driven without
+	 * making it safe first still leaves no command in effect. */
+	if (atomic_load(&d->dirty))
+		(void)px_dev_safe(d, dev_now(d));
 	px_dev_stop(d);
 	if (d->ops->destroy)
 		d->ops->destroy(d);
@@ -177,6 +203,9 @@ void px_dev_stop(struct px_dev *d)
 {
 	if (!d || !d->started)
 		return;
+	/* before the threads that would send it stop */
+	if (atomic_load(&d->dirty))
+		(void)px_dev_safe(d, dev_now(d));
 	if (d->ops->stop)
 		d->ops->stop(d);
 	d->started = 0;
@@ -347,6 +376,7 @@ int px_dev_pose_read(struct px_dev *d, int64_t now_ns,
 	int st, gone;
 	if (!d || !out)
 		return PX_E_INVAL;
+	seen(d, now_ns);
 	if (d->ops->poll)
 		d->ops->poll(d, now_ns);
 	s = px_param_read(d->hand, NULL);
@@ -385,6 +415,8 @@ int px_dev_force_write(struct px_dev *d, const struct px_force_cmd *c,
 	st = px_dev_state(d);
 	if (st == PX_DEV_STATE_UNPLUGGED || st == PX_DEV_STATE_FAILED)
 		return PX_E_NODEV;
+	atomic_store_explicit(&d->dirty, 1, memory_order_relaxed);
+	seen(d, now_ns);
 	rc = d->ops->force(d, c, now_ns);
 	px_dev_count_write(d, rc >= 0);
 	return rc;
@@ -405,7 +437,58 @@ int px_dev_dio_write(struct px_dev *d, int which, int value, int64_t now_ns)
 		return PX_E_INVAL;
 	if (!(d->ops->caps & PX_DEV_CAP_DIO) || !d->ops->dio_write)
 		return PX_E_UNSUPPORTED;
+	atomic_store_explicit(&d->dirty, 1, memory_order_relaxed);
+	seen(d, now_ns);
 	return d->ops->dio_write(d, which, value != 0, now_ns);
+}
+
+/* The generic safe output: one zero command through the back end's own
+ * force op (enable 0 encodes as zero in every back end), and the
+ * digital outputs off. An absent output line (PX_E_UNSUPPORTED) is not
+ * an error. */
+static int generic_safe(struct px_dev *d, int64_t now_ns)
+{
+	int rc = PX_OK, r;
+	if ((d->ops->caps & PX_DEV_CAP_FORCE) && d->ops->force) {
+		struct px_force_cmd zero;
+		memset(&zero, 0, sizeof zero);
+		rc = d->ops->force(d, &zero, now_ns);
+		if (rc == PX_E_UNSUPPORTED)
+			rc = PX_OK; /* a map with no outputs sends nothing */
+	}
+	if ((d->ops->caps & PX_DEV_CAP_DIO) && d->ops->dio_write) {
+		r = d->ops->dio_write(d, PX_DIO_ENABLE, 0, now_ns);
+		if (r < 0 && r != PX_E_UNSUPPORTED && rc == PX_OK)
+			rc = r;
+		r = d->ops->dio_write(d, PX_DIO_TIMING, 0, now_ns);
+		if (r < 0 && r != PX_E_UNSUPPORTED && rc == PX_OK)
+			rc = r;
+	}
+	return rc;
+}
+
+int px_dev_safe(struct px_dev *d, int64_t now_ns)
+{
+	int rc;
+	if (!d)
+		return PX_E_INVAL;
+	if (!(d->ops->caps & (PX_DEV_CAP_FORCE | PX_DEV_CAP_DIO)))
+		return PX_OK;
+	rc = d->ops->safe ? d->ops->safe(d, now_ns) : generic_safe(d, now_ns);
+	if (rc > 0)
+		rc = PX_OK;
+	if (d->ops->caps & PX_DEV_CAP_FORCE)
+		px_dev_count_write(d, rc == PX_OK);
+	if (rc == PX_OK) {
+		inc(d, C_SAFE);
+		atomic_store(&d->dirty, 0);
+	} else {
+		inc(d, C_SAFE_ERR);
+		atomic_store(&d->dirty, 1);
+		px_dev_record(d, PX_DEV_ERR_IO, rc, 0, -1, NULL,
+			      "safe output not confirmed", now_ns);
+	}
+	return rc;
 }
 
 /* ---- status ------------------------------------------------------------ */
@@ -606,6 +689,9 @@ int px_dev_status(const struct px_dev *d, struct px_dev_status *st)
 	st->io_errors = get(d, C_IOERR);
 	st->bus_errors = get(d, C_BUSERR);
 	st->errors = get(d, C_ERRORS);
+	st->safe_writes = get(d, C_SAFE);
+	st->safe_errors = get(d, C_SAFE_ERR);
+	st->outputs_safe = st->safe_writes > 0 && !atomic_load(&d->dirty);
 	st->last_frame_id = -1;
 	have = read_err(d, &e);
 	if (have > 0) {
@@ -657,6 +743,8 @@ struct px_loop *px__dev_loop(const struct px_dev *d)
 {
 	return d ? d->loop : NULL;
 }
+
+
 
 void px__dev_force_wrench(const struct px_force_cmd *c,
 			  double w[PX_WRENCH__COUNT])

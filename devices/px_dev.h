@@ -132,6 +132,11 @@ struct px_dev_status {
 	uint64_t writes, write_errors;
 	uint64_t io_errors;
 	uint64_t bus_errors;
+	uint64_t safe_writes;  /* safe outputs sent and confirmed (px_dev_safe) */
+	uint64_t safe_errors;  /* safe outputs that failed */
+	/* 1 when the newest output of the device is a confirmed safe one
+	 * (no force or output change since); 0 otherwise. */
+	int outputs_safe;
 	uint64_t errors;       /* all recorded problems */
 	/* The last recorded problem. */
 	int last_kind;         /* enum px_dev_errkind */
@@ -144,7 +149,11 @@ struct px_dev_status {
 
 /* A back end. Every pointer may be NULL where the back end has no such
  * thing. poll, force, estop and dio_write run in the cycle (RT rules);
- * start, stop and destroy at setup. */
+ * start, stop, safe and destroy at setup or shutdown. safe puts every
+ * output in its safe state (zero force and torque with enable off;
+ * enable and timing outputs off) and confirms it where the back end can
+ * (a write acknowledged, a line read back), waiting a bounded time at
+ * most; NULL means the generic safe output of px_dev_safe(). */
 struct px_dev_ops {
 	const char *backend;   /* "sim-haptic", "hidapi", ... */
 	unsigned caps;         /* enum px_dev_cap bits */
@@ -156,6 +165,7 @@ struct px_dev_ops {
 	int (*estop)(struct px_dev *d, int64_t now_ns, int *pressed);
 	int (*dio_write)(struct px_dev *d, int which, int value,
 			 int64_t now_ns);
+	int (*safe)(struct px_dev *d, int64_t now_ns);
 	void (*destroy)(struct px_dev *d); /* free the back end's resources */
 };
 
@@ -186,14 +196,37 @@ PX_API int px_dev_create(const struct px_dev_ops *ops,
 			 const struct px_dev_config *cfg, size_t impl_size,
 			 struct px_dev **out);
 
-/* Stop (if started), destroy the back end, free. NULL is a no-op. */
+/* Stop (if started), destroy the back end, free. A device with outputs
+ * that were written since its last safe output gets one first
+ * (px_dev_safe), so freeing never leaves the last command in effect.
+ * NULL is a no-op. */
 PX_API void px_dev_free(struct px_dev *d);
 
 /* Start the back end (reader threads, opening). Setup only. Returns
  * PX_OK or the back end's error (recorded in the status). */
 PX_API int px_dev_start(struct px_dev *d);
-/* Stop reader threads; the device can be started again. */
+/* Stop reader threads; the device can be started again. As
+ * px_dev_free(), a device written to since its last safe output gets
+ * one before its threads stop. */
 PX_API void px_dev_stop(struct px_dev *d);
+
+/*
+ * Put the device's outputs in their safe state at now_ns (loop clock):
+ * a force sink gets zero force and torque with enable off, through the
+ * same encoding as any command (codec, CAN signals); a digital I/O
+ * device gets its enable output (relay) and timing output off. Where the
+ * back end can confirm (a write acknowledged by the transport, an output
+ * line read back) it does, waiting at most about 250 ms for a device
+ * thread to send. Tried whatever the device state (an unplugged device
+ * cannot take it: PX_E_NODEV). A force write is counted as a write (so
+ * a run of N cycles that ends safely shows N + 1); the outcome is kept
+ * in the status (safe_writes, safe_errors, outputs_safe). Not for the
+ * cycle (it may wait): call it after the loop stops, before closing.
+ * Returns PX_OK (also for a device without outputs), PX_E_NODEV,
+ * PX_E_IO, PX_E_TIMEOUT (a device thread did not send in time) or the
+ * back end's error; PX_E_INVAL for NULL.
+ */
+PX_API int px_dev_safe(struct px_dev *d, int64_t now_ns);
 
 /*
  * Register the device's pose input with loop l's watchdog (timeout

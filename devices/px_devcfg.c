@@ -26,6 +26,7 @@ struct px_devcfg {
 	size_t n_drives;
 	struct px_canopen_pdo_map pdo;
 	char notes[256];
+	int co_safe; /* the master's drives confirmed disabled */
 };
 
 /* Config fault windows as px_sim faults, moved onto the loop clock;
@@ -851,11 +852,70 @@ int px_devcfg_open(const struct px_config *cfg,
 	return PX_OK;
 }
 
+static int64_t no_wait(void *user, int64_t now_ns, int64_t period_ns)
+{
+	(void)user;
+	return now_ns + period_ns;
+}
+
+void px_devcfg_safe_config_default(struct px_devcfg_safe_config *c)
+{
+	if (!c)
+		return;
+	memset(c, 0, sizeof *c);
+	px_canopen_stop_config_default(&c->canopen);
+}
+
+int px_devcfg_safe_stop(struct px_devcfg *h, int64_t now_ns,
+			const struct px_devcfg_safe_config *cfg,
+			struct px_devcfg_safe_result *res)
+{
+	struct px_devcfg_safe_config c;
+	int rc = PX_OK;
+	if (res) {
+		memset(res, 0, sizeof *res);
+		res->canopen.first_unconfirmed = -1;
+	}
+	if (!h)
+		return PX_E_INVAL;
+	if (cfg)
+		c = *cfg;
+	else
+		px_devcfg_safe_config_default(&c);
+	if (h->dev) {
+		rc = px_dev_safe(h->dev, now_ns);
+		if (res) {
+			res->dev_rc = rc;
+			res->caps = px_dev_caps(h->dev);
+		}
+	}
+	if (h->co) {
+		int r = px_canopen_safe_stop(h->co, now_ns, &c.canopen,
+					     res ? &res->canopen : NULL);
+		h->co_safe = r == PX_OK;
+		if (res)
+			res->canopen_rc = r;
+		if (rc == PX_OK)
+			rc = r;
+	}
+	return rc;
+}
+
 void px_devcfg_free(struct px_devcfg *h)
 {
 	if (!h)
 		return;
-	px_dev_free(h->dev);
+	if (h->co && !h->co_safe) {
+		/* Freed without px_devcfg_safe_stop(): one round of quick
+		 * stop / disable voltage still goes out before the bus
+		 * closes (no waiting for confirmation here). */
+		struct px_canopen_stop_config sc;
+		px_canopen_stop_config_default(&sc);
+		sc.max_rounds = 1;
+		sc.wait = no_wait;
+		(void)px_canopen_safe_stop(h->co, px_dev_mono_ns(), &sc, NULL);
+	}
+	px_dev_free(h->dev); /* a device written to gets its safe output */
 	px_canopen_free(h->co);
 	px_can_bus_close(h->co_bus);
 	if (h->own_sim_bus)

@@ -103,7 +103,43 @@ PX_API int px_devcfg_open(const struct px_config *cfg,
  * skipped on a virtual CAN interface), "" when nothing. Owned by h. */
 PX_API const char *px_devcfg_notes(const struct px_devcfg *h);
 
-/* Free the devices, master, buses and tables. NULL is a no-op. */
+/* How px_devcfg_safe_stop() stops a CANopen master's drives (see
+ * px_canopen_safe_stop()). */
+struct px_devcfg_safe_config {
+	struct px_canopen_stop_config canopen;
+};
+
+/* px_devcfg_safe_config_default(): px_canopen_stop_config_default(). */
+PX_API void px_devcfg_safe_config_default(struct px_devcfg_safe_config *c);
+
+struct px_devcfg_safe_result {
+	unsigned caps;        /* the device's (0 without one) */
+	int dev_rc;           /* px_dev_safe()'s result (PX_OK without) */
+	int canopen_rc;       /* px_canopen_safe_stop()'s (PX_OK without) */
+	struct px_canopen_stop_result canopen;
+};
+
+/*
+ * Put everything h opened in its safe state, in one call: the device's
+ * safe output (px_dev_safe(): zero force/torque with enable off, enable
+ * relay and timing line off), then the CANopen master's drives to quick
+ * stop and disabled, confirmed by their statuswords within cfg's bound
+ * (px_canopen_safe_stop(); its wait hook steps a simulated arm or a
+ * virtual clock). now_ns on the loop clock. cfg NULL: defaults. res
+ * (may be NULL) holds each part's outcome. Not for the cycle: call it
+ * after the loop stops, before px_devcfg_free(). Returns PX_OK when all
+ * confirmed, else the first error (PX_E_NODEV, PX_E_IO, PX_E_TIMEOUT,
+ * ...); every part is tried whatever an earlier one returned.
+ */
+PX_API int px_devcfg_safe_stop(struct px_devcfg *h, int64_t now_ns,
+			       const struct px_devcfg_safe_config *cfg,
+			       struct px_devcfg_safe_result *res);
+
+/* Free the devices, master, buses and tables. NULL is a no-op. A
+ * device written to since its last safe output gets one (px_dev_free),
+ * and a master whose drives were not confirmed disabled by
+ * px_devcfg_safe_stop() sends one round of quick stop / disable voltage
+ * (without waiting) before its bus closes. */
 PX_API void px_devcfg_free(struct px_devcfg *h);
 
 /* The pose/force/DIO device; NULL for a socketcan device with canopen

@@ -84,7 +84,7 @@ int px__dio_estop(struct px_dev *d, struct px__dio *io, int64_t now_ns,
 	*pressed = p;
 	l = px__dev_loop(d);
 	if (p && l)
-		px_loop_trip(l);
+		px_loop_trip_estop(l); /* latched: see px_loop.h */
 	return gone ? PX_E_NODEV : PX_OK;
 }
 

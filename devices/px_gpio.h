@@ -14,8 +14,10 @@
  * Fail-safe: an e-stop device that is unplugged, failed or cannot be
  * read reports pressed (px_dev_estop_read returns PX_E_NODEV with
  * *pressed = 1). With a loop attached (px_dev_attach) a pressed e-stop
- * calls px_loop_trip() every cycle it is read as pressed, so the loop
- * enters safe state and cannot be re-armed while it is held.
+ * calls px_loop_trip_estop() every cycle it is read as pressed, so the
+ * loop enters safe state, cannot be re-armed while it is held, and stays
+ * there after the release until an explicit px_loop_rearm() (automatic
+ * re-arm never ends an e-stop's safe state).
  *
  * Memory: one allocation at create (plus libgpiod's own at open);
  * reading events and setting outputs in the cycle allocate nothing.

@@ -88,6 +88,43 @@ static int gd_write(struct px_dev *d, int which, int value, int64_t now)
 	return PX_OK;
 }
 
+/* Enable (relay) and timing outputs off, each read back: the kernel's
+ * value of a requested output line is what the driver was last told,
+ * and a line another consumer or a failing chip changed shows here. */
+static int gd_safe(struct px_dev *d, int64_t now)
+{
+	static const int roles[2] = {PX_GPIO_ENABLE, PX_GPIO_TIMING};
+	struct gd *g = px_dev_impl(d);
+	int k, rc = PX_OK;
+	for (k = 0; k < 2; k++) {
+		int role = roles[k], want, got;
+		int r = gd_write(d, role == PX_GPIO_ENABLE ? PX_DIO_ENABLE
+							   : PX_DIO_TIMING,
+				 0, now);
+		if (r == PX_E_UNSUPPORTED)
+			continue;
+		if (r < 0) {
+			rc = rc < 0 ? rc : r;
+			continue;
+		}
+		want = px__dio_physical(&g->io, role, 0);
+		got = gpiod_line_get_value(g->line[role]);
+		if (got != want) {
+			px_dev_record(d, PX_DEV_ERR_IO, PX_E_IO,
+				      got < 0 ? errno : 0,
+				      g->io.cfg.line[role].offset, NULL,
+				      role == PX_GPIO_ENABLE
+					      ? "enable output read back on "
+						"after the safe output"
+					      : "timing output read back on "
+						"after the safe output",
+				      now);
+			rc = rc < 0 ? rc : PX_E_IO;
+		}
+	}
+	return rc;
+}
+
 static void gd_destroy(struct px_dev *d)
 {
 	struct gd *g = px_dev_impl(d);
@@ -105,6 +142,7 @@ static const struct px_dev_ops gd_ops = {
 	.caps = PX_DEV_CAP_DIO,
 	.estop = gd_estop,
 	.dio_write = gd_write,
+	.safe = gd_safe,
 	.destroy = gd_destroy,
 };
 

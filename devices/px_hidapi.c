@@ -23,6 +23,7 @@
 #define REP_MAX 256
 #define READ_TIMEOUT_MS 1
 #define REOPEN_NS 200000000
+#define SAFE_WAIT_NS 250000000 /* the I/O thread sends a safe output */
 
 struct outrep {
 	size_t len;
@@ -40,6 +41,12 @@ struct hid {
 	struct px_arena arena;
 	uint8_t arena_buf[4 * sizeof(struct outrep) + 512];
 	struct px_param *out;
+	/* Safe output: the shutdown side fills safe_rep, sets hold (no
+	 * older command goes out after it) and bumps safe_req; the I/O
+	 * thread sends it and answers with safe_rc and safe_ack. */
+	struct outrep safe_rep;
+	atomic_uint safe_req, safe_ack;
+	atomic_int safe_rc, hold;
 };
 
 /* hidapi's library state (for hidapi-libusb, its one libusb context) is
@@ -233,6 +240,26 @@ static void sleep_ns(int64_t ns)
 	nanosleep(&ts, NULL);
 }
 
+/* Send the safe output report (I/O thread, or the caller when no
+ * thread runs) and answer the request. */
+static void send_safe(struct px_dev *d, struct hid *x)
+{
+	unsigned r = atomic_load(&x->safe_req);
+	int rc = PX_OK;
+	errno = 0;
+	if (!x->h) {
+		rc = PX_E_NODEV;
+	} else if (hid_write(x->h, x->safe_rep.b, x->safe_rep.len) !=
+		   (int)x->safe_rep.len) {
+		rc = PX_E_IO;
+		px_dev_record(d, PX_DEV_ERR_IO, PX_E_IO, errno, x->safe_rep.b[0],
+			      NULL, "hid_write of the safe output failed",
+			      px_dev_mono_ns());
+	}
+	atomic_store(&x->safe_rc, rc);
+	atomic_store(&x->safe_ack, r);
+}
+
 /* One thread makes every hidapi call for a device: hidapi 0.13 keeps a
  * per-device error string that hid_read_timeout and hid_write both
  * replace, so reading and writing from two threads would race. Reads
@@ -269,13 +296,16 @@ static void *io_main(void *p)
 			continue;
 		}
 		o = px_param_read(x->out, &fresh);
-		if (fresh && o->len) {
+		if (fresh && o->len && !atomic_load(&x->hold)) {
 			errno = 0;
 			if (hid_write(x->h, o->b, o->len) < 0)
 				px_dev_record(d, PX_DEV_ERR_IO, PX_E_IO, errno,
 					      o->b[0], NULL, "hid_write failed",
 					      px_dev_mono_ns());
 		}
+		/* after any command of this turn, so the safe one is last */
+		if (atomic_load(&x->safe_req) != atomic_load(&x->safe_ack))
+			send_safe(d, x);
 	}
 	return NULL;
 }
@@ -313,8 +343,46 @@ static int hid_force(struct px_dev *d, const struct px_force_cmd *c,
 	if (n < 0)
 		return n;
 	o.len = (size_t)n;
+	atomic_store(&x->hold, 0);
 	px_param_write(x->out, &o); /* the I/O thread sends it */
 	return PX_OK;
+}
+
+/* Zero force through the codec; hid_write's byte count is the
+ * confirmation hidapi gives. With the I/O thread running it sends (it
+ * makes every hidapi call), the caller waits a bounded time. */
+static int hid_safe(struct px_dev *d, int64_t now)
+{
+	struct hid *x = px_dev_impl(d);
+	const struct px_codec_map *m = px_dev_config(d)->codec;
+	struct px_force_cmd zero;
+	int64_t t0;
+	unsigned r;
+	int n;
+	if (!m->n_outputs)
+		return PX_OK; /* an input-only device has nothing to zero */
+	memset(&zero, 0, sizeof zero);
+	n = px__dev_encode_force(d, m, &zero, now, x->safe_rep.b,
+				 sizeof x->safe_rep.b);
+	if (n < 0)
+		return n;
+	x->safe_rep.len = (size_t)n;
+	atomic_store(&x->hold, 1);
+	if (!x->threads) {
+		atomic_fetch_add(&x->safe_req, 1);
+		send_safe(d, x);
+		return atomic_load(&x->safe_rc);
+	}
+	if (px_dev_state(d) == PX_DEV_STATE_UNPLUGGED)
+		return PX_E_NODEV; /* the thread waits to reopen: no handle */
+	r = atomic_fetch_add(&x->safe_req, 1) + 1;
+	t0 = px_dev_mono_ns();
+	while (atomic_load(&x->safe_ack) != r) {
+		if (px_dev_mono_ns() - t0 > SAFE_WAIT_NS)
+			return PX_E_TIMEOUT;
+		sleep_ns(1000000);
+	}
+	return atomic_load(&x->safe_rc);
 }
 
 static void hid_destroy(struct px_dev *d)
@@ -330,6 +398,7 @@ static const struct px_dev_ops hid_ops = {
 	.start = hid_start,
 	.stop = hid_stop,
 	.force = hid_force,
+	.safe = hid_safe,
 	.destroy = hid_destroy,
 };
 
@@ -396,6 +465,10 @@ int px_hid_create(const struct px_dev_config *dcfg,
 	if (x->cfg.serial)
 		x->cfg.serial = x->serial;
 	atomic_init(&x->stop, 0);
+	atomic_init(&x->safe_req, 0);
+	atomic_init(&x->safe_ack, 0);
+	atomic_init(&x->safe_rc, 0);
+	atomic_init(&x->hold, 0);
 	px_arena_init(&x->arena, x->arena_buf, sizeof x->arena_buf);
 	memset(&zero, 0, sizeof zero);
 	rc = px_param_create(&x->arena, sizeof zero, &zero, &x->out);

@@ -40,6 +40,8 @@ struct sim {
 	int started;
 	int64_t t0, t, next_report;
 	double x[3], v[3], f[3], hand[3];
+	double tq[3];
+	int enable;             /* of the newest command received */
 	/* fault state */
 	int unplugged;
 	unsigned corrupt_turn;
@@ -557,7 +559,9 @@ static int sim_force(struct px_dev *d, const struct px_force_cmd *c,
 		return n;
 	if (s->unplugged)
 		return PX_E_NODEV;
-	/* The device end: decode what was sent. */
+	/* The device end: decode what was sent (channels the map does not
+	 * carry read 0). */
+	memset(w, 0, sizeof w);
 	memcpy(s->last_out, b, (size_t)n);
 	s->last_out_len = (size_t)n;
 	n = px_codec_decode_output(s->map, b, (size_t)n, w, &diag);
@@ -568,8 +572,11 @@ static int sim_force(struct px_dev *d, const struct px_force_cmd *c,
 		return n;
 	}
 	s->outs++;
-	for (k = 0; k < 3; k++)
+	for (k = 0; k < 3; k++) {
 		s->f[k] = w[k];
+		s->tq[k] = w[3 + k];
+	}
+	s->enable = c->enable != 0;
 	return PX_OK;
 }
 
@@ -721,7 +728,9 @@ int px_sim_haptic_state(struct px_dev *d, struct px_sim_haptic_state *st)
 		st->vel_m_s[k] = s->v[k];
 		st->hand_m[k] = s->hand[k];
 		st->force_n[k] = s->f[k];
+		st->torque_n_m[k] = s->tq[k];
 	}
+	st->enable = s->enable;
 	st->reports_sent = s->sent;
 	st->reports_faulted = s->faulted;
 	st->outputs_decoded = s->outs;

@@ -161,6 +161,11 @@ struct px_sim_haptic_state {
 	double pos_m[3], vel_m_s[3];
 	double hand_m[3];
 	double force_n[3];          /* force in effect (decoded command) */
+	/* What the device last received: the decoded torque of the
+	 * newest output report, and the command's enable flag (0 before
+	 * any); a safe output shows force and torque 0, enable 0. */
+	double torque_n_m[3];
+	int enable;
 	uint64_t reports_sent;
 	uint64_t reports_faulted;
 	uint64_t outputs_decoded;

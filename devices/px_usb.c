@@ -47,6 +47,8 @@ struct usb {
 	struct px_arena arena;
 	uint8_t arena_buf[4 * sizeof(struct outframe) + 512];
 	struct px_param *out;
+	/* set by a safe output: no older frame goes out after it */
+	atomic_int hold;
 };
 
 static int64_t mono_ns(void)
@@ -366,7 +368,7 @@ static void *writer_main(void *p)
 		if (!fresh || !o->len || !u->cfg.endpoint_out)
 			continue;
 		pthread_mutex_lock(&u->lock);
-		if (u->h) {
+		if (u->h && !atomic_load(&u->hold)) {
 			if (u->cfg.transfer == PX_USB_BULK)
 				rc = libusb_bulk_transfer(u->h, u->cfg.endpoint_out,
 							  (unsigned char *)o->b,
@@ -429,27 +431,83 @@ static void usb_stop(struct px_dev *d)
 	u->threads = 0;
 }
 
+/* Force command c as the frame the OUT endpoint takes: a vendor frame
+ * has no report id byte unless the map numbers its reports. */
+static int out_frame(struct px_dev *d, const struct px_force_cmd *c,
+		     int64_t now, struct outframe *o)
+{
+	const struct px_codec_map *m = px_dev_config(d)->codec;
+	int n, off;
+	n = px__dev_encode_force(d, m, c, now, o->b, sizeof o->b);
+	if (n < 0)
+		return n;
+	off = px_codec_numbered(m) ? 0 : 1;
+	o->len = (size_t)n - (size_t)off;
+	if (off)
+		memmove(o->b, o->b + 1, o->len);
+	return PX_OK;
+}
+
 static int usb_force(struct px_dev *d, const struct px_force_cmd *c,
 		     int64_t now)
 {
 	struct usb *u = px_dev_impl(d);
 	const struct px_codec_map *m = px_dev_config(d)->codec;
 	struct outframe o;
-	int n, off;
+	int rc;
 	if (!m->n_outputs || !u->cfg.endpoint_out)
 		return PX_E_UNSUPPORTED;
-	n = px__dev_encode_force(d, m, c, now, o.b, sizeof o.b);
-	if (n < 0)
-		return n;
-	/* a vendor frame has no report id byte unless the map numbers
-	 * its reports */
-	off = px_codec_numbered(m) ? 0 : 1;
-	o.len = (size_t)n - (size_t)off;
-	if (off)
-		memmove(o.b, o.b + 1, o.len);
+	rc = out_frame(d, c, now, &o);
+	if (rc < 0)
+		return rc;
+	atomic_store(&u->hold, 0);
 	px_param_write(u->out, &o);
 	sem_post(&u->wake);
 	return PX_OK;
+}
+
+/* Zero force, sent here as one synchronous transfer under the handle's
+ * lock (so the writer cannot send an older frame after it); libusb's
+ * transferred byte count confirms it. */
+static int usb_safe(struct px_dev *d, int64_t now)
+{
+	struct usb *u = px_dev_impl(d);
+	const struct px_codec_map *m = px_dev_config(d)->codec;
+	struct px_force_cmd zero;
+	struct outframe o;
+	int rc, done = 0;
+	if (!m->n_outputs || !u->cfg.endpoint_out)
+		return PX_OK; /* nothing to zero */
+	memset(&zero, 0, sizeof zero);
+	rc = out_frame(d, &zero, now, &o);
+	if (rc < 0)
+		return rc;
+	atomic_store(&u->hold, 1);
+	pthread_mutex_lock(&u->lock);
+	if (!u->h) {
+		rc = PX_E_NODEV;
+	} else {
+		if (u->cfg.transfer == PX_USB_BULK)
+			rc = libusb_bulk_transfer(u->h, u->cfg.endpoint_out,
+						  o.b, (int)o.len, &done, 100);
+		else
+			rc = libusb_interrupt_transfer(u->h, u->cfg.endpoint_out,
+						       o.b, (int)o.len, &done,
+						       100);
+		if (rc == 0 && done != (int)o.len)
+			rc = LIBUSB_ERROR_IO;
+		if (rc != 0) {
+			px_dev_record(d, PX_DEV_ERR_IO, map_err(rc),
+				      rc == LIBUSB_ERROR_NO_DEVICE ? ENODEV : 0,
+				      u->cfg.endpoint_out, NULL,
+				      "USB OUT transfer of the safe output "
+				      "failed",
+				      mono_ns());
+			rc = map_err(rc);
+		}
+	}
+	pthread_mutex_unlock(&u->lock);
+	return rc;
 }
 
 static void usb_destroy(struct px_dev *d)
@@ -473,6 +531,7 @@ static const struct px_dev_ops usb_ops = {
 	.start = usb_start,
 	.stop = usb_stop,
 	.force = usb_force,
+	.safe = usb_safe,
 	.destroy = usb_destroy,
 };
 
@@ -542,6 +601,7 @@ int px_usb_create(const struct px_dev_config *dcfg,
 	pthread_mutex_init(&u->lock, NULL);
 	sem_init(&u->wake, 0, 0);
 	atomic_init(&u->stop, 0);
+	atomic_init(&u->hold, 0);
 	atomic_init(&u->in_flight, 0);
 	atomic_init(&u->gone, 0);
 	atomic_init(&u->arrived, 0);

@@ -2,7 +2,7 @@
 
 static const char *const names[PX_FAULT__COUNT] = {
 	"none",          "input_stale", "compute_budget", "output_nonfinite",
-	"overrun",       "callback",    "trip",
+	"overrun",       "callback",    "trip",           "estop",
 };
 
 const char *px_fault_cause_name(int cause)

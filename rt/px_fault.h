@@ -31,7 +31,8 @@ enum px_fault_cause {
 	PX_FAULT_OVERRUN = 4,          /* cycle ended after the next deadline */
 	PX_FAULT_CALLBACK = 5,         /* a phase callback returned an error */
 	PX_FAULT_TRIP = 6,             /* px_loop_trip() from the application */
-	PX_FAULT__COUNT = 7
+	PX_FAULT_ESTOP = 7,            /* px_loop_trip_estop(): an emergency stop */
+	PX_FAULT__COUNT = 8
 };
 
 struct px_fault {

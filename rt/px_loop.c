@@ -52,7 +52,10 @@ struct px_loop {
 	uint64_t index;
 	uint32_t pending_missed;
 	uint32_t consec_overruns, consec_budget, ok_cycles;
-	unsigned trip_ack, rearm_ack, reset_ack;
+	unsigned trip_ack, rearm_ack, reset_ack, estop_ack;
+	/* an e-stop tripped since the last px_loop_rearm(): safe state
+	 * stays whatever rearm_after_ok_cycles says */
+	int latched;
 
 	/* Virtual clock; atomic so px_loop_now_ns() works from anywhere. */
 	_Atomic int64_t vnow;
@@ -60,7 +63,7 @@ struct px_loop {
 	/* Requests from other threads (counters: a request is pending
 	 * while the counter differs from the loop's ack). */
 	_Atomic int stop_req;
-	_Atomic unsigned trip_req, rearm_req, reset_req;
+	_Atomic unsigned trip_req, rearm_req, reset_req, estop_req;
 
 	/* Status, written by the loop thread, read by anyone. */
 	_Atomic int running, safe;
@@ -163,6 +166,7 @@ int px_loop_create(const struct px_loop_config *cfg, struct px_loop **out)
 	atomic_init(&l->stop_req, 0);
 	atomic_init(&l->trip_req, 0);
 	atomic_init(&l->rearm_req, 0);
+	atomic_init(&l->estop_req, 0);
 	atomic_init(&l->reset_req, 0);
 	atomic_init(&l->running, 0);
 	atomic_init(&l->safe, 0);
@@ -378,6 +382,7 @@ static void requests(struct px_loop *l, const struct px_loop_cycle *cy)
 	r = atomic_load_explicit(&l->rearm_req, memory_order_acquire);
 	if (r != l->rearm_ack) {
 		l->rearm_ack = r;
+		l->latched = 0;
 		l->consec_overruns = l->consec_budget = 0;
 		ST(l->safe_cause, PX_FAULT_NONE);
 		ST(l->safe_source, -1);
@@ -387,6 +392,13 @@ static void requests(struct px_loop *l, const struct px_loop_cycle *cy)
 	if (r != l->trip_ack) {
 		l->trip_ack = r;
 		fault(l, cy, PX_FAULT_TRIP, -1, 0, 1, 1);
+	}
+	r = atomic_load_explicit(&l->estop_req, memory_order_acquire);
+	if (r != l->estop_ack) {
+		l->estop_ack = r;
+		/* latched even when another cause holds safe state now */
+		l->latched = 1;
+		fault(l, cy, PX_FAULT_ESTOP, -1, 0, 1, 1);
 	}
 }
 
@@ -553,7 +565,10 @@ static int cycle(struct px_loop *l)
 	}
 	l->next_deadline = next;
 
-	if (l->cfg.rearm_after_ok_cycles && LD(l->safe)) {
+	/* Automatic re-arm ends safe state after quiet cycles, never one
+	 * an e-stop entered or joined: releasing an emergency stop must
+	 * not restart motion (ISO 13850); the reset is px_loop_rearm(). */
+	if (l->cfg.rearm_after_ok_cycles && LD(l->safe) && !l->latched) {
 		if (bad) {
 			l->ok_cycles = 0;
 		} else if (++l->ok_cycles >= l->cfg.rearm_after_ok_cycles) {
@@ -669,6 +684,13 @@ void px_loop_trip(struct px_loop *l)
 {
 	if (l)
 		atomic_fetch_add_explicit(&l->trip_req, 1,
+					  memory_order_release);
+}
+
+void px_loop_trip_estop(struct px_loop *l)
+{
+	if (l)
+		atomic_fetch_add_explicit(&l->estop_req, 1,
 					  memory_order_release);
 }
 

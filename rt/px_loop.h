@@ -25,6 +25,17 @@
  * a fault ring read outside the loop. Leaving safe state takes an
  * explicit px_loop_rearm() unless rearm_after_ok_cycles is set.
  *
+ * Which causes re-arm by themselves (rearm_after_ok_cycles): those that
+ * say the data or the timing was bad for a while and that the watchdog
+ * sees again in the very cycle they come back: a stale input (a device
+ * that answers again), compute over budget, overruns, a non-finite
+ * output, a failing phase, px_loop_trip() (the application's own trips,
+ * e.g. a velocity limit it checks every cycle). An emergency stop
+ * (px_loop_trip_estop(), PX_FAULT_ESTOP) never does: its release must
+ * not restart motion (ISO 13850, IEC 60204-1: the reset is a separate,
+ * deliberate act), so safe state entered or joined by an e-stop lasts
+ * until px_loop_rearm(), whatever the other causes do.
+ *
  * The loop knows no device library: device back ends plug in through
  * the phase callbacks, the watched-input stamps and the registered
  * output buffers and enable flags.
@@ -120,7 +131,8 @@ struct px_loop_config {
 	 * never. Default 3. */
 	uint32_t budget_limit;
 	/* 0 (default): safe state lasts until px_loop_rearm(). N > 0: it
-	 * also ends by itself after N consecutive cycles with no fault. */
+	 * also ends by itself after N consecutive cycles with no fault,
+	 * unless an e-stop tripped it (see the top of this file). */
 	uint32_t rearm_after_ok_cycles;
 	size_t max_inputs;      /* watched inputs (default 16) */
 	size_t max_outputs;     /* output blocks (default 16) */
@@ -226,9 +238,15 @@ PX_API void px_loop_stop(struct px_loop *loop);
  * its write. Any thread; async-signal-safe. @note RT-safe. */
 PX_API void px_loop_trip(struct px_loop *loop);
 
+/* Emergency stop (PX_FAULT_ESTOP): safe state as px_loop_trip(), and
+ * latched: automatic re-arm (rearm_after_ok_cycles) never ends it, only
+ * px_loop_rearm() does (and an e-stop still held trips again in the
+ * same cycle). Any thread; async-signal-safe. @note RT-safe. */
+PX_API void px_loop_trip_estop(struct px_loop *loop);
+
 /* Ask to leave safe state at the start of the next cycle (the watchdog
- * trips again in that cycle if a cause persists). Any thread.
- * @note RT-safe. */
+ * trips again in that cycle if a cause persists); the only way out of an
+ * e-stop's safe state. Any thread. @note RT-safe. */
 PX_API void px_loop_rearm(struct px_loop *loop);
 
 /* Loop clock now (virtual time for the virtual clock). Any thread.

@@ -226,7 +226,7 @@ static void test_estop_trips_loop_and_holds_safe_state(void)
 	PX_CHECK_INT_EQ(px_alloc_region_end(r), 0);
 	PX_CHECK(px_loop_is_safe(l));
 	px_loop_status(l, &ls);
-	PX_CHECK_INT_EQ(ls.safe_cause, PX_FAULT_TRIP);
+	PX_CHECK_INT_EQ(ls.safe_cause, PX_FAULT_ESTOP);
 	/* pressed from the last bounce at 100.4 ms + 5 ms debounce; the
 	 * trip applies from the next cycle on */
 	{
@@ -350,7 +350,7 @@ static void test_gpio_fault_lost_late_wrong_events(void)
 			     "%s: released at %lld", nm,
 			     (long long)fr.first_released);
 		PX_CHECK_MSG(fr.during.safe_entries >= 1 &&
-				     fr.during.safe_cause == PX_FAULT_TRIP,
+				     fr.during.safe_cause == PX_FAULT_ESTOP,
 			     "%s: cause %d", nm, (int)fr.during.safe_cause);
 		PX_CHECK_MSG(!fr.safe_at_end, "%s: safe after re-arm", nm);
 		PX_CHECK_MSG(strstr(fr.ds.last_msg, "io (sim-gpio): ") &&
