@@ -18,6 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "px_file.h"
 #include "px_obj.h"
 
 #define MAX_TOKEN 255
@@ -1007,9 +1008,8 @@ int px_obj_load_mem(const char *name, const char *data, size_t len,
 int px_obj_load_file(const char *path, struct px_obj_model **out,
 		     struct px_obj_error *err)
 {
-	FILE *f;
-	char *buf = NULL;
-	size_t len = 0, cap = 0;
+	char *buf = NULL, msg[sizeof(err->msg) + 512];
+	size_t len = 0;
 	int rc;
 
 	err_init(err, path);
@@ -1022,48 +1022,37 @@ int px_obj_load_file(const char *path, struct px_obj_model **out,
 		}
 		return PX_E_INVAL;
 	}
-	f = fopen(path, "rb");
-	if (!f) {
+	/* the model limit and the NUL check as bytes arrive: /dev/zero stops
+	 * at its first read instead of filling the memory */
+	rc = px_file_read(path, PX_FILE_MODEL_MAX_BYTES, PX_FILE_TEXT, "model",
+			  &buf, &len, msg, sizeof msg);
+	/* a missing file stays PX_E_IO, as this function has always said */
+	if (rc == PX_E_NOTFOUND)
+		rc = PX_E_IO;
+	if (rc != PX_OK) {
 		if (err) {
-			err->code = PX_E_IO;
-			snprintf(err->msg, sizeof(err->msg), "cannot open: %s",
-				 strerror(errno));
-		}
-		return PX_E_IO;
-	}
-	for (;;) {
-		size_t got;
-		if (len == cap) {
-			char *q;
-			cap = cap ? cap * 2 : 65536;
-			q = realloc(buf, cap);
-			if (!q) {
-				free(buf);
-				fclose(f);
-				if (err) {
-					err->code = PX_E_NOMEM;
-					snprintf(err->msg, sizeof(err->msg),
-						 "out of memory reading the file");
+			size_t np = strlen(path);
+			long ln = 0, col = 0;
+			const char *why = msg;
+			err->code = rc;
+			/* "<path>:<line>:<column>: ..." or "<path>: ..." */
+			if (strncmp(msg, path, np) == 0) {
+				why = msg + np;
+				if (rc == PX_E_PARSE &&
+				    sscanf(why, ":%ld:%ld:", &ln, &col) == 2 &&
+				    ln > 0 && ln <= INT_MAX && col <= INT_MAX) {
+					err->line = (int)ln;
+					err->column = (int)col;
+					why = strstr(why, ": ");
+					why = why ? why : msg + np;
 				}
-				return PX_E_NOMEM;
+				while (*why == ':' || *why == ' ')
+					why++;
 			}
-			buf = q;
+			snprintf(err->msg, sizeof(err->msg), "%s", why);
 		}
-		got = fread(buf + len, 1, cap - len, f);
-		len += got;
-		if (got == 0)
-			break;
+		return rc;
 	}
-	if (ferror(f)) {
-		free(buf);
-		fclose(f);
-		if (err) {
-			err->code = PX_E_IO;
-			snprintf(err->msg, sizeof(err->msg), "read error");
-		}
-		return PX_E_IO;
-	}
-	fclose(f);
 	rc = px_obj_load_mem(path, buf, len, out, err);
 	free(buf);
 	return rc;

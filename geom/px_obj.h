@@ -96,8 +96,13 @@ struct px_obj_error {
 /*
  * Load an OBJ file. On success *out is a new model (free it with
  * px_obj_free()). On failure *out is NULL and err (optional) says why.
+ * The file is read whole, at most PX_FILE_MODEL_MAX_BYTES (1 GiB,
+ * px_file.h; a larger regular file is refused from its size, a pipe or
+ * device when the count passes it), and a NUL byte is a parse error at
+ * its line and column.
  * Returns PX_OK, PX_E_INVAL (NULL arguments), PX_E_IO (cannot read),
- * PX_E_PARSE, PX_E_UNSUPPORTED, PX_E_NOMEM.
+ * PX_E_RANGE (over the size limit), PX_E_PARSE, PX_E_UNSUPPORTED,
+ * PX_E_NOMEM.
  */
 PX_API int px_obj_load_file(const char *path, struct px_obj_model **out,
 			    struct px_obj_error *err);
