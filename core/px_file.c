@@ -81,7 +81,8 @@ int px_file_read(const char *path, size_t max_bytes, unsigned flags,
 	fd = open(path, O_RDONLY | O_CLOEXEC);
 	if (fd < 0) {
 		int e = errno;
-		say(msg, msg_cap, path, strerror(e));
+		if (msg && msg_cap)
+			snprintf(msg, msg_cap, "%s: cannot open: %s", path, strerror(e));
 		return e == ENOENT ? PX_E_NOTFOUND : PX_E_IO;
 	}
 	if (fstat(fd, &st) != 0) {

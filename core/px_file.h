@@ -39,7 +39,7 @@ extern "C" {
  * *data (malloc'ed, one NUL byte past the end) and *len (the file's
  * bytes, without that NUL) belong to the caller. On failure *data is
  * NULL and msg (msg_cap bytes; may be NULL) says what and where:
- * "<path>: larger than the 64 MiB limit for <what> files",
+ * "<path>: cannot open: <reason>", "<path>: larger than the 64 MiB limit for <what> files",
  * "<path>:<line>:<column>: NUL byte in a text file". what names the kind
  * of file in that message ("model", "points").
  * Returns PX_OK, PX_E_INVAL (NULL argument), PX_E_NOTFOUND, PX_E_IO

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "px_file.h"
 #include "px_sim.h"
 #include "internal.h"
 
@@ -100,76 +101,107 @@ double px_sim_csv_duration_s(const struct px_sim_csv *c)
 	return c && c->n ? c->t[c->n - 1] - c->t[0] : 0.0;
 }
 
-static int parse_row(const char *s, double v[4])
+/* One row "t,x,y,z". Returns 0, or the 1-based field at fault with
+ * *why: "is empty", "is not a number", "is not finite", or text after
+ * the fourth field (field 5). */
+static int parse_row(const char *s, double v[4], const char **why)
 {
 	int k;
 	char *end;
 	for (k = 0; k < 4; k++) {
 		while (*s == ' ' || *s == '\t')
 			s++;
+		if (*s == ',' || *s == 0) {
+			*why = "is empty";
+			return k + 1;
+		}
 		errno = 0;
 		v[k] = strtod(s, &end);
-		if (end == s || errno == ERANGE || !isfinite(v[k]))
-			return -1;
+		if (end == s || errno == ERANGE) {
+			*why = "is not a number";
+			return k + 1;
+		}
+		if (!isfinite(v[k])) {
+			*why = "is not finite";
+			return k + 1;
+		}
 		s = end;
 		while (*s == ' ' || *s == '\t')
 			s++;
 		if (k < 3) {
-			if (*s != ',')
-				return -1;
+			if (*s != ',') {
+				*why = *s ? "is not a number" : "is missing";
+				return *s ? k + 1 : k + 2;
+			}
 			s++;
 		}
 	}
-	while (*s == ' ' || *s == '\t' || *s == '\r' || *s == '\n')
+	while (*s == ' ' || *s == '\t')
 		s++;
-	return *s == 0 ? 0 : -1;
+	if (*s) {
+		*why = "is extra text after z_m";
+		return 5;
+	}
+	return 0;
+}
+
+/* A header: text whose first field is not wholly a number ("NaN" and
+ * "inf" are numbers, and then an error as data). */
+static int csv_header(const char *s)
+{
+	char *end;
+	if (!isalpha((unsigned char)*s))
+		return 0;
+	strtod(s, &end);
+	while (*end == ' ' || *end == '\t')
+		end++;
+	return end == s || (*end != ',' && *end != 0);
 }
 
 int px_sim_csv_load(const char *path, struct px_sim_csv **out, char *msg,
 		    size_t cap)
 {
-	FILE *f;
-	char line[512];
+	char *data = NULL, *cur, *line;
 	struct px_sim_csv *c;
-	size_t capn = 0;
+	size_t capn = 0, len = 0;
 	int lineno = 0, rc = PX_OK, header_ok = 1;
 	if (msg && cap)
 		msg[0] = 0;
 	if (!path || !out)
 		return PX_E_INVAL;
 	*out = NULL;
-	f = fopen(path, "r");
-	if (!f) {
-		int e = errno;
-		if (msg)
-			snprintf(msg, cap, "%s: cannot open: %s", path,
-				 strerror(e));
-		return e == ENOENT ? PX_E_NOTFOUND : PX_E_IO;
-	}
+	/* whole, within the text limit: a NUL byte (/dev/zero) is an error
+	 * at its place, not a blank line read forever */
+	rc = px_file_read(path, PX_FILE_TEXT_MAX_BYTES, PX_FILE_TEXT, "trajectory",
+			  &data, &len, msg, cap);
+	if (rc != PX_OK)
+		return rc;
 	c = calloc(1, sizeof *c);
 	if (!c) {
-		fclose(f);
+		free(data);
 		return PX_E_NOMEM;
 	}
-	while (fgets(line, sizeof line, f)) {
+	cur = data;
+	while ((line = px_file_next_line(&cur)) != NULL) {
 		double v[4];
-		const char *s = line;
+		const char *s = line, *why = "";
+		int field;
 		lineno++;
 		while (isspace((unsigned char)*s))
 			s++;
 		if (*s == 0 || *s == '#')
 			continue;
-		if (parse_row(s, v) != 0) {
-			if (header_ok && c->n == 0 &&
-			    !isdigit((unsigned char)*s) && *s != '-' &&
-			    *s != '+' && *s != '.') {
+		field = parse_row(s, v, &why);
+		if (field) {
+			if (header_ok && c->n == 0 && csv_header(s)) {
 				header_ok = 0;
 				continue;
 			}
 			if (msg)
 				snprintf(msg, cap,
 					 "%s:%d: expected 4 finite numbers "
-					 "t_s,x_m,y_m,z_m", path, lineno);
+					 "t_s,x_m,y_m,z_m (field %d %s)", path,
+					 lineno, field, why);
 			rc = PX_E_PARSE;
 			break;
 		}
@@ -205,12 +237,7 @@ int px_sim_csv_load(const char *path, struct px_sim_csv **out, char *msg,
 		c->p[3 * c->n + 2] = v[3];
 		c->n++;
 	}
-	if (rc == PX_OK && ferror(f)) {
-		if (msg)
-			snprintf(msg, cap, "%s: read error", path);
-		rc = PX_E_IO;
-	}
-	fclose(f);
+	free(data);
 	if (rc == PX_OK && c->n == 0) {
 		if (msg)
 			snprintf(msg, cap, "%s: no samples", path);

@@ -89,14 +89,18 @@ struct px_sim_sine {
 };
 
 /* A trajectory loaded from CSV: lines "t_s,x_m,y_m,z_m" with t strictly
- * increasing; blank lines, '#' comments and one non-numeric header line
- * are skipped. */
+ * increasing; blank lines, '#' comments and one header line (its first
+ * field a name, not a number) before the first sample are skipped. An
+ * empty field, NaN or inf is an error. */
 struct px_sim_csv;
 
 /*
- * Load a CSV trajectory (setup). On PX_E_PARSE / PX_E_IO / PX_E_NOMEM
- * msg (cap bytes, may be NULL) says where: "hand.csv:7: expected 4
- * numbers t,x,y,z". Free with px_sim_csv_free (NULL no-op).
+ * Load a CSV trajectory (setup), at most PX_FILE_TEXT_MAX_BYTES (64 MiB,
+ * px_file.h; a NUL byte is an error at its line and column). On
+ * PX_E_PARSE / PX_E_IO / PX_E_RANGE (over the limit) / PX_E_NOTFOUND /
+ * PX_E_NOMEM msg (cap bytes, may be NULL) says where: "hand.csv:7:
+ * expected 4 finite numbers t_s,x_m,y_m,z_m (field 3 is empty)". Free
+ * with px_sim_csv_free (NULL no-op).
  */
 PX_API int px_sim_csv_load(const char *path, struct px_sim_csv **out,
 			   char *msg, size_t cap);

@@ -1049,7 +1049,7 @@ int px_obj_load_file(const char *path, struct px_obj_model **out,
 				while (*why == ':' || *why == ' ')
 					why++;
 			}
-			snprintf(err->msg, sizeof(err->msg), "%s", why);
+			snprintf(err->msg, sizeof(err->msg), "%.255s", why);
 		}
 		return rc;
 	}

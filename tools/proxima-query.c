@@ -6,8 +6,10 @@
  *
  * MODEL: Wavefront OBJ (free-form curves and surfaces, polygon faces, or
  * both: all entities form one model), STL, PLY (mesh with faces, point
- * cloud without), XYZ/CSV point clouds. POINTS.csv: one "x,y,z" per line;
- * a first line that starts with a letter is a header. Output, one line
+ * cloud without), XYZ/CSV point clouds. POINTS.csv: one "x,y,z" per line
+ * (at most 64 MiB, no NUL bytes, no empty fields); a first line whose
+ * first field is a name, not a number, is a header ("NaN,0,0" is a point,
+ * and an error). Output, one line
  * per point: "dist,cx,cy,cz,u,v" with %.17g; curves print v = 0, meshes
  * the triangle index as u and clouds the point index, with v = 0. The
  * distance is unsigned (closed meshes know inside from outside, but the
@@ -28,6 +30,7 @@
 #include <time.h>
 
 #include "px_dist.h"
+#include "px_file.h"
 #include "px_load.h"
 #include "px_mesh.h"
 #include "px_model.h"
@@ -42,8 +45,8 @@ static void usage(FILE *f)
 	fprintf(f, "usage: %s [--track] [--stats] MODEL POINTS.csv\n"
 		   "  MODEL       .obj (free-form curves/surfaces and/or faces), .stl,\n"
 		   "              .ply (mesh or point cloud), .xyz/.csv (point cloud)\n"
-		   "  POINTS.csv  one x,y,z per line (a first line starting with a\n"
-		   "              letter is a header)\n"
+		   "  POINTS.csv  one x,y,z per line (a first line of names is a\n"
+		   "              header; NaN or inf is an error)\n"
 		   "  --stats     setup time, model memory and per-query ns to stderr\n"
 		   "  --track     answer the points in order as one moving point by\n"
 		   "              coherent tracking of all critical distances\n"
@@ -95,84 +98,100 @@ static int parse_num(const char **s, double *out)
 	return 0;
 }
 
+/* A header line: text whose first field is not wholly a number. "NaN"
+ * and "inf" are numbers (and then an error as data); "x", "nanos" are
+ * names. */
+static int is_header(const char *s)
+{
+	char *end;
+	if (!isalpha((unsigned char)*s))
+		return 0;
+	strtod(s, &end);
+	while (*end == ' ' || *end == '\t')
+		end++;
+	return end == s || (*end != ',' && *end != '\0');
+}
+
+static int points_fail(const char *path, long lineno, const char *fmt, int field)
+{
+	fprintf(stderr, "%s: %s:%ld: ", prog, path, lineno);
+	fprintf(stderr, fmt, field);
+	fputc('\n', stderr);
+	return -1;
+}
+
+/* The points file, read whole within the text limit (a NUL byte, as
+ * from /dev/zero, is an error at its place instead of a blank line). */
 static int read_points(const char *path, struct points *pts)
 {
-	FILE *f = fopen(path, "r");
-	char line[4096];
+	char *data = NULL, *cur, *line, msg[1024];
+	size_t len = 0;
 	long lineno = 0;
+	int seen = 0, rc = -1;
 
-	if (!f) {
-		fprintf(stderr, "%s: %s: %s\n", prog, path, strerror(errno));
+	if (px_file_read(path, PX_FILE_TEXT_MAX_BYTES, PX_FILE_TEXT, "points", &data,
+			 &len, msg, sizeof msg) != PX_OK) {
+		fprintf(stderr, "%s: %s\n", prog, msg);
 		return -1;
 	}
-	while (fgets(line, sizeof(line), f)) {
+	cur = data;
+	while ((line = px_file_next_line(&cur)) != NULL) {
 		const char *s = line;
 		double v[3];
-		size_t len = strlen(line);
 		int k;
 
 		lineno++;
-		if (len == sizeof(line) - 1 && line[len - 1] != '\n') {
-			fprintf(stderr, "%s: %s:%ld: line too long\n", prog, path, lineno);
-			fclose(f);
-			return -1;
-		}
 		while (*s == ' ' || *s == '\t')
 			s++;
-		if (*s == '\n' || *s == '\r' || *s == 0)
+		if (*s == 0)
 			continue; /* blank line */
-		if (lineno == 1 && isalpha((unsigned char)*s) &&
-		    !ieq("nan", s) && strncmp(s, "nan", 3) && strncmp(s, "inf", 3))
-			continue; /* header */
+		if (!seen++ && is_header(s))
+			continue;
 		for (k = 0; k < 3; k++) {
+			const char *f = s;
+			while (*f == ' ' || *f == '\t')
+				f++;
+			if (*f == ',' || (*f == 0 && k > 0)) {
+				points_fail(path, lineno, "field %d is empty", k + 1);
+				goto out;
+			}
 			if (parse_num(&s, &v[k])) {
-				fprintf(stderr, "%s: %s:%ld: field %d: expected a number\n",
-					prog, path, lineno, k + 1);
-				fclose(f);
-				return -1;
+				points_fail(path, lineno, "field %d: expected a number", k + 1);
+				goto out;
 			}
 			if (!isfinite(v[k])) {
-				fprintf(stderr, "%s: %s:%ld: field %d: not a finite number\n",
-					prog, path, lineno, k + 1);
-				fclose(f);
-				return -1;
+				points_fail(path, lineno, "field %d: not a finite number", k + 1);
+				goto out;
 			}
 			if (k < 2) {
 				if (*s != ',') {
-					fprintf(stderr, "%s: %s:%ld: expected 3 comma-separated "
-							"numbers x,y,z\n", prog, path, lineno);
-					fclose(f);
-					return -1;
+					points_fail(path, lineno, "expected 3 comma-separated "
+						    "numbers x,y,z (field %d ends early)", k + 1);
+					goto out;
 				}
 				s++;
 			}
 		}
-		if (*s && *s != '\n' && *s != '\r') {
-			fprintf(stderr, "%s: %s:%ld: unexpected text after z\n", prog,
-				path, lineno);
-			fclose(f);
-			return -1;
+		if (*s) {
+			points_fail(path, lineno, "unexpected text after z (field %d)", 4);
+			goto out;
 		}
 		if (pts->n == pts->cap) {
 			size_t nc = pts->cap ? 2 * pts->cap : 1024;
 			px_vec3 *np = realloc(pts->p, nc * sizeof(*np));
 			if (!np) {
 				fprintf(stderr, "%s: out of memory\n", prog);
-				fclose(f);
-				return -1;
+				goto out;
 			}
 			pts->p = np;
 			pts->cap = nc;
 		}
 		pts->p[pts->n++] = px_v3(v[0], v[1], v[2]);
 	}
-	if (ferror(f)) {
-		fprintf(stderr, "%s: %s: read error\n", prog, path);
-		fclose(f);
-		return -1;
-	}
-	fclose(f);
-	return 0;
+	rc = 0;
+out:
+	free(data);
+	return rc;
 }
 
 /* The cold switch's counters of either tracker (--track --stats). */
