@@ -11,8 +11,9 @@
  * neither end a line early nor make a blank one.
  *
  * Limits: PX_FILE_TEXT_MAX_BYTES (64 MiB, as the config reader's) for
- * points files, trajectories and CAN logs; PX_FILE_MODEL_MAX_BYTES
- * (1 GiB) for meshes, point clouds and OBJ models.
+ * points files and trajectories; PX_FILE_LOG_MAX_BYTES (256 MiB) for
+ * candump logs replayed as a bus; PX_FILE_MODEL_MAX_BYTES (1 GiB) for
+ * meshes, point clouds and OBJ models.
  *
  * Memory and real-time rules: setup only (reads, allocates); the
  * returned buffer belongs to the caller, who frees it with free().
@@ -29,6 +30,7 @@ extern "C" {
 #endif
 
 #define PX_FILE_TEXT_MAX_BYTES ((size_t)64 << 20)
+#define PX_FILE_LOG_MAX_BYTES ((size_t)256 << 20)
 #define PX_FILE_MODEL_MAX_BYTES ((size_t)1 << 30)
 
 /* px_file_read() flags */

@@ -313,7 +313,9 @@ PX_API int px_can_log_parse(const char *line, struct px_can_msg *m,
  * Replay a candump -l file as a bus: frames (of interface iface, or all
  * when NULL) are received when now_ns - (first now_ns given to recv) has
  * reached their offset from the first frame; sends are accepted and
- * dropped. Loaded whole at open. On PX_E_PARSE msg says "file:line".
+ * dropped. Loaded whole at open, at most PX_FILE_LOG_MAX_BYTES (256 MiB,
+ * px_file.h: PX_E_RANGE past it); a NUL byte is a parse error at its
+ * line and column. On PX_E_PARSE msg says "file:line".
  */
 PX_API int px_can_replay_open(const char *path, const char *iface,
 			      struct px_can_bus **out, char *msg,

@@ -20,6 +20,7 @@
 
 #include "internal.h"
 #include "px_arena.h"
+#include "px_file.h"
 #include "px_can.h"
 #include "px_ring.h"
 
@@ -932,41 +933,37 @@ int px_can_iface_restart(const char *iface)
 int px_can_replay_open(const char *path, const char *iface,
 		       struct px_can_bus **out, char *msg, size_t cap)
 {
-	FILE *f;
-	char *line = NULL, ifn[IFNAMSIZ + 8];
+	char *data = NULL, *cur, *line, ifn[IFNAMSIZ + 8];
 	struct px_can_bus *b;
-	size_t capn = 0, lcap = 0;
-	ssize_t len;
+	size_t capn = 0, dlen = 0;
 	int lineno = 0, rc = PX_OK;
 	if (msg && cap)
 		msg[0] = 0;
 	if (!path || !out)
 		return PX_E_INVAL;
 	*out = NULL;
-	f = fopen(path, "r");
-	if (!f) {
-		int e = errno;
-		if (msg)
-			snprintf(msg, cap, "%s: %s", path, strerror(e));
-		return e == ENOENT ? PX_E_NOTFOUND : PX_E_IO;
-	}
+	/* Whole, within the log limit: a NUL byte is an error at its line
+	 * and column (it used to end a line early), and /dev/zero stops at
+	 * its first read. Whole lines: a fixed buffer split long lines into
+	 * pieces that were parsed as lines of their own (found by fuzzing). */
+	rc = px_file_read(path, PX_FILE_LOG_MAX_BYTES, PX_FILE_TEXT, "CAN log",
+			  &data, &dlen, msg, cap);
+	if (rc != PX_OK)
+		return rc;
 	b = bus_new(K_REPLAY);
 	if (!b) {
-		fclose(f);
+		free(data);
 		return PX_E_NOMEM;
 	}
 	b->fd_frames = 1;
-	/* Whole lines: a fixed buffer split long lines into pieces that
-	 * were parsed as lines of their own (found by fuzzing). A NUL byte
-	 * inside a line is an error too, not the line's end. */
-	while ((len = getline(&line, &lcap, f)) >= 0) {
+	cur = data;
+	while ((line = px_file_next_line(&cur)) != NULL) {
 		struct px_can_msg m;
 		int64_t t;
 		lineno++;
-		if (line[0] == '\n' || line[0] == '#' || len == 0)
+		if (line[0] == 0 || line[0] == '#')
 			continue;
-		if (strlen(line) != (size_t)len ||
-		    px_can_log_parse(line, &m, &t, ifn, sizeof ifn) != PX_OK) {
+		if (px_can_log_parse(line, &m, &t, ifn, sizeof ifn) != PX_OK) {
 			if (msg)
 				snprintf(msg, cap, "%s:%d: not a candump -l line "
 					 "\"(sec.usec) iface id#data\"", path,
@@ -997,8 +994,7 @@ int px_can_replay_open(const char *path, const char *iface,
 		b->rec_t[b->n_recs] = t;
 		b->n_recs++;
 	}
-	free(line);
-	fclose(f);
+	free(data);
 	if (rc != PX_OK) {
 		px_can_bus_close(b);
 		return rc;
