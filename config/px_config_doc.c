@@ -1,4 +1,5 @@
 /* YAML document loader on libyaml's event parser, and diagnostics. */
+#include <ctype.h>
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
@@ -452,26 +453,130 @@ static const struct px_config_node *find_anchor(const struct builder *b,
 	return NULL;
 }
 
-/* Tags: the YAML core ones are accepted (!!str makes a string); anything
- * else would need a meaning we do not have. */
+/* The YAML 1.2 core schema's forms of a tagged scalar's value, so that
+ * a tag cannot contradict its value ("!!null 2000000", "!!int abc",
+ * "!!bool 3"): the tag would otherwise be ignored and the value read as
+ * whatever it looks like. */
+static int is_core_int(const char *v, size_t n)
+{
+	size_t i = 0;
+	if (n > 2 && v[0] == '0' && (v[1] == 'x' || v[1] == 'o')) {
+		for (i = 2; i < n; i++)
+			if (v[1] == 'x' ? !isxdigit((unsigned char)v[i])
+					: (v[i] < '0' || v[i] > '7'))
+				return 0;
+		return 1;
+	}
+	if (i < n && (v[i] == '-' || v[i] == '+'))
+		i++;
+	if (i == n)
+		return 0;
+	for (; i < n; i++)
+		if (!isdigit((unsigned char)v[i]))
+			return 0;
+	return 1;
+}
+
+static int is_one_of(const char *v, size_t n, const char *const *words)
+{
+	for (; *words; words++)
+		if (strlen(*words) == n && memcmp(v, *words, n) == 0)
+			return 1;
+	return 0;
+}
+
+static int is_core_float(const char *v, size_t n)
+{
+	static const char *const special[] = {".inf", ".Inf", ".INF", "+.inf", "+.Inf",
+					      "+.INF", "-.inf", "-.Inf", "-.INF", ".nan",
+					      ".NaN", ".NAN", NULL};
+	size_t i = 0, digits = 0;
+	if (is_one_of(v, n, special) || is_core_int(v, n))
+		return 1;
+	if (i < n && (v[i] == '-' || v[i] == '+'))
+		i++;
+	for (; i < n && isdigit((unsigned char)v[i]); i++)
+		digits++;
+	if (i < n && v[i] == '.')
+		for (i++; i < n && isdigit((unsigned char)v[i]); i++)
+			digits++;
+	if (!digits)
+		return 0;
+	if (i < n && (v[i] == 'e' || v[i] == 'E')) {
+		size_t e0;
+		i++;
+		if (i < n && (v[i] == '-' || v[i] == '+'))
+			i++;
+		e0 = i;
+		while (i < n && isdigit((unsigned char)v[i]))
+			i++;
+		if (i == e0)
+			return 0;
+	}
+	return i == n;
+}
+
+/* Tags: the YAML core ones are accepted (!!str makes a string) where
+ * they agree with what they tag (a scalar's value in the core schema's
+ * form for !!int, !!float, !!bool and !!null; !!seq on a sequence, !!map
+ * on a mapping); anything else would need a meaning we do not have. */
 static int check_tag(struct builder *b, const yaml_char_t *tag,
 		     const yaml_event_t *ev, bool *is_str)
 {
 	static const char core[] = "tag:yaml.org,2002:";
+	static const char *const bools[] = {"true", "True", "TRUE", "false",
+					    "False", "FALSE", NULL};
+	static const char *const nulls[] = {"", "~", "null", "Null", "NULL", NULL};
 	const char *t = (const char *)tag;
-	char ex[80];
+	char ex[80], vx[80];
+	const char *want = NULL, *on = NULL;
 	if (!t)
 		return PX_OK;
 	if (strncmp(t, core, sizeof(core) - 1) == 0) {
 		const char *s = t + sizeof(core) - 1;
-		if (strcmp(s, "str") == 0) {
+		int scalar = ev->type == YAML_SCALAR_EVENT;
+		const char *v = scalar ? (const char *)ev->data.scalar.value : "";
+		size_t n = scalar ? ev->data.scalar.length : 0;
+		if (strcmp(s, "str") == 0 && scalar) {
 			*is_str = true;
 			return PX_OK;
 		}
-		if (!strcmp(s, "int") || !strcmp(s, "float") ||
-		    !strcmp(s, "bool") || !strcmp(s, "null") ||
-		    !strcmp(s, "seq") || !strcmp(s, "map"))
-			return PX_OK;
+		if (strcmp(s, "seq") == 0) {
+			if (ev->type == YAML_SEQUENCE_START_EVENT)
+				return PX_OK;
+			on = "a sequence";
+		} else if (strcmp(s, "map") == 0) {
+			if (ev->type == YAML_MAPPING_START_EVENT)
+				return PX_OK;
+			on = "a mapping";
+		} else if (!strcmp(s, "str") || !strcmp(s, "int") ||
+			   !strcmp(s, "float") || !strcmp(s, "bool") ||
+			   !strcmp(s, "null")) {
+			if (!scalar)
+				on = "a scalar";
+			else if (!strcmp(s, "int") && !is_core_int(v, n))
+				want = "an integer";
+			else if (!strcmp(s, "float") && !is_core_float(v, n))
+				want = "a number";
+			else if (!strcmp(s, "bool") && !is_one_of(v, n, bools))
+				want = "true or false";
+			else if (!strcmp(s, "null") && !is_one_of(v, n, nulls))
+				want = "null, ~ or nothing";
+			else
+				return PX_OK;
+		}
+		if (want) {
+			px__cfg_excerpt(vx, sizeof(vx), v, n);
+			berr(b, mark_line(&ev->start_mark), mark_col(&ev->start_mark),
+			     "YAML tag '!!%s' contradicts its value '%s' (!!%s wants %s)",
+			     s, vx, s, want);
+			return PX_E_PARSE;
+		}
+		if (on) {
+			berr(b, mark_line(&ev->start_mark), mark_col(&ev->start_mark),
+			     "YAML tag '!!%s' belongs on %s, not here", s, on);
+			return PX_E_PARSE;
+		}
 	}
 	if (strcmp(t, "!") == 0) /* non-specific tag: a quoted-like string */
 		return PX_OK;

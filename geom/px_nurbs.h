@@ -101,8 +101,21 @@ enum px_nurbs_fault {
 	PX_NURBS_FAULT_DOMAIN,      /* empty parameter domain */
 	PX_NURBS_FAULT_COORD_NAN,   /* control point coordinate not finite */
 	PX_NURBS_FAULT_WEIGHT,      /* weight not finite or not > 0 */
-	PX_NURBS_FAULT_NOSPC        /* arena too small */
+	PX_NURBS_FAULT_NOSPC,       /* arena too small */
+	PX_NURBS_FAULT_COORD_RANGE  /* |coordinate| > PX_NURBS_MAX_COORD, or a
+				     * weight outside PX_NURBS_MIN_WEIGHT ..
+				     * PX_NURBS_MAX_WEIGHT */
 };
+
+/* Largest |control point coordinate| (model units): the curve or surface
+ * lies in its control points' hull, so its extent and the squared
+ * distances of every query within the models' reach (1e150 beyond the
+ * box, px_model.h) stay finite. Weights are bounded so that the
+ * homogeneous sums (w times a coordinate) and the weight sums cannot
+ * overflow or vanish. */
+#define PX_NURBS_MAX_COORD 1e150
+#define PX_NURBS_MIN_WEIGHT 1e-100
+#define PX_NURBS_MAX_WEIGHT 1e100
 
 /*
  * Where and why validation failed. code is the px_err returned; dir is
@@ -150,8 +163,9 @@ PX_API size_t px_nurbs_surf_bytes(int degree_u, int degree_v, int n_u,
  * coordinates, w holds n_ctrl weights or is NULL (all 1). err may be
  * NULL; when given it is filled (fault NONE and code PX_OK on success).
  * Returns PX_OK, PX_E_INVAL (NULL, knot count/order/multiplicity,
- * too few points), PX_E_RANGE (degree, weight <= 0), PX_E_NAN,
- * PX_E_DEGENERATE (empty domain).
+ * too few points), PX_E_RANGE (degree, weight <= 0 or outside
+ * PX_NURBS_MIN_WEIGHT .. PX_NURBS_MAX_WEIGHT, a coordinate beyond
+ * +-PX_NURBS_MAX_COORD), PX_E_NAN, PX_E_DEGENERATE (empty domain).
  */
 PX_API int px_nurbs_curve_validate(int degree, int n_ctrl,
 				   const double *knots, int n_knots,

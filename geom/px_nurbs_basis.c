@@ -283,6 +283,23 @@ int px__nurbs_check_points(int count, int n_u, const double *xyz,
 				      "coordinate (%g, %g, %g)",
 				      i, x, y, z);
 			rc = PX_E_NAN;
+		} else if (wi < PX_NURBS_MIN_WEIGHT || wi > PX_NURBS_MAX_WEIGHT) {
+			px__nurbs_err(err, PX_E_RANGE, PX_NURBS_FAULT_COORD_RANGE, 0,
+				      i, wi, 0,
+				      "control point %d has weight %g (outside %g .. %g: "
+				      "the rational sums would overflow or vanish)",
+				      i, wi, PX_NURBS_MIN_WEIGHT, PX_NURBS_MAX_WEIGHT);
+			rc = PX_E_RANGE;
+		} else if (fabs(x) > PX_NURBS_MAX_COORD || fabs(y) > PX_NURBS_MAX_COORD ||
+			   fabs(z) > PX_NURBS_MAX_COORD) {
+			double v = fabs(x) > PX_NURBS_MAX_COORD ? x
+				   : fabs(y) > PX_NURBS_MAX_COORD ? y : z;
+			px__nurbs_err(err, PX_E_RANGE, PX_NURBS_FAULT_COORD_RANGE, 0,
+				      i, v, 0,
+				      "control point %d has coordinate %g beyond +-%g "
+				      "(squared distances would overflow)",
+				      i, v, PX_NURBS_MAX_COORD);
+			rc = PX_E_RANGE;
 		}
 		if (rc) {
 			if (err && n_u > 0) {

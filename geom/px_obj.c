@@ -578,6 +578,7 @@ static int nurbs_fail(struct ctx *c, const struct ent_rec *e,
 		break; /* the curv/surf statement itself */
 	case PX_NURBS_FAULT_WEIGHT:
 	case PX_NURBS_FAULT_COORD_NAN:
+	case PX_NURBS_FAULT_COORD_RANGE:
 		if (ne->index >= 0 && (size_t)ne->index < e->ctrl_count) {
 			const struct place *p = &cp[e->ctrl_off +
 						    (size_t)ne->index];
