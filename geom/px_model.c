@@ -62,6 +62,11 @@ int px_model_set_pose(struct px_model *m, px_pose pose)
 	rc = px_pose_sanitize(&pose);
 	if (rc != PX_OK)
 		return rc;
+	/* a model moved farther than the models' reach leaves squared
+	 * distances of the scene's box tests to overflow */
+	if (fabs(pose.t.x) > PX_MODEL_MAX_COORD || fabs(pose.t.y) > PX_MODEL_MAX_COORD ||
+	    fabs(pose.t.z) > PX_MODEL_MAX_COORD)
+		return PX_E_RANGE;
 	m->pose = pose;
 	return PX_OK;
 }

@@ -229,11 +229,16 @@ PX_API int px_model_create(const struct px_model_ops *ops, void *impl,
 /* Release a model and its implementation. NULL is a no-op. */
 PX_API void px_model_free(struct px_model *m);
 
+/* Largest |coordinate| of a model's box in its own frame and of a pose's
+ * translation (model units): squared distances of every query within
+ * reach (1e150 beyond the box, see px_model_query) then stay finite. */
+#define PX_MODEL_MAX_COORD 1e150
+
 /*
  * Set the model-to-world pose. The pose is checked and its quaternion
  * renormalized (px_pose_sanitize); on error the pose is left unchanged.
- * Returns PX_OK, PX_E_INVAL, PX_E_NAN, PX_E_DEGENERATE, PX_E_RANGE.
- * @note RT-safe.
+ * Returns PX_OK, PX_E_INVAL, PX_E_NAN, PX_E_DEGENERATE, PX_E_RANGE (also
+ * a translation beyond +-PX_MODEL_MAX_COORD). @note RT-safe.
  */
 PX_API int px_model_set_pose(struct px_model *m, px_pose pose);
 

@@ -64,6 +64,20 @@ int px_world_add(struct px_world *s, struct px_model *m, const char *name)
 		px_model_free(m);
 		return PX_E_NOSPC;
 	}
+	{
+		/* the scene's box bounds square distances to the box: a box
+		 * beyond the models' reach would make them infinite and the
+		 * model never nearest */
+		px_aabb b = px_model_local_aabb(m);
+		double reach = px_aabb_is_empty(&b) ? 0.0
+			: fmax(fmax(fabs(b.min.x), fabs(b.max.x)),
+			       fmax(fmax(fabs(b.min.y), fabs(b.max.y)),
+				    fmax(fabs(b.min.z), fabs(b.max.z))));
+		if (isfinite(reach) && reach > PX_MODEL_MAX_COORD) {
+			px_model_free(m);
+			return PX_E_RANGE;
+		}
+	}
 	e = &s->e[s->n];
 	memset(e, 0, sizeof(*e));
 	e->m = m;

@@ -82,8 +82,10 @@ PX_API void px_world_free(struct px_world *s);
 /*
  * Add model m (its pose as set) under name (may be NULL; copied, up to
  * 31 bytes). The scene owns m from now on, also on failure (then m is
- * freed). Setup only. Returns the model's index, PX_E_INVAL or
- * PX_E_NOSPC (capacity reached).
+ * freed). Setup only. Returns the model's index, PX_E_INVAL,
+ * PX_E_NOSPC (capacity reached) or PX_E_RANGE (the model's box reaches
+ * beyond +-PX_MODEL_MAX_COORD in its own frame: an unbounded model, as a
+ * plane, is fine).
  */
 PX_API int px_world_add(struct px_world *s, struct px_model *m,
 			const char *name);

@@ -417,10 +417,26 @@ static void add_model(struct px_config_reader *r, struct raw_scene *sc,
 		      const struct px_config_node *at, const char *where)
 {
 	int rc = px_model_set_pose(m, pose);
+	px_aabb b = px_model_local_aabb(m);
+	double reach;
 	if (rc != PX_OK) {
 		px_model_free(m);
 		px_config_reader_error(r, at, where, "bad pose: %s",
 				       px_strerror(rc));
+		sc->failed_ = 1;
+		return;
+	}
+	/* after the scale: the box the scene's distance bounds square */
+	reach = px_aabb_is_empty(&b) ? 0.0
+		: fmax(fmax(fabs(b.min.x), fabs(b.max.x)),
+		       fmax(fmax(fabs(b.min.y), fabs(b.max.y)),
+			    fmax(fabs(b.min.z), fabs(b.max.z))));
+	if (!(reach <= PX_MODEL_MAX_COORD) && !isinf(reach)) {
+		px_model_free(m);
+		px_config_reader_error(r, at, where,
+				       "the model's extent reaches %g, beyond "
+				       "+-%g after its scale (squared distances "
+				       "would overflow)", reach, PX_MODEL_MAX_COORD);
 		sc->failed_ = 1;
 		return;
 	}
