@@ -300,7 +300,8 @@ static int ply_line_check(int *first, long *line, const long *last, long now)
  * x, y, z exactly as doubles into *xyz (malloc'ed, 3 per vertex, *nv of
  * them), which the caller frees. */
 static int ply_validate(const char *path, FILE *f, size_t size, double **xyz,
-			size_t *nv, char *msg, size_t msg_cap)
+			size_t *nv, unsigned long long *n_faces, char *msg,
+			size_t msg_cap)
 {
 	struct ply_elem *E = NULL;
 	int ne = 0, fmt = -1, rc = PX_E_PARSE, k, vk = -1, ax[3] = {-1, -1, -1};
@@ -314,6 +315,7 @@ static int ply_validate(const char *path, FILE *f, size_t size, double **xyz,
 
 	*xyz = NULL;
 	*nv = 0;
+	*n_faces = 0;
 	E = calloc(PLY_MAX_ELEMS, sizeof(*E));
 	if (!E)
 		return PX_E_NOMEM;
@@ -552,6 +554,9 @@ static int ply_validate(const char *path, FILE *f, size_t size, double **xyz,
 		goto out;
 	}
 	rc = PX_OK;
+	for (k = 0; k < ne; k++)
+		if (strcmp(E[k].name, "face") == 0)
+			*n_faces += E[k].count;
 	*xyz = V;
 	*nv = (size_t)n_vertex;
 	V = NULL;
@@ -845,13 +850,19 @@ int px__import_file(const char *path, int want_tri, double **xyz,
 	if (has_ply_magic(data, len) || ends_with_ci(path, ".ply")) {
 		double *pv = NULL;
 		size_t pn = 0;
+		unsigned long long nf = 0;
 		FILE *f = mem_stream(path, data, len, msg, msg_cap);
 		if (!f) {
 			free(data);
 			return PX_E_IO;
 		}
-		rc = ply_validate(path, f, len, &pv, &pn, msg, msg_cap);
+		rc = ply_validate(path, f, len, &pv, &pn, &nf, msg, msg_cap);
 		fclose(f);
+		if (rc == PX_OK && want_tri && nf == 0) {
+			/* vertices only: a cloud (px_load.c looks for these words) */
+			snprintf(msg, msg_cap, "%s: no triangles in the file", path);
+			rc = PX_E_PARSE;
+		}
 		if (rc == PX_OK && !want_tri) {
 			/* points: the file's own values, doubles kept exact */
 			free(data);
