@@ -174,6 +174,27 @@ if awk -F, 'function abs(a) { return a < 0 ? -a : a }
 printf 'solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n' >"$tmp/broken.stl"
 expect "truncated STL" 1 "$bin" "$tmp/broken.stl" "$tmp/pts.csv"
 err_has "truncated STL named" 'broken.stl'
+# Hostile points and models: NUL bytes end in an error with their place
+# instead of a loop over "blank" lines, a first line NaN is a point (and
+# an error), not a header, an empty field names itself, and a cloud whose
+# extent overflows is refused at setup instead of crashing.
+expect "points from /dev/zero" 1 timeout 20 "$bin" tests/data/circle.obj /dev/zero
+err_has "points from /dev/zero: file:line:column" "/dev/zero:1:1: NUL byte"
+printf '1,2,3\n4,5\0006\n' >"$tmp/nul.csv"
+expect "NUL inside a points line" 1 "$bin" tests/data/circle.obj "$tmp/nul.csv"
+err_has "NUL inside a points line: file:line:column" "nul.csv:2:4: NUL byte"
+printf 'NaN,0,0\n1,2,3\n' >"$tmp/nanfirst.csv"
+expect "NaN first line" 1 "$bin" tests/data/circle.obj "$tmp/nanfirst.csv"
+err_has "NaN first line: file:line:field" "nanfirst.csv:1: field 1: not a finite number"
+printf 'x,y,z\n1,,3\n' >"$tmp/emptyfield.csv"
+expect "empty field" 1 "$bin" tests/data/circle.obj "$tmp/emptyfield.csv"
+err_has "empty field: file:line:field" "emptyfield.csv:2: field 2 is empty"
+printf '0 0 0\n1e308 0 0\n-1e308 1 1\n' >"$tmp/e308.xyz"
+expect "cloud at 1e308" 1 "$bin" "$tmp/e308.xyz" "$tmp/pts.csv"
+err_has "cloud at 1e308: file:line:field" 'e308.xyz:2: field 1: coordinate 1e\+308 beyond'
+ln -s /dev/zero "$tmp/zero.xyz"
+expect "model from /dev/zero as a cloud" 1 timeout 20 "$bin" "$tmp/zero.xyz" "$tmp/pts.csv"
+err_has "model from /dev/zero: file:line:column" "zero.xyz:1:1: NUL byte"
 expect "unknown option" 2 "$bin" --frobnicate tests/data/circle.obj "$tmp/pts.csv"
 expect "missing arguments" 2 "$bin" tests/data/circle.obj
 
