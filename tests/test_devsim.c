@@ -653,6 +653,111 @@ static void test_safe_state_sends_zero_force(void)
 	px_dev_free(d);
 }
 
+/* The safe output (px_dev_safe, and px_dev_stop of a device written to):
+ * what the simulated device last received is zero force with enable
+ * off, and it counts as one more write. */
+static void test_safe_output_is_what_the_device_received_last(void)
+{
+	struct px_sim_haptic_config hc;
+	struct px_dev *d;
+	struct px_force_cmd cmd = {{1.5, -0.7, 0.9}, {0.01, 0, 0}, 1};
+	struct px_pose_sample s;
+	struct px_sim_haptic_state st;
+	struct px_dev_status ds;
+	uint8_t out[16];
+	int64_t t;
+	int n, i;
+	px_sim_haptic_config_default(&hc);
+	d = make_sim("arm", &hc, 0);
+	for (t = 0; t < 100000000; t += 1000000) {
+		px_dev_pose_read(d, t, &s);
+		PX_CHECK_INT_EQ(px_dev_force_write(d, &cmd, t), PX_OK);
+	}
+	px_sim_haptic_state(d, &st);
+	PX_CHECK_NEAR(st.force_n[0], 1.5, 1e-3);
+	PX_CHECK_INT_EQ(st.enable, 1);
+	px_dev_status(d, &ds);
+	PX_CHECK_INT_EQ(ds.writes, 100);
+	PX_CHECK_INT_EQ(ds.outputs_safe, 0);
+	PX_CHECK_INT_EQ(px_dev_safe(d, t), PX_OK);
+	px_sim_haptic_state(d, &st);
+	for (i = 0; i < 3; i++) {
+		PX_CHECK_NEAR(st.force_n[i], 0, 0);
+		PX_CHECK_NEAR(st.torque_n_m[i], 0, 0);
+	}
+	PX_CHECK_INT_EQ(st.enable, 0);
+	n = px_sim_haptic_last_output(d, out, sizeof out);
+	PX_CHECK_INT_EQ(n, 7);
+	for (i = 1; i < n; i++)
+		PX_CHECK_INT_EQ(out[i], 0);
+	px_dev_status(d, &ds);
+	PX_CHECK_INT_EQ(ds.writes, 101);
+	PX_CHECK_INT_EQ(ds.safe_writes, 1);
+	PX_CHECK_INT_EQ(ds.outputs_safe, 1);
+	/* a command after it: no longer safe; stopping sends it again */
+	PX_CHECK_INT_EQ(px_dev_force_write(d, &cmd, t), PX_OK);
+	px_dev_status(d, &ds);
+	PX_CHECK_INT_EQ(ds.outputs_safe, 0);
+	px_sim_haptic_state(d, &st);
+	PX_CHECK_NEAR(st.force_n[0], 1.5, 1e-3);
+	px_dev_stop(d);
+	px_sim_haptic_state(d, &st);
+	PX_CHECK_NEAR(st.force_n[0], 0, 0);
+	PX_CHECK_INT_EQ(st.enable, 0);
+	px_dev_status(d, &ds);
+	PX_CHECK_INT_EQ(ds.safe_writes, 2);
+	PX_CHECK_INT_EQ(ds.outputs_safe, 1);
+	/* a device with nothing to zero: nothing sent, PX_OK */
+	hc.follow_hand = 1;
+	{
+		struct px_dev *p = make_sim("pose", &hc, 0);
+		PX_CHECK_INT_EQ(px_dev_safe(p, 0), PX_OK);
+		px_dev_status(p, &ds);
+		PX_CHECK_INT_EQ(ds.writes, 0);
+		px_dev_free(p);
+	}
+	PX_CHECK_INT_EQ(px_dev_safe(NULL, 0), PX_E_INVAL);
+	px_dev_free(d);
+}
+
+/* An unplugged device cannot take the safe output: an error, counted,
+ * and outputs_safe stays 0 until it is back and takes it. */
+static void test_safe_output_refused_while_unplugged(void)
+{
+	struct px_sim_haptic_config hc;
+	struct px_sim_fault f = {PX_SIM_FAULT_UNPLUG, 50000000, 50000000, 1.0, 0};
+	struct px_dev *d;
+	struct px_force_cmd cmd = {{2.0, 0, 0}, {0}, 1};
+	struct px_pose_sample s;
+	struct px_sim_haptic_state st;
+	struct px_dev_status ds;
+	int64_t t;
+	px_sim_haptic_config_default(&hc);
+	hc.faults = &f;
+	hc.n_faults = 1;
+	d = make_sim("arm", &hc, 0);
+	for (t = 0; t < 60000000; t += 1000000) {
+		px_dev_pose_read(d, t, &s);
+		px_dev_force_write(d, &cmd, t);
+	}
+	PX_CHECK_INT_EQ(px_dev_state(d), PX_DEV_STATE_UNPLUGGED);
+	PX_CHECK_INT_EQ(px_dev_safe(d, t), PX_E_NODEV);
+	px_sim_haptic_state(d, &st);
+	PX_CHECK_NEAR(st.force_n[0], 2.0, 1e-3); /* still what it had */
+	px_dev_status(d, &ds);
+	PX_CHECK_INT_EQ(ds.safe_errors, 1);
+	PX_CHECK_INT_EQ(ds.outputs_safe, 0);
+	PX_CHECK(strstr(ds.last_msg, "safe output not confirmed") != NULL);
+	/* back after the window: it takes it */
+	px_dev_pose_read(d, 110000000, &s);
+	PX_CHECK_INT_EQ(px_dev_safe(d, 110000000), PX_OK);
+	px_sim_haptic_state(d, &st);
+	PX_CHECK_NEAR(st.force_n[0], 0, 0);
+	px_dev_status(d, &ds);
+	PX_CHECK_INT_EQ(ds.outputs_safe, 1);
+	px_dev_free(d);
+}
+
 static int slow_read(struct px_loop *l, const struct px_loop_cycle *c,
 		     void *u)
 {
@@ -732,6 +837,8 @@ static const struct px_test tests[] = {
 	PX_T(test_fault_nan),
 	PX_T(test_fault_unplug_replug),
 	PX_T(test_safe_state_sends_zero_force),
+	PX_T(test_safe_output_is_what_the_device_received_last),
+	PX_T(test_safe_output_refused_while_unplugged),
 };
 
 PX_TEST_MAIN(tests)

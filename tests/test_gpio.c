@@ -513,6 +513,17 @@ static void test_gpiod_on_gpio_sim(void)
 	PX_CHECK_INT_EQ(p, 1);
 	PX_CHECK_INT_EQ(px_dev_dio_write(d, PX_DIO_ENABLE, 0, mono()), PX_OK);
 	PX_CHECK_INT_EQ(sysfs_read(dir, "sim_gpio1/value"), 0);
+	/* the safe output: on again, then px_dev_safe drops it, read
+	 * back by the back end and seen on the simulated chip */
+	PX_CHECK_INT_EQ(px_dev_dio_write(d, PX_DIO_ENABLE, 1, mono()), PX_OK);
+	PX_CHECK_INT_EQ(sysfs_read(dir, "sim_gpio1/value"), 1);
+	PX_CHECK_INT_EQ(px_dev_safe(d, mono()), PX_OK);
+	PX_CHECK_INT_EQ(sysfs_read(dir, "sim_gpio1/value"), 0);
+	{
+		struct px_dev_status st;
+		px_dev_status(d, &st);
+		PX_CHECK_INT_EQ(st.outputs_safe, 1);
+	}
 	px_dev_free(d);
 }
 
@@ -569,6 +580,117 @@ static void test_gpiod_by_name_on_gpio_sim(void)
 	PX_CHECK_MSG(strstr(msg, "no-such-line") != NULL, "%s", msg);
 }
 
+/* The safe output drops the enable relay and the timing line, whatever
+ * their polarity, and px_dev_stop() of a device written to sends it; a
+ * welded relay (stuck) is reported, not taken as safe. */
+static void test_safe_output_drops_relay(void)
+{
+	struct px_sim_fault stuck = {PX_SIM_FAULT_STUCK, 10000000, 10000000,
+				     1.0, 0};
+	struct px_dev_config dc;
+	struct px_dev_status st;
+	struct px_dev *d;
+	char msg[200];
+	int al;
+	px_dev_config_default(&dc);
+	dc.name = "io";
+	for (al = 0; al < 2; al++) {
+		struct px_gpio_config c = io_cfg(1);
+		c.line[PX_GPIO_ENABLE].active_low = al;
+		c.line[PX_GPIO_TIMING].active_low = al;
+		PX_CHECK_INT_EQ(px_gpio_sim_create(&dc, &c, NULL, 0, &d, msg,
+						   sizeof msg),
+				PX_OK);
+		PX_CHECK_INT_EQ(px_dev_dio_write(d, PX_DIO_ENABLE, 1, 1000), PX_OK);
+		PX_CHECK_INT_EQ(px_dev_dio_write(d, PX_DIO_TIMING, 1, 1000), PX_OK);
+		PX_CHECK_INT_EQ(px_gpio_sim_output(d, PX_GPIO_ENABLE), !al);
+		PX_CHECK_INT_EQ(px_dev_safe(d, 2000), PX_OK);
+		PX_CHECK_INT_EQ(px_gpio_sim_output(d, PX_GPIO_ENABLE), al);
+		PX_CHECK_INT_EQ(px_gpio_sim_output(d, PX_GPIO_TIMING), al);
+		px_dev_status(d, &st);
+		PX_CHECK_INT_EQ(st.outputs_safe, 1);
+		PX_CHECK_INT_EQ(st.writes, 0); /* no force write counted */
+		/* on again, then stopped: off again */
+		PX_CHECK_INT_EQ(px_dev_start(d), PX_OK);
+		PX_CHECK_INT_EQ(px_dev_dio_write(d, PX_DIO_ENABLE, 1, 3000), PX_OK);
+		px_dev_status(d, &st);
+		PX_CHECK_INT_EQ(st.outputs_safe, 0);
+		px_dev_stop(d);
+		PX_CHECK_INT_EQ(px_gpio_sim_output(d, PX_GPIO_ENABLE), al);
+		px_dev_status(d, &st);
+		PX_CHECK_INT_EQ(st.safe_writes, 2);
+		px_dev_free(d);
+	}
+	{
+		struct px_gpio_config c = io_cfg(1);
+		PX_CHECK_INT_EQ(px_gpio_sim_create(&dc, &c, &stuck, 1, &d, msg,
+						   sizeof msg),
+				PX_OK);
+		PX_CHECK_INT_EQ(px_dev_dio_write(d, PX_DIO_ENABLE, 1, 1000), PX_OK);
+		PX_CHECK_INT_EQ(px_dev_safe(d, 15000000), PX_E_IO);
+		PX_CHECK_INT_EQ(px_gpio_sim_output(d, PX_GPIO_ENABLE), 1);
+		px_dev_status(d, &st);
+		PX_CHECK_INT_EQ(st.outputs_safe, 0);
+		PX_CHECK_INT_EQ(st.safe_errors, 1);
+		/* the weld gone: it drops */
+		PX_CHECK_INT_EQ(px_dev_safe(d, 25000000), PX_OK);
+		PX_CHECK_INT_EQ(px_gpio_sim_output(d, PX_GPIO_ENABLE), 0);
+		px_dev_free(d);
+	}
+}
+
+/* Released e-stop with automatic re-arm: the loop stays in safe state
+ * (PX_FAULT_ESTOP is latched) until px_loop_rearm(); a stale-free
+ * application trip under the same setting re-arms by itself. */
+static void test_estop_release_needs_rearm_despite_auto_rearm(void)
+{
+	struct px_gpio_config c = io_cfg(1);
+	struct px_sim_fault f = {PX_SIM_FAULT_ESTOP, 100000000, 50000000, 1.0, 0};
+	struct px_dev_config dc;
+	struct px_loop_config lc;
+	struct px_loop *l;
+	struct px_loop_status ls;
+	static struct app a;
+	char msg[200];
+	int i;
+	memset(&a, 0, sizeof a);
+	px_dev_config_default(&dc);
+	dc.name = "io";
+	PX_CHECK_INT_EQ(px_gpio_sim_create(&dc, &c, &f, 1, &a.io, msg, sizeof msg),
+			PX_OK);
+	px_loop_config_default(&lc);
+	lc.clock = PX_LOOP_CLOCK_VIRTUAL;
+	lc.read = a_read;
+	lc.compute = a_compute;
+	lc.write = a_write;
+	lc.user = &a;
+	lc.hist_bins = 100;
+	lc.rearm_after_ok_cycles = 50; /* auto_rearm: 50 quiet cycles */
+	PX_CHECK_INT_EQ(px_loop_create(&lc, &l), PX_OK);
+	PX_CHECK_INT_EQ(px_loop_enable_add(l, "enable", &a.enable), 0);
+	PX_CHECK_INT_EQ(px_dev_attach(a.io, l), 0);
+	/* an application trip at cycle 20 re-arms by itself */
+	a.trip_at = 20;
+	PX_CHECK_INT_EQ(px_loop_run(l, 90), PX_OK);
+	PX_CHECK(!px_loop_is_safe(l));
+	PX_CHECK_INT_EQ(a.out_enable[30], 0);
+	PX_CHECK_INT_EQ(a.out_enable[89], 1);
+	/* pressed 100..150 ms, released: a second of quiet cycles later
+	 * the relay is still off */
+	PX_CHECK_INT_EQ(px_loop_run(l, 1110), PX_OK);
+	PX_CHECK(px_loop_is_safe(l));
+	px_loop_status(l, &ls);
+	PX_CHECK_INT_EQ(ls.safe_cause, PX_FAULT_ESTOP);
+	for (i = 110; i < 1200; i++)
+		PX_CHECK_MSG(a.out_enable[i] == 0, "relay on at cycle %d", i);
+	/* the deliberate reset */
+	px_loop_rearm(l);
+	PX_CHECK_INT_EQ(px_loop_run(l, 5), PX_OK);
+	PX_CHECK(!px_loop_is_safe(l));
+	px_loop_free(l);
+	px_dev_free(a.io);
+}
+
 static const struct px_test tests[] = {
 	PX_T(test_gpio_fault_lost_late_wrong_events),
 	PX_T(test_gpio_fault_duplicate_events),
@@ -577,6 +699,8 @@ static const struct px_test tests[] = {
 	PX_T(test_debounce_matches_reference),
 	PX_T(test_chatter_gives_one_press),
 	PX_T(test_estop_trips_loop_and_holds_safe_state),
+	PX_T(test_safe_output_drops_relay),
+	PX_T(test_estop_release_needs_rearm_despite_auto_rearm),
 	PX_T(test_gpiod_open_path),
 	PX_T(test_gpiod_on_gpio_sim),
 	PX_T(test_gpiod_by_name_on_gpio_sim),

@@ -557,6 +557,57 @@ static void test_rearm(void)
 	px_loop_free(f.l);
 }
 
+/* An e-stop latches safe state against automatic re-arm, also when it
+ * joins a safe state another cause entered (a NaN here), and a
+ * px_loop_rearm() clears it; the fault ring names the cause. */
+static void test_estop_latched_against_auto_rearm(void)
+{
+	struct px_loop_config cfg;
+	struct px_loop_status st;
+	struct px_fault ft;
+	struct fx f;
+	int k, estops = 0;
+
+	fx_init(&f, &cfg);
+	cfg.rearm_after_ok_cycles = 4;
+	fx_create(&f, &cfg);
+	f.nan_at = 2;
+	PX_CHECK_INT_EQ(px_loop_run(f.l, 3), PX_OK); /* safe from 2 */
+	px_loop_trip_estop(f.l);                      /* joins at 3 */
+	PX_CHECK_INT_EQ(px_loop_run(f.l, 40), PX_OK);
+	for (k = 2; k < 43; k++) {
+		PX_CHECK_MSG(f.w_safe[k] == 1 && f.w_enable[k] == 0 &&
+				     f.w_out[k] == 0.0,
+			     "cycle %d left safe state", k);
+	}
+	PX_CHECK_INT_EQ(px_loop_status(f.l, &st), PX_OK);
+	PX_CHECK_INT_EQ(st.safe_entries, 1);
+	while (px_loop_fault_pop(f.l, &ft) == PX_OK)
+		if (ft.cause == PX_FAULT_ESTOP) {
+			estops++;
+			PX_CHECK_INT_EQ(ft.cycle, 3);
+			PX_CHECK_INT_EQ(ft.safe, 1);
+		}
+	PX_CHECK_INT_EQ(estops, 1);
+	PX_CHECK(strcmp(px_fault_cause_name(PX_FAULT_ESTOP), "estop") == 0);
+	px_loop_rearm(f.l);
+	PX_CHECK_INT_EQ(px_loop_run(f.l, 2), PX_OK);
+	PX_CHECK_INT_EQ(f.w_safe[43], 0);
+	PX_CHECK(f.w_out[44] == 10.0);
+	/* after the reset, automatic re-arm works again for other causes */
+	f.nan_at = 50;
+	PX_CHECK_INT_EQ(px_loop_run(f.l, 15), PX_OK);
+	PX_CHECK_INT_EQ(f.w_safe[50], 1);
+	PX_CHECK_INT_EQ(f.w_safe[55], 0);
+	/* an e-stop entering safe state itself: latched as well, its cause */
+	px_loop_trip_estop(f.l);
+	PX_CHECK_INT_EQ(px_loop_run(f.l, 20), PX_OK);
+	PX_CHECK(px_loop_is_safe(f.l));
+	PX_CHECK_INT_EQ(px_loop_status(f.l, &st), PX_OK);
+	PX_CHECK_INT_EQ(st.safe_cause, PX_FAULT_ESTOP);
+	px_loop_free(f.l);
+}
+
 static void test_stop_from_phase(void)
 {
 	struct px_loop_config cfg;
@@ -791,6 +842,7 @@ static const struct px_test tests[] = {
 	PX_T(test_watchdog_nonfinite_output),
 	PX_T(test_watchdog_callback_error_and_trip),
 	PX_T(test_rearm),
+	PX_T(test_estop_latched_against_auto_rearm),
 	PX_T(test_stop_from_phase),
 	PX_T(test_no_allocation_100k_cycles),
 	PX_T(test_concurrent_status_and_stop),
