@@ -19,8 +19,14 @@
  * skipped and counted in *n_skipped); else only vertices. On success
  * *xyz (3 doubles per vertex) and *tri (3 per triangle, NULL when
  * !want_tri) are malloc'ed and owned by the caller. On failure msg holds
- * "<path>: <reason>". Returns PX_OK, PX_E_INVAL, PX_E_NOTFOUND, PX_E_IO,
- * PX_E_PARSE, PX_E_NOMEM, PX_E_OVERFLOW. Setup only.
+ * "<path>: <reason>". The file is read once, at most
+ * PX_FILE_MODEL_MAX_BYTES, and the importer parses those bytes. PLY
+ * files are checked against their header first (x, y, z required); a
+ * PLY read for points (!want_tri) is read exactly by that check, without
+ * the importer; a PLY mesh whose coordinates would move by more than
+ * 1e-5 of its extent in the importer's single precision is PX_E_RANGE.
+ * Returns PX_OK, PX_E_INVAL, PX_E_NOTFOUND, PX_E_IO, PX_E_PARSE,
+ * PX_E_RANGE, PX_E_NOMEM, PX_E_OVERFLOW. Setup only.
  */
 int px__import_file(const char *path, int want_tri, double **xyz,
 		    size_t *nv, uint32_t **tri, size_t *nt, size_t *n_skipped,

@@ -79,15 +79,22 @@ PX_API int px_cloud_model(const double *xyz, size_t n, double radius_m,
 			  struct px_cloud_report *rep, struct px_model **out);
 
 /*
- * Load a cloud: ".ply" files through the mesh importer (vertices only,
- * faces ignored; the body is checked against the header first;
- * coordinates pass through single-precision floats); any other name as text: one point per line, at least
- * three numbers separated by blanks, commas or semicolons (more columns,
- * e.g. colours or normals, are ignored), '#' or '//' comment lines and
- * blank lines skipped, and one header line of names allowed before the
- * first point. Errors name the file and, for text, line and column:
- * PX_E_NOTFOUND, PX_E_IO, PX_E_PARSE, and px_cloud_model()'s errors.
- * Setup only.
+ * Load a cloud, at most PX_FILE_MODEL_MAX_BYTES (1 GiB, px_file.h: a
+ * larger regular file is refused from its size, a pipe or device when
+ * the count passes it). ".ply" files: the header and body are checked
+ * against each other, the vertex element must have scalar x, y and z,
+ * and the coordinates are read exactly (float, double or integer types,
+ * ASCII or binary of either byte order; faces ignored). Any other name
+ * is text: one point per line, at least three numbers separated by
+ * blanks or by one comma or semicolon (more columns, e.g. colours or
+ * normals, are ignored; an empty field such as "1,,2" is an error), '#'
+ * or '//' comment lines and blank lines skipped, and one header line
+ * before the first point whose first field is a name, not a number
+ * ("NaN,0,0" is a point, and non-finite). A NUL byte is an error at its
+ * line and column. Errors name the file and, for text, line, column or
+ * field: PX_E_NOTFOUND, PX_E_IO, PX_E_PARSE, PX_E_RANGE (over the size
+ * limit, a coordinate beyond PX_CLOUD_MAX_COORD), and px_cloud_model()'s
+ * errors. Setup only.
  */
 PX_API int px_cloud_load(const char *path, double radius_m,
 			 struct px_cloud_report *rep, struct px_model **out);
