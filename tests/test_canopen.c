@@ -270,6 +270,130 @@ static void test_master_drives_simulated_arm(void)
 	px_can_sim_free(bus);
 }
 
+/* ---- safe stop ------------------------------------------------------------ */
+
+struct stopper {
+	struct px_canopen_sim *sim;
+	struct px_can_bus *sniff;
+	uint16_t cw1[64];   /* controlwords node 1 was sent, in order */
+	int n_cw1;
+	int calls;
+};
+
+static void sniff(struct stopper *k, int64_t now)
+{
+	struct px_can_msg m;
+	while (px_can_bus_recv(k->sniff, now, &m) == PX_OK)
+		if ((m.f.can_id & CAN_SFF_MASK) == 0x201 && m.f.len >= 2 &&
+		    k->n_cw1 < 64)
+			k->cw1[k->n_cw1++] =
+				(uint16_t)(m.f.data[0] | m.f.data[1] << 8);
+}
+
+/* The virtual clock of the safe stop: the arm answers each round. */
+static int64_t stop_wait(void *user, int64_t now, int64_t period_ns)
+{
+	struct stopper *k = user;
+	k->calls++;
+	now += period_ns;
+	px_canopen_sim_step(k->sim, now);
+	sniff(k, now);
+	return now;
+}
+
+/* An arm driven to operation enabled, then px_canopen_safe_stop():
+ * quick stop, then disable voltage, every drive confirmed in switch on
+ * disabled by its own statusword, the joints still; a drive that falls
+ * silent is named after the bounded wait and the others still stop. */
+static void test_safe_stop_disables_every_drive(void)
+{
+	struct px_can_sim_config bc;
+	struct px_can_sim *bus;
+	struct px_can_bus *ep_master, *ep_arm;
+	struct px_canopen_config cc;
+	struct px_canopen_sim_config sc;
+	struct px_canopen_stop_config stc;
+	struct px_canopen_stop_result res;
+	struct px_sim_fault silent = {PX_SIM_FAULT_UNPLUG, 1000000000, 5000000000LL,
+				      1.0, 3};
+	struct stopper k;
+	double targets[6] = {0.5, -0.25, 0.1, 0.2, 0.02, 0.0}, p0[6], p;
+	char msg[200];
+	int64_t t;
+	int pass, st, i;
+	for (pass = 0; pass < 2; pass++) {
+		struct px_canopen *co;
+		memset(&k, 0, sizeof k);
+		px_can_sim_config_default(&bc);
+		PX_CHECK_INT_EQ(px_can_sim_create(&bc, &bus), PX_OK);
+		PX_CHECK_INT_EQ(px_can_sim_endpoint(bus, &ep_master), PX_OK);
+		PX_CHECK_INT_EQ(px_can_sim_endpoint(bus, &ep_arm), PX_OK);
+		PX_CHECK_INT_EQ(px_can_sim_endpoint(bus, &k.sniff), PX_OK);
+		px_canopen_config_default(&cc);
+		cc.drives = arm;
+		cc.n_drives = 6;
+		PX_CHECK_INT_EQ(px_canopen_create(&cc, ep_master, &co, msg,
+						  sizeof msg),
+				PX_OK);
+		memset(&sc, 0, sizeof sc);
+		sc.drives = arm;
+		sc.n_drives = 6;
+		sc.faults = pass ? &silent : NULL;
+		sc.n_faults = pass ? 1 : 0;
+		PX_CHECK_INT_EQ(px_canopen_sim_create(&sc, ep_arm, &k.sim), PX_OK);
+		for (t = 1000000; t <= 1100000000; t += 1000000) {
+			px_canopen_sim_step(k.sim, t);
+			px_canopen_rx(co, t);
+			px_canopen_tx(co, t, targets, 6, 1);
+			sniff(&k, t);
+		}
+		if (!pass)
+			PX_CHECK(px_canopen_all_enabled(co));
+		for (i = 0; i < 6; i++)
+			px_canopen_sim_joint(k.sim, (size_t)i, &p0[i], &st);
+		k.n_cw1 = 0;
+		px_canopen_stop_config_default(&stc);
+		stc.wait = stop_wait;
+		stc.user = &k;
+		stc.timeout_ns = 300000000;
+		i = px_canopen_safe_stop(co, t, &stc, &res);
+		PX_CHECK_INT_EQ(res.drives, 6);
+		PX_CHECK(k.calls <= 301); /* bounded by the timeout */
+		PX_CHECK(res.elapsed_ns <= stc.timeout_ns + stc.period_ns);
+		/* quick stop first, then disable voltage */
+		PX_CHECK(k.n_cw1 >= 1);
+		PX_CHECK_INT_EQ(k.cw1[0], PX_CIA402_CW_QUICK_STOP);
+		if (k.n_cw1 > 1)
+			PX_CHECK_INT_EQ(k.cw1[k.n_cw1 - 1],
+					PX_CIA402_CW_DISABLE_VOLTAGE);
+		if (!pass) {
+			PX_CHECK_INT_EQ(i, PX_OK);
+			PX_CHECK_INT_EQ(res.disabled, 6);
+			PX_CHECK_INT_EQ(res.first_unconfirmed, -1);
+			PX_CHECK(res.rounds <= 3);
+		} else {
+			PX_CHECK_INT_EQ(i, PX_E_TIMEOUT);
+			PX_CHECK_INT_EQ(res.disabled, 5);
+			PX_CHECK_INT_EQ(res.first_unconfirmed, 3);
+		}
+		for (i = 0; i < 6; i++) {
+			px_canopen_sim_joint(k.sim, (size_t)i, &p, &st);
+			if (pass && i == 3)
+				continue; /* silent: never heard it */
+			PX_CHECK_MSG(st == PX_CIA402_SWITCH_ON_DISABLED,
+				     "drive %d: %s", i, px_cia402_state_name(st));
+			/* stopped where it was (a CSP drive not sent to 0) */
+			PX_CHECK_MSG(fabs(p - p0[i]) < 0.01, "drive %d moved %g",
+				     i, p - p0[i]);
+		}
+		PX_CHECK(!px_canopen_all_enabled(co));
+		px_canopen_sim_free(k.sim);
+		px_canopen_free(co);
+		px_can_sim_free(bus);
+	}
+	PX_CHECK_INT_EQ(px_canopen_safe_stop(NULL, 0, NULL, &res), PX_E_INVAL);
+}
+
 static void test_config_errors_name_the_drive(void)
 {
 	struct px_canopen_config cc;
@@ -499,6 +623,7 @@ static const struct px_test tests[] = {
 	PX_T(test_drive_transitions),
 	PX_T(test_master_drives_simulated_arm),
 	PX_T(test_config_errors_name_the_drive),
+	PX_T(test_safe_stop_disables_every_drive),
 };
 
 PX_TEST_MAIN(tests)
