@@ -860,6 +860,70 @@ static const struct px_can_signal dev_sigs[] = {
 	 PX_WRENCH_FZ, 0},
 };
 
+/* The last frame on the bus after a CAN force sink stops or is freed is
+ * zero force (belt and braces: px_dev_stop / px_dev_free send the safe
+ * output of a device written to), and px_dev_safe() sends it too. */
+static int last_force_frame(struct px_can_bus *robot, int64_t t, double *fx,
+			    double *fz)
+{
+	struct px_can_msg m;
+	int n = 0;
+	while (px_can_bus_recv(robot, t, &m) == PX_OK)
+		if (m.f.can_id == 0x200) {
+			px_can_signal_decode(&dev_sigs[3], m.f.data, m.f.len, fx);
+			px_can_signal_decode(&dev_sigs[4], m.f.data, m.f.len, fz);
+			n++;
+		}
+	return n;
+}
+
+static void test_can_device_safe_output(void)
+{
+	struct px_can_sim_config c;
+	struct px_can_sim *s;
+	struct px_can_bus *robot, *ctl;
+	struct px_dev_config dc;
+	struct px_dev *d;
+	struct px_dev_status st;
+	struct px_force_cmd cmd = {{1.25, 0, -2.0}, {0, 0, 0}, 1};
+	char msg[300];
+	double fx = 0, fz = 0;
+	px_can_sim_config_default(&c);
+	PX_CHECK_INT_EQ(px_can_sim_create(&c, &s), PX_OK);
+	PX_CHECK_INT_EQ(px_can_sim_endpoint(s, &robot), PX_OK);
+	PX_CHECK_INT_EQ(px_can_sim_endpoint(s, &ctl), PX_OK);
+	px_dev_config_default(&dc);
+	dc.name = "arm";
+	PX_CHECK_INT_EQ(px_can_dev_create(&dc, ctl, 0, dev_sigs, 5, &d, msg,
+					  sizeof msg),
+			PX_OK);
+	PX_CHECK_INT_EQ(px_dev_start(d), PX_OK);
+	PX_CHECK_INT_EQ(px_dev_force_write(d, &cmd, 1000000), PX_OK);
+	PX_CHECK_INT_EQ(last_force_frame(robot, 1000000, &fx, &fz), 1);
+	PX_CHECK_NEAR(fx, 1.25, 1e-12);
+	PX_CHECK_NEAR(fz, -2.0, 1e-12);
+	PX_CHECK_INT_EQ(px_dev_safe(d, 2000000), PX_OK);
+	PX_CHECK_INT_EQ(last_force_frame(robot, 2000000, &fx, &fz), 1);
+	PX_CHECK_NEAR(fx, 0, 0);
+	PX_CHECK_NEAR(fz, 0, 0);
+	/* written again, then stopped: the stop sends zero */
+	PX_CHECK_INT_EQ(px_dev_force_write(d, &cmd, 3000000), PX_OK);
+	px_dev_stop(d);
+	PX_CHECK_INT_EQ(last_force_frame(robot, 4000000, &fx, &fz), 2);
+	PX_CHECK_NEAR(fx, 0, 0);
+	PX_CHECK_NEAR(fz, 0, 0);
+	px_dev_status(d, &st);
+	PX_CHECK_INT_EQ(st.writes, 4);
+	PX_CHECK_INT_EQ(st.outputs_safe, 1);
+	/* and freed after a write: the last frame is zero as well */
+	PX_CHECK_INT_EQ(px_dev_force_write(d, &cmd, 5000000), PX_OK);
+	px_dev_free(d); /* closes ctl */
+	PX_CHECK_INT_EQ(last_force_frame(robot, 6000000, &fx, &fz), 2);
+	PX_CHECK_NEAR(fx, 0, 0);
+	PX_CHECK_NEAR(fz, 0, 0);
+	px_can_sim_free(s);
+}
+
 static void test_can_device_on_sim_bus(void)
 {
 	struct px_can_sim_config c;
@@ -1104,6 +1168,7 @@ static const struct px_test tests[] = {
 	PX_T(test_error_frames_on_vcan),
 	PX_T(test_replay_and_record),
 	PX_T(test_can_device_on_sim_bus),
+	PX_T(test_can_device_safe_output),
 };
 
 PX_TEST_MAIN(tests)
