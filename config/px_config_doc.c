@@ -3,6 +3,7 @@
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <yaml.h>
 
 #include "internal.h"
@@ -978,6 +979,18 @@ int px_config_doc_load_file(const char *path, struct px_config_doc **out,
 		px__cfg_diag_add(diag, path, 0, 0, "", "cannot open: %s",
 				 strerror(e));
 		return e == ENOMEM ? PX_E_NOMEM : PX_E_IO;
+	}
+	{
+		/* a regular file is judged by its size before it is read */
+		struct stat st;
+		if (fstat(fileno(f), &st) == 0 && S_ISREG(st.st_mode) &&
+		    (unsigned long long)st.st_size > MAX_FILE_BYTES) {
+			px__cfg_diag_add(diag, path, 0, 0, "",
+					 "larger than %u MiB; not a config file?",
+					 MAX_FILE_BYTES >> 20);
+			fclose(f);
+			return PX_E_PARSE;
+		}
 	}
 	for (;;) {
 		size_t got;

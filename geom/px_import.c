@@ -837,8 +837,10 @@ int px__import_file(const char *path, int want_tri, double **xyz,
 		*nt = 0;
 	/* read once, with the limit: the checks and the importer see the
 	 * same bytes, and a pipe or /dev/zero cannot grow without bound */
-	rc = px_file_read(path, PX_FILE_MODEL_MAX_BYTES, 0, "model", &data, &len,
-			  msg, msg_cap);
+	rc = px_file_read(path, PX_FILE_MODEL_MAX_BYTES,
+			  ends_with_ci(path, ".obj") || ends_with_ci(path, ".off")
+				  ? PX_FILE_TEXT : 0u,
+			  "model", &data, &len, msg, msg_cap);
 	if (rc != PX_OK)
 		return rc;
 	if (len == 0) {
