@@ -221,6 +221,14 @@ static void test_can_signal_axes(void)
 /* Drives from the config reach the master with their counts_per_unit:
  * a simulated arm built from the same table enables and the master's
  * position feedback is counts / counts_per_unit. */
+/* The safe stop's wait on a virtual clock: the arm answers each round. */
+static int64_t arm_wait(void *user, int64_t now, int64_t period_ns)
+{
+	now += period_ns;
+	px_canopen_sim_step(user, now);
+	return now;
+}
+
 static void test_canopen_drives(void)
 {
 	static const char y[] =
@@ -295,9 +303,96 @@ static void test_canopen_drives(void)
 	/* the CSP drive reached its target through the count scaling */
 	PX_CHECK_NEAR(st.position, 0.25, 2e-3);
 	PX_CHECK_NEAR(pos, 0.25, 2e-3);
+	/* one call stops everything the handle opened: both drives
+	 * confirmed disabled, the arm standing where it was */
+	{
+		struct px_devcfg_safe_config sfc;
+		struct px_devcfg_safe_result r;
+		px_devcfg_safe_config_default(&sfc);
+		sfc.canopen.wait = arm_wait;
+		sfc.canopen.user = arm;
+		PX_CHECK_INT_EQ(px_devcfg_safe_stop(h, 61000000, &sfc, &r),
+				PX_OK);
+		PX_CHECK_INT_EQ(r.canopen_rc, PX_OK);
+		PX_CHECK_INT_EQ(r.canopen.disabled, 2);
+		PX_CHECK_INT_EQ(r.caps, 0); /* no px_dev on a canopen device */
+		for (k = 0; k < 2; k++) {
+			double p2;
+			PX_CHECK_INT_EQ(px_canopen_sim_joint(arm, (size_t)k, &p2,
+							     &state),
+					PX_OK);
+			PX_CHECK_INT_EQ(state, PX_CIA402_SWITCH_ON_DISABLED);
+			if (k == 0)
+				PX_CHECK_NEAR(p2, pos, 1e-3);
+		}
+		PX_CHECK(!px_canopen_all_enabled(px_devcfg_canopen(h)));
+	}
 	px_canopen_sim_free(arm);
 	px_can_bus_close(ep);
 	px_devcfg_free(h);
+	px_config_free(cfg);
+}
+
+/* Freed without px_devcfg_safe_stop(): one round of quick stop goes out
+ * before the bus closes, so the drives end disabled anyway. */
+static void test_canopen_free_stops_drives(void)
+{
+	static const char y[] =
+		"version: 1\n"
+		"devices:\n"
+		"  - name: arm\n"
+		"    backend: socketcan\n"
+		"    socketcan:\n"
+		"      interface: simbus\n"
+		"      transport: sim\n"
+		"      canopen:\n"
+		"        heartbeat_period_ns: 0\n"
+		"        heartbeat_timeout_ns: 0\n"
+		"        drives:\n"
+		"          - {node_id: 3, mode: csv, joint: 0, counts_per_unit: 1000}\n";
+	struct px_config *cfg = px_test_config_load(y, &g_diag);
+	struct px_devcfg_options opt;
+	struct px_can_sim_config bc;
+	struct px_can_sim *bus = NULL;
+	struct px_devcfg *h = NULL;
+	struct px_canopen_drive_cfg dr[1];
+	struct px_canopen_sim_config sc;
+	struct px_canopen_sim *arm = NULL;
+	struct px_can_bus *ep = NULL;
+	double targets[1] = {0.5};
+	char msg[512];
+	int k, state;
+	PX_CHECK(cfg != NULL);
+	if (!cfg)
+		return;
+	px_can_sim_config_default(&bc);
+	PX_CHECK_INT_EQ(px_can_sim_create(&bc, &bus), PX_OK);
+	memset(&opt, 0, sizeof(opt));
+	opt.can_sim = bus; /* the bus outlives the handle */
+	PX_CHECK_MSG(px_devcfg_open(cfg, &cfg->devices[0], &opt, &h, msg,
+				    sizeof(msg)) == PX_OK,
+		     "%s", msg);
+	PX_CHECK_INT_EQ(px_devcfg_drives(h, dr, 1), 1);
+	memset(&sc, 0, sizeof(sc));
+	sc.drives = dr;
+	sc.n_drives = 1;
+	PX_CHECK_INT_EQ(px_can_sim_endpoint(bus, &ep), PX_OK);
+	PX_CHECK_INT_EQ(px_canopen_sim_create(&sc, ep, &arm), PX_OK);
+	for (k = 1; k <= 30; k++) {
+		int64_t t = k * 1000000LL;
+		px_canopen_sim_step(arm, t);
+		px_canopen_rx(px_devcfg_canopen(h), t);
+		px_canopen_tx(px_devcfg_canopen(h), t, targets, 1, 1);
+	}
+	PX_CHECK(px_canopen_all_enabled(px_devcfg_canopen(h)));
+	px_devcfg_free(h);
+	px_canopen_sim_step(arm, 31000000);
+	PX_CHECK_INT_EQ(px_canopen_sim_joint(arm, 0, NULL, &state), PX_OK);
+	PX_CHECK_MSG(state == PX_CIA402_SWITCH_ON_DISABLED, "drive left %s",
+		     px_cia402_state_name(state));
+	px_canopen_sim_free(arm);
+	px_can_bus_close(ep);
+	px_can_sim_free(bus);
 	px_config_free(cfg);
 }
 
@@ -480,6 +575,6 @@ static const struct px_test tests[] = {
 	PX_T(test_examples_open),   PX_T(test_sim_haptic_runs),
 	PX_T(test_can_signal_axes), PX_T(test_canopen_drives),
 	PX_T(test_gpio_roles),      PX_T(test_errors),
-	PX_T(test_signal_axis_config),
+	PX_T(test_signal_axis_config), PX_T(test_canopen_free_stops_drives),
 };
 PX_TEST_MAIN(tests)
