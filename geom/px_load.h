@@ -9,6 +9,12 @@
  * formats). Free-form OBJ (NURBS curves and surfaces) belongs to the
  * NURBS loader, not here.
  *
+ * Every file is read whole with the model limit, PX_FILE_MODEL_MAX_BYTES
+ * (1 GiB, px_file.h): a larger regular file is refused from its size, a
+ * pipe or device when the count passes it, and text formats refuse a NUL
+ * byte at its line and column. Coordinates beyond 1e150 are refused at
+ * load (their squared distances would overflow), with their place.
+ *
  * Memory and real-time rules: setup only (allocates, reads files).
  */
 #ifndef PX_LOAD_H
