@@ -400,7 +400,9 @@ static int unix_claim(const char *path, char *msg, size_t cap)
 	rc = connect(s, (struct sockaddr *)&a, sizeof a);
 	e = errno;
 	close(s);
-	if (rc == 0) {
+	/* accepted, or EPERM: a datagram socket connected to another peer
+	 * refuses new senders, and only a live process has it connected */
+	if (rc == 0 || e == EPERM) {
 		if (msg)
 			snprintf(msg, cap, "%s is in use: another process is "
 				 "bound to it (a second run on the same "

@@ -617,6 +617,28 @@ static void test_unix_path_claims(void)
 	px_can_bus_close(b);
 	PX_CHECK(!is_socket(peer)); /* b removed its own file */
 
+	/* a live socket connected to its own peer (as a running bus end
+	 * is): refused the same way */
+	{
+		char other[96];
+		struct sockaddr_un ad;
+		int o;
+		snprintf(other, sizeof other, "%.60s/other.sock", dir);
+		o = bind_raw(other);
+		memset(&ad, 0, sizeof ad);
+		ad.sun_family = AF_UNIX;
+		snprintf(ad.sun_path, sizeof ad.sun_path, "%s", other);
+		PX_CHECK(o >= 0 &&
+			 connect(raw, (struct sockaddr *)&ad, sizeof ad) == 0);
+		PX_CHECK_INT_EQ(px_can_unix_open(path, peer, &a, msg,
+						 sizeof msg),
+				PX_E_BUSY);
+		PX_CHECK_MSG(strstr(msg, "in use"), "message: %s", msg);
+		PX_CHECK(is_socket(path));
+		close(o);
+		unlink(other);
+	}
+
 	/* stale (its owner gone, the file left): taken over */
 	close(raw);
 	PX_CHECK(is_socket(path));

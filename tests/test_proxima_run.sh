@@ -3,7 +3,10 @@
 # (exit status and message format), flag parsing; then every shipped
 # config end to end in virtual time (summary JSON, no allocation after
 # setup, force within the clamp, CSV and SVG files), reproducibility, the
-# heap counter's self-check, safe state on a velocity limit, scene errors.
+# heap counter's self-check, safe state on a velocity limit, scene errors;
+# outputs that never follow a symlink nor overwrite an input, --check
+# running setup's checks, range-checked durations reported as loop and
+# wall time, socket paths of which only a stale socket is removed.
 # Prints a harness-style summary line.
 set -u
 name=test_proxima_run
@@ -38,7 +41,13 @@ for f in config/examples/*.yaml; do
 	if [ "$(wc -l <"$tmp/out")" -eq 1 ] &&
 		grep -qE "^$f: OK \([0-9]+ devices?, loop period [0-9]+ ns\)\$" "$tmp/out"; then
 		ok "one-line OK for $f"; else bad "one-line OK for $f"; fi
-	if [ -s "$tmp/err" ]; then echo "    unexpected stderr"; bad "--check $f is quiet on stderr"; else ok "--check $f is quiet on stderr"; fi
+	if grep -qE '^ *auto_rearm: *true' "$f" && grep -qE '(name|line): estop' "$f"; then
+		# auto re-arm never ends an e-stop's safe state: said, once,
+		# at the auto_rearm key
+		if [ "$(wc -l <"$tmp/err")" -eq 1 ] && grep -qE "^$f:[0-9]+:[0-9]+: warning: safety\.watchdog\.auto_rearm: true re-arms after other trips, never after the e-stop \(device '[a-z0-9_]+' line '[a-z0-9_]+'\)" "$tmp/err"; then
+			ok "--check $f warns that the e-stop needs an explicit re-arm"
+		else bad "--check $f warns that the e-stop needs an explicit re-arm"; fi
+	elif [ -s "$tmp/err" ]; then echo "    unexpected stderr"; bad "--check $f is quiet on stderr"; else ok "--check $f is quiet on stderr"; fi
 done
 
 cat >"$tmp/bad.yaml" <<'Y'
@@ -415,6 +424,274 @@ expect "device-level drive fault (node_id) on the in-process arm" 0 "$bin" "$tmp
 check "socketcan.faults node_id 2: the drive faulted ($(num "$tmp/ddr.json" drive_problem_cycles) cycles)" \
 	"$(num "$tmp/ddr.json" drive_problem_cycles) > 0 && $(num "$tmp/ddr.json" safe_state_trips) >= 1"
 check "the same run without it has no drive problem" "$(num "$tmp/can_avoid_sim.json" drive_problem_cycles) == 0"
+
+# ---- outputs never follow a symlink nor overwrite an input -------------
+# Every output (CSV, summary JSON, both plots) planted as a symbolic link
+# to a victim file: the victim is unchanged, each output is a regular
+# file with its content, and no temporary file is left behind.
+mkdir -p "$tmp/sl"
+printf 'victim\n' >"$tmp/sl/victim"
+for o in t.csv t_time.svg t_latency.svg s.json; do ln -s "$tmp/sl/victim" "$tmp/sl/$o"; done
+expect "run with every output a symlink to a victim" 0 "$bin" "$good" --virtual-time --duration-s 0.2 \
+	--telemetry "$tmp/sl/t.csv" --summary-json "$tmp/sl/s.json"
+if [ "$(cat "$tmp/sl/victim")" = victim ]; then ok "symlinked outputs: the victim is unchanged"; else bad "symlinked outputs: the victim is unchanged"; fi
+for o in t.csv t_time.svg t_latency.svg s.json; do
+	if [ -f "$tmp/sl/$o" ] && [ ! -L "$tmp/sl/$o" ]; then ok "output $o written as a regular file"
+	else bad "output $o written as a regular file"; fi
+done
+if head -n 1 "$tmp/sl/t.csv" | grep -q '^t_s,cycle,' && [ "$(($(wc -l <"$tmp/sl/t.csv") - 1))" -eq 200 ]; then
+	ok "symlinked CSV replaced by the telemetry"; else bad "symlinked CSV replaced by the telemetry"; fi
+check "symlinked JSON replaced by the summary" "$(num "$tmp/sl/s.json" cycles) == 200"
+svg "symlinked time plot replaced by a plot" "$tmp/sl/t_time.svg"
+if ls -A "$tmp/sl" | grep -q '\.tmp$'; then bad "no temporary output file left"; else ok "no temporary output file left"; fi
+# an output that is the config, or a link to it, or an input file: refused
+# before the run, the file unchanged
+absolute "$good" >"$tmp/in.yaml"
+cp "$tmp/in.yaml" "$tmp/in.keep"
+knob=config/examples/scenes/knob.stl
+cksum <"$knob" >"$tmp/knob.sum"
+expect "--telemetry the config refused" 2 "$bin" "$tmp/in.yaml" --virtual-time --duration-s 0.1 --telemetry "$tmp/in.yaml"
+has "--telemetry the config named" "$tmp/err" \
+	"proxima-run: --telemetry: $tmp/in.yaml is the config file $tmp/in.yaml (the same file): refusing to write an output over it"
+expect "--summary-json the config refused" 2 "$bin" "$tmp/in.yaml" --virtual-time --duration-s 0.1 \
+	--telemetry "$tmp/in.csv" --summary-json "$tmp/in.yaml"
+expect "--check: --summary-json the config refused" 2 "$bin" --check "$tmp/in.yaml" --summary-json "$tmp/in.yaml"
+ln -s "$tmp/in.yaml" "$tmp/in-link.json"
+expect "--summary-json a symlink to the config refused" 2 "$bin" "$tmp/in.yaml" --virtual-time --duration-s 0.1 \
+	--telemetry "$tmp/in.csv" --summary-json "$tmp/in-link.json"
+if grep -qF "$tmp/in-link.json is a symbolic link to the config file $tmp/in.yaml" "$tmp/err"; then ok "symlink to the config named"; else bad "symlink to the config named"; fi
+expect "--summary-json a scene file refused" 2 "$bin" "$tmp/in.yaml" --virtual-time --duration-s 0.1 \
+	--telemetry "$tmp/in.csv" --summary-json "$PWD/$knob"
+if grep -qF "is an input file of the config" "$tmp/err"; then ok "scene file named as an input"; else bad "scene file named as an input"; fi
+mkdir -p "$tmp/adir.csv"
+expect "--telemetry a directory refused" 2 "$bin" "$tmp/in.yaml" --virtual-time --duration-s 0.1 --telemetry "$tmp/adir.csv"
+has "directory output named" "$tmp/err" \
+	"proxima-run: --telemetry: $tmp/adir.csv exists and is a directory, not a regular file: refusing to replace it"
+sed "s|file: build/telemetry.csv|file: $tmp/in2.yaml|" "$tmp/in.yaml" >"$tmp/in2.yaml"
+cp "$tmp/in2.yaml" "$tmp/in2.keep"
+expect "--check: telemetry.file the config itself" 1 "$bin" --check "$tmp/in2.yaml"
+if grep -qE "^$tmp/in2.yaml:[0-9]+:[0-9]+: telemetry.file: $tmp/in2.yaml is the config file" "$tmp/err"; then
+	ok "telemetry.file the config: placed"; else bad "telemetry.file the config: placed"; fi
+expect "run: telemetry.file the config itself" 1 "$bin" "$tmp/in2.yaml" --virtual-time --duration-s 0.1
+if cmp -s "$tmp/in.yaml" "$tmp/in.keep" && cmp -s "$tmp/in2.yaml" "$tmp/in2.keep" && cksum <"$knob" | cmp -s - "$tmp/knob.sum"; then
+	ok "the config and the scene file are unchanged"; else bad "the config and the scene file are unchanged"; fi
+
+# ---- --check runs setup's checks (without opening hardware) -----------
+# each: non-zero status and a message with file:line:column
+ck() { # DESCRIPTION FILE KEY-REGEX
+	expect "--check: $1" 1 "$bin" --check "$2"
+	if grep -qE "^$2:[0-9]+:[0-9]+: $3" "$tmp/err"; then ok "--check: $1: placed"; else bad "--check: $1: placed"; fi
+	if [ -s "$tmp/out" ]; then bad "--check: $1: no OK line"; else ok "--check: $1: no OK line"; fi
+}
+absolute "$good" | sed 's/^  models:/  modles:/' >"$tmp/c1.yaml"
+ck "misspelt key under scene" "$tmp/c1.yaml" "scene.modles: unknown key"
+absolute "$good" | sed 's/pose: {xyz_m: \[-0.035, 0.0, 0.0\]/pose: {xyz_m: [.nan, 0.0, 0.0]/' >"$tmp/c2.yaml"
+ck "NaN model pose" "$tmp/c2.yaml" "scene.models\[1\].pose"
+absolute "$good" | sed 's|scenes/knob.stl|scenes/knob-missing.stl|' >"$tmp/c3.yaml"
+ck "missing scene file" "$tmp/c3.yaml" "scene.models\[1\].file: .*knob-missing.stl"
+absolute "$good" | sed 's/scale: 1.2/scale: 0/' >"$tmp/c4.yaml"
+ck "zero scale" "$tmp/c4.yaml" "scene.models\[1\].scale"
+absolute "$good" | sed 's/^  device: haptic$/  device: io/' >"$tmp/c5.yaml"
+ck "control device not a pose device" "$tmp/c5.yaml" "control.device: 'io' \(sim\) is not a pose device"
+absolute "$good" | sed 's/^      kind: haptic$/      kind: pose/' >"$tmp/c6.yaml"
+ck "control device takes no force" "$tmp/c6.yaml" "control.device: 'haptic' takes no force"
+absolute "$good" | sed 's|^  decimation: 1$|  decimation: 1\n  ring_records: 16777216|' >"$tmp/c7.yaml"
+ck "ring_records of 16 million (3 GiB)" "$tmp/c7.yaml" "telemetry.ring_records: 16777216 records take 3.[0-9] GiB"
+expect "run: ring_records of 16 million refused" 1 "$bin" "$tmp/c7.yaml" --virtual-time --duration-s 0.1
+absolute "$good" | sed 's|^  decimation: 1$|  decimation: 1\n  ring_records: 1000000|' >"$tmp/c8.yaml"
+expect "--check: ring_records of a million warned" 0 "$bin" --check "$tmp/c8.yaml"
+if grep -qE "^$tmp/c8.yaml:[0-9]+:[0-9]+: telemetry.ring_records: warning: 1000000 records take [0-9]+ MiB at setup" "$tmp/err"; then
+	ok "large ring_records warned with its place"; else bad "large ring_records warned with its place"; fi
+# a simulated device's own refusal (a trajectory file that is not there)
+absolute "$good" | sed 's/^        kind: sines$/        kind: csv\n        file: no-such-path.csv/; /^        sines:$/d; /^          - {axis:/d' >"$tmp/c9.yaml"
+expect "--check: a simulated device's trajectory file missing" 1 "$bin" --check "$tmp/c9.yaml"
+if grep -q "no-such-path.csv" "$tmp/err"; then ok "--check: missing trajectory named"; else bad "--check: missing trajectory named"; fi
+
+# ---- numeric flags are range-checked; durations reported truthfully ---
+for v in 1e300 -1 nan inf 1e9; do
+	expect "--duration-s $v refused" 2 "$bin" "$good" --virtual-time --duration-s "$v"
+	if grep -q "^usage: proxima-run" "$tmp/err" && grep -q "duration-s: '$v'" "$tmp/err"; then ok "--duration-s $v: usage error"; else bad "--duration-s $v: usage error"; fi
+done
+# virtual clock: --duration-s runs its cycles; injected slow computes
+# make missed periods, so the loop clock covers more than was asked, and
+# the summary says so
+expect "virtual run with missed periods" 0 "$bin" "$good" --virtual-time --duration-s 1 \
+	--fault overrun,loop,0.2,0.1,1,0.005 --summary-json "$tmp/dur.json" --telemetry "$tmp/dur.csv"
+check "virtual: 1000 cycles" "$(num "$tmp/dur.json" cycles) == 1000"
+check "virtual: periods were missed ($(num "$tmp/dur.json" missed_periods))" "$(num "$tmp/dur.json" missed_periods) > 10"
+check "virtual: loop time $(num "$tmp/dur.json" loop_time_s) s = (cycles + missed) x period" \
+	"$(num "$tmp/dur.json" loop_time_s) == (1000 + $(num "$tmp/dur.json" missed_periods)) * 0.001"
+check "virtual: wall_time_s reported" "\"$(num "$tmp/dur.json" wall_time_s)\" != \"\""
+if grep -q '"ended_by": "cycles"' "$tmp/dur.json"; then ok "virtual: ended by its cycles"; else bad "virtual: ended by its cycles"; fi
+if grep -qE "^  time              loop clock 1\.[0-9]+ s \([1-9][0-9]* missed periods\), wall [0-9.]+ s; --duration-s 1: ended by cycles$" "$tmp/out"; then
+	ok "summary has the time line"; else bad "summary has the time line"; fi
+# real clock: the same run ends when its time is up, whatever was missed
+absolute "$good" | sed 's/priority: 80/priority: 0/; s/lock_memory: true/lock_memory: false/' >"$tmp/real.yaml"
+expect "real-clock run with missed periods" 0 "$bin" "$tmp/real.yaml" --duration-s 1 \
+	--fault overrun,loop,0.2,0.1,1,0.005 --summary-json "$tmp/real.json" --telemetry "$tmp/real.csv"
+check "real: periods were missed ($(num "$tmp/real.json" missed_periods))" "$(num "$tmp/real.json" missed_periods) > 10"
+check "real: fewer cycles than asked ($(num "$tmp/real.json" cycles))" "$(num "$tmp/real.json" cycles) < 1000"
+check "real: loop time $(num "$tmp/real.json" loop_time_s) s is the 1 s asked" \
+	"$(num "$tmp/real.json" loop_time_s) >= 0.999 && $(num "$tmp/real.json" loop_time_s) <= 1.001"
+check "real: wall time $(num "$tmp/real.json" wall_time_s) s close to it" \
+	"$(num "$tmp/real.json" wall_time_s) >= 0.99 && $(num "$tmp/real.json" wall_time_s) < 1.5"
+if grep -q '"ended_by": "time"' "$tmp/real.json"; then ok "real: ended by its time"; else bad "real: ended by its time"; fi
+
+# ---- socket paths: only a stale socket is ever removed ----------------
+# can_avoid.yaml (the arm spawned as a second process, real clock) with
+# its socket in $tmp; what is already at the path decides.
+sock="$tmp/sk/bus.sock"
+mkdir -p "$tmp/sk"
+sed "s|socket_path: [^ ]*|socket_path: $sock|; s|device_timeout_ns: .*|device_timeout_ns: 500_000_000|; s|heartbeat_timeout_ns: .*|heartbeat_timeout_ns: 2_000_000_000|; s|file: build/|file: $tmp/sk/|" \
+	config/examples/can_avoid.yaml >"$tmp/sk.yaml"
+printf 'keep\n' >"$tmp/sk/victim"
+for kind in file peer-file dir link; do
+	rm -rf "$sock" "$sock.peer"
+	case $kind in
+	file) printf 'keep\n' >"$sock"; at=$sock what="a regular file" ;;
+	peer-file) printf 'keep\n' >"$sock.peer"; at=$sock.peer what="a regular file" ;;
+	dir) mkdir "$sock"; at=$sock what="a directory" ;;
+	link) ln -s "$tmp/sk/victim" "$sock"; at=$sock what="a symbolic link" ;;
+	esac
+	expect "socket_path: $kind there: the run refuses" 1 "$bin" "$tmp/sk.yaml" --duration-s 1
+	if grep -qF "$at exists and is $what, not a socket: refusing to remove it" "$tmp/err"; then
+		ok "socket_path: $kind named"; else bad "socket_path: $kind named"; fi
+	case $kind in
+	file | peer-file) [ "$(cat "$at")" = keep ] ;;
+	dir) [ -d "$sock" ] ;;
+	link) [ -L "$sock" ] && [ "$(cat "$tmp/sk/victim")" = keep ] ;;
+	esac && ok "socket_path: the $kind survives unchanged" || bad "socket_path: the $kind survives unchanged"
+done
+rm -rf "$sock" "$sock.peer"
+# a stale socket (its process killed) is taken over
+sab="$(dirname "$bin")/proxima-simarm"
+"$sab" --unix "$sock" "$tmp/sk/nobody" --seconds 30 >/dev/null 2>&1 &
+spid=$!
+i=0; while [ ! -S "$sock" ] && [ $i -lt 100 ]; do sleep 0.05; i=$((i + 1)); done
+kill -9 "$spid" 2>/dev/null; wait "$spid" 2>/dev/null
+if [ -S "$sock" ]; then ok "a killed process left a stale socket"; else bad "a killed process left a stale socket"; fi
+expect "stale socket taken over" 0 "$bin" "$tmp/sk.yaml" --duration-s 1 --summary-json "$tmp/sk1.json"
+check "stale socket: the drives ran over it" "$(num "$tmp/sk1.json" drives_enabled_cycles) > 100"
+if [ -e "$sock" ] || [ -e "$sock.peer" ]; then bad "both ends removed their own sockets at the end"; else ok "both ends removed their own sockets at the end"; fi
+# two runs on one path: the second is refused, the first's socket
+# survives the second's exit and the first runs to its end
+"$bin" "$tmp/sk.yaml" --duration-s 4 --summary-json "$tmp/sk2.json" >"$tmp/sk-first.out" 2>"$tmp/sk-first.err" &
+fpid=$!
+i=0; while ! { [ -S "$sock" ] && [ -S "$sock.peer" ]; } && [ $i -lt 200 ]; do sleep 0.05; i=$((i + 1)); done
+expect "a second run on the same socket_path refused" 1 "$bin" "$tmp/sk.yaml" --duration-s 1 --telemetry "$tmp/sk/second.csv"
+if grep -qF "$sock is in use: another process is bound to it" "$tmp/err"; then ok "socket in use named"; else bad "socket in use named"; fi
+if [ -S "$sock" ] && [ -S "$sock.peer" ]; then ok "the first run's sockets survive the second's exit"; else bad "the first run's sockets survive the second's exit"; fi
+wait "$fpid"; frc=$?
+check "the first run ends normally (exit $frc)" "$frc == 0"
+check "the first run's drives kept running ($(num "$tmp/sk2.json" drives_enabled_cycles) cycles)" \
+	"$(num "$tmp/sk2.json" drives_enabled_cycles) > 2000 && $(num "$tmp/sk2.json" drive_problem_cycles) == 0"
+# proxima-simarm: the same rules for the .peer end it binds, and its
+# numeric flags range-checked
+printf 'keep\n' >"$tmp/sk/peerfile"
+expect "proxima-simarm refuses a regular file as its socket" 1 "$sab" --unix "$tmp/sk/peerfile" "$tmp/sk/x" --seconds 1
+if [ "$(cat "$tmp/sk/peerfile")" = keep ]; then ok "proxima-simarm: the file survives"; else bad "proxima-simarm: the file survives"; fi
+for a in "--seconds 1e300" "--seconds nan" "--seconds -1" "--drives 0" "--drives 1x" "--drives 99999999999"; do
+	expect "proxima-simarm $a refused" 2 "$sab" --unix "$tmp/sk/y" "$tmp/sk/x" $a
+done
+
+# Shutdown: every way a run ends goes through the safe state before the
+# devices close. What the simulated devices last received is in the
+# JSON's shutdown record: zero force and torque with enable off, the
+# enable relay off; the force write that carried it is one more than the
+# cycles; CANopen drives end in switch on disabled.
+# shut_checks WHAT JSON REASON
+shut_checks() {
+	sj=$2
+	check "$1: shutdown safe" "$(num "$sj" shutdown_safe) == 1"
+	if grep -qF "\"shutdown_reason\": \"$3\"" "$sj"; then ok "$1: ended by $3"; else bad "$1: ended by $3"; fi
+	w=$(sed -n 's/.*"name": "haptic", "backend": "[a-z-]*", "state": [0-9]*, "reports": [0-9]*, "samples": [0-9]*, "writes": \([0-9]*\).*/\1/p' "$sj")
+	check "$1: haptic writes $w = cycles $(num "$sj" cycles) + 1 (the safe output last)" "$w == $(num "$sj" cycles) + 1"
+	if grep -qF '{"name": "haptic", "last_force_n": [0, 0, 0], "last_torque_n_m": [0, 0, 0], "last_enable": 0, "outputs_safe": 1}' "$sj"; then
+		ok "$1: the haptic device last received zero force, enable off"; else bad "$1: the haptic device last received zero force, enable off"; fi
+	if grep -qF '{"name": "io", "enable_line": 0, ' "$sj"; then
+		ok "$1: the enable relay is off"; else bad "$1: the enable relay is off"; fi
+}
+expect "shutdown: run ended by its duration" 0 "$bin" "$good" --virtual-time --duration-s 1 \
+	--summary-json "$tmp/sd.json" --telemetry "$tmp/sd.csv"
+shut_checks "duration" "$tmp/sd.json" "end of run"
+if grep -qE '^  shutdown          safe \(force zeroed on 1/1 device, relay off on 1/1\) after end of run in [0-9.]+ ms$' "$tmp/out"; then
+	ok "shutdown line in the summary"; else bad "shutdown line in the summary"; fi
+# the run's last telemetry row had force on: the zero came after it
+check "the last cycle still commanded force ($(tail -n 1 "$tmp/sd.csv" | cut -d, -f12) N)" \
+	"$(tail -n 1 "$tmp/sd.csv" | cut -d, -f12) > 0"
+for sig in INT TERM HUP QUIT USR1; do
+	PX_RUN_STOP_AT=555:$sig "$bin" "$good" --virtual-time --duration-s 5 --summary-json "$tmp/sd$sig.json" \
+		--telemetry "$tmp/sd.csv" >"$tmp/out" 2>"$tmp/err"
+	rc=$?
+	check "SIG$sig at cycle 555 (virtual): exit $rc, summary and JSON written" \
+		"$rc == 0 && $(num "$tmp/sd$sig.json" cycles) == 555"
+	shut_checks "SIG$sig" "$tmp/sd$sig.json" "SIG$sig"
+	if grep -q "^  shutdown          safe .* after SIG$sig in" "$tmp/out"; then ok "SIG$sig: summary printed"; else bad "SIG$sig: summary printed"; fi
+done
+# the same signals from outside, on the real clock
+for sig in INT TERM HUP; do
+	"$bin" "$good" --duration-s 30 --summary-json "$tmp/sr$sig.json" --telemetry "$tmp/sr.csv" \
+		>"$tmp/out" 2>"$tmp/err" &
+	pid=$!
+	sleep 1
+	kill -$sig $pid
+	wait $pid
+	rc=$?
+	check "kill -$sig (real clock): exit $rc" "$rc == 0"
+	[ -s "$tmp/sr$sig.json" ] || { bad "kill -$sig: summary JSON written"; continue; }
+	shut_checks "kill -$sig" "$tmp/sr$sig.json" "SIG$sig"
+done
+# drives: quick stop, then disabled, confirmed
+for how in duration TERM; do
+	if [ $how = TERM ]; then export PX_RUN_STOP_AT=1234:TERM; fi
+	expect "shutdown of the CANopen arm ($how)" 0 "$bin" config/examples/can_avoid_sim.yaml --virtual-time \
+		--duration-s 2 --summary-json "$tmp/sdc.json" --telemetry "$tmp/sdc.csv"
+	unset PX_RUN_STOP_AT
+	check "CANopen arm ($how): 6 drives disabled" \
+		"$(num "$tmp/sdc.json" shutdown_safe) == 1 && $(num "$tmp/sdc.json" drives_disabled) == 6 && $(num "$tmp/sdc.json" shutdown_drives) == 6"
+	check "CANopen arm ($how): every drive reports switch on disabled" \
+		"$(grep -c '"state": "switch on disabled"' "$tmp/sdc.json") == 6"
+	if grep -q "^  drives            6 on 'arm', enabled in [0-9]* cycles, 0 in operation enabled at the end$" "$tmp/out"; then
+		ok "CANopen arm ($how): none in operation enabled at the end"; else bad "CANopen arm ($how): none in operation enabled at the end"; fi
+done
+# a setup error after the devices opened (a HID device after them is
+# absent): safe outputs before closing
+# the ghost goes last: the sim devices open first
+{ absolute "$good" | sed -n '1,/^control:$/p' | sed '$d'
+  printf '  - name: ghost\n    backend: hidapi\n    hidapi:\n      vid: 0x1234\n      pid: 0x0fed\n      inputs:\n        - {report_id: 1, byte_offset: 0, bit_width: 32, scale: 1.0e-6, axis: x}\n\n'
+  absolute "$good" | sed -n '/^control:$/,$p'; } >"$tmp/late.yaml"
+expect "setup error after the devices opened" 1 "$bin" "$tmp/late.yaml" --duration-s 1 \
+	--telemetry "$tmp/late.csv"
+if grep -qE '^proxima-run: shutdown: safe \(force zeroed on 1/1 device, relay off on 1/1\) after setup error' "$tmp/err"; then
+	ok "setup error: outputs made safe before the devices closed"; else bad "setup error: outputs made safe before the devices closed"; fi
+# outputs that cannot be confirmed safe: a welded relay at the end
+sed '/^      kind: gpio$/a\      faults: [{kind: stuck, start_ns: 500_000_000, duration_ns: 5_000_000_000}]' \
+	"$good" | sed "s|file: scenes/|file: $PWD/config/examples/scenes/|" >"$tmp/weld.yaml"
+expect "a relay that does not drop: exit 1" 1 "$bin" "$tmp/weld.yaml" --virtual-time --duration-s 1 \
+	--summary-json "$tmp/weld.json" --telemetry "$tmp/weld.csv"
+if grep -qE "^proxima-run: shutdown: NOT SAFE \(force zeroed on 1/1 device, relay off on 0/1\) after end of run in [0-9.]+ ms: device 'io': relay off not confirmed" "$tmp/err"; then
+	ok "the welded relay named"; else bad "the welded relay named"; fi
+check "JSON: shutdown not safe" "$(num "$tmp/weld.json" shutdown_safe) == 0"
+# e-stop released with auto_rearm: the loop stays in safe state, relay
+# off, no force, until the end (an explicit re-arm is needed)
+absolute "$good" | sed 's/auto_rearm: false/auto_rearm: true/' >"$tmp/rearm.yaml"
+grep -q 'auto_rearm: true' "$tmp/rearm.yaml" || bad "auto_rearm set in the test config"
+expect "--check warns: auto_rearm with an e-stop" 0 "$bin" --check "$tmp/rearm.yaml"
+if grep -qE "^$tmp/rearm.yaml:[0-9]+:[0-9]+: warning: safety.watchdog.auto_rearm: true re-arms after other trips, never after the e-stop \(device 'io' line 'estop'\)" "$tmp/err"; then
+	ok "--check names the auto_rearm key and the e-stop line"; else bad "--check names the auto_rearm key and the e-stop line"; fi
+expect "e-stop pressed 1.0-1.2 s with auto_rearm" 0 "$bin" "$tmp/rearm.yaml" --virtual-time --duration-s 3 \
+	--fault estop,io,1,0.2 --summary-json "$tmp/rearm.json" --telemetry "$tmp/rearm.csv"
+check "released e-stop: still in safe state at the end" "$(num "$tmp/rearm.json" safe_at_end) == 1"
+check "released e-stop: every row from the press on safe with zero force" \
+	"$(awk -F, 'NR > 1 && $1 >= 1.01 && ($16 != 1 || $12 != 0) { n++ } END { print n + 0 }' "$tmp/rearm.csv") == 0"
+check "released e-stop: rows after the release exist ($(awk -F, 'NR > 1 && $1 >= 1.5' "$tmp/rearm.csv" | wc -l))" \
+	"$(awk -F, 'NR > 1 && $1 >= 1.5' "$tmp/rearm.csv" | wc -l) > 1000"
+# the same run with a velocity trip re-arms by itself (auto_rearm works)
+absolute "$good" | sed 's/auto_rearm: false/auto_rearm: true/; s/velocity_limit_m_per_s: .*/velocity_limit_m_per_s: 0.05/' >"$tmp/rearm2.yaml"
+expect "velocity trips with auto_rearm" 0 "$bin" "$tmp/rearm2.yaml" --virtual-time --duration-s 3 \
+	--summary-json "$tmp/rearm2.json" --telemetry "$tmp/rearm2.csv"
+check "velocity trips re-arm by themselves ($(num "$tmp/rearm2.json" safe_state_trips) trips)" \
+	"$(num "$tmp/rearm2.json" safe_state_trips) >= 2"
 
 echo "$name: $pass passed, $fail failed, $skip skipped"
 [ "$fail" -eq 0 ]

@@ -43,15 +43,29 @@
  * simulated bus gets its drives' side here, stepped in the read phase as
  * another node on the bus would answer.
  *
+ * Shutdown: every way out after the devices opened (duration reached,
+ * a signal, a loop error, a setup error) goes through safe_shutdown()
+ * before anything closes: zero force and torque with enable off on each
+ * force sink, enable relays and timing lines off (px_dev_safe), each
+ * CANopen master's drives to quick stop and then disabled, confirmed by
+ * their statuswords (px_devcfg_safe_stop), each within a bounded wait;
+ * the summary, the JSON (object 'shutdown') and the exit status say how
+ * it went. Every signal that would end or freeze the process (INT, TERM,
+ * HUP, QUIT, USR1, USR2, PIPE, ALRM, VTALRM, PROF, XCPU, XFSZ, TSTP)
+ * ends the run like Ctrl-C. PX_RUN_STOP_AT=CYCLE[:SIGNAL] raises SIGNAL
+ * after CYCLE cycles ("stop now", for tests). px_gpio.h is included for
+ * what simulated lines last received (the JSON's shutdown record).
+ *
  * Exit status: 0 ok, 1 invalid config or setup failure (an absent device
- * is named with the back end's reason), 2 usage error or --virtual-time
- * with hardware.
+ * is named with the back end's reason) or outputs not confirmed safe at
+ * the end, 2 usage error or --virtual-time with hardware.
  */
 #include <errno.h>
 #include <math.h>
 #include <poll.h>
 #include <pthread.h>
 #include <signal.h>
+#include <stdarg.h>
 #include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -70,11 +84,13 @@
 #include "px_control.h"
 #include "px_dev.h"
 #include "px_devcfg.h"
+#include "px_gpio.h"
 #include "px_loop.h"
 #include "px_ring.h"
 #include "px_world.h"
 #include "px_sim.h"
 #include "px_stats.h"
+#include "tool_out.h"
 #include "tool_svg.h"
 
 static const char usage_text[] =
@@ -83,8 +99,8 @@ static const char usage_text[] =
 	"       proxima-run --check CONFIG\n"
 	"\n"
 	"  --check            validate CONFIG, print every problem, and exit\n"
-	"  --duration-s N     run for N seconds (N > 0); default: until "
-	"Ctrl-C\n"
+	"  --duration-s N     run for N seconds of loop time (0 < N <= 1e8);\n"
+	"                     default: until Ctrl-C\n"
 	"  --virtual-time     run the loop on the virtual clock, as fast as "
 	"possible\n"
 	"  --summary-json F   write a machine-readable summary to F\n"
@@ -107,6 +123,10 @@ static int usage_error(const char *fmt, const char *arg)
 	fprintf(stderr, "\n%s", usage_text);
 	return 2;
 }
+
+/* --duration-s at most (about 3 years): cycles and the loop clock's
+ * nanoseconds stay far inside their integers at any period. */
+#define RUN_MAX_DURATION_S 1e8
 
 struct options {
 	const char *config;
@@ -160,10 +180,11 @@ static int parse_args(int argc, char **argv, struct options *o)
 				return usage_error("%s needs a value", a);
 			errno = 0;
 			d = strtod(v, &end);
-			if (end == v || *end || errno || !isfinite(d) || d <= 0)
+			if (end == v || *end || errno || !isfinite(d) || d <= 0 ||
+			    d > RUN_MAX_DURATION_S)
 				return usage_error(
 					"--duration-s: '%s' is not a positive "
-					"number of seconds",
+					"number of seconds (at most 1e8)",
 					v);
 			o->duration_s = d;
 		} else if (!rest && matches(a, "--summary-json")) {
@@ -510,8 +531,10 @@ struct app {
 	int alloc_probe;
 	uint64_t setup_heap_calls;
 	/* main thread */
-	FILE *csv_f;
+	FILE *csv_f;            /* csv_out.f while the CSV is written */
+	struct tool_out csv_out;
 	char csv_path[1024];
+	char time_svg[1100], lat_svg[1100];
 	struct tele *recs;
 	size_t n_recs, cap_recs;
 	uint64_t n_rows;        /* records drained (CSV rows) */
@@ -559,6 +582,13 @@ struct app {
 	uint64_t nonfinite_outputs;
 	int64_t first_deadline_ns, last_deadline_ns;
 	int have_deadline;
+	/* --duration-s runs its cycles (duration / period); on the real
+	 * clock the run also ends with the cycle whose deadline reaches
+	 * this (first deadline + duration - one period), so missed periods
+	 * never make it run longer than asked (0: no such bound) */
+	int64_t stop_deadline_ns;
+	int ended_by_time;      /* the run ended at stop_deadline_ns */
+	char out_why[TOOL_OUT_WHY_MAX]; /* why write_json() failed */
 };
 
 static struct app A;
@@ -578,10 +608,12 @@ static struct px_sim_fault campaign_fault(const struct raw_fault *f)
 }
 
 static volatile sig_atomic_t interrupted;
+static volatile sig_atomic_t stop_signal; /* the signal that ended the run */
 
 static void on_signal(int sig)
 {
-	(void)sig;
+	if (!stop_signal)
+		stop_signal = sig;
 	interrupted = 1;
 	if (A.loop)
 		px_loop_stop(A.loop);
@@ -855,6 +887,10 @@ static int phase_write(struct px_loop *l, const struct px_loop_cycle *c,
 			a->first_deadline_ns =
 				c->deadline_ns - (int64_t)c->missed * c->period_ns;
 			a->have_deadline = 1;
+			if (a->max_cycles && !a->o.virtual_time)
+				a->stop_deadline_ns =
+					a->first_deadline_ns +
+					(int64_t)(a->max_cycles - 1) * c->period_ns;
 		}
 		a->last_deadline_ns = c->deadline_ns;
 	}
@@ -930,6 +966,10 @@ static int phase_write(struct px_loop *l, const struct px_loop_cycle *c,
 	}
 	atomic_store_explicit(&a->allocs, heap_count() - a->heap_base,
 			      memory_order_relaxed);
+	if (a->stop_deadline_ns && c->deadline_ns >= a->stop_deadline_ns) {
+		a->ended_by_time = 1; /* --duration-s of real time gone */
+		return PX_LOOP_STOP;
+	}
 	return PX_OK;
 }
 
@@ -1384,6 +1424,10 @@ static void stop_arm(void)
 	}
 }
 
+static void teardown(void);
+static void rearm_warnings(FILE *f);
+static void plot_paths(char *time_svg, char *lat_svg, size_t cap);
+
 static int report_config(int rc, const struct px_config_diag *diag)
 {
 	int n = px_config_diag_total(diag);
@@ -1395,25 +1439,323 @@ static int report_config(int rc, const struct px_config_diag *diag)
 	return 1;
 }
 
-static int setup(void)
+/* ---- setup, part 1: the checks (no device opened) ------------------- */
+
+/* Telemetry ring memory (telemetry.ring_records records of struct tele,
+ * allocated at setup and locked with loop.lock_memory): a warning above
+ * TELE_WARN_BYTES, refused above TELE_MAX_BYTES (docs/config.md). */
+#define TELE_WARN_BYTES ((size_t)64 << 20)
+#define TELE_MAX_BYTES ((size_t)1 << 30)
+
+static int n_check_errors;
+
+/* One refusal in the config's own format, "file:line:column: key: what"
+ * (the key alone when the value has no place: a default). */
+static void check_error(const struct px_config_node *at, const char *key,
+			const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+static void check_error(const struct px_config_node *at, const char *key,
+			const char *fmt, ...)
+{
+	va_list ap;
+	if (at)
+		fprintf(stderr, "%s:%d:%d: %s: ", at->file, at->line, at->column,
+			key);
+	else
+		fprintf(stderr, "%s: %s: ", A.o.config, key);
+	va_start(ap, fmt);
+	vfprintf(stderr, fmt, ap);
+	va_end(ap);
+	fputc('\n', stderr);
+	n_check_errors++;
+}
+
+/* A node of the config by path of mapping keys (NULL: absent). */
+static const struct px_config_node *cfg_node(const char *sect, const char *key)
+{
+	const struct px_config_node *s =
+		px_config_node_get(px_config_doc_root(A.cfg->doc), sect);
+	return key ? px_config_node_get(s, key) : s;
+}
+
+/* What a config device can do once opened (the back ends' px_dev caps),
+ * known without opening it; *canopen: it carries CANopen drives. */
+static unsigned config_caps(const struct px_config_device *d, int *canopen)
+{
+	*canopen = 0;
+	switch (d->backend) {
+	case PX_CONFIG_BACKEND_SIM:
+		return d->sim.kind == PX_CONFIG_SIM_GPIO   ? PX_DEV_CAP_DIO
+		       : d->sim.kind == PX_CONFIG_SIM_POSE ? PX_DEV_CAP_POSE
+							   : PX_DEV_CAP_POSE |
+							     PX_DEV_CAP_FORCE;
+	case PX_CONFIG_BACKEND_HIDAPI:
+	case PX_CONFIG_BACKEND_LIBUSB:
+		return PX_DEV_CAP_POSE | PX_DEV_CAP_FORCE;
+	case PX_CONFIG_BACKEND_SOCKETCAN:
+		*canopen = d->socketcan.canopen.present &&
+			   d->socketcan.canopen.n_drives > 0;
+		return d->socketcan.n_signals ? PX_DEV_CAP_POSE | PX_DEV_CAP_FORCE
+					      : 0;
+	case PX_CONFIG_BACKEND_GPIOD:
+		return PX_DEV_CAP_DIO;
+	default:
+		return 0;
+	}
+}
+
+/* control.device must be able to do what control.mode asks of it. */
+static void check_control(void)
+{
+	const struct px_config_node *at = cfg_node("control", "device");
+	const struct px_config_device *d =
+		A.ctl.device ? px_config_device_find(A.cfg, A.ctl.device) : NULL;
+	unsigned caps;
+	int co = 0;
+	if (A.ctl.mode != PX_CONTROL_MODE_HAPTIC &&
+	    A.ctl.mode != PX_CONTROL_MODE_AVOIDANCE)
+		return;
+	if (!d) {
+		check_error(at ? at : cfg_node("control", NULL), "control.device",
+			    "mode '%s' needs a device",
+			    A.ctl.mode == PX_CONTROL_MODE_HAPTIC ? "haptic"
+								 : "avoidance");
+		return;
+	}
+	caps = config_caps(d, &co);
+	if (A.ctl.mode == PX_CONTROL_MODE_AVOIDANCE) {
+		if (!co)
+			check_error(at, "control.device",
+				    "control mode 'avoidance' needs control.device "
+				    "'%s' to be a socketcan device with canopen "
+				    "drives",
+				    d->name);
+		return;
+	}
+	if (!(caps & PX_DEV_CAP_POSE))
+		check_error(at, "control.device",
+			    "'%s' (%s) is not a pose device: haptic rendering "
+			    "needs one that reports a pose (sim kind haptic, "
+			    "hidapi, libusb, socketcan signals)",
+			    d->name, px_config_backend_names()[d->backend]);
+	else if (!(caps & PX_DEV_CAP_FORCE))
+		check_error(at, "control.device",
+			    "'%s' takes no force (a sim device of kind pose): "
+			    "haptic rendering needs a force output",
+			    d->name);
+}
+
+/* Setup-time memory of the telemetry: refused when absurd, a warning
+ * when large (the whole ring is allocated at setup and, with
+ * loop.lock_memory, locked in RAM). */
+static void check_memory(void)
+{
+	size_t rec = sizeof(struct tele);
+	uint64_t n = (uint64_t)A.cfg->telemetry.ring_records;
+	uint64_t ring = n * rec;
+	const struct px_config_node *at = cfg_node("telemetry", "ring_records");
+	if (ring > TELE_MAX_BYTES) {
+		check_error(at, "telemetry.ring_records",
+			    "%llu records take %.1f GiB (%zu bytes each): at "
+			    "most %llu (%zu MiB)",
+			    (unsigned long long)n, (double)ring / (1u << 30), rec,
+			    (unsigned long long)(TELE_MAX_BYTES / rec),
+			    TELE_MAX_BYTES >> 20);
+	} else if (ring > TELE_WARN_BYTES) {
+		if (at)
+			fprintf(stderr, "%s:%d:%d: ", at->file, at->line,
+				at->column);
+		fprintf(stderr,
+			"telemetry.ring_records: warning: %llu records take "
+			"%.0f MiB at setup%s (warning above %zu MiB)\n",
+			(unsigned long long)n, (double)ring / (1u << 20),
+			A.cfg->loop.lock_memory ? ", locked in RAM (loop."
+						  "lock_memory)"
+						: "",
+			TELE_WARN_BYTES >> 20);
+	}
+}
+
+/* Every file the config names as input ("file" keys: scene models,
+ * trajectories; not telemetry.file, an output), and the config itself:
+ * no output of this run may be written over them. */
+static void protect_inputs(const struct px_config_node *n, int depth,
+			   int in_telemetry)
+{
+	size_t i;
+	if (!n || depth > PX_CONFIG_MAX_DEPTH)
+		return;
+	if (n->kind == PX_CONFIG_NODE_SEQ)
+		for (i = 0; i < n->len; i++)
+			protect_inputs(n->items[i], depth + 1, 0);
+	if (n->kind != PX_CONFIG_NODE_MAP)
+		return;
+	for (i = 0; i < n->len; i++) {
+		const struct px_config_node *k = n->pairs[i].key;
+		const struct px_config_node *v = n->pairs[i].value;
+		if (!in_telemetry && strcmp(k->str, "file") == 0 &&
+		    v->kind == PX_CONFIG_NODE_SCALAR && v->str[0]) {
+			char path[2048];
+			config_dir_path(path, sizeof(path), A.o.config, v->str);
+			tool_out_protect(path, "an input file of the config,");
+		}
+		protect_inputs(v, depth + 1,
+			       depth == 0 && strcmp(k->str, "telemetry") == 0);
+	}
+}
+
+/* One output path: where it came from decides the status (2: a flag,
+ * 1: the config, with its place). Returns 0, 1 or 2. */
+static int check_output(const char *path, const char *flag,
+			const struct px_config_node *at, const char *key)
+{
+	char why[TOOL_OUT_WHY_MAX];
+	if (tool_out_check(path, why, sizeof(why)) == 0)
+		return 0;
+	if (flag) {
+		fprintf(stderr, "proxima-run: %s: %s\n", flag, why);
+		return 2;
+	}
+	check_error(at, key, "%s", why);
+	return 1;
+}
+
+/* The CSV, plot and summary paths, each checked before anything runs (a
+ * refusal after a long run would lose it). */
+static int check_outputs(void)
+{
+	const char *tflag = NULL;
+	const struct px_config_node *tat = cfg_node("telemetry", "file");
+	int rc, r;
+	tool_out_protect(A.o.config, "the config file");
+	protect_inputs(px_config_doc_root(A.cfg->doc), 0, 0);
+	if (A.o.telemetry) {
+		snprintf(A.csv_path, sizeof(A.csv_path), "%s", A.o.telemetry);
+		tflag = "--telemetry";
+	} else if (A.cfg->telemetry.file && A.cfg->telemetry.file[0]) {
+		snprintf(A.csv_path, sizeof(A.csv_path), "%s",
+			 A.cfg->telemetry.file);
+	}
+	plot_paths(A.time_svg, A.lat_svg, sizeof(A.time_svg));
+	rc = A.csv_path[0] ? check_output(A.csv_path, tflag, tat, "telemetry.file")
+			   : 0;
+	/* the plot names follow the CSV's (or are the default's) */
+	r = check_output(A.time_svg, tflag ? "--telemetry (its time plot)" : NULL,
+			 tat, "telemetry.file (its time plot)");
+	rc = rc ? rc : r;
+	r = check_output(A.lat_svg, tflag ? "--telemetry (its latency plot)" : NULL,
+			 tat, "telemetry.file (its latency plot)");
+	rc = rc ? rc : r;
+	if (A.o.summary_json) {
+		r = check_output(A.o.summary_json, "--summary-json", NULL, NULL);
+		rc = rc ? rc : r;
+	}
+	return rc;
+}
+
+/* Everything setup checks before it opens a device: the outputs, the
+ * scene (px_world_config_load: keys, values, files, geometry), what the
+ * clock allows, control.device against what the device can do, the
+ * telemetry memory, the haptic renderer's parameters. --check runs this
+ * (and opens the in-process simulated devices); a run goes on to open
+ * everything. Prints every problem; returns 0, 1 (invalid) or 2 (a
+ * flag's value, or --virtual-time with hardware). */
+static int validate(void)
 {
 	static struct px_config_diag diag;
-	struct px_loop_config lc;
 	const struct px_config *cfg = A.cfg;
-	size_t ring_cap = (size_t)cfg->telemetry.ring_records;
-	int i, rc;
+	int i, rc, status = 0;
 
 	A.ctl_dev = -1;
 	A.estop_first_ns = -1;
 	A.safe_first_after_estop_ns = -1;
-	A.clock0_ns = A.o.virtual_time ? 0 : mono_ns();
+	A.clock0_ns = A.o.virtual_time || A.o.check ? 0 : mono_ns();
 	A.min_distance_m = INFINITY;
 	A.min_proxy_distance_m = INFINITY;
 	A.decimation = cfg->telemetry.decimation > 0 ? cfg->telemetry.decimation : 1;
+	if (A.o.duration_s > 0)
+		A.max_cycles = (uint64_t)ceil(A.o.duration_s * 1e9 /
+					      (double)cfg->loop.period_ns);
+	n_check_errors = 0;
+
+	rc = check_outputs();
+	if (rc == 2)
+		return 2;
 	px_config_diag_init(&diag);
 	rc = px_world_config_load(cfg, &A.scene, &diag);
-	if (rc != PX_OK)
-		return report_config(rc, &diag);
+	if (rc != PX_OK) {
+		px_config_diag_print(&diag, stderr);
+		n_check_errors += px_config_diag_total(&diag) ? px_config_diag_total(&diag) : 1;
+		if (!px_config_diag_total(&diag))
+			fprintf(stderr, "%s: %s\n", A.o.config, px_strerror(rc));
+	}
+	for (i = 0; i < (int)cfg->n_devices; i++) {
+		if (!is_hardware(&cfg->devices[i]))
+			continue;
+		A.hardware = 1;
+		if (A.o.virtual_time) {
+			fprintf(stderr,
+				"proxima-run: device '%s' (%s): --virtual-time "
+				"drives simulated devices only; hardware and "
+				"buses shared with other processes run on the "
+				"real clock\n",
+				cfg->devices[i].name,
+				px_config_backend_names()[cfg->devices[i].backend]);
+			status = 2;
+		}
+	}
+	if (cfg->n_devices > MAX_DEVS)
+		check_error(cfg_node("devices", NULL), "devices",
+			    "%zu devices; a run takes at most %d",
+			    cfg->n_devices, MAX_DEVS);
+	check_control();
+	check_memory();
+	if (A.ctl.mode == PX_CONTROL_MODE_HAPTIC) {
+		rc = px_control_haptic_init(&A.haptic, &A.ctl.haptic,
+					    cfg->loop.period_ns);
+		if (rc != PX_OK)
+			check_error(cfg_node("control", "haptic"), "control.haptic",
+				    "the renderer refuses these parameters: %s",
+				    px_strerror(rc));
+	}
+	/* warnings (the file stays valid) go here, after the refusals */
+
+	if (n_check_errors) {
+		fprintf(stderr, "%s: invalid configuration (%d error%s)\n",
+			A.o.config, n_check_errors, n_check_errors == 1 ? "" : "s");
+		return status ? status : 1;
+	}
+	return status;
+}
+
+/* --check: validate(), then open what lives in this process (simulated
+ * devices, buses and arms) as the run would, so their own refusals show
+ * too; hardware and UNIX-socket buses are left closed. Returns the exit
+ * status. */
+static int check_config(void)
+{
+	int i, rc = validate();
+	for (i = 0; rc == 0 && i < (int)A.cfg->n_devices && i < MAX_DEVS; i++)
+		if (!is_hardware(&A.cfg->devices[i]))
+			rc = make_device(i);
+	if (rc == 0)
+		rearm_warnings(stderr);
+	if (rc == 0)
+		printf("%s: OK (%zu device%s, loop period %lld ns)\n", A.o.config,
+		       A.cfg->n_devices, A.cfg->n_devices == 1 ? "" : "s",
+		       (long long)A.cfg->loop.period_ns);
+	teardown();
+	return rc;
+}
+
+static int setup(void)
+{
+	struct px_loop_config lc;
+	const struct px_config *cfg = A.cfg;
+	size_t ring_cap = (size_t)cfg->telemetry.ring_records;
+	int i, rc = validate();
+
+	if (rc)
+		return rc;
 	/* the loop's queries follow a moving point (proxy, device, link
 	 * points): each model's search starts at last answer's feature */
 	px_world_control_query_coherent(A.scene, &A.hints, &A.query);
@@ -1433,21 +1775,6 @@ static int setup(void)
 			return 1;
 		}
 		px_world_control_query_tracked(A.scene, A.tracking, &A.query);
-	}
-	for (i = 0; i < (int)cfg->n_devices; i++) {
-		if (!is_hardware(&cfg->devices[i]))
-			continue;
-		A.hardware = 1;
-		if (A.o.virtual_time) {
-			fprintf(stderr,
-				"proxima-run: device '%s' (%s): --virtual-time "
-				"drives simulated devices only; hardware and "
-				"buses shared with other processes run on the "
-				"real clock\n",
-				cfg->devices[i].name,
-				px_config_backend_names()[cfg->devices[i].backend]);
-			return 2;
-		}
 	}
 	for (i = 0; i < (int)cfg->n_devices && i < MAX_DEVS; i++) {
 		rc = make_device(i);
@@ -1561,9 +1888,6 @@ static int setup(void)
 			px_strerror(rc));
 		return 1;
 	}
-	if (A.o.duration_s > 0)
-		A.max_cycles = (uint64_t)ceil(A.o.duration_s * 1e9 /
-					      (double)cfg->loop.period_ns);
 	if (A.sim.spawn_arm && spawn_arm())
 		return 1;
 	for (i = 0; i < (int)A.sim.n_faults; i++) {
@@ -1584,9 +1908,345 @@ static int setup(void)
 	return 0;
 }
 
+/* ---- shutdown: the safe state before anything closes ---------------- */
+
+/* Bound of each of the shutdown's waits (devices, then each CANopen
+ * master's drives): an unplugged device gets its safe output as soon as
+ * it is back within it, drives must confirm within it. Loop clock. */
+#define SHUTDOWN_TIMEOUT_NS 1000000000
+
+/* What the shutdown did: summary, JSON and exit status. */
+struct shutdown_report {
+	int done, safe;
+	char reason[32];        /* "end of run", "SIGINT", "setup error", ... */
+	int force_devs, force_zeroed;
+	int dio_devs, relays_off;
+	int drives, drives_disabled, drives_faulted;
+	int64_t elapsed_ns;     /* loop clock */
+	char why[320];          /* the first failure, "" when safe */
+};
+static struct shutdown_report SD;
+
+static int64_t shutdown_now(void)
+{
+	return A.loop && A.o.virtual_time ? px_loop_now_ns(A.loop) : mono_ns();
+}
+
+static int64_t shutdown_period_ns(void)
+{
+	return A.cfg && A.cfg->loop.period_ns > 0 ? A.cfg->loop.period_ns
+						  : 1000000;
+}
+
+/* Let period_ns pass between two shutdown rounds: the virtual clock
+ * jumps, the real one sleeps; an arm on the in-process bus answers as it
+ * does in the read phase. */
+static int64_t shutdown_wait(void *user, int64_t now, int64_t period_ns)
+{
+	(void)user;
+	if (A.o.virtual_time) {
+		now += period_ns;
+	} else {
+		struct timespec ts = {(time_t)(period_ns / 1000000000),
+				      (long)(period_ns % 1000000000)};
+		nanosleep(&ts, NULL);
+		now = mono_ns();
+	}
+	if (A.arm)
+		px_canopen_sim_step(A.arm, now);
+	return now;
+}
+
+/* The drives of one master after its safe stop: counted, and the first
+ * that did not confirm named. */
+static void shutdown_drives(const char *dev, struct px_canopen *co, int rc,
+			    const struct px_canopen_stop_result *r)
+{
+	SD.drives += (int)r->drives;
+	SD.drives_disabled += (int)r->disabled;
+	SD.drives_faulted += (int)r->faulted;
+	if (rc != PX_OK && !SD.why[0]) {
+		struct px_canopen_drive_status ds;
+		memset(&ds, 0, sizeof(ds));
+		ds.state = PX_CIA402_UNKNOWN;
+		if (r->first_unconfirmed >= 0)
+			px_canopen_drive_status(co, (size_t)r->first_unconfirmed,
+						&ds);
+		snprintf(SD.why, sizeof(SD.why),
+			 "device '%s': drive %d (node %u) not confirmed disabled "
+			 "within %.0f ms (%u rounds): %s, last state %s%s",
+			 dev, r->first_unconfirmed, ds.node_id,
+			 (double)SHUTDOWN_TIMEOUT_NS * 1e-6, r->rounds,
+			 px_strerror(rc), px_cia402_state_name(ds.state),
+			 ds.lost ? ", heartbeat lost" : "");
+	}
+}
+
+/*
+ * Every exit path comes here before any device closes: zero force and
+ * torque with enable off on each force sink, enable relays and timing
+ * lines off, then each CANopen master's drives to quick stop and
+ * disabled (px_devcfg_safe_stop), each confirmed where the device can;
+ * a device that could not take it (unplugged) is tried again each
+ * period within SHUTDOWN_TIMEOUT_NS. The loop has stopped: this runs on
+ * the main thread. Once per process.
+ */
+static void safe_shutdown(const char *reason)
+{
+	int64_t t0, now, period = shutdown_period_ns();
+	int confirmed[MAX_DEVS];
+	int i, pending;
+	if (SD.done)
+		return;
+	SD.done = 1;
+	snprintf(SD.reason, sizeof(SD.reason), "%s", reason);
+	now = t0 = shutdown_now();
+	memset(confirmed, 0, sizeof(confirmed));
+	/* first the force at the hand: one try each, at once */
+	for (i = 0; i < A.n_dev; i++) {
+		unsigned caps = px_dev_caps(A.dev[i]);
+		SD.force_devs += (caps & PX_DEV_CAP_FORCE) != 0;
+		SD.dio_devs += (caps & PX_DEV_CAP_DIO) != 0;
+		if (A.dev_owned[i] && (caps & (PX_DEV_CAP_FORCE | PX_DEV_CAP_DIO)))
+			confirmed[i] = px_dev_safe(A.dev[i], now) == PX_OK;
+	}
+	/* the handles' devices and their masters' drives */
+	for (i = 0; i < A.n_dcfg; i++) {
+		struct px_devcfg_safe_config sc;
+		struct px_devcfg_safe_result r;
+		struct px_canopen *co = px_devcfg_canopen(A.dcfg[i]);
+		px_devcfg_safe_config_default(&sc);
+		sc.canopen.timeout_ns = SHUTDOWN_TIMEOUT_NS;
+		sc.canopen.max_rounds =
+			(uint32_t)(SHUTDOWN_TIMEOUT_NS / period + 1);
+		sc.canopen.period_ns = period;
+		sc.canopen.wait = shutdown_wait;
+		(void)px_devcfg_safe_stop(A.dcfg[i], now, &sc, &r);
+		if (co) {
+			shutdown_drives(A.co_name ? A.co_name : "canopen", co,
+					r.canopen_rc, &r.canopen);
+			now += r.canopen.elapsed_ns;
+		}
+	}
+	for (i = 0; i < A.n_dev; i++) {
+		struct px_dev_status st;
+		if (!A.dev_owned[i] && px_dev_status(A.dev[i], &st) == PX_OK)
+			confirmed[i] = st.outputs_safe;
+	}
+	/* again, for a device that could not take it yet */
+	for (;;) {
+		pending = 0;
+		for (i = 0; i < A.n_dev; i++) {
+			struct px_dev *d = A.dev[i];
+			unsigned caps = px_dev_caps(d);
+			if (confirmed[i] || !(caps & (PX_DEV_CAP_FORCE | PX_DEV_CAP_DIO)))
+				continue;
+			if (caps & PX_DEV_CAP_POSE) {
+				/* a simulated device lives in its poll: it
+				 * comes back there */
+				struct px_pose_sample ps;
+				(void)px_dev_pose_read(d, now, &ps);
+			}
+			if (px_dev_safe(d, now) == PX_OK)
+				confirmed[i] = 1;
+			else
+				pending++;
+		}
+		if (!pending || now - t0 >= SHUTDOWN_TIMEOUT_NS)
+			break;
+		now = shutdown_wait(NULL, now, period);
+	}
+	for (i = 0; i < A.n_dev; i++) {
+		unsigned caps = px_dev_caps(A.dev[i]);
+		if (!(caps & (PX_DEV_CAP_FORCE | PX_DEV_CAP_DIO)))
+			continue;
+		if (confirmed[i]) {
+			SD.force_zeroed += (caps & PX_DEV_CAP_FORCE) != 0;
+			SD.relays_off += (caps & PX_DEV_CAP_DIO) != 0;
+		} else if (!SD.why[0]) {
+			struct px_dev_status st;
+			px_dev_status(A.dev[i], &st);
+			snprintf(SD.why, sizeof(SD.why),
+				 "device '%s': %s not confirmed within %.0f ms: %s",
+				 st.name,
+				 caps & PX_DEV_CAP_FORCE ? "zero force" : "relay off",
+				 (double)SHUTDOWN_TIMEOUT_NS * 1e-6, st.last_msg);
+		}
+	}
+	SD.elapsed_ns = now - t0;
+	SD.safe = !SD.why[0];
+}
+
+/* "safe (force zeroed on 1/1 device, relay off on 1/1, 6/6 drives
+ * disabled) after SIGINT in 2.0 ms", or NOT SAFE and why. */
+static void shutdown_line(FILE *f, const char *prefix)
+{
+	char parts[160] = "";
+	size_t n = 0;
+	if (SD.force_devs)
+		n += (size_t)snprintf(parts + n, sizeof(parts) - n,
+				      "force zeroed on %d/%d device%s",
+				      SD.force_zeroed, SD.force_devs,
+				      SD.force_devs == 1 ? "" : "s");
+	if (SD.dio_devs && n < sizeof(parts))
+		n += (size_t)snprintf(parts + n, sizeof(parts) - n,
+				      "%srelay off on %d/%d", n ? ", " : "",
+				      SD.relays_off, SD.dio_devs);
+	if (SD.drives && n < sizeof(parts))
+		n += (size_t)snprintf(parts + n, sizeof(parts) - n,
+				      "%s%d/%d drive%s disabled%s", n ? ", " : "",
+				      SD.drives_disabled, SD.drives,
+				      SD.drives == 1 ? "" : "s",
+				      SD.drives_faulted ? " (some in fault)" : "");
+	fprintf(f, "%s%s (%s) after %s in %.1f ms%s%s\n", prefix,
+		SD.safe ? "safe" : "NOT SAFE", n ? parts : "no outputs",
+		SD.reason, (double)SD.elapsed_ns * 1e-6, SD.why[0] ? ": " : "",
+		SD.why);
+}
+
+static void json_string(FILE *f, const char *s);
+
+/* The shutdown as a JSON object (a member of the summary), with what
+ * each simulated device last received. */
+static void json_shutdown(FILE *f)
+{
+	int i, first = 1;
+	fprintf(f,
+		"  \"shutdown\": {\"shutdown_safe\": %d, \"shutdown_reason\": "
+		"\"%s\", \"force_devices\": %d, \"force_zeroed\": %d, "
+		"\"relay_devices\": %d, \"relays_off\": %d, "
+		"\"shutdown_drives\": %d, \"drives_disabled\": %d, "
+		"\"drives_faulted\": %d, \"shutdown_ns\": %lld, "
+		"\"shutdown_error\": ",
+		SD.safe, SD.reason, SD.force_devs, SD.force_zeroed, SD.dio_devs,
+		SD.relays_off, SD.drives, SD.drives_disabled, SD.drives_faulted,
+		(long long)SD.elapsed_ns);
+	json_string(f, SD.why);
+	fputs(", \"last_outputs\": [", f);
+	for (i = 0; i < A.n_dev; i++) {
+		struct px_sim_haptic_state hs;
+		struct px_dev_status st;
+		int relay;
+		px_dev_status(A.dev[i], &st);
+		if (px_sim_haptic_state(A.dev[i], &hs) == PX_OK &&
+		    (px_dev_caps(A.dev[i]) & PX_DEV_CAP_FORCE)) {
+			fprintf(f, "%s{\"name\": ", first ? "" : ", ");
+			json_string(f, st.name);
+			fprintf(f,
+				", \"last_force_n\": [%.9g, "
+				"%.9g, %.9g], \"last_torque_n_m\": [%.9g, %.9g, "
+				"%.9g], \"last_enable\": %d, \"outputs_safe\": %d}",
+				hs.force_n[0],
+				hs.force_n[1], hs.force_n[2], hs.torque_n_m[0],
+				hs.torque_n_m[1], hs.torque_n_m[2], hs.enable,
+				st.outputs_safe);
+			first = 0;
+		} else if ((relay = px_gpio_sim_output(A.dev[i],
+						       PX_GPIO_ENABLE)) >= 0) {
+			fprintf(f, "%s{\"name\": ", first ? "" : ", ");
+			json_string(f, st.name);
+			fprintf(f,
+				", \"enable_line\": %d, "
+				"\"timing_line\": %d, \"outputs_safe\": %d}",
+				relay,
+				px_gpio_sim_output(A.dev[i], PX_GPIO_TIMING),
+				st.outputs_safe);
+			first = 0;
+		}
+	}
+	fputs("]},\n", f);
+}
+
+/* Ask for the safe state on every signal that would otherwise end (or,
+ * SIGTSTP, freeze) the process with the last command in effect: each
+ * ends the run like SIGINT, through the summary and safe_shutdown(). */
+static const int stop_signals[] = {SIGINT,    SIGTERM, SIGHUP,  SIGQUIT,
+				   SIGUSR1,   SIGUSR2, SIGPIPE, SIGALRM,
+				   SIGVTALRM, SIGPROF, SIGXCPU, SIGXFSZ,
+				   SIGTSTP};
+
+static void install_signals(void)
+{
+	struct sigaction sa;
+	size_t i;
+	memset(&sa, 0, sizeof(sa));
+	sa.sa_handler = on_signal;
+	sigemptyset(&sa.sa_mask);
+	sa.sa_flags = SA_RESTART;
+	for (i = 0; i < sizeof(stop_signals) / sizeof(stop_signals[0]); i++)
+		sigaction(stop_signals[i], &sa, NULL);
+}
+
+/* "SIGINT" for the run's end by a signal. */
+static void signal_reason(int sig, char *buf, size_t cap)
+{
+	const char *ab = sigabbrev_np(sig);
+	if (ab)
+		snprintf(buf, cap, "SIG%s", ab);
+	else
+		snprintf(buf, cap, "signal %d", sig);
+}
+
+/* safety.watchdog.auto_rearm with an e-stop line: the e-stop still
+ * needs an explicit re-arm (px_loop_trip_estop), which the user of such
+ * a config may not expect: say so, at the auto_rearm key. */
+static void rearm_warnings(FILE *f)
+{
+	const struct px_config *cfg = A.cfg;
+	const struct px_config_node *n = px_config_doc_root(cfg->doc);
+	const char *dev = NULL, *line = NULL;
+	size_t i, k;
+	if (!cfg->safety.watchdog.auto_rearm)
+		return;
+	if (cfg->safety.estop.present) {
+		dev = cfg->safety.estop.device;
+		line = cfg->safety.estop.line;
+	}
+	for (i = 0; !dev && i < cfg->n_devices; i++) {
+		const struct px_config_device *d = &cfg->devices[i];
+		const struct px_config_gpio_line *l = NULL;
+		size_t nl = 0;
+		if (d->backend == PX_CONFIG_BACKEND_SIM &&
+		    d->sim.kind == PX_CONFIG_SIM_GPIO) {
+			l = d->sim.lines;
+			nl = d->sim.n_lines;
+		} else if (d->backend == PX_CONFIG_BACKEND_GPIOD) {
+			l = d->gpiod.lines;
+			nl = d->gpiod.n_lines;
+		}
+		for (k = 0; k < nl; k++)
+			if (l[k].name && !strcmp(l[k].name, "estop")) {
+				dev = d->name;
+				line = l[k].name;
+				break;
+			}
+	}
+	if (!dev)
+		return;
+	n = px_config_node_get(px_config_node_get(px_config_node_get(n, "safety"),
+						  "watchdog"),
+			       "auto_rearm");
+	if (n)
+		fprintf(f, "%s:%d:%d: ", n->file, n->line, n->column);
+	else
+		fprintf(f, "%s: ", A.o.config);
+	fprintf(f,
+		"warning: safety.watchdog.auto_rearm: true re-arms after other "
+		"trips, never after the e-stop (device '%s' line '%s'): its "
+		"release keeps safe state until an explicit re-arm\n",
+		dev, line);
+}
+
 static void teardown(void)
 {
 	int i;
+	/* a setup error after devices opened (or any path that did not
+	 * stop them yet): the safe state before anything closes */
+	if (!SD.done && (A.n_dev || A.n_dcfg) && !A.o.check) {
+		safe_shutdown("setup error");
+		shutdown_line(stderr, "proxima-run: shutdown: ");
+	}
+	tool_out_discard(&A.csv_out); /* an unfinished CSV: never in place */
 	stop_arm();
 	px_loop_free(A.loop);
 	for (i = 0; i < A.n_dev; i++)
@@ -1749,12 +2409,46 @@ static void *loop_thread(void *arg)
 	return NULL;
 }
 
+/* PX_RUN_STOP_AT=CYCLE[:SIGNAL] in the environment raises SIGNAL (a
+ * name as kill -l gives it, default TERM) in this process once CYCLE
+ * cycles have run: "stop now" at a chosen cycle, through the real signal
+ * path (for tests and fault campaigns). 0 when not asked. */
+static uint64_t stop_at_cycle(int *sig)
+{
+	const char *e = getenv("PX_RUN_STOP_AT"), *c;
+	char *end;
+	unsigned long long n;
+	size_t i;
+	*sig = SIGTERM;
+	if (!e || !*e)
+		return 0;
+	n = strtoull(e, &end, 10);
+	if (end == e || (*end && *end != ':'))
+		return 0;
+	if (*end == ':') {
+		c = end + 1;
+		if (!strncmp(c, "SIG", 3))
+			c += 3;
+		for (i = 0; i < sizeof(stop_signals) / sizeof(stop_signals[0]);
+		     i++) {
+			const char *ab = sigabbrev_np(stop_signals[i]);
+			if (ab && !strcmp(ab, c))
+				*sig = stop_signals[i];
+		}
+	}
+	return (uint64_t)n;
+}
+
 static int run(void)
 {
 	struct rate_meter m;
 	int64_t status_every = isatty(2) ? 250000000 : 1000000000;
+	int stop_sig;
+	uint64_t stop_at = stop_at_cycle(&stop_sig);
 	memset(&m, 0, sizeof(m));
 	m.t_ns = mono_ns();
+	if (interrupted)
+		return PX_OK; /* a signal during setup: straight to shutdown */
 	if (A.o.virtual_time) {
 		/* Drain well before the ring can fill. */
 		uint64_t batch = (uint64_t)A.decimation *
@@ -1766,10 +2460,13 @@ static int run(void)
 		while (!interrupted && rc == PX_OK &&
 		       (A.max_cycles == 0 || done < A.max_cycles)) {
 			uint64_t k, before = heap_count();
-			for (k = 0; k < batch && rc == PX_OK &&
+			for (k = 0; k < batch && rc == PX_OK && !interrupted &&
 				    (A.max_cycles == 0 || done < A.max_cycles);
-			     k++, done++)
+			     k++, done++) {
 				rc = px_loop_step(A.loop);
+				if (stop_at && done + 1 == stop_at)
+					raise(stop_sig);
+			}
 			/* only the cycles' own heap calls, not the drain's */
 			allocs += heap_count() - before;
 			drain();
@@ -1788,6 +2485,12 @@ static int run(void)
 			nanosleep(&ts, NULL);
 			drain();
 			maybe_status(&m, mono_ns(), status_every);
+			if (stop_at && !interrupted) {
+				struct px_loop_status ls;
+				px_loop_status(A.loop, &ls);
+				if (ls.cycles >= stop_at)
+					raise(stop_sig);
+			}
 		}
 		pthread_join(th, NULL);
 		drain();
@@ -1960,6 +2663,30 @@ static void device_faults(struct dev_faults *df)
 
 static void json_campaign(FILE *f);
 
+/* The loop clock's span over the run: first deadline (periods skipped
+ * before it included) to the last cycle's end; missed periods count,
+ * as time that went by. On the real clock this is the run's real time,
+ * on the virtual clock its simulated time. */
+static double loop_time_s(const struct px_loop_status *st)
+{
+	if (!A.have_deadline)
+		return 0.0;
+	return (double)(A.last_deadline_ns - A.first_deadline_ns + st->period_ns) *
+	       1e-9;
+}
+
+/* What ended the run: "cycles" (--duration-s worth of cycles run),
+ * "time" (real clock: --duration-s of loop time gone, periods missed),
+ * "signal", or "stop" (the loop stopped: an error, a phase). */
+static const char *ended_by(const struct px_loop_status *st)
+{
+	if (A.max_cycles && st->cycles >= A.max_cycles)
+		return "cycles";
+	if (A.ended_by_time)
+		return "time";
+	return interrupted ? "signal" : "stop";
+}
+
 /* The slowest reaction to a trip: for every loop fault that put (or
  * kept) the loop in safe state, the cycles from the one that saw it to
  * the first in safe state (-1: no fault to check; 1000: none within the
@@ -2069,11 +2796,15 @@ static int write_json(const char *path, const struct px_loop_status *st,
 		      const char *time_svg, const char *lat_svg,
 		      const char *counter)
 {
-	FILE *f = fopen(path, "w");
+	static struct tool_out out;
+	FILE *f;
 	struct dev_faults df;
 	int k;
-	if (!f)
+	if (tool_out_open(&out, path) != 0) {
+		snprintf(A.out_why, sizeof(A.out_why), "%s", out.why);
 		return -1;
+	}
+	f = out.f;
 	device_faults(&df);
 	fprintf(f, "{\n  \"config\": ");
 	json_string(f, A.o.config);
@@ -2087,6 +2818,10 @@ static int write_json(const char *path, const struct px_loop_status *st,
 		(double)st->cycles * (double)st->period_ns * 1e-9, wall_s,
 		(unsigned long long)st->cycles, (unsigned long long)st->overruns,
 		(unsigned long long)st->missed_periods);
+	fprintf(f,
+		"  \"loop_time_s\": %.6f,\n  \"wall_time_s\": %.3f,\n"
+		"  \"duration_s\": %.9g,\n  \"ended_by\": \"%s\",\n",
+		loop_time_s(st), wall_s, A.o.duration_s, ended_by(st));
 	json_stats(f, "wakeup_latency_ns", lat, 0);
 	json_stats(f, "compute_ns", cmp, 0);
 	{
@@ -2139,6 +2874,7 @@ static int write_json(const char *path, const struct px_loop_status *st,
 		(unsigned long long)st->faults_dropped);
 	json_safety(f, st);
 	json_devices(f);
+	json_shutdown(f);
 	{
 		uint64_t checked;
 		int64_t worst = trip_to_safe(&checked);
@@ -2183,7 +2919,49 @@ static int write_json(const char *path, const struct px_loop_status *st,
 	fputs(", ", f);
 	json_string(f, lat_svg);
 	fputs("]\n}\n", f);
-	return fclose(f) == 0 ? 0 : -1;
+	if (tool_out_commit(&out) != 0) {
+		snprintf(A.out_why, sizeof(A.out_why), "%s", out.why);
+		return -1;
+	}
+	return 0;
+}
+
+/* The telemetry CSV (A.csv_path, checked by validate()): its header now,
+ * rows as the ring drains, renamed into place by close_csv(). Returns 0
+ * or 1 (said why). */
+static int open_csv(void)
+{
+	if (!A.csv_path[0])
+		return 0;
+	if (tool_out_open(&A.csv_out, A.csv_path) != 0) {
+		fprintf(stderr, "proxima-run: %s\n", A.csv_out.why);
+		return 1;
+	}
+	A.csv_f = A.csv_out.f;
+	fprintf(A.csv_f,
+		"t_s,cycle,x_m,y_m,z_m,proxy_x_m,proxy_y_m,proxy_z_m,"
+		"fx_n,fy_n,fz_n,force_n,distance_m,penetration_m,"
+		"contact,safe,wakeup_latency_ns,compute_ns,queries");
+	if (A.avoiding) {
+		/* distance_m is the clearance; x..z the closest link
+		 * point, proxy_* the obstacle point */
+		int j;
+		fprintf(A.csv_f, ",speed_scale");
+		for (j = 0; j < avoid_joints(); j++)
+			fprintf(A.csv_f, ",qdot%d_rad_per_s", j);
+	}
+	fputc('\n', A.csv_f);
+	return 0;
+}
+
+/* The CSV complete: in place under its name (said why when not). */
+static void close_csv(void)
+{
+	if (!A.csv_f)
+		return;
+	A.csv_f = NULL;
+	if (tool_out_commit(&A.csv_out) != 0)
+		fprintf(stderr, "proxima-run: %s\n", A.csv_out.why);
 }
 
 /* What the safety layer did about configured fault i: loop faults seen
@@ -2269,6 +3047,15 @@ static void print_summary(const struct px_loop_status *st,
 	       (unsigned long long)st->cycles,
 	       (double)st->cycles * (double)st->period_ns * 1e-9, wall_s,
 	       wall_s > 0 ? (double)st->cycles / wall_s : 0.0);
+	printf("  time              loop clock %.3f s (%llu missed period%s), "
+	       "wall %.3f s; ",
+	       loop_time_s(st), (unsigned long long)st->missed_periods,
+	       st->missed_periods == 1 ? "" : "s", wall_s);
+	if (A.o.duration_s > 0)
+		printf("--duration-s %g: ended by %s\n", A.o.duration_s,
+		       ended_by(st));
+	else
+		printf("until stopped: ended by %s\n", ended_by(st));
 	printf("  overruns          %llu (missed periods %llu)%s\n",
 	       (unsigned long long)st->overruns,
 	       (unsigned long long)st->missed_periods,
@@ -2357,6 +3144,7 @@ static void print_summary(const struct px_loop_status *st,
 	       "dropped\n",
 	       (unsigned long long)A.n_rows, (long long)A.decimation,
 	       (unsigned long long)px_ring_dropped(A.ring));
+	shutdown_line(stdout, "  shutdown          ");
 	print_campaign();
 }
 
@@ -2461,6 +3249,8 @@ int main(int argc, char **argv)
 	int rc = parse_args(argc, argv, &A.o);
 	if (rc)
 		return rc == 1 ? 0 : rc;
+	/* from here on a signal ends the run through the safe state */
+	install_signals();
 	rc = px_config_load_file(A.o.config, &A.cfg, &diag);
 	if (rc != PX_OK)
 		return report_config(rc, &diag);
@@ -2486,50 +3276,21 @@ int main(int argc, char **argv)
 		px_config_free(A.cfg);
 		return rc;
 	}
-	if (A.o.check) {
-		printf("%s: OK (%zu device%s, loop period %lld ns)\n", A.o.config,
-		       A.cfg->n_devices, A.cfg->n_devices == 1 ? "" : "s",
-		       (long long)A.cfg->loop.period_ns);
-		px_config_free(A.cfg);
-		return 0;
-	}
+	if (A.o.check)
+		return check_config();
 	rc = setup();
 	if (rc) {
 		teardown();
 		return rc;
 	}
-	if (A.o.telemetry)
-		snprintf(A.csv_path, sizeof(A.csv_path), "%s", A.o.telemetry);
-	else if (A.cfg->telemetry.file && A.cfg->telemetry.file[0])
-		snprintf(A.csv_path, sizeof(A.csv_path), "%s",
-			 A.cfg->telemetry.file);
-	if (A.csv_path[0]) {
-		A.csv_f = fopen(A.csv_path, "w");
-		if (!A.csv_f) {
-			fprintf(stderr, "proxima-run: %s: %s\n", A.csv_path,
-				strerror(errno));
-			teardown();
-			return 1;
-		}
-		fprintf(A.csv_f,
-			"t_s,cycle,x_m,y_m,z_m,proxy_x_m,proxy_y_m,proxy_z_m,"
-			"fx_n,fy_n,fz_n,force_n,distance_m,penetration_m,"
-			"contact,safe,wakeup_latency_ns,compute_ns,queries");
-		if (A.avoiding) {
-			/* distance_m is the clearance; x..z the closest link
-			 * point, proxy_* the obstacle point */
-			int j;
-			fprintf(A.csv_f, ",speed_scale");
-			for (j = 0; j < avoid_joints(); j++)
-				fprintf(A.csv_f, ",qdot%d_rad_per_s", j);
-		}
-		fputc('\n', A.csv_f);
+	if (open_csv()) {
+		teardown();
+		return 1;
 	}
 	A.alloc_probe = getenv("PX_RUN_ALLOC_PROBE") &&
 			strcmp(getenv("PX_RUN_ALLOC_PROBE"), "1") == 0;
 	A.setup_heap_calls = heap_count();
-	signal(SIGINT, on_signal);
-	signal(SIGTERM, on_signal);
+	rearm_warnings(stderr);
 	fprintf(stderr,
 		"proxima-run: %s: %zu scene model%s, %d device%s, %s, %s clock, "
 		"%s\n",
@@ -2546,6 +3307,18 @@ int main(int argc, char **argv)
 	wall0 = mono_ns();
 	rc = run();
 	wall_s = (double)(mono_ns() - wall0) * 1e-9;
+	{
+		/* the loop has stopped: zero force, relays off, drives
+		 * disabled, before the summary (which reports it) and
+		 * before anything closes */
+		char why[32];
+		if (stop_signal)
+			signal_reason(stop_signal, why, sizeof(why));
+		else
+			snprintf(why, sizeof(why), "%s",
+				 rc < 0 ? "loop error" : "end of run");
+		safe_shutdown(why);
+	}
 	drain();
 	{
 		struct px_loop_status s0;
@@ -2553,9 +3326,7 @@ int main(int argc, char **argv)
 		status_line(1, wall_s,
 			    wall_s > 0 ? (double)s0.cycles / wall_s : 0.0);
 	}
-	if (A.csv_f && fclose(A.csv_f) != 0)
-		fprintf(stderr, "proxima-run: %s: %s\n", A.csv_path, strerror(errno));
-	A.csv_f = NULL;
+	close_csv();
 	px_loop_status(A.loop, &st);
 	px_loop_stats(A.loop, PX_LOOP_STAT_LATENCY, &lat);
 	px_stats_read(A.compute, &cmp);
@@ -2567,19 +3338,20 @@ int main(int argc, char **argv)
 		printf("  plots             %s\n                    %s\n", time_svg,
 		       lat_svg);
 	else
-		fprintf(stderr, "proxima-run: cannot write the plots (%s): %s\n",
-			time_svg, strerror(errno));
+		fprintf(stderr, "proxima-run: cannot write the plots: %s\n",
+			tool_svg_error());
 	if (A.o.summary_json) {
 		if (write_json(A.o.summary_json, &st, &lat, &cmp, wall_s, time_svg,
 			       lat_svg, counter) == 0)
 			printf("  summary           %s\n", A.o.summary_json);
 		else
-			fprintf(stderr, "proxima-run: %s: %s\n", A.o.summary_json,
-				strerror(errno));
+			fprintf(stderr, "proxima-run: %s\n", A.out_why);
 	}
 	if (rc < 0)
 		fprintf(stderr, "proxima-run: the loop stopped: %s\n",
 			px_strerror(rc));
+	if (!SD.safe)
+		shutdown_line(stderr, "proxima-run: shutdown: ");
 	teardown();
-	return rc < 0 ? 1 : 0;
+	return rc < 0 || !SD.safe ? 1 : 0;
 }

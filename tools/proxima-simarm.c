@@ -4,6 +4,8 @@
  * other side of a controller using px_canopen. With --config it takes
  * the controller's drive table and PDO mapping (and, unless --can or
  * --unix is given, its bus) from the controller's configuration file. */
+#include <errno.h>
+#include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -44,9 +46,30 @@ static void usage(FILE *f)
 		"mapping are those of the controller's socketcan\ndevice NAME "
 		"(default: the first with canopen drives), and so is the bus: "
 		"its kernel\ninterface, or for transport unix the other end "
-		"(binds socket_path.peer, sends to\nsocket_path); the "
+		"(binds socket_path.peer, sends to\nsocket_path; an existing "
+		"file there is removed only when it is a stale socket); the "
 		"device's faults with node_id (estop, unplug of that drive)\n"
 		"are injected, timed from the start of proxima-simarm.\n");
+}
+
+/* A number for flag within [lo, hi]; integer ones must be whole. Returns
+ * 0, or 2 having said why (usage error). */
+static int number(const char *flag, const char *v, double lo, double hi,
+		  int integer, double *out)
+{
+	char *end;
+	double d;
+	errno = 0;
+	d = strtod(v, &end);
+	if (end == v || *end || errno || !isfinite(d) || d < lo || d > hi ||
+	    (integer && d != floor(d))) {
+		fprintf(stderr, "proxima-simarm: %s: '%s' is not %s in [%g, "
+			"%g]\n", flag, v, integer ? "a whole number" : "a number",
+			lo, hi);
+		return 2;
+	}
+	*out = d;
+	return 0;
 }
 
 int main(int argc, char **argv)
@@ -77,10 +100,16 @@ int main(int argc, char **argv)
 		} else if (!strcmp(argv[i], "--device") && i + 1 < argc) {
 			devname = argv[++i];
 		} else if (!strcmp(argv[i], "--drives") && i + 1 < argc) {
-			n = atoi(argv[++i]);
+			double d;
+			if (number("--drives", argv[++i], 1,
+				   PX_CANOPEN_MAX_DRIVES, 1, &d))
+				return 2;
+			n = (int)d;
 			layout_flags = 1;
 		} else if (!strcmp(argv[i], "--seconds") && i + 1 < argc) {
-			seconds = atof(argv[++i]);
+			/* bounded: the loop's nanoseconds stay in int64 */
+			if (number("--seconds", argv[++i], 0, 1e8, 0, &seconds))
+				return 2;
 		} else if (!strcmp(argv[i], "--mode") && i + 1 < argc) {
 			const char *m = argv[++i];
 			layout_flags = 1;

@@ -3,6 +3,9 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
+
+#include "tool_out.h"
 
 #define W 960.0
 #define PANEL_H 220.0
@@ -62,12 +65,22 @@ static void axes(FILE *f, double x0, double y0, double w, double h,
 		x0 - 55, y0 + h / 2, x0 - 55, y0 + h / 2, ylabel);
 }
 
+/* The file being written (one at a time) and the last failure. */
+static struct tool_out out;
+static char last_why[TOOL_OUT_WHY_MAX];
+
+const char *tool_svg_error(void)
+{
+	return last_why;
+}
+
 static FILE *open_svg(const char *path, double h, const char *title)
 {
-	FILE *f = fopen(path, "w");
-	if (!f)
+	if (tool_out_open(&out, path) != 0) {
+		snprintf(last_why, sizeof(last_why), "%s", out.why);
 		return NULL;
-	fprintf(f,
+	}
+	fprintf(out.f,
 		"<?xml version='1.0' encoding='UTF-8'?>\n"
 		"<svg xmlns='http://www.w3.org/2000/svg' width='%.0f' "
 		"height='%.0f' viewBox='0 0 %.0f %.0f' "
@@ -76,13 +89,17 @@ static FILE *open_svg(const char *path, double h, const char *title)
 		"<text x='%.1f' y='24' font-size='16' text-anchor='middle'>%s"
 		"</text>\n",
 		W, h, W, h, W / 2, title);
-	return f;
+	return out.f;
 }
 
 static int close_svg(FILE *f)
 {
 	fprintf(f, "</svg>\n");
-	return fclose(f) == 0 ? 0 : -1;
+	if (tool_out_commit(&out) != 0) {
+		snprintf(last_why, sizeof(last_why), "%s", out.why);
+		return -1;
+	}
+	return 0;
 }
 
 int tool_svg_lines(const char *path, const char *title, const char *xlabel,

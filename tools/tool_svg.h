@@ -1,7 +1,9 @@
 /*
  * tool_svg.h - plain SVG charts for the tools (no plotting dependency):
  * stacked panels of line series over a shared x axis, and histograms.
- * Setup/offline code: allocates, writes files.
+ * Setup/offline code: allocates, writes files. Each file is written
+ * through tool_out.h (a temporary file renamed over the target: no
+ * symbolic link followed, no protected input overwritten).
  */
 #ifndef TOOL_SVG_H
 #define TOOL_SVG_H
@@ -24,8 +26,8 @@ struct tool_svg_panel {
 /*
  * Write panels stacked vertically, sharing x (n values, increasing).
  * Long series are reduced to a min/max envelope per pixel column, so
- * peaks survive. Returns 0 or -1 (errno set) when the file cannot be
- * written.
+ * peaks survive. Returns 0 or -1 (errno set, tool_svg_error() says
+ * why) when the file cannot be written.
  */
 int tool_svg_lines(const char *path, const char *title, const char *xlabel,
 		   const double *x, size_t n, const struct tool_svg_panel *p,
@@ -47,5 +49,9 @@ struct tool_svg_hist {
 int tool_svg_histograms(const char *path, const char *title,
 			const char *xlabel, const struct tool_svg_hist *h,
 			int n);
+
+/* Why the last tool_svg_lines() / tool_svg_histograms() returned -1
+ * (naming the file), "" before any failure. */
+const char *tool_svg_error(void);
 
 #endif
