@@ -569,6 +569,7 @@ static int open_can(struct px_devcfg *h, const struct px_config *cfg,
 	size_t i;
 	int rc;
 	int has_co = c->canopen.present && c->canopen.n_drives > 0;
+	int chk = opt && opt->check_only;
 	if (c->n_signals == 0 && !has_co)
 		return fail(msg, cap, cfg, dc, "socketcan", PX_E_INVAL,
 			    "neither signals nor canopen drives: nothing "
@@ -577,7 +578,7 @@ static int open_can(struct px_devcfg *h, const struct px_config *cfg,
 		return fail(msg, cap, cfg, dc, "socketcan.signals", PX_E_INVAL,
 			    "transport 'unix' has one socket: give signals "
 			    "or canopen, not both");
-	if (c->transport == PX_CONFIG_CAN_KERNEL && c->bitrate > 0) {
+	if (!chk && c->transport == PX_CONFIG_CAN_KERNEL && c->bitrate > 0) {
 		int e = 0;
 		rc = px_can_iface_set_bitrate(c->interface, (uint32_t)c->bitrate,
 					      (uint32_t)c->restart_ms, &e, why,
@@ -639,9 +640,9 @@ static int open_can(struct px_devcfg *h, const struct px_config *cfg,
 				o->axis = s->axis - PX_CONFIG_SIGNAL_AXIS_X;
 			}
 		}
-		rc = can_bus_open(h, cfg, dc, opt, &bus, msg, cap);
-		if (rc != PX_OK)
-			return rc;
+		rc = chk ? PX_OK : can_bus_open(h, cfg, dc, opt, &bus, msg, cap);
+		if (rc != PX_OK || chk)
+			goto signals_done;
 		rc = px_can_dev_create(dcfg, bus, c->fd, h->signals,
 				       c->n_signals, &h->dev, why, sizeof(why));
 		if (rc != PX_OK) {
@@ -649,6 +650,9 @@ static int open_can(struct px_devcfg *h, const struct px_config *cfg,
 			return fail(msg, cap, cfg, dc, "socketcan.signals", rc,
 				    "%s", why);
 		}
+	signals_done:
+		if (rc != PX_OK)
+			return rc;
 	}
 	if (has_co) {
 		struct px_canopen_config cc;
@@ -684,6 +688,8 @@ static int open_can(struct px_devcfg *h, const struct px_config *cfg,
 			}
 			cc.own_node_id = (uint8_t)id;
 		}
+		if (chk)
+			return PX_OK;
 		rc = can_bus_open(h, cfg, dc, opt, &h->co_bus, msg, cap);
 		if (rc != PX_OK)
 			return rc;
@@ -705,7 +711,7 @@ int px_devcfg_open(const struct px_config *cfg,
 	struct px_devcfg *h;
 	struct px_dev_config dcfg;
 	char why[512];
-	int rc = PX_OK;
+	int rc = PX_OK, chk;
 	if (msg && cap)
 		msg[0] = '\0';
 	if (out)
@@ -717,6 +723,7 @@ int px_devcfg_open(const struct px_config *cfg,
 					   "a device not of this config");
 		return PX_E_INVAL;
 	}
+	chk = opt && opt->check_only;
 	h = calloc(1, sizeof(*h));
 	if (!h)
 		return fail(msg, cap, cfg, dc, NULL, PX_E_NOMEM,
@@ -786,7 +793,8 @@ int px_devcfg_open(const struct px_config *cfg,
 		hc.path = c->path;
 		hc.driver = c->driver == PX_CONFIG_HID_LIBUSB ? PX_HID_LIBUSB
 							      : PX_HID_HIDRAW;
-		rc = px_hid_create(&dcfg, &hc, &h->dev, why, sizeof(why));
+		rc = chk ? PX_OK
+			 : px_hid_create(&dcfg, &hc, &h->dev, why, sizeof(why));
 		if (rc != PX_OK)
 			fail(msg, cap, cfg, dc,
 			     hc.has_vid_pid ? "hidapi.vid" : "hidapi.path", rc,
@@ -818,7 +826,8 @@ int px_devcfg_open(const struct px_config *cfg,
 		uc.detach_kernel_driver = c->detach_kernel_driver;
 		uc.no_hotplug = c->no_hotplug;
 		uc.n_transfers = 4;
-		rc = px_usb_create(&dcfg, &uc, &h->dev, why, sizeof(why));
+		rc = chk ? PX_OK
+			 : px_usb_create(&dcfg, &uc, &h->dev, why, sizeof(why));
 		if (rc != PX_OK)
 			fail(msg, cap, cfg, dc, "libusb.vid", rc, "%s", why);
 		break;
@@ -834,7 +843,9 @@ int px_devcfg_open(const struct px_config *cfg,
 		if (rc != PX_OK)
 			break;
 		gc.chip = dc->gpiod.chip;
-		rc = px_gpiod_create(&dcfg, &gc, &h->dev, &e, why, sizeof(why));
+		rc = chk ? PX_OK
+			 : px_gpiod_create(&dcfg, &gc, &h->dev, &e, why,
+					   sizeof(why));
 		if (rc != PX_OK)
 			fail(msg, cap, cfg, dc, "gpiod.chip", rc, "%s", why);
 		break;
@@ -844,8 +855,8 @@ int px_devcfg_open(const struct px_config *cfg,
 			  "unknown back end %d", dc->backend);
 		break;
 	}
-	if (rc != PX_OK) {
-		px_devcfg_free(h);
+	if (rc != PX_OK || chk) {
+		px_devcfg_free(h); /* check_only: nothing was opened */
 		return rc;
 	}
 	*out = h;

@@ -83,6 +83,13 @@ struct px_devcfg_options {
 	 * Given for any other back end: PX_E_INVAL naming "faults". */
 	const struct px_sim_fault *faults;
 	size_t n_faults;
+	/* Check only (a runner's --check): every test px_devcfg_open()
+	 * makes of the config, without opening anything outside this
+	 * process: no HID or USB device, no CAN socket or interface
+	 * setting, no GPIO chip. Simulated back ends are created and freed
+	 * again. On success *out is NULL; on failure msg says why as for an
+	 * open. */
+	int check_only;
 };
 
 /*

@@ -441,6 +441,85 @@ static void test_gpio_roles(void)
 	px_config_free(cfg);
 }
 
+/* check_only: px_devcfg_open()'s tests of a config without opening
+ * anything outside the process. Every shipped example's devices pass
+ * (the real ones too, absent here), nothing comes back, a UNIX-socket
+ * bus binds no file, and a refusal reads as the open's would. */
+static void test_check_only(void)
+{
+	static const char *const files[] = {
+		"config/examples/haptic_sim.yaml",
+		"config/examples/haptic_hid.yaml",
+		"config/examples/spacemouse_hid.yaml",
+		"config/examples/can_sim.yaml",
+		"config/examples/can_arm.yaml",
+	};
+	struct px_devcfg_options opt;
+	char y[1024], sock[64], msg[512], msg2[512];
+	struct px_config *cfg;
+	struct px_devcfg *h;
+	size_t f, i;
+	memset(&opt, 0, sizeof(opt));
+	opt.check_only = 1;
+	if (access(files[0], R_OK) != 0)
+		PX_SKIP("config/examples not found (run from the source tree)");
+	for (f = 0; f < sizeof(files) / sizeof(files[0]); f++) {
+		int rc = px_config_load_file(files[f], &cfg, &g_diag);
+		PX_CHECK_MSG(rc == PX_OK, "%s: %s", files[f], px_strerror(rc));
+		if (rc != PX_OK)
+			continue;
+		for (i = 0; i < cfg->n_devices; i++) {
+			h = (struct px_devcfg *)&opt; /* must come back NULL */
+			rc = px_devcfg_open(cfg, &cfg->devices[i], &opt, &h, msg,
+					    sizeof(msg));
+			PX_CHECK_MSG(rc == PX_OK, "%s: %s", files[f], msg);
+			PX_CHECK(h == NULL);
+		}
+		px_config_free(cfg);
+	}
+	snprintf(sock, sizeof(sock), "/tmp/px-devcfg-check-%d.sock",
+		 (int)getpid());
+	snprintf(y, sizeof(y),
+		 "version: 1\n"
+		 "devices:\n"
+		 "  - name: arm\n"
+		 "    backend: socketcan\n"
+		 "    socketcan:\n"
+		 "      interface: simcan0\n"
+		 "      transport: unix\n"
+		 "      socket_path: %s\n"
+		 "      canopen:\n"
+		 "        drives:\n"
+		 "          - {node_id: 1, mode: csv, joint: 0}\n"
+		 "  - name: io\n"
+		 "    backend: gpiod\n"
+		 "    gpiod:\n"
+		 "      chip: gpiochip0\n"
+		 "      lines:\n"
+		 "        - {name: estop, offset: 1, direction: input}\n"
+		 "        - {name: spare, offset: 2, direction: output}\n",
+		 sock);
+	cfg = px_test_config_load(y, &g_diag);
+	PX_CHECK(cfg != NULL);
+	if (!cfg)
+		return;
+	PX_CHECK_INT_EQ(px_devcfg_open(cfg, &cfg->devices[0], &opt, &h, msg,
+				       sizeof(msg)),
+			PX_OK);
+	PX_CHECK(access(sock, F_OK) != 0); /* nothing bound */
+	PX_CHECK_INT_EQ(px_devcfg_open(cfg, &cfg->devices[1], &opt, &h, msg,
+				       sizeof(msg)),
+			PX_E_INVAL);
+	PX_CHECK(h == NULL);
+	PX_CHECK_INT_EQ(px_devcfg_open(cfg, &cfg->devices[1], NULL, &h, msg2,
+				       sizeof(msg2)),
+			PX_E_INVAL);
+	PX_CHECK_MSG(strcmp(msg, msg2) == 0 && strstr(msg, "line 'spare' has "
+							   "no role"),
+		     "check: '%s', open: '%s'", msg, msg2);
+	px_config_free(cfg);
+}
+
 /* What cannot be mapped is refused with the device, the key and why. */
 static void test_errors(void)
 {
@@ -576,5 +655,6 @@ static const struct px_test tests[] = {
 	PX_T(test_can_signal_axes), PX_T(test_canopen_drives),
 	PX_T(test_gpio_roles),      PX_T(test_errors),
 	PX_T(test_signal_axis_config), PX_T(test_canopen_free_stops_drives),
+	PX_T(test_check_only),
 };
 PX_TEST_MAIN(tests)

@@ -505,7 +505,14 @@ if grep -qE "^$tmp/c8.yaml:[0-9]+:[0-9]+: telemetry.ring_records: warning: 10000
 # a simulated device's own refusal (a trajectory file that is not there)
 absolute "$good" | sed 's/^        kind: sines$/        kind: csv\n        file: no-such-path.csv/; /^        sines:$/d; /^          - {axis:/d' >"$tmp/c9.yaml"
 expect "--check: a simulated device's trajectory file missing" 1 "$bin" --check "$tmp/c9.yaml"
-if grep -q "no-such-path.csv" "$tmp/err"; then ok "--check: missing trajectory named"; else bad "--check: missing trajectory named"; fi
+if grep -qE "^$tmp/c9.yaml:[0-9]+:[0-9]+: devices\[0\]\.sim\.trajectory\.file: .*no-such-path.csv" "$tmp/err"; then
+	ok "--check: missing trajectory placed"; else bad "--check: missing trajectory placed"; fi
+# a hardware device's config refused by px_devcfg without opening it (a
+# GPIO line with no role); the chip is never opened
+sed 's/name: timing, line_name/name: timer, line_name/' config/examples/can_arm.yaml >"$tmp/c10.yaml"
+expect "--check: a gpiod line without a role" 1 "$bin" --check "$tmp/c10.yaml"
+if grep -qE "^$tmp/c10.yaml:[0-9]+:[0-9]+: device 'io' \(gpiod, devices\[1\]\.gpiod\.lines\[2\]\): line 'timer' has no role" "$tmp/err"; then
+	ok "--check: gpiod line refusal placed"; else bad "--check: gpiod line refusal placed"; fi
 
 # ---- numeric flags are range-checked; durations reported truthfully ---
 for v in 1e300 -1 nan inf 1e9; do

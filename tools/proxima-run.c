@@ -1261,6 +1261,13 @@ static int make_device(int k)
 		config_dir_path(path, sizeof(path), A.o.config, s->trajectory.file);
 		rc = px_sim_csv_load(path, &A.csv[k], msg, sizeof(msg));
 		if (rc != PX_OK) {
+			const struct px_config_node *at = px_config_node_get(
+				px_config_node_get(px_config_node_get(d->node_, "sim"),
+						   "trajectory"),
+				"file");
+			if (at)
+				fprintf(stderr, "%s:%d:%d: devices[%d].sim.trajectory."
+					"file: ", at->file, at->line, at->column, k);
 			fprintf(stderr, "proxima-run: device '%s': %s\n", d->name,
 				msg[0] ? msg : px_strerror(rc));
 			return 1;
@@ -1727,16 +1734,39 @@ static int validate(void)
 	return status;
 }
 
+/* A device outside this process (hardware, a UNIX-socket bus) checked
+ * as px_devcfg_open() would check it, without opening it. Returns 0 or
+ * 1 (said why, at the device's place). */
+static int check_device(int k)
+{
+	const struct px_config_device *d = &A.cfg->devices[k];
+	struct px_devcfg_options opt;
+	struct px_devcfg *h = NULL;
+	char msg[512] = "";
+	int rc;
+	memset(&opt, 0, sizeof(opt));
+	opt.check_only = 1;
+	rc = px_devcfg_open(A.cfg, d, &opt, &h, msg, sizeof(msg));
+	px_devcfg_free(h);
+	if (rc == PX_OK)
+		return 0;
+	if (d->node_)
+		fprintf(stderr, "%s:%d:%d: ", d->node_->file, d->node_->line,
+			d->node_->column);
+	fprintf(stderr, "%s\n", msg[0] ? msg : px_strerror(rc));
+	return 1;
+}
+
 /* --check: validate(), then open what lives in this process (simulated
  * devices, buses and arms) as the run would, so their own refusals show
- * too; hardware and UNIX-socket buses are left closed. Returns the exit
- * status. */
+ * too; hardware and UNIX-socket buses get px_devcfg's checks without
+ * being opened. Returns the exit status. */
 static int check_config(void)
 {
 	int i, rc = validate();
 	for (i = 0; rc == 0 && i < (int)A.cfg->n_devices && i < MAX_DEVS; i++)
-		if (!is_hardware(&A.cfg->devices[i]))
-			rc = make_device(i);
+		rc = is_hardware(&A.cfg->devices[i]) ? check_device(i)
+						     : make_device(i);
 	if (rc == 0)
 		rearm_warnings(stderr);
 	if (rc == 0)
