@@ -514,6 +514,17 @@ expect "--check: a gpiod line without a role" 1 "$bin" --check "$tmp/c10.yaml"
 if grep -qE "^$tmp/c10.yaml:[0-9]+:[0-9]+: device 'io' \(gpiod, devices\[1\]\.gpiod\.lines\[2\]\): line 'timer' has no role" "$tmp/err"; then
 	ok "--check: gpiod line refusal placed"; else bad "--check: gpiod line refusal placed"; fi
 
+# a point cloud whose extent overflows double is refused at setup, by
+# --check and by the run alike, at the model's place: it never reaches
+# the cycle
+printf '1e308 0 0\n-1e308 0 0\n0 1e308 0\n' >"$tmp/big.xyz"
+printf 'version: 1\ndevices:\n  - {name: pen, backend: sim}\nscene:\n  models:\n    - {name: cloud, file: big.xyz, kind: cloud}\n' >"$tmp/c11.yaml"
+ck "a cloud whose extent overflows" "$tmp/c11.yaml" "scene.models\[0\].file: "
+expect "run: a cloud whose extent overflows is refused at setup" 1 "$bin" "$tmp/c11.yaml" --virtual-time \
+	--duration-s 0.1 --telemetry "$tmp/c11.csv"
+if grep -qE "^$tmp/c11.yaml:[0-9]+:[0-9]+: scene.models\[0\].file: " "$tmp/err" && [ ! -e "$tmp/c11.csv" ]; then
+	ok "run: overflowing cloud placed, no telemetry written"; else bad "run: overflowing cloud placed, no telemetry written"; fi
+
 # ---- numeric flags are range-checked; durations reported truthfully ---
 for v in 1e300 -1 nan inf 1e9; do
 	expect "--duration-s $v refused" 2 "$bin" "$good" --virtual-time --duration-s "$v"
