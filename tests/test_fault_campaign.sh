@@ -7,7 +7,9 @@
 # within one cycle of every watchdog trip; no NaN or infinity reaching an
 # output; telemetry records plus drops adding up to the cycles; the loop's
 # phase kept (last deadline = first + (cycles - 1 + missed periods) x
-# period). Prints a table of what the safety layer did.
+# period). Prints a table of what the safety layer did. Then each run
+# again, stopped by a signal at a seeded random cycle: every time zero
+# force, relays off and drives disabled at the end.
 set -u
 name=test_fault_campaign
 bin="${BUILD:-build}/bin/proxima-run"
@@ -99,5 +101,58 @@ for f in $scenarios; do
 	done
 done
 check "the campaign ran ($runs runs)" "$runs >= 20"
+
+# "Stop now" at random cycles under every fault kind: the same runs ended
+# by a signal (PX_RUN_STOP_AT=CYCLE:SIGNAL, the real signal path) at a
+# seeded random cycle, half of them inside the fault window (1.0-1.5 s).
+# Every time the machine must end with zero force and enable off on the
+# force sink, the relay off and every drive disabled, confirmed.
+# PX_CAMPAIGN_SEED repeats a campaign.
+seed=${PX_CAMPAIGN_SEED:-$(date +%s)}
+echo "stop now: seed $seed (PX_CAMPAIGN_SEED=$seed repeats it)"
+sigs="INT TERM HUP QUIT USR1 USR2 PIPE ALRM"
+stops=0
+for f in $scenarios; do
+	base=$(basename "$f" .yaml)
+	for k in $kinds; do
+		for dev in $(target "$f" "$k"); do
+			extra=""
+			[ "$k" = delay ] && extra=",1,0.03"
+			[ "$k" = overrun ] && extra=",1,0.003"
+			set -- $(awk -v s="$seed" -v n="$stops" -v ns="$(echo $sigs | wc -w)" 'BEGIN {
+				srand(s + n * 7919)
+				c = rand() < 0.5 ? 1000 + int(rand() * 500) : 1 + int(rand() * 2998)
+				print c, 1 + int(rand() * ns) }')
+			cyc=$1 sig=$(echo $sigs | cut -d' ' -f"$2")
+			j="$tmp/stop-$base-$k-$dev.json"
+			PX_RUN_STOP_AT="$cyc:$sig" "$bin" "$f" --virtual-time --duration-s 3 \
+				--fault "$k,$dev,1,0.5$extra" --summary-json "$j" \
+				--telemetry "$tmp/stop.csv" >"$tmp/out" 2>"$tmp/err"
+			rc=$?
+			stops=$((stops + 1))
+			what="stop now $base/$k@$dev at cycle $cyc by SIG$sig"
+			if [ "$rc" -ne 0 ] || [ ! -s "$j" ]; then bad "$what: run (exit $rc)"; continue; fi
+			check "$what: stopped there ($(num "$j" cycles) cycles)" "$(num "$j" cycles) == $cyc"
+			if grep -qF "\"shutdown_reason\": \"SIG$sig\"" "$j"; then ok; else bad "$what: ended by SIG$sig"; fi
+			check "$what: shutdown confirmed safe" "$(num "$j" shutdown_safe) == 1"
+			check "$what: force zeroed on $(num "$j" force_zeroed) of $(num "$j" force_devices)" \
+				"$(num "$j" force_zeroed) == $(num "$j" force_devices)"
+			check "$what: relays off on $(num "$j" relays_off) of $(num "$j" relay_devices)" \
+				"$(num "$j" relays_off) == $(num "$j" relay_devices)"
+			check "$what: $(num "$j" drives_disabled) of $(num "$j" shutdown_drives) drives disabled" \
+				"$(num "$j" drives_disabled) == $(num "$j" shutdown_drives)"
+			# what the simulated devices last received
+			if grep -q '"last_force_n"' "$j"; then
+				if grep -qE '"last_force_n": \[0, 0, 0\], "last_torque_n_m": \[0, 0, 0\], "last_enable": 0, "outputs_safe": 1' "$j"
+				then ok; else bad "$what: the haptic device last received zero force"; fi
+			fi
+			if grep -q '"enable_line"' "$j" && grep -q '"enable_line": 1' "$j"; then
+				bad "$what: an enable line left on"; else ok; fi
+			if grep -q '"state": "operation enabled"' "$j"; then
+				bad "$what: a drive left in operation enabled"; else ok; fi
+		done
+	done
+done
+check "stop now ran under every kind ($stops runs)" "$stops >= 20"
 echo "$name: $pass passed, $fail failed, $skip skipped"
 [ "$fail" -eq 0 ]
