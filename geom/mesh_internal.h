@@ -26,6 +26,14 @@
  * edges (error at most this fraction of the edge length). */
 #define NEEDLE_SIN2 1e-20
 
+/* struct mesh's degen[] per leaf triangle: DEGEN_ZERO a degenerate
+ * triangle (collapsed or needle: no face normal, no share of the
+ * pseudo-normals); DEGEN_SLOW one outside the fast point-triangle
+ * test's bound (thin, or edges beyond 2^+-100: px_mesh.c), which the
+ * robust test answers. Either sends the query to the robust test. */
+#define DEGEN_ZERO 1u
+#define DEGEN_SLOW 2u
+
 /* Two children per node, each with its box; cnt > 0 marks a leaf range
  * [idx, idx + cnt) of the reordered triangles, cnt == 0 an inner node
  * idx, and idx == EMPTY an absent child (only in a one-leaf root). */
@@ -146,7 +154,7 @@ static inline struct mtri px__mtri_get(const struct mesh *M, size_t li)
 	t.b = v.b;
 	t.c = v.c;
 	t.n = px_v3_cross(px_v3_sub(t.b, t.a), px_v3_sub(t.c, t.a));
-	t.inv_nn = M->degen[li] ? 0.0 : 1.0 / px_v3_norm2(t.n);
+	t.inv_nn = (M->degen[li] & DEGEN_ZERO) ? 0.0 : 1.0 / px_v3_norm2(t.n);
 	return t;
 }
 

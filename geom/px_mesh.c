@@ -14,53 +14,192 @@
 
 /* ---- point-triangle distance ------------------------------------------ */
 
-static double seg_closest(px_vec3 p, px_vec3 a, px_vec3 b, double *t,
-			  px_vec3 *q)
+/*
+ * Accuracy (px_mesh.h states the bound): the answer is the distance to
+ * a triangle whose vertices lie within a few units of rounding of the
+ * given ones, and that distance moves by at most as much as a vertex
+ * does, so it is right to a small multiple of u (d + l) (u = 2^-53, d
+ * the distance, l the longest edge). Two computations reach it:
+ *
+ * - The fast one (tri_core: Ericson's Voronoi-region walk on the dot
+ *   products at vertex a, the face point by the plain cross-product
+ *   normal) errs by about u (d + l) / sin(A), A the angle at a: the
+ *   normal's rounding is u |ab| |ac| per component against |n| = |ab|
+ *   |ac| sin(A), and the region tests vc, vb, va (Lagrange: vc = n .
+ *   (ab x ap)) carry the same factor. It is used where sin^2(A) >=
+ *   FAST_SIN2, which keeps that factor at 8 at most, and where no
+ *   product of four differences can overflow or sink into subnormals
+ *   (edges between 2^-100 and 2^100, |p - a| below 2^100).
+ * - The robust one (tri_exact) everywhere else: differences scaled by a
+ *   power of two (exact) so that the longest edge is about 1, the
+ *   normal by an error-free difference of products (fma), the face
+ *   point when its projection lies inside all three edges (side tests
+ *   n . (e x w), which carry the rounding of w only), and else the
+ *   nearest of the three edges. Its error does not depend on the shape
+ *   (needles of any aspect ratio) or on the scale.
+ */
+#define FAST_SIN2 (1.0 / 64.0)
+
+/* a * b - c * d with one rounding error (Kahan: the rounding error of
+ * c * d is recovered exactly by the fma). */
+static inline double dop(double a, double b, double c, double d)
 {
-	px_vec3 ab = px_v3_sub(b, a);
-	double l2 = px_v3_norm2(ab), s = 0.0;
-	if (l2 > 0.0) {
-		s = px_v3_dot(px_v3_sub(p, a), ab) / l2;
+	double w = c * d;
+	double e = fma(-c, d, w);
+	return fma(a, b, -w) + e;
+}
+
+static px_vec3 cross_acc(px_vec3 u, px_vec3 w)
+{
+	return px_v3(dop(u.y, w.z, u.z, w.y), dop(u.z, w.x, u.x, w.z),
+		     dop(u.x, w.y, u.y, w.x));
+}
+
+static inline double amax3(px_vec3 v)
+{
+	return fmax(fabs(v.x), fmax(fabs(v.y), fabs(v.z)));
+}
+
+/* 2^-e with 2^e > x >= 2^(e-1) (x > 0 finite): multiplying by it is
+ * exact and brings x into [0.5, 1). */
+static double pow2_scale(double x, int *e)
+{
+	(void)frexp(x, e);
+	return ldexp(1.0, -*e);
+}
+
+/* The accurate normal (b - a) x (c - a), as a unit vector (zero when
+ * the scaled cross product vanishes). Setup and the robust path. */
+static px_vec3 unit_normal_acc(px_vec3 a, px_vec3 b, px_vec3 c)
+{
+	px_vec3 ab = px_v3_sub(b, a), ac = px_v3_sub(c, a), n;
+	double m = fmax(amax3(ab), amax3(ac)), s, l;
+	int e;
+	if (!(m > 0.0) || !isfinite(m))
+		return px_v3(0, 0, 0);
+	s = pow2_scale(m, &e);
+	n = cross_acc(px_v3_scale(ab, s), px_v3_scale(ac, s));
+	l = sqrt(px_v3_norm2(n));
+	return l > 0.0 ? px_v3_scale(n, 1.0 / l) : px_v3(0, 0, 0);
+}
+
+/* Closest point of segment P + t E (t in [0, 1]) to the point at W from
+ * P: squared distance and t, computed from the differences only (no
+ * absolute coordinate enters, so the error is relative to |W| + |E|). An
+ * edge whose squared length underflows is its start point (it is then
+ * shorter than any rounding of the answer). */
+static inline double seg_d2(px_vec3 W, px_vec3 E, double *t)
+{
+	double l2 = px_v3_norm2(E), s = 0.0;
+	if (l2 > 0x1p-1000) {
+		s = px_v3_dot(W, E) / l2;
 		s = s < 0.0 ? 0.0 : (s > 1.0 ? 1.0 : s);
 	}
 	*t = s;
-	*q = px_v3_madd(a, ab, s);
-	return px_v3_dist2(p, *q);
+	return px_v3_norm2(px_v3_madd(W, E, -s));
 }
 
-/* Needle or collapsed triangle: nearest of its three edges. */
-static double tri_as_segments(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
-			      px_vec3 *q, int *feature, int *sub, double *u,
-			      double *v)
+/* The robust path (see the top of this section). RT-safe, bounded (it
+ * calls itself at most once, for a far point). */
+static double tri_exact(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c, px_vec3 *q,
+			int *feature, int *sub, double *u, double *v)
 {
-	px_vec3 P[3] = {a, b, c}, qq;
-	double best = INFINITY, t, bt = 0.0;
-	int e, be = 0;
-	for (e = 0; e < 3; e++) {
-		double d2 = seg_closest(p, P[e], P[(e + 1) % 3], &t, &qq);
-		if (d2 < best) {
-			best = d2;
-			bt = t;
-			be = e;
-			*q = qq;
+	px_vec3 P[3] = {a, b, c}, E[3], W[3], n;
+	double m, wm, s, d2[3], t[3], best, nn;
+	int k, e, bk;
+
+	for (k = 0; k < 3; k++) {
+		E[k] = px_v3_sub(P[(k + 1) % 3], P[k]);
+		W[k] = px_v3_sub(p, P[k]);
+	}
+	m = fmax(amax3(E[0]), fmax(amax3(E[1]), amax3(E[2])));
+	wm = amax3(W[0]);
+	if (!(m > 0.0)) {
+		/* one point */
+		*q = a;
+		*feature = PX_FEATURE_VERTEX;
+		*sub = 0;
+		*u = *v = 0.0;
+		return px_v3_norm2(W[0]);
+	}
+	if (wm > 0x1p400 * m) {
+		/* So far away that the scaled squares below could overflow:
+		 * the closest feature is that of the point moved along the
+		 * ray from a to 2^399 times the triangle's size (the feature
+		 * of a receding point settles long before: the differences
+		 * are 2^-399 of the distance), the distance p's own. */
+		px_vec3 pn = px_v3_madd(a, W[0], 0x1p399 * m / wm);
+		(void)tri_exact(pn, a, b, c, q, feature, sub, u, v);
+		return px_v3_dist2(p, *q);
+	}
+	s = pow2_scale(m, &e);
+	for (k = 0; k < 3; k++) {
+		E[k] = px_v3_scale(E[k], s);
+		W[k] = px_v3_scale(W[k], s);
+	}
+	/* n = ab x ac = E0 x -E2, to one rounding per component */
+	n = cross_acc(E[0], px_v3_neg(E[2]));
+	nn = px_v3_norm2(n);
+	/* Face: |n| above 2^-80 (the longest edge is about 1 here, so the
+	 * height is above 2^-81: below it the edges are the answer to far
+	 * below rounding) and the projection inside or on all three edges.
+	 * sigma_k / |n|^2 are the barycentric weights. */
+	if (nn > 0x1p-160) {
+		double sg[3];
+		for (k = 0; k < 3; k++)
+			sg[k] = px_v3_dot(px_v3_cross(E[k], W[k]), n);
+		if (sg[0] >= 0.0 && sg[1] >= 0.0 && sg[2] >= 0.0) {
+			double h = px_v3_dot(n, W[0]) / nn; /* scaled units / |n| */
+			*q = px_v3_madd(p, n, -h / s);
+			*feature = PX_FEATURE_FACE;
+			*sub = -1;
+			*u = sg[2] / nn;
+			*v = sg[0] / nn;
+			return ldexp(h * h * nn, 2 * e);
 		}
 	}
+	/* The nearest edge; for a point farther than 2^26 times the size,
+	 * by |x - a|^2 - 2 (p - a) . (x - a) (= |p - x|^2 - |p - a|^2, x
+	 * the edge's point) instead: there the squared distances round to
+	 * nearly one value, and the wrong edge could win, which the sign
+	 * of a closed mesh at the feature then inherits. Nearer, that key
+	 * carries the rounding of |p - a|^2 and the distances are better. */
 	{
-		/* barycentrics of the point on edge be */
+		px_vec3 O[3] = {px_v3(0, 0, 0), E[0], px_v3_neg(E[2])};
+		double key[3];
+		int far = wm * s > 0x1p26;
+		bk = 0;
+		for (k = 0; k < 3; k++) {
+			d2[k] = seg_d2(W[k], E[k], &t[k]);
+			if (far) {
+				px_vec3 x = px_v3_madd(O[k], E[k], t[k]);
+				key[k] = px_v3_norm2(x) - 2.0 * px_v3_dot(W[0], x);
+			} else {
+				key[k] = d2[k];
+			}
+			if (key[k] < key[bk])
+				bk = k;
+		}
+	}
+	best = d2[bk];
+	{
 		double w[3] = {0, 0, 0};
-		w[be] = 1.0 - bt;
-		w[(be + 1) % 3] = bt;
+		w[bk] = 1.0 - t[bk];
+		w[(bk + 1) % 3] = t[bk];
 		*u = w[1];
 		*v = w[2];
 	}
-	if (bt <= 0.0 || bt >= 1.0) {
+	/* the point from the scaled edge, back in the model's units */
+	*q = px_v3_madd(P[bk], E[bk], t[bk] / s);
+	if (t[bk] <= 0.0 || t[bk] >= 1.0) {
 		*feature = PX_FEATURE_VERTEX;
-		*sub = bt <= 0.0 ? be : (be + 1) % 3;
+		*sub = t[bk] <= 0.0 ? bk : (bk + 1) % 3;
+		*q = P[*sub];
 	} else {
 		*feature = PX_FEATURE_EDGE;
-		*sub = be;
+		*sub = bk;
 	}
-	return best;
+	return ldexp(best, 2 * e);
 }
 
 /*
@@ -68,20 +207,22 @@ static double tri_as_segments(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
  * the signs of dot products of p - vertex with the edges, as in Ericson,
  * Real-Time Collision Detection 5.1.5). The face point is taken by
  * projecting onto the plane along the cross-product normal rather than
- * from the barycentric ratios, which lose accuracy on thin triangles.
+ * from the barycentric ratios, which lose accuracy on thin triangles;
+ * edge distances from p - a and the edge (no absolute coordinate).
+ * n = (b - a) x (c - a), nn = |n|^2; robust: the fast path's bound does
+ * not hold for this triangle or point (tri_exact instead).
  */
-/* n = (b - a) x (c - a), nn = |n|^2, needle: treat as segments. */
 static inline __attribute__((always_inline)) double
 tri_core(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
-			      px_vec3 n, double nn, int needle, px_vec3 *q,
+			      px_vec3 n, double nn, int robust, px_vec3 *q,
 			      int *feature, int *sub, double *u, double *v)
 {
 	px_vec3 ab = px_v3_sub(b, a), ac = px_v3_sub(c, a), ap = px_v3_sub(p, a);
 	px_vec3 bp, cp;
 	double d1, d2, d3, d4, d5, d6, va, vb, vc, t;
 
-	if (needle)
-		return tri_as_segments(p, a, b, c, q, feature, sub, u, v);
+	if (robust)
+		return tri_exact(p, a, b, c, q, feature, sub, u, v);
 
 	d1 = px_v3_dot(ab, ap);
 	d2 = px_v3_dot(ac, ap);
@@ -111,7 +252,7 @@ tri_core(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
 		*sub = 0;
 		*u = t;
 		*v = 0.0;
-		return px_v3_dist2(p, *q);
+		return px_v3_norm2(px_v3_madd(ap, ab, -t));
 	}
 	cp = px_v3_sub(p, c);
 	d5 = px_v3_dot(ab, cp);
@@ -132,17 +273,18 @@ tri_core(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
 		*sub = 2;
 		*u = 0.0;
 		*v = t;
-		return px_v3_dist2(p, *q);
+		return px_v3_norm2(px_v3_madd(ap, ac, -t));
 	}
 	va = d3 * d6 - d5 * d4;
 	if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
+		px_vec3 bc = px_v3_sub(c, b);
 		t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-		*q = px_v3_madd(b, px_v3_sub(c, b), t);
+		*q = px_v3_madd(b, bc, t);
 		*feature = PX_FEATURE_EDGE;
 		*sub = 1;
 		*u = 1.0 - t;
 		*v = t;
-		return px_v3_dist2(p, *q);
+		return px_v3_norm2(px_v3_madd(bp, bc, -t));
 	}
 	/* face region */
 	{
@@ -157,20 +299,62 @@ tri_core(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
 	}
 }
 
-/* The needle test shared by the public routine and mesh setup. */
-static int is_needle(px_vec3 a, px_vec3 b, px_vec3 c, px_vec3 n)
+
+/* 1 when the fast path's bound holds for the triangle's shape and size
+ * (see the top of this section): sin^2 of the angle at a at least
+ * FAST_SIN2, edges ab and ac between 2^-100 and 2^100. The point's part
+ * (|p - a| below 2^100) is the caller's. */
+static inline int fast_size(double lab, double lac)
 {
-	px_vec3 ab = px_v3_sub(b, a), ac = px_v3_sub(c, a), bc = px_v3_sub(c, b);
-	double lab = px_v3_norm2(ab), lac = px_v3_norm2(ac), lbc = px_v3_norm2(bc);
-	double m = fmax(lab * lac, fmax(lab * lbc, lac * lbc));
-	return !(px_v3_norm2(n) > NEEDLE_SIN2 * m);
+	return lab >= 0x1p-200 && lab <= 0x1p200 && lac >= 0x1p-200 && lac <= 0x1p200;
+}
+
+static inline int fast_shape(double lab, double lac, double nn)
+{
+	return fast_size(lab, lac) && nn >= FAST_SIN2 * (lab * lac);
+}
+
+/*
+ * Mesh setup's view of a triangle: its edges ab, ac, bc scaled by a
+ * power of two to a largest component in [0.5, 1) (zero when all three
+ * vertices coincide); *needle when its height is below sqrt(NEEDLE_SIN2)
+ * of its edges (degenerate for topology and signs: no face normal; its
+ * distance is still exact, by tri_exact); *fast when the fast test's
+ * bound holds for it (fast_shape).
+ */
+static void tri_shape(px_vec3 a, px_vec3 b, px_vec3 c, px_vec3 *ab, px_vec3 *ac,
+		      px_vec3 *bc, int *needle, int *fast)
+{
+	px_vec3 e0 = px_v3_sub(b, a), e1 = px_v3_sub(c, a), e2 = px_v3_sub(c, b), n;
+	double m = fmax(amax3(e0), fmax(amax3(e1), amax3(e2))), s, la, lc, lb;
+	int e;
+	if (!(m > 0.0)) {
+		*ab = *ac = *bc = px_v3(0, 0, 0);
+		*needle = 1;
+		*fast = 0;
+		return;
+	}
+	s = pow2_scale(m, &e);
+	*ab = px_v3_scale(e0, s);
+	*ac = px_v3_scale(e1, s);
+	*bc = px_v3_scale(e2, s);
+	n = cross_acc(*ab, *ac);
+	la = px_v3_norm2(*ab);
+	lc = px_v3_norm2(*ac);
+	lb = px_v3_norm2(*bc);
+	*needle = !(px_v3_norm2(n) > NEEDLE_SIN2 * fmax(la * lc, fmax(la * lb, lc * lb)));
+	/* the size from the edges as given, the shape from the scaled ones */
+	*fast = fast_size(px_v3_norm2(e0), px_v3_norm2(e1)) &&
+		px_v3_norm2(n) >= FAST_SIN2 * la * lc;
 }
 
 double px_tri_closest(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
 		      px_vec3 *q, int *feature, int *sub, double *u, double *v)
 {
-	px_vec3 n = px_v3_cross(px_v3_sub(b, a), px_v3_sub(c, a)), qq;
-	int f_, s_;
+	px_vec3 ab = px_v3_sub(b, a), ac = px_v3_sub(c, a);
+	px_vec3 n = px_v3_cross(ab, ac), qq;
+	double nn = px_v3_norm2(n);
+	int f_, s_, robust;
 	double u_, v_;
 
 	if (!feature)
@@ -183,8 +367,18 @@ double px_tri_closest(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
 		v = &v_;
 	if (!q)
 		q = &qq;
-	return tri_core(p, a, b, c, n, px_v3_norm2(n), is_needle(a, b, c, n), q,
-			feature, sub, u, v);
+	if (!(amax3(p) <= PX_TRI_MAX_COORD && amax3(a) <= PX_TRI_MAX_COORD &&
+	      amax3(b) <= PX_TRI_MAX_COORD && amax3(c) <= PX_TRI_MAX_COORD)) {
+		/* out of range or not finite: no answer rather than a wrong one */
+		*q = p;
+		*feature = PX_FEATURE_NONE;
+		*sub = -1;
+		*u = *v = 0.0;
+		return NAN;
+	}
+	robust = !fast_shape(px_v3_norm2(ab), px_v3_norm2(ac), nn) ||
+		 !(px_v3_dist2(p, a) <= 0x1p200);
+	return tri_core(p, a, b, c, n, nn, robust, q, feature, sub, u, v);
 }
 
 /* ---- setup helpers ------------------------------------------------------ */
@@ -515,6 +709,7 @@ struct pq {
 	float pf[3];
 	float slack_box, slack_tri;
 	int use;
+	int fast; /* p and the mesh in the fast triangle test's range */
 };
 
 static inline void pq_init(const struct mesh *M, px_vec3 p, struct pq *q)
@@ -523,7 +718,10 @@ static inline void pq_init(const struct mesh *M, px_vec3 p, struct pq *q)
 	/* Differences stay below 4e18 and their squares (and sums of three)
 	 * far below FLT_MAX; beyond that a float square overflows to inf,
 	 * which would prune the closest box or triangle. */
-	q->use = pmax < 1e18 && M->absmax < 1e18;
+	q->fast = pmax < 1e18 && M->absmax < 1e18;
+	/* and above 2^-60, where the slack is a normal float and the
+	 * rounding of tiny coordinates to subnormal floats stays below it */
+	q->use = q->fast && M->absmax + pmax >= 0x1p-60;
 	q->pf[0] = (float)p.x;
 	q->pf[1] = (float)p.y;
 	q->pf[2] = (float)p.z;
@@ -568,22 +766,56 @@ static inline double tri_lb(const struct tlb *L, const struct pq *q)
 	return (double)(h * h + e * e) * (1.0 - 0x1p-18);
 }
 
+/*
+ * A degenerate triangle (needle: no face normal, so no face feature for
+ * the sign) whose exact closest point lies inside it: the edge nearest
+ * that point names the feature (its pseudo-normal gives the sign). The
+ * distance from the point with barycentric weights w to the line of the
+ * edge opposite vertex k is w[k] times that vertex's height, 2 area /
+ * |edge|: so the least w[k] / |edge k'| wins. RT-safe.
+ */
+static int face_as_edge(px_vec3 a, px_vec3 b, px_vec3 c, double u, double v,
+			int *sub)
+{
+	/* edge e (0: ab, 1: bc, 2: ca) is opposite vertex (e + 2) % 3 */
+	double w[3] = {1.0 - u - v, u, v};
+	double l[3] = {px_v3_dist(a, b), px_v3_dist(b, c), px_v3_dist(c, a)};
+	int e, be = 0;
+	for (e = 1; e < 3; e++)
+		if (w[(e + 2) % 3] * l[be] < w[(be + 2) % 3] * l[e])
+			be = e;
+	*sub = be;
+	return PX_FEATURE_EDGE;
+}
+
+/* A tie of squared distances (a far point: they round to one value)
+ * decided by |q - r|^2 - 2 (p - r) . (q - r) < 0, r the best point so
+ * far (= |p - q|^2 - |p - r|^2, without the rounding of the squares):
+ * the truly nearer feature then holds the answer and gives the sign. */
+static int nearer_than_best(px_vec3 p, px_vec3 q, const struct best *b)
+{
+	px_vec3 x = px_v3_sub(q, b->q);
+	return px_v3_norm2(x) - 2.0 * px_v3_dot(px_v3_sub(p, b->q), x) < 0.0;
+}
+
 /* plane_done: the caller's float bound (tri_lb) already compared the
  * plane distance, so the double one here would repeat it. */
 static inline void test_tri_x(const struct mesh *M, size_t li, px_vec3 p,
-			      struct best *b, int plane_done)
+			      struct best *b, int plane_done, int fast)
 {
 	const uint32_t *vi = M->tv + 3 * li;
 	px_vec3 ta = M->vx[vi[0]], tb = M->vx[vi[1]], tc = M->vx[vi[2]], n, q;
-	int f, s, needle;
+	int f, s, robust;
 	double u, v, d2, nn;
 
 	n = px_v3_cross(px_v3_sub(tb, ta), px_v3_sub(tc, ta));
 	/* |n|^2 as px_tri_closest computes it (a product, not a division);
 	 * 1 / |n|^2 (px__mtri_get) is 0 exactly for these */
 	nn = px_v3_norm2(n);
-	needle = M->degen[li] || nn == INFINITY;
-	if (!plane_done && !needle) {
+	/* degenerate, or a shape or size outside the fast test's bound
+	 * (set at setup, DEGEN_*), or a point too far out for it */
+	robust = M->degen[li] || !fast;
+	if (!plane_done && !robust) {
 		/* the distance to the plane is a lower bound (compared
 		 * without a division; the factor keeps rounding from ever
 		 * rejecting a triangle whose plane distance equals the bound) */
@@ -591,9 +823,13 @@ static inline void test_tri_x(const struct mesh *M, size_t li, px_vec3 p,
 		if (h * h > b->d2 * nn * (1.0 + 1e-12))
 			return;
 	}
-	d2 = tri_core(p, ta, tb, tc, n, nn, needle, &q, &f, &s, &u, &v);
+	d2 = tri_core(p, ta, tb, tc, n, nn, robust, &q, &f, &s, &u, &v);
+	if ((M->degen[li] & DEGEN_ZERO) && f == PX_FEATURE_FACE)
+		f = face_as_edge(ta, tb, tc, u, v, &s);
 	if (d2 < b->d2 ||
-	    (d2 == b->d2 && (b->li < 0 || (M->degen[b->li] && !M->degen[li])))) {
+	    (d2 == b->d2 && (b->li < 0 || ((M->degen[b->li] & DEGEN_ZERO) &&
+					   !(M->degen[li] & DEGEN_ZERO)) ||
+			     nearer_than_best(p, q, b)))) {
 		b->d2 = d2;
 		b->li = (long)li;
 		b->q = q;
@@ -610,10 +846,17 @@ static inline void test_tri_x(const struct mesh *M, size_t li, px_vec3 p,
 	}
 }
 
+/* 1 when p and the mesh are in the fast triangle test's range (struct
+ * pq's fast, for callers without one). */
+static inline int fast_range(const struct mesh *M, px_vec3 p)
+{
+	return M->absmax < 1e18 && fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z))) < 1e18;
+}
+
 static inline void test_tri(const struct mesh *M, size_t li, px_vec3 p,
 			    struct best *b)
 {
-	test_tri_x(M, li, p, b, 0);
+	test_tri_x(M, li, p, b, 0, fast_range(M, p));
 }
 
 /* Fill a result from the best triangle: the sign from the pseudo-normal
@@ -710,7 +953,7 @@ static void mesh_walk(const struct mesh *M, px_vec3 p, struct best *b,
 			}
 			for (k = 0; k < n; k++)
 				if (!(lb[k] > b->d2))
-					test_tri_x(M, i0 + k, p, b, 1);
+					test_tri_x(M, i0 + k, p, b, 1, pq.fast);
 			continue;
 		}
 		nd = &M->n4[st[sp].idx];
@@ -815,7 +1058,7 @@ static int mesh_closest_among(const void *impl, const struct px_model_query *qq,
 		if (!pq.use)
 			test_tri(M, li, qq->p, &b);
 		else if (!(tri_lb(&M->lb[li], &pq) > b.d2))
-			test_tri_x(M, li, qq->p, &b, 1);
+			test_tri_x(M, li, qq->p, &b, 1, pq.fast);
 	}
 	if (b.li < 0)
 		return 0;
@@ -1057,7 +1300,8 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 	uint8_t *deg = NULL, *used = NULL;
 	unsigned flags = opt ? opt->flags : 0u;
 	int leaf = (opt && opt->leaf_size) ? opt->leaf_size : 6;
-	int rc = PX_E_NOMEM, k;
+	int rc = PX_E_NOMEM, k, vexp = 0;
+	double vsc = 1.0, vol_s = 0.0; /* the volume in units of 2^(3 vexp) */
 	struct build B;
 
 	if (!rep)
@@ -1102,6 +1346,41 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 			rc = PX_E_NAN;
 			goto fail;
 		}
+	/* The accepted range (px_mesh.h): squared distances and the
+	 * hierarchy's and hint grid's arithmetic stay finite and normal. */
+	{
+		double lo[3] = {INFINITY, INFINITY, INFINITY},
+		       hi[3] = {-INFINITY, -INFINITY, -INFINITY}, ext = 0.0, amax = 0.0;
+		for (i = 0; i < nv; i++) {
+			if (!used[i])
+				continue;
+			for (k = 0; k < 3; k++) {
+				double x = xyz[3 * i + (size_t)k];
+				if (!(fabs(x) <= PX_MESH_MAX_COORD)) {
+					rep_msg(rep, "mesh: vertex %zu coordinate %.17g outside the "
+						     "accepted range (|x| <= %g)",
+						i, x, PX_MESH_MAX_COORD);
+					rc = PX_E_RANGE;
+					goto fail;
+				}
+				lo[k] = fmin(lo[k], x);
+				hi[k] = fmax(hi[k], x);
+			}
+		}
+		for (k = 0; k < 3; k++) {
+			ext = fmax(ext, hi[k] - lo[k]);
+			amax = fmax(amax, fmax(fabs(lo[k]), fabs(hi[k])));
+		}
+		if (amax > 0.0)
+			vsc = pow2_scale(amax, &vexp);
+		if (ext > 0.0 && ext < PX_MESH_MIN_EXTENT) {
+			rep_msg(rep, "mesh: extent %.17g below the accepted range (>= %g, or "
+				     "0): its squared distances would underflow",
+				ext, PX_MESH_MIN_EXTENT);
+			rc = PX_E_RANGE;
+			goto fail;
+		}
+	}
 
 	/* weld identical positions */
 	order = malloc(nv * sizeof(*order));
@@ -1139,21 +1418,29 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 			     *C = xyz + 3 * (size_t)c2;
 		px_vec3 a = px_v3(A[0], A[1], A[2]), b = px_v3(Bv[0], Bv[1], Bv[2]),
 			c = px_v3(C[0], C[1], C[2]);
-		px_vec3 ab = px_v3_sub(b, a), ac = px_v3_sub(c, a), bc = px_v3_sub(c, b);
-		px_vec3 nrm = px_v3_cross(ab, ac);
-		double lab = px_v3_norm2(ab), lac = px_v3_norm2(ac), lbc = px_v3_norm2(bc);
-		double m = fmax(lab * lac, fmax(lab * lbc, lac * lbc));
-		int collapsed = c0 == c1 || c1 == c2 || c0 == c2;
+		/* edges scaled by a power of two (exact) to a largest
+		 * component near 1: the shape tests, angles and normal are
+		 * scale-free, and nothing overflows at 1e150 or underflows at
+		 * 1e-140 */
+		px_vec3 ab, ac, bc;
+		int collapsed = c0 == c1 || c1 == c2 || c0 == c2, needle, fast;
 
+		tri_shape(a, b, c, &ab, &ac, &bc, &needle, &fast);
 		nb[3 * i] = nb[3 * i + 1] = nb[3 * i + 2] = -1;
-		(void)m;
-		if (collapsed || is_needle(a, b, c, nrm)) {
-			deg[i] = 1;
+		if (collapsed || needle) {
+			deg[i] = DEGEN_ZERO;
 			if (rep->n_degenerate++ == 0)
 				rep->first_degenerate = (long)i;
 		} else {
-			px_v3_normalize(nrm, px_v3(0, 0, 0), &fn[i]);
-			rep->volume += px_v3_dot(a, px_v3_cross(b, c)) / 6.0;
+			/* the accurate normal: the plain cross product of a
+			 * thin triangle's edges is off by u / sin(angle) */
+			fn[i] = unit_normal_acc(a, b, c);
+			if (!fast)
+				deg[i] = DEGEN_SLOW;
+			/* in units of 2^vexp: a 1e150 mesh's volume overflows */
+			vol_s += px_v3_dot(px_v3_scale(a, vsc),
+					   px_v3_cross(px_v3_scale(b, vsc), px_v3_scale(c, vsc))) /
+				 6.0;
 			/* angle-weighted vertex pseudo-normals */
 			vn[c0] = px_v3_madd(vn[c0], fn[i], ang(ab, ac));
 			vn[c1] = px_v3_madd(vn[c1], fn[i], ang(px_v3_neg(ab), bc));
@@ -1218,11 +1505,11 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 		rc = PX_E_DEGENERATE;
 		goto fail;
 	}
-	if (!rep->closed)
-		rep->volume = 0.0;
-	if (rep->closed && rep->volume < 0.0 && !(flags & PX_MESH_NO_FLIP)) {
+	rep->volume = rep->closed ? ldexp(vol_s, 3 * vexp) : 0.0;
+	if (rep->closed && vol_s < 0.0 && !(flags & PX_MESH_NO_FLIP)) {
 		rep->flipped = 1;
 		rep->volume = -rep->volume;
+		vol_s = -vol_s;
 		for (i = 0; i < nt; i++)
 			fn[i] = px_v3_neg(fn[i]);
 		for (i = 0; i < nv; i++)
@@ -1241,8 +1528,8 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 			for (i = 0; i < nv; i++)
 				if (used[i])
 					px_aabb_extend(&bb, px_v3(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]));
-			dg = px_aabb_diagonal(&bb);
-			if (!(rep->volume > 1e-9 * dg * dg * dg))
+			dg = px_aabb_diagonal(&bb) * vsc;
+			if (!(vol_s > 1e-9 * dg * dg * dg))
 				rep->convex = 0;
 		}
 		for (i = 0; i < nv; i++)
@@ -1251,7 +1538,7 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 						     fmax(fabs(xyz[3 * i + 1]), fabs(xyz[3 * i + 2]))));
 		for (i = 0; i < nt && rep->convex; i++) {
 			const double *A = xyz + 3 * (size_t)canon[tri[3 * i]];
-			if (deg[i])
+			if (deg[i] & DEGEN_ZERO)
 				continue;
 			for (k = 0; k < 3; k++) {
 				int32_t o = nb[3 * i + k];
@@ -1369,11 +1656,11 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 			M->tv[3 * i + k] = vmap[c];
 		}
 		memset(&M->lb[i], 0, sizeof(M->lb[i]));
-		if (!deg[t]) {
+		if (!(deg[t] & DEGEN_ZERO)) {
+			/* accurate (a thin triangle's plain normal could tilt
+			 * past the slack) */
 			struct tlb *L = &M->lb[i];
-			px_vec3 nrm = px_v3_cross(px_v3_sub(P[1], P[0]), px_v3_sub(P[2], P[0]));
-			double nl = sqrt(px_v3_norm2(nrm));
-			px_vec3 nu = px_v3_scale(nrm, 1.0 / nl);
+			px_vec3 nu = unit_normal_acc(P[0], P[1], P[2]);
 			L->c[0][0] = (float)nu.x;
 			L->c[1][0] = (float)nu.y;
 			L->c[2][0] = (float)nu.z;

@@ -20,8 +20,17 @@
  * triangles that survive get the exact double-precision test. The
  * distance to a triangle is
  * exact over all seven Voronoi regions (face, three edges, three
- * vertices), also for collapsed or needle triangles, which are treated
- * as the segments they are.
+ * vertices), also for slivers, needles of any aspect ratio and
+ * collapsed triangles (see px_tri_closest for the bound).
+ *
+ * Accepted range: every used vertex coordinate within
+ * +-PX_MESH_MAX_COORD (1e150) and the largest extent 0 or at least
+ * PX_MESH_MIN_EXTENT (1e-140); setup refuses anything else with
+ * PX_E_RANGE and a message naming the vertex or the extent. Query
+ * points up to 1e150 outside the box (px_model.h) are answered. The
+ * hierarchy's boxes are single-precision floats: beyond about 3e38 they
+ * round out to infinity and stop pruning, so a mesh out there is
+ * answered exactly but by visiting every triangle.
  *
  * Signed distance: on a watertight mesh the sign of (p - q) . n, with n
  * the pseudo-normal of the feature (face, edge or vertex) holding the
@@ -89,6 +98,18 @@ extern "C" {
 #define PX_MESH_REJECT_DEGENERATE 0x1u /* zero-area triangles are errors */
 #define PX_MESH_REQUIRE_CLOSED 0x2u    /* open/non-manifold are errors */
 #define PX_MESH_NO_FLIP 0x4u           /* keep inward orientation (sign inverted) */
+
+/* The accepted range (px_mesh_model refuses anything else with
+ * PX_E_RANGE): every used vertex coordinate within +-PX_MESH_MAX_COORD,
+ * so that differences, squared distances (also to query points up to the
+ * query reach of 1e150 outside the box, px_model.h) and the hierarchy's
+ * arithmetic stay finite; and the mesh's largest extent either 0 (one
+ * point) or at least PX_MESH_MIN_EXTENT, so that squared distances at
+ * its scale are normal doubles. px_tri_closest takes coordinates up to
+ * PX_TRI_MAX_COORD. */
+#define PX_MESH_MAX_COORD 1e150
+#define PX_MESH_MIN_EXTENT 1e-140
+#define PX_TRI_MAX_COORD 1e152
 
 /* Largest hint grid (cells of 4 bytes). */
 #define PX_MESH_MAX_GRID_CELLS (1L << 26)
@@ -159,10 +180,21 @@ PX_API int px_mesh_load(const char *path, const struct px_mesh_opts *opt,
  * Exact closest point of triangle (a, b, c) to p: returns the squared
  * distance, writes the point q, its feature (PX_FEATURE_FACE, _EDGE,
  * _VERTEX), sub (edge 0: ab, 1: bc, 2: ca, or vertex 0..2) and the
- * barycentric weights u (of b) and v (of c). Collapsed and needle
- * triangles are handled as segments. Any output pointer but q may be
- * NULL. @note RT-safe.
+ * barycentric weights u (of b) and v (of c). Any output pointer may be
+ * NULL.
+ *
+ * Accuracy: with d* the exact distance from the given doubles, u =
+ * 2^-53 and l the longest edge, the distance d = sqrt(result) obeys
+ * |d - d*| <= PX_TRI_ERR_ULPS u (d* + l) + 1e-160 for every shape
+ * (needles and slivers of any aspect ratio, collinear and repeated
+ * vertices) and scale (a triangle well shaped at its vertex a and of
+ * moderate size takes the fast test, others a robust one whose error
+ * does not depend on the shape; the last term is the subnormal range
+ * of the squares). Coordinates beyond +-PX_TRI_MAX_COORD (1e152) or not
+ * finite return NaN (q = p, feature PX_FEATURE_NONE): no answer rather
+ * than an overflowed one. @note RT-safe.
  */
+#define PX_TRI_ERR_ULPS 64.0
 PX_API double px_tri_closest(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
 			     px_vec3 *q, int *feature, int *sub, double *u,
 			     double *v);

@@ -6,10 +6,47 @@
 
 #include "px_prim.h"
 
+static int px_prim_check_shape(const struct px_prim *p);
+
+/* A length in the accepted range (px_prim.h); zero only where zero_ok. */
+static int len_ok(double x, int zero_ok)
+{
+	return (x >= PX_PRIM_MIN_LENGTH && x <= PX_PRIM_MAX_LENGTH) ||
+	       (zero_ok && x == 0.0);
+}
+
+/* The range half of the check (the shape's own rules are below). */
+static int prim_range(const struct px_prim *p)
+{
+	switch (p->type) {
+	case PX_PRIM_SPHERE:
+		return len_ok(p->a, 0);
+	case PX_PRIM_BOX:
+		return len_ok(p->a, 0) && len_ok(p->b, 0) && len_ok(p->c, 0);
+	case PX_PRIM_CAPSULE:
+	case PX_PRIM_CYLINDER:
+	case PX_PRIM_TORUS:
+		return len_ok(p->a, 0) && len_ok(p->b, 0);
+	case PX_PRIM_CONE:
+		return len_ok(p->a, 1) && len_ok(p->b, 0) && len_ok(p->c, 1);
+	default:
+		return 1;
+	}
+}
+
 int px_prim_check(const struct px_prim *p)
 {
+	int rc;
 	if (!p)
 		return PX_E_INVAL;
+	rc = px_prim_check_shape(p);
+	if (rc == PX_OK && !prim_range(p))
+		rc = PX_E_RANGE;
+	return rc;
+}
+
+static int px_prim_check_shape(const struct px_prim *p)
+{
 	switch (p->type) {
 	case PX_PRIM_SPHERE:
 		if (!isfinite(p->a))

@@ -30,6 +30,11 @@
  *    azimuth, tube angle; half-space: x, y.
  *  - certified = 1, gap = 0, iterations = 1.
  *
+ * Accuracy: the signed distance is within PX_PRIM_ERR_ULPS u (|q| +
+ * size) of the exact one (u = 2^-53, size the largest length), for
+ * lengths and points in the accepted range (PX_PRIM_MAX_LENGTH); the
+ * closed forms have no cancellation beyond that of |q| itself.
+ *
  * Memory and real-time rules: a struct px_prim is a plain value;
  * px_prim_closest() is RT-safe; px_prim_model() allocates the model
  * handle (setup).
@@ -64,10 +69,21 @@ struct px_prim {
 };
 
 /*
+ * The accepted range of every length (a cone's radii may also be 0):
+ * up to 1e150, so that squared distances to points within the query
+ * reach (1e150 beyond the box, px_model.h) stay finite; from 1e-140, so
+ * that they stay normal doubles at the primitive's own scale.
+ */
+#define PX_PRIM_MAX_LENGTH 1e150
+#define PX_PRIM_MIN_LENGTH 1e-140
+#define PX_PRIM_ERR_ULPS 16.0
+
+/*
  * Check a primitive: lengths finite and positive where required (cone:
  * a >= 0, c >= 0, not both zero; torus: 0 < b < a, since a spindle torus
- * is not the solid this distance describes). Returns PX_OK, PX_E_INVAL
- * (NULL or unknown type), PX_E_NAN, PX_E_RANGE. @note RT-safe.
+ * is not the solid this distance describes) and within the accepted
+ * range. Returns PX_OK, PX_E_INVAL (NULL or unknown type), PX_E_NAN,
+ * PX_E_RANGE. @note RT-safe.
  */
 PX_API int px_prim_check(const struct px_prim *p);
 

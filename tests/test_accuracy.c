@@ -1,0 +1,680 @@
+/*
+ * Accuracy of the exact distance tests against a higher-precision
+ * reference, on the inputs that break naive formulas: needles and
+ * slivers (aspect 1e3 to 1e9), degenerate triangles (zero area,
+ * collinear, repeated vertices), points far away (1e6 times the size)
+ * and very close to the surface (1e-12 of it), and scales from 1e-100
+ * to 1e100; and the accepted ranges of meshes and primitives (refused
+ * at setup beyond them, with the place named).
+ *
+ * The reference is independent of the code under test: the point-
+ * triangle distance as the least of the face-interior projection (when
+ * the projection lies inside) and the three edges, evaluated in
+ * __float128 (113-bit significand: products of two doubles are exact,
+ * so the normal of a 1e9 needle is still right to 1e-25), and the
+ * primitives' closed forms in long double. Every comparison asserts the
+ * bound the headers document, in units of u = 2^-53:
+ *   px_tri_closest, mesh queries: |d - d*| <= PX_TRI_ERR_ULPS u (d* + l)
+ *     + 1e-160, l the triangle's longest edge;
+ *   px_prim_closest: |d - d*| <= PX_PRIM_ERR_ULPS u (|q| + size).
+ * Seeds are printed by the harness (PX_TEST_SEED replays a failure).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "px_mesh.h"
+#include "px_model.h"
+#include "px_prim.h"
+#include "px_test.h"
+
+
+#define U 0x1p-53
+
+typedef __float128 q128;
+
+struct qv {
+	q128 x, y, z;
+};
+
+static struct qv qv_of(px_vec3 v)
+{
+	struct qv r = {v.x, v.y, v.z};
+	return r;
+}
+
+static struct qv qsub(struct qv a, struct qv b)
+{
+	struct qv r = {a.x - b.x, a.y - b.y, a.z - b.z};
+	return r;
+}
+
+static q128 qdot(struct qv a, struct qv b)
+{
+	return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+
+static struct qv qcross(struct qv a, struct qv b)
+{
+	struct qv r = {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z,
+		       a.x * b.y - a.y * b.x};
+	return r;
+}
+
+/* squared distance from w (relative to the segment start) to segment e */
+static q128 qseg(struct qv w, struct qv e)
+{
+	q128 l2 = qdot(e, e), t = 0;
+	struct qv d;
+	if (l2 > 0) {
+		t = qdot(w, e) / l2;
+		t = t < 0 ? 0 : (t > 1 ? 1 : t);
+	}
+	d.x = w.x - t * e.x;
+	d.y = w.y - t * e.y;
+	d.z = w.z - t * e.z;
+	return qdot(d, d);
+}
+
+/* Reference distance from p to triangle abc. */
+static long double ref_tri(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c)
+{
+	struct qv P[3] = {qv_of(a), qv_of(b), qv_of(c)}, Q = qv_of(p), n;
+	q128 best = -1, nn;
+	int k, inside = 1;
+
+	n = qcross(qsub(P[1], P[0]), qsub(P[2], P[0]));
+	nn = qdot(n, n);
+	for (k = 0; k < 3; k++) {
+		struct qv e = qsub(P[(k + 1) % 3], P[k]), w = qsub(Q, P[k]);
+		q128 d2 = qseg(w, e);
+		if (best < 0 || d2 < best)
+			best = d2;
+		if (qdot(qcross(e, w), n) < 0)
+			inside = 0;
+	}
+	if (inside && nn > 0) {
+		q128 h = qdot(n, qsub(Q, P[0]));
+		q128 d2 = h * h / nn;
+		if (d2 < best)
+			best = d2;
+	}
+	return sqrtl((long double)best);
+}
+
+static double longest_edge(px_vec3 a, px_vec3 b, px_vec3 c)
+{
+	return fmax(px_v3_dist(a, b), fmax(px_v3_dist(b, c), px_v3_dist(c, a)));
+}
+
+static px_vec3 rand_unit(void)
+{
+	px_vec3 v;
+	do
+		v = px_v3(px_rand_normal(), px_rand_normal(), px_rand_normal());
+	while (px_v3_norm2(v) < 1e-6);
+	return px_v3_scale(v, 1.0 / px_v3_norm(v));
+}
+
+/* a unit vector perpendicular to unit d */
+static px_vec3 perp(px_vec3 d)
+{
+	px_vec3 r = px_v3_cross(d, rand_unit());
+	return px_v3_scale(r, 1.0 / px_v3_norm(r));
+}
+
+/*
+ * A hard triangle of about unit size at the origin, kind 0..7: 0 well
+ * shaped; 1 a needle whose third vertex sits near the middle of the long
+ * edge (aspect 1e3..1e9); 2 a needle sharp at one vertex; 3 a sliver
+ * (three nearly collinear points spread along a line); 4 exactly
+ * collinear (axis-aligned, representable); 5 two repeated vertices; 6
+ * all three the same; 7 a needle with a random vertex order.
+ */
+static void hard_tri(int kind, px_vec3 v[3])
+{
+	px_vec3 d = rand_unit(), n = perp(d);
+	double asp = pow(10.0, px_rand_range(3.0, 9.0)), h = 1.0 / asp;
+	px_vec3 o = px_v3(px_rand_range(-0.5, 0.5), px_rand_range(-0.5, 0.5),
+			  px_rand_range(-0.5, 0.5));
+	switch (kind) {
+	case 0:
+		v[0] = o;
+		v[1] = px_v3_add(o, rand_unit());
+		v[2] = px_v3_add(o, rand_unit());
+		break;
+	case 1:
+	case 7:
+		v[0] = o;
+		v[1] = px_v3_madd(o, d, 1.0);
+		v[2] = px_v3_madd(px_v3_madd(o, d, px_rand_range(0.05, 0.95)), n, h);
+		if (kind == 7) {
+			px_vec3 t = v[0];
+			int r = px_rand_int(0, 2);
+			if (r == 1) {
+				v[0] = v[2];
+				v[2] = t;
+			} else if (r == 2) {
+				v[0] = v[1];
+				v[1] = t;
+			}
+		}
+		break;
+	case 2:
+		v[0] = o;
+		v[1] = px_v3_madd(o, d, 1.0);
+		v[2] = px_v3_madd(px_v3_madd(o, d, 1.0), n, h);
+		break;
+	case 3:
+		v[0] = o;
+		v[1] = px_v3_madd(px_v3_madd(o, d, px_rand_range(0.3, 0.7)), n, h * px_rand_range(-1, 1));
+		v[2] = px_v3_madd(o, d, 1.0);
+		break;
+	case 4: {
+		double x = (double)px_rand_int(-4, 4) / 4.0;
+		v[0] = px_v3(x, 0.25, -0.5);
+		v[1] = px_v3(x + 0.5, 0.25, -0.5);
+		v[2] = px_v3(x + 1.0, 0.25, -0.5);
+		break;
+	}
+	case 5:
+		v[0] = o;
+		v[1] = px_v3_add(o, rand_unit());
+		v[2] = v[1];
+		break;
+	default:
+		v[0] = v[1] = v[2] = o;
+		break;
+	}
+}
+
+/* A query point for triangle v of kind 0..4: 0 random near it; 1 just
+ * above an interior point (1e-12 .. 1e-3 of its size); 2 near an edge;
+ * 3 far away (1e6 times its size); 4 in the plane, inside or out. */
+static px_vec3 hard_point(int kind, const px_vec3 v[3])
+{
+	double w0 = px_rand_unit(), w1 = px_rand_unit() * (1.0 - w0);
+	px_vec3 in = px_v3_add(px_v3_scale(v[0], 1.0 - w0 - w1),
+			       px_v3_add(px_v3_scale(v[1], w0), px_v3_scale(v[2], w1)));
+	px_vec3 n = px_v3_cross(px_v3_sub(v[1], v[0]), px_v3_sub(v[2], v[0]));
+	double l = longest_edge(v[0], v[1], v[2]);
+	if (!(l > 0.0))
+		l = 1.0;
+	if (px_v3_norm2(n) > 0.0)
+		n = px_v3_scale(n, 1.0 / px_v3_norm(n));
+	else
+		n = rand_unit();
+	switch (kind) {
+	case 0:
+		return px_v3_madd(in, rand_unit(), l * px_rand_range(0.0, 2.0));
+	case 1:
+		return px_v3_madd(in, n, l * pow(10.0, px_rand_range(-12.0, -3.0)) *
+					      (px_rand_unit() < 0.5 ? -1 : 1));
+	case 2: {
+		int e = px_rand_int(0, 2);
+		px_vec3 x = px_v3_lerp(v[e], v[(e + 1) % 3], px_rand_unit());
+		return px_v3_madd(x, rand_unit(), l * pow(10.0, px_rand_range(-12.0, -1.0)));
+	}
+	case 3:
+		return px_v3_madd(in, rand_unit(), l * 1e6 * px_rand_range(1.0, 2.0));
+	default:
+		return px_v3_madd(in, perp(n), l * px_rand_range(-0.3, 0.3));
+	}
+}
+
+static px_vec3 scaled(px_vec3 v, double s, px_vec3 off)
+{
+	return px_v3_add(px_v3_scale(v, s), off);
+}
+
+/* error of one px_tri_closest answer in units of u (d* + l) */
+static double tri_err(px_vec3 p, const px_vec3 v[3], double *got, long double *want)
+{
+	px_vec3 q;
+	int f, s;
+	double u, w;
+	double d2 = px_tri_closest(p, v[0], v[1], v[2], &q, &f, &s, &u, &w);
+	long double ref = ref_tri(p, v[0], v[1], v[2]);
+	double l = longest_edge(v[0], v[1], v[2]), d = sqrt(d2);
+	*got = d;
+	*want = ref;
+	return (double)(fabsl((long double)d - ref) - 1e-160L) / (U * ((double)ref + l));
+}
+
+/*
+ * px_tri_closest over every kind of triangle and point, at scales 1e-100
+ * to 1e100 and translated by up to 1e3 times the size: the documented
+ * bound holds for every answer, and the closest point it reports lies
+ * at the reported distance.
+ */
+static void test_tri_bound(void)
+{
+	static const double scales[] = {1e-100, 1e-50, 1e-8, 1.0, 1e8, 1e50, 1e100};
+	double worst = 0.0;
+	int it, kinds[8] = {0};
+
+	for (it = 0; it < 60000; it++) {
+		px_vec3 v0[3], v[3], p, off;
+		int tk = it % 8, pk = (it / 8) % 5;
+		double s = scales[(it / 40) % 7], got, e;
+		long double want;
+		hard_tri(tk, v0);
+		p = hard_point(pk, v0);
+		off = px_rand_unit() < 0.5 ? px_v3(0, 0, 0)
+					   : px_v3_scale(rand_unit(), s * px_rand_range(0, 1e3));
+		v[0] = scaled(v0[0], s, off);
+		v[1] = scaled(v0[1], s, off);
+		v[2] = scaled(v0[2], s, off);
+		p = scaled(p, s, off);
+		e = tri_err(p, v, &got, &want);
+		if (e > worst)
+			worst = e;
+		if (e > PX_TRI_ERR_ULPS)
+			kinds[tk]++;
+		PX_CHECK_MSG(e <= PX_TRI_ERR_ULPS,
+			     "triangle kind %d, point kind %d, scale %g: distance %.17g, reference "
+			     "%.17Lg (%.1f u (d + l))",
+			     tk, pk, s, got, want, e);
+	}
+	printf("  px_tri_closest: worst error %.2f u (d + l) over 60000 answers (bound %g)\n",
+	       worst, PX_TRI_ERR_ULPS);
+	(void)kinds;
+}
+
+/*
+ * The reported case: needles of aspect 1e7..1e8 with the point just
+ * above the face. The distance is the height, not the in-plane distance
+ * to an edge (up to 30 times too large before).
+ */
+static void test_needle_face(void)
+{
+	int it, bad = 0;
+	double worst = 0.0;
+	for (it = 0; it < 20000; it++) {
+		px_vec3 d = rand_unit(), n = perp(d), v[3], p, base;
+		double asp = pow(10.0, px_rand_range(7.0, 8.0)), got, e;
+		double t = px_rand_range(0.2, 0.8), z = pow(10.0, px_rand_range(-12, -9));
+		long double want;
+		v[0] = px_v3(0, 0, 0);
+		v[1] = d;
+		v[2] = px_v3_madd(px_v3_scale(d, t), n, 1.0 / asp);
+		/* above a point inside, at a height below the needle's width */
+		base = px_v3_madd(px_v3_scale(d, t * px_rand_range(0.3, 0.9)), n,
+				  0.5 / asp * px_rand_range(0.2, 0.8));
+		p = px_v3_madd(base, px_v3_cross(d, n), z);
+		e = tri_err(p, v, &got, &want);
+		bad += e > PX_TRI_ERR_ULPS;
+		worst = fmax(worst, (double)(got / want));
+		PX_CHECK_MSG(e <= PX_TRI_ERR_ULPS,
+			     "needle aspect %.3g, height %.3g: distance %.17g, reference %.17Lg "
+			     "(%.3g times)",
+			     asp, z, got, want, (double)(got / want));
+	}
+	printf("  needles 1e7..1e8: largest distance / reference %.6f\n", worst);
+	(void)bad;
+}
+
+/* ---- meshes ---------------------------------------------------------------- */
+
+/* least reference distance over every triangle of the arrays */
+static long double ref_mesh(const double *xyz, const uint32_t *tri, size_t nt, px_vec3 p,
+			    double *lmax)
+{
+	long double best = INFINITY;
+	size_t i;
+	*lmax = 0.0;
+	for (i = 0; i < nt; i++) {
+		px_vec3 v[3];
+		long double d;
+		int k;
+		for (k = 0; k < 3; k++) {
+			const double *X = xyz + 3 * tri[3 * i + k];
+			v[k] = px_v3(X[0], X[1], X[2]);
+		}
+		d = ref_tri(p, v[0], v[1], v[2]);
+		if (d < best)
+			best = d;
+		*lmax = fmax(*lmax, longest_edge(v[0], v[1], v[2]));
+	}
+	return best;
+}
+
+/*
+ * A closed thin prism (a needle solid: a triangle of width 1e-7 .. 1e-9
+ * swept along 1 m, capped; every side triangle a needle) and an open fan
+ * of needles, at scales 1e-100 .. 1e100, with and without a hint grid:
+ * every query answers within the bound of the linear reference, and
+ * coherent queries agree.
+ */
+static void test_mesh_needles(void)
+{
+	static const double scales[] = {1e-100, 1e-20, 1.0, 1e20, 1e100};
+	double worst = 0.0;
+	int sc, g;
+	for (sc = 0; sc < 5; sc++)
+		for (g = 0; g < 2; g++) {
+			double s = scales[sc], w = pow(10.0, -px_rand_range(7.0, 9.0));
+			/* prism: triangle (0,0) (w,0) (w/2, w) in yz, x from 0 to 1 */
+			double xyz[3 * 6 + 3 * 12];
+			uint32_t tri[3 * 8 + 3 * 10];
+			static const uint32_t pt[] = {0, 2, 1, 3, 4, 5, 0, 1, 4, 0, 4, 3,
+						      1, 2, 5, 1, 5, 4, 2, 0, 3, 2, 3, 5};
+			struct px_mesh_opts opt;
+			struct px_mesh_report rp;
+			struct px_model *m;
+			size_t nv = 6, nt = 8, i;
+			int k, it;
+			double yz[3][2] = {{0, 0}, {w, 0}, {w / 2, w}};
+			for (i = 0; i < 3; i++) {
+				xyz[3 * i] = 0.0;
+				xyz[3 * i + 1] = yz[i][0] * s;
+				xyz[3 * i + 2] = yz[i][1] * s;
+				xyz[3 * (i + 3)] = s;
+				xyz[3 * (i + 3) + 1] = yz[i][0] * s;
+				xyz[3 * (i + 3) + 2] = yz[i][1] * s;
+			}
+			memcpy(tri, pt, sizeof(pt));
+			/* fan of needles beside it (z = 2 w s), 12 vertices */
+			for (i = 0; i < 12; i++) {
+				xyz[3 * (nv + i)] = s * (double)i / 11.0;
+				xyz[3 * (nv + i) + 1] = s * (i % 2 ? w : 0.0) + 3 * w * s;
+				xyz[3 * (nv + i) + 2] = 2 * w * s;
+			}
+			for (i = 0; i < 10; i++) {
+				tri[3 * (nt + i)] = (uint32_t)(nv + i);
+				tri[3 * (nt + i) + 1] = (uint32_t)(nv + i + 1);
+				tri[3 * (nt + i) + 2] = (uint32_t)(nv + i + 2);
+			}
+			nv += 12;
+			nt += 10;
+			memset(&opt, 0, sizeof(opt));
+			opt.grid_cells = g ? 64 : 0;
+			PX_CHECK_INT_EQ(px_mesh_model(xyz, nv, tri, nt, &opt, &rp, &m), PX_OK);
+			for (it = 0; it < 400; it++) {
+				struct px_model_result r;
+				long double ref;
+				double lmax, e;
+				px_vec3 p = px_v3(px_rand_range(-0.1, 1.1) * s,
+						  px_rand_range(-2, 6) * w * s, px_rand_range(-2, 4) * w * s);
+				if (it % 4 == 1) /* far */
+					p = px_v3_madd(p, rand_unit(), 1e6 * s);
+				if (it % 4 == 2) /* on a side face, 1e-12 of w off */
+					p = px_v3(px_rand_range(0.1, 0.9) * s, px_rand_range(0.3, 0.7) * w * s,
+						  -1e-12 * w * s * px_rand_range(-1, 1));
+				ref = ref_mesh(xyz, tri, nt, p, &lmax);
+				PX_CHECK_INT_EQ(px_model_query(m, p, &r), 1);
+				e = (double)(fabsl((long double)fabs(r.distance) - ref) - 1e-160L) /
+				    (U * ((double)ref + lmax));
+				worst = fmax(worst, e);
+				PX_CHECK_MSG(e <= PX_TRI_ERR_ULPS,
+					     "scale %g width %.3g grid %d point %d: %.17g vs %.17Lg "
+					     "(%.1f u)",
+					     s, w, g, it, r.distance, ref, e);
+				for (k = 0; k < 1; k++) {
+					struct px_model_result r2;
+					PX_CHECK_INT_EQ(px_model_query_ex(m, p, INFINITY, PX_QUERY_COHERENT,
+									  r.index, &r2),
+							1);
+					PX_CHECK(fabs(fabs(r2.distance) - fabs(r.distance)) <=
+						 PX_TRI_ERR_ULPS * U * ((double)ref + lmax));
+				}
+			}
+			px_model_free(m);
+		}
+	printf("  needle meshes: worst error %.2f u (d + l)\n", worst);
+}
+
+/*
+ * The accepted range: a vertex beyond 1e150 (and 1e250, 1e308: where
+ * answers used to go wrong) is refused with PX_E_RANGE and a message
+ * naming the vertex; so is a mesh smaller than 1e-140. At 1e150 itself
+ * the mesh builds, also with a hint grid, and answers within the bound;
+ * a query point beyond the query reach is refused.
+ */
+static void test_mesh_range(void)
+{
+	static const double big[] = {1.01e150, 1e200, 1e250, 1e308, -1e300};
+	double xyz[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+	uint32_t tri[12] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+	struct px_mesh_report rp;
+	struct px_mesh_opts opt;
+	struct px_model *m = NULL;
+	int i, it;
+
+	for (i = 0; i < 5; i++) {
+		double x[12];
+		memcpy(x, xyz, sizeof(x));
+		x[3 * 2 + 1] = big[i];
+		PX_CHECK_INT_EQ(px_mesh_model(x, 4, tri, 4, NULL, &rp, &m), PX_E_RANGE);
+		PX_CHECK(m == NULL);
+		PX_CHECK_MSG(strstr(rp.message, "vertex 2") != NULL && strstr(rp.message, "range"),
+			     "%s", rp.message);
+	}
+	{
+		double x[12];
+		for (i = 0; i < 12; i++)
+			x[i] = xyz[i] * 1e-200 + 1.0;
+		/* extent 1e-200 (the coordinates round to 1: extent 0, accepted) */
+		PX_CHECK_INT_EQ(px_mesh_model(x, 4, tri, 4, NULL, &rp, &m), PX_OK);
+		px_model_free(m);
+		for (i = 0; i < 12; i++)
+			x[i] = xyz[i] * 1e-200;
+		PX_CHECK_INT_EQ(px_mesh_model(x, 4, tri, 4, NULL, &rp, &m), PX_E_RANGE);
+		PX_CHECK_MSG(strstr(rp.message, "extent") != NULL, "%s", rp.message);
+	}
+	/* 1e150 and -1e150: the largest accepted, with and without a grid */
+	for (i = 0; i < 2; i++) {
+		double x[3 * 40];
+		uint32_t t[3 * 38];
+		size_t nt = 38, k;
+		for (k = 0; k < 40; k++) {
+			x[3 * k] = 1e150 * cos(0.3 * (double)k) * (k % 2 ? 1 : -1);
+			x[3 * k + 1] = 1e150 * sin(0.7 * (double)k);
+			x[3 * k + 2] = 1e150 * ((double)(k % 3) - 1.0) * 0.9;
+		}
+		for (k = 0; k < nt; k++) {
+			t[3 * k] = (uint32_t)k;
+			t[3 * k + 1] = (uint32_t)k + 1;
+			t[3 * k + 2] = (uint32_t)k + 2;
+		}
+		memset(&opt, 0, sizeof(opt));
+		opt.grid_cells = i ? PX_MESH_MAX_GRID_CELLS : 0;
+		PX_CHECK_MSG(px_mesh_model(x, 40, t, nt, &opt, &rp, &m) == PX_OK, "%s", rp.message);
+		for (it = 0; it < 200; it++) {
+			struct px_model_result r;
+			px_vec3 p = px_v3(px_rand_range(-1.5e150, 1.5e150), px_rand_range(-1.5e150, 1.5e150),
+					  px_rand_range(-1.5e150, 1.5e150));
+			double lmax, e;
+			long double ref = ref_mesh(x, t, nt, p, &lmax);
+			PX_CHECK_INT_EQ(px_model_query(m, p, &r), 1);
+			PX_CHECK(isfinite(r.distance));
+			e = (double)(fabsl((long double)fabs(r.distance) - ref)) / (U * ((double)ref + lmax));
+			PX_CHECK_MSG(e <= PX_TRI_ERR_ULPS, "1e150 mesh: %.17g vs %.17Lg (%.1f u)",
+				     r.distance, ref, e);
+		}
+		{
+			struct px_model_result r;
+			PX_CHECK_INT_EQ(px_model_query(m, px_v3(0, 0, 5e150), &r), PX_E_RANGE);
+		}
+		px_model_free(m);
+	}
+}
+
+/* px_tri_closest refuses coordinates beyond its range (NaN: no answer
+ * rather than an overflowed one) and non-finite ones. */
+static void test_tri_range(void)
+{
+	px_vec3 a = px_v3(0, 0, 0), b = px_v3(1, 0, 0), c = px_v3(0, 1, 0), q;
+	int f, s;
+	double d2 = px_tri_closest(px_v3(0, 0, 1e200), a, b, c, &q, &f, &s, NULL, NULL);
+	PX_CHECK(isnan(d2));
+	PX_CHECK_INT_EQ(f, PX_FEATURE_NONE);
+	d2 = px_tri_closest(px_v3(0, 0, 1), a, px_v3(1e300, 0, 0), c, &q, &f, &s, NULL, NULL);
+	PX_CHECK(isnan(d2));
+	d2 = px_tri_closest(px_v3(0, 0, NAN), a, b, c, &q, &f, &s, NULL, NULL);
+	PX_CHECK(isnan(d2));
+	/* the largest accepted: finite and right */
+	d2 = px_tri_closest(px_v3(0.25e152, 0.25e152, 1e152), px_v3(0, 0, 0),
+			    px_v3(1e152, 0, 0), px_v3(0, 1e152, 0), &q, &f, &s, NULL, NULL);
+	PX_CHECK_CLOSE(sqrt(d2), 1e152, 0.0, 4 * U);
+	PX_CHECK_INT_EQ(f, PX_FEATURE_FACE);
+}
+
+/* ---- primitives ------------------------------------------------------------ */
+
+/* long double reference: signed distance of q to primitive p */
+static long double ld_seg2(long double px, long double pz, long double ax, long double az,
+			   long double bx, long double bz)
+{
+	long double dx = bx - ax, dz = bz - az, l2 = dx * dx + dz * dz, t = 0;
+	if (l2 > 0) {
+		t = ((px - ax) * dx + (pz - az) * dz) / l2;
+		t = t < 0 ? 0 : (t > 1 ? 1 : t);
+	}
+	dx = px - (ax + t * dx);
+	dz = pz - (az + t * dz);
+	return sqrtl(dx * dx + dz * dz);
+}
+
+static long double ref_prim(const struct px_prim *p, px_vec3 q)
+{
+	long double x = q.x, y = q.y, z = q.z, rho = sqrtl(x * x + y * y);
+	long double a = p->a, b = p->b, c = p->c;
+	switch (p->type) {
+	case PX_PRIM_SPHERE:
+		return sqrtl(x * x + y * y + z * z) - a;
+	case PX_PRIM_BOX: {
+		long double o[3] = {fabsl(x) - a, fabsl(y) - b, fabsl(z) - c}, s = 0, m = o[0];
+		int k;
+		for (k = 0; k < 3; k++) {
+			if (o[k] > 0)
+				s += o[k] * o[k];
+			if (o[k] > m)
+				m = o[k];
+		}
+		return m > 0 ? sqrtl(s) : m;
+	}
+	case PX_PRIM_CAPSULE: {
+		long double zc = z < -b ? -b : (z > b ? b : z);
+		return sqrtl(rho * rho + (z - zc) * (z - zc)) - a;
+	}
+	case PX_PRIM_CYLINDER:
+	case PX_PRIM_CONE: {
+		long double r0 = a, r1 = p->type == PX_PRIM_CONE ? c : a, h = b;
+		long double d = ld_seg2(rho, z, 0, -h, r0, -h), e;
+		int inside;
+		e = ld_seg2(rho, z, r0, -h, r1, h);
+		d = e < d ? e : d;
+		e = ld_seg2(rho, z, r1, h, 0, h);
+		d = e < d ? e : d;
+		inside = fabsl(z) <= h && rho <= r0 + (r1 - r0) * (z + h) / (2 * h);
+		return inside ? -d : d;
+	}
+	case PX_PRIM_TORUS:
+		return sqrtl((rho - a) * (rho - a) + z * z) - b;
+	default:
+		return z;
+	}
+}
+
+static double prim_size(const struct px_prim *p)
+{
+	return fmax(fabs(p->a), fmax(fabs(p->b), fabs(p->c)));
+}
+
+/*
+ * Every primitive at scales 1e-100 .. 1e100 with thin and flat shapes
+ * (aspect up to 1e9), points near the surface (1e-12 of the size),
+ * inside, and far away (1e6 times the size): the signed distance within
+ * the documented bound of the long double reference, and the reported
+ * point at the reported distance.
+ */
+static void test_prim_bound(void)
+{
+	static const double scales[] = {1e-100, 1e-30, 1e-3, 1.0, 1e3, 1e30, 1e100};
+	double worst = 0.0;
+	int it;
+	for (it = 0; it < 40000; it++) {
+		struct px_prim p;
+		struct px_model_result r;
+		double s = scales[it % 7], asp = pow(10.0, px_rand_range(0, 9)), e, size;
+		long double ref;
+		px_vec3 q;
+		memset(&p, 0, sizeof(p));
+		p.type = (enum px_prim_type)(1 + (it / 7) % 7);
+		p.a = s * px_rand_range(0.5, 1.5);
+		p.b = s * px_rand_range(0.5, 1.5) / (px_rand_unit() < 0.3 ? asp : 1.0);
+		p.c = s * px_rand_range(0.5, 1.5) * (px_rand_unit() < 0.3 ? asp : 1.0);
+		if (p.type == PX_PRIM_TORUS && !(p.b < p.a))
+			p.b = p.a * 0.5;
+		if (p.type == PX_PRIM_CONE && px_rand_unit() < 0.3)
+			p.c = 0.0;
+		if (p.type == PX_PRIM_CAPSULE || p.type == PX_PRIM_CYLINDER)
+			p.a = p.a / (px_rand_unit() < 0.3 ? asp : 1.0);
+		PX_CHECK_INT_EQ(px_prim_check(&p), PX_OK);
+		size = prim_size(&p);
+		q = px_v3_scale(rand_unit(), size * px_rand_range(0, 2));
+		if (it % 3 == 1) {
+			/* near the surface: step from the closest point along
+			 * the normal by 1e-12 .. 1e-3 of the size */
+			PX_CHECK_INT_EQ(px_prim_closest(&p, q, 0, &r), PX_OK);
+			q = px_v3_madd(r.point, r.direction,
+				       size * pow(10.0, px_rand_range(-12, -3)) *
+					       (px_rand_unit() < 0.5 ? -1 : 1));
+		} else if (it % 3 == 2) {
+			q = px_v3_scale(rand_unit(), size * 1e6 * px_rand_range(1, 2));
+		}
+		PX_CHECK_INT_EQ(px_prim_closest(&p, q, 0, &r), PX_OK);
+		ref = ref_prim(&p, q);
+		e = (double)fabsl((long double)r.distance - ref) / (U * (px_v3_norm(q) + size));
+		worst = fmax(worst, e);
+		PX_CHECK_MSG(e <= PX_PRIM_ERR_ULPS,
+			     "primitive %d (%g %g %g) at (%g %g %g): %.17g vs %.17Lg (%.1f u)",
+			     p.type, p.a, p.b, p.c, q.x, q.y, q.z, r.distance, ref, e);
+		PX_CHECK_MSG(fabs(px_v3_dist(q, r.point) - fabs(r.distance)) <=
+				     PX_PRIM_ERR_ULPS * U * (px_v3_norm(q) + size),
+			     "primitive %d: point at %.17g, distance %.17g", p.type,
+			     px_v3_dist(q, r.point), r.distance);
+	}
+	printf("  primitives: worst error %.2f u (|q| + size)\n", worst);
+}
+
+/* Lengths beyond the accepted range are refused (PX_E_RANGE) by the
+ * check and by the model; at the limits the answers are finite. */
+static void test_prim_range(void)
+{
+	static const enum px_prim_type ty[] = {PX_PRIM_SPHERE, PX_PRIM_BOX, PX_PRIM_CAPSULE,
+					       PX_PRIM_CYLINDER, PX_PRIM_CONE, PX_PRIM_TORUS};
+	int i;
+	for (i = 0; i < 6; i++) {
+		struct px_prim p = {ty[i], 1e200, 1e199, 1e199};
+		struct px_model *m = NULL;
+		struct px_model_result r;
+		PX_CHECK_INT_EQ(px_prim_check(&p), PX_E_RANGE);
+		PX_CHECK_INT_EQ(px_prim_model(&p, &m), PX_E_RANGE);
+		PX_CHECK(m == NULL);
+		p.a = 2e-150;
+		p.b = 1e-150;
+		p.c = 1e-150;
+		PX_CHECK_INT_EQ(px_prim_check(&p), PX_E_RANGE);
+		p.a = PX_PRIM_MAX_LENGTH;
+		p.b = PX_PRIM_MAX_LENGTH / 2;
+		p.c = PX_PRIM_MAX_LENGTH / 2;
+		PX_CHECK_INT_EQ(px_prim_check(&p), PX_OK);
+		PX_CHECK_INT_EQ(px_prim_closest(&p, px_v3(3e150, -2e150, 1e150), 0, &r), PX_OK);
+		PX_CHECK(isfinite(r.distance) && px_v3_isfinite(r.point));
+		PX_CHECK_MSG((double)fabsl((long double)r.distance -
+					   ref_prim(&p, px_v3(3e150, -2e150, 1e150))) <=
+				     PX_PRIM_ERR_ULPS * U * 5e150,
+			     "type %d at the limit: %.17g", ty[i], r.distance);
+	}
+}
+
+static const struct px_test tests[] = {
+	PX_T(test_tri_bound),   PX_T(test_needle_face), PX_T(test_tri_range),
+	PX_T(test_mesh_needles), PX_T(test_mesh_range), PX_T(test_prim_bound),
+	PX_T(test_prim_range),
+};
+
+PX_TEST_MAIN(tests)
