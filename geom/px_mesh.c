@@ -2,6 +2,7 @@
  * px_mesh.c - triangle mesh model: validation, topology, pseudo-normals,
  * AABB hierarchy, exact point-triangle distance.
  */
+#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -1211,16 +1212,19 @@ void px__grid_layout(px_aabb box, long cap, int d[3], px_vec3 *org, double *h_ou
 	margin = len > 0.0 ? 0.125 * len : 1.0;
 	vol = (ext[0] + 2 * margin) * (ext[1] + 2 * margin) * (ext[2] + 2 * margin);
 	h = cbrt(vol / (double)cap);
-	/* a model wider than about 1e102 overflows the volume, not its
-	 * cube root */
-	if (!isfinite(h))
+	/* a model wider than about 1e102 overflows the volume, one
+	 * smaller than about 1e-103 underflows it to 0; neither its cube
+	 * root */
+	if (!isfinite(h) || !(h > 0.0))
 		h = cbrt(ext[0] + 2 * margin) * cbrt(ext[1] + 2 * margin) *
 		    cbrt(ext[2] + 2 * margin) / cbrt((double)cap);
 	for (it = 0;; it++) {
 		double cells = 1.0;
 		for (k = 0; k < 3; k++) {
 			double n = ceil((ext[k] + 2 * margin) / h);
-			d[k] = n < 1.0 ? 1 : (int)n;
+			/* clamped before the cast (undefined past INT_MAX);
+			 * more than cap cells fail the test below anyway */
+			d[k] = !(n >= 1.0) ? 1 : (n > (double)cap ? (int)(cap < INT_MAX ? cap : INT_MAX) : (int)n);
 			cells *= d[k];
 		}
 		if (cells <= (double)cap || it > 200)

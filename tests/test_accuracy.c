@@ -501,6 +501,59 @@ static void test_mesh_range(void)
 	}
 }
 
+/*
+ * Hint grids at the ends of the accepted range: meshes of extent 1e-139
+ * (the volume of the grown box underflows to 0 there), 1e-100, 1 and
+ * 2e150, flat ones among them, with the largest grid budget: setup
+ * neither crashes nor overflows a cell count, and every answer agrees
+ * with the one without the grid.
+ */
+static void test_grid_extremes(void)
+{
+	static const double scales[] = {1e-139, 1e-100, 1.0, 1e150};
+	int sc, flat;
+	for (sc = 0; sc < 4; sc++)
+		for (flat = 0; flat < 2; flat++) {
+			enum { N = 300 };
+			double *xyz = malloc(9 * N * sizeof(double));
+			uint32_t *tri = malloc(3 * N * sizeof(uint32_t));
+			struct px_mesh_opts opt;
+			struct px_mesh_report rp;
+			struct px_model *mg, *m0;
+			double s = scales[sc];
+			size_t i;
+			int it;
+			PX_CHECK(xyz && tri);
+			for (i = 0; i < 9 * N; i++)
+				xyz[i] = (i % 3 == 2 && flat) ? 0.0 : s * px_rand_range(-1, 1);
+			for (i = 0; i < 3 * N; i++)
+				tri[i] = (uint32_t)i;
+			memset(&opt, 0, sizeof(opt));
+			PX_CHECK_MSG(px_mesh_model(xyz, 3 * N, tri, N, &opt, &rp, &m0) == PX_OK, "%s",
+				     rp.message);
+			opt.grid_cells = PX_MESH_MAX_GRID_CELLS;
+			PX_CHECK_MSG(px_mesh_model(xyz, 3 * N, tri, N, &opt, &rp, &mg) == PX_OK, "%s",
+				     rp.message);
+			for (it = 0; it < 200; it++) {
+				struct px_model_result a, b;
+				/* within the query reach (1e150 beyond the box) at 1e150 */
+				px_vec3 p = px_v3_scale(rand_unit(), s * px_rand_range(0, sc == 3 ? 0.99 : 3.0));
+				PX_CHECK_INT_EQ(px_model_query(m0, p, &a), 1);
+				PX_CHECK_INT_EQ(px_model_query(mg, p, &b), 1);
+				/* both exact: equal within the bound (ties of
+				 * triangles may be broken differently) */
+				PX_CHECK_MSG(fabs(a.distance - b.distance) <=
+						     PX_TRI_ERR_ULPS * U * (fabs(a.distance) + 4 * s),
+					     "scale %g flat %d: grid %.17g, none %.17g", s, flat,
+					     b.distance, a.distance);
+			}
+			px_model_free(m0);
+			px_model_free(mg);
+			free(xyz);
+			free(tri);
+		}
+}
+
 /* px_tri_closest refuses coordinates beyond its range (NaN: no answer
  * rather than an overflowed one) and non-finite ones. */
 static void test_tri_range(void)
@@ -673,7 +726,8 @@ static void test_prim_range(void)
 
 static const struct px_test tests[] = {
 	PX_T(test_tri_bound),   PX_T(test_needle_face), PX_T(test_tri_range),
-	PX_T(test_mesh_needles), PX_T(test_mesh_range), PX_T(test_prim_bound),
+	PX_T(test_mesh_needles), PX_T(test_mesh_range), PX_T(test_grid_extremes),
+	PX_T(test_prim_bound),
 	PX_T(test_prim_range),
 };
 
