@@ -248,6 +248,10 @@ int main(int argc, char **argv)
 	}
 	signal(SIGINT, on_signal);
 	signal(SIGTERM, on_signal);
+	/* stdout may be a pipe its reader closed (proxima-run reads only
+	 * the first line): a late report must not kill the arm before it
+	 * has closed its bus and removed its socket */
+	signal(SIGPIPE, SIG_IGN);
 	printf("proxima-simarm: %d drives on %s%s%s\n", n, iface ? iface : local,
 	       config ? ", layout from " : "", config ? config : "");
 	fflush(stdout);
@@ -262,6 +266,20 @@ int main(int argc, char **argv)
 		ts.tv_sec = next / 1000000000;
 		ts.tv_nsec = next % 1000000000;
 		clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL);
+	}
+	{
+		/* the drives' own view at the end: what the controller last
+		 * told them over the bus (a controller that stopped safely
+		 * leaves each in switch on disabled) */
+		int k, st;
+		double pos;
+		for (k = 0; k < n; k++)
+			if (px_canopen_sim_joint(sim, (size_t)k, &pos, &st) == PX_OK)
+				printf("proxima-simarm: drive %d (node %u) at the "
+				       "end: %s, position %.6g\n",
+				       k, drv[k].node_id, px_cia402_state_name(st),
+				       pos);
+		fflush(stdout);
 	}
 	px_canopen_sim_free(sim);
 	px_can_bus_close(bus);
