@@ -200,6 +200,24 @@ static void test_uhid_device_roundtrip(void)
 	PX_CHECK_INT_EQ(ev.u.output.data[0], 2);
 	PX_CHECK_INT_EQ(ev.u.output.data[1] | (ev.u.output.data[2] << 8), 1500);
 	PX_CHECK_INT_EQ(ev.u.output.data[5] | (ev.u.output.data[6] << 8), 3000);
+	/* the safe output: sent by the I/O thread, confirmed by hidapi's
+	 * byte count, and the last report the device gets is zero */
+	PX_CHECK_INT_EQ(px_dev_force_write(d, &cmd, px_dev_mono_ns()), PX_OK);
+	PX_CHECK_INT_EQ(px_dev_safe(d, px_dev_mono_ns()), PX_OK);
+	{
+		uint8_t last[7] = {0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff};
+		int got = 0;
+		while (uhid_wait(fd, UHID_OUTPUT, &ev, 300) == 0) {
+			memcpy(last, ev.u.output.data, 7);
+			got++;
+		}
+		PX_CHECK(got >= 1);
+		PX_CHECK_INT_EQ(last[0], 2);
+		for (k = 1; k < 7; k++)
+			PX_CHECK_INT_EQ(last[k], 0);
+	}
+	px_dev_status(d, &st);
+	PX_CHECK_INT_EQ(st.outputs_safe, 1);
 	/* unplug: the reader sees it, the cycle gets PX_E_NODEV */
 	memset(&ev, 0, sizeof ev);
 	ev.type = UHID_DESTROY;
@@ -325,6 +343,10 @@ static void test_usb_hid_gadget(void)
 	{
 		struct px_force_cmd cmd = {{1.5, -0.25, 7.0}, {0, 0, 0}, 1};
 		struct pollfd p = {fd, POLLIN, 0};
+		/* the gadget may still hold the safe (zero) report an earlier
+		 * program's device sent when it was freed: not this one's */
+		while (poll(&p, 1, 200) == 1 && read(fd, rep, sizeof rep) > 0)
+			;
 		PX_CHECK_INT_EQ(px_dev_force_write(d, &cmd, px_dev_mono_ns()),
 				PX_OK);
 		PX_CHECK(poll(&p, 1, 5000) == 1);

@@ -15,10 +15,13 @@
  * of counts to STATUS_FILE:
  *
  *   inputs N outputs N nonzero N max_mn N tail_outputs N tail_nonzero N
+ *   ... last_fx N last_fy N last_fz N
  *
  * where tail_* counts the output reports of the last TAIL_S seconds
  * before the end (the scenario presses the e-stop well before: all of
- * them must be zero). Exit status 0, or 1 with the reason on stderr.
+ * them must be zero) and last_* is the last output report received (mN):
+ * what the device was left with when the host stopped. Exit status 0, or
+ * 1 with the reason on stderr.
  */
 #include <errno.h>
 #include <fcntl.h>
@@ -82,7 +85,7 @@ int main(int argc, char **argv)
 	unsigned long inputs = 0, outputs = 0, nonzero = 0, tail_n = 0,
 		      tail_nz = 0;
 	size_t head = 0, count = 0, i;
-	int fd, opened = 0, closed = 0, max_mn = 0;
+	int fd, opened = 0, closed = 0, max_mn = 0, last[3] = {0, 0, 0};
 	FILE *f;
 	if (argc != 3 || (seconds = atof(argv[1])) <= 0) {
 		fprintf(stderr, "usage: uhid_feed SECONDS STATUS_FILE\n");
@@ -158,6 +161,7 @@ int main(int argc, char **argv)
 				int k, nz = 0;
 				for (k = 0; k < 3; k++) {
 					int v = get_i16(ev.u.output.data + 1 + 2 * k);
+					last[k] = v;
 					if (v)
 						nz = 1;
 					if (abs(v) > max_mn)
@@ -199,8 +203,10 @@ int main(int argc, char **argv)
 	}
 	fprintf(f,
 		"inputs %lu outputs %lu nonzero %lu max_mn %d tail_outputs %lu "
-		"tail_nonzero %lu opened %d closed %d\n",
-		inputs, outputs, nonzero, max_mn, tail_n, tail_nz, opened, closed);
+		"tail_nonzero %lu opened %d closed %d last_fx %d last_fy %d "
+		"last_fz %d\n",
+		inputs, outputs, nonzero, max_mn, tail_n, tail_nz, opened, closed,
+		last[0], last[1], last[2]);
 	fclose(f);
 	if (!opened) {
 		fprintf(stderr, "uhid_feed: nobody opened the device\n");
