@@ -108,14 +108,18 @@ enum px_nurbs_fault {
 };
 
 /* Largest |control point coordinate| (model units): the curve or surface
- * lies in its control points' hull, so its extent and the squared
- * distances of every query within the models' reach (1e150 beyond the
- * box, px_model.h) stay finite. Weights are bounded so that the
+ * lies in its control points' hull, so its extent stays finite, and so
+ * do the surface searches' 2x2 systems, whose determinants multiply two
+ * squared lengths (the fourth power of the extent: surfaces of extent
+ * 5e77 to 3e80 answered wrongly). Weights are bounded so that the
  * homogeneous sums (w times a coordinate) and the weight sums cannot
- * overflow or vanish. */
-#define PX_NURBS_MAX_COORD 1e150
+ * overflow or vanish, and one entity's weights may differ by at most
+ * PX_NURBS_MAX_WEIGHT_RATIO (beyond about 1e12 the distance search's
+ * bounds stop holding). */
+#define PX_NURBS_MAX_COORD 1e75
 #define PX_NURBS_MIN_WEIGHT 1e-100
 #define PX_NURBS_MAX_WEIGHT 1e100
+#define PX_NURBS_MAX_WEIGHT_RATIO 1e6
 
 /*
  * Where and why validation failed. code is the px_err returned; dir is
@@ -164,8 +168,9 @@ PX_API size_t px_nurbs_surf_bytes(int degree_u, int degree_v, int n_u,
  * NULL; when given it is filled (fault NONE and code PX_OK on success).
  * Returns PX_OK, PX_E_INVAL (NULL, knot count/order/multiplicity,
  * too few points), PX_E_RANGE (degree, weight <= 0 or outside
- * PX_NURBS_MIN_WEIGHT .. PX_NURBS_MAX_WEIGHT, a coordinate beyond
- * +-PX_NURBS_MAX_COORD), PX_E_NAN, PX_E_DEGENERATE (empty domain).
+ * PX_NURBS_MIN_WEIGHT .. PX_NURBS_MAX_WEIGHT, weights further apart than
+ * PX_NURBS_MAX_WEIGHT_RATIO, a coordinate beyond +-PX_NURBS_MAX_COORD),
+ * PX_E_NAN, PX_E_DEGENERATE (empty domain).
  */
 PX_API int px_nurbs_curve_validate(int degree, int n_ctrl,
 				   const double *knots, int n_knots,

@@ -247,7 +247,8 @@ int px__nurbs_check_points(int count, int n_u, const double *xyz,
 			   const double *w, const double *pw,
 			   struct px_nurbs_error *err)
 {
-	int i;
+	int i, i_lo = 0, i_hi = 0;
+	double w_lo = INFINITY, w_hi = 0.0;
 
 	if (!xyz && !pw) {
 		px__nurbs_err(err, PX_E_INVAL, PX_NURBS_FAULT_ARG, 0, -1, 0, 0,
@@ -308,6 +309,29 @@ int px__nurbs_check_points(int count, int n_u, const double *xyz,
 			}
 			return rc;
 		}
+		if (wi < w_lo) {
+			w_lo = wi;
+			i_lo = i;
+		}
+		if (wi > w_hi) {
+			w_hi = wi;
+			i_hi = i;
+		}
+	}
+	/* Weights further apart than this pull the curve so hard towards a
+	 * control point that the distance search's bounds stop holding: a
+	 * cubic with weights 1e7 and 1e-7 answered up to 0.3 % too far. */
+	if (w_hi > PX_NURBS_MAX_WEIGHT_RATIO * w_lo) {
+		px__nurbs_err(err, PX_E_RANGE, PX_NURBS_FAULT_WEIGHT, 0, i_hi, w_hi,
+			      w_lo,
+			      "control point %d has weight %g, more than %g times "
+			      "the weight %g of control point %d",
+			      i_hi, w_hi, PX_NURBS_MAX_WEIGHT_RATIO, w_lo, i_lo);
+		if (err && n_u > 0) {
+			err->index_i = i_hi % n_u;
+			err->index_j = i_hi / n_u;
+		}
+		return PX_E_RANGE;
 	}
 	return PX_OK;
 }

@@ -23,6 +23,7 @@
 #include "px_arena.h"
 #include "px_can.h"
 #include "px_cloud.h"
+#include "px_dist.h"
 #include "px_config.h"
 #include "px_file.h"
 #include "px_load.h"
@@ -426,9 +427,29 @@ static void test_cloud_extent(void)
 	}
 }
 
+/* The 3x3 biquadratic dome of half-width S (the control points at +-S,
+ * the middle one raised), its distance model in *dm. */
+static void dome(double S, unsigned char *mem, size_t cap, struct px_nurbs_surf *s,
+		 struct px_dist_model **dm)
+{
+	static const double k[] = {0, 0, 0, 1, 1, 1};
+	struct px_arena a;
+	double sx[27];
+	int i;
+	for (i = 0; i < 9; i++) {
+		sx[3 * i] = (i % 3 - 1) * S;
+		sx[3 * i + 1] = (i / 3 - 1) * S;
+		sx[3 * i + 2] = i == 4 ? S : -S;
+	}
+	px_arena_init(&a, mem, cap);
+	PX_CHECK_INT_EQ(px_nurbs_surf_init(s, &a, 2, 2, 3, 3, k, 6, k, 6, sx, NULL, NULL),
+			PX_OK);
+	PX_CHECK_INT_EQ(px_dist_model_create(NULL, 0, s, 1, NULL, dm), PX_OK);
+}
+
 static void test_nurbs_extent(void)
 {
-	static unsigned char mem[8192];
+	static unsigned char mem[8192], m1[1 << 15], m2[1 << 15];
 	static const double k[] = {0, 0, 0, 1, 1, 1};
 	struct px_arena a;
 	struct px_nurbs_curve c;
@@ -445,14 +466,25 @@ static void test_nurbs_extent(void)
 	px_arena_init(&a, mem, sizeof mem);
 	PX_CHECK_INT_EQ(px_nurbs_curve_init(&c, &a, 2, 3, k, 6, x, NULL, &e), PX_E_RANGE);
 	x[4] = 1.0;
+	x[6] = PX_NURBS_MAX_COORD; /* at the limit */
+	PX_CHECK_INT_EQ(px_nurbs_curve_validate(2, 3, k, 6, x, NULL, &e), PX_OK);
+	x[6] = 2 * PX_NURBS_MAX_COORD;
+	PX_CHECK_INT_EQ(px_nurbs_curve_validate(2, 3, k, 6, x, NULL, &e), PX_E_RANGE);
+	PX_CHECK_INT_EQ(e.index, 2);
+	x[6] = 2.0;
+	/* weights: bounded, and within a ratio of each other */
 	w[2] = 1e120;
 	PX_CHECK_INT_EQ(px_nurbs_curve_validate(2, 3, k, 6, x, w, &e), PX_E_RANGE);
 	PX_CHECK_INT_EQ(e.index, 2);
 	has(e.msg, "weight", NULL);
-	w[2] = 1e90; /* inside the bounds */
+	w[0] = 1e-3;
+	w[2] = 1e3;
 	PX_CHECK_INT_EQ(px_nurbs_curve_validate(2, 3, k, 6, x, w, &e), PX_OK);
-	x[6] = 1e150; /* at the limit */
-	PX_CHECK_INT_EQ(px_nurbs_curve_validate(2, 3, k, 6, x, NULL, &e), PX_OK);
+	w[2] = 2e3;
+	PX_CHECK_INT_EQ(px_nurbs_curve_validate(2, 3, k, 6, x, w, &e), PX_E_RANGE);
+	PX_CHECK_INT_EQ(e.fault, PX_NURBS_FAULT_WEIGHT);
+	PX_CHECK_INT_EQ(e.index, 2);
+	has(e.msg, "control point 2 has weight 2000", "of control point 0");
 
 	for (i = 0; i < 9; i++) {
 		sx[3 * i] = i % 3;
@@ -460,12 +492,36 @@ static void test_nurbs_extent(void)
 		sx[3 * i + 2] = 0.0;
 		sw[i] = 1.0;
 	}
-	sx[3 * 5 + 2] = -3e150;
+	sx[3 * 5 + 2] = -3 * PX_NURBS_MAX_COORD;
 	PX_CHECK_INT_EQ(px_nurbs_surf_validate(2, 2, 3, 3, k, 6, k, 6, sx, sw, &e),
 			PX_E_RANGE);
 	PX_CHECK_INT_EQ(e.fault, PX_NURBS_FAULT_COORD_RANGE);
 	PX_CHECK_INT_EQ(e.index_i, 2);
 	PX_CHECK_INT_EQ(e.index_j, 1);
+
+	/* at the limit a surface answers as its unit-size copy, scaled: the
+	 * fourth powers of its extent in the search stay finite (at 5e77
+	 * about a quarter of these answers were wrong) */
+	{
+		struct px_nurbs_surf s1, s2;
+		struct px_dist_model *d1 = NULL, *d2 = NULL;
+		struct px_dist_result r1, r2;
+		const double S = PX_NURBS_MAX_COORD;
+		int j;
+		dome(1.0, m1, sizeof m1, &s1, &d1);
+		dome(S, m2, sizeof m2, &s2, &d2);
+		for (j = 0; j < 100; j++) {
+			px_vec3 p = px_v3(((j * 37) % 21 - 10) * 0.15, ((j * 11) % 17 - 8) * 0.2,
+					  ((j * 7) % 13 - 6) * 0.3);
+			PX_CHECK_INT_EQ(px_dist_query(d1, p, &r1), PX_OK);
+			PX_CHECK_INT_EQ(px_dist_query(d2, px_v3_scale(p, S), &r2), PX_OK);
+			PX_CHECK_MSG(fabs(r2.dist / S - r1.dist) <= 1e-9 * (1 + r1.dist),
+				     "point %d: %.17g at scale 1e75, %.17g at scale 1", j,
+				     r2.dist / S, r1.dist);
+		}
+		px_dist_model_free(d1);
+		px_dist_model_free(d2);
+	}
 
 	/* through an OBJ file: the control point's place */
 	{
