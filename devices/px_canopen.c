@@ -593,7 +593,7 @@ static int send_rpdo(struct px_canopen *co, size_t i, int32_t raw, int64_t now)
 /* SYNC when enabled, and the heartbeat when due. */
 static int sync_and_heartbeat(struct px_canopen *co, int64_t now)
 {
-	uint8_t b[1];
+	uint8_t b[1] = {0};
 	int rc = PX_OK;
 	if (co->cfg.sync && send_frame(co->bus, 0x080, b, 0, now) == PX_E_IO)
 		rc = PX_E_IO;
