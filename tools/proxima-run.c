@@ -1690,10 +1690,11 @@ static int validate(void)
 	px_config_diag_init(&diag);
 	rc = px_world_config_load(cfg, &A.scene, &diag);
 	if (rc != PX_OK) {
+		int n = px_config_diag_total(&diag);
 		px_config_diag_print(&diag, stderr);
-		n_check_errors += px_config_diag_total(&diag) ? px_config_diag_total(&diag) : 1;
-		if (!px_config_diag_total(&diag))
+		if (n == 0)
 			fprintf(stderr, "%s: %s\n", A.o.config, px_strerror(rc));
+		n_check_errors += n ? n : 1;
 	}
 	for (i = 0; i < (int)cfg->n_devices; i++) {
 		if (!is_hardware(&cfg->devices[i]))
@@ -1724,8 +1725,6 @@ static int validate(void)
 				    "the renderer refuses these parameters: %s",
 				    px_strerror(rc));
 	}
-	/* warnings (the file stays valid) go here, after the refusals */
-
 	if (n_check_errors) {
 		fprintf(stderr, "%s: invalid configuration (%d error%s)\n",
 			A.o.config, n_check_errors, n_check_errors == 1 ? "" : "s");
