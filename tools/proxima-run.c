@@ -56,9 +56,20 @@
  * after CYCLE cycles ("stop now", for tests). px_gpio.h is included for
  * what simulated lines last received (the JSON's shutdown record).
  *
+ * Checks: validate() makes every check setup makes before it opens a
+ * device (outputs, scene, clock, control.device against what the device
+ * can do, telemetry memory, renderer); --check runs it, opens the
+ * in-process simulated devices and checks the others through px_devcfg
+ * without opening them. Outputs go through tools/tool_out.h (temporary
+ * file renamed over the target: no symbolic link followed, never over
+ * the config or an input file). --duration-s runs duration / period
+ * cycles; on the real clock the run also ends once its loop clock has
+ * covered the duration, so missed periods never stretch it.
+ *
  * Exit status: 0 ok, 1 invalid config or setup failure (an absent device
  * is named with the back end's reason) or outputs not confirmed safe at
- * the end, 2 usage error or --virtual-time with hardware.
+ * the end, 2 usage error (a flag's value, an output flag refused) or
+ * --virtual-time with hardware.
  */
 #include <errno.h>
 #include <math.h>
