@@ -1343,21 +1343,12 @@ static int make_device(int k)
 	return 0;
 }
 
-/* sim.spawn_arm: start proxima-simarm (next to this program) as the
- * drives' side of the unix-socket bus, as a second process, and wait
- * until it has bound its socket. It gets SIGTERM when this process ends
- * (teardown, or PR_SET_PDEATHSIG if this one dies). Returns 0 or 1. */
-static int spawn_arm(void)
+/* proxima-simarm next to this program, in exe (cap bytes). Returns 0 or
+ * 1 (said why). */
+static int arm_exe(char *exe, size_t cap)
 {
-	const struct px_config_device *d =
-		px_config_device_find(A.cfg, A.sim.spawn_arm);
-	const struct px_config_socketcan *c = &d->socketcan;
-	char exe[1024], line[256] = "";
-	int fds[2];
-	ssize_t len = readlink("/proc/self/exe", exe, sizeof(exe) - 32);
+	ssize_t len = cap > 32 ? readlink("/proc/self/exe", exe, cap - 32) : -1;
 	char *slash;
-	size_t got = 0;
-	int64_t until;
 	if (len <= 0 || !(slash = memrchr(exe, '/', (size_t)len))) {
 		fprintf(stderr, "proxima-run: sim.spawn_arm: cannot find this "
 				"program's directory\n");
@@ -1370,6 +1361,24 @@ static int spawn_arm(void)
 			exe, strerror(errno));
 		return 1;
 	}
+	return 0;
+}
+
+/* sim.spawn_arm: start proxima-simarm (next to this program) as the
+ * drives' side of the unix-socket bus, as a second process, and wait
+ * until it has bound its socket. It gets SIGTERM when this process ends
+ * (teardown, or PR_SET_PDEATHSIG if this one dies). Returns 0 or 1. */
+static int spawn_arm(void)
+{
+	const struct px_config_device *d =
+		px_config_device_find(A.cfg, A.sim.spawn_arm);
+	const struct px_config_socketcan *c = &d->socketcan;
+	char exe[1024], line[256] = "";
+	int fds[2];
+	size_t got = 0;
+	int64_t until;
+	if (arm_exe(exe, sizeof(exe)))
+		return 1;
 	if (pipe(fds) != 0) {
 		fprintf(stderr, "proxima-run: sim.spawn_arm: pipe: %s\n",
 			strerror(errno));
@@ -1744,6 +1753,37 @@ static int validate(void)
 	return status;
 }
 
+/* The loop as the config describes it (setup, and --check's trial). */
+static void loop_config(struct px_loop_config *lcp)
+{
+	const struct px_config *cfg = A.cfg;
+	struct px_loop_config lc;
+	px_loop_config_default(&lc);
+	lc.period_ns = cfg->loop.period_ns;
+	lc.clock = A.o.virtual_time ? PX_LOOP_CLOCK_VIRTUAL : PX_LOOP_CLOCK_MONOTONIC;
+	lc.overrun = cfg->loop.overrun_policy == PX_CONFIG_OVERRUN_CATCH_UP
+			     ? PX_LOOP_OVERRUN_CATCH_UP
+			     : PX_LOOP_OVERRUN_SKIP;
+	lc.overrun_limit = (uint32_t)cfg->loop.max_consecutive_overruns;
+	lc.compute_budget_ns = cfg->safety.watchdog.compute_budget_ns;
+	lc.budget_limit = (uint32_t)cfg->safety.watchdog.max_over_budget;
+	/* auto_rearm: leave safe state after 50 ms without a fault */
+	lc.rearm_after_ok_cycles =
+		cfg->safety.watchdog.auto_rearm
+			? (uint32_t)(50000000 / cfg->loop.period_ns + 1)
+			: 0;
+	lc.read = phase_read;
+	lc.compute = phase_compute;
+	lc.write = phase_write;
+	lc.user = &A;
+	lc.rt_enable = !A.o.virtual_time;
+	lc.rt.priority = (int)cfg->loop.priority;
+	lc.rt.cpu = (int)cfg->loop.cpu;
+	lc.rt.lock_memory = cfg->loop.lock_memory;
+	lc.rt.dma_latency = cfg->loop.dma_latency;
+	*lcp = lc;
+}
+
 /* A device outside this process (hardware, a UNIX-socket bus) checked
  * as px_devcfg_open() would check it, without opening it. Returns 0 or
  * 1 (said why, at the device's place). */
@@ -1773,10 +1813,24 @@ static int check_device(int k)
  * being opened. Returns the exit status. */
 static int check_config(void)
 {
+	struct px_loop_config lc;
+	char exe[1024];
 	int i, rc = validate();
 	for (i = 0; rc == 0 && i < (int)A.cfg->n_devices && i < MAX_DEVS; i++)
 		rc = is_hardware(&A.cfg->devices[i]) ? check_device(i)
 						     : make_device(i);
+	if (rc == 0) {
+		/* the loop as the run makes it (real-time setup is applied
+		 * only when a run starts) */
+		loop_config(&lc);
+		rc = px_loop_create(&lc, &A.loop);
+		if (rc != PX_OK)
+			fprintf(stderr, "proxima-run: %s: loop: %s\n", A.o.config,
+				px_strerror(rc));
+		rc = rc != PX_OK;
+	}
+	if (rc == 0 && A.sim.spawn_arm)
+		rc = arm_exe(exe, sizeof(exe));
 	if (rc == 0)
 		rearm_warnings(stderr);
 	if (rc == 0)
@@ -1858,29 +1912,7 @@ static int setup(void)
 		}
 	}
 
-	px_loop_config_default(&lc);
-	lc.period_ns = cfg->loop.period_ns;
-	lc.clock = A.o.virtual_time ? PX_LOOP_CLOCK_VIRTUAL : PX_LOOP_CLOCK_MONOTONIC;
-	lc.overrun = cfg->loop.overrun_policy == PX_CONFIG_OVERRUN_CATCH_UP
-			     ? PX_LOOP_OVERRUN_CATCH_UP
-			     : PX_LOOP_OVERRUN_SKIP;
-	lc.overrun_limit = (uint32_t)cfg->loop.max_consecutive_overruns;
-	lc.compute_budget_ns = cfg->safety.watchdog.compute_budget_ns;
-	lc.budget_limit = (uint32_t)cfg->safety.watchdog.max_over_budget;
-	/* auto_rearm: leave safe state after 50 ms without a fault */
-	lc.rearm_after_ok_cycles =
-		cfg->safety.watchdog.auto_rearm
-			? (uint32_t)(50000000 / cfg->loop.period_ns + 1)
-			: 0;
-	lc.read = phase_read;
-	lc.compute = phase_compute;
-	lc.write = phase_write;
-	lc.user = &A;
-	lc.rt_enable = !A.o.virtual_time;
-	lc.rt.priority = (int)cfg->loop.priority;
-	lc.rt.cpu = (int)cfg->loop.cpu;
-	lc.rt.lock_memory = cfg->loop.lock_memory;
-	lc.rt.dma_latency = cfg->loop.dma_latency;
+	loop_config(&lc);
 	rc = px_loop_create(&lc, &A.loop);
 	if (rc != PX_OK) {
 		fprintf(stderr, "proxima-run: loop: %s\n", px_strerror(rc));
