@@ -55,9 +55,11 @@ struct node4 {
 #define STACK4 (3 * PX_MESH_MAX_DEPTH + 4)
 
 /* Triangle with its (unnormalized) normal n = (b - a) x (c - a) and
- * 1 / |n|^2 (0 for degenerate triangles), for the plane-distance lower
- * bound: a value made on demand from the compact vertex data
- * (px__mtri_get), not stored. */
+ * 1 / |n|^2, for the plane-distance lower bound: 0 for degenerate
+ * triangles and for those whose plain normal is not accurate (DEGEN_SLOW:
+ * thin, where it tilts by u / sin(angle), or of extreme size), so they
+ * are never pruned by it; a value made on demand from the compact vertex
+ * data (px__mtri_get), not stored. */
 struct mtri {
 	px_vec3 a, b, c;
 	px_vec3 n;
@@ -154,7 +156,7 @@ static inline struct mtri px__mtri_get(const struct mesh *M, size_t li)
 	t.b = v.b;
 	t.c = v.c;
 	t.n = px_v3_cross(px_v3_sub(t.b, t.a), px_v3_sub(t.c, t.a));
-	t.inv_nn = (M->degen[li] & DEGEN_ZERO) ? 0.0 : 1.0 / px_v3_norm2(t.n);
+	t.inv_nn = M->degen[li] ? 0.0 : 1.0 / px_v3_norm2(t.n);
 	return t;
 }
 
@@ -285,6 +287,28 @@ static inline void px__box4_d2f(const struct node4 *nd, const float pf[3],
  */
 double px__tri_tri(const px_vec3 A[3], const px_vec3 B[3], px_vec3 *pa,
 		   px_vec3 *pb, int *crossing);
+
+/*
+ * Whether points P[0..n-1] need a frame of their own before the pair
+ * formulas (products of four differences: cross-product line parameters,
+ * plane tests) are safe and translation-free: 1 when their extent about
+ * o is outside [2^-100, 2^100] or their coordinates exceed 2^26 times
+ * it; then *s = 2^-*e brings the extent into [0.5, 1) (exact) and the
+ * caller works on (P - o) s, returning squared distances times 2^(2 e).
+ * 0 (nothing to do) otherwise, and also for an extent of 0 (then *e =
+ * INT_MIN: every point is o). RT-safe.
+ */
+int px__pair_frame(const px_vec3 *P, int n, px_vec3 o, double *s, int *e);
+
+/* u x w with one rounding per component (error-free products by fma):
+ * accurate also for nearly parallel vectors. RT-safe. */
+px_vec3 px__cross_acc(px_vec3 u, px_vec3 w);
+
+/* Unit normal of triangle abc, accurate to a few u in direction for any
+ * shape and scale (the plain cross product where the fast point-triangle
+ * test's bound holds, the error-free one elsewhere: px_mesh.c); zero for
+ * a triangle without area. RT-safe. */
+px_vec3 px__tri_unit_normal(px_vec3 a, px_vec3 b, px_vec3 c);
 
 /* Answer of px__mesh_pair(). */
 struct px__mesh_pair {

@@ -50,7 +50,7 @@ static inline double dop(double a, double b, double c, double d)
 	return fma(a, b, -w) + e;
 }
 
-static px_vec3 cross_acc(px_vec3 u, px_vec3 w)
+px_vec3 px__cross_acc(px_vec3 u, px_vec3 w)
 {
 	return px_v3(dop(u.y, w.z, u.z, w.y), dop(u.z, w.x, u.x, w.z),
 		     dop(u.x, w.y, u.y, w.x));
@@ -79,7 +79,7 @@ static px_vec3 unit_normal_acc(px_vec3 a, px_vec3 b, px_vec3 c)
 	if (!(m > 0.0) || !isfinite(m))
 		return px_v3(0, 0, 0);
 	s = pow2_scale(m, &e);
-	n = cross_acc(px_v3_scale(ab, s), px_v3_scale(ac, s));
+	n = px__cross_acc(px_v3_scale(ab, s), px_v3_scale(ac, s));
 	l = sqrt(px_v3_norm2(n));
 	return l > 0.0 ? px_v3_scale(n, 1.0 / l) : px_v3(0, 0, 0);
 }
@@ -139,7 +139,7 @@ static double tri_exact(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c, px_vec3 *q,
 		W[k] = px_v3_scale(W[k], s);
 	}
 	/* n = ab x ac = E0 x -E2, to one rounding per component */
-	n = cross_acc(E[0], px_v3_neg(E[2]));
+	n = px__cross_acc(E[0], px_v3_neg(E[2]));
 	nn = px_v3_norm2(n);
 	/* Face: |n| above 2^-80 (the longest edge is about 1 here, so the
 	 * height is above 2^-81: below it the edges are the answer to far
@@ -339,7 +339,7 @@ static void tri_shape(px_vec3 a, px_vec3 b, px_vec3 c, px_vec3 *ab, px_vec3 *ac,
 	*ab = px_v3_scale(e0, s);
 	*ac = px_v3_scale(e1, s);
 	*bc = px_v3_scale(e2, s);
-	n = cross_acc(*ab, *ac);
+	n = px__cross_acc(*ab, *ac);
 	la = px_v3_norm2(*ab);
 	lc = px_v3_norm2(*ac);
 	lb = px_v3_norm2(*bc);
@@ -347,6 +347,16 @@ static void tri_shape(px_vec3 a, px_vec3 b, px_vec3 c, px_vec3 *ab, px_vec3 *ac,
 	/* the size from the edges as given, the shape from the scaled ones */
 	*fast = fast_size(px_v3_norm2(e0), px_v3_norm2(e1)) &&
 		px_v3_norm2(n) >= FAST_SIN2 * la * lc;
+}
+
+px_vec3 px__tri_unit_normal(px_vec3 a, px_vec3 b, px_vec3 c)
+{
+	px_vec3 ab = px_v3_sub(b, a), ac = px_v3_sub(c, a);
+	px_vec3 n = px_v3_cross(ab, ac);
+	double nn = px_v3_norm2(n);
+	if (fast_shape(px_v3_norm2(ab), px_v3_norm2(ac), nn))
+		return px_v3_scale(n, 1.0 / sqrt(nn));
+	return unit_normal_acc(a, b, c);
 }
 
 double px_tri_closest(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
@@ -1222,9 +1232,10 @@ void px__grid_layout(px_aabb box, long cap, int d[3], px_vec3 *org, double *h_ou
 		double cells = 1.0;
 		for (k = 0; k < 3; k++) {
 			double n = ceil((ext[k] + 2 * margin) / h);
-			/* clamped before the cast (undefined past INT_MAX);
-			 * more than cap cells fail the test below anyway */
-			d[k] = !(n >= 1.0) ? 1 : (n > (double)cap ? (int)(cap < INT_MAX ? cap : INT_MAX) : (int)n);
+			/* clamped before the cast (undefined past INT_MAX) to
+			 * cap + 1, which still fails the test below */
+			double nmax = cap < INT_MAX ? (double)cap + 1.0 : (double)INT_MAX;
+			d[k] = !(n >= 1.0) ? 1 : (n > nmax ? (int)nmax : (int)n);
 			cells *= d[k];
 		}
 		if (cells <= (double)cap || it > 200)

@@ -22,6 +22,7 @@
  * so the work is bounded by the product of the node counts (and in
  * practice a small multiple of the nodes near the closest pair).
  */
+#include <limits.h>
 #include <math.h>
 #include <string.h>
 
@@ -111,17 +112,6 @@ static int seg_crosses(px_vec3 p, px_vec3 q, double dp, double dq,
 	return 1;
 }
 
-/* 1 when the triangle with normal n is a needle in the sense of the mesh
- * module (NEEDLE_SIN2): its plane is then too ill-defined for face
- * projections, and its edges are its distance. */
-static int needle(const px_vec3 T[3], px_vec3 n)
-{
-	double l0 = px_v3_dist2(T[0], T[1]), l1 = px_v3_dist2(T[1], T[2]),
-	       l2 = px_v3_dist2(T[2], T[0]);
-	double m = fmax(l0 * l1, fmax(l0 * l2, l1 * l2));
-	return !(px_v3_norm2(n) > NEEDLE_SIN2 * m);
-}
-
 /* Does the projection of p onto T's plane fall inside T (closed)? */
 static int projects_inside(px_vec3 p, const px_vec3 T[3], px_vec3 n)
 {
@@ -134,15 +124,59 @@ static int projects_inside(px_vec3 p, const px_vec3 T[3], px_vec3 n)
 	return 1;
 }
 
+int px__pair_frame(const px_vec3 *P, int n, px_vec3 o, double *s, int *e)
+{
+	double ext = 0.0, mag = 0.0;
+	int i;
+	for (i = 0; i < n; i++) {
+		px_vec3 d = px_v3_sub(P[i], o);
+		ext = fmax(ext, fmax(fabs(d.x), fmax(fabs(d.y), fabs(d.z))));
+		mag = fmax(mag, fmax(fabs(P[i].x), fmax(fabs(P[i].y), fabs(P[i].z))));
+	}
+	if (!(ext > 0.0)) {
+		*e = INT_MIN;
+		*s = 1.0;
+		return 0;
+	}
+	if (ext >= 0x1p-100 && ext <= 0x1p100 && mag <= 0x1p26 * ext)
+		return 0;
+	(void)frexp(ext, e);
+	*s = ldexp(1.0, -*e);
+	return 1;
+}
+
 double px__tri_tri(const px_vec3 A[3], const px_vec3 B[3], px_vec3 *pa,
 		   px_vec3 *pb, int *crossing)
 {
-	px_vec3 na = px_v3_cross(px_v3_sub(A[1], A[0]), px_v3_sub(A[2], A[0]));
-	px_vec3 nb = px_v3_cross(px_v3_sub(B[1], B[0]), px_v3_sub(B[2], B[0]));
+	/* Unit normals, accurate for needles and slivers too (the plain
+	 * cross product of a needle's edges tilts by u / sin(angle), enough
+	 * to miss a crossing or skip the nearest vertex-face pair); a
+	 * triangle without area has none and is its edges. */
+	px_vec3 na = px__tri_unit_normal(A[0], A[1], A[2]);
+	px_vec3 nb = px__tri_unit_normal(B[0], B[1], B[2]);
 	px_vec3 x, c1, c2;
 	double best = INFINITY, d2, ha[3], hb[3];
-	int i, j, fa = !needle(A, na), fb = !needle(B, nb);
+	int i, j, fa = px_v3_norm2(na) > 0.0, fb = px_v3_norm2(nb) > 0.0;
 	int sep;
+
+	{
+		/* tiny, huge or far from the origin: the same in a frame at
+		 * A[0] scaled to a unit extent (the products of four
+		 * differences in seg_seg would underflow or overflow) */
+		px_vec3 P[6] = {A[0], A[1], A[2], B[0], B[1], B[2]}, A2[3], B2[3];
+		double sc;
+		int e;
+		if (px__pair_frame(P, 6, A[0], &sc, &e)) {
+			for (i = 0; i < 3; i++) {
+				A2[i] = px_v3_scale(px_v3_sub(A[i], A[0]), sc);
+				B2[i] = px_v3_scale(px_v3_sub(B[i], A[0]), sc);
+			}
+			d2 = px__tri_tri(A2, B2, &c1, &c2, crossing);
+			*pa = px_v3_madd(A[0], c1, 1.0 / sc);
+			*pb = px_v3_madd(A[0], c2, 1.0 / sc);
+			return ldexp(d2, 2 * e);
+		}
+	}
 
 	*crossing = 0;
 	for (i = 0; i < 3; i++) {
@@ -189,7 +223,7 @@ double px__tri_tri(const px_vec3 A[3], const px_vec3 B[3], px_vec3 *pa,
 			}
 		}
 	for (i = 0; i < 3; i++) {
-		if (fb && ha[i] * ha[i] < best * px_v3_norm2(nb) &&
+		if (fb && ha[i] * ha[i] < best &&
 		    projects_inside(A[i], B, nb)) {
 			d2 = px_tri_closest(A[i], B[0], B[1], B[2], &c2, NULL, NULL, NULL, NULL);
 			if (d2 < best) {
@@ -198,7 +232,7 @@ double px__tri_tri(const px_vec3 A[3], const px_vec3 B[3], px_vec3 *pa,
 				*pb = c2;
 			}
 		}
-		if (fa && hb[i] * hb[i] < best * px_v3_norm2(na) &&
+		if (fa && hb[i] * hb[i] < best &&
 		    projects_inside(B[i], A, na)) {
 			d2 = px_tri_closest(B[i], A[0], A[1], A[2], &c1, NULL, NULL, NULL, NULL);
 			if (d2 < best) {

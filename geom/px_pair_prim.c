@@ -8,6 +8,7 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "mesh_internal.h"
 #include "pair_internal.h"
 #include "px_mesh.h"
 #include "px_prim.h"
@@ -36,12 +37,37 @@ double px__seg_seg(px_vec3 p0, px_vec3 p1, px_vec3 q0, px_vec3 q1, double *s,
 	 * a poorly conditioned interior solve can only lose. */
 	double cs[5], ct[5], best = INFINITY;
 	double a = px_v3_norm2(dp), e = px_v3_norm2(dq), b = px_v3_dot(dp, dq);
-	double c = px_v3_dot(dp, r), f = px_v3_dot(dq, r), den = a * e - b * b;
+	double den = a * e - b * b;
 	int n = 0, k;
 
-	if (den > 1e-12 * a * e) {
-		double si = (b * f - c * e) / den, ti = (a * f - b * c) / den;
-		if (si >= 0.0 && si <= 1.0 && ti >= 0.0 && ti <= 1.0) {
+	{
+		/* tiny, huge or far out: the same at p0 scaled to a unit
+		 * extent (den is a product of four differences) */
+		px_vec3 P[4] = {p0, p1, q0, q1};
+		double sc;
+		int ex;
+		if (px__pair_frame(P, 4, p0, &sc, &ex))
+			return ldexp(px__seg_seg(px_v3(0, 0, 0), px_v3_scale(dp, sc),
+						 px_v3_scale(px_v3_sub(q0, p0), sc),
+						 px_v3_scale(px_v3_sub(q1, p0), sc), s, t),
+				     2 * ex);
+	}
+
+	if (a > 0.0 && e > 0.0) {
+		/* by Lagrange's identity s = (b f - c e) / den = n . (dq x r) /
+		 * |n|^2, n = dp x dq (f = dq . r, c = dp . r): with n to one
+		 * rounding (for nearly parallel segments the plain n tilts by
+		 * u / sin(angle) and den cancels to u / sin^2) s errs only
+		 * along the valley, where the distance barely moves */
+		px_vec3 nv = den >= a * e * (1.0 / 64.0) ? px_v3_cross(dp, dq) : px__cross_acc(dp, dq);
+		double nn = px_v3_norm2(nv);
+		double si = px_v3_dot(nv, px_v3_cross(dq, r)) / nn;
+		/* t as the best for that s (not from its own formula): errors
+		 * of the two that do not match would leave the valley, by up to
+		 * u |r| / sin(angle) */
+		double ti = clamp01((px_v3_dot(dq, r) + b * si) / e);
+		/* (parallel: nn = 0, a NaN parameter fails the test) */
+		if (si >= 0.0 && si <= 1.0) {
 			cs[n] = si;
 			ct[n++] = ti;
 		}
@@ -56,7 +82,8 @@ double px__seg_seg(px_vec3 p0, px_vec3 p1, px_vec3 q0, px_vec3 q1, double *s,
 	cs[n++] = seg_param(p0, dp, q1);
 	*s = *t = 0.0;
 	for (k = 0; k < n; k++) {
-		double d2 = px_v3_dist2(px_v3_madd(p0, dp, cs[k]), px_v3_madd(q0, dq, ct[k]));
+		/* from the differences: no absolute coordinate's rounding */
+		double d2 = px_v3_norm2(px_v3_sub(px_v3_madd(r, dp, cs[k]), px_v3_scale(dq, ct[k])));
 		if (d2 < best) {
 			best = d2;
 			*s = cs[k];
@@ -147,6 +174,21 @@ double px__seg_tri(px_vec3 p0, px_vec3 p1, const px_vec3 v[3], double *s,
 	px_vec3 d = px_v3_sub(p1, p0), n, x;
 	double best, d2, hs0, hs1;
 	int k;
+
+	{
+		/* tiny, huge or far out: the same at p0 scaled to a unit
+		 * extent (the plane test is a product of three differences) */
+		px_vec3 P[5] = {p0, p1, v[0], v[1], v[2]}, w[3];
+		double sc;
+		int ex;
+		if (px__pair_frame(P, 5, p0, &sc, &ex)) {
+			for (k = 0; k < 3; k++)
+				w[k] = px_v3_scale(px_v3_sub(v[k], p0), sc);
+			d2 = px__seg_tri(px_v3(0, 0, 0), px_v3_scale(d, sc), w, s, &x);
+			*q = px_v3_madd(p0, x, 1.0 / sc);
+			return ldexp(d2, 2 * ex);
+		}
+	}
 
 	/* the end points */
 	best = px_tri_closest(p0, v[0], v[1], v[2], q, NULL, NULL, NULL, NULL);

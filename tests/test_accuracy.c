@@ -24,6 +24,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mesh_internal.h"
+#include "pair_internal.h"
 #include "px_mesh.h"
 #include "px_model.h"
 #include "px_prim.h"
@@ -313,6 +315,184 @@ static void test_needle_face(void)
 	}
 	printf("  needles 1e7..1e8: largest distance / reference %.6f\n", worst);
 	(void)bad;
+}
+
+/* ---- triangle pairs and segments ------------------------------------------ */
+
+/* Reference squared distance of segments p0p1 and q0q1: the least of the
+ * interior stationary point (when it lies in the unit square) and the
+ * four end-point-to-segment distances. */
+static q128 qsegseg(struct qv p0, struct qv p1, struct qv q0, struct qv q1)
+{
+	struct qv d1 = qsub(p1, p0), d2 = qsub(q1, q0), r = qsub(p0, q0);
+	q128 a = qdot(d1, d1), e = qdot(d2, d2), b = qdot(d1, d2), c = qdot(d1, r),
+	     f = qdot(d2, r), den = a * e - b * b, best, x;
+	best = qseg(qsub(p0, q0), d2);
+	x = qseg(qsub(p1, q0), d2);
+	best = x < best ? x : best;
+	x = qseg(qsub(q0, p0), d1);
+	best = x < best ? x : best;
+	x = qseg(qsub(q1, p0), d1);
+	best = x < best ? x : best;
+	if (den > 0) {
+		q128 sv = (b * f - c * e) / den, tv = (a * f - b * c) / den;
+		if (sv >= 0 && sv <= 1 && tv >= 0 && tv <= 1) {
+			struct qv w = {r.x + sv * d1.x - tv * d2.x, r.y + sv * d1.y - tv * d2.y,
+				       r.z + sv * d1.z - tv * d2.z};
+			x = qdot(w, w);
+			best = x < best ? x : best;
+		}
+	}
+	return best;
+}
+
+/* does segment pq pass through triangle T (reference)? */
+static int qcrosses(struct qv p, struct qv q, const struct qv T[3])
+{
+	struct qv n = qcross(qsub(T[1], T[0]), qsub(T[2], T[0])), x;
+	q128 dp = qdot(n, qsub(p, T[0])), dq = qdot(n, qsub(q, T[0])), t;
+	int k;
+	if ((dp > 0 && dq > 0) || (dp < 0 && dq < 0) || dp == dq || qdot(n, n) == 0)
+		return 0;
+	t = dp / (dp - dq);
+	x.x = p.x + t * (q.x - p.x);
+	x.y = p.y + t * (q.y - p.y);
+	x.z = p.z + t * (q.z - p.z);
+	for (k = 0; k < 3; k++)
+		if (qdot(qcross(qsub(T[(k + 1) % 3], T[k]), qsub(x, T[k])), n) < 0)
+			return 0;
+	return 1;
+}
+
+/* Reference distance of triangles A and B: 0 when an edge of one passes
+ * through the other, else the least of the six vertex-triangle and nine
+ * edge-edge distances. */
+static long double ref_tri_tri(const px_vec3 A[3], const px_vec3 B[3])
+{
+	struct qv a[3], b[3];
+	long double best = INFINITY;
+	int i, j;
+	for (i = 0; i < 3; i++) {
+		a[i] = qv_of(A[i]);
+		b[i] = qv_of(B[i]);
+	}
+	for (i = 0; i < 3; i++)
+		if (qcrosses(a[i], a[(i + 1) % 3], b) || qcrosses(b[i], b[(i + 1) % 3], a))
+			return 0.0L;
+	for (i = 0; i < 3; i++) {
+		long double d = ref_tri(A[i], B[0], B[1], B[2]);
+		best = d < best ? d : best;
+		d = ref_tri(B[i], A[0], A[1], A[2]);
+		best = d < best ? d : best;
+		for (j = 0; j < 3; j++) {
+			d = sqrtl((long double)qsegseg(a[i], a[(i + 1) % 3], b[j], b[(j + 1) % 3]));
+			best = d < best ? d : best;
+		}
+	}
+	return best;
+}
+
+/*
+ * Triangle pairs (the mesh-pair and mesh-primitive core): hard triangles
+ * against hard triangles nearby (needles beside needles, slivers across
+ * faces, nearly parallel and nearly touching pairs), at scales 1e-100 ..
+ * 1e100: px__tri_tri within PX_TRI_ERR_ULPS u (d + l) of the reference,
+ * l the longest edge of the two.
+ */
+static void test_tri_tri_bound(void)
+{
+	static const double scales[] = {1e-100, 1e-8, 1.0, 1e8, 1e100};
+	double worst = 0.0;
+	int it;
+	for (it = 0; it < 20000; it++) {
+		px_vec3 A[3], B[3], pa, pb, off;
+		double s = scales[it % 5], l, d, e;
+		long double ref;
+		int k, cr;
+		hard_tri(px_rand_int(0, 7), A);
+		hard_tri(px_rand_int(0, 7), B);
+		/* B moved next to a point of A: just above its face (1e-12 ..
+		 * 1e-3), or anywhere near */
+		off = px_v3_sub(hard_point(px_rand_int(0, 4) == 3 ? 0 : px_rand_int(0, 2), A), B[0]);
+		for (k = 0; k < 3; k++) {
+			B[k] = px_v3_scale(px_v3_add(B[k], off), s);
+			A[k] = px_v3_scale(A[k], s);
+		}
+		d = sqrt(px__tri_tri(A, B, &pa, &pb, &cr));
+		ref = ref_tri_tri(A, B);
+		l = fmax(longest_edge(A[0], A[1], A[2]), longest_edge(B[0], B[1], B[2]));
+		e = (double)(fabsl((long double)d - ref) - 1e-160L) / (U * ((double)ref + l));
+		worst = fmax(worst, e);
+		PX_CHECK_MSG(e <= PX_TRI_ERR_ULPS,
+			     "pair %d scale %g: %.17g vs %.17Lg (%.1f u (d + l)), crossing %d", it, s,
+			     d, ref, e, cr);
+	}
+	printf("  px__tri_tri: worst error %.2f u (d + l) over 20000 pairs\n", worst);
+}
+
+/*
+ * Segments against segments and against triangles (capsule pairs and
+ * capsule-mesh pairs): nearly parallel segments (angles 1e-3 .. 1e-9),
+ * crossing and touching ones, at scales 1e-100 .. 1e100.
+ */
+static void test_seg_bound(void)
+{
+	static const double scales[] = {1e-100, 1e-8, 1.0, 1e8, 1e100};
+	double worst = 0.0, worst_t = 0.0;
+	int it;
+	for (it = 0; it < 20000; it++) {
+		double s = scales[it % 5], a, b, l, e, d;
+		px_vec3 dir = rand_unit(), n = perp(dir), p0, p1, q0, q1, v[3], qq;
+		long double ref;
+		int k;
+		p0 = px_v3_scale(rand_unit(), px_rand_range(0, 1));
+		p1 = px_v3_madd(p0, dir, px_rand_range(0.1, 2));
+		q0 = px_v3_madd(px_v3_madd(p0, dir, px_rand_range(-1, 1)), n,
+				pow(10.0, px_rand_range(-12, 0)));
+		q1 = px_v3_madd(q0, px_v3_add(dir, px_v3_scale(perp(dir), pow(10.0, px_rand_range(-9, -3)))),
+				px_rand_range(0.1, 2) * (px_rand_unit() < 0.5 ? -1 : 1));
+		p0 = px_v3_scale(p0, s);
+		p1 = px_v3_scale(p1, s);
+		q0 = px_v3_scale(q0, s);
+		q1 = px_v3_scale(q1, s);
+		d = sqrt(px__seg_seg(p0, p1, q0, q1, &a, &b));
+		ref = sqrtl((long double)qsegseg(qv_of(p0), qv_of(p1), qv_of(q0), qv_of(q1)));
+		l = fmax(px_v3_dist(p0, p1), px_v3_dist(q0, q1));
+		e = (double)(fabsl((long double)d - ref) - 1e-160L) / (U * ((double)ref + l));
+		worst = fmax(worst, e);
+		PX_CHECK_MSG(e <= PX_TRI_ERR_ULPS,
+			     "segments %d scale %g: %.17g vs %.17Lg (%.1f u): (%.17g %.17g %.17g) "
+			     "(%.17g %.17g %.17g) (%.17g %.17g %.17g) (%.17g %.17g %.17g)",
+			     it, s, d, ref, e, p0.x, p0.y, p0.z, p1.x, p1.y, p1.z, q0.x, q0.y, q0.z,
+			     q1.x, q1.y, q1.z);
+		/* the same pair as two collapsed triangles (the mesh pair's
+		 * edge-edge distance) */
+		{
+			px_vec3 T1[3] = {p0, p1, p1}, T2[3] = {q0, q1, q1}, x1, x2;
+			int cr;
+			d = sqrt(px__tri_tri(T1, T2, &x1, &x2, &cr));
+			e = (double)(fabsl((long double)d - ref) - 1e-160L) / (U * ((double)ref + l));
+			worst = fmax(worst, e);
+			PX_CHECK_MSG(e <= PX_TRI_ERR_ULPS,
+				     "edges as triangles %d scale %g: %.17g vs %.17Lg (%.1f u)", it, s, d,
+				     ref, e);
+		}
+		/* the segment against a hard triangle placed at it */
+		hard_tri(px_rand_int(0, 7), v);
+		for (k = 0; k < 3; k++)
+			v[k] = px_v3_add(px_v3_scale(v[k], s), px_v3_scale(px_v3_sub(p0, p1), 0.5 * px_rand_unit()));
+		d = sqrt(px__seg_tri(p0, p1, v, &a, &qq));
+		{
+			px_vec3 T[3] = {p0, p1, p1};
+			ref = ref_tri_tri(T, v);
+		}
+		l = fmax(px_v3_dist(p0, p1), longest_edge(v[0], v[1], v[2]));
+		e = (double)(fabsl((long double)d - ref) - 1e-160L) / (U * ((double)ref + l));
+		worst_t = fmax(worst_t, e);
+		PX_CHECK_MSG(e <= PX_TRI_ERR_ULPS,
+			     "segment-triangle %d scale %g: %.17g vs %.17Lg (%.1f u)", it, s, d, ref, e);
+	}
+	printf("  px__seg_seg: worst %.2f u (d + l); px__seg_tri: worst %.2f\n", worst, worst_t);
 }
 
 /* ---- meshes ---------------------------------------------------------------- */
@@ -726,6 +906,7 @@ static void test_prim_range(void)
 
 static const struct px_test tests[] = {
 	PX_T(test_tri_bound),   PX_T(test_needle_face), PX_T(test_tri_range),
+	PX_T(test_tri_tri_bound), PX_T(test_seg_bound),
 	PX_T(test_mesh_needles), PX_T(test_mesh_range), PX_T(test_grid_extremes),
 	PX_T(test_prim_bound),
 	PX_T(test_prim_range),
