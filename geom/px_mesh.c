@@ -56,9 +56,16 @@ px_vec3 px__cross_acc(px_vec3 u, px_vec3 w)
 		     dop(u.x, w.y, u.y, w.x));
 }
 
+/* compares, not fmax (a library call); NaN gives NaN or a smaller
+ * value, which the callers' range tests (written to fail on NaN) see */
+static inline double mx2(double a, double b)
+{
+	return a > b ? a : b;
+}
+
 static inline double amax3(px_vec3 v)
 {
-	return fmax(fabs(v.x), fmax(fabs(v.y), fabs(v.z)));
+	return mx2(fabs(v.x), mx2(fabs(v.y), fabs(v.z)));
 }
 
 /* 2^-e with 2^e > x >= 2^(e-1) (x > 0 finite): multiplying by it is
@@ -74,7 +81,7 @@ static double pow2_scale(double x, int *e)
 static px_vec3 unit_normal_acc(px_vec3 a, px_vec3 b, px_vec3 c)
 {
 	px_vec3 ab = px_v3_sub(b, a), ac = px_v3_sub(c, a), n;
-	double m = fmax(amax3(ab), amax3(ac)), s, l;
+	double m = mx2(amax3(ab), amax3(ac)), s, l;
 	int e;
 	if (!(m > 0.0) || !isfinite(m))
 		return px_v3(0, 0, 0);
@@ -113,7 +120,7 @@ static double tri_exact(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c, px_vec3 *q,
 		E[k] = px_v3_sub(P[(k + 1) % 3], P[k]);
 		W[k] = px_v3_sub(p, P[k]);
 	}
-	m = fmax(amax3(E[0]), fmax(amax3(E[1]), amax3(E[2])));
+	m = mx2(amax3(E[0]), mx2(amax3(E[1]), amax3(E[2])));
 	wm = amax3(W[0]);
 	if (!(m > 0.0)) {
 		/* one point */
@@ -327,7 +334,7 @@ static void tri_shape(px_vec3 a, px_vec3 b, px_vec3 c, px_vec3 *ab, px_vec3 *ac,
 		      px_vec3 *bc, int *needle, int *fast)
 {
 	px_vec3 e0 = px_v3_sub(b, a), e1 = px_v3_sub(c, a), e2 = px_v3_sub(c, b), n;
-	double m = fmax(amax3(e0), fmax(amax3(e1), amax3(e2))), s, la, lc, lb;
+	double m = mx2(amax3(e0), mx2(amax3(e1), amax3(e2))), s, la, lc, lb;
 	int e;
 	if (!(m > 0.0)) {
 		*ab = *ac = *bc = px_v3(0, 0, 0);
@@ -378,8 +385,12 @@ double px_tri_closest(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
 		v = &v_;
 	if (!q)
 		q = &qq;
-	if (!(amax3(p) <= PX_TRI_MAX_COORD && amax3(a) <= PX_TRI_MAX_COORD &&
-	      amax3(b) <= PX_TRI_MAX_COORD && amax3(c) <= PX_TRI_MAX_COORD)) {
+	robust = !fast_shape(px_v3_norm2(ab), px_v3_norm2(ac), nn) ||
+		 !(px_v3_dist2(p, a) <= 0x1p200);
+	/* (the fast test's differences and products are finite by its
+	 * own conditions, which NaN and infinity fail) */
+	if (robust && !(amax3(p) <= PX_TRI_MAX_COORD && amax3(a) <= PX_TRI_MAX_COORD &&
+			amax3(b) <= PX_TRI_MAX_COORD && amax3(c) <= PX_TRI_MAX_COORD)) {
 		/* out of range or not finite: no answer rather than a wrong one */
 		*q = p;
 		*feature = PX_FEATURE_NONE;
@@ -387,8 +398,6 @@ double px_tri_closest(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
 		*u = *v = 0.0;
 		return NAN;
 	}
-	robust = !fast_shape(px_v3_norm2(ab), px_v3_norm2(ac), nn) ||
-		 !(px_v3_dist2(p, a) <= 0x1p200);
 	return tri_core(p, a, b, c, n, nn, robust, q, feature, sub, u, v);
 }
 
@@ -861,7 +870,7 @@ static inline void test_tri_x(const struct mesh *M, size_t li, px_vec3 p,
  * pq's fast, for callers without one). */
 static inline int fast_range(const struct mesh *M, px_vec3 p)
 {
-	return M->absmax < 1e18 && fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z))) < 1e18;
+	return M->absmax < 1e18 && amax3(p) < 1e18;
 }
 
 static inline void test_tri(const struct mesh *M, size_t li, px_vec3 p,

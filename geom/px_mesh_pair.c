@@ -128,10 +128,16 @@ int px__pair_frame(const px_vec3 *P, int n, px_vec3 o, double *s, int *e)
 {
 	double ext = 0.0, mag = 0.0;
 	int i;
+	/* compares, not fmax (a library call); a NaN fails the range test */
 	for (i = 0; i < n; i++) {
 		px_vec3 d = px_v3_sub(P[i], o);
-		ext = fmax(ext, fmax(fabs(d.x), fmax(fabs(d.y), fabs(d.z))));
-		mag = fmax(mag, fmax(fabs(P[i].x), fmax(fabs(P[i].y), fabs(P[i].z))));
+		double x[6] = {fabs(d.x), fabs(d.y), fabs(d.z), fabs(P[i].x), fabs(P[i].y),
+			       fabs(P[i].z)};
+		int k;
+		for (k = 0; k < 3; k++) {
+			ext = x[k] > ext ? x[k] : ext;
+			mag = x[3 + k] > mag ? x[3 + k] : mag;
+		}
 	}
 	if (!(ext > 0.0)) {
 		*e = INT_MIN;
