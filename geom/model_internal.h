@@ -23,8 +23,9 @@
  * PX_FILE_MODEL_MAX_BYTES, and the importer parses those bytes. PLY
  * files are checked against their header first (x, y, z required); a
  * PLY read for points (!want_tri) is read exactly by that check, without
- * the importer; a PLY mesh whose coordinates would move by more than
- * 1e-5 of its extent in the importer's single precision is PX_E_RANGE.
+ * the importer; a mesh (PLY, ASCII STL, OBJ) whose coordinates would
+ * move by more than 1e-5 of its extent in the importer's single
+ * precision is PX_E_RANGE.
  * Returns PX_OK, PX_E_INVAL, PX_E_NOTFOUND, PX_E_IO, PX_E_PARSE,
  * PX_E_RANGE, PX_E_NOMEM, PX_E_OVERFLOW. Setup only.
  */

@@ -768,8 +768,9 @@ static FILE *mem_stream(const char *path, char *data, size_t len, char *msg,
 }
 
 /* A mesh from the importer passes through single-precision floats: the
- * PLY's own values (read exactly by the check) must not move by more
- * than PX_IMPORT_FLOAT_TOL of the model's largest extent, or the mesh is
+ * file's own values (a PLY's read exactly by its check, the decimal
+ * coordinates of an ASCII STL or an OBJ) must not move by more than
+ * PX_IMPORT_FLOAT_TOL of the model's largest extent, or the mesh is
  * refused rather than answered off (a model far from its origin, as
  * survey coordinates are, loses its small digits). */
 #define PX_IMPORT_FLOAT_TOL 1e-5
@@ -797,13 +798,61 @@ static int float_loss_check(const char *path, const double *v, size_t nv,
 				continue; /* left to the mesh's own range checks */
 			lost = fabs(x - (double)(float)x);
 			if (lost > tol) {
-				snprintf(msg, msg_cap, "%s: PLY vertex %zu: %c = %.17g loses %g "
+				snprintf(msg, msg_cap, "%s: vertex %zu: %c = %.17g loses %g "
 					 "in the importer's single precision, more than %g "
 					 "(%g of the model's extent %g)", path, i, "xyz"[k], x,
 					 lost, tol, PX_IMPORT_FLOAT_TOL, ext);
 				return PX_E_RANGE;
 			}
 		}
+	return PX_OK;
+}
+
+/* The coordinates of the text lines that start with the word kw
+ * ("vertex" in an ASCII STL, "v" in an OBJ), three numbers each, as the
+ * file writes them (the structure checks have run; a line that does not
+ * read as three numbers is left to the importer). */
+static int text_coords(const char *data, const char *kw, double **out, size_t *n_out)
+{
+	size_t kl = strlen(kw), n = 0, cap = 0;
+	const char *p = data;
+	double *v = NULL;
+	while (*p) {
+		const char *e = strchr(p, '\n');
+		while (*p == ' ' || *p == '\t')
+			p++;
+		if (strncmp(p, kw, kl) == 0 && (p[kl] == ' ' || p[kl] == '\t')) {
+			double c[3];
+			char *end;
+			int k;
+			const char *q = p + kl;
+			for (k = 0; k < 3; k++) {
+				c[k] = strtod(q, &end);
+				if (end == q)
+					break;
+				q = end;
+			}
+			if (k == 3) {
+				if (n == cap) {
+					size_t nc = cap ? 2 * cap : 1024;
+					double *nv = realloc(v, 3 * nc * sizeof(*nv));
+					if (!nv) {
+						free(v);
+						return PX_E_NOMEM;
+					}
+					v = nv;
+					cap = nc;
+				}
+				memcpy(v + 3 * n, c, sizeof c);
+				n++;
+			}
+		}
+		if (!e)
+			break;
+		p = e + 1;
+	}
+	*out = v;
+	*n_out = n;
 	return PX_OK;
 }
 
@@ -892,6 +941,23 @@ int px__import_file(const char *path, int want_tri, double **xyz,
 		}
 		rc = stl_validate(path, data, len, f, msg, msg_cap);
 		fclose(f);
+		if (rc != PX_OK) {
+			free(data);
+			return rc;
+		}
+	}
+	/* text meshes write their coordinates in decimal: the same precision
+	 * check as for PLY (a binary STL is single precision already) */
+	if (!hint[0] && (ends_with_ci(path, ".obj") ||
+			 (ends_with_ci(path, ".stl") &&
+			  !(len >= 84 && len == 84ull + 50ull * ply_uint((const unsigned char *)
+									 data + 80, 4, 0))))) {
+		double *tv = NULL;
+		size_t tn = 0;
+		rc = text_coords(data, ends_with_ci(path, ".obj") ? "v" : "vertex", &tv, &tn);
+		if (rc == PX_OK)
+			rc = float_loss_check(path, tv, tn, msg, msg_cap);
+		free(tv);
 		if (rc != PX_OK) {
 			free(data);
 			return rc;

@@ -870,11 +870,25 @@ static void test_ply_double_exact(void)
 					"5000000.123 1 0\n3 0 1 2\n");
 		PX_CHECK_INT_EQ(px_mesh_load(p, NULL, &rep, &m), PX_E_RANGE);
 		PX_CHECK(m == NULL);
-		has(rep.message, p, "PLY vertex 0: x = 5000000.1");
+		has(rep.message, p, "vertex 0: x = 5000000.1");
 		p = put("near_mesh.ply", "ply\nformat ascii 1.0\nelement vertex 3\n"
 					 "property double x\nproperty double y\nproperty double z\n"
 					 "element face 1\nproperty list uchar int vertex_indices\n"
 					 "end_header\n0.1 0 0\n1.1 0 0\n0.1 1 0\n3 0 1 2\n");
+		PX_CHECK_MSG(px_mesh_load(p, NULL, &rep, &m) == PX_OK, "%s", rep.message);
+		px_model_free(m);
+		/* decimal coordinates of an ASCII STL and of OBJ faces too */
+		p = put("far.stl", "solid far\nfacet normal 0 0 1\nouter loop\n"
+				   "vertex 5000000.123 0 0\nvertex 5000001.123 0 0\n"
+				   "vertex 5000000.123 1 0\nendloop\nendfacet\nendsolid far\n");
+		PX_CHECK_INT_EQ(px_mesh_load(p, NULL, &rep, &m), PX_E_RANGE);
+		has(rep.message, p, "vertex 0: x = 5000000.1");
+		p = put("far_faces.obj", "v 5000000.123 0 0\nv 5000001.123 0 0\n"
+					 "v 5000000.123 1 0\nf 1 2 3\n");
+		PX_CHECK_INT_EQ(px_model_load(p, 0.0, &m, NULL, 0), PX_E_RANGE);
+		p = put("near.stl", "solid near\nfacet normal 0 0 1\nouter loop\n"
+				    "vertex 0.123 0 0\nvertex 1.123 0 0\nvertex 0.123 1 0\n"
+				    "endloop\nendfacet\nendsolid near\n");
 		PX_CHECK_MSG(px_mesh_load(p, NULL, &rep, &m) == PX_OK, "%s", rep.message);
 		px_model_free(m);
 	}
