@@ -606,6 +606,62 @@ static void test_mesh_needles(void)
 }
 
 /*
+ * A closed needle solid alone (the prism above: side triangles of aspect
+ * 1e7..1e9, all taking the robust test): watertight, and the sign right
+ * for points inside its thin cross-section and just outside it, at
+ * scales 1e-100 .. 1e100, with distances within the bound.
+ */
+static void test_needle_solid_sign(void)
+{
+	static const double scales[] = {1e-100, 1.0, 1e100};
+	static const uint32_t pt[] = {0, 2, 1, 3, 4, 5, 0, 1, 4, 0, 4, 3,
+				      1, 2, 5, 1, 5, 4, 2, 0, 3, 2, 3, 5};
+	int sc, it;
+	for (sc = 0; sc < 3; sc++) {
+		double s = scales[sc], w = pow(10.0, -px_rand_range(7.0, 9.0)), xyz[18];
+		double yz[3][2] = {{0, 0}, {w, 0}, {w / 2, w}};
+		struct px_mesh_report rp;
+		struct px_model *m;
+		size_t i;
+		for (i = 0; i < 3; i++) {
+			xyz[3 * i] = 0.0;
+			xyz[3 * (i + 3)] = s;
+			xyz[3 * i + 1] = xyz[3 * (i + 3) + 1] = yz[i][0] * s;
+			xyz[3 * i + 2] = xyz[3 * (i + 3) + 2] = yz[i][1] * s;
+		}
+		PX_CHECK_MSG(px_mesh_model(xyz, 6, pt, 8, NULL, &rp, &m) == PX_OK, "%s", rp.message);
+		PX_CHECK_MSG(rp.closed, "needle prism not closed: %s", rp.message);
+		for (it = 0; it < 300; it++) {
+			struct px_model_result r;
+			/* inside: a point of the cross-section's interior; outside:
+			 * beyond one of its sides by up to w */
+			double x = px_rand_range(0.05, 0.95) * s;
+			double a0 = px_rand_range(0.1, 0.8), a1 = px_rand_range(0.1, 0.9) * (1 - a0);
+			double y = (a0 * yz[1][0] + a1 * yz[2][0]) * s, z = (a0 * yz[1][1] + a1 * yz[2][1]) * s;
+			int inside = it % 2 == 0;
+			double lmax, e;
+			long double ref;
+			px_vec3 p;
+			if (!inside)
+				z = -px_rand_range(1e-6, 1.0) * w * s; /* below the bottom side */
+			p = px_v3(x, y, z);
+			ref = ref_mesh(xyz, pt, 8, p, &lmax);
+			PX_CHECK_INT_EQ(px_model_query(m, p, &r), 1);
+			PX_CHECK(r.is_signed);
+			PX_CHECK_MSG(r.inside == inside,
+				     "scale %g width %.3g: point %s reported %s (distance %.17g)", s, w,
+				     inside ? "inside" : "outside", r.inside ? "inside" : "outside",
+				     r.distance);
+			e = (double)(fabsl((long double)fabs(r.distance) - ref) - 1e-160L) /
+			    (U * ((double)ref + lmax));
+			PX_CHECK_MSG(e <= PX_TRI_ERR_ULPS, "scale %g: %.17g vs %.17Lg (%.1f u)", s,
+				     r.distance, ref, e);
+		}
+		px_model_free(m);
+	}
+}
+
+/*
  * The accepted range: a vertex beyond 1e150 (and 1e250, 1e308: where
  * answers used to go wrong) is refused with PX_E_RANGE and a message
  * naming the vertex; so is a mesh smaller than 1e-140. At 1e150 itself
@@ -907,7 +963,7 @@ static void test_prim_range(void)
 static const struct px_test tests[] = {
 	PX_T(test_tri_bound),   PX_T(test_needle_face), PX_T(test_tri_range),
 	PX_T(test_tri_tri_bound), PX_T(test_seg_bound),
-	PX_T(test_mesh_needles), PX_T(test_mesh_range), PX_T(test_grid_extremes),
+	PX_T(test_mesh_needles), PX_T(test_needle_solid_sign), PX_T(test_mesh_range), PX_T(test_grid_extremes),
 	PX_T(test_prim_bound),
 	PX_T(test_prim_range),
 };
