@@ -88,7 +88,9 @@ static const struct px_config_key model_keys[] = {
 	K_ENUM(struct raw_model, kind, "kind", PX_CONFIG_REQUIRED, kind_names,
 	       KIND_MESH),
 	K_SUB(struct raw_model, pose, "pose", pose_schema),
-	K_DBL(struct raw_model, scale, "scale", PX_CONFIG_MIN_EXCL, 0, 1e6, 1.0),
+	/* below 1e-9 a query 1e141 m off would map past the models' reach
+	 * in the file's own units and fail in the loop */
+	K_DBL(struct raw_model, scale, "scale", 0, 1e-9, 1e6, 1.0),
 	K_DBLP(struct raw_model, cloud_radius_m, "cloud_radius_m", 0, 0, 100,
 	       has_cloud_radius),
 };

@@ -559,6 +559,16 @@ static void test_scene_extent(void)
 	PX_CHECK(diag.count > 0);
 	has(diag.errors[0].msg, "s.yaml:3:", "beyond");
 	px_config_free(cfg);
+	/* a scale so small that near queries would leave the reach in the
+	 * file's units: a key error */
+	snprintf(yaml, sizeof yaml, "scene:\n  models:\n    - file: %s\n"
+		 "      kind: cloud\n      scale: 1e-300\n", p);
+	PX_CHECK(px_config_load_mem("s.yaml", yaml, strlen(yaml), &cfg, &diag) != PX_OK ||
+		 px_world_config_load(cfg, &w, &diag) != PX_OK);
+	PX_CHECK(w == NULL && diag.count > 0);
+	has(diag.errors[0].msg, "s.yaml:5:14:", "scale");
+	px_config_free(cfg);
+	cfg = NULL;
 
 	PX_CHECK_INT_EQ(px_world_create(2, &w), PX_OK);
 	PX_CHECK_INT_EQ(px_cloud_model(xyz, 2, 0.0, NULL, &m), PX_OK);
