@@ -21,9 +21,11 @@
 #include "px_math.h"
 #include "px_mesh.h"
 
-/* A triangle whose height over its longest edge is below this fraction
- * of that edge is a needle: its distance is taken as that of its three
- * edges (error at most this fraction of the edge length). */
+/* A triangle whose squared height over its longest edge is below this
+ * fraction of that edge's squared length is a needle: degenerate for
+ * topology and signs (no face normal, no share of the pseudo-normals; a
+ * closest point inside it is reported on its nearest edge). Its distance
+ * is still exact (px_mesh.c's robust test). */
 #define NEEDLE_SIN2 1e-20
 
 /* struct mesh's degen[] per leaf triangle: DEGEN_ZERO a degenerate
