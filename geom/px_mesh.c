@@ -366,12 +366,33 @@ px_vec3 px__tri_unit_normal(px_vec3 a, px_vec3 b, px_vec3 c)
 	return unit_normal_acc(a, b, c);
 }
 
+/* The fast test with the vertices rotated by r (a' = P[r], b', c'
+ * following): outputs mapped back to the caller's order. */
+static double tri_core_rot(px_vec3 p, const px_vec3 P[3], int r, px_vec3 *q,
+			   int *feature, int *sub, double *u, double *v)
+{
+	px_vec3 a = P[r], b = P[(r + 1) % 3], c = P[(r + 2) % 3];
+	px_vec3 n = px_v3_cross(px_v3_sub(b, a), px_v3_sub(c, a));
+	double w[3], d2, u2, v2;
+	int f, s2;
+	d2 = tri_core(p, a, b, c, n, px_v3_norm2(n), 0, q, &f, &s2, &u2, &v2);
+	/* weights of a', b', c' (edge b'c' has none on a', exactly) */
+	w[0] = (f == PX_FEATURE_EDGE && s2 == 1) ? 0.0 : 1.0 - u2 - v2;
+	w[1] = u2;
+	w[2] = v2;
+	*feature = f;
+	*sub = f == PX_FEATURE_FACE ? s2 : (s2 + r) % 3;
+	*u = w[(4 - r) % 3];
+	*v = w[(5 - r) % 3];
+	return d2;
+}
+
 double px_tri_closest(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
 		      px_vec3 *q, int *feature, int *sub, double *u, double *v)
 {
 	px_vec3 ab = px_v3_sub(b, a), ac = px_v3_sub(c, a);
 	px_vec3 n = px_v3_cross(ab, ac), qq;
-	double nn = px_v3_norm2(n);
+	double nn = px_v3_norm2(n), lab = px_v3_norm2(ab), lac = px_v3_norm2(ac);
 	int f_, s_, robust;
 	double u_, v_;
 
@@ -385,8 +406,20 @@ double px_tri_closest(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,
 		v = &v_;
 	if (!q)
 		q = &qq;
-	robust = !fast_shape(px_v3_norm2(ab), px_v3_norm2(ac), nn) ||
-		 !(px_v3_dist2(p, a) <= 0x1p200);
+	robust = !fast_shape(lab, lac, nn) || !(px_v3_dist2(p, a) <= 0x1p200);
+	if (robust) {
+		/* A triangle thin only at a (GJK's simplices often are)
+		 * takes the fast test from the vertex opposite its longest
+		 * edge, where the angle is widest. */
+		px_vec3 P[3] = {a, b, c};
+		double lbc = px_v3_dist2(b, c);
+		int r = lbc >= lab && lbc >= lac ? 0 : (lac >= lab ? 1 : 2);
+		if (r != 0) {
+			double l1 = r == 1 ? lab : lac, l2 = lbc;
+			if (fast_shape(l1, l2, nn) && px_v3_dist2(p, P[r]) <= 0x1p200)
+				return tri_core_rot(p, P, r, q, feature, sub, u, v);
+		}
+	}
 	/* (the fast test's differences and products are finite by its
 	 * own conditions, which NaN and infinity fail) */
 	if (robust && !(amax3(p) <= PX_TRI_MAX_COORD && amax3(a) <= PX_TRI_MAX_COORD &&
@@ -1681,10 +1714,11 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 		}
 		memset(&M->lb[i], 0, sizeof(M->lb[i]));
 		if (!(deg[t] & DEGEN_ZERO)) {
-			/* accurate (a thin triangle's plain normal could tilt
-			 * past the slack) */
+			/* the accurate normal (a thin triangle's plain one could
+			 * tilt past the slack), in the vertex order, which the
+			 * edges' outward normals below need: unflipped */
 			struct tlb *L = &M->lb[i];
-			px_vec3 nu = unit_normal_acc(P[0], P[1], P[2]);
+			px_vec3 nu = rep->flipped ? px_v3_neg(fn[t]) : fn[t];
 			L->c[0][0] = (float)nu.x;
 			L->c[1][0] = (float)nu.y;
 			L->c[2][0] = (float)nu.z;

@@ -190,9 +190,16 @@ PX_API int px_mesh_load(const char *path, const struct px_mesh_opts *opt,
  * vertices) and scale (a triangle well shaped at its vertex a and of
  * moderate size takes the fast test, others a robust one whose error
  * does not depend on the shape; the last term is the subnormal range
- * of the squares). Coordinates beyond +-PX_TRI_MAX_COORD (1e152) or not
- * finite return NaN (q = p, feature PX_FEATURE_NONE): no answer rather
- * than an overflowed one. @note RT-safe.
+ * of the squares). Non-finite coordinates return NaN (q = p, feature
+ * PX_FEATURE_NONE), and so do coordinates beyond +-PX_TRI_MAX_COORD
+ * (1e152) unless the triangle and p are close enough together for the
+ * fast test (whose differences then stay small): no answer rather than
+ * an overflowed one. q lies at the returned distance to the same
+ * bound (plus its own rounding as a point); u and v carry a rounding
+ * that grows with the aspect ratio (a needle's weights move by that much
+ * more when a vertex moves by rounding): take the point from q. A
+ * triangle thin only at a takes the fast test from the vertex with the
+ * widest angle. @note RT-safe.
  */
 #define PX_TRI_ERR_ULPS 64.0
 PX_API double px_tri_closest(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c,

@@ -230,17 +230,64 @@ static px_vec3 scaled(px_vec3 v, double s, px_vec3 off)
 	return px_v3_add(px_v3_scale(v, s), off);
 }
 
-/* error of one px_tri_closest answer in units of u (d* + l) */
+/* error of one px_tri_closest answer in units of u (d* + l); checks
+ * that the point, feature and weights it reports agree with each other
+ * and with the distance */
 static double tri_err(px_vec3 p, const px_vec3 v[3], double *got, long double *want)
 {
-	px_vec3 q;
+	px_vec3 q, qw;
 	int f, s;
-	double u, w;
+	double u, w, il, an, cond;
 	double d2 = px_tri_closest(p, v[0], v[1], v[2], &q, &f, &s, &u, &w);
 	long double ref = ref_tri(p, v[0], v[1], v[2]);
-	double l = longest_edge(v[0], v[1], v[2]), d = sqrt(d2);
+	double l = longest_edge(v[0], v[1], v[2]), d = sqrt(d2), tol;
 	*got = d;
 	*want = ref;
+	tol = PX_TRI_ERR_ULPS * U * ((double)ref + l) + 1e-160;
+	/* the aspect ratio l^2 / (2 area) (edges divided by l first: their
+	 * squares would underflow) */
+	il = l > 0.0 ? 1.0 / l : 1.0;
+	an = px_v3_norm(px_v3_cross(px_v3_scale(px_v3_sub(v[1], v[0]), il),
+				    px_v3_scale(px_v3_sub(v[2], v[0]), il)));
+	cond = an > 0.0 ? fmax(1.0, 1.0 / an) : 1.0;
+	/* the point at the distance (to its own rounding as a point:
+	 * u |q|), and where its weights put it */
+	PX_CHECK_MSG(fabs(px_v3_dist(p, q) - d) <= tol + 4 * U * (px_v3_norm(q) + px_v3_norm(p)),
+		     "point at %.17g, distance %.17g", px_v3_dist(p, q), d);
+	/* the weights of a thin triangle's point are conditioned by l^2 /
+	 * (2 area), the aspect ratio (moving a vertex by rounding moves the
+	 * weights of a fixed point by that much more), and those of a far
+	 * point's foot by its distance (p's own rounding moves the foot) */
+	qw = px_v3_add(px_v3_scale(v[0], 1.0 - u - w),
+		       px_v3_add(px_v3_scale(v[1], u), px_v3_scale(v[2], w)));
+	{
+		if (f == PX_FEATURE_FACE)
+			PX_CHECK_MSG(px_v3_dist(q, qw) <=
+					     tol + 16 * U * (l * cond + d + px_v3_norm(q)),
+				     "face weights (%.17g %.17g) put the point %.3g off (l %.3g, "
+				     "aspect %.3g, d %.3g)",
+				     u, w, px_v3_dist(q, qw), l, cond, d);
+		else
+			PX_CHECK_MSG(px_v3_dist(q, qw) <= tol + 16 * U * (l + px_v3_norm(q)),
+				     "weights (%.17g %.17g) put the point %.3g off", u, w,
+				     px_v3_dist(q, qw));
+	}
+	PX_CHECK_MSG(u >= -16 * U * cond && w >= -16 * U * cond && u + w <= 1.0 + 16 * U * cond,
+		     "weights %.17g %.17g (aspect %.3g)", u, w, cond);
+	if (f == PX_FEATURE_VERTEX) {
+		PX_CHECK(s >= 0 && s <= 2);
+		PX_CHECK_MSG(px_v3_dist(q, v[s]) == 0.0, "vertex %d, point %.3g off it", s,
+			     px_v3_dist(q, v[s]));
+	} else if (f == PX_FEATURE_EDGE) {
+		/* the weight of the vertex opposite edge s is 0 */
+		double wt[3] = {1.0 - u - w, u, w};
+		PX_CHECK(s >= 0 && s <= 2);
+		/* (the weight of a is 1 - u - v: zero to rounding on edge 1) */
+		PX_CHECK_MSG(fabs(wt[(s + 2) % 3]) <= 2 * U, "edge %d with weights %.3g %.3g %.3g",
+			     s, wt[0], wt[1], wt[2]);
+	} else {
+		PX_CHECK_INT_EQ(f, PX_FEATURE_FACE);
+	}
 	return (double)(fabsl((long double)d - ref) - 1e-160L) / (U * ((double)ref + l));
 }
 
