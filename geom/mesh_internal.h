@@ -35,6 +35,9 @@
  * robust test answers. Either sends the query to the robust test. */
 #define DEGEN_ZERO 1u
 #define DEGEN_SLOW 2u
+/* Bits 2-3: the vertex (1 or 2) the fast test pivots on for a triangle
+ * thin only at its first vertex (0: the first). */
+#define DEGEN_ROT_SHIFT 2
 
 /* Two children per node, each with its box; cnt > 0 marks a leaf range
  * [idx, idx + cnt) of the reordered triangles, cnt == 0 an inner node

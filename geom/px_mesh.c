@@ -328,10 +328,10 @@ static inline int fast_shape(double lab, double lac, double nn)
  * vertices coincide); *needle when its height is below sqrt(NEEDLE_SIN2)
  * of its edges (degenerate for topology and signs: no face normal; its
  * distance is still exact, by tri_exact); *fast when the fast test's
- * bound holds for it (fast_shape).
+ * bound holds for it (fast_shape) at vertex *rot (0: a, 1: b, 2: c).
  */
 static void tri_shape(px_vec3 a, px_vec3 b, px_vec3 c, px_vec3 *ab, px_vec3 *ac,
-		      px_vec3 *bc, int *needle, int *fast)
+		      px_vec3 *bc, int *needle, int *fast, int *rot)
 {
 	px_vec3 e0 = px_v3_sub(b, a), e1 = px_v3_sub(c, a), e2 = px_v3_sub(c, b), n;
 	double m = mx2(amax3(e0), mx2(amax3(e1), amax3(e2))), s, la, lc, lb;
@@ -340,6 +340,7 @@ static void tri_shape(px_vec3 a, px_vec3 b, px_vec3 c, px_vec3 *ab, px_vec3 *ac,
 		*ab = *ac = *bc = px_v3(0, 0, 0);
 		*needle = 1;
 		*fast = 0;
+		*rot = 0;
 		return;
 	}
 	s = pow2_scale(m, &e);
@@ -351,9 +352,20 @@ static void tri_shape(px_vec3 a, px_vec3 b, px_vec3 c, px_vec3 *ab, px_vec3 *ac,
 	lc = px_v3_norm2(*ac);
 	lb = px_v3_norm2(*bc);
 	*needle = !(px_v3_norm2(n) > NEEDLE_SIN2 * fmax(la * lc, fmax(la * lb, lc * lb)));
-	/* the size from the edges as given, the shape from the scaled ones */
+	/* the size from the edges as given, the shape from the scaled ones;
+	 * a triangle thin at a but not at its widest vertex (opposite the
+	 * longest edge) takes the fast test from there */
+	*rot = 0;
 	*fast = fast_size(px_v3_norm2(e0), px_v3_norm2(e1)) &&
 		px_v3_norm2(n) >= FAST_SIN2 * la * lc;
+	if (!*fast && !(lb >= la && lb >= lc)) {
+		int r = lc >= la ? 1 : 2;
+		double l1 = r == 1 ? la : lc, u1 = r == 1 ? px_v3_norm2(e0) : px_v3_norm2(e1);
+		if (fast_size(u1, px_v3_norm2(e2)) && px_v3_norm2(n) >= FAST_SIN2 * l1 * lb) {
+			*fast = 1;
+			*rot = r;
+		}
+	}
 }
 
 px_vec3 px__tri_unit_normal(px_vec3 a, px_vec3 b, px_vec3 c)
@@ -366,24 +378,30 @@ px_vec3 px__tri_unit_normal(px_vec3 a, px_vec3 b, px_vec3 c)
 	return unit_normal_acc(a, b, c);
 }
 
-/* The fast test with the vertices rotated by r (a' = P[r], b', c'
- * following): outputs mapped back to the caller's order. */
-static double tri_core_rot(px_vec3 p, const px_vec3 P[3], int r, px_vec3 *q,
-			   int *feature, int *sub, double *u, double *v)
+/* The fast test with the vertices rotated by r (1 or 2: a' = P[r], b',
+ * c' following): outputs mapped back to the caller's order. Out of
+ * line: the rare path, kept out of the mesh walk's inlined common one. */
+static __attribute__((noinline)) double
+tri_core_rot(px_vec3 p, const px_vec3 P[3], int r, px_vec3 *q, int *feature, int *sub,
+	     double *u, double *v)
 {
-	px_vec3 a = P[r], b = P[(r + 1) % 3], c = P[(r + 2) % 3];
+	px_vec3 a = P[r], b = P[r == 1 ? 2 : 0], c = P[r == 1 ? 0 : 1];
 	px_vec3 n = px_v3_cross(px_v3_sub(b, a), px_v3_sub(c, a));
-	double w[3], d2, u2, v2;
+	double d2, u2, v2, w0;
 	int f, s2;
 	d2 = tri_core(p, a, b, c, n, px_v3_norm2(n), 0, q, &f, &s2, &u2, &v2);
-	/* weights of a', b', c' (edge b'c' has none on a', exactly) */
-	w[0] = (f == PX_FEATURE_EDGE && s2 == 1) ? 0.0 : 1.0 - u2 - v2;
-	w[1] = u2;
-	w[2] = v2;
+	/* the weight of a' (none on edge b'c', exactly) */
+	w0 = (f == PX_FEATURE_EDGE && s2 == 1) ? 0.0 : 1.0 - u2 - v2;
 	*feature = f;
-	*sub = f == PX_FEATURE_FACE ? s2 : (s2 + r) % 3;
-	*u = w[(4 - r) % 3];
-	*v = w[(5 - r) % 3];
+	if (f != PX_FEATURE_FACE) {
+		s2 += r;
+		*sub = s2 >= 3 ? s2 - 3 : s2;
+	} else {
+		*sub = s2;
+	}
+	/* r = 1: (a, b, c) = (c', a', b'); r = 2: (b', c', a') */
+	*u = r == 1 ? w0 : v2;
+	*v = r == 1 ? u2 : w0;
 	return d2;
 }
 
@@ -858,7 +876,7 @@ static inline void test_tri_x(const struct mesh *M, size_t li, px_vec3 p,
 {
 	const uint32_t *vi = M->tv + 3 * li;
 	px_vec3 ta = M->vx[vi[0]], tb = M->vx[vi[1]], tc = M->vx[vi[2]], n, q;
-	int f, s, robust;
+	int f, s, robust, rot;
 	double u, v, d2, nn;
 
 	n = px_v3_cross(px_v3_sub(tb, ta), px_v3_sub(tc, ta));
@@ -866,9 +884,11 @@ static inline void test_tri_x(const struct mesh *M, size_t li, px_vec3 p,
 	 * 1 / |n|^2 (px__mtri_get) is 0 exactly for these */
 	nn = px_v3_norm2(n);
 	/* degenerate, or a shape or size outside the fast test's bound
-	 * (set at setup, DEGEN_*), or a point too far out for it */
-	robust = M->degen[li] || !fast;
-	if (!plane_done && !robust) {
+	 * (set at setup, DEGEN_*), or a point too far out for it; a
+	 * triangle thin only at a takes the fast test from another vertex */
+	robust = (M->degen[li] & (DEGEN_ZERO | DEGEN_SLOW)) || !fast;
+	rot = M->degen[li] >> DEGEN_ROT_SHIFT;
+	if (!plane_done && !robust && !rot) {
 		/* the distance to the plane is a lower bound (compared
 		 * without a division; the factor keeps rounding from ever
 		 * rejecting a triangle whose plane distance equals the bound) */
@@ -876,7 +896,12 @@ static inline void test_tri_x(const struct mesh *M, size_t li, px_vec3 p,
 		if (h * h > b->d2 * nn * (1.0 + 1e-12))
 			return;
 	}
-	d2 = tri_core(p, ta, tb, tc, n, nn, robust, &q, &f, &s, &u, &v);
+	if (rot && !robust) {
+		px_vec3 P[3] = {ta, tb, tc};
+		d2 = tri_core_rot(p, P, rot, &q, &f, &s, &u, &v);
+	} else {
+		d2 = tri_core(p, ta, tb, tc, n, nn, robust, &q, &f, &s, &u, &v);
+	}
 	if ((M->degen[li] & DEGEN_ZERO) && f == PX_FEATURE_FACE)
 		f = face_as_edge(ta, tb, tc, u, v, &s);
 	if (d2 < b->d2 ||
@@ -1480,9 +1505,9 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 		 * scale-free, and nothing overflows at 1e150 or underflows at
 		 * 1e-140 */
 		px_vec3 ab, ac, bc;
-		int collapsed = c0 == c1 || c1 == c2 || c0 == c2, needle, fast;
+		int collapsed = c0 == c1 || c1 == c2 || c0 == c2, needle, fast, rot;
 
-		tri_shape(a, b, c, &ab, &ac, &bc, &needle, &fast);
+		tri_shape(a, b, c, &ab, &ac, &bc, &needle, &fast, &rot);
 		nb[3 * i] = nb[3 * i + 1] = nb[3 * i + 2] = -1;
 		if (collapsed || needle) {
 			deg[i] = DEGEN_ZERO;
@@ -1492,8 +1517,7 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 			/* the accurate normal: the plain cross product of a
 			 * thin triangle's edges is off by u / sin(angle) */
 			fn[i] = unit_normal_acc(a, b, c);
-			if (!fast)
-				deg[i] = DEGEN_SLOW;
+			deg[i] = !fast ? DEGEN_SLOW : (uint8_t)(rot << DEGEN_ROT_SHIFT);
 			/* in units of 2^vexp: a 1e150 mesh's volume overflows */
 			vol_s += px_v3_dot(px_v3_scale(a, vsc),
 					   px_v3_cross(px_v3_scale(b, vsc), px_v3_scale(c, vsc))) /
