@@ -29,9 +29,10 @@
  * PX_E_RANGE and a message naming the vertex or the extent. Query
  * points up to 1e150 outside the box (px_model.h) are answered. The
  * hierarchy's boxes are single-precision floats: beyond about 3e38 they
- * round out to infinity, and for a mesh smaller than about 1e-35 out to
- * a few float steps, and stop pruning, so such a mesh is answered
- * exactly but by visiting every triangle.
+ * round out to infinity, and below about 1e-38 (subnormal floats) they
+ * coarsen until, near 1e-45, they no longer separate anything; such a
+ * mesh is answered exactly, but by visiting more (up to every)
+ * triangle.
  *
  * Signed distance: on a watertight mesh the sign of (p - q) . n, with n
  * the pseudo-normal of the feature (face, edge or vertex) holding the
