@@ -364,6 +364,37 @@ static void test_needle_face(void)
 	(void)bad;
 }
 
+/*
+ * The fast test at the edge of its filter: the angle at a just above
+ * asin(1/8) (sin^2 = FAST_SIN2 = 1/64) or its supplement, points on,
+ * above and beside the face and anywhere near: within the bound (its
+ * error grows as 1 / sin of that angle, so this is where it is largest).
+ */
+static void test_fast_filter_edge(void)
+{
+	double worst = 0.0, got;
+	long double want;
+	int it;
+	for (it = 0; it < 100000; it++) {
+		double ang = asin(0.125) * (1.0 + 0.05 * px_rand_unit());
+		double l1 = px_rand_range(0.1, 1.1), l2 = px_rand_range(0.1, 1.1), e;
+		px_vec3 d = rand_unit(), n = perp(d), m = px_v3_cross(d, n), v[3], p;
+		if (px_rand_unit() < 0.5)
+			ang = 3.14159265358979323846 - ang;
+		v[0] = px_v3(px_rand_range(-0.5, 0.5), px_rand_range(-0.5, 0.5), px_rand_range(-0.5, 0.5));
+		v[1] = px_v3_madd(v[0], d, l1);
+		v[2] = px_v3_madd(px_v3_madd(v[0], d, l2 * cos(ang)), n, l2 * sin(ang));
+		p = hard_point(it % 5, v);
+		if (it % 7 == 0) /* in the plane, just off the face */
+			p = px_v3_madd(p, m, 1e-9 * px_rand_range(-1, 1));
+		e = tri_err(p, v, &got, &want);
+		worst = fmax(worst, e);
+		PX_CHECK_MSG(e <= PX_TRI_ERR_ULPS, "angle %.17g: %.17g vs %.17Lg (%.1f u)", ang, got,
+			     want, e);
+	}
+	printf("  fast test at its filter's edge: worst %.2f u (d + l)\n", worst);
+}
+
 /* ---- triangle pairs and segments ------------------------------------------ */
 
 /* Reference squared distance of segments p0p1 and q0q1: the least of the
@@ -1008,7 +1039,8 @@ static void test_prim_range(void)
 }
 
 static const struct px_test tests[] = {
-	PX_T(test_tri_bound),   PX_T(test_needle_face), PX_T(test_tri_range),
+	PX_T(test_tri_bound),   PX_T(test_needle_face), PX_T(test_fast_filter_edge),
+	PX_T(test_tri_range),
 	PX_T(test_tri_tri_bound), PX_T(test_seg_bound),
 	PX_T(test_mesh_needles), PX_T(test_needle_solid_sign), PX_T(test_mesh_range), PX_T(test_grid_extremes),
 	PX_T(test_prim_bound),
