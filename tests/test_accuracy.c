@@ -573,6 +573,104 @@ static void test_seg_bound(void)
 	printf("  px__seg_seg: worst %.2f u (d + l); px__seg_tri: worst %.2f\n", worst, worst_t);
 }
 
+static void comp_set(px_vec3 *v, int i, double x)
+{
+	if (i == 0)
+		v->x = x;
+	else if (i == 1)
+		v->y = x;
+	else
+		v->z = x;
+}
+
+/* squared distance of x to the box |x_k| <= h_k, long double */
+static long double ld_box_d2(const long double x[3], const double h[3])
+{
+	long double s = 0;
+	int k;
+	for (k = 0; k < 3; k++) {
+		long double o = fabsl(x[k]) - h[k];
+		if (o > 0)
+			s += o * o;
+	}
+	return s;
+}
+
+/* Reference segment-box distance: the squared distance along the
+ * segment is convex, so a golden-section search in long double finds
+ * its least value (200 steps: the bracket shrinks far below rounding). */
+static long double ref_seg_box(px_vec3 p0, px_vec3 p1, const double h[3])
+{
+	long double lo = 0, hi = 1, g = 0.6180339887498948482L, best;
+	long double P[3] = {p0.x, p0.y, p0.z}, D[3] = {(long double)p1.x - p0.x,
+							(long double)p1.y - p0.y,
+							(long double)p1.z - p0.z};
+	int it, k;
+	for (it = 0; it < 200; it++) {
+		long double t1 = hi - g * (hi - lo), t2 = lo + g * (hi - lo), x1[3], x2[3];
+		for (k = 0; k < 3; k++) {
+			x1[k] = P[k] + t1 * D[k];
+			x2[k] = P[k] + t2 * D[k];
+		}
+		if (ld_box_d2(x1, h) <= ld_box_d2(x2, h))
+			hi = t2;
+		else
+			lo = t1;
+	}
+	{
+		long double x[3], e[3], t = 0.5L * (lo + hi);
+		for (k = 0; k < 3; k++) {
+			x[k] = P[k] + t * D[k];
+			e[k] = P[k];
+		}
+		best = ld_box_d2(x, h);
+		/* and the end points, where a search bracket may stop short */
+		x[0] = e[0] + D[0];
+		x[1] = e[1] + D[1];
+		x[2] = e[2] + D[2];
+		if (ld_box_d2(e, h) < best)
+			best = ld_box_d2(e, h);
+		if (ld_box_d2(x, h) < best)
+			best = ld_box_d2(x, h);
+	}
+	return sqrtl(best);
+}
+
+/*
+ * Segments against boxes (capsule-box pairs): segments nearly parallel
+ * to a face or an edge, grazing a corner, crossing, at scales 1e-100 ..
+ * 1e100: px__seg_box within PX_TRI_ERR_ULPS u (d + size).
+ */
+static void test_seg_box_bound(void)
+{
+	static const double scales[] = {1e-100, 1e-8, 1.0, 1e8, 1e100};
+	double worst = 0.0;
+	int it;
+	for (it = 0; it < 20000; it++) {
+		double s = scales[it % 5], h[3], t, size, e, d;
+		px_vec3 p0, p1, q, dir;
+		long double ref;
+		int k;
+		for (k = 0; k < 3; k++)
+			h[k] = s * px_rand_range(0.1, 1.0) / (px_rand_unit() < 0.2 ? 1e6 : 1.0);
+		/* start near a face, an edge or a corner, run nearly along it */
+		p0 = px_v3(h[0] * px_rand_range(-1.2, 1.2), h[1] * px_rand_range(-1.2, 1.2),
+			   h[2] * px_rand_range(-1.2, 1.2));
+		comp_set(&p0, it % 3, h[it % 3] * (1.0 + pow(10.0, px_rand_range(-12, 0))));
+		dir = rand_unit();
+		comp_set(&dir, it % 3, px_v3_comp(dir, it % 3) * pow(10.0, px_rand_range(-9, 0)));
+		p1 = px_v3_madd(p0, dir, s * px_rand_range(0.1, 3.0));
+		d = sqrt(px__seg_box(p0, p1, h, &t, &q));
+		ref = ref_seg_box(p0, p1, h);
+		size = fmax(h[0], fmax(h[1], fmax(h[2], px_v3_dist(p0, p1))));
+		e = (double)(fabsl((long double)d - ref) - 1e-160L) / (U * ((double)ref + size));
+		worst = fmax(worst, e);
+		PX_CHECK_MSG(e <= PX_TRI_ERR_ULPS, "segment-box %d scale %g: %.17g vs %.17Lg (%.1f u)",
+			     it, s, d, ref, e);
+	}
+	printf("  px__seg_box: worst %.2f u (d + size)\n", worst);
+}
+
 /* ---- meshes ---------------------------------------------------------------- */
 
 /* least reference distance over every triangle of the arrays */
@@ -1041,7 +1139,7 @@ static void test_prim_range(void)
 static const struct px_test tests[] = {
 	PX_T(test_tri_bound),   PX_T(test_needle_face), PX_T(test_fast_filter_edge),
 	PX_T(test_tri_range),
-	PX_T(test_tri_tri_bound), PX_T(test_seg_bound),
+	PX_T(test_tri_tri_bound), PX_T(test_seg_bound), PX_T(test_seg_box_bound),
 	PX_T(test_mesh_needles), PX_T(test_needle_solid_sign), PX_T(test_mesh_range), PX_T(test_grid_extremes),
 	PX_T(test_prim_bound),
 	PX_T(test_prim_range),
