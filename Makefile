@@ -1,5 +1,8 @@
 # proxima - plain GNU make.  `make help` lists targets and variables.
 
+# `make` alone builds the library and the tools.
+.DEFAULT_GOAL := all
+
 # ---- overridable ---------------------------------------------------------
 CC       ?= cc
 PREFIX   ?= /usr/local
@@ -104,9 +107,6 @@ FORCE:
         clean help deps check-deps fcl-bench
 
 all: lib tools
-
-# Keep objects made by chained pattern rules.
-.SECONDARY:
 
 # Keep objects made by chained pattern rules.
 .SECONDARY:
