@@ -187,8 +187,9 @@ bench: all
 	@$(MAKE) --no-print-directory fcl-bench || echo "make bench: FCL reference not built"
 	@$(MAKE) --no-print-directory run-benches
 
+# Runs every benchmark and writes docs/benchmarks.md from their output.
 run-benches:
-	@set -e; for b in $(BENCH_BIN) $(CXX_BENCH_BIN); do echo "== $$b"; $$b; done
+	@sh bench/report.sh $(BENCH_BIN) $(CXX_BENCH_BIN)
 
 # FCL reference program for bench_models, only where FCL is installed
 # (checked when it runs, after `make bench` installed the packages).

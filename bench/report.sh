@@ -1,0 +1,100 @@
+#!/bin/sh
+# bench/report.sh BENCH... - run the benchmark binaries in order and write
+# docs/benchmarks.md from their output.
+#
+# Each benchmark's output also goes to the terminal as it runs. The report
+# has the date, the machine (nproc, CPU model, kernel, load average at the
+# start), a short paragraph per benchmark saying what it compares, and each
+# benchmark's output verbatim. The report is written to a temporary file
+# and renamed into place only when every benchmark succeeded; a failing
+# benchmark leaves the previous report as it was and makes this script
+# fail.
+#
+# Environment: BENCH_REPORT (output file, default docs/benchmarks.md).
+# Run from the source tree: bench_scene reads config/examples/.
+
+set -u
+
+out=${BENCH_REPORT:-docs/benchmarks.md}
+tmp=$(mktemp "${TMPDIR:-/tmp}/px-bench.XXXXXX") || exit 1
+log=$(mktemp "${TMPDIR:-/tmp}/px-bench-log.XXXXXX") || { rm -f "$tmp"; exit 1; }
+trap 'rm -f "$tmp" "$log"' EXIT INT TERM HUP
+
+# What each benchmark compares (by binary name).
+describe() {
+	case "$1" in
+	bench_control) echo "Time per cycle and scene queries per cycle of the haptic proxy and penalty renderers and of the avoidance step (6 joints, 6 capsules) against a small analytic scene (sphere, thin plate, floor), so the figures are the control code's own cost." ;;
+	bench_dist) echo "The global distance query (\`px_dist_query\`) on representative NURBS curves and patches: time per query (median, p99, max) for random points in the model's box enlarged by 25 % per side, root iterations, pieces solved per query and model memory." ;;
+	bench_dist_occt) echo "The same models and points next to OpenCASCADE in one process, each query interleaved with OCCT's (so the figures here are cold-cache times): OCCT's correct set-up (surface projection plus boundary curves and corners) and its fastest (Extrema tree search, minimum only), with the ratios and how often either answer is on a wrong branch." ;;
+	bench_models) echo "Point-to-model queries: a 70,490-triangle mesh (cold and coherent), a 100,000-point cloud, primitives, model pairs and scenes of 20 and 200 models; FCL 0.7 on the same mesh queries and mesh pairs where Debian's libfcl-dev is installed, with the ratio and a check that both give the same distances." ;;
+	bench_nurbs) echo "Evaluation cost of NURBS curves and surfaces (the inner step of every Newton iteration of the distance core), best of several runs by thread CPU time." ;;
+	bench_recog) echo "The knowledge step: recognition time at setup and closed-form closest-point time per query for a NURBS circle, a sphere and a torus patch built as surfaces of revolution." ;;
+	bench_rt) echo "The real-time loop at 1 kHz against cyclictest (rt-tests) at the same priority and interval, alternating in 1 s chunks so that both see the same load, with both latency distributions and their ratios; then the cost of a ring push, a statistics record and read, and a virtual-clock cycle. \`PX_BENCH_RT_SECONDS\` (default 10 per side) and \`PX_BENCH_RT_PRIO\` (default 80) change the run." ;;
+	bench_scene) echo "The loop's scene queries on the shipped example scene (\`config/examples/haptic_sim.yaml\`) three ways - plain global queries, coherent queries (hints) and tracked streams - along the same smooth paths at several speeds, with the answers compared; then the proxy renderer's whole step through the coherent and the tracked adapters." ;;
+	bench_track) echo "Coherent tracking (\`px_track\`, \`px_strack\`) on moving-point paths (smooth random paths and sums of sinusoids, steps of 0.01 %, 0.1 %, 1 % and 5 % of the model size) next to the cold global query on the same points: per-update median, p99, p99.9 and max, the work's own worst case (\`max_min3\`: each update's least time over three replayed runs), ratios, transitions, cells solved and wrong answers (must be 0)." ;;
+	*) echo "" ;;
+	esac
+}
+
+cpu=$(sed -n 's/^model name[[:space:]]*:[[:space:]]*//p' /proc/cpuinfo 2>/dev/null | head -n 1)
+[ -n "$cpu" ] || cpu=unknown
+load=$(cut -d ' ' -f 1-3 /proc/loadavg 2>/dev/null || echo unknown)
+
+{
+	echo "# Benchmarks"
+	echo
+	echo "Current figures of every benchmark under \`bench/\`, written by"
+	echo "\`make bench\` (\`bench/report.sh\`): each benchmark's output as it"
+	echo "printed it. Timings depend on the machine and its load; ratios"
+	echo "measured in one run, and instruction counts, move less than"
+	echo "absolute times. Do not edit by hand: run \`make bench\` again."
+	echo
+	echo "- date: $(date -u '+%Y-%m-%d %H:%M UTC')"
+	echo "- machine: $(nproc) CPUs, $cpu"
+	echo "- kernel: $(uname -sr)"
+	echo "- load average at the start: $load"
+	echo
+	echo "| benchmark | what it compares |"
+	echo "|---|---|"
+	for b in "$@"; do
+		n=$(basename "$b")
+		echo "| [\`$n\`](#$n) | $(describe "$n") |"
+	done
+} > "$tmp"
+
+status=0
+for b in "$@"; do
+	n=$(basename "$b")
+	echo "== $b"
+	t0=$(date +%s)
+	"$b" > "$log" 2>&1
+	rc=$?
+	t1=$(date +%s)
+	cat "$log"
+	if [ "$rc" -ne 0 ]; then
+		echo "bench/report.sh: $b exited with status $rc" >&2
+		status=1
+		continue
+	fi
+	{
+		echo
+		echo "## $n"
+		echo
+		describe "$n"
+		echo
+		src=bench/$n.c
+		[ -f "$src" ] || src=bench/$n.cpp
+		echo "\`$b\` (\`$src\`), $((t1 - t0)) s:"
+		echo
+		echo '```'
+		cat "$log"
+		echo '```'
+	} >> "$tmp"
+done
+
+if [ "$status" -ne 0 ]; then
+	echo "bench/report.sh: $out not written" >&2
+	exit 1
+fi
+mkdir -p "$(dirname "$out")" && cp "$tmp" "$out.tmp" && mv "$out.tmp" "$out" || exit 1
+echo "bench/report.sh: wrote $out"
