@@ -23,7 +23,14 @@ NAME    := proxima
 VERSION := $(shell sed -n 's/^\#define PX_VERSION_STRING "\(.*\)"/\1/p' core/px_base.h)
 SOMAJOR := $(firstword $(subst ., ,$(VERSION)))
 
-MODULE_DIRS := core geom rt devices config control scene
+# Library folders are found, not listed: every folder under a top-level
+# folder that is not one of NON_LIB_DIRS or a build directory and holds .c
+# or .h files (geom/nurbs, devices/backends, app, ...) is a module folder:
+# its sources go into the library and it is on the include path.
+NON_LIB_DIRS := tests tools bench fuzz examples docs
+LIB_TOP := $(filter-out $(NON_LIB_DIRS) build% $(firstword $(subst /, ,$(BUILD))),\
+             $(patsubst %/,%,$(wildcard */)))
+MODULE_DIRS := $(sort $(patsubst %/,%,$(dir $(shell find $(LIB_TOP) -type f -name '*.[ch]'))))
 WARN    := -Wall -Wextra -Wshadow -Wstrict-prototypes -Werror
 INCS    := $(addprefix -I,$(MODULE_DIRS))
 BASE_CFLAGS := -std=c11 -D_GNU_SOURCE $(WARN) $(INCS) -fvisibility=hidden -MMD -MP
@@ -56,7 +63,7 @@ LIBS    = $(PKG_LIBS) -lm -lpthread
 # ---- sources -------------------------------------------------------------
 LIB_SRC  := $(foreach d,$(MODULE_DIRS),$(wildcard $(d)/*.c))
 LIB_OBJ  := $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC))
-PUB_HDRS := $(filter-out %/internal.h,$(foreach d,$(MODULE_DIRS),$(wildcard $(d)/px*.h)))
+PUB_HDRS := $(filter-out %internal.h,$(foreach d,$(MODULE_DIRS),$(wildcard $(d)/px*.h)))
 
 TEST_SUPPORT_SRC := $(wildcard tests/px_*.c)
 TEST_SUPPORT_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(TEST_SUPPORT_SRC))
