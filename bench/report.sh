@@ -17,8 +17,9 @@ set -u
 
 out=${BENCH_REPORT:-docs/benchmarks.md}
 tmp=$(mktemp "${TMPDIR:-/tmp}/px-bench.XXXXXX") || exit 1
-log=$(mktemp "${TMPDIR:-/tmp}/px-bench-log.XXXXXX") || { rm -f "$tmp"; exit 1; }
-trap 'rm -f "$tmp" "$log"' EXIT INT TERM HUP
+body=$(mktemp "${TMPDIR:-/tmp}/px-bench-body.XXXXXX") || { rm -f "$tmp"; exit 1; }
+log=$(mktemp "${TMPDIR:-/tmp}/px-bench-log.XXXXXX") || { rm -f "$tmp" "$body"; exit 1; }
+trap 'rm -f "$tmp" "$body" "$log"' EXIT INT TERM HUP
 
 # What each benchmark compares (by binary name).
 describe() {
@@ -29,7 +30,7 @@ describe() {
 	bench_models) echo "Point-to-model queries: a 70,490-triangle mesh (cold and coherent), a 100,000-point cloud, primitives, model pairs and scenes of 20 and 200 models; FCL 0.7 on the same mesh queries and mesh pairs where Debian's libfcl-dev is installed, with the ratio and a check that both give the same distances." ;;
 	bench_nurbs) echo "Evaluation cost of NURBS curves and surfaces (the inner step of every Newton iteration of the distance core), best of several runs by thread CPU time." ;;
 	bench_recog) echo "The knowledge step: recognition time at setup and closed-form closest-point time per query for a NURBS circle, a sphere and a torus patch built as surfaces of revolution." ;;
-	bench_rt) echo "The real-time loop at 1 kHz against cyclictest (rt-tests) at the same priority and interval, alternating in 1 s chunks so that both see the same load, with both latency distributions and their ratios; then the cost of a ring push, a statistics record and read, and a virtual-clock cycle. \`PX_BENCH_RT_SECONDS\` (default 10 per side) and \`PX_BENCH_RT_PRIO\` (default 80) change the run." ;;
+	bench_rt) echo "The real-time loop at 1 kHz against cyclictest (rt-tests) at the same priority and interval, alternating in 1 s chunks so that both see the same load, with both latency distributions and their ratios, after the cost of a ring push, a statistics record and read, and a virtual-clock cycle. \`PX_BENCH_RT_SECONDS\` (default 10 per side) and \`PX_BENCH_RT_PRIO\` (default 80) change the run." ;;
 	bench_scene) echo "The loop's scene queries on the shipped example scene (\`config/examples/haptic_sim.yaml\`) three ways - plain global queries, coherent queries (hints) and tracked streams - along the same smooth paths at several speeds, with the answers compared; then the proxy renderer's whole step through the coherent and the tracked adapters." ;;
 	bench_track) echo "Coherent tracking (\`px_track\`, \`px_strack\`) on moving-point paths (smooth random paths and sums of sinusoids, steps of 0.01 %, 0.1 %, 1 % and 5 % of the model size) next to the cold global query on the same points: per-update median, p99, p99.9 and max, the work's own worst case (\`max_min3\`: each update's least time over three replayed runs), ratios, transitions, cells solved and wrong answers (must be 0)." ;;
 	*) echo "" ;;
@@ -40,27 +41,8 @@ cpu=$(sed -n 's/^model name[[:space:]]*:[[:space:]]*//p' /proc/cpuinfo 2>/dev/nu
 [ -n "$cpu" ] || cpu=unknown
 load=$(cut -d ' ' -f 1-3 /proc/loadavg 2>/dev/null || echo unknown)
 
-{
-	echo "# Benchmarks"
-	echo
-	echo "Current figures of every benchmark under \`bench/\`, written by"
-	echo "\`make bench\` (\`bench/report.sh\`): each benchmark's output as it"
-	echo "printed it. Timings depend on the machine and its load; ratios"
-	echo "measured in one run, and instruction counts, move less than"
-	echo "absolute times. Do not edit by hand: run \`make bench\` again."
-	echo
-	echo "- date: $(date -u '+%Y-%m-%d %H:%M UTC')"
-	echo "- machine: $(nproc) CPUs, $cpu"
-	echo "- kernel: $(uname -sr)"
-	echo "- load average at the start: $load"
-	echo
-	echo "| benchmark | what it compares |"
-	echo "|---|---|"
-	for b in "$@"; do
-		n=$(basename "$b")
-		echo "| [\`$n\`](#$n) | $(describe "$n") |"
-	done
-} > "$tmp"
+started=$(date -u '+%Y-%m-%d %H:%M UTC')
+all0=$(date +%s)
 
 status=0
 for b in "$@"; do
@@ -84,13 +66,38 @@ for b in "$@"; do
 		echo
 		src=bench/$n.c
 		[ -f "$src" ] || src=bench/$n.cpp
-		echo "\`$b\` (\`$src\`), $((t1 - t0)) s:"
+		echo "\`$src\`, $((t1 - t0)) s:"
 		echo
 		echo '```'
 		cat "$log"
 		echo '```'
-	} >> "$tmp"
+	} >> "$body"
 done
+all1=$(date +%s)
+
+{
+	echo "# Benchmarks"
+	echo
+	echo "Current figures of every benchmark under \`bench/\`, written by"
+	echo "\`make bench\` (\`bench/report.sh\`): each benchmark's output as it"
+	echo "printed it. Timings depend on the machine and its load; ratios"
+	echo "measured in one run move less than absolute times. Do not edit"
+	echo "by hand: run \`make bench\` again."
+	echo
+	echo "- date: $started"
+	echo "- machine: $(nproc) CPUs, $cpu"
+	echo "- kernel: $(uname -sr)"
+	echo "- load average at the start: $load"
+	echo "- run time of all benchmarks: $((all1 - all0)) s"
+	echo
+	echo "| benchmark | what it compares |"
+	echo "|---|---|"
+	for b in "$@"; do
+		n=$(basename "$b")
+		echo "| [\`$n\`](#$n) | $(describe "$n") |"
+	done
+} > "$tmp"
+cat "$body" >> "$tmp"
 
 if [ "$status" -ne 0 ]; then
 	echo "bench/report.sh: $out not written" >&2
