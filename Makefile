@@ -78,6 +78,13 @@ TOOL_SUPPORT_OBJ += $(BUILD)/obj/tests/px_alloc_count.o
 TOOL_SRC := $(wildcard tools/proxima-*.c)
 TOOL_BIN := $(patsubst tools/%.c,$(BUILD)/bin/%,$(TOOL_SRC))
 
+# examples/*.c: programs that see only the public headers, as a user's
+# code does (<proxima/px_*.h> from $(BUILD)/include, the installed layout).
+EXAMPLE_SRC := $(wildcard examples/*.c)
+EXAMPLE_BIN := $(patsubst examples/%.c,$(BUILD)/examples/%,$(EXAMPLE_SRC))
+INC_DIR     := $(BUILD)/include
+INC_STAMP   := $(INC_DIR)/$(NAME)/.stamp
+
 BENCH_SRC := $(wildcard bench/bench_*.c)
 BENCH_BIN := $(patsubst bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 # C++ comparisons against OpenCASCADE, built only where its headers are.
@@ -110,10 +117,10 @@ DEB_PACKAGES += libassimp-dev
 
 FORCE:
 
-.PHONY: FORCE all lib tools tests benches run-benches test bench sanitize install uninstall \
+.PHONY: FORCE all lib tools examples tests benches run-benches test bench sanitize install uninstall \
         clean help deps check-deps fcl-bench
 
-all: lib tools
+all: lib tools examples
 
 # Keep objects made by chained pattern rules.
 .SECONDARY:
@@ -123,6 +130,8 @@ lib: $(STATIC_LIB) $(SHARED_LIB) $(PC_FILE)
 tools: $(TOOL_BIN)
 
 tests: $(TEST_BIN)
+
+examples: $(EXAMPLE_BIN)
 
 benches: $(BENCH_BIN) $(CXX_BENCH_BIN)
 
@@ -166,6 +175,20 @@ $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT_OBJ) $(STATIC_LIB)
 $(BUILD)/bin/%: $(BUILD)/obj/tools/%.o $(TOOL_SUPPORT_OBJ) $(STATIC_LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_LDFLAGS) -o $@ $< $(TOOL_SUPPORT_OBJ) $(STATIC_LIB) $(LIBS)
+
+# The public headers, flat under $(INC_DIR)/$(NAME)/ as they install.
+$(INC_STAMP): $(PUB_HDRS)
+	@rm -rf $(dir $@) && mkdir -p $(dir $@)
+	cp $(PUB_HDRS) $(dir $@)
+	@touch $@
+
+$(BUILD)/obj/examples/%.o: examples/%.c $(INC_STAMP)
+	@mkdir -p $(dir $@)
+	$(CC) -std=c11 $(WARN) -I$(INC_DIR) $(OPTFLAGS) $(SANFLAGS) $(CFLAGS) -MMD -MP -c $< -o $@
+
+$(BUILD)/examples/%: $(BUILD)/obj/examples/%.o $(STATIC_LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_LDFLAGS) -o $@ $< $(STATIC_LIB) $(LIBS)
 
 $(BUILD)/bench/%_occt: bench/%_occt.cpp $(STATIC_LIB)
 	@mkdir -p $(dir $@)
@@ -246,7 +269,8 @@ clean:
 
 help:
 	@echo 'Targets:'
-	@echo '  all        static and shared library (build/lib), tools (build/bin)'
+	@echo '  all        static and shared library (build/lib), tools (build/bin),'
+	@echo '             examples (build/examples); the default target'
 	@echo '  test       install missing packages, build, run the whole test suite'
 	@echo '  bench      build and run the benchmarks'
 	@echo '  sanitize   the test suite built with AddressSanitizer + UBSan'
@@ -365,5 +389,5 @@ stress: $(BUILD)/tests/test_hostile
 	PX_STRESS=1 $(BUILD)/tests/test_hostile
 
 -include $(LIB_OBJ:.o=.d) $(TEST_SUPPORT_OBJ:.o=.d) $(TOOL_SUPPORT_OBJ:.o=.d)
--include $(patsubst %.c,$(BUILD)/obj/%.d,$(TEST_SRC) $(TOOL_SRC) $(BENCH_SRC))
+-include $(patsubst %.c,$(BUILD)/obj/%.d,$(TEST_SRC) $(TOOL_SRC) $(BENCH_SRC) $(EXAMPLE_SRC))
 -include $(patsubst %.c,$(BUILD)/obj/%.d,$(FUZZ_SRC) fuzz/replay.c)
