@@ -3,7 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "internal.h"
+#include "config_internal.h"
 #include "schema_internal.h"
 
 #define NS_PER_S 1000000000LL

@@ -6,7 +6,7 @@
 #include <sys/stat.h>
 #include <yaml.h>
 
-#include "internal.h"
+#include "config_internal.h"
 
 /* A config file larger than this is certainly a mistake (wrong file). */
 #define MAX_FILE_BYTES (64u << 20)

@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "internal.h"
+#include "config_internal.h"
 
 #define MAX_SCHEMA_KEYS 128
 #define MAX_NUMBER_CHARS 128

@@ -5,7 +5,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "internal.h"
+#include "control_internal.h"
 
 px_pose px_control_pose_from_xyz_rpy(px_vec3 xyz_m, px_vec3 rpy_rad)
 {

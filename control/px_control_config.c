@@ -8,7 +8,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "internal.h"
+#include "control_internal.h"
 #include "px_config.h"
 #include "schema_internal.h"
 

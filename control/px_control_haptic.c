@@ -25,7 +25,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "internal.h"
+#include "control_internal.h"
 
 #define CONTACT_BAND 2.0  /* contact when clearance < CONTACT_BAND * r */
 #define APPROACH_COS -0.01 /* moving toward a surface point */

@@ -1,7 +1,7 @@
 /* Scene query helpers, force limiting and the passivity bound. */
 #include <math.h>
 
-#include "internal.h"
+#include "control_internal.h"
 
 int px__ctl_point(const struct px_control_query *q, px_vec3 p,
 		  double max_distance_m, struct px_control_hit *out,

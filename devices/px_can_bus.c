@@ -18,7 +18,7 @@
 #include <linux/can/netlink.h>
 #include <linux/can/raw.h>
 
-#include "internal.h"
+#include "dev_internal.h"
 #include "px_arena.h"
 #include "px_file.h"
 #include "px_can.h"

@@ -6,7 +6,7 @@
 #include <linux/can/error.h>
 
 #include "px_can.h"
-#include "internal.h"
+#include "dev_internal.h"
 
 #define MAX_SIG 64
 #define MAX_OUT_IDS 8

@@ -6,7 +6,7 @@
 
 #include <linux/can/error.h>
 
-#include "internal.h"
+#include "dev_internal.h"
 
 int px__can_fx_init(struct px__can_fx *fx, const struct px_sim_fault *f,
 		    size_t n, uint64_t seed, char *msg, size_t cap)

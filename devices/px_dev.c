@@ -12,7 +12,7 @@
 #include "px_dev.h"
 #include "px_loop.h"
 #include "px_param.h"
-#include "internal.h"
+#include "dev_internal.h"
 
 enum {
 	C_REPORTS, C_SAMPLES, C_DECODE, C_NONFINITE, C_DUP, C_STUCK,

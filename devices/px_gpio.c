@@ -3,7 +3,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "internal.h"
+#include "dev_internal.h"
 #include "px_gpio.h"
 #include "px_loop.h"
 

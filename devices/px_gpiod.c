@@ -8,7 +8,7 @@
 
 #include <gpiod.h>
 
-#include "internal.h"
+#include "dev_internal.h"
 #include "px_gpio.h"
 
 #define CONSUMER "proxima"

@@ -14,7 +14,7 @@
 #include "px_arena.h"
 #include "px_hid.h"
 #include "px_param.h"
-#include "internal.h"
+#include "dev_internal.h"
 
 #ifndef PX_HIDAPI_DRIVER
 #define PX_HIDAPI_DRIVER "hidraw"

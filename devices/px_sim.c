@@ -9,7 +9,7 @@
 
 #include "px_file.h"
 #include "px_sim.h"
-#include "internal.h"
+#include "dev_internal.h"
 
 #define REP_MAX 64
 #define QCAP 32          /* reports in flight (delay) */

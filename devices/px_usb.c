@@ -13,7 +13,7 @@
 #include "px_arena.h"
 #include "px_param.h"
 #include "px_usb.h"
-#include "internal.h"
+#include "dev_internal.h"
 
 #define MAX_XFER 16
 #define FRAME_MAX 1024

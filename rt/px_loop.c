@@ -9,7 +9,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "internal.h"
+#include "rt_internal.h"
 #include "px_arena.h"
 #include "px_ring.h"
 
