@@ -1,7 +1,8 @@
 /*
  * mesh_internal.h - the triangle mesh model's data layout, shared by the
  * files that implement it (point queries in px_mesh.c, mesh-to-mesh
- * queries beside it). Not part of the public API.
+ * queries beside it), with the point cloud's box tree and the file
+ * importer they share. Not part of the public API.
  *
  * Memory and real-time rules: everything here is built at setup
  * (px_mesh_create) and read only by queries.
@@ -358,5 +359,33 @@ int px__mesh_vs_model(const struct px_model *m, const struct px_model *o,
 				 double *d),
 		      void *ctx, int max_queries, double *best, int *best_tri,
 		      int *queries);
+
+/*
+ * Read a mesh or point file with the Open Asset Import Library: all
+ * meshes of the scene with their node transforms applied (a mesh that no
+ * node references, as for a faceless PLY, is taken as it is), polygons
+ * triangulated. want_tri: collect triangles (other primitives are
+ * skipped and counted in *n_skipped); else only vertices. On success
+ * *xyz (3 doubles per vertex) and *tri (3 per triangle, NULL when
+ * !want_tri) are malloc'ed and owned by the caller. On failure msg holds
+ * "<path>: <reason>". The file is read once, at most
+ * PX_FILE_MODEL_MAX_BYTES, and the importer parses those bytes. PLY
+ * files are checked against their header first (x, y, z required); a
+ * PLY read for points (!want_tri) is read exactly by that check, without
+ * the importer; a mesh (PLY, ASCII STL, OBJ) whose coordinates would
+ * move by more than 1e-5 of its extent in the importer's single
+ * precision is PX_E_RANGE.
+ * Returns PX_OK, PX_E_INVAL, PX_E_NOTFOUND, PX_E_IO, PX_E_PARSE,
+ * PX_E_RANGE, PX_E_NOMEM, PX_E_OVERFLOW. Setup only.
+ */
+int px__import_file(const char *path, int want_tri, double **xyz,
+		    size_t *nv, uint32_t **tri, size_t *nt, size_t *n_skipped,
+		    char *msg, size_t msg_cap);
+
+/* Point cloud hint grid (px_cloud.c), for tests: the input index of the
+ * point the grid names for p, and the centre of p's cell (clamped to the
+ * grid); -1 when m is not a cloud or has no grid. RT-safe. */
+struct px_model;
+long px__cloud_grid_hint(const struct px_model *m, px_vec3 p, px_vec3 *centre);
 
 #endif

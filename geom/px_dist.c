@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "model_internal.h"
+#include "math_internal.h"
 #include "px_arena.h"
 #include "px_cpiece.h"
 #include "px_spiece.h"

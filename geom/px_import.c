@@ -24,7 +24,7 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
-#include "model_internal.h"
+#include "mesh_internal.h"
 #include "px_base.h"
 #include "px_file.h"
 

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "px_model.h"
+#include "math_internal.h"
 #include "model_internal.h"
 
 struct px_model {

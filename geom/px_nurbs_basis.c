@@ -9,7 +9,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "internal.h"
+#include "nurbs_internal.h"
 #include "px_nurbs.h"
 
 void px__nurbs_ok(struct px_nurbs_error *err)

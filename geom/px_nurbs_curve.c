@@ -7,7 +7,7 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "internal.h"
+#include "nurbs_internal.h"
 #include "px_nurbs.h"
 
 size_t px_nurbs_curve_bytes(int degree, int n_ctrl)

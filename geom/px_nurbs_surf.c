@@ -8,7 +8,7 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "internal.h"
+#include "nurbs_internal.h"
 #include "px_nurbs.h"
 
 size_t px_nurbs_surf_bytes(int degree_u, int degree_v, int n_u, int n_v)

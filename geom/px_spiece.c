@@ -4,7 +4,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "internal.h"
+#include "dist_internal.h"
 #include "px_bern.h"
 
 #define MD PX_SPIECE_MAX_DEGREE

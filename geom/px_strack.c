@@ -28,7 +28,9 @@
 #include <string.h>
 
 #include "gov_internal.h"
-#include "internal.h"
+#include "math_internal.h"
+#include "nurbs_internal.h"
+#include "track_internal.h"
 #include "px_bern.h"
 
 #define ST_NEWTON 16

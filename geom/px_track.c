@@ -36,7 +36,8 @@
 #include <string.h>
 
 #include "gov_internal.h"
-#include "internal.h"
+#include "math_internal.h"
+#include "track_internal.h"
 #include "px_bern.h"
 
 #define TRK_MAXD PX_NURBS_MAX_DEGREE

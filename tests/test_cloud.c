@@ -8,7 +8,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "model_internal.h"
+#include "mesh_internal.h"
 #include "px_alloc_count.h"
 #include "px_cloud.h"
 #include "px_test.h"

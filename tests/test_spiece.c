@@ -3,7 +3,7 @@
 #include <math.h>
 #include <stdio.h>
 
-#include "internal.h"
+#include "dist_internal.h"
 #include "px_alloc_count.h"
 #include "px_bern.h"
 #include "px_cpiece.h"
