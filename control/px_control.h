@@ -91,7 +91,7 @@ struct px_control_seg_hit {
  * distance - gap): the proxy's no-crossing guarantee and the certified
  * clearances rest on it. Both must be RT-safe when used from a cycle.
  *
- * Backing it with a scene model (geom/px_model.h, px_model_query_ex):
+ * Backing it with a scene model (geom/model/px_model.h, px_model_query_ex):
  * valid = (return 1), distance_m = distance (minus gap when not
  * certified), point_m = point, normal = direction, two_sided =
  * !is_signed.

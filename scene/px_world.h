@@ -3,7 +3,7 @@
  * section of a proxima config turned into a fixed list of named, posed
  * models (primitives, meshes, point clouds, NURBS), the nearest surface
  * to a point with a broad phase, and that answer as the control module's
- * query interface. (geom/px_scene.h is the general scene with a
+ * query interface. (geom/scene/px_scene.h is the general scene with a
  * hierarchy, within-distance and tool queries; this module is the
  * runner's view of a config. Building it on px_scene is planned.)
  *

@@ -1,5 +1,5 @@
 /*
- * Exact mesh-to-mesh distance (geom/px_mesh_pair.c).
+ * Exact mesh-to-mesh distance (geom/mesh/px_mesh_pair.c).
  *
  * References, written independently of the library's routines: the
  * triangle-triangle distance is checked against (1) the nine edge-edge

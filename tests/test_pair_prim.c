@@ -1,5 +1,5 @@
 /*
- * Closed-form pairs (geom/px_pair_prim.c): segment/segment and
+ * Closed-form pairs (geom/pair/px_pair_prim.c): segment/segment and
  * segment/box closest points against brute-force minimisation, and
  * capsule/capsule and capsule/box pair distances, penetration depths,
  * normals and witnesses through px_pair_distance().

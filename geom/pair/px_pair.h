@@ -28,7 +28,7 @@
  *   centre;
  * - a capsule against a capsule or a box: closed forms on the axis
  *   segment (segment/segment and segment/box distances, each a convex
- *   piecewise quadratic minimised exactly; geom/px_pair_prim.c), with
+ *   piecewise quadratic minimised exactly; geom/pair/px_pair_prim.c), with
  *   the depth, normal and witnesses of an overlap; only a capsule whose
  *   axis meets the box goes on to GJK and EPA;
  * - two convex models with support functions (convex primitives, convex
@@ -38,7 +38,7 @@
  *   two exact projections onto the surfaces;
  * - two triangle meshes (any, closed or open, convex or not): the exact
  *   minimum over all triangle pairs, by a simultaneous traversal of both
- *   hierarchies (geom/px_mesh_pair.c: box pairs bounded below in both
+ *   hierarchies (geom/mesh/px_mesh_pair.c: box pairs bounded below in both
  *   frames and along the line of centres, exact triangle-triangle
  *   distances with a crossing test); index_a/index_b are the triangles.
  *   In coherent mode last cycle's triangle pair is the starting bound;
