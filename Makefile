@@ -73,8 +73,15 @@ TEST_SH  := $(wildcard tests/test_*.sh)
 
 TOOL_SUPPORT_SRC := $(wildcard tools/tool_*.c)
 TOOL_SUPPORT_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(TOOL_SUPPORT_SRC))
-# proxima-run reports heap calls after setup with the tests' counter.
+# proxima-run reports the heap calls made after setup with the tests'
+# counter when one is loaded: the tests preload it as its own shared
+# object (ALLOC_SO, never installed), so the installed tools keep the
+# system allocator. Sanitizer builds count through the sanitizer's hooks,
+# which a preloaded object cannot reach: there the tools link it.
+ALLOC_SO := $(BUILD)/lib/lib$(NAME)-alloc-count.so
+ifeq ($(SAN),1)
 TOOL_SUPPORT_OBJ += $(BUILD)/obj/tests/px_alloc_count.o
+endif
 TOOL_SRC := $(wildcard tools/proxima-*.c)
 TOOL_BIN := $(patsubst tools/%.c,$(BUILD)/bin/%,$(TOOL_SRC))
 
@@ -129,7 +136,7 @@ lib: $(STATIC_LIB) $(SHARED_LIB) $(PC_FILE)
 
 tools: $(TOOL_BIN)
 
-tests: $(TEST_BIN)
+tests: $(TEST_BIN) $(if $(filter 1,$(SAN)),,$(ALLOC_SO))
 
 examples: $(EXAMPLE_BIN)
 
@@ -164,7 +171,7 @@ $(PC_FILE): FORCE
 	  'Description: real-time distance queries and control loops for haptics and robotics' \
 	  'Version: $(VERSION)' \
 	  'Requires.private: $(PKGS)' \
-	  'Cflags: -I$${includedir}/$(NAME)' \
+	  'Cflags: -I$${includedir}' \
 	  'Libs: -L$${libdir} -l$(NAME)' \
 	  'Libs.private: -lm -lpthread' > $@
 
@@ -175,6 +182,13 @@ $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT_OBJ) $(STATIC_LIB)
 $(BUILD)/bin/%: $(BUILD)/obj/tools/%.o $(TOOL_SUPPORT_OBJ) $(STATIC_LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_LDFLAGS) -o $@ $< $(TOOL_SUPPORT_OBJ) $(STATIC_LIB) $(LIBS)
+
+# Initial-exec TLS: the per-thread count must not make the dynamic
+# loader allocate on a thread's first heap call.
+$(ALLOC_SO): tests/px_alloc_count.c tests/px_alloc_count.h
+	@mkdir -p $(dir $@)
+	$(CC) -std=c11 -D_GNU_SOURCE $(WARN) $(OPTFLAGS) $(CFLAGS) -Itests -fPIC -shared \
+	  -ftls-model=initial-exec $(LDFLAGS) -o $@ $<
 
 # The public headers, flat under $(INC_DIR)/$(NAME)/ as they install.
 $(INC_STAMP): $(PUB_HDRS)
@@ -241,8 +255,9 @@ RUN_CONFIG  ?= config/examples/haptic_sim.yaml
 RUN_SECONDS ?= 10
 RUN_ARGS    ?=
 .PHONY: run
-run: deps all
-	$(BUILD)/bin/proxima-run $(RUN_CONFIG) --duration-s $(RUN_SECONDS) \
+# The run counts its heap calls after setup with the tests' counter.
+run: deps all $(if $(filter 1,$(SAN)),,$(ALLOC_SO))
+	$(if $(filter 1,$(SAN)),,LD_PRELOAD=$(abspath $(ALLOC_SO))) $(BUILD)/bin/proxima-run $(RUN_CONFIG) --duration-s $(RUN_SECONDS) \
 	  --summary-json $(BUILD)/run-summary.json $(RUN_ARGS)
 
 deps:

@@ -22,8 +22,18 @@ check() { # description, command...
 }
 check "make install DESTDIR PREFIX=/usr" \
 	${MAKE:-make} -s install DESTDIR="$tmp/root" PREFIX=/usr BUILD="${BUILD:-build}"
+# The installed tools use the system allocator: the tests' heap counter
+# (libproxima-alloc-count.so) is neither linked in nor installed.
+own_malloc() {
+	for f in "$tmp/root/usr/bin/"proxima-*; do
+		if nm "$f" | grep -qE ' [TtWw] (malloc|free)$'; then
+			echo "$f defines malloc/free"; return 1; fi
+	done
+	! ls "$tmp/root/usr/lib/" | grep -q alloc-count
+}
+check "installed tools carry no heap counter" own_malloc
 cat >"$tmp/consumer.c" <<'C'
-#include <px.h>
+#include <proxima/px.h>
 #include <stdio.h>
 #include <string.h>
 int main(void)
@@ -51,6 +61,16 @@ slibs=$(pkg-config --static --libs proxima)
 check "consumer compiles against the shared library" \
 	${CC:-cc} -std=c11 -Wall -Werror $cflags "$tmp/consumer.c" -o "$tmp/consumer" $libs
 check "shared consumer runs" env LD_LIBRARY_PATH="$tmp/root/usr/lib" "$tmp/consumer"
+# Every installed header stands alone as <proxima/px_*.h> (the headers
+# include each other by plain name, which resolves in their own folder).
+selfcheck() {
+	for h in "$tmp/root/usr/include/proxima/"*.h; do
+		printf '#include <proxima/%s>\n' "$(basename "$h")" >"$tmp/one.c"
+		${CC:-cc} -std=c11 -Wall -Werror $cflags -c "$tmp/one.c" -o "$tmp/one.o" ||
+			{ echo "$(basename "$h") does not compile alone"; return 1; }
+	done
+}
+check "each installed header compiles alone" selfcheck
 check "consumer links statically" \
 	${CC:-cc} -std=c11 -Wall -Werror $cflags "$tmp/consumer.c" -o "$tmp/consumer_static" \
 	"$tmp/root/usr/lib/libproxima.a" $slibs

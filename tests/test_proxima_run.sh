@@ -35,6 +35,14 @@ if [ ! -x "$bin" ]; then
 	echo "$name: 0 passed, 0 failed, 1 skipped"
 	exit 0
 fi
+# proxima-run counts heap calls with the tests' counter, preloaded as a
+# shared object (sanitizer builds link it into the tools instead).
+counter_so="${BUILD:-build}/lib/libproxima-alloc-count.so"
+if [ "${SAN:-}" != 1 ]; then
+	[ -f "$counter_so" ] || { echo "FAIL $counter_so not built"; fail=$((fail + 1)); }
+	counter_so="$(cd "$(dirname "$counter_so")" && pwd)/$(basename "$counter_so")"
+	export LD_PRELOAD="$counter_so${LD_PRELOAD:+:$LD_PRELOAD}"
+fi
 
 for f in config/examples/*.yaml; do
 	expect "--check $f" 0 "$bin" --check "$f"
@@ -238,6 +246,17 @@ if [ -s "$tmp/a.cut" ] && cmp -s "$tmp/a.cut" "$tmp/b.cut"; then
 expect "allocation probe run" 0 env PX_RUN_ALLOC_PROBE=1 "$bin" "$good" --virtual-time \
 	--duration-s 0.1 --summary-json "$tmp/probe.json" --telemetry "$tmp/probe.csv"
 check "the probe's malloc and free are counted" "$(num "$tmp/probe.json" allocations_after_setup) == 2"
+if grep -q '"allocation_counter": "none"' "$tmp/probe.json"; then
+	bad "the heap counter is loaded"; else ok "the heap counter is loaded"; fi
+# Without the counter (as installed) the run works and says so.
+if [ "${SAN:-}" != 1 ]; then
+	expect "run without the heap counter" 0 env -u LD_PRELOAD "$bin" "$good" --virtual-time \
+		--duration-s 0.1 --summary-json "$tmp/nocount.json"
+	if grep -q '"allocation_counter": "none"' "$tmp/nocount.json" &&
+	   grep -q '^  allocations       not counted' "$tmp/out"; then
+		ok "without the counter: allocation_counter none, not counted"
+	else bad "without the counter: allocation_counter none, not counted"; fi
+fi
 
 # Penalty renderer on the same scene: force still within the clamp.
 absolute "$good" | sed 's/renderer: proxy /renderer: penalty/' >"$tmp/penalty.yaml"

@@ -16,11 +16,14 @@
  * config's real-time setup) while the main thread drains the telemetry
  * ring, writes the CSV and prints the status; with --virtual-time the
  * main thread steps the loop itself and drains the ring between batches
- * of cycles. Heap calls are counted per thread by an allocator hook in
- * this program (glibc: interposed malloc family; sanitizer builds: the
- * sanitizer's malloc/free hooks) and only the calls the loop's thread
- * makes while cycles run are reported (allocations_after_setup), beside
- * the calls setup made (allocations_setup, showing the counter is live).
+ * of cycles. Heap calls are counted per thread by the tests' allocator
+ * hook when it is loaded (LD_PRELOAD=libproxima-alloc-count.so, as the
+ * test suite runs this program: the interposed malloc family; sanitizer
+ * builds link it: the sanitizer's malloc/free hooks) and only the calls
+ * the loop's thread makes while cycles run are reported
+ * (allocations_after_setup), beside the calls setup made
+ * (allocations_setup, showing the counter is live). Without the hook
+ * allocation_counter is "none" and nothing is counted.
  * PX_RUN_ALLOC_PROBE=1 in the environment makes cycle 10 allocate and
  * free once on purpose: the count is then 2 (a self-check for tests).
  *
@@ -233,11 +236,21 @@ static int parse_args(int argc, char **argv, struct options *o)
 
 /* ---- heap call counter (per thread) -------------------------------- */
 
-/* The same counter the tests use (tests/px_alloc_count.c, linked into
- * the tools): every malloc-family call of the loop thread is seen. */
+/* The tests' counter (tests/px_alloc_count.c) when it is there: preloaded
+ * as libproxima-alloc-count.so, or linked in sanitizer builds. It sees
+ * every malloc-family call of the loop thread. Weak, so that a run
+ * without it still works and says the counter is "none". */
+#pragma weak px_alloc_count_thread
+#pragma weak px_alloc_count_mode
+
 static uint64_t heap_count(void)
 {
-	return px_alloc_count_thread();
+	return px_alloc_count_thread ? px_alloc_count_thread() : 0;
+}
+
+static const char *heap_counter_name(void)
+{
+	return px_alloc_count_mode ? px_alloc_count_mode() : "none";
 }
 
 /* ---- the `sim` section: fault campaigns --------------------------- */
@@ -3208,10 +3221,14 @@ static void print_summary(const struct px_loop_status *st,
 		       (unsigned long long)ts.verifications,
 		       (unsigned long long)ts.disagreements);
 	}
-	printf("\n  allocations       %llu after setup (loop thread; setup made "
-	       "%llu)\n",
-	       (unsigned long long)atomic_load(&A.allocs),
-	       (unsigned long long)A.setup_heap_calls);
+	if (!px_alloc_count_thread)
+		printf("\n  allocations       not counted (no heap counter: "
+		       "preload libproxima-alloc-count.so)\n");
+	else
+		printf("\n  allocations       %llu after setup (loop thread; "
+		       "setup made %llu)\n",
+		       (unsigned long long)atomic_load(&A.allocs),
+		       (unsigned long long)A.setup_heap_calls);
 	printf("  telemetry         %llu records (every %lld cycles), %llu "
 	       "dropped\n",
 	       (unsigned long long)A.n_rows, (long long)A.decimation,
@@ -3312,7 +3329,7 @@ static int add_cli_faults(void)
 int main(int argc, char **argv)
 {
 	static struct px_config_diag diag;
-	const char *counter = px_alloc_count_mode();
+	const char *counter = heap_counter_name();
 	struct px_loop_status st;
 	struct px_stats_snapshot lat, cmp;
 	char time_svg[1100], lat_svg[1100];

@@ -20,6 +20,8 @@ ok() { echo "ok   $1"; pass=$((pass + 1)); }
 bad() { echo "FAIL $1"; fail=$((fail + 1)); }
 bin=/px/build/bin tmp=/tmp/e2e
 run=$bin/proxima-run cfg=/px/vm/e2e.yaml
+# proxima-run counts the loop's heap calls with the tests' counter.
+export LD_PRELOAD=/px/build/lib/libproxima-alloc-count.so
 mkdir -p "$tmp"
 finish() { echo "$name: $pass passed, $fail failed, $skip skipped"; [ "$fail" -eq 0 ]; exit $?; }
 # num KEY: the number after "KEY": in the summary JSON (first match)
@@ -92,6 +94,7 @@ fi
 check "enable relay on before the press ($enable_before)" "$enable_before == 1"
 check "enable relay off after the press ($enable_after)" "$enable_after == 0"
 check "no allocation in the loop ($(num allocations_after_setup))" "$(num allocations_after_setup) == 0"
+check "the heap counter saw setup's allocations" "$(num allocations_setup) > 0"
 # the device's own view: forces arrived, none after the press
 if [ "$frc" -eq 0 ] && [ -s "$tmp/uhid.txt" ]; then
 	ok "uhid_feed ran"

@@ -66,6 +66,7 @@ $build/tests/test_gpio=$g/tests/test_gpio
 $build/bin/proxima-probe=$g/bin/proxima-probe
 $build/bin/proxima-simarm=$g/bin/proxima-simarm
 $build/bin/proxima-run=$g/bin/proxima-run
+$build/lib/libproxima-alloc-count.so=$g/lib/libproxima-alloc-count.so
 $vmdir/uhid_feed=$g/tests/uhid_feed
 $top/tests/run.sh=/px/tests/run.sh
 $top/tests/test_probe.sh=/px/tests/test_probe.sh"
