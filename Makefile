@@ -46,22 +46,54 @@ endif
 ALL_CFLAGS := $(BASE_CFLAGS) $(OPTFLAGS) $(SANFLAGS) $(CFLAGS)
 ALL_LDFLAGS := $(SANFLAGS) $(LDFLAGS)
 
-# Optional libraries found with pkg-config (device back ends, config).
-PKGS     := yaml-0.1
-# Device back ends. hidapi comes as two builds with the same symbols:
-# HIDAPI=hidraw (default, /dev/hidraw*) or HIDAPI=libusb.
+# ---- optional parts ------------------------------------------------------
+# The distance core, the loop and the control code need libc, libm and
+# pthread only. Each part below is compiled in when pkg-config finds its
+# library; WITH_<PART>=0 leaves it out, WITH_DEVICES=0 every device back
+# end. A part left out is replaced by its <file>_none.c, whose functions
+# return PX_E_UNSUPPORTED with a message naming the missing library, and
+# px_features.h says PX_HAVE_<PART> 0.
+# hidapi comes as two builds with the same symbols: HIDAPI=hidraw
+# (default, /dev/hidraw*) or HIDAPI=libusb.
 HIDAPI   ?= hidraw
-PKGS     += hidapi-$(HIDAPI) libusb-1.0 libsocketcan libgpiod
-# Mesh and point-cloud file import (STL, OBJ, PLY).
-PKGS     += assimp
-# Asked when a recipe runs, not when this file is read, so that packages
-# `make deps` has just installed are found by the same `make test`.
+OPT_PARTS := HIDAPI LIBUSB SOCKETCAN GPIOD ASSIMP YAML
+OPT_DEVICE_PARTS := HIDAPI LIBUSB SOCKETCAN GPIOD
+PKG_HIDAPI    := hidapi-$(HIDAPI)
+PKG_LIBUSB    := libusb-1.0
+PKG_SOCKETCAN := libsocketcan
+PKG_GPIOD     := libgpiod
+PKG_ASSIMP    := assimp
+PKG_YAML      := yaml-0.1
+SRC_HIDAPI    := px_hidapi.c
+SRC_LIBUSB    := px_usb.c
+SRC_SOCKETCAN := px_socketcan.c
+SRC_GPIOD     := px_gpiod.c
+SRC_ASSIMP    := px_import.c
+SRC_YAML      := px_config_yaml.c
+DESC_HIDAPI    := HID devices (hidapi-$(HIDAPI))
+DESC_LIBUSB    := USB devices (libusb-1.0)
+DESC_SOCKETCAN := CAN interface state and bitrate (libsocketcan)
+DESC_GPIOD     := GPIO lines (libgpiod)
+DESC_ASSIMP    := mesh files (assimp)
+DESC_YAML      := YAML configs (libyaml)
+WITH_DEVICES ?= 1
+pc_have = $(shell pkg-config --exists $(1) 2>/dev/null && echo 1 || echo 0)
+# Found once per make (a sub-make after `make deps` looks again).
+$(foreach p,$(OPT_PARTS),$(if $(filter undefined,$(origin WITH_$(p))),\
+  $(eval WITH_$(p) := $(if $(and $(filter $(p),$(OPT_DEVICE_PARTS)),$(filter 0,$(WITH_DEVICES))),0,$(call pc_have,$(PKG_$(p)))))))
+OPT_ON   := $(foreach p,$(OPT_PARTS),$(if $(filter 1,$(WITH_$(p))),$(p)))
+PKGS     := $(foreach p,$(OPT_ON),$(PKG_$(p)))
+# The file of each part that this build leaves out.
+OPT_OUT_SRC := $(foreach p,$(OPT_PARTS),$(if $(filter 1,$(WITH_$(p))),\
+                 $(SRC_$(p):.c=_none.c),$(SRC_$(p))))
+# Asked when a recipe runs, not when this file is read.
 PKG_CFLAGS = $(if $(PKGS),$(shell pkg-config --cflags $(PKGS)))
 PKG_LIBS   = $(if $(PKGS),$(shell pkg-config --libs $(PKGS)))
 LIBS    = $(PKG_LIBS) -lm -lpthread
 
 # ---- sources -------------------------------------------------------------
-LIB_SRC  := $(foreach d,$(MODULE_DIRS),$(wildcard $(d)/*.c))
+LIB_SRC  := $(filter-out $(addprefix %/,$(OPT_OUT_SRC)),\
+              $(foreach d,$(MODULE_DIRS),$(wildcard $(d)/*.c)))
 LIB_OBJ  := $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC))
 PUB_HDRS := $(filter-out %internal.h,$(foreach d,$(MODULE_DIRS),$(wildcard $(d)/px*.h)))
 
@@ -91,6 +123,7 @@ EXAMPLE_SRC := $(wildcard examples/*.c)
 EXAMPLE_BIN := $(patsubst examples/%.c,$(BUILD)/examples/%,$(EXAMPLE_SRC))
 INC_DIR     := $(BUILD)/include
 INC_STAMP   := $(INC_DIR)/$(NAME)/.stamp
+FEATURES_H  := $(INC_DIR)/$(NAME)/px_features.h
 
 BENCH_SRC := $(wildcard bench/bench_*.c)
 BENCH_BIN := $(patsubst bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
@@ -147,19 +180,15 @@ $(BUILD)/obj/%.o: %.c
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) $(PKG_CFLAGS) -fPIC -c $< -o $@
 
-# `make -j test` installs missing packages before compiling what needs them.
-ifneq ($(filter test run,$(MAKECMDGOALS)),)
-$(LIB_OBJ): | deps
-endif
-
-$(STATIC_LIB): $(LIB_OBJ)
+# The library is made again when the set of optional parts changes.
+$(STATIC_LIB): $(LIB_OBJ) $(FEATURES_H)
 	@mkdir -p $(dir $@)
 	rm -f $@
-	ar rcs $@ $^
+	ar rcs $@ $(filter %.o,$^)
 
-$(SHARED_LIB): $(LIB_OBJ)
+$(SHARED_LIB): $(LIB_OBJ) $(FEATURES_H)
 	@mkdir -p $(dir $@)
-	$(CC) -shared -Wl,-soname,lib$(NAME).so.$(SOMAJOR) $(ALL_LDFLAGS) -o $@ $^ $(LIBS)
+	$(CC) -shared -Wl,-soname,lib$(NAME).so.$(SOMAJOR) $(ALL_LDFLAGS) -o $@ $(filter %.o,$^) $(LIBS)
 	ln -sf lib$(NAME).so.$(VERSION) $(BUILD)/lib/lib$(NAME).so.$(SOMAJOR)
 	ln -sf lib$(NAME).so.$(SOMAJOR) $(BUILD)/lib/lib$(NAME).so
 
@@ -192,11 +221,22 @@ $(ALLOC_SO): tests/px_alloc_count.c tests/px_alloc_count.h
 
 # The public headers, flat under $(INC_DIR)/$(NAME)/ as they install.
 $(INC_STAMP): $(PUB_HDRS)
-	@rm -rf $(dir $@) && mkdir -p $(dir $@)
+	@mkdir -p $(dir $@)
+	@find $(dir $@) -name 'px*.h' ! -name px_features.h -exec rm -f {} +
 	cp $(PUB_HDRS) $(dir $@)
 	@touch $@
 
-$(BUILD)/obj/examples/%.o: examples/%.c $(INC_STAMP)
+# What this build has (rewritten only when that changes).
+$(FEATURES_H): FORCE
+	@mkdir -p $(dir $@)
+	@{ printf '%s\n' '/* px_features.h - the optional parts of this build of proxima' \
+	    ' * (generated by make): 1 compiled in, 0 left out (its functions' \
+	    ' * return PX_E_UNSUPPORTED). */' '#ifndef PX_FEATURES_H' '#define PX_FEATURES_H'; \
+	  $(foreach p,$(OPT_PARTS),printf '#define PX_HAVE_%s %s\n' $(p) $(WITH_$(p));) \
+	  printf '%s\n' '#endif'; } > $@.tmp
+	@if cmp -s $@.tmp $@; then rm -f $@.tmp; else mv $@.tmp $@; fi
+
+$(BUILD)/obj/examples/%.o: examples/%.c $(INC_STAMP) $(FEATURES_H)
 	@mkdir -p $(dir $@)
 	$(CC) -std=c11 $(WARN) -I$(INC_DIR) $(OPTFLAGS) $(SANFLAGS) $(CFLAGS) -MMD -MP -c $< -o $@
 
@@ -214,13 +254,16 @@ $(BUILD)/bench/%: $(BUILD)/obj/bench/%.o $(STATIC_LIB)
 	$(CC) $(ALL_LDFLAGS) -o $@ $< $(STATIC_LIB) $(LIBS)
 
 # The HID back end reports which hidapi build it was linked with.
-$(BUILD)/obj/devices/px_hidapi.o: ALL_CFLAGS += -DPX_HIDAPI_DRIVER=\"$(HIDAPI)\"
+$(BUILD)/obj/devices/backends/px_hidapi.o: ALL_CFLAGS += -DPX_HIDAPI_DRIVER=\"$(HIDAPI)\"
 
 # Test and bench sources also see the test harness headers.
 $(BUILD)/obj/tests/%.o $(BUILD)/obj/bench/%.o $(BUILD)/obj/tools/%.o: ALL_CFLAGS += -Itests -Itools
 
 # ---- top-level actions ---------------------------------------------------
-test: deps all tests
+# `make deps` first; a second make then finds the optional parts it may
+# just have installed.
+test: deps
+	@$(MAKE) --no-print-directory all tests
 	@BUILD=$(BUILD) SAN=$(SAN) CC="$(CC)" MAKE="$(MAKE)" TEST_TIMEOUT=$(TEST_TIMEOUT) \
 	  sh tests/run.sh $(TEST_BIN) $(TEST_SH)
 
@@ -256,20 +299,21 @@ RUN_SECONDS ?= 10
 RUN_ARGS    ?=
 .PHONY: run
 # The run counts its heap calls after setup with the tests' counter.
-run: deps all $(if $(filter 1,$(SAN)),,$(ALLOC_SO))
+run: deps
+	@$(MAKE) --no-print-directory all $(if $(filter 1,$(SAN)),,$(ALLOC_SO))
 	$(if $(filter 1,$(SAN)),,LD_PRELOAD=$(abspath $(ALLOC_SO))) $(BUILD)/bin/proxima-run $(RUN_CONFIG) --duration-s $(RUN_SECONDS) \
 	  --summary-json $(BUILD)/run-summary.json $(RUN_ARGS)
 
 deps:
 	@sh tools/install-deps.sh $(DEB_PACKAGES)
 
-install: lib tools
+install: lib tools $(FEATURES_H)
 	install -d $(DESTDIR)$(LIBDIR)/pkgconfig $(DESTDIR)$(INCLUDEDIR)/$(NAME) $(DESTDIR)$(BINDIR)
 	install -m 644 $(STATIC_LIB) $(DESTDIR)$(LIBDIR)/
 	install -m 755 $(SHARED_LIB) $(DESTDIR)$(LIBDIR)/
 	ln -sf lib$(NAME).so.$(VERSION) $(DESTDIR)$(LIBDIR)/lib$(NAME).so.$(SOMAJOR)
 	ln -sf lib$(NAME).so.$(SOMAJOR) $(DESTDIR)$(LIBDIR)/lib$(NAME).so
-	install -m 644 $(PUB_HDRS) $(DESTDIR)$(INCLUDEDIR)/$(NAME)/
+	install -m 644 $(PUB_HDRS) $(FEATURES_H) $(DESTDIR)$(INCLUDEDIR)/$(NAME)/
 	install -m 644 $(PC_FILE) $(DESTDIR)$(LIBDIR)/pkgconfig/
 	$(if $(TOOL_BIN),install -m 755 $(TOOL_BIN) $(DESTDIR)$(BINDIR)/)
 
@@ -304,6 +348,10 @@ help:
 	@echo '  INCLUDEDIR=$(INCLUDEDIR) BINDIR=$(BINDIR) BUILD=$(BUILD)'
 	@echo '  OPTFLAGS=$(OPTFLAGS) CFLAGS=$(CFLAGS) LDFLAGS=$(LDFLAGS)'
 	@echo '  TEST_TIMEOUT=$(TEST_TIMEOUT) (seconds per test binary)'
+	@echo '  HIDAPI=$(HIDAPI) (hidraw or libusb: the hidapi build to link)'
+	@echo 'Optional parts (compiled in when pkg-config finds them; WITH_<PART>=0'
+	@echo 'leaves one out, WITH_DEVICES=0 every device back end):'
+	@$(foreach p,$(OPT_PARTS),printf '  %-16s %s\n' 'WITH_$(p)=$(WITH_$(p))' '$(DESC_$(p))';)
 	@echo 'Environment for tests: PX_TEST_SEED=<n> replays a seed,'
 	@echo '  PX_TEST_ONLY=<name> runs one test of a binary.'
 

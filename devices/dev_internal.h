@@ -88,4 +88,18 @@ int px__can_fx_apply(struct px__can_fx *fx, const struct px_can_msg *m,
 int px__can_fx_due(struct px__can_fx *fx, int64_t now, struct px_can_msg *m,
 		   const void **tag);
 
+/* Netlink calls on a CAN interface (backends/px_socketcan.c through
+ * libsocketcan; px_socketcan_none.c in a build without it: have() 0,
+ * every call fails with EOPNOTSUPP or PX_E_UNSUPPORTED). The do/set/get
+ * calls return 0 or -1 with errno, as libsocketcan's; state and restart
+ * return PX_OK or a px_err. */
+int px__socketcan_have(void);
+int px__socketcan_state(const char *iface, int *px_state);
+int px__socketcan_do_stop(const char *iface);
+int px__socketcan_do_start(const char *iface);
+int px__socketcan_set_bitrate(const char *iface, uint32_t bitrate);
+int px__socketcan_set_restart_ms(const char *iface, uint32_t ms);
+int px__socketcan_get_bitrate(const char *iface, uint32_t *bitrate);
+int px__socketcan_restart(const char *iface);
+
 #endif

@@ -1,5 +1,6 @@
 /* CAN buses: raw SocketCAN, in-process simulation, UNIX datagram
- * simulation, candump replay; interface state through libsocketcan. */
+ * simulation, candump replay; interface state and bitrate through the
+ * netlink calls of backends/px_socketcan.c (libsocketcan). */
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
@@ -13,7 +14,6 @@
 #include <time.h>
 #include <unistd.h>
 
-#include <libsocketcan.h>
 #include <linux/can/error.h>
 #include <linux/can/netlink.h>
 #include <linux/can/raw.h>
@@ -760,7 +760,6 @@ static int raw_recv(struct px_can_bus *b, int64_t now, struct px_can_msg *m)
 int px_can_iface_state(const char *iface, int *state)
 {
 	char p[64];
-	int s = 0;
 	if (!iface || !state)
 		return PX_E_INVAL;
 	if (if_nametoindex(iface) == 0)
@@ -771,20 +770,10 @@ int px_can_iface_state(const char *iface, int *state)
 	snprintf(p, sizeof p, "/sys/class/net/%s/device", iface);
 	if (strlen(iface) >= IF_NAMESIZE || access(p, F_OK) != 0)
 		return PX_E_UNSUPPORTED;
-	if (can_get_state(iface, &s) != 0)
-		return PX_E_IO;
-	switch (s) {
-	case CAN_STATE_ERROR_ACTIVE: *state = PX_CAN_STATE_ACTIVE; break;
-	case CAN_STATE_ERROR_WARNING: *state = PX_CAN_STATE_WARNING; break;
-	case CAN_STATE_ERROR_PASSIVE: *state = PX_CAN_STATE_PASSIVE; break;
-	case CAN_STATE_BUS_OFF: *state = PX_CAN_STATE_BUS_OFF; break;
-	case CAN_STATE_STOPPED: *state = PX_CAN_STATE_STOPPED; break;
-	default: *state = PX_CAN_STATE_UNKNOWN; break;
-	}
-	return PX_OK;
+	return px__socketcan_state(iface, state);
 }
 
-/* ---- bitrate through libsocketcan ----------------------------------------- */
+/* ---- bitrate through netlink (libsocketcan) --------------------------- */
 
 static int nl_exists(const char *iface)
 {
@@ -799,29 +788,11 @@ static int nl_is_virtual(const char *iface)
 	return access(p, F_OK) != 0;
 }
 
-static int nl_set_bitrate(const char *iface, uint32_t bitrate)
-{
-	return can_set_bitrate(iface, bitrate);
-}
-
-static int nl_set_restart_ms(const char *iface, uint32_t ms)
-{
-	return can_set_restart_ms(iface, ms);
-}
-
-static int nl_get_bitrate(const char *iface, uint32_t *bitrate)
-{
-	struct can_bittiming bt;
-	memset(&bt, 0, sizeof bt);
-	if (can_get_bittiming(iface, &bt) != 0)
-		return -1;
-	*bitrate = bt.bitrate;
-	return 0;
-}
-
 static const struct px_can_netlink_ops nl_default = {
-	nl_exists,	    nl_is_virtual,  can_do_stop,   can_do_start,
-	nl_set_bitrate, nl_set_restart_ms, nl_get_bitrate,
+	nl_exists,		     nl_is_virtual,
+	px__socketcan_do_stop,	     px__socketcan_do_start,
+	px__socketcan_set_bitrate, px__socketcan_set_restart_ms,
+	px__socketcan_get_bitrate,
 };
 static const struct px_can_netlink_ops *nl = &nl_default;
 
@@ -867,6 +838,14 @@ int px_can_iface_set_bitrate(const char *iface, uint32_t bitrate,
 				 "bytes) and a bitrate of 1 .. 8000000 bit/s",
 				 IFNAMSIZ);
 		return PX_E_INVAL;
+	}
+	if (nl == &nl_default && !px__socketcan_have()) {
+		if (msg)
+			snprintf(msg, cap, "%s: this build has no libsocketcan: "
+				 "%u bit/s not applied (set it with ip link set "
+				 "%s type can bitrate %u)", iface, bitrate,
+				 iface, bitrate);
+		return PX_E_UNSUPPORTED;
 	}
 	if (!nl->exists(iface)) {
 		if (msg)
@@ -927,7 +906,7 @@ int px_can_iface_restart(const char *iface)
 		return PX_E_INVAL;
 	if (if_nametoindex(iface) == 0)
 		return PX_E_NODEV;
-	return can_do_restart(iface) == 0 ? PX_OK : PX_E_IO;
+	return px__socketcan_restart(iface);
 }
 
 /* ---- replay ---------------------------------------------------------------- */

@@ -36,7 +36,7 @@ alt=$vmdir/hidapi-libusb
 mkdir -p "$alt"
 rm -rf "$alt/obj"
 cp -pR "$build/obj" "$alt/obj"
-rm -f "$alt/obj/devices/px_hidapi.o" "$alt/obj/devices/px_hidapi.d"
+rm -f "$alt/obj/devices/backends/px_hidapi.o" "$alt/obj/devices/backends/px_hidapi.d"
 if ! env -u MAKEFLAGS -u MFLAGS ${MAKE:-make} -s --no-print-directory -C "$top" \
 	BUILD="$alt" HIDAPI=libusb "$alt/tests/test_hid" >"$vmdir/alt.log" 2>&1; then
 	cat "$vmdir/alt.log"
