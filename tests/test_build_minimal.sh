@@ -47,7 +47,7 @@ nolibs() { # the shared library needs no optional library
 	return 0
 }
 check "libproxima uses no optional library" nolibs
-for ex in distance haptic_loop; do
+for ex in distance haptic_loop can_arm_distances; do
 	check "examples/$ex.c links with -lproxima -lm -lpthread" \
 		${CC:-cc} -std=c11 -Wall -Wextra -Werror -I"$inc" "examples/$ex.c" \
 		-o "$tmp/$ex" -L"$lib" -lproxima -lm -lpthread
