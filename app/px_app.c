@@ -1,0 +1,256 @@
+/* The app's public calls and its message helpers. */
+#include "app_internal.h"
+
+void px_app_options_default(struct px_app_options *opt)
+{
+	memset(opt, 0, sizeof(*opt));
+}
+
+void app_note(struct px_app *a, const char *fmt, ...)
+{
+	char buf[4096];
+	va_list ap;
+	va_start(ap, fmt);
+	vsnprintf(buf, sizeof(buf), fmt, ap);
+	va_end(ap);
+	if (a->msg && a->msg_cap && !a->msg[0]) {
+		/* the caller's msg: the first line of the first message */
+		size_t n = strcspn(buf, "\n");
+		if (n >= a->msg_cap)
+			n = a->msg_cap - 1;
+		memcpy(a->msg, buf, n);
+		a->msg[n] = '\0';
+	}
+	if (a->o.note)
+		a->o.note(a->o.user, buf);
+}
+
+/* A config diagnostic list as message text (px_config_diag_print writes
+ * to a stream: here one in memory, handed to opt.note). */
+void app_diag_print(struct px_app *a, const struct px_config_diag *diag)
+{
+	char *buf = NULL;
+	size_t n = 0;
+	FILE *f = open_memstream(&buf, &n);
+	if (!f)
+		return;
+	px_config_diag_print(diag, f);
+	fclose(f);
+	if (buf && buf[0])
+		app_note(a, "%s", buf);
+	free(buf);
+}
+
+uint64_t app_heap_count(struct px_app *a)
+{
+	return a->o.heap_count ? a->o.heap_count() : 0;
+}
+
+/* The plots' names follow the CSV's (or the default CSV name's). */
+void app_plot_paths(struct px_app *a, char *time_svg, char *lat_svg, size_t cap)
+{
+	const char *base = a->csv_path[0] ? a->csv_path : "proxima-run.csv";
+	size_t n = strlen(base);
+	if (n > 4 && strcmp(base + n - 4, ".csv") == 0)
+		n -= 4;
+	snprintf(time_svg, cap, "%.*s_time.svg", (int)n, base);
+	snprintf(lat_svg, cap, "%.*s_latency.svg", (int)n, base);
+}
+
+void px_app_shutdown_describe(const struct px_app *a, char *buf, size_t cap)
+{
+	const struct shutdown_report *sd = &a->sd;
+	char parts[160] = "";
+	size_t n = 0;
+	if (sd->force_devs)
+		n += (size_t)snprintf(parts + n, sizeof(parts) - n,
+				      "force zeroed on %d/%d device%s",
+				      sd->force_zeroed, sd->force_devs,
+				      sd->force_devs == 1 ? "" : "s");
+	if (sd->dio_devs && n < sizeof(parts))
+		n += (size_t)snprintf(parts + n, sizeof(parts) - n,
+				      "%srelay off on %d/%d", n ? ", " : "",
+				      sd->relays_off, sd->dio_devs);
+	if (sd->drives && n < sizeof(parts))
+		n += (size_t)snprintf(parts + n, sizeof(parts) - n,
+				      "%s%d/%d drive%s disabled%s", n ? ", " : "",
+				      sd->drives_disabled, sd->drives,
+				      sd->drives == 1 ? "" : "s",
+				      sd->drives_faulted ? " (some in fault)" : "");
+	snprintf(buf, cap, "%s (%s) after %s in %.1f ms%s%s",
+		 sd->safe ? "safe" : "NOT SAFE", n ? parts : "no outputs",
+		 sd->reason, (double)sd->elapsed_ns * 1e-6, sd->why[0] ? ": " : "",
+		 sd->why);
+}
+
+void app_note_shutdown(struct px_app *a, const char *prefix)
+{
+	char line[1024];
+	px_app_shutdown_describe(a, line, sizeof(line));
+	app_note(a, "%s%s\n", prefix, line);
+}
+
+/* Internal status (0, 1 invalid or failed, 2 options refused) as the
+ * public code. */
+static int app_code(int status)
+{
+	return status == 0 ? PX_OK : status == 2 ? PX_E_INVAL : PX_E_PARSE;
+}
+
+int px_app_create(const struct px_config *cfg, const struct px_app_options *opt,
+		  struct px_app **out, char *msg, size_t cap)
+{
+	struct px_app *a;
+	int rc;
+	if (msg && cap)
+		msg[0] = '\0';
+	if (!out)
+		return PX_E_INVAL;
+	*out = NULL;
+	if (!cfg || !opt || !opt->config || opt->n_faults < 0 ||
+	    opt->n_faults > PX_APP_MAX_CLI_FAULTS || opt->duration_s < 0 ||
+	    !(opt->duration_s <= 1e8)) {
+		if (msg && cap)
+			snprintf(msg, cap, "px_app_create: %s",
+				 !cfg || !opt || !opt->config
+					 ? "no config (or no config path)"
+					 : "duration_s outside [0, 1e8] or "
+					   "n_faults outside [0, 64]");
+		return PX_E_INVAL;
+	}
+	a = calloc(1, sizeof(*a));
+	if (!a)
+		return PX_E_NOMEM;
+	a->o = *opt;
+	/* the app reads the config only; its handle is not const for the
+	 * px_world/px_devcfg calls that take it so */
+	a->cfg = (struct px_config *)(uintptr_t)cfg;
+	a->msg = msg;
+	a->msg_cap = cap;
+	rc = px_control_config_read(cfg, &a->ctl, &a->diag);
+	if (rc != PX_OK) {
+		app_report_config(a, rc, &a->diag);
+		rc = 1;
+		goto fail;
+	}
+	a->sim.cfg_ = cfg;
+	rc = px_config_read(cfg->doc, cfg->sim, "sim", app_sim_schema(), &a->sim,
+			    &a->diag);
+	if (rc != PX_OK) {
+		app_report_config(a, rc, &a->diag);
+		rc = 1;
+		goto fail;
+	}
+	if (a->ctl.warning[0])
+		app_note(a, "%s\n", a->ctl.warning);
+	rc = app_add_cli_faults(a);
+	if (rc)
+		goto fail;
+	rc = a->o.check ? app_check_config(a) : app_setup(a);
+	if (rc)
+		goto fail;
+	a->msg = NULL;
+	*out = a;
+	return PX_OK;
+fail:
+	app_teardown(a);
+	free(a);
+	return app_code(rc);
+}
+
+void px_app_warnings(struct px_app *a)
+{
+	app_rearm_warnings(a);
+}
+
+struct px_loop *px_app_loop(struct px_app *a)
+{
+	return a->loop;
+}
+
+struct px_dev *px_app_device(struct px_app *a, const char *name)
+{
+	int i;
+	for (i = 0; name && i < a->n_dev; i++)
+		if (!strcmp(px_dev_name(a->dev[i]), name))
+			return a->dev[i];
+	return NULL;
+}
+
+int px_app_run(struct px_app *a)
+{
+	return app_run(a);
+}
+
+int px_app_step(struct px_app *a)
+{
+	return px_loop_step(a->loop);
+}
+
+int px_app_summary(const struct px_app *a, struct px_app_summary *s)
+{
+	struct px_loop_status st;
+	if (!a || !s)
+		return PX_E_INVAL;
+	memset(s, 0, sizeof(*s));
+	if (a->loop && px_loop_status(a->loop, &st) == PX_OK) {
+		s->cycles = st.cycles;
+		s->overruns = st.overruns;
+		s->missed_periods = st.missed_periods;
+		s->safe_state_trips = st.safe_entries;
+		if (a->have_deadline)
+			s->loop_time_s = (double)(a->last_deadline_ns -
+						  a->first_deadline_ns +
+						  st.period_ns) *
+					 1e-9;
+	}
+	s->max_force_n = a->max_force_n;
+	s->contact_cycles = a->contact_cycles;
+	s->min_distance_m = a->min_distance_m;
+	s->max_penetration_m = a->max_penetration_m;
+	s->min_proxy_distance_m = a->min_proxy_distance_m;
+	s->min_clearance_m = a->min_clearance_m;
+	s->velocity_trips = a->velocity_trips;
+	s->query_errors = a->query_errors;
+	s->estop_presses = a->estop_presses;
+	s->estop_cycles = a->estop_cycles;
+	s->telemetry_records = a->n_rows;
+	s->telemetry_dropped = a->ring ? px_ring_dropped(a->ring) : 0;
+	s->faults_popped = a->faults_popped;
+	s->allocations_after_setup = atomic_load(&a->allocs);
+	s->shutdown_done = a->sd.done;
+	s->shutdown_safe = a->sd.safe;
+	snprintf(s->shutdown_reason, sizeof(s->shutdown_reason), "%s",
+		 a->sd.reason);
+	return PX_OK;
+}
+
+void px_app_stop(struct px_app *a)
+{
+	if (!a)
+		return;
+	atomic_store(&a->stop_requested, 1);
+	if (a->loop)
+		px_loop_stop(a->loop);
+}
+
+void px_app_drain(struct px_app *a,
+		  void (*record)(void *user, const struct px_app_record *r),
+		  void *user)
+{
+	app_drain(a, record, user);
+}
+
+int px_app_shutdown(struct px_app *a, const char *reason)
+{
+	app_safe_shutdown(a, reason ? reason : "shutdown");
+	return a->sd.safe ? PX_OK : PX_E_TIMEOUT;
+}
+
+void px_app_free(struct px_app *a)
+{
+	if (!a)
+		return;
+	app_teardown(a);
+	free(a);
+}

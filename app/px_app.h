@@ -1,0 +1,179 @@
+/*
+ * px_app.h - a whole proxima application from its loaded config: the
+ * devices, the scene, the control, the 1 kHz loop and its safety policy.
+ *
+ * What: px_app_create() validates the config and opens what it names
+ * (simulated haptic/pose devices, every px_devcfg back end, a CANopen arm
+ * on the in-process or a UNIX-socket bus, the fault campaign of the `sim`
+ * section and of opt->faults), then makes the px_loop whose read, compute
+ * and write phases are this module's. The safety policy lives here: the
+ * velocity-limit trip, e-stop lines (a press trips, a release never
+ * restarts motion by itself), the enable relay (off in safe state), the
+ * CANopen drives held and quick-stopped in safe state, and
+ * px_app_shutdown(): zero force, relays off, drives quick-stopped and
+ * disabled, each confirmed within a bounded wait, before any device
+ * closes. px_app_free() runs it too when it has not run yet.
+ *
+ * Threads: create, run, drain, shutdown and free belong to one control
+ * thread. With the real clock px_app_run() runs the loop on its own thread
+ * (the config's real-time setup) and drains telemetry on the calling
+ * thread; on the virtual clock it steps the loop on the calling thread.
+ * px_app_stop() is async-signal-safe and may be called from any thread.
+ *
+ * Memory: everything is allocated by create (telemetry ring, statistics,
+ * devices); the cycle phases allocate nothing, take no lock and do no I/O
+ * but device calls. Messages (errors, warnings, notes) are text passed to
+ * opt->note in order; the library prints nothing itself.
+ *
+ * Real time: the phases (through the loop) are RT-safe; everything else
+ * here is setup or non-real-time.
+ */
+#ifndef PX_APP_H
+#define PX_APP_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "px_base.h"
+#include "px_config.h"
+#include "px_dev.h"
+#include "px_loop.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+struct px_app;
+
+/* Joints whose commanded velocity a record carries. */
+#define PX_APP_RECORD_JOINTS 6
+/* At most this many --fault style entries in px_app_options. */
+#define PX_APP_MAX_CLI_FAULTS 64
+
+/* One telemetry record, pushed by the write phase every
+ * telemetry.decimation-th cycle and read by px_app_drain(). */
+struct px_app_record {
+	double t_s;
+	uint64_t cycle;
+	double dev_m[3], proxy_m[3], force_n[3];
+	double force_mag_n;
+	double distance_m;    /* NaN: no meaningful distance this cycle */
+	double penetration_m;
+	int64_t latency_ns, compute_ns;
+	int32_t contact, safe, queries, valid;
+	/* avoidance: speed scale and commanded joint velocities */
+	double scale, qdot[PX_APP_RECORD_JOINTS];
+};
+
+struct px_app_options {
+	const char *config;    /* the config's path: base of relative files */
+	int check;             /* validate, open only in-process devices */
+	int virtual_time;      /* loop on the virtual clock */
+	double duration_s;     /* run length in loop time; 0: until stopped */
+	const char *summary_json; /* an output path to check, or NULL */
+	const char *telemetry; /* CSV path overriding telemetry.file */
+	/* entries KIND,DEVICE,START_S,DURATION_S[,PROBABILITY[,DELAY_S]]
+	 * added to sim.faults */
+	const char *faults[PX_APP_MAX_CLI_FAULTS];
+	int n_faults;
+	int alloc_probe;       /* cycle 10 allocates once (counter self-check) */
+	/* run after this many cycles: at_cycle(user) is called once (0 none) */
+	uint64_t stop_at_cycle;
+	/* hooks, each optional; user is passed back */
+	void *user;
+	void (*note)(void *user, const char *text); /* message text, in order */
+	uint64_t (*heap_count)(void);  /* heap calls of the calling thread */
+	int (*output_check)(void *user, const char *path, char *why, size_t cap);
+	void (*input_protect)(void *user, const char *path, const char *what);
+	void (*tick)(void *user);      /* between batches of px_app_run */
+	void (*at_cycle)(void *user);
+	void (*record)(void *user, const struct px_app_record *r);
+};
+
+PX_API void px_app_options_default(struct px_app_options *opt);
+
+/*
+ * Validate cfg and, unless opt->check, open everything and make the loop.
+ * cfg is the caller's and must outlive the app. Returns PX_OK, PX_E_INVAL
+ * (options refused: an output path, a fault entry, the virtual clock with
+ * hardware), PX_E_PARSE (the config is invalid or setup failed) or
+ * PX_E_NOMEM; msg gets the first message line, every message has gone to
+ * opt->note. On failure everything opened is back in the safe state and
+ * closed.
+ */
+PX_API int px_app_create(const struct px_config *cfg,
+			 const struct px_app_options *opt, struct px_app **out,
+			 char *msg, size_t cap);
+
+/* The config's warnings (e.g. auto_rearm beside an e-stop) to opt->note. */
+PX_API void px_app_warnings(struct px_app *app);
+
+/* The app's loop (its phases attached), to step or inspect. */
+PX_API struct px_loop *px_app_loop(struct px_app *app);
+
+/* The device of that config name (NULL: none), e.g. for a simulated
+ * device's state (px_sim_haptic_state). The app owns it. */
+PX_API struct px_dev *px_app_device(struct px_app *app, const char *name);
+
+/* Run until the duration, px_app_stop() or a loop error; drains into
+ * opt->record. Returns PX_OK or the loop's error. */
+PX_API int px_app_run(struct px_app *app);
+
+/* One cycle (read, compute, write) on the calling thread: the caller's
+ * own loop steps the app (on the virtual clock it returns at once, on the
+ * real one after the cycle's deadline). Returns PX_OK, PX_LOOP_STOP or the
+ * loop's error. RT-safe on the app's side (no allocation, no I/O but
+ * device calls); drain from time to time so the ring does not fill. */
+PX_API int px_app_step(struct px_app *app);
+
+/* Ask the run to end. Async-signal-safe. */
+PX_API void px_app_stop(struct px_app *app);
+
+/* Pop the telemetry records (into record(user, r), may be NULL) and the
+ * loop's faults (counted). Non-real-time thread. */
+PX_API void px_app_drain(struct px_app *app,
+			 void (*record)(void *user, const struct px_app_record *r),
+			 void *user);
+
+/* The safe state before anything closes (once; reason is reported).
+ * Returns PX_OK when every output was confirmed safe, else PX_E_TIMEOUT. */
+PX_API int px_app_shutdown(struct px_app *app, const char *reason);
+
+/* "safe (force zeroed on 1/1 device, ...) after REASON in 0.0 ms" */
+PX_API void px_app_shutdown_describe(const struct px_app *app, char *buf,
+				     size_t cap);
+
+/* The figures of the run so far (after px_app_shutdown: of the whole
+ * run), the numbers proxima-run prints. Non-real-time thread; call
+ * px_app_drain() first for the drained counts to be complete. */
+struct px_app_summary {
+	uint64_t cycles, overruns, missed_periods;
+	double loop_time_s;
+	double max_force_n;           /* over every cycle */
+	uint64_t contact_cycles;
+	double min_distance_m;        /* INFINITY: no distance seen */
+	double max_penetration_m;
+	double min_proxy_distance_m;  /* of the drained records */
+	double min_clearance_m;       /* avoidance: the arm's least clearance */
+	uint64_t safe_state_trips;    /* entries into safe state */
+	uint64_t velocity_trips;
+	uint64_t query_errors;
+	uint64_t estop_presses, estop_cycles;
+	uint64_t telemetry_records;   /* drained */
+	uint64_t telemetry_dropped;
+	uint64_t faults_popped;
+	uint64_t allocations_after_setup; /* 0 without opt.heap_count */
+	int shutdown_done, shutdown_safe;
+	char shutdown_reason[32];
+};
+
+PX_API int px_app_summary(const struct px_app *app, struct px_app_summary *out);
+
+/* Shutdown if not done, close everything. NULL is a no-op. */
+PX_API void px_app_free(struct px_app *app);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,279 @@
+/*
+ * app/: the runner as a module - create/free on every shipped simulated
+ * config, the cycle stepped from the test's own loop against the app's
+ * own run, the safe state at shutdown, no heap calls in the cycles, the
+ * summary against the figures proxima-run prints, bad options refused.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "px_alloc_count.h"
+#include "px_app.h"
+#include "px_config.h"
+#include "px_sim.h"
+#include "px_test.h"
+
+#define HAPTIC_SIM "config/examples/haptic_sim.yaml"
+#define MAX_RECS 4096
+
+/* The shipped configs that run without hardware, in this process
+ * (can_sim's arm is another program, proxima-simarm: test_proxima_run). */
+static const char *const sim_configs[] = {
+	"config/examples/haptic_sim.yaml",
+	"config/examples/haptic_faults.yaml",
+	"config/examples/can_avoid_sim.yaml",
+};
+
+static char notes[16384];
+
+static void on_note(void *user, const char *text)
+{
+	size_t n = strlen(notes);
+	(void)user;
+	snprintf(notes + n, sizeof(notes) - n, "%s", text);
+}
+
+struct recs {
+	struct px_app_record r[MAX_RECS];
+	size_t n;
+};
+
+static void on_record(void *user, const struct px_app_record *r)
+{
+	struct recs *rs = user;
+	if (rs->n < MAX_RECS) {
+		rs->r[rs->n] = *r;
+		rs->r[rs->n].compute_ns = 0; /* wall clock: not compared */
+		rs->n++;
+	}
+}
+
+static struct px_config *load(const char *path)
+{
+	static struct px_config_diag diag;
+	struct px_config *cfg = NULL;
+	int rc = px_config_load_file(path, &cfg, &diag);
+	PX_CHECK_MSG(rc == PX_OK, "%s: %s", path, px_strerror(rc));
+	return cfg;
+}
+
+static void options(struct px_app_options *o, const char *path, double dur_s)
+{
+	px_app_options_default(o);
+	o->config = path;
+	o->virtual_time = 1;
+	o->duration_s = dur_s;
+	o->note = on_note;
+}
+
+static struct px_app *create(const struct px_config *cfg,
+			     const struct px_app_options *o)
+{
+	struct px_app *app = NULL;
+	char msg[256];
+	int rc;
+	notes[0] = '\0';
+	rc = px_app_create(cfg, o, &app, msg, sizeof(msg));
+	PX_CHECK_MSG(rc == PX_OK, "%s: %s: %s (%s)", o->config, px_strerror(rc),
+		     msg, notes);
+	return app;
+}
+
+static void test_create_free_every_sim_config(void)
+{
+	size_t i;
+	for (i = 0; i < sizeof(sim_configs) / sizeof(sim_configs[0]); i++) {
+		struct px_config *cfg = load(sim_configs[i]);
+		struct px_app_options o;
+		struct px_app *app;
+		options(&o, sim_configs[i], 0.1);
+		app = create(cfg, &o);
+		PX_CHECK(px_app_loop(app) != NULL);
+		PX_CHECK_INT_EQ(px_app_run(app), PX_OK);
+		px_app_free(app); /* the shutdown runs here */
+		/* and the checks alone, as --check makes them */
+		o.check = 1;
+		app = create(cfg, &o);
+		px_app_free(app);
+		px_config_free(cfg);
+	}
+	px_app_free(NULL);
+}
+
+/* The same cycles, stepped here (draining every 100) or by px_app_run,
+ * give the same telemetry. */
+static void test_own_loop_matches_the_apps_run(void)
+{
+	static struct recs a, b;
+	struct px_config *cfg = load(HAPTIC_SIM);
+	struct px_app_options o;
+	struct px_app *app;
+	int k;
+	options(&o, HAPTIC_SIM, 0.5);
+	o.record = on_record;
+	o.user = &a;
+	a.n = b.n = 0;
+	app = create(cfg, &o);
+	PX_CHECK_INT_EQ(px_app_run(app), PX_OK);
+	px_app_drain(app, on_record, &a);
+	px_app_free(app);
+
+	o.record = NULL;
+	o.user = NULL;
+	app = create(cfg, &o);
+	for (k = 0; k < 500; k++) {
+		PX_CHECK_INT_EQ(px_app_step(app), PX_OK);
+		if (k % 100 == 99)
+			px_app_drain(app, on_record, &b);
+	}
+	px_app_drain(app, on_record, &b);
+	px_app_free(app);
+	px_config_free(cfg);
+	PX_CHECK_INT_EQ((long long)a.n, 500);
+	PX_CHECK_INT_EQ((long long)b.n, (long long)a.n);
+	PX_CHECK(memcmp(a.r, b.r, a.n * sizeof(a.r[0])) == 0);
+}
+
+/* In contact the device receives force; after px_app_shutdown it last
+ * received zero force and torque with enable off. */
+static void test_shutdown_leaves_zero_force(void)
+{
+	struct px_config *cfg = load(HAPTIC_SIM);
+	struct px_app_options o;
+	struct px_app *app;
+	struct px_sim_haptic_state hs;
+	struct px_app_summary s;
+	struct px_dev *dev;
+	int k, pushed = 0;
+	options(&o, HAPTIC_SIM, 0);
+	app = create(cfg, &o);
+	dev = px_app_device(app, "haptic");
+	PX_CHECK(dev != NULL);
+	PX_CHECK(px_app_device(app, "no such device") == NULL);
+	for (k = 0; k < 3000 && !pushed; k++) {
+		PX_CHECK_INT_EQ(px_app_step(app), PX_OK);
+		PX_CHECK_INT_EQ(px_sim_haptic_state(dev, &hs), PX_OK);
+		pushed = hs.enable && (hs.force_n[0] != 0 || hs.force_n[1] != 0 ||
+				       hs.force_n[2] != 0);
+		if (k % 100 == 99)
+			px_app_drain(app, NULL, NULL);
+	}
+	PX_CHECK_MSG(pushed, "no force within %d cycles", k);
+	PX_CHECK_INT_EQ(px_app_shutdown(app, "test"), PX_OK);
+	PX_CHECK_INT_EQ(px_sim_haptic_state(dev, &hs), PX_OK);
+	PX_CHECK(hs.force_n[0] == 0 && hs.force_n[1] == 0 && hs.force_n[2] == 0);
+	PX_CHECK(hs.torque_n_m[0] == 0 && hs.torque_n_m[1] == 0 &&
+		 hs.torque_n_m[2] == 0);
+	PX_CHECK_INT_EQ(hs.enable, 0);
+	PX_CHECK_INT_EQ(px_app_summary(app, &s), PX_OK);
+	PX_CHECK(s.shutdown_done && s.shutdown_safe);
+	PX_CHECK(strcmp(s.shutdown_reason, "test") == 0);
+	/* once: a second call reports the first */
+	PX_CHECK_INT_EQ(px_app_shutdown(app, "again"), PX_OK);
+	PX_CHECK_INT_EQ(px_app_summary(app, &s), PX_OK);
+	PX_CHECK(strcmp(s.shutdown_reason, "test") == 0);
+	px_app_free(app);
+	px_config_free(cfg);
+}
+
+static void test_cycles_allocate_nothing(void)
+{
+	size_t i;
+	for (i = 0; i < sizeof(sim_configs) / sizeof(sim_configs[0]); i++) {
+		struct px_config *cfg = load(sim_configs[i]);
+		struct px_app_options o;
+		struct px_app *app;
+		uint64_t heap = 0, h0;
+		int k;
+		options(&o, sim_configs[i], 0);
+		app = create(cfg, &o);
+		for (k = 0; k < 2000; k++) {
+			h0 = px_alloc_region_begin();
+			PX_CHECK_INT_EQ(px_app_step(app), PX_OK);
+			heap += px_alloc_region_end(h0);
+			if (k % 100 == 99)
+				px_app_drain(app, NULL, NULL);
+		}
+		PX_CHECK_MSG(heap == 0, "%s: %llu heap calls in 2000 cycles",
+			     sim_configs[i], (unsigned long long)heap);
+		px_app_free(app);
+		px_config_free(cfg);
+	}
+}
+
+/* haptic_sim for 2 s on the virtual clock: the figures proxima-run
+ * prints and writes for it (test_proxima_run checks those outputs). */
+static void test_summary_is_proxima_runs(void)
+{
+	struct px_config *cfg = load(HAPTIC_SIM);
+	struct px_app_options o;
+	struct px_app *app;
+	struct px_app_summary s;
+	options(&o, HAPTIC_SIM, 2.0);
+	o.heap_count = px_alloc_count_thread;
+	app = create(cfg, &o);
+	PX_CHECK_INT_EQ(px_app_run(app), PX_OK);
+	PX_CHECK_INT_EQ(px_app_shutdown(app, "end of run"), PX_OK);
+	px_app_drain(app, NULL, NULL);
+	PX_CHECK_INT_EQ(px_app_summary(app, &s), PX_OK);
+	PX_CHECK_INT_EQ((long long)s.cycles, 2000);
+	PX_CHECK_NEAR(s.loop_time_s, 2.0, 1e-12);
+	PX_CHECK_INT_EQ((long long)s.telemetry_records, 2000);
+	PX_CHECK_INT_EQ((long long)s.telemetry_dropped, 0);
+	PX_CHECK_INT_EQ((long long)s.safe_state_trips, 0);
+	PX_CHECK_INT_EQ((long long)s.allocations_after_setup, 0);
+	PX_CHECK_NEAR(s.max_force_n, 8.0, 1e-12);
+	PX_CHECK(s.min_distance_m < 0 && s.max_penetration_m > 0);
+	PX_CHECK_NEAR(s.min_distance_m, -s.max_penetration_m, 1e-15);
+	PX_CHECK(s.min_proxy_distance_m > 0);
+	PX_CHECK(s.contact_cycles > 0 && s.contact_cycles < s.cycles);
+	px_app_free(app);
+	px_config_free(cfg);
+}
+
+static void test_bad_options_refused(void)
+{
+	struct px_config *cfg = load(HAPTIC_SIM);
+	struct px_config *hid = load("config/examples/haptic_hid.yaml");
+	struct px_app_options o;
+	struct px_app *app = (struct px_app *)&app;
+	char msg[256];
+	options(&o, NULL, 1);
+	PX_CHECK_INT_EQ(px_app_create(cfg, &o, &app, msg, sizeof(msg)), PX_E_INVAL);
+	PX_CHECK(app == NULL && msg[0]);
+	options(&o, HAPTIC_SIM, -1);
+	PX_CHECK_INT_EQ(px_app_create(cfg, &o, &app, msg, sizeof(msg)), PX_E_INVAL);
+	PX_CHECK(msg[0]);
+	PX_CHECK_INT_EQ(px_app_create(NULL, &o, &app, msg, sizeof(msg)), PX_E_INVAL);
+	options(&o, HAPTIC_SIM, 1);
+	o.faults[0] = "melt,haptic,0,1";
+	o.n_faults = 1;
+	notes[0] = '\0';
+	PX_CHECK_INT_EQ(px_app_create(cfg, &o, &app, msg, sizeof(msg)), PX_E_INVAL);
+	PX_CHECK_MSG(strstr(msg, "unknown kind 'melt'") != NULL, "%s", msg);
+	PX_CHECK(strstr(notes, "unknown kind 'melt'") != NULL);
+	o.faults[0] = "drop,nosuchdevice,0,1";
+	PX_CHECK_INT_EQ(px_app_create(cfg, &o, &app, msg, sizeof(msg)), PX_E_INVAL);
+	PX_CHECK(msg[0]);
+	/* the virtual clock drives simulated devices only */
+	options(&o, "config/examples/haptic_hid.yaml", 1);
+	PX_CHECK_INT_EQ(px_app_create(hid, &o, &app, msg, sizeof(msg)), PX_E_INVAL);
+	PX_CHECK_MSG(strstr(msg, "--virtual-time drives simulated devices only"),
+		     "%s", msg);
+	PX_CHECK(app == NULL);
+	px_config_free(hid);
+	px_config_free(cfg);
+}
+
+static const struct px_test tests[] = {
+	PX_T(test_create_free_every_sim_config),
+	PX_T(test_own_loop_matches_the_apps_run),
+	PX_T(test_shutdown_leaves_zero_force),
+	PX_T(test_cycles_allocate_nothing),
+	PX_T(test_summary_is_proxima_runs),
+	PX_T(test_bad_options_refused),
+};
+
+PX_TEST_MAIN(tests)
