@@ -44,7 +44,7 @@
 /* ---- the `sim` section: fault campaigns --------------------------- */
 
 #define SIM_RANGE (PX_CONFIG_HAS_MIN | PX_CONFIG_HAS_MAX)
-#define MAX_CAMPAIGN 64
+#define MAX_CAMPAIGN PX_APP_MAX_CAMPAIGN
 
 /* Fault kinds a simulated haptic/pose device takes (enum px_sim_fault_kind
  * is index + 1). */

@@ -187,9 +187,67 @@ int px_app_step(struct px_app *a)
 	return px_loop_step(a->loop);
 }
 
+/* The campaign's window i against the loop faults seen. */
+static void reaction(const struct px_app *a, size_t i, struct px_app_reaction *r)
+{
+	const struct raw_fault *f = &a->sim.faults[i];
+	const struct px_config_device *d = px_config_device_find(a->cfg, f->device);
+	int64_t tmo = d && d->stale_timeout_ns ? d->stale_timeout_ns
+					       : a->cfg->safety.watchdog.device_timeout_ns;
+	int64_t t0 = a->clock0_ns + f->start_ns;
+	int64_t t1 = t0 + f->duration_ns + tmo + 10000000;
+	size_t k;
+	r->kind = app_fault_kind_names[f->kind];
+	r->device = f->device;
+	r->start_ns = f->start_ns;
+	r->duration_ns = f->duration_ns;
+	r->probability = f->probability;
+	r->loop_faults = 0;
+	r->safe_after_ns = -1;
+	for (k = 0; k < a->n_lfaults; k++) {
+		const struct px_fault *lf = &a->lfaults[k];
+		if (lf->t_ns < t0 || lf->t_ns > t1)
+			continue;
+		r->loop_faults++;
+		if (lf->safe && r->safe_after_ns < 0)
+			r->safe_after_ns = lf->t_ns - t0;
+	}
+}
+
+/* Cycles from each loop fault that reported safe state to the first
+ * cycle recorded in safe state (at most 1000 looked at; a fault whose
+ * run ended first is not counted). -1: none checked. */
+static int64_t trip_to_safe(const struct px_app *a, uint64_t *checked)
+{
+	int64_t worst = -1;
+	size_t k;
+	*checked = 0;
+	if (!a->safe_bits)
+		return -1;
+	for (k = 0; k < a->n_lfaults; k++) {
+		const struct px_fault *lf = &a->lfaults[k];
+		int64_t d = 1000;
+		uint64_t c;
+		if (!lf->safe || lf->cycle >= a->safe_bits_n)
+			continue;
+		for (c = lf->cycle; c < a->safe_bits_n && c < lf->cycle + 1000; c++)
+			if (a->safe_bits[c >> 3] & (1u << (c & 7))) {
+				d = (int64_t)(c - lf->cycle);
+				break;
+			}
+		if (c == a->safe_bits_n && d == 1000)
+			continue; /* the run ended first */
+		(*checked)++;
+		if (d > worst)
+			worst = d;
+	}
+	return worst;
+}
+
 int px_app_summary(const struct px_app *a, struct px_app_summary *s)
 {
 	struct px_loop_status st;
+	size_t i;
 	if (!a || !s)
 		return PX_E_INVAL;
 	memset(s, 0, sizeof(*s));
@@ -222,6 +280,10 @@ int px_app_summary(const struct px_app *a, struct px_app_summary *s)
 	s->shutdown_safe = a->sd.safe;
 	snprintf(s->shutdown_reason, sizeof(s->shutdown_reason), "%s",
 		 a->sd.reason);
+	s->max_trip_to_safe_cycles = trip_to_safe(a, &s->watchdog_trips_checked);
+	for (i = 0; i < a->sim.n_faults && i < PX_APP_MAX_CAMPAIGN; i++)
+		reaction(a, i, &s->reactions[i]);
+	s->n_reactions = i;
 	return PX_OK;
 }
 

@@ -143,6 +143,22 @@ PX_API int px_app_shutdown(struct px_app *app, const char *reason);
 PX_API void px_app_shutdown_describe(const struct px_app *app, char *buf,
 				     size_t cap);
 
+/* At most this many fault windows (sim.faults and opt.faults together). */
+#define PX_APP_MAX_CAMPAIGN 64
+
+/* How the loop reacted to one fault window of the campaign: the loop
+ * faults from the window's start to its end plus the device's timeout
+ * (and 10 ms), and how long after the start the first of them found the
+ * loop in safe state. */
+struct px_app_reaction {
+	const char *kind;       /* "drop", "delay", ..., "overrun" */
+	const char *device;     /* the app's; valid until px_app_free */
+	int64_t start_ns, duration_ns; /* from the run's start */
+	double probability;
+	uint64_t loop_faults;
+	int64_t safe_after_ns;  /* -1: no safe state (samples stayed fresh) */
+};
+
 /* The figures of the run so far (after px_app_shutdown: of the whole
  * run), the numbers proxima-run prints. Non-real-time thread; call
  * px_app_drain() first for the drained counts to be complete. */
@@ -165,6 +181,13 @@ struct px_app_summary {
 	uint64_t allocations_after_setup; /* 0 without opt.heap_count */
 	int shutdown_done, shutdown_safe;
 	char shutdown_reason[32];
+	/* every loop fault that found the loop in safe state, checked
+	 * against the per-cycle record: how many, and the most cycles from
+	 * the fault to safe state (-1: none checked) */
+	uint64_t watchdog_trips_checked;
+	int64_t max_trip_to_safe_cycles;
+	size_t n_reactions;
+	struct px_app_reaction reactions[PX_APP_MAX_CAMPAIGN];
 };
 
 PX_API int px_app_summary(const struct px_app *app, struct px_app_summary *out);

@@ -233,6 +233,36 @@ static void test_summary_is_proxima_runs(void)
 	px_config_free(cfg);
 }
 
+/* haptic_faults for 2 s: the campaign's reactions proxima-run reports
+ * (its fault campaign lines and JSON array), here from the summary. */
+static void test_campaign_reactions_in_the_summary(void)
+{
+	static const char path[] = "config/examples/haptic_faults.yaml";
+	struct px_config *cfg = load(path);
+	struct px_app_options o;
+	struct px_app *app;
+	static struct px_app_summary s;
+	options(&o, path, 2.0);
+	app = create(cfg, &o);
+	PX_CHECK_INT_EQ(px_app_run(app), PX_OK);
+	PX_CHECK_INT_EQ(px_app_shutdown(app, "end of run"), PX_OK);
+	px_app_drain(app, NULL, NULL);
+	PX_CHECK_INT_EQ(px_app_summary(app, &s), PX_OK);
+	PX_CHECK_INT_EQ((long long)s.n_reactions, 9);
+	PX_CHECK(strcmp(s.reactions[0].kind, "drop") == 0);
+	PX_CHECK_INT_EQ((long long)s.reactions[0].safe_after_ns, -1);
+	PX_CHECK(strcmp(s.reactions[1].kind, "delay") == 0);
+	PX_CHECK(strcmp(s.reactions[1].device, "haptic") == 0);
+	PX_CHECK_INT_EQ((long long)s.reactions[1].start_ns, 500000000);
+	PX_CHECK_INT_EQ((long long)s.reactions[1].loop_faults, 3);
+	PX_CHECK_INT_EQ((long long)s.reactions[1].safe_after_ns, 20000000);
+	PX_CHECK(strcmp(s.reactions[8].kind, "overrun") == 0);
+	PX_CHECK(s.watchdog_trips_checked > 0);
+	PX_CHECK_INT_EQ((long long)s.max_trip_to_safe_cycles, 0);
+	px_app_free(app);
+	px_config_free(cfg);
+}
+
 static void test_bad_options_refused(void)
 {
 	struct px_config *cfg = load(HAPTIC_SIM);
@@ -273,6 +303,7 @@ static const struct px_test tests[] = {
 	PX_T(test_shutdown_leaves_zero_force),
 	PX_T(test_cycles_allocate_nothing),
 	PX_T(test_summary_is_proxima_runs),
+	PX_T(test_campaign_reactions_in_the_summary),
 	PX_T(test_bad_options_refused),
 };
 

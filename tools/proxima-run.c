@@ -192,6 +192,7 @@ static const char *heap_counter_name(void)
 
 static struct px_app *A;
 static struct px_config *CFG;
+static struct px_app_summary S; /* after the run: what the app reports */
 
 static struct {
 	FILE *csv_f;            /* csv_out.f while the CSV is written */
@@ -651,37 +652,6 @@ static const char *ended_by(const struct px_loop_status *st)
 	return interrupted ? "signal" : "stop";
 }
 
-/* The slowest reaction to a trip: for every loop fault that put (or
- * kept) the loop in safe state, the cycles from the one that saw it to
- * the first in safe state (-1: no fault to check; 1000: none within the
- * run). Needs the per-cycle record (runs of a known length) and the
- * faults list (kept when faults are injected). */
-static int64_t trip_to_safe(uint64_t *checked)
-{
-	int64_t worst = -1;
-	size_t k;
-	*checked = 0;
-	if (!A->safe_bits)
-		return -1;
-	for (k = 0; k < A->n_lfaults; k++) {
-		const struct px_fault *lf = &A->lfaults[k];
-		int64_t d = 1000;
-		uint64_t c;
-		if (!lf->safe || lf->cycle >= A->safe_bits_n)
-			continue;
-		for (c = lf->cycle; c < A->safe_bits_n && c < lf->cycle + 1000; c++)
-			if (A->safe_bits[c >> 3] & (1u << (c & 7))) {
-				d = (int64_t)(c - lf->cycle);
-				break;
-			}
-		if (c == A->safe_bits_n && d == 1000)
-			continue; /* the run ended first */
-		(*checked)++;
-		if (d > worst)
-			worst = d;
-	}
-	return worst;
-}
 
 /* What the safety layer and the e-stop did: presses seen, how long after
  * the first press the loop was in safe state (ns, -1: never), state at
@@ -840,8 +810,8 @@ static int write_json(const char *path, const struct px_loop_status *st,
 	json_devices(f);
 	json_shutdown(f);
 	{
-		uint64_t checked;
-		int64_t worst = trip_to_safe(&checked);
+		uint64_t checked = S.watchdog_trips_checked;
+		int64_t worst = S.max_trip_to_safe_cycles;
 		int64_t span = A->have_deadline ? A->last_deadline_ns -
 							 A->first_deadline_ns
 					       : 0;
@@ -928,50 +898,22 @@ static void close_csv(void)
 		fprintf(stderr, "proxima-run: %s\n", T.csv_out.why);
 }
 
-/* What the safety layer did about configured fault i: loop faults seen
- * from the window's start to its end plus the device timeout (and 10 ms),
- * and the time from the start to the first that put or kept the loop in
- * safe state (-1: none). */
-static void campaign_reaction(size_t i, uint64_t *n, int64_t *safe_after_ns,
-			      int64_t *t0, int64_t *t1)
-{
-	const struct raw_fault *f = &A->sim.faults[i];
-	const struct px_config_device *d = px_config_device_find(A->cfg, f->device);
-	int64_t tmo = d && d->stale_timeout_ns ? d->stale_timeout_ns
-					       : A->cfg->safety.watchdog.device_timeout_ns;
-	size_t k;
-	*t0 = A->clock0_ns + f->start_ns;
-	*t1 = *t0 + f->duration_ns + tmo + 10000000;
-	*n = 0;
-	*safe_after_ns = -1;
-	for (k = 0; k < A->n_lfaults; k++) {
-		const struct px_fault *lf = &A->lfaults[k];
-		if (lf->t_ns < *t0 || lf->t_ns > *t1)
-			continue;
-		(*n)++;
-		if (lf->safe && *safe_after_ns < 0)
-			*safe_after_ns = lf->t_ns - *t0;
-	}
-}
 
 static void print_campaign(void)
 {
 	size_t i;
-	if (!A->sim.n_faults)
+	if (!S.n_reactions)
 		return;
 	printf("  fault campaign    (loop faults from each window's start to "
 	       "its end + device timeout)\n");
-	for (i = 0; i < A->sim.n_faults; i++) {
-		const struct raw_fault *f = &A->sim.faults[i];
-		uint64_t n;
-		int64_t after, t0, t1;
-		campaign_reaction(i, &n, &after, &t0, &t1);
+	for (i = 0; i < S.n_reactions; i++) {
+		const struct px_app_reaction *r = &S.reactions[i];
 		printf("    %-9s %-8s %7.3f..%7.3f s p %.2f: %4llu loop faults, ",
-		       app_fault_kind_names[f->kind], f->device, (double)f->start_ns * 1e-9,
-		       (double)(f->start_ns + f->duration_ns) * 1e-9, f->probability,
-		       (unsigned long long)n);
-		if (after >= 0)
-			printf("safe state after %.1f ms\n", (double)after * 1e-6);
+		       r->kind, r->device, (double)r->start_ns * 1e-9,
+		       (double)(r->start_ns + r->duration_ns) * 1e-9, r->probability,
+		       (unsigned long long)r->loop_faults);
+		if (r->safe_after_ns >= 0)
+			printf("safe state after %.1f ms\n", (double)r->safe_after_ns * 1e-6);
 		else
 			printf("no safe state (samples stayed fresh)\n");
 	}
@@ -981,22 +923,19 @@ static void json_campaign(FILE *f)
 {
 	size_t i;
 	fputs("  \"fault_campaign\": [", f);
-	for (i = 0; i < A->sim.n_faults; i++) {
-		const struct raw_fault *x = &A->sim.faults[i];
-		uint64_t n;
-		int64_t after, t0, t1;
-		campaign_reaction(i, &n, &after, &t0, &t1);
-		fprintf(f,
-			"%s\n    {\"kind\": \"%s\", \"device\": ", i ? "," : "",
-			app_fault_kind_names[x->kind]);
-		json_string(f, x->device);
+	for (i = 0; i < S.n_reactions; i++) {
+		const struct px_app_reaction *r = &S.reactions[i];
+		fprintf(f, "%s\n    {\"kind\": \"%s\", \"device\": ", i ? "," : "",
+			r->kind);
+		json_string(f, r->device);
 		fprintf(f,
 			", \"start_ns\": %lld, \"duration_ns\": %lld, "
 			"\"loop_faults\": %llu, \"safe_after_ns\": %lld}",
-			(long long)x->start_ns, (long long)x->duration_ns,
-			(unsigned long long)n, (long long)after);
+			(long long)r->start_ns, (long long)r->duration_ns,
+			(unsigned long long)r->loop_faults,
+			(long long)r->safe_after_ns);
 	}
-	fputs(A->sim.n_faults ? "\n  ],\n" : "],\n", f);
+	fputs(S.n_reactions ? "\n  ],\n" : "],\n", f);
 }
 
 static void print_summary(const struct px_loop_status *st,
@@ -1212,6 +1151,7 @@ int main(int argc, char **argv)
 			    wall_s > 0 ? (double)s0.cycles / wall_s : 0.0);
 	}
 	close_csv();
+	px_app_summary(A, &S);
 	px_loop_status(A->loop, &st);
 	px_loop_stats(A->loop, PX_LOOP_STAT_LATENCY, &lat);
 	px_stats_read(A->compute, &cmp);
