@@ -48,7 +48,7 @@
 #include <unistd.h>
 
 #include "gov_internal.h"
-#include "track_internal.h"
+#include "track_hooks.h"
 #include "px_arena.h"
 #include "px_dist.h"
 #include "px_nurbs.h"

@@ -16,7 +16,7 @@
 #include <string.h>
 
 #include "gov_internal.h"
-#include "track_internal.h"
+#include "track_hooks.h"
 #include "px_alloc_count.h"
 #include "px_arena.h"
 #include "px_dist.h"

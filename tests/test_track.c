@@ -15,7 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "track_internal.h"
+#include "track_hooks.h"
 #include "px_alloc_count.h"
 #include "px_arena.h"
 #include "px_dist.h"

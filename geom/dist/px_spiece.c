@@ -1082,7 +1082,7 @@ static void quad_halves(int o, int quad, int *a, int *b)
  */
 #define POOL_DOUBLES 8192
 int px__spiece_pool_cap = -1;
-/* Test hook (internal.h): 1 leaves the preconditioned monotonicity test
+/* Test hook (dist_internal.h): 1 leaves the preconditioned monotonicity test
  * out (precond_monotone()). */
 int px__spiece_no_precond = 0;
 #define POOL_SLOTS 64
@@ -1570,7 +1570,7 @@ out:
 }
 
 /*
- * Test hook (internal.h): the preconditioned monotonicity test on the
+ * Test hook (dist_internal.h): the preconditioned monotonicity test on the
  * rectangle [s0, s1] x [t0, t1] (local coordinates) of sp for the point
  * p, its tensors in orientation o, as the query makes it; and, apart
  * from it, the least eigenvalue of the symmetric Jacobian part sampled

@@ -1,6 +1,6 @@
 /*
  * gov_internal.h - the cost governor shared by the two trackers
- * (px_track.c, px_strack.c): when the query point moves so fast that
+ * (track_*.c, strack_*.c): when the query point moves so fast that
  * following every critical point costs more than the exact global query
  * (events in most updates, leaves or cells re-solved every cycle), the
  * tracker answers with that query instead ("cold" updates) and comes back

@@ -1,0 +1,718 @@
+/*
+ * strack_setup.c - surface tracker (px_strack.h): setup and teardown:
+ * options, patches, cells, px_strack_create() and px_strack_free(), the
+ * getters. The layout and the shared declarations are in strack_internal.h.
+ */
+#include "strack_internal.h"
+
+int px_strack_critical(const struct px_strack *t, int s, double *u, double *v,
+		       int *type, int cap)
+{
+	const struct ssurf *f;
+	int i;
+	if (!t || (cap > 0 && (!u || !v || !type)))
+		return PX_E_INVAL;
+	if (s < 0 || s >= t->n_surf)
+		return PX_E_RANGE;
+	f = &t->sf[s];
+	for (i = 0; i < f->nz && i < cap; i++) {
+		struct crit w = f->z[i], last;
+		/* a point resting on the hot path, followed to the current
+		 * point on a copy (the state stays as the next update
+		 * expects it); as it was if that fails */
+		if (t->hot_s >= 0 && !(s == t->hot_s && i == t->hot_j) &&
+		    px__st_follow(f, &w, t->hot_p, px_v3_sub(t->p, t->hot_p), t->p,
+			   &last))
+			w = f->z[i];
+		u[i] = w.u;
+		v[i] = w.v;
+		type[i] = w.type;
+	}
+	return f->nz;
+}
+
+void px_strack_get_stats(const struct px_strack *t, struct px_strack_stats *s)
+{
+	if (!s)
+		return;
+	if (!t) {
+		memset(s, 0, sizeof(*s));
+		return;
+	}
+	*s = t->st;
+	s->tracked_ns = t->gov.trk_ns;
+	s->cold_ns = t->gov.cold_ns;
+}
+
+void px_strack_get_info(const struct px_strack *t, struct px_strack_info *info)
+{
+	if (!info)
+		return;
+	memset(info, 0, sizeof(*info));
+	if (!t)
+		return;
+	info->n_surfaces = t->n_surf;
+	info->n_curves = t->n_curves;
+	info->n_patches = t->n_patches;
+	info->n_cells = t->n_cells;
+	info->n_edges = t->n_edges;
+	info->n_poles = t->n_poles;
+	info->n_unbounded = t->n_unbounded;
+	info->work = t->work;
+}
+
+struct px_dist_model *px_strack_dist_model(struct px_strack *t)
+{
+	return t ? t->dist : NULL;
+}
+
+/* ------------------------------------------------------------------ */
+/* setup                                                               */
+
+void px_strack_opts_default(struct px_strack_opts *o)
+{
+	if (!o)
+		return;
+	memset(o, 0, sizeof(*o));
+	o->cells_per_span = 3;
+	o->seeds = 2;
+	o->samples = 6;
+	o->max_crit = 256;
+	o->work_margin = 1.0;
+	o->verify_every = 0;
+	o->max_solves = 4;
+	o->dist = NULL;
+	o->cold_switch = 1;
+	o->max_tests = 32;
+}
+
+void px_strack_free(struct px_strack *t)
+{
+	int i;
+	if (!t)
+		return;
+	px_dist_model_free(t->dist);
+	px_track_free(t->ct);
+	if (t->sf)
+		for (i = 0; i < t->n_surf; i++) {
+			free(t->sf[i].mem);
+			free(t->sf[i].pt);
+			free(t->sf[i].pool);
+			free(t->sf[i].pool4);
+			free(t->sf[i].pu);
+			free(t->sf[i].pv);
+			free(t->sf[i].cu);
+			free(t->sf[i].cv);
+			free(t->sf[i].z);
+			free(t->sf[i].tmp);
+			free(t->sf[i].wp);
+		}
+	free(t->sf);
+	free(t->cell);
+	free(t->rcell);
+	free(t->qcert);
+	free(t->pcache);
+	free(t->scache);
+	free(t->edge);
+	free(t->pole);
+	free(t->ex);
+	free(t->gdue);
+	free(t->cube);
+	free(t->popped);
+	free(t->hits);
+	free(t->pend);
+	free(t->pend_ps);
+	free(t->pend_kind);
+	free(t->ring_list);
+	free(t->pend_need);
+	free(t->cbox);
+	free(t);
+}
+
+/* Copy a surface into owned memory. */
+static int surf_copy(struct ssurf *f, const struct px_nurbs_surf *s)
+{
+	size_t nu = (size_t)s->n_knots[0], nv = (size_t)s->n_knots[1];
+	size_t np = 4 * (size_t)s->n_ctrl[0] * (size_t)s->n_ctrl[1];
+	f->mem = malloc((nu + nv + np) * sizeof(double));
+	if (!f->mem)
+		return PX_E_NOMEM;
+	memcpy(f->mem, s->knots[0], nu * sizeof(double));
+	memcpy(f->mem + nu, s->knots[1], nv * sizeof(double));
+	memcpy(f->mem + nu + nv, s->pw, np * sizeof(double));
+	f->s = *s;
+	f->s.knots[0] = f->mem;
+	f->s.knots[1] = f->mem + nu;
+	f->s.pw = f->mem + nu + nv;
+	return PX_OK;
+}
+
+/*
+ * Cells per span along u (ncs_u, one per patch column) and v. A rational
+ * patch's derivative enclosures widen with the spread of its weights
+ * (the quotient rule over a cell where W changes by a factor: the
+ * bench's sheet with weights 0.6-1.5 had S_uu enclosed in [-130, 11]
+ * over a cell), and with them the certificates' radii fall to nothing;
+ * halving the cells narrows them about fourfold. So a span whose patches
+ * have weights more than ST_WRATIO_FINE apart gets twice the cells (at
+ * most 16): on such a sheet small steps then cost less, their worst
+ * updates too (larger steps cross cells either way); the setup and
+ * memory of those cells grow fourfold. Polynomial patches and
+ * circular arcs (weights 1 and 0.71) keep cells_per_span.
+ */
+#define ST_WRATIO_FINE 1.5
+
+int px__strack_coarse = 0;
+
+static void span_cells(const struct ssurf *f, int cps, int *ncs_u, int *ncs_v)
+{
+	int a, b, fine = 2 * cps > 16 ? 16 : 2 * cps;
+	for (a = 0; a < f->npu; a++)
+		ncs_u[a] = cps;
+	for (b = 0; b < f->npv; b++)
+		ncs_v[b] = cps;
+	for (b = 0; b < f->npv; b++)
+		for (a = 0; a < f->npu; a++)
+			if (f->pt[b * f->npu + a].wratio > ST_WRATIO_FINE &&
+			    !px__strack_coarse) {
+				ncs_u[a] = fine;
+				ncs_v[b] = fine;
+			}
+}
+
+/* Cell bounds: each span [b[k], b[k + 1]] cut in ncs[k] equal parts. */
+static void span_bounds_fill(double *cb, const double *b, int nb, const int *ncs)
+{
+	int k, j, n = 0;
+	for (k = 0; k < nb - 1; k++)
+		for (j = 0; j < ncs[k]; j++)
+			cb[n++] = b[k] + (b[k + 1] - b[k]) * j / ncs[k];
+}
+
+/* Power-form Bezier patches of a surface between the bounds ub x vb. */
+static int build_patches(struct ssurf *f, const double *ub, int nu,
+			 const double *vb, int nv)
+{
+	int p = f->s.degree[0], q = f->s.degree[1], np = (p + 1) * (q + 1);
+	int a, b, i, j, k, r;
+	size_t wl = PX_NURBS_SURF_WORK_LEN(p, q, f->s.n_ctrl[0], f->s.n_ctrl[1]);
+	double *work = malloc(wl * sizeof(double)), tmp[PX_NURBS_MAX_DEGREE + 1];
+	f->npu = nu - 1;
+	f->npv = nv - 1;
+	f->pt = calloc((size_t)(f->npu * f->npv), sizeof(*f->pt));
+	f->pool = calloc((size_t)(f->npu * f->npv) * 4 * (size_t)np, sizeof(double));
+	f->pool4 = NULL;
+	if (p == 3 && q == 3 && px__st_have_fma()) {
+		/* 512 bytes a patch: a multiple of the alignment */
+		f->pool4 = aligned_alloc(64, (size_t)(f->npu * f->npv) * 64 * sizeof(double));
+		if (!f->pool4) {
+			free(work);
+			return PX_E_NOMEM;
+		}
+	}
+	f->pu = malloc((size_t)nu * sizeof(double));
+	f->pv = malloc((size_t)nv * sizeof(double));
+	if (!work || !f->pt || !f->pool || !f->pu || !f->pv) {
+		free(work);
+		return PX_E_NOMEM;
+	}
+	memcpy(f->pu, ub, (size_t)nu * sizeof(double));
+	memcpy(f->pv, vb, (size_t)nv * sizeof(double));
+	/* the fault: a thousand times as long, on any Hessian and weights */
+	f->quick_loose = px__strack_quick_fault;
+	f->quick_u = (f->quick_loose ? 1e3 : 1.0) * ST_QUICK * f->du / f->npu;
+	f->quick_v = (f->quick_loose ? 1e3 : 1.0) * ST_QUICK * f->dv / f->npv;
+	for (b = 0; b < f->npv; b++)
+		for (a = 0; a < f->npu; a++) {
+			struct patch *pt = &f->pt[b * f->npu + a];
+			struct px_nurbs_surf sub;
+			double pt_w;
+			double *c = f->pool + (size_t)(b * f->npu + a) * 4 * (size_t)np;
+			int rc = px_nurbs_surf_extract_work(&f->s, ub[a], ub[a + 1], vb[b],
+							    vb[b + 1], work, wl, &sub);
+			if (rc || sub.n_ctrl[0] != p + 1 || sub.n_ctrl[1] != q + 1) {
+				free(work);
+				return rc ? rc : PX_E_INVAL;
+			}
+			pt->u0 = ub[a];
+			pt->u1 = ub[a + 1];
+			pt->v0 = vb[b];
+			pt->v1 = vb[b + 1];
+			pt->iu = 1.0 / (pt->u1 - pt->u0);
+			pt->iv = 1.0 / (pt->v1 - pt->v0);
+			pt->p = p;
+			pt->q = q;
+			pt->c = c;
+			{
+				/* equal weights: divide them out, evaluate as a
+				 * polynomial */
+				double w0 = sub.pw[3], wlo = w0, whi = w0;
+				int m;
+				pt->rat = 0;
+				for (m = 0; m < np; m++) {
+					double w = sub.pw[4 * m + 3];
+					if (w != w0)
+						pt->rat = 1;
+					wlo = w < wlo ? w : wlo;
+					whi = w > whi ? w : whi;
+				}
+				pt->wratio = whi / wlo;
+				pt_w = pt->rat ? 1.0 : w0;
+				if (pt->wratio > ST_QUICK_WRATIO && !f->quick_loose)
+					f->quick_u = f->quick_v = 0.0;
+			}
+			for (k = 0; k < 4; k++) {
+				double *ck = c + k * np;
+				for (j = 0; j <= q; j++)
+					for (i = 0; i <= p; i++)
+						ck[j * (p + 1) + i] =
+							k == 3 && !pt->rat ? 1.0
+									   : sub.pw[4 * (j * (p + 1) + i) + k] / pt_w;
+				/* Bernstein to power form along s, then along t */
+				for (j = 0; j <= q; j++) {
+					double *row = ck + j * (p + 1);
+					for (i = 0; i <= p; i++) {
+						double v = 0.0;
+						for (r = 0; r <= i; r++)
+							v += (((i - r) & 1) ? -1.0 : 1.0) *
+							     px_bern_binom(i, r) * row[r];
+						tmp[i] = px_bern_binom(p, i) * v;
+					}
+					memcpy(row, tmp, (size_t)(p + 1) * sizeof(double));
+				}
+				for (i = 0; i <= p; i++) {
+					for (j = 0; j <= q; j++) {
+						double v = 0.0;
+						for (r = 0; r <= j; r++)
+							v += (((j - r) & 1) ? -1.0 : 1.0) *
+							     px_bern_binom(j, r) * ck[r * (p + 1) + i];
+						tmp[j] = px_bern_binom(q, j) * v;
+					}
+					for (j = 0; j <= q; j++)
+						ck[j * (p + 1) + i] = tmp[j];
+				}
+			}
+			pt->c4 = NULL;
+			if (f->pool4) {
+				double *c4 = f->pool4 + (size_t)(b * f->npu + a) * 64;
+				for (k = 0; k < 4; k++)
+					for (i = 0; i < 16; i++)
+						c4[4 * i + k] = c[k * 16 + i];
+				pt->c4 = c4;
+			}
+		}
+	free(work);
+	return PX_OK;
+}
+
+int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
+		     const struct px_nurbs_surf *surfs, int n_surfs,
+		     const struct px_strack_opts *opts, struct px_strack **out)
+{
+	struct px_strack *t;
+	struct px_strack_opts o;
+	struct px_nurbs_curve *cc = NULL;
+	double **cpw = NULL, *ub = NULL, *vb = NULL;
+	int *ncs_u = NULL, *ncs_v = NULL;
+	double *work = NULL;
+	size_t wl = 0, npend;
+	int rc, i, j, k, max_knots = 0, cap_edges, n_cc = 0, cell_cap = 0;
+	px_aabb bounds;
+
+	if (!out || (n_curves > 0 && !curves) || !surfs || n_surfs <= 0 ||
+	    n_curves < 0)
+		return PX_E_INVAL;
+	*out = NULL;
+	if (opts)
+		o = *opts;
+	else
+		px_strack_opts_default(&o);
+	if (o.cells_per_span < 1 || o.cells_per_span > 16 || o.seeds < 1 ||
+	    o.seeds > 8 || o.samples < 2 || o.samples > 32 || o.max_crit < 2 ||
+	    o.max_crit > 1 << 20 || o.verify_every < 0 || o.max_solves < 0 ||
+	    o.max_tests < 0 ||
+	    !(o.work_margin >= 0.0))
+		return PX_E_INVAL;
+	for (i = 0; i < n_surfs; i++) {
+		if (surfs[i].degree[0] < 1 || surfs[i].degree[1] < 1 ||
+		    surfs[i].degree[0] > PX_NURBS_MAX_DEGREE ||
+		    surfs[i].degree[1] > PX_NURBS_MAX_DEGREE)
+			return PX_E_RANGE;
+		if (!surfs[i].knots[0] || !surfs[i].knots[1] || !surfs[i].pw)
+			return PX_E_INVAL;
+		for (k = 0; k < 2; k++)
+			if (surfs[i].n_knots[k] > max_knots)
+				max_knots = surfs[i].n_knots[k];
+	}
+	t = calloc(1, sizeof(*t));
+	if (!t)
+		return PX_E_NOMEM;
+	t->opts = o;
+	{
+		struct cell_done none;
+		int sk[ST_SEEDS_MAX];
+		memset(&none, 0, sizeof(none));
+		t->full_seeds = px__st_cell_seeds(&none, sk);
+	}
+	t->n_curves = n_curves;
+	t->n_surf = n_surfs;
+	rc = px_dist_model_create(curves, n_curves, surfs, n_surfs, o.dist,
+				  &t->dist);
+	if (rc) {
+		free(t);
+		return rc;
+	}
+	t->sf = calloc((size_t)n_surfs, sizeof(*t->sf));
+	ub = calloc((size_t)max_knots + 2, sizeof(double));
+	vb = calloc((size_t)max_knots + 2, sizeof(double));
+	ncs_u = calloc((size_t)max_knots + 2, sizeof(int));
+	ncs_v = calloc((size_t)max_knots + 2, sizeof(int));
+	if (!t->sf || !ub || !vb || !ncs_u || !ncs_v) {
+		rc = PX_E_NOMEM;
+		goto fail;
+	}
+	/* surfaces, domains, cells */
+	bounds = px_aabb_empty();
+	for (i = 0; i < n_curves; i++) {
+		px_aabb hb = px_nurbs_curve_aabb(&curves[i]);
+		bounds = px_aabb_union(&bounds, &hb);
+	}
+	for (i = 0; i < n_surfs; i++) {
+		struct ssurf *f = &t->sf[i];
+		px_aabb hb = px_nurbs_surf_aabb(&surfs[i]);
+		int nu, nv;
+		bounds = px_aabb_union(&bounds, &hb);
+		rc = surf_copy(f, &surfs[i]);
+		if (rc)
+			goto fail;
+		px_nurbs_surf_domain(&f->s, &f->u0, &f->u1, &f->v0, &f->v1);
+		f->du = f->u1 - f->u0;
+		f->dv = f->v1 - f->v0;
+		{
+			double tol = 1e-12 * (1.0 + px_aabb_diagonal(&hb));
+			f->wrap_u = px_nurbs_surf_seam(&f->s, 0, tol, 1e-9) >= 1;
+			f->wrap_v = px_nurbs_surf_seam(&f->s, 1, tol, 1e-9) >= 1;
+		}
+		nu = px__st_span_bounds(&f->s, 0, f->u0, f->u1, ub);
+		nv = px__st_span_bounds(&f->s, 1, f->v0, f->v1, vb);
+		t->n_patches += (nu - 1) * (nv - 1);
+		rc = build_patches(f, ub, nu, vb, nv);
+		if (rc)
+			goto fail;
+		span_cells(f, o.cells_per_span, ncs_u, ncs_v);
+		for (f->ncu = 0, k = 0; k < nu - 1; k++)
+			f->ncu += ncs_u[k];
+		for (f->ncv = 0, k = 0; k < nv - 1; k++)
+			f->ncv += ncs_v[k];
+		f->cu = calloc((size_t)f->ncu + 1, sizeof(double));
+		f->cv = calloc((size_t)f->ncv + 1, sizeof(double));
+		f->cap = o.max_crit;
+		f->z = calloc((size_t)f->cap, sizeof(*f->z));
+		f->tmp = calloc((size_t)f->cap, sizeof(*f->tmp));
+		if (!f->cu || !f->cv || !f->z || !f->tmp) {
+			rc = PX_E_NOMEM;
+			goto fail;
+		}
+		span_bounds_fill(f->cu, ub, nu, ncs_u);
+		f->cu[f->ncu] = f->u1;
+		span_bounds_fill(f->cv, vb, nv, ncs_v);
+		f->cv[f->ncv] = f->v1;
+		f->first_cell = cell_cap;
+		cell_cap += f->ncu * f->ncv;
+	}
+	t->scale = px_aabb_diagonal(&bounds);
+	if (!(t->scale > 0.0))
+		t->scale = 1.0;
+	{
+		double m = o.work_margin * t->scale;
+		t->work.min = px_v3_sub(bounds.min, px_v3(m, m, m));
+		t->work.max = px_v3_add(bounds.max, px_v3(m, m, m));
+	}
+	t->cell = calloc((size_t)cell_cap + 1, sizeof(*t->cell));
+	t->rcell = calloc(4 * (size_t)cell_cap + 1, sizeof(*t->rcell));
+	t->qcert = calloc(16 * (size_t)cell_cap + 1, sizeof(*t->qcert));
+	t->ex = calloc((size_t)cell_cap + 1, sizeof(*t->ex));
+	t->gdue = calloc((size_t)cell_cap / ST_GROUP + 2, sizeof(*t->gdue));
+	t->cube = calloc((size_t)cell_cap + 1, sizeof(*t->cube));
+	t->popped = calloc((size_t)cell_cap + 1, sizeof(int));
+	t->hits = calloc((size_t)cell_cap + 1, sizeof(int));
+	/* pending items: each cell once, a crossing solve a hit, ST_RINGS
+	 * bounds a surface */
+	npend = (2 + ST_RINGS) * (size_t)cell_cap + 2;
+	t->pend = calloc(npend, sizeof(int));
+	t->pend_ps = calloc(npend, sizeof(px_vec3));
+	t->pend_need = calloc(npend, sizeof(double));
+	t->pend_kind = calloc(npend, 1);
+	t->ring_list = calloc((size_t)cell_cap + 1, sizeof(int));
+	for (i = 0; i < n_surfs; i++) {
+		const struct px_nurbs_surf *sf = &t->sf[i].s;
+		size_t l = PX_NURBS_SURF_WORK_LEN(sf->degree[0], sf->degree[1],
+						  sf->n_ctrl[0], sf->n_ctrl[1]);
+		if (l > wl)
+			wl = l;
+	}
+	work = malloc(wl * sizeof(double));
+	if (!t->cell || !t->rcell || !t->qcert || !t->ex || !t->gdue || !t->cube || !t->popped || !t->hits ||
+	    !t->pend || !t->pend_ps || !t->pend_kind || !t->pend_need ||
+	    !t->ring_list || !work) {
+		rc = PX_E_NOMEM;
+		goto fail;
+	}
+	for (i = 0; i < n_surfs; i++) {
+		struct ssurf *f = &t->sf[i];
+		for (k = 0; k < 4; k++)
+			/* as for the poles below */
+			f->pole[k] = !((k < 2 && f->wrap_u) || (k >= 2 && f->wrap_v)) &&
+				     px_nurbs_surf_edge_collapsed(&f->s, k,
+								  1e-12 * (1.0 + t->scale));
+		for (j = 0; j < f->ncv; j++)
+			for (k = 0; k < f->ncu; k++) {
+				struct scell *c = &t->cell[f->first_cell + j * f->ncu + k];
+				c->surf = i;
+				c->u0 = f->cu[k];
+				c->u1 = f->cu[k + 1];
+				c->v0 = f->cv[j];
+				c->v1 = f->cv[j + 1];
+				{
+					double um = 0.5 * (c->u0 + c->u1), vm = 0.5 * (c->v0 + c->v1);
+					int ch;
+					px_aabb cb = px_aabb_empty();
+					c->child = 4 * (f->first_cell + j * f->ncu + k);
+					for (ch = 0; ch < 4; ch++) {
+						struct scell *rg = &t->rcell[c->child + ch];
+						int open[4];
+						px_aabb rb;
+						rg->surf = i;
+						rg->u0 = ch & 1 ? um : c->u0;
+						rg->u1 = ch & 1 ? c->u1 : um;
+						rg->v0 = ch & 2 ? vm : c->v0;
+						rg->v1 = ch & 2 ? c->v1 : vm;
+						px__st_sides_open(f, rg, open);
+						if ((rg->u0 == f->u0 && f->pole[0]) ||
+						    (rg->u1 == f->u1 && f->pole[1]) ||
+						    (rg->v0 == f->v0 && f->pole[2]) ||
+						    (rg->v1 == f->v1 && f->pole[3]))
+							c->always = 1;
+						rc = px__st_cell_cert(t, rg, f, work, wl, open);
+						if (rc)
+							goto fail;
+						rc = px__st_quarter_certs(t, rg, f, work, wl,
+								   &t->qcert[4 * (c->child + ch)]);
+						if (rc)
+							goto fail;
+						rb.min = px_v3(rg->cert.S[0].lo, rg->cert.S[1].lo, rg->cert.S[2].lo);
+						rb.max = px_v3(rg->cert.S[0].hi, rg->cert.S[1].hi, rg->cert.S[2].hi);
+						cb = px_aabb_union(&cb, &rb);
+					}
+					c->size = px_aabb_diagonal(&cb);
+					t->n_unbounded += c->always;
+				}
+			}
+	}
+	t->n_cells = cell_cap;
+	for (i = 0; i < n_surfs; i++) {
+		rc = px__st_wind_pieces(t, i);
+		if (rc)
+			goto fail;
+	}
+
+	/* curve tracker: free curves, then open (uncollapsed) edges and
+	 * C0 creases as iso-curves; collapsed edges become poles */
+	cap_edges = 0;
+	for (i = 0; i < n_surfs; i++)
+		cap_edges += 4 + 2 * max_knots;
+	t->edge = calloc((size_t)cap_edges, sizeof(*t->edge));
+	t->pole = calloc((size_t)4 * n_surfs, sizeof(*t->pole));
+	cc = calloc((size_t)(n_curves + cap_edges), sizeof(*cc));
+	cpw = calloc((size_t)cap_edges, sizeof(*cpw));
+	if (!t->edge || !t->pole || !cc || !cpw) {
+		rc = PX_E_NOMEM;
+		goto fail;
+	}
+	for (i = 0; i < n_curves; i++)
+		cc[n_cc++] = curves[i];
+	for (i = 0; i < n_surfs; i++) {
+		struct ssurf *f = &t->sf[i];
+		double tol = 1e-12 * (1.0 + t->scale), brk[64];
+		int e, nb, d;
+		for (e = 0; e < 4; e++) {
+			int dir = e < 2 ? 1 : 0; /* curve direction */
+			double tv = e == 0 ? f->u0 : e == 1 ? f->u1 : e == 2 ? f->v0 : f->v1;
+			if ((e < 2 && f->wrap_u) || (e >= 2 && f->wrap_v))
+				continue;
+			if (px_nurbs_surf_edge_collapsed(&f->s, e, tol)) {
+				struct pole *pl = &t->pole[t->n_poles++];
+				f->pole[e] = 1;
+				pl->u = e < 2 ? tv : f->u0;
+				pl->v = e < 2 ? f->v0 : tv;
+				pl->q = px_nurbs_surf_point(&f->s, pl->u, pl->v);
+				pl->surf = i;
+				continue;
+			}
+			{
+				size_t len = 4 * (size_t)f->s.n_ctrl[dir];
+				struct edge *ed = &t->edge[t->n_edges];
+				cpw[t->n_edges] = malloc(len * sizeof(double));
+				if (!cpw[t->n_edges]) {
+					rc = PX_E_NOMEM;
+					goto fail;
+				}
+				rc = px_nurbs_surf_iso_curve(&f->s, dir, tv, cpw[t->n_edges],
+							     len, &cc[n_cc]);
+				if (rc) {
+					free(cpw[t->n_edges]);
+					cpw[t->n_edges] = NULL;
+					goto fail;
+				}
+				ed->surf = i;
+				ed->dir = dir;
+				ed->t = tv;
+				t->n_edges++;
+				n_cc++;
+			}
+		}
+		for (d = 0; d < 2; d++) {
+			/* creases across direction d: curves along the other */
+			nb = px_nurbs_surf_breaks(&f->s, d, brk, 64);
+			for (k = 0; k < nb && k < 64; k++) {
+				int dir = 1 - d;
+				size_t len = 4 * (size_t)f->s.n_ctrl[dir];
+				struct edge *ed = &t->edge[t->n_edges];
+				if (t->n_edges >= cap_edges)
+					break;
+				cpw[t->n_edges] = malloc(len * sizeof(double));
+				if (!cpw[t->n_edges]) {
+					rc = PX_E_NOMEM;
+					goto fail;
+				}
+				rc = px_nurbs_surf_iso_curve(&f->s, dir, brk[k], cpw[t->n_edges],
+							     len, &cc[n_cc]);
+				if (rc) {
+					free(cpw[t->n_edges]);
+					cpw[t->n_edges] = NULL;
+					goto fail;
+				}
+				ed->surf = i;
+				ed->dir = dir;
+				ed->t = brk[k];
+				t->n_edges++;
+				n_cc++;
+			}
+		}
+	}
+	if (n_cc > 0) {
+		struct px_track_opts to;
+		double *cw = NULL;
+		size_t cwl = 0;
+		int nb = 0;
+		for (i = 0; i < n_cc; i++) {
+			size_t l = PX_NURBS_CURVE_WORK_LEN(cc[i].degree, cc[i].n_ctrl);
+			cwl = l > cwl ? l : cwl;
+			nb += 2 * cc[i].n_knots;
+		}
+		t->cbox = calloc((size_t)nb, sizeof(*t->cbox));
+		cw = malloc(cwl * sizeof(double));
+		if (!t->cbox || !cw) {
+			free(cw);
+			rc = PX_E_NOMEM;
+			goto fail;
+		}
+		for (i = 0; i < n_cc && rc == PX_OK; i++) {
+			const double *U = cc[i].knots;
+			int p = cc[i].degree, n = cc[i].n_ctrl, h;
+			for (k = p; k < n && rc == PX_OK; k++) {
+				if (!(U[k + 1] > U[k]))
+					continue;
+				for (h = 0; h < 2 && rc == PX_OK; h++) {
+					double a = U[k] + 0.5 * h * (U[k + 1] - U[k]);
+					double b = h ? U[k + 1] : 0.5 * (U[k] + U[k + 1]);
+					px_aabb bx;
+					rc = px_nurbs_curve_sub_aabb(&cc[i], a, b, cw, cwl, &bx);
+					if (rc == PX_OK)
+						/* rounding of evaluated points */
+						t->cbox[t->n_cbox++] = px_aabb_inflate(&bx, 1e-12 * t->scale);
+				}
+			}
+		}
+		free(cw);
+		if (rc)
+			goto fail;
+		px_track_opts_default(&to);
+		/* the surface tracker decides what is followed; its curve
+		 * tracker must always track */
+		to.cold_switch = 0;
+		to.work = t->work;
+		to.dist = o.dist;
+		rc = px_track_create(cc, n_cc, &to, &t->ct);
+		if (rc)
+			goto fail;
+	}
+	{
+		/* the piece cache where a region is rational: a slot for each
+		 * quarter of up to 64 such regions (about 4.4 KiB a slot),
+		 * fewer when the model has fewer */
+		int nrat = 0, n = 1;
+		for (i = 0; i < 4 * t->n_cells; i++)
+			nrat += t->rcell[i].cert.rat;
+		if (nrat > 0) {
+			while (n < 4 * nrat && n < 256)
+				n *= 2;
+			t->pcache = malloc((size_t)n * sizeof(*t->pcache));
+			if (!t->pcache) {
+				rc = PX_E_NOMEM;
+				goto fail;
+			}
+			for (i = 0; i < n; i++) {
+				t->pcache[i].key = -1;
+				t->pcache[i].filled = 0;
+			}
+			t->pcache_n = n;
+		}
+	}
+	{
+		/* the cut cache: 128 slots (about 5.4 KiB each), fewer for
+		 * small models */
+		int n = 1;
+		while (n < 4 * t->n_cells && n < 128)
+			n *= 2;
+		t->scache = malloc((size_t)n * sizeof(*t->scache));
+		if (!t->scache) {
+			rc = PX_E_NOMEM;
+			goto fail;
+		}
+		for (i = 0; i < n; i++) {
+			t->scache[i].key = -1;
+			t->scache[i].filled = 0;
+		}
+		t->scache_n = n;
+	}
+	t->epoch = 1;
+	t->hot_s = -1;
+	t->ans_s = -1;
+	{
+		/* the cold query's cost where a tool works: about the model
+		 * (as px_track does) */
+		px_aabb cb = bounds;
+		double m = 0.3 * t->scale;
+		cb.min = px_v3_sub(cb.min, px_v3(m, m, m));
+		cb.max = px_v3_add(cb.max, px_v3(m, m, m));
+		px__gov_init(&t->gov, o.cold_switch != 0,
+			     o.cold_switch ? px__gov_calibrate(t->dist, cb) : 1.0);
+	}
+	rc = PX_OK;
+	*out = t;
+	t = NULL;
+fail:
+	if (cpw)
+		for (i = 0; i < cap_edges; i++)
+			free(cpw[i]);
+	free(cpw);
+	free(cc);
+	free(ub);
+	free(vb);
+	free(ncs_u);
+	free(ncs_v);
+	free(work);
+	px_strack_free(t);
+	return rc;
+}
