@@ -70,6 +70,13 @@ SRC_SOCKETCAN := px_socketcan.c
 SRC_GPIOD     := px_gpiod.c
 SRC_ASSIMP    := px_import.c
 SRC_YAML      := px_config_yaml.c
+# Tests name the parts they need by these tags (PX_TEST_NEEDS, tests/run.sh).
+TAG_HIDAPI    := hidapi
+TAG_LIBUSB    := libusb
+TAG_SOCKETCAN := libsocketcan
+TAG_GPIOD     := libgpiod
+TAG_ASSIMP    := assimp
+TAG_YAML      := libyaml
 DESC_HIDAPI    := HID devices (hidapi-$(HIDAPI))
 DESC_LIBUSB    := USB devices (libusb-1.0)
 DESC_SOCKETCAN := CAN interface state and bitrate (libsocketcan)
@@ -123,7 +130,8 @@ EXAMPLE_SRC := $(wildcard examples/*.c)
 EXAMPLE_BIN := $(patsubst examples/%.c,$(BUILD)/examples/%,$(EXAMPLE_SRC))
 INC_DIR     := $(BUILD)/include
 INC_STAMP   := $(INC_DIR)/$(NAME)/.stamp
-FEATURES_H  := $(INC_DIR)/$(NAME)/px_features.h
+# Generated: what this build has; on every compile's include path.
+FEATURES_H  := $(BUILD)/gen/px_features.h
 
 BENCH_SRC := $(wildcard bench/bench_*.c)
 BENCH_BIN := $(patsubst bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
@@ -176,9 +184,9 @@ examples: $(EXAMPLE_BIN)
 benches: $(BENCH_BIN) $(CXX_BENCH_BIN)
 
 # ---- rules ---------------------------------------------------------------
-$(BUILD)/obj/%.o: %.c
+$(BUILD)/obj/%.o: %.c | $(FEATURES_H)
 	@mkdir -p $(dir $@)
-	$(CC) $(ALL_CFLAGS) $(PKG_CFLAGS) -fPIC -c $< -o $@
+	$(CC) $(ALL_CFLAGS) -I$(BUILD)/gen $(PKG_CFLAGS) -fPIC -c $< -o $@
 
 # The library is made again when the set of optional parts changes.
 $(STATIC_LIB): $(LIB_OBJ) $(FEATURES_H)
@@ -220,10 +228,9 @@ $(ALLOC_SO): tests/px_alloc_count.c tests/px_alloc_count.h
 	  -ftls-model=initial-exec $(LDFLAGS) -o $@ $<
 
 # The public headers, flat under $(INC_DIR)/$(NAME)/ as they install.
-$(INC_STAMP): $(PUB_HDRS)
-	@mkdir -p $(dir $@)
-	@find $(dir $@) -name 'px*.h' ! -name px_features.h -exec rm -f {} +
-	cp $(PUB_HDRS) $(dir $@)
+$(INC_STAMP): $(PUB_HDRS) $(FEATURES_H)
+	@rm -rf $(dir $@) && mkdir -p $(dir $@)
+	cp $(PUB_HDRS) $(FEATURES_H) $(dir $@)
 	@touch $@
 
 # What this build has (rewritten only when that changes).
@@ -236,7 +243,7 @@ $(FEATURES_H): FORCE
 	  printf '%s\n' '#endif'; } > $@.tmp
 	@if cmp -s $@.tmp $@; then rm -f $@.tmp; else mv $@.tmp $@; fi
 
-$(BUILD)/obj/examples/%.o: examples/%.c $(INC_STAMP) $(FEATURES_H)
+$(BUILD)/obj/examples/%.o: examples/%.c $(INC_STAMP)
 	@mkdir -p $(dir $@)
 	$(CC) -std=c11 $(WARN) -I$(INC_DIR) $(OPTFLAGS) $(SANFLAGS) $(CFLAGS) -MMD -MP -c $< -o $@
 
@@ -263,8 +270,13 @@ $(BUILD)/obj/tests/%.o $(BUILD)/obj/bench/%.o $(BUILD)/obj/tools/%.o: ALL_CFLAGS
 # `make deps` first; a second make then finds the optional parts it may
 # just have installed.
 test: deps
-	@$(MAKE) --no-print-directory all tests
+	@$(MAKE) --no-print-directory test-run
+
+# A test that needs a part this build left out skips, saying which.
+.PHONY: test-run
+test-run: all tests
 	@BUILD=$(BUILD) SAN=$(SAN) CC="$(CC)" MAKE="$(MAKE)" TEST_TIMEOUT=$(TEST_TIMEOUT) \
+	  PX_WITHOUT="$(foreach p,$(OPT_PARTS),$(if $(filter 1,$(WITH_$(p))),,$(TAG_$(p))))" \
 	  sh tests/run.sh $(TEST_BIN) $(TEST_SH)
 
 bench: all

@@ -145,6 +145,19 @@ void px_test_skip_(const char *fmt, ...)
 	longjmp(jump_, 1 + SKIPPED);
 }
 
+const char *px_test_part_lib_(const char *part)
+{
+	static const char *const names[][2] = {
+		{"HIDAPI", "hidapi"},	  {"LIBUSB", "libusb"},
+		{"SOCKETCAN", "libsocketcan"}, {"GPIOD", "libgpiod"},
+		{"ASSIMP", "assimp"},	  {"YAML", "libyaml"},
+	};
+	for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
+		if (!strcmp(part, names[i][0]))
+			return names[i][1];
+	return part;
+}
+
 static const char *base_name(const char *path)
 {
 	const char *s = strrchr(path, '/');

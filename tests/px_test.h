@@ -15,6 +15,7 @@
 #ifndef PX_TEST_H
 #define PX_TEST_H
 
+#include "px_features.h"
 #include <math.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -43,6 +44,16 @@ _Noreturn void px_test_fail_(const char *file, int line, const char *fmt,
 			     ...) __attribute__((format(printf, 3, 4)));
 _Noreturn void px_test_skip_(const char *fmt, ...)
 	__attribute__((format(printf, 1, 2)));
+/* Skip the test when the build left out an optional part it needs
+ * (PART as in px_features.h: HIDAPI, LIBUSB, SOCKETCAN, GPIOD, ASSIMP,
+ * YAML), saying which: "skipped: built without libyaml". */
+#define PX_NEEDS(PART)                                                      \
+	do {                                                                \
+		if (!PX_HAVE_##PART)                                        \
+			px_test_skip_("built without %s",                   \
+				      px_test_part_lib_(#PART));            \
+	} while (0)
+const char *px_test_part_lib_(const char *part);
 /* Count one assertion (a test with no assertion at all fails). */
 void px_test_count_(void);
 

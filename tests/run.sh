@@ -7,8 +7,30 @@ timeout_s=${TEST_TIMEOUT:-900}
 tp=0 tf=0 ts=0
 log=$(mktemp)
 trap 'rm -f "$log"' EXIT
+# A test whose source names the optional parts it needs (a line
+# "PX_TEST_NEEDS: libyaml libgpiod", tags as in the Makefile) skips when
+# the build left one out (PX_WITHOUT, from make).
+missing_part() { # test binary or script: prints the first part left out
+	case "$1" in
+	*.sh) src=$1 ;;
+	*/fuzz-replay/*) src=fuzz/$(basename "$1").c ;;
+	*) src=tests/$(basename "$1").c ;;
+	esac
+	[ -n "${PX_WITHOUT:-}" ] && [ -f "$src" ] || return 1
+	for p in $(sed -n 's/.*PX_TEST_NEEDS:\([a-z0-9 ]*\).*/\1/p' "$src"); do
+		for w in $PX_WITHOUT; do
+			[ "$w" = "$p" ] && { echo "$p"; return 0; }
+		done
+	done
+	return 1
+}
 for t in "$@"; do
 	echo "== $t"
+	if part=$(missing_part "$t"); then
+		echo "$(basename "$t" .sh): skipped: built without $part"
+		ts=$((ts + 1))
+		continue
+	fi
 	case "$t" in
 	*.sh) timeout "$timeout_s" sh "$t" >"$log" 2>&1 ;;
 	*) timeout "$timeout_s" "$t" >"$log" 2>&1 ;;

@@ -703,6 +703,7 @@ static void test_raw_open_path(void)
  * is changed; without vcan0 the interface is named as missing. */
 static void test_bitrate_on_vcan_or_absent(void)
 {
+	PX_NEEDS(SOCKETCAN);
 	char msg[400];
 	int e = -1, rc;
 	rc = px_can_iface_set_bitrate("vcan0", 500000, 0, &e, msg, sizeof msg);

@@ -520,6 +520,7 @@ static void test_master_with_simarm_on_vcan(void)
  * enable; the e-stop of node 7 in the first 300 ms shows as its EMCY. */
 static void test_simarm_takes_the_config_mapping(void)
 {
+	PX_NEEDS(YAML);
 	const char *build = getenv("BUILD");
 	char tool[256], path[64], sock[64], msg[512];
 	struct px_config *cfg = NULL;

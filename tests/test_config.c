@@ -1,4 +1,5 @@
 /* YAML loader, schema reader and application config. */
+/* PX_TEST_NEEDS: libyaml (tests/run.sh skips it in builds without) */
 #include <dirent.h>
 #include <inttypes.h>
 #include <stdio.h>

@@ -1613,6 +1613,7 @@ static void expect_control_error(const char *body, const char *path, int line,
 
 static void test_config_haptic_section(void)
 {
+	PX_NEEDS(YAML);
 	static struct px_config_diag diag;
 	static struct px_control_config c;
 	struct px_control_haptic h;
@@ -1669,6 +1670,7 @@ static void test_config_haptic_section(void)
 
 static void test_config_errors(void)
 {
+	PX_NEEDS(YAML);
 	expect_control_error("control:\n  mode: haptic\n  device: pen\n"
 			     "  haptic:\n    stifness_n_per_m: 10\n",
 			     "control.haptic.stifness_n_per_m", 19,
@@ -1751,6 +1753,7 @@ static void test_config_errors(void)
 /* A chain read from the config equals the same chain built in code. */
 static void test_config_chain_matches_code(void)
 {
+	PX_NEEDS(YAML);
 	static struct px_config_diag diag;
 	static struct px_control_config c;
 	struct px_control_chain ref;
@@ -1808,6 +1811,7 @@ static void test_config_chain_matches_code(void)
 
 static void test_config_docs_and_examples(void)
 {
+	PX_NEEDS(YAML);
 	static struct px_config_diag diag;
 	static struct px_control_config c;
 	struct px_config *cfg;

@@ -1,5 +1,6 @@
 /* Opening devices from configurations (px_devcfg): every shipped example,
  * signal axes, drive scaling, GPIO roles and the errors. */
+/* PX_TEST_NEEDS: libyaml (tests/run.sh skips it in builds without) */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>

@@ -3,6 +3,7 @@
  * master's own node id, libusb no_hotplug, the stuck and duplicate
  * detectors, and the CAN bitrate applied through a simulated netlink
  * (libsocketcan call table). */
+/* PX_TEST_NEEDS: libyaml (tests/run.sh skips it in builds without) */
 #include <errno.h>
 #include <stdio.h>
 #include <string.h>

@@ -2,6 +2,7 @@
  * config's own to simulated haptic/pose and GPIO devices, on the loop
  * clock as given (clock0_ns moves only the config's), too many refused
  * naming sim.faults, and refused for back ends that are not simulated. */
+/* PX_TEST_NEEDS: libyaml (tests/run.sh skips it in builds without) */
 #include <stdio.h>
 #include <string.h>
 

@@ -10,6 +10,7 @@
 # period). Prints a table of what the safety layer did. Then each run
 # again, stopped by a signal at a seeded random cycle: every time zero
 # force, relays off and drives disabled at the end.
+# PX_TEST_NEEDS: libyaml (tests/run.sh skips it in builds without)
 set -u
 name=test_fault_campaign
 bin="${BUILD:-build}/bin/proxima-run"

@@ -430,6 +430,7 @@ static void test_gpio_fault_kinds_refused(void)
 
 static void test_gpiod_open_path(void)
 {
+	PX_NEEDS(GPIOD);
 	struct px_gpio_config c = io_cfg(1);
 	struct px_dev_config dc;
 	struct px_dev *d;

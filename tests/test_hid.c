@@ -2,6 +2,7 @@
  * clear errors. Where /dev/uhid exists (the VM suite) a virtual HID
  * device is created through it and the real back end reads its input
  * reports, writes output reports, and sees it unplugged. */
+/* PX_TEST_NEEDS: hidapi (tests/run.sh skips it in builds without) */
 #include <errno.h>
 #include <fcntl.h>
 #include <poll.h>

@@ -33,6 +33,7 @@ static void put(const char *name, const char *text)
 
 static void test_kinds(void)
 {
+	PX_NEEDS(ASSIMP);
 	/* a closed tetrahedron as ASCII STL (outward faces) */
 	static const char *tet =
 		"solid t\n"

@@ -802,6 +802,7 @@ static void write_files(const struct gen_mesh *g)
 
 static void test_load_files(void)
 {
+	PX_NEEDS(ASSIMP);
 	/* coordinates in eighths: exact in the importer's floats */
 	double h[3] = {0.5, 0.25, 0.75};
 	struct gen_mesh g;

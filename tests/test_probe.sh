@@ -1,6 +1,7 @@
 #!/bin/sh
 # proxima-probe: runs, prints one or more lines per subsystem, each
 # starting with its name, and an absent subsystem as exactly one line.
+# PX_TEST_NEEDS: libgpiod (tests/run.sh skips it in builds without)
 set -u
 name=test_probe
 bin=${BUILD:-build}/bin/proxima-probe

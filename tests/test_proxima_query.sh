@@ -2,6 +2,7 @@
 # proxima-query's contract (issue: distance core): output format, exact
 # distances on models with known geometry, header handling, and clear
 # errors with their place. Prints a harness-style summary line.
+# PX_TEST_NEEDS: assimp (tests/run.sh skips it in builds without)
 set -u
 name=test_proxima_query
 bin="${BUILD:-build}/bin/proxima-query"

@@ -8,6 +8,7 @@
 # running setup's checks, range-checked durations reported as loop and
 # wall time, socket paths of which only a stale socket is removed.
 # Prints a harness-style summary line.
+# PX_TEST_NEEDS: libyaml (tests/run.sh skips it in builds without)
 set -u
 name=test_proxima_run
 bin="${BUILD:-build}/bin/proxima-run"

@@ -216,6 +216,7 @@ static void test_next_line(void)
 
 static void test_readers_size_limits(void)
 {
+	PX_NEEDS(ASSIMP);
 	struct px_cloud_report crep;
 	struct px_mesh_report mrep;
 	struct px_model *m = (struct px_model *)1;
@@ -271,6 +272,7 @@ static void test_readers_size_limits(void)
  * with its place, instead of skipping "blank" lines forever. */
 static void test_readers_dev_zero(void)
 {
+	PX_NEEDS(ASSIMP);
 	struct px_cloud_report crep;
 	struct px_model *m = (struct px_model *)1;
 	struct px_obj_model *o = (struct px_obj_model *)1;
@@ -343,6 +345,7 @@ static void test_model_fifo(void)
 
 static void test_readers_nul_place(void)
 {
+	PX_NEEDS(ASSIMP);
 	struct px_cloud_report crep;
 	struct px_model *m = NULL;
 	struct px_obj_model *o = NULL;
@@ -541,6 +544,7 @@ static void test_nurbs_extent(void)
  * place, and px_world_add() refuses the box itself. */
 static void test_scene_extent(void)
 {
+	PX_NEEDS(YAML);
 	static struct px_config_diag diag;
 	struct px_config *cfg = NULL;
 	struct px_world *w = NULL;
@@ -587,6 +591,7 @@ static void test_scene_extent(void)
 
 static void test_ply_missing_property(void)
 {
+	PX_NEEDS(ASSIMP);
 	struct px_cloud_report rep;
 	struct px_model *m = NULL;
 	char msg[600];
@@ -699,6 +704,7 @@ static int tag_errors(const char *yaml, const char **first)
 
 static void test_yaml_tags(void)
 {
+	PX_NEEDS(YAML);
 	static const struct {
 		const char *yaml, *msg;
 	} bad[] = {
@@ -759,6 +765,7 @@ static void stl_binary(unsigned char *b, uint32_t count_in_header, size_t n_tri,
 
 static void test_stl_binary_count(void)
 {
+	PX_NEEDS(ASSIMP);
 	unsigned char b[84 + 50 * 3];
 	struct px_mesh_report rep;
 	struct px_model *m = NULL;
@@ -823,6 +830,7 @@ static void check_far_cloud(const char *p)
 
 static void test_ply_double_exact(void)
 {
+	PX_NEEDS(ASSIMP);
 	static const char head[] = "element vertex 3\nproperty double x\n"
 				   "property double y\nproperty double z\nend_header\n";
 	const double v[9] = {5000000.123, -2.5, 0.001, 1, 2, 3, -4, 5, 6};

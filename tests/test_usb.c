@@ -33,6 +33,7 @@ static struct px_usb_config base_cfg(void)
 
 static void test_open_errors(void)
 {
+	PX_NEEDS(LIBUSB);
 	struct px_dev_config c;
 	struct px_usb_config u = base_cfg();
 	struct px_dev *d;

@@ -403,6 +403,7 @@ static void test_config_example_scene(void)
 
 static void test_config_scale(void)
 {
+	PX_NEEDS(YAML);
 	static struct px_config_diag diag;
 	struct px_world *s;
 	char text[2048];
@@ -460,6 +461,7 @@ static int has(const struct px_config_diag *d, const char *msg)
 
 static void test_config_errors(void)
 {
+	PX_NEEDS(YAML);
 	static struct px_config_diag diag;
 	struct px_world *s = (struct px_world *)&diag;
 	PX_CHECK_INT_EQ(load("scene:\n  models:\n    - {file: nope.stl, kind: mesh}\n",
@@ -565,6 +567,7 @@ static void test_proxy_leaves_the_end_of_a_face(void)
  * allocated once the streams are made. */
 static void test_tracked_matches_plain(void)
 {
+	PX_NEEDS(YAML);
 	static struct px_config_diag diag;
 	struct px_world *s, *other;
 	struct px_world_tracking *t;
