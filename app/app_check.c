@@ -379,7 +379,7 @@ int app_check_output(struct px_app *a, const char *path, const char *flag,
 	    a->o.output_check(a->o.user, path, why, sizeof(why)) == 0)
 		return 0;
 	if (flag) {
-		app_note(a, "proxima-run: %s: %s\n", flag, why);
+		app_note(a, "%s: %s: %s\n", app_name(a), flag, why);
 		return 2;
 	}
 	app_check_error(a, at, key, "%s", why);
@@ -462,10 +462,10 @@ int app_validate(struct px_app *a)
 		a->hardware = 1;
 		if (a->o.virtual_time) {
 			app_note(a,
-				"proxima-run: device '%s' (%s): --virtual-time "
+				"%s: device '%s' (%s): --virtual-time "
 				"drives simulated devices only; hardware and "
 				"buses shared with other processes run on the "
-				"real clock\n",
+				"real clock\n", app_name(a),
 				cfg->devices[i].name,
 				px_config_backend_names()[cfg->devices[i].backend]);
 			status = 2;
@@ -565,7 +565,7 @@ int app_check_config(struct px_app *a)
 		app_loop_config(a, &lc);
 		rc = px_loop_create(&lc, &a->loop);
 		if (rc != PX_OK)
-			app_note(a, "proxima-run: %s: loop: %s\n", a->o.config,
+			app_note(a, "%s: %s: loop: %s\n", app_name(a), a->o.config,
 				px_strerror(rc));
 		rc = rc != PX_OK;
 	}
@@ -648,14 +648,14 @@ int app_add_cli_faults(struct px_app *a)
 		if (!why)
 			why = app_fault_misfit(a->cfg, &a->all_faults[n], buf, sizeof(buf));
 		if (why) {
-			app_note(a, "proxima-run: --fault %s: %s\n",
+			app_note(a, "%s: --fault %s: %s\n", app_name(a),
 				a->o.faults[i], why);
 			return 2;
 		}
 		n++;
 	}
 	if (n > MAX_CAMPAIGN) {
-		app_note(a, "proxima-run: more than %d faults\n", MAX_CAMPAIGN);
+		app_note(a, "%s: more than %d faults\n", app_name(a), MAX_CAMPAIGN);
 		return 2;
 	}
 	a->sim.faults = a->all_faults;

@@ -619,7 +619,7 @@ int app_run(struct px_app *a)
 		pthread_t th;
 		int fired = 0;
 		if (pthread_create(&th, NULL, loop_thread, a) != 0) {
-			app_note(a, "proxima-run: cannot start the loop thread\n");
+			app_note(a, "%s: cannot start the loop thread\n", app_name(a));
 			return PX_E_NOMEM;
 		}
 		while (!atomic_load(&a->loop_done)) {

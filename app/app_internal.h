@@ -232,6 +232,7 @@ struct px_app {
 void app_note(struct px_app *a, const char *fmt, ...)
 	__attribute__((format(printf, 2, 3)));
 uint64_t app_heap_count(struct px_app *a);
+const char *app_name(const struct px_app *a);
 int64_t app_mono_ns(void);
 void app_config_dir_path(char *out, size_t cap, const char *cfg_path,
 			 const char *file);
@@ -264,7 +265,7 @@ int app_check_config(struct px_app *a);
 int app_setup(struct px_app *a);
 void app_rearm_warnings(struct px_app *a);
 void app_diag_print(struct px_app *a, const struct px_config_diag *diag);
-void app_note_shutdown(struct px_app *a, const char *prefix);
+void app_note_shutdown(struct px_app *a);
 void app_teardown(struct px_app *a);
 void app_safe_shutdown(struct px_app *a, const char *reason);
 int app_avoid_joints(const struct px_app *a);

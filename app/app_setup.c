@@ -108,8 +108,8 @@ int app_make_devcfg(struct px_app *a, int k)
 		    d->backend != PX_CONFIG_BACKEND_SIM)
 			continue;
 		if (nline == PX_SIM_MAX_FAULTS) {
-			app_note(a, "proxima-run: device '%s': more than %d "
-					"faults\n",
+			app_note(a, "%s: device '%s': more than %d "
+					"faults\n", app_name(a),
 				d->name, PX_SIM_MAX_FAULTS);
 			return 1;
 		}
@@ -141,8 +141,8 @@ int app_make_devcfg(struct px_app *a, int k)
 		bc.n_faults = nbus;
 		rc = px_can_sim_create(&bc, &a->fault_bus);
 		if (rc != PX_OK) {
-			app_note(a, "proxima-run: device '%s': simulated bus: "
-					"%s\n",
+			app_note(a, "%s: device '%s': simulated bus: "
+					"%s\n", app_name(a),
 				d->name, px_strerror(rc));
 			return 1;
 		}
@@ -150,23 +150,23 @@ int app_make_devcfg(struct px_app *a, int k)
 	}
 	rc = px_devcfg_open(a->cfg, d, &opt, &h, msg, sizeof(msg));
 	if (rc != PX_OK) {
-		app_note(a, "proxima-run: %s\n",
+		app_note(a, "%s: %s\n", app_name(a),
 			msg[0] ? msg : px_strerror(rc));
 		if (d->backend != PX_CONFIG_BACKEND_SIM)
 			app_note(a,
-				"proxima-run: is the hardware connected and "
+				"%s: is the hardware connected and "
 				"readable? build/bin/proxima-probe lists what "
-				"this machine has\n");
+				"this machine has\n", app_name(a));
 		return 1;
 	}
 	a->dcfg[a->n_dcfg++] = h;
 	if (px_devcfg_notes(h)[0])
-		app_note(a, "proxima-run: device '%s': note: %s\n", d->name,
+		app_note(a, "%s: device '%s': note: %s\n", app_name(a), d->name,
 			px_devcfg_notes(h));
 	dev = px_devcfg_dev(h);
 	if (dev) {
 		if (a->n_dev >= MAX_DEVS) {
-			app_note(a, "proxima-run: more than %d devices\n",
+			app_note(a, "%s: more than %d devices\n", app_name(a),
 				MAX_DEVS);
 			return 1;
 		}
@@ -183,13 +183,13 @@ int app_make_devcfg(struct px_app *a, int k)
 		int n = px_devcfg_drives(h, drv, PX_CANOPEN_MAX_DRIVES);
 		if (a->co) {
 			app_note(a,
-				"proxima-run: device '%s': a second CANopen "
-				"arm ('%s' is the first); one per run\n",
+				"%s: device '%s': a second CANopen "
+				"arm ('%s' is the first); one per run\n", app_name(a),
 				d->name, a->co_name);
 			return 1;
 		}
 		if (n < 0) {
-			app_note(a, "proxima-run: device '%s': drives: %s\n",
+			app_note(a, "%s: device '%s': drives: %s\n", app_name(a),
 				d->name, px_strerror(n));
 			return 1;
 		}
@@ -200,9 +200,9 @@ int app_make_devcfg(struct px_app *a, int k)
 			a->drive_joint[i] = drv[i].joint;
 			if (drv[i].mode == PX_CIA402_CST) {
 				app_note(a,
-					"proxima-run: device '%s': drives in cst "
+					"%s: device '%s': drives in cst "
 					"take torques; proxima-run commands csp "
-					"or csv\n",
+					"or csv\n", app_name(a),
 					d->name);
 				return 1;
 			}
@@ -217,8 +217,8 @@ int app_make_devcfg(struct px_app *a, int k)
 						      MAX_CAMPAIGN - narm);
 			if (na < 0) {
 				app_note(a,
-					"proxima-run: device '%s': drive "
-					"faults: %s\n",
+					"%s: device '%s': drive "
+					"faults: %s\n", app_name(a),
 					d->name, px_strerror(na));
 				return 1;
 			}
@@ -236,8 +236,8 @@ int app_make_devcfg(struct px_app *a, int k)
 				rc = px_canopen_sim_create(&sc, a->ep_arm, &a->arm);
 			if (rc != PX_OK) {
 				app_note(a,
-					"proxima-run: device '%s': simulated arm "
-					"on the in-process bus: %s\n",
+					"%s: device '%s': simulated arm "
+					"on the in-process bus: %s\n", app_name(a),
 					d->name, px_strerror(rc));
 				return 1;
 			}
@@ -312,7 +312,7 @@ int app_make_device(struct px_app *a, int k)
 			if (at)
 				app_note(a, "%s:%d:%d: devices[%d].sim.trajectory."
 					"file: ", at->file, at->line, at->column, k);
-			app_note(a, "proxima-run: device '%s': %s\n", d->name,
+			app_note(a, "%s: device '%s': %s\n", app_name(a), d->name,
 				msg[0] ? msg : px_strerror(rc));
 			return 1;
 		}
@@ -327,8 +327,8 @@ int app_make_device(struct px_app *a, int k)
 			const struct px_config_fault *f = &s->faults[i];
 			if (n == PX_SIM_MAX_FAULTS) {
 				app_note(a,
-					"proxima-run: device '%s': more than %d "
-					"faults in devices[%d].sim.faults\n",
+					"%s: device '%s': more than %d "
+					"faults in devices[%d].sim.faults\n", app_name(a),
 					d->name, PX_SIM_MAX_FAULTS, k);
 				return 1;
 			}
@@ -346,8 +346,8 @@ int app_make_device(struct px_app *a, int k)
 				continue;
 			if (n == PX_SIM_MAX_FAULTS) {
 				app_note(a,
-					"proxima-run: device '%s': more than %d "
-					"faults\n",
+					"%s: device '%s': more than %d "
+					"faults\n", app_name(a),
 					d->name, PX_SIM_MAX_FAULTS);
 				return 1;
 			}
@@ -365,7 +365,7 @@ int app_make_device(struct px_app *a, int k)
 	dc.min_report_interval_ns = d->min_report_interval_ns;
 	rc = px_sim_haptic_create(&dc, &sc, &a->dev[a->n_dev], msg, sizeof(msg));
 	if (rc != PX_OK) {
-		app_note(a, "proxima-run: device '%s': %s\n", d->name,
+		app_note(a, "%s: device '%s': %s\n", app_name(a), d->name,
 			msg[0] ? msg : px_strerror(rc));
 		return 1;
 	}
@@ -383,14 +383,14 @@ int app_arm_exe(struct px_app *a, char *exe, size_t cap)
 	ssize_t len = cap > 32 ? readlink("/proc/self/exe", exe, cap - 32) : -1;
 	char *slash;
 	if (len <= 0 || !(slash = memrchr(exe, '/', (size_t)len))) {
-		app_note(a, "proxima-run: sim.spawn_arm: cannot find this "
-				"program's directory\n");
+		app_note(a, "%s: sim.spawn_arm: cannot find this "
+				"program's directory\n", app_name(a));
 		return 1;
 	}
 	strcpy(slash + 1, "proxima-simarm");
 	if (access(exe, X_OK) != 0) {
-		app_note(a, "proxima-run: sim.spawn_arm: %s: %s (make builds "
-				"it)\n",
+		app_note(a, "%s: sim.spawn_arm: %s: %s (make builds "
+				"it)\n", app_name(a),
 			exe, strerror(errno));
 		return 1;
 	}
@@ -413,14 +413,14 @@ int app_spawn_arm(struct px_app *a)
 	if (app_arm_exe(a, exe, sizeof(exe)))
 		return 1;
 	if (pipe(fds) != 0) {
-		app_note(a, "proxima-run: sim.spawn_arm: pipe: %s\n",
+		app_note(a, "%s: sim.spawn_arm: pipe: %s\n", app_name(a),
 			strerror(errno));
 		return 1;
 	}
 	fflush(NULL);
 	a->arm_pid = fork();
 	if (a->arm_pid < 0) {
-		app_note(a, "proxima-run: sim.spawn_arm: fork: %s\n",
+		app_note(a, "%s: sim.spawn_arm: fork: %s\n", app_name(a),
 			strerror(errno));
 		close(fds[0]);
 		close(fds[1]);
@@ -436,7 +436,7 @@ int app_spawn_arm(struct px_app *a)
 		 * faults, and the other end of socket_path */
 		execl(exe, "proxima-simarm", "--config", a->o.config, "--device",
 		      d->name, (char *)NULL);
-		app_note(a, "proxima-run: sim.spawn_arm: %s: %s\n", exe,
+		app_note(a, "%s: sim.spawn_arm: %s: %s\n", app_name(a), exe,
 			strerror(errno));
 		_exit(127);
 	}
@@ -462,14 +462,14 @@ int app_spawn_arm(struct px_app *a)
 		waitpid(a->arm_pid, &st, 0);
 		a->arm_pid = 0;
 		app_note(a,
-			"proxima-run: sim.spawn_arm: %s did not start (exit "
-			"status %d)\n",
+			"%s: sim.spawn_arm: %s did not start (exit "
+			"status %d)\n", app_name(a),
 			exe, WIFEXITED(st) ? WEXITSTATUS(st) : -1);
 		return 1;
 	}
 	app_note(a,
-		"proxima-run: spawned %s (pid %d): %zu drives on %s, layout "
-		"from %s\n",
+		"%s: spawned %s (pid %d): %zu drives on %s, layout "
+		"from %s\n", app_name(a),
 		exe, (int)a->arm_pid, c->canopen.n_drives, c->socket_path,
 		a->o.config);
 	return 0;
@@ -508,8 +508,8 @@ int app_setup(struct px_app *a)
 		rc = px_world_tracking_create(a->scene, NULL, &a->tracking);
 		if (rc != PX_OK) {
 			app_note(a,
-				"proxima-run: %s: scene.tracking: cannot make the "
-				"tracked streams: %s\n",
+				"%s: %s: scene.tracking: cannot make the "
+				"tracked streams: %s\n", app_name(a),
 				a->o.config, px_strerror(rc));
 			return 1;
 		}
@@ -522,9 +522,9 @@ int app_setup(struct px_app *a)
 	}
 	if (a->ctl.mode == PX_CONTROL_MODE_AVOIDANCE && !a->avoiding) {
 		app_note(a,
-			"proxima-run: control mode 'avoidance' needs "
+			"%s: control mode 'avoidance' needs "
 			"control.device '%s' to be a socketcan device with "
-			"canopen drives\n",
+			"canopen drives\n", app_name(a),
 			a->ctl.device ? a->ctl.device : "");
 		return 1;
 	}
@@ -533,8 +533,8 @@ int app_setup(struct px_app *a)
 	a->min_scale = 1.0;
 	a->rendering = a->ctl.mode == PX_CONTROL_MODE_HAPTIC && a->ctl_dev >= 0;
 	if (a->ctl.mode == PX_CONTROL_MODE_HAPTIC && a->ctl_dev < 0) {
-		app_note(a, "proxima-run: control.device '%s' is not a "
-				"pose device\n",
+		app_note(a, "%s: control.device '%s' is not a "
+				"pose device\n", app_name(a),
 			a->ctl.device);
 		return 1;
 	}
@@ -543,15 +543,15 @@ int app_setup(struct px_app *a)
 	if (a->rendering) {
 		if (!(px_dev_caps(a->dev[a->ctl_dev]) & PX_DEV_CAP_FORCE)) {
 			app_note(a,
-				"proxima-run: control.device '%s' takes no force "
-				"(a sim device of kind pose?)\n",
+				"%s: control.device '%s' takes no force "
+				"(a sim device of kind pose?)\n", app_name(a),
 				a->ctl.device);
 			return 1;
 		}
 		rc = px_control_haptic_init(&a->haptic, &a->ctl.haptic,
 					    cfg->loop.period_ns);
 		if (rc != PX_OK) {
-			app_note(a, "proxima-run: haptic setup: %s\n",
+			app_note(a, "%s: haptic setup: %s\n", app_name(a),
 				px_strerror(rc));
 			return 1;
 		}
@@ -560,7 +560,7 @@ int app_setup(struct px_app *a)
 	app_loop_config(a, &lc);
 	rc = px_loop_create(&lc, &a->loop);
 	if (rc != PX_OK) {
-		app_note(a, "proxima-run: loop: %s\n", px_strerror(rc));
+		app_note(a, "%s: loop: %s\n", app_name(a), px_strerror(rc));
 		return 1;
 	}
 	for (i = 0; i < a->n_dev; i++) {
@@ -573,7 +573,7 @@ int app_setup(struct px_app *a)
 			struct px_dev_status ds;
 			ds.last_msg[0] = '\0';
 			px_dev_status(a->dev[i], &ds);
-			app_note(a, "proxima-run: device '%s': %s%s%s\n",
+			app_note(a, "%s: device '%s': %s%s%s\n", app_name(a),
 				px_dev_name(a->dev[i]), px_strerror(rc),
 				ds.last_msg[0] ? ": " : "", ds.last_msg);
 			return 1;
@@ -586,7 +586,7 @@ int app_setup(struct px_app *a)
 						       : cfg->safety.watchdog.device_timeout_ns;
 		a->arm_input = px_loop_input_add(a->loop, a->co_name, tmo);
 		if (a->arm_input < 0) {
-			app_note(a, "proxima-run: arm watchdog: %s\n",
+			app_note(a, "%s: arm watchdog: %s\n", app_name(a),
 				px_strerror(a->arm_input));
 			return 1;
 		}
@@ -601,7 +601,7 @@ int app_setup(struct px_app *a)
 	if (rc == PX_OK)
 		rc = px_stats_create(&a->arena, 0, 0, &a->compute);
 	if (rc != PX_OK) {
-		app_note(a, "proxima-run: telemetry buffers: %s\n",
+		app_note(a, "%s: telemetry buffers: %s\n", app_name(a),
 			px_strerror(rc));
 		return 1;
 	}
@@ -680,7 +680,7 @@ void app_teardown(struct px_app *a)
 	 * stop them yet): the safe state before anything closes */
 	if (!a->sd.done && (a->n_dev || a->n_dcfg) && !a->o.check) {
 		app_safe_shutdown(a, "setup error");
-		app_note_shutdown(a, "proxima-run: shutdown: ");
+		app_note_shutdown(a);
 	}
 	app_stop_arm(a);
 	px_loop_free(a->loop);

@@ -41,6 +41,11 @@ void app_diag_print(struct px_app *a, const struct px_config_diag *diag)
 	free(buf);
 }
 
+const char *app_name(const struct px_app *a)
+{
+	return a->o.name ? a->o.name : "px_app";
+}
+
 uint64_t app_heap_count(struct px_app *a)
 {
 	return a->o.heap_count ? a->o.heap_count() : 0;
@@ -83,11 +88,11 @@ void px_app_shutdown_describe(const struct px_app *a, char *buf, size_t cap)
 		 sd->why);
 }
 
-void app_note_shutdown(struct px_app *a, const char *prefix)
+void app_note_shutdown(struct px_app *a)
 {
 	char line[1024];
 	px_app_shutdown_describe(a, line, sizeof(line));
-	app_note(a, "%s%s\n", prefix, line);
+	app_note(a, "%s: shutdown: %s\n", app_name(a), line);
 }
 
 /* Internal status (0, 1 invalid or failed, 2 options refused) as the
@@ -166,6 +171,16 @@ void px_app_warnings(struct px_app *a)
 struct px_loop *px_app_loop(struct px_app *a)
 {
 	return a->loop;
+}
+
+int px_app_device_count(const struct px_app *a)
+{
+	return a->n_dev;
+}
+
+struct px_dev *px_app_device_at(struct px_app *a, int i)
+{
+	return i >= 0 && i < a->n_dev ? a->dev[i] : NULL;
 }
 
 struct px_dev *px_app_device(struct px_app *a, const char *name)
@@ -280,6 +295,15 @@ int px_app_summary(const struct px_app *a, struct px_app_summary *s)
 	s->shutdown_safe = a->sd.safe;
 	snprintf(s->shutdown_reason, sizeof(s->shutdown_reason), "%s",
 		 a->sd.reason);
+	s->force_devices = a->sd.force_devs;
+	s->force_zeroed = a->sd.force_zeroed;
+	s->relay_devices = a->sd.dio_devs;
+	s->relays_off = a->sd.relays_off;
+	s->shutdown_drives = a->sd.drives;
+	s->drives_disabled = a->sd.drives_disabled;
+	s->drives_faulted = a->sd.drives_faulted;
+	s->shutdown_ns = a->sd.elapsed_ns;
+	snprintf(s->shutdown_error, sizeof(s->shutdown_error), "%s", a->sd.why);
 	s->max_trip_to_safe_cycles = trip_to_safe(a, &s->watchdog_trips_checked);
 	for (i = 0; i < a->sim.n_faults && i < PX_APP_MAX_CAMPAIGN; i++)
 		reaction(a, i, &s->reactions[i]);

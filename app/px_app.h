@@ -12,7 +12,8 @@
  * CANopen drives held and quick-stopped in safe state, and
  * px_app_shutdown(): zero force, relays off, drives quick-stopped and
  * disabled, each confirmed within a bounded wait, before any device
- * closes. px_app_free() runs it too when it has not run yet.
+ * closes. px_app_free() runs it too (reason "setup error") when it has
+ * not run yet.
  *
  * Threads: create, run, drain, shutdown and free belong to one control
  * thread. With the real clock px_app_run() runs the loop on its own thread
@@ -66,6 +67,7 @@ struct px_app_record {
 };
 
 struct px_app_options {
+	const char *name;      /* starts the messages; NULL: "px_app" */
 	const char *config;    /* the config's path: base of relative files */
 	int check;             /* validate, open only in-process devices */
 	int virtual_time;      /* loop on the virtual clock */
@@ -110,6 +112,10 @@ PX_API void px_app_warnings(struct px_app *app);
 
 /* The app's loop (its phases attached), to step or inspect. */
 PX_API struct px_loop *px_app_loop(struct px_app *app);
+
+/* The app's devices in config order (0 <= i < px_app_device_count). */
+PX_API int px_app_device_count(const struct px_app *app);
+PX_API struct px_dev *px_app_device_at(struct px_app *app, int i);
 
 /* The device of that config name (NULL: none), e.g. for a simulated
  * device's state (px_sim_haptic_state). The app owns it. */
@@ -179,8 +185,14 @@ struct px_app_summary {
 	uint64_t telemetry_dropped;
 	uint64_t faults_popped;
 	uint64_t allocations_after_setup; /* 0 without opt.heap_count */
+	/* the shutdown (px_app_shutdown): outputs made safe and confirmed */
 	int shutdown_done, shutdown_safe;
-	char shutdown_reason[32];
+	char shutdown_reason[32];     /* "end of run", "SIGINT", ... */
+	int force_devices, force_zeroed;
+	int relay_devices, relays_off;
+	int shutdown_drives, drives_disabled, drives_faulted;
+	int64_t shutdown_ns;          /* loop clock */
+	char shutdown_error[320];     /* the first failure, "" when safe */
 	/* every loop fault that found the loop in safe state, checked
 	 * against the per-cycle record: how many, and the most cycles from
 	 * the fault to safe state (-1: none checked) */

@@ -170,6 +170,15 @@ static void test_shutdown_leaves_zero_force(void)
 	PX_CHECK_INT_EQ(px_app_summary(app, &s), PX_OK);
 	PX_CHECK(s.shutdown_done && s.shutdown_safe);
 	PX_CHECK(strcmp(s.shutdown_reason, "test") == 0);
+	/* haptic_sim: the haptic device's force and the io relay */
+	PX_CHECK_INT_EQ(px_app_device_count(app), 2);
+	PX_CHECK(px_app_device_at(app, 0) == dev && px_app_device_at(app, 2) == NULL);
+	PX_CHECK_INT_EQ(s.force_devices, 1);
+	PX_CHECK_INT_EQ(s.force_zeroed, 1);
+	PX_CHECK_INT_EQ(s.relay_devices, 1);
+	PX_CHECK_INT_EQ(s.relays_off, 1);
+	PX_CHECK_INT_EQ(s.shutdown_drives, 0);
+	PX_CHECK(s.shutdown_error[0] == '\0');
 	/* once: a second call reports the first */
 	PX_CHECK_INT_EQ(px_app_shutdown(app, "again"), PX_OK);
 	PX_CHECK_INT_EQ(px_app_summary(app, &s), PX_OK);
@@ -283,6 +292,11 @@ static void test_bad_options_refused(void)
 	notes[0] = '\0';
 	PX_CHECK_INT_EQ(px_app_create(cfg, &o, &app, msg, sizeof(msg)), PX_E_INVAL);
 	PX_CHECK_MSG(strstr(msg, "unknown kind 'melt'") != NULL, "%s", msg);
+	/* messages start with opt.name (default px_app) */
+	PX_CHECK_MSG(strncmp(msg, "px_app: --fault melt", 20) == 0, "%s", msg);
+	o.name = "mytool";
+	PX_CHECK_INT_EQ(px_app_create(cfg, &o, &app, msg, sizeof(msg)), PX_E_INVAL);
+	PX_CHECK_MSG(strncmp(msg, "mytool: --fault melt", 20) == 0, "%s", msg);
 	PX_CHECK(strstr(notes, "unknown kind 'melt'") != NULL);
 	o.faults[0] = "drop,nosuchdevice,0,1";
 	PX_CHECK_INT_EQ(px_app_create(cfg, &o, &app, msg, sizeof(msg)), PX_E_INVAL);

@@ -235,18 +235,19 @@ static void json_shutdown(FILE *f)
 		"\"shutdown_drives\": %d, \"drives_disabled\": %d, "
 		"\"drives_faulted\": %d, \"shutdown_ns\": %lld, "
 		"\"shutdown_error\": ",
-		A->sd.safe, A->sd.reason, A->sd.force_devs, A->sd.force_zeroed, A->sd.dio_devs,
-		A->sd.relays_off, A->sd.drives, A->sd.drives_disabled, A->sd.drives_faulted,
-		(long long)A->sd.elapsed_ns);
-	json_string(f, A->sd.why);
+		S.shutdown_safe, S.shutdown_reason, S.force_devices, S.force_zeroed,
+		S.relay_devices, S.relays_off, S.shutdown_drives, S.drives_disabled,
+		S.drives_faulted, (long long)S.shutdown_ns);
+	json_string(f, S.shutdown_error);
 	fputs(", \"last_outputs\": [", f);
-	for (i = 0; i < A->n_dev; i++) {
+	for (i = 0; i < px_app_device_count(A); i++) {
+		struct px_dev *d = px_app_device_at(A, i);
 		struct px_sim_haptic_state hs;
 		struct px_dev_status st;
 		int relay;
-		px_dev_status(A->dev[i], &st);
-		if (px_sim_haptic_state(A->dev[i], &hs) == PX_OK &&
-		    (px_dev_caps(A->dev[i]) & PX_DEV_CAP_FORCE)) {
+		px_dev_status(d, &st);
+		if (px_sim_haptic_state(d, &hs) == PX_OK &&
+		    (px_dev_caps(d) & PX_DEV_CAP_FORCE)) {
 			fprintf(f, "%s{\"name\": ", first ? "" : ", ");
 			json_string(f, st.name);
 			fprintf(f,
@@ -258,7 +259,7 @@ static void json_shutdown(FILE *f)
 				hs.torque_n_m[1], hs.torque_n_m[2], hs.enable,
 				st.outputs_safe);
 			first = 0;
-		} else if ((relay = px_gpio_sim_output(A->dev[i],
+		} else if ((relay = px_gpio_sim_output(d,
 						       PX_GPIO_ENABLE)) >= 0) {
 			fprintf(f, "%s{\"name\": ", first ? "" : ", ");
 			json_string(f, st.name);
@@ -266,7 +267,7 @@ static void json_shutdown(FILE *f)
 				", \"enable_line\": %d, "
 				"\"timing_line\": %d, \"outputs_safe\": %d}",
 				relay,
-				px_gpio_sim_output(A->dev[i], PX_GPIO_TIMING),
+				px_gpio_sim_output(d, PX_GPIO_TIMING),
 				st.outputs_safe);
 			first = 0;
 		}
@@ -1082,6 +1083,7 @@ int main(int argc, char **argv)
 			o.config, n, n == 1 ? "" : "s");
 		return 1;
 	}
+	o.name = "proxima-run";
 	o.note = on_note;
 	o.heap_count = heap_count;
 	o.output_check = out_check;
@@ -1175,10 +1177,10 @@ int main(int argc, char **argv)
 	if (rc < 0)
 		fprintf(stderr, "proxima-run: the loop stopped: %s\n",
 			px_strerror(rc));
-	if (!A->sd.safe)
+	if (!S.shutdown_safe)
 		shutdown_line(stderr, "proxima-run: shutdown: ");
 	{
-		int safe = A->sd.safe;
+		int safe = S.shutdown_safe;
 		finish();
 		return rc < 0 || !safe ? 1 : 0;
 	}
