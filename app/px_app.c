@@ -173,6 +173,24 @@ struct px_loop *px_app_loop(struct px_app *a)
 	return a->loop;
 }
 
+struct px_stats *px_app_compute_stats(struct px_app *a)
+{
+	return a->compute;
+}
+
+struct px_canopen *px_app_canopen(struct px_app *a)
+{
+	return a->co;
+}
+
+int px_app_last_record(const struct px_app *a, struct px_app_record *out)
+{
+	if (!a->have_last)
+		return 0;
+	*out = a->last;
+	return 1;
+}
+
 int px_app_device_count(const struct px_app *a)
 {
 	return a->n_dev;
@@ -276,6 +294,13 @@ int px_app_summary(const struct px_app *a, struct px_app_summary *s)
 						  a->first_deadline_ns +
 						  st.period_ns) *
 					 1e-9;
+		s->phase_error_ns =
+			(a->have_deadline ? a->last_deadline_ns - a->first_deadline_ns
+					  : 0) -
+			(st.cycles ? ((int64_t)st.cycles - 1 +
+				      (int64_t)st.missed_periods) *
+					     st.period_ns
+				   : 0);
 	}
 	s->max_force_n = a->max_force_n;
 	s->contact_cycles = a->contact_cycles;
@@ -305,6 +330,45 @@ int px_app_summary(const struct px_app *a, struct px_app_summary *s)
 	s->shutdown_ns = a->sd.elapsed_ns;
 	snprintf(s->shutdown_error, sizeof(s->shutdown_error), "%s", a->sd.why);
 	s->max_trip_to_safe_cycles = trip_to_safe(a, &s->watchdog_trips_checked);
+	s->scene_models = px_world_count(a->scene);
+	s->rendering = a->rendering;
+	s->proxy_renderer = a->ctl.haptic.renderer == PX_CONTROL_PROXY;
+	s->avoiding = a->avoiding;
+	s->distance_reported = a->ctl_dev >= 0;
+	s->record_joints = app_avoid_joints(a);
+	s->max_cycles = a->max_cycles;
+	s->decimation = a->decimation;
+	s->force_clamp_n = a->ctl.haptic.max_force_n;
+	s->protective_distance_m = a->ctl.avoid.protective_distance_m;
+	s->influence_distance_m = a->ctl.avoid.influence_distance_m;
+	snprintf(s->csv_path, sizeof(s->csv_path), "%s", a->csv_path);
+	snprintf(s->time_svg, sizeof(s->time_svg), "%s", a->time_svg);
+	snprintf(s->lat_svg, sizeof(s->lat_svg), "%s", a->lat_svg);
+	s->ended_by_time = a->ended_by_time;
+	s->min_speed_scale = a->min_scale;
+	s->stop_cycles = a->stop_cycles;
+	s->last_query_error = a->last_query_err;
+	memcpy(s->faults_by_cause, a->faults_by_cause, sizeof(s->faults_by_cause));
+	s->faults_injected = a->sim.n_faults;
+	s->nonfinite_outputs = a->nonfinite_outputs;
+	s->estop_lines = a->n_dio;
+	s->estop_to_safe_ns = a->estop_first_ns >= 0 && a->safe_first_after_estop_ns >= 0
+				      ? a->safe_first_after_estop_ns - a->estop_first_ns
+				      : -1;
+	s->estop_to_safe_cycles =
+		a->estop_first_ns >= 0 && a->safe_first_after_estop_ns >= 0
+			? (int64_t)(a->safe_first_cycle_after_estop -
+				    a->estop_first_cycle)
+			: -1;
+	s->safe_cycles_before_estop = a->safe_cycles_before_estop;
+	s->safe_at_estop = a->safe_at_estop;
+	s->enable_write_errors = a->enable_errors;
+	s->n_drives = a->co ? a->n_drives : 0;
+	s->drives_device = a->co ? a->co_name : NULL;
+	s->drives_enabled_cycles = a->enabled_cycles;
+	s->drive_problem_cycles = a->drive_problem_cycles;
+	s->tracking_enabled = a->tracking != NULL;
+	s->tracking_streams = px_world_tracking_stats(a->tracking, &s->tracking);
 	for (i = 0; i < a->sim.n_faults && i < PX_APP_MAX_CAMPAIGN; i++)
 		reaction(a, i, &s->reactions[i]);
 	s->n_reactions = i;

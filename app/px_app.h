@@ -38,7 +38,10 @@
 #include "px_base.h"
 #include "px_config.h"
 #include "px_dev.h"
+#include "px_canopen.h"
 #include "px_loop.h"
+#include "px_stats.h"
+#include "px_world.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -116,6 +119,15 @@ PX_API struct px_loop *px_app_loop(struct px_app *app);
 /* The app's devices in config order (0 <= i < px_app_device_count). */
 PX_API int px_app_device_count(const struct px_app *app);
 PX_API struct px_dev *px_app_device_at(struct px_app *app, int i);
+
+/* The compute phase's duration statistics (wall clock), and the CANopen
+ * master of the arm (NULL: none); the app owns both. */
+PX_API struct px_stats *px_app_compute_stats(struct px_app *app);
+PX_API struct px_canopen *px_app_canopen(struct px_app *app);
+
+/* The newest drained record: 1 and *out, or 0 before any. */
+PX_API int px_app_last_record(const struct px_app *app,
+			      struct px_app_record *out);
 
 /* The device of that config name (NULL: none), e.g. for a simulated
  * device's state (px_sim_haptic_state). The app owns it. */
@@ -200,6 +212,36 @@ struct px_app_summary {
 	int64_t max_trip_to_safe_cycles;
 	size_t n_reactions;
 	struct px_app_reaction reactions[PX_APP_MAX_CAMPAIGN];
+	/* what the app is (known from create on) */
+	size_t scene_models;
+	int rendering;                /* haptic rendering on control.device */
+	int proxy_renderer;           /* ... with the proxy renderer */
+	int avoiding;                 /* avoidance on a CANopen arm */
+	int distance_reported;        /* a pose device's distance is followed */
+	int record_joints;            /* joints a record's qdot carries */
+	uint64_t max_cycles;          /* 0: until stopped */
+	int64_t decimation;           /* a record every this many cycles */
+	double force_clamp_n, protective_distance_m, influence_distance_m;
+	char csv_path[1024], time_svg[1100], lat_svg[1100]; /* "" none */
+	/* the run */
+	int ended_by_time;            /* real clock: the duration's time gone */
+	int64_t phase_error_ns;       /* deadlines' span minus the cycles' */
+	double min_speed_scale;
+	uint64_t stop_cycles;         /* avoidance: nominal motion stopped */
+	int last_query_error;
+	uint64_t faults_by_cause[PX_FAULT__COUNT];
+	size_t faults_injected;
+	uint64_t nonfinite_outputs;
+	int estop_lines;
+	int64_t estop_to_safe_ns, estop_to_safe_cycles; /* -1: no press/safe */
+	uint64_t safe_cycles_before_estop;
+	int safe_at_estop;
+	uint64_t enable_write_errors;
+	int n_drives;
+	const char *drives_device;    /* the CANopen arm's device, or NULL */
+	uint64_t drives_enabled_cycles, drive_problem_cycles;
+	int tracking_enabled, tracking_streams;
+	struct px_model_stream_stats tracking;
 };
 
 PX_API int px_app_summary(const struct px_app *app, struct px_app_summary *out);

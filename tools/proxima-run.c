@@ -46,9 +46,14 @@
 
 #include "px_alloc_count.h"
 #include "px_app.h"
-/* the summary and the JSON still read the app's state directly (until
- * px_app_summary): the module's private header, in this tree only */
-#include "app_internal.h"
+#include "px_canopen.h"
+#include "px_config.h"
+#include "px_dev.h"
+#include "px_gpio.h"
+#include "px_loop.h"
+#include "px_sim.h"
+#include "px_stats.h"
+#include "px_world.h"
 #include "tool_out.h"
 #include "tool_svg.h"
 
@@ -190,9 +195,20 @@ static const char *heap_counter_name(void)
 
 /* ---- the run's state on this side: the app, the CSV, the plots ------ */
 
+/* The plots keep the first PLOT_MAX records (about 17 min at 1 kHz). */
+#define PLOT_MAX ((size_t)1 << 20)
+
+static int64_t mono_ns(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+
 static struct px_app *A;
 static struct px_config *CFG;
-static struct px_app_summary S; /* after the run: what the app reports */
+static struct px_app_options O; /* the arguments */
+static struct px_app_summary S; /* what the app reports (after the run: all) */
 
 static struct {
 	FILE *csv_f;            /* csv_out.f while the CSV is written */
@@ -310,22 +326,24 @@ static void signal_reason(int sig, char *buf, size_t cap)
  * a config may not expect: say so, at the auto_rearm key. */
 static void status_line(int final, double wall_s, double rate)
 {
+	struct px_app_record last;
+	int have_last = px_app_last_record(A, &last);
 	struct px_stats_snapshot lat, cmp;
 	struct px_loop_status st;
 	static int tty = -1;
 	if (tty < 0)
 		tty = isatty(2);
-	px_loop_stats(A->loop, PX_LOOP_STAT_LATENCY, &lat);
-	px_stats_read(A->compute, &cmp);
-	px_loop_status(A->loop, &st);
+	px_loop_stats(px_app_loop(A), PX_LOOP_STAT_LATENCY, &lat);
+	px_stats_read(px_app_compute_stats(A), &cmp);
+	px_loop_status(px_app_loop(A), &st);
 	fprintf(stderr,
 		"%s[%7.2f s] %6.0f cycles/s | wake p99 %5.1f us | compute p99 "
 		"%5.1f us | distance %+8.2f mm | force %5.2f N | faults %llu%s%s",
-		tty ? "\r" : "", A->have_last ? A->last.t_s : 0.0, rate,
+		tty ? "\r" : "", have_last ? last.t_s : 0.0, rate,
 		(double)lat.p99_ns / 1e3, (double)cmp.p99_ns / 1e3,
-		A->have_last && isfinite(A->last.distance_m) ? A->last.distance_m * 1e3
+		have_last && isfinite(last.distance_m) ? last.distance_m * 1e3
 							     : 0.0,
-		A->have_last ? A->last.force_mag_n : 0.0,
+		have_last ? last.force_mag_n : 0.0,
 		(unsigned long long)st.faults, st.safe ? " | SAFE STATE" : "",
 		tty ? "\033[K" : "\n");
 	if (final && tty)
@@ -345,7 +363,7 @@ static void maybe_status(struct rate_meter *m, int64_t now, int64_t every_ns)
 	struct px_loop_status st;
 	if (now - m->t_ns < every_ns)
 		return;
-	px_loop_status(A->loop, &st);
+	px_loop_status(px_app_loop(A), &st);
 	m->rate = (double)(st.cycles - m->cycles) / ((double)(now - m->t_ns) * 1e-9);
 	m->cycles = st.cycles;
 	m->t_ns = now;
@@ -367,7 +385,7 @@ static int stop_sig;
 static void on_tick(void *user)
 {
 	(void)user;
-	maybe_status(&meter, app_mono_ns(), status_every_ns);
+	maybe_status(&meter, mono_ns(), status_every_ns);
 }
 
 static void on_stop_cycle(void *user)
@@ -417,9 +435,9 @@ static void on_record(void *user, const struct px_app_record *r)
 			r->penetration_m, r->contact, r->safe,
 			(long long)r->latency_ns, (long long)r->compute_ns,
 			r->queries);
-		if (A->avoiding) {
+		if (S.avoiding) {
 			fprintf(T.csv_f, ",%.6g", r->scale);
-			for (j = 0; j < app_avoid_joints(A); j++)
+			for (j = 0; j < S.record_joints; j++)
 				fprintf(T.csv_f, ",%.6g", r->qdot[j]);
 		}
 		fputc('\n', T.csv_f);
@@ -472,8 +490,8 @@ static uint64_t stop_at_cycle(int *sig)
 
 static void plot_paths(char *time_svg, char *lat_svg, size_t cap)
 {
-	snprintf(time_svg, cap, "%s", A->time_svg);
-	snprintf(lat_svg, cap, "%s", A->lat_svg);
+	snprintf(time_svg, cap, "%s", S.time_svg);
+	snprintf(lat_svg, cap, "%s", S.lat_svg);
 }
 
 static int write_plots(const char *time_svg, const char *lat_svg)
@@ -488,22 +506,22 @@ static int write_plots(const char *time_svg, const char *lat_svg)
 	static uint64_t lbins[PX_STATS_DEFAULT_BINS], cbins[PX_STATS_DEFAULT_BINS];
 	uint64_t lover = 0, cover = 0;
 	int nl, nc;
-	if (x && d && f && pen && fz && A->avoiding) {
-		static const char *const colors[TELE_JOINTS] = {
+	if (x && d && f && pen && fz && S.avoiding) {
+		static const char *const colors[PX_APP_RECORD_JOINTS] = {
 			"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd",
 			"#8c564b"};
-		static const char *const names[TELE_JOINTS] = {
+		static const char *const names[PX_APP_RECORD_JOINTS] = {
 			"joint 0", "joint 1", "joint 2", "joint 3", "joint 4",
 			"joint 5"};
-		double *qd[TELE_JOINTS] = {0};
-		struct tool_svg_series sq[TELE_JOINTS];
+		double *qd[PX_APP_RECORD_JOINTS] = {0};
+		struct tool_svg_series sq[PX_APP_RECORD_JOINTS];
 		struct tool_svg_series sd[] = {{"clearance", d, "#1f77b4"},
 					       {"protective", pen, "#d62728"}};
 		struct tool_svg_series ss[] = {{"speed scale", f, "#2ca02c"}};
 		struct tool_svg_panel p[] = {{"clearance (mm)", sd, 2},
 					     {"speed scale", ss, 1},
 					     {"commanded velocity (rad/s)", sq, 0}};
-		int j, nj = app_avoid_joints(A), ok = 1;
+		int j, nj = S.record_joints, ok = 1;
 		for (j = 0; j < nj; j++) {
 			qd[j] = calloc(n + 1, sizeof(double));
 			ok = ok && qd[j];
@@ -515,7 +533,7 @@ static int write_plots(const char *time_svg, const char *lat_svg)
 		for (i = 0; ok && i < n; i++) {
 			x[i] = T.recs[i].t_s;
 			d[i] = T.recs[i].distance_m * 1e3;
-			pen[i] = A->ctl.avoid.protective_distance_m * 1e3;
+			pen[i] = S.protective_distance_m * 1e3;
 			f[i] = T.recs[i].scale;
 			for (j = 0; j < nj; j++)
 				qd[j][i] = T.recs[i].qdot[j];
@@ -552,20 +570,20 @@ static int write_plots(const char *time_svg, const char *lat_svg)
 	free(f);
 	free(pen);
 	free(fz);
-	nl = px_stats_copy_bins(px_loop_stats_handle(A->loop, PX_LOOP_STAT_LATENCY),
+	nl = px_stats_copy_bins(px_loop_stats_handle(px_app_loop(A), PX_LOOP_STAT_LATENCY),
 				lbins, PX_STATS_DEFAULT_BINS, &lover);
-	nc = px_stats_copy_bins(A->compute, cbins, PX_STATS_DEFAULT_BINS, &cover);
+	nc = px_stats_copy_bins(px_app_compute_stats(A), cbins, PX_STATS_DEFAULT_BINS, &cover);
 	if (rc == 0 && nl >= 0 && nc >= 0) {
 		struct tool_svg_hist h[] = {
 			{"wake-up latency", lbins, (size_t)nl, lover,
 			 (double)px_stats_bin_ns(px_loop_stats_handle(
-				 A->loop, PX_LOOP_STAT_LATENCY)) /
+				 px_app_loop(A), PX_LOOP_STAT_LATENCY)) /
 				 1e3,
 			 "#1f77b4"},
 			{"compute time", cbins, (size_t)nc, cover,
-			 (double)px_stats_bin_ns(A->compute) / 1e3, "#9467bd"}};
+			 (double)px_stats_bin_ns(px_app_compute_stats(A)) / 1e3, "#9467bd"}};
 		rc = tool_svg_histograms(lat_svg,
-					 A->o.virtual_time
+					 O.virtual_time
 						 ? "proxima-run: latency (virtual "
 						   "clock: wake-up is 0 by "
 						   "construction)"
@@ -613,9 +631,9 @@ static void device_faults(struct dev_faults *df)
 {
 	int i;
 	memset(df, 0, sizeof(*df));
-	for (i = 0; i < A->n_dev; i++) {
+	for (i = 0; i < px_app_device_count(A); i++) {
 		struct px_dev_status s;
-		if (px_dev_status(A->dev[i], &s) != PX_OK)
+		if (px_dev_status(px_app_device_at(A, i), &s) != PX_OK)
 			continue;
 		df->by_kind[PX_DEV_ERR_DECODE] += s.decode_errors;
 		df->by_kind[PX_DEV_ERR_NONFINITE] += s.nonfinite;
@@ -635,10 +653,8 @@ static void json_campaign(FILE *f);
  * on the virtual clock its simulated time. */
 static double loop_time_s(const struct px_loop_status *st)
 {
-	if (!A->have_deadline)
-		return 0.0;
-	return (double)(A->last_deadline_ns - A->first_deadline_ns + st->period_ns) *
-	       1e-9;
+	(void)st;
+	return S.loop_time_s;
 }
 
 /* What ended the run: "cycles" (--duration-s worth of cycles run),
@@ -646,9 +662,9 @@ static double loop_time_s(const struct px_loop_status *st)
  * "signal", or "stop" (the loop stopped: an error, a phase). */
 static const char *ended_by(const struct px_loop_status *st)
 {
-	if (A->max_cycles && st->cycles >= A->max_cycles)
+	if (S.max_cycles && st->cycles >= S.max_cycles)
 		return "cycles";
-	if (A->ended_by_time)
+	if (S.ended_by_time)
 		return "time";
 	return interrupted ? "signal" : "stop";
 }
@@ -668,27 +684,22 @@ static void json_safety(FILE *f, const struct px_loop_status *st)
 		"  \"safe_at_estop\": %d,\n"
 		"  \"enable_write_errors\": %llu,\n",
 		st->safe, st->safe ? px_fault_cause_name(st->safe_cause) : "",
-		A->n_dio, (unsigned long long)A->estop_presses,
-		(unsigned long long)A->estop_cycles,
-		(long long)(A->estop_first_ns >= 0 && A->safe_first_after_estop_ns >= 0
-				    ? A->safe_first_after_estop_ns - A->estop_first_ns
-				    : -1),
-		(long long)(A->estop_first_ns >= 0 && A->safe_first_after_estop_ns >= 0
-				    ? (long long)(A->safe_first_cycle_after_estop -
-						  A->estop_first_cycle)
-				    : -1),
-		(unsigned long long)A->safe_cycles_before_estop, A->safe_at_estop,
-		(unsigned long long)A->enable_errors);
+		S.estop_lines, (unsigned long long)S.estop_presses,
+		(unsigned long long)S.estop_cycles,
+		(long long)S.estop_to_safe_ns, (long long)S.estop_to_safe_cycles,
+		(unsigned long long)S.safe_cycles_before_estop, S.safe_at_estop,
+		(unsigned long long)S.enable_write_errors);
 }
 
 /* Every device's counters, and the CANopen drives' states. */
 static void json_devices(FILE *f)
 {
+	struct px_canopen *co = px_app_canopen(A);
 	int i;
 	fputs("  \"devices\": [", f);
-	for (i = 0; i < A->n_dev; i++) {
+	for (i = 0; i < px_app_device_count(A); i++) {
 		struct px_dev_status s;
-		if (px_dev_status(A->dev[i], &s) != PX_OK)
+		if (px_dev_status(px_app_device_at(A, i), &s) != PX_OK)
 			continue;
 		fprintf(f, "%s\n    {\"name\": ", i ? "," : "");
 		json_string(f, s.name);
@@ -705,15 +716,15 @@ static void json_devices(FILE *f)
 		json_string(f, s.last_msg);
 		fputc('}', f);
 	}
-	fputs(A->n_dev ? "\n  ],\n" : "],\n", f);
+	fputs(px_app_device_count(A) ? "\n  ],\n" : "],\n", f);
 	fprintf(f,
 		"  \"drives_enabled_cycles\": %llu,\n"
 		"  \"drive_problem_cycles\": %llu,\n  \"drives\": [",
-		(unsigned long long)A->enabled_cycles,
-		(unsigned long long)A->drive_problem_cycles);
-	for (i = 0; A->co && i < A->n_drives; i++) {
+		(unsigned long long)S.drives_enabled_cycles,
+		(unsigned long long)S.drive_problem_cycles);
+	for (i = 0; co && i < S.n_drives; i++) {
 		struct px_canopen_drive_status ds;
-		if (px_canopen_drive_status(A->co, (size_t)i, &ds) != PX_OK)
+		if (px_canopen_drive_status(co, (size_t)i, &ds) != PX_OK)
 			continue;
 		fprintf(f,
 			"%s\n    {\"node_id\": %d, \"state\": \"%s\", "
@@ -722,7 +733,7 @@ static void json_devices(FILE *f)
 			json_num(ds.position), ds.lost,
 			(unsigned long long)ds.emcy_count);
 	}
-	fputs(A->co && A->n_drives ? "\n  ],\n" : "],\n", f);
+	fputs(co && S.n_drives ? "\n  ],\n" : "],\n", f);
 }
 
 static int write_json(const char *path, const struct px_loop_status *st,
@@ -742,13 +753,13 @@ static int write_json(const char *path, const struct px_loop_status *st,
 	f = out.f;
 	device_faults(&df);
 	fprintf(f, "{\n  \"config\": ");
-	json_string(f, A->o.config);
+	json_string(f, O.config);
 	fprintf(f,
 		",\n  \"clock\": \"%s\",\n  \"period_ns\": %lld,\n"
 		"  \"simulated_s\": %.6f,\n  \"wall_s\": %.3f,\n"
 		"  \"cycles\": %llu,\n  \"overruns\": %llu,\n"
 		"  \"missed_periods\": %llu,\n",
-		A->o.virtual_time ? "virtual" : "monotonic",
+		O.virtual_time ? "virtual" : "monotonic",
 		(long long)st->period_ns,
 		(double)st->cycles * (double)st->period_ns * 1e-9, wall_s,
 		(unsigned long long)st->cycles, (unsigned long long)st->overruns,
@@ -756,19 +767,20 @@ static int write_json(const char *path, const struct px_loop_status *st,
 	fprintf(f,
 		"  \"loop_time_s\": %.6f,\n  \"wall_time_s\": %.3f,\n"
 		"  \"duration_s\": %.9g,\n  \"ended_by\": \"%s\",\n",
-		loop_time_s(st), wall_s, A->o.duration_s, ended_by(st));
+		loop_time_s(st), wall_s, O.duration_s, ended_by(st));
 	json_stats(f, "wakeup_latency_ns", lat, 0);
 	json_stats(f, "compute_ns", cmp, 0);
 	{
 		struct px_model_stream_stats ts;
-		int ns = px_world_tracking_stats(A->tracking, &ts);
+		int ns = S.tracking_streams;
+		ts = S.tracking;
 		fprintf(f,
 			"  \"tracking\": {\"enabled\": %s, \"streams\": %d, "
 			"\"queries\": %llu, \"tracked\": %llu, \"hot\": %llu, "
 			"\"global\": %llu, \"cold\": %llu, \"jumps\": %llu, "
 			"\"reinits\": %llu, \"verifications\": %llu, "
 			"\"disagreements\": %llu},\n",
-			A->tracking ? "true" : "false", ns,
+			S.tracking_enabled ? "true" : "false", ns,
 			(unsigned long long)ts.queries,
 			(unsigned long long)ts.tracked,
 			(unsigned long long)ts.hot, (unsigned long long)ts.global,
@@ -785,17 +797,17 @@ static int write_json(const char *path, const struct px_loop_status *st,
 		"  \"min_speed_scale\": %.9g,\n"
 		"  \"contact_cycles\": %llu,\n  \"safe_state_trips\": %llu,\n"
 		"  \"faults\": {",
-		A->max_force_n, A->rendering ? A->ctl.haptic.max_force_n : 0.0,
-		json_num(A->min_distance_m), A->max_penetration_m,
-		json_num(A->min_proxy_distance_m),
-		A->avoiding ? json_num(A->min_clearance_m) : 0.0,
-		A->avoiding ? A->ctl.avoid.protective_distance_m : 0.0,
-		A->avoiding ? A->min_scale : 1.0,
-		(unsigned long long)A->contact_cycles,
+		S.max_force_n, S.rendering ? S.force_clamp_n : 0.0,
+		json_num(S.min_distance_m), S.max_penetration_m,
+		json_num(S.min_proxy_distance_m),
+		S.avoiding ? json_num(S.min_clearance_m) : 0.0,
+		S.avoiding ? S.protective_distance_m : 0.0,
+		S.avoiding ? S.min_speed_scale : 1.0,
+		(unsigned long long)S.contact_cycles,
 		(unsigned long long)st->safe_entries);
 	for (k = 1; k < PX_FAULT__COUNT; k++)
 		fprintf(f, "\"%s\": %llu, ", px_fault_cause_name(k),
-			(unsigned long long)A->faults_by_cause[k]);
+			(unsigned long long)S.faults_by_cause[k]);
 	for (k = 1; k < PX_DEV_ERR__COUNT; k++)
 		if (k != PX_DEV_ERR_OPEN && k != PX_DEV_ERR_ESTOP &&
 		    k != PX_DEV_ERR_ENCODE)
@@ -804,8 +816,8 @@ static int write_json(const char *path, const struct px_loop_status *st,
 	fprintf(f,
 		"\"velocity_limit\": %llu, \"query_error\": %llu, "
 		"\"dropped\": %llu},\n",
-		(unsigned long long)A->velocity_trips,
-		(unsigned long long)A->query_errors,
+		(unsigned long long)S.velocity_trips,
+		(unsigned long long)S.query_errors,
 		(unsigned long long)st->faults_dropped);
 	json_safety(f, st);
 	json_devices(f);
@@ -813,24 +825,16 @@ static int write_json(const char *path, const struct px_loop_status *st,
 	{
 		uint64_t checked = S.watchdog_trips_checked;
 		int64_t worst = S.max_trip_to_safe_cycles;
-		int64_t span = A->have_deadline ? A->last_deadline_ns -
-							 A->first_deadline_ns
-					       : 0;
-		int64_t want = st->cycles
-				       ? ((int64_t)st->cycles - 1 +
-					  (int64_t)st->missed_periods) *
-						 st->period_ns
-				       : 0;
 		fprintf(f,
 			"  \"faults_injected\": %zu,\n  \"faults_popped\": %llu,\n"
 			"  \"watchdog_trips_checked\": %llu,\n"
 			"  \"max_trip_to_safe_cycles\": %lld,\n"
 			"  \"nonfinite_outputs\": %llu,\n"
 			"  \"phase_error_ns\": %lld,\n",
-			A->sim.n_faults, (unsigned long long)A->faults_popped,
+			S.faults_injected, (unsigned long long)S.faults_popped,
 			(unsigned long long)checked, (long long)worst,
-			(unsigned long long)A->nonfinite_outputs,
-			(long long)(span - want));
+			(unsigned long long)S.nonfinite_outputs,
+			(long long)S.phase_error_ns);
 	}
 	json_campaign(f);
 	fprintf(f,
@@ -840,13 +844,13 @@ static int write_json(const char *path, const struct px_loop_status *st,
 		"  \"telemetry_records\": %llu,\n  \"telemetry_dropped\": %llu,\n"
 		"  \"telemetry_decimation\": %lld,\n"
 		"  \"realtime\": %d,\n  \"csv\": ",
-		(unsigned long long)atomic_load(&A->allocs),
+		(unsigned long long)S.allocations_after_setup,
 		(unsigned long long)T.setup_heap_calls, counter,
-		(unsigned long long)A->n_rows,
-		(unsigned long long)px_ring_dropped(A->ring), (long long)A->decimation,
+		(unsigned long long)S.telemetry_records,
+		(unsigned long long)S.telemetry_dropped, (long long)S.decimation,
 		st->realtime);
-	if (A->csv_path[0])
-		json_string(f, A->csv_path);
+	if (S.csv_path[0])
+		json_string(f, S.csv_path);
 	else
 		fputs("null", f);
 	fputs(",\n  \"plots\": [", f);
@@ -861,14 +865,14 @@ static int write_json(const char *path, const struct px_loop_status *st,
 	return 0;
 }
 
-/* The telemetry CSV (A->csv_path, checked by validate()): its header now,
+/* The telemetry CSV (S.csv_path, checked by validate()): its header now,
  * rows as the ring drains, renamed into place by close_csv(). Returns 0
  * or 1 (said why). */
 static int open_csv(void)
 {
-	if (!A->csv_path[0])
+	if (!S.csv_path[0])
 		return 0;
-	if (tool_out_open(&T.csv_out, A->csv_path) != 0) {
+	if (tool_out_open(&T.csv_out, S.csv_path) != 0) {
 		fprintf(stderr, "proxima-run: %s\n", T.csv_out.why);
 		return 1;
 	}
@@ -877,12 +881,12 @@ static int open_csv(void)
 		"t_s,cycle,x_m,y_m,z_m,proxy_x_m,proxy_y_m,proxy_z_m,"
 		"fx_n,fy_n,fz_n,force_n,distance_m,penetration_m,"
 		"contact,safe,wakeup_latency_ns,compute_ns,queries");
-	if (A->avoiding) {
+	if (S.avoiding) {
 		/* distance_m is the clearance; x..z the closest link
 		 * point, proxy_* the obstacle point */
 		int j;
 		fprintf(T.csv_f, ",speed_scale");
-		for (j = 0; j < app_avoid_joints(A); j++)
+		for (j = 0; j < S.record_joints; j++)
 			fprintf(T.csv_f, ",qdot%d_rad_per_s", j);
 	}
 	fputc('\n', T.csv_f);
@@ -944,8 +948,8 @@ static void print_summary(const struct px_loop_status *st,
 			  const struct px_stats_snapshot *cmp, double wall_s)
 {
 	int k;
-	printf("proxima-run: %s (%s clock)\n", A->o.config,
-	       A->o.virtual_time ? "virtual" : "monotonic");
+	printf("proxima-run: %s (%s clock)\n", O.config,
+	       O.virtual_time ? "virtual" : "monotonic");
 	printf("  cycles            %llu in %.3f s simulated, %.3f s wall "
 	       "(%.0f cycles/s)\n",
 	       (unsigned long long)st->cycles,
@@ -955,15 +959,15 @@ static void print_summary(const struct px_loop_status *st,
 	       "wall %.3f s; ",
 	       loop_time_s(st), (unsigned long long)st->missed_periods,
 	       st->missed_periods == 1 ? "" : "s", wall_s);
-	if (A->o.duration_s > 0)
-		printf("--duration-s %g: ended by %s\n", A->o.duration_s,
+	if (O.duration_s > 0)
+		printf("--duration-s %g: ended by %s\n", O.duration_s,
 		       ended_by(st));
 	else
 		printf("until stopped: ended by %s\n", ended_by(st));
 	printf("  overruns          %llu (missed periods %llu)%s\n",
 	       (unsigned long long)st->overruns,
 	       (unsigned long long)st->missed_periods,
-	       A->o.virtual_time ? ""
+	       O.virtual_time ? ""
 	       : st->realtime   ? " on SCHED_FIFO"
 				: " (not real-time scheduled)");
 	printf("  wake-up latency   p50 %.1f us, p99 %.1f us, p99.9 %.1f us, "
@@ -974,61 +978,62 @@ static void print_summary(const struct px_loop_status *st,
 	       "max %.1f us\n",
 	       cmp->p50_ns / 1e3, cmp->p99_ns / 1e3, cmp->p999_ns / 1e3,
 	       cmp->max_ns / 1e3);
-	if (A->rendering)
+	if (S.rendering)
 		printf("  force             max %.3f N (clamp %.3f N), contact "
 		       "in %.1f %% of cycles\n",
-		       A->max_force_n, A->ctl.haptic.max_force_n,
-		       st->cycles ? 100.0 * (double)A->contact_cycles /
+		       S.max_force_n, S.force_clamp_n,
+		       st->cycles ? 100.0 * (double)S.contact_cycles /
 					    (double)st->cycles
 				  : 0.0);
-	if (A->avoiding)
+	if (S.avoiding)
 		printf("  avoidance         min clearance %.1f mm (protective %.1f "
 		       "mm, influence %.1f mm), speed scale min %.2f, nominal "
 		       "motion stopped in %llu cycles\n",
-		       json_num(A->min_clearance_m) * 1e3,
-		       A->ctl.avoid.protective_distance_m * 1e3,
-		       A->ctl.avoid.influence_distance_m * 1e3, A->min_scale,
-		       (unsigned long long)A->stop_cycles);
-	else if (A->ctl_dev >= 0)
+		       json_num(S.min_clearance_m) * 1e3,
+		       S.protective_distance_m * 1e3,
+		       S.influence_distance_m * 1e3, S.min_speed_scale,
+		       (unsigned long long)S.stop_cycles);
+	else if (S.distance_reported)
 		printf("  distance          min %+.3f mm, max penetration %.3f mm, "
 	       "proxy min clearance %+.3f mm\n",
-	       json_num(A->min_distance_m) * 1e3, A->max_penetration_m * 1e3,
-	       json_num(A->min_proxy_distance_m) * 1e3);
+	       json_num(S.min_distance_m) * 1e3, S.max_penetration_m * 1e3,
+	       json_num(S.min_proxy_distance_m) * 1e3);
 	printf("  safe state        %llu trip%s",
 	       (unsigned long long)st->safe_entries,
 	       st->safe_entries == 1 ? "" : "s");
 	for (k = 1; k < PX_FAULT__COUNT; k++)
-		if (A->faults_by_cause[k])
+		if (S.faults_by_cause[k])
 			printf(", %s %llu", px_fault_cause_name(k),
-			       (unsigned long long)A->faults_by_cause[k]);
-	if (A->velocity_trips)
-		printf(", velocity limit %llu", (unsigned long long)A->velocity_trips);
-	if (A->query_errors)
+			       (unsigned long long)S.faults_by_cause[k]);
+	if (S.velocity_trips)
+		printf(", velocity limit %llu", (unsigned long long)S.velocity_trips);
+	if (S.query_errors)
 		printf(", query errors %llu (last: %s)",
-		       (unsigned long long)A->query_errors,
-		       px_strerror(A->last_query_err));
-	if (A->n_dio)
+		       (unsigned long long)S.query_errors,
+		       px_strerror(S.last_query_error));
+	if (S.estop_lines)
 		printf("\n  e-stop            %llu press%s, held %llu cycles%s",
-		       (unsigned long long)A->estop_presses,
-		       A->estop_presses == 1 ? "" : "es",
-		       (unsigned long long)A->estop_cycles,
+		       (unsigned long long)S.estop_presses,
+		       S.estop_presses == 1 ? "" : "es",
+		       (unsigned long long)S.estop_cycles,
 		       st->safe ? "; in safe state at the end" : "");
-	if (A->co) {
+	if (px_app_canopen(A)) {
 		int i, n = 0;
-		for (i = 0; i < A->n_drives; i++) {
+		for (i = 0; i < S.n_drives; i++) {
 			struct px_canopen_drive_status ds;
-			if (px_canopen_drive_status(A->co, (size_t)i, &ds) == PX_OK &&
+			if (px_canopen_drive_status(px_app_canopen(A), (size_t)i,
+						    &ds) == PX_OK &&
 			    ds.state == PX_CIA402_OPERATION_ENABLED)
 				n++;
 		}
 		printf("\n  drives            %d on '%s', enabled in %llu cycles, "
 		       "%d in operation enabled at the end",
-		       A->n_drives, A->co_name, (unsigned long long)A->enabled_cycles,
+		       S.n_drives, S.drives_device, (unsigned long long)S.drives_enabled_cycles,
 		       n);
 	}
-	if (A->tracking) {
-		struct px_model_stream_stats ts;
-		int ns = px_world_tracking_stats(A->tracking, &ts);
+	if (S.tracking_enabled) {
+		struct px_model_stream_stats ts = S.tracking;
+		int ns = S.tracking_streams;
 		double q = ts.queries ? (double)ts.queries : 1.0;
 		printf("\n  tracking          %d stream%s: %llu answers, %.1f %% "
 		       "tracked (%.1f %% hot), %.1f %% global, %.1f %% cold, "
@@ -1046,12 +1051,12 @@ static void print_summary(const struct px_loop_status *st,
 	else
 		printf("\n  allocations       %llu after setup (loop thread; "
 		       "setup made %llu)\n",
-		       (unsigned long long)atomic_load(&A->allocs),
+		       (unsigned long long)S.allocations_after_setup,
 		       (unsigned long long)T.setup_heap_calls);
 	printf("  telemetry         %llu records (every %lld cycles), %llu "
 	       "dropped\n",
-	       (unsigned long long)A->n_rows, (long long)A->decimation,
-	       (unsigned long long)px_ring_dropped(A->ring));
+	       (unsigned long long)S.telemetry_records, (long long)S.decimation,
+	       (unsigned long long)S.telemetry_dropped);
 	shutdown_line(stdout, "  shutdown          ");
 	print_campaign();
 }
@@ -1061,46 +1066,46 @@ static void print_summary(const struct px_loop_status *st,
 int main(int argc, char **argv)
 {
 	static struct px_config_diag diag;
-	static struct px_app_options o;
 	const char *counter = heap_counter_name();
 	struct px_loop_status st;
 	struct px_stats_snapshot lat, cmp;
 	char time_svg[1100], lat_svg[1100], msg[256];
 	int64_t wall0;
 	double wall_s;
-	int rc = parse_args(argc, argv, &o);
+	int rc = parse_args(argc, argv, &O);
 	if (rc)
 		return rc == 1 ? 0 : rc;
 	/* from here on a signal ends the run through the safe state */
 	install_signals();
-	rc = px_config_load_file(o.config, &CFG, &diag);
+	rc = px_config_load_file(O.config, &CFG, &diag);
 	if (rc != PX_OK) {
 		int n = px_config_diag_total(&diag);
 		px_config_diag_print(&diag, stderr);
 		if (n == 0)
-			fprintf(stderr, "%s: %s\n", o.config, px_strerror(rc));
+			fprintf(stderr, "%s: %s\n", O.config, px_strerror(rc));
 		fprintf(stderr, "%s: invalid configuration (%d error%s)\n",
-			o.config, n, n == 1 ? "" : "s");
+			O.config, n, n == 1 ? "" : "s");
 		return 1;
 	}
-	o.name = "proxima-run";
-	o.note = on_note;
-	o.heap_count = heap_count;
-	o.output_check = out_check;
-	o.input_protect = in_protect;
-	o.tick = on_tick;
-	o.record = on_record;
-	o.at_cycle = on_stop_cycle;
-	o.stop_at_cycle = stop_at_cycle(&stop_sig);
-	o.alloc_probe = getenv("PX_RUN_ALLOC_PROBE") &&
+	O.name = "proxima-run";
+	O.note = on_note;
+	O.heap_count = heap_count;
+	O.output_check = out_check;
+	O.input_protect = in_protect;
+	O.tick = on_tick;
+	O.record = on_record;
+	O.at_cycle = on_stop_cycle;
+	O.stop_at_cycle = stop_at_cycle(&stop_sig);
+	O.alloc_probe = getenv("PX_RUN_ALLOC_PROBE") &&
 			strcmp(getenv("PX_RUN_ALLOC_PROBE"), "1") == 0;
-	rc = px_app_create(CFG, &o, &A, msg, sizeof(msg));
+	rc = px_app_create(CFG, &O, &A, msg, sizeof(msg));
 	if (rc != PX_OK) {
 		px_config_free(CFG);
 		return rc == PX_E_INVAL ? 2 : 1;
 	}
-	if (o.check) {
-		printf("%s: OK (%zu device%s, loop period %lld ns)\n", o.config,
+	px_app_summary(A, &S); /* what the app is: outputs, mode */
+	if (O.check) {
+		printf("%s: OK (%zu device%s, loop period %lld ns)\n", O.config,
 		       CFG->n_devices, CFG->n_devices == 1 ? "" : "s",
 		       (long long)CFG->loop.period_ns);
 		finish();
@@ -1115,24 +1120,24 @@ int main(int argc, char **argv)
 	fprintf(stderr,
 		"proxima-run: %s: %zu scene model%s, %d device%s, %s, %s clock, "
 		"%s\n",
-		A->o.config, px_world_count(A->scene),
-		px_world_count(A->scene) == 1 ? "" : "s",
-		(int)A->cfg->n_devices, A->cfg->n_devices == 1 ? "" : "s",
-		A->rendering ? (A->ctl.haptic.renderer == PX_CONTROL_PROXY
+		O.config, S.scene_models,
+		S.scene_models == 1 ? "" : "s",
+		(int)CFG->n_devices, CFG->n_devices == 1 ? "" : "s",
+		S.rendering ? (S.proxy_renderer
 				       ? "haptic proxy rendering"
 				       : "haptic penalty rendering")
-		: A->avoiding ? "collision avoidance over CANopen"
+		: S.avoiding ? "collision avoidance over CANopen"
 			     : "no control output",
-		A->o.virtual_time ? "virtual" : "real-time",
-		A->max_cycles ? "fixed duration" : "until Ctrl-C");
-	wall0 = app_mono_ns();
+		O.virtual_time ? "virtual" : "real-time",
+		S.max_cycles ? "fixed duration" : "until Ctrl-C");
+	wall0 = mono_ns();
 	if (interrupted)
 		px_app_stop(A); /* a signal during setup: straight to shutdown */
 	status_every_ns = isatty(2) ? 250000000 : 1000000000;
 	memset(&meter, 0, sizeof(meter));
-	meter.t_ns = app_mono_ns();
+	meter.t_ns = mono_ns();
 	rc = px_app_run(A);
-	wall_s = (double)(app_mono_ns() - wall0) * 1e-9;
+	wall_s = (double)(mono_ns() - wall0) * 1e-9;
 	{
 		/* the loop has stopped: zero force, relays off, drives
 		 * disabled, before the summary (which reports it) and
@@ -1148,29 +1153,29 @@ int main(int argc, char **argv)
 	px_app_drain(A, on_record, NULL);
 	{
 		struct px_loop_status s0;
-		px_loop_status(A->loop, &s0);
+		px_loop_status(px_app_loop(A), &s0);
 		status_line(1, wall_s,
 			    wall_s > 0 ? (double)s0.cycles / wall_s : 0.0);
 	}
 	close_csv();
 	px_app_summary(A, &S);
-	px_loop_status(A->loop, &st);
-	px_loop_stats(A->loop, PX_LOOP_STAT_LATENCY, &lat);
-	px_stats_read(A->compute, &cmp);
+	px_loop_status(px_app_loop(A), &st);
+	px_loop_stats(px_app_loop(A), PX_LOOP_STAT_LATENCY, &lat);
+	px_stats_read(px_app_compute_stats(A), &cmp);
 	print_summary(&st, &lat, &cmp, wall_s);
 	plot_paths(time_svg, lat_svg, sizeof(time_svg));
-	if (A->csv_path[0])
-		printf("  csv               %s\n", A->csv_path);
+	if (S.csv_path[0])
+		printf("  csv               %s\n", S.csv_path);
 	if (write_plots(time_svg, lat_svg) == 0)
 		printf("  plots             %s\n                    %s\n", time_svg,
 		       lat_svg);
 	else
 		fprintf(stderr, "proxima-run: cannot write the plots: %s\n",
 			tool_svg_error());
-	if (A->o.summary_json) {
-		if (write_json(A->o.summary_json, &st, &lat, &cmp, wall_s, time_svg,
+	if (O.summary_json) {
+		if (write_json(O.summary_json, &st, &lat, &cmp, wall_s, time_svg,
 			       lat_svg, counter) == 0)
-			printf("  summary           %s\n", A->o.summary_json);
+			printf("  summary           %s\n", O.summary_json);
 		else
 			fprintf(stderr, "proxima-run: %s\n", T.out_why);
 	}
