@@ -238,6 +238,29 @@ static void test_summary_is_proxima_runs(void)
 	PX_CHECK_NEAR(s.min_distance_m, -s.max_penetration_m, 1e-15);
 	PX_CHECK(s.min_proxy_distance_m > 0);
 	PX_CHECK(s.contact_cycles > 0 && s.contact_cycles < s.cycles);
+	/* the banner's and the JSON's description of the app */
+	PX_CHECK_INT_EQ((long long)s.scene_models, 3);
+	PX_CHECK(s.rendering && s.proxy_renderer && !s.avoiding);
+	PX_CHECK(s.distance_reported);
+	PX_CHECK_INT_EQ((long long)s.max_cycles, 2000);
+	PX_CHECK_INT_EQ((long long)s.decimation, 1);
+	PX_CHECK_NEAR(s.force_clamp_n, 8.0, 0);
+	PX_CHECK(strcmp(s.csv_path, "build/telemetry.csv") == 0);
+	PX_CHECK(strcmp(s.time_svg, "build/telemetry_time.svg") == 0);
+	PX_CHECK(s.tracking_enabled && s.tracking_streams == 1);
+	PX_CHECK(s.tracking.queries > 0);
+	PX_CHECK_INT_EQ(s.estop_lines, 1);
+	PX_CHECK_INT_EQ((long long)s.estop_to_safe_ns, -1);
+	PX_CHECK_INT_EQ((long long)s.phase_error_ns, 0);
+	PX_CHECK_INT_EQ((long long)s.faults_injected, 0);
+	PX_CHECK_INT_EQ((long long)s.nonfinite_outputs, 0);
+	PX_CHECK(px_app_compute_stats(app) != NULL);
+	PX_CHECK(px_app_canopen(app) == NULL);
+	{
+		struct px_app_record last;
+		PX_CHECK_INT_EQ(px_app_last_record(app, &last), 1);
+		PX_CHECK_INT_EQ((long long)last.cycle, 1999);
+	}
 	px_app_free(app);
 	px_config_free(cfg);
 }
