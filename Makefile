@@ -109,6 +109,12 @@ TEST_SUPPORT_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(TEST_SUPPORT_SRC))
 TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 TEST_SH  := $(wildcard tests/test_*.sh)
+# Test hooks: the sources with test switches and hook functions are built
+# a second time with -DPX_TEST_HOOKS into TEST_LIB, which the tests and
+# benches link; the shipped library has none (geom/math/math_internal.h).
+TEST_HOOK_SRC := $(filter geom/track/%.c geom/dist/px_spiece.c,$(LIB_SRC))
+TEST_HOOK_OBJ := $(patsubst %.c,$(BUILD)/obj-hooks/%.o,$(TEST_HOOK_SRC))
+TEST_LIB := $(BUILD)/lib/lib$(NAME)-test.a
 
 TOOL_SUPPORT_SRC := $(wildcard tools/tool_*.c)
 TOOL_SUPPORT_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(TOOL_SUPPORT_SRC))
@@ -212,9 +218,18 @@ $(PC_FILE): FORCE
 	  'Libs: -L$${libdir} -l$(NAME)' \
 	  'Libs.private: -lm -lpthread' > $@
 
-$(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT_OBJ) $(STATIC_LIB)
+$(BUILD)/obj-hooks/%.o: %.c | $(FEATURES_H)
 	@mkdir -p $(dir $@)
-	$(CC) $(ALL_LDFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(STATIC_LIB) $(LIBS)
+	$(CC) $(ALL_CFLAGS) -DPX_TEST_HOOKS -I$(BUILD)/gen $(PKG_CFLAGS) -fPIC -c $< -o $@
+
+$(TEST_LIB): $(filter-out $(patsubst %.c,$(BUILD)/obj/%.o,$(TEST_HOOK_SRC)),$(LIB_OBJ)) $(TEST_HOOK_OBJ)
+	@mkdir -p $(dir $@)
+	rm -f $@
+	ar rcs $@ $^
+
+$(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT_OBJ) $(TEST_LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_LDFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(TEST_LIB) $(LIBS)
 
 $(BUILD)/bin/%: $(BUILD)/obj/tools/%.o $(TOOL_SUPPORT_OBJ) $(STATIC_LIB)
 	@mkdir -p $(dir $@)
@@ -256,15 +271,16 @@ $(BUILD)/bench/%_occt: bench/%_occt.cpp $(STATIC_LIB)
 	$(CXX) -std=c++17 -O2 -g -Wall -Wextra -Werror -Wno-deprecated-declarations \
 	  -isystem $(OCCT_INC) $(INCS) -o $@ $< $(STATIC_LIB) $(OCCT_LIBS) $(LIBS)
 
-$(BUILD)/bench/%: $(BUILD)/obj/bench/%.o $(STATIC_LIB)
+$(BUILD)/bench/%: $(BUILD)/obj/bench/%.o $(TEST_LIB)
 	@mkdir -p $(dir $@)
-	$(CC) $(ALL_LDFLAGS) -o $@ $< $(STATIC_LIB) $(LIBS)
+	$(CC) $(ALL_LDFLAGS) -o $@ $< $(TEST_LIB) $(LIBS)
 
 # The HID back end reports which hidapi build it was linked with.
 $(BUILD)/obj/devices/backends/px_hidapi.o: ALL_CFLAGS += -DPX_HIDAPI_DRIVER=\"$(HIDAPI)\"
 
 # Test and bench sources also see the test harness headers.
 $(BUILD)/obj/tests/%.o $(BUILD)/obj/bench/%.o $(BUILD)/obj/tools/%.o: ALL_CFLAGS += -Itests -Itools
+$(BUILD)/obj/tests/%.o $(BUILD)/obj/bench/%.o: ALL_CFLAGS += -DPX_TEST_HOOKS
 
 # ---- top-level actions ---------------------------------------------------
 # `make deps` first; a second make then finds the optional parts it may
@@ -463,6 +479,6 @@ memcheck: all
 stress: $(BUILD)/tests/test_hostile
 	PX_STRESS=1 $(BUILD)/tests/test_hostile
 
--include $(LIB_OBJ:.o=.d) $(TEST_SUPPORT_OBJ:.o=.d) $(TOOL_SUPPORT_OBJ:.o=.d)
+-include $(LIB_OBJ:.o=.d) $(TEST_HOOK_OBJ:.o=.d) $(TEST_SUPPORT_OBJ:.o=.d) $(TOOL_SUPPORT_OBJ:.o=.d)
 -include $(patsubst %.c,$(BUILD)/obj/%.d,$(TEST_SRC) $(TOOL_SRC) $(BENCH_SRC) $(EXAMPLE_SRC))
 -include $(patsubst %.c,$(BUILD)/obj/%.d,$(FUZZ_SRC) fuzz/replay.c)

@@ -5,15 +5,16 @@
 #ifndef PX_DIST_INTERNAL_H
 #define PX_DIST_INTERNAL_H
 
+#include "math_internal.h"
 #include "px_math.h"
 
 /* px_spiece: at most this many slots in a query's pool of parent
  * tensors (-1: as many as fit), so tests can run the restriction from
  * the root and compare. */
-extern int px__spiece_pool_cap;
+PX__TEST_SWITCH(int, px__spiece_pool_cap, -1);
 /* px_spiece: 1 leaves the preconditioned monotonicity test out (a
  * rectangle is then split where only it would prove one minimum). */
-extern int px__spiece_no_precond;
+PX__TEST_SWITCH(int, px__spiece_no_precond, 0);
 /* px_spiece: the preconditioned monotonicity test on one rectangle, and
  * the symmetric Jacobian part's least eigenvalue sampled there (see
  * px_spiece.c). */

@@ -1081,10 +1081,14 @@ static void quad_halves(int o, int quad, int *a, int *b)
  * (test_pool_matches_root_restriction).
  */
 #define POOL_DOUBLES 8192
+#ifdef PX_TEST_HOOKS
 int px__spiece_pool_cap = -1;
+#endif
 /* Test hook (dist_internal.h): 1 leaves the preconditioned monotonicity test
  * out (precond_monotone()). */
+#ifdef PX_TEST_HOOKS
 int px__spiece_no_precond = 0;
+#endif
 #define POOL_SLOTS 64
 
 struct pool {
@@ -1569,6 +1573,7 @@ out:
 	return x.improved;
 }
 
+#ifdef PX_TEST_HOOKS
 /*
  * Test hook (dist_internal.h): the preconditioned monotonicity test on the
  * rectangle [s0, s1] x [t0, t1] (local coordinates) of sp for the point
@@ -1637,3 +1642,4 @@ int px__spiece_precond_probe(const struct px_spiece *sp, px_vec3 p, double s0,
 	*sampled = least;
 	return rc;
 }
+#endif

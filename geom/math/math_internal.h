@@ -1,7 +1,8 @@
 /*
  * math_internal.h - private helpers of geom/ on plain math values (px_vec3,
  * px_aabb, periods), shared by the distance core, the trackers and the
- * models. Not installed, not part of the API.
+ * models, and the declaration of the test switches. Not installed, not
+ * part of the API.
  */
 #ifndef PX_MATH_INTERNAL_H
 #define PX_MATH_INTERNAL_H
@@ -35,5 +36,19 @@ static inline int px__too_far(const px_aabb *b, px_vec3 p)
 	       b->min.z - p.z > PX__MAX_QUERY_REACH ||
 	       p.z - b->max.z > PX__MAX_QUERY_REACH;
 }
+
+/*
+ * A test switch: a global the tests set to break a proof on purpose
+ * (and show that their checks catch it) or to take another path. Only
+ * the objects built with -DPX_TEST_HOOKS, which the tests and benches
+ * link, have it as a writable variable; in the shipped library it is
+ * the constant of normal operation, so the branches that read it
+ * compile away and nothing there can switch a proof off.
+ */
+#ifdef PX_TEST_HOOKS
+#define PX__TEST_SWITCH(type, name, normal) extern type name
+#else
+#define PX__TEST_SWITCH(type, name, normal) static const type name = normal
+#endif
 
 #endif

@@ -305,7 +305,9 @@ static struct iv tp_ratio_range(const struct tpoly *a, const struct tpoly *d)
 /* Test hook (track_hooks.h): 1 shrinks rat_tight()'s enclosures to a
  * third of their width about their midpoints (unsound: the focal test
  * must see it). Read at setup. */
+#ifdef PX_TEST_HOOKS
 int px__strack_rat_fault = 0;
+#endif
 
 static struct iv iv_meet(struct iv a, struct iv b)
 {

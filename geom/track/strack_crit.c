@@ -301,7 +301,9 @@ static int solve_units(const struct px_strack *t, int ns)
 
 /* Test hook (track_hooks.h): 1 leaves every open box uncut (Newton from
  * its centre, as before the cuts). */
+#ifdef PX_TEST_HOOKS
 int px__strack_sub_fault = 0;
+#endif
 
 /* Levels of sub-boxes below a region's quarter (or a box whose
  * contraction stayed undecided): 4 + 16 certificates at most each. */

@@ -129,7 +129,9 @@ eval4_bicubic(const double *c4, double s, double t, double h[6][4])
 	_mm256_storeu_pd(h[5], V2);
 }
 
+#ifdef PX_TEST_HOOKS
 int px__strack_no_fma = 0;
+#endif
 
 int px__st_have_fma(void)
 {
@@ -138,7 +140,9 @@ int px__st_have_fma(void)
 }
 #else
 #define ST_FMA 0
+#ifdef PX_TEST_HOOKS
 int px__strack_no_fma = 0;
+#endif
 int px__st_have_fma(void)
 {
 	return 0;

@@ -29,7 +29,9 @@
 
 /* Test hook (track_hooks.h): 0 leaves the preconditioned test out, 2 drops
  * its remainder terms (unsound). */
+#ifdef PX_TEST_HOOKS
 int px__strack_precond = 1;
+#endif
 
 /* Y, the inverse of the symmetric mid (entries 11, 12, 22), and
  * q = |I - Y mid| (zero but for rounding; padded by the rounding of the
@@ -239,7 +241,9 @@ int px__st_sym_regular(const double lo[3], const double hi[3], double *sig)
 
 /* Test hook (track_hooks.h): 1 drops the Hessian enclosure's radius from
  * one_root() (unsound: its test must see it). */
+#ifdef PX_TEST_HOOKS
 int px__strack_one_fault = 0;
+#endif
 
 /*
  * 1 when every symmetric matrix in the Hessian's enclosure over the cell
@@ -263,7 +267,9 @@ int px__st_one_root_h(const double mid[3], const double rad[3])
 /* Test hook (track_hooks.h): 1 drops the Hessian enclosure's radius from
  * contract_rate() (unsound: its test must see it); 2 leaves every
  * contract_solve() undecided. */
+#ifdef PX_TEST_HOOKS
 int px__strack_contract_fault = 0;
+#endif
 
 /*
  * 1 when x - Y E(x), Y the inverse of the Hessian enclosure's midpoint,
@@ -295,15 +301,21 @@ int px__st_contract_h(const struct rcert *c, const double mid[3],
 }
 
 /* Test hook (track_hooks.h): a factor on every certified radius. */
+#ifdef PX_TEST_HOOKS
 double px__strack_radius_scale = 1.0;
+#endif
 
 /* Test hook (track_hooks.h): 1 makes the curve tracker's certificate
  * (ct_note()) unbounded (unsound: a curve that comes nearer is missed). */
+#ifdef PX_TEST_HOOKS
 int px__strack_ct_fault = 0;
+#endif
 
 /* Test hook (track_hooks.h): 1 leaves the pieces out of the radii
  * (region_radius_full(), cell_radius()). */
+#ifdef PX_TEST_HOOKS
 int px__strack_piece_fault = 0;
+#endif
 
 /*
  * Certified radius at p of piece b of surface s, its certificate made as
@@ -482,7 +494,9 @@ static double piece_turn(const struct wpiece *w, int a, int b, px_vec3 p)
 
 /* Test hook (track_hooks.h): 1 turns every boundary piece the wrong way
  * (the winding number negated: the check must see it). */
+#ifdef PX_TEST_HOOKS
 int px__strack_wind_fault = 0;
+#endif
 
 /* Winding number of E along f's boundary at p into *w: 1 when known,
  * 0 when not (a side whose test fails, or no boundary to use). */
@@ -587,8 +601,12 @@ void px__st_expiries_rebuild(struct px_strack *t, px_vec3 p)
 #define ST_REKEY 0.1
 
 /* Test hook (track_hooks.h): 1 takes the cubes twice as wide. */
+#ifdef PX_TEST_HOOKS
 int px__strack_rekey_fault = 0;
+#endif
+#ifdef PX_TEST_HOOKS
 int px__strack_quick_fault = 0;
+#endif
 
 /* Start collecting the cells whose certificates the segment p0 -> p1
  * may break: the travel grows by the segment and the cells it makes due

@@ -162,7 +162,9 @@ static int surf_copy(struct ssurf *f, const struct px_nurbs_surf *s)
  */
 #define ST_WRATIO_FINE 1.5
 
+#ifdef PX_TEST_HOOKS
 int px__strack_coarse = 0;
+#endif
 
 static void span_cells(const struct ssurf *f, int cps, int *ncs_u, int *ncs_v)
 {

@@ -501,7 +501,9 @@ static double cross_at(const struct px_strack *t, const struct scell *c,
 /* Test hook (track_hooks.h): bit 0 solves the first ring only, bound or
  * not; bit 1 leaves out the solves past where a long step met a hit
  * cell's region (the bound alone must hold). */
+#ifdef PX_TEST_HOOKS
 int px__strack_ring_fault = 0;
+#endif
 
 /* K of certificate c (above) while x runs over the cube of half width r
  * about xm: 0 when E is proven nonzero, INFINITY when no bound. */

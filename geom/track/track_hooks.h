@@ -1,12 +1,16 @@
 /*
  * track_hooks.h - test and bench hooks of the curve and surface
  * trackers (track_*.c, strack_*.c). Not installed, not part of the API.
+ * The switches (PX__TEST_SWITCH, math_internal.h) are variables and the
+ * hook functions exist only in the test build of these objects
+ * (-DPX_TEST_HOOKS), which the tests and benches link.
  */
 #ifndef PX_TRACK_HOOKS_H
 #define PX_TRACK_HOOKS_H
 
 #include <stdint.h>
 
+#include "math_internal.h"
 #include "px_math.h"
 
 /* ---- coherent tracking (track_*.c) ---- */
@@ -52,7 +56,7 @@ double px__strack_cert_radius(const struct px_strack *t, int s, double u,
 /* Factor applied to every certified radius (1; the tests raise it to
  * show that their containment check fails for a non-conservative
  * bound). */
-extern double px__strack_radius_scale;
+PX__TEST_SWITCH(double, px__strack_radius_scale, 1.0);
 /* The region cell of surface s holding (u, v): its bounds (u0, u1, v0,
  * v1) in box; returns 1 when its certificates prove it free of critical
  * points for the point p, 0 when not, -1 for bad arguments. */
@@ -61,7 +65,7 @@ int px__strack_region(const struct px_strack *t, int s, double u, double v,
 /* The preconditioned emptiness test of the region certificates: 1 (the
  * default) on, 0 off, 2 with its remainder terms dropped (unsound: a
  * fault the tests must see). */
-extern int px__strack_precond;
+PX__TEST_SWITCH(int, px__strack_precond, 1);
 /* The region cell of surface s holding (u, v), bounds in box as above:
  * bit 0 of the result set when its Hessian enclosure at p proves it
  * holds at most one critical point, bit 1 + k the same for its quarter
@@ -70,7 +74,7 @@ int px__strack_one(const struct px_strack *t, int s, double u, double v,
 		   px_vec3 p, double box[4]);
 /* 1 drops the Hessian enclosure's radius from that test (unsound: a
  * fault the tests must see); 0 by default. */
-extern int px__strack_one_fault;
+PX__TEST_SWITCH(int, px__strack_one_fault, 0);
 /* The contraction solve of the region cell of surface s holding (u, v)
  * (bounds in box as above) and of its quarters at p: out[0] the
  * region's, out[1 + k] quarter k's: -1 where its Hessian enclosure does
@@ -82,7 +86,7 @@ int px__strack_contract(const struct px_strack *t, int s, double u, double v,
 /* 1 drops the Hessian enclosure's radius from the contraction's rate
  * (unsound: a fault the tests must see); 2 leaves every contraction
  * undecided (the solve falls back to seeds); 0 by default. */
-extern int px__strack_contract_fault;
+PX__TEST_SWITCH(int, px__strack_contract_fault, 0);
 /* px_strack: the certificate made at update time for box (u0, u1, v0,
  * v1) of surface s (inside one region cell: taylor_cert() from its
  * quarter's or region's third-derivative bounds) at p, as a solve's cut
@@ -96,17 +100,17 @@ int px__strack_sub(const struct px_strack *t, int s, const double box[4], px_vec
 /* px_strack: 1 shrinks the enclosures of a rational patch's derivatives
  * from their numerators to a third of their width (unsound: a fault the
  * focal test must see); read when certificates are made (create). */
-extern int px__strack_rat_fault;
+PX__TEST_SWITCH(int, px__strack_rat_fault, 0);
 /* px_strack: 1 leaves the pieces out of a region's radius (a rational
  * quarter without a radius of its own then has none). */
-extern int px__strack_piece_fault;
-extern int px__strack_ct_fault;
+PX__TEST_SWITCH(int, px__strack_piece_fault, 0);
+PX__TEST_SWITCH(int, px__strack_ct_fault, 0);
 /* Test hook: rational spans keep cells_per_span (no finer cells where
  * the weights are far apart), read by px_strack_create(). */
-extern int px__strack_coarse;
+PX__TEST_SWITCH(int, px__strack_coarse, 0);
 /* px_strack: 1 leaves every box no certificate decides uncut (Newton
  * from its centre), the solve as it was before the run-time cuts. */
-extern int px__strack_sub_fault;
+PX__TEST_SWITCH(int, px__strack_sub_fault, 0);
 /* The winding number of the gradient of the squared distance from p
  * along the domain boundary of surface s, which the tracker compares
  * with the index sum of its critical points (+1 minima and maxima, -1
@@ -116,22 +120,22 @@ extern int px__strack_sub_fault;
 int px__strack_winding(const struct px_strack *t, int s, px_vec3 p, int *w);
 /* 1 negates that winding number (a fault the tests must see); 0 by
  * default. */
-extern int px__strack_wind_fault;
+PX__TEST_SWITCH(int, px__strack_wind_fault, 0);
 /* Bit 0: a step solves the first ring of cells about each hit cell only,
  * whatever the escape bound says (unsound: its test must see it); bit 1:
  * no solve past where a long step met a hit cell's region. */
-extern int px__strack_ring_fault;
+PX__TEST_SWITCH(int, px__strack_ring_fault, 0);
 /* 1: a due cell keeps its certificate while the point is within twice
  * the cube its last test proved (unsound: the tests must see it). */
-extern int px__strack_rekey_fault;
+PX__TEST_SWITCH(int, px__strack_rekey_fault, 0);
 /* 1: surfaces made while it is set take Newton's quick last step
  * (snewton()) up to a thousand times as far, whatever the Hessian and
  * the weights (unsound: the tests must see it). */
-extern int px__strack_quick_fault;
+PX__TEST_SWITCH(int, px__strack_quick_fault, 0);
 /* 1: surface trackers made while it is set evaluate their bicubics
  * with the portable two-lane code, not the AVX2/FMA one (the tests
  * compare the two). */
-extern int px__strack_no_fma;
+PX__TEST_SWITCH(int, px__strack_no_fma, 0);
 /* Test hook: 1 turns the surface tracker's hot path off, 2 makes its
  * certificate never expire (a fault the tests must see). */
 void px__strack_set_hot_fault(struct px_strack *t, int fault);
