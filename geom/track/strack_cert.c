@@ -21,52 +21,6 @@ int px__st_span_bounds(const struct px_nurbs_surf *s, int dir, double a,
 	return n;
 }
 
-static struct iv iv_pt(double x)
-{
-	struct iv r = {x, x};
-	return r;
-}
-
-static struct iv iv_add(struct iv a, struct iv b)
-{
-	struct iv r = {a.lo + b.lo, a.hi + b.hi};
-	return r;
-}
-
-static struct iv iv_sub(struct iv a, struct iv b)
-{
-	struct iv r = {a.lo - b.hi, a.hi - b.lo};
-	return r;
-}
-
-static struct iv iv_scale(struct iv a, double k)
-{
-	struct iv r = {fmin(a.lo * k, a.hi * k), fmax(a.lo * k, a.hi * k)};
-	return r;
-}
-
-/* a / w for w > 0 */
-static struct iv iv_divw(struct iv a, struct iv w)
-{
-	struct iv iw = {1.0 / w.hi, 1.0 / w.lo};
-	return iv_mul(a, iw);
-}
-
-static struct iv iv_pad(struct iv a)
-{
-	double e = ST_PAD * (fabs(a.lo) + fabs(a.hi)) + 1e-300;
-	struct iv r = {a.lo - e, a.hi + e};
-	return r;
-}
-
-static void iv_grow(struct iv *a, double x)
-{
-	/* as fmin and fmax (a NaN x leaves a as it is), without their
-	 * calls: run for every point of a net at update time too */
-	a->lo = x < a->lo ? x : a->lo;
-	a->hi = x > a->hi ? x : a->hi;
-}
-
 /*
  * Enclosures of the homogeneous coordinates (k = 0..3) of the difference
  * nets of the Bezier net P ((p + 1) x (q + 1), u fastest, 4 per point),

@@ -531,6 +531,8 @@ static inline int has_pole(const struct ssurf *f)
 	return f->pole[0] | f->pole[1] | f->pole[2] | f->pole[3];
 }
 
+/* Interval arithmetic on struct iv, one set for the proofs at update
+ * time and the certificates made at setup. */
 static inline struct iv iv_mul(struct iv a, struct iv b)
 {
 	double p1 = a.lo * b.lo, p2 = a.lo * b.hi, p3 = a.hi * b.lo,
@@ -549,6 +551,52 @@ static inline struct iv iv_mul(struct iv a, struct iv b)
 static inline double iv_mag(struct iv a)
 {
 	return fmax(fabs(a.lo), fabs(a.hi));
+}
+
+static inline struct iv iv_pt(double x)
+{
+	struct iv r = {x, x};
+	return r;
+}
+
+static inline struct iv iv_add(struct iv a, struct iv b)
+{
+	struct iv r = {a.lo + b.lo, a.hi + b.hi};
+	return r;
+}
+
+static inline struct iv iv_sub(struct iv a, struct iv b)
+{
+	struct iv r = {a.lo - b.hi, a.hi - b.lo};
+	return r;
+}
+
+static inline struct iv iv_scale(struct iv a, double k)
+{
+	struct iv r = {fmin(a.lo * k, a.hi * k), fmax(a.lo * k, a.hi * k)};
+	return r;
+}
+
+/* a / w for w > 0 */
+static inline struct iv iv_divw(struct iv a, struct iv w)
+{
+	struct iv iw = {1.0 / w.hi, 1.0 / w.lo};
+	return iv_mul(a, iw);
+}
+
+static inline struct iv iv_pad(struct iv a)
+{
+	double e = ST_PAD * (fabs(a.lo) + fabs(a.hi)) + 1e-300;
+	struct iv r = {a.lo - e, a.hi + e};
+	return r;
+}
+
+static inline void iv_grow(struct iv *a, double x)
+{
+	/* as fmin and fmax (a NaN x leaves a as it is), without their
+	 * calls: run for every point of a net at update time too */
+	a->lo = x < a->lo ? x : a->lo;
+	a->hi = x > a->hi ? x : a->hi;
 }
 
 /* The Hessian's enclosure over the cell for the point p, midpoint and
