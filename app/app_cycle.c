@@ -198,6 +198,65 @@ int app_phase_compute(struct px_loop *l, const struct px_loop_cycle *c,
 	return PX_OK;
 }
 
+/* The telemetry record of this cycle (every decimation-th), pushed to
+ * the ring (dropped and counted when it is full). f: the force sent. */
+static void push_record(struct px_app *a, const struct px_loop_cycle *c,
+			double f)
+{
+	struct px_app_record r;
+	const struct px_pose_sample *s =
+		a->ctl_dev >= 0 ? &a->sample[a->ctl_dev] : NULL;
+	memset(&r, 0, sizeof(r));
+	r.t_s = (double)(c->deadline_ns - a->t0_ns) * 1e-9;
+	r.cycle = c->index;
+	if (s) {
+		r.dev_m[0] = s->pos_m.x;
+		r.dev_m[1] = s->pos_m.y;
+		r.dev_m[2] = s->pos_m.z;
+		r.valid = s->valid;
+	}
+	r.proxy_m[0] = a->out.proxy_m.x;
+	r.proxy_m[1] = a->out.proxy_m.y;
+	r.proxy_m[2] = a->out.proxy_m.z;
+	memcpy(r.force_n, a->cmd.force_n, sizeof(r.force_n));
+	r.force_mag_n = f;
+	/* a sample that broke the velocity limit has no meaningful
+	 * distance: left empty (NaN) rather than spoiling the plots */
+	r.distance_m = a->have_out && !a->over_velocity ? a->out.distance_m
+							: NAN;
+	r.penetration_m = a->have_out && !a->over_velocity
+				  ? a->out.penetration_m
+				  : NAN;
+	r.latency_ns = c->wake_ns - c->deadline_ns;
+	r.compute_ns = a->compute_t0;
+	r.scale = 1.0;
+	if (a->avoiding && a->started) {
+		int k = a->aout.closest_capsule, j;
+		r.scale = c->safe ? 0.0 : a->aout.scale;
+		for (j = 0; j < TELE_JOINTS && j < a->ctl.chain.n_joints; j++)
+			r.qdot[j] = c->safe ? 0.0 : a->aout.qdot[j];
+		r.distance_m = a->aout.min_clearance_m;
+		r.penetration_m = 0;
+		r.queries = a->aout.point_queries;
+		r.valid = 1;
+		if (k >= 0) {
+			px_vec3 pa = a->aout.caps[k].point_m;
+			px_vec3 pb = a->aout.caps[k].obstacle_m;
+			r.dev_m[0] = pa.x;
+			r.dev_m[1] = pa.y;
+			r.dev_m[2] = pa.z;
+			r.proxy_m[0] = pb.x;
+			r.proxy_m[1] = pb.y;
+			r.proxy_m[2] = pb.z;
+		}
+	}
+	r.contact = a->out.contact;
+	r.safe = c->safe;
+	if (!a->avoiding)
+		r.queries = a->out.point_queries;
+	px_ring_push(a->ring, &r);
+}
+
 int app_phase_write(struct px_loop *l, const struct px_loop_cycle *c,
 		       void *user)
 {
@@ -294,60 +353,8 @@ int app_phase_write(struct px_loop *l, const struct px_loop_cycle *c,
 		if (a->out.contact)
 			a->contact_cycles++;
 	}
-	if (c->index % (uint64_t)a->decimation == 0) {
-		struct px_app_record r;
-		const struct px_pose_sample *s =
-			a->ctl_dev >= 0 ? &a->sample[a->ctl_dev] : NULL;
-		memset(&r, 0, sizeof(r));
-		r.t_s = (double)(c->deadline_ns - a->t0_ns) * 1e-9;
-		r.cycle = c->index;
-		if (s) {
-			r.dev_m[0] = s->pos_m.x;
-			r.dev_m[1] = s->pos_m.y;
-			r.dev_m[2] = s->pos_m.z;
-			r.valid = s->valid;
-		}
-		r.proxy_m[0] = a->out.proxy_m.x;
-		r.proxy_m[1] = a->out.proxy_m.y;
-		r.proxy_m[2] = a->out.proxy_m.z;
-		memcpy(r.force_n, a->cmd.force_n, sizeof(r.force_n));
-		r.force_mag_n = f;
-		/* a sample that broke the velocity limit has no meaningful
-		 * distance: left empty (NaN) rather than spoiling the plots */
-		r.distance_m = a->have_out && !a->over_velocity ? a->out.distance_m
-								: NAN;
-		r.penetration_m = a->have_out && !a->over_velocity
-					  ? a->out.penetration_m
-					  : NAN;
-		r.latency_ns = c->wake_ns - c->deadline_ns;
-		r.compute_ns = a->compute_t0;
-		r.scale = 1.0;
-		if (a->avoiding && a->started) {
-			int k = a->aout.closest_capsule, j;
-			r.scale = c->safe ? 0.0 : a->aout.scale;
-			for (j = 0; j < TELE_JOINTS && j < a->ctl.chain.n_joints; j++)
-				r.qdot[j] = c->safe ? 0.0 : a->aout.qdot[j];
-			r.distance_m = a->aout.min_clearance_m;
-			r.penetration_m = 0;
-			r.queries = a->aout.point_queries;
-			r.valid = 1;
-			if (k >= 0) {
-				px_vec3 pa = a->aout.caps[k].point_m;
-				px_vec3 pb = a->aout.caps[k].obstacle_m;
-				r.dev_m[0] = pa.x;
-				r.dev_m[1] = pa.y;
-				r.dev_m[2] = pa.z;
-				r.proxy_m[0] = pb.x;
-				r.proxy_m[1] = pb.y;
-				r.proxy_m[2] = pb.z;
-			}
-		}
-		r.contact = a->out.contact;
-		r.safe = c->safe;
-		if (!a->avoiding)
-			r.queries = a->out.point_queries;
-		px_ring_push(a->ring, &r);
-	}
+	if (c->index % (uint64_t)a->decimation == 0)
+		push_record(a, c, f);
 	atomic_store_explicit(&a->allocs, app_heap_count(a) - a->heap_base,
 			      memory_order_relaxed);
 	if (a->stop_deadline_ns && c->deadline_ns >= a->stop_deadline_ns) {

@@ -87,19 +87,16 @@ const struct px_codec_map *app_make_codec(struct px_app *a, int k, const struct 
  * the in-process simulated bus gets its drives' side here as well (the
  * same drive table and PDO layouts as the master), stepped in the read
  * phase. Returns 0 or 1 (said why, naming the device). */
-int app_make_devcfg(struct px_app *a, int k)
+/* The campaign's fault windows that px_devcfg applies to device d: the
+ * e-stop presses of simulated lines, and for a CANopen arm on the
+ * in-process bus the bus's windows and drive 0's (*narm_out of them
+ * in a->armf). Returns 0 or 1 (said why). */
+static int devcfg_faults(struct px_app *a, const struct px_config_device *d,
+			 struct px_devcfg_options *opt, size_t *narm_out)
 {
-	const struct px_config_device *d = &a->cfg->devices[k];
-	struct px_devcfg *h;
-	struct px_devcfg_options opt;
-	struct px_dev *dev;
-	struct px_canopen *co;
 	struct px_sim_fault *busf = a->busf, *armf = a->armf, *linef = a->linef;
 	size_t nbus = 0, narm = 0, nline = 0, j;
-	char msg[512] = "";
-	int rc, i;
-	memset(&opt, 0, sizeof(opt));
-	opt.clock0_ns = a->clock0_ns; /* the config's own fault windows */
+	int rc;
 	/* the campaign's e-stop presses of simulated lines: fault windows
 	 * of the simulated GPIO device (px_devcfg applies them) */
 	for (j = 0; j < a->sim.n_faults; j++) {
@@ -115,8 +112,8 @@ int app_make_devcfg(struct px_app *a, int k)
 		}
 		linef[nline++] = app_campaign_fault(a, f);
 	}
-	opt.faults = nline ? linef : NULL;
-	opt.n_faults = nline;
+	opt->faults = nline ? linef : NULL;
+	opt->n_faults = nline;
 	/* faults of a CANopen arm on the in-process bus: the bus's (a bus
 	 * of ours, given to px_devcfg) and drive 0's (the simulated arm) */
 	for (j = 0; j < a->sim.n_faults; j++) {
@@ -146,8 +143,27 @@ int app_make_devcfg(struct px_app *a, int k)
 				d->name, px_strerror(rc));
 			return 1;
 		}
-		opt.can_sim = a->fault_bus;
+		opt->can_sim = a->fault_bus;
 	}
+	*narm_out = narm;
+	return 0;
+}
+
+int app_make_devcfg(struct px_app *a, int k)
+{
+	const struct px_config_device *d = &a->cfg->devices[k];
+	struct px_devcfg *h;
+	struct px_devcfg_options opt;
+	struct px_dev *dev;
+	struct px_canopen *co;
+	struct px_sim_fault *armf = a->armf;
+	size_t narm = 0;
+	char msg[512] = "";
+	int rc, i;
+	memset(&opt, 0, sizeof(opt));
+	opt.clock0_ns = a->clock0_ns; /* the config's own fault windows */
+	if (devcfg_faults(a, d, &opt, &narm))
+		return 1;
 	rc = px_devcfg_open(a->cfg, d, &opt, &h, msg, sizeof(msg));
 	if (rc != PX_OK) {
 		app_note(a, "%s: %s\n", app_name(a),
