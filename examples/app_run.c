@@ -1,3 +1,4 @@
+/* PX_TEST_NEEDS: libyaml (the shipped configs are YAML; tests/run.sh skips it in builds without) */
 /*
  * app_run.c - the shipped haptic_sim.yaml through the app module: the
  * config's devices, scene, control and safety policy, 2 s on the virtual

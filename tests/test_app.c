@@ -1,3 +1,4 @@
+/* PX_TEST_NEEDS: libyaml (the shipped configs are YAML; tests/run.sh skips it in builds without) */
 /*
  * app/: the runner as a module - create/free on every shipped simulated
  * config, the cycle stepped from the test's own loop against the app's
