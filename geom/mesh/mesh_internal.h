@@ -281,6 +281,52 @@ static inline void px__box4_d2f(const struct node4 *nd, const float pf[3],
 		d2[j] = (double)s[j] * (1.0 - 0x1p-18);
 }
 
+/* One entry of the 4-wide box-tree walks' stacks (meshes and clouds): a
+ * node (cnt == 0, its index idx) or a leaf range [idx, idx + cnt), with
+ * the lower bound d2 of its squared distance where the walk keeps one. */
+struct px__walk4 {
+	uint32_t idx, cnt;
+	double d2;
+};
+
+/* The within-radius walk of the tree n4 (root node 0) about p: every leaf
+ * range [i0, i0 + n) under boxes within squared distance r2 goes to
+ * leaf(ctx, i0, n), which returns 0 to go on or a negative error that
+ * ends the walk. st holds cap entries (enough for the depth checked at
+ * setup; a child past it is skipped). Returns 0 or leaf's error. RT-safe;
+ * inline, so that leaf() is called directly. */
+static inline int px__box4_within(const struct node4 *n4, px_vec3 p, double r2,
+				  struct px__walk4 *st, int cap,
+				  int (*leaf)(void *ctx, uint32_t i0, uint32_t n),
+				  void *ctx)
+{
+	int sp = 0, rc;
+	st[sp].idx = 0;
+	st[sp].cnt = 0;
+	sp++;
+	while (sp > 0) {
+		sp--;
+		if (st[sp].cnt > 0) {
+			rc = leaf(ctx, st[sp].idx, st[sp].cnt);
+			if (rc < 0)
+				return rc;
+		} else {
+			const struct node4 *nd = &n4[st[sp].idx];
+			double dc[4];
+			int c;
+			px__box4_d2(nd, p, dc);
+			for (c = 0; c < 4; c++) {
+				if (nd->idx[c] == EMPTY || dc[c] > r2 || sp >= cap)
+					continue;
+				st[sp].idx = nd->idx[c];
+				st[sp].cnt = nd->cnt[c];
+				sp++;
+			}
+		}
+	}
+	return 0;
+}
+
 /* ---- mesh-to-mesh distance (px_mesh_pair.c) ------------------------------ */
 
 /*

@@ -347,44 +347,35 @@ static int cloud_closest_among(const void *impl, const struct px_model_query *q,
 	return cloud_finish(C, q, bi, best, n, 1, r);
 }
 
+/* cloud_collect()'s leaf: the points of [i0, i0 + n) within the radius. */
+struct cloud_within {
+	const struct cloud *C;
+	px_vec3 p;
+	double r2;
+	int *idx, cap, n;
+};
+
+static int cloud_within_leaf(void *ctx, uint32_t i0, uint32_t n)
+{
+	struct cloud_within *w = ctx;
+	uint32_t i;
+	for (i = i0; i < i0 + n; i++)
+		if (px_v3_dist2(w->p, w->C->pt[i]) <= w->r2) {
+			if (w->n == w->cap)
+				return PX_E_NOSPC;
+			w->idx[w->n++] = (int)i;
+		}
+	return 0;
+}
+
 static int cloud_collect(const void *impl, px_vec3 p, double radius, int *idx,
 			 int cap)
 {
 	const struct cloud *C = impl;
-	struct {
-		uint32_t idx, cnt;
-	} st[CSTACK4];
-	double r2 = radius * radius;
-	int sp = 0, n = 0;
-
-	st[sp].idx = 0;
-	st[sp].cnt = 0;
-	sp++;
-	while (sp > 0) {
-		sp--;
-		if (st[sp].cnt > 0) {
-			uint32_t i;
-			for (i = st[sp].idx; i < st[sp].idx + st[sp].cnt; i++)
-				if (px_v3_dist2(p, C->pt[i]) <= r2) {
-					if (n == cap)
-						return PX_E_NOSPC;
-					idx[n++] = (int)i;
-				}
-		} else {
-			const struct node4 *nd = &C->n4[st[sp].idx];
-			double dc[4];
-			int c;
-			px__box4_d2(nd, p, dc);
-			for (c = 0; c < 4; c++) {
-				if (nd->idx[c] == EMPTY || dc[c] > r2 || sp >= CSTACK4)
-					continue;
-				st[sp].idx = nd->idx[c];
-				st[sp].cnt = nd->cnt[c];
-				sp++;
-			}
-		}
-	}
-	return n;
+	struct px__walk4 st[CSTACK4];
+	struct cloud_within w = {C, p, radius * radius, idx, cap, 0};
+	int rc = px__box4_within(C->n4, p, w.r2, st, CSTACK4, cloud_within_leaf, &w);
+	return rc < 0 ? rc : w.n;
 }
 
 static px_aabb cloud_aabb(const void *impl)

@@ -1147,53 +1147,54 @@ static int mesh_closest_among(const void *impl, const struct px_model_query *qq,
 	return 1;
 }
 
+/* mesh_collect()'s leaf: the triangles of [i0, i0 + n) within the
+ * radius. */
+struct mesh_within {
+	const struct mesh *M;
+	px_vec3 p;
+	double r2;
+	struct pq pq;
+	int *idx, cap, n;
+};
+
+static int mesh_within_leaf(void *ctx, uint32_t i0, uint32_t n)
+{
+	struct mesh_within *w = ctx;
+	const struct mesh *M = w->M;
+	uint32_t i;
+	for (i = i0; i < i0 + n; i++) {
+		const uint32_t *v = M->tv + 3 * i;
+		if (w->pq.use && tri_lb(&M->lb[i], &w->pq) > w->r2)
+			continue;
+		if (px_tri_closest(w->p, M->vx[v[0]], M->vx[v[1]], M->vx[v[2]], NULL,
+				   NULL, NULL, NULL, NULL) <= w->r2) {
+			if (w->n == w->cap)
+				return PX_E_NOSPC;
+			w->idx[w->n++] = (int)i;
+		}
+	}
+	return 0;
+}
+
 /* Leaf-order indices of every triangle within radius of p: the count,
  * or PX_E_NOSPC when there are more than cap. */
 static int mesh_collect(const void *impl, px_vec3 p, double radius, int *idx,
 			int cap)
 {
 	const struct mesh *M = impl;
-	struct {
-		uint32_t idx, cnt;
-	} st[STACK4];
-	double r2 = radius * radius;
-	int sp = 0, n = 0;
-	struct pq pq;
+	struct px__walk4 st[STACK4];
+	struct mesh_within w;
+	int rc;
 
-	pq_init(M, p, &pq);
-	st[sp].idx = 0;
-	st[sp].cnt = 0;
-	sp++;
-	while (sp > 0) {
-		sp--;
-		if (st[sp].cnt > 0) {
-			uint32_t i;
-			for (i = st[sp].idx; i < st[sp].idx + st[sp].cnt; i++) {
-				const uint32_t *v = M->tv + 3 * i;
-				if (pq.use && tri_lb(&M->lb[i], &pq) > r2)
-					continue;
-				if (px_tri_closest(p, M->vx[v[0]], M->vx[v[1]], M->vx[v[2]], NULL,
-						   NULL, NULL, NULL, NULL) <= r2) {
-					if (n == cap)
-						return PX_E_NOSPC;
-					idx[n++] = (int)i;
-				}
-			}
-		} else {
-			const struct node4 *nd = &M->n4[st[sp].idx];
-			double dc[4];
-			int c;
-			px__box4_d2(nd, p, dc);
-			for (c = 0; c < 4; c++) {
-				if (nd->idx[c] == EMPTY || dc[c] > r2 || sp >= STACK4)
-					continue;
-				st[sp].idx = nd->idx[c];
-				st[sp].cnt = nd->cnt[c];
-				sp++;
-			}
-		}
-	}
-	return n;
+	w.M = M;
+	w.p = p;
+	w.r2 = radius * radius;
+	w.idx = idx;
+	w.cap = cap;
+	w.n = 0;
+	pq_init(M, p, &w.pq);
+	rc = px__box4_within(M->n4, p, w.r2, st, STACK4, mesh_within_leaf, &w);
+	return rc < 0 ? rc : w.n;
 }
 
 static px_aabb mesh_aabb(const void *impl)
