@@ -569,8 +569,10 @@ expect "real-clock run with missed periods" 0 "$bin" "$tmp/real.yaml" --duration
 	--fault overrun,loop,0.2,0.1,1,0.005 --summary-json "$tmp/real.json" --telemetry "$tmp/real.csv"
 check "real: periods were missed ($(num "$tmp/real.json" missed_periods))" "$(num "$tmp/real.json" missed_periods) > 10"
 check "real: fewer cycles than asked ($(num "$tmp/real.json" cycles))" "$(num "$tmp/real.json" cycles) < 1000"
+# (the last cycle may itself skip a period or two on a busy machine; a
+# run that counted cycles would end at 1 s + every missed period)
 check "real: loop time $(num "$tmp/real.json" loop_time_s) s is the 1 s asked" \
-	"$(num "$tmp/real.json" loop_time_s) >= 0.999 && $(num "$tmp/real.json" loop_time_s) <= 1.001"
+	"$(num "$tmp/real.json" loop_time_s) >= 0.999 && $(num "$tmp/real.json" loop_time_s) < 1.0005 + $(num "$tmp/real.json" missed_periods) * 0.0005"
 check "real: wall time $(num "$tmp/real.json" wall_time_s) s close to it" \
 	"$(num "$tmp/real.json" wall_time_s) >= 0.99 && $(num "$tmp/real.json" wall_time_s) < 1.5"
 if grep -q '"ended_by": "time"' "$tmp/real.json"; then ok "real: ended by its time"; else bad "real: ended by its time"; fi
