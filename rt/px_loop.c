@@ -17,6 +17,9 @@
 #define MAX_TABLE 4096u
 #define MAX_FAULTS ((size_t)1 << 20)
 
+/* Where the open cycle stands (l->stage). */
+enum { STAGE_IDLE = 0, STAGE_READ = 1, STAGE_COMPUTE = 2 };
+
 struct input {
 	char name[NAME_LEN];
 	int64_t timeout_ns;
@@ -56,6 +59,10 @@ struct px_loop {
 	/* an e-stop tripped since the last px_loop_rearm(): safe state
 	 * stays whatever rearm_after_ok_cycles says */
 	int latched;
+	/* The open cycle: the next piece to run is the one after stage. */
+	struct px_loop_cycle cy;
+	int stage;
+	int cy_stop, cy_bad;
 
 	/* Virtual clock; atomic so px_loop_now_ns() works from anywhere. */
 	_Atomic int64_t vnow;
@@ -475,74 +482,111 @@ static void make_safe(struct px_loop *l)
 
 /* ---- one cycle ------------------------------------------------------------ */
 
-static int cycle(struct px_loop *l)
+/*
+ * A cycle is open -> read -> compute -> write, each piece run once, in
+ * that order, by px_loop_step() (the loop's own deadline) or by the
+ * caller's px_loop_read/compute/write (the caller's clock). Both run the
+ * same pieces, so the watchdog decides the same way whoever drives.
+ */
+
+/* The caller's time on the virtual clock moves it forward, never back;
+ * the phase starts at the loop clock (the real clock: at the caller's
+ * now_ns, taken on CLOCK_MONOTONIC). */
+static int64_t phase_start(struct px_loop *l, int64_t now_ns)
 {
-	struct px_loop_cycle cy;
-	const int64_t P = l->cfg.period_ns;
-	int64_t end, ct, next;
-	int stop = 0, bad = 0;
+	if (l->cfg.clock == PX_LOOP_CLOCK_VIRTUAL) {
+		sleep_until(l, now_ns);
+		return LD(l->vnow);
+	}
+	return now_ns;
+}
+
+static void cycle_open(struct px_loop *l, int64_t wake_ns)
+{
+	struct px_loop_cycle *cy = &l->cy;
 	size_t i;
 
-	memset(&cy, 0, sizeof(cy));
-	cy.index = l->index;
-	cy.period_ns = P;
-	if (!l->started) {
-		l->next_deadline = px_loop_now_ns(l) + P;
-		l->pending_missed = 0;
-	}
-	cy.deadline_ns = l->next_deadline;
-	cy.missed = l->pending_missed;
-	sleep_until(l, cy.deadline_ns);
-	cy.wake_ns = px_loop_now_ns(l);
-	px_stats_record(l->st[PX_LOOP_STAT_LATENCY], cy.wake_ns - cy.deadline_ns);
+	memset(cy, 0, sizeof(*cy));
+	cy->index = l->index;
+	cy->period_ns = l->cfg.period_ns;
+	cy->deadline_ns = l->next_deadline;
+	cy->missed = l->pending_missed;
+	cy->wake_ns = wake_ns;
+	px_stats_record(l->st[PX_LOOP_STAT_LATENCY],
+			cy->wake_ns - cy->deadline_ns);
 	if (!l->started) {
 		/* Inputs never stamped count from the first wake-up. */
 		for (i = 0; i < l->n_in; i++)
 			if (l->in[i].last_ns == INT64_MIN)
-				l->in[i].last_ns = cy.wake_ns;
+				l->in[i].last_ns = cy->wake_ns;
 		l->started = 1;
 	}
-	requests(l, &cy);
+	l->cy_stop = l->cy_bad = 0;
+	requests(l, cy);
+}
 
-	cy.safe = LD(l->safe);
-	cy.read_ns = px_loop_now_ns(l);
-	bad |= phase(l, l->cfg.read, &cy, 0, &stop);
-	bad |= check_inputs(l, &cy);
+static void cycle_read(struct px_loop *l, int64_t t_ns)
+{
+	struct px_loop_cycle *cy = &l->cy;
 
-	cy.safe = LD(l->safe);
-	cy.compute_ns = px_loop_now_ns(l);
-	bad |= phase(l, l->cfg.compute, &cy, 1, &stop);
-	cy.compute_end_ns = px_loop_now_ns(l);
-	ct = cy.compute_end_ns - cy.compute_ns;
+	cy->safe = LD(l->safe);
+	cy->read_ns = t_ns;
+	l->cy_bad |= phase(l, l->cfg.read, cy, 0, &l->cy_stop);
+	l->cy_bad |= check_inputs(l, cy);
+	l->stage = STAGE_READ;
+}
+
+static void cycle_compute(struct px_loop *l, int64_t t_ns)
+{
+	struct px_loop_cycle *cy = &l->cy;
+	int64_t ct;
+
+	cy->safe = LD(l->safe);
+	cy->compute_ns = t_ns;
+	l->cy_bad |= phase(l, l->cfg.compute, cy, 1, &l->cy_stop);
+	cy->compute_end_ns = px_loop_now_ns(l);
+	ct = cy->compute_end_ns - cy->compute_ns;
 	px_stats_record(l->st[PX_LOOP_STAT_COMPUTE], ct);
 	if (ct > l->cfg.compute_budget_ns) {
 		INC(l->budget_exceeded);
 		l->consec_budget++;
 		if (l->cfg.budget_limit &&
 		    l->consec_budget >= l->cfg.budget_limit) {
-			fault(l, &cy, PX_FAULT_COMPUTE_BUDGET, -1, ct, 1,
+			fault(l, cy, PX_FAULT_COMPUTE_BUDGET, -1, ct, 1,
 			      l->consec_budget == l->cfg.budget_limit);
-			bad = 1;
+			l->cy_bad = 1;
 		}
 	} else {
 		l->consec_budget = 0;
 	}
-	bad |= check_outputs(l, &cy);
+	l->cy_bad |= check_outputs(l, cy);
+	l->stage = STAGE_COMPUTE;
+}
+
+/* The write phase and the cycle's bookkeeping (overruns, the next
+ * deadline, automatic re-arm). */
+static int cycle_write(struct px_loop *l, int64_t t_ns)
+{
+	struct px_loop_cycle *cy = &l->cy;
+	const int64_t P = l->cfg.period_ns;
+	int64_t end, next;
+	int bad;
 
 	/* The same cycle that saw a fault writes only zeros. */
-	cy.safe = LD(l->safe);
-	if (cy.safe)
+	cy->safe = LD(l->safe);
+	if (cy->safe)
 		make_safe(l);
-	cy.write_ns = px_loop_now_ns(l);
-	bad |= phase(l, l->cfg.write, &cy, 2, &stop);
+	cy->write_ns = t_ns;
+	l->cy_bad |= phase(l, l->cfg.write, cy, 2, &l->cy_stop);
+	bad = l->cy_bad;
 
 	end = px_loop_now_ns(l);
-	px_stats_record(l->st[PX_LOOP_STAT_CYCLE], end - cy.wake_ns);
-	next = cy.deadline_ns + P;
+	px_stats_record(l->st[PX_LOOP_STAT_CYCLE], end - cy->wake_ns);
+	next = cy->deadline_ns + P;
 	l->pending_missed = 0;
 	if (end > next) {
 		/* Deadlines D + jP (j >= 1) already past at the end. */
-		int64_t k = (end - cy.deadline_ns - 1) / P;
+		int64_t k = (end - cy->deadline_ns - 1) / P;
 		int64_t skip = k;
 		int trip;
 
@@ -550,7 +594,7 @@ static int cycle(struct px_loop *l)
 			skip = k > (int64_t)l->cfg.max_catch_up
 				       ? k - (int64_t)l->cfg.max_catch_up
 				       : 0;
-		next = cy.deadline_ns + (skip + 1) * P;
+		next = cy->deadline_ns + (skip + 1) * P;
 		l->pending_missed = (uint32_t)(skip > UINT32_MAX ? UINT32_MAX
 								  : skip);
 		ST(l->missed, LD(l->missed) + (uint64_t)skip);
@@ -558,7 +602,7 @@ static int cycle(struct px_loop *l)
 		l->consec_overruns++;
 		trip = l->cfg.overrun_limit &&
 		       l->consec_overruns >= l->cfg.overrun_limit;
-		fault(l, &cy, PX_FAULT_OVERRUN, -1, k, trip, 1);
+		fault(l, cy, PX_FAULT_OVERRUN, -1, k, trip, 1);
 		bad |= trip;
 	} else {
 		l->consec_overruns = 0;
@@ -581,16 +625,81 @@ static int cycle(struct px_loop *l)
 	}
 	l->index++;
 	INC(l->cycles);
-	return stop ? PX_LOOP_STOP : PX_OK;
+	l->stage = STAGE_IDLE;
+	return l->cy_stop ? PX_LOOP_STOP : PX_OK;
+}
+
+static int cycle(struct px_loop *l)
+{
+	if (!l->started) {
+		l->next_deadline = px_loop_now_ns(l) + l->cfg.period_ns;
+		l->pending_missed = 0;
+	}
+	sleep_until(l, l->next_deadline);
+	cycle_open(l, px_loop_now_ns(l));
+	cycle_read(l, px_loop_now_ns(l));
+	cycle_compute(l, px_loop_now_ns(l));
+	return cycle_write(l, px_loop_now_ns(l));
 }
 
 int px_loop_step(struct px_loop *l)
 {
 	if (!l)
 		return PX_E_INVAL;
-	if (atomic_load(&l->running))
+	if (atomic_load(&l->running) || l->stage != STAGE_IDLE)
 		return PX_E_STATE;
 	return cycle(l);
+}
+
+/* The caller's phase calls: not while px_loop_run() owns the loop, and
+ * only the phase that comes next in the open cycle. */
+static int phase_check(struct px_loop *l, int stage)
+{
+	if (!l)
+		return PX_E_INVAL;
+	if (atomic_load_explicit(&l->running, memory_order_relaxed) ||
+	    l->stage != stage)
+		return PX_E_STATE;
+	return PX_OK;
+}
+
+int px_loop_read(struct px_loop *l, int64_t now_ns)
+{
+	int64_t t;
+	int rc = phase_check(l, STAGE_IDLE);
+
+	if (rc)
+		return rc;
+	t = phase_start(l, now_ns);
+	/* The caller's clock wakes the cycle: one due later than that (a
+	 * caller faster than the period, or the first cycle) is taken as
+	 * due now, so the latency is never negative. */
+	if (!l->started || t < l->next_deadline) {
+		l->next_deadline = t;
+		l->pending_missed = 0;
+	}
+	cycle_open(l, t);
+	cycle_read(l, t);
+	return l->cy_stop ? PX_LOOP_STOP : PX_OK;
+}
+
+int px_loop_compute(struct px_loop *l, int64_t now_ns)
+{
+	int rc = phase_check(l, STAGE_READ);
+
+	if (rc)
+		return rc;
+	cycle_compute(l, phase_start(l, now_ns));
+	return l->cy_stop ? PX_LOOP_STOP : PX_OK;
+}
+
+int px_loop_write(struct px_loop *l, int64_t now_ns)
+{
+	int rc = phase_check(l, STAGE_COMPUTE);
+
+	if (rc)
+		return rc;
+	return cycle_write(l, phase_start(l, now_ns));
 }
 
 /* Status readers copy l->rt while the generation is even and unchanged
@@ -612,7 +721,8 @@ int px_loop_run(struct px_loop *l, uint64_t max_cycles)
 
 	if (!l)
 		return PX_E_INVAL;
-	if (!atomic_compare_exchange_strong(&l->running, &expected, 1))
+	if (l->stage != STAGE_IDLE ||
+	    !atomic_compare_exchange_strong(&l->running, &expected, 1))
 		return PX_E_STATE;
 	if (l->cfg.rt_enable) {
 		struct px_rt_report rep;
@@ -653,7 +763,8 @@ int px_loop_start(struct px_loop *l, uint64_t max_cycles)
 {
 	if (!l)
 		return PX_E_INVAL;
-	if (l->thread_live || atomic_load(&l->running))
+	if (l->thread_live || atomic_load(&l->running) ||
+	    l->stage != STAGE_IDLE)
 		return PX_E_STATE;
 	l->thread_max = max_cycles;
 	l->thread_rc = PX_OK;

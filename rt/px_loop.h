@@ -52,9 +52,15 @@
  * it. Nothing a cycle does allocates. Output buffers and enable flags
  * stay owned by the caller and must outlive the loop.
  *
- * Threads: one thread runs the cycle (px_loop_run/px_loop_step, or the
- * thread px_loop_start makes). Functions marked "any thread" may be
- * called from others at any time; px_loop_fault_pop() from one reader.
+ * Driving: px_loop_run() (or its thread, px_loop_start()) keeps the
+ * deadlines; px_loop_step() runs one cycle; px_loop_read(), _compute()
+ * and _write() run one cycle phase by phase from the caller's own thread
+ * and clock, with the same checks between the phases as a whole cycle.
+ *
+ * Threads: one thread runs the cycle (px_loop_run, px_loop_step or the
+ * phase calls, or the thread px_loop_start makes). Functions marked "any
+ * thread" may be called from others at any time; px_loop_fault_pop()
+ * from one reader.
  * Setup functions (create, *_add) only before the loop runs.
  */
 #ifndef PX_LOOP_H
@@ -217,10 +223,41 @@ PX_API int px_loop_run(struct px_loop *loop, uint64_t max_cycles);
  * (virtual clock: jump to it), read, compute, write, bookkeeping.
  * For callers that drive the loop themselves (simulation, tests); no
  * real-time setup is applied. Returns PX_OK, PX_LOOP_STOP when a phase
- * asked to stop, PX_E_STATE while px_loop_run() owns the loop.
+ * asked to stop, PX_E_STATE while px_loop_run() owns the loop or a
+ * phase-by-phase cycle is open.
  * @note RT-safe.
  */
 PX_API int px_loop_step(struct px_loop *loop);
+
+/*
+ * One cycle phase by phase, for a caller that owns the thread and the
+ * clock (its own 1 kHz loop): px_loop_read(), px_loop_compute(),
+ * px_loop_write(), in that order, once each per cycle. Each runs its
+ * phase callback and the checks px_loop_step() runs after that phase
+ * (read: requests, the callback, stale inputs; compute: the callback, the
+ * budget, non-finite outputs; write: safe state's zeros and disables, the
+ * callback, overruns, automatic re-arm), so the outputs, faults and safe
+ * state are those of px_loop_step() at the same times.
+ *
+ * now_ns is when the caller starts the phase, on the loop clock: for
+ * the virtual clock it moves the simulated time forward to now_ns (never
+ * back); for the real clock it is CLOCK_MONOTONIC time, e.g. the caller's
+ * own wake-up. The loop does not sleep: the read opens the cycle at
+ * now_ns, due at the loop's next deadline, or at now_ns when that
+ * deadline has not come yet (the first cycle, a caller faster than the
+ * period); a write that ends after the next deadline counts an overrun as
+ * px_loop_step() does.
+ *
+ * Returns PX_OK, PX_LOOP_STOP once a phase of the cycle asked to stop
+ * (finish the cycle all the same), PX_E_INVAL (NULL), or PX_E_STATE: the
+ * call is out of order (e.g. write before compute; the open cycle is
+ * unchanged) or px_loop_run() owns the loop. While a cycle is open,
+ * px_loop_step(), px_loop_run() and px_loop_start() return PX_E_STATE.
+ * Loop thread. @note RT-safe.
+ */
+PX_API int px_loop_read(struct px_loop *loop, int64_t now_ns);
+PX_API int px_loop_compute(struct px_loop *loop, int64_t now_ns);
+PX_API int px_loop_write(struct px_loop *loop, int64_t now_ns);
 
 /*
  * Start px_loop_run(loop, max_cycles) on a new thread (setup only: the

@@ -1,6 +1,7 @@
 /* The real-time loop: phases, overruns, watchdog and safe state, status,
- * allocation-free cycles. Virtual-clock tests check exact behaviour;
- * real-clock tests check behaviour only, never timing. */
+ * allocation-free cycles, the same cycle driven phase by phase.
+ * Virtual-clock tests check exact behaviour; real-clock tests check
+ * behaviour only, never timing. */
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -782,6 +783,242 @@ static void test_concurrent_status_and_stop(void)
 	px_loop_free(f.l);
 }
 
+/* ---- phase by phase ------------------------------------------------------ */
+
+static void check_cycle_eq(const struct px_loop_cycle *a,
+			   const struct px_loop_cycle *b, int k)
+{
+	PX_CHECK_MSG(a->index == b->index && a->period_ns == b->period_ns &&
+			     a->deadline_ns == b->deadline_ns &&
+			     a->wake_ns == b->wake_ns &&
+			     a->read_ns == b->read_ns &&
+			     a->compute_ns == b->compute_ns &&
+			     a->compute_end_ns == b->compute_end_ns &&
+			     a->write_ns == b->write_ns &&
+			     a->missed == b->missed && a->safe == b->safe,
+		     "cycle %d: the phases saw another cycle than the step", k);
+}
+
+/* The same scripted faults, once by px_loop_step() and once by the phase
+ * calls at the deadlines' times: a stale input that comes back, compute
+ * over budget, a NaN and an infinity (all re-armed automatically), and an
+ * e-stop that stays latched against the automatic re-arm until
+ * px_loop_rearm(). Every phase, output, fault and status is the same. */
+static void test_phases_match_step(void)
+{
+	struct px_loop_config cfg;
+	struct fx a, b;
+	struct px_loop_status sa, sb;
+	struct px_fault fa, fb;
+	int k, i, n = 120, nf = 0;
+
+	fx_init(&b, &cfg);
+	fx_init(&a, &cfg);
+	cfg.rearm_after_ok_cycles = 3;
+	cfg.compute_budget_ns = P_NS / 2;
+	fx_create(&a, &cfg);
+	cfg.user = &b;
+	fx_create(&b, &cfg);
+	a.in_idx = px_loop_input_add(a.l, "haptic0", 3 * P_NS);
+	b.in_idx = px_loop_input_add(b.l, "haptic0", 3 * P_NS);
+	PX_CHECK(a.in_idx == 0 && b.in_idx == 0);
+	for (k = 0; k < MAXC; k++)
+		a.read_adv[k] = b.read_adv[k] = 1000 + 10 * k;
+	for (k = 40; k < 44; k++)
+		a.compute_adv[k] = b.compute_adv[k] = 7 * P_NS / 10;
+	a.nan_at = b.nan_at = 30;
+	a.inf_at = b.inf_at = 90;
+	a.read_err_at = b.read_err_at = 100;
+	for (k = 0; k < n; k++) {
+		int64_t now = (int64_t)(k + 1) * P_NS;
+		if (k == 10)
+			a.stamp_until = b.stamp_until = 10;
+		if (k == 20)
+			a.stamp_until = b.stamp_until = 1 << 30;
+		if (k == 50) {
+			px_loop_trip_estop(a.l);
+			px_loop_trip_estop(b.l);
+		}
+		if (k == 75) {
+			px_loop_rearm(a.l);
+			px_loop_rearm(b.l);
+		}
+		PX_CHECK_INT_EQ(px_loop_step(a.l), PX_OK);
+		PX_CHECK_INT_EQ(px_loop_read(b.l, now), PX_OK);
+		PX_CHECK_INT_EQ(px_loop_compute(b.l, now), PX_OK);
+		PX_CHECK_INT_EQ(px_loop_write(b.l, now), PX_OK);
+		PX_CHECK_MSG(px_loop_is_safe(a.l) == px_loop_is_safe(b.l),
+			     "cycle %d: safe %d by the step, %d by the phases",
+			     k, px_loop_is_safe(a.l), px_loop_is_safe(b.l));
+	}
+	PX_CHECK_INT_EQ(a.n, n);
+	PX_CHECK_INT_EQ(b.n, n);
+	PX_CHECK(a.order_n == b.order_n &&
+		 memcmp(a.order, b.order, (size_t)a.order_n) == 0);
+	for (k = 0; k < n; k++) {
+		check_cycle_eq(&a.cy[k], &b.cy[k], k);
+		PX_CHECK_MSG(a.w_safe[k] == b.w_safe[k] &&
+				     a.w_enable[k] == b.w_enable[k] &&
+				     a.w_out[k] == b.w_out[k],
+			     "cycle %d: other outputs than the step", k);
+	}
+	/* the script did trip each way: stale, NaN, e-stop held past the
+	 * automatic re-arm, a failing read */
+	PX_CHECK_INT_EQ(a.w_safe[11], 0);
+	PX_CHECK_INT_EQ(a.w_safe[12], 1);
+	PX_CHECK_INT_EQ(a.w_safe[29], 0);
+	PX_CHECK_INT_EQ(a.w_safe[30], 1);
+	PX_CHECK_INT_EQ(a.w_safe[42], 1);
+	PX_CHECK_INT_EQ(a.w_safe[49], 0);
+	for (k = 50; k < 75; k++)
+		PX_CHECK_MSG(b.w_safe[k] == 1 && b.w_enable[k] == 0 &&
+				     b.w_out[k] == 0.0,
+			     "cycle %d left the e-stop's safe state", k);
+	PX_CHECK_INT_EQ(b.w_safe[75], 0);
+	PX_CHECK(b.w_out[75] == 10.0);
+	PX_CHECK_INT_EQ(b.w_safe[90], 1);
+	PX_CHECK_INT_EQ(b.w_safe[100], 1);
+	PX_CHECK_INT_EQ(b.w_safe[n - 1], 0);
+	PX_CHECK_INT_EQ(px_loop_status(a.l, &sa), PX_OK);
+	PX_CHECK_INT_EQ(px_loop_status(b.l, &sb), PX_OK);
+	PX_CHECK(sa.cycles == sb.cycles && sa.overruns == sb.overruns &&
+		 sa.missed_periods == sb.missed_periods &&
+		 sa.budget_exceeded == sb.budget_exceeded &&
+		 sa.safe_entries == sb.safe_entries &&
+		 sa.faults == sb.faults && sa.safe == sb.safe &&
+		 sa.safe_cause == sb.safe_cause &&
+		 sa.safe_cycle == sb.safe_cycle);
+	PX_CHECK_INT_EQ(sa.budget_exceeded, 4);
+	PX_CHECK(sa.safe_entries >= 5);
+	while (px_loop_fault_pop(a.l, &fa) == PX_OK) {
+		PX_CHECK_INT_EQ(px_loop_fault_pop(b.l, &fb), PX_OK);
+		PX_CHECK_MSG(fa.cycle == fb.cycle && fa.t_ns == fb.t_ns &&
+				     fa.cause == fb.cause &&
+				     fa.source == fb.source &&
+				     fa.detail == fb.detail &&
+				     fa.safe == fb.safe,
+			     "fault %d differs", nf);
+		nf++;
+	}
+	PX_CHECK_INT_EQ(px_loop_fault_pop(b.l, &fb), PX_E_AGAIN);
+	PX_CHECK_INT_EQ((uint64_t)nf, sa.faults);
+	for (i = 0; i < PX_LOOP_STAT__COUNT; i++) {
+		struct px_stats_snapshot xa, xb;
+		PX_CHECK_INT_EQ(px_loop_stats(a.l, (enum px_loop_stat)i, &xa),
+				PX_OK);
+		PX_CHECK_INT_EQ(px_loop_stats(b.l, (enum px_loop_stat)i, &xb),
+				PX_OK);
+		PX_CHECK(xa.count == xb.count && xa.min_ns == xb.min_ns &&
+			 xa.max_ns == xb.max_ns && xa.p99_ns == xb.p99_ns);
+	}
+	px_loop_free(a.l);
+	px_loop_free(b.l);
+}
+
+/* Phases out of order are refused and leave the open cycle as it was;
+ * nothing else drives the loop while a cycle is open. */
+static void test_phases_out_of_order(void)
+{
+	struct px_loop_config cfg;
+	struct fx f;
+
+	fx_init(&f, &cfg);
+	fx_create(&f, &cfg);
+	PX_CHECK_INT_EQ(px_loop_write(f.l, P_NS), PX_E_STATE);
+	PX_CHECK_INT_EQ(px_loop_compute(f.l, P_NS), PX_E_STATE);
+	PX_CHECK_INT_EQ(f.order_n, 0);
+	PX_CHECK_INT_EQ(px_loop_read(f.l, P_NS), PX_OK);
+	PX_CHECK_INT_EQ(px_loop_read(f.l, P_NS), PX_E_STATE);
+	PX_CHECK_INT_EQ(px_loop_write(f.l, P_NS), PX_E_STATE);
+	PX_CHECK_INT_EQ(px_loop_step(f.l), PX_E_STATE);
+	PX_CHECK_INT_EQ(px_loop_run(f.l, 1), PX_E_STATE);
+	PX_CHECK_INT_EQ(px_loop_start(f.l, 1), PX_E_STATE);
+	PX_CHECK_INT_EQ(px_loop_compute(f.l, P_NS), PX_OK);
+	PX_CHECK_INT_EQ(px_loop_compute(f.l, P_NS), PX_E_STATE);
+	PX_CHECK_INT_EQ(px_loop_read(f.l, P_NS), PX_E_STATE);
+	PX_CHECK_INT_EQ(px_loop_write(f.l, P_NS), PX_OK);
+	PX_CHECK_INT_EQ(f.order_n, 3);
+	PX_CHECK(memcmp(f.order, "rcw", 3) == 0);
+	PX_CHECK_INT_EQ(px_loop_write(f.l, 2 * P_NS), PX_E_STATE);
+	/* a closed cycle: the step takes over at the next deadline */
+	PX_CHECK_INT_EQ(px_loop_step(f.l), PX_OK);
+	PX_CHECK_INT_EQ(f.n, 2);
+	PX_CHECK_INT_EQ(f.cy[1].deadline_ns, 2 * P_NS);
+	/* a stop asked by a phase comes back from that phase on */
+	f.stop_at = 2;
+	PX_CHECK_INT_EQ(px_loop_read(f.l, 3 * P_NS), PX_OK);
+	PX_CHECK_INT_EQ(px_loop_compute(f.l, 3 * P_NS), PX_OK);
+	PX_CHECK_INT_EQ(px_loop_write(f.l, 3 * P_NS), PX_LOOP_STOP);
+	PX_CHECK_INT_EQ(px_loop_read(NULL, 0), PX_E_INVAL);
+	PX_CHECK_INT_EQ(px_loop_compute(NULL, 0), PX_E_INVAL);
+	PX_CHECK_INT_EQ(px_loop_write(NULL, 0), PX_E_INVAL);
+	px_loop_free(f.l);
+}
+
+/* The real clock: the caller's times are the phases' starts, the cycle
+ * is due at the caller's wake-up and no phase sleeps. */
+static void test_phases_real_clock(void)
+{
+	struct px_loop_config cfg;
+	struct fx f;
+	struct timespec ts;
+	int64_t t0;
+	int k;
+
+	fx_init(&f, &cfg);
+	cfg.clock = PX_LOOP_CLOCK_MONOTONIC;
+	cfg.period_ns = 10 * P_NS;
+	fx_create(&f, &cfg);
+	for (k = 0; k < 3; k++) {
+		clock_gettime(CLOCK_MONOTONIC, &ts);
+		t0 = (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+		PX_CHECK_INT_EQ(px_loop_read(f.l, t0), PX_OK);
+		PX_CHECK_INT_EQ(px_loop_compute(f.l, t0 + 1), PX_OK);
+		PX_CHECK_INT_EQ(px_loop_write(f.l, t0 + 2), PX_OK);
+		PX_CHECK_INT_EQ(f.cy[k].wake_ns, t0);
+		PX_CHECK_INT_EQ(f.cy[k].deadline_ns, t0);
+		PX_CHECK_INT_EQ(f.cy[k].read_ns, t0);
+		PX_CHECK_INT_EQ(f.cy[k].compute_ns, t0 + 1);
+		PX_CHECK_INT_EQ(f.cy[k].write_ns, t0 + 2);
+	}
+	PX_CHECK_INT_EQ(f.n, 3);
+	px_loop_free(f.l);
+}
+
+/* 10,000 phase-driven cycles with a fault script: no heap call. */
+static void test_phases_no_allocation(void)
+{
+	struct px_loop_config cfg;
+	struct fx f;
+	uint64_t r;
+	int k;
+
+	fx_init(&f, &cfg);
+	cfg.rearm_after_ok_cycles = 2;
+	fx_create(&f, &cfg);
+	f.in_idx = px_loop_input_add(f.l, "in", 2 * P_NS);
+	f.nan_at = 50;
+	f.stamp_until = 100;
+	r = px_alloc_region_begin();
+	for (k = 0; k < 10000; k++) {
+		int64_t now = (int64_t)(k + 1) * P_NS;
+		if (k == 200)
+			f.stamp_until = 1 << 30;
+		if (k == 300)
+			px_loop_trip_estop(f.l);
+		if (k == 360)
+			px_loop_rearm(f.l);
+		f.order_n = 0; /* the order log holds MAXC cycles */
+		px_loop_read(f.l, now);
+		px_loop_compute(f.l, now);
+		px_loop_write(f.l, now);
+	}
+	PX_CHECK_INT_EQ(px_alloc_region_end(r), 0);
+	PX_CHECK_INT_EQ(f.w_safe[350], 1);
+	PX_CHECK_INT_EQ(f.w_safe[MAXC - 1], 0);
+	px_loop_free(f.l);
+}
+
 static void test_bad_args(void)
 {
 	struct px_loop_config cfg;
@@ -847,6 +1084,10 @@ static const struct px_test tests[] = {
 	PX_T(test_no_allocation_100k_cycles),
 	PX_T(test_concurrent_status_and_stop),
 	PX_T(test_bad_args),
+	PX_T(test_phases_match_step),
+	PX_T(test_phases_out_of_order),
+	PX_T(test_phases_real_clock),
+	PX_T(test_phases_no_allocation),
 };
 
 PX_TEST_MAIN(tests)
