@@ -220,6 +220,35 @@ int px_app_step(struct px_app *a)
 	return px_loop_step(a->loop);
 }
 
+/* The caller's phases: not in a check-only app (no loop), and never
+ * after the shutdown, whose safe outputs a later write would undo. */
+static int phase_ready(const struct px_app *a)
+{
+	if (!a)
+		return PX_E_INVAL;
+	if (!a->loop || a->sd.done)
+		return PX_E_STATE;
+	return PX_OK;
+}
+
+int px_app_read(struct px_app *a, int64_t now_ns)
+{
+	int rc = phase_ready(a);
+	return rc ? rc : px_loop_read(a->loop, now_ns);
+}
+
+int px_app_compute(struct px_app *a, int64_t now_ns)
+{
+	int rc = phase_ready(a);
+	return rc ? rc : px_loop_compute(a->loop, now_ns);
+}
+
+int px_app_write(struct px_app *a, int64_t now_ns)
+{
+	int rc = phase_ready(a);
+	return rc ? rc : px_loop_write(a->loop, now_ns);
+}
+
 /* The campaign's window i against the loop faults seen. */
 static void reaction(const struct px_app *a, size_t i, struct px_app_reaction *r)
 {

@@ -15,10 +15,11 @@
  * closes. px_app_free() runs it too (reason "setup error") when it has
  * not run yet.
  *
- * Threads: create, run, drain, shutdown and free belong to one control
- * thread. With the real clock px_app_run() runs the loop on its own thread
- * (the config's real-time setup) and drains telemetry on the calling
- * thread; on the virtual clock it steps the loop on the calling thread.
+ * Threads: create, run (or step, or the phases), drain, shutdown and
+ * free belong to one control thread. With the real clock px_app_run()
+ * runs the loop on its own thread (the config's real-time setup) and
+ * drains telemetry on the calling thread; on the virtual clock it steps
+ * the loop on the calling thread.
  * px_app_stop() is async-signal-safe and may be called from any thread.
  *
  * Memory: everything is allocated by create (telemetry ring, statistics,
@@ -143,6 +144,26 @@ PX_API int px_app_run(struct px_app *app);
  * loop's error. RT-safe on the app's side (no allocation, no I/O but
  * device calls); drain from time to time so the ring does not fill. */
 PX_API int px_app_step(struct px_app *app);
+
+/*
+ * One cycle phase by phase from the caller's own thread and clock (a
+ * program with its own 1 kHz loop): px_app_read(), px_app_compute(),
+ * px_app_write(), in that order, once each per cycle. They are
+ * px_loop_read/compute/write (px_loop.h) on the app's loop: the app's
+ * device reads, control and writes with the loop's watchdog and safe
+ * state between them, the same cycle as px_app_step() at the same times.
+ * now_ns as there: the simulated time on the virtual clock,
+ * CLOCK_MONOTONIC on the real one. The caller's own work goes before
+ * px_app_read() or after px_app_write(); px_app_loop() gives the loop's
+ * status, trips and re-arm. Returns PX_OK, PX_LOOP_STOP (a phase asked to
+ * stop: finish the cycle), PX_E_INVAL (NULL) or PX_E_STATE: out of order,
+ * a check-only app, or after px_app_shutdown() (a write then would undo
+ * the safe state). RT-safe as px_app_step(); drain between cycles or
+ * from one other thread (as px_app_run() does on the real clock).
+ */
+PX_API int px_app_read(struct px_app *app, int64_t now_ns);
+PX_API int px_app_compute(struct px_app *app, int64_t now_ns);
+PX_API int px_app_write(struct px_app *app, int64_t now_ns);
 
 /* Ask the run to end. Async-signal-safe. */
 PX_API void px_app_stop(struct px_app *app);

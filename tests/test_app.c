@@ -1,8 +1,8 @@
 /* PX_TEST_NEEDS: libyaml (the shipped configs are YAML; tests/run.sh skips it in builds without) */
 /*
  * app/: the runner as a module - create/free on every shipped simulated
- * config, the cycle stepped from the test's own loop against the app's
- * own run, the safe state at shutdown, no heap calls in the cycles, the
+ * config, the cycle stepped, or driven phase by phase, from the test's
+ * own loop against the app's own run, the safe state at shutdown, no heap calls in the cycles, the
  * summary against the figures proxima-run prints, bad options refused.
  */
 #include <math.h>
@@ -135,6 +135,94 @@ static void test_own_loop_matches_the_apps_run(void)
 	PX_CHECK_INT_EQ((long long)a.n, 500);
 	PX_CHECK_INT_EQ((long long)b.n, (long long)a.n);
 	PX_CHECK(memcmp(a.r, b.r, a.n * sizeof(a.r[0])) == 0);
+}
+
+/* The phases driven from the test's own loop with its own (simulated)
+ * clock, at the loop's deadlines: the same telemetry and figures as
+ * px_app_run, no heap call in any phase, the safe state at shutdown and
+ * no phase after it. */
+static void test_own_phases_match_the_apps_run(void)
+{
+	static struct recs a, b;
+	struct px_config *cfg = load(HAPTIC_SIM);
+	struct px_app_options o;
+	struct px_app_summary sa, sb;
+	struct px_loop_status ls;
+	struct px_sim_haptic_state hs;
+	struct px_app *app;
+	struct px_dev *dev;
+	uint64_t heap = 0, h0;
+	int64_t t0, now;
+	int k, pushed = 0;
+	options(&o, HAPTIC_SIM, 3.0);
+	o.record = on_record;
+	o.user = &a;
+	a.n = b.n = 0;
+	app = create(cfg, &o);
+	PX_CHECK_INT_EQ(px_app_run(app), PX_OK);
+	px_app_drain(app, on_record, &a);
+	PX_CHECK_INT_EQ(px_app_shutdown(app, "end of run"), PX_OK);
+	px_app_drain(app, on_record, &a);
+	PX_CHECK_INT_EQ(px_app_summary(app, &sa), PX_OK);
+	px_app_free(app);
+
+	o.record = NULL;
+	o.user = NULL;
+	app = create(cfg, &o);
+	dev = px_app_device(app, "haptic");
+	PX_CHECK(dev != NULL);
+	PX_CHECK_INT_EQ(px_loop_status(px_app_loop(app), &ls), PX_OK);
+	t0 = px_loop_now_ns(px_app_loop(app));
+	PX_CHECK_INT_EQ(px_app_write(app, t0), PX_E_STATE);
+	PX_CHECK_INT_EQ(px_app_compute(app, t0), PX_E_STATE);
+	for (k = 0; k < 3000; k++) {
+		now = t0 + (int64_t)(k + 1) * ls.period_ns;
+		h0 = px_alloc_region_begin();
+		PX_CHECK_INT_EQ(px_app_read(app, now), PX_OK);
+		PX_CHECK_INT_EQ(px_app_compute(app, now), PX_OK);
+		PX_CHECK_INT_EQ(px_app_write(app, now), PX_OK);
+		heap += px_alloc_region_end(h0);
+		PX_CHECK_INT_EQ(px_sim_haptic_state(dev, &hs), PX_OK);
+		pushed |= hs.enable && (hs.force_n[0] != 0 ||
+					hs.force_n[1] != 0 || hs.force_n[2] != 0);
+		if (k % 100 == 99)
+			px_app_drain(app, on_record, &b);
+	}
+	PX_CHECK_MSG(heap == 0, "%llu heap calls in 3000 phase-driven cycles",
+		     (unsigned long long)heap);
+	PX_CHECK_MSG(pushed, "no force in 3000 cycles");
+	px_app_drain(app, on_record, &b);
+	/* shut down in the middle of a cycle: safe, and the rest refused */
+	PX_CHECK_INT_EQ(px_app_read(app, now + ls.period_ns), PX_OK);
+	PX_CHECK_INT_EQ(px_app_shutdown(app, "end of run"), PX_OK);
+	PX_CHECK_INT_EQ(px_sim_haptic_state(dev, &hs), PX_OK);
+	PX_CHECK(hs.force_n[0] == 0 && hs.force_n[1] == 0 && hs.force_n[2] == 0);
+	PX_CHECK_INT_EQ(hs.enable, 0);
+	PX_CHECK_INT_EQ(px_app_compute(app, now + ls.period_ns), PX_E_STATE);
+	PX_CHECK_INT_EQ(px_app_write(app, now + ls.period_ns), PX_E_STATE);
+	PX_CHECK_INT_EQ(px_app_read(app, now + 2 * ls.period_ns), PX_E_STATE);
+	PX_CHECK_INT_EQ(px_sim_haptic_state(dev, &hs), PX_OK);
+	PX_CHECK_INT_EQ(hs.enable, 0);
+	px_app_drain(app, on_record, &b);
+	PX_CHECK_INT_EQ(px_app_summary(app, &sb), PX_OK);
+	PX_CHECK(sb.shutdown_done && sb.shutdown_safe);
+	PX_CHECK_INT_EQ(sb.force_zeroed, 1);
+	PX_CHECK_INT_EQ(sb.relays_off, 1);
+	px_app_free(app);
+	px_config_free(cfg);
+	PX_CHECK_INT_EQ((long long)a.n, 3000);
+	PX_CHECK_INT_EQ((long long)b.n, (long long)a.n);
+	PX_CHECK(memcmp(a.r, b.r, a.n * sizeof(a.r[0])) == 0);
+	/* the cycle left open by the shutdown is not counted */
+	PX_CHECK_INT_EQ(sb.cycles, sa.cycles);
+	PX_CHECK(sb.max_force_n == sa.max_force_n);
+	PX_CHECK_INT_EQ(sb.contact_cycles, sa.contact_cycles);
+	PX_CHECK(sb.min_distance_m == sa.min_distance_m);
+	PX_CHECK(sb.max_penetration_m == sa.max_penetration_m);
+	PX_CHECK_INT_EQ(sb.safe_state_trips, sa.safe_state_trips);
+	PX_CHECK_INT_EQ(sb.telemetry_records, sa.telemetry_records);
+	PX_CHECK_INT_EQ(sb.faults_popped, sa.faults_popped);
+	PX_CHECK_INT_EQ(px_app_read(NULL, 0), PX_E_INVAL);
 }
 
 /* In contact the device receives force; after px_app_shutdown it last
@@ -338,6 +426,7 @@ static void test_bad_options_refused(void)
 static const struct px_test tests[] = {
 	PX_T(test_create_free_every_sim_config),
 	PX_T(test_own_loop_matches_the_apps_run),
+	PX_T(test_own_phases_match_the_apps_run),
 	PX_T(test_shutdown_leaves_zero_force),
 	PX_T(test_cycles_allocate_nothing),
 	PX_T(test_summary_is_proxima_runs),
