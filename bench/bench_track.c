@@ -402,9 +402,8 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 			/* the tracker and the cold query each run the whole path
 			 * on their own: interleaved at the same point, the
 			 * second call finds the branch predictor trained by the
-			 * first on the same data (measured: a cold-answered
-			 * update's median 531 ns against the reference's 350 ns
-			 * in that order, 440 against 491 in the other) */
+			 * first on the same data, which flatters whichever runs
+			 * second */
 			/* the cold switch's decisions of the first run
 			 * replayed in the others (rclock) */
 			gsave = *px__track_gov(t);

@@ -924,9 +924,9 @@ int px_can_replay_open(const char *path, const char *iface,
 		return PX_E_INVAL;
 	*out = NULL;
 	/* Whole, within the log limit: a NUL byte is an error at its line
-	 * and column (it used to end a line early), and /dev/zero stops at
-	 * its first read. Whole lines: a fixed buffer split long lines into
-	 * pieces that were parsed as lines of their own (found by fuzzing). */
+	 * and column, never the end of a line, and /dev/zero stops at its
+	 * first read. Whole lines, never a fixed buffer that would split a
+	 * long line into pieces parsed as lines of their own. */
 	rc = px_file_read(path, PX_FILE_LOG_MAX_BYTES, PX_FILE_TEXT, "CAN log",
 			  &data, &dlen, msg, cap);
 	if (rc != PX_OK)

@@ -68,10 +68,9 @@ struct px_dist_opts {
 	 * take 2 to 64 samples, patches 2x2 to 4x4: samples only give the
 	 * wave its first upper bound and the best piece its Newton start;
 	 * the piece solvers prove the rest, so the cap costs no correctness.
-	 * Measured: 2x2 to 3x3 caps cost about the same, 6x6 and 8x8 caps
-	 * 9 % and 17 % more instructions per bicubic query, for the same
-	 * pieces solved per query; the paper's 1 % (about 26x26 per patch)
-	 * would scan hundreds of samples per visited piece). */
+	 * Denser caps solve the same pieces and only add sample scans; the
+	 * paper's 1 % (about 26x26 per patch) would scan hundreds of
+	 * samples per visited piece). */
 	double sample_tol;
 	/* References a grid cell holds before spilling. */
 	int cell_cap;

@@ -49,12 +49,10 @@
  * points outside the grid take the nearest cell), at most one cell per
  * 8 triangles; building it costs about one cold query per cell. The
  * answer is exact either way: the hint only sets the starting bound.
- * It is off by default because it does not pay on the machines
- * measured: on the 70k-triangle benchmark torus it saves a few percent
- * of a cold query's instructions (most of the work is the proof that no
- * other triangle is closer, not the search for a bound) but costs three
- * dependent memory fetches (cell, hint indices, hint vertices) before
- * the walk starts, about 10 % of the cold query's time.
+ * It is off by default because it seldom pays: most of a cold query's
+ * work is the proof that no other triangle is closer, not the search
+ * for a bound, while the hint costs three dependent memory fetches
+ * (cell, hint indices, hint vertices) before the walk starts.
  *
  * Coherent queries (PX_QUERY_COHERENT with last cycle's triangle index as
  * hint) start from that triangle's distance as an upper bound, which

@@ -32,8 +32,8 @@
  *    no NaN. Each cell carries that radius; its expiry on the travelled
  *    path length in the max norm (the sum of the steps' largest
  *    coordinate moves: it bounds the move from where the radius was
- *    taken in the cube's own norm, and is often half the Euclidean path;
- *    14-20 % fewer cell tests on the bench paths; the least of all and
+ *    taken in the cube's own norm, and is often half the Euclidean path,
+ *    so cells fall due less often; the least of all and
  *    of each group of 8 cells kept, so that the usual update compares
  *    one number) names the cells due;
  *    a due cell whose cube still holds the new point with a tenth of
@@ -188,8 +188,8 @@ struct px_strack_opts {
 	 * (default 4; 0: no bound). A solve's work is counted by the seeds
 	 * it runs: a cell whose region certificates prove it free of
 	 * critical points where it is solved costs those checks alone and
-	 * counts 1/8 of a solve (measured: about 2,200 instructions
-	 * against 7,000 or more for each Newton run from a seed; a box's
+	 * counts 1/8 of a solve (those checks cost a fraction of one
+	 * Newton run from a seed; a box's
 	 * contraction, stats.exact_solves, counts as one seed, and the
 	 * cut of an open box four certificates made at update time, 3/16
 	 * of a seed each; a cut is made only where the bound leaves room

@@ -577,8 +577,7 @@ static void centre_set(struct rcert *ce, const struct px_nurbs_surf_derivs *d)
  * and so on down to S, with top's third-derivative bounds (they hold
  * over every piece of its box); then cert_fill(). About as wide as b:
  * the width falls with the piece, which a hull of the box's own net
- * cut down to it would give too, at a seventh of the cost (measured:
- * 2,000 instructions against 14,000).
+ * cut down to it would give too, at a small part of the cost.
  */
 void px__st_taylor_cert(const struct ssurf *f, const double b[4],
 			const struct rcert *top, struct rcert *ce)
