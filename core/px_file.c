@@ -1,6 +1,7 @@
 /*
  * px_file.c - whole files read with a size limit (see px_file.h).
  */
+#include <ctype.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <stdio.h>
@@ -200,4 +201,15 @@ char *px_file_next_line(char **cursor)
 			(*cursor)[-1] = '\0';
 	}
 	return s;
+}
+
+int px_file_is_header(const char *line)
+{
+	char *end;
+	if (!line || !isalpha((unsigned char)*line))
+		return 0;
+	strtod(line, &end);
+	while (*end == ' ' || *end == '\t')
+		end++;
+	return end == line || (*end != ',' && *end != '\0');
 }

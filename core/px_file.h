@@ -68,6 +68,14 @@ PX_API int px_file_find_nul(const char *data, size_t len, long *line,
  */
 PX_API char *px_file_next_line(char **cursor);
 
+/*
+ * Is line (leading blanks already skipped) a header of column names
+ * rather than data: text starting with a letter whose first field is
+ * not wholly a number. "NaN" and "inf" are numbers (and then an error
+ * as data); "x" and "nanos" are names. Returns 1 or 0.
+ */
+PX_API int px_file_is_header(const char *line);
+
 #ifdef __cplusplus
 }
 #endif

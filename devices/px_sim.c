@@ -145,19 +145,6 @@ static int parse_row(const char *s, double v[4], const char **why)
 	return 0;
 }
 
-/* A header: text whose first field is not wholly a number ("NaN" and
- * "inf" are numbers, and then an error as data). */
-static int csv_header(const char *s)
-{
-	char *end;
-	if (!isalpha((unsigned char)*s))
-		return 0;
-	strtod(s, &end);
-	while (*end == ' ' || *end == '\t')
-		end++;
-	return end == s || (*end != ',' && *end != 0);
-}
-
 int px_sim_csv_load(const char *path, struct px_sim_csv **out, char *msg,
 		    size_t cap)
 {
@@ -193,7 +180,7 @@ int px_sim_csv_load(const char *path, struct px_sim_csv **out, char *msg,
 			continue;
 		field = parse_row(s, v, &why);
 		if (field) {
-			if (header_ok && c->n == 0 && csv_header(s)) {
+			if (header_ok && c->n == 0 && px_file_is_header(s)) {
 				header_ok = 0;
 				continue;
 			}

@@ -98,20 +98,6 @@ static int parse_num(const char **s, double *out)
 	return 0;
 }
 
-/* A header line: text whose first field is not wholly a number. "NaN"
- * and "inf" are numbers (and then an error as data); "x", "nanos" are
- * names. */
-static int is_header(const char *s)
-{
-	char *end;
-	if (!isalpha((unsigned char)*s))
-		return 0;
-	strtod(s, &end);
-	while (*end == ' ' || *end == '\t')
-		end++;
-	return end == s || (*end != ',' && *end != '\0');
-}
-
 static int points_fail(const char *path, long lineno, const char *fmt, int field)
 {
 	fprintf(stderr, "%s: %s:%ld: ", prog, path, lineno);
@@ -145,7 +131,7 @@ static int read_points(const char *path, struct points *pts)
 			s++;
 		if (*s == 0)
 			continue; /* blank line */
-		if (!seen++ && is_header(s))
+		if (!seen++ && px_file_is_header(s))
 			continue;
 		for (k = 0; k < 3; k++) {
 			const char *f = s;
