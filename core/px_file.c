@@ -213,3 +213,15 @@ int px_file_is_header(const char *line)
 		end++;
 	return end == line || (*end != ',' && *end != '\0');
 }
+
+const char *px_file_kind(mode_t m)
+{
+	return S_ISREG(m)    ? "a regular file"
+	       : S_ISDIR(m)  ? "a directory"
+	       : S_ISLNK(m)  ? "a symbolic link"
+	       : S_ISCHR(m)  ? "a character device"
+	       : S_ISBLK(m)  ? "a block device"
+	       : S_ISFIFO(m) ? "a FIFO"
+	       : S_ISSOCK(m) ? "a socket"
+			     : "an unknown kind of file";
+}

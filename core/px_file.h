@@ -22,6 +22,7 @@
 #define PX_FILE_H
 
 #include <stddef.h>
+#include <sys/types.h>
 
 #include "px_base.h"
 
@@ -75,6 +76,13 @@ PX_API char *px_file_next_line(char **cursor);
  * as data); "x" and "nanos" are names. Returns 1 or 0.
  */
 PX_API int px_file_is_header(const char *line);
+
+/*
+ * The kind of file a st_mode names, for messages: "a regular file", "a
+ * directory", "a symbolic link", "a character device", "a block
+ * device", "a FIFO", "a socket". A static string.
+ */
+PX_API const char *px_file_kind(mode_t mode);
 
 #ifdef __cplusplus
 }

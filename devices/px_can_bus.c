@@ -343,18 +343,6 @@ static int fault_recv(struct px_can_bus *b, int64_t now, struct px_can_msg *m)
 
 /* ---- UNIX datagram simulation ------------------------------------------- */
 
-/* What a file type is, for the refusal below. */
-static const char *file_kind(mode_t m)
-{
-	return S_ISREG(m)    ? "a regular file"
-	       : S_ISDIR(m)  ? "a directory"
-	       : S_ISLNK(m)  ? "a symbolic link"
-	       : S_ISCHR(m)  ? "a character device"
-	       : S_ISBLK(m)  ? "a block device"
-	       : S_ISFIFO(m) ? "a FIFO"
-			     : "not a regular file";
-}
-
 /* Make local_path free to bind without taking anything the caller did
  * not mean: nothing there is fine; a socket nobody is bound to (left by
  * a process that died: a datagram connect is refused) is removed;
@@ -383,7 +371,7 @@ static int unix_claim(const char *path, char *msg, size_t cap)
 		if (msg)
 			snprintf(msg, cap, "%s exists and is %s, not a socket: "
 				 "refusing to remove it", path,
-				 file_kind(st.st_mode));
+				 px_file_kind(st.st_mode));
 		return PX_E_INVAL;
 	}
 	s = socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);

@@ -9,6 +9,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "px_file.h"
+
 struct protected_file {
 	dev_t dev;
 	ino_t ino;
@@ -45,16 +47,6 @@ static const struct protected_file *find_protected(const struct stat *st)
 		if (prot[i].dev == st->st_dev && prot[i].ino == st->st_ino)
 			return &prot[i];
 	return NULL;
-}
-
-static const char *file_kind(mode_t m)
-{
-	return S_ISDIR(m)    ? "a directory"
-	       : S_ISCHR(m)  ? "a character device"
-	       : S_ISBLK(m)  ? "a block device"
-	       : S_ISFIFO(m) ? "a FIFO"
-	       : S_ISSOCK(m) ? "a socket"
-			     : "not a regular file";
 }
 
 /* The directory part of path ("." for a bare name). 0 or -1. */
@@ -110,7 +102,7 @@ int tool_out_check(const char *path, char *why, size_t cap)
 			return refuse(why, cap, EINVAL,
 				      "%s exists and is %s, not a regular file: "
 				      "refusing to replace it",
-				      path, file_kind(ls.st_mode));
+				      path, px_file_kind(ls.st_mode));
 		} else if ((p = find_protected(&ls))) {
 			return refuse(why, cap, EINVAL,
 				      "%s is %s %s (the same file): refusing to "
