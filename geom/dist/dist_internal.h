@@ -1,12 +1,198 @@
 /*
- * dist_internal.h - test hooks of the certified surface piece solver
- * (px_spiece.c). Not installed, not part of the API.
+ * dist_internal.h - private declarations of the distance core: the
+ * prepared model's layout (px_dist.c queries it, dist_build.c makes it),
+ * the decomposition of entities into pieces (dist_decomp.c), and the
+ * test hooks of the certified surface piece solver (spiece_solve.c).
+ * Not installed, not part of the API.
  */
 #ifndef PX_DIST_INTERNAL_H
 #define PX_DIST_INTERNAL_H
 
+#include <stdint.h>
+
 #include "math_internal.h"
+#include "px_arena.h"
+#include "px_cpiece.h"
+#include "px_dist.h"
 #include "px_math.h"
+#include "px_nurbs.h"
+#include "px_recog.h"
+#include "px_spiece.h"
+
+/* ---- the prepared model ------------------------------------------------- */
+
+/* Hot-path box distance: boxes here are never empty, and fmin/fmax
+ * would be library calls without -ffast-math. */
+static inline double gap1(double v, double lo, double hi)
+{
+	return v < lo ? lo - v : (v > hi ? v - hi : 0.0);
+}
+
+static inline double box_d2(const px_aabb *b, px_vec3 p)
+{
+	double dx = gap1(p.x, b->min.x, b->max.x);
+	double dy = gap1(p.y, b->min.y, b->max.y);
+	double dz = gap1(p.z, b->min.z, b->max.z);
+	return dx * dx + dy * dy + dz * dz;
+}
+
+struct cand {
+	double lb; /* squared lower bound */
+	int piece;
+};
+
+enum { PK_CURVE = 0, PK_PATCH = 1 };
+
+/* What one query in flight needs besides the read-only model: per-piece
+ * visit stamps (an epoch, so nothing is cleared per query) and the
+ * candidate list. */
+struct px_dist_ws {
+	uint32_t epoch;
+	uint32_t *stamp;
+	uint32_t *ent_stamp; /* entities answered in closed form */
+	struct cand *cand;
+	int n_pieces, n_ent;
+	int owned; /* allocated by px_dist_ws_create() */
+};
+
+/* One entry of the grid's index space: a curve piece or a patch. */
+struct piece {
+	px_aabb box;
+	int kind;    /* PK_CURVE or PK_PATCH */
+	int idx;     /* into cp or spc */
+	int ent;     /* entity */
+	/* Boundary curve of a surface: the curve runs along u (iso_dir 0,
+	 * v fixed at iso_t) or along v (iso_dir 1); -1 for an entity's own
+	 * curve pieces and patches. */
+	int iso_dir;
+	double iso_t;
+	int sample_start;
+	int ns, nt; /* samples: ns along the piece (curves) or ns x nt */
+	/* Oriented box around the control net (so around the piece):
+	 * candidates the axis-aligned box kept are dropped by it before
+	 * their solve reads the coefficient tables (most neighbours of the
+	 * foot point are nearly flat slabs that it bounds tightly). */
+	px_obb obb;
+};
+
+struct px_dist_model {
+	struct px_arena arena;
+	struct px_dist_opts opts;
+	int n_ent;
+	struct px_dist_entity_info *ent;
+	/* Knowledge step: entities that are exactly a primitive (with the
+	 * arrays their parameter inversion reads, copied here). */
+	struct px_recog_shape *shape;
+	int n_pieces;
+	struct piece *pieces;
+	int n_cp, n_sp;
+	struct px_cpiece *cp;
+	struct px_spiece *spc;
+	int n_samples;
+	px_vec3 *samples;
+	/* grid */
+	px_aabb bounds;
+	double h, inv_h;
+	int nx, ny, nz;
+	long n_cells, n_spill;
+	int cap;
+	int *cell_count;
+	/* Chebyshev distance (in cells) to the nearest non-empty cell: the
+	 * wave starts at that shell, all nearer ones being empty. */
+	uint16_t *cell_empty_r;
+	int *cell_slot;  /* n_cells * cap */
+	int *cell_spill; /* first spill index of each cell */
+	int *spill;
+	/* the workspace of px_dist_query() */
+	struct px_dist_ws ws;
+};
+
+/* Index of cell (i, j, k) of the model's grid. */
+static inline long px__dist_cell_index(const struct px_dist_model *m, int i,
+				       int j, int k)
+{
+	return ((long)k * m->ny + j) * m->nx + i;
+}
+
+/* ---- decomposition (dist_decomp.c) -------------------------------------- */
+
+/* Growing list of cut parameters (heap, setup only). */
+struct px__dist_cuts {
+	double *u;
+	int n, cap;
+};
+
+/*
+ * Parameters that cut one curve into pieces (sorted, distinct, both
+ * domain ends included), and its info: pf, tol, jitter, arc length,
+ * closed, breaks, cusps. Returns PX_OK, PX_E_NOMEM or PX_E_NOSPC.
+ */
+int px__dist_decompose(const struct px_nurbs_curve *c,
+		       const struct px_dist_opts *o,
+		       struct px_dist_entity_info *info,
+		       struct px__dist_cuts *out);
+
+/* Decomposition tolerance and jitter into info from its pf: the paper's
+ * table floored at floor_tol, unless the options fix them. */
+void px__dist_decomp_settings(struct px_dist_entity_info *info,
+			      double floor_tol, const struct px_dist_opts *o);
+
+/* Parametrization factor of a surface (max over u and v). */
+double px__dist_surf_pf(const struct px_nurbs_surf *s);
+
+/* Cut parameters of a surface in direction dir and the length of the
+ * iso-curve they come from (*len_out). */
+int px__dist_surf_cuts(const struct px_nurbs_surf *s, int dir,
+		       const struct px_dist_opts *o, double *len_out,
+		       struct px__dist_cuts *out);
+
+/* ---- surface pieces: Bernstein tensors (spiece_tensor.c) ---------------- */
+
+#define PX__SP_MD PX_SPIECE_MAX_DEGREE
+/* Largest tensor: gu of degree (3p - 1, 3q), or F of (2p, 2q). */
+#define PX__SP_TMAX ((3 * PX__SP_MD + 1) * (3 * PX__SP_MD + 1))
+
+/* Coefficients of a tensor of degrees (n, m). */
+static inline size_t px__sp_tsize(int n, int m)
+{
+	return (size_t)(n + 1) * (size_t)(m + 1);
+}
+
+/* Raise Bernstein basis values of degree k - 1 to degree k in place. */
+static inline void px__sp_raise(double *b, int k, double t, double u)
+{
+	int i;
+	b[k] = t * b[k - 1];
+	for (i = k - 1; i > 0; i--)
+		b[i] = u * b[i] + t * b[i - 1];
+	b[0] = u * b[0];
+}
+
+/* a (na, ma) times b (nb, mb) into out (na + nb, ma + mb). */
+void px__sp_mul(const double *a, int na, int ma, const double *b, int nb,
+		int mb, double *out);
+/* Derivative along s (degree n - 1, m) or along t (n, m - 1). */
+void px__sp_deriv_s(const double *c, int n, int m, double *out);
+void px__sp_deriv_t(const double *c, int n, int m, double *out);
+/* Restriction to [s0, s1] x [t0, t1]; out may alias c. */
+void px__sp_restrict(const double *c, int n, int m, double s0, double s1,
+		     double t0, double t1, double *out);
+/* Coefficient ranges of the derivatives along the rows (lo[0], hi[0])
+ * and along the columns (lo[1], hi[1]). */
+void px__sp_jac_range(const double *c, int n, int m, double lo[2],
+		      double hi[2]);
+/* Degree elevation by one along the rows (dir 0) or the columns. */
+void px__sp_elevate(const double *x, int n, int m, int dir, double *y);
+/* Derivative along the rows (columns) written back at the same degree. */
+void px__sp_d_rows(const double *x, int R, int C, double *out);
+void px__sp_d_cols(const double *x, int R, int C, double *out);
+/* Value at (s, t). */
+double px__sp_eval(const double *c, int n, int m, double s, double t);
+
+/* Point of a piece at local (s, t) (px_spiece.c). */
+px_vec3 px__sp_point(const struct px_spiece *sp, double s, double t);
+
+/* ---- test hooks of the surface piece solver (spiece_solve.c) ------------- */
 
 /* px_spiece: at most this many slots in a query's pool of parent
  * tensors (-1: as many as fit), so tests can run the restriction from
@@ -17,7 +203,7 @@ PX__TEST_SWITCH(int, px__spiece_pool_cap, -1);
 PX__TEST_SWITCH(int, px__spiece_no_precond, 0);
 /* px_spiece: the preconditioned monotonicity test on one rectangle, and
  * the symmetric Jacobian part's least eigenvalue sampled there (see
- * px_spiece.c). */
+ * spiece_solve.c). */
 struct px_spiece;
 int px__spiece_precond_probe(const struct px_spiece *sp, px_vec3 p, double s0,
 			     double s1, double t0, double t1, int o, int grid,

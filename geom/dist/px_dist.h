@@ -61,7 +61,7 @@ enum px_dist_kind { PX_DIST_CURVE = 0, PX_DIST_SURFACE = 1 };
 struct px_dist_opts {
 	/* Decomposition piece length as a fraction of the arc length and
 	 * the jitter factor (lower bound / upper bound); 0 picks both from
-	 * the parametrization-factor table (paper table in px_dist.c). */
+	 * the parametrization-factor table (paper table in dist_decomp.c). */
 	double decomp_tol;
 	double jitter;
 	/* Pre-sample spacing as a fraction of the arc length (curve pieces

@@ -104,7 +104,7 @@ struct px_spiece_hit {
 	px_vec3 point;
 	int iters, nodes;
 	/* Rectangles restricted from the whole patch because the query's
-	 * pool of parent tensors was full (cost only, see px_spiece.c). */
+	 * pool of parent tensors was full (cost only, see spiece_solve.c). */
 	int pool_misses;
 	int certified; /* as px_cpiece_hit */
 	double gap;
