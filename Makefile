@@ -108,7 +108,7 @@ TEST_SUPPORT_SRC := $(wildcard tests/px_*.c)
 TEST_SUPPORT_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(TEST_SUPPORT_SRC))
 TEST_SRC := $(wildcard tests/test_*.c)
 TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
-TEST_SH  := $(wildcard tests/test_*.sh)
+TEST_SH  := $(wildcard tests/test_*.sh tests/*/test_*.sh)
 # Test hooks: the sources with test switches and hook functions are built
 # a second time with -DPX_TEST_HOOKS into TEST_LIB, which the tests and
 # benches link; the shipped library has none (geom/math/math_internal.h).
@@ -129,6 +129,12 @@ TOOL_SUPPORT_OBJ += $(BUILD)/obj/tests/px_alloc_count.o
 endif
 TOOL_SRC := $(wildcard tools/proxima-*.c)
 TOOL_BIN := $(patsubst tools/%.c,$(BUILD)/bin/%,$(TOOL_SRC))
+# A tool's own parts: tools/<name>_*.c go into proxima-<name> alone
+# (tools/run_*.c into proxima-run); tools/tool_*.c into every tool.
+tool_parts = $(patsubst %.c,$(BUILD)/obj/%.o,$(wildcard tools/$(1)_*.c))
+TOOL_PART_OBJ := $(foreach t,$(TOOL_SRC:tools/proxima-%.c=%),$(call tool_parts,$(t)))
+$(foreach t,$(TOOL_SRC:tools/proxima-%.c=%),\
+  $(eval $(BUILD)/bin/proxima-$(t): $(call tool_parts,$(t))))
 
 # examples/*.c: programs that see only the public headers, as a user's
 # code does (<proxima/px_*.h> from $(BUILD)/include, the installed layout).
@@ -233,7 +239,7 @@ $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT_OBJ) $(TEST_LIB)
 
 $(BUILD)/bin/%: $(BUILD)/obj/tools/%.o $(TOOL_SUPPORT_OBJ) $(STATIC_LIB)
 	@mkdir -p $(dir $@)
-	$(CC) $(ALL_LDFLAGS) -o $@ $< $(TOOL_SUPPORT_OBJ) $(STATIC_LIB) $(LIBS)
+	$(CC) $(ALL_LDFLAGS) -o $@ $(filter %.o,$^) $(STATIC_LIB) $(LIBS)
 
 # Initial-exec TLS: the per-thread count must not make the dynamic
 # loader allocate on a thread's first heap call.
@@ -479,6 +485,7 @@ memcheck: all
 stress: $(BUILD)/tests/test_hostile
 	PX_STRESS=1 $(BUILD)/tests/test_hostile
 
--include $(LIB_OBJ:.o=.d) $(TEST_HOOK_OBJ:.o=.d) $(TEST_SUPPORT_OBJ:.o=.d) $(TOOL_SUPPORT_OBJ:.o=.d)
+-include $(LIB_OBJ:.o=.d) $(TEST_HOOK_OBJ:.o=.d) $(TEST_SUPPORT_OBJ:.o=.d) $(TOOL_SUPPORT_OBJ:.o=.d) \
+  $(TOOL_PART_OBJ:.o=.d)
 -include $(patsubst %.c,$(BUILD)/obj/%.d,$(TEST_SRC) $(TOOL_SRC) $(BENCH_SRC) $(EXAMPLE_SRC))
 -include $(patsubst %.c,$(BUILD)/obj/%.d,$(FUZZ_SRC) fuzz/replay.c)

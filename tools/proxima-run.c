@@ -12,8 +12,9 @@
  * freeze the process - INT, TERM, HUP, QUIT, USR1, USR2, PIPE, ALRM,
  * VTALRM, PROF, XCPU, XFSZ, TSTP - ends the run like Ctrl-C through
  * px_app_stop()), the live status line on stderr, and the files: the
- * telemetry CSV from the drained records, the SVG plots next to it, the
- * summary on stdout and as JSON (--summary-json). Output paths are
+ * telemetry CSV from the drained records, then the summary on stdout
+ * (tools/run_report.c), the SVG plots next to the CSV (run_plots.c) and
+ * the JSON of --summary-json (run_json.c). Output paths are
  * checked by the app at setup through tools/tool_out.h (temporary file
  * renamed over the target; never over the config or an input file).
  *
@@ -46,14 +47,10 @@
 
 #include "px_alloc_count.h"
 #include "px_app.h"
-#include "px_canopen.h"
 #include "px_config.h"
-#include "px_dev.h"
-#include "px_gpio.h"
 #include "px_loop.h"
-#include "px_sim.h"
 #include "px_stats.h"
-#include "px_world.h"
+#include "run_internal.h"
 #include "tool_out.h"
 #include "tool_svg.h"
 
@@ -216,7 +213,6 @@ static struct {
 	struct px_app_record *recs; /* the plots' records */
 	size_t n_recs, cap_recs;
 	uint64_t setup_heap_calls;
-	char out_why[TOOL_OUT_WHY_MAX]; /* why write_json() failed */
 } T;
 
 static volatile sig_atomic_t interrupted;
@@ -228,67 +224,6 @@ static void on_signal(int sig)
 		stop_signal = sig;
 	interrupted = 1;
 	px_app_stop(A);
-}
-
-static void shutdown_line(FILE *f, const char *prefix)
-{
-	char line[1024];
-	px_app_shutdown_describe(A, line, sizeof(line));
-	fprintf(f, "%s%s\n", prefix, line);
-}
-
-static void json_string(FILE *f, const char *s);
-
-/* The shutdown as a JSON object (a member of the summary), with what
- * each simulated device last received. */
-static void json_shutdown(FILE *f)
-{
-	int i, first = 1;
-	fprintf(f,
-		"  \"shutdown\": {\"shutdown_safe\": %d, \"shutdown_reason\": "
-		"\"%s\", \"force_devices\": %d, \"force_zeroed\": %d, "
-		"\"relay_devices\": %d, \"relays_off\": %d, "
-		"\"shutdown_drives\": %d, \"drives_disabled\": %d, "
-		"\"drives_faulted\": %d, \"shutdown_ns\": %lld, "
-		"\"shutdown_error\": ",
-		S.shutdown_safe, S.shutdown_reason, S.force_devices, S.force_zeroed,
-		S.relay_devices, S.relays_off, S.shutdown_drives, S.drives_disabled,
-		S.drives_faulted, (long long)S.shutdown_ns);
-	json_string(f, S.shutdown_error);
-	fputs(", \"last_outputs\": [", f);
-	for (i = 0; i < px_app_device_count(A); i++) {
-		struct px_dev *d = px_app_device_at(A, i);
-		struct px_sim_haptic_state hs;
-		struct px_dev_status st;
-		int relay;
-		px_dev_status(d, &st);
-		if (px_sim_haptic_state(d, &hs) == PX_OK &&
-		    (px_dev_caps(d) & PX_DEV_CAP_FORCE)) {
-			fprintf(f, "%s{\"name\": ", first ? "" : ", ");
-			json_string(f, st.name);
-			fprintf(f,
-				", \"last_force_n\": [%.9g, "
-				"%.9g, %.9g], \"last_torque_n_m\": [%.9g, %.9g, "
-				"%.9g], \"last_enable\": %d, \"outputs_safe\": %d}",
-				hs.force_n[0],
-				hs.force_n[1], hs.force_n[2], hs.torque_n_m[0],
-				hs.torque_n_m[1], hs.torque_n_m[2], hs.enable,
-				st.outputs_safe);
-			first = 0;
-		} else if ((relay = px_gpio_sim_output(d,
-						       PX_GPIO_ENABLE)) >= 0) {
-			fprintf(f, "%s{\"name\": ", first ? "" : ", ");
-			json_string(f, st.name);
-			fprintf(f,
-				", \"enable_line\": %d, "
-				"\"timing_line\": %d, \"outputs_safe\": %d}",
-				relay,
-				px_gpio_sim_output(d, PX_GPIO_TIMING),
-				st.outputs_safe);
-			first = 0;
-		}
-	}
-	fputs("]},\n", f);
 }
 
 /* Ask for the safe state on every signal that would otherwise end (or,
@@ -321,9 +256,8 @@ static void signal_reason(int sig, char *buf, size_t cap)
 		snprintf(buf, cap, "signal %d", sig);
 }
 
-/* safety.watchdog.auto_rearm with an e-stop line: the e-stop still
- * needs an explicit re-arm (px_loop_trip_estop), which the user of such
- * a config may not expect: say so, at the auto_rearm key. */
+/* The live status line on stderr: rewritten in place on a terminal, a
+ * new line each time otherwise. */
 static void status_line(int final, double wall_s, double rate)
 {
 	struct px_app_record last;
@@ -455,9 +389,6 @@ static void finish(void)
 	free(T.recs);
 }
 
-/* ---- results -------------------------------------------------------- */
-
-/* The plot names the app checked (next to the CSV). */
 /* PX_RUN_STOP_AT=CYCLE[:SIGNAL] in the environment raises SIGNAL (a
  * name as kill -l gives it, default TERM) in this process once CYCLE
  * cycles have run: "stop now" at a chosen cycle, through the real signal
@@ -486,383 +417,6 @@ static uint64_t stop_at_cycle(int *sig)
 		}
 	}
 	return (uint64_t)n;
-}
-
-static void plot_paths(char *time_svg, char *lat_svg, size_t cap)
-{
-	snprintf(time_svg, cap, "%s", S.time_svg);
-	snprintf(lat_svg, cap, "%s", S.lat_svg);
-}
-
-static int write_plots(const char *time_svg, const char *lat_svg)
-{
-	size_t n = T.n_recs, i;
-	double *x = calloc(n + 1, sizeof(double));
-	double *d = calloc(n + 1, sizeof(double));
-	double *f = calloc(n + 1, sizeof(double));
-	double *pen = calloc(n + 1, sizeof(double));
-	double *fz = calloc(n + 1, sizeof(double));
-	int rc = -1;
-	static uint64_t lbins[PX_STATS_DEFAULT_BINS], cbins[PX_STATS_DEFAULT_BINS];
-	uint64_t lover = 0, cover = 0;
-	int nl, nc;
-	if (x && d && f && pen && fz && S.avoiding) {
-		static const char *const colors[PX_APP_RECORD_JOINTS] = {
-			"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd",
-			"#8c564b"};
-		static const char *const names[PX_APP_RECORD_JOINTS] = {
-			"joint 0", "joint 1", "joint 2", "joint 3", "joint 4",
-			"joint 5"};
-		double *qd[PX_APP_RECORD_JOINTS] = {0};
-		struct tool_svg_series sq[PX_APP_RECORD_JOINTS];
-		struct tool_svg_series sd[] = {{"clearance", d, "#1f77b4"},
-					       {"protective", pen, "#d62728"}};
-		struct tool_svg_series ss[] = {{"speed scale", f, "#2ca02c"}};
-		struct tool_svg_panel p[] = {{"clearance (mm)", sd, 2},
-					     {"speed scale", ss, 1},
-					     {"commanded velocity (rad/s)", sq, 0}};
-		int j, nj = S.record_joints, ok = 1;
-		for (j = 0; j < nj; j++) {
-			qd[j] = calloc(n + 1, sizeof(double));
-			ok = ok && qd[j];
-			sq[j].name = names[j];
-			sq[j].y = qd[j];
-			sq[j].color = colors[j];
-		}
-		p[2].n_series = nj;
-		for (i = 0; ok && i < n; i++) {
-			x[i] = T.recs[i].t_s;
-			d[i] = T.recs[i].distance_m * 1e3;
-			pen[i] = S.protective_distance_m * 1e3;
-			f[i] = T.recs[i].scale;
-			for (j = 0; j < nj; j++)
-				qd[j][i] = T.recs[i].qdot[j];
-		}
-		if (ok)
-			rc = tool_svg_lines(time_svg,
-					    "proxima-run: clearance, speed scale "
-					    "and commanded joint velocity",
-					    "time (s)", x, n, p, 3);
-		for (j = 0; j < nj; j++)
-			free(qd[j]);
-	} else if (x && d && f && pen && fz) {
-		struct tool_svg_series sd[] = {{"distance", d, "#1f77b4"}};
-		struct tool_svg_series sf[] = {{"|F|", f, "#d62728"},
-					       {"Fz", fz, "#ff7f0e"}};
-		struct tool_svg_series sp[] = {{"penetration", pen, "#2ca02c"}};
-		struct tool_svg_panel p[] = {{"distance (mm)", sd, 1},
-					     {"force (N)", sf, 2},
-					     {"proxy penetration (mm)", sp, 1}};
-		for (i = 0; i < n; i++) {
-			x[i] = T.recs[i].t_s;
-			d[i] = T.recs[i].distance_m * 1e3;
-			f[i] = T.recs[i].force_mag_n;
-			fz[i] = T.recs[i].force_n[2];
-			pen[i] = T.recs[i].penetration_m * 1e3;
-		}
-		rc = tool_svg_lines(time_svg,
-				    "proxima-run: distance, force and proxy "
-				    "penetration",
-				    "time (s)", x, n, p, 3);
-	}
-	free(x);
-	free(d);
-	free(f);
-	free(pen);
-	free(fz);
-	nl = px_stats_copy_bins(px_loop_stats_handle(px_app_loop(A), PX_LOOP_STAT_LATENCY),
-				lbins, PX_STATS_DEFAULT_BINS, &lover);
-	nc = px_stats_copy_bins(px_app_compute_stats(A), cbins, PX_STATS_DEFAULT_BINS, &cover);
-	if (rc == 0 && nl >= 0 && nc >= 0) {
-		struct tool_svg_hist h[] = {
-			{"wake-up latency", lbins, (size_t)nl, lover,
-			 (double)px_stats_bin_ns(px_loop_stats_handle(
-				 px_app_loop(A), PX_LOOP_STAT_LATENCY)) /
-				 1e3,
-			 "#1f77b4"},
-			{"compute time", cbins, (size_t)nc, cover,
-			 (double)px_stats_bin_ns(px_app_compute_stats(A)) / 1e3, "#9467bd"}};
-		rc = tool_svg_histograms(lat_svg,
-					 O.virtual_time
-						 ? "proxima-run: latency (virtual "
-						   "clock: wake-up is 0 by "
-						   "construction)"
-						 : "proxima-run: latency",
-					 "microseconds", h, 2);
-	}
-	return rc;
-}
-
-static void json_stats(FILE *f, const char *name,
-		       const struct px_stats_snapshot *s, int last)
-{
-	fprintf(f,
-		"  \"%s\": {\"count\": %llu, \"p50\": %lld, \"p99\": %lld, "
-		"\"p999\": %lld, \"max\": %lld, \"mean\": %lld}%s\n",
-		name, (unsigned long long)s->count, (long long)s->p50_ns,
-		(long long)s->p99_ns, (long long)s->p999_ns, (long long)s->max_ns,
-		(long long)s->mean_ns, last ? "" : ",");
-}
-
-static void json_string(FILE *f, const char *s)
-{
-	fputc('"', f);
-	for (; *s; s++) {
-		if (*s == '"' || *s == '\\')
-			fprintf(f, "\\%c", *s);
-		else if ((unsigned char)*s < 0x20)
-			fprintf(f, "\\u%04x", *s);
-		else
-			fputc(*s, f);
-	}
-	fputc('"', f);
-}
-
-static double json_num(double v)
-{
-	return isfinite(v) ? v : 0.0;
-}
-
-struct dev_faults {
-	uint64_t by_kind[PX_DEV_ERR__COUNT];
-};
-
-static void device_faults(struct dev_faults *df)
-{
-	int i;
-	memset(df, 0, sizeof(*df));
-	for (i = 0; i < px_app_device_count(A); i++) {
-		struct px_dev_status s;
-		if (px_dev_status(px_app_device_at(A, i), &s) != PX_OK)
-			continue;
-		df->by_kind[PX_DEV_ERR_DECODE] += s.decode_errors;
-		df->by_kind[PX_DEV_ERR_NONFINITE] += s.nonfinite;
-		df->by_kind[PX_DEV_ERR_DUPLICATE] += s.duplicates;
-		df->by_kind[PX_DEV_ERR_STUCK] += s.stuck;
-		df->by_kind[PX_DEV_ERR_UNPLUG] += s.unplugs;
-		df->by_kind[PX_DEV_ERR_IO] += s.io_errors + s.write_errors;
-		df->by_kind[PX_DEV_ERR_BUS] += s.bus_errors;
-	}
-}
-
-static void json_campaign(FILE *f);
-
-/* The loop clock's span over the run: first deadline (periods skipped
- * before it included) to the last cycle's end; missed periods count,
- * as time that went by. On the real clock this is the run's real time,
- * on the virtual clock its simulated time. */
-static double loop_time_s(const struct px_loop_status *st)
-{
-	(void)st;
-	return S.loop_time_s;
-}
-
-/* What ended the run: "cycles" (--duration-s worth of cycles run),
- * "time" (real clock: --duration-s of loop time gone, periods missed),
- * "signal", or "stop" (the loop stopped: an error, a phase). */
-static const char *ended_by(const struct px_loop_status *st)
-{
-	if (S.max_cycles && st->cycles >= S.max_cycles)
-		return "cycles";
-	if (S.ended_by_time)
-		return "time";
-	return interrupted ? "signal" : "stop";
-}
-
-
-/* What the safety layer and the e-stop did: presses seen, how long after
- * the first press the loop was in safe state (ns, -1: never), state at
- * the end. */
-static void json_safety(FILE *f, const struct px_loop_status *st)
-{
-	fprintf(f,
-		"  \"safe_at_end\": %d,\n  \"safe_cause\": \"%s\",\n"
-		"  \"estop_lines\": %d,\n  \"estop_presses\": %llu,\n"
-		"  \"estop_cycles\": %llu,\n  \"estop_to_safe_ns\": %lld,\n"
-		"  \"estop_to_safe_cycles\": %lld,\n"
-		"  \"safe_cycles_before_estop\": %llu,\n"
-		"  \"safe_at_estop\": %d,\n"
-		"  \"enable_write_errors\": %llu,\n",
-		st->safe, st->safe ? px_fault_cause_name(st->safe_cause) : "",
-		S.estop_lines, (unsigned long long)S.estop_presses,
-		(unsigned long long)S.estop_cycles,
-		(long long)S.estop_to_safe_ns, (long long)S.estop_to_safe_cycles,
-		(unsigned long long)S.safe_cycles_before_estop, S.safe_at_estop,
-		(unsigned long long)S.enable_write_errors);
-}
-
-/* Every device's counters, and the CANopen drives' states. */
-static void json_devices(FILE *f)
-{
-	struct px_canopen *co = px_app_canopen(A);
-	int i;
-	fputs("  \"devices\": [", f);
-	for (i = 0; i < px_app_device_count(A); i++) {
-		struct px_dev_status s;
-		if (px_dev_status(px_app_device_at(A, i), &s) != PX_OK)
-			continue;
-		fprintf(f, "%s\n    {\"name\": ", i ? "," : "");
-		json_string(f, s.name);
-		fprintf(f, ", \"backend\": ");
-		json_string(f, s.backend);
-		fprintf(f,
-			", \"state\": %d, \"reports\": %llu, \"samples\": %llu, "
-			"\"writes\": %llu, \"write_errors\": %llu, \"errors\": "
-			"%llu, \"last_error\": ",
-			s.state, (unsigned long long)s.reports,
-			(unsigned long long)s.samples, (unsigned long long)s.writes,
-			(unsigned long long)s.write_errors,
-			(unsigned long long)s.errors);
-		json_string(f, s.last_msg);
-		fputc('}', f);
-	}
-	fputs(px_app_device_count(A) ? "\n  ],\n" : "],\n", f);
-	fprintf(f,
-		"  \"drives_enabled_cycles\": %llu,\n"
-		"  \"drive_problem_cycles\": %llu,\n  \"drives\": [",
-		(unsigned long long)S.drives_enabled_cycles,
-		(unsigned long long)S.drive_problem_cycles);
-	for (i = 0; co && i < S.n_drives; i++) {
-		struct px_canopen_drive_status ds;
-		if (px_canopen_drive_status(co, (size_t)i, &ds) != PX_OK)
-			continue;
-		fprintf(f,
-			"%s\n    {\"node_id\": %d, \"state\": \"%s\", "
-			"\"position\": %.9g, \"lost\": %d, \"emcy\": %llu}",
-			i ? "," : "", ds.node_id, px_cia402_state_name(ds.state),
-			json_num(ds.position), ds.lost,
-			(unsigned long long)ds.emcy_count);
-	}
-	fputs(co && S.n_drives ? "\n  ],\n" : "],\n", f);
-}
-
-static int write_json(const char *path, const struct px_loop_status *st,
-		      const struct px_stats_snapshot *lat,
-		      const struct px_stats_snapshot *cmp, double wall_s,
-		      const char *time_svg, const char *lat_svg,
-		      const char *counter)
-{
-	static struct tool_out out;
-	FILE *f;
-	struct dev_faults df;
-	int k;
-	if (tool_out_open(&out, path) != 0) {
-		snprintf(T.out_why, sizeof(T.out_why), "%s", out.why);
-		return -1;
-	}
-	f = out.f;
-	device_faults(&df);
-	fprintf(f, "{\n  \"config\": ");
-	json_string(f, O.config);
-	fprintf(f,
-		",\n  \"clock\": \"%s\",\n  \"period_ns\": %lld,\n"
-		"  \"simulated_s\": %.6f,\n  \"wall_s\": %.3f,\n"
-		"  \"cycles\": %llu,\n  \"overruns\": %llu,\n"
-		"  \"missed_periods\": %llu,\n",
-		O.virtual_time ? "virtual" : "monotonic",
-		(long long)st->period_ns,
-		(double)st->cycles * (double)st->period_ns * 1e-9, wall_s,
-		(unsigned long long)st->cycles, (unsigned long long)st->overruns,
-		(unsigned long long)st->missed_periods);
-	fprintf(f,
-		"  \"loop_time_s\": %.6f,\n  \"wall_time_s\": %.3f,\n"
-		"  \"duration_s\": %.9g,\n  \"ended_by\": \"%s\",\n",
-		loop_time_s(st), wall_s, O.duration_s, ended_by(st));
-	json_stats(f, "wakeup_latency_ns", lat, 0);
-	json_stats(f, "compute_ns", cmp, 0);
-	{
-		struct px_model_stream_stats ts;
-		int ns = S.tracking_streams;
-		ts = S.tracking;
-		fprintf(f,
-			"  \"tracking\": {\"enabled\": %s, \"streams\": %d, "
-			"\"queries\": %llu, \"tracked\": %llu, \"hot\": %llu, "
-			"\"global\": %llu, \"cold\": %llu, \"jumps\": %llu, "
-			"\"reinits\": %llu, \"verifications\": %llu, "
-			"\"disagreements\": %llu},\n",
-			S.tracking_enabled ? "true" : "false", ns,
-			(unsigned long long)ts.queries,
-			(unsigned long long)ts.tracked,
-			(unsigned long long)ts.hot, (unsigned long long)ts.global,
-			(unsigned long long)ts.cold, (unsigned long long)ts.jumps,
-			(unsigned long long)ts.reinits,
-			(unsigned long long)ts.verifications,
-			(unsigned long long)ts.disagreements);
-	}
-	fprintf(f,
-		"  \"max_force_n\": %.9g,\n  \"force_clamp_n\": %.9g,\n"
-		"  \"min_distance_m\": %.9g,\n  \"max_penetration_m\": %.9g,\n"
-		"  \"min_proxy_distance_m\": %.9g,\n"
-		"  \"min_clearance_m\": %.9g,\n  \"protective_distance_m\": %.9g,\n"
-		"  \"min_speed_scale\": %.9g,\n"
-		"  \"contact_cycles\": %llu,\n  \"safe_state_trips\": %llu,\n"
-		"  \"faults\": {",
-		S.max_force_n, S.rendering ? S.force_clamp_n : 0.0,
-		json_num(S.min_distance_m), S.max_penetration_m,
-		json_num(S.min_proxy_distance_m),
-		S.avoiding ? json_num(S.min_clearance_m) : 0.0,
-		S.avoiding ? S.protective_distance_m : 0.0,
-		S.avoiding ? S.min_speed_scale : 1.0,
-		(unsigned long long)S.contact_cycles,
-		(unsigned long long)st->safe_entries);
-	for (k = 1; k < PX_FAULT__COUNT; k++)
-		fprintf(f, "\"%s\": %llu, ", px_fault_cause_name(k),
-			(unsigned long long)S.faults_by_cause[k]);
-	for (k = 1; k < PX_DEV_ERR__COUNT; k++)
-		if (k != PX_DEV_ERR_OPEN && k != PX_DEV_ERR_ESTOP &&
-		    k != PX_DEV_ERR_ENCODE)
-			fprintf(f, "\"device_%s\": %llu, ", px_dev_errkind_name(k),
-				(unsigned long long)df.by_kind[k]);
-	fprintf(f,
-		"\"velocity_limit\": %llu, \"query_error\": %llu, "
-		"\"dropped\": %llu},\n",
-		(unsigned long long)S.velocity_trips,
-		(unsigned long long)S.query_errors,
-		(unsigned long long)st->faults_dropped);
-	json_safety(f, st);
-	json_devices(f);
-	json_shutdown(f);
-	{
-		uint64_t checked = S.watchdog_trips_checked;
-		int64_t worst = S.max_trip_to_safe_cycles;
-		fprintf(f,
-			"  \"faults_injected\": %zu,\n  \"faults_popped\": %llu,\n"
-			"  \"watchdog_trips_checked\": %llu,\n"
-			"  \"max_trip_to_safe_cycles\": %lld,\n"
-			"  \"nonfinite_outputs\": %llu,\n"
-			"  \"phase_error_ns\": %lld,\n",
-			S.faults_injected, (unsigned long long)S.faults_popped,
-			(unsigned long long)checked, (long long)worst,
-			(unsigned long long)S.nonfinite_outputs,
-			(long long)S.phase_error_ns);
-	}
-	json_campaign(f);
-	fprintf(f,
-		"  \"allocations_after_setup\": %llu,\n"
-		"  \"allocations_setup\": %llu,\n"
-		"  \"allocation_counter\": \"%s\",\n"
-		"  \"telemetry_records\": %llu,\n  \"telemetry_dropped\": %llu,\n"
-		"  \"telemetry_decimation\": %lld,\n"
-		"  \"realtime\": %d,\n  \"csv\": ",
-		(unsigned long long)S.allocations_after_setup,
-		(unsigned long long)T.setup_heap_calls, counter,
-		(unsigned long long)S.telemetry_records,
-		(unsigned long long)S.telemetry_dropped, (long long)S.decimation,
-		st->realtime);
-	if (S.csv_path[0])
-		json_string(f, S.csv_path);
-	else
-		fputs("null", f);
-	fputs(",\n  \"plots\": [", f);
-	json_string(f, time_svg);
-	fputs(", ", f);
-	json_string(f, lat_svg);
-	fputs("]\n}\n", f);
-	if (tool_out_commit(&out) != 0) {
-		snprintf(T.out_why, sizeof(T.out_why), "%s", out.why);
-		return -1;
-	}
-	return 0;
 }
 
 /* The telemetry CSV (S.csv_path, checked by validate()): its header now,
@@ -903,173 +457,66 @@ static void close_csv(void)
 		fprintf(stderr, "proxima-run: %s\n", T.csv_out.why);
 }
 
-
-static void print_campaign(void)
+/* After the run: the summary, the CSV and plot names, the plots and the
+ * JSON (the outputs are safe and the telemetry drained by now). */
+static void report(double wall_s, const char *counter)
 {
-	size_t i;
-	if (!S.n_reactions)
-		return;
-	printf("  fault campaign    (loop faults from each window's start to "
-	       "its end + device timeout)\n");
-	for (i = 0; i < S.n_reactions; i++) {
-		const struct px_app_reaction *r = &S.reactions[i];
-		printf("    %-9s %-8s %7.3f..%7.3f s p %.2f: %4llu loop faults, ",
-		       r->kind, r->device, (double)r->start_ns * 1e-9,
-		       (double)(r->start_ns + r->duration_ns) * 1e-9, r->probability,
-		       (unsigned long long)r->loop_faults);
-		if (r->safe_after_ns >= 0)
-			printf("safe state after %.1f ms\n", (double)r->safe_after_ns * 1e-6);
+	static struct run_result r;
+	char why[TOOL_OUT_WHY_MAX];
+	r.app = A;
+	r.opt = &O;
+	r.sum = &S;
+	px_loop_status(px_app_loop(A), &r.st);
+	px_loop_stats(px_app_loop(A), PX_LOOP_STAT_LATENCY, &r.lat);
+	px_stats_read(px_app_compute_stats(A), &r.cmp);
+	r.wall_s = wall_s;
+	r.interrupted = interrupted;
+	r.counted = px_alloc_count_thread != NULL;
+	r.counter = counter;
+	r.setup_heap_calls = T.setup_heap_calls;
+	r.recs = T.recs;
+	r.n_recs = T.n_recs;
+	run_print_summary(&r);
+	if (S.csv_path[0])
+		printf("  csv               %s\n", S.csv_path);
+	if (run_write_plots(&r, S.time_svg, S.lat_svg) == 0)
+		printf("  plots             %s\n                    %s\n",
+		       S.time_svg, S.lat_svg);
+	else
+		fprintf(stderr, "proxima-run: cannot write the plots: %s\n",
+			tool_svg_error());
+	if (O.summary_json) {
+		if (run_write_json(&r, O.summary_json, S.time_svg, S.lat_svg,
+				   why, sizeof(why)) == 0)
+			printf("  summary           %s\n", O.summary_json);
 		else
-			printf("no safe state (samples stayed fresh)\n");
+			fprintf(stderr, "proxima-run: %s\n", why);
 	}
 }
 
-static void json_campaign(FILE *f)
+/* What is about to run, on stderr. */
+static void announce(void)
 {
-	size_t i;
-	fputs("  \"fault_campaign\": [", f);
-	for (i = 0; i < S.n_reactions; i++) {
-		const struct px_app_reaction *r = &S.reactions[i];
-		fprintf(f, "%s\n    {\"kind\": \"%s\", \"device\": ", i ? "," : "",
-			r->kind);
-		json_string(f, r->device);
-		fprintf(f,
-			", \"start_ns\": %lld, \"duration_ns\": %lld, "
-			"\"loop_faults\": %llu, \"safe_after_ns\": %lld}",
-			(long long)r->start_ns, (long long)r->duration_ns,
-			(unsigned long long)r->loop_faults,
-			(long long)r->safe_after_ns);
-	}
-	fputs(S.n_reactions ? "\n  ],\n" : "],\n", f);
+	fprintf(stderr,
+		"proxima-run: %s: %zu scene model%s, %d device%s, %s, %s clock, "
+		"%s\n",
+		O.config, S.scene_models,
+		S.scene_models == 1 ? "" : "s",
+		(int)CFG->n_devices, CFG->n_devices == 1 ? "" : "s",
+		S.rendering ? (S.proxy_renderer
+				       ? "haptic proxy rendering"
+				       : "haptic penalty rendering")
+		: S.avoiding ? "collision avoidance over CANopen"
+			     : "no control output",
+		O.virtual_time ? "virtual" : "real-time",
+		S.max_cycles ? "fixed duration" : "until Ctrl-C");
 }
 
-static void print_summary(const struct px_loop_status *st,
-			  const struct px_stats_snapshot *lat,
-			  const struct px_stats_snapshot *cmp, double wall_s)
-{
-	int k;
-	printf("proxima-run: %s (%s clock)\n", O.config,
-	       O.virtual_time ? "virtual" : "monotonic");
-	printf("  cycles            %llu in %.3f s simulated, %.3f s wall "
-	       "(%.0f cycles/s)\n",
-	       (unsigned long long)st->cycles,
-	       (double)st->cycles * (double)st->period_ns * 1e-9, wall_s,
-	       wall_s > 0 ? (double)st->cycles / wall_s : 0.0);
-	printf("  time              loop clock %.3f s (%llu missed period%s), "
-	       "wall %.3f s; ",
-	       loop_time_s(st), (unsigned long long)st->missed_periods,
-	       st->missed_periods == 1 ? "" : "s", wall_s);
-	if (O.duration_s > 0)
-		printf("--duration-s %g: ended by %s\n", O.duration_s,
-		       ended_by(st));
-	else
-		printf("until stopped: ended by %s\n", ended_by(st));
-	printf("  overruns          %llu (missed periods %llu)%s\n",
-	       (unsigned long long)st->overruns,
-	       (unsigned long long)st->missed_periods,
-	       O.virtual_time ? ""
-	       : st->realtime   ? " on SCHED_FIFO"
-				: " (not real-time scheduled)");
-	printf("  wake-up latency   p50 %.1f us, p99 %.1f us, p99.9 %.1f us, "
-	       "max %.1f us\n",
-	       lat->p50_ns / 1e3, lat->p99_ns / 1e3, lat->p999_ns / 1e3,
-	       lat->max_ns / 1e3);
-	printf("  compute           p50 %.1f us, p99 %.1f us, p99.9 %.1f us, "
-	       "max %.1f us\n",
-	       cmp->p50_ns / 1e3, cmp->p99_ns / 1e3, cmp->p999_ns / 1e3,
-	       cmp->max_ns / 1e3);
-	if (S.rendering)
-		printf("  force             max %.3f N (clamp %.3f N), contact "
-		       "in %.1f %% of cycles\n",
-		       S.max_force_n, S.force_clamp_n,
-		       st->cycles ? 100.0 * (double)S.contact_cycles /
-					    (double)st->cycles
-				  : 0.0);
-	if (S.avoiding)
-		printf("  avoidance         min clearance %.1f mm (protective %.1f "
-		       "mm, influence %.1f mm), speed scale min %.2f, nominal "
-		       "motion stopped in %llu cycles\n",
-		       json_num(S.min_clearance_m) * 1e3,
-		       S.protective_distance_m * 1e3,
-		       S.influence_distance_m * 1e3, S.min_speed_scale,
-		       (unsigned long long)S.stop_cycles);
-	else if (S.distance_reported)
-		printf("  distance          min %+.3f mm, max penetration %.3f mm, "
-	       "proxy min clearance %+.3f mm\n",
-	       json_num(S.min_distance_m) * 1e3, S.max_penetration_m * 1e3,
-	       json_num(S.min_proxy_distance_m) * 1e3);
-	printf("  safe state        %llu trip%s",
-	       (unsigned long long)st->safe_entries,
-	       st->safe_entries == 1 ? "" : "s");
-	for (k = 1; k < PX_FAULT__COUNT; k++)
-		if (S.faults_by_cause[k])
-			printf(", %s %llu", px_fault_cause_name(k),
-			       (unsigned long long)S.faults_by_cause[k]);
-	if (S.velocity_trips)
-		printf(", velocity limit %llu", (unsigned long long)S.velocity_trips);
-	if (S.query_errors)
-		printf(", query errors %llu (last: %s)",
-		       (unsigned long long)S.query_errors,
-		       px_strerror(S.last_query_error));
-	if (S.estop_lines)
-		printf("\n  e-stop            %llu press%s, held %llu cycles%s",
-		       (unsigned long long)S.estop_presses,
-		       S.estop_presses == 1 ? "" : "es",
-		       (unsigned long long)S.estop_cycles,
-		       st->safe ? "; in safe state at the end" : "");
-	if (px_app_canopen(A)) {
-		int i, n = 0;
-		for (i = 0; i < S.n_drives; i++) {
-			struct px_canopen_drive_status ds;
-			if (px_canopen_drive_status(px_app_canopen(A), (size_t)i,
-						    &ds) == PX_OK &&
-			    ds.state == PX_CIA402_OPERATION_ENABLED)
-				n++;
-		}
-		printf("\n  drives            %d on '%s', enabled in %llu cycles, "
-		       "%d in operation enabled at the end",
-		       S.n_drives, S.drives_device, (unsigned long long)S.drives_enabled_cycles,
-		       n);
-	}
-	if (S.tracking_enabled) {
-		struct px_model_stream_stats ts = S.tracking;
-		int ns = S.tracking_streams;
-		double q = ts.queries ? (double)ts.queries : 1.0;
-		printf("\n  tracking          %d stream%s: %llu answers, %.1f %% "
-		       "tracked (%.1f %% hot), %.1f %% global, %.1f %% cold, "
-		       "%llu jumps, %llu verified, %llu disagreements",
-		       ns, ns == 1 ? "" : "s", (unsigned long long)ts.queries,
-		       100.0 * (double)ts.tracked / q, 100.0 * (double)ts.hot / q,
-		       100.0 * (double)ts.global / q, 100.0 * (double)ts.cold / q,
-		       (unsigned long long)ts.jumps,
-		       (unsigned long long)ts.verifications,
-		       (unsigned long long)ts.disagreements);
-	}
-	if (!px_alloc_count_thread)
-		printf("\n  allocations       not counted (no heap counter: "
-		       "preload libproxima-alloc-count.so)\n");
-	else
-		printf("\n  allocations       %llu after setup (loop thread; "
-		       "setup made %llu)\n",
-		       (unsigned long long)S.allocations_after_setup,
-		       (unsigned long long)T.setup_heap_calls);
-	printf("  telemetry         %llu records (every %lld cycles), %llu "
-	       "dropped\n",
-	       (unsigned long long)S.telemetry_records, (long long)S.decimation,
-	       (unsigned long long)S.telemetry_dropped);
-	shutdown_line(stdout, "  shutdown          ");
-	print_campaign();
-}
-
-/* Parse --fault KIND,DEVICE,START_S,DURATION_S[,PROBABILITY[,DELAY_S]]
- * into f. Returns NULL or why not. */
 int main(int argc, char **argv)
 {
 	static struct px_config_diag diag;
 	const char *counter = heap_counter_name();
-	struct px_loop_status st;
-	struct px_stats_snapshot lat, cmp;
-	char time_svg[1100], lat_svg[1100], msg[256];
+	char msg[256];
 	int64_t wall0;
 	double wall_s;
 	int rc = parse_args(argc, argv, &O);
@@ -1117,19 +564,7 @@ int main(int argc, char **argv)
 	}
 	T.setup_heap_calls = heap_count();
 	px_app_warnings(A);
-	fprintf(stderr,
-		"proxima-run: %s: %zu scene model%s, %d device%s, %s, %s clock, "
-		"%s\n",
-		O.config, S.scene_models,
-		S.scene_models == 1 ? "" : "s",
-		(int)CFG->n_devices, CFG->n_devices == 1 ? "" : "s",
-		S.rendering ? (S.proxy_renderer
-				       ? "haptic proxy rendering"
-				       : "haptic penalty rendering")
-		: S.avoiding ? "collision avoidance over CANopen"
-			     : "no control output",
-		O.virtual_time ? "virtual" : "real-time",
-		S.max_cycles ? "fixed duration" : "until Ctrl-C");
+	announce();
 	wall0 = mono_ns();
 	if (interrupted)
 		px_app_stop(A); /* a signal during setup: straight to shutdown */
@@ -1159,31 +594,12 @@ int main(int argc, char **argv)
 	}
 	close_csv();
 	px_app_summary(A, &S);
-	px_loop_status(px_app_loop(A), &st);
-	px_loop_stats(px_app_loop(A), PX_LOOP_STAT_LATENCY, &lat);
-	px_stats_read(px_app_compute_stats(A), &cmp);
-	print_summary(&st, &lat, &cmp, wall_s);
-	plot_paths(time_svg, lat_svg, sizeof(time_svg));
-	if (S.csv_path[0])
-		printf("  csv               %s\n", S.csv_path);
-	if (write_plots(time_svg, lat_svg) == 0)
-		printf("  plots             %s\n                    %s\n", time_svg,
-		       lat_svg);
-	else
-		fprintf(stderr, "proxima-run: cannot write the plots: %s\n",
-			tool_svg_error());
-	if (O.summary_json) {
-		if (write_json(O.summary_json, &st, &lat, &cmp, wall_s, time_svg,
-			       lat_svg, counter) == 0)
-			printf("  summary           %s\n", O.summary_json);
-		else
-			fprintf(stderr, "proxima-run: %s\n", T.out_why);
-	}
+	report(wall_s, counter);
 	if (rc < 0)
 		fprintf(stderr, "proxima-run: the loop stopped: %s\n",
 			px_strerror(rc));
 	if (!S.shutdown_safe)
-		shutdown_line(stderr, "proxima-run: shutdown: ");
+		run_shutdown_line(A, stderr, "proxima-run: shutdown: ");
 	{
 		int safe = S.shutdown_safe;
 		finish();
