@@ -79,11 +79,12 @@ static inline int trim_row(const struct px_trim *t, double y)
 void px__trim_point(const struct px_trim *t, const struct trim_piece *p,
 		    double s, double *x, double *y);
 
-/* Cartesian control points of node n of piece p (deg + 1 each) and their
- * box with the node's end points, unwidened. */
+/* Cartesian control points of node n of piece p (deg + 1 each), their
+ * weights when w is not NULL, and their box with the node's end points,
+ * unwidened. */
 void px__trim_node_ctrl(const struct px_trim *t, const struct trim_piece *p,
 			const struct trim_node *n, double *x, double *y,
-			double box[4]);
+			double *w, double box[4]);
 
 /* Winding number of (u, v) over the pieces of loops lo..hi-1 without the
  * grid; *on set when the point is on one of them (then *pi is the piece

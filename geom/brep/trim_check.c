@@ -77,7 +77,7 @@ enum { X_NONE = 0, X_FOUND = 1, X_UNDECIDED = 2 };
 static void xbox(const struct xctx *c, const struct xnode *a, double *x,
 		 double *y, double box[4])
 {
-	px__trim_node_ctrl(c->t, &c->t->pc[a->pi], &a->n, x, y, box);
+	px__trim_node_ctrl(c->t, &c->t->pc[a->pi], &a->n, x, y, NULL, box);
 }
 
 static void xsplit(const struct xctx *c, const struct xnode *a,

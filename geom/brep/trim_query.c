@@ -21,7 +21,7 @@ void px__trim_point(const struct px_trim *t, const struct trim_piece *p,
 
 void px__trim_node_ctrl(const struct px_trim *t, const struct trim_piece *p,
 			const struct trim_node *n, double *x, double *y,
-			double box[4])
+			double *w, double box[4])
 {
 	const double *X = t->coef + p->off;
 	const double *Y = X + p->deg + 1, *W = Y + p->deg + 1;
@@ -36,6 +36,8 @@ void px__trim_node_ctrl(const struct px_trim *t, const struct trim_piece *p,
 	box[2] = fmin(n->ay, n->ey), box[3] = fmax(n->ay, n->ey);
 	for (i = 0; i <= d; i++) {
 		x[i] = rx[i] / rw[i], y[i] = ry[i] / rw[i];
+		if (w)
+			w[i] = rw[i];
 		box[0] = fmin(box[0], x[i]), box[1] = fmax(box[1], x[i]);
 		box[2] = fmin(box[2], y[i]), box[3] = fmax(box[3], y[i]);
 	}
@@ -102,6 +104,70 @@ static void push_halves(const struct px_trim *t, const struct trim_piece *p,
 }
 
 /*
+ * Clipping (as Bezier clipping does): the curve meets the line y = v
+ * where f = W (y - v) vanishes, a polynomial whose Bernstein
+ * coefficients on the node are w_i (y_i - v); its roots lie where the
+ * hull of the points (i / d, f_i) meets the band |f| <= eps (eps covers
+ * the rounding of the f_i). Returns -1 when no root can exist (the
+ * curve keeps more than the slack away from the line, so its ends lie
+ * on one side and it counts nothing), 1 with the narrowed node in *out
+ * when the roots fit in at most half of the node (a little widened, and
+ * with both cut-off ends on the side of the node's ends: the cut-off
+ * parts keep off the line, so they count nothing), else 0 (halve).
+ * Near a simple crossing this shrinks the node quadratically.
+ */
+static int clip_node(const struct px_trim *t, const struct trim_piece *p,
+		     const struct trim_node *nd, const double *y,
+		     const double *w, double v, struct trim_node *out)
+{
+	double f[PX_NURBS_MAX_DEGREE + 1], eps = 0.0, lo = INFINITY;
+	double hi = -INFINITY, pad, c, e, cx, cy, ex, ey;
+	int i, j, k, d = p->deg;
+
+	for (i = 0; i <= d; i++) {
+		f[i] = w[i] * (y[i] - v);
+		eps = fmax(eps, w[i]);
+	}
+	eps *= 2.0 * t->slack;
+	for (i = 0; i <= d; i++)
+		if (fabs(f[i]) <= eps)
+			lo = fmin(lo, (double)i / d), hi = fmax(hi, (double)i / d);
+	for (k = -1; k <= 1; k += 2)
+		for (i = 0; i <= d; i++)
+			for (j = i + 1; j <= d; j++) {
+				double a = f[i] - k * eps, b = f[j] - k * eps, s;
+				if (!((a < 0 && b > 0) || (a > 0 && b < 0)))
+					continue;
+				s = (i + (j - i) * (a / (a - b))) / d;
+				lo = fmin(lo, s), hi = fmax(hi, s);
+			}
+	if (lo > hi)
+		return -1;
+	pad = 0.02 * (hi - lo) + 1e-9;
+	lo = lo - pad > 0.0 ? lo - pad : 0.0;
+	hi = hi + pad < 1.0 ? hi + pad : 1.0;
+	if (hi - lo > 0.5)
+		return 0;
+	c = lo > 0.0 ? nd->a + lo * (nd->b - nd->a) : nd->a;
+	e = hi < 1.0 ? nd->a + hi * (nd->b - nd->a) : nd->b;
+	if (!(c < e))
+		return 0;
+	cx = nd->ax, cy = nd->ay, ex = nd->ex, ey = nd->ey;
+	if (c > nd->a) {
+		px__trim_point(t, p, c, &cx, &cy);
+		if ((cy >= v) != (nd->ay >= v))
+			return 0;
+	}
+	if (e < nd->b) {
+		px__trim_point(t, p, e, &ex, &ey);
+		if ((ey >= v) != (nd->ey >= v))
+			return 0;
+	}
+	*out = (struct trim_node){c, e, cx, cy, ex, ey};
+	return 1;
+}
+
+/*
  * Depth-first halving; the left half is examined first, the right one
  * waits on the stack, so the stack never holds more than one node per
  * level. Every node that is not halved counts the exact crossings of
@@ -115,7 +181,7 @@ int px__trim_piece_cross(const struct px_trim *t, const struct trim_piece *p,
 	struct trim_node st[PX_TRIM_MAX_DEPTH + 2];
 	unsigned char dep[PX_TRIM_MAX_DEPTH + 2];
 	double x[PX_NURBS_MAX_DEGREE + 1], y[PX_NURBS_MAX_DEGREE + 1];
-	double box[4], xl, xr, sl = t->slack;
+	double w[PX_NURBS_MAX_DEGREE + 1], box[4], xl, xr, sl = t->slack;
 	int n = 1, sum = 0;
 
 	if (p->by1 < v || p->by0 > v || p->bx1 < u)
@@ -128,7 +194,7 @@ int px__trim_piece_cross(const struct px_trim *t, const struct trim_piece *p,
 		struct trim_node nd = st[--n];
 		int d = dep[n];
 
-		px__trim_node_ctrl(t, p, &nd, x, y, box);
+		px__trim_node_ctrl(t, p, &nd, x, y, w, box);
 		if (box[3] + sl < v || box[2] - sl > v || box[1] + sl < u)
 			continue;
 		if (box[0] - sl > u) {
@@ -148,7 +214,15 @@ int px__trim_piece_cross(const struct px_trim *t, const struct trim_piece *p,
 			*s = 0.5 * (nd.a + nd.b);
 			return 0;
 		}
-		push_halves(t, p, &nd, d, st, dep, &n);
+		switch (clip_node(t, p, &nd, y, w, v, &st[n])) {
+		case -1:
+			break;
+		case 1:
+			dep[n++] = (unsigned char)(d + 1);
+			break;
+		default:
+			push_halves(t, p, &nd, d, st, dep, &n);
+		}
 	}
 	return sum;
 }
@@ -257,7 +331,7 @@ static int piece_meets_box(const struct px_trim *t,
 
 		if (--*budget < 0)
 			return 1;
-		px__trim_node_ctrl(t, p, &nd, x, y, box);
+		px__trim_node_ctrl(t, p, &nd, x, y, NULL, box);
 		if (box[1] + sl < q[0] || box[0] - sl > q[1] ||
 		    box[3] + sl < q[2] || box[2] - sl > q[3])
 			continue;

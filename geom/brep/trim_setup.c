@@ -299,7 +299,15 @@ static int collect(const struct px_trim_loop *loops, int n_loops,
 					     q->ay, q->curve, close_tol);
 				return PX_E_INVAL;
 			}
+			/* the start of q moves to the end of p, and so does
+			 * its first control point: the curve runs through the
+			 * stored point (within rounding) */
 			q->ax = p->ex, q->ay = p->ey;
+			{
+				double *X = b->coef + q->off;
+				double *Y = X + q->deg + 1, *W = Y + q->deg + 1;
+				X[0] = q->ax * W[0], Y[0] = q->ay * W[0];
+			}
 		}
 	}
 	loop_first[n_loops] = b->n;

@@ -670,6 +670,156 @@ static void test_accepts(void)
 	px_trim_free(t);
 }
 
+/* Rays through vertices, along horizontal edges, points on corners and
+ * on grid lines: the half-open crossing rule must hold everywhere. */
+static void test_degenerate_rays(void)
+{
+	static struct dom d;
+	struct px_trim_error e;
+	struct px_trim *t;
+	double sq[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+	double dia[8] = {0.5, 0.1, 0.7, 0.3, 0.5, 0.5, 0.3, 0.3};
+	double rect[8] = {0.25, 0.6, 0.25, 0.8, 0.75, 0.8, 0.75, 0.6};
+	int g, i;
+
+	for (g = 0; g <= 5; g++) {
+		struct px_trim_opts o;
+		int k;
+		memset(&d, 0, sizeof(d));
+		d.n = 3;
+		add_polygon(&d.s[0], sq, 4);
+		add_polygon(&d.s[1], dia, 4);  /* counter-clockwise: reversed */
+		add_polygon(&d.s[2], rect, 4); /* clockwise */
+		for (k = 0; k < 3; k++) {
+			d.loops[k].curves = d.s[k].c;
+			d.loops[k].n_curves = d.s[k].n;
+			d.loops[k].reversed = NULL;
+		}
+		px_trim_opts_default(&o);
+		o.grid = g == 0 ? 0 : (int[]){1, 2, 4, 5, 256}[g - 1];
+		PX_CHECK_MSG(px_trim_create(d.loops, 3, &o, &e, &t) == PX_OK, "%s", e.msg);
+		PX_CHECK_INT_EQ(px_trim_loop_reversed(t, 1), 1);
+		PX_CHECK_INT_EQ(px_trim_loop_reversed(t, 2), 0);
+		/* through the diamond's vertices */
+		PX_CHECK_INT_EQ(px_trim_contains(t, 0.1, 0.3, NULL), PX_TRIM_INSIDE);
+		PX_CHECK_INT_EQ(px_trim_contains(t, 0.1, 0.1, NULL), PX_TRIM_INSIDE);
+		PX_CHECK_INT_EQ(px_trim_contains(t, 0.1, 0.5, NULL), PX_TRIM_INSIDE);
+		PX_CHECK_INT_EQ(px_trim_contains(t, 0.5, 0.3, NULL), PX_TRIM_OUTSIDE);
+		PX_CHECK_INT_EQ(px_trim_contains(t, 0.8, 0.3, NULL), PX_TRIM_INSIDE);
+		PX_CHECK_INT_EQ(px_trim_contains(t, 0.5, 0.1, NULL), PX_TRIM_BOUNDARY);
+		PX_CHECK_INT_EQ(px_trim_contains(t, 0.7, 0.3, NULL), PX_TRIM_BOUNDARY);
+		/* along the rectangle's horizontal edges */
+		PX_CHECK_INT_EQ(px_trim_contains(t, 0.1, 0.6, NULL), PX_TRIM_INSIDE);
+		PX_CHECK_INT_EQ(px_trim_contains(t, 0.1, 0.8, NULL), PX_TRIM_INSIDE);
+		PX_CHECK_INT_EQ(px_trim_contains(t, 0.9, 0.8, NULL), PX_TRIM_INSIDE);
+		PX_CHECK_INT_EQ(px_trim_contains(t, 0.5, 0.6, NULL), PX_TRIM_BOUNDARY);
+		PX_CHECK_INT_EQ(px_trim_contains(t, 0.25, 0.8, NULL), PX_TRIM_BOUNDARY);
+		PX_CHECK_INT_EQ(px_trim_contains(t, 0.5, 0.7, NULL), PX_TRIM_OUTSIDE);
+		/* the outer corners and edges, just in and out */
+		PX_CHECK_INT_EQ(px_trim_contains(t, 0, 0, NULL), PX_TRIM_BOUNDARY);
+		PX_CHECK_INT_EQ(px_trim_contains(t, 1, 1, NULL), PX_TRIM_BOUNDARY);
+		PX_CHECK_INT_EQ(px_trim_contains(t, 1e-12, 1e-12, NULL), PX_TRIM_INSIDE);
+		PX_CHECK_INT_EQ(px_trim_contains(t, -1e-12, 0.5, NULL), PX_TRIM_OUTSIDE);
+		PX_CHECK_INT_EQ(px_trim_contains(t, 0.5, 1 + 1e-12, NULL), PX_TRIM_OUTSIDE);
+		/* every grid line and random points against the exact answer */
+		for (i = 0; i < 20000; i++) {
+			int kind = i % 3;
+			double u = px_rand_range(-0.05, 1.05), v = px_rand_range(-0.05, 1.05);
+			int want, got, on;
+			if (kind == 1) /* on a grid line or a vertex's height */
+				v = (double)px_rand_int(0, 20) / 20;
+			if (kind == 2)
+				u = (double)px_rand_int(0, 20) / 20;
+			{
+				double ax = fabs(u - 0.5), ay = fabs(v - 0.3);
+				int in_sq = u > 0 && u < 1 && v > 0 && v < 1;
+				int in_dia = ax + ay < 0.2;
+				int in_rect = u > 0.25 && u < 0.75 && v > 0.6 && v < 0.8;
+				on = (u >= 0 && u <= 1 && v >= 0 && v <= 1 && !in_sq) ||
+				     fabs(ax + ay - 0.2) < 1e-9 ||
+				     (u >= 0.25 && u <= 0.75 && v >= 0.6 && v <= 0.8 && !in_rect);
+				want = in_sq && !in_dia && !in_rect;
+			}
+			got = px_trim_contains(t, u, v, NULL);
+			if (on)
+				continue;
+			PX_CHECK_MSG(got == want, "grid %d (%.17g, %.17g): got %d want %d",
+				     px_trim_grid_size(t), u, v, got, want);
+		}
+		px_trim_free(t);
+	}
+}
+
+/* The grid changes the speed, never an answer. */
+static void test_grid_sizes(void)
+{
+	struct dom d;
+	struct px_trim_error e;
+	struct px_trim *ref, *t;
+	int gs[] = {1, 2, 3, 7, 40, 256}, gi, i, k;
+
+	make_blobs(&d, 3, 0);
+	ref = build(&d, &e);
+	for (gi = 0; gi < 6; gi++) {
+		struct px_trim_opts o;
+		px_trim_opts_default(&o);
+		o.grid = gs[gi];
+		for (k = 0; k < d.n; k++) {
+			d.loops[k].curves = d.s[k].c;
+			d.loops[k].n_curves = d.s[k].n;
+			d.loops[k].reversed = d.s[k].rev;
+		}
+		PX_CHECK_MSG(px_trim_create(d.loops, d.n, &o, &e, &t) == PX_OK, "%s", e.msg);
+		PX_CHECK_INT_EQ(px_trim_grid_size(t), gs[gi]);
+		for (i = 0; i < 20000; i++) {
+			double u = px_rand_range(-1.1, 1.1), v = px_rand_range(-1.1, 1.1);
+			int a = px_trim_contains(ref, u, v, NULL), b = px_trim_contains(t, u, v, NULL);
+			PX_CHECK_MSG(a == b, "grid %d (%.17g, %.17g): %d vs %d", gs[gi], u, v, b, a);
+			if (i % 8 == 0) {
+				double s = pow(10, px_rand_range(-6, 0));
+				int ca = px_trim_classify_box(ref, u, u + s, v, v + s);
+				int cb = px_trim_classify_box(t, u, u + s, v, v + s);
+				PX_CHECK(ca == cb || ca == PX_TRIM_BOX_CROSSED || cb == PX_TRIM_BOX_CROSSED);
+			}
+		}
+		px_trim_free(t);
+	}
+	px_trim_free(ref);
+}
+
+/* Loops near each other but apart are accepted; closer than the
+ * touching tolerance they are refused. */
+static void test_near_loops(void)
+{
+	static struct dom d;
+	double sq[8] = {0, 0, 1, 0, 1, 1, 0, 1};
+	double gaps[] = {1e-3, 1e-6, 1e-8};
+	int i;
+
+	for (i = 0; i < 3; i++) {
+		struct px_trim_error e;
+		struct px_trim *t = NULL;
+		int rc;
+		memset(&d, 0, sizeof(d));
+		d.n = 2;
+		add_polygon(&d.s[0], sq, 4);
+		add_circle(&d.s[1], 0.5, 0.3 + gaps[i], 0.3, -2 * M_PI);
+		d.loops[0] = (struct px_trim_loop){d.s[0].c, 4, NULL};
+		d.loops[1] = (struct px_trim_loop){d.s[1].c, 1, NULL};
+		rc = px_trim_create(d.loops, 2, NULL, &e, &t);
+		PX_CHECK_MSG(rc == PX_OK, "gap %g: %s", gaps[i], e.msg);
+		PX_CHECK_INT_EQ(px_trim_contains(t, 0.5, 0.5 * gaps[i], NULL), PX_TRIM_INSIDE);
+		PX_CHECK_INT_EQ(px_trim_contains(t, 0.5, 2 * gaps[i], NULL), PX_TRIM_OUTSIDE);
+		px_trim_free(t);
+	}
+	memset(&d, 0, sizeof(d));
+	d.n = 2;
+	add_polygon(&d.s[0], sq, 4);
+	add_circle(&d.s[1], 0.5, 0.3 + 1e-13, 0.3, -2 * M_PI);
+	expect_refusal(&d, PX_E_INVAL, PX_TRIM_FAULT_CROSS,
+		       "outer loop curve 0 and hole 1 curve 0 cross or touch", NULL);
+}
+
 /* Queries make no heap calls. */
 static void test_no_alloc(void)
 {
@@ -696,5 +846,6 @@ static void test_no_alloc(void)
 static const struct px_test tests[] = {
 	PX_T(test_square_disc), PX_T(test_scales), PX_T(test_blobs_vs_polygon),
 	PX_T(test_boxes), PX_T(test_refusals), PX_T(test_accepts),
+	PX_T(test_degenerate_rays), PX_T(test_grid_sizes), PX_T(test_near_loops),
 	PX_T(test_no_alloc)};
 PX_TEST_MAIN(tests)
