@@ -51,6 +51,18 @@ struct px_trim {
 	double on_tol, close_tol;
 };
 
+/* Smaller / larger of two numbers that are not NaN (the queries' hot
+ * loops: libm's fmin/fmax are calls). */
+static inline double trim_min(double a, double b)
+{
+	return a < b ? a : b;
+}
+
+static inline double trim_max(double a, double b)
+{
+	return a > b ? a : b;
+}
+
 /* Grid column / row of a coordinate: monotone in x, clamped to the grid
  * (setup and queries must use these same functions). */
 static inline int trim_cell(double x, double x0, double inv, int g)

@@ -32,14 +32,14 @@ void px__trim_node_ctrl(const struct px_trim *t, const struct trim_piece *p,
 	px_bern_restrict(X, d, n->a, n->b, rx);
 	px_bern_restrict(Y, d, n->a, n->b, ry);
 	px_bern_restrict(W, d, n->a, n->b, rw);
-	box[0] = fmin(n->ax, n->ex), box[1] = fmax(n->ax, n->ex);
-	box[2] = fmin(n->ay, n->ey), box[3] = fmax(n->ay, n->ey);
+	box[0] = trim_min(n->ax, n->ex), box[1] = trim_max(n->ax, n->ex);
+	box[2] = trim_min(n->ay, n->ey), box[3] = trim_max(n->ay, n->ey);
 	for (i = 0; i <= d; i++) {
 		x[i] = rx[i] / rw[i], y[i] = ry[i] / rw[i];
 		if (w)
 			w[i] = rw[i];
-		box[0] = fmin(box[0], x[i]), box[1] = fmax(box[1], x[i]);
-		box[2] = fmin(box[2], y[i]), box[3] = fmax(box[3], y[i]);
+		box[0] = trim_min(box[0], x[i]), box[1] = trim_max(box[1], x[i]);
+		box[2] = trim_min(box[2], y[i]), box[3] = trim_max(box[3], y[i]);
 	}
 }
 
@@ -74,7 +74,7 @@ static void hull_cut(const double *x, const double *y, int d,
 	px[d + 2] = n->ex, py[d + 2] = n->ey - v;
 	for (i = 0; i < m; i++)
 		if (fabs(py[i]) <= sl)
-			lo = fmin(lo, px[i]), hi = fmax(hi, px[i]);
+			lo = trim_min(lo, px[i]), hi = trim_max(hi, px[i]);
 	for (e = -1; e <= 1; e += 2) {
 		double h = e * sl;
 		for (i = 0; i < m; i++)
@@ -83,7 +83,7 @@ static void hull_cut(const double *x, const double *y, int d,
 				if (!((a < 0 && b > 0) || (a > 0 && b < 0)))
 					continue;
 				c = px[i] + (px[j] - px[i]) * (a / (a - b));
-				lo = fmin(lo, c), hi = fmax(hi, c);
+				lo = trim_min(lo, c), hi = trim_max(hi, c);
 			}
 	}
 	*xl = lo, *xr = hi;
@@ -126,12 +126,12 @@ static int clip_node(const struct px_trim *t, const struct trim_piece *p,
 
 	for (i = 0; i <= d; i++) {
 		f[i] = w[i] * (y[i] - v);
-		eps = fmax(eps, w[i]);
+		eps = trim_max(eps, w[i]);
 	}
 	eps *= 2.0 * t->slack;
 	for (i = 0; i <= d; i++)
 		if (fabs(f[i]) <= eps)
-			lo = fmin(lo, (double)i / d), hi = fmax(hi, (double)i / d);
+			lo = trim_min(lo, (double)i / d), hi = trim_max(hi, (double)i / d);
 	for (k = -1; k <= 1; k += 2)
 		for (i = 0; i <= d; i++)
 			for (j = i + 1; j <= d; j++) {
@@ -139,7 +139,7 @@ static int clip_node(const struct px_trim *t, const struct trim_piece *p,
 				if (!((a < 0 && b > 0) || (a > 0 && b < 0)))
 					continue;
 				s = (i + (j - i) * (a / (a - b))) / d;
-				lo = fmin(lo, s), hi = fmax(hi, s);
+				lo = trim_min(lo, s), hi = trim_max(hi, s);
 			}
 	if (lo > hi)
 		return -1;
