@@ -1,9 +1,10 @@
 /*
  * dist_internal.h - private declarations of the distance core: the
  * prepared model's layout (px_dist.c queries it, dist_build.c makes it),
- * the decomposition of entities into pieces (dist_decomp.c), and the
- * test hooks of the certified surface piece solver (spiece_solve.c).
- * Not installed, not part of the API.
+ * the decomposition of entities into pieces (dist_decomp.c), the
+ * Bernstein tensor kernels of the surface pieces (spiece_tensor.c), and
+ * the test hooks of their certified solver (spiece_solve.c). Not
+ * installed, not part of the API.
  */
 #ifndef PX_DIST_INTERNAL_H
 #define PX_DIST_INTERNAL_H
@@ -20,21 +21,6 @@
 #include "px_spiece.h"
 
 /* ---- the prepared model ------------------------------------------------- */
-
-/* Hot-path box distance: boxes here are never empty, and fmin/fmax
- * would be library calls without -ffast-math. */
-static inline double gap1(double v, double lo, double hi)
-{
-	return v < lo ? lo - v : (v > hi ? v - hi : 0.0);
-}
-
-static inline double box_d2(const px_aabb *b, px_vec3 p)
-{
-	double dx = gap1(p.x, b->min.x, b->max.x);
-	double dy = gap1(p.y, b->min.y, b->max.y);
-	double dz = gap1(p.z, b->min.z, b->max.z);
-	return dx * dx + dy * dy + dz * dz;
-}
 
 struct cand {
 	double lb; /* squared lower bound */

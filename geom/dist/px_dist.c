@@ -14,6 +14,21 @@
 
 #include "dist_internal.h"
 
+/* Hot-path box distance: boxes here are never empty, and fmin/fmax
+ * would be library calls without -ffast-math. */
+static inline double gap1(double v, double lo, double hi)
+{
+	return v < lo ? lo - v : (v > hi ? v - hi : 0.0);
+}
+
+static inline double box_d2(const px_aabb *b, px_vec3 p)
+{
+	double dx = gap1(p.x, b->min.x, b->max.x);
+	double dy = gap1(p.y, b->min.y, b->max.y);
+	double dz = gap1(p.z, b->min.z, b->max.z);
+	return dx * dx + dy * dy + dz * dz;
+}
+
 /* ---- query ---------------------------------------------------------------- */
 
 /*

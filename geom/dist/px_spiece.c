@@ -52,6 +52,14 @@ size_t px_spiece_doubles_hw(int p, int q, const double (*hw)[4])
 
 /* ---- setup ------------------------------------------------------------------ */
 
+/* The next n doubles of the piece's memory. */
+static double *take(double **cur, size_t n)
+{
+	double *p = *cur;
+	*cur += n;
+	return p;
+}
+
 int px_spiece_init(struct px_spiece *sp, int p, int q, const double (*hw)[4],
 		   double u0, double u1, double v0, double v1, double *mem)
 {
@@ -87,20 +95,13 @@ int px_spiece_init(struct px_spiece *sp, int p, int q, const double (*hw)[4],
 		ngu = px__sp_tsize(ngu_s(p), ngu_t(q));
 		ngv = px__sp_tsize(ngv_s(p), ngv_t(q));
 	}
-	sp->h_ = cur;
-	cur += 4 * np;
-	sp->fa_ = cur;
-	cur += nfs;
-	sp->fb_ = cur;
-	cur += 3 * nfs;
-	sp->fw_ = cur;
-	cur += nfs;
-	sp->gua_ = cur;
-	cur += ngu;
-	sp->gub_ = cur;
-	cur += 3 * ngu;
-	sp->gva_ = cur;
-	cur += ngv;
+	sp->h_ = take(&cur, 4 * np);
+	sp->fa_ = take(&cur, nfs);
+	sp->fb_ = take(&cur, 3 * nfs);
+	sp->fw_ = take(&cur, nfs);
+	sp->gua_ = take(&cur, ngu);
+	sp->gub_ = take(&cur, 3 * ngu);
+	sp->gva_ = take(&cur, ngv);
 	sp->gvb_ = cur;
 	sp->box_ = px_aabb_empty();
 	for (i = 0; i < np; i++) {

@@ -25,7 +25,6 @@ int px__spiece_no_precond = 0;
 
 static int nf_s(int p) { return 2 * p; }
 
-
 /*
  * 1 when every coefficient is > eps, -1 when every one is < -eps, else 0.
  * eps covers the rounding of restrictions: two rectangles sharing an edge

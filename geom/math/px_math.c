@@ -121,11 +121,22 @@ PX_API int px_quat_normalize(px_quat q, px_quat *out)
 	return PX_OK;
 }
 
+/* The rotation by angle_rad about the unit axis u. */
+static px_quat quat_about_unit(px_vec3 u, double angle_rad)
+{
+	double h = 0.5 * angle_rad, s = sin(h);
+	px_quat q;
+	q.w = cos(h);
+	q.x = s * u.x;
+	q.y = s * u.y;
+	q.z = s * u.z;
+	return q;
+}
+
 PX_API int px_quat_from_axis_angle(px_vec3 axis, double angle_rad,
 				   px_quat *out)
 {
 	px_vec3 u;
-	double h, s;
 	int rc;
 
 	if (!isfinite(angle_rad)) {
@@ -137,12 +148,7 @@ PX_API int px_quat_from_axis_angle(px_vec3 axis, double angle_rad,
 		*out = px_quat_identity();
 		return rc;
 	}
-	h = 0.5 * angle_rad;
-	s = sin(h);
-	out->w = cos(h);
-	out->x = s * u.x;
-	out->y = s * u.y;
-	out->z = s * u.z;
+	*out = quat_about_unit(u, angle_rad);
 	return PX_OK;
 }
 
@@ -178,7 +184,7 @@ PX_API void px_quat_to_axis_angle(px_quat q, px_vec3 *axis, double *angle_rad)
 PX_API int px_quat_from_two_vectors(px_vec3 a, px_vec3 b, px_quat *out)
 {
 	px_vec3 ua, ub, k, uk;
-	double c, s, h;
+	double c, s;
 	int ra, rb;
 
 	ra = px_v3_normalize(a, px_v3(1.0, 0.0, 0.0), &ua);
@@ -211,12 +217,7 @@ PX_API int px_quat_from_two_vectors(px_vec3 a, px_vec3 b, px_quat *out)
 		return PX_OK;
 	}
 	s = px_v3_dot(k, uk); /* |k| = sin(angle), without underflow */
-	h = 0.5 * atan2(s, c);
-	s = sin(h);
-	out->w = cos(h);
-	out->x = s * uk.x;
-	out->y = s * uk.y;
-	out->z = s * uk.z;
+	*out = quat_about_unit(uk, atan2(s, c));
 	return PX_OK;
 }
 

@@ -674,6 +674,21 @@ static void stream_count(struct nurbs_stream *s, int source, int jumped)
 	s->jumps += jumped != 0;
 }
 
+/* A tracker's answer t (px_strack_result or px_track_result: the same
+ * field names) into the distance core's result d and the stream's note
+ * (a surface's v apart). */
+#define TRACK_ANSWER(d, note, t)                    \
+	do {                                        \
+		(d)->dist = (t).dist;               \
+		(d)->point = (t).point;             \
+		(d)->dir = (t).dir;                 \
+		(d)->u = (t).u;                     \
+		(d)->entity = (t).entity;           \
+		(note)->source = (t).source;        \
+		(note)->jumped = (t).jumped;        \
+		(note)->n_crit = (t).n_crit;        \
+	} while (0)
+
 static int stream_query(const void *impl, void *state,
 			const struct px_model_query *q, struct px_model_result *r,
 			struct px_model_stream_note *note)
@@ -689,28 +704,14 @@ static int stream_query(const void *impl, void *state,
 		rc = px_strack_update(s->st, q->p, &sr);
 		if (rc != PX_OK)
 			return rc;
-		d.dist = sr.dist;
-		d.point = sr.point;
-		d.dir = sr.dir;
-		d.u = sr.u;
+		TRACK_ANSWER(&d, note, sr);
 		d.v = sr.v;
-		d.entity = sr.entity;
-		note->source = sr.source;
-		note->jumped = sr.jumped;
-		note->n_crit = sr.n_crit;
 	} else {
 		struct px_track_result tr;
 		rc = px_track_update(s->tr, q->p, &tr);
 		if (rc != PX_OK)
 			return rc;
-		d.dist = tr.dist;
-		d.point = tr.point;
-		d.dir = tr.dir;
-		d.u = tr.u;
-		d.entity = tr.entity;
-		note->source = tr.source;
-		note->jumped = tr.jumped;
-		note->n_crit = tr.n_crit;
+		TRACK_ANSWER(&d, note, tr);
 	}
 	stream_count(s, note->source, note->jumped);
 	d.kind = d.entity < s->n_curves ? PX_DIST_CURVE : PX_DIST_SURFACE;
@@ -718,6 +719,16 @@ static int stream_query(const void *impl, void *state,
 	d.certified = 1;
 	return nurbs_answer(n, -1, q, &d, r);
 }
+
+/* The counts a stream reports from its tracker's stats t (px_strack_stats
+ * or px_track_stats: the same field names). */
+#define TRACK_STATS(st, t)                                \
+	do {                                              \
+		(st)->hot = (t).hot;                      \
+		(st)->reinits = (t).reinits;              \
+		(st)->verifications = (t).verifications;  \
+		(st)->disagreements = (t).disagreements;  \
+	} while (0)
 
 static void stream_stats(const void *state, struct px_model_stream_stats *st)
 {
@@ -729,17 +740,11 @@ static void stream_stats(const void *state, struct px_model_stream_stats *st)
 	if (s->st) {
 		struct px_strack_stats ss;
 		px_strack_get_stats(s->st, &ss);
-		st->hot = ss.hot;
-		st->reinits = ss.reinits;
-		st->verifications = ss.verifications;
-		st->disagreements = ss.disagreements;
+		TRACK_STATS(st, ss);
 	} else {
 		struct px_track_stats ts;
 		px_track_get_stats(s->tr, &ts);
-		st->hot = ts.hot;
-		st->reinits = ts.reinits;
-		st->verifications = ts.verifications;
-		st->disagreements = ts.disagreements;
+		TRACK_STATS(st, ts);
 	}
 }
 

@@ -31,6 +31,11 @@ void px__nurbs_err(struct px_nurbs_error *err, int code,
 		   double v2, const char *fmt, ...)
 	__attribute__((format(printf, 8, 9)));
 void px__nurbs_ok(struct px_nurbs_error *err);
+/* The start of the init and view functions: obj (size bytes), when
+ * given, is cleared; when null_arg (a NULL argument), PX_E_INVAL with err
+ * saying msg, else PX_OK with err untouched. */
+int px__nurbs_start(struct px_nurbs_error *err, void *obj, size_t size,
+		    int null_arg, const char *msg);
 
 /* Number of knots equal to u (exact) in U[0..n_knots-1]. */
 int px__nurbs_mult(const double *U, int n_knots, double u);

@@ -40,6 +40,18 @@ void px__nurbs_err(struct px_nurbs_error *err, int code,
 	va_end(ap);
 }
 
+int px__nurbs_start(struct px_nurbs_error *err, void *obj, size_t size,
+		    int null_arg, const char *msg)
+{
+	if (obj)
+		memset(obj, 0, size);
+	if (!null_arg)
+		return PX_OK;
+	px__nurbs_ok(err);
+	px__nurbs_err(err, PX_E_INVAL, PX_NURBS_FAULT_ARG, 0, -1, 0, 0, "%s", msg);
+	return PX_E_INVAL;
+}
+
 double px__nurbs_clamp(const double *U, int p, int n, double t)
 {
 	if (t < U[p])

@@ -35,6 +35,18 @@ int px_nurbs_curve_validate(int degree, int n_ctrl, const double *knots,
 	return px__nurbs_check_points(n_ctrl, 0, xyz, w, NULL, err);
 }
 
+/* The curve's fields over its (validated) knots U and points pw. */
+static void fill(struct px_nurbs_curve *c, int degree, int n_ctrl,
+		 const double *U, int n_knots, const double *pw)
+{
+	c->degree = degree;
+	c->n_ctrl = n_ctrl;
+	c->n_knots = n_knots;
+	c->knots = U;
+	c->pw = pw;
+	c->rational = !px__nurbs_unit_weights(pw, (size_t)n_ctrl);
+}
+
 int px_nurbs_curve_init(struct px_nurbs_curve *c, struct px_arena *a,
 			int degree, int n_ctrl, const double *knots,
 			int n_knots, const double *xyz, const double *w,
@@ -43,16 +55,11 @@ int px_nurbs_curve_init(struct px_nurbs_curve *c, struct px_arena *a,
 	double *U, *P;
 	int rc;
 
-	if (!c || !a || !xyz) {
-		px__nurbs_err(err, PX_E_INVAL, PX_NURBS_FAULT_ARG, 0, -1, 0, 0,
-			      "NULL curve, arena or control points");
-		if (c)
-			memset(c, 0, sizeof(*c));
-		return PX_E_INVAL;
-	}
-	memset(c, 0, sizeof(*c));
-	rc = px_nurbs_curve_validate(degree, n_ctrl, knots, n_knots, xyz, w,
-				     err);
+	rc = px__nurbs_start(err, c, sizeof(*c), !c || !a || !xyz,
+			     "NULL curve, arena or control points");
+	if (!rc)
+		rc = px_nurbs_curve_validate(degree, n_ctrl, knots, n_knots, xyz,
+					     w, err);
 	if (rc)
 		return rc;
 	U = px_arena_alloc(a, (size_t)n_knots * sizeof(double), 0);
@@ -65,12 +72,7 @@ int px_nurbs_curve_init(struct px_nurbs_curve *c, struct px_arena *a,
 	}
 	memcpy(U, knots, (size_t)n_knots * sizeof(double));
 	px__nurbs_homogeneous(P, xyz, w, (size_t)n_ctrl);
-	c->degree = degree;
-	c->n_ctrl = n_ctrl;
-	c->n_knots = n_knots;
-	c->knots = U;
-	c->pw = P;
-	c->rational = !px__nurbs_unit_weights(P, (size_t)n_ctrl);
+	fill(c, degree, n_ctrl, U, n_knots, P);
 	return PX_OK;
 }
 
@@ -81,25 +83,15 @@ int px_nurbs_curve_view(struct px_nurbs_curve *c, int degree, int n_ctrl,
 	int rc;
 
 	px__nurbs_ok(err);
-	if (!c || !pw) {
-		px__nurbs_err(err, PX_E_INVAL, PX_NURBS_FAULT_ARG, 0, -1, 0, 0,
-			      "NULL curve or control points");
-		if (c)
-			memset(c, 0, sizeof(*c));
-		return PX_E_INVAL;
-	}
-	memset(c, 0, sizeof(*c));
-	rc = px__nurbs_check_knots(degree, n_ctrl, knots, n_knots, -1, err);
+	rc = px__nurbs_start(err, c, sizeof(*c), !c || !pw,
+			     "NULL curve or control points");
+	if (!rc)
+		rc = px__nurbs_check_knots(degree, n_ctrl, knots, n_knots, -1, err);
 	if (!rc)
 		rc = px__nurbs_check_points(n_ctrl, 0, NULL, NULL, pw, err);
 	if (rc)
 		return rc;
-	c->degree = degree;
-	c->n_ctrl = n_ctrl;
-	c->n_knots = n_knots;
-	c->knots = knots;
-	c->pw = pw;
-	c->rational = !px__nurbs_unit_weights(pw, (size_t)n_ctrl);
+	fill(c, degree, n_ctrl, knots, n_knots, pw);
 	return PX_OK;
 }
 

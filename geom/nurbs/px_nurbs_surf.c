@@ -83,17 +83,11 @@ int px_nurbs_surf_init(struct px_nurbs_surf *s, struct px_arena *a,
 	size_t count;
 	int rc;
 
-	if (!s || !a || !xyz) {
-		px__nurbs_ok(err);
-		px__nurbs_err(err, PX_E_INVAL, PX_NURBS_FAULT_ARG, 0, -1, 0, 0,
-			      "NULL surface, arena or control points");
-		if (s)
-			memset(s, 0, sizeof(*s));
-		return PX_E_INVAL;
-	}
-	memset(s, 0, sizeof(*s));
-	rc = check_surf(degree_u, degree_v, n_u, n_v, knots_u, n_knots_u,
-			knots_v, n_knots_v, xyz, w, NULL, err);
+	rc = px__nurbs_start(err, s, sizeof(*s), !s || !a || !xyz,
+			     "NULL surface, arena or control points");
+	if (!rc)
+		rc = check_surf(degree_u, degree_v, n_u, n_v, knots_u, n_knots_u,
+				knots_v, n_knots_v, xyz, w, NULL, err);
 	if (rc)
 		return rc;
 	count = (size_t)n_u * (size_t)n_v;
@@ -121,17 +115,11 @@ int px_nurbs_surf_view(struct px_nurbs_surf *s, int degree_u, int degree_v,
 {
 	int rc;
 
-	if (!s || !pw) {
-		px__nurbs_ok(err);
-		px__nurbs_err(err, PX_E_INVAL, PX_NURBS_FAULT_ARG, 0, -1, 0, 0,
-			      "NULL surface or control points");
-		if (s)
-			memset(s, 0, sizeof(*s));
-		return PX_E_INVAL;
-	}
-	memset(s, 0, sizeof(*s));
-	rc = check_surf(degree_u, degree_v, n_u, n_v, knots_u, n_knots_u,
-			knots_v, n_knots_v, NULL, NULL, pw, err);
+	rc = px__nurbs_start(err, s, sizeof(*s), !s || !pw,
+			     "NULL surface or control points");
+	if (!rc)
+		rc = check_surf(degree_u, degree_v, n_u, n_v, knots_u, n_knots_u,
+				knots_v, n_knots_v, NULL, NULL, pw, err);
 	if (rc)
 		return rc;
 	fill(s, degree_u, degree_v, n_u, n_v, knots_u, knots_v, pw);

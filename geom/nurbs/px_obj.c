@@ -754,65 +754,71 @@ static int same_domain(const double *U, int p, int nk, const double *r)
 	return r[0] == U[p] && r[1] == U[nk - p - 1];
 }
 
-static int build(struct ctx *c, struct px_obj_model **out)
+/* Arena bytes of entity e (0 when too large to count), and the
+ * extraction scratch it needs into *scratch when larger. */
+static size_t entity_bytes(const struct ent_rec *e, const double *K,
+			   size_t *scratch)
+{
+	int d, nd = e->kind == PX_OBJ_SURF ? 2 : 1, n[2] = {1, 1}, narrow = 0;
+	size_t b, s = 0;
+
+	for (d = 0; d < nd; d++) {
+		const double *U = K + e->knot_off[d];
+		int p = e->deg[d], nk = e->knot_count[d];
+		n[d] = nk - p - 1;
+		if (!same_domain(U, p, nk, e->range + 2 * d))
+			narrow = 1;
+	}
+	if (narrow) {
+		/* count_inside + p + 1 <= n + p */
+		for (d = 0; d < nd; d++)
+			n[d] += e->deg[d];
+	}
+	if (e->kind == PX_OBJ_CURVE) {
+		b = px_nurbs_curve_bytes(e->deg[0], n[0]);
+		if (narrow)
+			s = PX_NURBS_CURVE_WORK_LEN(e->deg[0], n[0]);
+	} else {
+		b = px_nurbs_surf_bytes(e->deg[0], e->deg[1], n[0], n[1]);
+		if (narrow)
+			s = PX_NURBS_SURF_WORK_LEN(e->deg[0], e->deg[1], n[0], n[1]);
+	}
+	if (narrow) {
+		s = s * sizeof(double) + PX_ARENA_ALIGN;
+		*scratch = s > *scratch ? s : *scratch;
+	}
+	return b;
+}
+
+/* Arena size: every final entity plus the largest extraction scratch
+ * (given back after each extraction). */
+static int arena_bytes(struct ctx *c, size_t *bytes)
 {
 	const struct ent_rec *E = (const struct ent_rec *)c->ents.p;
 	const double *K = (const double *)c->knots.p;
-	struct px_obj_model *m;
-	size_t bytes = 0, scratch = 0, i;
-	int rc = PX_OK;
+	size_t scratch = 0, i;
 
-	/* Arena size: every final entity plus the largest extraction
-	 * scratch (given back after each extraction). */
+	*bytes = 0;
 	for (i = 0; i < c->ents.n; i++) {
-		const struct ent_rec *e = &E[i];
-		int d, nd = e->kind == PX_OBJ_SURF ? 2 : 1, n[2] = {1, 1};
-		int narrow = 0;
-		size_t b;
-		for (d = 0; d < nd; d++) {
-			const double *U = K + e->knot_off[d];
-			int p = e->deg[d], nk = e->knot_count[d];
-			n[d] = nk - p - 1;
-			if (!same_domain(U, p, nk, e->range + 2 * d)) {
-				narrow = 1;
-			}
-		}
-		if (narrow) {
-			/* count_inside + p + 1 <= n + p */
-			for (d = 0; d < nd; d++)
-				n[d] += e->deg[d];
-		}
-		if (e->kind == PX_OBJ_CURVE) {
-			b = px_nurbs_curve_bytes(e->deg[0], n[0]);
-			if (narrow) {
-				size_t s = (PX_NURBS_CURVE_WORK_LEN(
-						    e->deg[0], n[0])) *
-						   sizeof(double) +
-					   PX_ARENA_ALIGN;
-				scratch = s > scratch ? s : scratch;
-			}
-		} else {
-			b = px_nurbs_surf_bytes(e->deg[0], e->deg[1], n[0],
-						n[1]);
-			if (narrow) {
-				size_t s = (PX_NURBS_SURF_WORK_LEN(
-						    e->deg[0], e->deg[1], n[0],
-						    n[1])) *
-						   sizeof(double) +
-					   PX_ARENA_ALIGN;
-				scratch = s > scratch ? s : scratch;
-			}
-		}
-		if (!b || b > SIZE_MAX / 2 - bytes)
-			return fail_at(c, e->line, e->col, PX_E_NOMEM,
+		size_t b = entity_bytes(&E[i], K, &scratch);
+		if (!b || b > SIZE_MAX / 2 - *bytes)
+			return fail_at(c, E[i].line, E[i].col, PX_E_NOMEM,
 				       "entity too large");
-		bytes += b;
+		*bytes += b;
 	}
-	if (scratch > SIZE_MAX / 2 - bytes)
+	if (scratch > SIZE_MAX / 2 - *bytes)
 		return nomem(c);
-	bytes += scratch;
+	*bytes += scratch;
+	return PX_OK;
+}
 
-	m = calloc(1, sizeof(*m));
+/* The model with its arena of bytes, the entity array, and the
+ * vertices and triangles copied. */
+static int model_alloc(struct ctx *c, size_t bytes, struct px_obj_model **out)
+{
+	struct px_obj_model *m = calloc(1, sizeof(*m));
+	size_t i;
+
 	if (!m)
 		return nomem(c);
 	m->memory_bytes = sizeof(*m) + bytes;
@@ -844,75 +850,99 @@ static int build(struct ctx *c, struct px_obj_model **out)
 	if (c->tris.n)
 		memcpy(m->triangles, c->tris.p, c->tris.n * 3 * sizeof(int));
 	m->n_triangles = (int)c->tris.n;
+	*out = m;
+	return PX_OK;
+}
 
-	for (i = 0; i < c->ents.n && !rc; i++) {
-		const struct ent_rec *e = &E[i];
-		struct px_obj_entity *o = &m->entities[i];
-		const double *X = (const double *)c->xyz.p + 3 * e->ctrl_off;
-		const double *W = (const double *)c->wts.p + e->ctrl_off;
-		const double *Uu = K + e->knot_off[0];
-		struct px_arena tmp;
-		int pu = e->deg[0], nku = e->knot_count[0];
-		o->kind = (enum px_obj_kind)e->kind;
-		o->line = e->line;
-		o->rational = e->rat;
-		memcpy(o->range, e->range, sizeof(o->range));
-		memcpy(o->name, e->name, sizeof(o->name));
-		memset(&tmp, 0, sizeof(tmp));
-		if (e->kind == PX_OBJ_CURVE) {
-			struct px_nurbs_curve full;
-			if (same_domain(Uu, pu, nku, e->range)) {
-				rc = px_nurbs_curve_init(&o->curve, &m->arena_, pu,
-							 (int)e->ctrl_count, Uu,
-							 nku, X, W, NULL);
-			} else {
-				rc = px_arena_init_alloc(
-					&tmp, px_nurbs_curve_bytes(
-						      pu, (int)e->ctrl_count));
-				if (!rc)
-					rc = px_nurbs_curve_init(
-						&full, &tmp, pu,
-						(int)e->ctrl_count, Uu, nku, X,
-						W, NULL);
-				if (!rc)
-					rc = px_nurbs_curve_extract(
-						&full, e->range[0], e->range[1],
-						&m->arena_, &o->curve);
-			}
-		} else {
-			const double *Uv = K + e->knot_off[1];
-			int pv = e->deg[1], nkv = e->knot_count[1];
-			int nu = nku - pu - 1, nv = nkv - pv - 1;
-			struct px_nurbs_surf full;
-			if (same_domain(Uu, pu, nku, e->range) &&
-			    same_domain(Uv, pv, nkv, e->range + 2)) {
-				rc = px_nurbs_surf_init(&o->surf, &m->arena_, pu,
-							pv, nu, nv, Uu, nku, Uv,
-							nkv, X, W, NULL);
-			} else {
-				rc = px_arena_init_alloc(
-					&tmp,
-					px_nurbs_surf_bytes(pu, pv, nu, nv));
-				if (!rc)
-					rc = px_nurbs_surf_init(&full, &tmp, pu,
-								pv, nu, nv, Uu,
-								nku, Uv, nkv, X,
-								W, NULL);
-				if (!rc)
-					rc = px_nurbs_surf_extract(
-						&full, e->range[0], e->range[1],
-						e->range[2], e->range[3],
-						&m->arena_, &o->surf);
-			}
-		}
-		px_arena_fini(&tmp);
-		if (rc) {
-			rc = fail_at(c, e->line, e->col,
-				     rc == PX_E_NOMEM ? PX_E_NOMEM : PX_E_STATE,
-				     "cannot build the entity: %s",
-				     px_strerror(rc));
-		}
-	}
+/* Curve entity e into o (in the model's arena a): as given, or the
+ * declared range extracted from the whole curve built in tmp. */
+static int build_curve(const struct ent_rec *e, const double *K,
+		       const double *X, const double *W, struct px_arena *a,
+		       struct px_arena *tmp, struct px_obj_entity *o)
+{
+	const double *Uu = K + e->knot_off[0];
+	int pu = e->deg[0], nku = e->knot_count[0], rc;
+	struct px_nurbs_curve full;
+
+	if (same_domain(Uu, pu, nku, e->range))
+		return px_nurbs_curve_init(&o->curve, a, pu, (int)e->ctrl_count,
+					   Uu, nku, X, W, NULL);
+	rc = px_arena_init_alloc(tmp, px_nurbs_curve_bytes(pu, (int)e->ctrl_count));
+	if (!rc)
+		rc = px_nurbs_curve_init(&full, tmp, pu, (int)e->ctrl_count, Uu,
+					 nku, X, W, NULL);
+	if (!rc)
+		rc = px_nurbs_curve_extract(&full, e->range[0], e->range[1], a,
+					    &o->curve);
+	return rc;
+}
+
+/* The same for a surface entity. */
+static int build_surf(const struct ent_rec *e, const double *K,
+		      const double *X, const double *W, struct px_arena *a,
+		      struct px_arena *tmp, struct px_obj_entity *o)
+{
+	const double *Uu = K + e->knot_off[0], *Uv = K + e->knot_off[1];
+	int pu = e->deg[0], nku = e->knot_count[0];
+	int pv = e->deg[1], nkv = e->knot_count[1];
+	int nu = nku - pu - 1, nv = nkv - pv - 1, rc;
+	struct px_nurbs_surf full;
+
+	if (same_domain(Uu, pu, nku, e->range) &&
+	    same_domain(Uv, pv, nkv, e->range + 2))
+		return px_nurbs_surf_init(&o->surf, a, pu, pv, nu, nv, Uu, nku,
+					  Uv, nkv, X, W, NULL);
+	rc = px_arena_init_alloc(tmp, px_nurbs_surf_bytes(pu, pv, nu, nv));
+	if (!rc)
+		rc = px_nurbs_surf_init(&full, tmp, pu, pv, nu, nv, Uu, nku, Uv,
+					nkv, X, W, NULL);
+	if (!rc)
+		rc = px_nurbs_surf_extract(&full, e->range[0], e->range[1],
+					   e->range[2], e->range[3], a, &o->surf);
+	return rc;
+}
+
+static int build_entity(struct ctx *c, const struct ent_rec *e,
+			struct px_obj_model *m, struct px_obj_entity *o)
+{
+	const double *K = (const double *)c->knots.p;
+	const double *X = (const double *)c->xyz.p + 3 * e->ctrl_off;
+	const double *W = (const double *)c->wts.p + e->ctrl_off;
+	struct px_arena tmp;
+	int rc;
+
+	o->kind = (enum px_obj_kind)e->kind;
+	o->line = e->line;
+	o->rational = e->rat;
+	memcpy(o->range, e->range, sizeof(o->range));
+	memcpy(o->name, e->name, sizeof(o->name));
+	memset(&tmp, 0, sizeof(tmp));
+	if (e->kind == PX_OBJ_CURVE)
+		rc = build_curve(e, K, X, W, &m->arena_, &tmp, o);
+	else
+		rc = build_surf(e, K, X, W, &m->arena_, &tmp, o);
+	px_arena_fini(&tmp);
+	if (rc)
+		rc = fail_at(c, e->line, e->col,
+			     rc == PX_E_NOMEM ? PX_E_NOMEM : PX_E_STATE,
+			     "cannot build the entity: %s", px_strerror(rc));
+	return rc;
+}
+
+static int build(struct ctx *c, struct px_obj_model **out)
+{
+	const struct ent_rec *E = (const struct ent_rec *)c->ents.p;
+	struct px_obj_model *m = NULL;
+	size_t bytes, i;
+	int rc;
+
+	rc = arena_bytes(c, &bytes);
+	if (!rc)
+		rc = model_alloc(c, bytes, &m);
+	if (rc)
+		return rc;
+	for (i = 0; i < c->ents.n && !rc; i++)
+		rc = build_entity(c, &E[i], m, &m->entities[i]);
 	if (rc) {
 		px_obj_free(m);
 		return rc;

@@ -529,46 +529,45 @@ static double weight_factor(const struct px_nurbs_surf *s, int d, int jref,
 	return eps;
 }
 
-static int rec_rev(const struct px_nurbs_surf *s, int d, double tol,
-		   double margin, double size, struct px_recog_shape *out)
+/* The control row (along d) with the largest extent, viewed as a curve
+ * over rowpw: it fixes the axis and the sweep. 0 when it is not an arc. */
+static int rev_row(const struct px_nurbs_surf *s, int d, double tol,
+		   double margin, double *rowpw, struct px_nurbs_curve *row,
+		   struct crec *rr, int *jstar)
 {
-	int na = s->n_ctrl[d], nb = s->n_ctrl[1 - d], i, j, jstar = 0;
-	double rowpw[4 * PX_RECOG_MAX_CTRL], profpw[4 * PX_RECOG_MAX_CTRL];
-	double alpha[PX_RECOG_MAX_CTRL], beta[PX_RECOG_MAX_CTRL];
-	double h[PX_RECOG_MAX_CTRL], rho[PX_RECOG_MAX_CTRL];
-	px_vec3 E[PX_RECOG_MAX_CTRL];
-	double best = -1, rstar, dev = 0, weps, rmax = 0, hd, rhomin, wterm;
-	struct px_nurbs_curve row, prof;
-	struct crec rr, pr;
-	px_vec3 c, a;
-	double v0, v1;
+	int na = s->n_ctrl[d], nb = s->n_ctrl[1 - d], i, j;
+	double best = -1;
 
-	if (na > PX_RECOG_MAX_CTRL || nb > PX_RECOG_MAX_CTRL)
-		return 0;
-	/* The control row with the largest extent fixes axis and sweep. */
+	*jstar = 0;
 	for (j = 0; j < nb; j++) {
 		px_aabb b = box_empty();
 		for (i = 0; i < na; i++)
 			box_add(&b, hpt(net(s, d, i, j)));
 		if (box_diag(b) > best)
-			best = box_diag(b), jstar = j;
+			best = box_diag(b), *jstar = j;
 	}
 	for (i = 0; i < na; i++)
-		memcpy(rowpw + 4 * i, net(s, d, i, jstar), 4 * sizeof(double));
-	if (px_nurbs_curve_view(&row, s->degree[d], na, s->knots[d],
+		memcpy(rowpw + 4 * i, net(s, d, i, *jstar), 4 * sizeof(double));
+	if (px_nurbs_curve_view(row, s->degree[d], na, s->knots[d],
 				s->n_knots[d], rowpw, NULL) != PX_OK)
 		return 0;
-	if (!rec_arc(&row, tol, margin, &rr))
-		return 0;
-	c = rr.arc.center;
-	a = rr.arc.normal;
-	rstar = rr.arc.radius;
-	weps = weight_factor(s, d, jstar, alpha, beta);
-	if (!(weps < 0.25))
-		return 0;
-	for (i = 0; i < na; i++)
-		E[i] = px_v3_scale(px_v3_sub(hpt(rowpw + 4 * i), c), 1.0 / rstar);
-	/* Least-squares h_j, rho_j of P_ij - c = h_j a + rho_j E_i. */
+	return rec_arc(row, tol, margin, rr);
+}
+
+/*
+ * Least-squares h_j, rho_j of P_ij - c = h_j a + rho_j E_i for every
+ * row j (E_i: the unit directions of the arc row's points from the axis
+ * point c), with the largest rho in *rmax and the largest residual in
+ * *dev. 0 when a row is degenerate or crosses the axis.
+ */
+static int rev_meridian(const struct px_nurbs_surf *s, int d, double tol,
+			px_vec3 c, px_vec3 a, const px_vec3 *E, double *h,
+			double *rho, double *rmax, double *dev)
+{
+	int na = s->n_ctrl[d], nb = s->n_ctrl[1 - d], i, j;
+
+	*rmax = 0;
+	*dev = 0;
 	for (j = 0; j < nb; j++) {
 		double s11 = na, s12 = 0, s22 = 0, b1 = 0, b2 = 0, det;
 		for (i = 0; i < na; i++) {
@@ -588,17 +587,157 @@ static int rec_rev(const struct px_nurbs_surf *s, int d, double tol,
 				return 0; /* crosses the axis */
 			rho[j] = 0;
 		}
-		if (rho[j] > rmax)
-			rmax = rho[j];
+		if (rho[j] > *rmax)
+			*rmax = rho[j];
 		for (i = 0; i < na; i++) {
 			px_vec3 q = px_v3_sub(hpt(net(s, d, i, j)), c);
 			double e = px_v3_norm(px_v3_sub(
 				q, px_v3_add(px_v3_scale(a, h[j]),
 					     px_v3_scale(E[i], rho[j]))));
-			if (e > dev)
-				dev = e;
+			if (e > *dev)
+				*dev = e;
 		}
 	}
+	return 1;
+}
+
+/* Lowest rho of the ideal profile (meridian coordinates (h, rho, 0)):
+ * below zero it would leave the half-plane the reduction assumes. */
+static double profile_rho_min(const struct crec *pr)
+{
+	double f, rhomin;
+	px_vec3 q0, q1;
+
+	if (pr->kind == PX_RECOG_SEGMENT) {
+		q1 = px_v3_madd(pr->seg.p0, pr->seg.dir, pr->seg.len);
+		return fmin(pr->seg.p0.y, q1.y);
+	}
+	/* Direction -rho lies at angle f with cos f = -e0.y, sin f = -e1.y. */
+	f = atan2(-pr->arc.e1.y, -pr->arc.e0.y);
+	q0 = px_v3_madd(pr->arc.center, pr->arc.e0, pr->arc.radius);
+	q1 = px_v3_add(pr->arc.center,
+		       px_v3_add(px_v3_scale(pr->arc.e0,
+					     pr->arc.radius * cos(pr->arc.sweep)),
+				 px_v3_scale(pr->arc.e1,
+					     pr->arc.radius * sin(pr->arc.sweep))));
+	if (f < 0)
+		f += TWO_PI;
+	rhomin = fmin(q0.y, q1.y);
+	if (f <= pr->arc.sweep)
+		rhomin = pr->arc.center.y - pr->arc.radius;
+	return rhomin;
+}
+
+/* Kind and shape parameters of a surface of revolution about the axis
+ * (c, a) from its profile pr. */
+static void rev_kind(const struct crec *pr, px_vec3 c, px_vec3 a, double tol,
+		     struct px_recog_shape *out)
+{
+	if (pr->kind == PX_RECOG_SEGMENT) {
+		double dh = pr->seg.dir.x, dr = pr->seg.dir.y, L = pr->seg.len;
+		if (fabs(dr) * L <= tol) {
+			out->kind = PX_RECOG_CYLINDER;
+			out->radius = pr->seg.p0.y + 0.5 * dr * L;
+			out->center = px_v3_madd(c, a, pr->seg.p0.x);
+		} else if (fabs(dh) * L <= tol) {
+			out->kind = PX_RECOG_ANNULUS;
+			out->center = px_v3_madd(c, a, pr->seg.p0.x);
+		} else {
+			out->kind = PX_RECOG_CONE;
+			out->center = px_v3_madd(c, a,
+						 pr->seg.p0.x - pr->seg.p0.y * dh / dr);
+			out->half_angle = atan2(fabs(dr), fabs(dh));
+		}
+	} else {
+		out->center = px_v3_madd(c, a, pr->arc.center.x);
+		if (fabs(pr->arc.center.y) <= tol) {
+			out->kind = PX_RECOG_SPHERE;
+			out->radius = pr->arc.radius;
+		} else {
+			out->kind = PX_RECOG_TORUS;
+			out->radius = pr->arc.center.y;
+			out->radius2 = pr->arc.radius;
+		}
+	}
+}
+
+/*
+ * The shape of a surface of revolution (angle along d): the arc row rr
+ * (axis point c, axis a), the profile pr over the curve prof, the row
+ * curve row, and the proved bound hd.
+ */
+static void rev_fill(int d, double hd, double size, double tol,
+		     const struct crec *rr, const struct crec *pr,
+		     const struct px_nurbs_curve *row,
+		     const struct px_nurbs_curve *prof,
+		     struct px_recog_shape *out)
+{
+	px_vec3 c = rr->arc.center, a = rr->arc.normal;
+	double v0, v1, bestr = -1, bestv, u0, u1;
+	int i;
+
+	prim_clear(out);
+	out->is_surface = 1;
+	out->hausdorff = hd;
+	out->size = size;
+	out->rev.origin = c;
+	out->rev.axis = a;
+	out->rev.e0 = rr->arc.e0;
+	out->rev.e1 = rr->arc.e1;
+	out->rev.sweep = rr->arc.sweep;
+	out->rev.profile_is_arc = pr->kind == PX_RECOG_ARC;
+	out->rev.pseg = pr->seg;
+	out->rev.parc = pr->arc;
+	out->rev.dir_angle = d;
+	out->normal = a;
+	out->qarc[0] = rr->qa;
+	if (pr->kind == PX_RECOG_ARC)
+		out->qarc[1] = pr->qa;
+	else if (pr->linear)
+		out->linear = 1 << (1 - d);
+	/* Fixed parameters for inversion: the angle is read where the
+	 * profile is farthest from the axis; the profile at the start of
+	 * the angular range. */
+	px_nurbs_curve_domain(prof, &v0, &v1);
+	bestv = v0;
+	for (i = 0; i <= 32; i++) {
+		double v = v0 + (v1 - v0) * i / 32.0;
+		px_vec3 q = px_nurbs_curve_point(prof, v);
+		if (q.y > bestr)
+			bestr = q.y, bestv = v;
+	}
+	px_nurbs_curve_domain(row, &u0, &u1);
+	out->rev.ref_param[d] = bestv;
+	out->rev.ref_param[1 - d] = u0;
+	rev_kind(pr, c, a, tol, out);
+}
+
+static int rec_rev(const struct px_nurbs_surf *s, int d, double tol,
+		   double margin, double size, struct px_recog_shape *out)
+{
+	int na = s->n_ctrl[d], nb = s->n_ctrl[1 - d], i, j, jstar;
+	double rowpw[4 * PX_RECOG_MAX_CTRL], profpw[4 * PX_RECOG_MAX_CTRL];
+	double alpha[PX_RECOG_MAX_CTRL], beta[PX_RECOG_MAX_CTRL];
+	double h[PX_RECOG_MAX_CTRL], rho[PX_RECOG_MAX_CTRL];
+	px_vec3 E[PX_RECOG_MAX_CTRL];
+	double rstar, dev, weps, rmax, hd, wterm;
+	struct px_nurbs_curve row, prof;
+	struct crec rr, pr;
+
+	if (na > PX_RECOG_MAX_CTRL || nb > PX_RECOG_MAX_CTRL)
+		return 0;
+	if (!rev_row(s, d, tol, margin, rowpw, &row, &rr, &jstar))
+		return 0;
+	rstar = rr.arc.radius;
+	weps = weight_factor(s, d, jstar, alpha, beta);
+	if (!(weps < 0.25))
+		return 0;
+	for (i = 0; i < na; i++)
+		E[i] = px_v3_scale(px_v3_sub(hpt(rowpw + 4 * i), rr.arc.center),
+				   1.0 / rstar);
+	if (!rev_meridian(s, d, tol, rr.arc.center, rr.arc.normal, E, h, rho,
+			  &rmax, &dev))
+		return 0;
 	wterm = 2 * weps / (1 - weps) * net_radius(s);
 	if (dev + wterm > tol)
 		return 0;
@@ -614,94 +753,12 @@ static int rec_rev(const struct px_nurbs_surf *s, int d, double tol,
 		return 0;
 	if (!rec_curve_any(&prof, tol, margin, &pr))
 		return 0;
-	/* Lowest rho of the ideal profile: below zero it would leave the
-	 * half-plane the reduction assumes; tiny dips are charged to H. */
-	if (pr.kind == PX_RECOG_SEGMENT) {
-		px_vec3 q1 = px_v3_madd(pr.seg.p0, pr.seg.dir, pr.seg.len);
-		rhomin = fmin(pr.seg.p0.y, q1.y);
-	} else {
-		/* Direction -rho lies at angle f with cos f = -e0.y,
-		 * sin f = -e1.y. */
-		double f = atan2(-pr.arc.e1.y, -pr.arc.e0.y);
-		px_vec3 q0 = px_v3_madd(pr.arc.center, pr.arc.e0, pr.arc.radius);
-		px_vec3 q1 = px_v3_add(
-			pr.arc.center,
-			px_v3_add(px_v3_scale(pr.arc.e0,
-					      pr.arc.radius * cos(pr.arc.sweep)),
-				  px_v3_scale(pr.arc.e1,
-					      pr.arc.radius * sin(pr.arc.sweep))));
-		if (f < 0)
-			f += TWO_PI;
-		rhomin = fmin(q0.y, q1.y);
-		if (f <= pr.arc.sweep)
-			rhomin = pr.arc.center.y - pr.arc.radius;
-	}
+	/* Tiny dips of the profile below the axis are charged to H. */
 	hd = dev + wterm + 2 * pr.hd + rmax * rr.hd / rstar +
-	     2 * fmax(0.0, -rhomin) + margin;
+	     2 * fmax(0.0, -profile_rho_min(&pr)) + margin;
 	if (!(hd <= tol))
 		return 0;
-
-	prim_clear(out);
-	out->is_surface = 1;
-	out->hausdorff = hd;
-	out->size = size;
-	out->rev.origin = c;
-	out->rev.axis = a;
-	out->rev.e0 = rr.arc.e0;
-	out->rev.e1 = rr.arc.e1;
-	out->rev.sweep = rr.arc.sweep;
-	out->rev.profile_is_arc = pr.kind == PX_RECOG_ARC;
-	out->rev.pseg = pr.seg;
-	out->rev.parc = pr.arc;
-	out->rev.dir_angle = d;
-	out->normal = a;
-	out->qarc[0] = rr.qa;
-	if (pr.kind == PX_RECOG_ARC)
-		out->qarc[1] = pr.qa;
-	else if (pr.linear)
-		out->linear = 1 << (1 - d);
-	/* Fixed parameters for inversion: the angle is read where the
-	 * profile is farthest from the axis; the profile at the start of
-	 * the angular range. */
-	px_nurbs_curve_domain(&prof, &v0, &v1);
-	{
-		double bestr = -1, bestv = v0, u0, u1;
-		for (i = 0; i <= 32; i++) {
-			double v = v0 + (v1 - v0) * i / 32.0;
-			px_vec3 q = px_nurbs_curve_point(&prof, v);
-			if (q.y > bestr)
-				bestr = q.y, bestv = v;
-		}
-		px_nurbs_curve_domain(&row, &u0, &u1);
-		out->rev.ref_param[d] = bestv;
-		out->rev.ref_param[1 - d] = u0;
-	}
-	if (pr.kind == PX_RECOG_SEGMENT) {
-		double dh = pr.seg.dir.x, dr = pr.seg.dir.y, L = pr.seg.len;
-		if (fabs(dr) * L <= tol) {
-			out->kind = PX_RECOG_CYLINDER;
-			out->radius = pr.seg.p0.y + 0.5 * dr * L;
-			out->center = px_v3_madd(c, a, pr.seg.p0.x);
-		} else if (fabs(dh) * L <= tol) {
-			out->kind = PX_RECOG_ANNULUS;
-			out->center = px_v3_madd(c, a, pr.seg.p0.x);
-		} else {
-			out->kind = PX_RECOG_CONE;
-			out->center = px_v3_madd(c, a,
-						 pr.seg.p0.x - pr.seg.p0.y * dh / dr);
-			out->half_angle = atan2(fabs(dr), fabs(dh));
-		}
-	} else {
-		out->center = px_v3_madd(c, a, pr.arc.center.x);
-		if (fabs(pr.arc.center.y) <= tol) {
-			out->kind = PX_RECOG_SPHERE;
-			out->radius = pr.arc.radius;
-		} else {
-			out->kind = PX_RECOG_TORUS;
-			out->radius = pr.arc.center.y;
-			out->radius2 = pr.arc.radius;
-		}
-	}
+	rev_fill(d, hd, size, tol, &rr, &pr, &row, &prof, out);
 	return 1;
 }
 
