@@ -1,6 +1,10 @@
 /*
- * gov_internal.h - the cost governor shared by the two trackers
- * (track_*.c, strack_*.c): when the query point moves so fast that
+ * gov_internal.h - what the two trackers (track_*.c, strack_*.c) share:
+ * the cost governor, and the setup, counters and verification of their
+ * shared options and stats (px_track_shared_opts and
+ * px_track_shared_stats in px_track.h; at the end of this header).
+ *
+ * The governor: when the query point moves so fast that
  * following every critical point costs more than the exact global query
  * (events in most updates, leaves or cells re-solved every cycle), the
  * tracker answers with that query instead ("cold" updates) and comes back
@@ -49,10 +53,12 @@
 #ifndef PX_GOV_INTERNAL_H
 #define PX_GOV_INTERNAL_H
 
+#include <math.h>
 #include <stdint.h>
 
 #include "px_dist.h"
 #include "px_math.h"
+#include "px_track.h"
 
 #define PX_GOV_EVERY 16        /* one update timed in this many */
 #define PX_GOV_CLIP 4.0        /* a sample is at most this times the other mean */
@@ -125,8 +131,10 @@ static inline int px__gov_timed(struct px_gov *g)
 int64_t px__gov_now(const struct px_gov *g);
 
 /* A cold update's answer: px_dist_query() on m at p, timed as a cold
- * sample when this update is one to time. Returns as px_dist_query(). */
-int px__gov_cold_query(struct px_gov *g, struct px_dist_model *m, px_vec3 p,
+ * sample when this update is one to time, counted in st (updates, cold)
+ * when answered. Returns as px_dist_query(). */
+int px__gov_cold_query(struct px_gov *g, struct px_track_shared_stats *st,
+		       struct px_dist_model *m, px_vec3 p,
 		       struct px_dist_result *out);
 
 /* Every update's step length (the running mean the return looks at:
@@ -165,9 +173,44 @@ static inline int px__gov_stop(struct px_gov *g, int64_t t0)
  * back to tracking (g->cold is then cleared). */
 int px__gov_leave(struct px_gov *g);
 
+/* What an update does, as px__gov_begin() decides. */
+#define PX_GOV_TRACK 0  /* track */
+#define PX_GOV_COLD 1   /* answer with px__gov_cold_query(); where it has
+			 * no answer, px__gov_restart() and do as below */
+#define PX_GOV_RETURN 2 /* track again, the critical points found afresh
+			 * (stats.cold_left) */
+
+/* The governor at the start of an update whose step was len (unused
+ * while it is off). Inline: every update calls it. */
+static inline int px__gov_begin(struct px_gov *g, double len)
+{
+	if (!g->on)
+		return PX_GOV_TRACK;
+	px__gov_step(g, len);
+	if (!g->cold)
+		return PX_GOV_TRACK;
+	return px__gov_leave(g) ? PX_GOV_RETURN : PX_GOV_COLD;
+}
+
+/* A reset (px_*_reset()): the governor starts tracking afresh, counted
+ * as a return in st when it was cold. */
+static inline void px__gov_reset(struct px_gov *g,
+				 struct px_track_shared_stats *st)
+{
+	if (g->cold)
+		st->cold_left++;
+	px__gov_restart(g);
+}
+
 /* Setup only: the cold query's cost (ns) at points spread over box,
  * from the real clock. */
 double px__gov_calibrate(struct px_dist_model *m, px_aabb box);
+
+/* Setup only: px__gov_init() with, when on, the cold query's cost on m
+ * about the model (its bounds grown by 0.3 of its size scale: where a
+ * tool works, not the whole working volume). */
+void px__gov_setup(struct px_gov *g, int on, struct px_dist_model *m,
+		   px_aabb bounds, double scale);
 
 /* Tests: another clock (NULL: CLOCK_MONOTONIC). */
 void px__gov_set_clock(struct px_gov *g, px_gov_clock_fn fn, void *ctx);
@@ -175,5 +218,63 @@ void px__gov_set_clock(struct px_gov *g, px_gov_clock_fn fn, void *ctx);
 /* The state of src into dst, dst's clock kept (benches: a path replayed
  * from the same state). */
 void px__gov_copy(struct px_gov *dst, const struct px_gov *src);
+
+/* ---- the rest the trackers share: arguments, options, stats,
+ * verification ---- */
+
+/* The arguments of px_*_update() and px_*_reset(): PX_E_INVAL (tracker
+ * or result NULL), PX_E_NAN (p not finite) or PX_OK. */
+static inline int px__tracker_args(const void *t, const void *r, px_vec3 p)
+{
+	if (!t || !r)
+		return PX_E_INVAL;
+	if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
+		return PX_E_NAN;
+	return PX_OK;
+}
+
+/* Their defaults; max_crit is each tracker's own. */
+void px__tracker_opts_default(struct px_track_shared_opts *o, int max_crit);
+
+/* 1 when create accepts them (max_crit 2..2^20, verify_every >= 0,
+ * work_margin >= 0). */
+int px__tracker_opts_valid(const struct px_track_shared_opts *o);
+
+/* Setup only: the model's size (the diagonal of its bounds; 1 when
+ * they are a point) and its working volume (the bounds grown by margin
+ * times that size on every side). */
+double px__tracker_scale(px_aabb bounds);
+px_aabb px__tracker_work(px_aabb bounds, double margin, double scale);
+
+/* px_*_get_stats(): *out = *st (size bytes: a px_track_stats or a
+ * px_strack_stats, each beginning with the shared counters) with the
+ * running means of the governor g; zeros without a tracker (st NULL),
+ * nothing without out. */
+void px__tracker_stats_out(void *out, const void *st, size_t size,
+			   const struct px_gov *g);
+
+/* The verification of an update counted in st and answered at distance
+ * dist from p (opts.verify_every): 1 when px_dist_query() on m found a
+ * point closer by more than the rounding allowance at the model size
+ * scale (counted; the caller re-initialises and answers globally), else
+ * 0; *verified is set to 1 where the answers were compared. Inline:
+ * every update asks whether it is due. */
+static inline int px__tracker_verify(const struct px_track_shared_opts *o,
+				     struct px_track_shared_stats *st,
+				     struct px_dist_model *m, double scale,
+				     px_vec3 p, double dist, int *verified)
+{
+	struct px_dist_result g;
+	if (o->verify_every <= 0 || st->updates % (uint64_t)o->verify_every != 0)
+		return 0;
+	if (px_dist_query(m, p, &g))
+		return 0;
+	st->verifications++;
+	*verified = 1;
+	if (!(dist > g.dist + 1e-9 * (scale + g.dist)))
+		return 0;
+	st->disagreements++;
+	return 1;
+}
 
 #endif

@@ -4,6 +4,7 @@
 #include "gov_internal.h"
 
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
 
 /* running means: the last 32 timed samples weigh about two thirds */
@@ -120,13 +121,18 @@ static void cold_sample(struct px_gov *g, double ns)
 		g->cold_ns = 1.0;
 }
 
-int px__gov_cold_query(struct px_gov *g, struct px_dist_model *m, px_vec3 p,
+int px__gov_cold_query(struct px_gov *g, struct px_track_shared_stats *st,
+		       struct px_dist_model *m, px_vec3 p,
 		       struct px_dist_result *out)
 {
 	int64_t t0 = px__gov_start(g);
 	int rc = px_dist_query(m, p, out);
 	if (t0 != PX_GOV_UNTIMED)
 		cold_sample(g, (double)(px__gov_now(g) - t0));
+	if (rc == PX_OK) {
+		st->updates++;
+		st->cold++;
+	}
 	return rc;
 }
 
@@ -194,4 +200,63 @@ double px__gov_calibrate(struct px_dist_model *m, px_aabb box)
 		sum += t[i];
 	sum /= keep;
 	return sum > 1.0 ? sum : 1.0;
+}
+
+void px__gov_setup(struct px_gov *g, int on, struct px_dist_model *m,
+		   px_aabb bounds, double scale)
+{
+	px_aabb cb = bounds;
+	double d = 0.3 * scale;
+	cb.min = px_v3_sub(cb.min, px_v3(d, d, d));
+	cb.max = px_v3_add(cb.max, px_v3(d, d, d));
+	px__gov_init(g, on, on ? px__gov_calibrate(m, cb) : 1.0);
+}
+
+/* ------------------------------------------------------------------ */
+/* the shared options and stats                                        */
+
+void px__tracker_opts_default(struct px_track_shared_opts *o, int max_crit)
+{
+	o->work_margin = 1.0;
+	o->max_crit = max_crit;
+	o->verify_every = 0;
+	o->dist = NULL;
+	o->cold_switch = 1;
+}
+
+int px__tracker_opts_valid(const struct px_track_shared_opts *o)
+{
+	return o->max_crit >= 2 && o->max_crit <= 1 << 20 &&
+	       o->verify_every >= 0 && o->work_margin >= 0.0;
+}
+
+double px__tracker_scale(px_aabb bounds)
+{
+	double s = px_aabb_diagonal(&bounds);
+	return s > 0.0 ? s : 1.0;
+}
+
+px_aabb px__tracker_work(px_aabb bounds, double margin, double scale)
+{
+	px_aabb w;
+	double m = margin * scale;
+	w.min = px_v3_sub(bounds.min, px_v3(m, m, m));
+	w.max = px_v3_add(bounds.max, px_v3(m, m, m));
+	return w;
+}
+
+void px__tracker_stats_out(void *out, const void *st, size_t size,
+			   const struct px_gov *g)
+{
+	/* the shared counters are the first member of *out */
+	struct px_track_shared_stats *sh = out;
+	if (!out)
+		return;
+	if (!st) {
+		memset(out, 0, size);
+		return;
+	}
+	memcpy(out, st, size);
+	sh->tracked_ns = g->trk_ns;
+	sh->cold_ns = g->cold_ns;
 }

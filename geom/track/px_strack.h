@@ -160,6 +160,19 @@ extern "C" {
 #endif
 
 struct px_strack_opts {
+	/* work_margin, max_crit (interior points each surface can hold,
+	 * default 256), verify_every, dist, cold_switch: px_track.h.
+	 * Outside the working volume the update answers globally and the
+	 * set waits (max_solves > 0) or re-initialises (max_solves = 0).
+	 * Cold switch: the updates go cold when cells are due and solved
+	 * in most updates or the set keeps catching up; on the return the
+	 * critical points are re-established in budgeted slices as after
+	 * an over-budget update (max_solves > 0; at once with 0), the
+	 * curve tracker started afresh at the point (with max_solves > 0
+	 * in an update of its own, answered globally, before the first
+	 * slice: after many cold updates its memory is out of the caches,
+	 * and the two together made the return's worst update). */
+	PX_TRACK_SHARED(px_track_shared_opts, PX_TRACK_SHARED_OPTS_FIELDS);
 	/* Cells per Bezier patch along u and along v (default 3, 1..16).
 	 * Spans of rational patches whose weights are more than a factor
 	 * 1.5 apart get twice as many (at most 16): their derivative
@@ -175,15 +188,6 @@ struct px_strack_opts {
 	 * sampled; still checked (2..32) so that old option sets stay
 	 * valid. */
 	int samples;
-	/* Interior critical points each surface can hold (default 256). */
-	int max_crit;
-	/* Working volume margin as a fraction of the model diagonal
-	 * (default 1.0); outside it the update answers globally and the set
-	 * waits (max_solves > 0) or re-initialises (max_solves = 0). */
-	double work_margin;
-	/* Compare with the global query every verify_every updates (0: off,
-	 * the default). */
-	int verify_every;
 	/* Bound on the transition work of one update, in cell solves
 	 * (default 4; 0: no bound). A solve's work is counted by the seeds
 	 * it runs: a cell whose region certificates prove it free of
@@ -219,22 +223,6 @@ struct px_strack_opts {
 	 * stats.over_budget and stats.rebuild_updates). With 0 these cases
 	 * re-initialise at once (cost of px_strack_reset()). */
 	int max_solves;
-	/* Options of the global-query model (NULL: defaults). */
-	const struct px_dist_opts *dist;
-	/* Cold switch (default 1), as px_track_opts.cold_switch: when
-	 * tracking costs more than the exact global query (fast motion:
-	 * cells due and solved in most updates, the set catching up), the
-	 * updates are answered by px_dist_query() (source PX_TRACK_COLD)
-	 * until the mean step has halved (or as a probe after a while);
-	 * then the critical points are re-established in budgeted slices
-	 * as after an over-budget update (max_solves > 0; at once with 0),
-	 * the curve tracker started afresh at the point (with max_solves >
-	 * 0 in an update of its own, answered globally, before the first
-	 * slice: after many cold updates its memory is out of the caches,
-	 * and the two together made the return's worst update). Both answers are
-	 * exact; this bounds the cost of fast motion by the global
-	 * query's. 0: always track. */
-	int cold_switch;
 	/* Bound on the cell tests of one update (default 32; 0: no bound;
 	 * unused with max_solves 0). A test is up to 12 certificate
 	 * radii (0.3-0.7 us); a long step or a long lag makes many cells due at
@@ -288,14 +276,16 @@ struct px_strack_result {
  * features as for PX_TRACK_GLOBAL. */
 
 struct px_strack_stats {
-	uint64_t updates, reinits, outside, fallbacks, overflows;
-	uint64_t verifications, disagreements;
+	/* updates, reinits, outside, fallbacks, overflows, verifications,
+	 * disagreements, rekeys (due cells not tested again: the point was
+	 * still well inside the cube their last test proved, the path had
+	 * wound about in it), hot (updates on the hot path: the answering
+	 * minimum followed alone), cold, cold_entered, cold_left,
+	 * tracked_ns (every mode but cold), cold_ns: px_track.h */
+	PX_TRACK_SHARED(px_track_shared_stats, PX_TRACK_SHARED_STATS_FIELDS);
 	/* cells solved, cell region tests, points whose Newton failed (died
 	 * at a fold or left through an edge; their cell is solved again) */
 	uint64_t cell_solves, box_tests, lost;
-	/* due cells not tested again: the point was still well inside the
-	 * cube their last test proved (the path had wound about in it) */
-	uint64_t rekeys;
 	uint64_t born;     /* interior points found by cell solves */
 	/* boxes of cell solves that hold at most one critical point and
 	 * none of the held ones, where x - Y E(x) contracts (Krawczyk): the
@@ -336,13 +326,6 @@ struct px_strack_stats {
 	 * boundary (a point missed): answered globally, the set
 	 * re-established */
 	uint64_t unbalanced;
-	/* updates on the hot path: the answering minimum followed alone */
-	uint64_t hot;
-	/* cold switch: updates answered cold, switches to cold and back,
-	 * running mean cost (ns) of a timed tracked update (every mode but
-	 * cold) and of the cold query */
-	uint64_t cold, cold_entered, cold_left;
-	double tracked_ns, cold_ns;
 };
 
 struct px_strack_info {

@@ -127,41 +127,101 @@
 extern "C" {
 #endif
 
+/*
+ * What both trackers take and count (px_strack.h too): px_track_opts and
+ * px_strack_opts begin with the options of px_track_shared_opts,
+ * px_track_stats and px_strack_stats with the counters of
+ * px_track_shared_stats. Each is reached by its own name (o.max_crit,
+ * s.updates) or all of them together as the member shared (o.shared,
+ * s.shared), the same storage.
+ *
+ * Options:
+ *  - work_margin: the working volume is the model bounds grown by this
+ *    fraction of the model diagonal on every side (default 1.0); what a
+ *    query point outside it does, each tracker says.
+ *  - max_crit: critical points each entity (curve or surface) can hold
+ *    (default 64 for curves, 256 for surfaces; 2..2^20).
+ *  - verify_every: compare with the global query every verify_every
+ *    updates (0: off, the default); a disagreement re-initialises and
+ *    the update is answered globally.
+ *  - dist: options of the global-query model (NULL: its defaults).
+ *  - cold_switch (default 1): when the point moves so fast that tracking
+ *    costs more than the exact global query (one update in 16 is timed;
+ *    tracked mean over 1.5 times the cold query's), updates are answered
+ *    by px_dist_query() (source PX_TRACK_COLD) until the mean step has
+ *    halved (or as a probe after a while), then the critical points are
+ *    found afresh at the point and tracking goes on. Both answers are
+ *    exact; this bounds the cost of fast motion by the global query's.
+ *    0: always track.
+ */
+#define PX_TRACK_SHARED_OPTS_FIELDS                                           \
+	double work_margin;                                                  \
+	int max_crit;                                                        \
+	int verify_every;                                                    \
+	const struct px_dist_opts *dist;                                     \
+	int cold_switch;
+
+struct px_track_shared_opts {
+	PX_TRACK_SHARED_OPTS_FIELDS
+};
+
+/* Counters (since creation) of both trackers; rekeys counts leaves or
+ * cells, hot the updates that followed the answering point alone. */
+#define PX_TRACK_SHARED_STATS_FIELDS                                          \
+	uint64_t updates;                                                    \
+	uint64_t reinits;       /* tracked state re-initialised (anomalies,   \
+				 * failed checks) */                         \
+	uint64_t outside;       /* updates with a point outside the volume */ \
+	uint64_t fallbacks;     /* answered by the global query */           \
+	uint64_t overflows;     /* capacity exceeded (answered globally) */   \
+	uint64_t verifications;                                              \
+	uint64_t disagreements; /* verification found a closer point */      \
+	uint64_t rekeys;        /* due leaves or cells kept without their    \
+				 * test: the point still well inside the     \
+				 * ball or cube their last test proved */    \
+	uint64_t hot;           /* updates on the hot path */                \
+	uint64_t cold;          /* updates answered cold (cold_switch) */    \
+	uint64_t cold_entered, cold_left; /* switches to and from cold */    \
+	double tracked_ns, cold_ns; /* the cold switch's running means (ns) \
+				     * of a timed tracked update and of the  \
+				     * cold query */
+
+struct px_track_shared_stats {
+	PX_TRACK_SHARED_STATS_FIELDS
+};
+
+/* The first member of the four structs above: the shared part under both
+ * its names (C11 anonymous members; two structs of the same members in
+ * one union share their storage). */
+#define PX_TRACK_SHARED(tag, fields)                                          \
+	union {                                                              \
+		struct tag shared;                                           \
+		struct {                                                     \
+			fields                                               \
+		};                                                           \
+	}
+
 struct px_track_opts {
-	/* Working volume: the transition boxes are clipped to it; a query
-	 * point outside it re-initialises. An empty box (lo > hi, the
-	 * default) takes the model bounds grown by work_margin times their
-	 * diagonal on every side. */
+	/* work_margin, max_crit (default 64), verify_every, dist,
+	 * cold_switch: above. A query point outside the working volume
+	 * re-initialises. */
+	PX_TRACK_SHARED(px_track_shared_opts, PX_TRACK_SHARED_OPTS_FIELDS);
+	/* Working volume: the transition boxes are clipped to it. An empty
+	 * box (lo > hi, the default) takes the model bounds grown by
+	 * work_margin. */
 	px_aabb work;
-	double work_margin;   /* default 1.0 */
-	/* Critical points each entity can hold (default 64). */
-	int max_crit;
 	/* Parameter leaves per Bezier span (default 4, 1..64). */
 	int leaves_per_span;
 	/* Octree depth of the event cells of a leaf inside the working
 	 * volume (default 4, 0..7); their union per leaf bounds its safe
 	 * radius. */
 	int box_depth;
-	/* Compare with the global query every verify_every updates (0: off,
-	 * the default). */
-	int verify_every;
-	/* Options of the global query model (NULL for its defaults). */
-	const struct px_dist_opts *dist;
 	/* Lazy correction (default 1): a critical point provably still in
 	 * its parameter leaf rests (is not corrected) while it cannot be the
 	 * closest point - maxima always, minima while their last distance
 	 * minus the path travelled since exceeds the current best. 0
 	 * corrects every critical point on every update. */
 	int lazy;
-	/* Cold switch (default 1): when the point moves so fast that
-	 * tracking costs more than the exact global query (one update in 16
-	 * is timed; tracked mean over 1.5 times the cold query's), updates
-	 * are answered by px_dist_query() (source PX_TRACK_COLD) until the
-	 * mean step has halved, then the critical points are found afresh
-	 * at the point (one re-initialisation) and tracking goes on. Both
-	 * answers are exact; this bounds the cost of fast motion by the
-	 * global query's. 0: always track. */
-	int cold_switch;
 };
 
 /* Defaults as documented above. */
@@ -206,20 +266,17 @@ struct px_track_result {
 };
 
 struct px_track_stats {
-	uint64_t updates;
-	uint64_t reinits;        /* entity re-initialisations (anomalies) */
-	uint64_t outside;        /* updates with a point outside the volume */
-	uint64_t fallbacks;      /* answered by the global query */
-	uint64_t overflows;      /* capacity exceeded (also a fallback) */
+	/* updates, reinits (entity re-initialisations), outside,
+	 * fallbacks, overflows, verifications, disagreements, rekeys (due
+	 * leaves kept without the exact segment test), hot (updates
+	 * answered under the hot certificate: only the answering root
+	 * evolved, opts.lazy), cold, cold_entered, cold_left, tracked_ns,
+	 * cold_ns: above */
+	PX_TRACK_SHARED(px_track_shared_stats, PX_TRACK_SHARED_STATS_FIELDS);
 	uint64_t unresolved;     /* root isolation not certified (fallback) */
-	uint64_t verifications;
-	uint64_t disagreements;  /* verification found a closer point */
 	uint64_t leaf_solves;
 	uint64_t box_hits;       /* leaves whose safe radius ran out (given
 				  * the exact segment test) */
-	uint64_t rekeys;         /* due leaves kept without the test: the
-				  * point still well inside the ball their
-				  * last test proved */
 	uint64_t renewals;       /* resting roots' leaf certificates renewed
 				  * without correcting them (their leaf's
 				  * end values kept their signs) */
@@ -228,14 +285,6 @@ struct px_track_stats {
 				  * update (opts.lazy), summed over updates */
 	uint64_t rested_entities; /* entities passed whole under their rest
 				   * certificate, summed over updates */
-	uint64_t hot;            /* updates answered under the hot
-				  * certificate: only the answering root
-				  * evolved (opts.lazy) */
-	uint64_t cold;           /* updates answered cold (cold_switch) */
-	uint64_t cold_entered, cold_left; /* switches to and from cold */
-	double tracked_ns, cold_ns; /* the cold switch's running means of a
-				     * tracked update and of the global
-				     * query (timed samples) */
 };
 
 struct px_track_info {

@@ -148,12 +148,10 @@ int px__st_cold_update(struct px_strack *t, px_vec3 p, struct px_strack_result *
 {
 	struct px_dist_result g;
 	struct crit c;
-	int ok, rc = px__gov_cold_query(&t->gov, t->dist, p, &g);
+	int ok, rc = px__gov_cold_query(&t->gov, &t->st.shared, t->dist, p, &g);
 	if (rc)
 		return rc;
 	result_clear(r);
-	t->st.updates++;
-	t->st.cold++;
 	r->dist = g.dist;
 	r->point = g.point;
 	r->u = g.u;

@@ -33,15 +33,7 @@ int px_strack_critical(const struct px_strack *t, int s, double *u, double *v,
 
 void px_strack_get_stats(const struct px_strack *t, struct px_strack_stats *s)
 {
-	if (!s)
-		return;
-	if (!t) {
-		memset(s, 0, sizeof(*s));
-		return;
-	}
-	*s = t->st;
-	s->tracked_ns = t->gov.trk_ns;
-	s->cold_ns = t->gov.cold_ns;
+	px__tracker_stats_out(s, t ? &t->st : NULL, sizeof(*s), t ? &t->gov : NULL);
 }
 
 void px_strack_get_info(const struct px_strack *t, struct px_strack_info *info)
@@ -74,15 +66,11 @@ void px_strack_opts_default(struct px_strack_opts *o)
 	if (!o)
 		return;
 	memset(o, 0, sizeof(*o));
+	px__tracker_opts_default(&o->shared, 256);
 	o->cells_per_span = 3;
 	o->seeds = 2;
 	o->samples = 6;
-	o->max_crit = 256;
-	o->work_margin = 1.0;
-	o->verify_every = 0;
 	o->max_solves = 4;
-	o->dist = NULL;
-	o->cold_switch = 1;
 	o->max_tests = 32;
 }
 
@@ -307,34 +295,25 @@ static int build_patches(struct ssurf *f, const double *ub, int nu,
 	return PX_OK;
 }
 
-int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
-		     const struct px_nurbs_surf *surfs, int n_surfs,
-		     const struct px_strack_opts *opts, struct px_strack **out)
+/* The options (opts, or the defaults without) into o and whether
+ * px_strack_create() accepts them and the surfaces: PX_OK, PX_E_INVAL or
+ * PX_E_RANGE (degree); *max_knots the most knots of a surface in one
+ * direction. */
+static int create_check(const struct px_nurbs_surf *surfs, int n_surfs,
+			const struct px_strack_opts *opts,
+			struct px_strack_opts *o, int *max_knots)
 {
-	struct px_strack *t;
-	struct px_strack_opts o;
-	struct px_nurbs_curve *cc = NULL;
-	double **cpw = NULL, *ub = NULL, *vb = NULL;
-	int *ncs_u = NULL, *ncs_v = NULL;
-	double *work = NULL;
-	size_t wl = 0, npend;
-	int rc, i, j, k, max_knots = 0, cap_edges, n_cc = 0, cell_cap = 0;
-	px_aabb bounds;
-
-	if (!out || (n_curves > 0 && !curves) || !surfs || n_surfs <= 0 ||
-	    n_curves < 0)
-		return PX_E_INVAL;
-	*out = NULL;
+	int i, k;
 	if (opts)
-		o = *opts;
+		*o = *opts;
 	else
-		px_strack_opts_default(&o);
-	if (o.cells_per_span < 1 || o.cells_per_span > 16 || o.seeds < 1 ||
-	    o.seeds > 8 || o.samples < 2 || o.samples > 32 || o.max_crit < 2 ||
-	    o.max_crit > 1 << 20 || o.verify_every < 0 || o.max_solves < 0 ||
-	    o.max_tests < 0 ||
-	    !(o.work_margin >= 0.0))
+		px_strack_opts_default(o);
+	if (!px__tracker_opts_valid(&o->shared) || o->cells_per_span < 1 ||
+	    o->cells_per_span > 16 || o->seeds < 1 || o->seeds > 8 ||
+	    o->samples < 2 || o->samples > 32 || o->max_solves < 0 ||
+	    o->max_tests < 0)
 		return PX_E_INVAL;
+	*max_knots = 0;
 	for (i = 0; i < n_surfs; i++) {
 		if (surfs[i].degree[0] < 1 || surfs[i].degree[1] < 1 ||
 		    surfs[i].degree[0] > PX_NURBS_MAX_DEGREE ||
@@ -343,9 +322,415 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 		if (!surfs[i].knots[0] || !surfs[i].knots[1] || !surfs[i].pw)
 			return PX_E_INVAL;
 		for (k = 0; k < 2; k++)
-			if (surfs[i].n_knots[k] > max_knots)
-				max_knots = surfs[i].n_knots[k];
+			if (surfs[i].n_knots[k] > *max_knots)
+				*max_knots = surfs[i].n_knots[k];
 	}
+	return PX_OK;
+}
+
+/* Surface i: its copy, domain, seams, patches and the bounds of its
+ * cells (ub, vb, ncs_u, ncs_v: scratch for max_knots + 2 entries); its
+ * cells are numbered from *cell_cap on, which grows by their count. */
+static int surf_setup(struct px_strack *t, int i, const struct px_nurbs_surf *s,
+		      double *ub, double *vb, int *ncs_u, int *ncs_v,
+		      int *cell_cap)
+{
+	struct ssurf *f = &t->sf[i];
+	px_aabb hb = px_nurbs_surf_aabb(s);
+	double tol = 1e-12 * (1.0 + px_aabb_diagonal(&hb));
+	int nu, nv, k, rc = surf_copy(f, s);
+	if (rc)
+		return rc;
+	px_nurbs_surf_domain(&f->s, &f->u0, &f->u1, &f->v0, &f->v1);
+	f->du = f->u1 - f->u0;
+	f->dv = f->v1 - f->v0;
+	f->wrap_u = px_nurbs_surf_seam(&f->s, 0, tol, 1e-9) >= 1;
+	f->wrap_v = px_nurbs_surf_seam(&f->s, 1, tol, 1e-9) >= 1;
+	nu = px__st_span_bounds(&f->s, 0, f->u0, f->u1, ub);
+	nv = px__st_span_bounds(&f->s, 1, f->v0, f->v1, vb);
+	t->n_patches += (nu - 1) * (nv - 1);
+	rc = build_patches(f, ub, nu, vb, nv);
+	if (rc)
+		return rc;
+	span_cells(f, t->opts.cells_per_span, ncs_u, ncs_v);
+	for (f->ncu = 0, k = 0; k < nu - 1; k++)
+		f->ncu += ncs_u[k];
+	for (f->ncv = 0, k = 0; k < nv - 1; k++)
+		f->ncv += ncs_v[k];
+	f->cu = calloc((size_t)f->ncu + 1, sizeof(double));
+	f->cv = calloc((size_t)f->ncv + 1, sizeof(double));
+	f->cap = t->opts.max_crit;
+	f->z = calloc((size_t)f->cap, sizeof(*f->z));
+	f->tmp = calloc((size_t)f->cap, sizeof(*f->tmp));
+	if (!f->cu || !f->cv || !f->z || !f->tmp)
+		return PX_E_NOMEM;
+	span_bounds_fill(f->cu, ub, nu, ncs_u);
+	f->cu[f->ncu] = f->u1;
+	span_bounds_fill(f->cv, vb, nv, ncs_v);
+	f->cv[f->ncv] = f->v1;
+	f->first_cell = *cell_cap;
+	*cell_cap += f->ncu * f->ncv;
+	return PX_OK;
+}
+
+/* Every surface set up (surf_setup()); *bounds of the whole model (the
+ * curves' too), *cell_cap the cells of all surfaces. */
+static int surfs_setup(struct px_strack *t, const struct px_nurbs_curve *curves,
+		       int n_curves, const struct px_nurbs_surf *surfs,
+		       int max_knots, px_aabb *bounds, int *cell_cap)
+{
+	double *ub = calloc((size_t)max_knots + 2, sizeof(double));
+	double *vb = calloc((size_t)max_knots + 2, sizeof(double));
+	int *ncs_u = calloc((size_t)max_knots + 2, sizeof(int));
+	int *ncs_v = calloc((size_t)max_knots + 2, sizeof(int));
+	int i, rc = PX_OK;
+	t->sf = calloc((size_t)t->n_surf, sizeof(*t->sf));
+	if (!t->sf || !ub || !vb || !ncs_u || !ncs_v)
+		rc = PX_E_NOMEM;
+	*bounds = px_aabb_empty();
+	*cell_cap = 0;
+	for (i = 0; i < n_curves; i++) {
+		px_aabb hb = px_nurbs_curve_aabb(&curves[i]);
+		*bounds = px_aabb_union(bounds, &hb);
+	}
+	for (i = 0; i < t->n_surf && rc == PX_OK; i++) {
+		px_aabb hb = px_nurbs_surf_aabb(&surfs[i]);
+		*bounds = px_aabb_union(bounds, &hb);
+		rc = surf_setup(t, i, &surfs[i], ub, vb, ncs_u, ncs_v, cell_cap);
+	}
+	free(ub);
+	free(vb);
+	free(ncs_u);
+	free(ncs_v);
+	return rc;
+}
+
+/* The per-cell arrays for cell_cap cells. */
+static int cells_alloc(struct px_strack *t, int cell_cap)
+{
+	/* pending items: each cell once, a crossing solve a hit, ST_RINGS
+	 * bounds a surface */
+	size_t npend = (2 + ST_RINGS) * (size_t)cell_cap + 2;
+	t->cell = calloc((size_t)cell_cap + 1, sizeof(*t->cell));
+	t->rcell = calloc(4 * (size_t)cell_cap + 1, sizeof(*t->rcell));
+	t->qcert = calloc(16 * (size_t)cell_cap + 1, sizeof(*t->qcert));
+	t->ex = calloc((size_t)cell_cap + 1, sizeof(*t->ex));
+	t->gdue = calloc((size_t)cell_cap / ST_GROUP + 2, sizeof(*t->gdue));
+	t->cube = calloc((size_t)cell_cap + 1, sizeof(*t->cube));
+	t->popped = calloc((size_t)cell_cap + 1, sizeof(int));
+	t->hits = calloc((size_t)cell_cap + 1, sizeof(int));
+	t->pend = calloc(npend, sizeof(int));
+	t->pend_ps = calloc(npend, sizeof(px_vec3));
+	t->pend_need = calloc(npend, sizeof(double));
+	t->pend_kind = calloc(npend, 1);
+	t->ring_list = calloc((size_t)cell_cap + 1, sizeof(int));
+	if (!t->cell || !t->rcell || !t->qcert || !t->ex || !t->gdue ||
+	    !t->cube || !t->popped || !t->hits || !t->pend || !t->pend_ps ||
+	    !t->pend_kind || !t->pend_need || !t->ring_list)
+		return PX_E_NOMEM;
+	return PX_OK;
+}
+
+/* Cell ci of surface i (cell k along u, j along v): its bounds and its
+ * four region cells with their certificates (work: wl doubles). */
+static int cell_setup(struct px_strack *t, int i, int ci, int k, int j,
+		      double *work, size_t wl)
+{
+	const struct ssurf *f = &t->sf[i];
+	struct scell *c = &t->cell[ci];
+	double um, vm;
+	px_aabb cb = px_aabb_empty();
+	int ch, rc;
+	c->surf = i;
+	c->u0 = f->cu[k];
+	c->u1 = f->cu[k + 1];
+	c->v0 = f->cv[j];
+	c->v1 = f->cv[j + 1];
+	um = 0.5 * (c->u0 + c->u1);
+	vm = 0.5 * (c->v0 + c->v1);
+	c->child = 4 * ci;
+	for (ch = 0; ch < 4; ch++) {
+		struct scell *rg = &t->rcell[c->child + ch];
+		int open[4];
+		px_aabb rb;
+		rg->surf = i;
+		rg->u0 = ch & 1 ? um : c->u0;
+		rg->u1 = ch & 1 ? c->u1 : um;
+		rg->v0 = ch & 2 ? vm : c->v0;
+		rg->v1 = ch & 2 ? c->v1 : vm;
+		px__st_sides_open(f, rg, open);
+		if ((rg->u0 == f->u0 && f->pole[0]) ||
+		    (rg->u1 == f->u1 && f->pole[1]) ||
+		    (rg->v0 == f->v0 && f->pole[2]) ||
+		    (rg->v1 == f->v1 && f->pole[3]))
+			c->always = 1;
+		rc = px__st_cell_cert(t, rg, f, work, wl, open);
+		if (rc)
+			return rc;
+		rc = px__st_quarter_certs(t, rg, f, work, wl,
+					  &t->qcert[4 * (c->child + ch)]);
+		if (rc)
+			return rc;
+		rb.min = px_v3(rg->cert.S[0].lo, rg->cert.S[1].lo, rg->cert.S[2].lo);
+		rb.max = px_v3(rg->cert.S[0].hi, rg->cert.S[1].hi, rg->cert.S[2].hi);
+		cb = px_aabb_union(&cb, &rb);
+	}
+	c->size = px_aabb_diagonal(&cb);
+	t->n_unbounded += c->always;
+	return PX_OK;
+}
+
+/* Every surface's poles as far as the certificates need them and its
+ * cells (cell_setup()). */
+static int cells_setup(struct px_strack *t)
+{
+	size_t wl = 0;
+	double *work;
+	int i, j, k, rc = PX_OK;
+	for (i = 0; i < t->n_surf; i++) {
+		const struct px_nurbs_surf *sf = &t->sf[i].s;
+		size_t l = PX_NURBS_SURF_WORK_LEN(sf->degree[0], sf->degree[1],
+						  sf->n_ctrl[0], sf->n_ctrl[1]);
+		if (l > wl)
+			wl = l;
+	}
+	work = malloc(wl * sizeof(double));
+	if (!work)
+		return PX_E_NOMEM;
+	for (i = 0; i < t->n_surf && rc == PX_OK; i++) {
+		struct ssurf *f = &t->sf[i];
+		for (k = 0; k < 4; k++)
+			/* as for the poles (edges_setup()) */
+			f->pole[k] = !((k < 2 && f->wrap_u) || (k >= 2 && f->wrap_v)) &&
+				     px_nurbs_surf_edge_collapsed(&f->s, k,
+								  1e-12 * (1.0 + t->scale));
+		for (j = 0; j < f->ncv && rc == PX_OK; j++)
+			for (k = 0; k < f->ncu && rc == PX_OK; k++)
+				rc = cell_setup(t, i, f->first_cell + j * f->ncu + k,
+						k, j, work, wl);
+	}
+	free(work);
+	return rc;
+}
+
+/* The curves of the curve tracker: the free curves, then the open
+ * (uncollapsed) edges and C0 creases of the surfaces as iso-curves;
+ * cpw[e] owns the control points of edge e. */
+struct edge_set {
+	struct px_nurbs_curve *cc;
+	double **cpw;
+	int n_cc, cap;
+};
+
+/* The iso-curve of surface i at parameter tv in direction dir (the
+ * other held) as the next edge. */
+static int edge_add(struct px_strack *t, struct edge_set *es, int i, int dir,
+		    double tv)
+{
+	const struct ssurf *f = &t->sf[i];
+	size_t len = 4 * (size_t)f->s.n_ctrl[dir];
+	struct edge *ed = &t->edge[t->n_edges];
+	int rc;
+	es->cpw[t->n_edges] = malloc(len * sizeof(double));
+	if (!es->cpw[t->n_edges])
+		return PX_E_NOMEM;
+	rc = px_nurbs_surf_iso_curve(&f->s, dir, tv, es->cpw[t->n_edges], len,
+				     &es->cc[es->n_cc]);
+	if (rc) {
+		free(es->cpw[t->n_edges]);
+		es->cpw[t->n_edges] = NULL;
+		return rc;
+	}
+	ed->surf = i;
+	ed->dir = dir;
+	ed->t = tv;
+	t->n_edges++;
+	es->n_cc++;
+	return PX_OK;
+}
+
+/* Surface i's edges: collapsed ones become poles, the others (not at a
+ * closed seam) and the C0 creases edges. */
+static int surf_edges(struct px_strack *t, struct edge_set *es, int i)
+{
+	struct ssurf *f = &t->sf[i];
+	double tol = 1e-12 * (1.0 + t->scale), brk[64];
+	int e, nb, d, k, rc;
+	for (e = 0; e < 4; e++) {
+		int dir = e < 2 ? 1 : 0; /* curve direction */
+		double tv = e == 0 ? f->u0 : e == 1 ? f->u1 : e == 2 ? f->v0 : f->v1;
+		if ((e < 2 && f->wrap_u) || (e >= 2 && f->wrap_v))
+			continue;
+		if (px_nurbs_surf_edge_collapsed(&f->s, e, tol)) {
+			struct pole *pl = &t->pole[t->n_poles++];
+			f->pole[e] = 1;
+			pl->u = e < 2 ? tv : f->u0;
+			pl->v = e < 2 ? f->v0 : tv;
+			pl->q = px_nurbs_surf_point(&f->s, pl->u, pl->v);
+			pl->surf = i;
+			continue;
+		}
+		rc = edge_add(t, es, i, dir, tv);
+		if (rc)
+			return rc;
+	}
+	for (d = 0; d < 2; d++) {
+		/* creases across direction d: curves along the other */
+		nb = px_nurbs_surf_breaks(&f->s, d, brk, 64);
+		for (k = 0; k < nb && k < 64; k++) {
+			if (t->n_edges >= es->cap)
+				break;
+			rc = edge_add(t, es, i, 1 - d, brk[k]);
+			if (rc)
+				return rc;
+		}
+	}
+	return PX_OK;
+}
+
+/* The curve tracker's curves (struct edge_set), the poles. */
+static int edges_setup(struct px_strack *t, const struct px_nurbs_curve *curves,
+		       int n_curves, int max_knots, struct edge_set *es)
+{
+	int i, rc;
+	es->cap = 0;
+	for (i = 0; i < t->n_surf; i++)
+		es->cap += 4 + 2 * max_knots;
+	t->edge = calloc((size_t)es->cap, sizeof(*t->edge));
+	t->pole = calloc((size_t)4 * t->n_surf, sizeof(*t->pole));
+	es->cc = calloc((size_t)(n_curves + es->cap), sizeof(*es->cc));
+	es->cpw = calloc((size_t)es->cap, sizeof(*es->cpw));
+	if (!t->edge || !t->pole || !es->cc || !es->cpw)
+		return PX_E_NOMEM;
+	for (i = 0; i < n_curves; i++)
+		es->cc[es->n_cc++] = curves[i];
+	for (i = 0; i < t->n_surf; i++) {
+		rc = surf_edges(t, es, i);
+		if (rc)
+			return rc;
+	}
+	return PX_OK;
+}
+
+/* Boxes of the half spans of the n_cc curves cc (t->cbox), which prove
+ * the curve tracker farther than an interior minimum. */
+static int curve_boxes(struct px_strack *t, const struct px_nurbs_curve *cc,
+		       int n_cc)
+{
+	double *cw;
+	size_t cwl = 0;
+	int i, k, nb = 0, rc = PX_OK;
+	for (i = 0; i < n_cc; i++) {
+		size_t l = PX_NURBS_CURVE_WORK_LEN(cc[i].degree, cc[i].n_ctrl);
+		cwl = l > cwl ? l : cwl;
+		nb += 2 * cc[i].n_knots;
+	}
+	t->cbox = calloc((size_t)nb, sizeof(*t->cbox));
+	cw = malloc(cwl * sizeof(double));
+	if (!t->cbox || !cw) {
+		free(cw);
+		return PX_E_NOMEM;
+	}
+	for (i = 0; i < n_cc && rc == PX_OK; i++) {
+		const double *U = cc[i].knots;
+		int p = cc[i].degree, n = cc[i].n_ctrl, h;
+		for (k = p; k < n && rc == PX_OK; k++) {
+			if (!(U[k + 1] > U[k]))
+				continue;
+			for (h = 0; h < 2 && rc == PX_OK; h++) {
+				double a = U[k] + 0.5 * h * (U[k + 1] - U[k]);
+				double b = h ? U[k + 1] : 0.5 * (U[k] + U[k + 1]);
+				px_aabb bx;
+				rc = px_nurbs_curve_sub_aabb(&cc[i], a, b, cw, cwl, &bx);
+				if (rc == PX_OK)
+					/* rounding of evaluated points */
+					t->cbox[t->n_cbox++] = px_aabb_inflate(&bx, 1e-12 * t->scale);
+			}
+		}
+	}
+	free(cw);
+	return rc;
+}
+
+/* The curve tracker over the edge set (none when it is empty) and its
+ * boxes. */
+static int curves_setup(struct px_strack *t, const struct edge_set *es)
+{
+	struct px_track_opts to;
+	int rc;
+	if (es->n_cc == 0)
+		return PX_OK;
+	rc = curve_boxes(t, es->cc, es->n_cc);
+	if (rc)
+		return rc;
+	px_track_opts_default(&to);
+	/* the surface tracker decides what is followed; its curve tracker
+	 * must always track */
+	to.cold_switch = 0;
+	to.work = t->work;
+	to.dist = t->opts.dist;
+	return px_track_create(es->cc, es->n_cc, &to, &t->ct);
+}
+
+/* Slots for a cache: a power of two, at least want up to cap. */
+static int cache_slots(int want, int cap)
+{
+	int n = 1;
+	while (n < want && n < cap)
+		n *= 2;
+	return n;
+}
+
+/* n cache slots of size bytes, each beginning with its int key: all
+ * empty (key -1, nothing filled). */
+static void *cache_new(int n, size_t size)
+{
+	char *c = calloc((size_t)n, size);
+	int i;
+	for (i = 0; c && i < n; i++)
+		*(int *)(void *)(c + (size_t)i * size) = -1;
+	return c;
+}
+
+/* The certificate caches of the update. */
+static int caches_setup(struct px_strack *t)
+{
+	int i, nrat = 0;
+	/* the piece cache where a region is rational: a slot for each
+	 * quarter of up to 64 such regions (about 4.4 KiB a slot), fewer
+	 * when the model has fewer */
+	for (i = 0; i < 4 * t->n_cells; i++)
+		nrat += t->rcell[i].cert.rat;
+	if (nrat > 0) {
+		t->pcache_n = cache_slots(4 * nrat, 256);
+		t->pcache = cache_new(t->pcache_n, sizeof(*t->pcache));
+		if (!t->pcache)
+			return PX_E_NOMEM;
+	}
+	/* the cut cache: 128 slots (about 5.4 KiB each), fewer for small
+	 * models */
+	t->scache_n = cache_slots(4 * t->n_cells, 128);
+	t->scache = cache_new(t->scache_n, sizeof(*t->scache));
+	return t->scache ? PX_OK : PX_E_NOMEM;
+}
+
+int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
+		     const struct px_nurbs_surf *surfs, int n_surfs,
+		     const struct px_strack_opts *opts, struct px_strack **out)
+{
+	struct px_strack *t;
+	struct px_strack_opts o;
+	struct edge_set es = {0};
+	int rc, i, max_knots, cell_cap;
+	px_aabb bounds;
+
+	if (!out || (n_curves > 0 && !curves) || !surfs || n_surfs <= 0 ||
+	    n_curves < 0)
+		return PX_E_INVAL;
+	*out = NULL;
+	rc = create_check(surfs, n_surfs, opts, &o, &max_knots);
+	if (rc)
+		return rc;
 	t = calloc(1, sizeof(*t));
 	if (!t)
 		return PX_E_NOMEM;
@@ -364,357 +749,42 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 		free(t);
 		return rc;
 	}
-	t->sf = calloc((size_t)n_surfs, sizeof(*t->sf));
-	ub = calloc((size_t)max_knots + 2, sizeof(double));
-	vb = calloc((size_t)max_knots + 2, sizeof(double));
-	ncs_u = calloc((size_t)max_knots + 2, sizeof(int));
-	ncs_v = calloc((size_t)max_knots + 2, sizeof(int));
-	if (!t->sf || !ub || !vb || !ncs_u || !ncs_v) {
-		rc = PX_E_NOMEM;
+	rc = surfs_setup(t, curves, n_curves, surfs, max_knots, &bounds,
+			 &cell_cap);
+	if (rc)
 		goto fail;
-	}
-	/* surfaces, domains, cells */
-	bounds = px_aabb_empty();
-	for (i = 0; i < n_curves; i++) {
-		px_aabb hb = px_nurbs_curve_aabb(&curves[i]);
-		bounds = px_aabb_union(&bounds, &hb);
-	}
-	for (i = 0; i < n_surfs; i++) {
-		struct ssurf *f = &t->sf[i];
-		px_aabb hb = px_nurbs_surf_aabb(&surfs[i]);
-		int nu, nv;
-		bounds = px_aabb_union(&bounds, &hb);
-		rc = surf_copy(f, &surfs[i]);
-		if (rc)
-			goto fail;
-		px_nurbs_surf_domain(&f->s, &f->u0, &f->u1, &f->v0, &f->v1);
-		f->du = f->u1 - f->u0;
-		f->dv = f->v1 - f->v0;
-		{
-			double tol = 1e-12 * (1.0 + px_aabb_diagonal(&hb));
-			f->wrap_u = px_nurbs_surf_seam(&f->s, 0, tol, 1e-9) >= 1;
-			f->wrap_v = px_nurbs_surf_seam(&f->s, 1, tol, 1e-9) >= 1;
-		}
-		nu = px__st_span_bounds(&f->s, 0, f->u0, f->u1, ub);
-		nv = px__st_span_bounds(&f->s, 1, f->v0, f->v1, vb);
-		t->n_patches += (nu - 1) * (nv - 1);
-		rc = build_patches(f, ub, nu, vb, nv);
-		if (rc)
-			goto fail;
-		span_cells(f, o.cells_per_span, ncs_u, ncs_v);
-		for (f->ncu = 0, k = 0; k < nu - 1; k++)
-			f->ncu += ncs_u[k];
-		for (f->ncv = 0, k = 0; k < nv - 1; k++)
-			f->ncv += ncs_v[k];
-		f->cu = calloc((size_t)f->ncu + 1, sizeof(double));
-		f->cv = calloc((size_t)f->ncv + 1, sizeof(double));
-		f->cap = o.max_crit;
-		f->z = calloc((size_t)f->cap, sizeof(*f->z));
-		f->tmp = calloc((size_t)f->cap, sizeof(*f->tmp));
-		if (!f->cu || !f->cv || !f->z || !f->tmp) {
-			rc = PX_E_NOMEM;
-			goto fail;
-		}
-		span_bounds_fill(f->cu, ub, nu, ncs_u);
-		f->cu[f->ncu] = f->u1;
-		span_bounds_fill(f->cv, vb, nv, ncs_v);
-		f->cv[f->ncv] = f->v1;
-		f->first_cell = cell_cap;
-		cell_cap += f->ncu * f->ncv;
-	}
-	t->scale = px_aabb_diagonal(&bounds);
-	if (!(t->scale > 0.0))
-		t->scale = 1.0;
-	{
-		double m = o.work_margin * t->scale;
-		t->work.min = px_v3_sub(bounds.min, px_v3(m, m, m));
-		t->work.max = px_v3_add(bounds.max, px_v3(m, m, m));
-	}
-	t->cell = calloc((size_t)cell_cap + 1, sizeof(*t->cell));
-	t->rcell = calloc(4 * (size_t)cell_cap + 1, sizeof(*t->rcell));
-	t->qcert = calloc(16 * (size_t)cell_cap + 1, sizeof(*t->qcert));
-	t->ex = calloc((size_t)cell_cap + 1, sizeof(*t->ex));
-	t->gdue = calloc((size_t)cell_cap / ST_GROUP + 2, sizeof(*t->gdue));
-	t->cube = calloc((size_t)cell_cap + 1, sizeof(*t->cube));
-	t->popped = calloc((size_t)cell_cap + 1, sizeof(int));
-	t->hits = calloc((size_t)cell_cap + 1, sizeof(int));
-	/* pending items: each cell once, a crossing solve a hit, ST_RINGS
-	 * bounds a surface */
-	npend = (2 + ST_RINGS) * (size_t)cell_cap + 2;
-	t->pend = calloc(npend, sizeof(int));
-	t->pend_ps = calloc(npend, sizeof(px_vec3));
-	t->pend_need = calloc(npend, sizeof(double));
-	t->pend_kind = calloc(npend, 1);
-	t->ring_list = calloc((size_t)cell_cap + 1, sizeof(int));
-	for (i = 0; i < n_surfs; i++) {
-		const struct px_nurbs_surf *sf = &t->sf[i].s;
-		size_t l = PX_NURBS_SURF_WORK_LEN(sf->degree[0], sf->degree[1],
-						  sf->n_ctrl[0], sf->n_ctrl[1]);
-		if (l > wl)
-			wl = l;
-	}
-	work = malloc(wl * sizeof(double));
-	if (!t->cell || !t->rcell || !t->qcert || !t->ex || !t->gdue || !t->cube || !t->popped || !t->hits ||
-	    !t->pend || !t->pend_ps || !t->pend_kind || !t->pend_need ||
-	    !t->ring_list || !work) {
-		rc = PX_E_NOMEM;
+	t->scale = px__tracker_scale(bounds);
+	t->work = px__tracker_work(bounds, o.work_margin, t->scale);
+	rc = cells_alloc(t, cell_cap);
+	if (!rc)
+		rc = cells_setup(t);
+	if (rc)
 		goto fail;
-	}
-	for (i = 0; i < n_surfs; i++) {
-		struct ssurf *f = &t->sf[i];
-		for (k = 0; k < 4; k++)
-			/* as for the poles below */
-			f->pole[k] = !((k < 2 && f->wrap_u) || (k >= 2 && f->wrap_v)) &&
-				     px_nurbs_surf_edge_collapsed(&f->s, k,
-								  1e-12 * (1.0 + t->scale));
-		for (j = 0; j < f->ncv; j++)
-			for (k = 0; k < f->ncu; k++) {
-				struct scell *c = &t->cell[f->first_cell + j * f->ncu + k];
-				c->surf = i;
-				c->u0 = f->cu[k];
-				c->u1 = f->cu[k + 1];
-				c->v0 = f->cv[j];
-				c->v1 = f->cv[j + 1];
-				{
-					double um = 0.5 * (c->u0 + c->u1), vm = 0.5 * (c->v0 + c->v1);
-					int ch;
-					px_aabb cb = px_aabb_empty();
-					c->child = 4 * (f->first_cell + j * f->ncu + k);
-					for (ch = 0; ch < 4; ch++) {
-						struct scell *rg = &t->rcell[c->child + ch];
-						int open[4];
-						px_aabb rb;
-						rg->surf = i;
-						rg->u0 = ch & 1 ? um : c->u0;
-						rg->u1 = ch & 1 ? c->u1 : um;
-						rg->v0 = ch & 2 ? vm : c->v0;
-						rg->v1 = ch & 2 ? c->v1 : vm;
-						px__st_sides_open(f, rg, open);
-						if ((rg->u0 == f->u0 && f->pole[0]) ||
-						    (rg->u1 == f->u1 && f->pole[1]) ||
-						    (rg->v0 == f->v0 && f->pole[2]) ||
-						    (rg->v1 == f->v1 && f->pole[3]))
-							c->always = 1;
-						rc = px__st_cell_cert(t, rg, f, work, wl, open);
-						if (rc)
-							goto fail;
-						rc = px__st_quarter_certs(t, rg, f, work, wl,
-								   &t->qcert[4 * (c->child + ch)]);
-						if (rc)
-							goto fail;
-						rb.min = px_v3(rg->cert.S[0].lo, rg->cert.S[1].lo, rg->cert.S[2].lo);
-						rb.max = px_v3(rg->cert.S[0].hi, rg->cert.S[1].hi, rg->cert.S[2].hi);
-						cb = px_aabb_union(&cb, &rb);
-					}
-					c->size = px_aabb_diagonal(&cb);
-					t->n_unbounded += c->always;
-				}
-			}
-	}
 	t->n_cells = cell_cap;
 	for (i = 0; i < n_surfs; i++) {
 		rc = px__st_wind_pieces(t, i);
 		if (rc)
 			goto fail;
 	}
-
-	/* curve tracker: free curves, then open (uncollapsed) edges and
-	 * C0 creases as iso-curves; collapsed edges become poles */
-	cap_edges = 0;
-	for (i = 0; i < n_surfs; i++)
-		cap_edges += 4 + 2 * max_knots;
-	t->edge = calloc((size_t)cap_edges, sizeof(*t->edge));
-	t->pole = calloc((size_t)4 * n_surfs, sizeof(*t->pole));
-	cc = calloc((size_t)(n_curves + cap_edges), sizeof(*cc));
-	cpw = calloc((size_t)cap_edges, sizeof(*cpw));
-	if (!t->edge || !t->pole || !cc || !cpw) {
-		rc = PX_E_NOMEM;
+	rc = edges_setup(t, curves, n_curves, max_knots, &es);
+	if (!rc)
+		rc = curves_setup(t, &es);
+	if (!rc)
+		rc = caches_setup(t);
+	if (rc)
 		goto fail;
-	}
-	for (i = 0; i < n_curves; i++)
-		cc[n_cc++] = curves[i];
-	for (i = 0; i < n_surfs; i++) {
-		struct ssurf *f = &t->sf[i];
-		double tol = 1e-12 * (1.0 + t->scale), brk[64];
-		int e, nb, d;
-		for (e = 0; e < 4; e++) {
-			int dir = e < 2 ? 1 : 0; /* curve direction */
-			double tv = e == 0 ? f->u0 : e == 1 ? f->u1 : e == 2 ? f->v0 : f->v1;
-			if ((e < 2 && f->wrap_u) || (e >= 2 && f->wrap_v))
-				continue;
-			if (px_nurbs_surf_edge_collapsed(&f->s, e, tol)) {
-				struct pole *pl = &t->pole[t->n_poles++];
-				f->pole[e] = 1;
-				pl->u = e < 2 ? tv : f->u0;
-				pl->v = e < 2 ? f->v0 : tv;
-				pl->q = px_nurbs_surf_point(&f->s, pl->u, pl->v);
-				pl->surf = i;
-				continue;
-			}
-			{
-				size_t len = 4 * (size_t)f->s.n_ctrl[dir];
-				struct edge *ed = &t->edge[t->n_edges];
-				cpw[t->n_edges] = malloc(len * sizeof(double));
-				if (!cpw[t->n_edges]) {
-					rc = PX_E_NOMEM;
-					goto fail;
-				}
-				rc = px_nurbs_surf_iso_curve(&f->s, dir, tv, cpw[t->n_edges],
-							     len, &cc[n_cc]);
-				if (rc) {
-					free(cpw[t->n_edges]);
-					cpw[t->n_edges] = NULL;
-					goto fail;
-				}
-				ed->surf = i;
-				ed->dir = dir;
-				ed->t = tv;
-				t->n_edges++;
-				n_cc++;
-			}
-		}
-		for (d = 0; d < 2; d++) {
-			/* creases across direction d: curves along the other */
-			nb = px_nurbs_surf_breaks(&f->s, d, brk, 64);
-			for (k = 0; k < nb && k < 64; k++) {
-				int dir = 1 - d;
-				size_t len = 4 * (size_t)f->s.n_ctrl[dir];
-				struct edge *ed = &t->edge[t->n_edges];
-				if (t->n_edges >= cap_edges)
-					break;
-				cpw[t->n_edges] = malloc(len * sizeof(double));
-				if (!cpw[t->n_edges]) {
-					rc = PX_E_NOMEM;
-					goto fail;
-				}
-				rc = px_nurbs_surf_iso_curve(&f->s, dir, brk[k], cpw[t->n_edges],
-							     len, &cc[n_cc]);
-				if (rc) {
-					free(cpw[t->n_edges]);
-					cpw[t->n_edges] = NULL;
-					goto fail;
-				}
-				ed->surf = i;
-				ed->dir = dir;
-				ed->t = brk[k];
-				t->n_edges++;
-				n_cc++;
-			}
-		}
-	}
-	if (n_cc > 0) {
-		struct px_track_opts to;
-		double *cw = NULL;
-		size_t cwl = 0;
-		int nb = 0;
-		for (i = 0; i < n_cc; i++) {
-			size_t l = PX_NURBS_CURVE_WORK_LEN(cc[i].degree, cc[i].n_ctrl);
-			cwl = l > cwl ? l : cwl;
-			nb += 2 * cc[i].n_knots;
-		}
-		t->cbox = calloc((size_t)nb, sizeof(*t->cbox));
-		cw = malloc(cwl * sizeof(double));
-		if (!t->cbox || !cw) {
-			free(cw);
-			rc = PX_E_NOMEM;
-			goto fail;
-		}
-		for (i = 0; i < n_cc && rc == PX_OK; i++) {
-			const double *U = cc[i].knots;
-			int p = cc[i].degree, n = cc[i].n_ctrl, h;
-			for (k = p; k < n && rc == PX_OK; k++) {
-				if (!(U[k + 1] > U[k]))
-					continue;
-				for (h = 0; h < 2 && rc == PX_OK; h++) {
-					double a = U[k] + 0.5 * h * (U[k + 1] - U[k]);
-					double b = h ? U[k + 1] : 0.5 * (U[k] + U[k + 1]);
-					px_aabb bx;
-					rc = px_nurbs_curve_sub_aabb(&cc[i], a, b, cw, cwl, &bx);
-					if (rc == PX_OK)
-						/* rounding of evaluated points */
-						t->cbox[t->n_cbox++] = px_aabb_inflate(&bx, 1e-12 * t->scale);
-				}
-			}
-		}
-		free(cw);
-		if (rc)
-			goto fail;
-		px_track_opts_default(&to);
-		/* the surface tracker decides what is followed; its curve
-		 * tracker must always track */
-		to.cold_switch = 0;
-		to.work = t->work;
-		to.dist = o.dist;
-		rc = px_track_create(cc, n_cc, &to, &t->ct);
-		if (rc)
-			goto fail;
-	}
-	{
-		/* the piece cache where a region is rational: a slot for each
-		 * quarter of up to 64 such regions (about 4.4 KiB a slot),
-		 * fewer when the model has fewer */
-		int nrat = 0, n = 1;
-		for (i = 0; i < 4 * t->n_cells; i++)
-			nrat += t->rcell[i].cert.rat;
-		if (nrat > 0) {
-			while (n < 4 * nrat && n < 256)
-				n *= 2;
-			t->pcache = malloc((size_t)n * sizeof(*t->pcache));
-			if (!t->pcache) {
-				rc = PX_E_NOMEM;
-				goto fail;
-			}
-			for (i = 0; i < n; i++) {
-				t->pcache[i].key = -1;
-				t->pcache[i].filled = 0;
-			}
-			t->pcache_n = n;
-		}
-	}
-	{
-		/* the cut cache: 128 slots (about 5.4 KiB each), fewer for
-		 * small models */
-		int n = 1;
-		while (n < 4 * t->n_cells && n < 128)
-			n *= 2;
-		t->scache = malloc((size_t)n * sizeof(*t->scache));
-		if (!t->scache) {
-			rc = PX_E_NOMEM;
-			goto fail;
-		}
-		for (i = 0; i < n; i++) {
-			t->scache[i].key = -1;
-			t->scache[i].filled = 0;
-		}
-		t->scache_n = n;
-	}
 	t->epoch = 1;
 	t->hot_s = -1;
 	t->ans_s = -1;
-	{
-		/* the cold query's cost where a tool works: about the model
-		 * (as px_track does) */
-		px_aabb cb = bounds;
-		double m = 0.3 * t->scale;
-		cb.min = px_v3_sub(cb.min, px_v3(m, m, m));
-		cb.max = px_v3_add(cb.max, px_v3(m, m, m));
-		px__gov_init(&t->gov, o.cold_switch != 0,
-			     o.cold_switch ? px__gov_calibrate(t->dist, cb) : 1.0);
-	}
-	rc = PX_OK;
+	px__gov_setup(&t->gov, o.cold_switch != 0, t->dist, bounds, t->scale);
 	*out = t;
 	t = NULL;
 fail:
-	if (cpw)
-		for (i = 0; i < cap_edges; i++)
-			free(cpw[i]);
-	free(cpw);
-	free(cc);
-	free(ub);
-	free(vb);
-	free(ncs_u);
-	free(ncs_v);
-	free(work);
+	if (es.cpw)
+		for (i = 0; i < es.cap; i++)
+			free(es.cpw[i]);
+	free(es.cpw);
+	free(es.cc);
 	px_strack_free(t);
 	return rc;
 }

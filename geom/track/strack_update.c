@@ -167,26 +167,18 @@ static int reinit_all(struct px_strack *t, px_vec3 p)
 
 static void verify(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 {
-	struct px_dist_result g;
-	if (t->opts.verify_every <= 0 ||
-	    t->st.updates % (uint64_t)t->opts.verify_every != 0)
+	if (!px__tracker_verify(&t->opts.shared, &t->st.shared, t->dist, t->scale,
+				p, r->dist, &r->verified))
 		return;
-	if (px_dist_query(t->dist, p, &g))
-		return;
-	t->st.verifications++;
-	r->verified = 1;
-	if (r->dist > g.dist + 1e-9 * (t->scale + g.dist)) {
-		t->st.disagreements++;
-		t->st.reinits++;
-		if (t->opts.max_solves > 0) {
-			/* re-established over the next updates */
-			px__st_rebuild_start(t);
-		} else if (reinit_all(t, p)) {
-			t->st.overflows++;
-		}
-		px__st_answer_global(t, p, r);
-		r->verified = 1;
+	t->st.reinits++;
+	if (t->opts.max_solves > 0) {
+		/* re-established over the next updates */
+		px__st_rebuild_start(t);
+	} else if (reinit_all(t, p)) {
+		t->st.overflows++;
 	}
+	px__st_answer_global(t, p, r);
+	r->verified = 1;
 }
 
 /* The curve tracker's answer (none when the model has no curve and no
@@ -307,17 +299,14 @@ int px__st_full_reset(struct px_strack *t, px_vec3 p,
 
 int px_strack_reset(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 {
-	if (!t || !r)
-		return PX_E_INVAL;
-	if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
-		return PX_E_NAN;
+	int rc = px__tracker_args(t, r, p);
+	if (rc)
+		return rc;
 	result_clear(r);
 	t->st.updates++;
 	t->p = p;
 	t->init = 1;
-	if (t->gov.cold)
-		t->st.cold_left++;
-	px__gov_restart(&t->gov);
+	px__gov_reset(&t->gov, &t->st.shared);
 	t->gov_q = p;
 	t->ret_left = 0;
 	t->best_kind = 0;
@@ -1238,27 +1227,26 @@ static int strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result
 int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 {
 	int64_t t0;
-	int rc;
+	int rc = px__tracker_args(t, r, p), mode;
+	double len = 0.0;
 
-	if (!t || !r)
-		return PX_E_INVAL;
-	if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
-		return PX_E_NAN;
+	if (rc)
+		return rc;
 	if (!t->init)
 		return px_strack_reset(t, p, r);
 	if (t->gov.on) {
-		px__gov_step(&t->gov, px_v3_dist(t->gov_q, p));
+		len = px_v3_dist(t->gov_q, p);
 		t->gov_q = p;
-		if (t->gov.cold) {
-			if (!px__gov_leave(&t->gov)) {
-				if (px__st_cold_update(t, p, r) == 0)
-					return PX_OK;
-				/* no global answer here: track again */
-				px__gov_restart(&t->gov);
-			}
-			return px__st_cold_return(t, p, r);
-		}
 	}
+	mode = px__gov_begin(&t->gov, len);
+	if (mode == PX_GOV_COLD) {
+		if (px__st_cold_update(t, p, r) == 0)
+			return PX_OK;
+		/* no global answer here: track again */
+		px__gov_restart(&t->gov);
+	}
+	if (mode != PX_GOV_TRACK)
+		return px__st_cold_return(t, p, r);
 	t0 = t->ret_left == 0 ? px__gov_start(&t->gov) : PX_GOV_UNTIMED;
 	rc = strack_update(t, p, r);
 	if (t->ret_left > 0 && (t->mode == ST_TRACK || --t->ret_left == 0))

@@ -26,15 +26,7 @@ int px_track_critical(const struct px_track *t, int entity, double *u,
 
 void px_track_get_stats(const struct px_track *t, struct px_track_stats *s)
 {
-	if (!s)
-		return;
-	if (!t) {
-		memset(s, 0, sizeof(*s));
-		return;
-	}
-	*s = t->st;
-	s->tracked_ns = t->gov.trk_ns;
-	s->cold_ns = t->gov.cold_ns;
+	px__tracker_stats_out(s, t ? &t->st : NULL, sizeof(*s), t ? &t->gov : NULL);
 }
 
 void px_track_get_info(const struct px_track *t, struct px_track_info *info)
@@ -68,16 +60,12 @@ void px_track_opts_default(struct px_track_opts *o)
 	if (!o)
 		return;
 	memset(o, 0, sizeof(*o));
+	px__tracker_opts_default(&o->shared, 64);
 	o->work.min = px_v3(1, 1, 1);
 	o->work.max = px_v3(-1, -1, -1);
-	o->work_margin = 1.0;
-	o->max_crit = 64;
 	o->leaves_per_span = 4;
 	o->box_depth = 4;
-	o->verify_every = 0;
-	o->dist = NULL;
 	o->lazy = 1;
-	o->cold_switch = 1;
 }
 
 struct split {
@@ -326,38 +314,449 @@ void px_track_free(struct px_track *t)
 	free(t);
 }
 
-int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
-		    const struct px_track_opts *opts, struct px_track **out)
+/* The options (opts, or the defaults without) into o and whether
+ * px_track_create() accepts them and the curves: PX_OK, PX_E_RANGE
+ * (degree) or PX_E_INVAL; *max_ctrl the most control points of a curve,
+ * *span_cap a bound on the spans (knots and cusps: at most 32 a span). */
+static int create_check(const struct px_nurbs_curve *curves, int n_curves,
+			const struct px_track_opts *opts, struct px_track_opts *o,
+			int *max_ctrl, int *span_cap)
 {
-	struct px_track *t;
-	struct px_track_opts o;
-	struct split *spl = NULL;
-	double *work = NULL;
-	size_t work_len = 0, pool_cap = 0;
-	int rc, i, j, k, span_cap = 0, leaf_cap = 0, cand_cap = 0, max_ctrl = 0;
-	px_aabb bounds;
-
-	if (!out || !curves || n_curves <= 0)
-		return PX_E_INVAL;
-	*out = NULL;
+	int i;
 	if (opts)
-		o = *opts;
+		*o = *opts;
 	else
-		px_track_opts_default(&o);
-	if (o.max_crit < 2 || o.max_crit > 1 << 20 || o.leaves_per_span < 1 ||
-	    o.leaves_per_span > 64 || o.box_depth < 0 || o.box_depth > 7 ||
-	    o.verify_every < 0 || !(o.work_margin >= 0.0))
+		px_track_opts_default(o);
+	if (!px__tracker_opts_valid(&o->shared) || o->leaves_per_span < 1 ||
+	    o->leaves_per_span > 64 || o->box_depth < 0 || o->box_depth > 7)
 		return PX_E_INVAL;
+	*max_ctrl = 0;
+	*span_cap = 0;
 	for (i = 0; i < n_curves; i++) {
 		if (curves[i].degree < 1 || curves[i].degree > TRK_MAXD)
 			return PX_E_RANGE;
 		if (!curves[i].knots || !curves[i].pw)
 			return PX_E_INVAL;
-		if (curves[i].n_ctrl > max_ctrl)
-			max_ctrl = curves[i].n_ctrl;
-		/* spans: knots + cusps (bounded by 32 per span) */
-		span_cap += (curves[i].n_ctrl + 1) * 34 + 2;
+		if (curves[i].n_ctrl > *max_ctrl)
+			*max_ctrl = curves[i].n_ctrl;
+		*span_cap += (curves[i].n_ctrl + 1) * 34 + 2;
 	}
+	return PX_OK;
+}
+
+/* Span s over [s0, s1] of a curve of degree p from its Bezier piece sub:
+ * the power-basis tables. */
+static void span_setup(struct span *s, const struct px_nurbs_curve *sub,
+		       double s0, double s1, int p)
+{
+	double hb[4][TRK_MAXD + 1], sc = 1.0;
+	int q, jj, r;
+	s->u0 = s0;
+	s->u1 = s1;
+	s->inv = 1.0 / (s1 - s0);
+	s->deg = p;
+	for (q = 0; q <= p; q++)
+		for (jj = 0; jj < 4; jj++)
+			hb[jj][q] = sub->pw[4 * q + jj];
+	for (jj = 0; jj < 4; jj++)
+		for (q = 0; q <= p; q++) {
+			double v = 0.0;
+			for (r = 0; r <= q; r++)
+				v += (((q - r) & 1) ? -1.0 : 1.0) *
+				     px_bern_binom(q, r) * hb[jj][r];
+			s->pc[jj][q] = px_bern_binom(p, q) * v;
+		}
+	for (q = 0; q <= p; q++) {
+		for (jj = 0; jj < 4; jj++)
+			s->pu[jj][q] = s->pc[jj][q] * sc;
+		sc *= s->inv;
+	}
+	s->rat = 0;
+	for (q = 0; q <= p; q++)
+		if (s->pc[3][q] != (q == 0 ? 1.0 : 0.0))
+			s->rat = 1;
+#if TRK_VEC
+	for (jj = 0; jj < 4; jj++) {
+		const double *w = s->pu[jj];
+		int m = jj / 2, l2 = jj % 2;
+		for (q = 0; q < 4; q++)
+			s->hv[q][m][l2] = w[q];
+		s->hd1[0][m][l2] = w[1];
+		s->hd1[1][m][l2] = 2.0 * w[2];
+		s->hd1[2][m][l2] = 3.0 * w[3];
+		s->hd2[0][m][l2] = 2.0 * w[2];
+		s->hd2[1][m][l2] = 6.0 * w[3];
+	}
+#endif
+}
+
+/* What the setup passes over the curves keep: the splits (spl, span_cap
+ * entries), the curve work space (work_len doubles) and the sizes the
+ * first pass finds for the second. */
+struct setup {
+	struct split *spl;
+	int span_cap;
+	double *work;
+	size_t work_len;
+	int leaf_cap, cand_cap;
+	size_t pool_cap;
+};
+
+/* Curve c (entity i, hull its box): its domain, seam, spans and
+ * critical-point arrays; the sizes in su grow by what its leaves and
+ * candidates need. */
+static int curve_spans(struct px_track *t, int i, const struct px_nurbs_curve *c,
+		       const px_aabb *hull, struct setup *su)
+{
+	struct ent *e = &t->ent[i];
+	int ns, k, p = c->degree, rc;
+	double a, b;
+
+	px_nurbs_curve_domain(c, &a, &b);
+	e->u0 = a;
+	e->u1 = b;
+	e->len = b - a;
+	e->cyclic = px_nurbs_curve_seam(c, 1e-12 * (1.0 + px_aabb_diagonal(hull)),
+					1e-9) >= 1;
+	ns = curve_splits(c, su->spl, su->span_cap - t->n_spans - 2, &t->n_cusps);
+	e->first_span = t->n_spans;
+	for (k = 0; k <= ns; k++) {
+		double s0 = k == 0 ? a : su->spl[k - 1].u, s1 = k == ns ? b : su->spl[k].u;
+		struct px_nurbs_curve sub;
+		if (!(s1 > s0))
+			continue;
+		rc = px_nurbs_curve_extract_work(c, s0, s1, su->work, su->work_len, &sub);
+		if (rc)
+			return rc;
+		if (sub.n_ctrl != p + 1)
+			return PX_E_INVAL;
+		span_setup(&t->span[t->n_spans], &sub, s0, s1, p);
+		t->n_spans++;
+	}
+	e->n_spans = t->n_spans - e->first_span;
+	e->cap = t->opts.max_crit;
+	e->z = calloc((size_t)e->cap, sizeof(*e->z));
+	e->old = calloc((size_t)e->cap, sizeof(*e->old));
+	if (!e->z || !e->old)
+		return PX_E_NOMEM;
+	su->leaf_cap += e->n_spans * t->opts.leaves_per_span;
+	su->cand_cap += ns + 2;
+	for (k = 0; k < e->n_spans; k++) {
+		int n = 3 * p - 1;
+		su->pool_cap += (size_t)t->opts.leaves_per_span *
+				(size_t)(4 * (n + 1) + 4 * n);
+	}
+	return PX_OK;
+}
+
+/* The arrays of the leaves and candidates (sizes in su). */
+static int leaves_alloc(struct px_track *t, const struct setup *su)
+{
+	size_t lc = (size_t)su->leaf_cap;
+	t->leaf = calloc(lc, sizeof(*t->leaf));
+	t->pool = calloc(su->pool_cap ? su->pool_cap : 1, sizeof(double));
+	t->cand = calloc((size_t)su->cand_cap + 1, sizeof(*t->cand));
+	t->cexp = calloc((size_t)su->cand_cap + 1, sizeof(*t->cexp));
+	t->hits = calloc(lc + 1, sizeof(int));
+	t->expiry = calloc(lc + 1, sizeof(double));
+	t->ectr = calloc(lc + 1, sizeof(*t->ectr));
+	t->erad = calloc(lc + 1, sizeof(double));
+	t->gdue = calloc(lc / TRK_GROUP + 2, sizeof(double));
+	t->ipool = calloc(lc * (2 * TRK_NG + 2) + 1, sizeof(double));
+	if (!t->leaf || !t->pool || !t->cand || !t->cexp || !t->hits ||
+	    !t->expiry || !t->ectr || !t->erad || !t->gdue || !t->ipool)
+		return PX_E_NOMEM;
+	return PX_OK;
+}
+
+static void cand_add(struct px_track *t, const struct px_nurbs_curve *c, int i,
+		     double u, int kind)
+{
+	struct cand *cd = &t->cand[t->n_cand++];
+	cd->q = px_nurbs_curve_point(c, u);
+	cd->u = u;
+	cd->ent = i;
+	cd->kind = kind;
+}
+
+/* Curve c's (entity i) candidates for the minimum: open ends, a cornered
+ * seam, C0 breaks and cusps (spl: its ns splits); its breaks counted. */
+static void curve_cands(struct px_track *t, int i, const struct px_nurbs_curve *c,
+			const struct split *spl, int ns, int seam)
+{
+	struct ent *e = &t->ent[i];
+	int k;
+	e->first_cand = t->n_cand;
+	if (seam < 0) {
+		cand_add(t, c, i, e->u0, PX_TRACK_END);
+		cand_add(t, c, i, e->u1, PX_TRACK_END);
+	} else if (seam == 0) {
+		cand_add(t, c, i, e->u0, PX_TRACK_BREAK);
+	}
+	for (k = 0; k < ns; k++) {
+		if (spl[k].kind == K_C0 || spl[k].kind == K_CUSP)
+			cand_add(t, c, i, spl[k].u, PX_TRACK_BREAK);
+		if (spl[k].kind != K_SMOOTH)
+			t->n_breaks++;
+	}
+	e->n_cand = t->n_cand - e->first_cand;
+}
+
+/* The coefficients of leaf l, the part [t0, t1] of a span whose w^3 g
+ * has the Bernstein coefficients ga, gb of degree n, into a (pool):
+ * divided by (s - s0) / (s - s1) at a cusp start / end (cusp0, cusp1),
+ * then the derivative's; returns the leaf's degree. */
+static int leaf_coeffs(struct leaf *l, double *a, const double *ga,
+		       const double gb[3][TRK_NG], int n, double t0, double t1,
+		       int cusp0, int cusp1)
+{
+	double *b = a + n + 1;
+	int m = n, cc;
+	px_bern_restrict(ga, n, t0, t1, a);
+	for (cc = 0; cc < 3; cc++)
+		px_bern_restrict(gb[cc], n, t0, t1, b + cc * (n + 1));
+	if (cusp0) {
+		l->flags |= LF_CUSP0;
+		px__tk_bern_divide(a, m, 0);
+		for (cc = 0; cc < 3; cc++)
+			px__tk_bern_divide(b + cc * (n + 1), m, 0);
+		m--;
+	}
+	if (cusp1 && m >= 1) {
+		l->flags |= LF_CUSP1;
+		px__tk_bern_divide(a, m, 1);
+		for (cc = 0; cc < 3; cc++)
+			px__tk_bern_divide(b + cc * (n + 1), m, 1);
+		m--;
+	}
+	/* compact to stride m + 1 */
+	if (m != n) {
+		double tmp[4 * (TRK_NG + 1)];
+		for (cc = 0; cc < 4; cc++)
+			memcpy(tmp + cc * (m + 1), a + cc * (n + 1),
+			       (size_t)(m + 1) * sizeof(double));
+		memcpy(a, tmp, (size_t)(4 * (m + 1)) * sizeof(double));
+	}
+	if (m >= 1)
+		for (cc = 0; cc < 4; cc++)
+			px_bern_deriv(a + cc * (m + 1), m, a + 4 * (m + 1) + cc * m);
+	return m;
+}
+
+/* Leaf l's tolerances: the rounding of its affine coefficients a (degree
+ * m) anywhere in a working volume within wmax of the origin. */
+static void leaf_tols(struct leaf *l, const double *a, int m, double wmax)
+{
+	const double *da = a + 4 * (m + 1);
+	double tg = 0.0, td = 0.0;
+	int q;
+	for (q = 0; q <= m; q++) {
+		double s2 = fabs(a[q]) +
+			    wmax * (fabs(a[m + 1 + q]) + fabs(a[2 * (m + 1) + q]) +
+				    fabs(a[3 * (m + 1) + q]));
+		tg = fmax(tg, s2);
+	}
+	for (q = 0; q < m; q++) {
+		double s2 = fabs(da[q]) + wmax * (fabs(da[m + q]) +
+						  fabs(da[2 * m + q]) +
+						  fabs(da[3 * m + q]));
+		td = fmax(td, s2);
+	}
+	l->tol_g = 1e-12 * tg;
+	l->tol_d = 1e-12 * td;
+}
+
+/* The inverse norms of the p-gradients of leaf li's coefficients a
+ * (degree m) into ib (safe radii; 0 for a constant). */
+static void leaf_inorms(double *ib, const double *a, int m)
+{
+	const double *da = a + 4 * (m + 1);
+	int q;
+	for (q = 0; q <= m; q++) {
+		double nb = sqrt(a[m + 1 + q] * a[m + 1 + q] +
+				 a[2 * (m + 1) + q] * a[2 * (m + 1) + q] +
+				 a[3 * (m + 1) + q] * a[3 * (m + 1) + q]);
+		ib[q] = nb > 0.0 ? 1.0 / nb : INFINITY;
+	}
+	for (q = 0; q < m; q++) {
+		double nb = sqrt(da[m + q] * da[m + q] + da[2 * m + q] * da[2 * m + q] +
+				 da[3 * m + q] * da[3 * m + q]);
+		ib[m + 1 + q] = nb > 0.0 ? 1.0 / nb : INFINITY;
+	}
+}
+
+/* The leaves of span si (entity i, degree p; kind0 / kind1 the kinds of
+ * its ends; wmax as for leaf_tols()). */
+static void span_leaves(struct px_track *t, int i, int si, int p, int kind0,
+			int kind1, double wmax)
+{
+	const struct span *s = &t->span[si];
+	double hb[4][TRK_MAXD + 1], ga[TRK_NG], gb[3][TRK_NG];
+	int n = 3 * p - 1, q, jj, L, nl = t->opts.leaves_per_span;
+	/* Bernstein net back from the power basis */
+	for (jj = 0; jj < 4; jj++)
+		for (q = 0; q <= p; q++) {
+			double v = 0.0;
+			int r;
+			for (r = 0; r <= q; r++)
+				v += px_bern_binom(q, r) / px_bern_binom(p, r) *
+				     s->pc[jj][r];
+			hb[jj][q] = v;
+		}
+	span_g(p, hb, ga, gb);
+	for (L = 0; L < nl; L++) {
+		struct leaf *l = &t->leaf[t->n_leaves];
+		double t0 = (double)L / nl, t1 = (double)(L + 1) / nl;
+		double *a = t->pool + t->pool_len;
+		int m, k0 = L == 0 ? kind0 : K_SMOOTH,
+		       k1 = L == nl - 1 ? kind1 : K_SMOOTH;
+		l->u0 = s->u0 + (s->u1 - s->u0) * t0;
+		l->u1 = L == nl - 1 ? s->u1 : s->u0 + (s->u1 - s->u0) * t1;
+		l->ent = i;
+		l->span = si;
+		l->off = t->pool_len;
+		m = leaf_coeffs(l, a, ga, gb, n, t0, t1, k0 == K_CUSP, k1 == K_CUSP);
+		l->n = m;
+		leaf_tols(l, a, m, wmax);
+		l->ioff = (size_t)t->n_leaves * (2 * TRK_NG + 2);
+		leaf_inorms(t->ipool + l->ioff, a, m);
+		t->pool_len += (size_t)(4 * (m + 1) + 4 * m);
+		if (k0 != K_SMOOTH)
+			l->flags |= LF_EV0;
+		if (k1 != K_SMOOTH)
+			l->flags |= LF_EV1;
+		if (k0 == K_C0 || k0 == K_CUSP)
+			l->flags |= LF_SB0;
+		if (k1 == K_C0 || k1 == K_CUSP)
+			l->flags |= LF_SB1;
+		t->n_leaves++;
+	}
+}
+
+/* Curve c's (entity i) candidates and leaves. */
+static void curve_leaves(struct px_track *t, int i, const struct px_nurbs_curve *c,
+			 const struct setup *su)
+{
+	struct ent *e = &t->ent[i];
+	const struct split *spl = su->spl;
+	int ns, p = c->degree, seam, nc0 = 0, k, q;
+	px_aabb hull = px_nurbs_curve_aabb(c);
+	double wmax = fmax(fmax(fabs(t->work.min.x), fabs(t->work.max.x)),
+			   fmax(fmax(fabs(t->work.min.y), fabs(t->work.max.y)),
+				fmax(fabs(t->work.min.z), fabs(t->work.max.z))));
+
+	ns = curve_splits(c, su->spl, su->span_cap, &nc0);
+	seam = px_nurbs_curve_seam(c, 1e-12 * (1.0 + px_aabb_diagonal(&hull)), 1e-9);
+	e->first_leaf = t->n_leaves;
+	curve_cands(t, i, c, spl, ns, seam);
+	for (k = 0; k < e->n_spans; k++) {
+		const struct span *s = &t->span[e->first_span + k];
+		int kind0 = K_SMOOTH, kind1 = K_SMOOTH;
+		/* kinds of the span's ends */
+		for (q = 0; q < ns; q++) {
+			if (spl[q].u == s->u0)
+				kind0 = spl[q].kind;
+			if (spl[q].u == s->u1)
+				kind1 = spl[q].kind;
+		}
+		if (k == 0)
+			kind0 = seam >= 2 ? K_SMOOTH : seam == 1 ? K_C1 : K_C0;
+		if (k == e->n_spans - 1)
+			kind1 = seam >= 2 ? K_SMOOTH : seam == 1 ? K_C1 : K_C0;
+		span_leaves(t, i, e->first_span + k, p, kind0, kind1, wmax);
+	}
+	e->n_leaves = t->n_leaves - e->first_leaf;
+	if (!e->cyclic) {
+		/* open or cornered: parameters do not wrap */
+		t->leaf[e->first_leaf].flags |= LF_EV0 | LF_SB0;
+		t->leaf[t->n_leaves - 1].flags |= LF_EV1 | LF_SB1;
+	}
+	for (k = 0; k < e->n_leaves; k++)
+		if (t->leaf[e->first_leaf + k].flags & LF_SB0)
+			e->n_sb++;
+}
+
+/* Event cells: octree exclusion per leaf down to depth; their union box
+ * per leaf bounds its safe radius. */
+static int event_cells(struct px_track *t, int depth)
+{
+	struct cellbuf cb = {0};
+	long q;
+	int i;
+	for (i = 0; i < t->n_leaves; i++) {
+		long budget = 1L << 14, first = cb.n;
+		struct leaf *l = &t->leaf[i];
+		leaf_cells_rec(t, i, t->work, 0, depth, &cb, &budget);
+		if (cb.fail) {
+			free(cb.p);
+			return PX_E_NOMEM;
+		}
+		l->box = px_aabb_empty();
+		for (q = first; q < cb.n; q++) {
+			px_aabb_extend(&l->box, cb.p[q].box.min);
+			px_aabb_extend(&l->box, cb.p[q].box.max);
+		}
+		if (cb.n > first) {
+			l->boxed = 1;
+			t->n_boxed++;
+		}
+	}
+	t->n_prim = (int)cb.n;
+	free(cb.p);
+	return PX_OK;
+}
+
+/* The working volume: opts.work where it is a box, else about the model. */
+static px_aabb work_volume(const struct px_track_opts *o, px_aabb bounds,
+			   double scale)
+{
+	if (o->work.min.x <= o->work.max.x && o->work.min.y <= o->work.max.y &&
+	    o->work.min.z <= o->work.max.z)
+		return o->work;
+	return px__tracker_work(bounds, o->work_margin, scale);
+}
+
+/* Every curve's spans (curve_spans()), then the working volume, every
+ * curve's leaves and candidates (curve_leaves()) and the event cells;
+ * *bounds the model's. */
+static int curves_setup(struct px_track *t, const struct px_nurbs_curve *curves,
+			struct setup *su, px_aabb *bounds)
+{
+	int i, rc = PX_OK;
+	*bounds = px_aabb_empty();
+	for (i = 0; i < t->n_ent && rc == PX_OK; i++) {
+		px_aabb hull = px_nurbs_curve_aabb(&curves[i]);
+		px_aabb_extend(bounds, hull.min);
+		px_aabb_extend(bounds, hull.max);
+		rc = curve_spans(t, i, &curves[i], &hull, su);
+	}
+	if (rc)
+		return rc;
+	t->scale = px__tracker_scale(*bounds);
+	t->work = work_volume(&t->opts, *bounds, t->scale);
+	rc = leaves_alloc(t, su);
+	if (rc)
+		return rc;
+	for (i = 0; i < t->n_ent; i++)
+		curve_leaves(t, i, &curves[i], su);
+	return event_cells(t, t->opts.box_depth);
+}
+
+int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
+		    const struct px_track_opts *opts, struct px_track **out)
+{
+	struct px_track *t;
+	struct px_track_opts o;
+	struct setup su = {0};
+	int rc, max_ctrl;
+	px_aabb bounds;
+
+	if (!out || !curves || n_curves <= 0)
+		return PX_E_INVAL;
+	*out = NULL;
+	rc = create_check(curves, n_curves, opts, &o, &max_ctrl, &su.span_cap);
+	if (rc)
+		return rc;
 	t = calloc(1, sizeof(*t));
 	if (!t)
 		return PX_E_NOMEM;
@@ -369,365 +768,23 @@ int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
 	}
 	t->n_ent = n_curves;
 	t->ent = calloc((size_t)n_curves, sizeof(*t->ent));
-	t->span = calloc((size_t)span_cap, sizeof(*t->span));
-	spl = calloc((size_t)span_cap, sizeof(*spl));
-	work_len = PX_NURBS_CURVE_WORK_LEN(TRK_MAXD, max_ctrl);
-	work = calloc(work_len, sizeof(double));
-	if (!t->ent || !t->span || !spl || !work) {
+	t->span = calloc((size_t)su.span_cap, sizeof(*t->span));
+	su.spl = calloc((size_t)su.span_cap, sizeof(*su.spl));
+	su.work_len = PX_NURBS_CURVE_WORK_LEN(TRK_MAXD, max_ctrl);
+	su.work = calloc(su.work_len, sizeof(double));
+	if (!t->ent || !t->span || !su.spl || !su.work)
 		rc = PX_E_NOMEM;
+	if (!rc)
+		rc = curves_setup(t, curves, &su, &bounds);
+	if (rc)
 		goto fail;
-	}
-
-	/* spans and entity layout */
-	bounds = px_aabb_empty();
-	for (i = 0; i < n_curves; i++) {
-		const struct px_nurbs_curve *c = &curves[i];
-		struct ent *e = &t->ent[i];
-		int ns, seam, p = c->degree;
-		px_aabb hull = px_nurbs_curve_aabb(c);
-		double a, b;
-
-		px_aabb_extend(&bounds, hull.min);
-		px_aabb_extend(&bounds, hull.max);
-		px_nurbs_curve_domain(c, &a, &b);
-		e->u0 = a;
-		e->u1 = b;
-		e->len = b - a;
-		seam = px_nurbs_curve_seam(c, 1e-12 * (1.0 + px_aabb_diagonal(&hull)),
-					   1e-9);
-		e->cyclic = seam >= 1;
-		ns = curve_splits(c, spl, span_cap - t->n_spans - 2, &t->n_cusps);
-		e->first_span = t->n_spans;
-		for (k = 0; k <= ns; k++) {
-			double s0 = k == 0 ? a : spl[k - 1].u, s1 = k == ns ? b : spl[k].u;
-			struct px_nurbs_curve sub;
-			struct span *s = &t->span[t->n_spans];
-			double hb[4][TRK_MAXD + 1];
-			int q, jj;
-			if (!(s1 > s0))
-				continue;
-			rc = px_nurbs_curve_extract_work(c, s0, s1, work, work_len, &sub);
-			if (rc)
-				goto fail;
-			if (sub.n_ctrl != p + 1) {
-				rc = PX_E_INVAL;
-				goto fail;
-			}
-			s->u0 = s0;
-			s->u1 = s1;
-			s->inv = 1.0 / (s1 - s0);
-			s->deg = p;
-			for (q = 0; q <= p; q++)
-				for (jj = 0; jj < 4; jj++)
-					hb[jj][q] = sub.pw[4 * q + jj];
-			for (jj = 0; jj < 4; jj++)
-				for (q = 0; q <= p; q++) {
-					double v = 0.0;
-					int r;
-					for (r = 0; r <= q; r++)
-						v += (((q - r) & 1) ? -1.0 : 1.0) *
-						     px_bern_binom(q, r) * hb[jj][r];
-					s->pc[jj][q] = px_bern_binom(p, q) * v;
-				}
-			{
-				double sc = 1.0;
-				for (q = 0; q <= p; q++) {
-					for (jj = 0; jj < 4; jj++)
-						s->pu[jj][q] = s->pc[jj][q] * sc;
-					sc *= s->inv;
-				}
-				s->rat = 0;
-				for (q = 0; q <= p; q++)
-					if (s->pc[3][q] != (q == 0 ? 1.0 : 0.0))
-						s->rat = 1;
-#if TRK_VEC
-				for (jj = 0; jj < 4; jj++) {
-					const double *w = s->pu[jj];
-					int m = jj / 2, l2 = jj % 2;
-					for (q = 0; q < 4; q++)
-						s->hv[q][m][l2] = w[q];
-					s->hd1[0][m][l2] = w[1];
-					s->hd1[1][m][l2] = 2.0 * w[2];
-					s->hd1[2][m][l2] = 3.0 * w[3];
-					s->hd2[0][m][l2] = 2.0 * w[2];
-					s->hd2[1][m][l2] = 6.0 * w[3];
-				}
-#endif
-			}
-			t->n_spans++;
-		}
-		e->n_spans = t->n_spans - e->first_span;
-		/* kinds at span starts: record in a parallel pass below */
-		(void)seam;
-		e->cap = o.max_crit;
-		e->z = calloc((size_t)o.max_crit, sizeof(*e->z));
-		e->old = calloc((size_t)o.max_crit, sizeof(*e->old));
-		if (!e->z || !e->old) {
-			rc = PX_E_NOMEM;
-			goto fail;
-		}
-		leaf_cap += e->n_spans * o.leaves_per_span;
-		cand_cap += ns + 2;
-		for (k = 0; k < e->n_spans; k++) {
-			int n = 3 * p - 1;
-			pool_cap += (size_t)o.leaves_per_span *
-				    (size_t)(4 * (n + 1) + 4 * n);
-		}
-	}
-	t->scale = px_aabb_diagonal(&bounds);
-	if (!(t->scale > 0.0))
-		t->scale = 1.0;
-	if (o.work.min.x <= o.work.max.x && o.work.min.y <= o.work.max.y &&
-	    o.work.min.z <= o.work.max.z) {
-		t->work = o.work;
-	} else {
-		double m = o.work_margin * t->scale;
-		t->work.min = px_v3_sub(bounds.min, px_v3(m, m, m));
-		t->work.max = px_v3_add(bounds.max, px_v3(m, m, m));
-	}
-
-	t->leaf = calloc((size_t)leaf_cap, sizeof(*t->leaf));
-	t->pool = calloc(pool_cap ? pool_cap : 1, sizeof(double));
-	t->cand = calloc((size_t)cand_cap + 1, sizeof(*t->cand));
-	t->cexp = calloc((size_t)cand_cap + 1, sizeof(*t->cexp));
-	t->hits = calloc((size_t)leaf_cap + 1, sizeof(int));
-	t->expiry = calloc((size_t)leaf_cap + 1, sizeof(double));
-	t->ectr = calloc((size_t)leaf_cap + 1, sizeof(*t->ectr));
-	t->erad = calloc((size_t)leaf_cap + 1, sizeof(double));
-	t->gdue = calloc((size_t)leaf_cap / TRK_GROUP + 2, sizeof(double));
-	t->ipool = calloc((size_t)leaf_cap * (2 * TRK_NG + 2) + 1, sizeof(double));
-	if (!t->leaf || !t->pool || !t->cand || !t->cexp || !t->hits ||
-	    !t->expiry || !t->ectr || !t->erad || !t->gdue ||
-	    !t->ipool) {
-		rc = PX_E_NOMEM;
-		goto fail;
-	}
-
-	/* leaves, candidates */
-	for (i = 0; i < n_curves; i++) {
-		const struct px_nurbs_curve *c = &curves[i];
-		struct ent *e = &t->ent[i];
-		int ns, p = c->degree, seam, nc0 = 0;
-		px_aabb hull = px_nurbs_curve_aabb(c);
-		double wmax = fmax(fmax(fabs(t->work.min.x), fabs(t->work.max.x)),
-				   fmax(fmax(fabs(t->work.min.y), fabs(t->work.max.y)),
-					fmax(fabs(t->work.min.z), fabs(t->work.max.z))));
-
-		ns = curve_splits(c, spl, span_cap, &nc0);
-		seam = px_nurbs_curve_seam(c, 1e-12 * (1.0 + px_aabb_diagonal(&hull)),
-					   1e-9);
-		e->first_leaf = t->n_leaves;
-		e->first_cand = t->n_cand;
-		/* candidates: open ends, cornered seam, C0 breaks, cusps */
-		if (seam < 0) {
-			struct cand *cd = &t->cand[t->n_cand++];
-			cd->q = px_nurbs_curve_point(c, e->u0);
-			cd->u = e->u0;
-			cd->ent = i;
-			cd->kind = PX_TRACK_END;
-			cd = &t->cand[t->n_cand++];
-			cd->q = px_nurbs_curve_point(c, e->u1);
-			cd->u = e->u1;
-			cd->ent = i;
-			cd->kind = PX_TRACK_END;
-		} else if (seam == 0) {
-			struct cand *cd = &t->cand[t->n_cand++];
-			cd->q = px_nurbs_curve_point(c, e->u0);
-			cd->u = e->u0;
-			cd->ent = i;
-			cd->kind = PX_TRACK_BREAK;
-		}
-		for (k = 0; k < ns; k++) {
-			if (spl[k].kind == K_C0 || spl[k].kind == K_CUSP) {
-				struct cand *cd = &t->cand[t->n_cand++];
-				cd->q = px_nurbs_curve_point(c, spl[k].u);
-				cd->u = spl[k].u;
-				cd->ent = i;
-				cd->kind = PX_TRACK_BREAK;
-			}
-			if (spl[k].kind != K_SMOOTH)
-				t->n_breaks++;
-		}
-		e->n_cand = t->n_cand - e->first_cand;
-
-		for (k = 0; k < e->n_spans; k++) {
-			const struct span *s = &t->span[e->first_span + k];
-			int kind0 = K_SMOOTH, kind1 = K_SMOOTH, q, jj, L;
-			double hb[4][TRK_MAXD + 1], ga[TRK_NG], gb[3][TRK_NG];
-			int n = 3 * p - 1;
-			/* kinds of the span's ends */
-			for (q = 0; q < ns; q++) {
-				if (spl[q].u == s->u0)
-					kind0 = spl[q].kind;
-				if (spl[q].u == s->u1)
-					kind1 = spl[q].kind;
-			}
-			if (k == 0)
-				kind0 = seam >= 2 ? K_SMOOTH : seam == 1 ? K_C1 : K_C0;
-			if (k == e->n_spans - 1)
-				kind1 = seam >= 2 ? K_SMOOTH : seam == 1 ? K_C1 : K_C0;
-			/* Bernstein net back from the power basis */
-			for (jj = 0; jj < 4; jj++)
-				for (q = 0; q <= p; q++) {
-					double v = 0.0;
-					int r;
-					for (r = 0; r <= q; r++)
-						v += px_bern_binom(q, r) /
-						     px_bern_binom(p, r) * s->pc[jj][r];
-					hb[jj][q] = v;
-				}
-			span_g(p, hb, ga, gb);
-			for (L = 0; L < o.leaves_per_span; L++) {
-				struct leaf *l = &t->leaf[t->n_leaves];
-				double t0 = (double)L / o.leaves_per_span,
-				       t1 = (double)(L + 1) / o.leaves_per_span;
-				double *a = t->pool + t->pool_len, *b;
-				int m = n, cc;
-				l->u0 = s->u0 + (s->u1 - s->u0) * t0;
-				l->u1 = L == o.leaves_per_span - 1
-						? s->u1
-						: s->u0 + (s->u1 - s->u0) * t1;
-				l->ent = i;
-				l->span = e->first_span + k;
-				l->off = t->pool_len;
-				b = a + n + 1;
-				px_bern_restrict(ga, n, t0, t1, a);
-				for (cc = 0; cc < 3; cc++)
-					px_bern_restrict(gb[cc], n, t0, t1,
-							 b + cc * (n + 1));
-				if (L == 0 && kind0 == K_CUSP) {
-					l->flags |= LF_CUSP0;
-					px__tk_bern_divide(a, m, 0);
-					for (cc = 0; cc < 3; cc++)
-						px__tk_bern_divide(b + cc * (n + 1), m, 0);
-					m--;
-				}
-				if (L == o.leaves_per_span - 1 && kind1 == K_CUSP &&
-				    m >= 1) {
-					l->flags |= LF_CUSP1;
-					px__tk_bern_divide(a, m, 1);
-					for (cc = 0; cc < 3; cc++)
-						px__tk_bern_divide(b + cc * (n + 1), m, 1);
-					m--;
-				}
-				/* compact to stride m + 1 */
-				if (m != n) {
-					double tmp[4 * (TRK_NG + 1)];
-					for (cc = 0; cc < 4; cc++)
-						memcpy(tmp + cc * (m + 1),
-						       a + cc * (n + 1),
-						       (size_t)(m + 1) * sizeof(double));
-					memcpy(a, tmp, (size_t)(4 * (m + 1)) * sizeof(double));
-				}
-				l->n = m;
-				/* derivative coefficients */
-				{
-					double *da = a + 4 * (m + 1);
-					if (m >= 1)
-						for (cc = 0; cc < 4; cc++)
-							px_bern_deriv(a + cc * (m + 1), m,
-								      da + cc * m);
-				}
-				/* tolerances: rounding of the affine forms */
-				{
-					double tg = 0.0, td = 0.0;
-					for (q = 0; q <= m; q++) {
-						double s2 = fabs(a[q]) +
-							    wmax * (fabs(a[m + 1 + q]) +
-								    fabs(a[2 * (m + 1) + q]) +
-								    fabs(a[3 * (m + 1) + q]));
-						tg = fmax(tg, s2);
-					}
-					for (q = 0; q < m; q++) {
-						const double *da = a + 4 * (m + 1);
-						double s2 = fabs(da[q]) +
-							    wmax * (fabs(da[m + q]) +
-								    fabs(da[2 * m + q]) +
-								    fabs(da[3 * m + q]));
-						td = fmax(td, s2);
-					}
-					l->tol_g = 1e-12 * tg;
-					l->tol_d = 1e-12 * td;
-				}
-				/* inverse norms of the p-gradients of the
-				 * coefficients (safe radii); 0 for a constant */
-				{
-					double *ib = t->ipool + (size_t)t->n_leaves *
-								       (2 * TRK_NG + 2);
-					const double *da = a + 4 * (m + 1);
-					l->ioff = (size_t)t->n_leaves * (2 * TRK_NG + 2);
-					for (q = 0; q <= m; q++) {
-						double nb = sqrt(a[m + 1 + q] * a[m + 1 + q] +
-								 a[2 * (m + 1) + q] * a[2 * (m + 1) + q] +
-								 a[3 * (m + 1) + q] * a[3 * (m + 1) + q]);
-						ib[q] = nb > 0.0 ? 1.0 / nb : INFINITY;
-					}
-					for (q = 0; q < m; q++) {
-						double nb = sqrt(da[m + q] * da[m + q] +
-								 da[2 * m + q] * da[2 * m + q] +
-								 da[3 * m + q] * da[3 * m + q]);
-						ib[m + 1 + q] = nb > 0.0 ? 1.0 / nb : INFINITY;
-					}
-				}
-				t->pool_len += (size_t)(4 * (m + 1) + 4 * m);
-				if (L == 0 && kind0 != K_SMOOTH)
-					l->flags |= LF_EV0;
-				if (L == o.leaves_per_span - 1 && kind1 != K_SMOOTH)
-					l->flags |= LF_EV1;
-				if (L == 0 && (kind0 == K_C0 || kind0 == K_CUSP))
-					l->flags |= LF_SB0;
-				if (L == o.leaves_per_span - 1 &&
-				    (kind1 == K_C0 || kind1 == K_CUSP))
-					l->flags |= LF_SB1;
-				t->n_leaves++;
-			}
-		}
-		e->n_leaves = t->n_leaves - e->first_leaf;
-		if (!e->cyclic) {
-			/* open or cornered: parameters do not wrap */
-			t->leaf[e->first_leaf].flags |= LF_EV0 | LF_SB0;
-			t->leaf[t->n_leaves - 1].flags |= LF_EV1 | LF_SB1;
-		}
-		for (k = 0; k < e->n_leaves; k++)
-			if (t->leaf[e->first_leaf + k].flags & LF_SB0)
-				e->n_sb++;
-	}
-
-	/* event cells: octree exclusion per leaf down to box_depth; their
-	 * union box per leaf bounds its safe radius */
-	{
-		struct cellbuf cb = {0};
-		long q;
-		for (i = 0; i < t->n_leaves; i++) {
-			long budget = 1L << 14, first = cb.n;
-			struct leaf *l = &t->leaf[i];
-			leaf_cells_rec(t, i, t->work, 0, o.box_depth, &cb, &budget);
-			if (cb.fail) {
-				free(cb.p);
-				rc = PX_E_NOMEM;
-				goto fail;
-			}
-			l->box = px_aabb_empty();
-			for (q = first; q < cb.n; q++) {
-				px_aabb_extend(&l->box, cb.p[q].box.min);
-				px_aabb_extend(&l->box, cb.p[q].box.max);
-			}
-			if (cb.n > first) {
-				l->boxed = 1;
-				t->n_boxed++;
-			}
-		}
-		t->n_prim = (int)cb.n;
-		free(cb.p);
-	}
-
 	t->bytes = sizeof(*t) + (size_t)t->n_ent * sizeof(*t->ent) +
 		   (size_t)t->n_ent * 2 * (size_t)o.max_crit * sizeof(struct zero) +
-		   (size_t)span_cap * sizeof(*t->span) +
-		   (size_t)leaf_cap * (sizeof(*t->leaf) + 2 * sizeof(int) +
-				       (2 * TRK_NG + 2) * sizeof(double)) +
-		   pool_cap * sizeof(double) +
-		   (size_t)(cand_cap + 1) * (sizeof(*t->cand) + sizeof(double));
+		   (size_t)su.span_cap * sizeof(*t->span) +
+		   (size_t)su.leaf_cap * (sizeof(*t->leaf) + 2 * sizeof(int) +
+					  (2 * TRK_NG + 2) * sizeof(double)) +
+		   su.pool_cap * sizeof(double) +
+		   (size_t)(su.cand_cap + 1) * (sizeof(*t->cand) + sizeof(double));
 	t->epoch = 1;
 	t->hot_ent = -1;
 	t->ans_z = -1;
@@ -740,24 +797,14 @@ int px_track_create(const struct px_nurbs_curve *curves, int n_curves,
 		goto fail;
 	}
 	t->prev.ent = -1;
-	{
-		/* the cold query's cost where a tool works: about the
-		 * model, not the whole working volume */
-		px_aabb cb = bounds;
-		double m = 0.3 * t->scale;
-		cb.min = px_v3_sub(cb.min, px_v3(m, m, m));
-		cb.max = px_v3_add(cb.max, px_v3(m, m, m));
-		px__gov_init(&t->gov, o.cold_switch != 0,
-			     o.cold_switch ? px__gov_calibrate(t->dist, cb) : 1.0);
-	}
-	free(spl);
-	free(work);
-	(void)j;
+	px__gov_setup(&t->gov, o.cold_switch != 0, t->dist, bounds, t->scale);
+	free(su.spl);
+	free(su.work);
 	*out = t;
 	return PX_OK;
 fail:
-	free(spl);
-	free(work);
+	free(su.spl);
+	free(su.work);
 	px_track_free(t);
 	return rc;
 }

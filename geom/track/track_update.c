@@ -577,32 +577,22 @@ static void count_fail(struct px_track *t, int rc)
 
 static void verify(struct px_track *t, px_vec3 p, struct px_track_result *r)
 {
-	struct px_dist_result g;
-	if (t->opts.verify_every <= 0 ||
-	    t->st.updates % (uint64_t)t->opts.verify_every != 0)
+	int rc;
+	if (!px__tracker_verify(&t->opts.shared, &t->st.shared, t->dist, t->scale,
+				p, r->dist, &r->verified))
 		return;
-	if (px_dist_query(t->dist, p, &g))
-		return;
-	t->st.verifications++;
+	rc = reinit_all(t, p);
+	if (rc)
+		count_fail(t, rc);
+	answer_global(t, p, r);
 	r->verified = 1;
-	if (r->dist > g.dist + 1e-9 * (t->scale + g.dist)) {
-		int rc;
-		t->st.disagreements++;
-		rc = reinit_all(t, p);
-		if (rc)
-			count_fail(t, rc);
-		answer_global(t, p, r);
-		r->verified = 1;
-	}
 }
 
 int px_track_reset(struct px_track *t, px_vec3 p, struct px_track_result *r)
 {
-	int rc;
-	if (!t || !r)
-		return PX_E_INVAL;
-	if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
-		return PX_E_NAN;
+	int rc = px__tracker_args(t, r, p);
+	if (rc)
+		return rc;
 	result_clear(r);
 	t->st.updates++;
 	t->p = p;
@@ -611,9 +601,7 @@ int px_track_reset(struct px_track *t, px_vec3 p, struct px_track_result *r)
 	t->best_id = 0;
 	t->hot_ent = -1;
 	t->heap_ok = 0;
-	if (t->gov.cold)
-		t->st.cold_left++;
-	px__gov_restart(&t->gov);
+	px__gov_reset(&t->gov, &t->st.shared);
 	rc = reinit_all(t, p);
 	/* the leaves' safe radii here too, so that the next update costs
 	 * what an update costs */
@@ -697,12 +685,10 @@ static void prev_keep(struct px_track *t, const struct px_track_result *r)
 static int cold_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 {
 	struct px_dist_result g;
-	int rc = px__gov_cold_query(&t->gov, t->dist, p, &g);
+	int rc = px__gov_cold_query(&t->gov, &t->st.shared, t->dist, p, &g);
 	if (rc)
 		return rc;
 	result_clear(r);
-	t->st.updates++;
-	t->st.cold++;
 	r->dist = g.dist;
 	r->point = g.point;
 	r->u = g.u;
@@ -723,29 +709,25 @@ static int track_update(struct px_track *t, px_vec3 p, double len, int fresh,
 int px_track_update(struct px_track *t, px_vec3 p, struct px_track_result *r)
 {
 	int64_t t0;
-	int rc, fresh = 0;
+	int rc = px__tracker_args(t, r, p), fresh = 0, mode;
 	double len;
 
-	if (!t || !r)
-		return PX_E_INVAL;
-	if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z))
-		return PX_E_NAN;
+	if (rc)
+		return rc;
 	if (!t->init)
 		return px_track_reset(t, p, r);
 	/* the step's length, for the travelled path and the cold switch */
 	len = px_v3_dist(t->p, p);
-	if (t->gov.on) {
-		px__gov_step(&t->gov, len);
-		if (t->gov.cold) {
-			if (!px__gov_leave(&t->gov)) {
-				if (cold_update(t, p, r) == 0)
-					return PX_OK;
-				/* no global answer here (far away): track */
-				px__gov_restart(&t->gov);
-			}
-			t->st.cold_left++;
-			fresh = 1;
-		}
+	mode = px__gov_begin(&t->gov, len);
+	if (mode == PX_GOV_COLD) {
+		if (cold_update(t, p, r) == 0)
+			return PX_OK;
+		/* no global answer here (far away): track */
+		px__gov_restart(&t->gov);
+	}
+	if (mode != PX_GOV_TRACK) {
+		t->st.cold_left++;
+		fresh = 1;
 	}
 	t0 = px__gov_start(&t->gov);
 	rc = track_update(t, p, len, fresh, r);
@@ -827,73 +809,70 @@ static int track_update(struct px_track *t, px_vec3 p, double len, int fresh,
 
 /* The update beyond the hot path: evolution of every root that cannot
  * rest, the re-solved leaves, the checks, the answer. */
-static __attribute__((noinline)) int update_full(struct px_track *t, px_vec3 p, int nh,
-		       struct px_track_result *r)
+/* Entity i's roots outside the re-solved leaves evolved to p; in an
+ * entity without re-solved leaves a root whose leaf certificate holds
+ * may rest (can_rest) until the answer needs it, and the entity whole
+ * while its rest certificate holds. */
+static void ent_evolve(struct px_track *t, int i, px_vec3 p)
 {
-	int i, j, rc = 0, fail = 0, added = 0;
-
-	r->leaves_solved = nh;
-	t->st.leaf_solves += (uint64_t)nh;
-
-	for (i = 0; i < nh; i++)
-		t->ent[t->leaf[t->hits[i]].ent].hit = t->epoch;
-	t->n_rmin = 0;
-	/* evolve every root outside the re-solved leaves; in an entity
-	 * without re-solved leaves a root whose leaf certificate holds may
-	 * rest (can_rest) until the answer needs it */
-	for (i = 0; i < t->n_ent; i++) {
-		struct ent *e = &t->ent[i];
-		int w = 0;
-		e->nold = 0;
-		e->touched = 0;
-		e->full = !t->opts.lazy || e->hit == t->epoch;
-		e->moved = 0;
-		e->resting = 0;
-		if (e->stale)
-			continue;
-		if (!e->full && t->travel < e->rest_until) {
-			e->resting = 1;
-			t->st.rested_entities++;
-			continue;
-		}
-		e->rest_until = -1.0;
-		for (j = 0; j < e->nz; j++) {
-			struct zero *zj = &e->z[j];
-			int leaf0;
-			if (t->leaf[zj->leaf].mark == t->epoch) {
-				e->old[e->nold++] = *zj;
-				e->touched = 1;
-				continue;
-			}
-			/* without a re-solved leaf nothing is dropped: w == j */
-			if (!e->full && can_rest(t, e, j)) {
-				if (zj->type > 0) {
-					t->rmin[2 * t->n_rmin] = i;
-					t->rmin[2 * t->n_rmin + 1] = j;
-					t->n_rmin++;
-				}
-				w++;
-				continue;
-			}
-			leaf0 = zj->leaf;
-			if (w != j)
-				e->z[w] = *zj;
-			if (px__tk_evolve(t, e, &e->z[w], e->z[w].p, px_v3_sub(p, e->z[w].p),
-				   p)) {
-				e->stale = 1;
-				break;
-			}
-			if (e->z[w].leaf != leaf0)
-				e->full = 1;
-			w++;
-		}
-		if (!e->stale) {
-			e->nz = w;
-			if (e->full && catch_up(t, e, p))
-				e->stale = 1;
-		}
+	struct ent *e = &t->ent[i];
+	int j, w = 0;
+	e->nold = 0;
+	e->touched = 0;
+	e->full = !t->opts.lazy || e->hit == t->epoch;
+	e->moved = 0;
+	e->resting = 0;
+	if (e->stale)
+		return;
+	if (!e->full && t->travel < e->rest_until) {
+		e->resting = 1;
+		t->st.rested_entities++;
+		return;
 	}
-	/* re-solve the event leaves at the new point */
+	e->rest_until = -1.0;
+	for (j = 0; j < e->nz; j++) {
+		struct zero *zj = &e->z[j];
+		int leaf0;
+		if (t->leaf[zj->leaf].mark == t->epoch) {
+			e->old[e->nold++] = *zj;
+			e->touched = 1;
+			continue;
+		}
+		/* without a re-solved leaf nothing is dropped: w == j */
+		if (!e->full && can_rest(t, e, j)) {
+			if (zj->type > 0) {
+				t->rmin[2 * t->n_rmin] = i;
+				t->rmin[2 * t->n_rmin + 1] = j;
+				t->n_rmin++;
+			}
+			w++;
+			continue;
+		}
+		leaf0 = zj->leaf;
+		if (w != j)
+			e->z[w] = *zj;
+		if (px__tk_evolve(t, e, &e->z[w], e->z[w].p, px_v3_sub(p, e->z[w].p),
+				  p)) {
+			e->stale = 1;
+			break;
+		}
+		if (e->z[w].leaf != leaf0)
+			e->full = 1;
+		w++;
+	}
+	if (!e->stale) {
+		e->nz = w;
+		if (e->full && catch_up(t, e, p))
+			e->stale = 1;
+	}
+}
+
+/* The nh event leaves (t->hits) re-solved at p: 0, or the error that
+ * stopped it (the update then falls back); *added the roots they hold. */
+static int hits_solve(struct px_track *t, px_vec3 p, int nh, int *added)
+{
+	int i;
+	*added = 0;
 	for (i = 0; i < nh; i++) {
 		int li = t->hits[i];
 		struct ent *e = &t->ent[t->leaf[li].ent];
@@ -902,39 +881,47 @@ static __attribute__((noinline)) int update_full(struct px_track *t, px_vec3 p, 
 			continue;
 		n = px__tk_add_leaf_roots(t, e, li, p);
 		if (n < 0) {
-			rc = n;
 			e->stale = 1;
-			fail = 1;
-			break;
+			return n;
 		}
-		added += n;
+		*added += n;
 		e->touched = 1;
 	}
-	if (!fail && t->opts.lazy)
-		wake_minima(t, p);
-	if (!fail) {
-		for (i = 0; i < t->n_ent; i++) {
-			struct ent *e = &t->ent[i];
-			if (!e->stale && e->touched) {
-				px__tk_sort_zeros(e);
-				if (px__tk_ent_check(t, e, p))
-					e->stale = 1;
-			}
-		}
-		for (i = 0; i < t->n_ent; i++) {
-			struct ent *e = &t->ent[i];
-			if (!e->stale && !e->touched && e->moved) {
-				/* evolved roots kept type and stretch; two
-				 * converging to one root shows as a duplicate
-				 * (an entity whose roots all rest is unchanged) */
-				px__tk_sort_zeros(e);
-				if (px__tk_ent_dups(e))
-					e->stale = 1;
-			}
+	return 0;
+}
+
+/* The structure checks: an entity with re-solved leaves checked whole,
+ * one whose roots only evolved for duplicates; stale where they fail. */
+static void ents_check(struct px_track *t, px_vec3 p)
+{
+	int i;
+	for (i = 0; i < t->n_ent; i++) {
+		struct ent *e = &t->ent[i];
+		if (!e->stale && e->touched) {
+			px__tk_sort_zeros(e);
+			if (px__tk_ent_check(t, e, p))
+				e->stale = 1;
 		}
 	}
-	/* anomalies: rebuild those entities here */
-	for (i = 0; i < t->n_ent && !fail; i++) {
+	for (i = 0; i < t->n_ent; i++) {
+		struct ent *e = &t->ent[i];
+		if (!e->stale && !e->touched && e->moved) {
+			/* evolved roots kept type and stretch; two
+			 * converging to one root shows as a duplicate (an
+			 * entity whose roots all rest is unchanged) */
+			px__tk_sort_zeros(e);
+			if (px__tk_ent_dups(e))
+				e->stale = 1;
+		}
+	}
+}
+
+/* Anomalies: the stale entities rebuilt at p. Returns 0 or the first
+ * error. */
+static int stale_reinit(struct px_track *t, px_vec3 p, struct px_track_result *r)
+{
+	int i, rc;
+	for (i = 0; i < t->n_ent; i++) {
 		struct ent *e = &t->ent[i];
 		if (!e->stale)
 			continue;
@@ -942,9 +929,50 @@ static __attribute__((noinline)) int update_full(struct px_track *t, px_vec3 p, 
 		r->source = PX_TRACK_REINIT;
 		rc = px__tk_ent_reinit(t, e, p);
 		if (rc)
-			fail = 1;
+			return rc;
 	}
-	if (!fail && t->opts.lazy) {
+	return 0;
+}
+
+/* Creation / annihilation: the roots the re-solved leaves gained
+ * (added) against those they held. */
+static void count_pairs(struct px_track *t, int added, struct px_track_result *r)
+{
+	int i, before = 0;
+	for (i = 0; i < t->n_ent; i++)
+		before += t->ent[i].nold;
+	if (added > before) {
+		r->created = (added - before) / 2;
+		t->st.creations += (uint64_t)r->created;
+	} else if (added < before) {
+		r->annihilated = (before - added) / 2;
+		t->st.annihilations += (uint64_t)r->annihilated;
+	}
+}
+
+static __attribute__((noinline)) int update_full(struct px_track *t, px_vec3 p, int nh,
+		       struct px_track_result *r)
+{
+	int i, rc, added = 0;
+
+	r->leaves_solved = nh;
+	t->st.leaf_solves += (uint64_t)nh;
+
+	for (i = 0; i < nh; i++)
+		t->ent[t->leaf[t->hits[i]].ent].hit = t->epoch;
+	t->n_rmin = 0;
+	for (i = 0; i < t->n_ent; i++)
+		ent_evolve(t, i, p);
+	/* re-solve the event leaves at the new point */
+	rc = hits_solve(t, p, nh, &added);
+	if (!rc) {
+		if (t->opts.lazy)
+			wake_minima(t, p);
+		ents_check(t, p);
+		/* anomalies: rebuild those entities here */
+		rc = stale_reinit(t, p, r);
+	}
+	if (!rc && t->opts.lazy) {
 		for (i = 0; i < t->n_ent; i++) {
 			struct ent *e = &t->ent[i];
 			/* corrected roots too: their certificates were made
@@ -955,26 +983,15 @@ static __attribute__((noinline)) int update_full(struct px_track *t, px_vec3 p, 
 				ent_certify(t, e);
 		}
 	}
-	if (fail) {
+	if (rc) {
 		count_fail(t, rc);
 		for (i = 0; i < t->n_ent; i++)
 			t->ent[i].stale = 1;
 		answer_global(t, p, r);
 		return PX_OK;
 	}
-	if (r->source == PX_TRACK_TRACKED) {
-		/* creation / annihilation: roots the re-solved leaves gained */
-		int before = 0;
-		for (i = 0; i < t->n_ent; i++)
-			before += t->ent[i].nold;
-		if (added > before) {
-			r->created = (added - before) / 2;
-			t->st.creations += (uint64_t)r->created;
-		} else if (added < before) {
-			r->annihilated = (before - added) / 2;
-			t->st.annihilations += (uint64_t)r->annihilated;
-		}
-	}
+	if (r->source == PX_TRACK_TRACKED)
+		count_pairs(t, added, r);
 	answer(t, p, r);
 	r->leaves_solved = nh;
 	verify(t, p, r);
