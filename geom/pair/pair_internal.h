@@ -1,11 +1,12 @@
 /*
- * pair_internal.h - closed-form pairs for px_pair_distance (px_pair.c):
- * capsule against capsule and capsule against box, from the distance
- * between the capsules' axis segments and from a segment to a box. Not
- * part of the public API.
+ * pair_internal.h - the methods px_pair_distance (px_pair.c) chooses
+ * from: closed-form pairs (capsule against capsule or box:
+ * px_pair_prim.c), GJK and EPA for convex models (pair_gjk.c), the exact
+ * mesh paths (pair_mesh.c) and the general search by alternating
+ * projections (pair_search.c). Not part of the public API.
  *
- * Memory and real-time rules: no allocation, a fixed number of steps;
- * RT-safe.
+ * Memory and real-time rules: no allocation, fixed stacks and buffers,
+ * bounded steps; RT-safe.
  */
 #ifndef PX_PAIR_INTERNAL_H
 #define PX_PAIR_INTERNAL_H
@@ -62,5 +63,141 @@ int px__capsule_axis(const struct px_model *m, px_vec3 *e0, px_vec3 *e1,
  */
 int px__pair_closed(const struct px_model *a, const struct px_model *b,
 		    struct px_pair_result *res);
+
+/* ---- GJK and EPA (pair_gjk.c) ---------------------------------------------- */
+
+#define GJK_MAX_ITERS 128
+
+/* A point of the Minkowski difference with the support points of A and B
+ * that made it. */
+struct gjk_vert {
+	px_vec3 w, a, b; /* w = a - b */
+};
+
+/* A convex shape for GJK: a model with a support function, or a
+ * triangle (world-frame vertices) of a mesh. */
+struct shp {
+	const struct px_model *m;
+	const px_vec3 *v; /* 3 vertices, or NULL for m */
+};
+
+/*
+ * Distance of convex shapes a and b (Gilbert, Johnson and Keerthi):
+ * returns 1 with *dist and the witness points, 0 when they intersect,
+ * negative when a model has no support function. *iters: the steps (at
+ * most GJK_MAX_ITERS: then *dist is only an upper bound); S[0..*n_out-1]
+ * the final simplex (EPA's start). *vout (may be NULL): the point of
+ * A - B nearest the origin found; *lower (may be NULL): the best lower
+ * bound of the distance seen (the support plane's distance v . w / |v|),
+ * which certifies *dist. RT-safe.
+ */
+int px__gjk(const struct shp *a, const struct shp *b, double *dist, px_vec3 *pa,
+	    px_vec3 *pb, int *iters, struct gjk_vert S[4], int *n_out, px_vec3 *vout,
+	    double *lower);
+
+/*
+ * Penetration of overlapping convex models a and b from GJK's simplex
+ * S[0..ns-1] (expanding polytope): the depth, the normal (translate B by
+ * depth * normal to separate) and the witness points (pa - pb = depth *
+ * normal); *iters grows by the steps. Returns 1 converged, 0 when the
+ * fixed buffers ran out (an upper bound returned), -1 when no polytope
+ * could be built (flat Minkowski difference: depth 0). RT-safe.
+ */
+int px__epa(const struct px_model *a, const struct px_model *b,
+	    const struct gjk_vert *S, int ns, double *depth, px_vec3 *normal,
+	    px_vec3 *pa, px_vec3 *pb, int *iters);
+
+/* ---- the general search (pair_search.c) ---------------------------------- */
+
+/* A pair of points, one on each model, and how it was reached. */
+struct pair_run {
+	double d;
+	px_vec3 pa, pb;
+	int ia, ib;
+	int iters;
+	int converged;
+	int intersecting;
+};
+
+/*
+ * One start of the alternating projections. seed is a point to project
+ * onto A first (any point: a box corner, last cycle's pair), so every
+ * pair compared is (a point of A, the point of B closest to it) or the
+ * reverse, real surface points. Fills o; returns 0 or an error.
+ */
+int px__pair_run(const struct px_model *a, const struct px_model *b, px_vec3 seed,
+		 int max_iters, double tol, double rel, struct pair_run *o);
+
+/*
+ * Neighbourhood step on side x: every feature of x within the current
+ * distance of x's point (as many as a fixed buffer allows, shrinking the
+ * radius otherwise), each taken at its point nearest y's point and
+ * projected onto y. Discrete models (clouds, fine meshes) have many
+ * shallow local minima next to the global one; this jumps over them.
+ * Every pair tried is a real pair, so the distance can only drop.
+ * Returns 1 when it improved, 0 when not, a negative error.
+ */
+int px__pair_refine_side(const struct px_model *x, const struct px_model *y,
+			 px_vec3 *px, px_vec3 *py, int *ix, int *iy, double *d,
+			 int *iters);
+
+/* Seed k: 0 = closest point of A's box to B's box (alternating between
+ * the two convex boxes), then B's box corners and face centres, then
+ * A's (each later projected onto A by px__pair_run). Returns 0 past the
+ * last. */
+int px__pair_seed(const struct px_model *a, const struct px_model *b, int k, px_vec3 *out);
+
+/* 1 when box b is neither empty nor infinite. */
+int px__finite_box(const px_aabb *b);
+
+/*
+ * For closed models without an exact method: the point of x's surface
+ * deepest inside y (most negative signed distance to y), by projected
+ * descent from a start on x: step against y's distance gradient,
+ * project back onto x, keep the step when it went deeper (the step
+ * grows after a success and halves after a failure). A local search:
+ * results are flagged approximate. Returns 1 with *d (< 0) and the
+ * points when a point of x inside y was found, 0 when none, or an error.
+ */
+int px__pair_deepest(const struct px_model *x, const struct px_model *y, px_vec3 start,
+		     double scale, double *d, px_vec3 *px_, px_vec3 *qy, px_vec3 *dir,
+		     int *iters);
+
+/* ---- exact paths with a mesh (pair_mesh.c) ---------------------------------- */
+
+/* World-frame vertices of triangle t of mesh m (seeds for the depth
+ * search); all at m's origin when t is not a triangle of m. */
+void px__tri_world(const struct px_model *m, int t, px_vec3 v[3]);
+
+/*
+ * The surfaces are apart (best->d > 0), yet a closed model may hold the
+ * other whole: then the other's closest point lies inside it, which its
+ * signed distance tells. Marks best intersecting (that point as the
+ * overlap) and returns 1, else 0, or an error.
+ */
+int px__pair_contained(const struct px_model *a, const struct px_model *b,
+		       struct pair_run *best, int *total);
+
+/*
+ * Exact distance of mesh m to convex model o (support function): the
+ * mesh hierarchy bounded from below by o's point queries
+ * (px__mesh_vs_model), each remaining triangle measured by GJK (by a
+ * closed form for a capsule). The start bound is the triangle of hint
+ * (last cycle's) or of the mesh point nearest o's origin. Fills best
+ * (points polished by two exact projections) and returns 1 when proven
+ * global, 0 when the query budget ran out (best is then only the best
+ * found), or an error.
+ */
+int px__pair_mesh_convex(const struct px_model *m, const struct px_model *o, int hint,
+			 struct pair_run *best, int *total);
+
+/*
+ * Mesh m against point cloud c (radius 0, with the cache operations):
+ * best (m's side first when m_first, else c's) certified or improved
+ * exactly, triangle by triangle. Returns 1 when proven global, 0 when
+ * not (budget out, or c without the cache operations), or an error.
+ */
+int px__pair_mesh_cloud(const struct px_model *m, const struct px_model *c, int m_first,
+			struct pair_run *best, int *total);
 
 #endif

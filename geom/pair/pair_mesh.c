@@ -1,0 +1,337 @@
+/*
+ * pair_mesh.c - exact pairs with a mesh: a mesh against a convex model
+ * (the mesh hierarchy bounded by the other's point queries, GJK or a
+ * closed form per triangle) and a mesh against a point cloud, and the
+ * containment test of a closed model holding the other whole
+ * (pair_internal.h).
+ */
+#include <math.h>
+#include <string.h>
+
+#include "mesh_internal.h"
+#include "pair_internal.h"
+#include "px_mesh.h"
+
+void px__tri_world(const struct px_model *m, int t, px_vec3 v[3])
+{
+	int k;
+	if (t < 0 || px_mesh_triangle(m, (size_t)t, v) != PX_OK) {
+		v[0] = v[1] = v[2] = px_model_pose(m).t;
+		return;
+	}
+	for (k = 0; k < 3; k++)
+		v[k] = px_pose_transform_point(px_model_pose(m), v[k]);
+}
+
+int px__pair_contained(const struct px_model *a, const struct px_model *b,
+		       struct pair_run *best, int *total)
+{
+	int side, rc;
+	for (side = 0; side < 2; side++) {
+		const struct px_model *x = side ? b : a;
+		px_vec3 p = side ? best->pa : best->pb; /* a point of the other */
+		struct px_model_result q;
+		if (!(px_model_caps(x) & PX_MODEL_CAP_SIGNED))
+			continue;
+		if ((rc = px_model_query(x, p, &q)) < 0)
+			return rc;
+		(*total)++;
+		if (q.is_signed && q.distance < 0.0) {
+			best->intersecting = 1;
+			best->d = 0.0;
+			if (side)
+				best->pb = q.point;
+			else
+				best->pa = q.point;
+			return 1;
+		}
+	}
+	return 0;
+}
+
+/* Mesh against a convex model with a support function: each triangle
+ * is itself convex, so GJK between the two is exact. */
+struct tv_ctx {
+	const struct px_model *o;
+	int capsule;        /* o is a capsule: axis c0-c1, radius cr */
+	px_vec3 c0, c1;
+	double cr;
+	double best;
+	px_vec3 pt, po; /* on the triangle, on o */
+	px_vec3 tv[3];
+	int tri;
+	int iters;
+};
+
+static int tri_vs_convex(void *ctx, const px_vec3 v[3], int index, double *d)
+{
+	struct tv_ctx *c = ctx;
+	struct shp T = {NULL, v}, O = {c->o, NULL};
+	struct gjk_vert S[4];
+	double dist = 0.0;
+	px_vec3 pt = v[0], po = v[0];
+	int its = 0, ns = 0, g;
+
+	if (c->capsule) {
+		/* closed form: the axis segment against the triangle */
+		double s, d2 = px__seg_tri(c->c0, c->c1, v, &s, &pt);
+		px_vec3 a = px_v3_lerp(c->c0, c->c1, s);
+		dist = sqrt(d2) - c->cr;
+		if (dist <= 0.0) {
+			dist = 0.0;
+			po = pt; /* the triangle point is in the capsule */
+		} else {
+			po = px_v3_madd(a, px_v3_sub(pt, a), c->cr / sqrt(d2));
+		}
+		its = 1;
+		g = 1;
+	} else {
+		g = px__gjk(&T, &O, &dist, &pt, &po, &its, S, &ns, NULL, NULL);
+	}
+	c->iters += its;
+	if (g < 0)
+		return g;
+	if (g == 0)
+		dist = 0.0;
+	if (dist < c->best) {
+		c->best = dist;
+		c->pt = pt;
+		c->po = po;
+		c->tv[0] = v[0];
+		c->tv[1] = v[1];
+		c->tv[2] = v[2];
+		c->tri = index;
+	}
+	/* GJK out of iterations: only an upper bound, which the search
+	 * must not take as exact */
+	*d = its >= GJK_MAX_ITERS ? INFINITY : dist;
+	return 0;
+}
+
+/*
+ * Mesh against a point cloud (radius 0, with the cache operations),
+ * exact per triangle: a piece S of the triangle (centroid g, radius r)
+ * is at least d(g) - r from the cloud, d(g) being the cloud's exact
+ * nearest-point distance; pieces not bounded out collect the cloud
+ * points within best + r of g (every point closer than best to S is
+ * among them) and measure them exactly against the whole triangle.
+ * When there are too many such points the piece is split in four
+ * (midpoint subdivision, up to TP_DEPTH levels): near the answer g's
+ * nearest point is about best away, so the ball holds only the points
+ * of a thin shell, and few.
+ */
+#define TP_CAP 64
+#define TP_DEPTH 5
+
+struct tp_ctx {
+	const struct px_model *c;
+	double best;
+	px_vec3 pt, pc; /* on the triangle, the cloud point */
+	int tri, pidx;
+	int iters, budget;
+	int idx[TP_CAP];
+};
+
+static void tp_take(struct tp_ctx *c, const px_vec3 v[3], int index, px_vec3 x,
+		    int pidx, double *found)
+{
+	px_vec3 qt;
+	double dd = sqrt(px_tri_closest(x, v[0], v[1], v[2], &qt, NULL, NULL, NULL, NULL));
+	if (dd < *found)
+		*found = dd;
+	if (dd < c->best) {
+		c->best = dd;
+		c->pt = qt;
+		c->pc = x;
+		c->tri = index;
+		c->pidx = pidx;
+	}
+}
+
+static int tri_vs_points(void *ctx, const px_vec3 v[3], int index, double *d)
+{
+	struct tp_ctx *c = ctx;
+	const struct px_model_ops *o = px_model_get_ops(c->c);
+	const void *impl = px_model_impl(c->c);
+	px_pose P = px_model_pose(c->c);
+	struct {
+		px_vec3 v[3];
+		int depth;
+	} st[3 * TP_DEPTH + 2];
+	double found = INFINITY;
+	int sp = 1, unsure = 0, k, rc;
+
+	st[0].v[0] = v[0];
+	st[0].v[1] = v[1];
+	st[0].v[2] = v[2];
+	st[0].depth = 0;
+	while (sp > 0) {
+		const px_vec3 *S;
+		px_vec3 g, gl;
+		struct px_model_result nr;
+		struct px_model_query q;
+		double r;
+		int n, dep;
+		sp--;
+		S = st[sp].v;
+		dep = st[sp].depth;
+		g = px_v3_scale(px_v3_add(S[0], px_v3_add(S[1], S[2])), 1.0 / 3.0);
+		r = fmax(px_v3_dist(g, S[0]), fmax(px_v3_dist(g, S[1]), px_v3_dist(g, S[2])));
+		if (c->iters >= c->budget) {
+			unsure = 1;
+			break;
+		}
+		gl = px_pose_inverse_transform_point(P, g);
+		q.p = gl;
+		q.max_dist = INFINITY;
+		q.hint = -1;
+		q.flags = PX_QUERY_UNSIGNED;
+		if ((rc = o->closest(impl, &q, &nr)) < 0)
+			return rc;
+		c->iters++;
+		if (rc == 0)
+			continue;
+		/* the nearest point is itself a candidate pair */
+		tp_take(c, v, index, px_pose_transform_point(P, nr.point), nr.index, &found);
+		if (nr.distance - r >= c->best * (1.0 - 1e-12))
+			continue;
+		n = o->collect(impl, gl, (c->best + r) * (1.0 + 1e-12), c->idx, TP_CAP);
+		if (n == PX_E_NOSPC) {
+			if (dep >= TP_DEPTH || sp + 4 > (int)(sizeof(st) / sizeof(st[0]))) {
+				unsure = 1;
+				continue;
+			}
+			{
+				px_vec3 a = S[0], b = S[1], cc = S[2];
+				px_vec3 ab = px_v3_scale(px_v3_add(a, b), 0.5);
+				px_vec3 bc = px_v3_scale(px_v3_add(b, cc), 0.5);
+				px_vec3 ca = px_v3_scale(px_v3_add(cc, a), 0.5);
+				px_vec3 T4[4][3] = {{a, ab, ca}, {ab, b, bc}, {ca, bc, cc}, {ab, bc, ca}};
+				int j;
+				for (j = 0; j < 4; j++) {
+					st[sp].v[0] = T4[j][0];
+					st[sp].v[1] = T4[j][1];
+					st[sp].v[2] = T4[j][2];
+					st[sp].depth = dep + 1;
+					sp++;
+				}
+			}
+			continue;
+		}
+		if (n < 0)
+			return n;
+		for (k = 0; k < n; k++) {
+			struct px_model_result pr;
+			rc = o->closest_among(impl, &q, &c->idx[k], 1, &pr);
+			if (rc < 0)
+				return rc;
+			if (rc > 0)
+				tp_take(c, v, index, px_pose_transform_point(P, pr.point), pr.index,
+					&found);
+		}
+	}
+	/* the triangle is at least c->best away unless something closer
+	 * was measured */
+	*d = unsure ? INFINITY : fmin(found, c->best);
+	return 0;
+}
+
+#define MESH_CLOUD_QUERIES 1024
+
+#define MESH_CONVEX_QUERIES 4096
+
+int px__pair_mesh_convex(const struct px_model *m, const struct px_model *o, int hint,
+			 struct pair_run *best, int *total)
+{
+	struct tv_ctx c;
+	int rc, exact, queries = 0, bt = -1, j;
+	double bd;
+	px_vec3 v[3];
+	double dd;
+
+	memset(&c, 0, sizeof(c));
+	c.o = o;
+	c.capsule = px__capsule_axis(o, &c.c0, &c.c1, &c.cr);
+	c.best = INFINITY;
+	c.tri = -1;
+	if (hint < 0 || (size_t)hint >= px_mesh_triangle_count(m)) {
+		struct px_model_result q;
+		if ((rc = px_model_query_ex(m, px_model_pose(o).t, INFINITY, -1,
+					    PX_QUERY_UNSIGNED, &q)) < 0)
+			return rc;
+		(*total)++;
+		hint = q.index;
+	}
+	px__tri_world(m, hint, v);
+	if ((rc = tri_vs_convex(&c, v, hint, &dd)) < 0)
+		return rc;
+	bd = c.best;
+	bt = c.tri;
+	exact = px__mesh_vs_model(m, o, tri_vs_convex, &c, MESH_CONVEX_QUERIES, &bd, &bt,
+				  &queries);
+	*total += queries + c.iters;
+	if (exact < 0)
+		return exact;
+	best->converged = 1;
+	best->intersecting = c.best == 0.0;
+	best->d = c.best;
+	best->pa = c.pt;
+	/* overlapping: GJK's common point, on the triangle and in o */
+	best->pb = best->intersecting ? c.pt : c.po;
+	best->ia = c.tri;
+	best->ib = -1;
+	for (j = 0; j < 2 && !best->intersecting; j++) {
+		/* GJK's witness on o is a convex combination of support
+		 * points, a chord point just inside a curved o: two exact
+		 * projections put the pair on the surfaces (the triangle's
+		 * witness is on it already; both sets are convex, so this
+		 * converges to the true pair) */
+		struct px_model_result q;
+		px_vec3 pt;
+		if ((rc = px_model_query(o, best->pa, &q)) < 0)
+			return rc;
+		(*total)++;
+		if (q.is_signed && q.distance <= 0.0) {
+			best->intersecting = 1;
+			best->d = 0.0;
+			best->pb = best->pa;
+			break;
+		}
+		px_tri_closest(q.point, c.tv[0], c.tv[1], c.tv[2], &pt, NULL, NULL, NULL, NULL);
+		best->ib = q.index;
+		best->pb = q.point;
+		best->pa = pt;
+		best->d = px_v3_dist(pt, q.point);
+	}
+	return exact;
+}
+
+int px__pair_mesh_cloud(const struct px_model *m, const struct px_model *c, int m_first,
+			struct pair_run *best, int *total)
+{
+	const struct px_model_ops *co = px_model_get_ops(c);
+	struct tp_ctx tc;
+	double bd = best->d;
+	int bt = -1, queries = 0, ex;
+
+	if (!co->collect || !co->closest_among)
+		return 0;
+	memset(&tc, 0, sizeof(tc));
+	tc.c = c;
+	tc.best = best->d;
+	tc.tri = -1;
+	tc.budget = MESH_CLOUD_QUERIES;
+	ex = px__mesh_vs_model(m, c, tri_vs_points, &tc, MESH_CLOUD_QUERIES, &bd, &bt, &queries);
+	if (ex < 0)
+		return ex;
+	*total += queries + tc.iters;
+	if (tc.tri >= 0 && tc.best < best->d) {
+		best->d = tc.best;
+		best->pa = m_first ? tc.pt : tc.pc;
+		best->pb = m_first ? tc.pc : tc.pt;
+		best->ia = m_first ? tc.tri : tc.pidx;
+		best->ib = m_first ? tc.pidx : tc.tri;
+		best->intersecting = best->d == 0.0;
+	}
+	return ex;
+}
