@@ -1,11 +1,13 @@
 /*
  * mesh_internal.h - the triangle mesh model's data layout, shared by the
- * files that implement it (point queries in px_mesh.c, mesh-to-mesh
- * queries beside it), with the point cloud's box tree and the file
- * importer they share. Not part of the public API.
+ * files that implement it (point queries in px_mesh.c, the exact
+ * point-triangle test in mesh_tri.c, setup in mesh_build.c, mesh-to-mesh
+ * queries in px_mesh_pair.c), with the box-tree and hint-grid setup
+ * meshes and point clouds share (mesh_tree.c) and the file importer. Not
+ * part of the public API.
  *
  * Memory and real-time rules: everything here is built at setup
- * (px_mesh_create) and read only by queries.
+ * (px_mesh_model, px_cloud_model) and read only by queries.
  */
 #ifndef PX_MESH_INTERNAL_H
 #define PX_MESH_INTERNAL_H
@@ -26,13 +28,13 @@
  * fraction of that edge's squared length is a needle: degenerate for
  * topology and signs (no face normal, no share of the pseudo-normals; a
  * closest point inside it is reported on its nearest edge). Its distance
- * is still exact (px_mesh.c's robust test). */
+ * is still exact (mesh_tri.c's robust test). */
 #define NEEDLE_SIN2 1e-20
 
 /* struct mesh's degen[] per leaf triangle: DEGEN_ZERO a degenerate
  * triangle (collapsed or needle: no face normal, no share of the
  * pseudo-normals); DEGEN_SLOW one outside the fast point-triangle
- * test's bound (thin, or edges beyond 2^+-100: px_mesh.c), which the
+ * test's bound (thin, or edges beyond 2^+-100: mesh_tri.c), which the
  * robust test answers. Either sends the query to the robust test. */
 #define DEGEN_ZERO 1u
 #define DEGEN_SLOW 2u
@@ -166,6 +168,155 @@ static inline struct mtri px__mtri_get(const struct mesh *M, size_t li)
 	return t;
 }
 
+/* ---- point-triangle distance (mesh_tri.c) ---------------------------------- */
+
+/* compares, not fmax (a library call); NaN gives NaN or a smaller
+ * value, which the callers' range tests (written to fail on NaN) see */
+static inline double px__mx2(double a, double b)
+{
+	return a > b ? a : b;
+}
+
+static inline double px__amax3(px_vec3 v)
+{
+	return px__mx2(fabs(v.x), px__mx2(fabs(v.y), fabs(v.z)));
+}
+
+/* 2^-e with 2^e > x >= 2^(e-1) (x > 0 finite): multiplying by it is
+ * exact and brings x into [0.5, 1). */
+static inline double px__pow2_scale(double x, int *e)
+{
+	(void)frexp(x, e);
+	return ldexp(1.0, -*e);
+}
+
+/* The robust point-triangle test (mesh_tri.c's opening comment): any
+ * shape and scale, outputs as px_tri_closest's. RT-safe, bounded (it
+ * calls itself at most once, for a far point). */
+double px__tri_exact(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c, px_vec3 *q,
+		     int *feature, int *sub, double *u, double *v);
+
+/*
+ * Voronoi-region walk (the vertex, edge and face regions are decided by
+ * the signs of dot products of p - vertex with the edges, as in Ericson,
+ * Real-Time Collision Detection 5.1.5). The face point is taken by
+ * projecting onto the plane along the cross-product normal rather than
+ * from the barycentric ratios, which lose accuracy on thin triangles;
+ * edge distances from p - a and the edge (no absolute coordinate).
+ * n = (b - a) x (c - a), nn = |n|^2; robust: the fast path's bound does
+ * not hold for this triangle or point (px__tri_exact instead). Inline:
+ * the mesh walk's innermost test.
+ */
+static inline __attribute__((always_inline)) double
+px__tri_core(px_vec3 p, px_vec3 a, px_vec3 b, px_vec3 c, px_vec3 n, double nn, int robust,
+	     px_vec3 *q, int *feature, int *sub, double *u, double *v)
+{
+	px_vec3 ab = px_v3_sub(b, a), ac = px_v3_sub(c, a), ap = px_v3_sub(p, a);
+	px_vec3 bp, cp;
+	double d1, d2, d3, d4, d5, d6, va, vb, vc, t;
+
+	if (robust)
+		return px__tri_exact(p, a, b, c, q, feature, sub, u, v);
+
+	d1 = px_v3_dot(ab, ap);
+	d2 = px_v3_dot(ac, ap);
+	if (d1 <= 0.0 && d2 <= 0.0) {
+		*q = a;
+		*feature = PX_FEATURE_VERTEX;
+		*sub = 0;
+		*u = *v = 0.0;
+		return px_v3_norm2(ap);
+	}
+	bp = px_v3_sub(p, b);
+	d3 = px_v3_dot(ab, bp);
+	d4 = px_v3_dot(ac, bp);
+	if (d3 >= 0.0 && d4 <= d3) {
+		*q = b;
+		*feature = PX_FEATURE_VERTEX;
+		*sub = 1;
+		*u = 1.0;
+		*v = 0.0;
+		return px_v3_norm2(bp);
+	}
+	vc = d1 * d4 - d3 * d2;
+	if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+		t = d1 / (d1 - d3);
+		*q = px_v3_madd(a, ab, t);
+		*feature = PX_FEATURE_EDGE;
+		*sub = 0;
+		*u = t;
+		*v = 0.0;
+		return px_v3_norm2(px_v3_madd(ap, ab, -t));
+	}
+	cp = px_v3_sub(p, c);
+	d5 = px_v3_dot(ab, cp);
+	d6 = px_v3_dot(ac, cp);
+	if (d6 >= 0.0 && d5 <= d6) {
+		*q = c;
+		*feature = PX_FEATURE_VERTEX;
+		*sub = 2;
+		*u = 0.0;
+		*v = 1.0;
+		return px_v3_norm2(cp);
+	}
+	vb = d5 * d2 - d1 * d6;
+	if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+		t = d2 / (d2 - d6);
+		*q = px_v3_madd(a, ac, t);
+		*feature = PX_FEATURE_EDGE;
+		*sub = 2;
+		*u = 0.0;
+		*v = t;
+		return px_v3_norm2(px_v3_madd(ap, ac, -t));
+	}
+	va = d3 * d6 - d5 * d4;
+	if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
+		px_vec3 bc = px_v3_sub(c, b);
+		t = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+		*q = px_v3_madd(b, bc, t);
+		*feature = PX_FEATURE_EDGE;
+		*sub = 1;
+		*u = 1.0 - t;
+		*v = t;
+		return px_v3_norm2(px_v3_madd(bp, bc, -t));
+	}
+	/* face region */
+	{
+		double s = px_v3_dot(n, ap) / nn;
+		double den = va + vb + vc;
+		*q = px_v3_madd(p, n, -s);
+		*feature = PX_FEATURE_FACE;
+		*sub = -1;
+		*u = den != 0.0 ? vb / den : 0.0;
+		*v = den != 0.0 ? vc / den : 0.0;
+		return s * s * nn;
+	}
+}
+
+
+
+/* The fast test with the vertices rotated by r (1 or 2: a' = P[r], b',
+ * c' following): outputs mapped back to the caller's order. Out of
+ * line: the rare path, kept out of the mesh walk's inlined common one.
+ * RT-safe. */
+double px__tri_core_rot(px_vec3 p, const px_vec3 P[3], int r, px_vec3 *q, int *feature,
+			int *sub, double *u, double *v);
+
+/*
+ * Mesh setup's view of a triangle: its edges ab, ac, bc scaled by a
+ * power of two to a largest component in [0.5, 1) (zero when all three
+ * vertices coincide); *needle when its height is below sqrt(NEEDLE_SIN2)
+ * of its edges (degenerate for topology and signs: no face normal; its
+ * distance is still exact, by px__tri_exact); *fast when the fast test's
+ * bound holds for it at vertex *rot (0: a, 1: b, 2: c). Setup.
+ */
+void px__tri_shape(px_vec3 a, px_vec3 b, px_vec3 c, px_vec3 *ab, px_vec3 *ac,
+		   px_vec3 *bc, int *needle, int *fast, int *rot);
+
+/* The accurate normal (b - a) x (c - a), as a unit vector (zero when
+ * the scaled cross product vanishes). Setup and the robust path. */
+px_vec3 px__unit_normal_acc(px_vec3 a, px_vec3 b, px_vec3 c);
+
 /* Cell of a hint grid (gdim cells from corner org, 1 / cell size inv)
  * holding p, points outside taking the nearest cell. @note RT-safe. */
 static inline size_t px__grid_cell(const int gdim[3], px_vec3 org, double inv,
@@ -194,6 +345,31 @@ static inline uint32_t px__mesh_grid_hint(const struct mesh *M, px_vec3 p)
  * d[3] per axis, centred on the box, corner *org. Setup only. */
 void px__grid_layout(px_aabb box, long cap, int d[3], px_vec3 *org, double *h);
 
+/* Lay out a grid of at most cap cells over box (px__grid_layout: *dim
+ * cells of edge *h, 1 / edge *inv, corner *org) and fill each cell of
+ * *cell (malloc'ed, x fastest) with nearest(ctx, its centre, the
+ * previous cell's answer): an element index, or < 0 for none (the
+ * previous one is then kept). Returns the number of cells or
+ * PX_E_NOMEM. Setup only. */
+long px__grid_fill(px_aabb box, long cap, long (*nearest)(const void *ctx, px_vec3 c, long prev),
+		   const void *ctx, uint32_t **cell, int dim[3], px_vec3 *org, double *h,
+		   double *inv);
+
+/* ---- between the mesh's files -------------------------------------------- */
+
+/* Free a mesh (any part may be missing). Setup and teardown. */
+void px__mesh_free(void *impl);
+
+/* Wrap M into a model (px_mesh.c's operations; convex: with the support
+ * function). The model owns M from here on, also when this fails.
+ * Returns PX_OK or PX_E_NOMEM. Setup only. */
+int px__mesh_wrap(struct mesh *M, int convex, struct px_model **out);
+
+/* Leaf index of the triangle nearest c (an exact query of the finished
+ * hierarchy, started from leaf triangle prev when >= 0), or -1 for none:
+ * px__grid_fill's nearest for a mesh (ctx). Setup only. */
+long px__mesh_grid_nearest(const void *ctx, px_vec3 c, long prev);
+
 /* ---- shared with the point cloud's hierarchy (px_cloud.c) ---------- */
 
 /* Double to float rounded down / up (boxes stay lower bounds). */
@@ -208,6 +384,51 @@ static inline float px__f_up(double x)
 	float f = (float)x;
 	return (double)f < x ? nextafterf(f, INFINITY) : f;
 }
+
+/*
+ * A binary tree over n elements by recursive splits of an index range
+ * (meshes, clouds; any set of boxed elements, e.g. a scene's models):
+ * perm[0..n) the elements, reordered into leaf order; key 3 doubles per
+ * element (what splits sort: centroids, points). box(ctx, perm, n, lo,
+ * hi) gives the bounds of elements perm[0..n); split(ctx, perm, n,
+ * depth, klo, khi) (may be NULL) partitions perm[0..n) itself and
+ * returns the size of the left part, or 0 to take the median split of
+ * the widest key axis; store(nodes, node, c, lo, hi, idx, cnt) records
+ * child c (0, 1) of node: a leaf range [idx, idx + cnt) (cnt > 0) or the
+ * inner node idx (cnt 0), or an absent child (idx EMPTY, empty box: only
+ * in a root that is one leaf) with its box. Ranges of at most leaf
+ * elements are leaves. box_is_key: the box of a range is its keys'
+ * bounds (points), reused for its split. Setup only; recursion as deep
+ * as the tree (callers check the depth against their stacks).
+ */
+struct px__tree_build {
+	uint32_t *perm;
+	const double *key;
+	size_t leaf;
+	int box_is_key;
+	void *ctx;
+	void (*box)(void *ctx, const uint32_t *perm, size_t n, double lo[3], double hi[3]);
+	size_t (*split)(void *ctx, uint32_t *perm, size_t n, int depth, const double klo[3],
+			const double khi[3]);
+	void (*store)(void *nodes, uint32_t node, int c, const double lo[3], const double hi[3],
+		      uint32_t idx, uint32_t cnt);
+	void *nodes;    /* the node array store() writes */
+	size_t n_nodes; /* out: nodes stored (the root is node 0) */
+	int depth;      /* out: depth of the deepest node (the root's is 0) */
+};
+
+void px__tree_build(struct px__tree_build *B, size_t n);
+
+/* px__tree_build's store for an array of struct node: boxes rounded
+ * outwards to float. */
+void px__node_store(void *nodes, uint32_t me, int c, const double lo[3], const double hi[3],
+		    uint32_t idx, uint32_t cnt);
+
+/* Write a report message into msg (cap bytes) unless one is there
+ * already (the first problem is the one reported); msg may be NULL.
+ * Setup only. */
+void px__report_msg(char *msg, size_t cap, const char *fmt, ...)
+	__attribute__((format(printf, 3, 4)));
 
 /* Collapse the binary tree bn (root b) into four-wide nodes appended to
  * n4 (room for as many as bn has); returns the index of the new node.
@@ -358,7 +579,7 @@ px_vec3 px__cross_acc(px_vec3 u, px_vec3 w);
 
 /* Unit normal of triangle abc, accurate to a few u in direction for any
  * shape and scale (the plain cross product where the fast point-triangle
- * test's bound holds, the error-free one elsewhere: px_mesh.c); zero for
+ * test's bound holds, the error-free one elsewhere: mesh_tri.c); zero for
  * a triangle without area. RT-safe. */
 px_vec3 px__tri_unit_normal(px_vec3 a, px_vec3 b, px_vec3 c);
 

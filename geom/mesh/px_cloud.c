@@ -55,17 +55,8 @@ struct cloud {
 	struct nslab *ns;  /* per four-wide node, for its children */
 };
 
-static void rep_msg(struct px_cloud_report *rep, const char *fmt, ...)
-	__attribute__((format(printf, 2, 3)));
-static void rep_msg(struct px_cloud_report *rep, const char *fmt, ...)
-{
-	va_list ap;
-	if (!rep || rep->message[0])
-		return;
-	va_start(ap, fmt);
-	vsnprintf(rep->message, sizeof(rep->message), fmt, ap);
-	va_end(ap);
-}
+#define rep_msg(rep, ...) \
+	px__report_msg((rep) ? (rep)->message : NULL, sizeof((rep)->message), __VA_ARGS__)
 
 static void cloud_free(void *impl)
 {
@@ -83,59 +74,10 @@ static void cloud_free(void *impl)
 
 /* ---- build ------------------------------------------------------------------ */
 
-struct build {
-	uint32_t *perm;
-	const double *xyz;
-	struct node *nodes;
-	size_t n_nodes;
-	int depth;
-};
-
-static void range_box(const struct build *B, size_t s, size_t n, double lo[3],
-		      double hi[3])
+/* px__tree_build's box: the bounds of points perm[0..n) (xyz, ctx). */
+static void range_box(void *ctx, const uint32_t *perm, size_t n, double lo[3], double hi[3])
 {
-	px__key_bounds(B->perm + s, n, B->xyz, lo, hi);
-}
-
-static void store_box(struct node *nd, int c, const double lo[3], const double hi[3])
-{
-	int k;
-	for (k = 0; k < 3; k++) {
-		nd->lo[c][k] = px__f_down(lo[k]);
-		nd->hi[c][k] = px__f_up(hi[k]);
-	}
-}
-
-static uint32_t build_node(struct build *B, size_t s, size_t n, int depth,
-			   const double lo[3], const double hi[3])
-{
-	uint32_t me = (uint32_t)B->n_nodes++;
-	size_t part[2][2], half;
-	int c;
-
-	if (depth > B->depth)
-		B->depth = depth;
-	half = px__median_split(B->perm + s, n, B->xyz, lo, hi);
-	part[0][0] = s;
-	part[0][1] = half;
-	part[1][0] = s + half;
-	part[1][1] = n - half;
-	for (c = 0; c < 2; c++) {
-		struct node *nd = &B->nodes[me];
-		double clo[3], chi[3];
-		range_box(B, part[c][0], part[c][1], clo, chi);
-		store_box(nd, c, clo, chi);
-		if (part[c][1] <= LEAF) {
-			nd->idx[c] = (uint32_t)part[c][0];
-			nd->cnt[c] = (uint32_t)part[c][1];
-		} else {
-			uint32_t ch;
-			ch = build_node(B, part[c][0], part[c][1], depth + 1, clo, chi);
-			B->nodes[me].idx[c] = ch;
-			B->nodes[me].cnt[c] = 0;
-		}
-	}
-	return me;
+	px__key_bounds(perm, n, ctx, lo, hi);
 }
 
 /* ---- query ------------------------------------------------------------------ */
@@ -474,52 +416,36 @@ static void slab_build(struct cloud *C, uint32_t ni, size_t *s_out, size_t *e_ou
 	*e_out = e;
 }
 
+/* px__grid_fill's nearest for a cloud (ctx): the exact nearest point
+ * to c, from point prev when >= 0. Setup only. */
+static long grid_nearest(const void *ctx, px_vec3 c, long prev)
+{
+	const struct cloud *C = ctx;
+	double best = INFINITY;
+	long bi = -1;
+	int iters = 0, cert = 1;
+	if (prev >= 0) {
+		best = px_v3_dist2(c, C->pt[prev]);
+		bi = prev;
+	}
+	cloud_walk(C, c, &best, &bi, &iters, &cert);
+	return bi;
+}
+
 /* The hint grid (see struct cloud): one cell per 8 points, at most
  * 64^3; each cell's exact nearest point, found in a serpentine order
  * from its neighbour's. Setup only. */
 static int grid_build(struct cloud *C)
 {
-	long cap = (long)(C->n / 8);
-	int d[3], k, iz, jy, jx;
-	size_t ncell;
-	long prev = -1;
-	double h;
+	long cap = (long)(C->n / 8), ncell;
 
 	if (cap > 64L * 64 * 64)
 		cap = 64L * 64 * 64;
-	px__grid_layout(C->box, cap, d, &C->gorg, &h);
-	ncell = (size_t)d[0] * (size_t)d[1] * (size_t)d[2];
-	C->grid = malloc(ncell * sizeof(*C->grid));
-	if (!C->grid)
-		return PX_E_NOMEM;
-	for (k = 0; k < 3; k++)
-		C->gdim[k] = d[k];
-	C->gcell = h;
-	C->ginv = 1.0 / h;
-	for (iz = 0; iz < d[2]; iz++)
-		for (jy = 0; jy < d[1]; jy++) {
-			int y = (iz & 1) ? d[1] - 1 - jy : jy;
-			int back = ((iz * d[1] + jy) & 1) != 0;
-			for (jx = 0; jx < d[0]; jx++) {
-				int x = back ? d[0] - 1 - jx : jx;
-				px_vec3 c = px_v3(C->gorg.x + (x + 0.5) * h, C->gorg.y + (y + 0.5) * h,
-						  C->gorg.z + (iz + 0.5) * h);
-				double best = INFINITY;
-				long bi = -1;
-				int iters = 0, cert = 1;
-				if (prev >= 0) {
-					best = px_v3_dist2(c, C->pt[prev]);
-					bi = prev;
-				}
-				cloud_walk(C, c, &best, &bi, &iters, &cert);
-				if (bi < 0)
-					bi = prev >= 0 ? prev : 0;
-				prev = bi;
-				C->grid[((size_t)iz * (size_t)d[1] + (size_t)y) * (size_t)d[0] +
-					(size_t)x] = (uint32_t)bi;
-			}
-		}
-	C->bytes += ncell * sizeof(*C->grid);
+	ncell = px__grid_fill(C->box, cap, grid_nearest, C, &C->grid, C->gdim, &C->gorg, &C->gcell,
+			      &C->ginv);
+	if (ncell < 0)
+		return (int)ncell;
+	C->bytes += (size_t)ncell * sizeof(*C->grid);
 	return PX_OK;
 }
 
@@ -530,7 +456,7 @@ int px_cloud_model(const double *xyz, size_t n, double radius_m,
 	struct cloud *C = NULL;
 	uint32_t *perm = NULL;
 	struct node *nodes = NULL;
-	struct build B;
+	struct px__tree_build B;
 	size_t i;
 	int rc = PX_E_NOMEM, k;
 
@@ -592,30 +518,16 @@ int px_cloud_model(const double *xyz, size_t n, double radius_m,
 	memset(nodes, 0, (n / 2 + 2) * sizeof(*nodes));
 	for (i = 0; i < n; i++)
 		perm[i] = (uint32_t)i;
+	memset(&B, 0, sizeof(B));
 	B.perm = perm;
-	B.xyz = xyz;
+	B.key = xyz;
+	B.leaf = LEAF;
+	B.box_is_key = 1;
+	B.ctx = (void *)xyz;
+	B.box = range_box;
+	B.store = px__node_store;
 	B.nodes = nodes;
-	B.n_nodes = 0;
-	B.depth = 0;
-	if (n <= LEAF) {
-		struct node *nd = &nodes[0];
-		double lo[3], hi[3];
-		B.n_nodes = 1;
-		range_box(&B, 0, n, lo, hi);
-		store_box(nd, 0, lo, hi);
-		nd->idx[0] = 0;
-		nd->cnt[0] = (uint32_t)n;
-		for (k = 0; k < 3; k++) {
-			nd->lo[1][k] = INFINITY;
-			nd->hi[1][k] = -INFINITY;
-		}
-		nd->idx[1] = EMPTY;
-		nd->cnt[1] = 0;
-	} else {
-		double lo[3], hi[3];
-		range_box(&B, 0, n, lo, hi);
-		build_node(&B, 0, n, 0, lo, hi);
-	}
+	px__tree_build(&B, n);
 	C->depth = B.depth + 1;
 	if (C->depth > PX_CLOUD_MAX_DEPTH) {
 		rep_msg(rep, "tree too deep (%d)", C->depth);
