@@ -298,6 +298,297 @@ static int ply_line_check(int *first, long *line, const long *last, long now)
 	return now != *line;
 }
 
+/* One PLY check (ply_validate): the file, the header read so far, the
+ * vertices read, and where the body walk is (element k, instance i) for
+ * the messages. */
+struct ply {
+	const char *path;
+	FILE *f;
+	char *msg;
+	size_t msg_cap;
+	struct ply_elem *E;
+	int ne;
+	int fmt;     /* 0 ASCII, 1 binary little endian, 2 big endian; -1 none */
+	int vk;      /* the vertex element, -1 none */
+	int ax[3];   /* its properties x, y, z, -1 none */
+	long vline;  /* its header line */
+	long lineno;
+	unsigned long long n_vertex;
+	double *V;   /* 3 per vertex */
+	int k;
+	unsigned long long i;
+	/* ASCII: the line of the current instance, of the last one, and
+	 * whether the current one has no value yet */
+	long inst_line, inst_last;
+	int inst_first;
+};
+
+/* What a step of the check found besides success (0) and PX_E_NOMEM:
+ * a message written (PLY_BAD), the data ending early (PLY_SHORT), an
+ * instance not on one line of its own (PLY_ROWS). */
+#define PLY_BAD 1
+#define PLY_SHORT 2
+#define PLY_ROWS 3
+
+#define ply_msg(P, ...) (snprintf((P)->msg, (P)->msg_cap, __VA_ARGS__), PLY_BAD)
+
+/* Header: "element <name> <count>". */
+static int ply_element(struct ply *P, char w[4][64])
+{
+	struct ply_elem *el = &P->E[P->ne];
+	char *end;
+	if (P->ne == PLY_MAX_ELEMS)
+		return ply_msg(P, "%s:%ld: too many PLY elements", P->path, P->lineno);
+	/* the importer reads a name starting with a digit as the element
+	 * count (found by fuzzing: 'element 8888888face 1' took gigabytes
+	 * and minutes) */
+	if (!isalpha((unsigned char)w[1][0]) && w[1][0] != '_')
+		return ply_msg(P, "%s:%ld: PLY element name '%s' does not start with a letter",
+			       P->path, P->lineno, w[1]);
+	snprintf(el->name, sizeof(el->name), "%s", w[1]);
+	if (strcmp(w[1], "vertex") == 0 && P->vk < 0) {
+		P->vk = P->ne;
+		P->vline = P->lineno;
+	}
+	el->count = strtoull(w[2], &end, 10);
+	if (*end || w[2][0] == '-')
+		return ply_msg(P, "%s:%ld: bad element count '%s'", P->path, P->lineno, w[2]);
+	P->ne++;
+	return 0;
+}
+
+/* Header: "property <type> <name>" or "property list <count type>
+ * <item type> <name>" of the last element. */
+static int ply_property(struct ply *P, char w[4][64], int nw)
+{
+	struct ply_elem *el = &P->E[P->ne - 1];
+	struct ply_prop *pp;
+	if (el->n_props == PLY_MAX_PROPS)
+		return ply_msg(P, "%s:%ld: too many PLY properties", P->path, P->lineno);
+	pp = &el->props[el->n_props++];
+	if (strcmp(w[1], "list") == 0) {
+		pp->list = 1;
+		pp->csize = nw >= 4 ? ply_type_size(w[2]) : 0;
+		pp->size = nw >= 4 ? ply_type_size(w[3]) : 0;
+		if (nw >= 4)
+			ply_item_kind(w[3], pp);
+	} else {
+		pp->size = ply_type_size(w[1]);
+		ply_item_kind(w[1], pp);
+		snprintf(pp->name, sizeof(pp->name), "%s", w[2]);
+		if (P->ne - 1 == P->vk && !w[2][1] && w[2][0] >= 'x' && w[2][0] <= 'z' &&
+		    P->ax[w[2][0] - 'x'] < 0)
+			P->ax[w[2][0] - 'x'] = el->n_props - 1;
+	}
+	if (!pp->size || (pp->list && !pp->csize))
+		return ply_msg(P, "%s:%ld: bad PLY property type", P->path, P->lineno);
+	return 0;
+}
+
+/* Header: "format <ascii|binary_little_endian|binary_big_endian> 1.0". */
+static int ply_format(struct ply *P, char w[4][64], int nw)
+{
+	P->fmt = strcmp(w[1], "ascii") == 0 ? 0
+		 : strcmp(w[1], "binary_little_endian") == 0 ? 1
+		 : strcmp(w[1], "binary_big_endian") == 0 ? 2 : -2;
+	if (P->fmt == -2)
+		return ply_msg(P, "%s:%ld: unknown PLY format '%s'", P->path, P->lineno, w[1]);
+	/* the importer crashed (SEGV) on a binary header with a malformed
+	 * version and no elements (found by fuzzing) */
+	if (nw != 3 || strcmp(w[2], "1.0") != 0)
+		return ply_msg(P, "%s:%ld: PLY format line must end with version 1.0", P->path,
+			       P->lineno);
+	return 0;
+}
+
+/* The header up to end_header. */
+static int ply_header(struct ply *P)
+{
+	char line[512];
+	for (;;) {
+		char w[4][64];
+		int nw, rc = 0;
+		if (!fgets(line, sizeof(line), P->f))
+			return ply_msg(P, "%s:%ld: PLY header without end_header", P->path, P->lineno);
+		P->lineno++;
+		if (!strchr(line, '\n') && !feof(P->f))
+			return ply_msg(P, "%s:%ld: PLY header line too long or with a NUL byte",
+				       P->path, P->lineno);
+		nw = sscanf(line, "%63s %63s %63s %63s", w[0], w[1], w[2], w[3]);
+		if (P->lineno == 1) {
+			if (nw < 1 || strcmp(w[0], "ply") != 0)
+				return ply_msg(P, "%s:1: not a PLY file", P->path);
+			continue;
+		}
+		if (nw <= 0 || strcmp(w[0], "comment") == 0 || strcmp(w[0], "obj_info") == 0)
+			continue;
+		if (strcmp(w[0], "end_header") == 0)
+			break;
+		if (strcmp(w[0], "format") == 0 && nw >= 2)
+			rc = ply_format(P, w, nw);
+		else if (strcmp(w[0], "element") == 0 && nw >= 3)
+			rc = ply_element(P, w);
+		else if (strcmp(w[0], "property") == 0 && nw >= 3 && P->ne > 0)
+			rc = ply_property(P, w, nw);
+		else
+			rc = ply_msg(P, "%s:%ld: unexpected PLY header line", P->path, P->lineno);
+		if (rc)
+			return rc;
+	}
+	if (P->fmt < 0)
+		return ply_msg(P, "%s: PLY header without format", P->path);
+	return 0;
+}
+
+/* The vertex element the header declares: present, with x, y and z, a
+ * count the file's size bytes can hold; room for its coordinates. */
+static int ply_vertices(struct ply *P, size_t size)
+{
+	int k;
+	if (P->vk >= 0)
+		P->n_vertex = P->E[P->vk].count;
+	if (P->n_vertex == 0)
+		return ply_msg(P, "%s: PLY header declares no vertices", P->path);
+	/* a vertex without x, y or z loaded as 0 there: every point of a
+	 * cloud without z on the plane z = 0 */
+	for (k = 0; k < 3; k++)
+		if (P->ax[k] < 0)
+			return ply_msg(P, "%s:%ld: PLY element 'vertex' has no scalar property '%c'",
+				       P->path, P->vline, "xyz"[k]);
+	/* every vertex takes at least a byte a property (two in ASCII): a
+	 * count the file cannot hold is refused before the allocation */
+	if (P->n_vertex > size / (unsigned long long)P->E[P->vk].n_props)
+		return ply_msg(P, "%s:%ld: PLY header declares %llu vertices, more than its %zu "
+			       "bytes can hold", P->path, P->vline, P->n_vertex, size);
+	P->V = malloc((size_t)P->n_vertex * 3 * sizeof(*P->V));
+	if (!P->V) {
+		snprintf(P->msg, P->msg_cap, "%s: out of memory for %llu vertices", P->path,
+			 P->n_vertex);
+		return PX_E_NOMEM;
+	}
+	return 0;
+}
+
+/* Keep value x of property j of the current instance when it is a
+ * vertex coordinate. */
+static void ply_keep(struct ply *P, int j, double x)
+{
+	int a;
+	for (a = 0; a < 3; a++)
+		if (P->ax[a] == j)
+			P->V[3 * P->i + (size_t)a] = x;
+}
+
+/* Next ASCII value of the current instance, on its line. */
+static int ply_ascii_token(struct ply *P, char tok[64])
+{
+	if (!ply_token(P->f, tok, 64, &P->lineno))
+		return PLY_SHORT;
+	if (ply_line_check(&P->inst_first, &P->inst_line, &P->inst_last, P->lineno))
+		return PLY_ROWS;
+	return 0;
+}
+
+/* ASCII property j of the current instance. */
+static int ply_ascii_prop(struct ply *P, const struct ply_prop *pp, int j, int face)
+{
+	unsigned long long nitems = 1, t;
+	char tok[64], *end;
+	int rc;
+	if (pp->list) {
+		if ((rc = ply_ascii_token(P, tok)) != 0)
+			return rc;
+		nitems = strtoull(tok, &end, 10);
+		if (*end || tok[0] == '-' || !tok[0] || (face && nitems < 3))
+			return ply_msg(P, "%s:%ld: bad list length '%s'", P->path, P->lineno, tok);
+	}
+	for (t = 0; t < nitems; t++) {
+		if ((rc = ply_ascii_token(P, tok)) != 0)
+			return rc;
+		if (!num_ok(tok))
+			return ply_msg(P, "%s:%ld: not a number '%s'", P->path, P->lineno, tok);
+		if (P->k == P->vk && !pp->list)
+			ply_keep(P, j, strtod(tok, NULL));
+		if (face) {
+			unsigned long long vi = strtoull(tok, &end, 10);
+			if (*end || tok[0] == '-' || vi >= P->n_vertex)
+				return ply_msg(P, "%s:%ld: face %llu: vertex index '%s' not below %llu",
+					       P->path, P->lineno, P->i, tok, P->n_vertex);
+		}
+	}
+	return 0;
+}
+
+/* Binary property j of the current instance. */
+static int ply_binary_prop(struct ply *P, const struct ply_prop *pp, int j, int face)
+{
+	unsigned long long nitems = 1, t;
+	unsigned char b[8];
+	int big = P->fmt == 2;
+	if (pp->list) {
+		if (fread(b, 1, (size_t)pp->csize, P->f) != (size_t)pp->csize)
+			return PLY_SHORT;
+		nitems = ply_uint(b, pp->csize, big);
+		if (face && nitems < 3)
+			return ply_msg(P, "%s: face %llu has %llu vertices", P->path, P->i, nitems);
+	}
+	for (t = 0; t < nitems; t++) {
+		unsigned long long v;
+		if (fread(b, 1, (size_t)pp->size, P->f) != (size_t)pp->size)
+			return PLY_SHORT;
+		if (P->k == P->vk && !pp->list)
+			ply_keep(P, j, ply_value(b, pp, big));
+		if (!face)
+			continue;
+		v = ply_uint(b, pp->size, big);
+		if (!pp->isint || (pp->sgn && pp->size < 8 && (v >> (8 * pp->size - 1)) & 1u) ||
+		    v >= P->n_vertex)
+			return ply_msg(P, "%s: face %llu: vertex index not an integer below %llu",
+				       P->path, P->i, P->n_vertex);
+	}
+	return 0;
+}
+
+/* The body, element by element, and nothing after it. ASCII: the
+ * importer reads one element per line, so the check wants each
+ * element's values on a line of their own (a row with a value too many
+ * shifted the faces and aborted the importer). Face lists must be
+ * polygons over existing vertices: the importer's triangulation aborts
+ * the process on other indices (found by fuzzing). */
+static int ply_body(struct ply *P)
+{
+	char tok[64];
+	int j, rc;
+	P->inst_last = P->lineno - 1;
+	for (P->k = 0; P->k < P->ne; P->k++) {
+		const struct ply_elem *el = &P->E[P->k];
+		for (P->i = 0; P->i < el->count; P->i++) {
+			P->inst_first = 1;
+			for (j = 0; j < el->n_props; j++) {
+				const struct ply_prop *pp = &el->props[j];
+				int face = pp->list && strcmp(el->name, "face") == 0;
+				rc = P->fmt == 0 ? ply_ascii_prop(P, pp, j, face)
+						 : ply_binary_prop(P, pp, j, face);
+				if (rc == PLY_ROWS)
+					return ply_msg(P, "%s:%ld: PLY element '%s' %llu: not one line "
+						       "of values", P->path, P->lineno, el->name, P->i);
+				if (rc == PLY_SHORT)
+					return ply_msg(P, "%s: PLY data ends early (element '%s' %llu of "
+						       "%llu)", P->path, el->name, P->i, el->count);
+				if (rc)
+					return rc;
+			}
+			if (P->fmt == 0)
+				P->inst_last = P->inst_line;
+		}
+	}
+	if (P->fmt == 0 ? ply_token(P->f, tok, sizeof(tok), &P->lineno) : fgetc(P->f) != EOF)
+		return P->fmt == 0 ? ply_msg(P, "%s:%ld: data after the last PLY element", P->path,
+					     P->lineno)
+				   : ply_msg(P, "%s: data after the last PLY element", P->path);
+	return 0;
+}
+
 /* Check the PLY of size bytes at f (see above) and read its vertices'
  * x, y, z exactly as doubles into *xyz (malloc'ed, 3 per vertex, *nv of
  * them), which the caller frees. */
@@ -305,275 +596,40 @@ static int ply_validate(const char *path, FILE *f, size_t size, double **xyz,
 			size_t *nv, unsigned long long *n_faces, char *msg,
 			size_t msg_cap)
 {
-	struct ply_elem *E = NULL;
-	int ne = 0, fmt = -1, rc = PX_E_PARSE, k, vk = -1, ax[3] = {-1, -1, -1};
-	long vline = 0;
-	char line[512];
-	long lineno = 0;
-	unsigned long long i, n_vertex = 0;
-	long inst_line = 0, inst_last = 0;
-	int inst_first = 1;
-	double *V = NULL;
+	struct ply P;
+	int rc, k;
 
 	*xyz = NULL;
 	*nv = 0;
 	*n_faces = 0;
-	E = calloc(PLY_MAX_ELEMS, sizeof(*E));
-	if (!E)
+	memset(&P, 0, sizeof(P));
+	P.path = path;
+	P.f = f;
+	P.msg = msg;
+	P.msg_cap = msg_cap;
+	P.fmt = -1;
+	P.vk = -1;
+	P.ax[0] = P.ax[1] = P.ax[2] = -1;
+	P.inst_first = 1;
+	P.E = calloc(PLY_MAX_ELEMS, sizeof(*P.E));
+	if (!P.E)
 		return PX_E_NOMEM;
-	/* header */
-	for (;;) {
-		char w[4][64];
-		int nw;
-		if (!fgets(line, sizeof(line), f)) {
-			snprintf(msg, msg_cap, "%s:%ld: PLY header without end_header", path, lineno);
-			goto out;
-		}
-		lineno++;
-		if (!strchr(line, '\n') && !feof(f)) {
-			snprintf(msg, msg_cap, "%s:%ld: PLY header line too long or with a "
-				 "NUL byte", path, lineno);
-			goto out;
-		}
-		nw = sscanf(line, "%63s %63s %63s %63s", w[0], w[1], w[2], w[3]);
-		if (lineno == 1) {
-			if (nw < 1 || strcmp(w[0], "ply") != 0) {
-				snprintf(msg, msg_cap, "%s:1: not a PLY file", path);
-				goto out;
-			}
-			continue;
-		}
-		if (nw <= 0 || strcmp(w[0], "comment") == 0 || strcmp(w[0], "obj_info") == 0)
-			continue;
-		if (strcmp(w[0], "end_header") == 0)
-			break;
-		if (strcmp(w[0], "format") == 0 && nw >= 2) {
-			fmt = strcmp(w[1], "ascii") == 0 ? 0
-			      : strcmp(w[1], "binary_little_endian") == 0 ? 1
-			      : strcmp(w[1], "binary_big_endian") == 0 ? 2 : -2;
-			if (fmt == -2) {
-				snprintf(msg, msg_cap, "%s:%ld: unknown PLY format '%s'", path, lineno, w[1]);
-				goto out;
-			}
-			/* the importer crashed (SEGV) on a binary header with a
-			 * malformed version and no elements (found by fuzzing) */
-			if (nw != 3 || strcmp(w[2], "1.0") != 0) {
-				snprintf(msg, msg_cap, "%s:%ld: PLY format line must end with version 1.0", path, lineno);
-				goto out;
-			}
-		} else if (strcmp(w[0], "element") == 0 && nw >= 3) {
-			char *end;
-			if (ne == PLY_MAX_ELEMS) {
-				snprintf(msg, msg_cap, "%s:%ld: too many PLY elements", path, lineno);
-				goto out;
-			}
-			/* the importer reads a name starting with a digit as the
-			 * element count (found by fuzzing: 'element 8888888face 1'
-			 * took gigabytes and minutes) */
-			if (!isalpha((unsigned char)w[1][0]) && w[1][0] != '_') {
-				snprintf(msg, msg_cap, "%s:%ld: PLY element name '%s' does "
-					 "not start with a letter", path, lineno, w[1]);
-				goto out;
-			}
-			snprintf(E[ne].name, sizeof(E[ne].name), "%s", w[1]);
-			if (strcmp(w[1], "vertex") == 0 && vk < 0) {
-				vk = ne;
-				vline = lineno;
-			}
-			E[ne].count = strtoull(w[2], &end, 10);
-			if (*end || w[2][0] == '-') {
-				snprintf(msg, msg_cap, "%s:%ld: bad element count '%s'", path, lineno, w[2]);
-				goto out;
-			}
-			ne++;
-		} else if (strcmp(w[0], "property") == 0 && nw >= 3 && ne > 0) {
-			struct ply_elem *el = &E[ne - 1];
-			struct ply_prop *pp;
-			if (el->n_props == PLY_MAX_PROPS) {
-				snprintf(msg, msg_cap, "%s:%ld: too many PLY properties", path, lineno);
-				goto out;
-			}
-			pp = &el->props[el->n_props++];
-			if (strcmp(w[1], "list") == 0) {
-				pp->list = 1;
-				pp->csize = nw >= 4 ? ply_type_size(w[2]) : 0;
-				pp->size = nw >= 4 ? ply_type_size(w[3]) : 0;
-				if (nw >= 4) {
-					ply_item_kind(w[3], pp);
-				}
-			} else {
-				pp->size = ply_type_size(w[1]);
-				ply_item_kind(w[1], pp);
-				snprintf(pp->name, sizeof(pp->name), "%s", w[2]);
-				if (ne - 1 == vk && !w[2][1] && w[2][0] >= 'x' &&
-				    w[2][0] <= 'z' && ax[w[2][0] - 'x'] < 0)
-					ax[w[2][0] - 'x'] = el->n_props - 1;
-			}
-			if (!pp->size || (pp->list && !pp->csize)) {
-				snprintf(msg, msg_cap, "%s:%ld: bad PLY property type", path, lineno);
-				goto out;
-			}
-		} else {
-			snprintf(msg, msg_cap, "%s:%ld: unexpected PLY header line", path, lineno);
-			goto out;
-		}
+	rc = ply_header(&P);
+	if (rc == 0)
+		rc = ply_vertices(&P, size);
+	if (rc == 0)
+		rc = ply_body(&P);
+	if (rc == 0) {
+		for (k = 0; k < P.ne; k++)
+			if (strcmp(P.E[k].name, "face") == 0)
+				*n_faces += P.E[k].count;
+		*xyz = P.V;
+		*nv = (size_t)P.n_vertex;
+		P.V = NULL;
 	}
-	if (fmt < 0) {
-		snprintf(msg, msg_cap, "%s: PLY header without format", path);
-		goto out;
-	}
-	/* body; face lists must be polygons over existing vertices: the
-	 * importer's triangulation aborts the process on other indices
-	 * (found by fuzzing) */
-	if (vk >= 0)
-		n_vertex = E[vk].count;
-	if (n_vertex == 0) {
-		snprintf(msg, msg_cap, "%s: PLY header declares no vertices", path);
-		goto out;
-	}
-	/* a vertex without x, y or z loaded as 0 there: every point of a
-	 * cloud without z on the plane z = 0 */
-	for (k = 0; k < 3; k++)
-		if (ax[k] < 0) {
-			snprintf(msg, msg_cap, "%s:%ld: PLY element 'vertex' has no "
-				 "scalar property '%c'", path, vline, "xyz"[k]);
-			goto out;
-		}
-	/* every vertex takes at least a byte a property (two in ASCII): a
-	 * count the file cannot hold is refused before the allocation */
-	if (n_vertex > size / (unsigned long long)E[vk].n_props) {
-		snprintf(msg, msg_cap, "%s:%ld: PLY header declares %llu vertices, "
-			 "more than its %zu bytes can hold", path, vline, n_vertex, size);
-		goto out;
-	}
-	V = malloc((size_t)n_vertex * 3 * sizeof(*V));
-	if (!V) {
-		snprintf(msg, msg_cap, "%s: out of memory for %llu vertices", path,
-			 n_vertex);
-		rc = PX_E_NOMEM;
-		goto out;
-	}
-	/* ASCII: the importer reads one element per line, so the check
-	 * wants each element's values on a line of their own (a row with a
-	 * value too many shifted the faces and aborted the importer). */
-	inst_last = lineno - 1;
-	for (k = 0; k < ne; k++)
-		for (i = 0; i < E[k].count; i++) {
-			int j, a;
-			inst_first = 1;
-			for (j = 0; j < E[k].n_props; j++) {
-				const struct ply_prop *pp = &E[k].props[j];
-				unsigned long long nitems = 1, t;
-				int face = pp->list && strcmp(E[k].name, "face") == 0;
-				if (fmt == 0) {
-					char tok[64], *end;
-					if (pp->list) {
-						if (!ply_token(f, tok, sizeof(tok), &lineno))
-							goto truncated;
-						if (ply_line_check(&inst_first, &inst_line, &inst_last,
-								   lineno))
-							goto rows;
-						nitems = strtoull(tok, &end, 10);
-						if (*end || tok[0] == '-' || !tok[0] ||
-						    (face && nitems < 3)) {
-							snprintf(msg, msg_cap, "%s:%ld: bad list length '%s'",
-								 path, lineno, tok);
-							goto out;
-						}
-					}
-					for (t = 0; t < nitems; t++) {
-						if (!ply_token(f, tok, sizeof(tok), &lineno))
-							goto truncated;
-						if (ply_line_check(&inst_first, &inst_line, &inst_last,
-								   lineno))
-							goto rows;
-						if (!num_ok(tok)) {
-							snprintf(msg, msg_cap, "%s:%ld: not a number '%s'",
-								 path, lineno, tok);
-							goto out;
-						}
-						if (k == vk && !pp->list)
-							for (a = 0; a < 3; a++)
-								if (ax[a] == j)
-									V[3 * i + (size_t)a] = strtod(tok, NULL);
-						if (face) {
-							unsigned long long vi = strtoull(tok, &end, 10);
-							if (*end || tok[0] == '-' || vi >= n_vertex) {
-								snprintf(msg, msg_cap, "%s:%ld: face %llu: "
-									 "vertex index '%s' not below %llu",
-									 path, lineno, i, tok, n_vertex);
-								goto out;
-							}
-						}
-					}
-				} else {
-					unsigned char b[8];
-					if (pp->list) {
-						if (fread(b, 1, (size_t)pp->csize, f) != (size_t)pp->csize)
-							goto truncated;
-						nitems = ply_uint(b, pp->csize, fmt == 2);
-						if (face && nitems < 3) {
-							snprintf(msg, msg_cap, "%s: face %llu has %llu vertices",
-								 path, i, nitems);
-							goto out;
-						}
-					}
-					for (t = 0; t < nitems; t++) {
-						unsigned long long v;
-						if (fread(b, 1, (size_t)pp->size, f) != (size_t)pp->size)
-							goto truncated;
-						if (k == vk && !pp->list)
-							for (a = 0; a < 3; a++)
-								if (ax[a] == j)
-									V[3 * i + (size_t)a] =
-										ply_value(b, pp, fmt == 2);
-						if (!face)
-							continue;
-						v = ply_uint(b, pp->size, fmt == 2);
-						if (!pp->isint ||
-						    (pp->sgn && pp->size < 8 &&
-						     (v >> (8 * pp->size - 1)) & 1u) ||
-						    v >= n_vertex) {
-							snprintf(msg, msg_cap, "%s: face %llu: vertex index "
-								 "not an integer below %llu", path, i,
-								 n_vertex);
-							goto out;
-						}
-					}
-				}
-			}
-			if (fmt == 0)
-				inst_last = inst_line;
-		}
-	if (fmt == 0) {
-		char tok[64];
-		if (ply_token(f, tok, sizeof(tok), &lineno)) {
-			snprintf(msg, msg_cap, "%s:%ld: data after the last PLY element", path, lineno);
-			goto out;
-		}
-	} else if (fgetc(f) != EOF) {
-		snprintf(msg, msg_cap, "%s: data after the last PLY element", path);
-		goto out;
-	}
-	rc = PX_OK;
-	for (k = 0; k < ne; k++)
-		if (strcmp(E[k].name, "face") == 0)
-			*n_faces += E[k].count;
-	*xyz = V;
-	*nv = (size_t)n_vertex;
-	V = NULL;
-	goto out;
-rows:
-	snprintf(msg, msg_cap, "%s:%ld: PLY element '%s' %llu: not one line of values",
-		 path, lineno, E[k].name, i);
-	goto out;
-truncated:
-	snprintf(msg, msg_cap, "%s: PLY data ends early (element '%s' %llu of %llu)", path,
-		 E[k].name, i, E[k].count);
-out:
-	free(V);
-	free(E);
-	return rc;
+	free(P.V);
+	free(P.E);
+	return rc == 0 ? PX_OK : rc > 0 ? PX_E_PARSE : rc;
 }
 
 /* ---- strict STL structure check ---------------------------------------------
@@ -856,18 +912,131 @@ static int text_coords(const char *data, const char *kw, double **out, size_t *n
 	return PX_OK;
 }
 
+/* The structure check of a PLY file (data, len bytes). want_tri: it must
+ * have faces, and its vertices pass the importer's precision check;
+ * else its points are the answer, read exactly into *pv, *pn (the
+ * caller's). */
+static int check_ply(const char *path, char *data, size_t len, int want_tri, double **pv,
+		     size_t *pn, char *msg, size_t msg_cap)
+{
+	unsigned long long nf = 0;
+	FILE *f = mem_stream(path, data, len, msg, msg_cap);
+	int rc;
+	if (!f)
+		return PX_E_IO;
+	rc = ply_validate(path, f, len, pv, pn, &nf, msg, msg_cap);
+	fclose(f);
+	if (rc != PX_OK || !want_tri)
+		return rc;
+	if (nf == 0) {
+		/* vertices only: a cloud (px_load.c looks for these words) */
+		snprintf(msg, msg_cap, "%s: no triangles in the file", path);
+		rc = PX_E_PARSE;
+	} else {
+		rc = float_loss_check(path, *pv, *pn, msg, msg_cap);
+	}
+	free(*pv);
+	*pv = NULL;
+	return rc;
+}
+
+/* The checks before the importer: PLY and STL structure, and the
+ * precision of the decimal coordinates of text meshes (a binary STL is
+ * single precision already). *hint: the importer's format hint. A PLY
+ * read for points is answered here: *pv, *pn. */
+static int check_file(const char *path, char *data, size_t len, int want_tri, char hint[16],
+		      double **pv, size_t *pn, char *msg, size_t msg_cap)
+{
+	const char *dot = strrchr(path, '.'), *slash = strrchr(path, '/');
+	int rc;
+
+	/* A .ply name without the magic line goes to the check too: the
+	 * importer's PLY reader loops forever on some such headers (found
+	 * by fuzzing). */
+	if (has_ply_magic(data, len) || ends_with_ci(path, ".ply")) {
+		snprintf(hint, 16, "ply");
+		return check_ply(path, data, len, want_tri, pv, pn, msg, msg_cap);
+	}
+	if (ends_with_ci(path, ".stl")) {
+		FILE *f = mem_stream(path, data, len, msg, msg_cap);
+		if (!f)
+			return PX_E_IO;
+		rc = stl_validate(path, data, len, f, msg, msg_cap);
+		fclose(f);
+		if (rc != PX_OK)
+			return rc;
+	}
+	if (ends_with_ci(path, ".obj") ||
+	    (ends_with_ci(path, ".stl") &&
+	     !(len >= 84 && len == 84ull + 50ull * ply_uint((const unsigned char *)data + 80, 4, 0)))) {
+		double *tv = NULL;
+		size_t tn = 0;
+		rc = text_coords(data, ends_with_ci(path, ".obj") ? "v" : "vertex", &tv, &tn);
+		if (rc == PX_OK)
+			rc = float_loss_check(path, tv, tn, msg, msg_cap);
+		free(tv);
+		if (rc != PX_OK)
+			return rc;
+	}
+	if (dot && (!slash || dot > slash) && strlen(dot + 1) < 16)
+		snprintf(hint, 16, "%s", dot + 1);
+	return PX_OK;
+}
+
+/* Run the importer on data (len bytes, format hint) and collect its
+ * meshes into A: every mesh its nodes reference, with their transforms,
+ * and the meshes no node references as they are. */
+static int import_scene(const char *path, const char *data, size_t len, const char *hint,
+			struct acc *A, char *msg, size_t msg_cap)
+{
+	const struct aiScene *s;
+	struct aiMatrix4x4 I;
+	unsigned char *seen;
+	unsigned i;
+
+	if (len > 0xffffffffu) {
+		snprintf(msg, msg_cap, "%s: %zu bytes, more than the importer takes", path, len);
+		return PX_E_RANGE;
+	}
+	s = aiImportFileFromMemory(data, (unsigned)len, aiProcess_Triangulate, hint);
+	if (!s) {
+		snprintf(msg, msg_cap, "%s: %s", path, aiGetErrorString());
+		return PX_E_PARSE;
+	}
+	seen = calloc(s->mNumMeshes + 1, 1);
+	if (!seen) {
+		aiReleaseImport(s);
+		return PX_E_NOMEM;
+	}
+	memset(&I, 0, sizeof(I));
+	I.a1 = I.b2 = I.c3 = I.d4 = 1.0f;
+	if (s->mRootNode)
+		walk(A, s, s->mRootNode, &I, seen, 0);
+	for (i = 0; i < s->mNumMeshes; i++)
+		if (!seen[i])
+			add_mesh(A, s->mMeshes[i], NULL);
+	free(seen);
+	aiReleaseImport(s);
+	if (A->err) {
+		snprintf(msg, msg_cap, "%s: %s", path, px_strerror(A->err));
+		return A->err;
+	}
+	if (A->nv == 0 || (A->want_tri && A->nt == 0)) {
+		snprintf(msg, msg_cap, "%s: no %s in the file", path,
+			 A->want_tri ? "triangles" : "points");
+		return PX_E_PARSE;
+	}
+	return PX_OK;
+}
+
 int px__import_file(const char *path, int want_tri, double **xyz,
 		    size_t *nv, uint32_t **tri, size_t *nt, size_t *n_skipped,
 		    char *msg, size_t msg_cap)
 {
-	const struct aiScene *s;
 	struct acc A;
-	struct aiMatrix4x4 I;
-	unsigned char *seen;
-	unsigned i;
 	char *data = NULL, hint[16] = "";
-	size_t len = 0;
-	const char *dot, *slash;
+	double *pv = NULL;
+	size_t len = 0, pn = 0;
 	int rc;
 
 	memset(&A, 0, sizeof(A));
@@ -897,116 +1066,23 @@ int px__import_file(const char *path, int want_tri, double **xyz,
 		free(data);
 		return PX_E_PARSE;
 	}
-	/* A .ply name without the magic line goes to the check too: the
-	 * importer's PLY reader loops forever on some such headers (found
-	 * by fuzzing). */
-	if (has_ply_magic(data, len) || ends_with_ci(path, ".ply")) {
-		double *pv = NULL;
-		size_t pn = 0;
-		unsigned long long nf = 0;
-		FILE *f = mem_stream(path, data, len, msg, msg_cap);
-		if (!f) {
-			free(data);
-			return PX_E_IO;
-		}
-		rc = ply_validate(path, f, len, &pv, &pn, &nf, msg, msg_cap);
-		fclose(f);
-		if (rc == PX_OK && want_tri && nf == 0) {
-			/* vertices only: a cloud (px_load.c looks for these words) */
-			snprintf(msg, msg_cap, "%s: no triangles in the file", path);
-			rc = PX_E_PARSE;
-		}
-		if (rc == PX_OK && !want_tri) {
-			/* points: the file's own values, doubles kept exact */
-			free(data);
-			*xyz = pv;
-			*nv = pn;
-			if (n_skipped)
-				*n_skipped = 0;
-			return PX_OK;
-		}
-		if (rc == PX_OK)
-			rc = float_loss_check(path, pv, pn, msg, msg_cap);
-		free(pv);
-		if (rc != PX_OK) {
-			free(data);
-			return rc;
-		}
-		snprintf(hint, sizeof hint, "ply");
-	} else if (ends_with_ci(path, ".stl")) {
-		FILE *f = mem_stream(path, data, len, msg, msg_cap);
-		if (!f) {
-			free(data);
-			return PX_E_IO;
-		}
-		rc = stl_validate(path, data, len, f, msg, msg_cap);
-		fclose(f);
-		if (rc != PX_OK) {
-			free(data);
-			return rc;
-		}
-	}
-	/* text meshes write their coordinates in decimal: the same precision
-	 * check as for PLY (a binary STL is single precision already) */
-	if (!hint[0] && (ends_with_ci(path, ".obj") ||
-			 (ends_with_ci(path, ".stl") &&
-			  !(len >= 84 && len == 84ull + 50ull * ply_uint((const unsigned char *)
-									 data + 80, 4, 0))))) {
-		double *tv = NULL;
-		size_t tn = 0;
-		rc = text_coords(data, ends_with_ci(path, ".obj") ? "v" : "vertex", &tv, &tn);
-		if (rc == PX_OK)
-			rc = float_loss_check(path, tv, tn, msg, msg_cap);
-		free(tv);
-		if (rc != PX_OK) {
-			free(data);
-			return rc;
-		}
-	}
-	if (!hint[0]) {
-		dot = strrchr(path, '.');
-		slash = strrchr(path, '/');
-		if (dot && (!slash || dot > slash) && strlen(dot + 1) < sizeof hint)
-			snprintf(hint, sizeof hint, "%s", dot + 1);
-	}
-	if (len > 0xffffffffu) {
-		snprintf(msg, msg_cap, "%s: %zu bytes, more than the importer takes", path,
-			 len);
+	rc = check_file(path, data, len, want_tri, hint, &pv, &pn, msg, msg_cap);
+	if (rc == PX_OK && pv) {
+		/* points: the file's own values, doubles kept exact */
 		free(data);
-		return PX_E_RANGE;
+		*xyz = pv;
+		*nv = pn;
+		if (n_skipped)
+			*n_skipped = 0;
+		return PX_OK;
 	}
-	s = aiImportFileFromMemory(data, (unsigned)len, aiProcess_Triangulate, hint);
+	if (rc == PX_OK)
+		rc = import_scene(path, data, len, hint, &A, msg, msg_cap);
 	free(data);
-	if (!s) {
-		snprintf(msg, msg_cap, "%s: %s", path, aiGetErrorString());
-		return PX_E_PARSE;
-	}
-	seen = calloc(s->mNumMeshes + 1, 1);
-	if (!seen) {
-		aiReleaseImport(s);
-		return PX_E_NOMEM;
-	}
-	memset(&I, 0, sizeof(I));
-	I.a1 = I.b2 = I.c3 = I.d4 = 1.0f;
-	if (s->mRootNode)
-		walk(&A, s, s->mRootNode, &I, seen, 0);
-	for (i = 0; i < s->mNumMeshes; i++)
-		if (!seen[i])
-			add_mesh(&A, s->mMeshes[i], NULL);
-	free(seen);
-	aiReleaseImport(s);
-	if (A.err) {
-		snprintf(msg, msg_cap, "%s: %s", path, px_strerror(A.err));
+	if (rc != PX_OK) {
 		free(A.xyz);
 		free(A.tri);
-		return A.err;
-	}
-	if (A.nv == 0 || (want_tri && A.nt == 0)) {
-		snprintf(msg, msg_cap, "%s: no %s in the file", path,
-			 want_tri ? "triangles" : "points");
-		free(A.xyz);
-		free(A.tri);
-		return PX_E_PARSE;
+		return rc;
 	}
 	*xyz = A.xyz;
 	*nv = A.nv;
