@@ -421,7 +421,7 @@ int app_check_outputs(struct px_app *a)
 }
 
 /* Everything setup checks before it opens a device: the outputs, the
- * scene (px_world_config_load: keys, values, files, geometry), what the
+ * scene (px_scene_config_load: keys, values, files, geometry), what the
  * clock allows, control.device against what the device can do, the
  * telemetry memory, the haptic renderer's parameters. --check runs this
  * (and opens the in-process simulated devices); a run goes on to open
@@ -448,7 +448,7 @@ int app_validate(struct px_app *a)
 	if (rc == 2)
 		return 2;
 	px_config_diag_init(&a->diag);
-	rc = px_world_config_load(cfg, &a->scene, &a->diag);
+	rc = px_scene_config_load(cfg, &a->scene, &a->diag);
 	if (rc != PX_OK) {
 		int n = px_config_diag_total(&a->diag);
 		app_diag_print(a, &a->diag);

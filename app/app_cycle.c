@@ -548,9 +548,9 @@ void app_drain(struct px_app *a,
 		 * check each recorded proxy against the scene (not in the
 		 * cycle; the scene is only read). */
 		if (a->rendering && r.valid && !r.safe) {
-			struct px_world_hit h;
+			struct px_scene_hit h;
 			px_vec3 p = px_v3(r.proxy_m[0], r.proxy_m[1], r.proxy_m[2]);
-			if (px_world_nearest(a->scene, p, INFINITY, &h) == 1 &&
+			if (px_scene_nearest(a->scene, p, INFINITY, &h) == 1 &&
 			    h.distance_m < a->min_proxy_distance_m)
 				a->min_proxy_distance_m = h.distance_m;
 		}

@@ -37,7 +37,7 @@
 #include "px_ring.h"
 #include "px_sim.h"
 #include "px_stats.h"
-#include "px_world.h"
+#include "px_scene.h"
 
 #define APP_WHY_MAX 2560
 
@@ -107,11 +107,11 @@ struct px_app {
 	struct px_app_options o;
 	struct px_config *cfg;
 	struct px_control_config ctl;
-	struct px_world *scene;
-	struct px_world_hints hints; /* coherent queries of the loop thread */
+	struct px_scene *scene;
+	struct px_scene_hints hints; /* coherent queries of the loop thread */
 	/* haptic mode, scene.tracking on: the renderer's queries follow one
 	 * point through tracked streams (NULL otherwise) */
-	struct px_world_tracking *tracking;
+	struct px_scene_tracking *tracking;
 	struct px_control_query query;
 	struct px_control_haptic haptic;
 	struct px_dev *dev[MAX_DEVS];

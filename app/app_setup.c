@@ -513,15 +513,15 @@ int app_setup(struct px_app *a)
 		return rc;
 	/* the loop's queries follow a moving point (proxy, device, link
 	 * points): each model's search starts at last answer's feature */
-	px_world_control_query_coherent(a->scene, &a->hints, &a->query);
+	px_scene_control_query_coherent(a->scene, &a->hints, &a->query);
 	/* a haptic renderer's queries follow one point (the proxy, or the
 	 * device point): NURBS models follow it with tracked streams, the
 	 * exact answer at a fraction of the global query's cost
 	 * (scene.tracking); an arm's link points are many points, and stay
 	 * with the hints */
 	if (a->ctl.mode == PX_CONTROL_MODE_HAPTIC &&
-	    px_world_get_tracking(a->scene, NULL) == 1) {
-		rc = px_world_tracking_create(a->scene, NULL, &a->tracking);
+	    px_scene_get_tracking(a->scene, NULL) == 1) {
+		rc = px_scene_tracking_create(a->scene, NULL, &a->tracking);
 		if (rc != PX_OK) {
 			app_note(a,
 				"%s: %s: scene.tracking: cannot make the "
@@ -529,7 +529,7 @@ int app_setup(struct px_app *a)
 				a->o.config, px_strerror(rc));
 			return 1;
 		}
-		px_world_control_query_tracked(a->scene, a->tracking, &a->query);
+		px_scene_control_query_tracked(a->scene, a->tracking, &a->query);
 	}
 	for (i = 0; i < (int)cfg->n_devices && i < MAX_DEVS; i++) {
 		rc = app_make_device(a, i);
@@ -714,8 +714,8 @@ void app_teardown(struct px_app *a)
 	for (i = 0; i < a->n_dcfg; i++)
 		px_devcfg_free(a->dcfg[i]); /* devices, master, buses */
 	px_can_sim_free(a->fault_bus); /* after its endpoints */
-	px_world_tracking_free(a->tracking); /* before its world */
-	px_world_free(a->scene);
+	px_scene_tracking_free(a->tracking); /* before its scene */
+	px_scene_free(a->scene);
 	px_arena_fini(&a->arena);
 	free(a->lfaults);
 	free(a->all_faults);

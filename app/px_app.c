@@ -128,7 +128,7 @@ int px_app_create(const struct px_config *cfg, const struct px_app_options *opt,
 		return PX_E_NOMEM;
 	a->o = *opt;
 	/* the app reads the config only; its handle is not const for the
-	 * px_world/px_devcfg calls that take it so */
+	 * px_scene/px_devcfg calls that take it so */
 	a->cfg = (struct px_config *)(uintptr_t)cfg;
 	a->msg = msg;
 	a->msg_cap = cap;
@@ -359,7 +359,7 @@ int px_app_summary(const struct px_app *a, struct px_app_summary *s)
 	s->shutdown_ns = a->sd.elapsed_ns;
 	snprintf(s->shutdown_error, sizeof(s->shutdown_error), "%s", a->sd.why);
 	s->max_trip_to_safe_cycles = trip_to_safe(a, &s->watchdog_trips_checked);
-	s->scene_models = px_world_count(a->scene);
+	s->scene_models = px_scene_count(a->scene);
 	s->rendering = a->rendering;
 	s->proxy_renderer = a->ctl.haptic.renderer == PX_CONTROL_PROXY;
 	s->avoiding = a->avoiding;
@@ -397,7 +397,7 @@ int px_app_summary(const struct px_app *a, struct px_app_summary *s)
 	s->drives_enabled_cycles = a->enabled_cycles;
 	s->drive_problem_cycles = a->drive_problem_cycles;
 	s->tracking_enabled = a->tracking != NULL;
-	s->tracking_streams = px_world_tracking_stats(a->tracking, &s->tracking);
+	s->tracking_streams = px_scene_tracking_stats(a->tracking, &s->tracking);
 	for (i = 0; i < a->sim.n_faults && i < PX_APP_MAX_CAMPAIGN; i++)
 		reaction(a, i, &s->reactions[i]);
 	s->n_reactions = i;

@@ -42,7 +42,7 @@
 #include "px_canopen.h"
 #include "px_loop.h"
 #include "px_stats.h"
-#include "px_world.h"
+#include "px_scene.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -579,7 +579,7 @@ int main(int argc, char **argv)
 					    e * (2 * bm_unit(&sd) - 1));
 				px_quat_from_axis_angle(px_v3(bm_unit(&sd), bm_unit(&sd), 1), 3 * bm_unit(&sd), &P.q);
 				px_model_set_pose(ms[k], P);
-				px_scene_add(scn, ms[k], NULL);
+				px_scene_add_kept(scn, ms[k], NULL);
 			}
 			px_prim_model(&cap, &tool);
 			for (i = 0; i < NQ; i++) {

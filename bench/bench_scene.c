@@ -2,8 +2,8 @@
  * bench_scene.c - the loop's scene queries three ways on the shipped
  * example scene (config/examples/haptic_sim.yaml: a NURBS terrain and
  * wall, a scaled closed mesh, a cylinder): plain global queries
- * (px_world_nearest), coherent ones (hints), and tracked streams
- * (px_world_nearest_tracked: NURBS models follow the point with
+ * (px_scene_nearest), coherent ones (hints), and tracked streams
+ * (px_scene_nearest_tracked: NURBS models follow the point with
  * px_strack). The same smooth paths at several speeds, each query timed;
  * per-query median, p99 and max, the ratio of the medians to the tracked
  * one, and the answers compared (wrong: differs from the plain query by
@@ -23,7 +23,7 @@
 #include "px_config.h"
 #include "px_control.h"
 #include "px_model.h"
-#include "px_world.h"
+#include "px_scene.h"
 
 #define N 20000
 
@@ -55,32 +55,32 @@ static px_vec3 path(int k, double speed)
 		     -0.005 + 0.03 * sin(2 * M_PI * 0.5 * t));
 }
 
-static int bench_queries(struct px_world *s, double speed, const char *label)
+static int bench_queries(struct px_scene *s, double speed, const char *label)
 {
-	struct px_world_tracking *trk = NULL;
-	static struct px_world_hints hints;
+	struct px_scene_tracking *trk = NULL;
+	static struct px_scene_hints hints;
 	struct px_model_stream_stats st;
 	struct row r[3];
 	int k, m, wrong = 0, rc;
 	double step = 0;
 
-	rc = px_world_tracking_create(s, NULL, &trk);
+	rc = px_scene_tracking_create(s, NULL, &trk);
 	if (rc != PX_OK) {
 		fprintf(stderr, "bench_scene: tracking: %s\n", px_strerror(rc));
 		return 1;
 	}
-	px_world_hints_reset(&hints);
+	px_scene_hints_reset(&hints);
 	for (m = 0; m < 3; m++) {
 		for (k = 0; k < N; k++) {
 			px_vec3 p = path(k, speed);
-			struct px_world_hit h;
+			struct px_scene_hit h;
 			int64_t t0 = now_ns();
 			if (m == 0)
-				rc = px_world_nearest(s, p, 1.0, &h);
+				rc = px_scene_nearest(s, p, 1.0, &h);
 			else if (m == 1)
-				rc = px_world_nearest_coherent(s, p, 1.0, &hints, &h);
+				rc = px_scene_nearest_coherent(s, p, 1.0, &hints, &h);
 			else
-				rc = px_world_nearest_tracked(s, p, 1.0, trk, &h);
+				rc = px_scene_nearest_tracked(s, p, 1.0, trk, &h);
 			t_ns[m][k] = now_ns() - t0;
 			dist[m][k] = rc == 1 ? h.distance_m : INFINITY;
 			if (m == 0 && k > 0)
@@ -93,7 +93,7 @@ static int bench_queries(struct px_world *s, double speed, const char *label)
 				wrong++;
 	for (m = 0; m < 3; m++)
 		r[m] = summarize(t_ns[m]);
-	px_world_tracking_stats(trk, &st);
+	px_scene_tracking_stats(trk, &st);
 	printf("%-10s step %6.1f um | plain %6lld / %6lld / %7lld ns | "
 	       "hints %6lld / %6lld / %7lld ns | tracked %5lld / %6lld / %7lld ns | "
 	       "plain/tracked %5.1fx hints/tracked %5.1fx | tracked %.1f %% "
@@ -108,14 +108,14 @@ static int bench_queries(struct px_world *s, double speed, const char *label)
 	       100.0 * (double)st.hot / (double)(st.queries ? st.queries : 1),
 	       100.0 * (double)st.cold / (double)(st.queries ? st.queries : 1),
 	       wrong);
-	px_world_tracking_free(trk);
+	px_scene_tracking_free(trk);
 	return wrong != 0;
 }
 
-static int bench_haptic(struct px_world *s)
+static int bench_haptic(struct px_scene *s)
 {
-	struct px_world_tracking *trk = NULL;
-	static struct px_world_hints hints;
+	struct px_scene_tracking *trk = NULL;
+	static struct px_scene_hints hints;
 	struct px_control_query q[2];
 	struct px_control_haptic_params p;
 	struct px_control_haptic h;
@@ -125,11 +125,11 @@ static int bench_haptic(struct px_world *s)
 	static px_vec3 force[N];
 	int k, m, rc;
 
-	rc = px_world_tracking_create(s, NULL, &trk);
+	rc = px_scene_tracking_create(s, NULL, &trk);
 	if (rc != PX_OK)
 		return 1;
-	px_world_control_query_coherent(s, &hints, &q[0]);
-	px_world_control_query_tracked(s, trk, &q[1]);
+	px_scene_control_query_coherent(s, &hints, &q[0]);
+	px_scene_control_query_tracked(s, trk, &q[1]);
 	px_control_haptic_params_default(&p);
 	p.renderer = PX_CONTROL_PROXY;
 	p.stiffness_n_per_m = 1500;
@@ -161,7 +161,7 @@ static int bench_haptic(struct px_world *s)
 	       (long long)r[1].med, (long long)r[1].p99, (long long)r[1].max,
 	       (double)r[0].med / (double)(r[1].med > 0 ? r[1].med : 1),
 	       nq[1] / N, fdiff);
-	px_world_tracking_free(trk);
+	px_scene_tracking_free(trk);
 	/* the answers agree to rounding; the proxy's friction decisions may
 	 * still amplify a last-bit difference over a long path, so this is
 	 * reported, not judged */
@@ -172,13 +172,13 @@ int main(void)
 {
 	static struct px_config_diag diag;
 	struct px_config *cfg;
-	struct px_world *s;
+	struct px_scene *s;
 	int bad = 0;
 
 	px_config_diag_init(&diag);
 	if (px_config_load_file("config/examples/haptic_sim.yaml", &cfg, &diag) !=
 		    PX_OK ||
-	    px_world_config_load(cfg, &s, &diag) != PX_OK) {
+	    px_scene_config_load(cfg, &s, &diag) != PX_OK) {
 		px_config_diag_print(&diag, stderr);
 		fprintf(stderr, "bench_scene: run from the source tree\n");
 		return 1;
@@ -186,11 +186,11 @@ int main(void)
 	px_config_free(cfg);
 	printf("bench_scene: %zu models of config/examples/haptic_sim.yaml, %d "
 	       "queries a path; per query median / p99 / max\n",
-	       px_world_count(s), N);
+	       px_scene_count(s), N);
 	bad |= bench_queries(s, 0.1, "slow");
 	bad |= bench_queries(s, 1.0, "hand");
 	bad |= bench_queries(s, 10.0, "fast");
 	bad |= bench_haptic(s);
-	px_world_free(s);
+	px_scene_free(s);
 	return bad;
 }

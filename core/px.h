@@ -27,6 +27,6 @@
 #include "px_canopen.h"
 #include "px_gpio.h"
 #include "px_control.h"
-#include "px_world.h"
+#include "px_scene.h"
 
 #endif

@@ -17,7 +17,7 @@
 #include <proxima/px_control.h>
 #include <proxima/px_loop.h>
 #include <proxima/px_prim.h>
-#include <proxima/px_world.h>
+#include <proxima/px_scene.h>
 
 static const struct px_canopen_drive_cfg drives[2] = {
 	{1, PX_CIA402_CSV, 0, 100000.0, 0}, /* counts per rad */
@@ -89,7 +89,7 @@ int main(void)
 	struct px_canopen_sim_config sc = {0};
 	struct px_loop_config lc;
 	struct px_loop *loop;
-	struct px_world *world;
+	struct px_scene *scene;
 	struct px_model *m;
 	struct px_prim sphere = {PX_PRIM_SPHERE, BALL_M, 0, 0};
 	char msg[200] = "";
@@ -109,10 +109,10 @@ int main(void)
 	lc.clock = PX_LOOP_CLOCK_VIRTUAL;
 	lc.read = on_read, lc.compute = on_compute, lc.write = on_write;
 	lc.user = &a;
-	if (px_world_create(1, &world) || px_prim_model(&sphere, &m) ||
+	if (px_scene_create(1, &scene) || px_prim_model(&sphere, &m) ||
 	    px_model_set_pose(m, (px_pose){px_quat_identity(), ball}) ||
-	    px_world_add(world, m, "ball") < 0 ||
-	    px_world_control_query(world, &a.query) ||
+	    px_scene_add(scene, m, "ball") < 0 ||
+	    px_scene_control_query(scene, &a.query) ||
 	    px_can_sim_create(&bc, &bus) || px_can_sim_endpoint(bus, &ep_master) ||
 	    px_can_sim_endpoint(bus, &ep_arm) ||
 	    px_canopen_create(&cc, ep_master, &a.co, msg, sizeof msg) ||
@@ -137,6 +137,6 @@ int main(void)
 	px_canopen_free(a.co);
 	px_canopen_sim_free(a.sim);
 	px_can_sim_free(bus);
-	px_world_free(world);
+	px_scene_free(scene);
 	return ok ? 0 : 1;
 }

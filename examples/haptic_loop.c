@@ -1,7 +1,7 @@
 /*
  * haptic_loop.c - a 1 kHz haptic loop of one's own: px_loop runs the
  * cycle, a simulated haptic device (px_sim.h) gives the pose and takes
- * the force, a scene (px_world.h) holds a sphere to touch.
+ * the force, a scene (px_scene.h) holds a sphere to touch.
  *
  * The simulated hand moves up and down through the top of a 5 cm
  * sphere; a spring pushes the device's probe back out along the
@@ -16,7 +16,7 @@
 #include <proxima/px_loop.h>
 #include <proxima/px_prim.h>
 #include <proxima/px_sim.h>
-#include <proxima/px_world.h>
+#include <proxima/px_scene.h>
 
 #define RADIUS_M 0.05
 #define HAND_DEPTH_M 0.005 /* how far the hand reaches into the sphere */
@@ -26,7 +26,7 @@
 
 struct app {
 	struct px_dev *dev;
-	struct px_world *world;
+	struct px_scene *scene;
 	struct px_pose_sample pose;
 	struct px_force_cmd cmd; /* zeroed by the loop in safe state */
 	double max_depth_m;
@@ -42,9 +42,9 @@ static int on_read(struct px_loop *l, const struct px_loop_cycle *c, void *u)
 static int on_compute(struct px_loop *l, const struct px_loop_cycle *c, void *u)
 {
 	struct app *a = u;
-	struct px_world_hit hit;
+	struct px_scene_hit hit;
 	(void)l;
-	int rc = px_world_nearest(a->world, a->pose.pos_m, INFINITY, &hit);
+	int rc = px_scene_nearest(a->scene, a->pose.pos_m, INFINITY, &hit);
 	if (rc < 0)
 		return rc;
 	double depth = rc == 1 && hit.distance_m < 0 ? -hit.distance_m : 0.0;
@@ -89,8 +89,8 @@ int main(void)
 	lcfg.clock = PX_LOOP_CLOCK_VIRTUAL;
 	lcfg.read = on_read, lcfg.compute = on_compute, lcfg.write = on_write;
 	lcfg.user = &a;
-	if (px_world_create(1, &a.world) || px_prim_model(&ball, &m) ||
-	    px_world_add(a.world, m, "ball") < 0 ||
+	if (px_scene_create(1, &a.scene) || px_prim_model(&ball, &m) ||
+	    px_scene_add(a.scene, m, "ball") < 0 ||
 	    px_sim_haptic_create(&dcfg, &sim, &a.dev, NULL, 0) ||
 	    px_dev_start(a.dev) || px_loop_create(&lcfg, &loop) ||
 	    px_dev_attach(a.dev, loop) < 0 ||
@@ -106,7 +106,7 @@ int main(void)
 	px_loop_free(loop);
 	px_dev_stop(a.dev);
 	px_dev_free(a.dev);
-	px_world_free(a.world);
+	px_scene_free(a.scene);
 	return rc >= 0 && st.cycles == 3000 && !st.safe_entries &&
 			       a.max_depth_m > 0.0 &&
 			       a.max_depth_m < 0.5 * HAND_DEPTH_M ? 0 : 1;

@@ -33,7 +33,7 @@
 #include "px_obj.h"
 #include "px_sim.h"
 #include "px_test.h"
-#include "px_world.h"
+#include "px_scene.h"
 
 static char tmpdir[64];
 
@@ -541,13 +541,13 @@ static void test_nurbs_extent(void)
 }
 
 /* A scene model scaled beyond the reach: refused at setup with its
- * place, and px_world_add() refuses the box itself. */
+ * place, and px_scene_add() refuses the box itself. */
 static void test_scene_extent(void)
 {
 	PX_NEEDS(YAML);
 	static struct px_config_diag diag;
 	struct px_config *cfg = NULL;
-	struct px_world *w = NULL;
+	struct px_scene *w = NULL;
 	struct px_model *m = NULL;
 	char yaml[512];
 	const char *p = put("far.xyz", "0 0 0\n1e147 0 0\n");
@@ -558,7 +558,7 @@ static void test_scene_extent(void)
 		 "      kind: cloud\n      scale: 1e6\n", p);
 	PX_CHECK_INT_EQ(px_config_load_mem("s.yaml", yaml, strlen(yaml), &cfg, &diag),
 			PX_OK);
-	PX_CHECK(px_world_config_load(cfg, &w, &diag) != PX_OK);
+	PX_CHECK(px_scene_config_load(cfg, &w, &diag) != PX_OK);
 	PX_CHECK(w == NULL);
 	PX_CHECK(diag.count > 0);
 	has(diag.errors[0].msg, "s.yaml:3:", "beyond");
@@ -568,23 +568,23 @@ static void test_scene_extent(void)
 	snprintf(yaml, sizeof yaml, "scene:\n  models:\n    - file: %s\n"
 		 "      kind: cloud\n      scale: 1e-300\n", p);
 	PX_CHECK(px_config_load_mem("s.yaml", yaml, strlen(yaml), &cfg, &diag) != PX_OK ||
-		 px_world_config_load(cfg, &w, &diag) != PX_OK);
+		 px_scene_config_load(cfg, &w, &diag) != PX_OK);
 	PX_CHECK(w == NULL && diag.count > 0);
 	has(diag.errors[0].msg, "s.yaml:5:14:", "scale");
 	px_config_free(cfg);
 	cfg = NULL;
 
-	PX_CHECK_INT_EQ(px_world_create(2, &w), PX_OK);
+	PX_CHECK_INT_EQ(px_scene_create(2, &w), PX_OK);
 	PX_CHECK_INT_EQ(px_cloud_model(xyz, 2, 0.0, NULL, &m), PX_OK);
-	PX_CHECK_INT_EQ(px_world_add(w, m, "ok"), 0);
+	PX_CHECK_INT_EQ(px_scene_add(w, m, "ok"), 0);
 	xyz[3] = 1e150;
 	PX_CHECK_INT_EQ(px_cloud_model(xyz, 2, 1e149, NULL, &m), PX_OK);
-	PX_CHECK_INT_EQ(px_world_add(w, m, "far"), PX_E_RANGE);
+	PX_CHECK_INT_EQ(px_scene_add(w, m, "far"), PX_E_RANGE);
 	pose.t = px_v3(0, 2e150, 0);
-	PX_CHECK_INT_EQ(px_world_set_pose(w, 0, pose), PX_E_RANGE);
+	PX_CHECK_INT_EQ(px_scene_set_pose(w, 0, pose), PX_E_RANGE);
 	pose.t = px_v3(0, 1e6, 0);
-	PX_CHECK_INT_EQ(px_world_set_pose(w, 0, pose), PX_OK);
-	px_world_free(w);
+	PX_CHECK_INT_EQ(px_scene_set_pose(w, 0, pose), PX_OK);
+	px_scene_free(w);
 }
 
 /* ---- silent garbage ----------------------------------------------------- */

@@ -61,7 +61,7 @@ static void make_world(struct world *w, int with_floor)
 	w->n = 0;
 	for (i = 0; i < NM; i++) {
 		w->m[w->n] = rand_model(i);
-		PX_CHECK_INT_EQ(px_scene_add(w->s, w->m[w->n], NULL), PX_OK);
+		PX_CHECK_INT_EQ(px_scene_add_kept(w->s, w->m[w->n], NULL), PX_OK);
 		w->n++;
 	}
 	if (with_floor) {
@@ -70,7 +70,7 @@ static void make_world(struct world *w, int with_floor)
 		P.t.z = -4.0;
 		PX_CHECK_INT_EQ(px_prim_model(&hs, &w->m[w->n]), PX_OK);
 		px_model_set_pose(w->m[w->n], P);
-		PX_CHECK_INT_EQ(px_scene_add(w->s, w->m[w->n], NULL), PX_OK);
+		PX_CHECK_INT_EQ(px_scene_add_kept(w->s, w->m[w->n], NULL), PX_OK);
 		w->n++;
 	}
 }
@@ -121,8 +121,8 @@ static void test_nearest_and_within(void)
 					cnt++;
 			}
 			PX_CHECK_INT_EQ(px_scene_nearest(w.s, p, INFINITY, &h), 1);
-			PX_CHECK_MSG(h.distance == best, "nearest %d (%.15g) vs loop %d (%.15g)",
-				     h.model, h.distance, bid, best);
+			PX_CHECK_MSG(h.distance_m == best, "nearest %d (%.15g) vs loop %d (%.15g)",
+				     h.model, h.distance_m, bid, best);
 			/* a bound below the nearest distance finds nothing */
 			rc = px_scene_nearest(w.s, p, best > 0 ? 0.5 * best : INFINITY, &h);
 			PX_CHECK_INT_EQ(rc, best > 0 ? 0 : 1);
@@ -135,7 +135,7 @@ static void test_nearest_and_within(void)
 				PX_CHECK(!seen[hits[k].model]);
 				seen[hits[k].model] = 1;
 				px_model_query(w.m[hits[k].model], p, &r);
-				PX_CHECK(r.distance <= lim && r.distance == hits[k].distance);
+				PX_CHECK(r.distance <= lim && r.distance == hits[k].distance_m);
 			}
 			if (cnt > 1) {
 				rc = px_scene_within(w.s, p, lim, hits, 1, &nf);
@@ -181,9 +181,9 @@ static void test_tool(void)
 				struct px_pair_result r;
 				memset(&r, 0, sizeof(r));
 				px_pair_distance(tools[t], w.m[hits[k].model], NULL, &r);
-				PX_CHECK(hits[k].distance == r.distance);
+				PX_CHECK(hits[k].distance_m == r.distance);
 				PX_CHECK_NEAR(px_v3_dist(hits[k].point, hits[k].tool_point),
-					      hits[k].distance, 1e-9 + (hits[k].intersecting ? INFINITY : 0));
+					      hits[k].distance_m, 1e-9 + (hits[k].intersecting ? INFINITY : 0));
 			}
 		}
 	}
@@ -221,11 +221,11 @@ static void test_no_alloc_and_errors(void)
 	PX_CHECK_INT_EQ(px_scene_create(0, &s2), PX_E_INVAL);
 	PX_CHECK_INT_EQ(px_scene_create(1, &s2), PX_OK);
 	px_model_set_pose(tool, px_pose_identity());
-	PX_CHECK_INT_EQ(px_scene_add(s2, tool, NULL), PX_OK);
-	PX_CHECK_INT_EQ(px_scene_add(s2, tool, NULL), PX_E_NOSPC);
+	PX_CHECK_INT_EQ(px_scene_add_kept(s2, tool, NULL), PX_OK);
+	PX_CHECK_INT_EQ(px_scene_add_kept(s2, tool, NULL), PX_E_NOSPC);
 	PX_CHECK_INT_EQ(px_scene_update(s2), PX_OK);
 	PX_CHECK_INT_EQ(px_scene_nearest(s2, px_v3(1, 0, 0), INFINITY, &h), 1);
-	PX_CHECK_NEAR(h.distance, 0.8, 1e-12);
+	PX_CHECK_NEAR(h.distance_m, 0.8, 1e-12);
 	px_scene_free(s2);
 	px_scene_free(NULL);
 	px_model_free(tool);

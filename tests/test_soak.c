@@ -2,8 +2,8 @@
  * Soak: the whole stack for many cycles on the virtual clock - the rt/
  * loop, the simulated haptic device (devices/px_sim.h) with random fault
  * windows (drop, delay, duplicate, corrupt, stuck, NaN, unplug), the
- * proxy renderer of control/ against a world of a mesh, a cloud and two
- * primitives (scene/px_world.h), random parameter updates through a
+ * proxy renderer of control/ against a scene of a mesh, a cloud and two
+ * primitives (scene/px_scene.h), random parameter updates through a
  * px_param triple buffer, random compute overruns, NaN outputs and
  * trips. What must hold over the whole run:
  *  - not one heap call after setup (allocation counter);
@@ -41,7 +41,7 @@
 #include "px_prim.h"
 #include "px_sim.h"
 #include "px_test.h"
-#include "px_world.h"
+#include "px_scene.h"
 
 #define PERIOD_NS 1000000
 
@@ -54,7 +54,7 @@ struct soak_params {
 
 struct soak {
 	struct px_dev *dev;
-	struct px_world *world;
+	struct px_scene *scene;
 	struct px_control_query query;
 	struct px_control_haptic h;
 	struct px_param *param;
@@ -220,22 +220,22 @@ static void build_world(struct soak *S)
 	px_pose pose = px_pose_identity();
 	int i;
 
-	PX_CHECK_INT_EQ(px_world_create(8, &S->world), PX_OK);
+	PX_CHECK_INT_EQ(px_scene_create(8, &S->scene), PX_OK);
 	PX_CHECK_INT_EQ(px_prim_model(&sphere, &m), PX_OK);
 	pose.t = px_v3(0.0, 0.0, 0.05);
 	PX_CHECK_INT_EQ(px_model_set_pose(m, pose), PX_OK);
-	PX_CHECK(px_world_add(S->world, m, "sphere") >= 0);
+	PX_CHECK(px_scene_add(S->scene, m, "sphere") >= 0);
 	PX_CHECK_INT_EQ(px_prim_model(&floor, &m), PX_OK);
 	pose.t = px_v3(0.0, 0.0, -0.02);
 	PX_CHECK_INT_EQ(px_model_set_pose(m, pose), PX_OK);
-	PX_CHECK(px_world_add(S->world, m, "floor") >= 0);
+	PX_CHECK(px_scene_add(S->scene, m, "floor") >= 0);
 	PX_CHECK_INT_EQ(gen_box(h, 6, &g), 0);
 	PX_CHECK_INT_EQ(px_mesh_model(g.xyz, g.nv, g.tri, g.nt, NULL, NULL, &m),
 			PX_OK);
 	gen_free(&g);
 	pose.t = px_v3(0.06, 0.0, 0.06);
 	PX_CHECK_INT_EQ(px_model_set_pose(m, pose), PX_OK);
-	PX_CHECK(px_world_add(S->world, m, "box") >= 0);
+	PX_CHECK(px_scene_add(S->scene, m, "box") >= 0);
 	pts = malloc(3 * 2000 * sizeof(double));
 	PX_CHECK(pts != NULL);
 	for (i = 0; i < 2000; i++) {
@@ -246,8 +246,8 @@ static void build_world(struct soak *S)
 	}
 	PX_CHECK_INT_EQ(px_cloud_model(pts, 2000, 0.004, NULL, &m), PX_OK);
 	free(pts);
-	PX_CHECK(px_world_add(S->world, m, "cloud") >= 0);
-	PX_CHECK_INT_EQ(px_world_control_query(S->world, &S->query), PX_OK);
+	PX_CHECK(px_scene_add(S->scene, m, "cloud") >= 0);
+	PX_CHECK_INT_EQ(px_scene_control_query(S->scene, &S->query), PX_OK);
 }
 
 static void random_faults(struct px_sim_fault *f, size_t n, uint64_t cycles)
@@ -447,7 +447,7 @@ static void test_soak(void)
 
 	px_loop_free(S.loop);
 	px_dev_free(S.dev);
-	px_world_free(S.world);
+	px_scene_free(S.scene);
 }
 
 static const struct px_test tests[] = {

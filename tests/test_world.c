@@ -15,7 +15,7 @@
 #include "px_control.h"
 #include "px_model.h"
 #include "px_prim.h"
-#include "px_world.h"
+#include "px_scene.h"
 #include "px_test.h"
 #include "px_test_config.h"
 
@@ -31,11 +31,11 @@ static px_pose random_pose(double spread)
 	return p;
 }
 
-static struct px_world *random_scene(int n)
+static struct px_scene *random_scene(int n)
 {
-	struct px_world *s;
+	struct px_scene *s;
 	int i;
-	PX_CHECK_INT_EQ(px_world_create((size_t)n, &s), PX_OK);
+	PX_CHECK_INT_EQ(px_scene_create((size_t)n, &s), PX_OK);
 	for (i = 0; i < n; i++) {
 		struct px_prim pr;
 		struct px_model *m;
@@ -64,20 +64,20 @@ static struct px_world *random_scene(int n)
 		}
 		PX_CHECK_INT_EQ(px_prim_model(&pr, &m), PX_OK);
 		PX_CHECK_INT_EQ(px_model_set_pose(m, random_pose(3.0)), PX_OK);
-		PX_CHECK_INT_EQ(px_world_add(s, m, NULL), i);
+		PX_CHECK_INT_EQ(px_scene_add(s, m, NULL), i);
 	}
 	return s;
 }
 
 /* min over models of the signed distance, no broad phase */
-static double brute(const struct px_world *s, px_vec3 p, int *which)
+static double brute(const struct px_scene *s, px_vec3 p, int *which)
 {
 	double best = INFINITY;
 	size_t i;
 	*which = -1;
-	for (i = 0; i < px_world_count(s); i++) {
+	for (i = 0; i < px_scene_count(s); i++) {
 		struct px_model_result r;
-		PX_CHECK_INT_EQ(px_model_query(px_world_model(s, i), p, &r), 1);
+		PX_CHECK_INT_EQ(px_model_query(px_scene_model(s, i), p, &r), 1);
 		if (r.distance < best) {
 			best = r.distance;
 			*which = (int)i;
@@ -92,21 +92,21 @@ static void test_nearest_matches_brute_force(void)
 	long queried = 0, points = 0;
 	for (round = 0; round < 10; round++) {
 		int n = px_rand_int(1, 40), k;
-		struct px_world *s = random_scene(n);
+		struct px_scene *s = random_scene(n);
 		for (k = 0; k < 200; k++) {
 			px_vec3 p = px_v3(px_rand_range(-4, 4), px_rand_range(-4, 4),
 					  px_rand_range(-4, 4));
-			struct px_world_hit h;
+			struct px_scene_hit h;
 			int which;
 			double d = brute(s, p, &which);
-			PX_CHECK_INT_EQ(px_world_nearest(s, p, INFINITY, &h), 1);
+			PX_CHECK_INT_EQ(px_scene_nearest(s, p, INFINITY, &h), 1);
 			PX_CHECK_NEAR(h.distance_m, d, 1e-12);
 			PX_CHECK(h.model >= 0 && h.model < n);
 			PX_CHECK_NEAR(h.r.distance, d, 1e-12);
 			/* the answer's point lies on the model it names */
 			{
 				struct px_model_result r;
-				px_model_query(px_world_model(s, (size_t)h.model),
+				px_model_query(px_scene_model(s, (size_t)h.model),
 					       h.r.point, &r);
 				PX_CHECK_NEAR(r.distance, 0, 1e-9);
 			}
@@ -115,7 +115,7 @@ static void test_nearest_matches_brute_force(void)
 			/* range: nothing reported beyond it */
 			{
 				double range = fabs(d) * px_rand_range(0.2, 1.8);
-				int rc = px_world_nearest(s, p, range, &h);
+				int rc = px_scene_nearest(s, p, range, &h);
 				if (fabs(d) < range * (1 - 1e-9)) {
 					PX_CHECK_INT_EQ(rc, 1);
 					PX_CHECK_NEAR(h.distance_m, d, 1e-12);
@@ -125,7 +125,7 @@ static void test_nearest_matches_brute_force(void)
 				}
 			}
 		}
-		px_world_free(s);
+		px_scene_free(s);
 	}
 	printf("  broad phase: %.2f narrow-phase queries per point\n",
 	       (double)queried / (double)points);
@@ -138,13 +138,13 @@ static void test_nearest_matches_brute_force(void)
 static void test_coherent_matches_plain(void)
 {
 	struct gen_mesh g;
-	struct px_world *s;
+	struct px_scene *s;
 	struct px_model *m;
-	static struct px_world_hints hints;
+	static struct px_scene_hints hints;
 	struct px_control_query q;
 	long it_plain = 0, it_coh = 0;
 	int round, k, i;
-	PX_CHECK_INT_EQ(px_world_create(8, &s), PX_OK);
+	PX_CHECK_INT_EQ(px_scene_create(8, &s), PX_OK);
 	for (i = 0; i < 2; i++) {
 		px_pose pose = px_pose_identity();
 		PX_CHECK_INT_EQ(gen_sphere(0.5 + 0.2 * i, 24 + 8 * i, 48, &g), 0);
@@ -153,7 +153,7 @@ static void test_coherent_matches_plain(void)
 		gen_free(&g);
 		pose.t = px_v3(i ? 1.0 : -1.0, 0, 0);
 		PX_CHECK_INT_EQ(px_model_set_pose(m, pose), PX_OK);
-		PX_CHECK_INT_EQ(px_world_add(s, m, "ball"), i);
+		PX_CHECK_INT_EQ(px_scene_add(s, m, "ball"), i);
 	}
 	for (i = 0; i < 3; i++) {
 		struct px_prim pr;
@@ -162,24 +162,24 @@ static void test_coherent_matches_plain(void)
 		pr.a = pr.b = pr.c = 0.2;
 		PX_CHECK_INT_EQ(px_prim_model(&pr, &m), PX_OK);
 		PX_CHECK_INT_EQ(px_model_set_pose(m, random_pose(2.0)), PX_OK);
-		PX_CHECK_INT_EQ(px_world_add(s, m, NULL), i + 2);
+		PX_CHECK_INT_EQ(px_scene_add(s, m, NULL), i + 2);
 	}
 	for (round = 0; round < 20; round++) {
 		px_vec3 p = px_v3(px_rand_range(-2, 2), px_rand_range(-1, 1),
 				  px_rand_range(-1, 1));
 		uint64_t a;
-		px_world_hints_reset(&hints);
+		px_scene_hints_reset(&hints);
 		a = px_alloc_region_begin();
 		for (k = 0; k < 300; k++) {
-			struct px_world_hit h0, h1;
+			struct px_scene_hit h0, h1;
 			int r0, r1;
 			/* steps of a few mm, now and then a jump */
 			double step = px_rand_unit() < 0.02 ? 0.5 : 0.004;
 			p = px_v3_add(p, px_v3(step * px_rand_normal(),
 					       step * px_rand_normal(),
 					       step * px_rand_normal()));
-			r0 = px_world_nearest(s, p, INFINITY, &h0);
-			r1 = px_world_nearest_coherent(s, p, INFINITY, &hints, &h1);
+			r0 = px_scene_nearest(s, p, INFINITY, &h0);
+			r1 = px_scene_nearest_coherent(s, p, INFINITY, &hints, &h1);
 			PX_CHECK_INT_EQ(r1, r0);
 			PX_CHECK_NEAR(h1.distance_m, h0.distance_m, 1e-12);
 			if (h0.model >= 0 && h0.model < 2) {
@@ -192,34 +192,34 @@ static void test_coherent_matches_plain(void)
 	printf("  mesh work per query: plain %.1f, coherent %.1f\n",
 	       (double)it_plain / 6000.0, (double)it_coh / 6000.0);
 	/* the control adapter answers as the plain one */
-	PX_CHECK_INT_EQ(px_world_control_query_coherent(s, &hints, &q), PX_OK);
+	PX_CHECK_INT_EQ(px_scene_control_query_coherent(s, &hints, &q), PX_OK);
 	for (k = 0; k < 500; k++) {
 		px_vec3 p = px_v3(px_rand_range(-2, 2), px_rand_range(-1, 1),
 				  px_rand_range(-1, 1));
 		struct px_control_hit c;
-		struct px_world_hit h;
+		struct px_scene_hit h;
 		uint64_t a = px_alloc_region_begin();
 		PX_CHECK_INT_EQ(q.point(q.ctx, p, INFINITY, &c), PX_OK);
 		PX_CHECK_INT_EQ(px_alloc_region_end(a), 0);
-		PX_CHECK_INT_EQ(px_world_nearest(s, p, INFINITY, &h), 1);
+		PX_CHECK_INT_EQ(px_scene_nearest(s, p, INFINITY, &h), 1);
 		PX_CHECK(c.valid);
 		PX_CHECK_NEAR(c.distance_m, h.distance_m, 1e-12);
 	}
-	PX_CHECK_INT_EQ(px_world_control_query_coherent(s, NULL, &q), PX_E_INVAL);
-	PX_CHECK_INT_EQ(px_world_nearest_coherent(s, px_v3(0, 0, 0), INFINITY,
-						  NULL, &(struct px_world_hit){0}),
+	PX_CHECK_INT_EQ(px_scene_control_query_coherent(s, NULL, &q), PX_E_INVAL);
+	PX_CHECK_INT_EQ(px_scene_nearest_coherent(s, px_v3(0, 0, 0), INFINITY,
+						  NULL, &(struct px_scene_hit){0}),
 			PX_E_INVAL);
-	px_world_free(s);
+	px_scene_free(s);
 }
 
 static void test_broad_phase_skips_far_models(void)
 {
 	/* 50 unit spheres on a line, 10 m apart: a point near one of them
 	 * needs that one and at most its box neighbours. */
-	struct px_world *s;
-	struct px_world_hit h;
+	struct px_scene *s;
+	struct px_scene_hit h;
 	int i;
-	PX_CHECK_INT_EQ(px_world_create(50, &s), PX_OK);
+	PX_CHECK_INT_EQ(px_scene_create(50, &s), PX_OK);
 	for (i = 0; i < 50; i++) {
 		struct px_prim pr = {PX_PRIM_SPHERE, 1.0, 0, 0};
 		struct px_model *m;
@@ -227,27 +227,27 @@ static void test_broad_phase_skips_far_models(void)
 		pose.t = px_v3(10.0 * i, 0, 0);
 		PX_CHECK_INT_EQ(px_prim_model(&pr, &m), PX_OK);
 		px_model_set_pose(m, pose);
-		PX_CHECK(px_world_add(s, m, "ball") >= 0);
+		PX_CHECK(px_scene_add(s, m, "ball") >= 0);
 	}
-	PX_CHECK_INT_EQ(px_world_nearest(s, px_v3(201.5, 0.2, 0), INFINITY, &h), 1);
+	PX_CHECK_INT_EQ(px_scene_nearest(s, px_v3(201.5, 0.2, 0), INFINITY, &h), 1);
 	PX_CHECK_INT_EQ(h.model, 20);
 	PX_CHECK(h.models_queried <= 2);
-	PX_CHECK_INT_EQ(px_world_nearest(s, px_v3(200, 0, 0), INFINITY, &h), 1);
+	PX_CHECK_INT_EQ(px_scene_nearest(s, px_v3(200, 0, 0), INFINITY, &h), 1);
 	PX_CHECK_NEAR(h.distance_m, -1.0, 1e-12);
 	PX_CHECK(h.r.inside);
-	PX_CHECK_INT_EQ(px_world_nearest(s, px_v3(NAN, 0, 0), 1, &h), PX_E_NAN);
-	PX_CHECK_INT_EQ(px_world_nearest(s, px_v3(0, 0, 0), -1, &h), PX_E_INVAL);
+	PX_CHECK_INT_EQ(px_scene_nearest(s, px_v3(NAN, 0, 0), 1, &h), PX_E_NAN);
+	PX_CHECK_INT_EQ(px_scene_nearest(s, px_v3(0, 0, 0), -1, &h), PX_E_INVAL);
 	/* capacity */
 	{
 		struct px_prim pr = {PX_PRIM_SPHERE, 1.0, 0, 0};
 		struct px_model *m;
 		PX_CHECK_INT_EQ(px_prim_model(&pr, &m), PX_OK);
-		PX_CHECK_INT_EQ(px_world_add(s, m, "extra"), PX_E_NOSPC);
+		PX_CHECK_INT_EQ(px_scene_add(s, m, "extra"), PX_E_NOSPC);
 	}
-	PX_CHECK(strcmp(px_world_name(s, 3), "ball") == 0);
-	PX_CHECK(strcmp(px_world_name(s, 99), "") == 0);
-	px_world_free(s);
-	px_world_free(NULL);
+	PX_CHECK(strcmp(px_scene_name(s, 3), "ball") == 0);
+	PX_CHECK(strcmp(px_scene_name(s, 99), "") == 0);
+	px_scene_free(s);
+	px_scene_free(NULL);
 }
 
 /* A model that answers like a unit sphere but claims a gap. */
@@ -280,13 +280,13 @@ static const struct px_model_ops loose_ops = {
 
 static void test_control_adapter_never_overestimates(void)
 {
-	struct px_world *s = random_scene(12);
+	struct px_scene *s = random_scene(12);
 	struct px_control_query q;
 	struct px_model *m;
 	struct px_control_hit hit;
 	int k;
 	uint64_t a;
-	PX_CHECK_INT_EQ(px_world_control_query(s, &q), PX_OK);
+	PX_CHECK_INT_EQ(px_scene_control_query(s, &q), PX_OK);
 	a = px_alloc_region_begin();
 	for (k = 0; k < 500; k++) {
 		px_vec3 p = px_v3(px_rand_range(-4, 4), px_rand_range(-4, 4),
@@ -307,19 +307,19 @@ static void test_control_adapter_never_overestimates(void)
 			      0, 1e-9);
 	}
 	PX_CHECK_INT_EQ(px_alloc_region_end(a), 0);
-	px_world_free(s);
+	px_scene_free(s);
 
 	/* an uncertified answer reports distance - gap, two-sided */
-	PX_CHECK_INT_EQ(px_world_create(1, &s), PX_OK);
+	PX_CHECK_INT_EQ(px_scene_create(1, &s), PX_OK);
 	PX_CHECK_INT_EQ(px_model_create(&loose_ops, NULL, 0, &m), PX_OK);
-	PX_CHECK_INT_EQ(px_world_add(s, m, "loose"), 0);
-	px_world_control_query(s, &q);
+	PX_CHECK_INT_EQ(px_scene_add(s, m, "loose"), 0);
+	px_scene_control_query(s, &q);
 	PX_CHECK_INT_EQ(q.point(q.ctx, px_v3(3, 0, 0), 10.0, &hit), PX_OK);
 	PX_CHECK(hit.valid && hit.two_sided);
 	PX_CHECK_NEAR(hit.distance_m, 2.0 - 0.25, 1e-12);
 	PX_CHECK_INT_EQ(q.point(q.ctx, px_v3(1.1, 0, 0), 10.0, &hit), PX_OK);
 	PX_CHECK_NEAR(hit.distance_m, 0.0, 0);
-	px_world_free(s);
+	px_scene_free(s);
 }
 
 static const char *write_tmp(const char *name, const char *text)
@@ -338,14 +338,14 @@ static const char *write_tmp(const char *name, const char *text)
 	return p;
 }
 
-static int load(const char *text, struct px_world **s,
+static int load(const char *text, struct px_scene **s,
 		struct px_config_diag *diag)
 {
 	struct px_config *cfg = NULL;
 	int rc = px_config_load_mem("scene.yaml", text, strlen(text), &cfg, diag);
 	if (rc != PX_OK)
 		return rc;
-	rc = px_world_config_load(cfg, s, diag);
+	rc = px_scene_config_load(cfg, s, diag);
 	px_config_free(cfg);
 	return rc;
 }
@@ -354,8 +354,8 @@ static void test_config_example_scene(void)
 {
 	static struct px_config_diag diag;
 	struct px_config *cfg;
-	struct px_world *s;
-	struct px_world_hit h;
+	struct px_scene *s;
+	struct px_scene_hit h;
 	struct px_control_query q;
 	struct px_control_hit hit;
 	uint64_t a;
@@ -363,23 +363,23 @@ static void test_config_example_scene(void)
 	if (px_config_load_file("config/examples/haptic_sim.yaml", &cfg, &diag) !=
 	    PX_OK)
 		PX_SKIP("config/examples/haptic_sim.yaml not found");
-	PX_CHECK_INT_EQ(px_world_config_load(cfg, &s, &diag), PX_OK);
+	PX_CHECK_INT_EQ(px_scene_config_load(cfg, &s, &diag), PX_OK);
 	px_config_diag_print(&diag, stdout);
 	px_config_free(cfg);
-	PX_CHECK_INT_EQ(px_world_count(s), 3);
-	PX_CHECK_INT_EQ(px_model_kind(px_world_model(s, 0)), PX_MODEL_NURBS);
-	PX_CHECK_INT_EQ(px_model_kind(px_world_model(s, 1)), PX_MODEL_MESH);
-	PX_CHECK_INT_EQ(px_model_kind(px_world_model(s, 2)), PX_MODEL_PRIMITIVE);
-	PX_CHECK(strcmp(px_world_name(s, 1), "knob") == 0);
+	PX_CHECK_INT_EQ(px_scene_count(s), 3);
+	PX_CHECK_INT_EQ(px_model_kind(px_scene_model(s, 0)), PX_MODEL_NURBS);
+	PX_CHECK_INT_EQ(px_model_kind(px_scene_model(s, 1)), PX_MODEL_MESH);
+	PX_CHECK_INT_EQ(px_model_kind(px_scene_model(s, 2)), PX_MODEL_PRIMITIVE);
+	PX_CHECK(strcmp(px_scene_name(s, 1), "knob") == 0);
 	/* above the terrain's middle, far from the rest: NURBS, unsigned */
-	PX_CHECK_INT_EQ(px_world_nearest(s, px_v3(-0.08, -0.08, 0.0), 1.0, &h), 1);
+	PX_CHECK_INT_EQ(px_scene_nearest(s, px_v3(-0.08, -0.08, 0.0), 1.0, &h), 1);
 	PX_CHECK_INT_EQ(h.model, 0);
 	PX_CHECK(!h.r.is_signed && h.distance_m > 0);
 	/* centre of the knob (scaled 1.2: radius 0.024, inscribed >= 0.023) */
-	PX_CHECK_INT_EQ(px_world_nearest(s, px_v3(-0.035, 0, 0), 1.0, &h), 1);
+	PX_CHECK_INT_EQ(px_scene_nearest(s, px_v3(-0.035, 0, 0), 1.0, &h), 1);
 	PX_CHECK_INT_EQ(h.model, 1);
 	PX_CHECK(h.distance_m < -0.022 && h.distance_m > -0.0241);
-	px_world_control_query(s, &q);
+	px_scene_control_query(s, &q);
 	a = px_alloc_region_begin();
 	for (k = 0; k < 300; k++) {
 		px_vec3 p = px_v3(px_rand_range(-0.1, 0.1), px_rand_range(-0.1, 0.1),
@@ -388,9 +388,9 @@ static void test_config_example_scene(void)
 		double best = INFINITY;
 		PX_CHECK_INT_EQ(q.point(q.ctx, p, 1.0, &hit), PX_OK);
 		PX_CHECK(hit.valid);
-		for (i = 0; i < px_world_count(s); i++) {
+		for (i = 0; i < px_scene_count(s); i++) {
 			struct px_model_result r;
-			px_model_query(px_world_model(s, i), p, &r);
+			px_model_query(px_scene_model(s, i), p, &r);
 			if (r.distance < best)
 				best = r.distance;
 		}
@@ -398,14 +398,14 @@ static void test_config_example_scene(void)
 		PX_CHECK_NEAR(hit.distance_m, best, 1e-9);
 	}
 	PX_CHECK_INT_EQ(px_alloc_region_end(a), 0);
-	px_world_free(s);
+	px_scene_free(s);
 }
 
 static void test_config_scale(void)
 {
 	PX_NEEDS(YAML);
 	static struct px_config_diag diag;
-	struct px_world *s;
+	struct px_scene *s;
 	char text[2048];
 	const char *stl = "solid t\n facet normal 0 0 1\n  outer loop\n"
 			  "   vertex 0 0 0\n   vertex 1 0 0\n   vertex 0 1 0\n"
@@ -426,13 +426,13 @@ static void test_config_scale(void)
 	}
 	PX_CHECK_INT_EQ(load(text, &s, &diag), PX_OK);
 	px_config_diag_print(&diag, stdout);
-	PX_CHECK_INT_EQ(px_world_count(s), 2);
+	PX_CHECK_INT_EQ(px_scene_count(s), 2);
 	for (k = 0; k < 100; k++) {
 		px_vec3 p = px_v3(px_rand_range(-1, 1), px_rand_range(-1, 1),
 				  px_rand_range(-1, 1));
 		struct px_model_result r1, r2;
-		PX_CHECK_INT_EQ(px_model_query(px_world_model(s, 0), p, &r1), 1);
-		PX_CHECK_INT_EQ(px_model_query(px_world_model(s, 1),
+		PX_CHECK_INT_EQ(px_model_query(px_scene_model(s, 0), p, &r1), 1);
+		PX_CHECK_INT_EQ(px_model_query(px_scene_model(s, 1),
 					       px_v3_add(px_v3_scale(p, 2.5),
 							 px_v3(0, 0, 10)),
 					       &r2),
@@ -443,8 +443,8 @@ static void test_config_scale(void)
 						   px_v3(0, 0, 10))),
 			      0, 1e-6);
 	}
-	PX_CHECK_INT_EQ(px_model_kind(px_world_model(s, 1)), PX_MODEL_MESH);
-	px_world_free(s);
+	PX_CHECK_INT_EQ(px_model_kind(px_scene_model(s, 1)), PX_MODEL_MESH);
+	px_scene_free(s);
 	remove(path);
 }
 
@@ -463,7 +463,7 @@ static void test_config_errors(void)
 {
 	PX_NEEDS(YAML);
 	static struct px_config_diag diag;
-	struct px_world *s = (struct px_world *)&diag;
+	struct px_scene *s = (struct px_scene *)&diag;
 	PX_CHECK_INT_EQ(load("scene:\n  models:\n    - {file: nope.stl, kind: mesh}\n",
 			     &s, &diag),
 			PX_E_PARSE);
@@ -500,12 +500,12 @@ static void test_config_errors(void)
 	PX_CHECK(diag.count == 1 && strstr(diag.errors[0].msg, "scene.modles: unknown key"));
 	/* an absent section is an empty scene */
 	PX_CHECK_INT_EQ(load("loop: {period_ns: 1000000}\n", &s, &diag), PX_OK);
-	PX_CHECK_INT_EQ(px_world_count(s), 0);
+	PX_CHECK_INT_EQ(px_scene_count(s), 0);
 	{
-		struct px_world_hit h;
-		PX_CHECK_INT_EQ(px_world_nearest(s, px_v3(0, 0, 0), INFINITY, &h), 0);
+		struct px_scene_hit h;
+		PX_CHECK_INT_EQ(px_scene_nearest(s, px_v3(0, 0, 0), INFINITY, &h), 0);
 	}
-	px_world_free(s);
+	px_scene_free(s);
 }
 
 /* Haptic proxy on a scene: pressed into the -x face of a box, then the
@@ -514,7 +514,7 @@ static void test_config_errors(void)
  * never be inside the box, and the force must fall back to zero. */
 static void test_proxy_leaves_the_end_of_a_face(void)
 {
-	struct px_world *s;
+	struct px_scene *s;
 	struct px_model *m;
 	struct px_prim box = {PX_PRIM_BOX, 0.02, 0.02, 0.02};
 	struct px_control_query q;
@@ -524,14 +524,14 @@ static void test_proxy_leaves_the_end_of_a_face(void)
 	int k, inside = 0;
 	double max_pen = 0;
 	px_vec3 dev = px_v3(-0.05, 0, 0);
-	PX_CHECK_INT_EQ(px_world_create(1, &s), PX_OK);
+	PX_CHECK_INT_EQ(px_scene_create(1, &s), PX_OK);
 	PX_CHECK_INT_EQ(px_prim_model(&box, &m), PX_OK);
-	PX_CHECK_INT_EQ(px_world_add(s, m, "box"), 0);
-	px_world_control_query(s, &q);
+	PX_CHECK_INT_EQ(px_scene_add(s, m, "box"), 0);
+	px_scene_control_query(s, &q);
 	px_control_haptic_params_default(&hp);
 	PX_CHECK_INT_EQ(px_control_haptic_init(&h, &hp, 1000000), PX_OK);
 	for (k = 0; k < 400; k++) {
-		struct px_world_hit sh;
+		struct px_scene_hit sh;
 		if (k < 40)
 			dev.x += 0.001; /* into the face, 10 mm deep */
 		else if (k < 120)
@@ -542,7 +542,7 @@ static void test_proxy_leaves_the_end_of_a_face(void)
 			PX_CHECK(out.contact && out.penetration_m > 0.009);
 		if (out.penetration_m > max_pen)
 			max_pen = out.penetration_m;
-		PX_CHECK_INT_EQ(px_world_nearest(s, out.proxy_m, INFINITY, &sh), 1);
+		PX_CHECK_INT_EQ(px_scene_nearest(s, out.proxy_m, INFINITY, &sh), 1);
 		if (sh.distance_m < 0)
 			inside++;
 	}
@@ -555,10 +555,10 @@ static void test_proxy_leaves_the_end_of_a_face(void)
 		     out.proxy_m.z, dev.x, dev.y, dev.z);
 	PX_CHECK_NEAR(px_v3_dist(out.proxy_m, dev), 0, 1e-9);
 	PX_CHECK(px_v3_norm(out.force_n) < 0.05);
-	px_world_free(s);
+	px_scene_free(s);
 }
 
-/* Tracked queries (px_world_nearest_tracked) along smooth paths through a
+/* Tracked queries (px_scene_nearest_tracked) along smooth paths through a
  * scene of NURBS models (a scaled terrain, a closed rational sphere -
  * signed -, a curve-only circle: px_strack and px_track streams) and a
  * mesh: every answer equals the plain global one, the streams do the
@@ -569,8 +569,8 @@ static void test_tracked_matches_plain(void)
 {
 	PX_NEEDS(YAML);
 	static struct px_config_diag diag;
-	struct px_world *s, *other;
-	struct px_world_tracking *t;
+	struct px_scene *s, *other;
+	struct px_scene_tracking *t;
 	struct px_model_stream_opts so;
 	struct px_model_stream_stats st;
 	struct px_control_query q;
@@ -600,13 +600,13 @@ static void test_tracked_matches_plain(void)
 	}
 	px_model_stream_opts_default(&so);
 	so.verify_every = 7;
-	PX_CHECK_INT_EQ(px_world_tracking_create(s, &so, &t), PX_OK);
+	PX_CHECK_INT_EQ(px_scene_tracking_create(s, &so, &t), PX_OK);
 	/* three NURBS models follow with streams, the mesh with hints */
-	PX_CHECK_INT_EQ(px_world_tracking_stats(t, &st), 3);
+	PX_CHECK_INT_EQ(px_scene_tracking_stats(t, &st), 3);
 	/* the closed sphere is signed, also behind the scale */
 	{
-		struct px_world_hit h;
-		PX_CHECK_INT_EQ(px_world_nearest(s, px_v3(-0.04, 0.03, 0.0), 1.0,
+		struct px_scene_hit h;
+		PX_CHECK_INT_EQ(px_scene_nearest(s, px_v3(-0.04, 0.03, 0.0), 1.0,
 						 &h),
 				1);
 		PX_CHECK_INT_EQ(h.model, 1);
@@ -616,7 +616,7 @@ static void test_tracked_matches_plain(void)
 	for (pass = 0; pass < 2; pass++) {
 		for (k = 0; k < 6000; k++) {
 			double tt = (double)k / 1000.0 + 0.37 * pass;
-			struct px_world_hit h0, h1;
+			struct px_scene_hit h0, h1;
 			int r0, r1;
 			px_vec3 p = px_v3(0.09 * sin(0.9 * tt + 0.3 * pass),
 					  0.08 * sin(1.3 * tt + 1.0),
@@ -626,10 +626,10 @@ static void test_tracked_matches_plain(void)
 				px_pose pose = px_pose_identity();
 				pose.t = px_v3(-0.04 + 0.02 * sin(3.0 * tt), 0.03,
 					       0.0);
-				PX_CHECK_INT_EQ(px_world_set_pose(s, 1, pose), PX_OK);
+				PX_CHECK_INT_EQ(px_scene_set_pose(s, 1, pose), PX_OK);
 			}
-			r0 = px_world_nearest(s, p, 1.0, &h0);
-			r1 = px_world_nearest_tracked(s, p, 1.0, t, &h1);
+			r0 = px_scene_nearest(s, p, 1.0, &h0);
+			r1 = px_scene_nearest_tracked(s, p, 1.0, t, &h1);
 			PX_CHECK_INT_EQ(r1, r0);
 			PX_CHECK_NEAR(h1.distance_m, h0.distance_m, 1e-9);
 			if (fabs(h1.distance_m - h0.distance_m) > 1e-9)
@@ -662,7 +662,7 @@ static void test_tracked_matches_plain(void)
 		}
 	}
 	PX_CHECK_INT_EQ(px_alloc_region_end(a), 0);
-	PX_CHECK_INT_EQ(px_world_tracking_stats(t, &st), 3);
+	PX_CHECK_INT_EQ(px_scene_tracking_stats(t, &st), 3);
 	printf("  tracked scene: %ld stream answers of 12000; streams: %llu "
 	       "queries, %llu tracked (%llu hot), %llu global, %llu cold, "
 	       "%llu verified, %llu disagreements; jumps %d real, %d missed, "
@@ -683,50 +683,50 @@ static void test_tracked_matches_plain(void)
 	PX_CHECK_INT_EQ(missed, 0);
 
 	/* the control adapter answers as the plain one */
-	PX_CHECK_INT_EQ(px_world_control_query_tracked(s, t, &q), PX_OK);
+	PX_CHECK_INT_EQ(px_scene_control_query_tracked(s, t, &q), PX_OK);
 	for (k = 0; k < 300; k++) {
 		px_vec3 p = px_v3(0.05 * cos(k * 0.01), 0.05 * sin(k * 0.01), 0.01);
 		struct px_control_hit c;
-		struct px_world_hit h;
+		struct px_scene_hit h;
 		PX_CHECK_INT_EQ(q.point(q.ctx, p, 1.0, &c), PX_OK);
-		PX_CHECK_INT_EQ(px_world_nearest(s, p, 1.0, &h), 1);
+		PX_CHECK_INT_EQ(px_scene_nearest(s, p, 1.0, &h), 1);
 		PX_CHECK(c.valid);
 		PX_CHECK_NEAR(c.distance_m, h.distance_m, 1e-9);
 	}
 	/* bad input: a NaN point leaves the streams as they were; a
 	 * tracking state of another world is refused */
 	{
-		struct px_world_hit h;
-		PX_CHECK_INT_EQ(px_world_nearest_tracked(s, px_v3(NAN, 0, 0), 1.0,
+		struct px_scene_hit h;
+		PX_CHECK_INT_EQ(px_scene_nearest_tracked(s, px_v3(NAN, 0, 0), 1.0,
 							 t, &h),
 				PX_E_NAN);
-		PX_CHECK_INT_EQ(px_world_create(1, &other), PX_OK);
-		PX_CHECK_INT_EQ(px_world_nearest_tracked(other, px_v3(0, 0, 0),
+		PX_CHECK_INT_EQ(px_scene_create(1, &other), PX_OK);
+		PX_CHECK_INT_EQ(px_scene_nearest_tracked(other, px_v3(0, 0, 0),
 							 1.0, t, &h),
 				PX_E_INVAL);
-		PX_CHECK_INT_EQ(px_world_nearest_tracked(s, px_v3(0, 0, 0), 1.0,
+		PX_CHECK_INT_EQ(px_scene_nearest_tracked(s, px_v3(0, 0, 0), 1.0,
 							 NULL, &h),
 				PX_E_INVAL);
-		PX_CHECK_INT_EQ(px_world_control_query_tracked(other, t, &q),
+		PX_CHECK_INT_EQ(px_scene_control_query_tracked(other, t, &q),
 				PX_E_INVAL);
-		px_world_free(other);
+		px_scene_free(other);
 	}
-	px_world_tracking_free(t);
-	px_world_free(s);
+	px_scene_tracking_free(t);
+	px_scene_free(s);
 }
 
 static void test_schema_documented(void)
 {
 	char why[200];
 	char *docs;
-	PX_CHECK_INT_EQ(px_config_schema_validate(px_world_config_schema(), why,
+	PX_CHECK_INT_EQ(px_config_schema_validate(px_scene_config_schema(), why,
 						  sizeof(why)),
 			PX_OK);
 	docs = px_test_read_text("docs/config.md");
 	if (!docs)
 		PX_SKIP("docs/config.md not found (run from the source tree)");
 	PX_CHECK(strstr(docs, "## scene") != NULL);
-	px_test_check_documented(docs, px_world_config_schema(), 8);
+	px_test_check_documented(docs, px_scene_config_schema(), 8);
 	free(docs);
 }
 

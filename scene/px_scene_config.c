@@ -16,10 +16,11 @@
 #include "px_mesh.h"
 #include "px_obj.h"
 #include "px_prim.h"
-#include "px_world.h"
+#include "px_scene.h"
 #include "schema_internal.h"
 
 #define BIG 1e6
+#define LIST_MAX 256 /* models and primitives each (docs/config.md) */
 
 enum file_kind { KIND_MESH = 0, KIND_NURBS = 1, KIND_CLOUD = 2 };
 static const char *const kind_names[] = {"mesh", "nurbs", "cloud", NULL};
@@ -72,7 +73,7 @@ struct raw_scene {
 	const struct px_config *cfg_;
 	const struct px_config_diag *diag_;
 	int errors_before_;
-	struct px_world *scene_;
+	struct px_scene *scene_;
 	int failed_;
 };
 
@@ -172,14 +173,14 @@ SCHEMA(tracking_schema, "tracking", tracking_keys, NULL);
 
 static const struct px_config_key scene_keys[] = {
 	K_SEQ(struct raw_scene, models, n_models, "models", 0, model_schema,
-	      struct raw_model, 0, PX_WORLD_MAX_MODELS),
+	      struct raw_model, 0, LIST_MAX),
 	K_SEQ(struct raw_scene, prims, n_prims, "primitives", 0, prim_schema,
-	      struct raw_prim, 0, PX_WORLD_MAX_MODELS),
+	      struct raw_prim, 0, LIST_MAX),
 	K_SUB(struct raw_scene, tracking, "tracking", tracking_schema),
 };
 SCHEMA(scene_schema, "scene", scene_keys, scene_check);
 
-const struct px_config_schema *px_world_config_schema(void)
+const struct px_config_schema *px_scene_config_schema(void)
 {
 	return &scene_schema;
 }
@@ -442,7 +443,7 @@ static void add_model(struct px_config_reader *r, struct raw_scene *sc,
 		sc->failed_ = 1;
 		return;
 	}
-	rc = px_world_add(sc->scene_, m, name);
+	rc = px_scene_add(sc->scene_, m, name);
 	if (rc < 0) {
 		px_config_reader_error(r, at, where, "cannot add: %s",
 				       px_strerror(rc));
@@ -462,7 +463,7 @@ static void scene_check(struct px_config_reader *r,
 		sc->failed_ = 1;
 		return;
 	}
-	rc = px_world_create(total ? total : 1, &sc->scene_);
+	rc = px_scene_create(total ? total : 1, &sc->scene_);
 	if (rc != PX_OK) {
 		px_config_reader_error(r, map, "", "%s", px_strerror(rc));
 		sc->failed_ = 1;
@@ -532,7 +533,7 @@ static void scene_check(struct px_config_reader *r,
 	}
 }
 
-int px_world_config_load(const struct px_config *cfg, struct px_world **out,
+int px_scene_config_load(const struct px_config *cfg, struct px_scene **out,
 			 struct px_config_diag *diag)
 {
 	struct raw_scene raw;
@@ -550,9 +551,9 @@ int px_world_config_load(const struct px_config *cfg, struct px_world **out,
 	if (rc == PX_OK && raw.failed_)
 		rc = PX_E_PARSE;
 	if (rc == PX_OK && !raw.scene_)
-		rc = px_world_create(1, &raw.scene_);
+		rc = px_scene_create(1, &raw.scene_);
 	if (rc != PX_OK) {
-		px_world_free(raw.scene_);
+		px_scene_free(raw.scene_);
 		return rc;
 	}
 	{
@@ -561,7 +562,7 @@ int px_world_config_load(const struct px_config *cfg, struct px_world **out,
 		o.verify_every = (int)raw.tracking.verify_every;
 		o.max_solves = (int)raw.tracking.max_solves;
 		o.cold_switch = raw.tracking.cold_switch ? 1 : 0;
-		px_world_set_tracking(raw.scene_, raw.tracking.enabled, &o);
+		px_scene_set_tracking(raw.scene_, raw.tracking.enabled, &o);
 	}
 	*out = raw.scene_;
 	return PX_OK;
