@@ -22,7 +22,8 @@ struct px_scene_tracking {
 /* Lower bound of model e's signed distance to p, from its oriented box
  * under the current pose. Inside the box: -infinity for a closed model
  * (it may be inside), 0 for an open one. */
-static double lower_bound(const struct scene_entry *e, px_vec3 p)
+static inline __attribute__((always_inline)) double
+lower_bound(const struct scene_entry *e, px_vec3 p)
 {
 	px_obb b;
 	double d;
@@ -55,11 +56,11 @@ static void no_hit(struct px_scene_hit *out)
 	out->r.index = -1;
 }
 
-static void point_hit(struct px_scene_hit *h, int id, px_vec3 p,
+static void point_hit(struct px_scene_hit *h, int id, px_vec3 p, double d,
 		      const struct px_model_result *r)
 {
 	h->model = id;
-	h->distance_m = reported(r);
+	h->distance_m = d;
 	h->point = r->point;
 	h->tool_point = p;
 	h->feature_index = r->index;
@@ -82,7 +83,8 @@ struct near {
 
 /* Query model k, whose lower bound lo is below the best so far and
  * within range. Returns >= 0 or the model's error. */
-static int visit(struct near *c, size_t k, double lo)
+static inline __attribute__((always_inline)) int
+visit(struct near *c, size_t k, double lo)
 {
 	const struct scene_entry *e = &c->s->e[k];
 	struct px_model_result r;
@@ -112,7 +114,7 @@ static int visit(struct near *c, size_t k, double lo)
 		double d = reported(&r);
 		if (d < c->best && fabs(d) <= c->max) {
 			c->best = d;
-			point_hit(c->out, (int)k, c->p, &r);
+			point_hit(c->out, (int)k, c->p, d, &r);
 		}
 	}
 	return 0;
@@ -412,7 +414,7 @@ int px_scene_within(const struct px_scene *s, px_vec3 p, double dist,
 		if (rc == 1 && reported(&r) <= dist) {
 			if (n < cap) {
 				memset(&hits[n], 0, sizeof(hits[n]));
-				point_hit(&hits[n], (int)id, p, &r);
+				point_hit(&hits[n], (int)id, p, reported(&r), &r);
 			}
 			n++;
 		}

@@ -232,6 +232,74 @@ static void test_no_alloc_and_errors(void)
 	free_world(&w);
 }
 
+/* Poses set through the scene are seen by the very next query, in the
+ * hierarchy of a large scene (refit of a leaf and its ancestors) as in
+ * a small one; models the scene owns need no update, kept ones moved on
+ * their own do; nothing is allocated. */
+static void test_set_pose_seen_at_once(void)
+{
+	static const int sizes[2] = {6, 40};
+	int si;
+	for (si = 0; si < 2; si++) {
+		struct px_scene *s;
+		struct px_scene_hit h, hits[NM];
+		int n = sizes[si], i, k;
+		uint64_t a;
+		PX_CHECK_INT_EQ(px_scene_create((size_t)n, &s), PX_OK);
+		for (i = 0; i < n; i++)
+			PX_CHECK_INT_EQ(px_scene_add(s, rand_model(i), NULL), i);
+		a = px_alloc_region_begin();
+		for (k = 0; k < 400; k++) {
+			px_vec3 p = px_v3(px_rand_range(-3, 3), px_rand_range(-3, 3),
+					  px_rand_range(-3, 3));
+			double best = INFINITY, lim = px_rand_range(0, 1.0);
+			int j, cnt = 0;
+			size_t nf;
+			PX_CHECK_INT_EQ(px_scene_set_pose(s, (size_t)(k % n),
+							  px_test_rand_pose(3.0)),
+					PX_OK);
+			for (j = 0; j < n; j++) {
+				struct px_model_result r;
+				px_model_query(px_scene_model(s, (size_t)j), p, &r);
+				best = fmin(best, r.distance);
+				cnt += r.distance <= lim;
+			}
+			PX_CHECK_INT_EQ(px_scene_nearest(s, p, INFINITY, &h), 1);
+			PX_CHECK_MSG(h.distance_m == best, "n %d: nearest %.15g vs loop %.15g",
+				     n, h.distance_m, best);
+			PX_CHECK_INT_EQ(px_scene_within(s, p, lim, hits, NM, &nf), cnt);
+		}
+		PX_CHECK_INT_EQ(px_alloc_region_end(a), 0);
+		PX_CHECK_INT_EQ(px_scene_set_pose(s, (size_t)n, px_pose_identity()),
+				PX_E_INVAL);
+		px_scene_free(s);
+	}
+	/* kept models: moved on their own, seen after the update */
+	{
+		struct world w;
+		struct px_scene_hit h;
+		int c;
+		make_world(&w, 0);
+		PX_CHECK_INT_EQ(px_scene_update(w.s), PX_OK);
+		for (c = 0; c < 20; c++) {
+			px_vec3 p = px_v3(px_rand_range(-3, 3), px_rand_range(-3, 3),
+					  px_rand_range(-3, 3));
+			double best = INFINITY;
+			int j;
+			move_world(&w);
+			for (j = 0; j < w.n; j++) {
+				struct px_model_result r;
+				px_model_query(w.m[j], p, &r);
+				best = fmin(best, r.distance);
+			}
+			PX_CHECK_INT_EQ(px_scene_nearest(w.s, p, INFINITY, &h), 1);
+			PX_CHECK(h.distance_m == best);
+		}
+		free_world(&w);
+	}
+}
+
 static const struct px_test tests[] = {PX_T(test_nearest_and_within), PX_T(test_tool),
-				       PX_T(test_no_alloc_and_errors)};
+				       PX_T(test_no_alloc_and_errors),
+				       PX_T(test_set_pose_seen_at_once)};
 PX_TEST_MAIN(tests)
