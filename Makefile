@@ -104,11 +104,21 @@ LIB_SRC  := $(filter-out $(addprefix %/,$(OPT_OUT_SRC)),\
 LIB_OBJ  := $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC))
 PUB_HDRS := $(filter-out %internal.h,$(foreach d,$(MODULE_DIRS),$(wildcard $(d)/px*.h)))
 
-TEST_SUPPORT_SRC := $(wildcard tests/px_*.c)
+# tests/ mirrors the tree: the test of geom/track/ is tests/geom/track/
+# test_*.c, the shared fixtures are in tests/support/. The binaries stay
+# flat, $(BUILD)/tests/test_<name> (test names are unique), in the order
+# of their names; tests/vm/ holds the VM suite's own programs.
+TEST_SUPPORT_DIR := tests/support
+TEST_SUPPORT_SRC := $(wildcard $(TEST_SUPPORT_DIR)/px_*.c)
 TEST_SUPPORT_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(TEST_SUPPORT_SRC))
-TEST_SRC := $(wildcard tests/test_*.c)
-TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
-TEST_SH  := $(wildcard tests/test_*.sh tests/*/test_*.sh)
+test_find = $(shell find tests -name 'test_*.$(1)' -not -path '$(TEST_SUPPORT_DIR)/*' \
+              -not -path 'tests/vm/*' | awk -F/ '{ print $$NF, $$0 }' | sort | cut -d' ' -f2)
+TEST_SRC := $(call test_find,c)
+TEST_BIN := $(foreach t,$(TEST_SRC),$(BUILD)/tests/$(basename $(notdir $(t))))
+TEST_SH  := $(call test_find,sh)
+ifneq ($(words $(TEST_BIN)),$(words $(sort $(TEST_BIN))))
+$(error two test sources under tests/ have the same name: $(sort $(TEST_SRC)))
+endif
 # Test hooks: the sources with test switches and hook functions are built
 # a second time with -DPX_TEST_HOOKS into TEST_LIB, which the tests and
 # benches link; the shipped library has none (geom/math/math_internal.h).
@@ -125,7 +135,7 @@ TOOL_SUPPORT_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(TOOL_SUPPORT_SRC))
 # which a preloaded object cannot reach: there the tools link it.
 ALLOC_SO := $(BUILD)/lib/lib$(NAME)-alloc-count.so
 ifeq ($(SAN),1)
-TOOL_SUPPORT_OBJ += $(BUILD)/obj/tests/px_alloc_count.o
+TOOL_SUPPORT_OBJ += $(BUILD)/obj/$(TEST_SUPPORT_DIR)/px_alloc_count.o
 endif
 TOOL_SRC := $(wildcard tools/proxima-*.c)
 TOOL_BIN := $(patsubst tools/%.c,$(BUILD)/bin/%,$(TOOL_SRC))
@@ -233,9 +243,13 @@ $(TEST_LIB): $(filter-out $(patsubst %.c,$(BUILD)/obj/%.o,$(TEST_HOOK_SRC)),$(LI
 	rm -f $@
 	ar rcs $@ $^
 
-$(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT_OBJ) $(TEST_LIB)
-	@mkdir -p $(dir $@)
-	$(CC) $(ALL_LDFLAGS) -o $@ $< $(TEST_SUPPORT_OBJ) $(TEST_LIB) $(LIBS)
+# One rule per test: $(BUILD)/tests/test_x from tests/<folder>/test_x.c.
+define TEST_RULE
+$(BUILD)/tests/$(basename $(notdir $(1))): $(BUILD)/obj/$(1:.c=.o) $$(TEST_SUPPORT_OBJ) $$(TEST_LIB)
+	@mkdir -p $$(dir $$@)
+	$$(CC) $$(ALL_LDFLAGS) -o $$@ $$< $$(TEST_SUPPORT_OBJ) $$(TEST_LIB) $$(LIBS)
+endef
+$(foreach t,$(TEST_SRC),$(eval $(call TEST_RULE,$(t))))
 
 $(BUILD)/bin/%: $(BUILD)/obj/tools/%.o $(TOOL_SUPPORT_OBJ) $(STATIC_LIB)
 	@mkdir -p $(dir $@)
@@ -243,9 +257,9 @@ $(BUILD)/bin/%: $(BUILD)/obj/tools/%.o $(TOOL_SUPPORT_OBJ) $(STATIC_LIB)
 
 # Initial-exec TLS: the per-thread count must not make the dynamic
 # loader allocate on a thread's first heap call.
-$(ALLOC_SO): tests/px_alloc_count.c tests/px_alloc_count.h
+$(ALLOC_SO): $(TEST_SUPPORT_DIR)/px_alloc_count.c $(TEST_SUPPORT_DIR)/px_alloc_count.h
 	@mkdir -p $(dir $@)
-	$(CC) -std=c11 -D_GNU_SOURCE $(WARN) $(OPTFLAGS) $(CFLAGS) -Itests -fPIC -shared \
+	$(CC) -std=c11 -D_GNU_SOURCE $(WARN) $(OPTFLAGS) $(CFLAGS) -I$(TEST_SUPPORT_DIR) -fPIC -shared \
 	  -ftls-model=initial-exec $(LDFLAGS) -o $@ $<
 
 # The public headers, flat under $(INC_DIR)/$(NAME)/ as they install.
@@ -285,7 +299,7 @@ $(BUILD)/bench/%: $(BUILD)/obj/bench/%.o $(TEST_LIB)
 $(BUILD)/obj/devices/backends/px_hidapi.o: ALL_CFLAGS += -DPX_HIDAPI_DRIVER=\"$(HIDAPI)\"
 
 # Test and bench sources also see the test harness headers.
-$(BUILD)/obj/tests/%.o $(BUILD)/obj/bench/%.o $(BUILD)/obj/tools/%.o: ALL_CFLAGS += -Itests -Itools
+$(BUILD)/obj/tests/%.o $(BUILD)/obj/bench/%.o $(BUILD)/obj/tools/%.o: ALL_CFLAGS += -I$(TEST_SUPPORT_DIR) -Itools
 $(BUILD)/obj/tests/%.o $(BUILD)/obj/bench/%.o: ALL_CFLAGS += -DPX_TEST_HOOKS
 
 # ---- top-level actions ---------------------------------------------------
@@ -319,9 +333,9 @@ fcl-bench:
 	  $(MAKE) --no-print-directory $(BUILD)/bench/fcl_models; \
 	else echo "make bench: FCL not installed: bench_models runs without it"; fi
 
-$(BUILD)/bench/fcl_models: bench/fcl_models.cpp bench/models_common.h tests/mesh_gen.h
+$(BUILD)/bench/fcl_models: bench/fcl_models.cpp bench/models_common.h $(TEST_SUPPORT_DIR)/mesh_gen.h
 	@mkdir -p $(dir $@)
-	$(CXX) -O2 -g -std=c++14 -Itests -Ibench $$(pkg-config --cflags fcl) $< -o $@ $$(pkg-config --libs fcl)
+	$(CXX) -O2 -g -std=c++14 -I$(TEST_SUPPORT_DIR) -Ibench $$(pkg-config --cflags fcl) $< -o $@ $$(pkg-config --libs fcl)
 
 sanitize:
 	$(MAKE) BUILD=$(BUILD)/san SAN=1 test
@@ -469,7 +483,7 @@ fuzz:
 	echo "fuzz: no crash, leak or hang in $(FUZZ_SECONDS) s per target: $(FUZZ_RUN)"
 
 # ---- soak, memcheck, stress (reliability) ----------------------------------
-# `make soak`: tests/test_soak.c for SOAK_CYCLES cycles on the virtual
+# `make soak`: tests/rt/test_soak.c for SOAK_CYCLES cycles on the virtual
 # clock (make test runs 200000 of them). `make memcheck`: the tools under
 # valgrind on sample inputs (tests/memcheck.sh). `make stress`: the hostile
 # geometry tests with their large cases (PX_STRESS=1).

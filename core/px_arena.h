@@ -15,7 +15,7 @@
  * setup; when they are too small the call fails with PX_E_NOSPC rather
  * than growing. Functions that a cycle may call are marked
  * "@note RT-safe" in their headers; the test suite checks them with an
- * allocation counter (tests/px_alloc_count.h).
+ * allocation counter (tests/support/px_alloc_count.h).
  *
  * px_arena_alloc() itself never touches the heap, so it may also be used
  * from a cycle on a scratch arena that is reset with px_arena_reset_to()

@@ -14,7 +14,7 @@ missing_part() { # test binary or script: prints the first part left out
 	case "$1" in
 	*.sh) src=$1 ;;
 	*/fuzz-replay/*) src=fuzz/$(basename "$1").c ;;
-	*) src=tests/$(basename "$1").c ;;
+	*) src=$(find tests -name "$(basename "$1").c" -not -path 'tests/support/*' 2>/dev/null | head -n 1) ;;
 	esac
 	[ -n "${PX_WITHOUT:-}" ] && [ -f "$src" ] || return 1
 	for p in $(sed -n 's/.*PX_TEST_NEEDS:\([a-z0-9 ]*\).*/\1/p' "$src"); do

@@ -173,7 +173,7 @@ static int parse_args(int argc, char **argv, struct px_app_options *o)
 
 /* ---- heap call counter (per thread) -------------------------------- */
 
-/* The tests' counter (tests/px_alloc_count.c) when it is there: preloaded
+/* The tests' counter (tests/support/px_alloc_count.c) when it is there: preloaded
  * as libproxima-alloc-count.so, or linked in sanitizer builds. It sees
  * every malloc-family call of the loop thread. Weak, so that a run
  * without it still works and says the counter is "none". */

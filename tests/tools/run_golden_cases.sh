@@ -20,7 +20,7 @@
 #                          (PX_RUN_STOP_AT): "ended by signal", shutdown
 #                          after SIGINT
 #
-# The heap counter is there (preloaded as tests/test_proxima_run.sh does,
+# The heap counter is there (preloaded as tests/tools/test_proxima_run.sh does,
 # or linked in by an older build): allocations after setup and the
 # counter's name are compared.
 #

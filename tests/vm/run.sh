@@ -69,7 +69,7 @@ $build/bin/proxima-run=$g/bin/proxima-run
 $build/lib/libproxima-alloc-count.so=$g/lib/libproxima-alloc-count.so
 $vmdir/uhid_feed=$g/tests/uhid_feed
 $top/tests/run.sh=/px/tests/run.sh
-$top/tests/test_probe.sh=/px/tests/test_probe.sh"
+$top/tests/tools/test_probe.sh=/px/tests/test_probe.sh"
 for a in $files; do
 	f=${a%%=*}
 	[ -f "$f" ] || { echo "FAIL VM suite: $f is not built"; summary 0 1 0; exit 1; }

@@ -8,6 +8,8 @@
  * that disagree with the size, and PLY double coordinates kept exact.
  * Every refusal is checked for its code and for a message that names
  * the file and the place.
+ * Here under core/: the size limits, NUL checks and file-kind refusals
+ * every reader shares are core/px_file's.
  */
 #include <errno.h>
 #include <fcntl.h>

@@ -158,6 +158,15 @@ const char *px_test_part_lib_(const char *part)
 	return part;
 }
 
+void px_test_data_path(char *buf, size_t cap, const char *name)
+{
+	const char *f = __FILE__, *slash = strrchr(f, '/');
+	if (slash)
+		snprintf(buf, cap, "%.*s/../data/%s", (int)(slash - f), f, name);
+	else
+		snprintf(buf, cap, "../data/%s", name);
+}
+
 static const char *base_name(const char *path)
 {
 	const char *s = strrchr(path, '/');

@@ -962,7 +962,6 @@ static void test_bound_holds_when_loose(void)
  * not. */
 static void test_obj_files(void)
 {
-	const char *f = __FILE__, *slash = strrchr(f, '/');
 	const char *names[3] = {"circle.obj", "sphere.obj", "bicubic.obj"};
 	int k;
 	for (k = 0; k < 3; k++) {
@@ -971,11 +970,7 @@ static void test_obj_files(void)
 		struct px_obj_error e;
 		struct px_recog_shape pr;
 		int rc;
-		if (slash)
-			snprintf(path, sizeof(path), "%.*s/data/%s", (int)(slash - f), f,
-				 names[k]);
-		else
-			snprintf(path, sizeof(path), "data/%s", names[k]);
+		px_test_data_path(path, sizeof(path), names[k]);
 		rc = px_obj_load_file(path, &m, &e);
 		PX_CHECK_MSG(rc == PX_OK, "%s: %s", path, e.msg);
 		if (rc != PX_OK)

@@ -54,6 +54,10 @@ _Noreturn void px_test_skip_(const char *fmt, ...)
 				      px_test_part_lib_(#PART));            \
 	} while (0)
 const char *px_test_part_lib_(const char *part);
+/* buf = the path of tests/data/<name>, the shared test files, found from
+ * where the harness source is (tests/support/), not from the test's own
+ * folder. */
+void px_test_data_path(char *buf, size_t cap, const char *name);
 /* Count one assertion (a test with no assertion at all fails). */
 void px_test_count_(void);
 

@@ -18,7 +18,7 @@
 #include "px_hid.h"
 #include "px_test.h"
 #include "px_test_dev.h"
-#include "vm/haptic_rd.h"
+#include "../../vm/haptic_rd.h"
 
 static void test_open_by_vid_pid_not_found(void)
 {

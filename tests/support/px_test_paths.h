@@ -1,6 +1,6 @@
 /*
  * px_test_paths.h - moving-point trajectories shared by the tracking
- * tests and benchmarks (header only: the benchmarks build with -Itests
+ * tests and benchmarks (header only: the benchmarks build with -Itests/support
  * but do not link the test sources, so the random source is passed in).
  *
  * A path is n points inside box, consecutive points about step apart:

@@ -12,6 +12,8 @@
  * triangle or point; NURBS by dense sampling, which bounds the true
  * minimum from above, while the answer's own point (re-evaluated on the
  * entity) bounds it from below - a correct answer lies between.
+ * Here under geom/model/: the queries go through the model interface
+ * (px_model_*) over every kind of model.
  */
 #include <math.h>
 #include <stdio.h>

@@ -18,6 +18,8 @@
  *     + 1e-160, l the triangle's longest edge;
  *   px_prim_closest: |d - d*| <= PX_PRIM_ERR_ULPS u (|q| + size).
  * Seeds are printed by the harness (PX_TEST_SEED replays a failure).
+ * Here under geom/model/: every query goes through the model interface
+ * (px_model_*), over meshes and primitives.
  */
 #include <math.h>
 #include <stdio.h>

@@ -10,22 +10,13 @@
 #include "px_obj.h"
 #include "px_test.h"
 
-static void data_path(char *buf, size_t cap, const char *name)
-{
-	const char *f = __FILE__, *slash = strrchr(f, '/');
-	if (slash)
-		snprintf(buf, cap, "%.*s/data/%s", (int)(slash - f), f, name);
-	else
-		snprintf(buf, cap, "data/%s", name);
-}
-
 static struct px_obj_model *load(const char *name)
 {
 	char path[512];
 	struct px_obj_error e;
 	struct px_obj_model *m = NULL;
 	int rc;
-	data_path(path, sizeof(path), name);
+	px_test_data_path(path, sizeof(path), name);
 	rc = px_obj_load_file(path, &m, &e);
 	PX_CHECK_MSG(rc == PX_OK, "%s:%d:%d: %s (%s)", e.file, e.line,
 		     e.column, e.msg, px_strerror_name(rc));
@@ -40,7 +31,7 @@ static char *slurp(const char *name, size_t *len)
 	FILE *f;
 	char *buf;
 	long n;
-	data_path(path, sizeof(path), name);
+	px_test_data_path(path, sizeof(path), name);
 	f = fopen(path, "rb");
 	PX_CHECK_MSG(f != NULL, "cannot open %s", path);
 	fseek(f, 0, SEEK_END);
