@@ -1075,7 +1075,6 @@ static void test_can_faults_reach_the_watchdog(void)
 	struct px_can_sim *s;
 	struct px_can_bus *ctl;
 	struct px_dev_config dc;
-	struct px_loop_config lc;
 	struct px_loop *l;
 	struct px_loop_status ls;
 	static struct canapp a;
@@ -1093,12 +1092,7 @@ static void test_can_faults_reach_the_watchdog(void)
 	PX_CHECK_INT_EQ(px_can_dev_create(&dc, ctl, 0, dev_sigs, 3, &a.dev,
 					  msg, sizeof msg),
 			PX_OK);
-	px_loop_config_default(&lc);
-	lc.clock = PX_LOOP_CLOCK_VIRTUAL;
-	lc.read = can_read;
-	lc.user = &a;
-	lc.hist_bins = 100;
-	PX_CHECK_INT_EQ(px_loop_create(&lc, &l), PX_OK);
+	l = px_test_virtual_loop(can_read, NULL, NULL, &a);
 	PX_CHECK_INT_EQ(px_dev_attach(a.dev, l), 0);
 	PX_CHECK_INT_EQ(px_loop_run(l, 1), PX_OK);
 	r = px_alloc_region_begin();

@@ -15,6 +15,7 @@
 #include "px_can.h"
 #include "px_loop.h"
 #include "px_test.h"
+#include "px_test_dev.h"
 
 /* J1939-style position signals: unsigned raw with an offset, so the
  * all-ones "not available" pattern decodes far outside [min, max]. */
@@ -90,7 +91,6 @@ static void run_fault(int transport, int kind, int64_t delay_ns, double prob,
 	struct px_can_sim *sim = NULL;
 	struct px_can_bus *ctl = NULL, *raw = NULL;
 	struct px_dev_config dc;
-	struct px_loop_config lc;
 	struct px_loop *l;
 	static struct app a;
 	char msg[300];
@@ -130,12 +130,7 @@ static void run_fault(int transport, int kind, int64_t delay_ns, double prob,
 					  sizeof msg),
 			PX_OK);
 	PX_CHECK_INT_EQ(px_dev_start(a.dev), PX_OK);
-	px_loop_config_default(&lc);
-	lc.clock = PX_LOOP_CLOCK_VIRTUAL;
-	lc.read = app_read;
-	lc.user = &a;
-	lc.hist_bins = 100;
-	PX_CHECK_INT_EQ(px_loop_create(&lc, &l), PX_OK);
+	l = px_test_virtual_loop(app_read, NULL, NULL, &a);
 	PX_CHECK_INT_EQ(px_dev_attach(a.dev, l), 0);
 	PX_CHECK_INT_EQ(px_loop_run(l, 1), PX_OK);
 	r = px_alloc_region_begin();

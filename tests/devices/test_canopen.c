@@ -19,6 +19,8 @@
 #include "px_devcfg.h"
 #include "px_loop.h"
 #include "px_test.h"
+#include "px_test_dev.h"
+#include "px_test_config.h"
 
 static void test_statusword_table(void)
 {
@@ -173,7 +175,6 @@ static void test_master_drives_simulated_arm(void)
 		{PX_SIM_FAULT_ESTOP, 1500000000, 50000000, 1.0, 2},  /* drive 3 */
 		{PX_SIM_FAULT_UNPLUG, 2500000000LL, 500000000, 1.0, 1}, /* drive 2 */
 	};
-	struct px_loop_config lc;
 	struct px_loop *l;
 	struct px_canopen_drive_status ds;
 	static struct app a;
@@ -198,14 +199,7 @@ static void test_master_drives_simulated_arm(void)
 	sc.faults = faults;
 	sc.n_faults = 2;
 	PX_CHECK_INT_EQ(px_canopen_sim_create(&sc, ep_arm, &a.sim), PX_OK);
-	px_loop_config_default(&lc);
-	lc.clock = PX_LOOP_CLOCK_VIRTUAL;
-	lc.read = c_read;
-	lc.compute = c_compute;
-	lc.write = c_write;
-	lc.user = &a;
-	lc.hist_bins = 100;
-	PX_CHECK_INT_EQ(px_loop_create(&lc, &l), PX_OK);
+	l = px_test_virtual_loop(c_read, c_compute, c_write, &a);
 	PX_CHECK_INT_EQ(px_loop_enable_add(l, "drives", &a.loop_enable), 0);
 	a.enable = 1;
 	PX_CHECK_INT_EQ(px_loop_run(l, 1), PX_OK);
@@ -543,13 +537,7 @@ static void test_simarm_takes_the_config_mapping(void)
 	if (!f)
 		return;
 	fprintf(f,
-		"version: 1\n"
-		"devices:\n"
-		"  - name: arm\n"
-		"    backend: socketcan\n"
-		"    socketcan:\n"
-		"      interface: simbus\n"
-		"      transport: unix\n"
+		PX_TEST_YAML_HEAD PX_TEST_YAML_CAN("arm", "simbus", "unix")
 		"      socket_path: %s\n"
 		"      canopen:\n"
 		"        heartbeat_timeout_ns: 0\n"

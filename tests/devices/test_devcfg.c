@@ -141,13 +141,7 @@ static void test_sim_haptic_runs(void)
 static void test_can_signal_axes(void)
 {
 	static const char y[] =
-		"version: 1\n"
-		"devices:\n"
-		"  - name: ft\n"
-		"    backend: socketcan\n"
-		"    socketcan:\n"
-		"      interface: simbus\n"
-		"      transport: sim\n"
+		PX_TEST_YAML_HEAD PX_TEST_YAML_CAN("ft", "simbus", "sim")
 		"      signals:\n"
 		"        - {name: px, id: 0x101, direction: input, start_bit: 0, length: 16, signed: true, scale: 0.001, axis: x}\n"
 		"        - {name: pz, id: 0x101, direction: input, start_bit: 16, length: 16, signed: true, scale: 0.001, axis: z}\n"
@@ -233,13 +227,7 @@ static int64_t arm_wait(void *user, int64_t now, int64_t period_ns)
 static void test_canopen_drives(void)
 {
 	static const char y[] =
-		"version: 1\n"
-		"devices:\n"
-		"  - name: arm\n"
-		"    backend: socketcan\n"
-		"    socketcan:\n"
-		"      interface: simbus\n"
-		"      transport: sim\n"
+		PX_TEST_YAML_HEAD PX_TEST_YAML_CAN("arm", "simbus", "sim")
 		"      canopen:\n"
 		"        heartbeat_period_ns: 0\n"
 		"        heartbeat_timeout_ns: 0\n"
@@ -339,13 +327,7 @@ static void test_canopen_drives(void)
 static void test_canopen_free_stops_drives(void)
 {
 	static const char y[] =
-		"version: 1\n"
-		"devices:\n"
-		"  - name: arm\n"
-		"    backend: socketcan\n"
-		"    socketcan:\n"
-		"      interface: simbus\n"
-		"      transport: sim\n"
+		PX_TEST_YAML_HEAD PX_TEST_YAML_CAN("arm", "simbus", "sim")
 		"      canopen:\n"
 		"        heartbeat_period_ns: 0\n"
 		"        heartbeat_timeout_ns: 0\n"
@@ -407,10 +389,7 @@ static void test_gpio_roles(void)
 		"  estop: {device: io, line: stop_button}\n"
 		"  enable: {device: io, line: relay}\n"
 		"devices:\n"
-		"  - name: io\n"
-		"    backend: sim\n"
-		"    sim:\n"
-		"      kind: gpio\n"
+		PX_TEST_YAML_SIM_GPIO("io")
 		"      lines:\n"
 		"        - {name: stop_button, direction: input, active_low: true}\n"
 		"        - {name: relay, direction: output}\n"
@@ -481,13 +460,7 @@ static void test_check_only(void)
 	snprintf(sock, sizeof(sock), "/tmp/px-devcfg-check-%d.sock",
 		 (int)getpid());
 	snprintf(y, sizeof(y),
-		 "version: 1\n"
-		 "devices:\n"
-		 "  - name: arm\n"
-		 "    backend: socketcan\n"
-		 "    socketcan:\n"
-		 "      interface: simcan0\n"
-		 "      transport: unix\n"
+		 PX_TEST_YAML_HEAD PX_TEST_YAML_CAN("arm", "simcan0", "unix")
 		 "      socket_path: %s\n"
 		 "      canopen:\n"
 		 "        drives:\n"
@@ -529,32 +502,16 @@ static void test_errors(void)
 		const char *key;  /* expected in the message */
 		const char *what; /* expected in the message */
 	} cases[] = {
-		{"version: 1\n"
-		 "devices:\n"
-		 "  - name: io\n"
-		 "    backend: sim\n"
-		 "    sim:\n"
-		 "      kind: gpio\n"
+		{PX_TEST_YAML_HEAD PX_TEST_YAML_SIM_GPIO("io")
 		 "      lines:\n"
 		 "        - {name: estop, direction: input}\n"
 		 "        - {name: lamp, direction: output}\n",
 		 "devices[0].sim.lines[1]", "'lamp' has no role"},
-		{"version: 1\n"
-		 "devices:\n"
-		 "  - name: io\n"
-		 "    backend: sim\n"
-		 "    sim:\n"
-		 "      kind: gpio\n"
+		{PX_TEST_YAML_HEAD PX_TEST_YAML_SIM_GPIO("io")
 		 "      lines:\n"
 		 "        - {name: enable, direction: input}\n",
 		 "devices[0].sim.lines[0]", "must be an output"},
-		{"version: 1\n"
-		 "devices:\n"
-		 "  - name: arm\n"
-		 "    backend: socketcan\n"
-		 "    socketcan:\n"
-		 "      interface: x\n"
-		 "      transport: unix\n"
+		{PX_TEST_YAML_HEAD PX_TEST_YAML_CAN("arm", "x", "unix")
 		 "      socket_path: /tmp/px-devcfg-test.sock\n"
 		 "      signals:\n"
 		 "        - {name: a, id: 1, direction: input, start_bit: 0, length: 8}\n"
@@ -574,13 +531,7 @@ static void test_errors(void)
 		 "    sim:\n"
 		 "      trajectory: {kind: csv, file: /nonexistent/hand.csv}\n",
 		 "devices[0].sim.trajectory.file", "/nonexistent/hand.csv"},
-		{"version: 1\n"
-		 "devices:\n"
-		 "  - name: arm\n"
-		 "    backend: socketcan\n"
-		 "    socketcan:\n"
-		 "      interface: x\n"
-		 "      transport: sim\n"
+		{PX_TEST_YAML_HEAD PX_TEST_YAML_CAN("arm", "x", "sim")
 		 "      canopen:\n"
 		 "        drives: [{node_id: 1, joint: 0}]\n"
 		 "        tpdo1: [{index: 0x6041, bits: 16}, {index: 0x6064, bits: 16}]\n",
@@ -631,13 +582,7 @@ static void test_errors(void)
 static void test_signal_axis_config(void)
 {
 	static const char y[] =
-		"version: 1\n"
-		"devices:\n"
-		"  - name: c\n"
-		"    backend: socketcan\n"
-		"    socketcan:\n"
-		"      interface: x\n"
-		"      transport: sim\n"
+		PX_TEST_YAML_HEAD PX_TEST_YAML_CAN("c", "x", "sim")
 		"      signals:\n"
 		"        - {name: a, id: 1, direction: input, start_bit: 0, length: 8, axis: fx}\n"
 		"        - {name: b, id: 2, direction: output, start_bit: 0, length: 8, axis: rz}\n";

@@ -210,18 +210,7 @@ out:
 static void test_sim_faults_from_config(void)
 {
 	static const char y[] =
-		"version: 1\n"
-		"devices:\n"
-		"  - name: hap\n"
-		"    backend: sim\n"
-		"    sim:\n"
-		"      faults:\n"
-		"        - {kind: nan, start_ns: 10000000, duration_ns: 10000000}\n"
-		"  - name: io\n"
-		"    backend: sim\n"
-		"    sim:\n"
-		"      kind: gpio\n"
-		"      lines: [{name: estop, direction: input}]\n"
+		PX_TEST_YAML_HEAD PX_TEST_YAML_SIM_HAP_IO
 		"      faults:\n"
 		"        - {kind: estop, start_ns: 5000000, duration_ns: 5000000}\n";
 	struct px_config *cfg = px_test_config_load(y, &g_diag);
@@ -377,13 +366,7 @@ static void test_canopen_own_node_id(void)
 static void test_arm_faults_from_config(void)
 {
 	static const char y[] =
-		"version: 1\n"
-		"devices:\n"
-		"  - name: arm\n"
-		"    backend: socketcan\n"
-		"    socketcan:\n"
-		"      interface: simbus\n"
-		"      transport: sim\n"
+		PX_TEST_YAML_HEAD PX_TEST_YAML_CAN("arm", "simbus", "sim")
 		"      canopen:\n"
 		"        heartbeat_period_ns: 10000000\n"
 		"        heartbeat_timeout_ns: 30000000\n"

@@ -15,23 +15,8 @@
 static struct px_config_diag g_diag;
 
 static const char yaml[] =
-	"version: 1\n"
-	"devices:\n"
-	"  - name: hap\n"
-	"    backend: sim\n"
-	"    sim:\n"
-	"      faults:\n"
-	"        - {kind: nan, start_ns: 10000000, duration_ns: 10000000}\n"
-	"  - name: io\n"
-	"    backend: sim\n"
-	"    sim:\n"
-	"      kind: gpio\n"
-	"      lines: [{name: estop, direction: input}]\n"
-	"  - name: bus\n"
-	"    backend: socketcan\n"
-	"    socketcan:\n"
-	"      interface: s0\n"
-	"      transport: sim\n"
+	PX_TEST_YAML_HEAD PX_TEST_YAML_SIM_HAP_IO
+	PX_TEST_YAML_CAN("bus", "s0", "sim")
 	"      signals:\n"
 	"        - {name: x, id: 0x100, direction: input, start_bit: 0, "
 	"length: 16, signed: true, scale: 0.0001, axis: x}\n";

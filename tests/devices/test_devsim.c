@@ -15,6 +15,7 @@
 #include "px_loop.h"
 #include "px_sim.h"
 #include "px_test.h"
+#include "px_test_dev.h"
 
 /* ---- a bare back end fed by hand or by a thread ------------------------ */
 
@@ -403,16 +404,7 @@ static int app_write(struct px_loop *l, const struct px_loop_cycle *c,
 
 static struct px_loop *make_loop(struct app *a, struct px_dev *d)
 {
-	struct px_loop_config lc;
-	struct px_loop *l;
-	px_loop_config_default(&lc);
-	lc.clock = PX_LOOP_CLOCK_VIRTUAL;
-	lc.read = app_read;
-	lc.compute = app_compute;
-	lc.write = app_write;
-	lc.user = a;
-	lc.hist_bins = 100;
-	PX_CHECK_INT_EQ(px_loop_create(&lc, &l), PX_OK);
+	struct px_loop *l = px_test_virtual_loop(app_read, app_compute, app_write, a);
 	memset(a, 0, sizeof *a);
 	a->dev = d;
 	a->k = 50.0;
@@ -780,7 +772,6 @@ static void test_slow_pose_device_age_is_visible(void)
 	struct px_sim_haptic_config hc = sines_cfg();
 	struct px_dev_config c;
 	struct px_dev *d;
-	struct px_loop_config lc;
 	struct px_loop *l;
 	struct px_loop_status ls;
 	struct app a;
@@ -797,12 +788,7 @@ static void test_slow_pose_device_age_is_visible(void)
 	hc.traj.center_m[2] = -0.02;
 	PX_CHECK_INT_EQ(px_sim_haptic_create(&c, &hc, &d, msg, sizeof msg),
 			PX_OK);
-	px_loop_config_default(&lc);
-	lc.clock = PX_LOOP_CLOCK_VIRTUAL;
-	lc.read = slow_read;
-	lc.user = &a;
-	lc.hist_bins = 100;
-	PX_CHECK_INT_EQ(px_loop_create(&lc, &l), PX_OK);
+	l = px_test_virtual_loop(slow_read, NULL, NULL, &a);
 	memset(&a, 0, sizeof a);
 	a.dev = d;
 	PX_CHECK_INT_EQ(px_dev_attach(d, l), 0);

@@ -198,7 +198,6 @@ static void test_estop_trips_loop_and_holds_safe_state(void)
 		{PX_SIM_FAULT_UNPLUG, 600000000, 50000000, 1.0, 0},
 	};
 	struct px_dev_config dc;
-	struct px_loop_config lc;
 	struct px_loop *l;
 	struct px_loop_status ls;
 	static struct app a;
@@ -210,14 +209,7 @@ static void test_estop_trips_loop_and_holds_safe_state(void)
 	dc.name = "io";
 	PX_CHECK_INT_EQ(px_gpio_sim_create(&dc, &c, f, 2, &a.io, msg, sizeof msg),
 			PX_OK);
-	px_loop_config_default(&lc);
-	lc.clock = PX_LOOP_CLOCK_VIRTUAL;
-	lc.read = a_read;
-	lc.compute = a_compute;
-	lc.write = a_write;
-	lc.user = &a;
-	lc.hist_bins = 100;
-	PX_CHECK_INT_EQ(px_loop_create(&lc, &l), PX_OK);
+	l = px_test_virtual_loop(a_read, a_compute, a_write, &a);
 	PX_CHECK_INT_EQ(px_loop_enable_add(l, "enable", &a.enable), 0);
 	PX_CHECK_INT_EQ(px_dev_attach(a.io, l), 0);
 	PX_CHECK_INT_EQ(px_loop_run(l, 1), PX_OK);
@@ -278,7 +270,6 @@ static void run_gpio_fault(int kind, int64_t delay_ns, int trip_at,
 	struct px_gpio_config c = io_cfg(1);
 	struct px_sim_fault f = {kind, 50000000, 200000000, 1.0, delay_ns};
 	struct px_dev_config dc;
-	struct px_loop_config lc;
 	struct px_loop *l;
 	static struct app a;
 	char msg[300];
@@ -296,14 +287,7 @@ static void run_gpio_fault(int kind, int64_t delay_ns, int trip_at,
 	px_gpio_sim_drive(a.io, PX_GPIO_ESTOP, 0, 100000000);
 	px_gpio_sim_drive(a.io, PX_GPIO_ESTOP, 1, 150000000);
 	a.trip_at = trip_at;
-	px_loop_config_default(&lc);
-	lc.clock = PX_LOOP_CLOCK_VIRTUAL;
-	lc.read = a_read;
-	lc.compute = a_compute;
-	lc.write = a_write;
-	lc.user = &a;
-	lc.hist_bins = 100;
-	PX_CHECK_INT_EQ(px_loop_create(&lc, &l), PX_OK);
+	l = px_test_virtual_loop(a_read, a_compute, a_write, &a);
 	PX_CHECK_INT_EQ(px_loop_enable_add(l, "enable", &a.enable), 0);
 	PX_CHECK_INT_EQ(px_dev_attach(a.io, l), 0);
 	r = px_alloc_region_begin();

@@ -26,4 +26,39 @@ void px_test_check_documented(const char *docs,
 struct px_config *px_test_config_load(const char *yaml,
 				      struct px_config_diag *diag);
 
+/*
+ * Config writers: the pieces of YAML the device tests build their
+ * configs from: string literals the compiler joins, so each config
+ * keeps its exact lines (diagnostics name lines and columns).
+ *   PX_TEST_YAML_HEAD                 the version and the devices list
+ *   PX_TEST_YAML_CAN(name, if, tr)    a socketcan device up to its
+ *                                     transport line (sim or unix)
+ *   PX_TEST_YAML_SIM_GPIO(name)       a simulated GPIO device up to its
+ *                                     kind line
+ *   PX_TEST_YAML_SIM_HAP_IO           two whole simulated devices: "hap",
+ *                                     a NaN window at 10 ms for 10 ms,
+ *                                     and GPIO "io" with an estop input
+ */
+#define PX_TEST_YAML_HEAD "version: 1\n" \
+			  "devices:\n"
+#define PX_TEST_YAML_CAN(name, iface, transport)                            \
+	"  - name: " name "\n"                                              \
+	"    backend: socketcan\n"                                           \
+	"    socketcan:\n"                                                   \
+	"      interface: " iface "\n"                                       \
+	"      transport: " transport "\n"
+#define PX_TEST_YAML_SIM_GPIO(name)                                         \
+	"  - name: " name "\n"                                              \
+	"    backend: sim\n"                                                 \
+	"    sim:\n"                                                         \
+	"      kind: gpio\n"
+#define PX_TEST_YAML_SIM_HAP_IO                                             \
+	"  - name: hap\n"                                                    \
+	"    backend: sim\n"                                                 \
+	"    sim:\n"                                                         \
+	"      faults:\n"                                                    \
+	"        - {kind: nan, start_ns: 10000000, duration_ns: 10000000}\n" \
+	PX_TEST_YAML_SIM_GPIO("io")                                         \
+	"      lines: [{name: estop, direction: input}]\n"
+
 #endif

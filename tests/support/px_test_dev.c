@@ -4,6 +4,7 @@
 #include <time.h>
 
 #include "px_dev.h"
+#include "px_test.h"
 
 void px_test_wait_ms(int ms)
 {
@@ -31,4 +32,21 @@ int64_t px_test_deadline_ms(int ms)
 int px_test_past(int64_t deadline_ns)
 {
 	return px_dev_mono_ns() > deadline_ns;
+}
+
+struct px_loop *px_test_virtual_loop(px_loop_phase_fn read,
+				     px_loop_phase_fn compute,
+				     px_loop_phase_fn write, void *user)
+{
+	struct px_loop_config lc;
+	struct px_loop *l = NULL;
+	px_loop_config_default(&lc);
+	lc.clock = PX_LOOP_CLOCK_VIRTUAL;
+	lc.read = read;
+	lc.compute = compute;
+	lc.write = write;
+	lc.user = user;
+	lc.hist_bins = 100;
+	PX_CHECK_INT_EQ(px_loop_create(&lc, &l), PX_OK);
+	return l;
 }

@@ -13,6 +13,8 @@
 
 #include <stdint.h>
 
+#include "px_loop.h"
+
 /* Sleep ms milliseconds. */
 void px_test_wait_ms(int ms);
 
@@ -24,5 +26,12 @@ int64_t px_test_deadline_ms(int ms);
 
 /* 1 once px_dev_mono_ns() is past deadline_ns, else 0. */
 int px_test_past(int64_t deadline_ns);
+
+/* A loop on the virtual clock with these phases (NULL: none) and user,
+ * 100 histogram bins, the rest px_loop_config_default()'s; the test
+ * fails when it cannot be made. */
+struct px_loop *px_test_virtual_loop(px_loop_phase_fn read,
+				     px_loop_phase_fn compute,
+				     px_loop_phase_fn write, void *user);
 
 #endif

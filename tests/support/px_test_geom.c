@@ -4,6 +4,7 @@
 
 #include "px_mesh.h"
 #include "px_test.h"
+#include "mesh_gen.h"
 
 px_quat px_test_rand_quat(void)
 {
@@ -40,4 +41,34 @@ double px_test_mesh_brute(const struct px_model *m, px_vec3 p)
 			best = d2;
 	}
 	return sqrt(best);
+}
+
+struct px_model *px_test_mesh_shape(int kind, int box_div, double *radius)
+{
+	struct gen_mesh g;
+	struct px_model *m = NULL;
+	double h[3] = {0.3, 0.5, 0.2}, r;
+	switch (kind) {
+	case 0:
+		gen_torus(0.6, 0.2, 16, 8, &g);
+		r = 0.8;
+		break;
+	case 1:
+		gen_sphere(0.5, 8, 12, &g);
+		r = 0.5;
+		break;
+	case 2:
+		gen_box(h, box_div, &g);
+		r = sqrt(0.09 + 0.25 + 0.04);
+		break;
+	default:
+		gen_lprism(0.4, 0.3, &g);
+		r = sqrt(2 * 0.64 + 0.09);
+		break;
+	}
+	if (radius)
+		*radius = r;
+	PX_CHECK_INT_EQ(px_mesh_model(g.xyz, g.nv, g.tri, g.nt, NULL, NULL, &m), PX_OK);
+	gen_free(&g);
+	return m;
 }

@@ -21,4 +21,11 @@ struct px_model;
  * with. */
 double px_test_mesh_brute(const struct px_model *m, px_vec3 p);
 
+/* Mesh model number kind of four, the shapes the pair tests share:
+ * 0 a torus (radii 0.6 and 0.2, 16 x 8), 1 a sphere (radius 0.5, 8 x 12),
+ * 2 a box of half sides 0.3, 0.5, 0.2 with box_div x box_div quads a
+ * face, 3 an L-shaped prism (arm 0.4, height 0.3). *radius, when radius
+ * is not NULL: the distance from the origin within which it lies. */
+struct px_model *px_test_mesh_shape(int kind, int box_div, double *radius);
+
 #endif

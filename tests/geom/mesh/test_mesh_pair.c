@@ -22,6 +22,7 @@
 #include "px_pair.h"
 #include "px_prim.h"
 #include "px_test.h"
+#include "px_test_geom.h"
 
 static px_vec3 rand_pt(double s)
 {
@@ -261,30 +262,6 @@ static struct px_model *soup(int nt, double s)
 	return m;
 }
 
-static struct px_model *shape(int kind)
-{
-	struct gen_mesh g;
-	struct px_model *m = NULL;
-	double h[3] = {0.3, 0.5, 0.2};
-	switch (kind) {
-	case 0:
-		gen_torus(0.6, 0.2, 16, 8, &g);
-		break;
-	case 1:
-		gen_sphere(0.5, 8, 12, &g);
-		break;
-	case 2:
-		gen_box(h, 2, &g);
-		break;
-	default:
-		gen_lprism(0.4, 0.3, &g);
-		break;
-	}
-	PX_CHECK_INT_EQ(px_mesh_model(g.xyz, g.nv, g.tri, g.nt, NULL, NULL, &m), PX_OK);
-	gen_free(&g);
-	return m;
-}
-
 /* Minimum of the reference over all triangle pairs (world frame). */
 static double brute(const struct px_model *a, const struct px_model *b)
 {
@@ -326,9 +303,10 @@ static void test_mesh_pair_vs_brute(void)
 {
 	int trial, zero = 0, n = 120;
 	for (trial = 0; trial < n; trial++) {
-		struct px_model *a = trial % 3 == 0 ? soup(px_rand_int(1, 120), 1.0) : shape(trial % 4);
+		struct px_model *a = trial % 3 == 0 ? soup(px_rand_int(1, 120), 1.0)
+						    : px_test_mesh_shape(trial % 4, 2, NULL);
 		struct px_model *b = trial % 2 == 0 ? soup(px_rand_int(1, 120), 0.7)
-						    : shape((trial / 4) % 4);
+						    : px_test_mesh_shape((trial / 4) % 4, 2, NULL);
 		struct px__mesh_pair r, r2;
 		double ref;
 		px_vec3 dir = rand_pt(1);
@@ -387,7 +365,7 @@ static void test_mesh_pair_parallel_faces(void)
 
 static void test_mesh_pair_errors_and_alloc(void)
 {
-	struct px_model *a = shape(0), *b = shape(1);
+	struct px_model *a = px_test_mesh_shape(0, 2, NULL), *b = px_test_mesh_shape(1, 2, NULL);
 	struct px__mesh_pair r;
 	uint64_t reg;
 	int i;
@@ -493,7 +471,8 @@ static void test_pair_mesh_vs_convex_primitives(void)
 {
 	int trial, n = 160, inter = 0, contained = 0;
 	for (trial = 0; trial < n; trial++) {
-		struct px_model *m = trial % 5 == 4 ? soup(px_rand_int(4, 80), 0.6) : shape(trial % 4);
+		struct px_model *m = trial % 5 == 4 ? soup(px_rand_int(4, 80), 0.6)
+						    : px_test_mesh_shape(trial % 4, 2, NULL);
 		struct px_model *pr = NULL;
 		struct px_prim P;
 		struct px_pair_result r;
@@ -618,7 +597,7 @@ static void test_pair_mesh_in_mesh(void)
 
 static void test_pair_exact_paths_alloc(void)
 {
-	struct px_model *a = shape(0), *b = shape(3);
+	struct px_model *a = px_test_mesh_shape(0, 2, NULL), *b = px_test_mesh_shape(3, 2, NULL);
 	struct px_prim bx = {PX_PRIM_BOX, 0.1, 0.2, 0.3}, cy = {PX_PRIM_CYLINDER, 0.1, 0.2, 0};
 	struct px_model *p1, *p2;
 	struct px_pair_result r;
@@ -655,7 +634,8 @@ static void test_pair_coherent_local_ok(void)
 	 * off the mesh/convex path; centre distance past contact */
 	int kb = px_rand_int(0, 1);
 	double R = kb ? 1.6 : 2.0;
-	struct px_model *a = shape(0), *b = shape(kb);
+	struct px_model *a = px_test_mesh_shape(0, 2, NULL);
+	struct px_model *b = px_test_mesh_shape(kb, 2, NULL);
 	struct px_pair_result rc, rl, r0;
 	struct px_pair_opts ex = {1, 64, 1e-12, 1, 0, 0}, lo = {1, 64, 1e-12, 1, 0, 1};
 	struct px_model_result qa, qb;

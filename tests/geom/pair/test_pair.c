@@ -101,34 +101,6 @@ static double brute_mesh_mesh(const struct px_model *a, const struct px_model *b
 	return sqrt(best);
 }
 
-static struct px_model *make_mesh(int kind, double *radius)
-{
-	struct gen_mesh g;
-	struct px_model *m = NULL;
-	double h[3] = {0.3, 0.5, 0.2};
-	switch (kind) {
-	case 0:
-		gen_torus(0.6, 0.2, 16, 8, &g);
-		*radius = 0.8;
-		break;
-	case 1:
-		gen_sphere(0.5, 8, 12, &g);
-		*radius = 0.5;
-		break;
-	case 2:
-		gen_box(h, 1, &g);
-		*radius = sqrt(0.09 + 0.25 + 0.04);
-		break;
-	default:
-		gen_lprism(0.4, 0.3, &g);
-		*radius = sqrt(2 * 0.64 + 0.09);
-		break;
-	}
-	PX_CHECK_INT_EQ(px_mesh_model(g.xyz, g.nv, g.tri, g.nt, NULL, NULL, &m), PX_OK);
-	gen_free(&g);
-	return m;
-}
-
 static void check_pair_result(const struct px_model *a, const struct px_model *b,
 			      const struct px_pair_result *r)
 {
@@ -146,8 +118,8 @@ static void test_mesh_pairs_hit_rate(void)
 	struct px_pair_opts o = {8, 64, 1e-12, 0, 0, 0};
 	for (trial = 0; trial < n; trial++) {
 		double ra, rb, ref, sep;
-		struct px_model *a = make_mesh(trial % 4, &ra);
-		struct px_model *b = make_mesh((trial / 4) % 4, &rb);
+		struct px_model *a = px_test_mesh_shape(trial % 4, 1, &ra);
+		struct px_model *b = px_test_mesh_shape((trial / 4) % 4, 1, &rb);
 		struct px_pair_result r;
 		px_vec3 dir = rand_dir();
 		memset(&r, 0, sizeof(r));
@@ -631,7 +603,7 @@ static void test_cloud_vs_box(void)
 static void test_coherent_and_alloc(void)
 {
 	double ra, rb;
-	struct px_model *a = make_mesh(0, &ra), *b = make_mesh(1, &rb);
+	struct px_model *a = px_test_mesh_shape(0, 1, &ra), *b = px_test_mesh_shape(1, 1, &rb);
 	struct px_pair_result rc, rf;
 	struct px_pair_opts co = {1, 64, 1e-12, 1, 0, 0}, fo = {8, 64, 1e-12, 0, 0, 0};
 	uint64_t al;
@@ -662,8 +634,8 @@ static void test_coherent_and_alloc(void)
 static void test_convex_mesh_flag(void)
 {
 	double r;
-	struct px_model *t = make_mesh(0, &r), *s = make_mesh(1, &r), *bx = make_mesh(2, &r),
-			*l = make_mesh(3, &r);
+	struct px_model *t = px_test_mesh_shape(0, 1, &r), *s = px_test_mesh_shape(1, 1, &r);
+	struct px_model *bx = px_test_mesh_shape(2, 1, &r), *l = px_test_mesh_shape(3, 1, &r);
 	PX_CHECK(!(px_model_caps(t) & PX_MODEL_CAP_CONVEX));
 	PX_CHECK(px_model_caps(s) & PX_MODEL_CAP_CONVEX);
 	PX_CHECK(px_model_caps(bx) & PX_MODEL_CAP_CONVEX);
@@ -685,7 +657,7 @@ static void test_mesh_vs_cloud_certified(void)
 	double *x = malloc(3 * np * sizeof(double));
 	for (trial = 0; trial < n; trial++) {
 		double rm, ref = INFINITY;
-		struct px_model *m = make_mesh(trial % 4, &rm), *c;
+		struct px_model *m = px_test_mesh_shape(trial % 4, 1, &rm), *c;
 		struct px_pair_result r;
 		px_pose Pc = rand_rot_pose(px_v3_scale(rand_dir(), rm + px_rand_range(0.35, 1.2)));
 		double rr = px_rand_range(0.1, 0.3);
