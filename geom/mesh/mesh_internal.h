@@ -548,6 +548,72 @@ static inline int px__box4_within(const struct node4 *n4, px_vec3 p, double r2,
 	return 0;
 }
 
+/*
+ * The nearest-first walk of the tree n4 (root node 0), meshes' and
+ * clouds' point query: pops the entry nearest by its bound, skips it
+ * when the bound is past *best (or equal once *found >= 0), hands a leaf
+ * range [i0, i0 + n) to leaf(ctx, i0, n), which improves *best and
+ * *found, and expands a node: bounds(ctx, node index, node, d2) gives its
+ * four children's lower bounds of the squared distance, and the children
+ * that can still win are pushed farthest first (so the nearest is
+ * expanded first), each announced to fetch(ctx, idx, cnt) to start its
+ * memory loads. st holds cap entries (enough for the depth checked at
+ * setup: past it a child is dropped and 0 returned, else 1). *iters
+ * counts the entries expanded. RT-safe; inline so that the callbacks are
+ * called directly (the walk is the query's hot loop).
+ */
+static inline __attribute__((always_inline)) int
+px__box4_nearest(const struct node4 *n4, struct px__walk4 *st, int cap, const double *best,
+		 const long *found, void (*leaf)(void *ctx, uint32_t i0, uint32_t n),
+		 void (*bounds)(void *ctx, uint32_t node, const struct node4 *nd, double d2[4]),
+		 void (*fetch)(void *ctx, uint32_t idx, uint32_t cnt), void *ctx, int *iters)
+{
+	int sp = 0, certified = 1;
+
+	st[sp].idx = 0;
+	st[sp].cnt = 0;
+	st[sp].d2 = 0.0;
+	sp++;
+	while (sp > 0) {
+		const struct node4 *nd;
+		double dc[4];
+		int ord[4], no = 0, j, c;
+
+		sp--;
+		if (st[sp].d2 > *best || (st[sp].d2 == *best && *found >= 0))
+			continue;
+		(*iters)++;
+		if (st[sp].cnt > 0) {
+			leaf(ctx, st[sp].idx, st[sp].cnt);
+			continue;
+		}
+		nd = &n4[st[sp].idx];
+		bounds(ctx, st[sp].idx, nd, dc);
+		/* children that can still win, nearest first */
+		for (j = 0; j < 4; j++) {
+			if (nd->idx[j] == EMPTY || dc[j] > *best)
+				continue;
+			for (c = no; c > 0 && dc[ord[c - 1]] > dc[j]; c--)
+				ord[c] = ord[c - 1];
+			ord[c] = j;
+			no++;
+		}
+		for (c = no - 1; c >= 0; c--) {
+			j = ord[c];
+			if (sp >= cap) {
+				certified = 0; /* cannot happen: depth checked at setup */
+				continue;
+			}
+			st[sp].idx = nd->idx[j];
+			st[sp].cnt = nd->cnt[j];
+			st[sp].d2 = dc[j];
+			fetch(ctx, st[sp].idx, st[sp].cnt);
+			sp++;
+		}
+	}
+	return certified;
+}
+
 /* ---- mesh-to-mesh distance (px_mesh_pair.c) ------------------------------ */
 
 /*

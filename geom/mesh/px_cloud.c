@@ -127,6 +127,74 @@ static int cloud_finish(const struct cloud *C, const struct px_model_query *q,
 }
 
 
+/* The cloud walk's context (px__box4_nearest's callbacks): the nearest
+ * centre so far (bi at squared distance best), and p in single precision
+ * with the slacks that keep the float box and slab bounds lower bounds
+ * (use: p and the cloud lie within 1e18). */
+struct cwalk {
+	const struct cloud *C;
+	px_vec3 p;
+	double best;
+	long bi;
+	int use;
+	float pf[3];
+	float slack, slack_s;
+};
+
+static inline void cloud_leaf(void *ctx, uint32_t i0, uint32_t n)
+{
+	struct cwalk *w = ctx;
+	uint32_t i;
+	for (i = i0; i < i0 + n; i++) {
+		double d2 = px_v3_dist2(w->p, w->C->pt[i]);
+		if (d2 < w->best || (d2 == w->best && w->bi < 0)) {
+			w->best = d2;
+			w->bi = (long)i;
+		}
+	}
+}
+
+static inline void cloud_bounds(void *ctx, uint32_t node, const struct node4 *nd, double dc[4])
+{
+	const struct cwalk *w = ctx;
+	const struct nslab *S = &w->C->ns[node];
+	const float *pf = w->pf;
+	int j;
+	if (!w->use) {
+		px__box4_d2(nd, w->p, dc);
+		return;
+	}
+	px__box4_d2f(nd, pf, w->slack, dc);
+	/* the slabs: rounding as in the mesh's tri_lb */
+	for (j = 0; j < 4; j++) {
+		float h = S->n[0][j] * pf[0] + S->n[1][j] * pf[1] + S->n[2][j] * pf[2];
+		float g = S->lo[j] - h > h - S->hi[j] ? S->lo[j] - h : h - S->hi[j];
+		g -= w->slack_s;
+		if (g > 0.0f) {
+			double v = (double)(g * g) * (1.0 - 0x1p-18);
+			dc[j] = v > dc[j] ? v : dc[j];
+		}
+	}
+}
+
+static inline void cloud_fetch(void *ctx, uint32_t idx, uint32_t cnt)
+{
+	const struct cloud *C = ((const struct cwalk *)ctx)->C;
+	if (cnt) {
+		/* up to 8 points of 24 bytes: three or four lines */
+		const char *q = (const char *)&C->pt[idx];
+		__builtin_prefetch(q);
+		__builtin_prefetch(q + 64);
+		__builtin_prefetch(q + 128);
+		__builtin_prefetch(q + 191);
+	} else {
+		const char *q = (const char *)&C->n4[idx];
+		__builtin_prefetch(q);
+		__builtin_prefetch(q + 64);
+		__builtin_prefetch(&C->ns[idx]);
+	}
+}
+
 /* The hierarchy walk: improves the nearest centre (*bi at squared
  * distance *best, which may already be a bound from a hint). Boxes are
  * compared in single precision with the slack that keeps them lower
@@ -135,101 +203,29 @@ static int cloud_finish(const struct cloud *C, const struct px_model_query *q,
 static void cloud_walk(const struct cloud *C, px_vec3 p, double *best_io,
 		       long *bi_io, int *iters_io, int *certified_io)
 {
-	struct {
-		uint32_t idx, cnt;
-		double d2;
-	} st[CSTACK4];
-	int sp = 0, iters = *iters_io, certified = 1;
-	double best = *best_io;
-	long bi = *bi_io;
+	struct px__walk4 st[CSTACK4];
+	struct cwalk w;
 	double pmax = fmax(fabs(p.x), fmax(fabs(p.y), fabs(p.z)));
-	int use = pmax < 1e18 && C->absmax < 1e18;
-	float pf[3] = {(float)p.x, (float)p.y, (float)p.z};
-	float slack = (float)(0x1p-22 * (C->absmax + pmax));
+	int iters = *iters_io;
+
+	w.C = C;
+	w.p = p;
+	w.best = *best_io;
+	w.bi = *bi_io;
+	w.use = pmax < 1e18 && C->absmax < 1e18;
+	w.pf[0] = (float)p.x;
+	w.pf[1] = (float)p.y;
+	w.pf[2] = (float)p.z;
+	w.slack = (float)(0x1p-22 * (C->absmax + pmax));
 	/* plane values: a float unit vector, products and sums, the rounded
 	 * p: below 16 * 2^-24 (|p| + |cloud|); twice that */
-	float slack_s = (float)(0x1p-19 * (C->absmax + pmax));
-
-	st[0].idx = 0;
-	st[0].cnt = 0;
-	st[0].d2 = 0.0;
-	sp = 1;
-	while (sp > 0) {
-		const struct node4 *nd;
-		double dc[4];
-		int ord[4], no = 0, j, c;
-
-		sp--;
-		if (st[sp].d2 > best || (st[sp].d2 == best && bi >= 0))
-			continue;
-		iters++;
-		if (st[sp].cnt > 0) {
-			uint32_t i;
-			for (i = st[sp].idx; i < st[sp].idx + st[sp].cnt; i++) {
-				double d2 = px_v3_dist2(p, C->pt[i]);
-				if (d2 < best || (d2 == best && bi < 0)) {
-					best = d2;
-					bi = (long)i;
-				}
-			}
-			continue;
-		}
-		nd = &C->n4[st[sp].idx];
-		if (use) {
-			const struct nslab *S = &C->ns[st[sp].idx];
-			px__box4_d2f(nd, pf, slack, dc);
-			/* the slabs: rounding as in the mesh's tri_lb */
-			for (j = 0; j < 4; j++) {
-				float h = S->n[0][j] * pf[0] + S->n[1][j] * pf[1] + S->n[2][j] * pf[2];
-				float g = S->lo[j] - h > h - S->hi[j] ? S->lo[j] - h : h - S->hi[j];
-				g -= slack_s;
-				if (g > 0.0f) {
-					double v = (double)(g * g) * (1.0 - 0x1p-18);
-					dc[j] = v > dc[j] ? v : dc[j];
-				}
-			}
-		} else {
-			px__box4_d2(nd, p, dc);
-		}
-		/* children that can still win, nearest first */
-		for (j = 0; j < 4; j++) {
-			if (nd->idx[j] == EMPTY || dc[j] > best)
-				continue;
-			for (c = no; c > 0 && dc[ord[c - 1]] > dc[j]; c--)
-				ord[c] = ord[c - 1];
-			ord[c] = j;
-			no++;
-		}
-		for (c = no - 1; c >= 0; c--) {
-			j = ord[c];
-			if (sp >= CSTACK4) {
-				certified = 0; /* cannot happen: depth checked at setup */
-				continue;
-			}
-			st[sp].idx = nd->idx[j];
-			st[sp].cnt = nd->cnt[j];
-			st[sp].d2 = dc[j];
-			if (st[sp].cnt) {
-				/* up to 8 points of 24 bytes: three or four lines */
-				const char *q = (const char *)&C->pt[st[sp].idx];
-				__builtin_prefetch(q);
-				__builtin_prefetch(q + 64);
-				__builtin_prefetch(q + 128);
-				__builtin_prefetch(q + 191);
-			} else {
-				const char *q = (const char *)&C->n4[st[sp].idx];
-				__builtin_prefetch(q);
-				__builtin_prefetch(q + 64);
-				__builtin_prefetch(&C->ns[st[sp].idx]);
-			}
-			sp++;
-		}
-	}
-	*best_io = best;
-	*bi_io = bi;
-	*iters_io = iters;
-	if (!certified)
+	w.slack_s = (float)(0x1p-19 * (C->absmax + pmax));
+	if (!px__box4_nearest(C->n4, st, CSTACK4, &w.best, &w.bi, cloud_leaf, cloud_bounds,
+			      cloud_fetch, &w, &iters))
 		*certified_io = 0;
+	*best_io = w.best;
+	*bi_io = w.bi;
+	*iters_io = iters;
 }
 
 static int cloud_closest(const void *impl, const struct px_model_query *q,

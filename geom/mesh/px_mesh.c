@@ -239,102 +239,89 @@ static void mesh_finish(const struct mesh *M, px_vec3 p, const struct best *bp,
 }
 
 
+/* The mesh walk's context (px__box4_nearest's callbacks). */
+struct mwalk {
+	const struct mesh *M;
+	px_vec3 p;
+	struct best *b;
+	struct pq pq;
+};
+
+static inline void mesh_leaf(void *ctx, uint32_t i0, uint32_t n)
+{
+	struct mwalk *w = ctx;
+	const struct mesh *M = w->M;
+	double lb[16];
+	uint32_t k;
+	if (!w->pq.use) {
+		for (k = 0; k < n; k++)
+			test_tri(M, i0 + k, w->p, w->b);
+		return;
+	}
+	/* all bounds of the leaf first, then the vertex fetches of the
+	 * triangles they keep at once, then the exact tests: the fetches
+	 * overlap instead of queueing */
+	for (k = 0; k < n; k++) {
+		lb[k] = tri_lb(&M->lb[i0 + k], &w->pq);
+		if (!(lb[k] > w->b->d2)) {
+			const uint32_t *v = M->tv + 3 * (i0 + k);
+			__builtin_prefetch(M->vx + v[0]);
+			__builtin_prefetch(M->vx + v[1]);
+			__builtin_prefetch(M->vx + v[2]);
+		}
+	}
+	for (k = 0; k < n; k++)
+		if (!(lb[k] > w->b->d2))
+			test_tri_x(M, i0 + k, w->p, w->b, 1, w->pq.fast);
+}
+
+static inline void mesh_bounds(void *ctx, uint32_t node, const struct node4 *nd, double d2[4])
+{
+	const struct mwalk *w = ctx;
+	(void)node;
+	if (w->pq.use)
+		px__box4_d2f(nd, w->pq.pf, w->pq.slack_box, d2);
+	else
+		px__box4_d2(nd, w->p, d2);
+}
+
+/* Start the memory fetch of a pushed entry: the node or the leaf's
+ * triangles are needed within a few steps. */
+static inline void mesh_fetch(void *ctx, uint32_t idx, uint32_t cnt)
+{
+	const struct mesh *M = ((const struct mwalk *)ctx)->M;
+	if (cnt) {
+		/* one line per triangle */
+		const struct tlb *L = &M->lb[idx];
+		uint32_t k;
+		for (k = 0; k < cnt; k++)
+			__builtin_prefetch(L + k);
+		__builtin_prefetch(M->tv + 3 * idx);
+	} else {
+		/* a node spans two lines */
+		const char *q = (const char *)&M->n4[idx];
+		__builtin_prefetch(q);
+		__builtin_prefetch(q + 64);
+	}
+}
+
 /* The hierarchy walk: improves *b (which may already hold a bound from
  * a hint) to the exact closest triangle within its bound. RT-safe. */
 static void mesh_walk(const struct mesh *M, px_vec3 p, struct best *b,
 		      int *iters_io, int *certified_io)
 {
-	struct {
-		uint32_t idx, cnt;
-		double d2;
-	} st[STACK4];
-	int sp = 0, iters = *iters_io, certified = 1;
-	struct pq pq;
+	struct px__walk4 st[STACK4];
+	struct mwalk w;
+	int iters = *iters_io;
 
-	pq_init(M, p, &pq);
-	st[sp].idx = 0;
-	st[sp].cnt = 0;
-	st[sp].d2 = 0.0;
-	sp++;
-	while (sp > 0) {
-		const struct node4 *nd;
-		double dc[4];
-		int ord[4], no = 0, j, c;
-
-		sp--;
-		if (st[sp].d2 > b->d2 || (st[sp].d2 == b->d2 && b->li >= 0))
-			continue;
-		iters++;
-		if (st[sp].cnt > 0) {
-			uint32_t i0 = st[sp].idx, n = st[sp].cnt, k;
-			double lb[16];
-			if (!pq.use) {
-				for (k = 0; k < n; k++)
-					test_tri(M, i0 + k, p, b);
-				continue;
-			}
-			/* all bounds of the leaf first, then the vertex fetches
-			 * of the triangles they keep at once, then the exact
-			 * tests: the fetches overlap instead of queueing */
-			for (k = 0; k < n; k++) {
-				lb[k] = tri_lb(&M->lb[i0 + k], &pq);
-				if (!(lb[k] > b->d2)) {
-					const uint32_t *v = M->tv + 3 * (i0 + k);
-					__builtin_prefetch(M->vx + v[0]);
-					__builtin_prefetch(M->vx + v[1]);
-					__builtin_prefetch(M->vx + v[2]);
-				}
-			}
-			for (k = 0; k < n; k++)
-				if (!(lb[k] > b->d2))
-					test_tri_x(M, i0 + k, p, b, 1, pq.fast);
-			continue;
-		}
-		nd = &M->n4[st[sp].idx];
-		if (pq.use)
-			px__box4_d2f(nd, pq.pf, pq.slack_box, dc);
-		else
-			px__box4_d2(nd, p, dc);
-		/* children that can still win, nearest first */
-		for (j = 0; j < 4; j++) {
-			if (nd->idx[j] == EMPTY || dc[j] > b->d2)
-				continue;
-			for (c = no; c > 0 && dc[ord[c - 1]] > dc[j]; c--)
-				ord[c] = ord[c - 1];
-			ord[c] = j;
-			no++;
-		}
-		/* push the farthest first so the nearest is expanded first */
-		for (c = no - 1; c >= 0; c--) {
-			j = ord[c];
-			if (sp >= STACK4) {
-				certified = 0; /* cannot happen: depth checked at setup */
-				continue;
-			}
-			st[sp].idx = nd->idx[j];
-			st[sp].cnt = nd->cnt[j];
-			st[sp].d2 = dc[j];
-			/* start the memory fetch now: the node or the leaf's
-			 * triangles are needed within a few steps */
-			if (st[sp].cnt) {
-				/* one line per triangle */
-				const struct tlb *L = &M->lb[st[sp].idx];
-				uint32_t k;
-				for (k = 0; k < st[sp].cnt; k++)
-					__builtin_prefetch(L + k);
-				__builtin_prefetch(M->tv + 3 * st[sp].idx);
-			} else {
-				/* a node spans two lines */
-				const char *q = (const char *)&M->n4[st[sp].idx];
-				__builtin_prefetch(q);
-				__builtin_prefetch(q + 64);
-			}
-			sp++;
-		}
-	}
-	*iters_io = iters;
-	if (!certified)
+	w.M = M;
+	w.p = p;
+	w.b = b;
+	pq_init(M, p, &w.pq);
+	if (!px__box4_nearest(M->n4, st, STACK4, &b->d2, &b->li, mesh_leaf, mesh_bounds,
+			      mesh_fetch, &w, &iters))
 		*certified_io = 0;
+	*iters_io = iters;
 }
 
 static void best_init(struct best *b, px_vec3 p, double max_dist)
