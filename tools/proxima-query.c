@@ -196,300 +196,348 @@ static int cmp_i64(const void *a, const void *b)
 	return (x > y) - (x < y);
 }
 
-int main(int argc, char **argv)
-{
-	const char *model_path = NULL, *points_path = NULL;
-	int track = 0, stats = 0, i, rc, nc = 0, ns = 0;
-	struct px_obj_model *obj = NULL;
-	struct px_obj_error oerr;
-	struct px_nurbs_curve *curves = NULL;
-	struct px_nurbs_surf *surfs = NULL;
-	struct px_dist_model *m = NULL;
-	struct px_model *mesh = NULL;
-	struct px_track *trk = NULL;
-	struct px_strack *strk = NULL;
-	struct points pts = {0};
-	int64_t t_setup, *times = NULL;
-	const char *ext;
+/* What one run holds: the options, the model in whichever of its forms
+ * the file gives (free-form entities: a global model or a tracker; faces,
+ * meshes and clouds: a px_model), the points and their times. */
+struct query {
+	const char *model_path, *points_path;
+	int track, stats;
+	struct px_obj_model *obj;
+	struct px_nurbs_curve *curves;
+	struct px_nurbs_surf *surfs;
+	int nc, ns;
+	struct px_dist_model *m;
+	struct px_model *mesh;
+	struct px_track *trk;
+	struct px_strack *strk;
+	struct points pts;
+	int64_t t_setup, *times;
+};
 
+/* Options and the two paths: 0 to go on, else the exit status (-1: 0
+ * after --help). */
+static int parse_args(int argc, char **argv, struct query *q)
+{
+	int i;
 	for (i = 1; i < argc; i++) {
 		if (!strcmp(argv[i], "--track"))
-			track = 1;
+			q->track = 1;
 		else if (!strcmp(argv[i], "--stats"))
-			stats = 1;
+			q->stats = 1;
 		else if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
 			usage(stdout);
-			return 0;
+			return -1;
 		} else if (argv[i][0] == '-' && argv[i][1]) {
 			fprintf(stderr, "%s: unknown option '%s'\n", prog, argv[i]);
 			usage(stderr);
 			return 2;
-		} else if (!model_path)
-			model_path = argv[i];
-		else if (!points_path)
-			points_path = argv[i];
+		} else if (!q->model_path)
+			q->model_path = argv[i];
+		else if (!q->points_path)
+			q->points_path = argv[i];
 		else {
 			fprintf(stderr, "%s: unexpected argument '%s'\n", prog, argv[i]);
 			usage(stderr);
 			return 2;
 		}
 	}
-	if (!model_path || !points_path) {
+	if (!q->model_path || !q->points_path) {
 		usage(stderr);
 		return 2;
 	}
-	ext = ext_of(model_path);
-	t_setup = now_ns();
-	if (track && !ieq(ext, "obj")) {
+	return 0;
+}
+
+/* The OBJ file's faces as a mesh of the same model. */
+static int load_obj_faces(struct query *q)
+{
+	struct px_mesh_report rep;
+	const struct px_obj_model *obj = q->obj;
+	uint32_t *tri = malloc(3 * (size_t)obj->n_triangles * sizeof(*tri));
+	int i, rc;
+	if (!tri) {
+		fprintf(stderr, "%s: out of memory\n", prog);
+		return 1;
+	}
+	for (i = 0; i < 3 * obj->n_triangles; i++)
+		tri[i] = (uint32_t)obj->triangles[i];
+	rc = px_mesh_model(obj->vertices, (size_t)obj->n_vertices, tri,
+			   (size_t)obj->n_triangles, NULL, &rep, &q->mesh);
+	free(tri);
+	if (rc) {
+		fprintf(stderr, "%s: %s: faces: %s\n", prog, q->model_path,
+			rep.message[0] ? rep.message : px_strerror(rc));
+		return 1;
+	}
+	return 0;
+}
+
+/* An OBJ: its free-form entities as a global model or a tracker, its
+ * faces as a mesh. 0 or the exit status. */
+static int load_obj(struct query *q)
+{
+	struct px_obj_error oerr;
+	const struct px_obj_model *obj;
+	int i, rc = px_obj_load_file(q->model_path, &q->obj, &oerr);
+	if (rc) {
+		if (oerr.line > 0)
+			fprintf(stderr, "%s: %s:%d:%d: %s\n", prog, oerr.file,
+				oerr.line, oerr.column, oerr.msg);
+		else
+			fprintf(stderr, "%s: %s: %s\n", prog, q->model_path,
+				oerr.msg[0] ? oerr.msg : px_strerror(rc));
+		return 1;
+	}
+	obj = q->obj;
+	q->curves = calloc((size_t)obj->n_entities + 1, sizeof(*q->curves));
+	q->surfs = calloc((size_t)obj->n_entities + 1, sizeof(*q->surfs));
+	if (!q->curves || !q->surfs) {
+		fprintf(stderr, "%s: out of memory\n", prog);
+		return 1;
+	}
+	for (i = 0; i < obj->n_entities; i++) {
+		if (obj->entities[i].kind == PX_OBJ_CURVE)
+			q->curves[q->nc++] = obj->entities[i].curve;
+		else
+			q->surfs[q->ns++] = obj->entities[i].surf;
+	}
+	if (q->nc + q->ns == 0 && obj->n_triangles == 0) {
+		fprintf(stderr, "%s: %s: no free-form curve or surface and no "
+				"face in the file\n", prog, q->model_path);
+		return 1;
+	}
+	if (q->track && obj->n_triangles > 0) {
+		fprintf(stderr, "%s: %s: --track: coherent tracking supports "
+				"free-form curves and surfaces only (the model "
+				"has faces); run without --track for independent "
+				"global queries\n",
+			prog, q->model_path);
+		return 2;
+	}
+	rc = PX_OK;
+	if (q->track && q->ns > 0)
+		rc = px_strack_create(q->curves, q->nc, q->surfs, q->ns, NULL, &q->strk);
+	else if (q->track)
+		rc = px_track_create(q->curves, q->nc, NULL, &q->trk);
+	else if (q->nc + q->ns > 0)
+		rc = px_dist_model_create(q->curves, q->nc, q->surfs, q->ns, NULL, &q->m);
+	if (rc) {
+		fprintf(stderr, "%s: %s: cannot prepare the %s: %s\n", prog,
+			q->model_path, q->track ? "tracker" : "model", px_strerror(rc));
+		return 1;
+	}
+	return obj->n_triangles > 0 ? load_obj_faces(q) : 0;
+}
+
+/* The model, by the file's type. 0 or the exit status. */
+static int load_model(struct query *q)
+{
+	const char *ext = ext_of(q->model_path);
+	char msg[512];
+	int rc;
+	if (q->track && !ieq(ext, "obj")) {
 		fprintf(stderr, "%s: %s: --track: coherent tracking supports "
 				"free-form curves and surfaces (.obj) only; run "
 				"without --track for independent global queries\n",
-			prog, model_path);
+			prog, q->model_path);
 		return 2;
 	}
-	if (!ieq(ext, "obj")) {
-		/* Meshes and point clouds. */
-		char msg[512];
-		rc = px_model_load(model_path, 0.0, &mesh, msg, sizeof(msg));
-		if (rc) {
-			fprintf(stderr, "%s: %s\n", prog, msg[0] ? msg : px_strerror(rc));
-			return 1;
-		}
-		if (msg[0] && stats)
-			fprintf(stderr, "%s: %s\n", prog, msg);
-	} else {
-		rc = px_obj_load_file(model_path, &obj, &oerr);
-		if (rc) {
-			if (oerr.line > 0)
-				fprintf(stderr, "%s: %s:%d:%d: %s\n", prog, oerr.file,
-					oerr.line, oerr.column, oerr.msg);
-			else
-				fprintf(stderr, "%s: %s: %s\n", prog, model_path,
-					oerr.msg[0] ? oerr.msg : px_strerror(rc));
-			return 1;
-		}
-		curves = calloc((size_t)obj->n_entities + 1, sizeof(*curves));
-		surfs = calloc((size_t)obj->n_entities + 1, sizeof(*surfs));
-		if (!curves || !surfs) {
-			fprintf(stderr, "%s: out of memory\n", prog);
-			rc = 1;
-			goto out;
-		}
-		for (i = 0; i < obj->n_entities; i++) {
-			if (obj->entities[i].kind == PX_OBJ_CURVE)
-				curves[nc++] = obj->entities[i].curve;
-			else
-				surfs[ns++] = obj->entities[i].surf;
-		}
-		if (nc + ns == 0 && obj->n_triangles == 0) {
-			fprintf(stderr, "%s: %s: no free-form curve or surface and no "
-					"face in the file\n", prog, model_path);
-			rc = 1;
-			goto out;
-		}
-		if (track && obj->n_triangles > 0) {
-			fprintf(stderr, "%s: %s: --track: coherent tracking supports "
-					"free-form curves and surfaces only (the model "
-					"has faces); run without --track for independent "
-					"global queries\n",
-				prog, model_path);
-			rc = 2;
-			goto out;
-		}
-		rc = PX_OK;
-		if (track && ns > 0)
-			rc = px_strack_create(curves, nc, surfs, ns, NULL, &strk);
-		else if (track)
-			rc = px_track_create(curves, nc, NULL, &trk);
-		else if (nc + ns > 0)
-			rc = px_dist_model_create(curves, nc, surfs, ns, NULL, &m);
-		if (rc) {
-			fprintf(stderr, "%s: %s: cannot prepare the %s: %s\n", prog,
-				model_path, track ? "tracker" : "model",
-				px_strerror(rc));
-			rc = 1;
-			goto out;
-		}
-		if (obj->n_triangles > 0) {
-			/* The file's faces are a mesh of the same model. */
-			struct px_mesh_report rep;
-			uint32_t *tri = malloc(3 * (size_t)obj->n_triangles * sizeof(*tri));
-			if (!tri) {
-				fprintf(stderr, "%s: out of memory\n", prog);
-				rc = 1;
-				goto out;
-			}
-			for (i = 0; i < 3 * obj->n_triangles; i++)
-				tri[i] = (uint32_t)obj->triangles[i];
-			rc = px_mesh_model(obj->vertices, (size_t)obj->n_vertices, tri,
-					   (size_t)obj->n_triangles, NULL, &rep, &mesh);
-			free(tri);
-			if (rc) {
-				fprintf(stderr, "%s: %s: faces: %s\n", prog, model_path,
-					rep.message[0] ? rep.message : px_strerror(rc));
-				rc = 1;
-				goto out;
-			}
-		}
+	if (ieq(ext, "obj"))
+		return load_obj(q);
+	/* meshes and point clouds */
+	rc = px_model_load(q->model_path, 0.0, &q->mesh, msg, sizeof(msg));
+	if (rc) {
+		fprintf(stderr, "%s: %s\n", prog, msg[0] ? msg : px_strerror(rc));
+		return 1;
 	}
-	t_setup = now_ns() - t_setup;
+	if (msg[0] && q->stats)
+		fprintf(stderr, "%s: %s\n", prog, msg);
+	return 0;
+}
 
-	if (read_points(points_path, &pts)) {
-		rc = 1;
-		goto out;
+/* The output row of one point: distance, closest point, parameters. */
+struct row {
+	double dist;
+	px_vec3 cp;
+	double u, v;
+};
+
+/* One point through whichever forms the model has; the nearest answer. */
+static int query_point(const struct query *q, px_vec3 p, struct row *o)
+{
+	int qrc = 0;
+	*o = (struct row){INFINITY, px_v3(0, 0, 0), 0.0, 0.0};
+	if (q->trk) {
+		struct px_track_result tr;
+		qrc = px_track_update(q->trk, p, &tr);
+		if (!qrc)
+			*o = (struct row){tr.dist, tr.point, tr.u, 0.0};
 	}
-	times = malloc((pts.n ? pts.n : 1) * sizeof(*times));
-	if (!times) {
+	if (q->strk) {
+		struct px_strack_result tr;
+		qrc = px_strack_update(q->strk, p, &tr);
+		if (!qrc)
+			*o = (struct row){tr.dist, tr.point, tr.u, tr.v};
+	}
+	if (q->m) {
+		struct px_dist_result r;
+		qrc = px_dist_query(q->m, p, &r);
+		if (!qrc)
+			*o = (struct row){r.dist, r.point, r.u, r.v};
+	}
+	if (q->mesh && !qrc) {
+		struct px_model_result r;
+		qrc = px_model_query_ex(q->mesh, p, INFINITY, -1, PX_QUERY_UNSIGNED, &r);
+		/* u: the triangle or point index */
+		if (qrc == 1 && r.distance < o->dist)
+			*o = (struct row){r.distance, r.point, (double)r.index, 0.0};
+		qrc = qrc < 0 ? qrc : 0;
+	}
+	return qrc;
+}
+
+/* Every point, one output line each, timed. 0 or the exit status. */
+static int run_points(struct query *q)
+{
+	size_t k;
+	if (read_points(q->points_path, &q->pts))
+		return 1;
+	q->times = malloc((q->pts.n ? q->pts.n : 1) * sizeof(*q->times));
+	if (!q->times) {
 		fprintf(stderr, "%s: out of memory\n", prog);
-		rc = 1;
-		goto out;
+		return 1;
 	}
-	for (size_t k = 0; k < pts.n; k++) {
-		/* the output row: distance, closest point, parameters */
-		struct row {
-			double dist;
-			px_vec3 cp;
-			double u, v;
-		} o = {INFINITY, px_v3(0, 0, 0), 0.0, 0.0};
+	for (k = 0; k < q->pts.n; k++) {
+		struct row o;
 		int64_t t0 = now_ns();
-		int qrc = 0;
-		if (trk) {
-			struct px_track_result tr;
-			qrc = px_track_update(trk, pts.p[k], &tr);
-			if (!qrc)
-				o = (struct row){tr.dist, tr.point, tr.u, 0.0};
-		}
-		if (strk) {
-			struct px_strack_result tr;
-			qrc = px_strack_update(strk, pts.p[k], &tr);
-			if (!qrc)
-				o = (struct row){tr.dist, tr.point, tr.u, tr.v};
-		}
-		if (m) {
-			struct px_dist_result r;
-			qrc = px_dist_query(m, pts.p[k], &r);
-			if (!qrc)
-				o = (struct row){r.dist, r.point, r.u, r.v};
-		}
-		if (mesh && !qrc) {
-			struct px_model_result r;
-			qrc = px_model_query_ex(mesh, pts.p[k], INFINITY, -1,
-						PX_QUERY_UNSIGNED, &r);
-			/* u: the triangle or point index */
-			if (qrc == 1 && r.distance < o.dist)
-				o = (struct row){r.distance, r.point,
-						 (double)r.index, 0.0};
-			qrc = qrc < 0 ? qrc : 0;
-		}
-		times[k] = now_ns() - t0;
+		int qrc = query_point(q, q->pts.p[k], &o);
+		q->times[k] = now_ns() - t0;
 		if (qrc) {
-			fprintf(stderr, "%s: %s: point %zu: %s\n", prog, points_path,
+			fprintf(stderr, "%s: %s: point %zu: %s\n", prog, q->points_path,
 				k + 1, px_strerror(qrc));
-			rc = 1;
-			goto out;
+			return 1;
 		}
 		printf("%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", o.dist, o.cp.x,
 		       o.cp.y, o.cp.z, o.u, o.v);
 	}
 	if (fflush(stdout) || ferror(stdout)) {
 		fprintf(stderr, "%s: write error on standard output\n", prog);
-		rc = 1;
-		goto out;
+		return 1;
 	}
-	if (stats) {
-		struct px_dist_info info;
-		size_t bytes = 0;
-		const struct px_dist_model *dm = trk ? px_track_dist_model(trk)
-					       : strk ? px_strack_dist_model(strk) : m;
-		if (dm) {
-			px_dist_model_info(dm, &info);
-			bytes += info.bytes;
-		}
-		if (mesh)
-			bytes += px_model_memory_bytes(mesh);
-		fprintf(stderr, "setup_ms %.3f\n", t_setup / 1e6);
-		fprintf(stderr, "model_bytes %zu\n", bytes);
-		if (dm)
-			fprintf(stderr, "entities %d pieces %d (curve pieces %d, patches %d)\n",
-				info.n_entities, info.n_pieces, info.n_curve_pieces,
-				info.n_patches);
-		if (mesh)
-			fprintf(stderr, "%s model: %s\n", px_model_name(mesh),
-				px_model_kind(mesh) == PX_MODEL_CLOUD ? "point cloud" : "triangles");
-		if (pts.n) {
-			qsort(times, pts.n, sizeof(*times), cmp_i64);
-			fprintf(stderr,
-				"queries %zu query_ns min %lld median %lld p99 %lld max %lld\n",
-				pts.n, (long long)times[0], (long long)times[pts.n / 2],
-				(long long)times[(pts.n * 99) / 100 < pts.n ? (pts.n * 99) / 100
-									  : pts.n - 1],
-				(long long)times[pts.n - 1]);
-		} else {
-			fprintf(stderr, "queries 0\n");
-		}
-		if (trk) {
-			struct px_track_stats st;
-			struct px_track_info ti;
-			px_track_get_stats(trk, &st);
-			px_track_get_info(trk, &ti);
-			fprintf(stderr, "track_leaves %d boxed %d tracker_bytes %zu\n",
-				ti.n_leaves, ti.n_boxed_leaves, ti.bytes);
-			fprintf(stderr,
-				"track_updates %llu leaf_solves %llu created %llu "
-				"annihilated %llu reinits %llu outside %llu fallbacks %llu\n",
-				(unsigned long long)st.updates,
-				(unsigned long long)st.leaf_solves,
-				(unsigned long long)st.creations,
-				(unsigned long long)st.annihilations,
-				(unsigned long long)st.reinits,
-				(unsigned long long)st.outside,
-				(unsigned long long)st.fallbacks);
-			fprintf(stderr,
-				"track_hot %llu rested %llu rested_entities %llu\n",
-				(unsigned long long)st.hot,
-				(unsigned long long)st.rested,
-				(unsigned long long)st.rested_entities);
-			print_cold("track", st.cold, st.cold_entered, st.cold_left,
-				   st.tracked_ns, st.cold_ns);
-		}
-		if (strk) {
-			struct px_strack_stats st;
-			struct px_strack_info si;
-			px_strack_get_stats(strk, &st);
-			px_strack_get_info(strk, &si);
-			fprintf(stderr, "strack_surfaces %d patches %d cells %d edges %d "
-				"poles %d\n", si.n_surfaces, si.n_patches, si.n_cells,
-				si.n_edges, si.n_poles);
-			fprintf(stderr,
-				"strack_updates %llu cell_solves %llu reinits %llu "
-				"outside %llu fallbacks %llu\n",
-				(unsigned long long)st.updates,
-				(unsigned long long)st.cell_solves,
-				(unsigned long long)st.reinits,
-				(unsigned long long)st.outside,
-				(unsigned long long)st.fallbacks);
-			fprintf(stderr,
-				"strack_over_budget %llu catching_up %llu "
-				"curve_skips %llu\n",
-				(unsigned long long)st.over_budget,
-				(unsigned long long)st.rebuild_updates,
-				(unsigned long long)st.curve_skips);
-			fprintf(stderr, "strack_hot %llu\n",
-				(unsigned long long)st.hot);
-			print_cold("strack", st.cold, st.cold_entered, st.cold_left,
-				   st.tracked_ns, st.cold_ns);
-		}
+	return 0;
+}
+
+/* --track --stats: the curve tracker's counters. */
+static void print_track_stats(const struct px_track *trk)
+{
+	struct px_track_stats st;
+	struct px_track_info ti;
+	px_track_get_stats(trk, &st);
+	px_track_get_info(trk, &ti);
+	fprintf(stderr, "track_leaves %d boxed %d tracker_bytes %zu\n",
+		ti.n_leaves, ti.n_boxed_leaves, ti.bytes);
+	fprintf(stderr,
+		"track_updates %llu leaf_solves %llu created %llu "
+		"annihilated %llu reinits %llu outside %llu fallbacks %llu\n",
+		(unsigned long long)st.updates, (unsigned long long)st.leaf_solves,
+		(unsigned long long)st.creations, (unsigned long long)st.annihilations,
+		(unsigned long long)st.reinits, (unsigned long long)st.outside,
+		(unsigned long long)st.fallbacks);
+	fprintf(stderr, "track_hot %llu rested %llu rested_entities %llu\n",
+		(unsigned long long)st.hot, (unsigned long long)st.rested,
+		(unsigned long long)st.rested_entities);
+	print_cold("track", st.cold, st.cold_entered, st.cold_left, st.tracked_ns,
+		   st.cold_ns);
+}
+
+/* --track --stats: the surface tracker's counters. */
+static void print_strack_stats(const struct px_strack *strk)
+{
+	struct px_strack_stats st;
+	struct px_strack_info si;
+	px_strack_get_stats(strk, &st);
+	px_strack_get_info(strk, &si);
+	fprintf(stderr, "strack_surfaces %d patches %d cells %d edges %d "
+		"poles %d\n", si.n_surfaces, si.n_patches, si.n_cells,
+		si.n_edges, si.n_poles);
+	fprintf(stderr,
+		"strack_updates %llu cell_solves %llu reinits %llu "
+		"outside %llu fallbacks %llu\n",
+		(unsigned long long)st.updates, (unsigned long long)st.cell_solves,
+		(unsigned long long)st.reinits, (unsigned long long)st.outside,
+		(unsigned long long)st.fallbacks);
+	fprintf(stderr,
+		"strack_over_budget %llu catching_up %llu "
+		"curve_skips %llu\n",
+		(unsigned long long)st.over_budget,
+		(unsigned long long)st.rebuild_updates,
+		(unsigned long long)st.curve_skips);
+	fprintf(stderr, "strack_hot %llu\n", (unsigned long long)st.hot);
+	print_cold("strack", st.cold, st.cold_entered, st.cold_left, st.tracked_ns,
+		   st.cold_ns);
+}
+
+/* --stats: setup, memory, query times and the trackers' counters. */
+static void print_stats(const struct query *q)
+{
+	struct px_dist_info info;
+	size_t bytes = 0, n = q->pts.n;
+	const struct px_dist_model *dm = q->trk ? px_track_dist_model(q->trk)
+				       : q->strk ? px_strack_dist_model(q->strk) : q->m;
+	if (dm) {
+		px_dist_model_info(dm, &info);
+		bytes += info.bytes;
 	}
-	rc = 0;
-out:
-	px_strack_free(strk);
-	px_track_free(trk);
-	px_dist_model_free(m);
-	px_model_free(mesh);
-	px_obj_free(obj);
-	free(curves);
-	free(surfs);
-	free(pts.p);
-	free(times);
+	if (q->mesh)
+		bytes += px_model_memory_bytes(q->mesh);
+	fprintf(stderr, "setup_ms %.3f\n", q->t_setup / 1e6);
+	fprintf(stderr, "model_bytes %zu\n", bytes);
+	if (dm)
+		fprintf(stderr, "entities %d pieces %d (curve pieces %d, patches %d)\n",
+			info.n_entities, info.n_pieces, info.n_curve_pieces,
+			info.n_patches);
+	if (q->mesh)
+		fprintf(stderr, "%s model: %s\n", px_model_name(q->mesh),
+			px_model_kind(q->mesh) == PX_MODEL_CLOUD ? "point cloud" : "triangles");
+	if (n) {
+		qsort(q->times, n, sizeof(*q->times), cmp_i64);
+		fprintf(stderr, "queries %zu query_ns min %lld median %lld p99 %lld max %lld\n",
+			n, (long long)q->times[0], (long long)q->times[n / 2],
+			(long long)q->times[(n * 99) / 100 < n ? (n * 99) / 100 : n - 1],
+			(long long)q->times[n - 1]);
+	} else {
+		fprintf(stderr, "queries 0\n");
+	}
+	if (q->trk)
+		print_track_stats(q->trk);
+	if (q->strk)
+		print_strack_stats(q->strk);
+}
+
+int main(int argc, char **argv)
+{
+	struct query q;
+	int rc;
+
+	memset(&q, 0, sizeof(q));
+	rc = parse_args(argc, argv, &q);
+	if (rc)
+		return rc < 0 ? 0 : rc;
+	q.t_setup = now_ns();
+	rc = load_model(&q);
+	q.t_setup = now_ns() - q.t_setup;
+	if (!rc)
+		rc = run_points(&q);
+	if (!rc && q.stats)
+		print_stats(&q);
+	px_strack_free(q.strk);
+	px_track_free(q.trk);
+	px_dist_model_free(q.m);
+	px_model_free(q.mesh);
+	px_obj_free(q.obj);
+	free(q.curves);
+	free(q.surfs);
+	free(q.pts.p);
+	free(q.times);
 	return rc;
 }
