@@ -72,19 +72,121 @@ static int number(const char *flag, const char *v, double lo, double hi,
 	return 0;
 }
 
+/* What a --config gives: the bus's other end, the drives, their PDO
+ * layout and faults. */
+struct layout {
+	struct px_config *cfg;
+	struct px_canopen_pdo_map pdo;
+	struct px_canopen_drive_cfg drv[PX_CANOPEN_MAX_DRIVES];
+	struct px_sim_fault faults[PX_SIM_MAX_FAULTS];
+	int n, n_faults;
+	const char *iface, *local, *peer;
+	char upeer[256], ulocal[256];
+};
+
+/* The arm of a config's device (devname, or the first socketcan device
+ * with CANopen drives); need_bus: the bus's end from the config too.
+ * 0, or the exit status with the config freed. */
+static int from_config(struct layout *L, const char *config, const char *devname,
+		       int need_bus)
+{
+	static struct px_config_diag diag;
+	const struct px_config_device *dc = NULL;
+	size_t k, nd = 0;
+	char msg[400];
+	int rc;
+	px_config_diag_init(&diag);
+	rc = px_config_load_file(config, &L->cfg, &diag);
+	if (rc != PX_OK) {
+		px_config_diag_print(&diag, stderr);
+		fprintf(stderr, "proxima-simarm: %s: invalid "
+			"configuration\n", config);
+		return 1;
+	}
+	for (k = 0; k < L->cfg->n_devices && !dc; k++) {
+		const struct px_config_device *d = &L->cfg->devices[k];
+		if (devname ? !strcmp(d->name, devname)
+			    : d->backend == PX_CONFIG_BACKEND_SOCKETCAN &&
+				      d->socketcan.canopen.n_drives)
+			dc = d;
+	}
+	if (!dc) {
+		fprintf(stderr, "proxima-simarm: %s: %s\n", config,
+			devname ? "no device of that name"
+				: "no socketcan device with canopen "
+				  "drives");
+		goto fail1;
+	}
+	rc = px_devcfg_canopen_layout(L->cfg, dc, L->drv, PX_CANOPEN_MAX_DRIVES, &nd,
+				      &L->pdo, msg, sizeof msg);
+	if (rc != PX_OK) {
+		fprintf(stderr, "proxima-simarm: %s: %s\n", config,
+			msg[0] ? msg : px_strerror(rc));
+		goto fail1;
+	}
+	L->n = (int)nd;
+	/* the config's drive faults (node_id), from our start */
+	L->n_faults = px_devcfg_arm_faults(L->cfg, dc, 0, L->faults, PX_SIM_MAX_FAULTS);
+	if (L->n_faults < 0) {
+		fprintf(stderr, "proxima-simarm: %s: device '%s': "
+			"faults: %s\n", config, dc->name,
+			px_strerror(L->n_faults));
+		goto fail1;
+	}
+	if (need_bus) {
+		const struct px_config_socketcan *c = &dc->socketcan;
+		if (c->transport == PX_CONFIG_CAN_KERNEL) {
+			L->iface = c->interface;
+		} else if (c->transport == PX_CONFIG_CAN_UNIX) {
+			/* the controller binds socket_path and sends
+			 * to socket_path.peer: the other end */
+			snprintf(L->ulocal, sizeof L->ulocal, "%s.peer", c->socket_path);
+			snprintf(L->upeer, sizeof L->upeer, "%s", c->socket_path);
+			L->local = L->ulocal;
+			L->peer = L->upeer;
+		} else {
+			fprintf(stderr, "proxima-simarm: device '%s' is "
+				"on an in-process simulated bus "
+				"(transport sim), which another process "
+				"cannot join: use transport unix or give "
+				"--can / --unix\n", dc->name);
+			px_config_free(L->cfg);
+			L->cfg = NULL;
+			return 2;
+		}
+	}
+	return 0;
+fail1:
+	px_config_free(L->cfg);
+	L->cfg = NULL;
+	return 1;
+}
+
+/* The drives' own view at the end: what the controller last told them
+ * over the bus (a controller that stopped safely leaves each in switch
+ * on disabled). */
+static void report_end(struct px_canopen_sim *sim,
+		       const struct px_canopen_drive_cfg *drv, int n)
+{
+	int k, st;
+	double pos;
+	for (k = 0; k < n; k++)
+		if (px_canopen_sim_joint(sim, (size_t)k, &pos, &st) == PX_OK)
+			printf("proxima-simarm: drive %d (node %u) at the "
+			       "end: %s, position %.6g\n",
+			       k, drv[k].node_id, px_cia402_state_name(st), pos);
+	fflush(stdout);
+}
+
 int main(int argc, char **argv)
 {
 	const char *iface = NULL, *local = NULL, *peer = NULL;
 	const char *config = NULL, *devname = NULL;
 	int n = 6, mode = PX_CIA402_CSV, i, rc, e, layout_flags = 0;
-	struct px_config *cfg = NULL;
-	struct px_canopen_pdo_map pdo;
-	struct px_sim_fault faults[PX_SIM_MAX_FAULTS];
+	static struct layout L;
 	int n_faults = 0;
-	char upeer[256], ulocal[256];
 	double seconds = 0;
 	struct px_can_bus *bus = NULL;
-	struct px_canopen_drive_cfg drv[PX_CANOPEN_MAX_DRIVES];
 	struct px_canopen_sim_config sc;
 	struct px_canopen_sim *sim;
 	char msg[400];
@@ -131,84 +233,25 @@ int main(int argc, char **argv)
 		}
 	}
 	if (config) {
-		static struct px_config_diag diag;
-		const struct px_config_device *dc = NULL;
-		size_t k, nd = 0;
 		if (layout_flags) {
 			fprintf(stderr, "proxima-simarm: --drives and --mode "
 				"come from the config with --config\n");
 			return 2;
 		}
-		px_config_diag_init(&diag);
-		rc = px_config_load_file(config, &cfg, &diag);
-		if (rc != PX_OK) {
-			px_config_diag_print(&diag, stderr);
-			fprintf(stderr, "proxima-simarm: %s: invalid "
-				"configuration\n", config);
-			return 1;
-		}
-		for (k = 0; k < cfg->n_devices && !dc; k++) {
-			const struct px_config_device *d = &cfg->devices[k];
-			if (devname ? !strcmp(d->name, devname)
-				    : d->backend == PX_CONFIG_BACKEND_SOCKETCAN &&
-					      d->socketcan.canopen.n_drives)
-				dc = d;
-		}
-		if (!dc) {
-			fprintf(stderr, "proxima-simarm: %s: %s\n", config,
-				devname ? "no device of that name"
-					: "no socketcan device with canopen "
-					  "drives");
-			px_config_free(cfg);
-			return 1;
-		}
-		rc = px_devcfg_canopen_layout(cfg, dc, drv,
-					      PX_CANOPEN_MAX_DRIVES, &nd, &pdo,
-					      msg, sizeof msg);
-		if (rc != PX_OK) {
-			fprintf(stderr, "proxima-simarm: %s: %s\n", config,
-				msg[0] ? msg : px_strerror(rc));
-			px_config_free(cfg);
-			return 1;
-		}
-		n = (int)nd;
-		/* the config's drive faults (node_id), from our start */
-		n_faults = px_devcfg_arm_faults(cfg, dc, 0, faults,
-						PX_SIM_MAX_FAULTS);
-		if (n_faults < 0) {
-			fprintf(stderr, "proxima-simarm: %s: device '%s': "
-				"faults: %s\n", config, dc->name,
-				px_strerror(n_faults));
-			px_config_free(cfg);
-			return 1;
-		}
+		rc = from_config(&L, config, devname, !iface && !local);
+		if (rc)
+			return rc;
+		n = L.n;
+		n_faults = L.n_faults;
 		if (!iface && !local) {
-			const struct px_config_socketcan *c = &dc->socketcan;
-			if (c->transport == PX_CONFIG_CAN_KERNEL) {
-				iface = c->interface;
-			} else if (c->transport == PX_CONFIG_CAN_UNIX) {
-				/* the controller binds socket_path and sends
-				 * to socket_path.peer: the other end */
-				snprintf(ulocal, sizeof ulocal, "%s.peer",
-					 c->socket_path);
-				snprintf(upeer, sizeof upeer, "%s",
-					 c->socket_path);
-				local = ulocal;
-				peer = upeer;
-			} else {
-				fprintf(stderr, "proxima-simarm: device '%s' is "
-					"on an in-process simulated bus "
-					"(transport sim), which another process "
-					"cannot join: use transport unix or give "
-					"--can / --unix\n", dc->name);
-				px_config_free(cfg);
-				return 2;
-			}
+			iface = L.iface;
+			local = L.local;
+			peer = L.peer;
 		}
 	}
 	if ((!iface && !local) || n < 1 || n > PX_CANOPEN_MAX_DRIVES) {
 		usage(stderr);
-		px_config_free(cfg);
+		px_config_free(L.cfg);
 		return 2;
 	}
 	if (iface) {
@@ -221,29 +264,29 @@ int main(int argc, char **argv)
 	}
 	if (rc != PX_OK) {
 		fprintf(stderr, "proxima-simarm: %s\n", msg);
-		px_config_free(cfg);
+		px_config_free(L.cfg);
 		return 1;
 	}
 	for (i = 0; i < n && !config; i++) {
-		drv[i].node_id = (uint8_t)(i + 1);
-		drv[i].mode = mode;
-		drv[i].joint = i;
-		drv[i].counts_per_unit = 100000.0;
-		drv[i].rated_torque_n_m = 1.0;
+		L.drv[i].node_id = (uint8_t)(i + 1);
+		L.drv[i].mode = mode;
+		L.drv[i].joint = i;
+		L.drv[i].counts_per_unit = 100000.0;
+		L.drv[i].rated_torque_n_m = 1.0;
 	}
 	t0 = next = mono();
 	for (i = 0; i < n_faults; i++)
-		faults[i].start_ns += t0;
+		L.faults[i].start_ns += t0;
 	memset(&sc, 0, sizeof sc);
-	sc.pdo = config ? &pdo : NULL;
-	sc.faults = n_faults > 0 ? faults : NULL;
+	sc.pdo = config ? &L.pdo : NULL;
+	sc.faults = n_faults > 0 ? L.faults : NULL;
 	sc.n_faults = n_faults > 0 ? (size_t)n_faults : 0;
-	sc.drives = drv;
+	sc.drives = L.drv;
 	sc.n_drives = (size_t)n;
 	if (px_canopen_sim_create(&sc, bus, &sim) != PX_OK) {
 		fprintf(stderr, "proxima-simarm: cannot create the arm\n");
 		px_can_bus_close(bus);
-		px_config_free(cfg);
+		px_config_free(L.cfg);
 		return 1;
 	}
 	signal(SIGINT, on_signal);
@@ -267,22 +310,9 @@ int main(int argc, char **argv)
 		ts.tv_nsec = next % 1000000000;
 		clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, NULL);
 	}
-	{
-		/* the drives' own view at the end: what the controller last
-		 * told them over the bus (a controller that stopped safely
-		 * leaves each in switch on disabled) */
-		int k, st;
-		double pos;
-		for (k = 0; k < n; k++)
-			if (px_canopen_sim_joint(sim, (size_t)k, &pos, &st) == PX_OK)
-				printf("proxima-simarm: drive %d (node %u) at the "
-				       "end: %s, position %.6g\n",
-				       k, drv[k].node_id, px_cia402_state_name(st),
-				       pos);
-		fflush(stdout);
-	}
+	report_end(sim, L.drv, n);
 	px_canopen_sim_free(sim);
 	px_can_bus_close(bus);
-	px_config_free(cfg);
+	px_config_free(L.cfg);
 	return 0;
 }
