@@ -49,14 +49,15 @@ ALL_LDFLAGS := $(SANFLAGS) $(LDFLAGS)
 # ---- optional parts ------------------------------------------------------
 # The distance core, the loop and the control code need libc, libm and
 # pthread only. Each part below is compiled in when pkg-config finds its
-# library; WITH_<PART>=0 leaves it out, WITH_DEVICES=0 every device back
-# end. A part left out is replaced by its <file>_none.c, whose functions
+# library (OpenCASCADE, which has no pkg-config file, when its headers
+# are installed); WITH_<PART>=0 leaves it out, WITH_DEVICES=0 every
+# device back end. A part left out is replaced by its <file>_none.c, whose functions
 # return PX_E_UNSUPPORTED with a message naming the missing library, and
 # px_features.h says PX_HAVE_<PART> 0.
 # hidapi comes as two builds with the same symbols: HIDAPI=hidraw
 # (default, /dev/hidraw*) or HIDAPI=libusb.
 HIDAPI   ?= hidraw
-OPT_PARTS := HIDAPI LIBUSB SOCKETCAN GPIOD ASSIMP YAML
+OPT_PARTS := HIDAPI LIBUSB SOCKETCAN GPIOD ASSIMP YAML OCCT
 OPT_DEVICE_PARTS := HIDAPI LIBUSB SOCKETCAN GPIOD
 PKG_HIDAPI    := hidapi-$(HIDAPI)
 PKG_LIBUSB    := libusb-1.0
@@ -70,6 +71,7 @@ SRC_SOCKETCAN := px_socketcan.c
 SRC_GPIOD     := px_gpiod.c
 SRC_ASSIMP    := px_import.c
 SRC_YAML      := px_config_yaml.c
+SRC_OCCT      := cad_occt.cpp
 # Tests name the parts they need by these tags (PX_TEST_NEEDS, tests/run.sh).
 TAG_HIDAPI    := hidapi
 TAG_LIBUSB    := libusb
@@ -77,31 +79,50 @@ TAG_SOCKETCAN := libsocketcan
 TAG_GPIOD     := libgpiod
 TAG_ASSIMP    := assimp
 TAG_YAML      := libyaml
+TAG_OCCT      := occt
 DESC_HIDAPI    := HID devices (hidapi-$(HIDAPI))
 DESC_LIBUSB    := USB devices (libusb-1.0)
 DESC_SOCKETCAN := CAN interface state and bitrate (libsocketcan)
 DESC_GPIOD     := GPIO lines (libgpiod)
 DESC_ASSIMP    := mesh files (assimp)
 DESC_YAML      := YAML configs (libyaml)
+DESC_OCCT      := STEP and IGES parts (OpenCASCADE)
 WITH_DEVICES ?= 1
 pc_have = $(shell pkg-config --exists $(1) 2>/dev/null && echo 1 || echo 0)
+# OpenCASCADE: its headers, the toolkits the importer links (C++, so the
+# C++ runtime with them) and the C++ compile flags.
+OCCT_INC := /usr/include/opencascade
+OCCT_PART_LIBS := -lTKXSBase -lTKSTEP -lTKSTEPBase -lTKSTEPAttr -lTKSTEP209 -lTKIGES \
+  -lTKShHealing -lTKTopAlgo -lTKBRep -lTKGeomAlgo -lTKGeomBase -lTKG3d -lTKG2d -lTKMath \
+  -lTKernel -lstdc++
+have_part = $(if $(filter OCCT,$(1)),$(if $(wildcard $(OCCT_INC)/Standard.hxx),1,0),\
+  $(call pc_have,$(PKG_$(1))))
 # Found once per make (a sub-make after `make deps` looks again).
 $(foreach p,$(OPT_PARTS),$(if $(filter undefined,$(origin WITH_$(p))),\
-  $(eval WITH_$(p) := $(if $(and $(filter $(p),$(OPT_DEVICE_PARTS)),$(filter 0,$(WITH_DEVICES))),0,$(call pc_have,$(PKG_$(p)))))))
+  $(eval WITH_$(p) := $(if $(and $(filter $(p),$(OPT_DEVICE_PARTS)),$(filter 0,$(WITH_DEVICES))),0,$(call have_part,$(p))))))
 OPT_ON   := $(foreach p,$(OPT_PARTS),$(if $(filter 1,$(WITH_$(p))),$(p)))
 PKGS     := $(foreach p,$(OPT_ON),$(PKG_$(p)))
 # The file of each part that this build leaves out.
 OPT_OUT_SRC := $(foreach p,$(OPT_PARTS),$(if $(filter 1,$(WITH_$(p))),\
-                 $(SRC_$(p):.c=_none.c),$(SRC_$(p))))
+                 $(basename $(SRC_$(p)))_none.c,$(SRC_$(p))))
 # Asked when a recipe runs, not when this file is read.
 PKG_CFLAGS = $(if $(PKGS),$(shell pkg-config --cflags $(PKGS)))
 PKG_LIBS   = $(if $(PKGS),$(shell pkg-config --libs $(PKGS)))
-LIBS    = $(PKG_LIBS) -lm -lpthread
+# Libraries of the parts without a pkg-config file (also in proxima.pc).
+OPT_LIBS := $(if $(filter 1,$(WITH_OCCT)),$(OCCT_PART_LIBS))
+LIBS    = $(PKG_LIBS) $(OPT_LIBS) -lm -lpthread
+CXX_WARN := $(filter-out -Wstrict-prototypes,$(WARN))
+ALL_CXXFLAGS = -std=c++17 -D_GNU_SOURCE $(CXX_WARN) $(INCS) -isystem $(OCCT_INC) \
+  -fvisibility=hidden -MMD -MP $(OPTFLAGS) $(SANFLAGS) $(CXXFLAGS)
 
 # ---- sources -------------------------------------------------------------
 LIB_SRC  := $(filter-out $(addprefix %/,$(OPT_OUT_SRC)),\
               $(foreach d,$(MODULE_DIRS),$(wildcard $(d)/*.c)))
-LIB_OBJ  := $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC))
+# C++ library files: an optional part's bridge to a C++ library.
+LIB_CXX_SRC := $(filter-out $(addprefix %/,$(OPT_OUT_SRC)),\
+              $(foreach d,$(MODULE_DIRS),$(wildcard $(d)/*.cpp)))
+LIB_OBJ  := $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC)) \
+            $(patsubst %.cpp,$(BUILD)/obj/%.o,$(LIB_CXX_SRC))
 PUB_HDRS := $(filter-out %internal.h,$(foreach d,$(MODULE_DIRS),$(wildcard $(d)/px*.h)))
 
 # tests/ mirrors the tree: the test of geom/track/ is tests/geom/track/
@@ -111,6 +132,10 @@ PUB_HDRS := $(filter-out %internal.h,$(foreach d,$(MODULE_DIRS),$(wildcard $(d)/
 TEST_SUPPORT_DIR := tests/support
 TEST_SUPPORT_SRC := $(wildcard $(TEST_SUPPORT_DIR)/px_*.c)
 TEST_SUPPORT_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(TEST_SUPPORT_SRC))
+# C++ fixtures (OpenCASCADE references) in builds with OpenCASCADE, in
+# the tests' library: linked only into the tests that call them.
+TEST_SUPPORT_CXX_SRC := $(if $(filter 1,$(WITH_OCCT)),$(wildcard $(TEST_SUPPORT_DIR)/px_*.cpp))
+TEST_SUPPORT_CXX_OBJ := $(patsubst %.cpp,$(BUILD)/obj/%.o,$(TEST_SUPPORT_CXX_SRC))
 test_find = $(shell find tests -name 'test_*.$(1)' -not -path '$(TEST_SUPPORT_DIR)/*' \
               -not -path 'tests/vm/*' | awk -F/ '{ print $$NF, $$0 }' | sort | cut -d' ' -f2)
 TEST_SRC := $(call test_find,c)
@@ -138,7 +163,13 @@ ifeq ($(SAN),1)
 TOOL_SUPPORT_OBJ += $(BUILD)/obj/$(TEST_SUPPORT_DIR)/px_alloc_count.o
 endif
 TOOL_SRC := $(wildcard tools/proxima-*.c)
-TOOL_BIN := $(patsubst tools/%.c,$(BUILD)/bin/%,$(TOOL_SRC))
+# C++ tools (the CAD part generator) in builds with OpenCASCADE.
+TOOL_CXX_SRC := $(if $(filter 1,$(WITH_OCCT)),$(wildcard tools/proxima-*.cpp))
+TOOL_BIN := $(patsubst tools/%.c,$(BUILD)/bin/%,$(TOOL_SRC)) \
+            $(patsubst tools/%.cpp,$(BUILD)/bin/%,$(TOOL_CXX_SRC))
+# The modelling toolkits the part generator builds its solids with.
+OCCT_MODEL_LIBS := -lTKOffset -lTKFillet -lTKFeat -lTKBool -lTKBO -lTKPrim
+$(BUILD)/bin/proxima-cadgen: LIBS += $(OCCT_MODEL_LIBS)
 # A tool's own parts: tools/<name>_*.c go into proxima-<name> alone
 # (tools/run_*.c into proxima-run); tools/tool_*.c into every tool.
 tool_parts = $(patsubst %.c,$(BUILD)/obj/%.o,$(wildcard tools/$(1)_*.c))
@@ -158,7 +189,6 @@ FEATURES_H  := $(BUILD)/gen/px_features.h
 BENCH_SRC := $(wildcard bench/bench_*.c)
 BENCH_BIN := $(patsubst bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 # C++ comparisons against OpenCASCADE, built only where its headers are.
-OCCT_INC := /usr/include/opencascade
 OCCT_LIBS := -lTKGeomAlgo -lTKGeomBase -lTKG3d -lTKG2d -lTKMath -lTKernel
 CXX_BENCH_SRC := $(if $(wildcard $(OCCT_INC)/Standard.hxx),$(wildcard bench/bench_*_occt.cpp))
 CXX_BENCH_BIN := $(patsubst bench/%.cpp,$(BUILD)/bench/%,$(CXX_BENCH_SRC))
@@ -184,6 +214,9 @@ BENCH_DEB_PACKAGES += libfcl-dev
 DEB_PACKAGES += libyaml-dev
 # geom/: mesh and point-cloud import.
 DEB_PACKAGES += libassimp-dev
+# geom/brep/: STEP and IGES import (OpenCASCADE 7.6) and its C++ compiler.
+DEB_PACKAGES += g++ libocct-data-exchange-dev libocct-modeling-algorithms-dev
+DEB_PACKAGES += libocct-modeling-data-dev libocct-foundation-dev
 
 FORCE:
 
@@ -210,6 +243,10 @@ $(BUILD)/obj/%.o: %.c | $(FEATURES_H)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -I$(BUILD)/gen $(PKG_CFLAGS) -fPIC -c $< -o $@
 
+$(BUILD)/obj/%.o: %.cpp | $(FEATURES_H)
+	@mkdir -p $(dir $@)
+	$(CXX) $(ALL_CXXFLAGS) -I$(BUILD)/gen -fPIC -c $< -o $@
+
 # The library is made again when the set of optional parts changes.
 $(STATIC_LIB): $(LIB_OBJ) $(FEATURES_H)
 	@mkdir -p $(dir $@)
@@ -232,13 +269,14 @@ $(PC_FILE): FORCE
 	  'Requires.private: $(PKGS)' \
 	  'Cflags: -I$${includedir}' \
 	  'Libs: -L$${libdir} -l$(NAME)' \
-	  'Libs.private: -lm -lpthread' > $@
+	  'Libs.private: $(OPT_LIBS) -lm -lpthread' > $@
 
 $(BUILD)/obj-hooks/%.o: %.c | $(FEATURES_H)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -DPX_TEST_HOOKS -I$(BUILD)/gen $(PKG_CFLAGS) -fPIC -c $< -o $@
 
-$(TEST_LIB): $(filter-out $(patsubst %.c,$(BUILD)/obj/%.o,$(TEST_HOOK_SRC)),$(LIB_OBJ)) $(TEST_HOOK_OBJ)
+$(TEST_LIB): $(filter-out $(patsubst %.c,$(BUILD)/obj/%.o,$(TEST_HOOK_SRC)),$(LIB_OBJ)) $(TEST_HOOK_OBJ) \
+             $(TEST_SUPPORT_CXX_OBJ)
 	@mkdir -p $(dir $@)
 	rm -f $@
 	ar rcs $@ $^
@@ -502,4 +540,5 @@ stress: $(BUILD)/tests/test_hostile
 -include $(LIB_OBJ:.o=.d) $(TEST_HOOK_OBJ:.o=.d) $(TEST_SUPPORT_OBJ:.o=.d) $(TOOL_SUPPORT_OBJ:.o=.d) \
   $(TOOL_PART_OBJ:.o=.d)
 -include $(patsubst %.c,$(BUILD)/obj/%.d,$(TEST_SRC) $(TOOL_SRC) $(BENCH_SRC) $(EXAMPLE_SRC))
+-include $(patsubst %.cpp,$(BUILD)/obj/%.d,$(TOOL_CXX_SRC) $(TEST_SUPPORT_CXX_SRC))
 -include $(patsubst %.c,$(BUILD)/obj/%.d,$(FUZZ_SRC) fuzz/replay.c)

@@ -1,6 +1,6 @@
 #!/bin/sh
 # The library with every optional part left out (WITH_DEVICES=0
-# WITH_ASSIMP=0 WITH_YAML=0), built into its own directory and installed
+# WITH_ASSIMP=0 WITH_YAML=0 WITH_OCCT=0), built into its own directory and installed
 # into a scratch DESTDIR: it needs libc, libm and pthread alone, its
 # proxima.pc requires nothing, px_features.h says so, the examples link
 # with only -lproxima -lm -lpthread and run, and each left-out part
@@ -27,7 +27,7 @@ check() { # description, command...
 full=${BUILD:-build}
 min="$tmp/build"
 root="$tmp/root"
-off="WITH_DEVICES=0 WITH_ASSIMP=0 WITH_YAML=0"
+off="WITH_DEVICES=0 WITH_ASSIMP=0 WITH_YAML=0 WITH_OCCT=0"
 # The full build's objects are the same code: starting from them, only
 # the parts' *_none.c files compile here.
 mkdir -p "$min"
@@ -42,8 +42,8 @@ check "px_features.h: every part 0" \
 	       grep -q 'PX_HAVE_YAML 0' '$inc/proxima/px_features.h'"
 check "proxima.pc requires nothing" grep -qx 'Requires.private: *' "$lib/pkgconfig/proxima.pc"
 nolibs() { # the shared library needs no optional library
-	ldd "$lib/libproxima.so" | grep -E 'yaml|hidapi|usb|socketcan|gpiod|assimp' && return 1
-	nm -u "$lib/libproxima.a" | grep -E ' (yaml_|hid_|libusb_|can_(do|get|set)_|gpiod_|aiImport)' && return 1
+	ldd "$lib/libproxima.so" | grep -E 'yaml|hidapi|usb|socketcan|gpiod|assimp|libTK|stdc\+\+' && return 1
+	nm -u "$lib/libproxima.a" | grep -E ' (yaml_|hid_|libusb_|can_(do|get|set)_|gpiod_|aiImport|_Z)' && return 1
 	return 0
 }
 check "libproxima uses no optional library" nolibs
@@ -62,6 +62,7 @@ cat >"$tmp/parts.c" <<'C'
 #include <proxima/px.h>
 #include <proxima/px_features.h>
 #include <proxima/px_mesh.h>
+#include <proxima/px_cad.h>
 #include <stdio.h>
 #include <string.h>
 static int says(const char *what, int rc, const char *msg, const char *lib)
@@ -78,6 +79,7 @@ int main(int argc, char **argv)
 	struct px_gpio_config gc;
 	struct px_config *cfg;
 	struct px_model *m;
+	struct px_cad *cad;
 	struct px_dev *d;
 	char msg[256];
 	int bad = 0, rc;
@@ -99,14 +101,18 @@ int main(int argc, char **argv)
 	rc = px_mesh_load(argv[2], NULL, NULL, &m);
 	bad |= rc != PX_E_UNSUPPORTED;
 	printf("mesh: %s\n", px_strerror(rc));
-	return bad || PX_HAVE_YAML || PX_HAVE_HIDAPI;
+	rc = px_cad_load(argv[3], NULL, &cad, msg, sizeof msg);
+	bad |= says("cad", rc, msg, "OpenCASCADE") || cad != NULL ||
+	       px_cad_desc(cad) != NULL;
+	return bad || PX_HAVE_YAML || PX_HAVE_HIDAPI || PX_HAVE_OCCT;
 }
 C
 check "a program using the left-out parts links" \
 	${CC:-cc} -std=c11 -Wall -Wextra -Werror -I"$inc" "$tmp/parts.c" \
 	-o "$tmp/parts" "$lib/libproxima.a" -lm -lpthread
 check "left-out parts say PX_E_UNSUPPORTED and name their library" \
-	"$tmp/parts" config/examples/haptic_sim.yaml config/examples/scenes/knob.stl
+	"$tmp/parts" config/examples/haptic_sim.yaml config/examples/scenes/knob.stl \
+	config/examples/parts/filleted_block.step
 check "proxima-run --check names the missing YAML loader" \
 	sh -c "! '$root/usr/bin/proxima-run' --check config/examples/haptic_sim.yaml >'$tmp/run.out' 2>&1;
 	       grep -q 'built without libyaml' '$tmp/run.out'"
