@@ -203,9 +203,22 @@ const part parts[] = {
 	{"assembly", assembly},
 };
 
-bool write_step(const TopoDS_Shape &s, const std::string &path,
+// The shape with its coordinates in unit (modelled in millimetres).
+TopoDS_Shape in_unit(const TopoDS_Shape &s, const char *unit)
+{
+	if (strcmp(unit, "M"))
+		return s;
+	gp_Trsf t;
+	t.SetScale(gp_Pnt(0, 0, 0), 0.001);
+	return BRepBuilderAPI_Transform(s, t, Standard_True).Shape();
+}
+
+// The STEP writer labels the file with write.step.unit but writes the
+// coordinates as given: they are converted first.
+bool write_step(const TopoDS_Shape &shape, const std::string &path,
 		const char *unit)
 {
+	TopoDS_Shape s = in_unit(shape, unit);
 	STEPControl_Writer w;
 	Interface_Static::SetCVal("xstep.cascade.unit", "MM");
 	Interface_Static::SetCVal("write.step.unit", unit);
