@@ -284,6 +284,7 @@ static const struct px_model_ops scaled_ops[] = {
 	SCALED_OPS(PX_MODEL_CUSTOM),    SCALED_OPS(PX_MODEL_PRIMITIVE),
 	SCALED_OPS(PX_MODEL_MESH),      SCALED_OPS(PX_MODEL_CLOUD),
 	SCALED_OPS(PX_MODEL_NURBS),     SCALED_OPS(PX_MODEL_CUSTOM),
+	SCALED_OPS(PX_MODEL_BREP),
 };
 
 static int scale_model(struct px_model **m, double s)
@@ -302,7 +303,7 @@ static int scale_model(struct px_model **m, double s)
 	w->s = s;
 	*m = NULL;
 	/* Coherence hints are passed through, so the capability stays. */
-	return px_model_create(&scaled_ops[k >= 1 && k <= 4 ? k : 0], w,
+	return px_model_create(&scaled_ops[k >= 1 && k <= PX_MODEL_BREP ? k : 0], w,
 			       px_model_caps(w->inner), m);
 }
 

@@ -1,12 +1,19 @@
 /*
  * brep_internal.h - private layout of the trimmed domain (px_trim.h),
  * shared by its setup (trim_setup.c, trim_check.c) and its queries
- * (trim_query.c). Not installed, not part of the API.
+ * (trim_query.c), and of the B-rep model (px_brep.h: brep_setup.c
+ * builds it, brep_sign.c signs its answers, brep_model.c queries it).
+ * Not installed, not part of the API.
  */
 #ifndef PX_BREP_INTERNAL_H
 #define PX_BREP_INTERNAL_H
 
+#include <stdatomic.h>
+
 #include "px_arena.h"
+#include "dist_internal.h"
+#include "px_brep.h"
+#include "px_dist.h"
 #include "px_trim.h"
 
 /* One Bezier piece of a loop. The homogeneous coefficients (x*w, y*w,
@@ -129,5 +136,92 @@ void px__trim_err(struct px_trim_error *err, int code,
 		  const char *fmt, ...) __attribute__((format(printf, 11, 12)));
 /* "outer loop" / "hole k" */
 const char *px__trim_loop_name(int k, char *buf, size_t len);
+
+/* ---- the B-rep model ------------------------------------------------------ */
+
+/* Query workspaces of one B-rep (threads borrow one without waiting). */
+#define BREP_WS 4
+/* (edge parameter, loop curve parameter) pairs per coedge: the start of
+ * the few Gauss-Newton steps that find a face's (u, v) at an edge point. */
+#define BREP_MAP_N 33
+
+/* One curve of one loop of a face, and the edge it runs along. */
+struct brep_coedge {
+	struct px_nurbs_curve pc; /* the loop curve in (u, v), copied */
+	int face, loop, curve;
+	int edge;                 /* -1: collapsed to a point */
+	int dir;                  /* +1 / -1: along / against the oriented loop */
+	double t[BREP_MAP_N], s[BREP_MAP_N]; /* edge -> curve parameters */
+	int mapped;               /* the table holds (edge with a curve) */
+};
+
+struct brep_face {
+	struct px_nurbs_surf surf; /* scaled copy */
+	struct px_trim *trim;      /* NULL: the whole surface */
+	int reversed, shell;
+	long id;
+};
+
+struct brep_edge {
+	struct px_nurbs_curve c; /* scaled copy */
+	int v0, v1;
+	long id;
+	double t0, t1;           /* domain */
+	int co[2], n_co;         /* its coedges (the first two) */
+	int uses;                /* coedges running along it */
+};
+
+/* A point candidate: a vertex no edge ends at, or a loop curve whose
+ * image is a point. */
+struct brep_point {
+	px_vec3 p;
+	int vertex;              /* vertex id, or -1 */
+};
+
+struct px_brep {
+	int n_faces, n_edges, n_vertices, n_shells, n_solids, n_co, n_pts;
+	int n_trimmed;
+	struct brep_face *faces;
+	struct brep_edge *edges;
+	struct brep_coedge *co;
+	px_vec3 *verts;
+	struct brep_point *pts;
+	int *shell_solid;          /* per shell */
+	int *shell_closed;
+	struct px__dist_trim *dtrim;     /* per face, for the distance core */
+	struct px_dist_model *dm;
+	struct px_dist_ws *ws[BREP_WS];
+	atomic_flag busy[BREP_WS];
+	double *mem;               /* the copied arrays */
+	px_aabb box;
+	double size;               /* box diagonal */
+	double on_tol;             /* closer counts as on the model */
+	/* sign */
+	int closed;
+	px_vec3 *vnormal;          /* per vertex: angle-weighted pseudo-normal */
+	char why[200];
+	char *name, *source;
+	size_t bytes;
+};
+
+/* Sign setup (brep_sign.c): the coedge parameter tables, the vertex
+ * pseudo-normals, the closedness and orientation checks; fills
+ * b->closed and b->why. PX_OK or PX_E_NOMEM. */
+int px__brep_sign_setup(struct px_brep *b);
+
+/* Sign of the query point p of unsigned answer d (d->dist > on_tol) on
+ * a closed B-rep: -1 inside, +1 outside. @note RT-safe. */
+int px__brep_sign(const struct px_brep *b, px_vec3 p,
+		  const struct px_dist_result *d);
+
+/* Outward unit normal of face f at (u, v) (reversed faces flipped;
+ * zero where Su x Sv vanishes). @note RT-safe. */
+px_vec3 px__brep_face_normal(const struct px_brep *b, int f, double u,
+			     double v);
+
+/* Unsigned global answer of the B-rep (distance core + point
+ * candidates) with workspace slot k. @note RT-safe. */
+int px__brep_closest(const struct px_brep *b, int k, px_vec3 p,
+		     struct px_dist_result *d);
 
 #endif

@@ -32,6 +32,7 @@
 #define PX_BREP_H
 
 #include "px_base.h"
+#include "px_dist.h"
 #include "px_nurbs.h"
 #include "px_trim.h"
 
@@ -101,6 +102,101 @@ struct px_brep_desc {
 	const char *name;
 	const char *source;
 };
+
+/* ---- the model ---------------------------------------------------------- */
+
+/* Setup options: the distance core's (px_dist.h) and the trimmed
+ * domains' (px_trim.h). */
+struct px_brep_opts {
+	struct px_dist_opts dist;
+	struct px_trim_opts trim;
+};
+
+/* Defaults of both. */
+PX_API void px_brep_opts_default(struct px_brep_opts *o);
+
+/*
+ * Where and why px_brep_create() refused a description: code is the
+ * px_err returned; face, loop, curve, edge, vertex, shell name the
+ * culprit (-1 when not involved; loop 0 is the outer loop); id is the
+ * importer's id of the face or edge (0 none); trim and nurbs carry the
+ * trimmed domain's or the kernel's own report when one of them refused.
+ * msg is a complete sentence naming the face, loop and curve, e.g.
+ * "face 2 (id 57): hole 1 curve 0: gap of 0.01 between curves 0 and 1".
+ */
+struct px_brep_error {
+	int code;
+	int face, loop, curve, edge, vertex, shell;
+	long id;
+	struct px_trim_error trim;
+	struct px_nurbs_error nurbs;
+	char msg[384];
+};
+
+struct px_brep;
+
+/*
+ * Validate d and build the B-rep: every face's surface (the kernel's
+ * validation), its loops (px_trim_create(); a face without loops is the
+ * whole surface), the trimmed domain inside the surface's parameter
+ * domain, every edge's curve, every index in range (coedge -> edge,
+ * edge -> vertex, face -> shell, shell -> solid), scale finite and
+ * > 0. Every loop curve needs a 3D edge (coedge edge >= 0) unless its
+ * image on the surface is a single point (a pole, a collapsed side):
+ * such a point is a vertex candidate; a loop curve with neither is
+ * refused (the distance to it would not be exact). Coordinates are
+ * scaled; everything is copied into memory the handle owns and fixed
+ * from then on. opts NULL: defaults; err may be NULL. Returns PX_OK,
+ * PX_E_INVAL (a bad description: err says where), PX_E_RANGE, PX_E_NAN,
+ * PX_E_DEGENERATE (zero-area loop), PX_E_NOCONV, PX_E_NOMEM, PX_E_NOSPC.
+ * Setup only.
+ */
+PX_API int px_brep_create(const struct px_brep_desc *d,
+			  const struct px_brep_opts *opts,
+			  struct px_brep_error *err, struct px_brep **out);
+
+/* Release a B-rep not handed to px_model_from_brep() (NULL is fine). */
+PX_API void px_brep_free(struct px_brep *b);
+
+/*
+ * What setup made of a B-rep. closed: 1 when queries are signed: every
+ * shell closed and in a solid, every edge used twice by faces of one
+ * shell in opposite directions (the faces agree on the outside), every
+ * vertex's pseudo-normal defined, and a point beyond the box comes out
+ * outside; why says so or names the first failing check.
+ */
+struct px_brep_info {
+	int n_faces, n_edges, n_vertices, n_shells, n_solids;
+	int n_trimmed;       /* faces with loops */
+	int n_point_cands;   /* free vertices and collapsed loop curves */
+	int closed;
+	char why[200];
+	px_aabb bounds;      /* metres */
+	size_t bytes;
+};
+
+/* Returns PX_OK or PX_E_INVAL. @note RT-safe. */
+PX_API int px_brep_info(const struct px_brep *b, struct px_brep_info *info);
+
+/*
+ * The B-rep as a px_model of kind PX_MODEL_BREP named after desc.name
+ * (px_model_name(); "brep" when none). The model takes b over, also on
+ * failure. Capabilities: PX_MODEL_CAP_EXACT, and PX_MODEL_CAP_SIGNED
+ * when px_brep_info() says closed. Signed answers (inside negative)
+ * come from the B-rep's own faces: the foot point's face normal
+ * (reversed faces flip it), on an edge the sum of its two faces'
+ * normals there, at a vertex its angle-weighted pseudo-normal (for a
+ * point whose closest point is that edge or vertex, it points towards
+ * the point exactly when the point is outside); a point on the model
+ * (within rounding) is outside. Up to four threads may query at once
+ * (a fifth gets PX_E_BUSY). Setup only.
+ */
+struct px_model;
+PX_API int px_model_from_brep(struct px_brep *b, struct px_model **out);
+
+/* The B-rep behind a model from px_model_from_brep(), or NULL.
+ * @note RT-safe. */
+PX_API const struct px_brep *px_model_brep(const struct px_model *m);
 
 #ifdef __cplusplus
 }

@@ -500,6 +500,7 @@ static int add_entities(struct builder *bl, const struct px_nurbs_curve *curves,
 /* What the model's block holds besides the pieces and the grid. */
 struct layout {
 	int n_curves, n_ent, n_cp, n_sp;
+	int trimmed; /* the model keeps per-entity trimmed domains */
 	size_t sp_doubles;    /* the patches' tensors */
 	size_t shape_doubles; /* the closed-form shapes' copies of their arrays */
 };
@@ -512,14 +513,20 @@ struct layout {
  */
 static void recognize(const struct px_nurbs_curve *curves,
 		      const struct px_nurbs_surf *surfs,
+		      const struct px__dist_trim *trims,
 		      struct px_dist_entity_info *ent,
 		      struct px_recog_shape *shapes, struct layout *ly)
 {
 	int e, n_curves = ly->n_curves;
 	for (e = 0; e < ly->n_ent; e++) {
 		struct px_recog_shape *sh = &shapes[e];
-		int got = e < n_curves ? px_recog_curve(&curves[e], 0.0, sh)
-				       : px_recog_surf(&surfs[e - n_curves], 0.0, sh);
+		int got;
+		/* A closed form answers the whole surface, not its trimmed
+		 * part. */
+		if (e >= n_curves && trims && trims[e - n_curves].inside)
+			continue;
+		got = e < n_curves ? px_recog_curve(&curves[e], 0.0, sh)
+				   : px_recog_surf(&surfs[e - n_curves], 0.0, sh);
 		if (got != 1 || sh->kind == PX_RECOG_PLANE ||
 		    !(sh->hausdorff <= 1e-11 * (sh->size > 0.0 ? sh->size : 1.0))) {
 			memset(sh, 0, sizeof(*sh));
@@ -606,6 +613,8 @@ static long *count_refs(struct px_dist_model *hdr, const struct builder *bl)
 		return NULL;
 	for (i = 0; i < bl->n; i++) {
 		int lo[3], hi[3], x, y, z;
+		if (bl->tp[i].pc.trim == PIECE_PRUNED)
+			continue;
 		cell_range(hdr, bl->tp[i].pc.box, lo, hi);
 		for (z = lo[2]; z <= hi[2]; z++)
 			for (y = lo[1]; y <= hi[1]; y++)
@@ -629,6 +638,7 @@ static size_t model_bytes(const struct px_dist_model *hdr,
 	return ALIGNED(sizeof(*hdr)) +
 	       ALIGNED(n_ent * sizeof(struct px_dist_entity_info)) +
 	       ALIGNED(n_ent * sizeof(struct px_recog_shape)) +
+	       (ly->trimmed ? ALIGNED(n_ent * sizeof(struct px__dist_trim)) : 0) +
 	       ALIGNED(ly->shape_doubles * sizeof(double)) +
 	       ALIGNED(n_ent * sizeof(uint32_t)) +
 	       ALIGNED(n * sizeof(struct piece)) +
@@ -689,7 +699,8 @@ static int model_alloc(const struct px_dist_model *hdr, const struct builder *bl
 	    !TAKE(m->spill, m->n_spill + 1) || !TAKE(m->ws.stamp, bl->n) ||
 	    !TAKE(m->ws.cand, bl->n) || !TAKE(m->shape, n_ent) ||
 	    !TAKE(m->ws.ent_stamp, n_ent) ||
-	    (ly->shape_doubles && !TAKE(*shmem, ly->shape_doubles)))
+	    (ly->shape_doubles && !TAKE(*shmem, ly->shape_doubles)) ||
+	    (ly->trimmed && !TAKE(m->trim, n_ent)))
 		return PX_E_NOMEM; /* the sizing above is wrong: a bug */
 #undef TAKE
 	return PX_OK;
@@ -784,6 +795,8 @@ static void bin_pieces(struct px_dist_model *m, const long *refs)
 	}
 	for (i = 0; i < m->n_pieces; i++) {
 		int lo[3], hi[3], x, y, z;
+		if (m->pieces[i].trim == PIECE_PRUNED)
+			continue;
 		cell_range(m, m->pieces[i].box, lo, hi);
 		for (z = lo[2]; z <= hi[2]; z++)
 			for (y = lo[1]; y <= hi[1]; y++)
@@ -798,10 +811,70 @@ static void bin_pieces(struct px_dist_model *m, const long *refs)
 	}
 }
 
+/*
+ * Trimmed surfaces (px__dist_model_create_trimmed()): every piece of
+ * surface e is classified against its domain once, so that queries pay
+ * nothing for it. Domain edges go (the surface's edge points are never
+ * strictly inside its trimmed domain; the trimming edges are the
+ * caller's curves); patches and creases wholly outside are pruned,
+ * crossed ones lose their samples and are solved with the filter.
+ */
+static void apply_trims(struct builder *bl, const struct px_nurbs_surf *surfs,
+			const struct px__dist_trim *trims, int n_curves)
+{
+	int i;
+	for (i = 0; i < bl->n; i++) {
+		struct tmp_piece *t = &bl->tp[i];
+		const struct px__dist_trim *tr;
+		double a, b, c, d, box[4];
+		int cls;
+		if (t->pc.ent < n_curves)
+			continue;
+		tr = &trims[t->pc.ent - n_curves];
+		if (!tr->inside)
+			continue;
+		px_nurbs_surf_domain(&surfs[t->pc.ent - n_curves], &a, &b, &c, &d);
+		if (t->pc.kind == PK_PATCH) {
+			memcpy(box, t->r, sizeof(box));
+		} else if ((t->pc.iso_dir == 1 && (t->pc.iso_t == a || t->pc.iso_t == b)) ||
+			   (t->pc.iso_dir == 0 && (t->pc.iso_t == c || t->pc.iso_t == d))) {
+			t->pc.trim = PIECE_PRUNED;
+		} else if (t->pc.iso_dir == 1) {
+			box[0] = box[1] = t->pc.iso_t;
+			box[2] = t->cp.u0_;
+			box[3] = t->cp.u1_;
+		} else {
+			box[0] = t->cp.u0_;
+			box[1] = t->cp.u1_;
+			box[2] = box[3] = t->pc.iso_t;
+		}
+		if (t->pc.trim != PIECE_PRUNED) {
+			cls = tr->classify(tr->ctx, box[0], box[1], box[2], box[3]);
+			t->pc.trim = cls == 1 ? PIECE_WHOLE
+					      : (cls == 0 ? PIECE_PRUNED : PIECE_CROSSED);
+		}
+		if (t->pc.trim != PIECE_WHOLE) {
+			bl->n_samples -= (long)t->pc.ns * t->pc.nt;
+			t->pc.ns = 0;
+			t->pc.nt = 0;
+		}
+	}
+}
+
 int px_dist_model_create(const struct px_nurbs_curve *curves, int n_curves,
 			 const struct px_nurbs_surf *surfs, int n_surfs,
 			 const struct px_dist_opts *opts,
 			 struct px_dist_model **out)
+{
+	return px__dist_model_create_trimmed(curves, n_curves, surfs, n_surfs,
+					     NULL, opts, out);
+}
+
+int px__dist_model_create_trimmed(const struct px_nurbs_curve *curves,
+				  int n_curves, const struct px_nurbs_surf *surfs,
+				  int n_surfs, const struct px__dist_trim *trims,
+				  const struct px_dist_opts *opts,
+				  struct px_dist_model **out)
 {
 	struct px_dist_opts o;
 	struct px_dist_entity_info *ent = NULL;
@@ -833,12 +906,16 @@ int px_dist_model_create(const struct px_nurbs_curve *curves, int n_curves,
 	rc = add_entities(&bl, curves, n_curves, surfs, n_surfs, &o, ent);
 	if (rc)
 		goto fail;
+	if (trims) {
+		apply_trims(&bl, surfs, trims, n_curves);
+		ly.trimmed = 1;
+	}
 	shapes = calloc((size_t)ly.n_ent, sizeof(*shapes));
 	if (!shapes) {
 		rc = PX_E_NOMEM;
 		goto fail;
 	}
-	recognize(curves, surfs, ent, shapes, &ly);
+	recognize(curves, surfs, trims, ent, shapes, &ly);
 	count_pieces(&bl, &ly);
 	memset(&hdr, 0, sizeof(hdr));
 	grid_geometry(&hdr, &bl, ent, ly.n_ent, o.max_cells);
@@ -854,6 +931,11 @@ int px_dist_model_create(const struct px_nurbs_curve *curves, int n_curves,
 	memcpy(m->ent, ent, (size_t)ly.n_ent * sizeof(*ent));
 	memcpy(m->shape, shapes, (size_t)ly.n_ent * sizeof(*shapes));
 	copy_shape_arrays(m, curves, n_curves, surfs, shmem);
+	if (trims) {
+		int e;
+		for (e = 0; e < n_surfs; e++)
+			m->trim[n_curves + e] = trims[e];
+	}
 	rc = fill_pieces(m, &bl, spmem);
 	if (rc)
 		goto fail;

@@ -20,6 +20,60 @@
 #include "px_recog.h"
 #include "px_spiece.h"
 
+/* ---- trimmed surfaces ---------------------------------------------------- */
+
+/*
+ * A trimmed surface's domain as the core sees it (geom/brep fills it
+ * from its px_trim, so the core does not depend on that module).
+ * classify: 0 when the parameter box lies wholly outside the domain, 1
+ * wholly inside, 2 when a loop may cross it (never wrong for 0 and 1).
+ * inside: 1 when (u, v) lies strictly inside (not on a loop). Both are
+ * RT-safe and read-only. A surface whose inside is NULL is untrimmed.
+ */
+struct px__dist_trim {
+	const void *ctx;
+	int (*inside)(const void *ctx, double u, double v);
+	int (*classify)(const void *ctx, double u0, double u1, double v0,
+			double v1);
+};
+
+/* What a piece solver checks a candidate against: the domain, and for a
+ * curve piece on a surface the iso line it runs along (iso_dir 1: u =
+ * iso_t and the piece's parameter is v; 0: v = iso_t). */
+struct px__uv_filter {
+	int (*inside)(const void *ctx, double u, double v);
+	const void *ctx;
+	int iso_dir;
+	double iso_t;
+};
+
+/* The piece solvers restricted to a trimmed domain: a candidate outside
+ * it neither answers nor lowers *best_d2 (so the minima inside are still
+ * all examined); filter NULL is the plain solver. @note RT-safe. */
+int px__cpiece_closest_in(const struct px_cpiece *pc, px_vec3 p,
+			  const struct px__uv_filter *flt, double *best_d2,
+			  struct px_cpiece_hit *hit);
+int px__spiece_closest_in(const struct px_spiece *sp, px_vec3 p, double hint_s,
+			  double hint_t, const struct px__uv_filter *flt,
+			  double *best_d2, struct px_spiece_hit *hit);
+
+/*
+ * px_dist_model_create() with trimmed surfaces: trims[i] (n_surfs
+ * entries, or NULL for none) is surface i's domain. The trimmed
+ * domain must lie in the surface's parameter domain. Per trimmed
+ * surface, patches outside the domain are never binned, patches a loop
+ * crosses are solved with the filter and give no pre-samples (a sample
+ * outside the domain is no upper bound), the domain edges are not
+ * candidates (the caller adds the trimming edges as curves) and creases
+ * are classified like patches; no closed-form shape answers it. Setup
+ * only.
+ */
+int px__dist_model_create_trimmed(const struct px_nurbs_curve *curves,
+				  int n_curves, const struct px_nurbs_surf *surfs,
+				  int n_surfs, const struct px__dist_trim *trims,
+				  const struct px_dist_opts *opts,
+				  struct px_dist_model **out);
+
 /* ---- the prepared model ------------------------------------------------- */
 
 struct cand {
@@ -28,6 +82,7 @@ struct cand {
 };
 
 enum { PK_CURVE = 0, PK_PATCH = 1 };
+enum { PIECE_WHOLE = 0, PIECE_CROSSED = 1, PIECE_PRUNED = 2 };
 
 /* What one query in flight needs besides the read-only model: per-piece
  * visit stamps (an epoch, so nothing is cleared per query) and the
@@ -54,6 +109,9 @@ struct piece {
 	double iso_t;
 	int sample_start;
 	int ns, nt; /* samples: ns along the piece (curves) or ns x nt */
+	/* Trimmed surfaces: PIECE_WHOLE, PIECE_CROSSED (solved with the
+	 * domain's filter) or PIECE_PRUNED (outside, never binned). */
+	int trim;
 	/* Oriented box around the control net (so around the piece):
 	 * candidates the axis-aligned box kept are dropped by it before
 	 * their solve reads the coefficient tables (most neighbours of the
@@ -69,6 +127,9 @@ struct px_dist_model {
 	/* Knowledge step: entities that are exactly a primitive (with the
 	 * arrays their parameter inversion reads, copied here). */
 	struct px_recog_shape *shape;
+	/* Per entity: the trimmed domain (inside NULL: untrimmed), or NULL
+	 * for a model without trimmed surfaces. */
+	struct px__dist_trim *trim;
 	int n_pieces;
 	struct piece *pieces;
 	int n_cp, n_sp;

@@ -1,4 +1,5 @@
 #include "px_cpiece.h"
+#include "dist_internal.h"
 
 #include <math.h>
 #include <string.h>
@@ -305,24 +306,35 @@ struct span {
 	int depth;
 };
 
-static void consider(const struct px_cpiece *pc, px_vec3 p, double t,
-		     double *best, struct px_cpiece_hit *hit, int *improved)
+/* The point at t lowers the bound when it is nearer and, with a filter,
+ * inside its trimmed domain (a critical point outside the domain is no
+ * answer, and must not prune the ones inside). */
+static inline __attribute__((always_inline)) void
+consider(const struct px_cpiece *pc, px_vec3 p, double t,
+		     const struct px__uv_filter *flt, double *best,
+		     struct px_cpiece_hit *hit, int *improved)
 {
 	px_vec3 q = t <= 0.0 ? pc->end_[0]
 			     : (t >= 1.0 ? pc->end_[1] : px_cpiece_eval(pc, t, NULL));
 	double d2 = px_v3_dist2(q, p);
 	if (d2 < *best) {
+		double u = t >= 1.0 ? pc->u1_ : pc->u0_ + t * (pc->u1_ - pc->u0_);
+		if (flt && !flt->inside(flt->ctx, flt->iso_dir == 1 ? flt->iso_t : u,
+					flt->iso_dir == 1 ? u : flt->iso_t))
+			return;
 		*best = d2;
 		hit->d2 = d2;
 		hit->point = q;
-		hit->u = t >= 1.0 ? pc->u1_
-				  : pc->u0_ + t * (pc->u1_ - pc->u0_);
+		hit->u = u;
 		*improved = 1;
 	}
 }
 
-int px_cpiece_closest(const struct px_cpiece *pc, px_vec3 p, double *best_d2,
-		      struct px_cpiece_hit *hit)
+/* The solver, inlined into both entry points so that the plain one
+ * (flt NULL) compiles without the filter. */
+static inline __attribute__((always_inline)) int
+closest(const struct px_cpiece *pc, px_vec3 p, const struct px__uv_filter *flt,
+	double *best_d2, struct px_cpiece_hit *hit)
 {
 	double g[PX_CPIECE_NG], c[PX_CPIECE_NG], f[PX_CPIECE_NF], cs[PX_CPIECE_NG];
 	double eps_g = 0.0;
@@ -368,8 +380,8 @@ int px_cpiece_closest(const struct px_cpiece *pc, px_vec3 p, double *best_d2,
 	}
 	/* End points: candidates in their own right (open ends, corners
 	 * at knots) and a bound that prunes early. */
-	consider(pc, p, 0.0, &best, hit, &improved);
-	consider(pc, p, 1.0, &best, hit, &improved);
+	consider(pc, p, 0.0, flt, &best, hit, &improved);
+	consider(pc, p, 1.0, flt, &best, hit, &improved);
 	for (i = 0; i <= n; i++)
 		g[i] = pc->ga_[i] - (p.x * pc->gb_[0][i] + p.y * pc->gb_[1][i] +
 				     p.z * pc->gb_[2][i]);
@@ -410,11 +422,11 @@ int px_cpiece_closest(const struct px_cpiece *pc, px_vec3 p, double *best_d2,
 		c[0] = e.gs;
 		c[n] = e.gt;
 		if (fabs(c[0]) <= eps_g) {
-			consider(pc, p, e.s, &best, hit, &improved);
+			consider(pc, p, e.s, flt, &best, hit, &improved);
 			c[0] = 0.0;
 		}
 		if (fabs(c[n]) <= eps_g) {
-			consider(pc, p, e.t, &best, hit, &improved);
+			consider(pc, p, e.t, flt, &best, hit, &improved);
 			c[n] = 0.0;
 		}
 		sc = px_bern_sign_changes(c, n, 0.0);
@@ -427,11 +439,11 @@ int px_cpiece_closest(const struct px_cpiece *pc, px_vec3 p, double *best_d2,
 				continue; /* the one critical point is a maximum */
 			consider(pc, p,
 				 e.s + refine_root(c, n, &hit->iters) * (e.t - e.s),
-				 &best, hit, &improved);
+				 flt, &best, hit, &improved);
 			continue;
 		}
 		if (e.depth >= PX_CPIECE_MAX_DEPTH) {
-			consider(pc, p, 0.5 * (e.s + e.t), &best, hit, &improved);
+			consider(pc, p, 0.5 * (e.s + e.t), flt, &best, hit, &improved);
 			lb_unresolved = fmin(lb_unresolved, lb);
 			continue;
 		}
@@ -466,4 +478,17 @@ int px_cpiece_closest(const struct px_cpiece *pc, px_vec3 p, double *best_d2,
 out:
 	*best_d2 = best;
 	return improved;
+}
+
+int px_cpiece_closest(const struct px_cpiece *pc, px_vec3 p, double *best_d2,
+		      struct px_cpiece_hit *hit)
+{
+	return closest(pc, p, NULL, best_d2, hit);
+}
+
+int px__cpiece_closest_in(const struct px_cpiece *pc, px_vec3 p,
+			  const struct px__uv_filter *flt, double *best_d2,
+			  struct px_cpiece_hit *hit)
+{
+	return closest(pc, p, flt, best_d2, hit);
 }

@@ -338,7 +338,16 @@ static inline void solve_curve(const struct px_dist_model *m, px_vec3 p,
 			       struct solve *sv, struct px_dist_result *r)
 {
 	struct px_cpiece_hit hit;
-	if (px_cpiece_closest(&m->cp[pc->idx], p, &sv->best, &hit)) {
+	int got;
+	if (pc->trim == PIECE_CROSSED) {
+		const struct px__uv_filter f = {m->trim[pc->ent].inside,
+						m->trim[pc->ent].ctx, pc->iso_dir,
+						pc->iso_t};
+		got = px__cpiece_closest_in(&m->cp[pc->idx], p, &f, &sv->best, &hit);
+	} else {
+		got = px_cpiece_closest(&m->cp[pc->idx], p, &sv->best, &hit);
+	}
+	if (got) {
 		r->point = hit.point;
 		r->piece = cd->piece;
 		if (pc->iso_dir == 1) {
@@ -363,13 +372,23 @@ static inline void solve_patch(const struct px_dist_model *m, px_vec3 p,
 {
 	struct px_spiece_hit hit;
 	double hs = NAN, ht = NAN;
+	int got;
 	if (cd->piece == q->best_piece) {
 		/* Newton starts at the best pre-sample. */
 		int ks = q->best_sample - pc->sample_start;
 		hs = (double)(ks / pc->nt) / (pc->ns - 1);
 		ht = (double)(ks % pc->nt) / (pc->nt - 1);
 	}
-	if (px_spiece_closest_hint(&m->spc[pc->idx], p, hs, ht, &sv->best, &hit)) {
+	if (pc->trim == PIECE_CROSSED) {
+		const struct px__uv_filter f = {m->trim[pc->ent].inside,
+						m->trim[pc->ent].ctx, -1, 0.0};
+		got = px__spiece_closest_in(&m->spc[pc->idx], p, hs, ht, &f,
+					    &sv->best, &hit);
+	} else {
+		got = px_spiece_closest_hint(&m->spc[pc->idx], p, hs, ht, &sv->best,
+					     &hit);
+	}
+	if (got) {
 		r->point = hit.point;
 		r->piece = cd->piece;
 		r->u = hit.u;

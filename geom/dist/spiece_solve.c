@@ -211,19 +211,27 @@ struct qctx {
 	double hint_s, hint_t; /* Newton start, or NaN */
 	double best, slack;
 	struct px_spiece_hit *hit;
+	const struct px__uv_filter *flt; /* trimmed domain, or NULL */
 	int improved;
 };
 
-static void consider(struct qctx *x, double s, double t)
+/* The point at (s, t) lowers the bound when it is nearer and, with a
+ * filter, inside its trimmed domain. */
+static inline __attribute__((always_inline)) void
+consider(struct qctx *x, double s, double t)
 {
 	px_vec3 q = px__sp_point(x->sp, s, t);
 	double d2 = px_v3_dist2(q, x->p);
 	if (d2 < x->best) {
+		double u = x->sp->u0_ + s * (x->sp->u1_ - x->sp->u0_);
+		double v = x->sp->v0_ + t * (x->sp->v1_ - x->sp->v0_);
+		if (x->flt && !x->flt->inside(x->flt->ctx, u, v))
+			return;
 		x->best = d2;
 		x->hit->d2 = d2;
 		x->hit->point = q;
-		x->hit->u = x->sp->u0_ + s * (x->sp->u1_ - x->sp->u0_);
-		x->hit->v = x->sp->v0_ + t * (x->sp->v1_ - x->sp->v0_);
+		x->hit->u = u;
+		x->hit->v = v;
 		x->improved = 1;
 	}
 }
@@ -936,7 +944,8 @@ static void split_rect(struct ptens *pt, const struct qctx *x, struct pool *pl,
  * bounding sphere or that bound already shows nothing nearer than the
  * best.
  */
-static int query_start(struct ptens *pt, struct qctx *x, const struct px_spiece *sp,
+static inline __attribute__((always_inline)) int
+query_start(struct ptens *pt, struct qctx *x, const struct px_spiece *sp,
 		       px_vec3 p, double *rf, double *rw, struct rect *root)
 {
 	const int P = sp->p_, Q = sp->q_;
@@ -977,9 +986,12 @@ static int query_start(struct ptens *pt, struct qctx *x, const struct px_spiece 
 	return root->lb < x->best - x->slack;
 }
 
-int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
-			   double hint_s, double hint_t, double *best_d2,
-			   struct px_spiece_hit *hit)
+/* The solver, inlined into both entry points so that the plain one
+ * (flt NULL) compiles without the filter. */
+static inline __attribute__((always_inline)) int
+closest(const struct px_spiece *sp, px_vec3 p, double hint_s, double hint_t,
+	const struct px__uv_filter *flt, double *best_d2,
+	struct px_spiece_hit *hit)
 {
 	struct ptens pt;
 	double rf[TMAX], rw[TMAX], rg[TMAX], rv[TMAX];
@@ -998,6 +1010,7 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 	x.hint_t = hint_t;
 	x.best = *best_d2;
 	x.hit = hit;
+	x.flt = flt;
 	x.improved = 0;
 	hit->iters = 0;
 	hit->nodes = 0;
@@ -1063,6 +1076,20 @@ int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
 out:
 	*best_d2 = x.best;
 	return x.improved;
+}
+
+int px_spiece_closest_hint(const struct px_spiece *sp, px_vec3 p,
+			   double hint_s, double hint_t, double *best_d2,
+			   struct px_spiece_hit *hit)
+{
+	return closest(sp, p, hint_s, hint_t, NULL, best_d2, hit);
+}
+
+int px__spiece_closest_in(const struct px_spiece *sp, px_vec3 p, double hint_s,
+			  double hint_t, const struct px__uv_filter *flt,
+			  double *best_d2, struct px_spiece_hit *hit)
+{
+	return closest(sp, p, hint_s, hint_t, flt, best_d2, hit);
 }
 
 #ifdef PX_TEST_HOOKS

@@ -58,7 +58,8 @@ enum px_model_kind {
 	PX_MODEL_MESH = 2,
 	PX_MODEL_CLOUD = 3,
 	PX_MODEL_NURBS = 4,
-	PX_MODEL_CUSTOM = 5
+	PX_MODEL_CUSTOM = 5,
+	PX_MODEL_BREP = 6 /* trimmed NURBS faces, edges, vertices (px_brep.h) */
 };
 
 /* The kind of feature the closest point lies on. */
