@@ -77,7 +77,7 @@ static void run(struct brep_gen *g)
 		return;
 	}
 	t0 = now_ns() - t0;
-	px_brep_info(b, &info);
+	px_brep_get_info(b, &info);
 	if (px_model_from_brep(b, &mb) != PX_OK) {
 		printf("%s: model failed\n", g->d.name);
 		return;

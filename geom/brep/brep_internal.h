@@ -176,6 +176,7 @@ struct brep_edge {
 struct brep_point {
 	px_vec3 p;
 	int vertex;              /* vertex id, or -1 */
+	int collapsed;           /* a loop curve's image (else a free vertex) */
 };
 
 struct px_brep {

@@ -214,7 +214,7 @@ const struct px_brep *px_model_brep(const struct px_model *m)
 	return ((const struct brep_holder *)px_model_impl(m))->b;
 }
 
-int px_brep_info(const struct px_brep *b, struct px_brep_info *info)
+int px_brep_get_info(const struct px_brep *b, struct px_brep_info *info)
 {
 	if (!b || !info)
 		return PX_E_INVAL;

@@ -17,8 +17,8 @@ void px_brep_opts_default(struct px_brep_opts *o)
 {
 	if (!o)
 		return;
-	px_dist_opts_default(&o->dist);
 	px_trim_opts_default(&o->trim);
+	o->dist = NULL;
 }
 
 static void berr(struct px_brep_error *err, int code, int face, int loop,
@@ -422,6 +422,7 @@ static int collapsed_curve(struct px_brep *b, const struct px_brep_desc *d,
 	}
 	b->pts[b->n_pts].p = p0;
 	b->pts[b->n_pts].vertex = vi;
+	b->pts[b->n_pts].collapsed = 1;
 	b->n_pts++;
 	return PX_OK;
 }
@@ -505,7 +506,7 @@ static int build_dist(struct px_brep *b, const struct px_brep_opts *o)
 	for (i = 0; i < b->n_edges; i++)
 		cv[i] = b->edges[i].c;
 	rc = px__dist_model_create_trimmed(cv, b->n_edges, sf, b->n_faces,
-					   b->dtrim, &o->dist, &b->dm);
+					   b->dtrim, o->dist, &b->dm);
 	free(sf);
 	free(cv);
 	for (i = 0; rc == PX_OK && i < BREP_WS; i++)

@@ -9,7 +9,13 @@
  * outward unit normal times the corner's angle, measured in the tangent
  * plane from the outgoing loop tangent round the normal to the reversed
  * incoming one (a loop runs with its face on the left: outer loops
- * counter-clockwise, holes clockwise, as px_trim orients them).
+ * counter-clockwise, holes clockwise, as px_trim orients them). Where a
+ * loop curve collapses to the vertex (a pole, an apex, a blend's
+ * corner) the face has no tangent plane there: its fan of directions
+ * round the vertex is swept instead, from the incoming edge backwards,
+ * through points just inside the face along the collapsed curve, to the
+ * outgoing edge, each step's angle weighting the unit normal there (as
+ * px_model_nurbs.c does at poles).
  *
  * Signed only when every face is trimmed, every shell is closed and in
  * a solid, every edge is used by exactly two coedges of one shell that
@@ -189,6 +195,95 @@ static int corner_vertex(const struct px_brep *b, int i, int j, px_vec3 x)
 	return best;
 }
 
+/* The coedge after i in its loop (the loop's first after its last). */
+static int next_coedge(const struct px_brep *b, int i)
+{
+	const struct brep_coedge *c = &b->co[i];
+	int j = i + 1;
+	if (j < b->n_co && b->co[j].face == c->face && b->co[j].loop == c->loop)
+		return j;
+	for (j = i; j > 0 && b->co[j - 1].face == c->face && b->co[j - 1].loop == c->loop;
+	     j--)
+		;
+	return j;
+}
+
+/* 3D unit direction of the (u, v) tangent t at the surface derivatives
+ * d (zero when it has none). */
+static px_vec3 dir3(const struct px_nurbs_surf_derivs *d, px_vec3 t)
+{
+	px_vec3 r = px_v3_add(px_v3_scale(d->su, t.x), px_v3_scale(d->sv, t.y));
+	double l = px_v3_norm(r);
+	return l > 0.0 ? px_v3_scale(r, 1.0 / l) : px_v3(0, 0, 0);
+}
+
+#define BREP_FAN 32
+#define BREP_FAN_DELTA 1e-5 /* inward offset, fraction of the domain */
+
+/*
+ * The fan of face f round vertex x where loop curve k (coedge ic, image
+ * x) collapses: incoming coedge ia ends there, outgoing ib starts. Adds
+ * the angle-weighted outward normals to *acc; 0 when a direction or
+ * normal is missing.
+ */
+static int pole_fan(const struct px_brep *b, int ia, int ic, int ib, px_vec3 x,
+		    px_vec3 *acc)
+{
+	const struct brep_coedge *c = &b->co[ic];
+	const struct brep_face *f = &b->faces[c->face];
+	double sg = f->reversed ? -1.0 : 1.0, a0, a1, b0, b1, t0, t1, del;
+	double lr = px_trim_loop_reversed(f->trim, c->loop) == 1 ? -1.0 : 1.0;
+	struct px_nurbs_surf_derivs d;
+	px_vec3 p, ta, tb, prev, prev_n = px_v3(0, 0, 0);
+	int k;
+
+	px_nurbs_surf_domain(&f->surf, &a0, &a1, &b0, &b1);
+	del = BREP_FAN_DELTA * fmax(a1 - a0, b1 - b0);
+	coedge_end(&b->co[ia], 1, &p, &ta);
+	px_nurbs_surf_eval(&f->surf, p.x, p.y, 1, &d);
+	prev = px_v3_neg(dir3(&d, ta));
+	coedge_end(&b->co[ib], 0, &p, &tb);
+	px_nurbs_surf_eval(&f->surf, p.x, p.y, 1, &d);
+	tb = dir3(&d, tb);
+	if (px_v3_norm(prev) == 0.0 || px_v3_norm(tb) == 0.0)
+		return 0;
+	px_nurbs_curve_domain(&c->pc, &t0, &t1);
+	for (k = 0; k <= BREP_FAN + 1; k++) {
+		px_vec3 q, n;
+		if (k <= BREP_FAN) {
+			/* Along the collapsed curve in the loop's direction,
+			 * offset to its left (into the face). */
+			double s = c->dir > 0 ? t0 + (t1 - t0) * (k + 0.5) / (BREP_FAN + 1)
+					      : t1 - (t1 - t0) * (k + 0.5) / (BREP_FAN + 1);
+			px_vec3 cd[2], lt;
+			double l;
+			px_nurbs_curve_eval(&c->pc, s, 1, cd);
+			lt = px_v3_scale(cd[1], c->dir * lr);
+			l = hypot(lt.x, lt.y);
+			if (!(l > 0.0))
+				return 0;
+			px_nurbs_surf_eval(&f->surf, cd[0].x - del * lt.y / l * lr,
+					   cd[0].y + del * lt.x / l * lr, 1, &d);
+			q = px_v3_sub(d.s, x);
+			n = px_v3_cross(d.su, d.sv);
+			if (!(px_v3_norm(q) > 0.0 && px_v3_norm(n) > 0.0))
+				return 0;
+			q = px_v3_scale(q, 1.0 / px_v3_norm(q));
+			n = px_v3_scale(n, sg / px_v3_norm(n));
+		} else {
+			q = tb;
+			n = prev_n;
+		}
+		if (k == 0)
+			prev_n = n;
+		*acc = px_v3_madd(*acc, k == 0 ? n : (k <= BREP_FAN ? px_v3_scale(px_v3_add(n, prev_n), 0.5) : prev_n),
+				  atan2(px_v3_norm(px_v3_cross(prev, q)), px_v3_dot(prev, q)));
+		prev = q;
+		prev_n = n;
+	}
+	return 1;
+}
+
 /* Every face corner's angle times its outward normal into its vertex's
  * pseudo-normal; bad[v] set where a corner has no tangent or normal. */
 static void corners(struct px_brep *b, unsigned char *bad)
@@ -197,15 +292,22 @@ static void corners(struct px_brep *b, unsigned char *bad)
 	for (i = 0; i < b->n_co; i++) {
 		const struct brep_coedge *c = &b->co[i];
 		const struct brep_face *f = &b->faces[c->face];
-		int j = i + 1, lr, v;
+		int j = next_coedge(b, i), lr, v;
 		px_vec3 p, q, a, bt, in, out, m, n3;
 		struct px_nurbs_surf_derivs d;
 		double th, l1, l2, lm;
-		if (j >= b->n_co || b->co[j].face != c->face || b->co[j].loop != c->loop)
-			for (j = i; j > 0 && b->co[j - 1].face == c->face &&
-				    b->co[j - 1].loop == c->loop;
-			     j--)
-				;
+		if (c->edge < 0)
+			continue; /* the fan of the curve before it */
+		if (b->co[j].edge < 0) {
+			int jn = next_coedge(b, j);
+			coedge_end(c, 1, &p, &a);
+			px_nurbs_surf_eval(&f->surf, p.x, p.y, 1, &d);
+			v = corner_vertex(b, i, jn, d.s);
+			if (v >= 0 && (b->co[jn].edge < 0 ||
+				       !pole_fan(b, i, j, jn, b->verts[v], &b->vnormal[v])))
+				bad[v] = 1;
+			continue;
+		}
 		coedge_end(c, 1, &p, &a);
 		coedge_end(&b->co[j], 0, &q, &bt);
 		lr = px_trim_loop_reversed(f->trim, c->loop) == 1;
@@ -256,17 +358,15 @@ static int check_closed(struct px_brep *b)
 				 "face %d has no loops (its edges are unknown)", i);
 			return 0;
 		}
-	for (i = 0; i < b->n_co; i++)
-		if (b->co[i].edge < 0) {
-			snprintf(b->why, sizeof(b->why),
-				 "face %d loop %d curve %d collapses to a point",
-				 b->co[i].face, b->co[i].loop, b->co[i].curve);
-			return 0;
-		}
 	for (i = 0; i < b->n_pts; i++)
-		if (b->pts[i].vertex >= 0) {
-			snprintf(b->why, sizeof(b->why), "vertex %d is on no edge",
-				 b->pts[i].vertex);
+		if (!b->pts[i].collapsed || b->pts[i].vertex < 0) {
+			if (b->pts[i].collapsed)
+				snprintf(b->why, sizeof(b->why),
+					 "a loop curve collapses to a point that is no "
+					 "vertex");
+			else
+				snprintf(b->why, sizeof(b->why),
+					 "vertex %d is on no edge", b->pts[i].vertex);
 			return 0;
 		}
 	return 1;

@@ -32,7 +32,6 @@
 #define PX_BREP_H
 
 #include "px_base.h"
-#include "px_dist.h"
 #include "px_nurbs.h"
 #include "px_trim.h"
 
@@ -105,11 +104,13 @@ struct px_brep_desc {
 
 /* ---- the model ---------------------------------------------------------- */
 
-/* Setup options: the distance core's (px_dist.h) and the trimmed
- * domains' (px_trim.h). */
+/* Setup options: the trimmed domains' (px_trim.h) and the distance
+ * core's (px_dist.h; NULL: its defaults, read during px_brep_create()
+ * only). */
+struct px_dist_opts;
 struct px_brep_opts {
-	struct px_dist_opts dist;
 	struct px_trim_opts trim;
+	const struct px_dist_opts *dist;
 };
 
 /* Defaults of both. */
@@ -176,13 +177,13 @@ struct px_brep_info {
 };
 
 /* Returns PX_OK or PX_E_INVAL. @note RT-safe. */
-PX_API int px_brep_info(const struct px_brep *b, struct px_brep_info *info);
+PX_API int px_brep_get_info(const struct px_brep *b, struct px_brep_info *info);
 
 /*
  * The B-rep as a px_model of kind PX_MODEL_BREP named after desc.name
  * (px_model_name(); "brep" when none). The model takes b over, also on
  * failure. Capabilities: PX_MODEL_CAP_EXACT, and PX_MODEL_CAP_SIGNED
- * when px_brep_info() says closed. Signed answers (inside negative)
+ * when px_brep_get_info() says closed. Signed answers (inside negative)
  * come from the B-rep's own faces: the foot point's face normal
  * (reversed faces flip it), on an edge the sum of its two faces'
  * normals there, at a vertex its angle-weighted pseudo-normal (for a

@@ -513,19 +513,13 @@ struct layout {
  */
 static void recognize(const struct px_nurbs_curve *curves,
 		      const struct px_nurbs_surf *surfs,
-		      const struct px__dist_trim *trims,
 		      struct px_dist_entity_info *ent,
 		      struct px_recog_shape *shapes, struct layout *ly)
 {
 	int e, n_curves = ly->n_curves;
 	for (e = 0; e < ly->n_ent; e++) {
 		struct px_recog_shape *sh = &shapes[e];
-		int got;
-		/* A closed form answers the whole surface, not its trimmed
-		 * part. */
-		if (e >= n_curves && trims && trims[e - n_curves].inside)
-			continue;
-		got = e < n_curves ? px_recog_curve(&curves[e], 0.0, sh)
+		int got = e < n_curves ? px_recog_curve(&curves[e], 0.0, sh)
 				   : px_recog_surf(&surfs[e - n_curves], 0.0, sh);
 		if (got != 1 || sh->kind == PX_RECOG_PLANE ||
 		    !(sh->hausdorff <= 1e-11 * (sh->size > 0.0 ? sh->size : 1.0))) {
@@ -915,7 +909,7 @@ int px__dist_model_create_trimmed(const struct px_nurbs_curve *curves,
 		rc = PX_E_NOMEM;
 		goto fail;
 	}
-	recognize(curves, surfs, trims, ent, shapes, &ly);
+	recognize(curves, surfs, ent, shapes, &ly);
 	count_pieces(&bl, &ly);
 	memset(&hdr, 0, sizeof(hdr));
 	grid_geometry(&hdr, &bl, ent, ly.n_ent, o.max_cells);

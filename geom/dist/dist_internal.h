@@ -65,7 +65,8 @@ int px__spiece_closest_in(const struct px_spiece *sp, px_vec3 p, double hint_s,
  * crosses are solved with the filter and give no pre-samples (a sample
  * outside the domain is no upper bound), the domain edges are not
  * candidates (the caller adds the trimming edges as curves) and creases
- * are classified like patches; no closed-form shape answers it. Setup
+ * are classified like patches; a closed-form shape answers it only
+ * where the whole surface's closest point lies inside the domain. Setup
  * only.
  */
 int px__dist_model_create_trimmed(const struct px_nurbs_curve *curves,

@@ -321,6 +321,11 @@ static inline int solve_shape(const struct px_dist_model *m,
 	if (px_recog_closest(&m->shape[pc->ent], p, PX_RECOG_WANT_PARAMS, &h) !=
 	    PX_OK)
 		return 0; /* no closed form for this query */
+	/* A trimmed surface: the whole surface's minimum answers its trimmed
+	 * part only when it lies inside the domain; else the pieces do. */
+	if (m->trim && m->trim[pc->ent].inside &&
+	    !m->trim[pc->ent].inside(m->trim[pc->ent].ctx, h.u, h.v))
+		return 0;
 	ws->ent_stamp[pc->ent] = ws->epoch;
 	r->pieces_solved++;
 	if (h.dist * h.dist < sv->best) {

@@ -15,6 +15,8 @@
 #include "brep_gen.h"
 #include "px_alloc_count.h"
 #include "px_brep.h"
+#include "px_cad.h"
+#include "px_features.h"
 #include "px_model.h"
 #include "px_test.h"
 #include "px_trim.h"
@@ -23,7 +25,7 @@
 
 struct ref {
 	const struct px_brep_desc *d;
-	struct px_trim *trim[BG_MAXF];
+	struct px_trim **trim; /* per face */
 	double size;
 };
 
@@ -33,6 +35,8 @@ static void ref_init(struct ref *r, const struct px_brep_desc *d)
 	int f, i;
 	memset(r, 0, sizeof(*r));
 	r->d = d;
+	r->trim = calloc((size_t)d->n_faces, sizeof(*r->trim));
+	PX_CHECK(r->trim != NULL);
 	for (f = 0; f < d->n_faces; f++) {
 		px_aabb sb;
 		PX_CHECK(px_trim_create(d->faces[f].loops, d->faces[f].n_loops, NULL, NULL,
@@ -50,6 +54,7 @@ static void ref_fini(struct ref *r)
 	int f;
 	for (f = 0; f < r->d->n_faces; f++)
 		px_trim_free(r->trim[f]);
+	free(r->trim);
 }
 
 /* Newton on |S(u, v) - p|^2 from (u, v), inside the domain; the best
@@ -252,7 +257,7 @@ static void run_part(struct brep_gen *g, int n, int (*inside)(px_vec3), int want
 
 	rc = px_brep_create(&g->d, NULL, &err, &b);
 	PX_CHECK_MSG(rc == PX_OK, "%s: %s", g->d.name, err.msg);
-	PX_CHECK(px_brep_info(b, &info) == PX_OK);
+	PX_CHECK(px_brep_get_info(b, &info) == PX_OK);
 	PX_CHECK_MSG(info.closed == want_closed, "%s: closed %d: %s", g->d.name, info.closed,
 		     info.why);
 	PX_CHECK_INT_EQ(px_model_from_brep(b, &m), PX_OK);
@@ -363,6 +368,72 @@ static void test_thin_box(void)
 	}
 	px_model_free(m);
 	free(g);
+}
+
+/* The shipped STEP part (a filleted block with a drilled hole, read by
+ * px_cad): closed and signed (its fillet corners have collapsed loop
+ * curves); distances against the reference in the file's millimetres;
+ * along random lines the sign changes only where the distance passes
+ * through zero (a wrong side anywhere would be a jump). */
+static void test_step_block(void)
+{
+	struct px_cad *c;
+	struct px_brep *b;
+	struct px_brep_info info;
+	struct px_model *m;
+	struct px_brep_error err;
+	const struct px_brep_desc *d;
+	struct ref r;
+	char path[512], msg[256];
+	double sc;
+	int i, k, flips = 0;
+
+	PX_NEEDS(OCCT);
+	px_test_data_path(path, sizeof(path), "../../config/examples/parts/filleted_block.step");
+	PX_CHECK_MSG(px_cad_load(path, NULL, &c, msg, sizeof(msg)) == PX_OK, "%s", msg);
+	d = px_cad_desc(c);
+	sc = d->scale;
+	PX_CHECK_MSG(px_brep_create(d, NULL, &err, &b) == PX_OK, "%s", err.msg);
+	px_brep_get_info(b, &info);
+	PX_CHECK_MSG(info.closed, "%s", info.why);
+	PX_CHECK(info.n_point_cands > 0);
+	PX_CHECK_INT_EQ(px_model_from_brep(b, &m), PX_OK);
+	ref_init(&r, d);
+	for (i = 0; i < 60; i++) {
+		px_vec3 p = rand_point(&r, (px_aabb){px_v3_scale(info.bounds.min, 1.0 / sc),
+						     px_v3_scale(info.bounds.max, 1.0 / sc)});
+		struct px_model_result a;
+		double want;
+		PX_CHECK_INT_EQ(px_model_query(m, px_v3_scale(p, sc), &a), 1);
+		want = ref_dist(&r, p) * sc;
+		PX_CHECK_MSG(fabs(a.distance) <= want + 1e-9 * r.size * sc,
+			     "point %d: %.17g, reference %.17g (feature %d index %d)", i,
+			     fabs(a.distance), want, a.feature, a.index);
+		PX_CHECK(a.certified);
+		PX_CHECK(a.is_signed);
+	}
+	for (i = 0; i < 60; i++) {
+		px_vec3 lo = info.bounds.min, e = px_v3_sub(info.bounds.max, lo), o, dir;
+		double h = 2e-4 * px_v3_norm(e), prev = 0.0;
+		o = px_v3(lo.x + e.x * px_rand_range(-0.1, 1.1), lo.y + e.y * px_rand_range(-0.1, 1.1),
+			  lo.z + e.z * px_rand_range(-0.1, 1.1));
+		dir = px_v3(px_rand_range(-1, 1), px_rand_range(-1, 1), px_rand_range(-1, 1));
+		dir = px_v3_scale(dir, h / px_v3_norm(dir));
+		for (k = 0; k < 400; k++) {
+			struct px_model_result a;
+			PX_CHECK_INT_EQ(px_model_query(m, px_v3_madd(o, dir, k), &a), 1);
+			if (k > 0 && (a.distance < 0.0) != (prev < 0.0)) {
+				flips++;
+				PX_CHECK_MSG(fabs(a.distance) + fabs(prev) <= 1.001 * h,
+					     "line %d step %d: %g then %g", i, k, prev, a.distance);
+			}
+			prev = a.distance;
+		}
+	}
+	PX_CHECK(flips > 0);
+	ref_fini(&r);
+	px_model_free(m);
+	px_cad_free(c);
 }
 
 /* ---- refusals ------------------------------------------------------------------- */
@@ -489,7 +560,7 @@ static void test_unsigned_why(void)
 	faces[2].reversed = !faces[2].reversed;
 	d.faces = faces;
 	PX_CHECK_INT_EQ(px_brep_create(&d, NULL, NULL, &b), PX_OK);
-	px_brep_info(b, &info);
+	px_brep_get_info(b, &info);
 	PX_CHECK(!info.closed);
 	PX_CHECK_MSG(strstr(info.why, "disagree") != NULL, "%s", info.why);
 	px_brep_free(b);
@@ -497,7 +568,7 @@ static void test_unsigned_why(void)
 	d = g->d;
 	d.n_faces = 5; /* the outer box without its y sides' last face */
 	PX_CHECK_INT_EQ(px_brep_create(&d, NULL, NULL, &b), PX_OK);
-	px_brep_info(b, &info);
+	px_brep_get_info(b, &info);
 	PX_CHECK(!info.closed);
 	PX_CHECK_MSG(strstr(info.why, "edge") != NULL, "%s", info.why);
 	px_brep_free(b);
@@ -505,7 +576,7 @@ static void test_unsigned_why(void)
 	d = g->d;
 	d.scale = 1000.0; /* millimetres in, metres out: scaled, still closed */
 	PX_CHECK_INT_EQ(px_brep_create(&d, NULL, NULL, &b), PX_OK);
-	px_brep_info(b, &info);
+	px_brep_get_info(b, &info);
 	PX_CHECK(info.closed);
 	PX_CHECK_CLOSE(info.bounds.max.x, 100.0, 1e-9, 0);
 	px_brep_free(b);
@@ -537,6 +608,6 @@ static void test_no_alloc(void)
 
 static const struct px_test tests[] = {
 	PX_T(test_sheet_hole), PX_T(test_cube_hole),	PX_T(test_freeform),
-	PX_T(test_thin_box),   PX_T(test_refusals),	PX_T(test_unsigned_why),
-	PX_T(test_no_alloc)};
+	PX_T(test_thin_box),   PX_T(test_step_block),	PX_T(test_refusals),
+	PX_T(test_unsigned_why), PX_T(test_no_alloc)};
 PX_TEST_MAIN(tests)
