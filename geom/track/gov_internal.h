@@ -46,6 +46,18 @@
  * the new point); the thresholds keep a steady speed from switching
  * back and forth.
  *
+ * A tracker with a work budget also says, each tracked update, whether
+ * the update fell behind: its set could not follow the point within the
+ * budget, so the update paid the budget's work and the global query on
+ * top (px__gov_behind()). That is known without a clock, and it is the
+ * cost the clock's means hide: the updates of a catch-up are each several
+ * global queries, few enough not to move a mean and many enough to set
+ * the tail. The tracker goes cold at once when a catch-up runs longer
+ * than PX_GOV_BEHIND_RUN updates (the point outruns the budget), or when
+ * one starts within PX_GOV_BEHIND_GAP tracked updates of the last one
+ * (catch-ups are not rare on this path); the first after a (re)start
+ * (the catch-up of a return's rebuild) is not held against the second.
+ *
  * Memory and real-time rules: a plain struct inside the tracker, no
  * allocation; every call is O(1) and lock-free. Tests replace the clock
  * (px__gov_set_clock) to make the switching deterministic.
@@ -71,6 +83,8 @@
 #define PX_GOV_PROBE_MAX 16384
 #define PX_GOV_BACK 2048
 #define PX_GOV_WARM 16         /* untimed updates after a (re)start */
+#define PX_GOV_BEHIND_RUN 4    /* updates of one catch-up before going cold */
+#define PX_GOV_BEHIND_GAP 1024 /* tracked updates between catch-ups, at least */
 
 /* The clock: nanoseconds, monotonic. ctx is the tests' own. */
 typedef int64_t (*px_gov_clock_fn)(void *ctx);
@@ -89,6 +103,8 @@ struct px_gov {
 	double trk_ns, cold_ns;   /* running means */
 	double step, step_enter;  /* running mean step length; at going cold */
 	uint64_t entered, left;   /* switches, for the stats */
+	uint32_t behind_gap;      /* tracked updates since a catch-up began */
+	int behind_run;           /* updates of the current catch-up */
 	px_gov_clock_fn clock;
 	void *clock_ctx;
 };
@@ -167,6 +183,27 @@ static inline int px__gov_stop(struct px_gov *g, int64_t t0)
 {
 	return t0 != PX_GOV_UNTIMED &&
 	       px__gov_tracked(g, (double)(px__gov_now(g) - t0));
+}
+
+/* A tracked update fell behind (the catch-up's rule above): returns 1
+ * when the tracker should go cold from the next update on (g->cold is
+ * then set). */
+int px__gov_fell_behind(struct px_gov *g);
+
+/* After every tracked update (while the governor is on): behind 1 when
+ * the update fell behind (answered globally, its set short of the point
+ * after the budget's work), else 0. Returns as px__gov_fell_behind().
+ * Inline: every update calls it. */
+static inline int px__gov_behind(struct px_gov *g, int behind)
+{
+	if (!g->on || g->cold)
+		return 0;
+	if (behind)
+		return px__gov_fell_behind(g);
+	g->behind_run = 0;
+	if (g->behind_gap < UINT32_MAX)
+		g->behind_gap++;
+	return 0;
 }
 
 /* In cold mode, once per update: returns 1 when this update should go

@@ -42,6 +42,8 @@ void px__gov_restart(struct px_gov *g)
 	g->trk_ns = 0.0;
 	g->tick = 0;
 	g->skip = PX_GOV_WARM;
+	g->behind_gap = UINT32_MAX;
+	g->behind_run = 0;
 }
 
 void px__gov_set_clock(struct px_gov *g, px_gov_clock_fn fn, void *ctx)
@@ -71,6 +73,29 @@ static double clip(double x, double lim)
 	return x > lim ? lim : x;
 }
 
+/* Going cold from the next update on (a probe that failed waits twice
+ * as long for the next; a return by step that failed soon asks for a
+ * step halved again). Returns 1. */
+static int go_cold(struct px_gov *g)
+{
+	if (g->probing) {
+		g->probe = g->probe < PX_GOV_PROBE_MAX / 2 ? 2 * g->probe
+							   : PX_GOV_PROBE_MAX;
+	} else {
+		g->probe = PX_GOV_PROBE;
+		g->step_enter = g->step;
+		g->leave = g->n_back < PX_GOV_BACK
+				   ? (g->leave > PX_GOV_LEAVE / 8 ? 0.5 * g->leave
+								 : g->leave)
+				   : PX_GOV_LEAVE;
+	}
+	g->cold = 1;
+	g->probing = 0;
+	g->n_cold = 0;
+	g->entered++;
+	return 1;
+}
+
 int px__gov_tracked(struct px_gov *g, double ns)
 {
 	int need = px__gov_need(g);
@@ -88,26 +113,24 @@ int px__gov_tracked(struct px_gov *g, double ns)
 		g->trk_ns += GOV_ALPHA * (ns - g->trk_ns);
 	if (g->n_trk < need)
 		return 0;
-	if (g->trk_ns > PX_GOV_ENTER * g->cold_ns) {
-		if (g->probing) {
-			g->probe = g->probe < PX_GOV_PROBE_MAX / 2 ? 2 * g->probe
-								   : PX_GOV_PROBE_MAX;
-		} else {
-			g->probe = PX_GOV_PROBE;
-			g->step_enter = g->step;
-			g->leave = g->n_back < PX_GOV_BACK
-					   ? (g->leave > PX_GOV_LEAVE / 8 ? 0.5 * g->leave
-									 : g->leave)
-					   : PX_GOV_LEAVE;
-		}
-		g->cold = 1;
-		g->probing = 0;
-		g->n_cold = 0;
-		g->entered++;
-		return 1;
-	}
+	if (g->trk_ns > PX_GOV_ENTER * g->cold_ns)
+		return go_cold(g);
 	g->probing = 0;
 	return 0;
+}
+
+int px__gov_fell_behind(struct px_gov *g)
+{
+	if (!g->on || g->cold)
+		return 0;
+	if (g->behind_run++ == 0) {
+		/* a catch-up begins */
+		int soon = g->behind_gap < PX_GOV_BEHIND_GAP;
+		g->behind_gap = 0;
+		if (soon)
+			return go_cold(g);
+	}
+	return g->behind_run > PX_GOV_BEHIND_RUN ? go_cold(g) : 0;
 }
 
 /* A timed cold update took ns (the query alone). */

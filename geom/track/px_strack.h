@@ -127,8 +127,10 @@
  *    tracker alone); the other points rest and are followed from where
  *    they were at the next full update (stats.hot).
  *  - Fast motion (opts.cold_switch): while following the set costs more
- *    than the global query, the global query answers (PX_TRACK_COLD);
- *    the set is re-established when the steps have shrunk.
+ *    than the global query, or while the set keeps falling behind the
+ *    point (catching up over the budget), the global query answers
+ *    (PX_TRACK_COLD); the set is re-established when the steps have
+ *    shrunk.
  *  - Never silent: verification every verify_every updates against
  *    px_dist_query() on the whole model counts disagreements and
  *    re-initialises; capacity overflow answers globally (counted).

@@ -1224,6 +1224,18 @@ static int strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result
 	return PX_OK;
 }
 
+/* Whether the update that answered r at p fell behind (the governor's
+ * px__gov_behind()): answered globally with the set short of the point
+ * after its work (catching up or owing solves), the point inside the
+ * working volume (outside it the set waits without work). A rebuild is
+ * not behind: it is the return's own cost, or a failed check's. */
+static int fell_behind(const struct px_strack *t, px_vec3 p,
+		       const struct px_strack_result *r)
+{
+	return r->source == PX_TRACK_GLOBAL &&
+	       (t->mode == ST_LAG || t->mode == ST_PEND) && in_work(t, p);
+}
+
 int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 {
 	int64_t t0;
@@ -1251,7 +1263,7 @@ int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 	rc = strack_update(t, p, r);
 	if (t->ret_left > 0 && (t->mode == ST_TRACK || --t->ret_left == 0))
 		t->ret_left = 0;
-	if (px__gov_stop(&t->gov, t0))
+	if (px__gov_behind(&t->gov, fell_behind(t, p, r)) || px__gov_stop(&t->gov, t0))
 		px__st_cold_enter(t, p, r);
 	return rc;
 }
