@@ -390,7 +390,6 @@ static int check_edges(struct px_brep *b, double tol)
 		}
 		for (k = 0; k < 2; k++) {
 			struct brep_coedge *c = &b->co[be->co[k]];
-			double s0, t0, t1;
 			if (!map_coedge(b, c, tol)) {
 				snprintf(b->why, sizeof(b->why),
 					 "face %d loop %d curve %d does not run along "
@@ -398,11 +397,8 @@ static int check_edges(struct px_brep *b, double tol)
 					 c->face, c->loop, c->curve, e);
 				return 0;
 			}
-			px_nurbs_curve_domain(&c->pc, &t0, &t1);
-			s0 = c->s[BREP_MAP_N / 2];
-			tg[k] = induced_tangent(b, c, refine_s(b, c, x, s0, NULL));
-			(void)t0;
-			(void)t1;
+			tg[k] = induced_tangent(b, c,
+						refine_s(b, c, x, c->s[BREP_MAP_N / 2], NULL));
 		}
 		if (!(px_v3_dot(tg[0], tg[1]) < -0.5)) {
 			snprintf(b->why, sizeof(b->why),

@@ -20,7 +20,8 @@
  * Answers (struct px_model_result): index is the face (feature
  * PX_FEATURE_SURFACE, (u, v) its surface parameters), the edge
  * (PX_FEATURE_CURVE, u the edge curve's parameter) or the vertex
- * (PX_FEATURE_VERTEX); certified keeps its meaning (the global minimum
+ * (PX_FEATURE_VERTEX; -1 for the point of a collapsed loop curve that is
+ * no vertex); certified keeps its meaning (the global minimum
  * over the trimmed faces, their edges and vertices, proven).
  *
  * Memory and real-time rules: px_brep_create() and px_model_from_brep()

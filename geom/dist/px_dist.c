@@ -343,16 +343,7 @@ static inline void solve_curve(const struct px_dist_model *m, px_vec3 p,
 			       struct solve *sv, struct px_dist_result *r)
 {
 	struct px_cpiece_hit hit;
-	int got;
-	if (pc->trim == PIECE_CROSSED) {
-		const struct px__uv_filter f = {m->trim[pc->ent].inside,
-						m->trim[pc->ent].ctx, pc->iso_dir,
-						pc->iso_t};
-		got = px__cpiece_closest_in(&m->cp[pc->idx], p, &f, &sv->best, &hit);
-	} else {
-		got = px_cpiece_closest(&m->cp[pc->idx], p, &sv->best, &hit);
-	}
-	if (got) {
+	if (px_cpiece_closest(&m->cp[pc->idx], p, &sv->best, &hit)) {
 		r->point = hit.point;
 		r->piece = cd->piece;
 		if (pc->iso_dir == 1) {
@@ -377,23 +368,13 @@ static inline void solve_patch(const struct px_dist_model *m, px_vec3 p,
 {
 	struct px_spiece_hit hit;
 	double hs = NAN, ht = NAN;
-	int got;
 	if (cd->piece == q->best_piece) {
 		/* Newton starts at the best pre-sample. */
 		int ks = q->best_sample - pc->sample_start;
 		hs = (double)(ks / pc->nt) / (pc->ns - 1);
 		ht = (double)(ks % pc->nt) / (pc->nt - 1);
 	}
-	if (pc->trim == PIECE_CROSSED) {
-		const struct px__uv_filter f = {m->trim[pc->ent].inside,
-						m->trim[pc->ent].ctx, -1, 0.0};
-		got = px__spiece_closest_in(&m->spc[pc->idx], p, hs, ht, &f,
-					    &sv->best, &hit);
-	} else {
-		got = px_spiece_closest_hint(&m->spc[pc->idx], p, hs, ht, &sv->best,
-					     &hit);
-	}
-	if (got) {
+	if (px_spiece_closest_hint(&m->spc[pc->idx], p, hs, ht, &sv->best, &hit)) {
 		r->point = hit.point;
 		r->piece = cd->piece;
 		r->u = hit.u;
@@ -401,6 +382,42 @@ static inline void solve_patch(const struct px_dist_model *m, px_vec3 p,
 	}
 	r->iters += hit.iters;
 	note_cert(r, sv, hit.certified, hit.gap);
+}
+
+/* A piece of a trimmed surface that a loop crosses: its solver keeps
+ * only minima inside the domain (no pre-samples, so no Newton hint).
+ * Out of line: untrimmed models never come here. */
+static __attribute__((noinline)) void
+solve_crossed(const struct px_dist_model *m, px_vec3 p, const struct cand *cd,
+	      const struct piece *pc, struct solve *sv, struct px_dist_result *r)
+{
+	const struct px__uv_filter f = {m->trim[pc->ent].inside, m->trim[pc->ent].ctx,
+					pc->iso_dir, pc->iso_t};
+	int got, iters, certified;
+	double gap, u, v = 0.0;
+	px_vec3 pt;
+	if (pc->kind == PK_CURVE) {
+		struct px_cpiece_hit h;
+		got = px__cpiece_closest_in(&m->cp[pc->idx], p, &f, &sv->best, &h);
+		iters = h.iters, certified = h.certified, gap = h.gap;
+		pt = h.point;
+		u = pc->iso_dir == 1 ? pc->iso_t : h.u;
+		v = pc->iso_dir == 1 ? h.u : pc->iso_t;
+	} else {
+		struct px_spiece_hit h;
+		got = px__spiece_closest_in(&m->spc[pc->idx], p, NAN, NAN, &f, &sv->best,
+					    &h);
+		iters = h.iters, certified = h.certified, gap = h.gap;
+		pt = h.point, u = h.u, v = h.v;
+	}
+	if (got) {
+		r->point = pt;
+		r->piece = cd->piece;
+		r->u = u;
+		r->v = v;
+	}
+	r->iters += iters;
+	note_cert(r, sv, certified, gap);
 }
 
 /*
@@ -450,7 +467,9 @@ static void solve_candidates(const struct px_dist_model *m,
 		if (i > 0 && px_obb_dist2(&pc->obb, p) >= sv->best)
 			continue;
 		r->pieces_solved++;
-		if (pc->kind == PK_CURVE)
+		if (pc->trim == PIECE_CROSSED)
+			solve_crossed(m, p, cd, pc, sv, r);
+		else if (pc->kind == PK_CURVE)
 			solve_curve(m, p, cd, pc, sv, r);
 		else
 			solve_patch(m, p, cd, pc, q, sv, r);

@@ -257,6 +257,73 @@ static inline struct brep_gen *brep_gen_sheet_hole(void)
 	return g;
 }
 
+/* Roof over the unit square (ridge of height h along u = 0.5: a C0
+ * crease of a degree-1 surface) with a round hole of radius 0.25 about
+ * (0.5, 0.5) that the crease crosses: the hole's two half circles and
+ * the square's sides are the exact images (the surface is affine on
+ * each side of the ridge). One face, an open shell. */
+static inline struct brep_gen *brep_gen_roof_hole(void)
+{
+	static const double Uu[5] = {0, 0, 0.5, 1, 1}, Uv[4] = {0, 0, 1, 1};
+	const double h = 0.2, r = 0.25;
+	struct brep_gen *g = bg_new();
+	struct px_nurbs_surf s;
+	double *ku = bg_alloc(g, 5), *kv = bg_alloc(g, 4), *pw = bg_alloc(g, 24);
+	int i, j, f, l, k, vid[4], vh[2];
+	const double cu[5] = {0, 1, 1, 0, 0}, cv[5] = {0, 0, 1, 1, 0};
+	memcpy(ku, Uu, sizeof(Uu));
+	memcpy(kv, Uv, sizeof(Uv));
+	for (j = 0; j < 2; j++)
+		for (i = 0; i < 3; i++) {
+			double *q = pw + 4 * (j * 3 + i);
+			q[0] = 0.5 * i;
+			q[1] = j;
+			q[2] = i == 1 ? h : 0.0;
+			q[3] = 1.0;
+		}
+	if (px_nurbs_surf_view(&s, 1, 1, 3, 2, ku, 5, kv, 4, pw, NULL) != PX_OK)
+		abort();
+	g->shells[g->ns++] = (struct px_brep_shell_desc){0, -1, 0};
+	f = bg_face(g, s, 0, 0);
+	l = bg_loop(g, f);
+	for (k = 0; k < 4; k++)
+		vid[k] = bg_vertex(g, px_v3(cu[k], cv[k], 0));
+	for (k = 0; k < 4; k++) {
+		px_vec3 a = px_v3(cu[k], cv[k], 0), b = px_v3(cu[k + 1], cv[k + 1], 0);
+		struct px_nurbs_curve e3;
+		if (cv[k] == cv[k + 1]) {
+			/* Along u over the ridge: three points, the knot at the
+			 * ridge as the surface's. */
+			const double epw[12] = {a.x, a.y, 0, 1, 0.5, a.y, h, 1, b.x, b.y, 0, 1};
+			const double U[5] = {0, 0, 0.5, 1, 1};
+			e3 = bg_curve(g, 1, 3, epw, U);
+		} else {
+			e3 = bg_line(g, a, b);
+		}
+		bg_coedge(g, f, l, bg_line(g, a, b), 0, bg_edge(g, e3, vid[k], vid[(k + 1) % 4]));
+	}
+	/* The hole: the half circle left of the ridge (angles pi/2 to 3pi/2)
+	 * and the right one, each mapped by its side's affine map. */
+	vh[0] = bg_vertex(g, px_v3(0.5, 0.5 + r, h));
+	vh[1] = bg_vertex(g, px_v3(0.5, 0.5 - r, h));
+	l = bg_loop(g, f);
+	for (k = 0; k < 2; k++) {
+		double xy[10], w[5], U[8], p2[20], p3[20];
+		int n = arc2d(M_PI / 2 + k * M_PI, M_PI, 2, xy, w, U), m;
+		for (m = 0; m < n; m++) {
+			double u = 0.5 + r * xy[2 * m], v = 0.5 + r * xy[2 * m + 1];
+			double z = k == 0 ? 2.0 * h * u : 2.0 * h * (1.0 - u);
+			p2[4 * m] = u * w[m], p2[4 * m + 1] = v * w[m], p2[4 * m + 2] = 0.0;
+			p3[4 * m] = u * w[m], p3[4 * m + 1] = v * w[m], p3[4 * m + 2] = z * w[m];
+			p2[4 * m + 3] = p3[4 * m + 3] = w[m];
+		}
+		bg_coedge(g, f, l, bg_curve(g, 2, n, p2, U), 0,
+			  bg_edge(g, bg_curve(g, 2, n, p3, U), vh[k], vh[1 - k]));
+	}
+	bg_finish(g, 0, "roof_hole");
+	return g;
+}
+
 /* The six faces of the box [lo, hi] (outward normals away from its
  * middle, or towards it for a void), holes none. */
 static inline void bg_box(struct brep_gen *g, px_vec3 lo, px_vec3 hi, int shell, int voidb)

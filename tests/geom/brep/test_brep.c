@@ -320,6 +320,30 @@ static void test_sheet_hole(void)
 	free(g);
 }
 
+/* A hole across a C0 crease: the crease's curve pieces are crossed by
+ * the hole and must not answer from inside it. */
+static void test_roof_hole(void)
+{
+	struct brep_gen *g = brep_gen_roof_hole();
+	struct px_brep *b;
+	struct px_model *m;
+	struct px_model_result a;
+	PX_CHECK_INT_EQ(px_brep_create(&g->d, NULL, NULL, &b), PX_OK);
+	PX_CHECK_INT_EQ(px_model_from_brep(b, &m), PX_OK);
+	/* Above the ridge in the hole's middle: the ridge point (0.5, 0.5,
+	 * 0.2) is in the hole; the hole's rim is nearest. */
+	PX_CHECK_INT_EQ(px_model_query(m, px_v3(0.5, 0.5, 0.5), &a), 1);
+	PX_CHECK(a.distance > 0.3 + 1e-3);
+	PX_CHECK(a.feature != PX_FEATURE_SURFACE);
+	/* Above the ridge outside the hole: on the crease. */
+	PX_CHECK_INT_EQ(px_model_query(m, px_v3(0.5, 0.1, 0.5), &a), 1);
+	PX_CHECK_CLOSE(a.distance, 0.3, 1e-12, 0);
+	PX_CHECK_INT_EQ(a.feature, PX_FEATURE_SURFACE);
+	px_model_free(m);
+	run_part(g, 250, NULL, 0);
+	free(g);
+}
+
 static int cube_hole_inside(px_vec3 p)
 {
 	return p.x > 0 && p.x < 1 && p.y > 0 && p.y < 1 && p.z > 0 && p.z < 1 &&
@@ -607,7 +631,8 @@ static void test_no_alloc(void)
 }
 
 static const struct px_test tests[] = {
-	PX_T(test_sheet_hole), PX_T(test_cube_hole),	PX_T(test_freeform),
+	PX_T(test_sheet_hole), PX_T(test_roof_hole),	PX_T(test_cube_hole),
+	PX_T(test_freeform),
 	PX_T(test_thin_box),   PX_T(test_step_block),	PX_T(test_refusals),
 	PX_T(test_unsigned_why), PX_T(test_no_alloc)};
 PX_TEST_MAIN(tests)
