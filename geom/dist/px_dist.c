@@ -322,8 +322,9 @@ static inline int solve_shape(const struct px_dist_model *m,
 	    PX_OK)
 		return 0; /* no closed form for this query */
 	/* A trimmed surface: the whole surface's minimum answers its trimmed
-	 * part only when it lies inside the domain; else the pieces do. */
-	if (m->trim && m->trim[pc->ent].inside &&
+	 * part when it lies inside the domain, else the pieces do; when it
+	 * is no nearer than the best, nothing on the part is either. */
+	if (m->trim && m->trim[pc->ent].inside && h.dist * h.dist < sv->best &&
 	    !m->trim[pc->ent].inside(m->trim[pc->ent].ctx, h.u, h.v))
 		return 0;
 	ws->ent_stamp[pc->ent] = ws->epoch;
