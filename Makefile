@@ -441,6 +441,11 @@ help:
 	@echo 'Environment for tests: PX_TEST_SEED=<n> replays a seed,'
 	@echo '  PX_TEST_ONLY=<name> runs one test of a binary.'
 
+# One variable's value, for scripts: `make -s print-OPT_PARTS`
+# (tests/test_build_parts.sh reads the parts and their tags).
+print-%:
+	@echo '$($*)'
+
 # ---- fuzzing (clang + libFuzzer) -----------------------------------------
 # Every fuzz/fuzz_<name>.c is a libFuzzer target. `make fuzz` builds the
 # library once with clang's fuzzer instrumentation plus ASan and UBSan

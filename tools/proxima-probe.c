@@ -11,6 +11,7 @@
 #include <linux/can.h>
 
 #include "px_can.h"
+#include "px_features.h"
 #include "px_gpio.h"
 #include "px_hid.h"
 #include "px_usb.h"
@@ -37,7 +38,13 @@ static int sys_type(const char *ifname)
 
 static void probe_hid(void)
 {
-	int n = px_hid_list(print_item, "hid:");
+	int n;
+	if (!PX_HAVE_HIDAPI) {
+		printf("hid: this build has no HID back end (built without "
+		       "hidapi)\n");
+		return;
+	}
+	n = px_hid_list(print_item, "hid:");
 	if (n < 0)
 		printf("hid: hidapi (%s) could not start: %s\n",
 		       px_hid_driver_name(), px_strerror(n));
@@ -106,7 +113,13 @@ static void probe_can(void)
 
 static void probe_gpio(int lines)
 {
-	int n = px_gpiod_list(lines, print_item, "gpio:");
+	int n;
+	if (!PX_HAVE_GPIOD) {
+		printf("gpio: this build has no GPIO back end (built without "
+		       "libgpiod)\n");
+		return;
+	}
+	n = px_gpiod_list(lines, print_item, "gpio:");
 	if (n == PX_E_NOTFOUND)
 		printf("gpio: no GPIO chips (no /dev/gpiochip*; libgpiod %s)\n",
 		       px_gpiod_version());

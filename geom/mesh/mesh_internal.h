@@ -14,6 +14,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #include <math.h>
 
@@ -714,6 +715,34 @@ int px__mesh_vs_model(const struct px_model *m, const struct px_model *o,
 int px__import_file(const char *path, int want_tri, double **xyz,
 		    size_t *nv, uint32_t **tri, size_t *nt, size_t *n_skipped,
 		    char *msg, size_t msg_cap);
+
+/* ---- mesh_ply.c: the importer's parts that need no importer library
+ * (so that PLY point clouds load in a build without assimp). Setup only. */
+
+/* The file once, at most PX_FILE_MODEL_MAX_BYTES (.obj and .off as
+ * text): *data (malloc'ed) and *len; an empty file is PX_E_PARSE. */
+int px__import_read(const char *path, char **data, size_t *len, char *msg,
+		    size_t msg_cap);
+/* A PLY: the magic line, or a .ply name (the check sees those too). */
+int px__ply_file(const char *path, const char *data, size_t len);
+/* The PLY's structure checked against its header, element by element,
+ * and its vertices' x, y, z read exactly as doubles into *xyz
+ * (malloc'ed, 3 per vertex, *nv of them). want_tri: a file without
+ * faces is PX_E_PARSE "<path>: no triangles in the file" (a cloud).
+ * Returns PX_OK, PX_E_PARSE, PX_E_IO or PX_E_NOMEM. */
+int px__ply_read(const char *path, char *data, size_t len, int want_tri,
+		 double **xyz, size_t *nv, char *msg, size_t msg_cap);
+/* An unsigned integer of size bytes (big: big-endian). */
+unsigned long long px__ply_uint(const unsigned char *b, int size, int big);
+/* A decimal number as the importer's parser reads it: sign, digits with
+ * an optional point, optional exponent; or nan / inf (strtod() alone
+ * would also take hexadecimal floats). */
+int px__num_ok(const char *t);
+/* A reader over len bytes at data: NULL with msg on failure. */
+FILE *px__mem_stream(const char *path, char *data, size_t len, char *msg,
+		     size_t msg_cap);
+/* s ends with ext, ignoring case. */
+int px__ends_with_ci(const char *s, const char *ext);
 
 /* Point cloud hint grid (px_cloud.c), for tests: the input index of the
  * point the grid names for p, and the centre of p's cell (clamped to the

@@ -1,7 +1,11 @@
-/* The mesh importer of a build without the Open Asset Import Library:
- * every file read through it is refused with a message that says so
- * (px_mesh_load, and PLY point clouds, which share its reader). */
+/* The mesh importer of a build without the Open Asset Import Library.
+ * PLY files are checked and their vertices read without it
+ * (mesh_ply.c): a PLY point cloud loads as in every build, and a PLY
+ * with vertices only, read as a mesh, says "no triangles" as there (so
+ * px_model_load takes it as a cloud). Every other mesh - a PLY with
+ * faces, STL, OBJ, ... - is refused with a message that says why. */
 #include <stdio.h>
+#include <stdlib.h>
 
 #include "mesh_internal.h"
 
@@ -9,19 +13,37 @@ int px__import_file(const char *path, int want_tri, double **xyz,
 		    size_t *nv, uint32_t **tri, size_t *nt, size_t *n_skipped,
 		    char *msg, size_t msg_cap)
 {
-	(void)want_tri;
-	if (xyz)
-		*xyz = NULL;
-	if (nv)
-		*nv = 0;
+	char *data = NULL;
+	size_t len = 0;
+	int rc, ply;
+	if (msg_cap)
+		msg[0] = '\0';
 	if (tri)
 		*tri = NULL;
 	if (nt)
 		*nt = 0;
 	if (n_skipped)
 		*n_skipped = 0;
-	if (msg && msg_cap)
-		snprintf(msg, msg_cap, "%s: this build has no mesh importer "
-			 "(built without assimp)", path ? path : "<null>");
+	if (!path || !xyz || !nv || (want_tri && (!tri || !nt))) {
+		snprintf(msg, msg_cap, "invalid arguments");
+		return PX_E_INVAL;
+	}
+	*xyz = NULL;
+	*nv = 0;
+	rc = px__import_read(path, &data, &len, msg, msg_cap);
+	if (rc != PX_OK)
+		return rc;
+	ply = px__ply_file(path, data, len);
+	if (ply)
+		rc = px__ply_read(path, data, len, want_tri, xyz, nv, msg, msg_cap);
+	free(data);
+	if (ply && (rc != PX_OK || !want_tri))
+		return rc;
+	free(*xyz);
+	*xyz = NULL;
+	*nv = 0;
+	snprintf(msg, msg_cap, "%s: this build has no mesh importer%s "
+		 "(built without assimp)", path,
+		 ply ? " for the faces of a PLY" : "");
 	return PX_E_UNSUPPORTED;
 }

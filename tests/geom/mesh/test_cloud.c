@@ -234,7 +234,6 @@ static void check_error(const char *name, int code, const char *what, long line)
 
 static void test_files(void)
 {
-	PX_NEEDS(ASSIMP);
 	const double ref[] = {1, 2, 3, -0.5, 0.25, 1e-3, 4, 5, 6};
 	const char *names[] = {"a.xyz", "b.csv", "c.txt", "d.ply", "e.ply", "bad1.xyz",
 			       "bad2.csv", "bad3.xyz", "empty.xyz", "bad.ply", "trunc.ply",
