@@ -33,7 +33,10 @@
  * that step size (profiling). Each curve path runs
  * three times; a summary line per model gives the medians per step size
  * (worse path kind) and the ratio to the cold query, and a targets line
- * says which of the issue's curve targets are met.
+ * says which of the issue's curve targets are met. Each surface ends
+ * with the tracked path against the cold query it replaces: median and
+ * p99 ratios per step size (also by each update's least of 3 runs) and
+ * the steps where it is never slower at either.
  * Prints figures only; nothing here is a pass/fail test.
  */
 #include <math.h>
@@ -704,9 +707,69 @@ struct surf_row {
 	/* medians of each update's and each cold query's least time over
 	 * the three runs (interrupts and a busy machine mostly fall out) */
 	int64_t med3, cold_med3;
+	/* 99th percentiles: of the first run, and of the least times */
+	int64_t p99, cold_p99, p99_3, cold_p99_3;
 	long wrong;
 	double net, bat; /* ratio of medians net of the clock; of block means */
 };
+
+static double q_ratio(int64_t a, int64_t b)
+{
+	return b > 0 ? (double)a / (double)b : 0.0;
+}
+
+/* The steps (in %) where ok[] holds, into out (64 bytes). */
+static void step_list(char *out, const int ok[4], const double steps[4])
+{
+	int n = 0, s;
+	out[0] = 0;
+	for (s = 0; s < 4; s++)
+		if (ok[s])
+			n += snprintf(out + n, 64 - (size_t)n, "%s%g", n ? ", " : "",
+				      steps[s] * 100.0);
+	if (!n)
+		snprintf(out, 64, "none");
+}
+
+/* The tracked path against the cold query it replaces, per step size:
+ * median and p99 of the tracked updates over the cold query's (first
+ * run; in brackets each update's least of 3 runs, where interrupts and
+ * other load mostly fall out), and the steps where the tracked path is
+ * never slower (at most the cold query's median and p99 on both
+ * paths). */
+static void never_slower(const char *name, struct surf_row row[2][4],
+			 const double steps[4])
+{
+	int med_ok[4], p99_ok[4], med3_ok[4], p993_ok[4], s, k;
+	char lm[64], lp[64], lm3[64], lp3[64];
+	printf("  against the cold query %s, tracked / cold (random / sines; "
+	       "each update's least of 3 runs in brackets):\n", name);
+	for (s = 0; s < 4; s++) {
+		const struct surf_row *a = &row[0][s], *b = &row[1][s];
+		printf("    step %-5g %%: median %4.2f / %4.2f [%4.2f / %4.2f], "
+		       "p99 %4.2f / %4.2f [%4.2f / %4.2f]\n", steps[s] * 100.0,
+		       q_ratio(a->med, a->cold_med), q_ratio(b->med, b->cold_med),
+		       q_ratio(a->med3, a->cold_med3), q_ratio(b->med3, b->cold_med3),
+		       q_ratio(a->p99, a->cold_p99), q_ratio(b->p99, b->cold_p99),
+		       q_ratio(a->p99_3, a->cold_p99_3),
+		       q_ratio(b->p99_3, b->cold_p99_3));
+		med_ok[s] = p99_ok[s] = med3_ok[s] = p993_ok[s] = 1;
+		for (k = 0; k < 2; k++) {
+			const struct surf_row *w = &row[k][s];
+			med_ok[s] &= w->med <= w->cold_med;
+			p99_ok[s] &= w->p99 <= w->cold_p99;
+			med3_ok[s] &= w->med3 <= w->cold_med3;
+			p993_ok[s] &= w->p99_3 <= w->cold_p99_3;
+		}
+	}
+	step_list(lm, med_ok, steps);
+	step_list(lp, p99_ok, steps);
+	step_list(lm3, med3_ok, steps);
+	step_list(lp3, p993_ok, steps);
+	printf("  never slower than the cold query %s, steps (%%) where met on "
+	       "both paths: median %s, p99 %s; by each update's least of 3 "
+	       "runs: median %s, p99 %s\n", name, lm, lp, lm3, lp3);
+}
 
 static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 {
@@ -907,9 +970,11 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 				memcpy(tsort, tw, sizeof(tsort));
 				qsort(tsort, NSSTEP, sizeof(tsort[0]), cmp_i64);
 				row[kind][s].med3 = tsort[NSSTEP / 2];
+				row[kind][s].p99_3 = tsort[NSSTEP * 99 / 100];
 				memcpy(tsort, tgw, sizeof(tsort));
 				qsort(tsort, NSSTEP, sizeof(tsort[0]), cmp_i64);
 				row[kind][s].cold_med3 = tsort[NSSTEP / 2];
+				row[kind][s].cold_p99_3 = tsort[NSSTEP * 99 / 100];
 				if (worst_env && kw >= 0)
 					printf("  (worst update %d: %.1f us, cells solved %d, "
 					       "cell tests %d, source %d)\n", kw,
@@ -951,6 +1016,8 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 			row[kind][s].p999 = tt[NSSTEP * 999 / 1000];
 			row[kind][s].max = tt[NSSTEP - 1];
 			row[kind][s].cold_med = tg[NSSTEP / 2];
+			row[kind][s].p99 = tt[NSSTEP * 99 / 100];
+			row[kind][s].cold_p99 = tg[NSSTEP * 99 / 100];
 			row[kind][s].ins_med = ins_fd >= 0 ? it[NSSTEP / 2] : -1;
 			row[kind][s].cold_ins_med = ins_fd >= 0 ? ig[NSSTEP / 2] : -1;
 			row[kind][s].ins_max = ins_fd >= 0 ? it[NSSTEP - 1] : -1;
@@ -1035,16 +1102,8 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 			char *out[8] = {lm, lx, lr, li, lw, ln, lb, l3};
 			int *ok[8] = {med_ok, max_ok, ratio_ok, iratio_ok, wmax_ok,
 				      net_ok, bat_ok, m3_ok}, m;
-			for (m = 0; m < 8; m++) {
-				int n = 0;
-				out[m][0] = 0;
-				for (s = 0; s < 4; s++)
-					if (ok[m][s])
-						n += snprintf(out[m] + n, 64 - (size_t)n, "%s%g", n ? ", " : "",
-							      steps[s] * 100.0);
-				if (!n)
-					snprintf(out[m], 64, "none");
-			}
+			for (m = 0; m < 8; m++)
+				step_list(out[m], ok[m], steps);
 		}
 		printf("  targets %s, steps (%%) where met on both paths: median <= "
 		       "1.5 us: %s; max <= 20 us: %s (raw max %.1f us, p99.9 %.1f us: "
@@ -1057,6 +1116,7 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 		       name, lm, lx, worst_max / 1e3, worst_p999 / 1e3, lw, worst_w / 1e3,
 		       worst_cw / 1e3, lr,
 		       li, ln, lb, l3, wrong == 0 ? "MET" : "NOT MET", wrong);
+		never_slower(name, row, steps);
 	}
 	{
 		struct px_strack *tv = NULL;
