@@ -57,6 +57,10 @@
  * one starts within PX_GOV_BEHIND_GAP tracked updates of the last one
  * (catch-ups are not rare on this path); the first after a (re)start
  * (the catch-up of a return's rebuild) is not held against the second.
+ * After a return the set was rebuilt where the point was when the
+ * rebuild began, so its catch-up covers the whole path since: one that
+ * is not done in PX_GOV_BEHIND_RETURN updates will not be (the point
+ * moves on as fast), and the return goes cold again then.
  *
  * Memory and real-time rules: a plain struct inside the tracker, no
  * allocation; every call is O(1) and lock-free. Tests replace the clock
@@ -85,6 +89,7 @@
 #define PX_GOV_WARM 16         /* untimed updates after a (re)start */
 #define PX_GOV_BEHIND_RUN 4    /* updates of one catch-up before going cold */
 #define PX_GOV_BEHIND_GAP 1024 /* tracked updates between catch-ups, at least */
+#define PX_GOV_BEHIND_RETURN 1 /* the same as PX_GOV_BEHIND_RUN after a return */
 
 /* The clock: nanoseconds, monotonic. ctx is the tests' own. */
 typedef int64_t (*px_gov_clock_fn)(void *ctx);
@@ -105,6 +110,7 @@ struct px_gov {
 	uint64_t entered, left;   /* switches, for the stats */
 	uint32_t behind_gap;      /* tracked updates since a catch-up began */
 	int behind_run;           /* updates of the current catch-up */
+	int returning;            /* back from cold, not yet on track */
 	px_gov_clock_fn clock;
 	void *clock_ctx;
 };
@@ -192,15 +198,17 @@ int px__gov_fell_behind(struct px_gov *g);
 
 /* After every tracked update (while the governor is on): behind 1 when
  * the update fell behind (answered globally, its set short of the point
- * after the budget's work), else 0. Returns as px__gov_fell_behind().
- * Inline: every update calls it. */
+ * after the budget's work), 0 when it was on track, -1 when neither (the
+ * set being rebuilt, or waiting for the point to come back). Returns as
+ * px__gov_fell_behind(). Inline: every update calls it. */
 static inline int px__gov_behind(struct px_gov *g, int behind)
 {
-	if (!g->on || g->cold)
+	if (!g->on || g->cold || behind < 0)
 		return 0;
 	if (behind)
 		return px__gov_fell_behind(g);
 	g->behind_run = 0;
+	g->returning = 0;
 	if (g->behind_gap < UINT32_MAX)
 		g->behind_gap++;
 	return 0;

@@ -44,6 +44,7 @@ void px__gov_restart(struct px_gov *g)
 	g->skip = PX_GOV_WARM;
 	g->behind_gap = UINT32_MAX;
 	g->behind_run = 0;
+	g->returning = 0;
 }
 
 void px__gov_set_clock(struct px_gov *g, px_gov_clock_fn fn, void *ctx)
@@ -130,7 +131,9 @@ int px__gov_fell_behind(struct px_gov *g)
 		if (soon)
 			return go_cold(g);
 	}
-	return g->behind_run > PX_GOV_BEHIND_RUN ? go_cold(g) : 0;
+	return g->behind_run > (g->returning ? PX_GOV_BEHIND_RETURN : PX_GOV_BEHIND_RUN)
+		       ? go_cold(g)
+		       : 0;
 }
 
 /* A timed cold update took ns (the query alone). */
@@ -175,6 +178,7 @@ int px__gov_leave(struct px_gov *g)
 	px__gov_restart(g);
 	g->probing = probe;
 	g->n_back = probe ? UINT32_MAX : 0;
+	g->returning = 1;
 	return 1;
 }
 

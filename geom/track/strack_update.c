@@ -1224,16 +1224,19 @@ static int strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result
 	return PX_OK;
 }
 
-/* Whether the update that answered r at p fell behind (the governor's
- * px__gov_behind()): answered globally with the set short of the point
- * after its work (catching up or owing solves), the point inside the
- * working volume (outside it the set waits without work). A rebuild is
- * not behind: it is the return's own cost, or a failed check's. */
+/* Whether the update that answered r at p fell behind, for the
+ * governor's px__gov_behind(): 1 when answered globally with the set
+ * short of the point after its work (catching up or owing solves); -1
+ * when the set is being rebuilt (the return's own cost, or a failed
+ * check's) or waits outside the working volume without work; else 0. */
 static int fell_behind(const struct px_strack *t, px_vec3 p,
 		       const struct px_strack_result *r)
 {
-	return r->source == PX_TRACK_GLOBAL &&
-	       (t->mode == ST_LAG || t->mode == ST_PEND) && in_work(t, p);
+	if (r->source != PX_TRACK_GLOBAL)
+		return 0;
+	if (t->mode == ST_REBUILD || !in_work(t, p))
+		return -1;
+	return t->mode == ST_LAG || t->mode == ST_PEND;
 }
 
 int px_strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
