@@ -471,7 +471,9 @@ FUZZ_NAMES   := $(patsubst fuzz/fuzz_%.c,%,$(FUZZ_SRC))
 comma        := ,
 FUZZ_RUN     := $(if $(FUZZ_TARGETS),$(subst $(comma), ,$(FUZZ_TARGETS)),$(FUZZ_NAMES))
 FUZZ_BIN     := $(patsubst %,$(BUILD)/fuzz/fuzz_%,$(FUZZ_NAMES))
-FUZZ_LIB_OBJ := $(patsubst %.c,$(BUILD)/fuzz/obj/%.o,$(LIB_SRC))
+# C++ parts are built with their C stand-in there (the fuzz targets
+# reach no C++ library).
+FUZZ_LIB_OBJ := $(patsubst %.c,$(BUILD)/fuzz/obj/%.o,$(LIB_SRC) $(LIB_CXX_SRC:.cpp=_none.c))
 FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=undefined
 FUZZ_FLAGS   := -std=c11 -D_GNU_SOURCE $(WARN) $(INCS) -g -O1 \
                 -Wno-unused-function -fno-omit-frame-pointer $(FUZZ_SAN)

@@ -75,6 +75,36 @@ check "consumer links statically" \
 	${CC:-cc} -std=c11 -Wall -Werror $cflags "$tmp/consumer.c" -o "$tmp/consumer_static" \
 	"$tmp/root/usr/lib/libproxima.a" $slibs
 check "static consumer runs" "$tmp/consumer_static"
+# The optional parts' libraries come with the static library through
+# Libs.private (OpenCASCADE and the C++ runtime have no .pc of their own).
+cat >"$tmp/cad.c" <<'C'
+#include <proxima/px_cad.h>
+#include <proxima/px_features.h>
+#include <stdio.h>
+int main(int argc, char **argv)
+{
+	struct px_cad *c;
+	char msg[256];
+	int rc = px_cad_load(argc > 1 ? argv[1] : "", NULL, &c, msg, sizeof msg);
+	if (!PX_HAVE_OCCT)
+		return rc != PX_E_UNSUPPORTED;
+	if (rc != PX_OK) {
+		puts(msg);
+		return 1;
+	}
+	printf("%d faces\n", px_cad_desc(c)->n_faces);
+	px_cad_free(c);
+	return 0;
+}
+C
+check "a STEP-reading consumer links statically" \
+	${CC:-cc} -std=c11 -Wall -Werror $cflags "$tmp/cad.c" -o "$tmp/cad_static" \
+	"$tmp/root/usr/lib/libproxima.a" $slibs
+check "static STEP-reading consumer runs" "$tmp/cad_static" config/examples/parts/filleted_block.step
+check "a STEP-reading consumer links with the shared library" \
+	${CC:-cc} -std=c11 -Wall -Werror $cflags "$tmp/cad.c" -o "$tmp/cad_shared" $libs
+check "shared STEP-reading consumer runs" \
+	env LD_LIBRARY_PATH="$tmp/root/usr/lib" "$tmp/cad_shared" config/examples/parts/filleted_block.step
 check "uninstall removes everything" \
 	sh -c "${MAKE:-make} -s uninstall DESTDIR='$tmp/root' PREFIX=/usr BUILD='${BUILD:-build}' &&
 	       test -z \"\$(find '$tmp/root' -type f -o -type l)\""

@@ -93,9 +93,17 @@ protected:
 	{
 		if (g < Message_Fail || fails.size() > 400)
 			return;
+		// The reader frames its messages in asterisks and lines.
+		std::string t(s.ToCString());
+		for (char &ch : t)
+			if (ch == '\n' || ch == '\r' || ch == '\t')
+				ch = ' ';
+		size_t a = t.find_first_not_of("* "), b = t.find_last_not_of("* ");
+		if (a == std::string::npos)
+			return;
 		if (!fails.empty())
 			fails += "; ";
-		fails += s.ToCString();
+		fails += t.substr(a, b - a + 1);
 	}
 };
 
@@ -120,6 +128,27 @@ public:
 
 private:
 	Message_SequenceOfPrinters saved_;
+};
+
+// The reader's session unit (a process-wide setting) is millimetres
+// while a file is read, then what it was.
+class session_unit_mm {
+public:
+	session_unit_mm()
+	{
+		Standard_CString u = Interface_Static::CVal("xstep.cascade.unit");
+		saved_ = u ? u : "";
+		Interface_Static::SetCVal("xstep.cascade.unit", "MM");
+	}
+	~session_unit_mm()
+	{
+		if (!saved_.empty())
+			Interface_Static::SetCVal("xstep.cascade.unit",
+						  saved_.c_str());
+	}
+
+private:
+	std::string saved_;
 };
 
 std::mutex load_lock;
@@ -238,11 +267,11 @@ bool first_fail(const Interface_CheckIterator &list,
 
 // Reads the file with the reader of its format; refuses on any failure
 // the reader reports. Leaves the transferred shape in shape and a map
-// from every transferred face to its entity label in labels.
+// from its faces and edges to their entity labels in labels.
 struct read_result {
 	TopoDS_Shape shape;
 	std::vector<std::string> labels;
-	TopTools_DataMapOfShapeInteger face_label;
+	TopTools_DataMapOfShapeInteger shape_label;
 };
 
 template <class Reader>
@@ -250,7 +279,7 @@ void read_with(Reader &reader, const std::string &path, read_result &rr)
 {
 	quiet_messenger quiet;
 	// Coordinates come back in millimetres whatever the file's unit.
-	Interface_Static::SetCVal("xstep.cascade.unit", "MM");
+	session_unit_mm mm;
 	IFSelect_ReturnStatus st = reader.ReadFile(path.c_str());
 	Handle(Interface_InterfaceModel) model = reader.Model();
 	std::string fail;
@@ -274,17 +303,18 @@ void read_with(Reader &reader, const std::string &path, read_result &rr)
 	rr.shape = reader.OneShape();
 	if (rr.shape.IsNull())
 		refuse(PX_E_PARSE, "no shape in the file");
-	// Every face of the result with the entity it came from, where the
-	// reader recorded it (faces its healing replaced have none).
-	TopTools_IndexedMapOfShape faces;
-	TopExp::MapShapes(rr.shape, TopAbs_FACE, faces);
+	// Every face and edge of the result with the entity it came from,
+	// where the reader recorded it (shapes its healing replaced have
+	// none).
+	TopTools_IndexedMapOfShape subs;
+	TopExp::MapShapes(rr.shape, TopAbs_FACE, subs);
+	TopExp::MapShapes(rr.shape, TopAbs_EDGE, subs);
 	for (int i = 1; !tp.IsNull() && i <= tp->NbMapped(); i++) {
 		TopoDS_Shape r = TransferBRep::ShapeResult(tp, tp->Mapped(i));
-		if (r.IsNull() || r.ShapeType() != TopAbs_FACE ||
-		    !faces.Contains(r) || rr.face_label.IsBound(r))
+		if (r.IsNull() || !subs.Contains(r) || rr.shape_label.IsBound(r))
 			continue;
 		rr.labels.push_back(entity_label(model, tp->Mapped(i)));
-		rr.face_label.Bind(r, (int)rr.labels.size() - 1);
+		rr.shape_label.Bind(r, (int)rr.labels.size() - 1);
 	}
 }
 
@@ -301,10 +331,10 @@ void read_file(const std::string &path, read_result &rr)
 
 // ---- conversion ------------------------------------------------------
 
-// The converted shape and the labels moved onto its faces.
+// The converted shape and the labels moved onto its faces and edges.
 struct model_src {
 	TopoDS_Shape shape;
-	TopTools_DataMapOfShapeInteger face_label;
+	TopTools_DataMapOfShapeInteger shape_label;
 	std::vector<std::string> labels;
 	TopTools_IndexedMapOfShape edge_map, vertex_map;
 	std::vector<int> edge_index; // edge_map index - 1 -> desc edge, -1
@@ -317,11 +347,11 @@ void convert(const read_result &rr, model_src &m)
 		refuse(PX_E_UNSUPPORTED, "conversion to NURBS failed");
 	m.shape = nc.Shape();
 	m.labels = rr.labels;
-	for (TopTools_DataMapOfShapeInteger::Iterator it(rr.face_label);
+	for (TopTools_DataMapOfShapeInteger::Iterator it(rr.shape_label);
 	     it.More(); it.Next()) {
 		TopoDS_Shape nf = nc.ModifiedShape(it.Key());
 		if (!nf.IsNull())
-			m.face_label.Bind(nf, it.Value());
+			m.shape_label.Bind(nf, it.Value());
 	}
 	TopExp::MapShapes(m.shape, TopAbs_EDGE, m.edge_map);
 	TopExp::MapShapes(m.shape, TopAbs_VERTEX, m.vertex_map);
@@ -332,15 +362,15 @@ void convert(const read_result &rr, model_src &m)
 std::string face_name(const model_src &m, const TopoDS_Face &f, int k)
 {
 	int li;
-	if (m.face_label.Find(f, li) && !m.labels[(size_t)li].empty())
+	if (m.shape_label.Find(f, li) && !m.labels[(size_t)li].empty())
 		return "face " + m.labels[(size_t)li];
 	return "face " + std::to_string(k) + " (no entity)";
 }
 
-long face_id(const model_src &m, const TopoDS_Face &f)
+long shape_id(const model_src &m, const TopoDS_Shape &s)
 {
 	int li;
-	if (m.face_label.Find(f, li))
+	if (m.shape_label.Find(s, li))
 		return label_number(m.labels[(size_t)li]);
 	return 0;
 }
@@ -405,13 +435,14 @@ int edge_of(px_cad &c, model_src &m, const TopoDS_Edge &e)
 	Handle(Geom_BSplineCurve) b = GeomConvert::CurveToBSplineCurve(
 		new Geom_TrimmedCurve(g, f, l));
 	px_brep_edge_desc ed;
+	ed.id = shape_id(m, e);
 	ed.curve = curve_of<Geom_BSplineCurve, gp_Pnt>(
-		c, b, 3, "edge " + std::to_string(k));
+		c, b, 3, ed.id ? "edge " + m.labels[(size_t)m.shape_label.Find(e)]
+			       : "edge " + std::to_string(k) + " (no entity)");
 	TopoDS_Vertex v0, v1;
 	TopExp::Vertices(TopoDS::Edge(e.Oriented(TopAbs_FORWARD)), v0, v1);
 	ed.v0 = v0.IsNull() ? -1 : m.vertex_map.FindIndex(v0) - 1;
 	ed.v1 = v1.IsNull() ? -1 : m.vertex_map.FindIndex(v1) - 1;
-	ed.id = 0;
 	c.edges.push_back(ed);
 	slot = (int)c.edges.size() - 1;
 	return slot;
@@ -605,7 +636,7 @@ void add_face(px_cad &c, model_src &m, const TopoDS_Face &f, int shell,
 	fd.coedges = cl.data();
 	fd.reversed = f.Orientation() == TopAbs_REVERSED ? 1 : 0;
 	fd.shell = shell;
-	fd.id = face_id(m, f);
+	fd.id = shape_id(m, f);
 	c.faces.push_back(fd);
 }
 

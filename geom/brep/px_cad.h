@@ -48,7 +48,11 @@
  *
  * Setup only: the load allocates, and it takes a process-wide lock
  * (OpenCASCADE's reader settings are global), so loads run one at a
- * time. Every exception of OpenCASCADE is caught inside.
+ * time. While it reads, it sets OpenCASCADE's session unit
+ * (xstep.cascade.unit) to millimetres and silences its default
+ * messenger's printers (their failure messages go into msg), and puts
+ * both back after. Every exception of OpenCASCADE is caught inside;
+ * signals are left to the application (no OSD::SetSignal()).
  */
 #ifndef PX_CAD_H
 #define PX_CAD_H
