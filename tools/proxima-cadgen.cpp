@@ -14,6 +14,8 @@
 //   cylsphere       a cylinder and a sphere fused (seams and a pole)
 //   assembly        filleted_block and cylsphere side by side: two
 //                   solids in one file
+//   crossed_sheet   the sheet with a hole that crosses its outer loop
+//                   (a faulty part: readers must refuse it)
 // --unit gives the unit written to the file (the geometry is the same);
 // IGES files hold the B-rep (shells and solids), not loose faces.
 // Exit status 0 when every file was written, 1 otherwise.
@@ -128,8 +130,9 @@ TopoDS_Shape bottle()
 }
 
 // A wavy bicubic sheet over 80 x 60, cut by a closed spline loop in its
-// parameter plane and a circular hole.
-TopoDS_Shape sheet()
+// parameter plane and a circular hole of radius hole_r (parameter
+// units; the loop is 0.29 to 0.43 from the middle).
+TopoDS_Shape trimmed_sheet(double hole_r)
 {
 	TColgp_Array2OfPnt poles(1, 5, 1, 4);
 	for (int i = 1; i <= 5; i++)
@@ -156,7 +159,7 @@ TopoDS_Shape sheet()
 	TopoDS_Edge eo = BRepBuilderAPI_MakeEdge(loop, surf).Edge();
 	TopoDS_Wire wo = BRepBuilderAPI_MakeWire(eo).Wire();
 	Handle(Geom2d_Circle) circ =
-		new Geom2d_Circle(gp_Ax2d(gp_Pnt2d(0.55, 0.5), gp_Dir2d(1, 0)), 0.1);
+		new Geom2d_Circle(gp_Ax2d(gp_Pnt2d(0.55, 0.5), gp_Dir2d(1, 0)), hole_r);
 	TopoDS_Edge eh = BRepBuilderAPI_MakeEdge(circ, surf).Edge();
 	TopoDS_Wire wh = BRepBuilderAPI_MakeWire(eh).Wire();
 	BRepBuilderAPI_MakeFace mf(surf, wo, Standard_True);
@@ -167,6 +170,18 @@ TopoDS_Shape sheet()
 	fix.FixOrientation();
 	fix.Perform();
 	return fix.Face();
+}
+
+TopoDS_Shape sheet()
+{
+	return trimmed_sheet(0.1);
+}
+
+// A faulty part for the importer's refusals: the hole crosses the
+// sheet's outer loop.
+TopoDS_Shape crossed_sheet()
+{
+	return trimmed_sheet(0.35);
 }
 
 TopoDS_Shape cylsphere()
@@ -200,7 +215,7 @@ struct part {
 const part parts[] = {
 	{"filleted_block", filleted_block}, {"plate", plate},
 	{"bottle", bottle}, {"sheet", sheet}, {"cylsphere", cylsphere},
-	{"assembly", assembly},
+	{"assembly", assembly}, {"crossed_sheet", crossed_sheet},
 };
 
 // The shape with its coordinates in unit (modelled in millimetres).

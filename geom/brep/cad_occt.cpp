@@ -30,7 +30,10 @@
 #include <Geom2dConvert.hxx>
 #include <Geom2d_BSplineCurve.hxx>
 #include <Geom2d_TrimmedCurve.hxx>
+#include <GeomAdaptor_Surface.hxx>
 #include <GeomConvert.hxx>
+#include <GeomConvert_ApproxCurve.hxx>
+#include <Geom2dConvert_ApproxCurve.hxx>
 #include <Geom_BSplineCurve.hxx>
 #include <Geom_BSplineSurface.hxx>
 #include <Geom_TrimmedCurve.hxx>
@@ -415,6 +418,35 @@ px_nurbs_curve curve_of(px_cad &c, const Handle(BS) &b, int dim,
 	return out;
 }
 
+// A curve above the kernel's degree (the reader's own fits of edge
+// curves go up to 14), approximated within tol with the same
+// parameter; left as it is when that fails (curve_of() refuses it).
+Handle(Geom_BSplineCurve) within_degree(const Handle(Geom_BSplineCurve) &b,
+					double tol)
+{
+	if (b->Degree() <= PX_NURBS_MAX_DEGREE)
+		return b;
+	GeomConvert_ApproxCurve ap(b, tol, GeomAbs_C2, 1000,
+				   PX_NURBS_MAX_DEGREE - 1);
+	return ap.HasResult() && ap.MaxError() <= tol ? ap.Curve() : b;
+}
+
+Handle(Geom2d_BSplineCurve)
+within_degree(const Handle(Geom2d_BSplineCurve) &b, double tol)
+{
+	if (b->Degree() <= PX_NURBS_MAX_DEGREE)
+		return b;
+	Geom2dConvert_ApproxCurve ap(b, tol, GeomAbs_C2, 1000,
+				     PX_NURBS_MAX_DEGREE - 1);
+	return ap.HasResult() && ap.MaxError() <= tol ? ap.Curve() : b;
+}
+
+// An edge's tolerance, at least the reader's default precision.
+double edge_tol(const TopoDS_Edge &e)
+{
+	return std::max(BRep_Tool::Tolerance(e), 1e-7);
+}
+
 // The desc edge of a converted edge, made on first use (-1: degenerate
 // or without a 3D curve).
 int edge_of(px_cad &c, model_src &m, const TopoDS_Edge &e)
@@ -432,8 +464,9 @@ int edge_of(px_cad &c, model_src &m, const TopoDS_Edge &e)
 	Handle(Geom_Curve) g = BRep_Tool::Curve(e, f, l);
 	if (g.IsNull())
 		return slot;
-	Handle(Geom_BSplineCurve) b = GeomConvert::CurveToBSplineCurve(
-		new Geom_TrimmedCurve(g, f, l));
+	Handle(Geom_BSplineCurve) b = within_degree(
+		GeomConvert::CurveToBSplineCurve(new Geom_TrimmedCurve(g, f, l)),
+		edge_tol(e));
 	px_brep_edge_desc ed;
 	ed.id = shape_id(m, e);
 	ed.curve = curve_of<Geom_BSplineCurve, gp_Pnt>(
@@ -551,13 +584,74 @@ void close_poles(px_cad &c, std::vector<px_nurbs_curve> &cv,
 	}
 }
 
+// A loop curve that leaves the surface's parameter domain (the reader's
+// curves may, where an edge runs into a pole and any u is the same
+// point) gets its control points clamped into the domain, when the
+// surface then still follows the edge's 3D curve within twice the
+// edge's tolerance; otherwise the face is refused.
+void clamp_to_surface(px_cad &c, px_nurbs_curve &pc, const px_nurbs_surf &s,
+		      const TopoDS_Edge &e, const std::string &who)
+{
+	double u0, u1, v0, v1, worst = 0, out = 0;
+	px_nurbs_surf_domain(&s, &u0, &u1, &v0, &v1);
+	// Control points may lie outside where the curve does not (a
+	// rational arc's do): the curve itself is what must stay inside.
+	double a0, a1;
+	px_nurbs_curve_domain(&pc, &a0, &a1);
+	for (int i = 0; i <= 512; i++) {
+		px_vec3 q = px_nurbs_curve_point(&pc, a0 + (a1 - a0) * i / 512.0);
+		out = std::max({out, u0 - q.x, q.x - u1, v0 - q.y, q.y - v1});
+	}
+	if (out <= 1e-9 * std::hypot(u1 - u0, v1 - v0))
+		return;
+	int n = pc.n_ctrl;
+	std::vector<double> &pw = new_reals(c, (size_t)(4 * n));
+	bool moved = false;
+	for (int i = 0; i < n; i++) {
+		double w = pc.pw[4 * i + 3], x = pc.pw[4 * i] / w;
+		double y = pc.pw[4 * i + 1] / w;
+		double cx = std::min(std::max(x, u0), u1);
+		double cy = std::min(std::max(y, v0), v1);
+		moved = moved || cx != x || cy != y;
+		pw[(size_t)(4 * i)] = cx * w;
+		pw[(size_t)(4 * i + 1)] = cy * w;
+		pw[(size_t)(4 * i + 2)] = 0.0;
+		pw[(size_t)(4 * i + 3)] = w;
+	}
+	if (!moved)
+		return;
+	px_nurbs_curve in;
+	px_nurbs_error err;
+	int rc = px_nurbs_curve_view(&in, pc.degree, n, pc.knots, pc.n_knots,
+				     pw.data(), &err);
+	if (rc != PX_OK)
+		refuse(rc, "%s: %s", who.c_str(), err.msg);
+	double f, l, t0, t1;
+	Handle(Geom_Curve) g = BRep_Tool::Degenerated(e) ? Handle(Geom_Curve)()
+							: BRep_Tool::Curve(e, f, l);
+	px_nurbs_curve_domain(&in, &t0, &t1);
+	for (int i = 0; !g.IsNull() && i <= 64; i++) {
+		double t = t0 + (t1 - t0) * i / 64.0;
+		px_vec3 uv = px_nurbs_curve_point(&in, t);
+		px_vec3 p = px_nurbs_surf_point(&s, uv.x, uv.y);
+		gp_Pnt q = g->Value(f + (l - f) * (t - t0) / (t1 - t0));
+		worst = std::max(worst, q.Distance(gp_Pnt(p.x, p.y, p.z)));
+	}
+	if (worst > 2 * edge_tol(e))
+		refuse(PX_E_UNSUPPORTED, "%s leaves the surface's domain [%g, "
+		       "%g] x [%g, %g], %g from its edge when brought inside",
+		       who.c_str(), u0, u1, v0, v1, worst);
+	pc = in;
+}
+
 // One wire as a trimming loop: its edges in order (BRepTools_WireExplorer
 // follows the connection), each curve on the surface with its direction
 // and its edge.
 px_trim_loop loop_of(px_cad &c, model_src &m, const TopoDS_Face &f,
-		     const TopoDS_Wire &w, const std::string &who,
-		     const px_brep_coedge **coedges)
+		     const px_nurbs_surf &s, const TopoDS_Wire &w,
+		     const std::string &who, const px_brep_coedge **coedges)
 {
+	GeomAdaptor_Surface gs(BRep_Tool::Surface(f));
 	int n_all = 0;
 	for (TopExp_Explorer ex(w, TopAbs_EDGE); ex.More(); ex.Next())
 		n_all++;
@@ -576,10 +670,13 @@ px_trim_loop loop_of(px_cad &c, model_src &m, const TopoDS_Face &f,
 		if (g.IsNull())
 			refuse(PX_E_PARSE, "%s: an edge has no curve on the "
 			       "surface", cw.c_str());
-		Handle(Geom2d_BSplineCurve) b =
+		double tol = edge_tol(e);
+		Handle(Geom2d_BSplineCurve) b = within_degree(
 			Geom2dConvert::CurveToBSplineCurve(
-				new Geom2d_TrimmedCurve(g, t0, t1));
+				new Geom2d_TrimmedCurve(g, t0, t1)),
+			std::min(gs.UResolution(tol), gs.VResolution(tol)));
 		cv.push_back(curve_of<Geom2d_BSplineCurve, gp_Pnt2d>(c, b, 2, cw));
+		clamp_to_surface(c, cv.back(), s, e, cw);
 		rev.push_back(e.Orientation() == TopAbs_REVERSED ? 1 : 0);
 		ce.push_back(px_brep_coedge{edge_of(c, m, e)});
 		degen.push_back(BRep_Tool::Degenerated(e) ? 1 : 0);
@@ -619,7 +716,7 @@ void add_face(px_cad &c, model_src &m, const TopoDS_Face &f, int shell,
 	std::vector<const px_brep_coedge *> &cl = c.coedge_lists.back();
 	cl.resize(wires.size());
 	for (size_t i = 0; i < wires.size(); i++)
-		lp.push_back(loop_of(c, m, f, wires[i],
+		lp.push_back(loop_of(c, m, f, fd.surf, wires[i],
 				     who + " loop " + std::to_string(i), &cl[i]));
 	GProp_GProps props;
 	BRepGProp::SurfaceProperties(f, props);

@@ -16,7 +16,13 @@
  * edges' curves in that surface's own parameter space, as 2D NURBS with
  * z = 0: the conversion changes the angular parameter of periodic
  * surfaces, so the curves are those OpenCASCADE projects onto the
- * converted surface, within each edge's tolerance of the 3D edge.
+ * converted surface, within each edge's tolerance of the 3D edge. A
+ * loop curve that leaves the surface's domain (where the reader lets an
+ * edge run into a pole at any u) is brought inside when the surface
+ * then still follows the edge within twice its tolerance. Curves of
+ * degree above PX_NURBS_MAX_DEGREE (the reader fits edge curves up to
+ * degree 14) are approximated within their edge's tolerance with the
+ * same parameter.
  * Edges are the 3D edge curves (exact NURBS), running from vertex v0 to
  * v1; edges collapsed to a point (poles of spheres and cones) have no 3D
  * curve and their loop curves map to edge -1. Periodic surfaces are cut
@@ -39,12 +45,13 @@
  * Refusals. A file that does not exist, is larger than opts.max_bytes,
  * fails to parse, whose reader reports a failure (syntax, an entity
  * referring to one that is missing, a transfer failure), that holds no
- * face, or a face whose surface or loops the kernel refuses (degree
+ * face, or a face whose surface or loops the kernel refuses (a surface
  * above PX_NURBS_MAX_DEGREE, open or self-crossing loops, zero area) is
  * refused as a whole: nothing is half-loaded. msg then names the file
  * and, where the reader tells it, the place (STEP "#entity" or
  * "line N", IGES "D<entry>"), e.g.
- * "part.step: face #84: loop 0 curve 2 and loop 0 curve 5 cross ...".
+ * "part.step: face #17: outer loop curve 0 and hole 1 curve 0 cross or
+ * touch near (0.2, 0.45)".
  *
  * Setup only: the load allocates, and it takes a process-wide lock
  * (OpenCASCADE's reader settings are global), so loads run one at a

@@ -8,7 +8,9 @@
  * away from the loops; the loop curves mapped through the surface lie
  * on their 3D edges, and those on the file's edges; the face
  * orientations point out of the solids; counts, closed shells, units,
- * assemblies; malformed files refused with a message naming the file.
+ * assemblies; every part builds as a B-rep model, signed for solids;
+ * malformed and faulty files refused with a message naming the file
+ * and the place.
  */
 #include <math.h>
 #include <stdio.h>
@@ -16,6 +18,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "px_brep.h"
 #include "px_cad.h"
 #include "px_features.h"
 #include "px_test.h"
@@ -319,6 +322,29 @@ static void test_topology(void)
 		}
 }
 
+/* Every part builds as a distance model, signed where it is a solid. */
+static void check_model(const char *path)
+{
+	struct px_cad *c = load_ok(path, NULL);
+	const struct px_brep_desc *d = px_cad_desc(c);
+	struct px_brep_error err;
+	struct px_brep_info info;
+	struct px_brep *b = NULL;
+	int rc = px_brep_create(d, NULL, &err, &b);
+	PX_CHECK_MSG(rc == PX_OK, "%s: %s", path, err.msg);
+	PX_CHECK_INT_EQ(px_brep_get_info(b, &info), PX_OK);
+	PX_CHECK_INT_EQ(info.n_faces, d->n_faces);
+	PX_CHECK_MSG(info.closed == (d->n_solids > 0), "%s: closed %d (%s)", path,
+		     info.closed, info.why);
+	px_brep_free(b);
+	px_cad_free(c);
+}
+
+static void test_models(void)
+{
+	each_file(check_model);
+}
+
 /* A file in metres reads as the same part; the user's scale multiplies. */
 static void test_units(void)
 {
@@ -488,6 +514,14 @@ static void test_malformed(void)
 		refused(bad, "missing entity", e ? ": D" : "#99999");
 		free(b);
 	}
+	/* A face whose hole crosses its outer loop: refused naming the
+	 * face's entity and the crossing. */
+	for (e = 0; e < 2; e++) {
+		part_path(src, sizeof src, "crossed_sheet", ext[e]);
+		refused(src, "loops crossing", e ? "face D" : "face #");
+		PX_CHECK_INT_EQ(px_cad_load(src, NULL, &c, msg, sizeof msg), PX_E_INVAL);
+		PX_CHECK(strstr(msg, "cross") != NULL);
+	}
 	snprintf(bad, sizeof bad, "%s/nothing.step", part_dir());
 	PX_CHECK_INT_EQ(px_cad_load(bad, NULL, &c, msg, sizeof msg), PX_E_NOTFOUND);
 	PX_CHECK(strstr(msg, bad) != NULL);
@@ -534,6 +568,7 @@ static void test_cleanup(void)
 
 static const struct px_test tests[] = {
 	PX_T(test_topology),	 PX_T(test_surfaces_domains), PX_T(test_edges),
+	PX_T(test_models),
 	PX_T(test_units),	 PX_T(test_assembly),	      PX_T(test_malformed),
 	PX_T(test_shipped_part), PX_T(test_cleanup)};
 #else
