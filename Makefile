@@ -220,7 +220,7 @@ DEB_PACKAGES += libocct-modeling-data-dev libocct-foundation-dev
 
 FORCE:
 
-.PHONY: FORCE all lib tools examples tests benches run-benches test bench sanitize install uninstall \
+.PHONY: FORCE all lib tools examples tests benches run-benches bench-section test bench sanitize install uninstall \
         clean help deps check-deps fcl-bench
 
 all: lib tools examples
@@ -364,6 +364,12 @@ bench: all
 run-benches:
 	@sh bench/report.sh $(BENCH_BIN) $(CXX_BENCH_BIN)
 
+# Runs one benchmark and replaces its section of docs/benchmarks.md, the
+# rest of the report kept: make bench-section BENCH=bench_track
+bench-section: benches
+	@test -n "$(BENCH)" || { echo "make bench-section: BENCH=name, e.g. bench_track"; exit 1; }
+	@BENCH_SECTIONS=1 sh bench/report.sh $(BUILD)/bench/$(BENCH)
+
 # FCL reference program for bench_models, only where FCL is installed
 # (checked when it runs, after `make bench` installed the packages).
 fcl-bench:
@@ -418,6 +424,7 @@ help:
 	@echo '             examples (build/examples); the default target'
 	@echo '  test       install missing packages, build, run the whole test suite'
 	@echo '  bench      build and run the benchmarks'
+	@echo '  bench-section BENCH=name  run one benchmark, replace its section of docs/benchmarks.md'
 	@echo '  sanitize   the test suite built with AddressSanitizer + UBSan'
 	@echo '  run        build, then run proxima-run on RUN_CONFIG for RUN_SECONDS (default config, 10 s)'
 	@echo '  fuzz       build fuzz/fuzz_*.c with libFuzzer, run each FUZZ_SECONDS=$(FUZZ_SECONDS) s'

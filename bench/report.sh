@@ -10,7 +10,10 @@
 # benchmark leaves the previous report as it was and makes this script
 # fail.
 #
-# Environment: BENCH_REPORT (output file, default docs/benchmarks.md).
+# Environment: BENCH_REPORT (output file, default docs/benchmarks.md);
+# BENCH_SECTIONS=1 replaces only the named benchmarks' sections of the
+# existing report, the rest of it (its header too) kept as it was; each
+# new section then says when it ran (make bench-section BENCH=name).
 # Run from the source tree: bench_scene reads config/examples/.
 
 set -u
@@ -33,7 +36,7 @@ describe() {
 	bench_rt) echo "The real-time loop at 1 kHz against cyclictest (rt-tests) at the same priority and interval, alternating in 1 s chunks so that both see the same load, with both latency distributions and their ratios, after the cost of a ring push, a statistics record and read, and a virtual-clock cycle. \`PX_BENCH_RT_SECONDS\` (default 10 per side) and \`PX_BENCH_RT_PRIO\` (default 80) change the run." ;;
 	bench_scene) echo "The loop's scene queries on the shipped example scene (\`config/examples/haptic_sim.yaml\`) three ways - plain global queries, coherent queries (hints) and tracked streams - along the same smooth paths at several speeds, with the answers compared; then the proxy renderer's whole step through the coherent and the tracked adapters." ;;
 	bench_brep) echo "Trimmed B-rep models built in C (a sheet with a round hole, a drilled cube, a free-form sheet trimmed by a spline loop with a hole, a closed box with 1 mm walls): the cold point query (signed where the part is closed) next to the untrimmed NURBS model of the same surfaces on the same points, per-query median, p99 and max and their ratio: what trimming costs." ;;
-	bench_track) echo "Coherent tracking (\`px_track\`, \`px_strack\`) on moving-point paths (smooth random paths and sums of sinusoids, steps of 0.01 %, 0.1 %, 1 % and 5 % of the model size) next to the cold global query on the same points: per-update median, p99, p99.9 and max, the work's own worst case (\`max_min3\`: each update's least time over three replayed runs), ratios, transitions, cells solved and wrong answers (must be 0)." ;;
+	bench_track) echo "Coherent tracking (\`px_track\`, \`px_strack\`) on moving-point paths (smooth random paths and sums of sinusoids, steps of 0.01 %, 0.1 %, 1 % and 5 % of the model size) next to the cold global query on the same points: per-update median, p99, p99.9 and max, the work's own worst case (\`max_min3\`: each update's least time over three replayed runs), ratios, transitions, cells solved and wrong answers (must be 0); for each surface, the tracked path's median and p99 over the cold query's per step size and where it is never slower." ;;
 	*) echo "" ;;
 	esac
 }
@@ -67,7 +70,11 @@ for b in "$@"; do
 		echo
 		src=bench/$n.c
 		[ -f "$src" ] || src=bench/$n.cpp
-		echo "\`$src\`, $((t1 - t0)) s:"
+		if [ "${BENCH_SECTIONS:-0}" = 1 ]; then
+			echo "\`$src\`, $((t1 - t0)) s, run alone on $(date -u '+%Y-%m-%d %H:%M UTC') (load average at its start: $(cut -d ' ' -f 1-3 /proc/loadavg 2>/dev/null || echo unknown)):"
+		else
+			echo "\`$src\`, $((t1 - t0)) s:"
+		fi
 		echo
 		echo '```'
 		cat "$log"
@@ -75,6 +82,42 @@ for b in "$@"; do
 	} >> "$body"
 done
 all1=$(date +%s)
+
+if [ "${BENCH_SECTIONS:-0}" = 1 ]; then
+	# each old section (from its "## name" line to the next "## ") is
+	# replaced by the new one; names not in the report are appended
+	if [ "$status" -ne 0 ] || [ ! -f "$out" ]; then
+		echo "bench/report.sh: $out not written" >&2
+		exit 1
+	fi
+	# and their rows of the header's table
+	for b in "$@"; do
+		n=$(basename "$b")
+		echo "| [\`$n\`](#$n) | $(describe "$n") |"
+	done > "$log"
+	awk -v newf="$body" -v rowf="$log" '
+		BEGIN {
+			while ((getline l < newf) > 0) {
+				if (l ~ /^## /) { cur = substr(l, 4); order[++n] = cur }
+				if (cur != "") sec[cur] = sec[cur] l "\n"
+			}
+			for (k in sec) sub(/\n+$/, "\n", sec[k])
+			while ((getline l < rowf) > 0) {
+				k = l; sub(/^\| \[`/, "", k); sub(/`.*/, "", k); row[k] = l
+			}
+		}
+		/^\| \[`/ { k = $0; sub(/^\| \[`/, "", k); sub(/`.*/, "", k)
+			     if (k in row) { print row[k]; next } }
+		/^## / { if (skip) print ""
+			 name = substr($0, 4); skip = (name in sec)
+			 if (skip) { printf "%s", sec[name]; done[name] = 1 } }
+		!skip { print }
+		END { for (i = 1; i <= n; i++) if (!(order[i] in done)) printf "\n%s", sec[order[i]] }
+	' "$out" > "$tmp" || exit 1
+	mkdir -p "$(dirname "$out")" && cp "$tmp" "$out.tmp" && mv "$out.tmp" "$out" || exit 1
+	echo "bench/report.sh: replaced sections of $out"
+	exit 0
+fi
 
 {
 	echo "# Benchmarks"
