@@ -2530,6 +2530,96 @@ out:
 }
 
 /*
+ * The cold switch without the clock: a point so fast that the set keeps
+ * falling behind (updates over the budget, then catch-ups each paying
+ * owed work and the global query) goes cold although the clock says
+ * tracking costs nothing (every reading 1 ns after the last), and no
+ * catch-up from tracking lasts longer than PX_GOV_BEHIND_RUN updates
+ * after the one that fell behind. A tracker without the switch on the
+ * same path falls behind (the path is not too easy), every answer of
+ * both is exact and no update allocates.
+ */
+static void test_behind_cold(void)
+{
+	static px_vec3 q[1500];
+	struct px_nurbs_surf s;
+	struct px_strack *t = NULL, *t0 = NULL;
+	struct px_strack_opts o;
+	struct px_strack_result r, r0;
+	struct px_strack_stats st, st0;
+	struct px_dist_model *ref = NULL;
+	struct px_dist_info di;
+	struct px_test_clock fc = {0, 1};
+	px_aabb box;
+	double size;
+	long wrong = 0;
+	int k, run = -1, longest = 0, prev_src = PX_TRACK_TRACKED;
+
+	px_arena_init(&arena, arena_mem, sizeof(arena_mem));
+	PX_CHECK_INT_EQ(surf_wavy(&s, 0, 0, 0, 0), PX_OK);
+	px_strack_opts_default(&o);
+	PX_CHECK_INT_EQ(px_strack_create(NULL, 0, &s, 1, &o, &t), PX_OK);
+	o.cold_switch = 0;
+	PX_CHECK_INT_EQ(px_strack_create(NULL, 0, &s, 1, &o, &t0), PX_OK);
+	PX_CHECK_INT_EQ(px_dist_model_create(NULL, 0, &s, 1, NULL, &ref), PX_OK);
+	if (!t || !t0 || !ref)
+		goto out;
+	px__strack_set_clock(t, px_test_clock_read, &fc);
+	px_dist_model_info(ref, &di);
+	size = px_aabb_diagonal(&di.bounds);
+	box = px_aabb_inflate(&di.bounds, 0.25 * size);
+	make_path(q, 1500, 0, box, 5e-2 * size);
+	px_strack_reset(t, q[0], &r);
+	px_strack_reset(t0, q[0], &r0);
+	for (k = 1; k < 1500; k++) {
+		struct px_dist_result g;
+		uint64_t reg = px_alloc_region_begin();
+		int rc = px_strack_update(t, q[k], &r), rc0 = px_strack_update(t0, q[k], &r0);
+		if (px_alloc_region_end(reg) != 0) {
+			PX_CHECK_MSG(0, "update allocated");
+			goto out;
+		}
+		PX_CHECK_INT_EQ(rc, PX_OK);
+		PX_CHECK_INT_EQ(rc0, PX_OK);
+		px_dist_query(ref, q[k], &g);
+		wrong += fabs(r.dist - g.dist) > 1e-9 * (size + g.dist);
+		wrong += fabs(r0.dist - g.dist) > 1e-9 * (size + g.dist);
+		/* the global answers that follow a tracked one: a catch-up
+		 * (after a cold answer they are a return's rebuild) */
+		if (r.source == PX_TRACK_GLOBAL) {
+			if (run >= 0 || prev_src == PX_TRACK_TRACKED || prev_src == PX_TRACK_REINIT)
+				run++;
+			if (run > longest)
+				longest = run;
+		} else {
+			run = -1;
+		}
+		prev_src = r.source;
+	}
+	px_strack_get_stats(t, &st);
+	px_strack_get_stats(t0, &st0);
+	printf("  fast path: %llu cold of %llu updates, entered %llu, longest "
+	       "catch-up from tracking %d updates after the first; without the "
+	       "switch over budget %llu, answered globally while catching up "
+	       "%llu; wrong %ld\n",
+	       (unsigned long long)st.cold, (unsigned long long)st.updates,
+	       (unsigned long long)st.cold_entered, longest,
+	       (unsigned long long)st0.over_budget,
+	       (unsigned long long)st0.rebuild_updates, wrong);
+	PX_CHECK_INT_EQ(wrong, 0);
+	PX_CHECK_MSG(st0.over_budget > 0, "the path never went over the budget");
+	PX_CHECK_MSG(st.cold_entered >= 1 && st.cold > 750,
+		     "the fast path went cold for %llu updates",
+		     (unsigned long long)st.cold);
+	PX_CHECK_MSG(longest <= PX_GOV_BEHIND_RUN, "a catch-up lasted %d updates",
+		     longest);
+out:
+	px_strack_free(t);
+	px_strack_free(t0);
+	px_dist_model_free(ref);
+}
+
+/*
  * The bench's replay of the cold switch (bench_track: the runs behind a
  * least-of-3 take the first run's decisions): the switch's state copied
  * out before a run and back in before another, with the same clock
@@ -2693,6 +2783,7 @@ static const struct px_test tests[] = {
 	PX_T(test_index_check),
 	PX_T(test_errors),
 	PX_T(test_cold_switch), PX_T(test_return_rebuild), PX_T(test_gov_replay),
+	PX_T(test_behind_cold),
 };
 
 PX_TEST_MAIN(tests)
