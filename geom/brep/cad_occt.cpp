@@ -270,7 +270,7 @@ bool first_fail(const Interface_CheckIterator &list,
 
 // Reads the file with the reader of its format; refuses on any failure
 // the reader reports. Leaves the transferred shape in shape and a map
-// from its faces and edges to their entity labels in labels.
+// from the faces and edges it made (unplaced) to their entity labels.
 struct read_result {
 	TopoDS_Shape shape;
 	std::vector<std::string> labels;
@@ -306,15 +306,16 @@ void read_with(Reader &reader, const std::string &path, read_result &rr)
 	rr.shape = reader.OneShape();
 	if (rr.shape.IsNull())
 		refuse(PX_E_PARSE, "no shape in the file");
-	// Every face and edge of the result with the entity it came from,
-	// where the reader recorded it (shapes its healing replaced have
-	// none).
-	TopTools_IndexedMapOfShape subs;
-	TopExp::MapShapes(rr.shape, TopAbs_FACE, subs);
-	TopExp::MapShapes(rr.shape, TopAbs_EDGE, subs);
+	// Every face and edge the reader made with the entity it came from,
+	// without placement: an assembly places the same face in each
+	// instance (faces its healing replaced have no entity).
 	for (int i = 1; !tp.IsNull() && i <= tp->NbMapped(); i++) {
 		TopoDS_Shape r = TransferBRep::ShapeResult(tp, tp->Mapped(i));
-		if (r.IsNull() || !subs.Contains(r) || rr.shape_label.IsBound(r))
+		if (r.IsNull() || (r.ShapeType() != TopAbs_FACE &&
+				   r.ShapeType() != TopAbs_EDGE))
+			continue;
+		r.Location(TopLoc_Location());
+		if (rr.shape_label.IsBound(r))
 			continue;
 		rr.labels.push_back(entity_label(model, tp->Mapped(i)));
 		rr.shape_label.Bind(r, (int)rr.labels.size() - 1);
@@ -350,11 +351,18 @@ void convert(const read_result &rr, model_src &m)
 		refuse(PX_E_UNSUPPORTED, "conversion to NURBS failed");
 	m.shape = nc.Shape();
 	m.labels = rr.labels;
-	for (TopTools_DataMapOfShapeInteger::Iterator it(rr.shape_label);
-	     it.More(); it.Next()) {
-		TopoDS_Shape nf = nc.ModifiedShape(it.Key());
+	TopTools_IndexedMapOfShape subs;
+	TopExp::MapShapes(rr.shape, TopAbs_FACE, subs);
+	TopExp::MapShapes(rr.shape, TopAbs_EDGE, subs);
+	for (int i = 1; i <= subs.Extent(); i++) {
+		TopoDS_Shape key = subs(i);
+		key.Location(TopLoc_Location());
+		int li;
+		if (!rr.shape_label.Find(key, li))
+			continue;
+		TopoDS_Shape nf = nc.ModifiedShape(subs(i));
 		if (!nf.IsNull())
-			m.shape_label.Bind(nf, it.Value());
+			m.shape_label.Bind(nf, li);
 	}
 	TopExp::MapShapes(m.shape, TopAbs_EDGE, m.edge_map);
 	TopExp::MapShapes(m.shape, TopAbs_VERTEX, m.vertex_map);

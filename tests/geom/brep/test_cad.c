@@ -387,6 +387,11 @@ static void test_assembly(void)
 		PX_CHECK_INT_EQ(px_cad_desc(c)->n_solids, 2);
 		PX_CHECK_INT_EQ(px_cad_desc(c)->n_faces, 30);
 		PX_CHECK_INT_EQ(px_cad_desc(c)->n_shells, 2);
+		/* the file's entities survive the placement of the parts */
+		for (k = 0; k < px_cad_desc(c)->n_faces; k++)
+			PX_CHECK_MSG(px_cad_desc(c)->faces[k].id > 0, "%s face %d", path, k);
+		for (k = 0; !e && k < px_cad_desc(c)->n_edges; k++)
+			PX_CHECK_MSG(px_cad_desc(c)->edges[k].id > 0, "%s edge %d", path, k);
 		px_cad_free(c);
 		px_cad_opts_default(&o);
 		for (k = 0; k < 2; k++) {
