@@ -1,6 +1,6 @@
 /*
  * The `scene` section of a proxima config: schema, model files (meshes,
- * clouds, NURBS OBJ), inline primitives, poses and scale. Every key is
+ * clouds, NURBS OBJ, STEP/IGES parts), inline primitives, poses and scale. Every key is
  * documented in docs/config.md (a test checks that).
  */
 #include <limits.h>
@@ -13,6 +13,7 @@
 #include "px_config.h"
 #include "px_control.h"
 #include "px_dist.h"
+#include "px_load.h"
 #include "px_mesh.h"
 #include "px_obj.h"
 #include "px_prim.h"
@@ -22,8 +23,8 @@
 #define BIG 1e6
 #define LIST_MAX 256 /* models and primitives each (docs/config.md) */
 
-enum file_kind { KIND_MESH = 0, KIND_NURBS = 1, KIND_CLOUD = 2 };
-static const char *const kind_names[] = {"mesh", "nurbs", "cloud", NULL};
+enum file_kind { KIND_MESH = 0, KIND_NURBS = 1, KIND_CLOUD = 2, KIND_CAD = 3 };
+static const char *const kind_names[] = {"mesh", "nurbs", "cloud", "cad", NULL};
 static const char *const prim_names[] = {"sphere",   "box",  "capsule",
 					 "cylinder", "cone", "torus",
 					 "halfspace", NULL};
@@ -392,6 +393,13 @@ static int load_model(const struct raw_model *m, const char *path,
 		if (rc != PX_OK)
 			snprintf(msg, cap, "%.500s",
 				 rep.message[0] ? rep.message : px_strerror(rc));
+	} else if (m->kind == KIND_CAD) {
+		/* the scale goes into the B-rep itself (exact, no wrapper):
+		 * it multiplies the importer's metres */
+		rc = px_model_load_cad(path, m->scale, out, msg, cap);
+		/* a warning (open part) is no error */
+		if (rc == PX_OK)
+			return PX_OK;
 	} else {
 		rc = load_nurbs(path, out, msg, cap);
 	}

@@ -2,18 +2,23 @@
  * proxima-query - global closest points from a file of query points to a
  * model.
  *
- *   proxima-query [--track] [--stats] MODEL POINTS.csv
+ *   proxima-query [--track] [--signed] [--stats] MODEL POINTS.csv
  *
  * MODEL: Wavefront OBJ (free-form curves and surfaces, polygon faces, or
  * both: all entities form one model), STL, PLY (mesh with faces, point
- * cloud without), XYZ/CSV point clouds. POINTS.csv: one "x,y,z" per line
+ * cloud without), XYZ/CSV point clouds, STEP/IGES parts (.step, .stp,
+ * .iges, .igs: the whole file as one exact B-rep in metres, px_load.h;
+ * builds with OpenCASCADE only). POINTS.csv: one "x,y,z" per line
  * (at most 64 MiB, no NUL bytes, no empty fields); a first line whose
  * first field is a name, not a number, is a header ("NaN,0,0" is a point,
  * and an error). Output, one line
  * per point: "dist,cx,cy,cz,u,v" with %.17g; curves print v = 0, meshes
- * the triangle index as u and clouds the point index, with v = 0. The
- * distance is unsigned (closed meshes know inside from outside, but the
- * contract is the distance). --stats writes setup time, model memory and
+ * the triangle index as u and clouds the point index, with v = 0; B-rep
+ * parts the closest face's surface parameters (u, v), or on an edge the
+ * edge curve's parameter as u and v = 0 (px_brep.h). The distance is
+ * unsigned unless --signed: then closed models (closed meshes and B-rep
+ * solids) answer inside negative; any other model stays unsigned and
+ * stderr says so once. --stats writes setup time, model memory and
  * per-query times to stderr.
  * --track answers the points in file order as one moving point with the
  * coherent trackers (px_track.h for curves, px_strack.h when the model
@@ -42,11 +47,17 @@ static const char *prog = "proxima-query";
 
 static void usage(FILE *f)
 {
-	fprintf(f, "usage: %s [--track] [--stats] MODEL POINTS.csv\n"
+	fprintf(f, "usage: %s [--track] [--signed] [--stats] MODEL POINTS.csv\n"
 		   "  MODEL       .obj (free-form curves/surfaces and/or faces), .stl,\n"
-		   "              .ply (mesh or point cloud), .xyz/.csv (point cloud)\n"
+		   "              .ply (mesh or point cloud), .xyz/.csv (point cloud),\n"
+		   "              .step/.stp/.iges/.igs (CAD part, needs OpenCASCADE)\n"
 		   "  POINTS.csv  one x,y,z per line (a first line of names is a\n"
 		   "              header; NaN or inf is an error)\n"
+		   "  output      dist,cx,cy,cz,u,v per point (u,v: curve/surface\n"
+		   "              parameters, B-rep face parameters, or the triangle\n"
+		   "              or point index as u)\n"
+		   "  --signed    inside negative for closed models (closed meshes,\n"
+		   "              B-rep solids); others stay unsigned (said on stderr)\n"
 		   "  --stats     setup time, model memory and per-query ns to stderr\n"
 		   "  --track     answer the points in order as one moving point by\n"
 		   "              coherent tracking of all critical distances\n"
@@ -201,7 +212,7 @@ static int cmp_i64(const void *a, const void *b)
  * meshes and clouds: a px_model), the points and their times. */
 struct query {
 	const char *model_path, *points_path;
-	int track, stats;
+	int track, stats, signed_dist;
 	struct px_obj_model *obj;
 	struct px_nurbs_curve *curves;
 	struct px_nurbs_surf *surfs;
@@ -224,6 +235,8 @@ static int parse_args(int argc, char **argv, struct query *q)
 			q->track = 1;
 		else if (!strcmp(argv[i], "--stats"))
 			q->stats = 1;
+		else if (!strcmp(argv[i], "--signed"))
+			q->signed_dist = 1;
 		else if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
 			usage(stdout);
 			return -1;
@@ -355,6 +368,21 @@ static int load_model(struct query *q)
 	return 0;
 }
 
+/* --signed: signed answers only where the whole model is one closed
+ * px_model; otherwise a note, once, and unsigned answers. */
+static void check_signed(struct query *q)
+{
+	if (!q->signed_dist)
+		return;
+	if (q->mesh && !q->m && !q->trk && !q->strk &&
+	    (px_model_caps(q->mesh) & PX_MODEL_CAP_SIGNED))
+		return;
+	fprintf(stderr, "%s: %s: --signed: the model is not a closed mesh or "
+			"B-rep solid; distances are unsigned\n",
+		prog, q->model_path);
+	q->signed_dist = 0;
+}
+
 /* The output row of one point: distance, closest point, parameters. */
 struct row {
 	double dist;
@@ -387,10 +415,16 @@ static int query_point(const struct query *q, px_vec3 p, struct row *o)
 	}
 	if (q->mesh && !qrc) {
 		struct px_model_result r;
-		qrc = px_model_query_ex(q->mesh, p, INFINITY, -1, PX_QUERY_UNSIGNED, &r);
-		/* u: the triangle or point index */
-		if (qrc == 1 && r.distance < o->dist)
-			*o = (struct row){r.distance, r.point, (double)r.index, 0.0};
+		qrc = px_model_query_ex(q->mesh, p, INFINITY, -1,
+					q->signed_dist ? 0u : PX_QUERY_UNSIGNED, &r);
+		/* u, v: a B-rep's parameters, else u the triangle or point
+		 * index (signed answers come from one model alone) */
+		if (qrc == 1 && (q->signed_dist || r.distance < o->dist)) {
+			if (px_model_kind(q->mesh) == PX_MODEL_BREP)
+				*o = (struct row){r.distance, r.point, r.u, r.v};
+			else
+				*o = (struct row){r.distance, r.point, (double)r.index, 0.0};
+		}
 		qrc = qrc < 0 ? qrc : 0;
 	}
 	return qrc;
@@ -498,7 +532,9 @@ static void print_stats(const struct query *q)
 			info.n_patches);
 	if (q->mesh)
 		fprintf(stderr, "%s model: %s\n", px_model_name(q->mesh),
-			px_model_kind(q->mesh) == PX_MODEL_CLOUD ? "point cloud" : "triangles");
+			px_model_kind(q->mesh) == PX_MODEL_CLOUD ? "point cloud"
+			: px_model_kind(q->mesh) == PX_MODEL_BREP ? "B-rep faces"
+								   : "triangles");
 	if (n) {
 		qsort(q->times, n, sizeof(*q->times), cmp_i64);
 		fprintf(stderr, "queries %zu query_ns min %lld median %lld p99 %lld max %lld\n",
@@ -526,6 +562,8 @@ int main(int argc, char **argv)
 	q.t_setup = now_ns();
 	rc = load_model(&q);
 	q.t_setup = now_ns() - q.t_setup;
+	if (!rc)
+		check_signed(&q);
 	if (!rc)
 		rc = run_points(&q);
 	if (!rc && q.stats)

@@ -1,11 +1,16 @@
 /*
- * px_load.c - mesh or point cloud, chosen by file name and content.
+ * px_load.c - mesh, point cloud or CAD part, chosen by file name and
+ * content.
  */
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 #include <strings.h>
 
+#include "px_brep.h"
+#include "px_cad.h"
 #include "px_cloud.h"
+#include "px_file.h"
 #include "px_load.h"
 #include "px_mesh.h"
 
@@ -21,6 +26,62 @@ static void put(char *msg, size_t cap, const char *text)
 		snprintf(msg, cap, "%s", text);
 }
 
+int px_model_is_cad_name(const char *path)
+{
+	return path && (ends_with(path, ".step") || ends_with(path, ".stp") ||
+			ends_with(path, ".iges") || ends_with(path, ".igs"));
+}
+
+/* The importer's description becomes a B-rep that owns its own copy, so
+ * the importer's handle goes before the model is made. */
+int px_model_load_cad(const char *path, double scale, struct px_model **out,
+		      char *msg, size_t msg_cap)
+{
+	struct px_cad_opts o;
+	struct px_cad *c = NULL;
+	struct px_brep *b = NULL;
+	struct px_brep_error err;
+	struct px_brep_info info;
+	int rc;
+
+	put(msg, msg_cap, "");
+	if (out)
+		*out = NULL;
+	if (!path || !out || !(scale > 0.0) || !isfinite(scale)) {
+		put(msg, msg_cap, "invalid arguments");
+		return PX_E_INVAL;
+	}
+	px_cad_opts_default(&o);
+	o.scale = scale;
+	o.max_bytes = PX_FILE_MODEL_MAX_BYTES;
+	rc = px_cad_load(path, &o, &c, msg, msg_cap);
+	if (rc != PX_OK) {
+		if (msg && msg_cap && !msg[0])
+			snprintf(msg, msg_cap, "%s: %s", path, px_strerror(rc));
+		return rc;
+	}
+	memset(&err, 0, sizeof(err));
+	rc = px_brep_create(px_cad_desc(c), NULL, &err, &b);
+	px_cad_free(c);
+	if (rc != PX_OK) {
+		if (msg && msg_cap)
+			snprintf(msg, msg_cap, "%s: %s", path,
+				 err.msg[0] ? err.msg : px_strerror(rc));
+		return rc;
+	}
+	px_brep_get_info(b, &info);
+	rc = px_model_from_brep(b, out);
+	if (rc != PX_OK) {
+		if (msg && msg_cap)
+			snprintf(msg, msg_cap, "%s: %s", path, px_strerror(rc));
+		return rc;
+	}
+	if (!info.closed && msg && msg_cap)
+		snprintf(msg, msg_cap, "%s: open B-rep, distances are unsigned (%s)",
+			 path, info.why);
+	return PX_OK;
+}
+
 int px_model_load(const char *path, double cloud_radius_m,
 		  struct px_model **out, char *msg, size_t msg_cap)
 {
@@ -31,6 +92,8 @@ int px_model_load(const char *path, double cloud_radius_m,
 		put(msg, msg_cap, "invalid arguments");
 		return PX_E_INVAL;
 	}
+	if (px_model_is_cad_name(path))
+		return px_model_load_cad(path, 1.0, out, msg, msg_cap);
 	if (ends_with(path, ".xyz") || ends_with(path, ".csv") ||
 	    ends_with(path, ".txt") || ends_with(path, ".pts"))
 		cloud = 1;

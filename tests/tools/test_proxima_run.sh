@@ -45,7 +45,30 @@ if [ "${SAN:-}" != 1 ]; then
 	export LD_PRELOAD="$counter_so${LD_PRELOAD:+:$LD_PRELOAD}"
 fi
 
+# A config with a STEP/IGES part (kind cad) loads in builds with
+# OpenCASCADE only, and not under ASan (the reader's global allocations
+# show as leaks at exit): cad_skip CONFIG sets why and succeeds then.
+cad_skip() {
+	grep -q 'kind: cad' "$1" || return 1
+	if ! grep -qx '#define PX_HAVE_OCCT 1' "${BUILD:-build}/gen/px_features.h"; then
+		why="built without OpenCASCADE"
+	elif [ "${SAN:-}" = 1 ]; then
+		why="OpenCASCADE's global allocations show as leaks under ASan"
+	else
+		return 1
+	fi
+}
+
 for f in config/examples/*.yaml; do
+	if cad_skip "$f"; then
+		if [ "$why" = "built without OpenCASCADE" ]; then
+			expect "--check $f without OpenCASCADE" 1 "$bin" --check "$f"
+			if grep -qF "built without OpenCASCADE" "$tmp/err"; then ok "--check $f says built without OpenCASCADE"
+			else bad "--check $f says built without OpenCASCADE"; fi
+		fi
+		skp "$f: $why"
+		continue
+	fi
 	expect "--check $f" 0 "$bin" --check "$f"
 	if [ "$(wc -l <"$tmp/out")" -eq 1 ] &&
 		grep -qE "^$f: OK \([0-9]+ devices?, loop period [0-9]+ ns\)\$" "$tmp/out"; then
@@ -149,6 +172,7 @@ absolute() { sed "s|file: scenes/|file: $PWD/config/examples/scenes/|" "$1"; }
 ran=0
 for f in config/examples/*.yaml; do
 	base=$(basename "$f" .yaml)
+	if cad_skip "$f"; then skp "$f runs: $why"; continue; fi
 	if grep -qE 'backend: (hidapi|libusb|gpiod)|transport: kernel' "$f"; then
 		# real devices run on the real clock only
 		expect "$f: no virtual time with hardware" 2 "$bin" "$f" --virtual-time --duration-s 1
