@@ -294,15 +294,6 @@ bool make_part(const part &p, const std::string &dir, const char *unit,
 
 } // namespace
 
-// Sanitizer builds: the modelling and writing toolkits keep some of
-// their allocations for the life of the process (libTK*), which is
-// theirs.
-extern "C" __attribute__((visibility("default"), used)) const char *
-__lsan_default_suppressions()
-{
-	return "leak:libTK\n";
-}
-
 int main(int argc, char **argv)
 {
 	const char *unit = "MM", *fmt = "both";
