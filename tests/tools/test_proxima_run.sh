@@ -589,8 +589,10 @@ if grep -qE "^  time              loop clock 1\.[0-9]+ s \([1-9][0-9]* missed pe
 	ok "summary has the time line"; else bad "summary has the time line"; fi
 # real clock: the same run ends when its time is up, whatever was missed
 absolute "$good" | sed 's/priority: 80/priority: 0/; s/lock_memory: true/lock_memory: false/' >"$tmp/real.yaml"
+# (fault windows count from the start of setup, which a sanitizer build
+# on a busy machine can stretch past 0.3 s: the window sits late)
 expect "real-clock run with missed periods" 0 "$bin" "$tmp/real.yaml" --duration-s 1 \
-	--fault overrun,loop,0.2,0.1,1,0.005 --summary-json "$tmp/real.json" --telemetry "$tmp/real.csv"
+	--fault overrun,loop,0.6,0.15,1,0.005 --summary-json "$tmp/real.json" --telemetry "$tmp/real.csv"
 check "real: periods were missed ($(num "$tmp/real.json" missed_periods))" "$(num "$tmp/real.json" missed_periods) > 10"
 check "real: fewer cycles than asked ($(num "$tmp/real.json" cycles))" "$(num "$tmp/real.json" cycles) < 1000"
 # (the last cycle may itself skip a period or two on a busy machine; a
