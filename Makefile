@@ -191,6 +191,8 @@ BENCH_BIN := $(patsubst bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 # C++ comparisons against OpenCASCADE, built only where its headers are.
 OCCT_LIBS := -lTKGeomAlgo -lTKGeomBase -lTKG3d -lTKG2d -lTKMath -lTKernel
 CXX_BENCH_SRC := $(if $(wildcard $(OCCT_INC)/Standard.hxx),$(wildcard bench/bench_*_occt.cpp))
+# The CAD parts' comparison needs the library's STEP reader too.
+CXX_BENCH_SRC := $(filter-out $(if $(filter 1,$(WITH_OCCT)),,bench/bench_brep_occt.cpp),$(CXX_BENCH_SRC))
 CXX_BENCH_BIN := $(patsubst bench/%.cpp,$(BUILD)/bench/%,$(CXX_BENCH_SRC))
 
 STATIC_LIB := $(BUILD)/lib/lib$(NAME).a
@@ -328,6 +330,16 @@ $(BUILD)/bench/%_occt: bench/%_occt.cpp $(STATIC_LIB)
 	@mkdir -p $(dir $@)
 	$(CXX) -std=c++17 -O2 -g -Wall -Wextra -Werror -Wno-deprecated-declarations \
 	  -isystem $(OCCT_INC) $(INCS) -o $@ $< $(STATIC_LIB) $(OCCT_LIBS) $(LIBS)
+
+# The CAD parts against OpenCASCADE: the parts come from the part
+# generator, their checks from the tests' OpenCASCADE reference.
+$(BUILD)/bench/bench_brep_occt: bench/bench_brep_occt.cpp $(TEST_SUPPORT_DIR)/px_occt_ref.cpp \
+                                $(TEST_SUPPORT_DIR)/px_occt_ref.h bench/bench_util.h $(STATIC_LIB) \
+                                $(BUILD)/bin/proxima-cadgen
+	@mkdir -p $(dir $@)
+	$(CXX) -std=c++17 -O2 -g -Wall -Wextra -Werror -Wno-deprecated-declarations \
+	  -isystem $(OCCT_INC) $(INCS) -I$(TEST_SUPPORT_DIR) -o $@ $< $(TEST_SUPPORT_DIR)/px_occt_ref.cpp \
+	  $(STATIC_LIB) $(OCCT_LIBS) $(LIBS)
 
 $(BUILD)/bench/%: $(BUILD)/obj/bench/%.o $(TEST_LIB)
 	@mkdir -p $(dir $@)

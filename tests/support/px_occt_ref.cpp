@@ -28,6 +28,7 @@
 #include <TopoDS.hxx>
 #include <TopoDS_Shell.hxx>
 #include <TopoDS_Solid.hxx>
+#include <gp_Pnt2d.hxx>
 
 #include "px_occt_ref.h"
 
@@ -228,6 +229,28 @@ extern "C" double px_occt_ref_edge_dist(const struct px_occt_ref *r,
 			best = std::min(best, pr.LowerDistance());
 		best = std::min(best, pnt(p).Distance(r->edges[i]->Value(r->e0[i])));
 		best = std::min(best, pnt(p).Distance(r->edges[i]->Value(r->e1[i])));
+	}
+	return best;
+}
+
+extern "C" double px_occt_ref_gap(const struct px_occt_ref *r, const double p[3],
+			       double tol)
+{
+	double best = px_occt_ref_edge_dist(r, p);
+	for (const TopoDS_Face &f : r->faces) {
+		try {
+			GeomAPI_ProjectPointOnSurf pr(pnt(p), BRep_Tool::Surface(f));
+			for (int i = 1; i <= pr.NbPoints(); i++) {
+				double u, v;
+				if (pr.Distance(i) >= best)
+					continue;
+				pr.Parameters(i, u, v);
+				BRepClass_FaceClassifier fc(f, gp_Pnt2d(u, v), tol);
+				if (fc.State() != TopAbs_OUT)
+					best = pr.Distance(i);
+			}
+		} catch (const Standard_Failure &) {
+		}
 	}
 	return best;
 }

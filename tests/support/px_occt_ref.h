@@ -49,6 +49,13 @@ double px_occt_ref_edge_dist(const struct px_occt_ref *r, const double p[3]);
  * 2 on one within tol, else 0. */
 int px_occt_ref_solid_state(const struct px_occt_ref *r, const double p[3],
 			    double tol);
+/* How far p is from the trimmed shape as read, by local projection
+ * only: the least of the distances to the feet of p on each face's
+ * surface (GeomAPI_ProjectPointOnSurf, every extremum) that lie in the
+ * face (BRepClass_FaceClassifier at the foot's (u, v), within tol) and
+ * of px_occt_ref_edge_dist(). Small for a point of the shape: tells a
+ * real closest point from one that is not (no global search). */
+double px_occt_ref_gap(const struct px_occt_ref *r, const double p[3], double tol);
 /* Distance from p to a NURBS curve (projection on OpenCASCADE's copy). */
 double px_occt_ref_curve_dist(const struct px_nurbs_curve *c,
 			      const double p[3]);
