@@ -225,4 +225,33 @@ px_vec3 px__brep_face_normal(const struct px_brep *b, int f, double u,
 int px__brep_closest(const struct px_brep *b, int k, px_vec3 p,
 		     struct px_dist_result *d);
 
+/* ---- composed edges (brep_compose.c) ----------------------------------------- */
+
+/* The exact image S(c(t)) of the (u, v) curve c on s, parametrised by
+ * c's t, as a NURBS curve viewing *mem (free() it). Returns PX_OK, 1
+ * when c is one point of the parameter plane (nothing made), or an
+ * error with why (a sentence) filled. Setup only. */
+int px__brep_compose_curve(const struct px_nurbs_surf *s,
+			   const struct px_nurbs_curve *c, double **mem,
+			   struct px_nurbs_curve *out, char *why, size_t why_cap);
+
+/* A description with an own composed edge for every loop curve that has
+ * none (and no single-point image): d is a copy of the caller's with
+ * the faces' coedges and the edges replaced. */
+struct brep_aug {
+	struct px_brep_desc d;
+	struct px_brep_face_desc *faces;
+	struct px_brep_edge_desc *edges;
+	struct px_brep_coedge *co;
+	const struct px_brep_coedge **cop;
+	double **mem;
+	int n_mem;
+};
+
+/* Fill g from d (g->d.faces NULL: nothing to add, use d itself).
+ * PX_OK or the composition's refusal in err. */
+int px__brep_compose(const struct px_brep_desc *d, struct brep_aug *g,
+		     struct px_brep_error *err);
+void px__brep_aug_free(struct brep_aug *g);
+
 #endif

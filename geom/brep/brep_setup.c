@@ -19,6 +19,7 @@ void px_brep_opts_default(struct px_brep_opts *o)
 		return;
 	px_trim_opts_default(&o->trim);
 	o->dist = NULL;
+	o->compose_edges = 0;
 }
 
 static void berr(struct px_brep_error *err, int code, int face, int loop,
@@ -604,6 +605,7 @@ int px_brep_create(const struct px_brep_desc *d, const struct px_brep_opts *opts
 		   struct px_brep_error *err, struct px_brep **out)
 {
 	struct px_brep_opts o;
+	struct brep_aug aug;
 	struct px_brep *b;
 	int rc, k;
 
@@ -627,7 +629,12 @@ int px_brep_create(const struct px_brep_desc *d, const struct px_brep_opts *opts
 	for (k = 0; k < BREP_WS; k++)
 		atomic_flag_clear(&b->busy[k]);
 	b->bytes = sizeof(*b);
-	rc = create_steps(b, d, &o, err);
+	/* loop curves without edges get their exact images (brep_compose.c) */
+	memset(&aug, 0, sizeof(aug));
+	rc = o.compose_edges ? px__brep_compose(d, &aug, err) : PX_OK;
+	if (!rc)
+		rc = create_steps(b, aug.d.faces ? &aug.d : d, &o, err);
+	px__brep_aug_free(&aug);
 	if (rc) {
 		if (err && !err->msg[0])
 			berr(err, rc, -1, -1, -1, -1, 0, "setup failed (%s)",

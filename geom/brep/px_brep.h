@@ -112,6 +112,12 @@ struct px_dist_opts;
 struct px_brep_opts {
 	struct px_trim_opts trim;
 	const struct px_dist_opts *dist;
+	/* 1: a loop curve without a 3D edge (coedge edge -1) whose image is
+	 * not a single point gets its exact image on the surface as an own
+	 * edge (degree d (p + q) for a degree-d curve on a (p, q) surface,
+	 * d p or d q when u or v is constant along it; refused above
+	 * PX_NURBS_MAX_DEGREE); 0 (default): such a curve is refused. */
+	int compose_edges;
 };
 
 /* Defaults of both. */
@@ -146,7 +152,8 @@ struct px_brep;
  * > 0. Every loop curve needs a 3D edge (coedge edge >= 0) unless its
  * image on the surface is a single point (a pole, a collapsed side):
  * such a point is a vertex candidate; a loop curve with neither is
- * refused (the distance to it would not be exact). Coordinates are
+ * refused (the distance to it would not be exact) unless
+ * opts->compose_edges asks for its exact image as an edge. Coordinates are
  * scaled; everything is copied into memory the handle owns and fixed
  * from then on. opts NULL: defaults; err may be NULL. Returns PX_OK,
  * PX_E_INVAL (a bad description: err says where), PX_E_RANGE, PX_E_NAN,
