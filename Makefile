@@ -27,7 +27,7 @@ SOMAJOR := $(firstword $(subst ., ,$(VERSION)))
 # folder that is not one of NON_LIB_DIRS or a build directory and holds .c
 # or .h files (geom/nurbs, devices/backends, app, ...) is a module folder:
 # its sources go into the library and it is on the include path.
-NON_LIB_DIRS := tests tools bench fuzz examples docs
+NON_LIB_DIRS := tests tools bench fuzz examples docs python
 LIB_TOP := $(filter-out $(NON_LIB_DIRS) build% $(firstword $(subst /, ,$(BUILD))),\
              $(patsubst %/,%,$(wildcard */)))
 MODULE_DIRS := $(sort $(patsubst %/,%,$(dir $(shell find $(LIB_TOP) -type f -name '*.[ch]'))))
@@ -214,6 +214,8 @@ BENCH_DEB_PACKAGES += libocct-modeling-data-dev
 BENCH_DEB_PACKAGES += libfcl-dev
 # config/: YAML loader.
 DEB_PACKAGES += libyaml-dev
+# python/: the Python package and its example's plots.
+DEB_PACKAGES += python3 python3-dev python3-cffi python3-numpy python3-matplotlib
 # geom/: mesh and point-cloud import.
 DEB_PACKAGES += libassimp-dev
 # geom/brep/: STEP and IGES import (OpenCASCADE 7.6) and its C++ compiler.
@@ -239,6 +241,35 @@ tests: $(TEST_BIN) $(if $(filter 1,$(SAN)),,$(ALLOC_SO))
 examples: $(EXAMPLE_BIN)
 
 benches: $(BENCH_BIN) $(CXX_BENCH_BIN)
+
+# ---- Python package (python/) ---------------------------------------------
+# The proxima module for Debian's python3 (cffi, API mode: python/build_ext.py
+# says why), built into $(BUILD)/python (PYTHONPATH=$(BUILD)/python) when
+# that python has cffi, numpy and its C headers; WITH_PYTHON=0 leaves it
+# out. Not in sanitizer builds: an ASan library cannot load into a plain
+# interpreter.
+PYTHON ?= $(firstword $(wildcard /usr/bin/python3) python3)
+PY_PROBE := import cffi, numpy, os, sysconfig, sys; \
+  sys.exit(not os.path.exists(os.path.join(sysconfig.get_paths()["include"], "Python.h")))
+ifeq ($(origin WITH_PYTHON),undefined)
+WITH_PYTHON := $(if $(filter 1,$(SAN)),0,$(shell $(PYTHON) -c '$(PY_PROBE)' 2>/dev/null && echo 1 || echo 0))
+endif
+PY_SRC := python/build_ext.py $(wildcard python/proxima/*.py python/proxima/_pxpy.[ch])
+PY_STAMP := $(BUILD)/python/proxima/__init__.py
+PY_BUILD = $(PYTHON) python/build_ext.py $(1) $(addprefix --include ,$(MODULE_DIRS) $(BUILD)/gen) \
+  --libdir $(BUILD)/lib --rpath $(2) --cflags "$(WARN) $(OPTFLAGS) $(CFLAGS)"
+# Debian's interpreter searches <prefix>/lib/python3.X/dist-packages.
+PY_VER = $(shell $(PYTHON) -c 'import sys; print("%d.%d" % sys.version_info[:2])')
+PYDIR ?= $(LIBDIR)/python$(PY_VER)/dist-packages
+
+.PHONY: python
+python: $(PY_STAMP)
+ifeq ($(WITH_PYTHON),1)
+all: python
+endif
+
+$(PY_STAMP): $(PY_SRC) $(SHARED_LIB) $(PUB_HDRS)
+	$(call PY_BUILD,$(BUILD)/python,$(abspath $(BUILD)/lib))
 
 # ---- rules ---------------------------------------------------------------
 $(BUILD)/obj/%.o: %.c | $(FEATURES_H)
@@ -362,8 +393,8 @@ test: deps
 .PHONY: test-run
 test-run: all tests
 	@BUILD=$(BUILD) SAN=$(SAN) CC="$(CC)" MAKE="$(MAKE)" TEST_TIMEOUT=$(TEST_TIMEOUT) \
-	  PX_WITHOUT="$(foreach p,$(OPT_PARTS),$(if $(filter 1,$(WITH_$(p))),,$(TAG_$(p))))" \
-	  sh tests/run.sh $(TEST_BIN) $(TEST_SH)
+	  PX_WITHOUT="$(foreach p,$(OPT_PARTS),$(if $(filter 1,$(WITH_$(p))),,$(TAG_$(p)))) $(if $(filter 1,$(WITH_PYTHON)),,python)" \
+	  PYTHON="$(PYTHON)" sh tests/run.sh $(TEST_BIN) $(TEST_SH)
 
 bench: all
 	@sh tools/install-deps.sh $(BENCH_DEB_PACKAGES) || echo "make bench: continuing without $(BENCH_DEB_PACKAGES)"
@@ -374,13 +405,15 @@ bench: all
 
 # Runs every benchmark and writes docs/benchmarks.md from their output.
 run-benches:
-	@sh bench/report.sh $(BENCH_BIN) $(CXX_BENCH_BIN)
+	@BUILD=$(BUILD) PYTHON=$(PYTHON) sh bench/report.sh $(BENCH_BIN) $(CXX_BENCH_BIN) \
+	  $(if $(filter 1,$(WITH_PYTHON)),bench/bench_python.sh)
 
 # Runs one benchmark and replaces its section of docs/benchmarks.md, the
 # rest of the report kept: make bench-section BENCH=bench_track
 bench-section: benches
 	@test -n "$(BENCH)" || { echo "make bench-section: BENCH=name, e.g. bench_track"; exit 1; }
-	@BENCH_SECTIONS=1 sh bench/report.sh $(BUILD)/bench/$(BENCH)
+	@BUILD=$(BUILD) PYTHON=$(PYTHON) BENCH_SECTIONS=1 sh bench/report.sh \
+	  $(if $(filter bench_python,$(BENCH)),bench/bench_python.sh,$(BUILD)/bench/$(BENCH))
 
 # FCL reference program for bench_models, only where FCL is installed
 # (checked when it runs, after `make bench` installed the packages).
@@ -420,11 +453,17 @@ install: lib tools $(FEATURES_H)
 	install -m 644 $(PUB_HDRS) $(FEATURES_H) $(DESTDIR)$(INCLUDEDIR)/$(NAME)/
 	install -m 644 $(PC_FILE) $(DESTDIR)$(LIBDIR)/pkgconfig/
 	$(if $(TOOL_BIN),install -m 755 $(TOOL_BIN) $(DESTDIR)$(BINDIR)/)
+ifeq ($(WITH_PYTHON),1)
+	$(call PY_BUILD,$(BUILD)/python-install,$(LIBDIR))
+	install -d $(DESTDIR)$(PYDIR)/proxima
+	install -m 644 $(BUILD)/python-install/proxima/*.py $(DESTDIR)$(PYDIR)/proxima/
+	install -m 755 $(BUILD)/python-install/proxima/*.so $(DESTDIR)$(PYDIR)/proxima/
+endif
 
 uninstall:
 	rm -f $(DESTDIR)$(LIBDIR)/lib$(NAME).a $(DESTDIR)$(LIBDIR)/lib$(NAME).so*
 	rm -f $(DESTDIR)$(LIBDIR)/pkgconfig/$(NAME).pc
-	rm -rf $(DESTDIR)$(INCLUDEDIR)/$(NAME)
+	rm -rf $(DESTDIR)$(INCLUDEDIR)/$(NAME) $(DESTDIR)$(PYDIR)/proxima
 	rm -f $(addprefix $(DESTDIR)$(BINDIR)/,$(notdir $(TOOL_BIN)))
 
 clean:
@@ -433,7 +472,8 @@ clean:
 help:
 	@echo 'Targets:'
 	@echo '  all        static and shared library (build/lib), tools (build/bin),'
-	@echo '             examples (build/examples); the default target'
+	@echo '             examples (build/examples), the Python package'
+	@echo '             (build/python, WITH_PYTHON=$(WITH_PYTHON)); the default target'
 	@echo '  test       install missing packages, build, run the whole test suite'
 	@echo '  bench      build and run the benchmarks'
 	@echo '  bench-section BENCH=name  run one benchmark, replace its section of docs/benchmarks.md'
@@ -451,6 +491,7 @@ help:
 	@echo 'Variables (make VAR=value):'
 	@echo '  CC=$(CC) PREFIX=$(PREFIX) DESTDIR=$(DESTDIR) LIBDIR=$(LIBDIR)'
 	@echo '  INCLUDEDIR=$(INCLUDEDIR) BINDIR=$(BINDIR) BUILD=$(BUILD)'
+	@echo '  PYTHON=$(PYTHON) PYDIR=$(PYDIR) (where install puts the proxima package)'
 	@echo '  OPTFLAGS=$(OPTFLAGS) CFLAGS=$(CFLAGS) LDFLAGS=$(LDFLAGS)'
 	@echo '  TEST_TIMEOUT=$(TEST_TIMEOUT) (seconds per test binary)'
 	@echo '  HIDAPI=$(HIDAPI) (hidraw or libusb: the hidapi build to link)'

@@ -38,6 +38,7 @@ describe() {
 	bench_brep_occt) echo "The CAD parts of \`proxima-cadgen\` (filleted block, plate with holes and a pocket, bottle with 1 mm walls, trimmed free-form sheet, fused cylinder and sphere) written to STEP and read by \`px_cad\` + \`px_brep\` and by OpenCASCADE: proxima's cold query (signed for solids) next to \`BRepExtrema_DistShapeShape\` (the point as a vertex, the part loaded once) and, for the sign, that plus \`BRepClass3d_SolidClassifier\`, on the same points (random in the box enlarged by 25 % per side, and near the surface on both sides), each point's least time over three interleaved passes: median, p99, max, the ratios, and the wrong distances and signs of either side." ;;
 	bench_brep) echo "Trimmed B-rep models built in C (a sheet with a round hole, a drilled cube, a free-form sheet trimmed by a spline loop with a hole, a closed box with 1 mm walls): the cold point query (signed where the part is closed) next to the untrimmed NURBS model of the same surfaces on the same points, per-query median, p99 and max and their ratio: what trimming costs." ;;
 	bench_track) echo "Coherent tracking (\`px_track\`, \`px_strack\`) on moving-point paths (smooth random paths and sums of sinusoids, steps of 0.01 %, 0.1 %, 1 % and 5 % of the model size) next to the cold global query on the same points: per-update median, p99, p99.9 and max, the work's own worst case (\`max_min3\`: each update's least time over three replayed runs), ratios, transitions, cells solved and wrong answers (must be 0); for each surface, the tracked path's median and p99 over the cold query's per step size and where it is never slower." ;;
+	bench_python) echo "The Python package (\`python/\`, cffi): one \`Model.query()\` call on 10,000 random points next to \`proxima-query --stats\` on the same file and points. C: the tool's mean per timed query (wall clock, each query timed alone); Python: the call's thread CPU time per point (best and median of 7 calls); the ratio is Python's median over C's mean, and the answers must be equal bit for bit." ;;
 	*) echo "" ;;
 	esac
 }
@@ -51,7 +52,7 @@ all0=$(date +%s)
 
 status=0
 for b in "$@"; do
-	n=$(basename "$b")
+	n=$(basename "$b" .sh)
 	echo "== $b"
 	t0=$(date +%s)
 	"$b" > "$log" 2>&1
@@ -93,7 +94,7 @@ if [ "${BENCH_SECTIONS:-0}" = 1 ]; then
 	fi
 	# and their rows of the header's table
 	for b in "$@"; do
-		n=$(basename "$b")
+		n=$(basename "$b" .sh)
 		echo "| [\`$n\`](#$n) | $(describe "$n") |"
 	done > "$log"
 	awk -v newf="$body" -v rowf="$log" '
@@ -138,7 +139,7 @@ fi
 	echo "| benchmark | what it compares |"
 	echo "|---|---|"
 	for b in "$@"; do
-		n=$(basename "$b")
+		n=$(basename "$b" .sh)
 		echo "| [\`$n\`](#$n) | $(describe "$n") |"
 	done
 } > "$tmp"

@@ -15,7 +15,7 @@ if [ "${SAN:-}" = 1 ]; then
 fi
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-pass=0 fail=0
+pass=0 fail=0 skip=0
 check() { # description, command...
 	d=$1; shift
 	if "$@" >"$tmp/out" 2>&1; then
@@ -47,6 +47,19 @@ nolibs() { # the shared library needs no optional library
 	return 0
 }
 check "libproxima uses no optional library" nolibs
+# The Python package, where this machine builds it: installed under the
+# prefix's dist-packages, importable there, answering through the
+# installed library (LD_LIBRARY_PATH: the rpath names /usr/lib).
+py=$(${MAKE:-make} -s --no-print-directory print-PYTHON)
+if [ "$(${MAKE:-make} -s --no-print-directory print-WITH_PYTHON)" = 1 ]; then
+	pydir=$(ls -d "$lib"/python3.*/dist-packages 2>/dev/null | head -n 1)
+	check "make install put the Python package under the prefix" test -f "$pydir/proxima/__init__.py"
+	check "the installed package imports and answers" env LD_LIBRARY_PATH="$lib" \
+		PYTHONPATH="$pydir" PYTHONDONTWRITEBYTECODE=1 "$py" -c \
+		'import proxima; d = proxima.sphere(1.0).distance([[3.0, 0.0, 0.0]]); assert d[0] == 2.0, d; print(proxima.__file__)'
+else
+	echo "skip Python package: not built here (make print-WITH_PYTHON)"; skip=$((skip + 1))
+fi
 for ex in distance haptic_loop can_arm_distances; do
 	check "examples/$ex.c links with -lproxima -lm -lpthread" \
 		${CC:-cc} -std=c11 -Wall -Wextra -Werror -I"$inc" "examples/$ex.c" \
@@ -116,5 +129,5 @@ check "left-out parts say PX_E_UNSUPPORTED and name their library" \
 check "proxima-run --check names the missing YAML loader" \
 	sh -c "! '$root/usr/bin/proxima-run' --check config/examples/haptic_sim.yaml >'$tmp/run.out' 2>&1;
 	       grep -q 'built without libyaml' '$tmp/run.out'"
-echo "$name: $pass passed, $fail failed, 0 skipped"
+echo "$name: $pass passed, $fail failed, $skip skipped"
 [ "$fail" -eq 0 ]

@@ -536,11 +536,16 @@ static void print_stats(const struct query *q)
 			: px_model_kind(q->mesh) == PX_MODEL_BREP ? "B-rep faces"
 								   : "triangles");
 	if (n) {
+		long long sum = 0;
+		size_t i;
+		for (i = 0; i < n; i++)
+			sum += (long long)q->times[i];
 		qsort(q->times, n, sizeof(*q->times), cmp_i64);
 		fprintf(stderr, "queries %zu query_ns min %lld median %lld p99 %lld max %lld\n",
 			n, (long long)q->times[0], (long long)q->times[n / 2],
 			(long long)q->times[(n * 99) / 100 < n ? (n * 99) / 100 : n - 1],
 			(long long)q->times[n - 1]);
+		fprintf(stderr, "query_ns_total %lld mean %.1f\n", sum, (double)sum / (double)n);
 	} else {
 		fprintf(stderr, "queries 0\n");
 	}
