@@ -166,7 +166,8 @@ PX_API int px_scene_nearest_coherent(const struct px_scene *s, px_vec3 p,
 /* ---- tracked queries ----------------------------------------------
  *
  * One moving point followed through the scene: each model that can
- * track (NURBS: px_model.h's streams) gets a stream, the others hints.
+ * track (NURBS, B-rep: px_model.h's streams) gets a stream, the others
+ * hints.
  * Same exact answers as px_scene_nearest(); a model the broad phase
  * passes over catches up when next asked. Streams are made for the
  * models present at creation; later ones are queried with hints.

@@ -139,6 +139,10 @@ const char *px__trim_loop_name(int k, char *buf, size_t len);
 
 /* ---- the B-rep model ------------------------------------------------------ */
 
+/* Kind of a point candidate's answer in px_dist_result.kind (entity is
+ * then the index into pts). */
+#define BREP_POINT 2
+
 /* Query workspaces of one B-rep (threads borrow one without waiting). */
 #define BREP_WS 4
 /* (edge parameter, loop curve parameter) pairs per coedge: the start of
@@ -253,5 +257,29 @@ struct brep_aug {
 int px__brep_compose(const struct px_brep_desc *d, struct brep_aug *g,
 		     struct px_brep_error *err);
 void px__brep_aug_free(struct brep_aug *g);
+
+/* The model's answer (px_model.h) from the unsigned one d, the global
+ * query's or a stream's: the sign, the feature. Returns 1, or 0 beyond
+ * q->max_dist. @note RT-safe. */
+struct px_model_query;
+struct px_model_result;
+int px__brep_answer(const struct px_brep *b, const struct px_model_query *q,
+		    const struct px_dist_result *d, struct px_model_result *r);
+
+/* The B-rep behind the px_model implementation impl (brep_model.c). */
+struct px_brep *px__brep_of(const void *impl);
+
+/* Tracked streams (brep_stream.c): the four stream operations of
+ * struct px_model_ops on the implementation of px_model_from_brep(). */
+struct px_model_stream_opts;
+struct px_model_stream_note;
+struct px_model_stream_stats;
+int px__brep_stream_create(const void *impl, const struct px_model_stream_opts *o,
+			   void **state);
+int px__brep_stream_query(const void *impl, void *state,
+			  const struct px_model_query *q, struct px_model_result *r,
+			  struct px_model_stream_note *note);
+void px__brep_stream_stats(const void *state, struct px_model_stream_stats *st);
+void px__brep_stream_free(void *state);
 
 #endif

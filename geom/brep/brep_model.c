@@ -11,10 +11,6 @@
 #include "brep_internal.h"
 #include "px_model.h"
 
-/* Kind of a point candidate's answer in px_dist_result.kind (entity is
- * then the index into pts). */
-#define BREP_POINT 2
-
 int px__brep_closest(const struct px_brep *b, int k, px_vec3 p,
 		     struct px_dist_result *d)
 {
@@ -95,7 +91,7 @@ static int brep_closest(const void *impl, const struct px_model_query *q,
 	/* Taking a workspace is the one write a query makes. */
 	struct px_brep *b = (struct px_brep *)(uintptr_t)impl;
 	struct px_dist_result d;
-	int k, rc, sg = 1, want_sign = b->closed && !(q->flags & PX_QUERY_UNSIGNED);
+	int k, rc;
 
 	k = ws_take(b);
 	if (k == BREP_WS)
@@ -104,6 +100,15 @@ static int brep_closest(const void *impl, const struct px_model_query *q,
 	ws_give(b, k);
 	if (rc != PX_OK)
 		return rc;
+	return px__brep_answer(b, q, &d, r);
+}
+
+int px__brep_answer(const struct px_brep *b, const struct px_model_query *q,
+		    const struct px_dist_result *dp, struct px_model_result *r)
+{
+	struct px_dist_result d = *dp;
+	int sg = 1, want_sign = b->closed && !(q->flags & PX_QUERY_UNSIGNED);
+
 	if (d.dist > q->max_dist)
 		return 0;
 	/* Within rounding of the surface the side is noise: outside. */
@@ -201,9 +206,18 @@ int px_model_from_brep(struct px_brep *b, struct px_model **out)
 	h->ops.aabb = holder_aabb;
 	h->ops.memory_bytes = holder_bytes;
 	h->ops.free = holder_free;
+	h->ops.stream_create = px__brep_stream_create;
+	h->ops.stream_query = px__brep_stream_query;
+	h->ops.stream_stats = px__brep_stream_stats;
+	h->ops.stream_free = px__brep_stream_free;
 	return px_model_create(&h->ops, h,
 			       PX_MODEL_CAP_EXACT | (b->closed ? PX_MODEL_CAP_SIGNED : 0u),
 			       out);
+}
+
+struct px_brep *px__brep_of(const void *impl)
+{
+	return ((const struct brep_holder *)impl)->b;
 }
 
 const struct px_brep *px_model_brep(const struct px_model *m)

@@ -24,6 +24,11 @@
  * no vertex); certified keeps its meaning (the global minimum
  * over the trimmed faces, their edges and vertices, proven).
  *
+ * Tracked streams (px_model_stream_create()) follow the critical points
+ * of the faces' surfaces and answer with those inside the trimmed
+ * domains, the edges followed as curves, the point candidates checked
+ * directly: the global query's answers, sign included.
+ *
  * Memory and real-time rules: px_brep_create() and px_model_from_brep()
  * allocate (setup only); queries on the model never touch the heap, run
  * in bounded loops, keep no state and may run in several threads at

@@ -25,7 +25,7 @@
  * point out), and on the surface it is the outward normal where one is
  * defined.
  *
- * Representations that can follow a moving point (NURBS) also hand out
+ * Representations that can follow a moving point (NURBS, B-rep) also hand out
  * tracked streams (px_model_stream_create(), below): per-point state made
  * at setup whose answers are the same as a query's, at a fraction of the
  * cost when the point moves a little between them.
@@ -326,7 +326,9 @@ PX_API unsigned long px_model_cache_refills(const struct px_model_cache *c);
  * can be followed instead of searched for: a stream keeps every critical
  * distance of the model from that point and detects where pairs of them
  * are born or die as the point moves (NURBS models: px_strack for
- * surfaces, px_track for curves alone), so most answers cost a fraction
+ * surfaces, px_track for curves alone; B-rep models: px_strack over the
+ * faces' surfaces answering inside the trimmed domains, brep_stream.c),
+ * so most answers cost a fraction
  * of a global query, and each is still the exact global closest point
  * (the same as px_model_query_ex(); where the tracked set cannot prove
  * it, the global query answers). The stream follows the point in the

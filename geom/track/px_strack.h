@@ -116,7 +116,9 @@
  *    model size of travel.
  *  - Answer: the smallest of the surface minima and the curve tracker's
  *    answer; jumped when the closest feature is not the continuation of
- *    the last one.
+ *    the last one. (Trimmed surfaces, the B-rep's streams: only minima
+ *    inside a face's domain answer, strack_internal.h's
+ *    px__strack_create_trimmed().)
  *  - Hot path: after an update answered by a surface minimum, a
  *    certificate from the distance margins of the other minima, the
  *    poles and the curve boxes (all 1-Lipschitz: the margin shrinks at

@@ -219,6 +219,10 @@ struct ssurf {
 	 * K and least width */
 	int rl_n, rl_next;
 	double rl_kl[4], rl_wl[4];
+	/* a trimmed surface (px__strack_create_trimmed()): dom_in(dom, u,
+	 * v) nonzero where (u, v) is in its closed domain; NULL untrimmed */
+	int (*dom_in)(const void *dom, double u, double v);
+	const void *dom;
 };
 
 struct edge {
@@ -341,6 +345,10 @@ struct px_strack {
 	int best_kind;          /* 0 none, 1 surface min, 2 curve tracker, 3 pole */
 	uint32_t best_id;
 	int ans_s, ans_j;       /* answer(): the answering surface minimum */
+	/* answer(): the nearest tracked candidate is a trimmed surface's
+	 * crease outside its domain (it proves nothing of the others): the
+	 * update is answered globally */
+	int ans_open;
 	/* hot path: every critical point but hot_j of surface hot_s rests at
 	 * its state of hot_p (track_step starts them there); while the path
 	 * stays below hot_until and no cell is due, an update follows that
@@ -460,6 +468,29 @@ int px__st_sym_regular(const double lo[3], const double hi[3], double *sig);
 int px__st_winding(const struct px_strack *t, const struct ssurf *f,
 		   px_vec3 p, int *w);
 
+/* strack_setup.c */
+
+/*
+ * px_strack_create() for trimmed surfaces (the B-rep's streams): trims
+ * (n_surfs entries) the distance core's view of each surface's domain
+ * (dist_internal.h; inside NULL: untrimmed), in(ctx, u, v) nonzero where
+ * (u, v) lies in the closed domain of the surface whose ctx it is. A
+ * trimmed surface's interior critical points are followed over the
+ * whole surface, but only those in its domain answer; its domain edges
+ * and poles are no candidates (the caller gives the trimming edges as
+ * curves and checks the points a loop collapses to itself); a crease
+ * of it answering outside its domain makes the update global. The
+ * global query (fall-back, verification, cold switch) is the distance
+ * core over the trimmed domains. Setup only.
+ */
+struct px__dist_trim;
+int px__strack_create_trimmed(const struct px_nurbs_curve *curves, int n_curves,
+			      const struct px_nurbs_surf *surfs, int n_surfs,
+			      const struct px__dist_trim *trims,
+			      int (*in)(const void *ctx, double u, double v),
+			      const struct px_strack_opts *opts,
+			      struct px_strack **out);
+
 /* strack_update.c */
 void px__st_answer_global(struct px_strack *t, px_vec3 p,
 			  struct px_strack_result *r);
@@ -524,6 +555,12 @@ static inline int crit_type(const struct crit *z)
 	if (det > 0.0)
 		return z->h11 > 0.0 ? 1 : -1;
 	return 0;
+}
+
+/* (u, v) in the closed domain of f (always, untrimmed). */
+static inline int st_in_domain(const struct ssurf *f, double u, double v)
+{
+	return !f->dom_in || f->dom_in(f->dom, u, v);
 }
 
 static inline int has_pole(const struct ssurf *f)

@@ -5,6 +5,8 @@
  */
 #include "strack_internal.h"
 
+#include "dist_internal.h"
+
 int px_strack_critical(const struct px_strack *t, int s, double *u, double *v,
 		       int *type, int cap)
 {
@@ -561,6 +563,10 @@ static int surf_edges(struct px_strack *t, struct edge_set *es, int i)
 		double tv = e == 0 ? f->u0 : e == 1 ? f->u1 : e == 2 ? f->v0 : f->v1;
 		if ((e < 2 && f->wrap_u) || (e >= 2 && f->wrap_v))
 			continue;
+		/* a trimmed surface's boundary is its trimming edges, the
+		 * caller's curves (f->pole[] stays: Newton needs it) */
+		if (f->dom_in)
+			continue;
 		if (px_nurbs_surf_edge_collapsed(&f->s, e, tol)) {
 			struct pole *pl = &t->pole[t->n_poles++];
 			f->pole[e] = 1;
@@ -714,9 +720,13 @@ static int caches_setup(struct px_strack *t)
 	return t->scache ? PX_OK : PX_E_NOMEM;
 }
 
-int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
-		     const struct px_nurbs_surf *surfs, int n_surfs,
-		     const struct px_strack_opts *opts, struct px_strack **out)
+/* px_strack_create() and px__strack_create_trimmed() (trims NULL: no
+ * trimmed surface). */
+static int strack_create(const struct px_nurbs_curve *curves, int n_curves,
+			 const struct px_nurbs_surf *surfs, int n_surfs,
+			 const struct px__dist_trim *trims,
+			 int (*in)(const void *ctx, double u, double v),
+			 const struct px_strack_opts *opts, struct px_strack **out)
 {
 	struct px_strack *t;
 	struct px_strack_opts o;
@@ -743,8 +753,10 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	}
 	t->n_curves = n_curves;
 	t->n_surf = n_surfs;
-	rc = px_dist_model_create(curves, n_curves, surfs, n_surfs, o.dist,
-				  &t->dist);
+	rc = trims ? px__dist_model_create_trimmed(curves, n_curves, surfs, n_surfs,
+						   trims, o.dist, &t->dist)
+		   : px_dist_model_create(curves, n_curves, surfs, n_surfs, o.dist,
+					  &t->dist);
 	if (rc) {
 		free(t);
 		return rc;
@@ -761,6 +773,11 @@ int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
 	if (rc)
 		goto fail;
 	t->n_cells = cell_cap;
+	for (i = 0; trims && i < n_surfs; i++)
+		if (trims[i].inside) {
+			t->sf[i].dom_in = in;
+			t->sf[i].dom = trims[i].ctx;
+		}
 	for (i = 0; i < n_surfs; i++) {
 		rc = px__st_wind_pieces(t, i);
 		if (rc)
@@ -787,4 +804,25 @@ fail:
 	free(es.cc);
 	px_strack_free(t);
 	return rc;
+}
+
+int px_strack_create(const struct px_nurbs_curve *curves, int n_curves,
+		     const struct px_nurbs_surf *surfs, int n_surfs,
+		     const struct px_strack_opts *opts, struct px_strack **out)
+{
+	return strack_create(curves, n_curves, surfs, n_surfs, NULL, NULL, opts,
+			     out);
+}
+
+int px__strack_create_trimmed(const struct px_nurbs_curve *curves, int n_curves,
+			      const struct px_nurbs_surf *surfs, int n_surfs,
+			      const struct px__dist_trim *trims,
+			      int (*in)(const void *ctx, double u, double v),
+			      const struct px_strack_opts *opts,
+			      struct px_strack **out)
+{
+	if (!trims || !in)
+		return PX_E_INVAL;
+	return strack_create(curves, n_curves, surfs, n_surfs, trims, in, opts,
+			     out);
 }

@@ -64,6 +64,19 @@ static void answer_curve(const struct px_strack *t,
 	}
 }
 
+/* The curve tracker's answer cr is a crease of
+ * a trimmed surface outside its domain: no candidate of the model. */
+static inline int crease_out(const struct px_strack *t,
+			     const struct px_track_result *cr)
+{
+	const struct edge *e;
+	if (cr->entity < t->n_curves)
+		return 0;
+	e = &t->edge[cr->entity - t->n_curves];
+	return !st_in_domain(&t->sf[e->surf], e->dir ? e->t : cr->u,
+			     e->dir ? cr->u : e->t);
+}
+
 static void answer(struct px_strack *t, px_vec3 p,
 		   const struct px_track_result *cr, struct px_strack_result *r)
 {
@@ -84,7 +97,7 @@ static void answer(struct px_strack *t, px_vec3 p,
 			if (z->type <= 0)
 				continue;
 			d2 = px_v3_dist2(z->s, p);
-			if (d2 < best) {
+			if (d2 < best && st_in_domain(&t->sf[i], z->u, z->v)) {
 				best = d2;
 				kind = 1;
 				id = z->id;
@@ -112,6 +125,10 @@ static void answer(struct px_strack *t, px_vec3 p,
 	}
 	fill_dir(r, p);
 	count_crit(t, r, cr->n_crit);
+	/* (the caller answers globally: the last answer stays) */
+	t->ans_open = kind == 2 && crease_out(t, cr);
+	if (t->ans_open)
+		return;
 	r->jumped = kind != t->best_kind || (kind == 2 && cr->jumped) ||
 		    (kind != 2 && id != t->best_id);
 	if (t->best_kind == 0 && t->have_last)
@@ -256,7 +273,8 @@ static int curves_needed(const struct px_strack *t, px_vec3 p)
 		for (j = 0; j < t->sf[i].nz; j++) {
 			const struct crit *z = &t->sf[i].z[j];
 			double d2 = px_v3_dist2(z->s, p);
-			if (z->type > 0 && d2 < best)
+			if (z->type > 0 && d2 < best &&
+			    st_in_domain(&t->sf[i], z->u, z->v))
 				best = d2;
 		}
 	for (i = 0; i < t->n_poles; i++) {
@@ -292,7 +310,10 @@ int px__st_full_reset(struct px_strack *t, px_vec3 p,
 	} else {
 		answer(t, p, &cr, r);
 		r->jumped = 1;
-		verify(t, p, r);
+		if (t->ans_open)
+			px__st_answer_global(t, p, r);
+		else
+			verify(t, p, r);
 	}
 	return PX_OK;
 }
@@ -948,6 +969,13 @@ static int catch_up(struct px_strack *t, px_vec3 p, struct px_strack_result *r)
 		} else if (rc == 0 && p1.x == p.x && p1.y == p.y && p1.z == p.z) {
 			/* caught up: checked against the global answer */
 			answer(t, p, &cr, r);
+			if (t->ans_open) {
+				/* the set is complete: only this answer is
+				 * not its own */
+				t->mode = ST_TRACK;
+				px__st_answer_global(t, p, r);
+				return PX_OK;
+			}
 			if (px_dist_query(t->dist, p, &g) == PX_OK) {
 				t->st.verifications++;
 				r->verified = 1;
@@ -984,7 +1012,7 @@ static void hot_arm(struct px_strack *t, px_vec3 p,
 		    const struct px_strack_result *r)
 {
 	double best = r->dist, tol = 1e-9 * (best + t->scale), until, m, lim,
-	       cc = INFINITY;
+	       cc = INFINITY, uout = INFINITY;
 	int i, j;
 	int curve = r->feature == PX_STRACK_CURVE || r->feature == PX_STRACK_EDGE;
 	t->hot_s = -1;
@@ -1002,6 +1030,10 @@ static void hot_arm(struct px_strack *t, px_vec3 p,
 			    (!curve && i == t->ans_s && j == t->ans_j))
 				continue;
 			m = px_v3_dist(z->s, p) - best - tol;
+			if (!st_in_domain(&t->sf[i], z->u, z->v)) {
+				uout = m < uout ? m : uout;
+				continue;
+			}
 			if (!(m > 0.0))
 				return;
 			if (m < until)
@@ -1050,6 +1082,15 @@ static void hot_arm(struct px_strack *t, px_vec3 p,
 		else
 			until = uc;
 	}
+	/* A minimum outside its trimmed domain enters it through a
+	 * trimming edge, a curve: while the curves are proven farther than
+	 * the answer along the way (their bound is 1-Lipschitz too), it
+	 * enters and stays farther; else its own margin counts. */
+	if ((curve || t->hot_curves || !t->ct) && uout < INFINITY) {
+		if (!(uout > 0.0))
+			return;
+		until = uout < until ? uout : until;
+	}
 	until *= 0.5;
 	if (lim < until)
 		until = lim;
@@ -1083,7 +1124,8 @@ static int hot_update(struct px_strack *t, px_vec3 p,
 	if (use_min) {
 		f = &t->sf[t->hot_s];
 		w = f->z[t->hot_j];
-		if (px__st_evolve(f, &w, px_v3_sub(p, t->p), p) || w.type != 1)
+		if (px__st_evolve(f, &w, px_v3_sub(p, t->p), p) || w.type != 1 ||
+		    !st_in_domain(f, w.u, w.v))
 			return 1;
 	}
 	r->n_crit = t->hot_ncrit;
@@ -1099,6 +1141,8 @@ static int hot_update(struct px_strack *t, px_vec3 p,
 		if (cr.entity >= 0 &&
 		    (!use_min || cr.dist * cr.dist < px_v3_dist2(w.s, p)))
 			kind = 2;
+		if (kind == 2 && crease_out(t, &cr))
+			return 1; /* the full update answers globally */
 		if (use_min && kind == 1 && cr.entity >= 0)
 			ct_note(t, p, cr.dist, px_v3_dist(w.s, p));
 	} else if (t->hot_curves) {
@@ -1215,6 +1259,11 @@ static int strack_update(struct px_strack *t, px_vec3 p, struct px_strack_result
 		t->st.curve_cert_skips += ran == 2;
 	}
 	answer(t, p, &cr, r);
+	if (t->ans_open) {
+		t->hot_s = -1;
+		px__st_answer_global(t, p, r);
+		return PX_OK;
+	}
 	if (ran == 1 && cr.entity >= 0 && isfinite(r->dist))
 		ct_note(t, p, cr.dist, r->dist);
 	if (cr.source != PX_TRACK_TRACKED)

@@ -322,6 +322,25 @@ check "verify_every 1: verified ($(sub "$tmp/verify.json" tracking verifications
 	"$(sub "$tmp/verify.json" tracking verifications) > 1000 && $(sub "$tmp/verify.json" tracking disagreements) == 0"
 check "verify_every 1: no allocation after setup" "$(num "$tmp/verify.json" allocations_after_setup) == 0"
 
+# CAD parts (kind cad, B-rep models) are tracked too: the shipped CAD
+# example with the cold switch off (every answer from the stream) and
+# every tracked answer checked against the global query.
+cad=config/examples/haptic_cad.yaml
+if cad_skip "$cad"; then skp "$cad tracked: $why"; else
+	sed "s|file: parts/|file: $PWD/config/examples/parts/|; s/^  models:/  tracking: {cold_switch: false, verify_every: 1}\n  models:/" \
+		"$cad" >"$tmp/cadtrack.yaml"
+	expect "$cad tracked, every answer verified" 0 "$bin" "$tmp/cadtrack.yaml" --virtual-time \
+		--duration-s 3 --summary-json "$tmp/cadtrack.json" --telemetry "$tmp/cadtrack.csv"
+	check "$cad: a stream for the part" "$(sub "$tmp/cadtrack.json" tracking streams) == 1"
+	check "$cad: mostly tracked ($(sub "$tmp/cadtrack.json" tracking tracked) of $(sub "$tmp/cadtrack.json" tracking queries))" \
+		"$(sub "$tmp/cadtrack.json" tracking tracked) > $(sub "$tmp/cadtrack.json" tracking queries) / 2"
+	check "$cad: verified ($(sub "$tmp/cadtrack.json" tracking verifications)), no disagreement" \
+		"$(sub "$tmp/cadtrack.json" tracking verifications) > 1000 && $(sub "$tmp/cadtrack.json" tracking disagreements) == 0"
+	check "$cad tracked: no allocation after setup" "$(num "$tmp/cadtrack.json" allocations_after_setup) == 0"
+	if grep -qE '^  tracking          1 stream: [0-9]+ answers, [0-9.]+ % tracked' "$tmp/out"; then
+		ok "$cad: summary has the tracking line"; else bad "$cad: summary has the tracking line"; fi
+fi
+
 # Safety: a velocity limit below the hand's speed trips safe state; from
 # then on every force sent is zero (no auto re-arm).
 absolute "$good" | sed 's/velocity_limit_m_per_s: .*/velocity_limit_m_per_s: 0.05/' >"$tmp/slow.yaml"
