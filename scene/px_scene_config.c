@@ -15,6 +15,7 @@
 #include "px_dist.h"
 #include "px_load.h"
 #include "px_mesh.h"
+#include "px_brep_obj.h"
 #include "px_obj.h"
 #include "px_prim.h"
 #include "px_scene.h"
@@ -338,6 +339,21 @@ static int load_nurbs(const char *path, struct px_model **out, char *msg,
 		else
 			snprintf(msg, cap, "%.256s: %.256s", path,
 				 err.msg[0] ? err.msg : px_strerror(rc));
+		return rc;
+	}
+	if (px_obj_trimmed(obj)) {
+		/* trimmed surfaces: a B-rep (px_brep_obj.h) */
+		struct px_brep *b = NULL;
+		rc = px_brep_from_obj(obj, 1.0, &b, &err);
+		if (!rc)
+			rc = px_model_from_brep(b, out);
+		if (rc && err.line > 0)
+			snprintf(msg, cap, "%.256s:%d:%d: %.256s", path, err.line,
+				 err.column, err.msg);
+		else if (rc)
+			snprintf(msg, cap, "%.256s: %.256s", path,
+				 err.msg[0] ? err.msg : px_strerror(rc));
+		px_obj_free(obj);
 		return rc;
 	}
 	curves = calloc((size_t)obj->n_entities + 1, sizeof(*curves));

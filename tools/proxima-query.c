@@ -39,6 +39,7 @@
 #include "px_load.h"
 #include "px_mesh.h"
 #include "px_model.h"
+#include "px_brep_obj.h"
 #include "px_obj.h"
 #include "px_strack.h"
 #include "px_track.h"
@@ -302,6 +303,31 @@ static int load_obj(struct query *q)
 		return 1;
 	}
 	obj = q->obj;
+	if (px_obj_trimmed(obj)) {
+		/* trimmed surfaces: one B-rep model (px_brep_obj.h) */
+		struct px_brep *b = NULL;
+		if (q->track) {
+			fprintf(stderr, "%s: %s: --track: trimmed surfaces are "
+					"answered by global queries only; run "
+					"without --track\n",
+				prog, q->model_path);
+			return 2;
+		}
+		rc = px_brep_from_obj(obj, 1.0, &b, &oerr);
+		if (!rc)
+			rc = px_model_from_brep(b, &q->mesh);
+		if (rc) {
+			if (oerr.line > 0)
+				fprintf(stderr, "%s: %s:%d:%d: %s\n", prog,
+					q->model_path, oerr.line, oerr.column,
+					oerr.msg);
+			else
+				fprintf(stderr, "%s: %s: %s\n", prog, q->model_path,
+					oerr.msg[0] ? oerr.msg : px_strerror(rc));
+			return 1;
+		}
+		return 0;
+	}
 	q->curves = calloc((size_t)obj->n_entities + 1, sizeof(*q->curves));
 	q->surfs = calloc((size_t)obj->n_entities + 1, sizeof(*q->surfs));
 	if (!q->curves || !q->surfs) {

@@ -8,6 +8,7 @@
 #include <strings.h>
 
 #include "px_brep.h"
+#include "px_brep_obj.h"
 #include "px_cad.h"
 #include "px_cloud.h"
 #include "px_file.h"
@@ -97,6 +98,13 @@ int px_model_load(const char *path, double cloud_radius_m,
 	if (ends_with(path, ".xyz") || ends_with(path, ".csv") ||
 	    ends_with(path, ".txt") || ends_with(path, ".pts"))
 		cloud = 1;
+	if (!cloud && ends_with(path, ".obj")) {
+		/* trimmed free-form surfaces: a B-rep (px_brep_obj.h) */
+		int trimmed = 0;
+		rc = px_model_load_obj_brep(path, 1.0, &trimmed, out, msg, msg_cap);
+		if (trimmed)
+			return rc;
+	}
 	if (!cloud) {
 		struct px_mesh_report rep;
 		rc = px_mesh_load(path, NULL, &rep, out);

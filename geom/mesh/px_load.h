@@ -7,7 +7,9 @@
  * clouds; .ply is a mesh when it has faces and a point cloud when it has
  * only vertices; .step, .stp, .iges and .igs are CAD parts. Other names
  * are tried as meshes (the importer knows many formats). Free-form OBJ
- * (NURBS curves and surfaces) belongs to the NURBS loader, not here.
+ * (NURBS curves and surfaces) belongs to the NURBS loader, not here,
+ * except an OBJ with trim or hole statements: it is read as a B-rep
+ * (px_model_load_obj_brep(), px_brep_obj.h; unsigned, an open sheet).
  *
  * CAD parts (px_model_load_cad()) are read with px_cad_load() and built
  * with px_brep_create() into one model of kind PX_MODEL_BREP: the whole

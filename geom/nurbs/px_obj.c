@@ -157,6 +157,7 @@ static int lex(struct lexer *lx, struct tok *t)
 
 struct ent_rec {
 	int kind, line, col, rat, deg[2];
+	int n_outer;       /* 'trim' loops of a surface */
 	int deg_line, deg_col;
 	double range[4];
 	size_t ctrl_off, ctrl_count; /* into xyz/w pools (and ref places) */
@@ -167,6 +168,14 @@ struct ent_rec {
 
 struct place {
 	int line, col;
+};
+
+/* A trim or hole statement: its surface (index into ents) and curves
+ * (tcs[first .. first + n - 1]). */
+struct loop_rec {
+	size_t ent;
+	int hole, line, col;
+	size_t first, n;
 };
 
 struct ctx {
@@ -182,6 +191,10 @@ struct ctx {
 	struct vec kplace; /* struct place per knot */
 	struct vec tris;   /* int[3] */
 	struct vec ents;   /* struct ent_rec */
+	struct vec vps;    /* double[3] per parameter vertex (u, v, w) */
+	struct vec c2;     /* size_t: the ents index of each finished curv2 */
+	struct vec loops;  /* struct loop_rec */
+	struct vec tcs;    /* struct px_obj_trim_curve */
 	int have_cstype, rat, deg[2], ndeg, deg_line, deg_col;
 	int in_body;       /* index + 1 of the open entity, 0 if none */
 	char oname[64]; /* name of the last o or g statement */
@@ -293,37 +306,48 @@ static int tok_int(struct ctx *c, const struct tok *t, const char *what,
 	return PX_OK;
 }
 
-/* Vertex reference "v", "v/vt", "v//vn", "v/vt/vn": 0-based index. */
-static int tok_vref(struct ctx *c, const struct tok *t, size_t *idx)
+/* Reference to the what (vertex, parameter vertex, curv2) number t
+ * among nv defined so far ("v", "v/vt", "v//vn", "v/vt/vn" forms: the
+ * part before the first slash): 0-based index. */
+static int tok_ref(struct ctx *c, const struct tok *t, const char *what,
+		   const char *whats, size_t nv, size_t *idx)
 {
+	char ref[48];
 	long v;
 	int len = 0, rc;
-	size_t nv = c->verts.n;
 	while (len < t->len && t->s[len] != '/')
 		len++;
-	rc = tok_int(c, t, "vertex reference", len, &v);
+	snprintf(ref, sizeof(ref), "%s reference", what);
+	rc = tok_int(c, t, ref, len, &v);
 	if (rc)
 		return rc;
 	if (v == 0)
 		return fail(c, t, PX_E_PARSE,
-			    "vertex index 0 (OBJ indices start at 1; negative "
-			    "ones count back from the last vertex)");
+			    "%s index 0 (OBJ indices start at 1; negative "
+			    "ones count back from the last %s)",
+			    what, what);
 	if (v > 0) {
 		if ((size_t)v > nv)
 			return fail(c, t, PX_E_PARSE,
-				    "vertex %ld is not defined (%zu vertices "
+				    "%s %ld is not defined (%zu %s "
 				    "so far)",
-				    v, nv);
+				    what, v, nv, whats);
 		*idx = (size_t)v - 1;
 	} else {
 		if ((size_t)(-v) > nv)
 			return fail(c, t, PX_E_PARSE,
-				    "relative vertex %ld reaches before the "
-				    "first vertex (%zu so far)",
-				    v, nv);
+				    "relative %s %ld reaches before the "
+				    "first %s (%zu so far)",
+				    what, v, what, nv);
 		*idx = nv - (size_t)(-v);
 	}
 	return PX_OK;
+}
+
+/* Vertex reference: 0-based index. */
+static int tok_vref(struct ctx *c, const struct tok *t, size_t *idx)
+{
+	return tok_ref(c, t, "vertex", "vertices", c->verts.n, idx);
 }
 
 /* Read one statement into c->toks; returns T_WORD if it has tokens,
@@ -440,11 +464,14 @@ static int st_deg(struct ctx *c, const struct tok *tk, size_t n)
 	return PX_OK;
 }
 
-static int st_element(struct ctx *c, const struct tok *tk, size_t n, int surf)
+/* curv (what 0), surf (1) or curv2 (2, over parameter vertices, no
+ * range). */
+static int st_element(struct ctx *c, const struct tok *tk, size_t n, int what)
 {
 	struct ent_rec e;
-	size_t nr = surf ? 4 : 2, i;
-	const char *kw = surf ? "surf" : "curv";
+	int surf = what == 1, c2 = what == 2;
+	size_t nr = surf ? 4 : (c2 ? 0 : 2), i;
+	const char *kw = surf ? "surf" : (c2 ? "curv2" : "curv");
 	int rc;
 
 	if (c->in_body)
@@ -453,20 +480,25 @@ static int st_element(struct ctx *c, const struct tok *tk, size_t n, int surf)
 			    "(missing 'end')",
 			    kw, cur_ent(c)->line);
 	if (!c->have_cstype)
-		return fail(c, &tk[0], PX_E_PARSE,
-			    "'%s' before any 'cstype' statement", kw);
+		return fail(c, &tk[0], c2 ? PX_E_UNSUPPORTED : PX_E_PARSE,
+			    c2 ? "'%s' before any 'cstype' statement is not "
+				 "supported"
+			       : "'%s' before any 'cstype' statement",
+			    kw);
 	if (!c->ndeg || (surf && c->ndeg < 2))
 		return fail(c, &tk[0], PX_E_PARSE,
 			    surf ? "'surf' needs 'deg degu degv' first"
-				 : "'curv' needs 'deg degu' first");
+				 : "'%s' needs 'deg degu' first", kw);
 	if (n < 1 + nr + 2)
 		return fail(c, &tk[0], PX_E_PARSE,
 			    surf ? "'surf' takes s0 s1 t0 t1 and at least two "
 				   "control points"
-				 : "'curv' takes u0 u1 and at least two "
-				   "control points");
+				 : (c2 ? "'curv2' takes at least two parameter "
+					 "vertices"
+				       : "'curv' takes u0 u1 and at least two "
+					 "control points"));
 	memset(&e, 0, sizeof(e));
-	e.kind = surf ? PX_OBJ_SURF : PX_OBJ_CURVE;
+	e.kind = surf ? PX_OBJ_SURF : (c2 ? PX_OBJ_CURVE2 : PX_OBJ_CURVE);
 	e.line = tk[0].line;
 	e.col = tk[0].col;
 	e.rat = c->rat;
@@ -496,13 +528,25 @@ static int st_element(struct ctx *c, const struct tok *tk, size_t n, int surf)
 		size_t vi;
 		const double *v;
 		struct place pl = {tk[i].line, tk[i].col};
-		rc = tok_vref(c, &tk[i], &vi);
-		if (rc)
-			return rc;
-		v = (const double *)c->verts.p + 4 * vi;
-		memcpy((double *)c->xyz.p + 3 * c->xyz.n, v, 3 * sizeof(double));
+		double *x = (double *)c->xyz.p + 3 * c->xyz.n;
+		if (c2) {
+			rc = tok_ref(c, &tk[i], "parameter vertex",
+				     "parameter vertices", c->vps.n, &vi);
+			if (rc)
+				return rc;
+			v = (const double *)c->vps.p + 3 * vi;
+			x[0] = v[0];
+			x[1] = v[1];
+			x[2] = 0.0;
+		} else {
+			rc = tok_vref(c, &tk[i], &vi);
+			if (rc)
+				return rc;
+			v = (const double *)c->verts.p + 4 * vi;
+			memcpy(x, v, 3 * sizeof(double));
+		}
 		c->xyz.n++;
-		VEC_AT(c->wts, double, c->wts.n++) = e.rat ? v[3] : 1.0;
+		VEC_AT(c->wts, double, c->wts.n++) = e.rat ? v[c2 ? 2 : 3] : 1.0;
 		VEC_AT(c->cplace, struct place, c->cplace.n++) = pl;
 	}
 	if (vec_push(&c->ents, &e))
@@ -522,7 +566,7 @@ static int st_parm(struct ctx *c, const struct tok *tk, size_t n)
 	if (n < 2 || (!tok_is(&tk[1], "u") && !tok_is(&tk[1], "v")))
 		return fail(c, &tk[0], PX_E_PARSE, "'parm' takes u|v and knots");
 	d = tok_is(&tk[1], "v");
-	if (d == 1 && e->kind == PX_OBJ_CURVE)
+	if (d == 1 && e->kind != PX_OBJ_SURF)
 		return fail(c, &tk[1], PX_E_PARSE,
 			    "'parm v' in the body of a curve");
 	if (e->knot_count[d] >= 0)
@@ -590,7 +634,7 @@ static int nurbs_fail(struct ctx *c, const struct ent_rec *e,
 		break;
 	}
 	return fail_at(c, line, col, code, "%s of line %d: %s",
-		       e->kind == PX_OBJ_CURVE ? "curve" : "surface", e->line,
+		       e->kind == PX_OBJ_SURF ? "surface" : "curve", e->line,
 		       ne->msg);
 }
 
@@ -620,7 +664,7 @@ static int st_end(struct ctx *c, const struct tok *tk, size_t n)
 				    "vector",
 				    nd == 2 ? "surface" : "curve", e->line,
 				    d ? 'v' : 'u');
-	if (e->kind == PX_OBJ_CURVE) {
+	if (e->kind != PX_OBJ_SURF) {
 		int p = e->deg[0], nk = e->knot_count[0];
 		int need = (int)e->ctrl_count + p + 1;
 		if (nk != need)
@@ -650,6 +694,14 @@ static int st_end(struct ctx *c, const struct tok *tk, size_t n)
 	}
 	if (rc)
 		return nurbs_fail(c, e, &ne);
+	if (e->kind == PX_OBJ_CURVE2) {
+		/* no range: the knot domain; referable from now on */
+		size_t idx = (size_t)(c->in_body - 1);
+		e->range[0] = K[e->knot_off[0] + (size_t)e->deg[0]];
+		e->range[1] = K[e->knot_off[0] + (size_t)(e->knot_count[0] - e->deg[0] - 1)];
+		if (vec_push(&c->c2, &idx))
+			return nomem(c);
+	}
 	for (d = 0; d < nd; d++) {
 		int p = e->deg[d], nk = e->knot_count[d];
 		const double *U = K + e->knot_off[d];
@@ -663,6 +715,105 @@ static int st_end(struct ctx *c, const struct tok *tk, size_t n)
 				       lo, hi);
 	}
 	c->in_body = 0;
+	return PX_OK;
+}
+
+/* "vp u [v [w]]": a parameter vertex (v 0 and w 1 when left out). */
+static int st_vp(struct ctx *c, const struct tok *tk, size_t n)
+{
+	double v[3] = {0, 0, 1};
+	size_t i;
+	int rc;
+	if (n < 2 || n > 4)
+		return fail(c, &tk[0], PX_E_PARSE, "'vp' takes u [v [w]]");
+	for (i = 1; i < n; i++) {
+		rc = tok_double(c, &tk[i], "parameter vertex", &v[i - 1]);
+		if (rc)
+			return rc;
+	}
+	if (vec_reserve(&c->vps, 1))
+		return nomem(c);
+	memcpy((double *)c->vps.p + 3 * c->vps.n, v, sizeof(v));
+	c->vps.n++;
+	return PX_OK;
+}
+
+/* "trim", "hole" (kind 0, 1: loops of the open surface) or "scrv" (2:
+ * a special curve, checked and not kept): triples u0 u1 curv2. */
+static int st_loop(struct ctx *c, const struct tok *tk, size_t n, int kind)
+{
+	static const char *const kw[] = {"trim", "hole", "scrv"};
+	struct ent_rec *e = cur_ent(c);
+	struct loop_rec lr;
+	size_t i;
+	int rc;
+
+	if (!e || e->kind != PX_OBJ_SURF)
+		return fail(c, &tk[0], PX_E_UNSUPPORTED,
+			    "'%s' is supported only inside a surf body",
+			    kw[kind]);
+	if (n < 4 || (n - 1) % 3)
+		return fail(c, &tk[0], PX_E_PARSE,
+			    "'%s' takes triples u0 u1 curv2 (got %zu values)",
+			    kw[kind], n - 1);
+	if (kind == 0 && e->n_outer)
+		return fail(c, &tk[0], PX_E_UNSUPPORTED,
+			    "second 'trim' loop of the surface of line %d (one "
+			    "outer loop per surface)",
+			    e->line);
+	lr.ent = (size_t)(c->in_body - 1);
+	lr.hole = kind == 1;
+	lr.line = tk[0].line;
+	lr.col = tk[0].col;
+	lr.first = c->tcs.n;
+	lr.n = (n - 1) / 3;
+	for (i = 1; i < n; i += 3) {
+		struct px_obj_trim_curve tc;
+		const struct ent_rec *ce;
+		size_t ci;
+		rc = tok_double(c, &tk[i], "curve parameter", &tc.t0);
+		if (!rc)
+			rc = tok_double(c, &tk[i + 1], "curve parameter", &tc.t1);
+		if (!rc)
+			rc = tok_ref(c, &tk[i + 2], "curv2", "curv2 curves",
+				     c->c2.n, &ci);
+		if (rc)
+			return rc;
+		ce = &VEC_AT(c->ents, struct ent_rec, VEC_AT(c->c2, size_t, ci));
+		if (tc.t0 == tc.t1 || fmin(tc.t0, tc.t1) < ce->range[0] ||
+		    fmax(tc.t0, tc.t1) > ce->range[1])
+			return fail(c, &tk[i], PX_E_PARSE,
+				    "range %g..%g of curv2 %zu (line %d) is "
+				    "empty or outside its domain %g..%g",
+				    tc.t0, tc.t1, ci + 1, ce->line, ce->range[0],
+				    ce->range[1]);
+		tc.curv2 = (int)ci;
+		if (kind < 2 && vec_push(&c->tcs, &tc))
+			return nomem(c);
+	}
+	if (kind == 2)
+		return PX_OK;
+	e = cur_ent(c);
+	e->n_outer += kind == 0;
+	return vec_push(&c->loops, &lr) ? nomem(c) : PX_OK;
+}
+
+/* "sp vp1 vp2 ...": special points of the open curve or surface; they
+ * only guide tessellation, so they are checked and not kept. */
+static int st_sp(struct ctx *c, const struct tok *tk, size_t n)
+{
+	size_t i, vi;
+	int rc;
+	if (!c->in_body)
+		return fail(c, &tk[0], PX_E_UNSUPPORTED,
+			    "'sp' is supported only inside a curve or surface "
+			    "body");
+	for (i = 1; i < n; i++) {
+		rc = tok_ref(c, &tk[i], "parameter vertex",
+			     "parameter vertices", c->vps.n, &vi);
+		if (rc)
+			return rc;
+	}
 	return PX_OK;
 }
 
@@ -703,14 +854,13 @@ static void set_name(char *dst, size_t cap, const struct tok *tk, size_t n)
 static int statement(struct ctx *c)
 {
 	static const char *const ignored[] = {
-		"vt",       "vn",        "vp",        "s",         "mg",
+		"vt",       "vn",        "s",         "mg",
 		"usemtl",   "mtllib",    "maplib",    "usemap",    "bevel",
 		"c_interp", "d_interp",  "lod",       "shadow_obj", "trace_obj",
 		"ctech",    "stech"};
 	static const char *const unsupported[] = {
-		"bmat", "step", "curv2", "trim", "hole", "scrv", "sp",
-		"con",  "p",    "l",     "bsp",  "bzp",  "cdc",  "cdp",
-		"res"};
+		"bmat", "step", "con", "p",   "l",
+		"bsp",  "bzp",  "cdc", "cdp", "res"};
 	const struct tok *tk = (const struct tok *)c->toks.p;
 	size_t n = c->toks.n, k;
 	char sb[48];
@@ -727,6 +877,18 @@ static int statement(struct ctx *c)
 		return st_element(c, tk, n, 0);
 	if (tok_is(&tk[0], "surf"))
 		return st_element(c, tk, n, 1);
+	if (tok_is(&tk[0], "curv2"))
+		return st_element(c, tk, n, 2);
+	if (tok_is(&tk[0], "vp"))
+		return st_vp(c, tk, n);
+	if (tok_is(&tk[0], "trim"))
+		return st_loop(c, tk, n, 0);
+	if (tok_is(&tk[0], "hole"))
+		return st_loop(c, tk, n, 1);
+	if (tok_is(&tk[0], "scrv"))
+		return st_loop(c, tk, n, 2);
+	if (tok_is(&tk[0], "sp"))
+		return st_sp(c, tk, n);
 	if (tok_is(&tk[0], "parm"))
 		return st_parm(c, tk, n);
 	if (tok_is(&tk[0], "end"))
@@ -774,7 +936,7 @@ static size_t entity_bytes(const struct ent_rec *e, const double *K,
 		for (d = 0; d < nd; d++)
 			n[d] += e->deg[d];
 	}
-	if (e->kind == PX_OBJ_CURVE) {
+	if (e->kind != PX_OBJ_SURF) {
 		b = px_nurbs_curve_bytes(e->deg[0], n[0]);
 		if (narrow)
 			s = PX_NURBS_CURVE_WORK_LEN(e->deg[0], n[0]);
@@ -917,7 +1079,7 @@ static int build_entity(struct ctx *c, const struct ent_rec *e,
 	memcpy(o->range, e->range, sizeof(o->range));
 	memcpy(o->name, e->name, sizeof(o->name));
 	memset(&tmp, 0, sizeof(tmp));
-	if (e->kind == PX_OBJ_CURVE)
+	if (e->kind != PX_OBJ_SURF)
 		rc = build_curve(e, K, X, W, &m->arena_, &tmp, o);
 	else
 		rc = build_surf(e, K, X, W, &m->arena_, &tmp, o);
@@ -929,11 +1091,29 @@ static int build_entity(struct ctx *c, const struct ent_rec *e,
 	return rc;
 }
 
+/* The trimming tables: curv2 curves, loops (their surfaces renumbered
+ * as model entities through map) and loop curves. */
+static int trim_alloc(struct ctx *c, struct px_obj_model *m)
+{
+	size_t n2 = c->c2.n, nl = c->loops.n, nt = c->tcs.n;
+	m->curv2 = n2 ? calloc(n2, sizeof(*m->curv2)) : NULL;
+	m->loops = nl ? calloc(nl, sizeof(*m->loops)) : NULL;
+	m->trim_curves = nt ? malloc(nt * sizeof(*m->trim_curves)) : NULL;
+	m->memory_bytes += n2 * sizeof(*m->curv2) + nl * sizeof(*m->loops) +
+			   nt * sizeof(*m->trim_curves);
+	if ((n2 && !m->curv2) || (nl && !m->loops) || (nt && !m->trim_curves))
+		return nomem(c);
+	if (nt)
+		memcpy(m->trim_curves, c->tcs.p, nt * sizeof(*m->trim_curves));
+	m->n_trim_curves = (int)nt;
+	return PX_OK;
+}
+
 static int build(struct ctx *c, struct px_obj_model **out)
 {
 	const struct ent_rec *E = (const struct ent_rec *)c->ents.p;
 	struct px_obj_model *m = NULL;
-	size_t bytes, i;
+	size_t bytes, i, *map;
 	int rc;
 
 	rc = arena_bytes(c, &bytes);
@@ -941,13 +1121,32 @@ static int build(struct ctx *c, struct px_obj_model **out)
 		rc = model_alloc(c, bytes, &m);
 	if (rc)
 		return rc;
-	for (i = 0; i < c->ents.n && !rc; i++)
-		rc = build_entity(c, &E[i], m, &m->entities[i]);
+	map = calloc(c->ents.n + 1, sizeof(*map));
+	rc = map ? trim_alloc(c, m) : nomem(c);
+	for (i = 0; i < c->ents.n && !rc; i++) {
+		if (E[i].kind == PX_OBJ_CURVE2) {
+			map[i] = (size_t)m->n_curv2;
+			rc = build_entity(c, &E[i], m, &m->curv2[m->n_curv2++]);
+		} else {
+			map[i] = (size_t)m->n_entities;
+			rc = build_entity(c, &E[i], m, &m->entities[m->n_entities++]);
+		}
+	}
+	for (i = 0; i < c->loops.n && !rc; i++) {
+		const struct loop_rec *lr = &VEC_AT(c->loops, struct loop_rec, i);
+		struct px_obj_loop *l = &m->loops[m->n_loops++];
+		l->entity = (int)map[lr->ent];
+		l->hole = lr->hole;
+		l->line = lr->line;
+		l->column = lr->col;
+		l->first = (int)lr->first;
+		l->n = (int)lr->n;
+	}
+	free(map);
 	if (rc) {
 		px_obj_free(m);
 		return rc;
 	}
-	m->n_entities = (int)c->ents.n;
 	*out = m;
 	return PX_OK;
 }
@@ -963,6 +1162,10 @@ static void ctx_free(struct ctx *c)
 	free(c->kplace.p);
 	free(c->tris.p);
 	free(c->ents.p);
+	free(c->vps.p);
+	free(c->c2.p);
+	free(c->loops.p);
+	free(c->tcs.p);
 }
 
 static void err_init(struct px_obj_error *err, const char *name)
@@ -1006,6 +1209,10 @@ int px_obj_load_mem(const char *name, const char *data, size_t len,
 	c.kplace.elem = sizeof(struct place);
 	c.tris.elem = 3 * sizeof(int);
 	c.ents.elem = sizeof(struct ent_rec);
+	c.vps.elem = 3 * sizeof(double);
+	c.c2.elem = sizeof(size_t);
+	c.loops.elem = sizeof(struct loop_rec);
+	c.tcs.elem = sizeof(struct px_obj_trim_curve);
 
 	for (;;) {
 		rc = read_statement(&c);
@@ -1024,11 +1231,12 @@ int px_obj_load_mem(const char *name, const char *data, size_t len,
 		rc = fail_at(&c, e->line, e->col, PX_E_PARSE,
 			     "%s of line %d has no 'end' before the end of "
 			     "the file",
-			     e->kind == PX_OBJ_CURVE ? "curv" : "surf",
+			     e->kind == PX_OBJ_SURF ? "surf"
+						    : (e->kind == PX_OBJ_CURVE2 ? "curv2" : "curv"),
 			     e->line);
 	}
 	if (!rc && (c.verts.n > (size_t)INT_MAX || c.tris.n > (size_t)INT_MAX ||
-		    c.ents.n > (size_t)INT_MAX))
+		    c.ents.n > (size_t)INT_MAX || c.tcs.n > (size_t)INT_MAX))
 		rc = fail_at(&c, 0, 0, PX_E_PARSE, "too many elements");
 	if (!rc)
 		rc = build(&c, out);
@@ -1095,6 +1303,9 @@ void px_obj_free(struct px_obj_model *m)
 		return;
 	px_arena_fini(&m->arena_);
 	free(m->entities);
+	free(m->curv2);
+	free(m->loops);
+	free(m->trim_curves);
 	free(m->vertices);
 	free(m->triangles);
 	free(m);

@@ -56,7 +56,7 @@
 extern "C" {
 #endif
 
-enum px_obj_kind { PX_OBJ_CURVE = 1, PX_OBJ_SURF = 2 };
+enum px_obj_kind { PX_OBJ_CURVE = 1, PX_OBJ_SURF = 2, PX_OBJ_CURVE2 = 3 };
 
 /* One free-form entity of the file. */
 struct px_obj_entity {
@@ -69,10 +69,34 @@ struct px_obj_entity {
 	char name[64];               /* name of the last "o" or "g", or "" */
 };
 
+/* One curve of a trimming loop: curv2 number curv2 (0-based index into
+ * px_obj_model.curv2) on its parameters t0..t1 (t0 > t1: run from t0
+ * down to t1), as the trim or hole statement gives it. */
+struct px_obj_trim_curve {
+	int curv2;
+	double t0, t1;
+};
+
+/* A trim (hole == 0, the outer loop) or hole statement of the surface
+ * entities[entity]: its curves trim_curves[first .. first + n - 1] in
+ * order, and the statement's place. */
+struct px_obj_loop {
+	int entity;
+	int hole;
+	int line, column;
+	int first, n;
+};
+
 /* A loaded file. Read-only for the caller. */
 struct px_obj_model {
 	int n_entities;
-	struct px_obj_entity *entities;
+	struct px_obj_entity *entities; /* curves and surfaces (no curv2) */
+	int n_curv2;
+	struct px_obj_entity *curv2;    /* kind PX_OBJ_CURVE2: (u, v, 0) curves */
+	int n_loops;
+	struct px_obj_loop *loops;      /* in file order */
+	int n_trim_curves;
+	struct px_obj_trim_curve *trim_curves;
 	int n_vertices;     /* every "v" of the file */
 	double *vertices;   /* 3 * n_vertices (x, y, z) */
 	int n_triangles;    /* from the "f" statements */

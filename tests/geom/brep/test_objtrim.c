@@ -1,0 +1,524 @@
+/*
+ * Trimmed OBJ files (curv2, trim, hole, scrv, sp) read as B-rep models
+ * (px_brep_obj.h), written here: a plane sheet with a rational circular
+ * hole and a multi-face file against exact answers; a free-form sheet
+ * trimmed by a spline loop and a polygon hole against a reference of
+ * dense samples of the surface inside its trimmed domain and of the
+ * composed edges, polished; zero wrong answers. Malformed files are
+ * refused with their line and what is wrong; px_model_load() reads a
+ * trimmed .obj as a B-rep and leaves untrimmed ones to the mesh loader.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "px_brep_obj.h"
+#include "px_features.h"
+#include "px_load.h"
+#include "px_model.h"
+#include "px_obj.h"
+#include "px_test.h"
+#include "px_trim.h"
+
+/* A 2 x 2 plane z = z0 over [0, 1]^2 (u, v scaled by 2) and, when
+ * hole, a rational circle of radius 0.25 around (0.5, 0.5) as its hole
+ * (the outer loop: the domain). */
+static int plane_text(char *buf, size_t cap, double z0, int hole, int first_v,
+		      int first_vp, int first_c2)
+{
+	static const double cx[9] = {1, 1, 0, -1, -1, -1, 0, 1, 1};
+	static const double cy[9] = {0, 1, 1, 1, 0, -1, -1, -1, 0};
+	int n = 0, i;
+	n += snprintf(buf + n, cap - (size_t)n,
+		      "v 0 0 %g\nv 2 0 %g\nv 0 2 %g\nv 2 2 %g\n", z0, z0, z0, z0);
+	if (hole) {
+		for (i = 0; i < 9; i++)
+			n += snprintf(buf + n, cap - (size_t)n, "vp %.17g %.17g %.17g\n",
+				      0.5 + 0.25 * cx[i], 0.5 + 0.25 * cy[i],
+				      (i & 1) ? sqrt(0.5) : 1.0);
+		n += snprintf(buf + n, cap - (size_t)n,
+			      "cstype rat bspline\ndeg 2\ncurv2");
+		for (i = 0; i < 9; i++)
+			n += snprintf(buf + n, cap - (size_t)n, " %d", first_vp + i);
+		n += snprintf(buf + n, cap - (size_t)n,
+			      "\nparm u 0 0 0 1 1 2 2 3 3 4 4 4\nend\n");
+	}
+	n += snprintf(buf + n, cap - (size_t)n,
+		      "cstype bspline\ndeg 1 1\nsurf 0 1 0 1 %d %d %d %d\n"
+		      "parm u 0 0 1 1\nparm v 0 0 1 1\n",
+		      first_v, first_v + 1, first_v + 2, first_v + 3);
+	if (hole)
+		n += snprintf(buf + n, cap - (size_t)n, "hole 0 4 %d\n", first_c2);
+	n += snprintf(buf + n, cap - (size_t)n, "end\n");
+	return n;
+}
+
+/* Exact distance to the square [0, 2]^2 at z0 without the disc of
+ * radius 0.5 around (1, 1) (hole) . */
+static double plane_exact(px_vec3 p, double z0, int hole)
+{
+	double x = fmin(fmax(p.x, 0.0), 2.0), y = fmin(fmax(p.y, 0.0), 2.0);
+	double dx = x - 1.0, dy = y - 1.0, r = sqrt(dx * dx + dy * dy);
+	if (hole && r < 0.5) {
+		if (r == 0.0) {
+			dx = 1.0;
+			dy = 0.0;
+			r = 1.0;
+		}
+		x = 1.0 + 0.5 * dx / r;
+		y = 1.0 + 0.5 * dy / r;
+	}
+	return px_v3_dist(p, px_v3(x, y, z0));
+}
+
+static struct px_model *load_text(const char *text, struct px_obj_error *e, int *rc)
+{
+	struct px_obj_model *m = NULL;
+	struct px_brep *b = NULL;
+	struct px_model *md = NULL;
+	memset(e, 0, sizeof(*e));
+	*rc = px_obj_load_mem("t.obj", text, strlen(text), &m, e);
+	if (!*rc)
+		*rc = px_brep_from_obj(m, 1.0, &b, e);
+	px_obj_free(m);
+	if (!*rc)
+		*rc = px_model_from_brep(b, &md);
+	return md;
+}
+
+static px_vec3 rand_point(double lo, double hi, double zlo, double zhi)
+{
+	return px_v3(px_rand_range(lo, hi), px_rand_range(lo, hi),
+		     px_rand_range(zlo, zhi));
+}
+
+/* The sheet with the circular hole, and a file with it and a second
+ * (untrimmed) plane above: every answer exact to 1e-9 of the size. */
+static void test_plane_hole(void)
+{
+	static char text[8192];
+	struct px_obj_error e;
+	struct px_brep_info info;
+	struct px_model *m;
+	int rc, i, n, wrong = 0;
+
+	plane_text(text, sizeof(text), 0.0, 1, 1, 1, 1);
+	m = load_text(text, &e, &rc);
+	PX_CHECK_MSG(rc == PX_OK, "%d:%d %s", e.line, e.column, e.msg);
+	if (!m)
+		return;
+	PX_CHECK_INT_EQ(px_model_kind(m), PX_MODEL_BREP);
+	px_brep_get_info(px_model_brep(m), &info);
+	PX_CHECK_INT_EQ(info.n_faces, 1);
+	PX_CHECK_INT_EQ(info.n_edges, 5); /* 4 domain sides + the circle */
+	PX_CHECK_INT_EQ(info.closed, 0);
+	for (i = 0; i < 3000; i++) {
+		struct px_model_result r;
+		/* near the hole's rim half the time */
+		px_vec3 p = i & 1 ? rand_point(-0.5, 2.5, -1.0, 1.0)
+				  : px_v3(1.0 + px_rand_range(-0.7, 0.7),
+					  1.0 + px_rand_range(-0.7, 0.7),
+					  px_rand_range(-0.05, 0.05));
+		double want = plane_exact(p, 0.0, 1);
+		PX_CHECK_INT_EQ(px_model_query(m, p, &r), 1);
+		if (!(fabs(r.distance - want) <= 1e-9 * 2.83) ||
+		    !(fabs(px_v3_dist(p, r.point) - r.distance) <= 1e-9)) {
+			if (wrong++ < 5)
+				PX_CHECK_MSG(0, "(%g, %g, %g): %.15g, exact %.15g", p.x,
+					     p.y, p.z, r.distance, want);
+		}
+	}
+	PX_CHECK_INT_EQ(wrong, 0);
+	px_model_free(m);
+
+	/* two faces: the holed sheet and a whole plane 0.3 above it */
+	n = plane_text(text, sizeof(text), 0.0, 1, 1, 1, 1);
+	plane_text(text + n, sizeof(text) - (size_t)n, 0.3, 0, 5, 10, 0);
+	m = load_text(text, &e, &rc);
+	PX_CHECK_MSG(rc == PX_OK, "%d:%d %s", e.line, e.column, e.msg);
+	if (!m)
+		return;
+	px_brep_get_info(px_model_brep(m), &info);
+	PX_CHECK_INT_EQ(info.n_faces, 2);
+	PX_CHECK_INT_EQ(info.n_trimmed, 1);
+	for (i = 0; i < 2000; i++) {
+		struct px_model_result r;
+		px_vec3 p = rand_point(-0.5, 2.5, -0.6, 0.9);
+		double want = fmin(plane_exact(p, 0.0, 1), plane_exact(p, 0.3, 0));
+		PX_CHECK_INT_EQ(px_model_query(m, p, &r), 1);
+		if (!(fabs(r.distance - want) <= 1e-9 * 2.83) && wrong++ < 5)
+			PX_CHECK_MSG(0, "two faces (%g, %g, %g): %.15g, exact %.15g",
+				     p.x, p.y, p.z, r.distance, want);
+	}
+	PX_CHECK_INT_EQ(wrong, 0);
+	px_model_free(m);
+}
+
+/* ---- the free-form sheet ---------------------------------------------------- */
+
+#define FF_NU 6
+#define FF_NV 5
+
+/* A wavy biquadratic sheet over [0, 1]^2, trimmed by a closed
+ * quadratic B-spline (8 points, the last equal to the first) and a
+ * triangular hole of three degree-1 curv2 curves (the third reversed). */
+static void freeform_text(char *buf, size_t cap, double *ctrl)
+{
+	static const double lp[8][2] = {{0.1, 0.1}, {0.5, 0.02}, {0.92, 0.1},
+					{0.97, 0.55}, {0.85, 0.95}, {0.4, 0.9},
+					{0.05, 0.6}, {0.1, 0.1}};
+	static const double tri[3][2] = {{0.35, 0.35}, {0.65, 0.4}, {0.5, 0.65}};
+	int n = 0, i, j;
+	for (j = 0; j < FF_NV; j++)
+		for (i = 0; i < FF_NU; i++) {
+			double *P = ctrl + 3 * (j * FF_NU + i);
+			P[0] = 3.0 * i / (FF_NU - 1);
+			P[1] = 2.5 * j / (FF_NV - 1);
+			P[2] = 0.4 * sin(1.7 * i + 0.3) * cos(1.3 * j);
+			n += snprintf(buf + n, cap - (size_t)n, "v %.17g %.17g %.17g\n",
+				      P[0], P[1], P[2]);
+		}
+	for (i = 0; i < 8; i++)
+		n += snprintf(buf + n, cap - (size_t)n, "vp %g %g\n", lp[i][0], lp[i][1]);
+	for (i = 0; i < 3; i++)
+		n += snprintf(buf + n, cap - (size_t)n, "vp %g %g\n", tri[i][0], tri[i][1]);
+	n += snprintf(buf + n, cap - (size_t)n,
+		      "cstype bspline\ndeg 2\n"
+		      "curv2 1 2 3 4 5 6 7 8\nparm u 0 0 0 1 2 3 4 5 6 6 6\nend\n"
+		      "deg 1\n"
+		      "curv2 9 10\nparm u 0 0 1 1\nend\n"
+		      "curv2 10 11\nparm u 0 0 1 1\nend\n"
+		      "curv2 9 11\nparm u 0 0 1 1\nend\n"
+		      "deg 2 2\nsurf 0 1 0 1");
+	for (i = 1; i <= FF_NU * FF_NV; i++)
+		n += snprintf(buf + n, cap - (size_t)n, " %d", i);
+	snprintf(buf + n, cap - (size_t)n,
+		 "\nparm u 0 0 0 0.25 0.5 0.75 1 1 1\nparm v 0 0 0 0.3 0.6 1 1 1\n"
+		 "trim 0 6 1\nhole 0 1 2 0 1 3 1 0 4\nsp 9\nscrv 0 1 2\nend\n");
+}
+
+/* Reference: samples of the surface inside the domain and of the loop
+ * images, the best of each polished by projected Newton steps. */
+struct ffref {
+	const struct px_nurbs_surf *s;
+	const struct px_trim *t;
+	const struct px_nurbs_curve *c[4];
+	int nc;
+	double *su, *sv;
+	px_vec3 *sp;
+	int ns;
+};
+
+static double ff_polish_surf(const struct ffref *f, px_vec3 p, double u, double v)
+{
+	double best = px_v3_dist(px_nurbs_surf_point(f->s, u, v), p);
+	int it;
+	for (it = 0; it < 40; it++) {
+		struct px_nurbs_surf_derivs d;
+		px_vec3 r;
+		double a, b, c, g0, g1, det, du, dv, nd, lam = 1.0;
+		px_nurbs_surf_eval(f->s, u, v, 1, &d);
+		r = px_v3_sub(d.s, p);
+		a = px_v3_dot(d.su, d.su);
+		b = px_v3_dot(d.su, d.sv);
+		c = px_v3_dot(d.sv, d.sv);
+		g0 = px_v3_dot(r, d.su);
+		g1 = px_v3_dot(r, d.sv);
+		det = a * c - b * b;
+		if (!(det > 0.0))
+			break;
+		du = -(c * g0 - b * g1) / det;
+		dv = -(a * g1 - b * g0) / det;
+		for (; lam > 1e-6; lam *= 0.5) {
+			double un = u + lam * du, vn = v + lam * dv;
+			if (un < 0 || un > 1 || vn < 0 || vn > 1 ||
+			    px_trim_contains(f->t, un, vn, NULL) == PX_TRIM_OUTSIDE)
+				continue;
+			nd = px_v3_dist(px_nurbs_surf_point(f->s, un, vn), p);
+			if (nd < best) {
+				best = nd;
+				u = un;
+				v = vn;
+				break;
+			}
+		}
+		if (lam <= 1e-6)
+			break;
+	}
+	return best;
+}
+
+static double ff_polish_curve(const struct ffref *f, const struct px_nurbs_curve *c,
+			      px_vec3 p, double t, double step)
+{
+	double t0, t1, best;
+	px_vec3 q = px_nurbs_curve_point(c, t);
+	px_nurbs_curve_domain(c, &t0, &t1);
+	best = px_v3_dist(px_nurbs_surf_point(f->s, q.x, q.y), p);
+	for (; step > 1e-15 * (t1 - t0); step *= 0.5) {
+		int k, moved = 1;
+		while (moved) {
+			moved = 0;
+			for (k = -1; k <= 1; k += 2) {
+				double tn = fmin(fmax(t + k * step, t0), t1), d;
+				q = px_nurbs_curve_point(c, tn);
+				d = px_v3_dist(px_nurbs_surf_point(f->s, q.x, q.y), p);
+				if (d < best) {
+					best = d;
+					t = tn;
+					moved = 1;
+				}
+			}
+		}
+	}
+	return best;
+}
+
+static double ff_reference(const struct ffref *f, px_vec3 p)
+{
+	double best = INFINITY;
+	int i, k, bi = -1;
+	for (i = 0; i < f->ns; i++) {
+		double d = px_v3_dist2(f->sp[i], p);
+		if (d < best) {
+			best = d;
+			bi = i;
+		}
+	}
+	best = ff_polish_surf(f, p, f->su[bi], f->sv[bi]);
+	for (k = 0; k < f->nc; k++) {
+		double t0, t1, bd = INFINITY, bt = 0;
+		px_nurbs_curve_domain(f->c[k], &t0, &t1);
+		for (i = 0; i <= 400; i++) {
+			double t = t0 + (t1 - t0) * i / 400.0, d;
+			px_vec3 q = px_nurbs_curve_point(f->c[k], t);
+			d = px_v3_dist(px_nurbs_surf_point(f->s, q.x, q.y), p);
+			if (d < bd) {
+				bd = d;
+				bt = t;
+			}
+		}
+		best = fmin(best, ff_polish_curve(f, f->c[k], p, bt, (t1 - t0) / 400.0));
+	}
+	return best;
+}
+
+static void test_freeform(void)
+{
+	static char text[16384];
+	double ctrl[3 * FF_NU * FF_NV];
+	struct px_obj_model *om = NULL;
+	struct px_obj_error e;
+	struct px_brep_info info;
+	struct px_trim_loop loops[2];
+	struct px_nurbs_curve hc[3];
+	unsigned char hrev[3] = {0, 0, 1};
+	struct px_trim *t = NULL;
+	struct ffref f;
+	struct px_model *m;
+	double size;
+	int rc, i, j, wrong = 0, outside = 0;
+
+	freeform_text(text, sizeof(text), ctrl);
+	PX_CHECK_INT_EQ(px_obj_load_mem("ff.obj", text, strlen(text), &om, &e), PX_OK);
+	if (!om) {
+		PX_CHECK_MSG(0, "%d:%d %s", e.line, e.column, e.msg);
+		return;
+	}
+	PX_CHECK_INT_EQ(om->n_curv2, 4);
+	PX_CHECK_INT_EQ(om->n_loops, 2);
+	PX_CHECK(px_obj_trimmed(om));
+	m = load_text(text, &e, &rc);
+	PX_CHECK_MSG(rc == PX_OK, "%d:%d %s", e.line, e.column, e.msg);
+	if (!m) {
+		px_obj_free(om);
+		return;
+	}
+	px_brep_get_info(px_model_brep(m), &info);
+	PX_CHECK_INT_EQ(info.n_edges, 4);
+	/* the reference's own domain */
+	loops[0].curves = &om->curv2[0].curve;
+	loops[0].n_curves = 1;
+	loops[0].reversed = NULL;
+	for (i = 0; i < 3; i++)
+		hc[i] = om->curv2[1 + i].curve;
+	loops[1].curves = hc;
+	loops[1].n_curves = 3;
+	loops[1].reversed = hrev;
+	PX_CHECK_INT_EQ(px_trim_create(loops, 2, NULL, NULL, &t), PX_OK);
+	memset(&f, 0, sizeof(f));
+	f.s = &om->entities[0].surf;
+	f.t = t;
+	for (i = 0; i < 4; i++)
+		f.c[i] = &om->curv2[i].curve;
+	f.nc = 4;
+	f.su = malloc(201 * 201 * sizeof(double));
+	f.sv = malloc(201 * 201 * sizeof(double));
+	f.sp = malloc(201 * 201 * sizeof(px_vec3));
+	for (i = 0; i <= 200; i++)
+		for (j = 0; j <= 200; j++) {
+			double u = i / 200.0, v = j / 200.0;
+			if (px_trim_contains(t, u, v, NULL) != PX_TRIM_INSIDE)
+				continue;
+			f.su[f.ns] = u;
+			f.sv[f.ns] = v;
+			f.sp[f.ns++] = px_nurbs_surf_point(f.s, u, v);
+		}
+	size = 3.5;
+	for (i = 0; i < 600; i++) {
+		struct px_model_result r;
+		px_vec3 p = px_v3(px_rand_range(-0.5, 3.5), px_rand_range(-0.5, 3.0),
+				  px_rand_range(-1.0, 1.0));
+		double want = ff_reference(&f, p);
+		int where;
+		PX_CHECK_INT_EQ(px_model_query(m, p, &r), 1);
+		/* never worse than the reference, always a point of the
+		 * trimmed sheet (so never better than the true minimum) */
+		if (!(r.distance <= want + 1e-9 * size) && wrong++ < 5)
+			PX_CHECK_MSG(0, "(%g, %g, %g): %.15g, reference %.15g", p.x,
+				     p.y, p.z, r.distance, want);
+		where = px_trim_contains(t, r.u, r.v, NULL);
+		if (r.feature == PX_FEATURE_SURFACE &&
+		    (where == PX_TRIM_OUTSIDE ||
+		     px_v3_dist(px_nurbs_surf_point(f.s, r.u, r.v), r.point) > 1e-9))
+			outside++;
+		if (!(fabs(px_v3_dist(p, r.point) - r.distance) <= 1e-9) && wrong++ < 5)
+			PX_CHECK_MSG(0, "point not at the distance");
+	}
+	PX_CHECK_INT_EQ(wrong, 0);
+	PX_CHECK_INT_EQ(outside, 0);
+	free(f.su);
+	free(f.sv);
+	free(f.sp);
+	px_trim_free(t);
+	px_model_free(m);
+	px_obj_free(om);
+}
+
+/* ---- refusals ---------------------------------------------------------------- */
+
+struct bad {
+	const char *tail; /* after the plane's head */
+	int code, line;
+	const char *needle;
+};
+
+/* Lines 1-8: four vertices, three parameter vertices, cstype. Line 9
+ * on: the cases. */
+#define HEAD "v 0 0 0\nv 2 0 0\nv 0 2 0\nv 2 2 0\nvp 0.3 0.3\nvp 0.7 0.3\nvp 0.5 0.7\ncstype bspline\n"
+#define SURF "deg 1 1\nsurf 0 1 0 1 1 2 3 4\nparm u 0 0 1 1\nparm v 0 0 1 1\n"
+#define TRI "deg 1\ncurv2 1 2\nparm u 0 0 1 1\nend\ncurv2 2 3\nparm u 0 0 1 1\nend\n" \
+	    "curv2 3 1\nparm u 0 0 1 1\nend\n"
+
+static const struct bad bad_files[] = {
+	/* syntax: not triples (line 23, after TRI (lines 9-18) and SURF) */
+	{TRI SURF "hole 0 1 1 0 1\nend\n", PX_E_PARSE, 23, "triples"},
+	/* a missing curv2 */
+	{TRI SURF "hole 0 1 1 0 1 2 0 1 9\nend\n", PX_E_PARSE, 23,
+	 "curv2 9 is not defined (3 curv2 curves so far)"},
+	/* a range outside the curv2's domain */
+	{TRI SURF "hole 0 1 1 0 2 2 0 1 3\nend\n", PX_E_PARSE, 23,
+	 "outside its domain"},
+	/* a missing parameter vertex */
+	{"deg 1\ncurv2 1 12\n", PX_E_PARSE, 10,
+	 "parameter vertex 12 is not defined (3 parameter vertices so far)"},
+	/* an open loop: the third side left out */
+	{TRI SURF "hole 0 1 1 0 1 2\nend\n", PX_E_INVAL, 23, "is open"},
+	/* a zero-area loop: there and back */
+	{TRI SURF "hole 0 1 1 1 0 1\nend\n", PX_E_DEGENERATE, 23, "area"},
+	/* a self-crossing loop: a bow tie */
+	{"vp 0.9 0.9\nvp 0.3 0.7\ndeg 1\ncurv2 1 2 5 4 1\nparm u 0 0 1 2 3 4 4\nend\n" SURF
+	 "hole 0 4 1\nend\n",
+	 PX_E_INVAL, 19, "cross"},
+	/* a loop outside the surface's domain */
+	{"vp 1.5 0.3\ndeg 1\ncurv2 1 4 3 1\nparm u 0 0 1 2 3 3\nend\n" SURF
+	 "trim 0 3 1\nend\n",
+	 PX_E_INVAL, 18, "outside the surface's domain"},
+	/* a second outer loop */
+	{TRI SURF "trim 0 1 1 0 1 2 0 1 3\ntrim 0 1 1 0 1 2 0 1 3\nend\n",
+	 PX_E_UNSUPPORTED, 24, "second 'trim'"},
+	/* limits: a cubic curv2 on a bicubic surface (degree 18) */
+	{"vp 0.4 0.6\ndeg 3\ncurv2 1 2 4 1\nparm u 0 0 0 0 1 1 1 1\nend\ndeg 3 3\n"
+	 "surf 0 1 0 1 1 2 3 4 1 2 3 4 1 2 3 4 1 2 3 4\n"
+	 "parm u 0 0 0 0 1 1 1 1\nparm v 0 0 0 0 1 1 1 1\nhole 0 1 1\nend\n",
+	 PX_E_NOSPC, 18, "degree 18"},
+	/* a trim outside a surf body */
+	{TRI "hole 0 1 1 0 1 2 0 1 3\n", PX_E_UNSUPPORTED, 19, "inside a surf body"},
+	/* a polygon face in a trimmed file */
+	{TRI "f 1 2 3\n" SURF "hole 0 1 1 0 1 2 0 1 3\nend\n", PX_E_UNSUPPORTED, 0,
+	 "polygon faces"},
+};
+
+static void test_refusals(void)
+{
+	size_t i;
+	for (i = 0; i < sizeof(bad_files) / sizeof(bad_files[0]); i++) {
+		char text[4096];
+		struct px_obj_error e;
+		struct px_model *m;
+		int rc;
+		snprintf(text, sizeof(text), "%s%s", HEAD, bad_files[i].tail);
+		m = load_text(text, &e, &rc);
+		PX_CHECK_MSG(m == NULL && rc == bad_files[i].code &&
+				     e.line == bad_files[i].line &&
+				     strstr(e.msg, bad_files[i].needle) != NULL,
+			     "case %zu: rc %d (want %d) line %d (want %d): %s", i, rc,
+			     bad_files[i].code, e.line, bad_files[i].line, e.msg);
+		px_model_free(m);
+	}
+}
+
+/* px_model_load(): a trimmed .obj is a B-rep, its refusal names the
+ * file and line; an untrimmed free-form .obj goes where it went. */
+static void test_model_load(void)
+{
+	static char text[8192];
+	char path[256], msg[512], msg2[512];
+	struct px_model *m = NULL;
+	FILE *fp;
+	int rc;
+
+	snprintf(path, sizeof(path), "/tmp/px_objtrim_%d.obj", (int)getpid());
+	plane_text(text, sizeof(text), 0.0, 1, 1, 1, 1);
+	fp = fopen(path, "w");
+	PX_CHECK(fp != NULL);
+	if (!fp)
+		return;
+	fputs(text, fp);
+	fclose(fp);
+	rc = px_model_load(path, 0.0, &m, msg, sizeof(msg));
+	PX_CHECK_MSG(rc == PX_OK, "%s", msg);
+	PX_CHECK(m && px_model_kind(m) == PX_MODEL_BREP);
+	PX_CHECK(strstr(msg, "unsigned") != NULL);
+	px_model_free(m);
+	m = NULL;
+	/* the hole's curv2 turned into a straight 'there and back' */
+	fp = fopen(path, "w");
+	fputs("v 0 0 0\nv 2 0 0\nv 0 2 0\nv 2 2 0\nvp 0.3 0.3\nvp 0.7 0.3\n"
+	      "cstype bspline\ndeg 1\ncurv2 1 2 1\nparm u 0 0 1 2 2\nend\n"
+	      "deg 1 1\nsurf 0 1 0 1 1 2 3 4\nparm u 0 0 1 1\nparm v 0 0 1 1\n"
+	      "hole 0 2 1\nend\n",
+	      fp);
+	fclose(fp);
+	rc = px_model_load(path, 0.0, &m, msg, sizeof(msg));
+	PX_CHECK_INT_EQ(rc, PX_E_DEGENERATE);
+	PX_CHECK(m == NULL);
+	snprintf(msg2, sizeof(msg2), "%s:16:1: ", path);
+	PX_CHECK_MSG(strncmp(msg, msg2, strlen(msg2)) == 0, "%s", msg);
+	/* untrimmed: the mesh loader's answer, as before */
+	plane_text(text, sizeof(text), 0.0, 0, 1, 1, 1);
+	fp = fopen(path, "w");
+	fputs(text, fp);
+	fclose(fp);
+	rc = px_model_load(path, 0.0, &m, msg, sizeof(msg));
+	PX_CHECK(rc != PX_OK || px_model_kind(m) == PX_MODEL_MESH);
+	px_model_free(m);
+	unlink(path);
+}
+
+static const struct px_test tests[] = {
+	PX_T(test_plane_hole), PX_T(test_freeform), PX_T(test_refusals),
+	PX_T(test_model_load)};
+PX_TEST_MAIN(tests)
