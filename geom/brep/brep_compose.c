@@ -49,6 +49,8 @@ struct cmp {
 	size_t cwlen, swlen;
 	int pi, pj;             /* spans of the patch in swork (-1 none) */
 	struct px_nurbs_surf patch;
+	double *sp;             /* split parameters of one span, sp_cap */
+	int sp_cap;
 	double *pw;             /* output control points, 4 each */
 	double *brk;            /* piece ends: n_pc + 1 */
 	int n_pc, cap;
@@ -352,7 +354,7 @@ static int compose_range(struct cmp *x, double ta, double tb, int i, int j,
 static int compose_span(struct cmp *x, double ta, double tb)
 {
 	struct px_nurbs_curve pc;
-	double sp[2 * CMP_MAX_DEPTH * 8 + 2];
+	double *sp = x->sp;
 	int n = 0, k, rc, dir;
 
 	rc = px_nurbs_curve_extract_work(x->c, ta, tb, x->cwork, x->cwlen, &pc);
@@ -360,8 +362,7 @@ static int compose_span(struct cmp *x, double ta, double tb)
 		return cmp_fail(x, rc, "cannot extract the curve on [%g, %g]", ta, tb);
 	for (dir = 0; dir < 2; dir++)
 		if (dir ? x->ev : x->eu) {
-			rc = knot_crossings(x, pc.pw, dir, sp, &n,
-					    (int)(sizeof(sp) / sizeof(sp[0])) - 1);
+			rc = knot_crossings(x, pc.pw, dir, sp, &n, x->sp_cap - 1);
 			if (rc)
 				return rc;
 		}
@@ -417,7 +418,11 @@ int px__brep_compose_curve(const struct px_nurbs_surf *s,
 	x.swork = malloc(x.swlen * sizeof(double));
 	x.brk = malloc(17 * sizeof(double));
 	x.cap = 0;
-	rc = x.cwork && x.swork && x.brk ? PX_OK : PX_E_NOMEM;
+	/* a knot line is crossed at most d times by a piece (a few more
+	 * side changes where rounding blurs a tangency) */
+	x.sp_cap = (s->n_knots[0] + s->n_knots[1]) * (x.d + 4) + 16;
+	x.sp = malloc((size_t)x.sp_cap * sizeof(double));
+	rc = x.cwork && x.swork && x.brk && x.sp ? PX_OK : PX_E_NOMEM;
 	px_nurbs_curve_domain(c, &t0, &t1);
 	if (!rc)
 		x.brk[0] = t0;
@@ -428,6 +433,7 @@ int px__brep_compose_curve(const struct px_nurbs_surf *s,
 	}
 	free(x.cwork);
 	free(x.swork);
+	free(x.sp);
 	if (!rc && x.n_pc < 1)
 		rc = cmp_fail(&x, PX_E_STATE, "no piece");
 	if (rc) {

@@ -89,7 +89,8 @@ static size_t arena_need(const struct px_obj_model *m)
 		n += px_nurbs_curve_extract_bytes(&m->curv2[m->trim_curves[i].curv2].curve) +
 		     2 * PX_ARENA_ALIGN;
 	for (i = 0; i < m->n_entities; i++)
-		n += 4 * (px_nurbs_curve_bytes(1, 2) + 2 * PX_ARENA_ALIGN);
+		n += 4 * (px_nurbs_curve_bytes(1, 2) + 2 * PX_ARENA_ALIGN) +
+		     4 * sizeof(struct px_nurbs_curve) + PX_ARENA_ALIGN;
 	n += (size_t)(m->n_entities + m->n_loops + 1) *
 	     (sizeof(struct px_trim_loop) + 2 * sizeof(int) + PX_ARENA_ALIGN) +
 	     (size_t)m->n_trim_curves * (sizeof(struct px_nurbs_curve) + 1 + PX_ARENA_ALIGN);

@@ -24,15 +24,28 @@
  *    defined before it is used.
  *  - Comments (#), blank lines, CRLF line ends, continuation lines (a
  *    backslash at the end of a line joins the next one).
+ *  - Trimming: "vp u [v [w]]" parameter vertices (v 0, w 1 when left
+ *    out); "curv2 vp1 vp2 ..." with the current cstype and deg, its
+ *    "parm u" and "end" (a 2D curve (u, v, 0) over the whole knot domain,
+ *    w its weight when rational; in px_obj_model.curv2, not among the
+ *    entities); inside a surf body "trim u0 u1 c ..." (the outer loop, at
+ *    most one per surface) and "hole u0 u1 c ..." (holes): loops of
+ *    curv2 curves c (1-based or negative, defined before) on [u0, u1]
+ *    within their domains, in px_obj_model.loops and trim_curves (the
+ *    B-rep is built by px_brep_obj.h). "scrv" (same form) and "sp vp ..."
+ *    (in a curve or surface body) are checked (references, ranges) and
+ *    not kept: they only guide tessellation.
  *  - Accepted and ignored because they do not change the geometry:
- *    vt, vn, vp, g, o, s, mg, usemtl, mtllib, maplib, usemap, bevel,
+ *    vt, vn, g, o, s, mg, usemtl, mtllib, maplib, usemap, bevel,
  *    c_interp, d_interp, lod, shadow_obj, trace_obj, ctech, stech.
  *
  * Rejected with an error that names the file, line and column:
  * malformed statements (PX_E_PARSE) and valid OBJ this loader does not
  * handle (PX_E_UNSUPPORTED): Bezier, Cardinal, Taylor and basis-matrix
- * types, bmat, step, curv2, trim, hole, scrv, sp, con, points (p) and
- * lines (l), the superseded 2.11 patch statements, unknown statements.
+ * types, bmat, step, con, points (p) and lines (l), the superseded 2.11
+ * patch statements, a second trim loop of one surface, trim, hole and
+ * scrv outside a surf body, sp outside a body, curv2 before any cstype;
+ * unknown statements.
  * NURBS data errors (knot order, multiplicity, weights...) come from
  * px_nurbs validation and are reported at the statement that holds the
  * offending value, with the NURBS detail in px_obj_error.nurbs.
