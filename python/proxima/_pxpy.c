@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "px_base.h"
+#include "px_brep_obj.h"
 #include "px_cloud.h"
 #include "px_dist.h"
 #include "px_load.h"
@@ -68,6 +69,21 @@ static int load_obj(const char *path, struct px_model **out, char *msg,
 				   oe.column, oe.msg);
 		return say(msg, cap, rc, "%s: %s", path,
 			   oe.msg[0] ? oe.msg : px_strerror(rc));
+	}
+	if (px_obj_trimmed(obj)) {
+		/* trimmed surfaces: one B-rep model (px_brep_obj.h) */
+		struct px_brep *b = NULL;
+		rc = px_brep_from_obj(obj, 1.0, &b, &oe);
+		px_obj_free(obj);
+		if (!rc)
+			rc = px_model_from_brep(b, out);
+		if (rc && oe.line > 0)
+			return say(msg, cap, rc, "%s:%d:%d: %s", path, oe.line,
+				   oe.column, oe.msg);
+		if (rc)
+			return say(msg, cap, rc, "%s: %s", path,
+				   oe.msg[0] ? oe.msg : px_strerror(rc));
+		return PX_OK;
 	}
 	if (obj->n_entities > 0 && obj->n_triangles > 0) {
 		px_obj_free(obj);
