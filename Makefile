@@ -157,10 +157,12 @@ TOOL_SUPPORT_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(TOOL_SUPPORT_SRC))
 # counter when one is loaded: the tests preload it as its own shared
 # object (ALLOC_SO, never installed), so the installed tools keep the
 # system allocator. Sanitizer builds count through the sanitizer's hooks,
-# which a preloaded object cannot reach: there the tools link it.
+# which a preloaded object cannot reach: there the tools link it, and the
+# tests' leak suppressions for OpenCASCADE's toolkits (px_lsan.c).
 ALLOC_SO := $(BUILD)/lib/lib$(NAME)-alloc-count.so
 ifeq ($(SAN),1)
-TOOL_SUPPORT_OBJ += $(BUILD)/obj/$(TEST_SUPPORT_DIR)/px_alloc_count.o
+TOOL_SUPPORT_OBJ += $(BUILD)/obj/$(TEST_SUPPORT_DIR)/px_alloc_count.o \
+                    $(BUILD)/obj/$(TEST_SUPPORT_DIR)/px_lsan.o
 endif
 TOOL_SRC := $(wildcard tools/proxima-*.c)
 # C++ tools (the CAD part generator) in builds with OpenCASCADE.

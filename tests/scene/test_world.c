@@ -474,9 +474,6 @@ static void test_config_cad(void)
 		PX_CHECK(found == 2);
 	}
 	PX_NEEDS(OCCT);
-#ifdef __SANITIZE_ADDRESS__
-	PX_SKIP("OpenCASCADE's global allocations show as leaks under ASan");
-#endif
 	if (load(text, &s, &diag) != PX_OK) {
 		px_config_diag_print(&diag, stdout);
 		PX_CHECK(0);

@@ -1,10 +1,10 @@
 /*
  * B-rep models (px_brep.h) built in C (tests/support/brep_gen.h): every
- * answer against a reference written here (dense sampling of each face
- * restricted to its trimmed domain, of every edge and the vertices,
- * polished by Newton), never worse by more than 1e-9 of the part size
- * and always a point of the trimmed model (so never better than the true
- * minimum); signs against the parts' exact inside tests, thin walls
+ * answer against the tests' reference (tests/support/brep_ref.h: dense
+ * sampling of each face restricted to its trimmed domain, of every edge
+ * and the vertices, polished by Newton), never worse by more than 1e-9
+ * of the part size and always a point of the trimmed model (so never
+ * better than the true minimum); signs against the parts' exact inside tests, thin walls
  * included; the refusals with their messages; no heap calls in queries.
  */
 #include <math.h>
@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "brep_gen.h"
+#include "brep_ref.h"
 #include "px_alloc_count.h"
 #include "px_brep.h"
 #include "px_cad.h"
@@ -20,229 +21,6 @@
 #include "px_model.h"
 #include "px_test.h"
 #include "px_trim.h"
-
-/* ---- the reference ----------------------------------------------------------- */
-
-struct ref {
-	const struct px_brep_desc *d;
-	struct px_trim **trim; /* per face */
-	double size;
-};
-
-static void ref_init(struct ref *r, const struct px_brep_desc *d)
-{
-	px_aabb b = px_aabb_empty();
-	int f, i;
-	memset(r, 0, sizeof(*r));
-	r->d = d;
-	r->trim = calloc((size_t)d->n_faces, sizeof(*r->trim));
-	PX_CHECK(r->trim != NULL);
-	for (f = 0; f < d->n_faces; f++) {
-		px_aabb sb;
-		PX_CHECK(px_trim_create(d->faces[f].loops, d->faces[f].n_loops, NULL, NULL,
-					&r->trim[f]) == PX_OK);
-		sb = px_nurbs_surf_aabb(&d->faces[f].surf);
-		b = px_aabb_union(&b, &sb);
-	}
-	for (i = 0; i < d->n_vertices; i++)
-		px_aabb_extend(&b, d->vertices[i]);
-	r->size = px_aabb_diagonal(&b);
-}
-
-static void ref_fini(struct ref *r)
-{
-	int f;
-	for (f = 0; f < r->d->n_faces; f++)
-		px_trim_free(r->trim[f]);
-	free(r->trim);
-}
-
-/* Newton on |S(u, v) - p|^2 from (u, v), inside the domain; the best
- * point met that lies inside the trimmed domain lowers *best. */
-static void polish_face(const struct ref *r, int f, px_vec3 p, double u, double v,
-			double *best)
-{
-	const struct px_nurbs_surf *s = &r->d->faces[f].surf;
-	double u0, u1, v0, v1;
-	int it;
-	px_nurbs_surf_domain(s, &u0, &u1, &v0, &v1);
-	for (it = 0; it < 30; it++) {
-		struct px_nurbs_surf_derivs dd;
-		px_vec3 e;
-		double g0, g1, h00, h01, h11, det, du, dv;
-		px_nurbs_surf_eval(s, u, v, 2, &dd);
-		e = px_v3_sub(dd.s, p);
-		if (px_trim_contains(r->trim[f], u, v, NULL) == PX_TRIM_INSIDE &&
-		    px_v3_dot(e, e) < *best)
-			*best = px_v3_dot(e, e);
-		g0 = px_v3_dot(e, dd.su);
-		g1 = px_v3_dot(e, dd.sv);
-		h00 = px_v3_dot(dd.su, dd.su) + px_v3_dot(e, dd.suu);
-		h01 = px_v3_dot(dd.su, dd.sv) + px_v3_dot(e, dd.suv);
-		h11 = px_v3_dot(dd.sv, dd.sv) + px_v3_dot(e, dd.svv);
-		det = h00 * h11 - h01 * h01;
-		if (!(det > 0.0 && h00 > 0.0)) {
-			h00 = px_v3_dot(dd.su, dd.su);
-			h01 = px_v3_dot(dd.su, dd.sv);
-			h11 = px_v3_dot(dd.sv, dd.sv);
-			det = h00 * h11 - h01 * h01;
-			if (!(det > 0.0))
-				break;
-		}
-		du = -(h11 * g0 - h01 * g1) / det;
-		dv = -(h00 * g1 - h01 * g0) / det;
-		u = fmin(fmax(u + du, u0), u1);
-		v = fmin(fmax(v + dv, v0), v1);
-		if (fabs(du) + fabs(dv) < 1e-15)
-			break;
-	}
-}
-
-static void polish_curve(const struct px_nurbs_curve *c, px_vec3 p, double t, double *best)
-{
-	double t0, t1;
-	int it;
-	px_nurbs_curve_domain(c, &t0, &t1);
-	for (it = 0; it < 30; it++) {
-		px_vec3 d[3], e;
-		double g, h, dt;
-		px_nurbs_curve_eval(c, t, 2, d);
-		e = px_v3_sub(d[0], p);
-		if (px_v3_dot(e, e) < *best)
-			*best = px_v3_dot(e, e);
-		g = px_v3_dot(e, d[1]);
-		h = px_v3_dot(d[1], d[1]) + px_v3_dot(e, d[2]);
-		if (!(h > 0.0))
-			h = px_v3_dot(d[1], d[1]);
-		if (!(h > 0.0))
-			break;
-		dt = -g / h;
-		t = fmin(fmax(t + dt, t0), t1);
-		if (fabs(dt) < 1e-15)
-			break;
-	}
-}
-
-/* Reference distance from p to the trimmed model. */
-static double ref_dist(const struct ref *r, px_vec3 p)
-{
-	const struct px_brep_desc *d = r->d;
-	const int N = 64, K = 4;
-	double best = INFINITY;
-	int f, e, i, j, k;
-	for (f = 0; f < d->n_faces; f++) {
-		const struct px_nurbs_surf *s = &d->faces[f].surf;
-		double u0, u1, v0, v1, kd[4], ku[4], kv[4];
-		px_nurbs_surf_domain(s, &u0, &u1, &v0, &v1);
-		for (k = 0; k < K; k++)
-			kd[k] = INFINITY, ku[k] = kv[k] = 0.0;
-		for (i = 0; i <= N; i++)
-			for (j = 0; j <= N; j++) {
-				double u = u0 + (u1 - u0) * i / N, v = v0 + (v1 - v0) * j / N, d2;
-				if (px_trim_contains(r->trim[f], u, v, NULL) != PX_TRIM_INSIDE)
-					continue;
-				d2 = px_v3_dist2(px_nurbs_surf_point(s, u, v), p);
-				for (k = 0; k < K; k++)
-					if (d2 < kd[k]) {
-						int m;
-						for (m = K - 1; m > k; m--)
-							kd[m] = kd[m - 1], ku[m] = ku[m - 1],
-							kv[m] = kv[m - 1];
-						kd[k] = d2, ku[k] = u, kv[k] = v;
-						break;
-					}
-			}
-		for (k = 0; k < K; k++)
-			if (isfinite(kd[k])) {
-				best = fmin(best, kd[k]);
-				polish_face(r, f, p, ku[k], kv[k], &best);
-			}
-	}
-	for (e = 0; e < d->n_edges; e++) {
-		const struct px_nurbs_curve *c = &d->edges[e].curve;
-		double t0, t1, bt = 0.0, bd = INFINITY;
-		px_nurbs_curve_domain(c, &t0, &t1);
-		for (i = 0; i <= 400; i++) {
-			double t = t0 + (t1 - t0) * i / 400.0;
-			double d2 = px_v3_dist2(px_nurbs_curve_point(c, t), p);
-			if (d2 < bd)
-				bd = d2, bt = t;
-		}
-		best = fmin(best, bd);
-		polish_curve(c, p, bt, &best);
-	}
-	for (i = 0; i < d->n_vertices; i++)
-		best = fmin(best, px_v3_dist2(d->vertices[i], p));
-	return sqrt(best);
-}
-
-/* The answer's point lies on the trimmed model where it says. */
-static void check_on_model(const struct ref *r, const struct px_model_result *a)
-{
-	const struct px_brep_desc *d = r->d;
-	double tol = 1e-9 * r->size;
-	px_vec3 q;
-	if (a->feature == PX_FEATURE_SURFACE) {
-		PX_CHECK(a->index >= 0 && a->index < d->n_faces);
-		q = px_nurbs_surf_point(&d->faces[a->index].surf, a->u, a->v);
-		PX_CHECK_MSG(px_trim_contains(r->trim[a->index], a->u, a->v, NULL) !=
-				     PX_TRIM_OUTSIDE,
-			     "face %d answer (%g, %g) outside its domain", a->index, a->u, a->v);
-	} else if (a->feature == PX_FEATURE_CURVE) {
-		PX_CHECK(a->index >= 0 && a->index < d->n_edges);
-		q = px_nurbs_curve_point(&d->edges[a->index].curve, a->u);
-	} else {
-		PX_CHECK_INT_EQ(a->feature, PX_FEATURE_VERTEX);
-		PX_CHECK(a->index >= 0 && a->index < d->n_vertices);
-		q = d->vertices[a->index];
-	}
-	PX_CHECK_MSG(px_v3_dist(q, a->point) <= tol, "answer point %g off its feature",
-		     px_v3_dist(q, a->point));
-}
-
-/* A random query point: in the enlarged box, near a face (both sides),
- * near an edge, or far. */
-static px_vec3 rand_point(const struct ref *r, px_aabb box)
-{
-	const struct px_brep_desc *d = r->d;
-	int kind = (int)(px_rand_u64() % 5);
-	px_vec3 c = px_v3_scale(px_v3_add(box.min, box.max), 0.5);
-	double s = r->size;
-	if (kind == 0 || kind == 4) {
-		double k = kind == 4 ? 10.0 : 0.8;
-		return px_v3(c.x + px_rand_range(-k, k) * s, c.y + px_rand_range(-k, k) * s,
-			     c.z + px_rand_range(-k, k) * s);
-	}
-	if (kind == 1) {
-		int f = (int)(px_rand_u64() % (uint64_t)d->n_faces), tries;
-		const struct px_nurbs_surf *sf = &d->faces[f].surf;
-		double u0, u1, v0, v1;
-		px_nurbs_surf_domain(sf, &u0, &u1, &v0, &v1);
-		for (tries = 0; tries < 100; tries++) {
-			double u = px_rand_range(u0, u1), v = px_rand_range(v0, v1);
-			struct px_nurbs_surf_derivs dd;
-			px_vec3 n;
-			double h;
-			if (px_trim_contains(r->trim[f], u, v, NULL) != PX_TRIM_INSIDE)
-				continue;
-			px_nurbs_surf_eval(sf, u, v, 1, &dd);
-			n = px_v3_cross(dd.su, dd.sv);
-			n = px_v3_scale(n, 1.0 / px_v3_norm(n));
-			h = s * pow(10.0, px_rand_range(-7.0, -1.5)) * (px_rand_u64() & 1 ? 1 : -1);
-			return px_v3_madd(dd.s, n, h);
-		}
-	}
-	if (d->n_edges > 0) {
-		int e = (int)(px_rand_u64() % (uint64_t)d->n_edges);
-		double t0, t1;
-		px_vec3 q;
-		px_nurbs_curve_domain(&d->edges[e].curve, &t0, &t1);
-		q = px_nurbs_curve_point(&d->edges[e].curve, px_rand_range(t0, t1));
-		return px_v3(q.x + s * px_rand_range(-0.05, 0.05), q.y + s * px_rand_range(-0.05, 0.05),
-			     q.z + s * px_rand_range(-0.05, 0.05));
-	}
-	return c;
-}
 
 /* n random points against the reference; inside() (NULL: open part)
  * gives the exact side. */
@@ -267,7 +45,7 @@ static void run_part(struct brep_gen *g, int n, int (*inside)(px_vec3), int want
 	PX_CHECK_INT_EQ(!!(px_model_caps(m) & PX_MODEL_CAP_SIGNED), want_closed);
 	ref_init(&r, &g->d);
 	for (i = 0; i < n; i++) {
-		px_vec3 p = rand_point(&r, info.bounds);
+		px_vec3 p = ref_rand_point(&r, info.bounds);
 		struct px_model_result a;
 		double want, got;
 		PX_CHECK_INT_EQ(px_model_query(m, p, &a), 1);
@@ -413,12 +191,6 @@ static void test_step_block(void)
 	int i, k, flips = 0;
 
 	PX_NEEDS(OCCT);
-#ifdef __SANITIZE_ADDRESS__
-	/* OpenCASCADE's reader keeps global allocations that the leak
-	 * checker reports at exit; the B-rep's own memory is checked by the
-	 * other tests. */
-	PX_SKIP("OpenCASCADE's global allocations show as leaks under ASan");
-#endif
 	px_test_data_path(path, sizeof(path), "../../config/examples/parts/filleted_block.step");
 	PX_CHECK_MSG(px_cad_load(path, NULL, &c, msg, sizeof(msg)) == PX_OK, "%s", msg);
 	d = px_cad_desc(c);
@@ -430,7 +202,7 @@ static void test_step_block(void)
 	PX_CHECK_INT_EQ(px_model_from_brep(b, &m), PX_OK);
 	ref_init(&r, d);
 	for (i = 0; i < 60; i++) {
-		px_vec3 p = rand_point(&r, (px_aabb){px_v3_scale(info.bounds.min, 1.0 / sc),
+		px_vec3 p = ref_rand_point(&r, (px_aabb){px_v3_scale(info.bounds.min, 1.0 / sc),
 						     px_v3_scale(info.bounds.max, 1.0 / sc)});
 		struct px_model_result a;
 		double want;

@@ -16,12 +16,14 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "px_brep.h"
 #include "px_cad.h"
 #include "px_features.h"
 #include "px_test.h"
+#include "px_test_cad.h"
 
 #if PX_HAVE_OCCT
 #include "px_occt_ref.h"
@@ -30,36 +32,19 @@ static const char *const parts[] = {"filleted_block", "plate", "bottle",
 				    "sheet", "cylsphere"};
 #define N_PARTS (sizeof parts / sizeof parts[0])
 
-static char dir[256];
-
-/* Sanitizer builds: OpenCASCADE's readers keep some parse buffers for
- * the life of the process (its libTK* libraries), which is theirs. */
-__attribute__((visibility("default"), used)) const char *
-__lsan_default_suppressions(void);
-const char *__lsan_default_suppressions(void)
-{
-	return "leak:libTK\n";
-}
-
-/* The parts, written once per run by the generator next to this test
- * binary ($(BUILD)/bin/proxima-cadgen). */
+/* The parts, and the block in metres in the subfolder m/. */
 static const char *part_dir(void)
 {
-	char exe[256], cmd[1600];
-	ssize_t n;
-	if (dir[0])
-		return dir;
-	n = readlink("/proc/self/exe", exe, sizeof exe - 1);
-	PX_CHECK(n > 0);
-	exe[n] = 0;
-	*strrchr(exe, '/') = 0;
-	snprintf(dir, sizeof dir, "/tmp/px_cad_XXXXXX");
-	PX_CHECK(mkdtemp(dir) != NULL);
-	snprintf(cmd, sizeof cmd, "'%s/../bin/proxima-cadgen' '%s' && "
-		 "mkdir -p '%s/m' && '%s/../bin/proxima-cadgen' --unit M "
-		 "--format step '%s/m' filleted_block",
-		 exe, dir, dir, exe, dir);
-	PX_CHECK_MSG(system(cmd) == 0, "%s failed", cmd);
+	static int made;
+	const char *dir = px_test_cad_dir();
+	char args[600];
+	if (!made) {
+		snprintf(args, sizeof args, "%s/m", dir);
+		PX_CHECK(mkdir(args, 0755) == 0);
+		snprintf(args, sizeof args, "--unit M --format step '%s/m' filleted_block", dir);
+		PX_CHECK_MSG(px_test_cadgen(args) == 0, "proxima-cadgen %s failed", args);
+		made = 1;
+	}
 	return dir;
 }
 
@@ -555,19 +540,9 @@ static void test_shipped_part(void)
 	px_cad_free(c);
 }
 
-static void cleanup(void)
-{
-	char cmd[300];
-	if (!dir[0])
-		return;
-	snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
-	if (system(cmd) != 0)
-		fprintf(stderr, "could not remove %s\n", dir);
-}
-
 static void test_cleanup(void)
 {
-	cleanup();
+	px_test_cad_cleanup();
 	PX_CHECK(1);
 }
 

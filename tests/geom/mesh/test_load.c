@@ -128,9 +128,6 @@ static void test_cad_parts(void)
 			     strstr(msg, "built without OpenCASCADE"), "%s", msg);
 	}
 	PX_NEEDS(OCCT);
-#ifdef __SANITIZE_ADDRESS__
-	PX_SKIP("OpenCASCADE's global allocations show as leaks under ASan");
-#endif
 	PX_CHECK_MSG(px_model_load(block, 0, &m, msg, sizeof(msg)) == PX_OK, "%s", msg);
 	PX_CHECK_MSG(msg[0] == '\0', "%s", msg);
 	PX_CHECK_INT_EQ(px_model_kind(m), PX_MODEL_BREP);
