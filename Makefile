@@ -57,7 +57,7 @@ ALL_LDFLAGS := $(SANFLAGS) $(LDFLAGS)
 # hidapi comes as two builds with the same symbols: HIDAPI=hidraw
 # (default, /dev/hidraw*) or HIDAPI=libusb.
 HIDAPI   ?= hidraw
-OPT_PARTS := HIDAPI LIBUSB SOCKETCAN GPIOD ASSIMP YAML OCCT
+OPT_PARTS := HIDAPI LIBUSB SOCKETCAN GPIOD ASSIMP YAML OCCT XML
 OPT_DEVICE_PARTS := HIDAPI LIBUSB SOCKETCAN GPIOD
 PKG_HIDAPI    := hidapi-$(HIDAPI)
 PKG_LIBUSB    := libusb-1.0
@@ -65,6 +65,7 @@ PKG_SOCKETCAN := libsocketcan
 PKG_GPIOD     := libgpiod
 PKG_ASSIMP    := assimp
 PKG_YAML      := yaml-0.1
+PKG_XML       := libxml-2.0
 SRC_HIDAPI    := px_hidapi.c
 SRC_LIBUSB    := px_usb.c
 SRC_SOCKETCAN := px_socketcan.c
@@ -72,6 +73,7 @@ SRC_GPIOD     := px_gpiod.c
 SRC_ASSIMP    := px_import.c
 SRC_YAML      := px_config_yaml.c
 SRC_OCCT      := cad_occt.cpp
+SRC_XML       := urdf_xml.c
 # Tests name the parts they need by these tags (PX_TEST_NEEDS, tests/run.sh).
 TAG_HIDAPI    := hidapi
 TAG_LIBUSB    := libusb
@@ -80,6 +82,7 @@ TAG_GPIOD     := libgpiod
 TAG_ASSIMP    := assimp
 TAG_YAML      := libyaml
 TAG_OCCT      := occt
+TAG_XML       := libxml2
 DESC_HIDAPI    := HID devices (hidapi-$(HIDAPI))
 DESC_LIBUSB    := USB devices (libusb-1.0)
 DESC_SOCKETCAN := CAN interface state and bitrate (libsocketcan)
@@ -87,6 +90,7 @@ DESC_GPIOD     := GPIO lines (libgpiod)
 DESC_ASSIMP    := mesh files (assimp)
 DESC_YAML      := YAML configs (libyaml)
 DESC_OCCT      := STEP and IGES parts (OpenCASCADE)
+DESC_XML       := URDF robots (libxml2)
 WITH_DEVICES ?= 1
 pc_have = $(shell pkg-config --exists $(1) 2>/dev/null && echo 1 || echo 0)
 # OpenCASCADE: its headers, the toolkits the importer links (C++, so the
@@ -220,6 +224,8 @@ DEB_PACKAGES += libyaml-dev
 DEB_PACKAGES += python3 python3-dev python3-cffi python3-numpy python3-matplotlib
 # geom/: mesh and point-cloud import.
 DEB_PACKAGES += libassimp-dev
+# robot/: URDF files.
+DEB_PACKAGES += libxml2-dev
 # geom/brep/: STEP and IGES import (OpenCASCADE 7.6) and its C++ compiler.
 DEB_PACKAGES += g++ libocct-data-exchange-dev libocct-modeling-algorithms-dev
 DEB_PACKAGES += libocct-modeling-data-dev libocct-foundation-dev
