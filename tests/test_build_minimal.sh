@@ -27,7 +27,7 @@ check() { # description, command...
 full=${BUILD:-build}
 min="$tmp/build"
 root="$tmp/root"
-off="WITH_DEVICES=0 WITH_ASSIMP=0 WITH_YAML=0 WITH_OCCT=0"
+off="WITH_DEVICES=0 WITH_ASSIMP=0 WITH_YAML=0 WITH_OCCT=0 WITH_XML=0"
 # The full build's objects are the same code: starting from them, only
 # the parts' *_none.c files compile here.
 mkdir -p "$min"
@@ -42,8 +42,8 @@ check "px_features.h: every part 0" \
 	       grep -q 'PX_HAVE_YAML 0' '$inc/proxima/px_features.h'"
 check "proxima.pc requires nothing" grep -qx 'Requires.private: *' "$lib/pkgconfig/proxima.pc"
 nolibs() { # the shared library needs no optional library
-	ldd "$lib/libproxima.so" | grep -E 'yaml|hidapi|usb|socketcan|gpiod|assimp|libTK|stdc\+\+' && return 1
-	nm -u "$lib/libproxima.a" | grep -E ' (yaml_|hid_|libusb_|can_(do|get|set)_|gpiod_|aiImport|_Z)' && return 1
+	ldd "$lib/libproxima.so" | grep -E 'yaml|hidapi|usb|socketcan|gpiod|assimp|libTK|stdc\+\+|xml2' && return 1
+	nm -u "$lib/libproxima.a" | grep -E ' (yaml_|hid_|libusb_|can_(do|get|set)_|gpiod_|aiImport|_Z|xml)' && return 1
 	return 0
 }
 check "libproxima uses no optional library" nolibs
@@ -76,6 +76,7 @@ cat >"$tmp/parts.c" <<'C'
 #include <proxima/px_features.h>
 #include <proxima/px_mesh.h>
 #include <proxima/px_cad.h>
+#include <proxima/px_urdf.h>
 #include <stdio.h>
 #include <string.h>
 static int says(const char *what, int rc, const char *msg, const char *lib)
@@ -117,7 +118,13 @@ int main(int argc, char **argv)
 	rc = px_cad_load(argv[3], NULL, &cad, msg, sizeof msg);
 	bad |= says("cad", rc, msg, "OpenCASCADE") || cad != NULL ||
 	       px_cad_desc(cad) != NULL;
-	return bad || PX_HAVE_YAML || PX_HAVE_HIDAPI || PX_HAVE_OCCT;
+	{
+		struct px_urdf *u = NULL;
+		struct px_urdf_error ue;
+		rc = px_urdf_load_mem("arm.urdf", "<robot/>", 8, NULL, &u, &ue);
+		bad |= says("urdf", rc, ue.msg, "libxml2") || u != NULL;
+	}
+	return bad || PX_HAVE_YAML || PX_HAVE_HIDAPI || PX_HAVE_OCCT || PX_HAVE_XML;
 }
 C
 check "a program using the left-out parts links" \
