@@ -37,6 +37,9 @@
  * with the tracked path against the cold query it replaces: median and
  * p99 ratios per step size (also by each update's least of 3 runs) and
  * the steps where it is never slower at either.
+ * B-rep models (tests/support/brep_gen.h's parts, the shipped STEP block
+ * with OpenCASCADE) follow: their tracked streams against the cold query
+ * (BENCH_TRACK_BREP_ONLY=1 runs them alone).
  * Prints figures only; nothing here is a pass/fail test.
  */
 #include <math.h>
@@ -50,10 +53,15 @@
 #include <sys/syscall.h>
 #include <unistd.h>
 
+#include "brep_gen.h"
 #include "gov_internal.h"
 #include "track_hooks.h"
 #include "px_arena.h"
+#include "px_brep.h"
 #include "px_dist.h"
+#include "px_features.h"
+#include "px_load.h"
+#include "px_model.h"
 #include "px_nurbs.h"
 #include "px_strack.h"
 #include "px_test_paths.h"
@@ -1147,6 +1155,123 @@ static void run_surf(const char *name, const struct px_nurbs_surf *ss, int ns)
 	px_dist_model_free(ref);
 }
 
+/* ---- B-rep models: tracked streams against the cold query ---- */
+
+#define BREP_N 5000
+
+/* Median, p99 and max of t[0..n) (sorted here). */
+static void pct3(int64_t *t, int n, int64_t out[3])
+{
+	qsort(t, (size_t)n, sizeof(t[0]), cmp_i64);
+	out[0] = t[n / 2];
+	out[1] = t[(size_t)n * 99 / 100];
+	out[2] = t[n - 1];
+}
+
+/*
+ * One B-rep part: each path kind at steps of 0.1 % and 1 % of the part's
+ * diagonal through its box grown by a fifth, a tracked stream
+ * (px_model_stream_query(), cold switch on as in the loop, then off:
+ * every answer from the tracker or its global fall-back) and the cold
+ * query (px_model_query()) on the same points, each in a pass of its
+ * own; wrong counts answers whose distance or side differs from the
+ * cold query's.
+ */
+static void run_brep(const char *name, struct px_model *m)
+{
+	static const double steps[2] = {0.001, 0.01};
+	static px_vec3 q[BREP_N];
+	static int64_t tt[BREP_N], tc[BREP_N];
+	static struct px_model_result rc[BREP_N];
+	px_aabb box = px_model_local_aabb(m);
+	double size = px_aabb_diagonal(&box);
+	int kind, si, cs, i;
+	box = px_aabb_inflate(&box, 0.1 * size);
+	for (kind = 0; kind < 2; kind++)
+		for (si = 0; si < 2; si++) {
+			int64_t pc[3];
+			make_path(q, BREP_N, kind, box, steps[si] * size);
+			for (i = 0; i < BREP_N; i++) {
+				int64_t t0 = now_ns();
+				px_model_query(m, q[i], &rc[i]);
+				tc[i] = now_ns() - t0;
+			}
+			pct3(tc, BREP_N, pc);
+			for (cs = 1; cs >= 0; cs--) {
+				struct px_model_stream_opts o;
+				struct px_model_stream_stats st;
+				struct px_model_stream *s;
+				int64_t pt[3];
+				int wrong = 0;
+				px_model_stream_opts_default(&o);
+				o.cold_switch = cs;
+				if (px_model_stream_create(m, &o, &s) != PX_OK) {
+					printf("  %-16s no stream\n", name);
+					return;
+				}
+				for (i = 0; i < BREP_N; i++) {
+					struct px_model_result r;
+					int64_t t0 = now_ns();
+					px_model_stream_query(s, q[i], INFINITY, 0, &r, NULL);
+					tt[i] = now_ns() - t0;
+					wrong += fabs(r.distance - rc[i].distance) >
+							 1e-9 * (size + fabs(rc[i].distance)) ||
+						 r.inside != rc[i].inside;
+				}
+				px_model_stream_get_stats(s, &st);
+				px_model_stream_free(s);
+				pct3(tt, BREP_N, pt);
+				printf("  %-16s %-6s %4.1f%% cold_switch %d  tracked %6lld %7lld %8lld"
+				       "  cold %6lld %7lld %8lld  ratio %5.2f %5.2f  tracked %5.1f%% "
+				       "hot %5.1f%% cold %5.1f%%  wrong %d\n",
+				       name, kind ? "sines" : "random", 100.0 * steps[si], cs,
+				       (long long)pt[0], (long long)pt[1], (long long)pt[2],
+				       (long long)pc[0], (long long)pc[1], (long long)pc[2],
+				       (double)pc[0] / (double)pt[0], (double)pc[1] / (double)pt[1],
+				       100.0 * (double)st.tracked / (double)st.queries,
+				       100.0 * (double)st.hot / (double)st.queries,
+				       100.0 * (double)st.cold / (double)st.queries, wrong);
+			}
+		}
+}
+
+/* The parts of tests/support/brep_gen.h and, with OpenCASCADE, the
+ * shipped STEP block. */
+static void run_breps(void)
+{
+	struct brep_gen *(*gen[4])(void) = {brep_gen_sheet_hole, brep_gen_cube_hole,
+					    brep_gen_freeform, brep_gen_thin_box};
+	int k;
+	printf("\nB-rep models: px_model_stream_query() vs cold px_model_query() on the "
+	       "same points (ns: median, p99, max; ratio = cold / tracked at the median "
+	       "and p99; tracked/hot/cold: shares of the stream's answers; wrong: "
+	       "answers differing from the cold query's)\n");
+	for (k = 0; k < 4; k++) {
+		struct brep_gen *g = gen[k]();
+		struct px_brep *b;
+		struct px_model *m;
+		if (px_brep_create(&g->d, NULL, NULL, &b) == PX_OK &&
+		    px_model_from_brep(b, &m) == PX_OK) {
+			run_brep(g->d.name, m);
+			px_model_free(m);
+		}
+		free(g);
+	}
+#if PX_HAVE_OCCT
+	{
+		struct px_model *m;
+		char msg[256];
+		if (px_model_load("config/examples/parts/filleted_block.step", 0.0, &m, msg,
+				  sizeof(msg)) == PX_OK) {
+			run_brep("filleted_block", m);
+			px_model_free(m);
+		} else {
+			printf("  filleted_block: %s\n", msg);
+		}
+	}
+#endif
+}
+
 int main(void)
 {
 	struct px_nurbs_curve c[6];
@@ -1154,7 +1279,10 @@ int main(void)
 	measure_timer();
 	printf("clock: an empty timed region takes %lld ns (median)\n",
 	       (long long)timer_ns);
-	/* BENCH_TRACK_SURF_ONLY=1: the surface part alone (profiling) */
+	/* BENCH_TRACK_SURF_ONLY=1: the surface part alone (profiling);
+	 * BENCH_TRACK_BREP_ONLY=1: the B-rep models alone */
+	if (getenv("BENCH_TRACK_BREP_ONLY"))
+		goto breps;
 	if (getenv("BENCH_TRACK_SURF_ONLY"))
 		goto surfaces;
 	printf("px_track: per-update ns vs cold px_dist_query on the same points "
@@ -1200,5 +1328,7 @@ surfaces:
 		if (rational_surf(&sf[3]) == PX_OK)
 			run_surf("rational wavy, 16 patches", &sf[3], 1);
 	}
+breps:
+	run_breps();
 	return 0;
 }
