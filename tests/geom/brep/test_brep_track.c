@@ -288,9 +288,6 @@ static void test_step_block(void)
 	char path[512], msg[256];
 
 	PX_NEEDS(OCCT);
-#ifdef __SANITIZE_ADDRESS__
-	PX_SKIP("OpenCASCADE's global allocations show as leaks under ASan");
-#endif
 	px_test_data_path(path, sizeof(path), "../../config/examples/parts/filleted_block.step");
 	PX_CHECK_MSG(px_model_load(path, 0.0, &m, msg, sizeof(msg)) == PX_OK, "%s", msg);
 	PX_CHECK_INT_EQ(px_model_kind(m), PX_MODEL_BREP);
