@@ -64,8 +64,8 @@ static void answer_curve(const struct px_strack *t,
 	}
 }
 
-/* The curve tracker's answer cr is a crease of
- * a trimmed surface outside its domain: no candidate of the model. */
+/* The curve tracker's answer cr is a crease of a trimmed surface outside
+ * its domain: no candidate of the model. */
 static inline int crease_out(const struct px_strack *t,
 			     const struct px_track_result *cr)
 {
