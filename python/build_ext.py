@@ -101,6 +101,19 @@ int pxpy_scene_nearest_tracked(const struct px_scene *s,
                                size_t n, double max_dist,
                                const struct pxpy_out *o, size_t *bad,
                                char *msg, size_t msg_cap);
+struct px_urdf_robot;
+int pxpy_robot_load(const char *path, const char *base, const char *tip,
+                    const char *package_paths, struct px_urdf_robot **out,
+                    char *msg, size_t msg_cap);
+void pxpy_robot_free(struct px_urdf_robot *r);
+int pxpy_robot_dof(const struct px_urdf_robot *r);
+const char *pxpy_robot_joint_name(const struct px_urdf_robot *r, int j);
+int pxpy_robot_limits(const struct px_urdf_robot *r, int j, double *out3);
+int pxpy_robot_body_count(const struct px_urdf_robot *r);
+struct px_model *pxpy_robot_body(const struct px_urdf_robot *r, int i,
+                                 const char **link, int *frame);
+int pxpy_robot_set_q(struct px_urdf_robot *r, const double *q, double *frames,
+                     char *msg, size_t msg_cap);
 const char *pxpy_strerror(int code);
 const char *pxpy_version(void);
 """

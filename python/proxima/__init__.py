@@ -28,7 +28,7 @@ __all__ = [
     "Error", "Model", "Answers", "Stream", "Scene", "SceneTracking", "Pair",
     "NurbsCurve", "NurbsSurface", "load", "mesh", "cloud", "nurbs",
     "sphere", "box", "capsule", "cylinder", "cone", "torus", "halfspace",
-    "pair", "version",
+    "pair", "version", "Robot", "load_urdf",
 ]
 
 # px_model.h: enum px_model_kind, enum px_feature, capability bits
@@ -677,3 +677,83 @@ class SceneTracking(_Handle):
         super().close()
         if live:
             self._scene._trackings -= 1
+
+
+class _Body(Model):
+    """A robot's collision shape: a model the robot owns and poses."""
+
+    def __init__(self, ptr, robot, link, frame):
+        super().__init__(ptr, "%s:%s" % (robot.source, link))
+        self._robot = robot
+        self.link = link
+        self.frame = frame
+
+    def close(self):
+        if getattr(self, "_users", 0) > 0:
+            raise Error("%s is used by %d stream(s) or scene(s): close them "
+                        "first" % (self._what(), self._users), -10)
+        self._ptr = None  # the robot frees it
+
+
+class Robot(_Handle):
+    """A URDF robot's chain from a base link to a tip link
+    (load_urdf()): joints, limits, and one model per collision shape
+    (bodies) posed by set_q()."""
+
+    _free = lib.pxpy_robot_free
+
+    def __init__(self, ptr, source):
+        super().__init__(ptr)
+        self.source = source
+        self.joint_names = [ffi.string(lib.pxpy_robot_joint_name(ptr, j)).decode()
+                            for j in range(lib.pxpy_robot_dof(ptr))]
+        self.bodies = []
+        link, frame = ffi.new("const char **"), ffi.new("int *")
+        for i in range(lib.pxpy_robot_body_count(ptr)):
+            m = lib.pxpy_robot_body(ptr, i, link, frame)
+            self.bodies.append(_Body(m, self, ffi.string(link[0]).decode(), frame[0]))
+
+    @property
+    def dof(self):
+        return len(self.joint_names)
+
+    def limits(self):
+        """(dof, 3) array: lower, upper, velocity of each movable joint."""
+        out = np.empty((self.dof, 3))
+        for j in range(self.dof):
+            lib.pxpy_robot_limits(self._live(), j, _ptr(out[j]))
+        return out
+
+    def set_q(self, q):
+        """Pose every body for joint positions q (dof values); returns the
+        chain frames as a (dof + 1, 7) array (w, x, y, z, tx, ty, tz)."""
+        a = np.ascontiguousarray(np.asarray(q, dtype=np.float64).ravel())
+        if a.shape != (self.dof,):
+            raise ValueError("q: expected %d joint positions, got shape %s"
+                             % (self.dof, a.shape))
+        frames = np.empty((self.dof + 1, 7))
+        msg = ffi.new("char[]", _MSG_CAP)
+        rc = lib.pxpy_robot_set_q(self._live(), _ptr(a) if a.size else ffi.NULL,
+                                  _ptr(frames), msg, _MSG_CAP)
+        if rc < 0:
+            _raise(rc, msg)
+        return frames
+
+    def close(self):
+        for b in getattr(self, "bodies", ()):
+            b.close()
+        super().close()
+
+
+def load_urdf(path, tip_link, base_link=None, package_paths=()):
+    """The chain base_link..tip_link (base: the root) of a URDF file;
+    package:// meshes are looked up under each of package_paths."""
+    out = ffi.new("struct px_urdf_robot **")
+    msg = ffi.new("char[]", _MSG_CAP)
+    p = str(path)
+    pk = ":".join(str(x) for x in package_paths)
+    rc = lib.pxpy_robot_load(p.encode(), base_link.encode() if base_link else ffi.NULL,
+                             str(tip_link).encode(), pk.encode(), out, msg, _MSG_CAP)
+    if rc < 0:
+        _raise(rc, msg)
+    return Robot(out[0], p)

@@ -21,6 +21,7 @@
 #include "px_pair.h"
 #include "px_prim.h"
 #include "px_scene.h"
+#include "px_urdf.h"
 
 #include "_pxpy.h"
 
@@ -653,6 +654,93 @@ int pxpy_scene_nearest_tracked(const struct px_scene *s,
 		if (rc < 0)
 			return point_error(rc, x, i, bad, msg, msg_cap);
 		put_hit(o, i, &h, rc > 0);
+	}
+	return PX_OK;
+}
+
+/* ---- robots ---------------------------------------------------------------- */
+
+int pxpy_robot_load(const char *path, const char *base, const char *tip,
+		    const char *package_paths, struct px_urdf_robot **out,
+		    char *msg, size_t msg_cap)
+{
+	const char *dirs[PX_URDF_MAX_PACKAGE_PATHS];
+	char buf[4096];
+	struct px_urdf_opts o;
+	struct px_urdf_error e;
+	struct px_urdf *u = NULL;
+	int rc, n = 0;
+	*out = NULL;
+	memset(&o, 0, sizeof(o));
+	if (package_paths && package_paths[0]) {
+		char *p, *save = NULL;
+		snprintf(buf, sizeof(buf), "%s", package_paths);
+		for (p = strtok_r(buf, ":", &save); p && n < PX_URDF_MAX_PACKAGE_PATHS;
+		     p = strtok_r(NULL, ":", &save))
+			dirs[n++] = p;
+		o.package_paths = dirs;
+		o.n_package_paths = n;
+	}
+	rc = px_urdf_load(path, &o, &u, &e);
+	if (rc == PX_OK)
+		rc = px_urdf_robot_create(u, base, tip, px_pose_identity(), out, &e);
+	px_urdf_free(u);
+	if (rc)
+		return say(msg, msg_cap, rc, "%s", e.msg[0] ? e.msg : px_strerror(rc));
+	return PX_OK;
+}
+
+void pxpy_robot_free(struct px_urdf_robot *r)
+{
+	px_urdf_robot_free(r);
+}
+
+int pxpy_robot_dof(const struct px_urdf_robot *r)
+{
+	return px_urdf_robot_dof(r);
+}
+
+const char *pxpy_robot_joint_name(const struct px_urdf_robot *r, int j)
+{
+	return px_urdf_robot_joint_name(r, j);
+}
+
+int pxpy_robot_limits(const struct px_urdf_robot *r, int j, double *out3)
+{
+	return px_urdf_robot_limits(r, j, &out3[0], &out3[1], &out3[2]);
+}
+
+int pxpy_robot_body_count(const struct px_urdf_robot *r)
+{
+	return px_urdf_robot_body_count(r);
+}
+
+struct px_model *pxpy_robot_body(const struct px_urdf_robot *r, int i,
+				 const char **link, int *frame)
+{
+	const struct px_urdf_body *b = px_urdf_robot_body(r, i);
+	*link = px_urdf_robot_body_link(r, i);
+	*frame = b ? b->frame : -1;
+	return b ? b->model : NULL;
+}
+
+int pxpy_robot_set_q(struct px_urdf_robot *r, const double *q, double *frames,
+		     char *msg, size_t msg_cap)
+{
+	px_pose f[PX_CONTROL_MAX_JOINTS + 1];
+	int i, rc = px_urdf_robot_set_q(r, q, f, PX_CONTROL_MAX_JOINTS + 1);
+	if (rc)
+		return say(msg, msg_cap, rc, "joint positions: %s",
+			   rc == PX_E_NAN ? "not finite" : px_strerror(rc));
+	for (i = 0; frames && i <= px_urdf_robot_dof(r); i++) {
+		double *o = frames + 7 * i;
+		o[0] = f[i].q.w;
+		o[1] = f[i].q.x;
+		o[2] = f[i].q.y;
+		o[3] = f[i].q.z;
+		o[4] = f[i].t.x;
+		o[5] = f[i].t.y;
+		o[6] = f[i].t.z;
 	}
 	return PX_OK;
 }

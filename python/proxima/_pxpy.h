@@ -127,6 +127,27 @@ int pxpy_scene_nearest_tracked(const struct px_scene *s,
 			       const struct pxpy_out *o, size_t *bad,
 			       char *msg, size_t msg_cap);
 
+/* ---- robots (px_urdf.h) ---------------------------------------------------- */
+
+struct px_urdf_robot;
+/* The chain base..tip of a URDF file (base NULL: the root); package
+ * paths separated by ':' (may be NULL). */
+int pxpy_robot_load(const char *path, const char *base, const char *tip,
+		    const char *package_paths, struct px_urdf_robot **out,
+		    char *msg, size_t msg_cap);
+void pxpy_robot_free(struct px_urdf_robot *r);
+int pxpy_robot_dof(const struct px_urdf_robot *r);
+const char *pxpy_robot_joint_name(const struct px_urdf_robot *r, int j);
+/* lower, upper, velocity */
+int pxpy_robot_limits(const struct px_urdf_robot *r, int j, double *out3);
+int pxpy_robot_body_count(const struct px_urdf_robot *r);
+/* Body i: its model (owned by the robot), link name, frame. */
+struct px_model *pxpy_robot_body(const struct px_urdf_robot *r, int i,
+				 const char **link, int *frame);
+/* q: dof values; frames (7 doubles each: w x y z, x y z) may be NULL. */
+int pxpy_robot_set_q(struct px_urdf_robot *r, const double *q, double *frames,
+		     char *msg, size_t msg_cap);
+
 /* ---- misc ---------------------------------------------------------------- */
 
 const char *pxpy_strerror(int code);

@@ -410,6 +410,64 @@ def test_memory():
        "answers: resident size grew %d kB (< 4 MB)" % (after - before))
 
 
+URDF = """<?xml version='1.0'?>
+<robot name='two'>
+  <link name='base'/>
+  <link name='upper'><collision><origin xyz='0.25 0 0'/><geometry><box size='0.5 0.1 0.1'/></geometry></collision></link>
+  <link name='lower'><collision><geometry><sphere radius='0.05'/></geometry></collision></link>
+  <joint name='shoulder' type='revolute'><parent link='base'/><child link='upper'/>
+    <axis xyz='0 0 1'/><limit lower='-2' upper='2' velocity='1.5'/></joint>
+  <joint name='elbow' type='continuous'><parent link='upper'/><child link='lower'/>
+    <origin xyz='0.5 0 0'/><axis xyz='0 0 1'/></joint>
+</robot>
+"""
+
+
+def test_urdf():
+    if "libxml2" in os.environ.get("PX_WITHOUT", "").split():
+        skip("URDF: built without libxml2")
+        return
+    tmp = tempfile.mkdtemp()
+    path = os.path.join(tmp, "two.urdf")
+    with open(path, "w") as f:
+        f.write(URDF)
+    r = proxima.load_urdf(path, "lower")
+    ok(r.dof == 2 and r.joint_names == ["shoulder", "elbow"] and len(r.bodies) == 2,
+       "URDF robot: 2 joints, 2 bodies (%s)" % r.joint_names)
+    ok(np.allclose(r.limits()[0], [-2, 2, 1.5]) and math.isinf(r.limits()[1][1]),
+       "joint limits read")
+    for q0 in (0.0, 0.7, -1.3):
+        frames = r.set_q([q0, 0.4])
+        ball = [b for b in r.bodies if b.link == "lower"][0]
+        want = 0.5 * np.array([math.cos(q0), math.sin(q0), 0.0])
+        ok(np.allclose(ball.pose[1], want, atol=1e-15) and np.allclose(frames[2][4:], want),
+           "forward kinematics puts the elbow at 0.5 (cos q, sin q, 0) for q = %g" % q0)
+        ok(abs(ball.distance([want + [0, 0, 0.2]])[0] - 0.15) < 1e-12,
+           "the elbow's sphere answers queries where it is")
+    ob = proxima.sphere(0.1)
+    ob.set_pose(translation=(0.0, 0.0, 0.5))
+    pr = proxima.pair(r.bodies[0], ob)
+    # the arm's box reaches the z axis at its top face (z = 0.05): 0.45
+    # below the obstacle's centre, minus its radius
+    ok(abs(pr.distance - 0.35) < 1e-9,
+       "a body in a model pair: box to sphere 0.35 (%.12g)" % pr.distance)
+    sc = proxima.Scene(4)
+    sc.add(r.bodies[1])
+    raises(r.close, proxima.Error, ("used by",), "a robot whose body is in a scene refuses to close")
+    sc.close()
+    r.close()
+    raises(lambda: r.bodies[0].query([[0, 0, 0]]), proxima.Error, ("closed",),
+           "bodies are closed with their robot")
+    bad = os.path.join(tmp, "bad.urdf")
+    with open(bad, "w") as f:
+        f.write(URDF.replace("continuous", "ball"))
+    raises(lambda: proxima.load_urdf(bad, "lower"), proxima.Error,
+           (bad + ":8: <joint name='elbow'>: unknown joint type 'ball'",),
+           "a bad URDF raises with file, line and element")
+    raises(lambda: proxima.load_urdf(path, "nowhere"), proxima.Error, ("no link named 'nowhere'",),
+           "an unknown tip link raises")
+
+
 def test_example():
     out = os.path.join(tempfile.mkdtemp(), "field.png")
     r = subprocess.run([sys.executable, os.path.join(ROOT, "examples", "distance_field.py"),
@@ -426,7 +484,7 @@ def main():
         return 1
     for t in (test_tool_equal, test_tracked_equal, test_from_arrays,
               test_primitives_pose_pair_scene, test_arrays, test_errors,
-              test_lifetimes, test_threads, test_memory, test_example):
+              test_lifetimes, test_threads, test_memory, test_urdf, test_example):
         print("== %s" % t.__name__)
         try:
             t()
