@@ -329,7 +329,12 @@ static int load_nurbs(const char *path, struct px_model **out, char *msg,
 	struct px_obj_error err;
 	struct px_nurbs_curve *curves = NULL;
 	struct px_nurbs_surf *surfs = NULL;
-	int nc = 0, ns = 0, i, rc;
+	int nc = 0, ns = 0, i, rc, trimmed = 0;
+	/* trim or hole loops: a B-rep of trimmed faces (px_brep_obj.h) */
+	rc = px_model_load_obj_brep(path, 1.0, &trimmed, out, msg, cap);
+	if (trimmed)
+		return rc;
+	msg[0] = '\0';
 	memset(&err, 0, sizeof(err));
 	rc = px_obj_load_file(path, &obj, &err);
 	if (rc != PX_OK) {
@@ -339,21 +344,6 @@ static int load_nurbs(const char *path, struct px_model **out, char *msg,
 		else
 			snprintf(msg, cap, "%.256s: %.256s", path,
 				 err.msg[0] ? err.msg : px_strerror(rc));
-		return rc;
-	}
-	if (px_obj_trimmed(obj)) {
-		/* trimmed surfaces: a B-rep (px_brep_obj.h) */
-		struct px_brep *b = NULL;
-		rc = px_brep_from_obj(obj, 1.0, &b, &err);
-		if (!rc)
-			rc = px_model_from_brep(b, out);
-		if (rc && err.line > 0)
-			snprintf(msg, cap, "%.256s:%d:%d: %.256s", path, err.line,
-				 err.column, err.msg);
-		else if (rc)
-			snprintf(msg, cap, "%.256s: %.256s", path,
-				 err.msg[0] ? err.msg : px_strerror(rc));
-		px_obj_free(obj);
 		return rc;
 	}
 	curves = calloc((size_t)obj->n_entities + 1, sizeof(*curves));

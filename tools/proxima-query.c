@@ -303,31 +303,6 @@ static int load_obj(struct query *q)
 		return 1;
 	}
 	obj = q->obj;
-	if (px_obj_trimmed(obj)) {
-		/* trimmed surfaces: one B-rep model (px_brep_obj.h) */
-		struct px_brep *b = NULL;
-		if (q->track) {
-			fprintf(stderr, "%s: %s: --track: trimmed surfaces are "
-					"answered by global queries only; run "
-					"without --track\n",
-				prog, q->model_path);
-			return 2;
-		}
-		rc = px_brep_from_obj(obj, 1.0, &b, &oerr);
-		if (!rc)
-			rc = px_model_from_brep(b, &q->mesh);
-		if (rc) {
-			if (oerr.line > 0)
-				fprintf(stderr, "%s: %s:%d:%d: %s\n", prog,
-					q->model_path, oerr.line, oerr.column,
-					oerr.msg);
-			else
-				fprintf(stderr, "%s: %s: %s\n", prog, q->model_path,
-					oerr.msg[0] ? oerr.msg : px_strerror(rc));
-			return 1;
-		}
-		return 0;
-	}
 	q->curves = calloc((size_t)obj->n_entities + 1, sizeof(*q->curves));
 	q->surfs = calloc((size_t)obj->n_entities + 1, sizeof(*q->surfs));
 	if (!q->curves || !q->surfs) {
@@ -381,8 +356,29 @@ static int load_model(struct query *q)
 			prog, q->model_path);
 		return 2;
 	}
-	if (ieq(ext, "obj"))
-		return load_obj(q);
+	if (ieq(ext, "obj")) {
+		/* trim or hole loops: one B-rep of trimmed faces
+		 * (px_brep_obj.h), answered by global queries */
+		int trimmed = 0;
+		rc = px_model_load_obj_brep(q->model_path, 1.0, &trimmed, &q->mesh,
+					    msg, sizeof(msg));
+		if (!trimmed)
+			return load_obj(q);
+		if (rc) {
+			fprintf(stderr, "%s: %s\n", prog, msg);
+			return 1;
+		}
+		if (q->track) {
+			fprintf(stderr, "%s: %s: --track: trimmed surfaces are "
+					"answered by global queries only; run "
+					"without --track\n",
+				prog, q->model_path);
+			return 2;
+		}
+		if (msg[0] && q->stats)
+			fprintf(stderr, "%s: %s\n", prog, msg);
+		return 0;
+	}
 	/* meshes and point clouds */
 	rc = px_model_load(q->model_path, 0.0, &q->mesh, msg, sizeof(msg));
 	if (rc) {

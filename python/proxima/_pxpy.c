@@ -63,28 +63,20 @@ static int load_obj(const char *path, struct px_model **out, char *msg,
 	struct px_nurbs_curve *cv = NULL;
 	struct px_nurbs_surf *sf = NULL;
 	size_t ne;
-	int i, nc = 0, ns = 0, rc = px_obj_load_file(path, &obj, &oe);
+	int i, nc = 0, ns = 0, trimmed = 0, rc;
+	/* trim or hole loops: one B-rep of trimmed faces (px_brep_obj.h) */
+	rc = px_model_load_obj_brep(path, 1.0, &trimmed, out, msg, cap);
+	if (trimmed)
+		return rc;
+	if (msg && cap)
+		msg[0] = '\0';
+	rc = px_obj_load_file(path, &obj, &oe);
 	if (rc) {
 		if (oe.line > 0)
 			return say(msg, cap, rc, "%s:%d:%d: %s", oe.file, oe.line,
 				   oe.column, oe.msg);
 		return say(msg, cap, rc, "%s: %s", path,
 			   oe.msg[0] ? oe.msg : px_strerror(rc));
-	}
-	if (px_obj_trimmed(obj)) {
-		/* trimmed surfaces: one B-rep model (px_brep_obj.h) */
-		struct px_brep *b = NULL;
-		rc = px_brep_from_obj(obj, 1.0, &b, &oe);
-		px_obj_free(obj);
-		if (!rc)
-			rc = px_model_from_brep(b, out);
-		if (rc && oe.line > 0)
-			return say(msg, cap, rc, "%s:%d:%d: %s", path, oe.line,
-				   oe.column, oe.msg);
-		if (rc)
-			return say(msg, cap, rc, "%s: %s", path,
-				   oe.msg[0] ? oe.msg : px_strerror(rc));
-		return PX_OK;
 	}
 	if (obj->n_entities > 0 && obj->n_triangles > 0) {
 		px_obj_free(obj);

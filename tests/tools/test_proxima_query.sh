@@ -262,5 +262,24 @@ else
 	err_has "missing STEP named" 'none\.stp'
 fi
 
+# Trimmed OBJ: a 2 x 2 plane sheet with a rational circular hole of
+# radius 0.5 about (1, 1), read as a B-rep: exact distances.
+cp fuzz/corpus/objtrim/hole_circle.obj "$tmp/hole.obj"
+printf '1,1,0.3\n1.2,1,0\n0.5,0.5,0.2\n3,1,0\n' >"$tmp/hole.csv"
+expect "trimmed OBJ" 0 "$bin" "$tmp/hole.obj" "$tmp/hole.csv"
+if awk -F, 'function abs(a) { return a < 0 ? -a : a }
+	NF != 6 { bad = 1 }
+	NR == 1 && abs($1 - sqrt(0.25 + 0.09)) > 1e-12 { print "above the hole: " $1; bad = 1 }
+	NR == 2 && abs($1 - 0.3) > 1e-12 { print "in the hole: " $1; bad = 1 }
+	NR == 3 && abs($1 - 0.2) > 1e-12 { print "above the sheet: " $1; bad = 1 }
+	NR == 4 && abs($1 - 1) > 1e-12 { print "beside: " $1; bad = 1 }
+	END { exit bad }' "$tmp/out" >"$tmp/err"; then
+	ok "trimmed OBJ: the hole's rim and the sheet, exact"; else bad "trimmed OBJ: distances"; fi
+expect "trimmed OBJ --track refused" 2 "$bin" --track "$tmp/hole.obj" "$tmp/hole.csv"
+err_has "trimmed OBJ --track says why" 'global queries only'
+sed 's/^hole 0 4 1$/hole 0 2 1/' "$tmp/hole.obj" >"$tmp/half.obj"
+expect "trimmed OBJ with an open loop" 1 "$bin" "$tmp/half.obj" "$tmp/hole.csv"
+err_has "open loop named with its line" 'half\.obj:24:1: .*is open'
+
 echo "$name: $pass passed, $fail failed, $skip skipped"
 [ "$fail" -eq 0 ]
