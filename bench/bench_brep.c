@@ -11,6 +11,9 @@
  *
  *   bench_brep [PREFIX [N]]
  * runs the parts whose name starts with PREFIX, N queries each.
+ *   bench_brep --file PATH [N]
+ * times a STEP / IGES / OBJ part read by px_model_load() alone (signed
+ * where it is closed) on the same kind of points.
  */
 #include <math.h>
 #include <stdint.h>
@@ -20,6 +23,7 @@
 
 #include "brep_gen.h"
 #include "px_brep.h"
+#include "px_load.h"
 #include "px_dist.h"
 #include "px_model.h"
 
@@ -57,6 +61,53 @@ static struct stats time_model(const struct px_model *m, const px_vec3 *q, int n
 	return s;
 }
 
+/* Random points in box b enlarged by 25 % per side. */
+static void box_points(px_aabb b, px_vec3 *q, int n)
+{
+	px_vec3 lo = b.min, hi = b.max;
+	px_vec3 e = px_v3_scale(px_v3_sub(hi, lo), 0.25);
+	int i;
+	lo = px_v3_sub(lo, e);
+	hi = px_v3_add(hi, e);
+	for (i = 0; i < n; i++)
+		q[i] = px_v3(lo.x + (hi.x - lo.x) * urand(), lo.y + (hi.y - lo.y) * urand(),
+			     lo.z + (hi.z - lo.z) * urand());
+}
+
+static int run_file(const char *path)
+{
+	static px_vec3 q[NQ_MAX];
+	struct px_brep_info info;
+	const struct px_brep *b;
+	struct px_model *m;
+	struct stats s;
+	char msg[256];
+	long unc;
+	int64_t t0 = now_ns();
+	int rc = px_model_load(path, 0.0, &m, msg, sizeof msg);
+
+	t0 = now_ns() - t0;
+	if (rc != PX_OK) {
+		printf("%s: %s (%s)\n", path, px_strerror(rc), msg);
+		return 1;
+	}
+	b = px_model_brep(m);
+	if (!b || px_brep_get_info(b, &info) != PX_OK) {
+		printf("%s: not a B-rep\n", path);
+		px_model_free(m);
+		return 1;
+	}
+	box_points(info.bounds, q, NQ);
+	s = time_model(m, q, NQ, &unc);
+	printf("%-12s %d faces %d edges %d vertices, %s; load %.2f ms, %zu bytes\n",
+	       path, info.n_faces, info.n_edges, info.n_vertices,
+	       info.closed ? "closed: signed" : "open: unsigned", t0 / 1e6, info.bytes);
+	printf("%-12s per query ns: median %lld p99 %lld max %lld; uncertified %ld / %d\n",
+	       "", (long long)s.med, (long long)s.p99, (long long)s.max, unc, NQ);
+	px_model_free(m);
+	return 0;
+}
+
 static void run(struct brep_gen *g)
 {
 	static px_vec3 q[NQ_MAX];
@@ -92,15 +143,7 @@ static void run(struct brep_gen *g)
 		px_model_free(mb);
 		return;
 	}
-	{
-		px_vec3 lo = info.bounds.min, hi = info.bounds.max;
-		px_vec3 e = px_v3_scale(px_v3_sub(hi, lo), 0.25);
-		lo = px_v3_sub(lo, e);
-		hi = px_v3_add(hi, e);
-		for (i = 0; i < NQ; i++)
-			q[i] = px_v3(lo.x + (hi.x - lo.x) * urand(), lo.y + (hi.y - lo.y) * urand(),
-				     lo.z + (hi.z - lo.z) * urand());
-	}
+	box_points(info.bounds, q, NQ);
 	if (!filter || !strncmp(g->d.name, filter, strlen(filter))) {
 		sb = time_model(mb, q, NQ, &ub);
 		sn = time_model(mn, q, NQ, &un);
@@ -125,6 +168,13 @@ int main(int argc, char **argv)
 	struct brep_gen *(*parts[])(void) = {brep_gen_sheet_hole, brep_gen_cube_hole,
 					     brep_gen_freeform, brep_gen_thin_box};
 	size_t i;
+	if (argc > 2 && !strcmp(argv[1], "--file")) {
+		if (argc > 3)
+			NQ = atoi(argv[3]);
+		if (NQ < 1 || NQ > NQ_MAX)
+			NQ = NQ_MAX;
+		return run_file(argv[2]);
+	}
 	if (argc > 1 && argv[1][0])
 		filter = argv[1];
 	if (argc > 2)

@@ -485,6 +485,17 @@ static char *dup_str(const char *s)
 	return c;
 }
 
+/* link_topology() made every loop curve an edge (a curve of the
+ * distance core) or, collapsed, a point candidate: so those answer the
+ * whole boundary of every trimmed domain (px__dist_trim.edged). */
+static void mark_edged(struct px_brep *b)
+{
+	int f;
+	for (f = 0; f < b->n_faces; f++)
+		if (b->dtrim[f].inside)
+			b->dtrim[f].edged = 1;
+}
+
 /* The distance core over edges (curves) and faces (trimmed surfaces),
  * its workspaces, the box. */
 static int build_dist(struct px_brep *b, const struct px_brep_opts *o)
@@ -506,6 +517,7 @@ static int build_dist(struct px_brep *b, const struct px_brep_opts *o)
 		sf[i] = b->faces[i].surf;
 	for (i = 0; i < b->n_edges; i++)
 		cv[i] = b->edges[i].c;
+	mark_edged(b);
 	rc = px__dist_model_create_trimmed(cv, b->n_edges, sf, b->n_faces,
 					   b->dtrim, o->dist, &b->dm);
 	free(sf);

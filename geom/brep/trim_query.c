@@ -19,19 +19,59 @@ void px__trim_point(const struct px_trim *t, const struct trim_piece *p,
 	*y = px_bern_eval(Y, p->deg, s) / w;
 }
 
+/*
+ * The three coefficient runs c[0 .. 3 (d + 1)) restricted to [a, b] in
+ * place: px_bern_restrict()'s de Casteljau steps in the same order (so
+ * the same values), run on the three at once without copies (a query
+ * near a loop restricts a node at every halving).
+ */
+static void restrict3(double *c, int d, double a, double b)
+{
+	double *X = c, *Y = c + d + 1, *W = Y + d + 1, s, l;
+	int i, k;
+
+	if (b < 1.0) {
+		/* Left part at b: the first coefficient of every step. */
+		double lx[PX_NURBS_MAX_DEGREE + 1], ly[PX_NURBS_MAX_DEGREE + 1];
+		double lw[PX_NURBS_MAX_DEGREE + 1];
+		s = 1.0 - b;
+		lx[0] = X[0], ly[0] = Y[0], lw[0] = W[0];
+		for (k = d; k > 0; k--) {
+			for (i = 0; i < k; i++) {
+				X[i] = s * X[i] + b * X[i + 1];
+				Y[i] = s * Y[i] + b * Y[i + 1];
+				W[i] = s * W[i] + b * W[i + 1];
+			}
+			lx[d - k + 1] = X[0], ly[d - k + 1] = Y[0], lw[d - k + 1] = W[0];
+		}
+		for (i = 0; i <= d; i++)
+			X[i] = lx[i], Y[i] = ly[i], W[i] = lw[i];
+		a = a / b;
+	}
+	if (a > 0.0) {
+		/* Right part at a: what the steps leave. */
+		l = a;
+		s = 1.0 - l;
+		for (k = d; k > 0; k--)
+			for (i = 0; i < k; i++) {
+				X[i] = s * X[i] + l * X[i + 1];
+				Y[i] = s * Y[i] + l * Y[i + 1];
+				W[i] = s * W[i] + l * W[i + 1];
+			}
+	}
+}
+
 void px__trim_node_ctrl(const struct px_trim *t, const struct trim_piece *p,
 			const struct trim_node *n, double *x, double *y,
 			double *w, double box[4])
 {
-	const double *X = t->coef + p->off;
-	const double *Y = X + p->deg + 1, *W = Y + p->deg + 1;
-	double rx[PX_NURBS_MAX_DEGREE + 1], ry[PX_NURBS_MAX_DEGREE + 1];
-	double rw[PX_NURBS_MAX_DEGREE + 1];
+	double c[3 * (PX_NURBS_MAX_DEGREE + 1)];
+	const double *rx = c, *ry = c + p->deg + 1, *rw = ry + p->deg + 1;
 	int i, d = p->deg;
 
-	px_bern_restrict(X, d, n->a, n->b, rx);
-	px_bern_restrict(Y, d, n->a, n->b, ry);
-	px_bern_restrict(W, d, n->a, n->b, rw);
+	for (i = 0; i < 3 * (d + 1); i++)
+		c[i] = t->coef[p->off + i];
+	restrict3(c, d, n->a, n->b);
 	box[0] = trim_min(n->ax, n->ex), box[1] = trim_max(n->ax, n->ex);
 	box[2] = trim_min(n->ay, n->ey), box[3] = trim_max(n->ay, n->ey);
 	for (i = 0; i <= d; i++) {

@@ -396,6 +396,13 @@ out:
 	return rc;
 }
 
+/* Pieces the grid holds (the others are outside a trimmed domain or
+ * stand behind their entity's PK_SHAPE item). */
+static int binned(const struct piece *pc)
+{
+	return pc->trim != PIECE_PRUNED && pc->trim != PIECE_SHAPE;
+}
+
 static void cell_range(const struct px_dist_model *m, px_aabb b, int lo[3],
 		       int hi[3])
 {
@@ -541,6 +548,8 @@ static void count_pieces(const struct builder *bl, struct layout *ly)
 {
 	int i;
 	for (i = 0; i < bl->n; i++) {
+		if (bl->tp[i].pc.kind == PK_SHAPE)
+			continue;
 		if (bl->tp[i].pc.kind == PK_CURVE) {
 			ly->n_cp++;
 		} else {
@@ -551,6 +560,12 @@ static void count_pieces(const struct builder *bl, struct layout *ly)
 	}
 }
 
+/* A PK_SHAPE item counts as this many pieces in the cell budget: it
+ * stands for a whole face or edge, whose box spans many cells; finer
+ * cells let the wave meet the nearest faces first, so it answers fewer
+ * in closed form (on CAD parts 8 beat both 2 and 32 under callgrind). */
+#define SHAPE_ITEM_WEIGHT 8
+
 /* Grid geometry (paper section 6) into hdr: bounds, cell size from the
  * finest entity's piece count along the longest extent, cell counts. */
 static void grid_geometry(struct px_dist_model *hdr, const struct builder *bl,
@@ -560,11 +575,17 @@ static void grid_geometry(struct px_dist_model *hdr, const struct builder *bl,
 	px_vec3 ext;
 	double mx;
 	int i, e, per = 1;
-	long cell_budget = bl->n / 2;
+	long cell_budget = 0;
 
 	hdr->bounds = px_aabb_empty();
-	for (i = 0; i < bl->n; i++)
+	for (i = 0; i < bl->n; i++) {
 		hdr->bounds = px_aabb_union(&hdr->bounds, &bl->tp[i].pc.box);
+		if (bl->tp[i].pc.kind == PK_SHAPE)
+			cell_budget += SHAPE_ITEM_WEIGHT;
+		else
+			cell_budget += bl->tp[i].pc.trim != PIECE_SHAPE;
+	}
+	cell_budget /= 2;
 	ext = px_v3_sub(hdr->bounds.max, hdr->bounds.min);
 	mx = fmax(ext.x, fmax(ext.y, ext.z));
 	for (e = 0; e < n_ent; e++)
@@ -607,7 +628,7 @@ static long *count_refs(struct px_dist_model *hdr, const struct builder *bl)
 		return NULL;
 	for (i = 0; i < bl->n; i++) {
 		int lo[3], hi[3], x, y, z;
-		if (bl->tp[i].pc.trim == PIECE_PRUNED)
+		if (!binned(&bl->tp[i].pc))
 			continue;
 		cell_range(hdr, bl->tp[i].pc.box, lo, hi);
 		for (z = lo[2]; z <= hi[2]; z++)
@@ -748,6 +769,8 @@ static int fill_pieces(struct px_dist_model *m, const struct builder *bl,
 		int a, b;
 		*pc = t->pc;
 		pc->sample_start = smp;
+		if (t->pc.kind == PK_SHAPE)
+			continue;
 		if (t->pc.kind == PK_CURVE) {
 			pc->idx = ic;
 			m->cp[ic] = t->cp;
@@ -789,7 +812,7 @@ static void bin_pieces(struct px_dist_model *m, const long *refs)
 	}
 	for (i = 0; i < m->n_pieces; i++) {
 		int lo[3], hi[3], x, y, z;
-		if (m->pieces[i].trim == PIECE_PRUNED)
+		if (!binned(&m->pieces[i]))
 			continue;
 		cell_range(m, m->pieces[i].box, lo, hi);
 		for (z = lo[2]; z <= hi[2]; z++)
@@ -855,6 +878,63 @@ static void apply_trims(struct builder *bl, const struct px_nurbs_surf *surfs,
 	}
 }
 
+/*
+ * Trimmed models: an entity the closed form answers whole goes into the
+ * grid as one PK_SHAPE item with the box of its pieces that are not
+ * pruned; those pieces stay in the model (results name the first),
+ * unbinned and without samples. Answered whole: a curve, an untrimmed
+ * surface, or a trimmed one whose domain boundary lies on the caller's
+ * curves (px__dist_trim.edged). Every recognised surface (parallelogram,
+ * cylinder, cone, annulus, sphere, torus patch) has no interior local
+ * minimum of the distance but its global minimum: in the angle about
+ * the axis the distance is least at the query's angle and greatest
+ * opposite, and along the profile (a segment or an arc) it has one
+ * minimum; a query on the axis or at the centre makes a set of equal
+ * minima, connected, so it reaches the domain's boundary if it meets
+ * the domain. So when the closed form's point is not inside the domain,
+ * the nearest point of the trimmed surface is on its boundary, which
+ * the curves answer.
+ */
+static int add_shape_items(struct builder *bl,
+			   const struct px_dist_entity_info *ent,
+			   const struct px_recog_shape *shapes,
+			   const struct px__dist_trim *trims, int n_curves,
+			   int n_ent)
+{
+	int e, i;
+	for (e = 0; e < n_ent; e++) {
+		const struct px_dist_entity_info *in = &ent[e];
+		int lo = in->first_piece, hi = lo + in->n_pieces + in->n_boundary_pieces;
+		struct tmp_piece *t;
+		px_aabb box = px_aabb_empty();
+		const struct px__dist_trim *tr = e >= n_curves ? &trims[e - n_curves] : NULL;
+		if (shapes[e].kind == PX_RECOG_NONE || (tr && tr->inside && !tr->edged))
+			continue;
+		for (i = lo; i < hi; i++)
+			if (bl->tp[i].pc.trim != PIECE_PRUNED)
+				box = px_aabb_union(&box, &bl->tp[i].pc.box);
+		if (px_aabb_is_empty(&box))
+			continue; /* nothing of it is in the domain */
+		for (i = lo; i < hi; i++) {
+			struct tmp_piece *f = &bl->tp[i];
+			if (f->pc.trim == PIECE_WHOLE)
+				bl->n_samples -= (long)f->pc.ns * f->pc.nt;
+			f->pc.trim = PIECE_SHAPE;
+			f->pc.ns = f->pc.nt = 0;
+		}
+		t = new_piece(bl);
+		if (!t)
+			return PX_E_NOMEM;
+		t->pc.kind = PK_SHAPE;
+		t->pc.ent = e;
+		t->pc.idx = lo;
+		t->pc.iso_dir = -1;
+		t->pc.box = box;
+		t->pc.trim = PIECE_WHOLE;
+	}
+	return PX_OK;
+}
+
 int px_dist_model_create(const struct px_nurbs_curve *curves, int n_curves,
 			 const struct px_nurbs_surf *surfs, int n_surfs,
 			 const struct px_dist_opts *opts,
@@ -878,7 +958,7 @@ int px__dist_model_create_trimmed(const struct px_nurbs_curve *curves,
 	struct layout ly;
 	long *refs = NULL;
 	double *spmem, *shmem;
-	int rc;
+	int rc, hdr_shape_items = 0;
 
 	if (!out)
 		return PX_E_INVAL;
@@ -910,6 +990,13 @@ int px__dist_model_create_trimmed(const struct px_nurbs_curve *curves,
 		goto fail;
 	}
 	recognize(curves, surfs, ent, shapes, &ly);
+	if (trims) {
+		int n0 = bl.n;
+		rc = add_shape_items(&bl, ent, shapes, trims, n_curves, ly.n_ent);
+		if (rc)
+			goto fail;
+		hdr_shape_items = bl.n - n0;
+	}
 	count_pieces(&bl, &ly);
 	memset(&hdr, 0, sizeof(hdr));
 	grid_geometry(&hdr, &bl, ent, ly.n_ent, o.max_cells);
@@ -922,6 +1009,7 @@ int px__dist_model_create_trimmed(const struct px_nurbs_curve *curves,
 	rc = model_alloc(&hdr, &bl, &ly, &o, &m, &spmem, &shmem);
 	if (rc)
 		goto fail;
+	m->n_shape_items = hdr_shape_items;
 	memcpy(m->ent, ent, (size_t)ly.n_ent * sizeof(*ent));
 	memcpy(m->shape, shapes, (size_t)ly.n_ent * sizeof(*shapes));
 	copy_shape_arrays(m, curves, n_curves, surfs, shmem);

@@ -29,12 +29,18 @@
  * wholly inside, 2 when a loop may cross it (never wrong for 0 and 1).
  * inside: 1 when (u, v) lies strictly inside (not on a loop). Both are
  * RT-safe and read-only. A surface whose inside is NULL is untrimmed.
+ * edged: 1 when every point of the domain's boundary maps onto one of
+ * the model's curves or a point the caller answers itself; then a
+ * closed-form surface (whose only interior local minimum is its global
+ * one) whose closest point lies outside the domain has nothing nearer
+ * in it than its boundary, and is answered whole by the closed form.
  */
 struct px__dist_trim {
 	const void *ctx;
 	int (*inside)(const void *ctx, double u, double v);
 	int (*classify)(const void *ctx, double u0, double u1, double v0,
 			double v1);
+	int edged;
 };
 
 /* What a piece solver checks a candidate against: the domain, and for a
@@ -82,8 +88,11 @@ struct cand {
 	int piece;
 };
 
-enum { PK_CURVE = 0, PK_PATCH = 1 };
-enum { PIECE_WHOLE = 0, PIECE_CROSSED = 1, PIECE_PRUNED = 2 };
+/* PK_SHAPE: a whole closed-form entity in the grid (trimmed models). */
+enum { PK_CURVE = 0, PK_PATCH = 1, PK_SHAPE = 2 };
+/* PIECE_SHAPE: a piece of an entity the grid holds as one PK_SHAPE item
+ * (never binned). */
+enum { PIECE_WHOLE = 0, PIECE_CROSSED = 1, PIECE_PRUNED = 2, PIECE_SHAPE = 3 };
 
 /* What one query in flight needs besides the read-only model: per-piece
  * visit stamps (an epoch, so nothing is cleared per query) and the
@@ -100,8 +109,8 @@ struct px_dist_ws {
 /* One entry of the grid's index space: a curve piece or a patch. */
 struct piece {
 	px_aabb box;
-	int kind;    /* PK_CURVE or PK_PATCH */
-	int idx;     /* into cp or spc */
+	int kind;    /* PK_CURVE, PK_PATCH or PK_SHAPE */
+	int idx;     /* into cp or spc; PK_SHAPE: the entity's first piece */
 	int ent;     /* entity */
 	/* Boundary curve of a surface: the curve runs along u (iso_dir 0,
 	 * v fixed at iso_t) or along v (iso_dir 1); -1 for an entity's own
@@ -111,7 +120,8 @@ struct piece {
 	int sample_start;
 	int ns, nt; /* samples: ns along the piece (curves) or ns x nt */
 	/* Trimmed surfaces: PIECE_WHOLE, PIECE_CROSSED (solved with the
-	 * domain's filter) or PIECE_PRUNED (outside, never binned). */
+	 * domain's filter) or PIECE_PRUNED (outside, never binned); any
+	 * piece of a trimmed model: PIECE_SHAPE. */
 	int trim;
 	/* Oriented box around the control net (so around the piece):
 	 * candidates the axis-aligned box kept are dropped by it before
@@ -133,6 +143,10 @@ struct px_dist_model {
 	struct px__dist_trim *trim;
 	int n_pieces;
 	struct piece *pieces;
+	/* Trimmed models: entities answered whole in closed form sit in the
+	 * grid as one PK_SHAPE item each (the last n_shape_items pieces)
+	 * instead of their pieces: the wave answers them as it meets them. */
+	int n_shape_items;
 	int n_cp, n_sp;
 	struct px_cpiece *cp;
 	struct px_spiece *spc;

@@ -37,8 +37,9 @@ static inline double box_d2(const px_aabb *b, px_vec3 p)
  * block's faces, each clipped to the grid. INFINITY when the block covers
  * the grid. Exact for p inside or outside the grid.
  */
-static double outside_lb2(const struct px_dist_model *m, px_vec3 p,
-			  const int lo[3], const int hi[3])
+static inline __attribute__((always_inline)) double
+outside_lb2(const struct px_dist_model *m, px_vec3 p, const int lo[3],
+	    const int hi[3])
 {
 	const int n[3] = {m->nx, m->ny, m->nz};
 	const double g0[3] = {m->bounds.min.x, m->bounds.min.y, m->bounds.min.z};
@@ -78,16 +79,74 @@ static inline int clamp_cell(double v, int n)
 
 struct qstate {
 	double best;  /* squared upper bound */
-	int best_sample; /* global sample index */
+	int best_sample; /* global sample index; -1: a closed-form answer */
 	int best_piece;
+	px_vec3 best_point; /* the closed-form answer: point, parameters */
+	double best_u, best_v;
 	int n_cand;
 	int cells;
+	int shapes; /* closed forms evaluated */
 };
 
-/* Inline: called for every piece of every visited cell. */
-static inline void visit_piece(const struct px_dist_model *m,
-			       struct px_dist_ws *ws, px_vec3 p, int id,
-			       struct qstate *q)
+/*
+ * 1 when (u, v) lies on the edge of the surface's parameter domain (to
+ * 1e-13 of its extent, the trimmed domains' boundary tolerance): a
+ * closed-form answer there says the surface has no interior minimum (it
+ * has but its global one), so the nearest point of a trimmed part of it
+ * is on the part's boundary, without asking the domain (whose loops
+ * often run along that edge, where its test is dearest).
+ */
+static inline int on_domain_edge(const struct px_recog_shape *sh, double u,
+				 double v)
+{
+	double eu = 1e-13 * (sh->dom[1] - sh->dom[0]);
+	double ev = 1e-13 * (sh->dom[3] - sh->dom[2]);
+	return u <= sh->dom[0] + eu || u >= sh->dom[1] - eu ||
+	       v <= sh->dom[2] + ev || v >= sh->dom[3] - ev;
+}
+
+/*
+ * A PK_SHAPE item (trimmed models, dist_build.c: add_shape_items()):
+ * its entity in closed form, once per query. The answer is exact, so it
+ * is the wave's upper bound at once and nothing is left to solve; on a
+ * trimmed surface an answer outside the domain means the nearest point
+ * is on the domain's boundary, which other entities answer. Out of line:
+ * untrimmed models never come here.
+ */
+static __attribute__((noinline)) void
+visit_shape(const struct px_dist_model *m, struct px_dist_ws *ws, px_vec3 p,
+	    const struct piece *pc, struct qstate *q)
+{
+	const struct px__dist_trim *tr = m->trim ? &m->trim[pc->ent] : NULL;
+	struct px_recog_hit h;
+	double d2;
+
+	if (ws->ent_stamp[pc->ent] == ws->epoch)
+		return;
+	ws->ent_stamp[pc->ent] = ws->epoch;
+	q->shapes++;
+	if (px_recog_closest(&m->shape[pc->ent], p, PX_RECOG_WANT_PARAMS, &h) != PX_OK)
+		return; /* only an unrecognised kind refuses: never made an item */
+	d2 = h.dist * h.dist;
+	if (d2 >= q->best)
+		return;
+	if (tr && tr->inside &&
+	    (on_domain_edge(&m->shape[pc->ent], h.u, h.v) ||
+	     !tr->inside(tr->ctx, h.u, h.v)))
+		return;
+	q->best = d2;
+	q->best_sample = -1;
+	q->best_piece = pc->idx;
+	q->best_point = h.point;
+	q->best_u = h.u;
+	q->best_v = h.v;
+}
+
+/* Inline: called for every piece of every visited cell. shapes: the
+ * model has PK_SHAPE items (a constant in each specialised wave). */
+static inline __attribute__((always_inline)) void
+visit_piece(const struct px_dist_model *m, struct px_dist_ws *ws, px_vec3 p,
+	    int id, struct qstate *q, const int shapes)
 {
 	const struct piece *pc = &m->pieces[id];
 	double lb, near_d2 = INFINITY;
@@ -99,6 +158,10 @@ static inline void visit_piece(const struct px_dist_model *m,
 	lb = box_d2(&pc->box, p);
 	if (lb >= q->best)
 		return;
+	if (shapes && pc->kind == PK_SHAPE) {
+		visit_shape(m, ws, p, pc, q);
+		return;
+	}
 	/* Branch-free scan (conditional moves): which sample of a random
 	 * query's piece is nearest is unpredictable. */
 	for (s = pc->sample_start, e = s + pc->ns * pc->nt; s < e; s++) {
@@ -117,8 +180,9 @@ static inline void visit_piece(const struct px_dist_model *m,
 	q->n_cand++;
 }
 
-static void visit_cell(const struct px_dist_model *m, struct px_dist_ws *ws,
-		       px_vec3 p, int x, int y, int z, struct qstate *q)
+static inline __attribute__((always_inline)) void
+visit_cell_k(const struct px_dist_model *m, struct px_dist_ws *ws, px_vec3 p,
+	     int x, int y, int z, struct qstate *q, const int shapes)
 {
 	long ci = px__dist_cell_index(m, x, y, z);
 	int k, n = m->cell_count[ci];
@@ -139,9 +203,23 @@ static void visit_cell(const struct px_dist_model *m, struct px_dist_ws *ws,
 		return;
 	q->cells++;
 	for (k = 0; k < n && k < m->cap; k++)
-		visit_piece(m, ws, p, m->cell_slot[ci * m->cap + k], q);
+		visit_piece(m, ws, p, m->cell_slot[ci * m->cap + k], q, shapes);
 	for (k = m->cap; k < n; k++)
-		visit_piece(m, ws, p, m->spill[m->cell_spill[ci] + k - m->cap], q);
+		visit_piece(m, ws, p, m->spill[m->cell_spill[ci] + k - m->cap], q,
+			    shapes);
+}
+
+static void visit_cell(const struct px_dist_model *m, struct px_dist_ws *ws,
+		       px_vec3 p, int x, int y, int z, struct qstate *q)
+{
+	visit_cell_k(m, ws, p, x, y, z, q, 0);
+}
+
+static void visit_cell_shapes(const struct px_dist_model *m,
+			      struct px_dist_ws *ws, px_vec3 p, int x, int y,
+			      int z, struct qstate *q)
+{
+	visit_cell_k(m, ws, p, x, y, z, q, 1);
 }
 
 /* Heap sort by lower bound: bounded, in place, no allocation (the C
@@ -244,9 +322,10 @@ void px_dist_ws_free(struct px_dist_ws *ws)
 
 /* The wave: shells of cells at Chebyshev distance k from the cell
  * nearest to p, until everything not yet reached is farther than the
- * best sample. */
-static void wave(const struct px_dist_model *m, struct px_dist_ws *ws,
-		 px_vec3 p, struct qstate *q)
+ * best sample (or closed-form answer). */
+static inline __attribute__((always_inline)) void
+wave_k(const struct px_dist_model *m, struct px_dist_ws *ws, px_vec3 p,
+       struct qstate *q, const int shapes)
 {
 	int c[3], k, kmax, i;
 
@@ -279,16 +358,33 @@ static void wave(const struct px_dist_model *m, struct px_dist_ws *ws,
 				if (rim) {
 					for (x = c[0] - k; x <= c[0] + k; x++)
 						if (x >= 0 && x < m->nx)
-							visit_cell(m, ws, p, x, y, z, q);
+							(shapes ? visit_cell_shapes : visit_cell)(
+								m, ws, p, x, y, z, q);
 				} else {
 					if (c[0] - k >= 0)
-						visit_cell(m, ws, p, c[0] - k, y, z, q);
+						(shapes ? visit_cell_shapes : visit_cell)(
+							m, ws, p, c[0] - k, y, z, q);
 					if (k > 0 && c[0] + k < m->nx)
-						visit_cell(m, ws, p, c[0] + k, y, z, q);
+						(shapes ? visit_cell_shapes : visit_cell)(
+							m, ws, p, c[0] + k, y, z, q);
 				}
 			}
 		}
 	}
+}
+
+/* The wave specialised once per model kind, so that models without
+ * PK_SHAPE items pay nothing for them. */
+static void wave(const struct px_dist_model *m, struct px_dist_ws *ws,
+		 px_vec3 p, struct qstate *q)
+{
+	wave_k(m, ws, p, q, 0);
+}
+
+static void wave_shapes(const struct px_dist_model *m, struct px_dist_ws *ws,
+			px_vec3 p, struct qstate *q)
+{
+	wave_k(m, ws, p, q, 1);
 }
 
 /* What the solves of one query carry from candidate to candidate. */
@@ -428,44 +524,48 @@ solve_crossed(const struct px_dist_model *m, px_vec3 p, const struct cand *cd,
  * best after it are sorted (nearest bound first): most fall out there,
  * and sorting a handful costs little.
  */
-static void solve_candidates(const struct px_dist_model *m,
-			     struct px_dist_ws *ws, px_vec3 p, struct qstate *q,
-			     struct solve *sv, struct px_dist_result *r)
+static inline __attribute__((always_inline)) void
+solve_candidates(const struct px_dist_model *m, struct px_dist_ws *ws,
+		 px_vec3 p, struct qstate *q, struct solve *sv,
+		 struct px_dist_result *r, const int shapes)
 {
+	/* A closed-form best (models with PK_SHAPE items) is already the
+	 * answer of its entity: then every candidate waits for the sort. */
+	const int head = !shapes || q->best_sample >= 0;
 	int i, sorted;
-	for (i = 0; i < q->n_cand; i++)
+	for (i = 0; i < q->n_cand && head; i++)
 		if (ws->cand[i].piece == q->best_piece) {
 			struct cand t = ws->cand[i];
 			ws->cand[i] = ws->cand[0];
 			ws->cand[0] = t;
 			break;
 		}
-	sorted = q->n_cand <= 1;
+	sorted = q->n_cand <= head;
 	for (i = 0; i < q->n_cand; i++) {
 		const struct cand *cd;
 		const struct piece *pc;
-		if (i == 1 && !sorted) {
-			int j, n = 1;
-			for (j = 1; j < q->n_cand; j++)
+		if (i == head && !sorted) {
+			int j, n = head;
+			for (j = head; j < q->n_cand; j++)
 				if (ws->cand[j].lb < sv->best)
 					ws->cand[n++] = ws->cand[j];
 			q->n_cand = n;
-			sort_cand(ws->cand + 1, n - 1);
+			sort_cand(ws->cand + head, n - head);
 			sorted = 1;
-			if (n <= 1)
+			if (n <= i)
 				break;
 		}
 		cd = &ws->cand[i];
 		pc = &m->pieces[cd->piece];
-		/* Past the first, the list is sorted by lower bound. */
-		if (i > 0 && cd->lb >= sv->best)
+		/* Past the head, the list is sorted by lower bound. */
+		if (i >= head && cd->lb >= sv->best)
 			break;
 		if (m->shape[pc->ent].kind != PX_RECOG_NONE &&
 		    solve_shape(m, ws, p, cd, pc, sv, r))
 			continue;
 		/* The oriented box can only drop a piece (the list order is
 		 * by the axis-aligned bound, so go on to the next). */
-		if (i > 0 && px_obb_dist2(&pc->obb, p) >= sv->best)
+		if (i >= head && px_obb_dist2(&pc->obb, p) >= sv->best)
 			continue;
 		r->pieces_solved++;
 		if (pc->trim == PIECE_CROSSED)
@@ -502,8 +602,13 @@ int px_dist_query_ws(const struct px_dist_model *m, struct px_dist_ws *ws,
 	q.best_sample = 0;
 	q.n_cand = 0;
 	q.cells = 0;
-	wave(m, ws, p, &q);
+	q.shapes = 0;
+	if (m->n_shape_items)
+		wave_shapes(m, ws, p, &q);
+	else
+		wave(m, ws, p, &q);
 	r->cells_visited = q.cells;
+	r->pieces_solved = q.shapes;
 	if (q.best_piece < 0)
 		/* The wave meets every piece, so only overflowing squared
 		 * distances (a model spanning more than about 1e154) leave
@@ -514,10 +619,19 @@ int px_dist_query_ws(const struct px_dist_model *m, struct px_dist_ws *ws,
 	 * answer exists even if no solve improves on it. */
 	sv.best = q.best;
 	sv.gap = 0.0;
-	r->point = m->samples[q.best_sample];
 	r->piece = q.best_piece;
-	sample_params(m, q.best_piece, q.best_sample, &r->u, &r->v);
-	solve_candidates(m, ws, p, &q, &sv, r);
+	if (q.best_sample >= 0) {
+		r->point = m->samples[q.best_sample];
+		sample_params(m, q.best_piece, q.best_sample, &r->u, &r->v);
+	} else {
+		r->point = q.best_point;
+		r->u = q.best_u;
+		r->v = q.best_v;
+	}
+	if (m->n_shape_items)
+		solve_candidates(m, ws, p, &q, &sv, r, 1);
+	else
+		solve_candidates(m, ws, p, &q, &sv, r, 0);
 	r->dist = sqrt(sv.best);
 	if (!isfinite(r->dist))
 		return PX_E_RANGE; /* overflow: see PX__MAX_QUERY_REACH */
