@@ -204,6 +204,10 @@ struct px_brep {
 	/* sign */
 	int closed;
 	px_vec3 *vnormal;          /* per vertex: angle-weighted pseudo-normal */
+	/* per face: +1 / -1 when its closed form's normal (brep_sign.c:
+	 * shape_normal()) is the outward one / its opposite, 0 when the
+	 * surface must be evaluated; NULL for open B-reps */
+	signed char *fsign;
 	char why[200];
 	char *name, *source;
 	size_t bytes;

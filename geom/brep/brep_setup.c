@@ -555,6 +555,7 @@ void px_brep_free(struct px_brep *b)
 	free(b->shell_solid);
 	free(b->shell_closed);
 	free(b->vnormal);
+	free(b->fsign);
 	free(b->mem);
 	free(b->name);
 	free(b->source);

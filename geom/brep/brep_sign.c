@@ -411,6 +411,8 @@ static int check_edges(struct px_brep *b, double tol)
 	return 1;
 }
 
+static int shape_signs(struct px_brep *b);
+
 int px__brep_sign_setup(struct px_brep *b)
 {
 	unsigned char *bad;
@@ -424,6 +426,8 @@ int px__brep_sign_setup(struct px_brep *b)
 		return PX_OK;
 	if (!check_edges(b, tol))
 		return PX_OK;
+	if (shape_signs(b) != PX_OK)
+		return PX_E_NOMEM;
 	b->vnormal = calloc((size_t)b->n_vertices + 1, sizeof(*b->vnormal));
 	bad = calloc((size_t)b->n_vertices + 1, 1);
 	if (!b->vnormal || !bad) {
@@ -475,6 +479,96 @@ static int edge_vertex(const struct px_brep *b, const struct px_dist_result *d)
 	return -1;
 }
 
+/*
+ * Unit normal at (or, off it, nearest to) x of the closed-form shape
+ * of a face (a parallelogram or a surface of revolution, px_recog.h):
+ * the profile's normal in x's meridian half-plane. Zero where that is
+ * not defined (x on the axis, at an arc's centre, another kind).
+ * @note RT-safe.
+ */
+static px_vec3 shape_normal(const struct px_recog_shape *sh, px_vec3 x)
+{
+	const struct px_recog_rev *rv = &sh->rev;
+	px_vec3 w, er, n;
+	double h, rho, l;
+
+	switch (sh->kind) {
+	case PX_RECOG_PARALLELOGRAM:
+		n = sh->quad.normal;
+		break;
+	case PX_RECOG_CYLINDER:
+	case PX_RECOG_CONE:
+	case PX_RECOG_ANNULUS:
+	case PX_RECOG_SPHERE:
+	case PX_RECOG_TORUS:
+		w = px_v3_sub(x, rv->origin);
+		h = px_v3_dot(rv->axis, w);
+		er = px_v3_madd(w, rv->axis, -h);
+		rho = px_v3_norm(er);
+		/* So near the axis the radial direction is rounding noise. */
+		if (!(rho > 1e-9 * px_v3_norm(w)))
+			return px_v3(0, 0, 0);
+		er = px_v3_scale(er, 1.0 / rho);
+		if (rv->profile_is_arc) /* from the arc's centre (h, rho) */
+			n = px_v3_madd(px_v3_scale(rv->axis, h - rv->parc.center.x), er,
+				       rho - rv->parc.center.y);
+		else /* across the segment's direction (dh, drho) */
+			n = px_v3_madd(px_v3_scale(rv->axis, -rv->pseg.dir.y), er,
+				       rv->pseg.dir.x);
+		break;
+	default:
+		return px_v3(0, 0, 0);
+	}
+	l = px_v3_norm(n);
+	return l > 0.0 ? px_v3_scale(n, 1.0 / l) : px_v3(0, 0, 0);
+}
+
+/* Outward unit normal of face f at its point x from the face's closed
+ * form, or zero when it has none (then the surface is evaluated). */
+static px_vec3 fast_normal(const struct px_brep *b, int f, px_vec3 x)
+{
+	if (!b->fsign || !b->fsign[f])
+		return px_v3(0, 0, 0);
+	return px_v3_scale(shape_normal(&b->dm->shape[b->n_edges + f], x),
+			   (double)b->fsign[f]);
+}
+
+/*
+ * Per face with a closed form: +1 / -1 when the shape's normal is the
+ * outward normal / its opposite, checked on a 3 x 3 set of interior
+ * parameters (the sign is the same all over a regular patch: both are
+ * continuous unit normal fields), 0 when a sample disagrees or is
+ * degenerate (then queries evaluate the surface). PX_OK or PX_E_NOMEM.
+ */
+static int shape_signs(struct px_brep *b)
+{
+	int f, i, j;
+	b->fsign = calloc((size_t)b->n_faces + 1, 1);
+	if (!b->fsign)
+		return PX_E_NOMEM;
+	b->bytes += (size_t)b->n_faces + 1;
+	for (f = 0; f < b->n_faces; f++) {
+		const struct px_recog_shape *sh = &b->dm->shape[b->n_edges + f];
+		double u0, u1, v0, v1;
+		int sg = 0, ok = sh->kind != PX_RECOG_NONE;
+		px_nurbs_surf_domain(&b->faces[f].surf, &u0, &u1, &v0, &v1);
+		for (i = 1; i <= 3 && ok; i++)
+			for (j = 1; j <= 3 && ok; j++) {
+				double u = u0 + (u1 - u0) * i / 4.0, v = v0 + (v1 - v0) * j / 4.0;
+				px_vec3 no = px__brep_face_normal(b, f, u, v);
+				px_vec3 ns = shape_normal(
+					sh, px_nurbs_surf_point(&b->faces[f].surf, u, v));
+				double c = px_v3_dot(no, ns);
+				int s = c > 0.99 ? 1 : (c < -0.99 ? -1 : 0);
+				if (!s || (sg && s != sg))
+					ok = 0;
+				sg = s;
+			}
+		b->fsign[f] = (signed char)(ok ? sg : 0);
+	}
+	return PX_OK;
+}
+
 int px__brep_sign(const struct px_brep *b, px_vec3 p,
 		  const struct px_dist_result *d)
 {
@@ -482,7 +576,10 @@ int px__brep_sign(const struct px_brep *b, px_vec3 p,
 	int k;
 
 	if (d->kind == PX_DIST_SURFACE) {
-		n = px__brep_face_normal(b, d->entity - b->n_edges, d->u, d->v);
+		int f = d->entity - b->n_edges;
+		n = fast_normal(b, f, d->point);
+		if (px_v3_dot(n, n) == 0.0)
+			n = px__brep_face_normal(b, f, d->u, d->v);
 	} else if (d->kind == PX_DIST_CURVE) {
 		int v = edge_vertex(b, d);
 		if (v >= 0) {
@@ -491,9 +588,13 @@ int px__brep_sign(const struct px_brep *b, px_vec3 p,
 			const struct brep_edge *e = &b->edges[d->entity];
 			for (k = 0; k < e->n_co; k++) {
 				const struct brep_coedge *c = &b->co[e->co[k]];
+				px_vec3 nf = fast_normal(b, c->face, d->point);
 				double u, v2;
-				coedge_uv(b, c, d->u, d->point, &u, &v2);
-				n = px_v3_add(n, px__brep_face_normal(b, c->face, u, v2));
+				if (px_v3_dot(nf, nf) == 0.0) {
+					coedge_uv(b, c, d->u, d->point, &u, &v2);
+					nf = px__brep_face_normal(b, c->face, u, v2);
+				}
+				n = px_v3_add(n, nf);
 			}
 		}
 	} else if (b->pts[d->entity].vertex >= 0) {
