@@ -46,6 +46,7 @@
 #include "px_control.h"
 #include "px_math.h"
 #include "px_model.h"
+#include "px_pair.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -204,6 +205,43 @@ PX_API const char *px_urdf_robot_body_link(const struct px_urdf_robot *r, int i)
  */
 PX_API int px_urdf_robot_set_q(struct px_urdf_robot *r, const double *q,
 			       px_pose *frames, size_t cap);
+
+/* ---- clearances ------------------------------------------------------------ */
+
+/*
+ * Obstacles the robot's bodies are measured against (models the caller
+ * keeps, posed by the caller; at most 1024). Sets up one model pair per
+ * body and obstacle and keeps each pair's last answer for coherence.
+ * Returns PX_OK, PX_E_INVAL, PX_E_RANGE (too many), PX_E_NOMEM. Setup.
+ */
+#define PX_URDF_MAX_OBSTACLES 1024
+PX_API int px_urdf_robot_set_obstacles(struct px_urdf_robot *r,
+				       struct px_model *const *obstacles, int n);
+
+/* The clearance of one body to one obstacle (px_pair.h's answer). */
+struct px_urdf_clearance {
+	int body, obstacle;
+	double distance_m;      /* -depth when they intersect */
+	px_vec3 point_robot;    /* on the body, world */
+	px_vec3 point_obstacle; /* on the obstacle, world */
+	px_vec3 normal;         /* unit, from the obstacle towards the body */
+	int intersecting;
+	int local_only;         /* may be only a local minimum */
+};
+
+/*
+ * Every body against every obstacle at the poses last set
+ * (px_urdf_robot_set_q() and the obstacles' own), as model pairs
+ * (px_pair_distance(); o NULL: defaults). coherent != 0 starts each
+ * pair from its answer of the last call. out (may be NULL, else cap >=
+ * bodies x obstacles entries, body-major) receives every pair; *min
+ * (may be NULL) the smallest. Returns the number of pairs, or
+ * PX_E_INVAL, PX_E_NOSPC, a pair's error. @note RT-safe.
+ */
+PX_API int px_urdf_robot_clearances(struct px_urdf_robot *r,
+				    const struct px_pair_opts *o, int coherent,
+				    struct px_urdf_clearance *out, size_t cap,
+				    struct px_urdf_clearance *min);
 
 #ifdef __cplusplus
 }

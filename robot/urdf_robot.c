@@ -23,6 +23,10 @@ struct px_urdf_robot {
 	struct px_urdf_body *bodies;
 	char (*body_link)[NAME_LEN];
 	px_pose frames[PX_CONTROL_MAX_JOINTS + 1];
+	/* clearances: obstacles and the last answer of each pair */
+	int n_obstacles;
+	struct px_model **obstacles;
+	struct px_pair_result *pairs;
 };
 
 void px_urdf_robot_free(struct px_urdf_robot *r)
@@ -34,6 +38,8 @@ void px_urdf_robot_free(struct px_urdf_robot *r)
 		px_model_free(r->bodies[i].model);
 	free(r->bodies);
 	free(r->body_link);
+	free(r->obstacles);
+	free(r->pairs);
 	free(r);
 }
 
@@ -346,4 +352,79 @@ int px_urdf_robot_set_q(struct px_urdf_robot *r, const double *q, px_pose *frame
 	if (frames)
 		memcpy(frames, r->frames, ((size_t)r->dof + 1) * sizeof(*frames));
 	return PX_OK;
+}
+
+int px_urdf_robot_set_obstacles(struct px_urdf_robot *r,
+				struct px_model *const *obstacles, int n)
+{
+	struct px_model **ob;
+	struct px_pair_result *pr;
+	int i;
+	if (!r || n < 0 || (n > 0 && !obstacles))
+		return PX_E_INVAL;
+	if (n > PX_URDF_MAX_OBSTACLES)
+		return PX_E_RANGE;
+	for (i = 0; i < n; i++)
+		if (!obstacles[i])
+			return PX_E_INVAL;
+	ob = calloc((size_t)n + 1, sizeof(*ob));
+	pr = calloc((size_t)n * (size_t)r->n_bodies + 1, sizeof(*pr));
+	if (!ob || !pr) {
+		free(ob);
+		free(pr);
+		return PX_E_NOMEM;
+	}
+	if (n)
+		memcpy(ob, obstacles, (size_t)n * sizeof(*ob));
+	free(r->obstacles);
+	free(r->pairs);
+	r->obstacles = ob;
+	r->pairs = pr;
+	r->n_obstacles = n;
+	return PX_OK;
+}
+
+int px_urdf_robot_clearances(struct px_urdf_robot *r, const struct px_pair_opts *o,
+			     int coherent, struct px_urdf_clearance *out, size_t cap,
+			     struct px_urdf_clearance *min)
+{
+	struct px_pair_opts po;
+	int b, k, n = 0, rc;
+	if (!r)
+		return PX_E_INVAL;
+	if (out && cap < (size_t)r->n_bodies * (size_t)r->n_obstacles)
+		return PX_E_NOSPC;
+	if (o)
+		po = *o;
+	else
+		memset(&po, 0, sizeof(po));
+	po.coherent = coherent ? 1 : 0;
+	if (min) {
+		memset(min, 0, sizeof(*min));
+		min->body = min->obstacle = -1;
+		min->distance_m = INFINITY;
+	}
+	for (b = 0; b < r->n_bodies; b++)
+		for (k = 0; k < r->n_obstacles; k++, n++) {
+			struct px_pair_result *p = &r->pairs[n];
+			struct px_urdf_clearance c;
+			if (!coherent)
+				p->valid = 0;
+			rc = px_pair_distance(r->obstacles[k], r->bodies[b].model, &po, p);
+			if (rc)
+				return rc;
+			c.body = b;
+			c.obstacle = k;
+			c.distance_m = p->distance;
+			c.point_robot = p->point_b;
+			c.point_obstacle = p->point_a;
+			c.normal = p->normal;
+			c.intersecting = p->intersecting;
+			c.local_only = p->local_only;
+			if (out)
+				out[n] = c;
+			if (min && c.distance_m < min->distance_m)
+				*min = c;
+		}
+	return n;
 }

@@ -15,6 +15,8 @@
 #include <unistd.h>
 
 #include "px_alloc_count.h"
+#include "px_cloud.h"
+#include "px_prim.h"
 #include "px_features.h"
 #include "px_test.h"
 #include "px_urdf.h"
@@ -411,6 +413,98 @@ static void test_set_q_no_alloc(void)
 	px_urdf_robot_free(r);
 }
 
+/* Clearances of every body against a sphere and a point cloud: each
+ * pair against point queries (the sphere: its centre's signed distance
+ * minus the radius; the cloud: the nearest of its points), cold and
+ * coherent along a joint path, no allocation. */
+static void test_clearances(void)
+{
+	struct px_urdf *u;
+	struct px_urdf_robot *r;
+	struct px_urdf_error e;
+	struct px_model *obs[2], *ball, *cloud;
+	struct px_prim sp = {PX_PRIM_SPHERE, 0.08, 0, 0};
+	struct px_urdf_clearance cl[64], mn;
+	double pts[3 * 40];
+	px_pose pose = px_pose_identity();
+	int i, k, n, nb, checked = 0, certified = 0;
+	uint64_t a;
+	PX_NEEDS(XML);
+	PX_NEEDS(ASSIMP);
+	u = load_arm();
+	PX_CHECK_INT_EQ(px_urdf_robot_create(u, "base", "tool", px_pose_identity(), &r, &e), PX_OK);
+	px_urdf_free(u);
+	PX_CHECK_INT_EQ(px_prim_model(&sp, &ball), PX_OK);
+	pose.t = px_v3(0.25, 0.1, 0.45);
+	PX_CHECK_INT_EQ(px_model_set_pose(ball, pose), PX_OK);
+	for (i = 0; i < 40; i++) {
+		pts[3 * i] = -0.3 + 0.02 * (i % 8);
+		pts[3 * i + 1] = 0.2 + 0.03 * (i / 8);
+		pts[3 * i + 2] = 0.3 + 0.01 * (i % 5);
+	}
+	PX_CHECK_INT_EQ(px_cloud_model(pts, 40, 0.0, NULL, &cloud), PX_OK);
+	obs[0] = ball;
+	obs[1] = cloud;
+	PX_CHECK_INT_EQ(px_urdf_robot_set_obstacles(r, obs, 2), PX_OK);
+	nb = px_urdf_robot_body_count(r);
+	PX_CHECK(2 * nb <= 64);
+	for (i = 0; i < 200; i++) {
+		double q[6], t = i / 199.0;
+		q[0] = 2.5 * sin(3.1 * t);
+		q[1] = -1.0 + 1.5 * t;
+		q[2] = 2.0 * cos(2.3 * t);
+		q[3] = 0.1 + 0.1 * sin(5 * t);
+		q[4] = 1.2 * sin(1.7 * t);
+		q[5] = t;
+		PX_CHECK_INT_EQ(px_urdf_robot_set_q(r, q, NULL, 0), PX_OK);
+		a = px_alloc_region_begin();
+		n = px_urdf_robot_clearances(r, NULL, i > 0, cl, 64, &mn);
+		PX_CHECK_INT_EQ(px_alloc_region_end(a), 0);
+		PX_CHECK_INT_EQ(n, 2 * nb);
+		for (k = 0; k < n; k++) {
+			const struct px_urdf_body *bd = px_urdf_robot_body(r, cl[k].body);
+			struct px_model_result res;
+			double ref = INFINITY;
+			if (cl[k].obstacle == 0) {
+				PX_CHECK_INT_EQ(px_model_query(bd->model, pose.t, &res), 1);
+				ref = res.distance - sp.a;
+			} else {
+				int j;
+				for (j = 0; j < 40; j++) {
+					PX_CHECK_INT_EQ(px_model_query(bd->model,
+								      px_v3(pts[3 * j], pts[3 * j + 1], pts[3 * j + 2]),
+								      &res), 1);
+					ref = fmin(ref, res.distance);
+				}
+			}
+			PX_CHECK(mn.distance_m <= cl[k].distance_m);
+			if (ref <= 1e-6)
+				continue; /* touching or inside: the pair's depth, not a distance */
+			/* never below the truth; equal where certified */
+			PX_CHECK_MSG(cl[k].distance_m >= ref - 1e-9,
+				     "step %d body %d (%s) obstacle %d: %.12g below the reference %.12g",
+				     i, cl[k].body, px_urdf_robot_body_link(r, cl[k].body),
+				     cl[k].obstacle, cl[k].distance_m, ref);
+			checked++;
+			if (!cl[k].local_only) {
+				certified++;
+				PX_CHECK_MSG(fabs(cl[k].distance_m - ref) <= 1e-9,
+					     "step %d body %d (%s) obstacle %d: %.12g, reference %.12g",
+					     i, cl[k].body, px_urdf_robot_body_link(r, cl[k].body),
+					     cl[k].obstacle, cl[k].distance_m, ref);
+				PX_CHECK(fabs(px_v3_dist(cl[k].point_robot, cl[k].point_obstacle) -
+					      cl[k].distance_m) <= 1e-6);
+			}
+		}
+	}
+	PX_CHECK_MSG(checked > 1000 && certified * 2 > checked,
+		     "%d pairs checked, %d certified", checked, certified);
+	PX_CHECK_INT_EQ(px_urdf_robot_clearances(r, NULL, 0, cl, 3, NULL), PX_E_NOSPC);
+	px_urdf_robot_free(r);
+	px_model_free(ball);
+	px_model_free(cloud);
+}
+
 /* ---- refusals ---------------------------------------------------------- */
 
 static void refused(const char *what, const char *xml, int code, const char *place)
@@ -536,6 +630,7 @@ static void test_cleanup(void)
 
 static const struct px_test tests[] = {
 	PX_T(test_reads_the_arm), PX_T(test_forward_kinematics), PX_T(test_shapes),
-	PX_T(test_set_q_no_alloc), PX_T(test_refusals), PX_T(test_chain_refusals),
+	PX_T(test_set_q_no_alloc), PX_T(test_clearances), PX_T(test_refusals),
+	PX_T(test_chain_refusals),
 	PX_T(test_cleanup)};
 PX_TEST_MAIN(tests)
