@@ -338,12 +338,7 @@ static int load_nurbs(const char *path, struct px_model **out, char *msg,
 	memset(&err, 0, sizeof(err));
 	rc = px_obj_load_file(path, &obj, &err);
 	if (rc != PX_OK) {
-		if (err.line > 0)
-			snprintf(msg, cap, "%.256s:%d:%d: %.256s", path, err.line,
-				 err.column, err.msg);
-		else
-			snprintf(msg, cap, "%.256s: %.256s", path,
-				 err.msg[0] ? err.msg : px_strerror(rc));
+		px_obj_error_text(&err, path, rc, msg, cap);
 		return rc;
 	}
 	curves = calloc((size_t)obj->n_entities + 1, sizeof(*curves));

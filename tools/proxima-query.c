@@ -294,12 +294,9 @@ static int load_obj(struct query *q)
 	const struct px_obj_model *obj;
 	int i, rc = px_obj_load_file(q->model_path, &q->obj, &oerr);
 	if (rc) {
-		if (oerr.line > 0)
-			fprintf(stderr, "%s: %s:%d:%d: %s\n", prog, oerr.file,
-				oerr.line, oerr.column, oerr.msg);
-		else
-			fprintf(stderr, "%s: %s: %s\n", prog, q->model_path,
-				oerr.msg[0] ? oerr.msg : px_strerror(rc));
+		char m[600];
+		fprintf(stderr, "%s: %s\n", prog,
+			px_obj_error_text(&oerr, q->model_path, rc, m, sizeof(m)));
 		return 1;
 	}
 	obj = q->obj;

@@ -375,14 +375,7 @@ int px_model_load_obj_brep(const char *path, double scale, int *trimmed,
 	if (!rc)
 		rc = px_model_from_brep(b, out);
 	if (rc) {
-		if (msg && msg_cap) {
-			if (e.line > 0)
-				snprintf(msg, msg_cap, "%s:%d:%d: %s", path, e.line,
-					 e.column, e.msg);
-			else
-				snprintf(msg, msg_cap, "%s: %s", path,
-					 e.msg[0] ? e.msg : px_strerror(rc));
-		}
+		px_obj_error_text(&e, path, rc, msg, msg_cap);
 		return rc;
 	}
 	px_brep_get_info(px_model_brep(*out), &info);

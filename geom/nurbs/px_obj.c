@@ -1310,3 +1310,17 @@ void px_obj_free(struct px_obj_model *m)
 	free(m->triangles);
 	free(m);
 }
+
+const char *px_obj_error_text(const struct px_obj_error *err, const char *path,
+			      int rc, char *buf, size_t cap)
+{
+	if (!buf || !cap)
+		return buf;
+	if (err && err->line > 0)
+		snprintf(buf, cap, "%s:%d:%d: %s", err->file, err->line, err->column,
+			 err->msg);
+	else
+		snprintf(buf, cap, "%s: %s", path ? path : "",
+			 err && err->msg[0] ? err->msg : px_strerror(rc));
+	return buf;
+}

@@ -155,6 +155,13 @@ PX_API int px_obj_load_mem(const char *name, const char *data, size_t len,
 /* Release a model; NULL is a no-op. */
 PX_API void px_obj_free(struct px_obj_model *m);
 
+/* The message of a failed load, for users: "FILE:LINE:COL: MSG" where
+ * the error has a place, else "PATH: MSG" (px_strerror(rc) when err has
+ * no message). Written into buf (cap bytes); returns buf. */
+PX_API const char *px_obj_error_text(const struct px_obj_error *err,
+				     const char *path, int rc, char *buf,
+				     size_t cap);
+
 #ifdef __cplusplus
 }
 #endif

@@ -72,11 +72,8 @@ static int load_obj(const char *path, struct px_model **out, char *msg,
 		msg[0] = '\0';
 	rc = px_obj_load_file(path, &obj, &oe);
 	if (rc) {
-		if (oe.line > 0)
-			return say(msg, cap, rc, "%s:%d:%d: %s", oe.file, oe.line,
-				   oe.column, oe.msg);
-		return say(msg, cap, rc, "%s: %s", path,
-			   oe.msg[0] ? oe.msg : px_strerror(rc));
+		px_obj_error_text(&oe, path, rc, msg, cap);
+		return rc;
 	}
 	if (obj->n_entities > 0 && obj->n_triangles > 0) {
 		px_obj_free(obj);
