@@ -57,7 +57,7 @@ ALL_LDFLAGS := $(SANFLAGS) $(LDFLAGS)
 # hidapi comes as two builds with the same symbols: HIDAPI=hidraw
 # (default, /dev/hidraw*) or HIDAPI=libusb.
 HIDAPI   ?= hidraw
-OPT_PARTS := HIDAPI LIBUSB SOCKETCAN GPIOD ASSIMP YAML OCCT XML
+OPT_PARTS := HIDAPI LIBUSB SOCKETCAN GPIOD ASSIMP YAML OCCT XML DDS
 OPT_DEVICE_PARTS := HIDAPI LIBUSB SOCKETCAN GPIOD
 PKG_HIDAPI    := hidapi-$(HIDAPI)
 PKG_LIBUSB    := libusb-1.0
@@ -66,6 +66,7 @@ PKG_GPIOD     := libgpiod
 PKG_ASSIMP    := assimp
 PKG_YAML      := yaml-0.1
 PKG_XML       := libxml-2.0
+PKG_DDS       := CycloneDDS
 SRC_HIDAPI    := px_hidapi.c
 SRC_LIBUSB    := px_usb.c
 SRC_SOCKETCAN := px_socketcan.c
@@ -74,6 +75,7 @@ SRC_ASSIMP    := px_import.c
 SRC_YAML      := px_config_yaml.c
 SRC_OCCT      := cad_occt.cpp
 SRC_XML       := urdf_xml.c
+SRC_DDS       := px_bridge_dds.c
 # Tests name the parts they need by these tags (PX_TEST_NEEDS, tests/run.sh).
 TAG_HIDAPI    := hidapi
 TAG_LIBUSB    := libusb
@@ -83,6 +85,7 @@ TAG_ASSIMP    := assimp
 TAG_YAML      := libyaml
 TAG_OCCT      := occt
 TAG_XML       := libxml2
+TAG_DDS       := cyclonedds
 DESC_HIDAPI    := HID devices (hidapi-$(HIDAPI))
 DESC_LIBUSB    := USB devices (libusb-1.0)
 DESC_SOCKETCAN := CAN interface state and bitrate (libsocketcan)
@@ -91,6 +94,7 @@ DESC_ASSIMP    := mesh files (assimp)
 DESC_YAML      := YAML configs (libyaml)
 DESC_OCCT      := STEP and IGES parts (OpenCASCADE)
 DESC_XML       := URDF robots (libxml2)
+DESC_DDS       := ROS 2 compatible DDS bridge (Cyclone DDS and its idlc)
 WITH_DEVICES ?= 1
 pc_have = $(shell pkg-config --exists $(1) 2>/dev/null && echo 1 || echo 0)
 # OpenCASCADE: its headers, the toolkits the importer links (C++, so the
@@ -99,8 +103,12 @@ OCCT_INC := /usr/include/opencascade
 OCCT_PART_LIBS := -lTKXSBase -lTKSTEP -lTKSTEPBase -lTKSTEPAttr -lTKSTEP209 -lTKIGES \
   -lTKShHealing -lTKTopAlgo -lTKBRep -lTKGeomAlgo -lTKGeomBase -lTKG3d -lTKG2d -lTKMath \
   -lTKernel -lstdc++
+# Cyclone DDS: its library and the IDL compiler that turns bridge/idl/
+# into C (cyclonedds-tools).
+IDLC ?= $(shell command -v idlc 2>/dev/null)
 have_part = $(if $(filter OCCT,$(1)),$(if $(wildcard $(OCCT_INC)/Standard.hxx),1,0),\
-  $(call pc_have,$(PKG_$(1))))
+  $(if $(filter DDS,$(1)),$(if $(IDLC),$(call pc_have,$(PKG_DDS)),0),\
+  $(call pc_have,$(PKG_$(1)))))
 # Found once per make (a sub-make after `make deps` looks again).
 $(foreach p,$(OPT_PARTS),$(if $(filter undefined,$(origin WITH_$(p))),\
   $(eval WITH_$(p) := $(if $(and $(filter $(p),$(OPT_DEVICE_PARTS)),$(filter 0,$(WITH_DEVICES))),0,$(call have_part,$(p))))))
@@ -128,6 +136,16 @@ LIB_CXX_SRC := $(filter-out $(addprefix %/,$(OPT_OUT_SRC)),\
 LIB_OBJ  := $(patsubst %.c,$(BUILD)/obj/%.o,$(LIB_SRC)) \
             $(patsubst %.cpp,$(BUILD)/obj/%.o,$(LIB_CXX_SRC))
 PUB_HDRS := $(filter-out %internal.h,$(foreach d,$(MODULE_DIRS),$(wildcard $(d)/px*.h)))
+# The DDS bridge's message types: bridge/idl/*.idl compiled by idlc at
+# build time into $(BUILD)/gen/bridge/ (C types and topic descriptors,
+# never in the tree), their objects into the library.
+DDS_IDL   := $(wildcard bridge/idl/*.idl)
+DDS_GEN   := $(BUILD)/gen/bridge
+DDS_GEN_H := $(patsubst bridge/idl/%.idl,$(DDS_GEN)/%.h,$(DDS_IDL))
+DDS_GEN_OBJ := $(patsubst bridge/idl/%.idl,$(BUILD)/obj/gen-bridge/%.o,$(DDS_IDL))
+ifeq ($(WITH_DDS),1)
+LIB_OBJ  += $(DDS_GEN_OBJ)
+endif
 
 # tests/ mirrors the tree: the test of geom/track/ is tests/geom/track/
 # test_*.c, the shared fixtures are in tests/support/. The binaries stay
@@ -210,6 +228,8 @@ DEB_PACKAGES := gcc make libc6-dev pkg-config
 DEB_PACKAGES += libhidapi-dev libusb-1.0-0-dev libsocketcan-dev libgpiod-dev
 # static linking of hidapi and libusb needs libudev.so
 DEB_PACKAGES += libudev-dev
+# bridge/: the DDS bridge (Cyclone DDS and its IDL compiler).
+DEB_PACKAGES += cyclonedds-dev cyclonedds-tools
 # Debian packages the benchmarks compare against (installed by `make bench`;
 # a benchmark whose reference is missing says so and still runs).
 BENCH_DEB_PACKAGES := rt-tests g++ libocct-modeling-algorithms-dev
@@ -283,6 +303,22 @@ $(PY_STAMP): $(PY_SRC) $(SHARED_LIB) $(PUB_HDRS)
 $(BUILD)/obj/%.o: %.c | $(FEATURES_H)
 	@mkdir -p $(dir $@)
 	$(CC) $(ALL_CFLAGS) -I$(BUILD)/gen $(PKG_CFLAGS) -fPIC -c $< -o $@
+
+# idlc writes a .c and a .h per IDL file; the includes between the IDL
+# files become includes between the headers.
+$(DDS_GEN)/%.c $(DDS_GEN)/%.h: bridge/idl/%.idl $(DDS_IDL)
+	@mkdir -p $(DDS_GEN)
+	$(IDLC) -x final -Ibridge/idl -o $(DDS_GEN) $<
+
+$(BUILD)/obj/gen-bridge/%.o: $(DDS_GEN)/%.c $(DDS_GEN_H)
+	@mkdir -p $(dir $@)
+	$(CC) $(ALL_CFLAGS) -I$(DDS_GEN) $(PKG_CFLAGS) -fPIC -c $< -o $@
+
+# What includes the generated headers (the bridge, its tests) sees them.
+ifeq ($(WITH_DDS),1)
+$(BUILD)/obj/bridge/%.o $(BUILD)/obj-hooks/bridge/%.o $(BUILD)/obj/tests/bridge/%.o: ALL_CFLAGS += -I$(DDS_GEN)
+$(patsubst %.c,$(BUILD)/obj/%.o,$(wildcard bridge/*.c tests/bridge/*.c)): | $(DDS_GEN_H)
+endif
 
 $(BUILD)/obj/%.o: %.cpp | $(FEATURES_H)
 	@mkdir -p $(dir $@)
@@ -539,9 +575,11 @@ FUZZ_NAMES   := $(patsubst fuzz/fuzz_%.c,%,$(FUZZ_SRC))
 comma        := ,
 FUZZ_RUN     := $(if $(FUZZ_TARGETS),$(subst $(comma), ,$(FUZZ_TARGETS)),$(FUZZ_NAMES))
 FUZZ_BIN     := $(patsubst %,$(BUILD)/fuzz/fuzz_%,$(FUZZ_NAMES))
-# C++ parts are built with their C stand-in there (the fuzz targets
-# reach no C++ library).
-FUZZ_LIB_OBJ := $(patsubst %.c,$(BUILD)/fuzz/obj/%.o,$(LIB_SRC) $(LIB_CXX_SRC:.cpp=_none.c))
+# C++ parts and the DDS bridge are built with their C stand-ins there
+# (the fuzz targets reach neither C++ nor DDS, whose generated types are
+# not in the fuzz build).
+FUZZ_LIB_SRC := $(patsubst %/$(SRC_DDS),%/$(SRC_DDS:.c=_none.c),$(LIB_SRC))
+FUZZ_LIB_OBJ := $(patsubst %.c,$(BUILD)/fuzz/obj/%.o,$(FUZZ_LIB_SRC) $(LIB_CXX_SRC:.cpp=_none.c))
 FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=undefined
 FUZZ_FLAGS   := -std=c11 -D_GNU_SOURCE $(WARN) $(INCS) -g -O1 \
                 -Wno-unused-function -fno-omit-frame-pointer $(FUZZ_SAN)

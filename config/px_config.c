@@ -1072,6 +1072,7 @@ static const struct px_config_key root_keys[] = {
 	K_MAP(struct px_config, scene, "scene"),
 	K_MAP(struct px_config, control, "control"),
 	K_MAP(struct px_config, sim, "sim"),
+	K_MAP(struct px_config, bridge, "bridge"),
 };
 SCHEMA(root_schema, "config", root_keys, root_check);
 

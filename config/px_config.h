@@ -709,6 +709,7 @@ struct px_config {
 	const struct px_config_node *scene;
 	const struct px_config_node *control;
 	const struct px_config_node *sim;
+	const struct px_config_node *bridge; /* read by bridge/px_bridge.h */
 	struct px_config_doc *doc; /* owns every string and array above */
 };
 

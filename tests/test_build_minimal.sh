@@ -1,10 +1,11 @@
 #!/bin/sh
 # The library with every optional part left out (WITH_DEVICES=0
-# WITH_ASSIMP=0 WITH_YAML=0 WITH_OCCT=0), built into its own directory and installed
-# into a scratch DESTDIR: it needs libc, libm and pthread alone, its
-# proxima.pc requires nothing, px_features.h says so, the examples link
-# with only -lproxima -lm -lpthread and run, and each left-out part
-# answers PX_E_UNSUPPORTED with a message naming its library.
+# WITH_ASSIMP=0 WITH_YAML=0 WITH_OCCT=0 WITH_XML=0 WITH_DDS=0), built
+# into its own directory and installed into a scratch DESTDIR: it needs
+# libc, libm and pthread alone, its proxima.pc requires nothing,
+# px_features.h says so, the examples link with only -lproxima -lm
+# -lpthread and run, and each left-out part answers PX_E_UNSUPPORTED with
+# a message naming its library.
 # Prints a harness-style summary line.
 set -u
 name=test_build_minimal
@@ -27,7 +28,7 @@ check() { # description, command...
 full=${BUILD:-build}
 min="$tmp/build"
 root="$tmp/root"
-off="WITH_DEVICES=0 WITH_ASSIMP=0 WITH_YAML=0 WITH_OCCT=0 WITH_XML=0"
+off="WITH_DEVICES=0 WITH_ASSIMP=0 WITH_YAML=0 WITH_OCCT=0 WITH_XML=0 WITH_DDS=0"
 # The full build's objects are the same code: starting from them, only
 # the parts' *_none.c files compile here.
 mkdir -p "$min"
@@ -42,8 +43,8 @@ check "px_features.h: every part 0" \
 	       grep -q 'PX_HAVE_YAML 0' '$inc/proxima/px_features.h'"
 check "proxima.pc requires nothing" grep -qx 'Requires.private: *' "$lib/pkgconfig/proxima.pc"
 nolibs() { # the shared library needs no optional library
-	ldd "$lib/libproxima.so" | grep -E 'yaml|hidapi|usb|socketcan|gpiod|assimp|libTK|stdc\+\+|xml2' && return 1
-	nm -u "$lib/libproxima.a" | grep -E ' (yaml_|hid_|libusb_|can_(do|get|set)_|gpiod_|aiImport|_Z|xml)' && return 1
+	ldd "$lib/libproxima.so" | grep -E 'yaml|hidapi|usb|socketcan|gpiod|assimp|libTK|stdc\+\+|xml2|ddsc' && return 1
+	nm -u "$lib/libproxima.a" | grep -E ' (yaml_|hid_|libusb_|can_(do|get|set)_|gpiod_|aiImport|_Z|xml|dds_)' && return 1
 	return 0
 }
 check "libproxima uses no optional library" nolibs
@@ -77,6 +78,7 @@ cat >"$tmp/parts.c" <<'C'
 #include <proxima/px_mesh.h>
 #include <proxima/px_cad.h>
 #include <proxima/px_urdf.h>
+#include <proxima/px_bridge.h>
 #include <stdio.h>
 #include <string.h>
 static int says(const char *what, int rc, const char *msg, const char *lib)
@@ -124,7 +126,15 @@ int main(int argc, char **argv)
 		rc = px_urdf_load_mem("arm.urdf", "<robot/>", 8, NULL, &u, &ue);
 		bad |= says("urdf", rc, ue.msg, "libxml2") || u != NULL;
 	}
-	return bad || PX_HAVE_YAML || PX_HAVE_HIDAPI || PX_HAVE_OCCT || PX_HAVE_XML;
+	{
+		struct px_bridge_config bc;
+		struct px_bridge *b = NULL;
+		px_bridge_config_default(&bc);
+		rc = px_bridge_create(&bc, &b, msg, sizeof msg);
+		bad |= says("bridge", rc, msg, "Cyclone DDS") || b != NULL;
+	}
+	return bad || PX_HAVE_YAML || PX_HAVE_HIDAPI || PX_HAVE_OCCT || PX_HAVE_XML ||
+	       PX_HAVE_DDS;
 }
 C
 check "a program using the left-out parts links" \

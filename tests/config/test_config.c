@@ -250,7 +250,8 @@ static void test_value_errors(void)
 		     "t.yaml:1:1: scenery: unknown key (did you mean 'scene'?)");
 	expect_error("robot: {}\n",
 		     "t.yaml:1:1: robot: unknown key (expected one of: version, "
-		     "loop, safety, telemetry, devices, scene, control, sim)");
+		     "loop, safety, telemetry, devices, scene, control, sim, "
+		     "bridge)");
 	expect_error("version: 2\n",
 		     "t.yaml:1:10: version: 2 is out of range [1, 1]");
 	/* UTF-8 text is shown as text; line separators and C1 controls are

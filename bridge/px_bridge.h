@@ -1,0 +1,213 @@
+/*
+ * px_bridge.h - a ROS 2 compatible DDS bridge (Eclipse Cyclone DDS): the
+ * loop's tool and proxy poses, force, distance and status published on
+ * DDS topics that ROS 2 nodes and tools read as their own.
+ *
+ * Conventions (ROS 2 Humble, Iron and Jazzy alike; docs/bridge.md):
+ * topics are named "rt/<namespace>/<name>", types
+ * "<package>::msg::dds_::<Type>_" with ROS 2's message layouts (the IDL
+ * files in bridge/idl/, compiled by Cyclone's idlc at build time).
+ * Streams are best-effort keep-last-1, the status reliable keep-last-1;
+ * both volatile, as ROS 2's sensor-data and default profiles.
+ *
+ * Threads: px_bridge_create() starts one bridge thread that publishes
+ * the offered samples, each stream at its configured rate in the
+ * samples' own time (their stamps), and the newest status at its rate.
+ * px_bridge_offer() and px_bridge_offer_status() copy a sample into the
+ * bridge's queue under a short lock and return: call them from a
+ * non-real-time thread (the app's drain), never from a cycle. px_bridge_publish_*() write at once
+ * from the calling (non-real-time) thread. A bridge is used by one
+ * feeding thread at a time besides its own.
+ *
+ * Memory: create allocates (the DDS entities, the thread); offering and
+ * the bridge thread's publishing may allocate inside Cyclone DDS. Nothing
+ * here is real-time safe; the loop's thread never calls it.
+ *
+ * Build: an optional part (PX_HAVE_DDS in px_features.h). Without Cyclone
+ * DDS the config functions work and px_bridge_create() returns
+ * PX_E_UNSUPPORTED, saying "built without Cyclone DDS".
+ */
+#ifndef PX_BRIDGE_H
+#define PX_BRIDGE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "px_base.h"
+#include "px_config.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+struct px_bridge;
+
+/* The streams the bridge publishes, and the direct-write topics. */
+enum px_bridge_topic {
+	PX_BRIDGE_TOOL_POSE = 0, /* geometry_msgs/PoseStamped "tool_pose" */
+	PX_BRIDGE_PROXY_POSE,    /* geometry_msgs/PoseStamped "proxy_pose" */
+	PX_BRIDGE_WRENCH,        /* geometry_msgs/WrenchStamped "wrench" */
+	PX_BRIDGE_CLOSEST_POINT, /* geometry_msgs/PointStamped "closest_point" */
+	PX_BRIDGE_DISTANCE,      /* proxima_msgs/Distance "distance" */
+	PX_BRIDGE_STATUS,        /* proxima_msgs/Status "status" (reliable) */
+	PX_BRIDGE_JOINT_STATES,  /* sensor_msgs/JointState "joint_states" */
+	PX_BRIDGE_CLOUD,         /* sensor_msgs/PointCloud2 "cloud" */
+	PX_BRIDGE_TOPIC__COUNT
+};
+
+/* Discovery: unicast to the peers on this machine, or multicast. */
+enum px_bridge_discovery {
+	PX_BRIDGE_DISCOVERY_AUTO = 0, /* unicast on loopback, else multicast */
+	PX_BRIDGE_DISCOVERY_UNICAST,
+	PX_BRIDGE_DISCOVERY_MULTICAST
+};
+
+#define PX_BRIDGE_NAME_MAX 128 /* namespace, interface, frame id */
+#define PX_BRIDGE_TOPIC_MAX 192 /* "rt/<namespace>/<name>" */
+#define PX_BRIDGE_DDS_CONFIG_MAX 1024 /* the generated Cyclone XML */
+
+/* The section "bridge" of a config (docs/config.md). Rates in Hz; 0
+ * leaves that stream unpublished. Strings point into the config's
+ * document (or are the caller's). */
+struct px_bridge_config {
+	bool enable;
+	int64_t domain_id;       /* 0..232 */
+	const char *ns;          /* key "namespace": ROS 2 name, no leading / */
+	const char *interface;   /* network interface name or IPv4 address */
+	int discovery;           /* enum px_bridge_discovery */
+	const char *frame_id;    /* header.frame_id of every message */
+	double tool_pose_rate_hz;
+	double proxy_pose_rate_hz;
+	double wrench_rate_hz;
+	double distance_rate_hz; /* distance and closest_point */
+	double status_rate_hz;
+};
+
+/* Defaults: off, domain 0, namespace "proxima", interface "lo",
+ * discovery auto, frame "world", streams at 100 Hz (distance 50 Hz),
+ * status at 10 Hz. */
+PX_API void px_bridge_config_default(struct px_bridge_config *c);
+
+/* The section's schema (tools and the docs check). */
+PX_API const struct px_config_schema *px_bridge_config_schema(void);
+
+/*
+ * Read the section "bridge" of a loaded config into out (defaults when
+ * absent). Problems go to diag as "file:line:column: bridge.key: what".
+ * Returns PX_OK, PX_E_PARSE or PX_E_INVAL (NULL).
+ */
+PX_API int px_bridge_config_read(const struct px_config *cfg,
+				 struct px_bridge_config *out,
+				 struct px_config_diag *diag);
+
+/* Check a filled config (also one made in code): names, ranges. PX_OK
+ * or PX_E_INVAL with why. */
+PX_API int px_bridge_config_check(const struct px_bridge_config *c,
+				  char *why, size_t cap);
+
+/* "rt/<namespace>/<name>" into buf. PX_OK or PX_E_RANGE (too long). */
+PX_API int px_bridge_topic_name(const char *ns, const char *name, char *buf,
+				size_t cap);
+
+/* A topic's name ("tool_pose") and its DDS type name
+ * ("geometry_msgs::msg::dds_::PoseStamped_"); NULL out of range. */
+PX_API const char *px_bridge_topic_short_name(enum px_bridge_topic t);
+PX_API const char *px_bridge_topic_type_name(enum px_bridge_topic t);
+/* 1: the topic is reliable (status), 0: best-effort keep-last-1. */
+PX_API int px_bridge_topic_reliable(enum px_bridge_topic t);
+
+/* The topic's type for a reader of one's own: Cyclone DDS's
+ * dds_topic_descriptor_t (const), compiled from bridge/idl/. NULL out of
+ * range or in a build without Cyclone DDS. */
+PX_API const void *px_bridge_topic_descriptor(enum px_bridge_topic t);
+
+/*
+ * The Cyclone DDS configuration the bridge runs with (XML, the content a
+ * CYCLONEDDS_URI could hold): the interface, multicast off and the
+ * localhost peers for unicast discovery. PX_OK or PX_E_RANGE / PX_E_INVAL.
+ */
+PX_API int px_bridge_dds_config(const struct px_bridge_config *c, char *buf,
+				size_t cap);
+
+/* What the loop did, as one feeding thread offers it. Times are
+ * CLOCK_REALTIME nanoseconds (ROS 2's stamps). */
+struct px_bridge_sample {
+	int64_t stamp_ns;
+	double tool_m[3];
+	double tool_quat_xyzw[4];
+	double proxy_m[3];
+	double force_n[3];
+	double torque_n_m[3];
+	bool distance_valid;
+	double distance_m;      /* signed: < 0 in contact */
+	double tool_point_m[3]; /* the point the distance is measured from */
+	double closest_m[3];    /* the closest point of the scene */
+	double normal[3];       /* unit, from the scene towards the tool */
+};
+
+struct px_bridge_status {
+	int64_t stamp_ns;
+	double loop_rate_hz;
+	double latency_p50_us, latency_p99_us, latency_max_us;
+	bool safe_state;
+	uint64_t cycles, overruns, faults, safe_state_trips;
+	uint64_t telemetry_dropped;
+};
+
+/* What the bridge did. */
+struct px_bridge_counts {
+	uint64_t offered, status_offered;
+	uint64_t dropped; /* offered samples the queue had no room for */
+	uint64_t published[PX_BRIDGE_TOPIC__COUNT];
+	uint64_t write_errors;
+	int last_error; /* Cyclone's return code of the last failed write */
+};
+
+/*
+ * Join the domain with the configuration of px_bridge_dds_config(),
+ * make the topics and writers and start the bridge thread. c's strings
+ * are copied. Returns PX_OK, PX_E_INVAL (c refused: msg says why),
+ * PX_E_IO (Cyclone DDS refused: msg has its reason), PX_E_NOMEM or
+ * PX_E_UNSUPPORTED (built without Cyclone DDS).
+ */
+PX_API int px_bridge_create(const struct px_bridge_config *c,
+			    struct px_bridge **out, char *msg, size_t cap);
+
+/* A sample for the bridge thread's queue (full: the oldest is dropped and
+ * counted), stamps in increasing order; the newest status. PX_OK or
+ * PX_E_INVAL. */
+PX_API int px_bridge_offer(struct px_bridge *b,
+			   const struct px_bridge_sample *s);
+PX_API int px_bridge_offer_status(struct px_bridge *b,
+				  const struct px_bridge_status *s);
+
+/* Write one message now. names may be NULL (then "joint<i>"); position,
+ * velocity, effort may be NULL (an empty array, as ROS 2 allows).
+ * PX_OK, PX_E_INVAL or PX_E_IO. */
+PX_API int px_bridge_publish_joint_state(struct px_bridge *b, int64_t stamp_ns,
+					 size_t n, const char *const *names,
+					 const double *position_rad,
+					 const double *velocity_rad_per_s,
+					 const double *effort_n_m);
+/* n points x, y, z (float32, metres) as an unordered dense cloud. */
+PX_API int px_bridge_publish_cloud(struct px_bridge *b, int64_t stamp_ns,
+				   const float *xyz_m, size_t n);
+
+/* Wait (at most timeout_ns) until each stream writer with a nonzero rate
+ * and the status writer has at least min_readers matched readers. PX_OK
+ * or PX_E_TIMEOUT. For tests and tools that must not publish into the
+ * void. */
+PX_API int px_bridge_wait_readers(struct px_bridge *b, int min_readers,
+				  int64_t timeout_ns);
+
+PX_API void px_bridge_counts(struct px_bridge *b, struct px_bridge_counts *out);
+
+/* Stop the thread, leave the domain. NULL is a no-op. */
+PX_API void px_bridge_free(struct px_bridge *b);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
