@@ -183,6 +183,11 @@ struct px_canopen *px_app_canopen(struct px_app *a)
 	return a->co;
 }
 
+const struct px_scene *px_app_scene(const struct px_app *a)
+{
+	return a ? a->scene : NULL;
+}
+
 int px_app_last_record(const struct px_app *a, struct px_app_record *out)
 {
 	if (!a->have_last)

@@ -126,6 +126,11 @@ PX_API struct px_dev *px_app_device_at(struct px_app *app, int i);
 PX_API struct px_stats *px_app_compute_stats(struct px_app *app);
 PX_API struct px_canopen *px_app_canopen(struct px_app *app);
 
+/* The scene the loop queries (NULL: none), for queries from a
+ * non-real-time thread beside the loop (as px_app_drain() makes); the
+ * app owns it. */
+PX_API const struct px_scene *px_app_scene(const struct px_app *app);
+
 /* The newest drained record: 1 and *out, or 0 before any. */
 PX_API int px_app_last_record(const struct px_app *app,
 			      struct px_app_record *out);

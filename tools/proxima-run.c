@@ -320,6 +320,7 @@ static void on_tick(void *user)
 {
 	(void)user;
 	maybe_status(&meter, mono_ns(), status_every_ns);
+	run_bridge_tick();
 }
 
 static void on_stop_cycle(void *user)
@@ -343,6 +344,7 @@ static void in_protect(void *user, const char *path, const char *what)
 static void on_record(void *user, const struct px_app_record *r)
 {
 	(void)user;
+	run_bridge_record(r);
 	/* the plots keep the first PLOT_MAX records (about 17 min at
 	 * 1 kHz); the CSV gets everything */
 	if (T.n_recs < PLOT_MAX) {
@@ -382,6 +384,7 @@ static void on_record(void *user, const struct px_app_record *r)
  * config it reads. */
 static void finish(void)
 {
+	run_bridge_stop();
 	tool_out_discard(&T.csv_out); /* an unfinished CSV: never in place */
 	px_app_free(A);
 	A = NULL;
@@ -534,6 +537,10 @@ int main(int argc, char **argv)
 			O.config, n, n == 1 ? "" : "s");
 		return 1;
 	}
+	if (run_bridge_read(CFG, O.config)) {
+		px_config_free(CFG);
+		return 1;
+	}
 	O.name = "proxima-run";
 	O.note = on_note;
 	O.heap_count = heap_count;
@@ -558,7 +565,7 @@ int main(int argc, char **argv)
 		finish();
 		return 0;
 	}
-	if (open_csv()) {
+	if (open_csv() || run_bridge_start(A, S.avoiding)) {
 		finish();
 		return 1;
 	}

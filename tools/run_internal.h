@@ -67,4 +67,14 @@ int run_write_json(const struct run_result *r, const char *path,
 int run_write_plots(const struct run_result *r, const char *time_svg,
 		    const char *lat_svg);
 
+/* The DDS bridge (run_bridge.c), all on the draining thread: read the
+ * config's bridge section (errors printed; 0 or 1), start it when
+ * enabled (0, or 1 said why), hand it each drained record and, from the
+ * tick, the loop's status; stop prints what it published. */
+int run_bridge_read(const struct px_config *cfg, const char *path);
+int run_bridge_start(struct px_app *app, int avoiding);
+void run_bridge_record(const struct px_app_record *r);
+void run_bridge_tick(void);
+void run_bridge_stop(void);
+
 #endif
