@@ -440,7 +440,7 @@ int px_bridge_publish_joint_state(struct px_bridge *b, int64_t stamp_ns,
 			nm[i] = (char *)names[i];
 		} else {
 			nm[i] = text + 16 * i;
-			snprintf(nm[i], 16, "joint%zu", i);
+			snprintf(nm[i], 16, "joint%u", (unsigned)i);
 		}
 	}
 	memset(&m, 0, sizeof(m));
