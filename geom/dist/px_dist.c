@@ -107,58 +107,6 @@ static inline int on_domain_edge(const struct px_recog_shape *sh, double u,
 }
 
 /*
- * A lower bound on the squared distance from p to a closed-form shape,
- * far cheaper than its closest point (no angles): the whole circle of
- * an arc; for a surface of revolution the profile's whole circle (or
- * its segment) in p's meridian half-plane, which no point of the swept
- * profile (rho >= 0) is nearer than; a parallelogram's plane. 0 for a
- * segment (its closest point costs no more).
- */
-static inline double shape_lb2(const struct px_recog_shape *sh, px_vec3 p)
-{
-	const struct px_recog_rev *rv = &sh->rev;
-	px_vec3 w;
-	double a, b, c, l;
-
-	switch (sh->kind) {
-	case PX_RECOG_ARC:
-		w = px_v3_sub(p, sh->arc.center);
-		a = px_v3_dot(sh->arc.normal, w);
-		b = px_v3_dot(sh->arc.e0, w);
-		c = px_v3_dot(sh->arc.e1, w);
-		l = sqrt(b * b + c * c) - sh->arc.radius;
-		return a * a + l * l;
-	case PX_RECOG_PARALLELOGRAM:
-		a = px_v3_dot(sh->quad.normal, px_v3_sub(p, sh->quad.origin));
-		return a * a / px_v3_dot(sh->quad.normal, sh->quad.normal);
-	case PX_RECOG_CYLINDER:
-	case PX_RECOG_CONE:
-	case PX_RECOG_ANNULUS:
-	case PX_RECOG_SPHERE:
-	case PX_RECOG_TORUS:
-		w = px_v3_sub(p, rv->origin);
-		a = px_v3_dot(rv->axis, w); /* meridian (a, b) */
-		b = px_v3_dot(w, w) - a * a;
-		b = b > 0.0 ? sqrt(b) : 0.0;
-		if (rv->profile_is_arc) {
-			a -= rv->parc.center.x;
-			b -= rv->parc.center.y;
-			l = sqrt(a * a + b * b) - rv->parc.radius;
-			return l * l;
-		}
-		a -= rv->pseg.p0.x;
-		b -= rv->pseg.p0.y;
-		c = a * rv->pseg.dir.x + b * rv->pseg.dir.y;
-		c = c < 0.0 ? 0.0 : (c > rv->pseg.len ? rv->pseg.len : c);
-		a -= c * rv->pseg.dir.x;
-		b -= c * rv->pseg.dir.y;
-		return a * a + b * b;
-	default:
-		return 0.0;
-	}
-}
-
-/*
  * A PK_SHAPE item (trimmed models, dist_build.c: add_shape_items()):
  * its entity in closed form, once per query. The answer is exact, so it
  * is the wave's upper bound at once and nothing is left to solve; on a
@@ -177,7 +125,7 @@ visit_shape(const struct px_dist_model *m, struct px_dist_ws *ws, px_vec3 p,
 	if (ws->ent_stamp[pc->ent] == ws->epoch)
 		return;
 	/* Rounding margin: the bound only skips what is clearly farther. */
-	if (shape_lb2(&m->shape[pc->ent], p) * (1.0 - 1e-9) >= q->best)
+	if (px__dist_shape_lb2(&m->shape[pc->ent], p) * (1.0 - 1e-9) >= q->best)
 		return; /* q->best only falls: no other item of it can win */
 	ws->ent_stamp[pc->ent] = ws->epoch;
 	q->shapes++;

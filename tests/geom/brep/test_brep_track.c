@@ -297,6 +297,75 @@ static void test_step_block(void)
 	px_model_free(m);
 }
 
+/* ---- closed-form faces: answered ahead of the tracker, from a bound on
+ * everything else; across a face edge, and across the bore's axis (the
+ * closest point jumps while the face stays the same) ---- */
+
+static px_vec3 top_to_edge(double s)
+{
+	return px_v3(0.2 + 1.1 * s, 0.2, 1.1 - 0.05 * s);
+}
+
+static px_vec3 bore_across(double s)
+{
+	return px_v3(0.5, 0.4 + 0.2 * s, 0.5);
+}
+
+static void test_closed_form(void)
+{
+	struct brep_gen *g = brep_gen_cube_hole();
+	struct px_brep *b;
+	struct px_model *m;
+	struct px_model_stream_opts o;
+	int cs;
+	PX_CHECK_INT_EQ(px_brep_create(&g->d, NULL, NULL, &b), PX_OK);
+	PX_CHECK_INT_EQ(px_model_from_brep(b, &m), PX_OK);
+	for (cs = 0; cs <= 1; cs++) {
+		struct px_model_stream *s;
+		struct tally t;
+		int i, n = 400, jumps = 0, at = -1;
+		px_vec3 prev = px_v3(0, 0, 0);
+		px_model_stream_opts_default(&o);
+		o.cold_switch = cs;
+		/* over the top face (about the first 70 % of the path) and
+		 * past its edge: the face's answers come from the bound;
+		 * follow() checks every answer and the jumped flag at the
+		 * face-to-edge change */
+		memset(&t, 0, sizeof(t));
+		follow(m, "cube_hole top to edge", top_to_edge, n, &o, &t);
+		PX_CHECK_MSG(t.st.hot * 2 >= t.st.queries, "cold_switch %d: %llu of %llu by the bound",
+			     cs, (unsigned long long)t.st.hot, (unsigned long long)t.st.queries);
+		PX_CHECK(t.jumps >= 2);
+		/* through the bore's axis (no step on it, away from its
+		 * seam): one jump, where the point crosses it */
+		PX_CHECK_INT_EQ(px_model_stream_create(m, &o, &s), PX_OK);
+		n = 401;
+		for (i = 0; i <= n; i++) {
+			px_vec3 p = bore_across((double)i / n);
+			struct px_model_result a, c;
+			struct px_model_stream_note note;
+			PX_CHECK_INT_EQ(px_model_stream_query(s, p, INFINITY, 0, &a, &note), 1);
+			PX_CHECK_INT_EQ(px_model_query(m, p, &c), 1);
+			PX_CHECK(fabs(a.distance - c.distance) <= 1e-12 * (2.0 + fabs(c.distance)));
+			PX_CHECK_INT_EQ(a.feature, PX_FEATURE_SURFACE);
+			if (i > 0 && note.jumped) {
+				jumps++;
+				at = i;
+				PX_CHECK(px_v3_dist(a.point, prev) > 0.3);
+			}
+			prev = a.point;
+		}
+		px_model_stream_get_stats(s, &t.st);
+		px_model_stream_free(s);
+		PX_CHECK_INT_EQ(jumps, 1);
+		PX_CHECK(at == n / 2 || at == n / 2 + 1);
+		PX_CHECK_MSG(t.st.hot * 2 >= t.st.queries, "bore, cold_switch %d: %llu of %llu by the bound",
+			     cs, (unsigned long long)t.st.hot, (unsigned long long)t.st.queries);
+	}
+	px_model_free(m);
+	free(g);
+}
+
 /* A B-rep stream follows the model's pose, as any stream. */
 static void test_pose(void)
 {
@@ -326,5 +395,5 @@ static void test_pose(void)
 static const struct px_test tests[] = {
 	PX_T(test_sheet_hole), PX_T(test_roof_hole), PX_T(test_cube_hole),
 	PX_T(test_freeform),   PX_T(test_thin_box),  PX_T(test_step_block),
-	PX_T(test_pose)};
+	PX_T(test_closed_form), PX_T(test_pose)};
 PX_TEST_MAIN(tests)
