@@ -48,6 +48,9 @@
 #define CF_WAIT_MAX 64
 /* A bound is sought that lasts this many steps like the last one. */
 #define CF_AHEAD 2.0
+/* The near entities of a full pass: within this many times that
+ * margin again (cf_bound()). */
+#define CF_NEAR 8.0
 
 struct brep_stream {
 	struct px_strack *st;
@@ -61,9 +64,11 @@ struct brep_stream {
 	const struct px_recog_shape **shape;
 	const struct px_recog_shape **eshape; /* per entity: NULL none */
 	px_aabb *box;
-	double *lb;     /* per entity: a lower bound on its distance from cq */
-	double *nb;     /* the pass's new ones */
-	int worst;      /* the entity that last failed a bound (-1: none) */
+	/* cf_bound()'s two levels: the near entities of face nface (-1:
+	 * none) and the far ones' least bound at nc */
+	int *near, n_near, nface;
+	px_vec3 nc;
+	double far;
 	int *own_first, *own;
 	uint32_t *stamp, gen;
 	double tol;     /* rounding allowance on the bound */
@@ -78,6 +83,10 @@ struct brep_stream {
 	 * NULL); what the bound does not prove the global query answers
 	 * in its own workspace */
 	struct px_dist_ws *ws;
+	/* the options' verification of the bound's answers (its own
+	 * workspace ws then, also with a tracker) */
+	int verify_every;
+	uint64_t n_cf, verifications, disagreements;
 };
 
 /* (u, v) in the closed trimmed domain ctx (a px_trim). */
@@ -95,8 +104,7 @@ void px__brep_stream_free(void *state)
 	px_dist_ws_free(s->ws);
 	free(s->shape);
 	free(s->eshape);
-	free(s->lb);
-	free(s->nb);
+	free(s->near);
 	free(s->box);
 	free(s->own_first);
 	free(s->own);
@@ -143,16 +151,14 @@ static int cf_setup(struct brep_stream *s, const struct px_brep *b, int *all)
 		return PX_OK;
 	s->box = malloc((size_t)(ne + nf) * sizeof(*s->box));
 	s->eshape = calloc((size_t)(ne + nf), sizeof(*s->eshape));
-	s->lb = malloc((size_t)(ne + nf) * sizeof(*s->lb));
-	s->nb = malloc((size_t)(ne + nf) * sizeof(*s->nb));
+	s->near = malloc((size_t)(ne + nf) * sizeof(*s->near));
 	s->own_first = calloc((size_t)nf + 1, sizeof(int));
 	s->own = malloc(((size_t)b->n_co + 1) * sizeof(int));
 	s->stamp = calloc((size_t)ne + 1, sizeof(uint32_t));
-	if (!s->box || !s->eshape || !s->lb || !s->nb || !s->own_first || !s->own || !s->stamp)
+	if (!s->box || !s->eshape || !s->near || !s->own_first || !s->own || !s->stamp)
 		return PX_E_NOMEM;
-	s->worst = -1;
+	s->nface = -1;
 	for (i = 0; i < ne + nf; i++) {
-		s->lb[i] = -INFINITY;
 		const struct px_recog_shape *sh = &b->dm->shape[i];
 		if (sh->kind != PX_RECOG_NONE && sh->kind != PX_RECOG_PLANE)
 			s->eshape[i] = sh;
@@ -198,14 +204,14 @@ int px__brep_stream_create(const void *impl, const struct px_model_stream_opts *
 		return PX_E_NOMEM;
 	s->last = -1;
 	s->feature = -1;
+	s->verify_every = o->verify_every;
 	rc = cf_setup(s, b, &all);
-	if (rc == PX_OK && all && o->cold_switch) {
-		/* the tracker would follow every critical point of each
-		 * face's NURBS form, while the global query answers the
-		 * faces in closed form: the bound or that query */
+	if (rc == PX_OK && ((all && o->cold_switch) || (s->box && o->verify_every > 0)))
 		rc = px_dist_ws_create(b->dm, &s->ws);
-		goto out;
-	}
+	if (rc == PX_OK && all && o->cold_switch)
+		goto out; /* the tracker would follow every critical point of
+			   * each face's NURBS form, while the global query
+			   * answers the faces in closed form */
 	sf = malloc((size_t)b->n_faces * sizeof(*sf));
 	if (b->n_edges)
 		cv = malloc((size_t)b->n_edges * sizeof(*cv));
@@ -286,48 +292,71 @@ static inline double ent_bound(const struct brep_stream *s, int i, px_vec3 p,
 
 /*
  * A lower bound on the distance from p to every entity but face f and
- * its edges, less the rounding allowance. Each entity keeps its own
- * bound at the last point cq (lb); at p it is that less |p - cq| (the
- * distance is 1-Lipschitz), made afresh (ent_bound()) only where that
- * falls below need, the bound sought. Every entity's is moved to p
- * (cq = p), so a face change keeps them. An entity nearer than must
- * (the least bound that proves the answer) ends the pass at once
- * (-INFINITY); it is tried first the next time (where the point moves
- * slowly it is the same one); the bounds stay those at cq then.
+ * its edges (less the rounding allowance), or -INFINITY as soon as one
+ * is seen nearer than must (the least bound that proves the answer).
+ * Two levels, so that a bound made afresh at every update (long steps)
+ * costs a few entities, not all: a full pass over all of them at a
+ * point nc keeps those within need (the near ones, each made as
+ * ent_bound()) and the least bound of the others (far); later, for the
+ * same face, the near ones are made afresh at p and the others are
+ * bounded by far - |p - nc| (distances are 1-Lipschitz), until that
+ * falls below must and a full pass is made again. The near entity that
+ * last failed is tried first (where the point moves slowly it fails
+ * again, and the update goes to the global query at once).
  */
-static double cf_bound(struct brep_stream *s, const struct px_brep *b, int f,
-		       px_vec3 p, double need, double must)
+static double cf_full(struct brep_stream *s, const struct px_brep *b, int f,
+		      px_vec3 p, double need, double must)
 {
-	int ne = b->n_edges, n = ne + b->n_faces, i, w = s->worst;
-	double best = INFINITY, dq = px_v3_dist(p, s->cq);
-	must += s->tol;
+	int ne = b->n_edges, n = ne + b->n_faces, i;
+	double best = INFINITY, far = INFINITY;
+	s->nface = -1;
+	s->n_near = 0;
 	if (++s->gen == 0) {
 		memset(s->stamp, 0, (size_t)ne * sizeof(uint32_t));
 		s->gen = 1;
 	}
 	for (i = s->own_first[f]; i < s->own_first[f + 1]; i++)
 		s->stamp[s->own[i]] = s->gen;
-	if (w >= 0 && w != ne + f && (w >= ne || s->stamp[w] != s->gen) &&
-	    !(s->lb[w] - dq >= must) && ent_bound(s, w, p, need) < must)
-		return -INFINITY;
-	/* into nb, kept only when the pass ends well */
 	for (i = 0; i < n; i++) {
-		double l = s->lb[i] - dq;
-		if (i == ne + f || (i < ne && s->stamp[i] == s->gen)) {
-			s->nb[i] = l;
+		double l;
+		if (i == ne + f || (i < ne && s->stamp[i] == s->gen))
 			continue;
+		l = ent_bound(s, i, p, need);
+		if (l < must)
+			return -INFINITY;
+		if (l < need) {
+			s->near[s->n_near++] = i;
+			best = l < best ? l : best;
+		} else {
+			far = l < far ? l : far;
 		}
-		if (!(l >= need))
-			l = ent_bound(s, i, p, need);
+	}
+	s->nface = f;
+	s->nc = p;
+	s->far = far;
+	return (best < far ? best : far) - s->tol;
+}
+
+static double cf_bound(struct brep_stream *s, const struct px_brep *b, int f,
+		       px_vec3 p, double need, double must)
+{
+	double best;
+	int k;
+	must += s->tol;
+	best = s->far - px_v3_dist(p, s->nc);
+	if (s->nface != f || !(best >= must))
+		return cf_full(s, b, f, p, need + CF_NEAR * (need - must), must);
+	for (k = 0; k < s->n_near; k++) {
+		int i = s->near[k];
+		double l = ent_bound(s, i, p, INFINITY);
 		if (l < must) {
-			s->worst = i;
+			/* first the next time */
+			s->near[k] = s->near[0];
+			s->near[0] = i;
 			return -INFINITY;
 		}
-		s->nb[i] = l;
 		best = l < best ? l : best;
 	}
-	memcpy(s->lb, s->nb, (size_t)n * sizeof(double));
-	s->cq = p;
 	return best - s->tol;
 }
 
@@ -372,6 +401,7 @@ static int cf_update(struct brep_stream *s, const struct px_brep *b, px_vec3 p,
 			cf_failed(s);
 			return 0;
 		}
+		s->cq = p;
 		s->cl = l;
 	}
 	s->cf = f;
@@ -410,6 +440,23 @@ static void cf_start(struct brep_stream *s, const struct px_brep *b, px_vec3 p,
 		return;
 	}
 	cf_failed(s);
+}
+
+/* The options' verification of the bound's answer d at p: a global
+ * answer nearer by more than the rounding allowance is counted, replaces
+ * d and drops the bound. */
+static void verify(struct brep_stream *s, const struct px_brep *b, px_vec3 p,
+		   struct px_dist_result *d)
+{
+	struct px_dist_result g;
+	if (px_dist_query_ws(b->dm, s->ws, p, &g) != PX_OK)
+		return;
+	s->verifications++;
+	if (!(d->dist > g.dist + 1e-9 * (b->size + g.dist)))
+		return;
+	s->disagreements++;
+	s->cf = -1;
+	*d = g;
 }
 
 /* The tracker's answer at p into *d (and the note). */
@@ -460,7 +507,9 @@ int px__brep_stream_query(const void *impl, void *state,
 		note->jumped = s->last >= 0 || s->feature != PX_FEATURE_SURFACE ||
 			       s->index != s->cf || moved_far(s, q->p, d.point);
 		s->hot++;
-	} else if (s->ws) {
+		if (s->verify_every > 0 && ++s->n_cf % (uint64_t)s->verify_every == 0)
+			verify(s, b, q->p, &d);
+	} else if (!s->st) {
 		rc = px_dist_query_ws(b->dm, s->ws, q->p, &d);
 		if (rc != PX_OK)
 			return rc;
@@ -520,6 +569,6 @@ void px__brep_stream_stats(const void *state, struct px_model_stream_stats *st)
 	px_strack_get_stats(s->st, &ss);
 	st->hot = ss.hot + s->hot;
 	st->reinits = ss.reinits;
-	st->verifications = ss.verifications;
-	st->disagreements = ss.disagreements;
+	st->verifications = ss.verifications + s->verifications;
+	st->disagreements = ss.disagreements + s->disagreements;
 }

@@ -19,6 +19,7 @@
 #include "px_load.h"
 #include "px_model.h"
 #include "px_test.h"
+#include "px_test_paths.h"
 
 /* A path: the point at s in [0, 1]. */
 typedef px_vec3 (*path_fn)(double s);
@@ -366,6 +367,58 @@ static void test_closed_form(void)
 	free(g);
 }
 
+/* ---- smooth random paths and sums of sines through the parts of
+ * closed-form faces and their box, at steps of 0.1 % and 1 % of their
+ * size: the bound is kept, moved and made afresh at every kind of step,
+ * with and without the tracker behind it ---- */
+
+#define NRAND 3000
+static px_vec3 rand_q[NRAND + 1];
+
+static px_vec3 rand_path(double s)
+{
+	return rand_q[(int)lround(s * NRAND)];
+}
+
+static void random_legs(struct px_model *m, const char *name)
+{
+	static const struct px_path_opts po = {px_rand_unit, px_rand_normal, 0.97, 0.25, 1.2};
+	px_aabb box = px_model_local_aabb(m);
+	double size = px_aabb_diagonal(&box), step;
+	int kind, cs;
+	box = px_aabb_inflate(&box, 0.1 * size);
+	for (kind = 0; kind < 2; kind++)
+		for (step = 1e-3; step < 2e-2; step *= 10.0)
+			for (cs = 0; cs <= 1; cs++) {
+				struct px_model_stream_opts o;
+				struct tally t;
+				px_test_path(rand_q, NRAND + 1, kind, box, step * size, &po);
+				px_model_stream_opts_default(&o);
+				o.cold_switch = cs;
+				memset(&t, 0, sizeof(t));
+				follow(m, name, rand_path, NRAND, &o, &t);
+				PX_CHECK_MSG(t.point_off <= t.steps / 100,
+					     "%s: %d points off the global ones", name, t.point_off);
+			}
+}
+
+static void test_random_paths(void)
+{
+	struct brep_gen *(*gen[3])(void) = {brep_gen_cube_hole, brep_gen_thin_box,
+					    brep_gen_sheet_hole};
+	int k;
+	for (k = 0; k < 3; k++) {
+		struct brep_gen *g = gen[k]();
+		struct px_brep *b;
+		struct px_model *m;
+		PX_CHECK_INT_EQ(px_brep_create(&g->d, NULL, NULL, &b), PX_OK);
+		PX_CHECK_INT_EQ(px_model_from_brep(b, &m), PX_OK);
+		random_legs(m, g->d.name);
+		px_model_free(m);
+		free(g);
+	}
+}
+
 /* A B-rep stream follows the model's pose, as any stream. */
 static void test_pose(void)
 {
@@ -395,5 +448,5 @@ static void test_pose(void)
 static const struct px_test tests[] = {
 	PX_T(test_sheet_hole), PX_T(test_roof_hole), PX_T(test_cube_hole),
 	PX_T(test_freeform),   PX_T(test_thin_box),  PX_T(test_step_block),
-	PX_T(test_closed_form), PX_T(test_pose)};
+	PX_T(test_closed_form), PX_T(test_random_paths), PX_T(test_pose)};
 PX_TEST_MAIN(tests)
