@@ -476,6 +476,8 @@ int app_validate(struct px_app *a)
 			    "%zu devices; a run takes at most %d",
 			    cfg->n_devices, MAX_DEVS);
 	app_check_control(a);
+	if (!a->n_check_errors)
+		app_robot_setup(a);
 	app_check_memory(a);
 	if (a->ctl.mode == PX_CONTROL_MODE_HAPTIC) {
 		rc = px_control_haptic_init(&a->haptic, &a->ctl.haptic,

@@ -38,6 +38,7 @@
 #include "px_sim.h"
 #include "px_stats.h"
 #include "px_scene.h"
+#include "px_urdf.h"
 
 #define APP_WHY_MAX 2560
 
@@ -187,6 +188,12 @@ struct px_app {
 	int have_q, enabled;
 	int64_t last_feedback_ns;
 	struct px_control_avoid_out aout;
+	/* control.avoidance.urdf: the robot, its link models measured
+	 * (clearance: models), config joint i = chain joint joint_perm[i] */
+	struct px_urdf_robot *robot;
+	int robot_models;
+	int joint_perm[PX_CONTROL_MAX_JOINTS];
+	struct px_urdf_avoid_out uout;
 	double min_clearance_m, min_scale;
 	uint64_t stop_cycles;   /* cycles with the nominal motion stopped */
 	/* fault campaign */
@@ -269,6 +276,9 @@ void app_note_shutdown(struct px_app *a);
 void app_teardown(struct px_app *a);
 void app_safe_shutdown(struct px_app *a, const char *reason);
 int app_avoid_joints(const struct px_app *a);
+int app_robot_setup(struct px_app *a);
+void app_robot_free(struct px_app *a);
+int app_robot_step(struct px_app *a, const double *qnom, int64_t period_ns);
 void app_drain(struct px_app *a,
 	       void (*record)(void *user, const struct px_app_record *r),
 	       void *user);

@@ -715,6 +715,7 @@ void app_teardown(struct px_app *a)
 		px_devcfg_free(a->dcfg[i]); /* devices, master, buses */
 	px_can_sim_free(a->fault_bus); /* after its endpoints */
 	px_scene_tracking_free(a->tracking); /* before its scene */
+	app_robot_free(a); /* its pairs point at the scene's models */
 	px_scene_free(a->scene);
 	px_arena_fini(&a->arena);
 	free(a->lfaults);

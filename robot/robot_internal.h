@@ -36,4 +36,41 @@ struct px_urdf *px__urdf_new(const char *file, int with_dir);
 
 char *px__urdf_strdup(const char *s);
 
+#define URDF_NAME_LEN 64
+
+struct px_urdf_robot {
+	struct px_control_chain chain;
+	int dof;
+	char names[PX_CONTROL_MAX_JOINTS][URDF_NAME_LEN];
+	double lower[PX_CONTROL_MAX_JOINTS], upper[PX_CONTROL_MAX_JOINTS];
+	double velocity[PX_CONTROL_MAX_JOINTS];
+	int n_bodies;
+	struct px_urdf_body *bodies;
+	char (*body_link)[URDF_NAME_LEN];
+	px_pose frames[PX_CONTROL_MAX_JOINTS + 1];
+	/* clearances: obstacles and the last answer of each pair */
+	int n_obstacles;
+	struct px_model **obstacles;
+	struct px_pair_result *pairs;
+	/* self-clearance: body pairs measured and their last answers */
+	int n_self;
+	int (*self)[2];
+	struct px_pair_result *self_pairs;
+	/* avoidance: clearances and contacts of one cycle (sized by
+	 * px__urdf_avoid_size at setup) */
+	int cap_contacts;
+	struct px_urdf_clearance *cl;
+	struct px_control_contact *contacts;
+	int *contact_of;
+};
+
+/* A pair's answer as a clearance (point_b on the body). */
+struct px_urdf_clearance px__urdf_clearance(const struct px_pair_result *p, int body,
+					    int obstacle, int other_body);
+
+/* Size the avoidance buffers for the obstacles and self pairs set
+ * (urdf_avoid.c); free them. */
+int px__urdf_avoid_size(struct px_urdf_robot *r);
+void px__urdf_avoid_free(struct px_urdf_robot *r);
+
 #endif

@@ -11,24 +11,6 @@
 #include "px_prim.h"
 #include "robot_internal.h"
 
-#define NAME_LEN 64
-
-struct px_urdf_robot {
-	struct px_control_chain chain;
-	int dof;
-	char names[PX_CONTROL_MAX_JOINTS][NAME_LEN];
-	double lower[PX_CONTROL_MAX_JOINTS], upper[PX_CONTROL_MAX_JOINTS];
-	double velocity[PX_CONTROL_MAX_JOINTS];
-	int n_bodies;
-	struct px_urdf_body *bodies;
-	char (*body_link)[NAME_LEN];
-	px_pose frames[PX_CONTROL_MAX_JOINTS + 1];
-	/* clearances: obstacles and the last answer of each pair */
-	int n_obstacles;
-	struct px_model **obstacles;
-	struct px_pair_result *pairs;
-};
-
 void px_urdf_robot_free(struct px_urdf_robot *r)
 {
 	int i;
@@ -40,6 +22,7 @@ void px_urdf_robot_free(struct px_urdf_robot *r)
 	free(r->body_link);
 	free(r->obstacles);
 	free(r->pairs);
+	px__urdf_avoid_free(r);
 	free(r);
 }
 
@@ -172,7 +155,7 @@ static int build_chain(struct px_urdf_robot *r, const struct px_urdf *u, int bas
 			if (rc)
 				return px__urdf_fail(err, rc, u->file, j->line, "",
 						     "joint '%.60s': %s", j->name, px_strerror(rc));
-			snprintf(r->names[r->dof], NAME_LEN, "%s", j->name);
+			snprintf(r->names[r->dof], URDF_NAME_LEN, "%s", j->name);
 			r->lower[r->dof] = j->lower;
 			r->upper[r->dof] = j->upper;
 			r->velocity[r->dof] = j->velocity;
@@ -228,7 +211,7 @@ static int make_bodies(struct px_urdf_robot *r, const struct px_urdf *u,
 			b->offset = px_pose_compose(offset[l], lk->shapes[i].origin);
 			b->link = l;
 			b->shape = i;
-			snprintf(r->body_link[r->n_bodies], NAME_LEN, "%s", lk->name);
+			snprintf(r->body_link[r->n_bodies], URDF_NAME_LEN, "%s", lk->name);
 			r->n_bodies++;
 		}
 	}
@@ -381,7 +364,23 @@ int px_urdf_robot_set_obstacles(struct px_urdf_robot *r,
 	r->obstacles = ob;
 	r->pairs = pr;
 	r->n_obstacles = n;
-	return PX_OK;
+	return px__urdf_avoid_size(r);
+}
+
+struct px_urdf_clearance px__urdf_clearance(const struct px_pair_result *p, int body,
+					    int obstacle, int other_body)
+{
+	struct px_urdf_clearance c;
+	c.body = body;
+	c.obstacle = obstacle;
+	c.other_body = other_body;
+	c.distance_m = p->distance;
+	c.point_robot = p->point_b;
+	c.point_obstacle = p->point_a;
+	c.normal = p->normal;
+	c.intersecting = p->intersecting;
+	c.local_only = p->local_only;
+	return c;
 }
 
 int px_urdf_robot_clearances(struct px_urdf_robot *r, const struct px_pair_opts *o,
@@ -401,7 +400,7 @@ int px_urdf_robot_clearances(struct px_urdf_robot *r, const struct px_pair_opts 
 	po.coherent = coherent ? 1 : 0;
 	if (min) {
 		memset(min, 0, sizeof(*min));
-		min->body = min->obstacle = -1;
+		min->body = min->obstacle = min->other_body = -1;
 		min->distance_m = INFINITY;
 	}
 	for (b = 0; b < r->n_bodies; b++)
@@ -413,14 +412,7 @@ int px_urdf_robot_clearances(struct px_urdf_robot *r, const struct px_pair_opts 
 			rc = px_pair_distance(r->obstacles[k], r->bodies[b].model, &po, p);
 			if (rc)
 				return rc;
-			c.body = b;
-			c.obstacle = k;
-			c.distance_m = p->distance;
-			c.point_robot = p->point_b;
-			c.point_obstacle = p->point_a;
-			c.normal = p->normal;
-			c.intersecting = p->intersecting;
-			c.local_only = p->local_only;
+			c = px__urdf_clearance(p, b, k, -1);
 			if (out)
 				out[n] = c;
 			if (min && c.distance_m < min->distance_m)
