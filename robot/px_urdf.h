@@ -250,7 +250,7 @@ PX_API int px_urdf_robot_clearances(struct px_urdf_robot *r,
  * Replace obstacle k by model m (same kind of use as set_obstacles:
  * the caller keeps m) between two calls of px_urdf_robot_clearances(),
  * e.g. a point cloud rebuilt outside the cycle and handed over
- * (px_cloud_swap.h). The pairs of every body with obstacle k forget
+ * (px_cloud_feed.h). The pairs of every body with obstacle k forget
  * their last answer, so the next call measures them cold. Returns
  * PX_OK, PX_E_INVAL. @note RT-safe (no heap: bodies steps).
  */

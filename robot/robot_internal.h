@@ -68,6 +68,22 @@ struct px_urdf_robot {
 struct px_urdf_clearance px__urdf_clearance(const struct px_pair_result *p, int body,
 					    int obstacle, int other_body);
 
+/* One pair (a's answer, b the body): measured into c (returns 1) unless
+ * the models' world boxes are reach or more apart (returns 0: c holds
+ * the boxes' gap, a lower bound), or an error. */
+int px__urdf_pair(const struct px_model *a, const struct px_model *b,
+		  const struct px_pair_opts *po, int coherent, double reach,
+		  struct px_pair_result *p, int body, int obstacle, int other_body,
+		  struct px_urdf_clearance *c);
+void px__urdf_pair_opts(const struct px_pair_opts *o, int coherent,
+			struct px_pair_opts *po);
+void px__urdf_min_init(struct px_urdf_clearance *min);
+/* px_urdf_robot_clearances() with a reach (INFINITY: every pair
+ * measured); *measured (may be NULL) counts the pairs measured. */
+int px__urdf_obstacle_pairs(struct px_urdf_robot *r, const struct px_pair_opts *o,
+			    int coherent, double reach, struct px_urdf_clearance *out,
+			    size_t cap, struct px_urdf_clearance *min, int *measured);
+
 /* Size the avoidance buffers for the obstacles and self pairs set
  * (urdf_avoid.c); free them. */
 int px__urdf_avoid_size(struct px_urdf_robot *r);

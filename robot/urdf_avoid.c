@@ -143,20 +143,9 @@ int px_urdf_robot_set_self(struct px_urdf_robot *r, const char *const *allowed,
 	return rc ? rc : n;
 }
 
-static void pair_opts(const struct px_pair_opts *o, int coherent,
-		      struct px_pair_opts *po)
-{
-	if (o)
-		*po = *o;
-	else
-		memset(po, 0, sizeof(*po));
-	po->coherent = coherent ? 1 : 0;
-}
-
-int px_urdf_robot_self_clearances(struct px_urdf_robot *r,
-				  const struct px_pair_opts *o, int coherent,
-				  struct px_urdf_clearance *out, size_t cap,
-				  struct px_urdf_clearance *min)
+static int self_pairs(struct px_urdf_robot *r, const struct px_pair_opts *o,
+		      int coherent, double reach, struct px_urdf_clearance *out,
+		      size_t cap, struct px_urdf_clearance *min, int *measured)
 {
 	struct px_pair_opts po;
 	int i, rc;
@@ -164,28 +153,31 @@ int px_urdf_robot_self_clearances(struct px_urdf_robot *r,
 		return PX_E_INVAL;
 	if (out && cap < (size_t)r->n_self)
 		return PX_E_NOSPC;
-	pair_opts(o, coherent, &po);
-	if (min) {
-		memset(min, 0, sizeof(*min));
-		min->body = min->obstacle = min->other_body = -1;
-		min->distance_m = INFINITY;
-	}
+	px__urdf_pair_opts(o, coherent, &po);
+	px__urdf_min_init(min);
 	for (i = 0; i < r->n_self; i++) {
-		struct px_pair_result *p = &r->self_pairs[i];
 		struct px_urdf_clearance c;
 		int a = r->self[i][0], b = r->self[i][1];
-		if (!coherent)
-			p->valid = 0;
-		rc = px_pair_distance(r->bodies[a].model, r->bodies[b].model, &po, p);
-		if (rc)
+		rc = px__urdf_pair(r->bodies[a].model, r->bodies[b].model, &po, coherent, reach,
+				   &r->self_pairs[i], b, -1, a, &c);
+		if (rc < 0)
 			return rc;
-		c = px__urdf_clearance(p, b, -1, a);
+		if (measured)
+			*measured += rc;
 		if (out)
 			out[i] = c;
 		if (min && c.distance_m < min->distance_m)
 			*min = c;
 	}
 	return r->n_self;
+}
+
+int px_urdf_robot_self_clearances(struct px_urdf_robot *r,
+				  const struct px_pair_opts *o, int coherent,
+				  struct px_urdf_clearance *out, size_t cap,
+				  struct px_urdf_clearance *min)
+{
+	return self_pairs(r, o, coherent, INFINITY, out, cap, min, NULL);
 }
 
 /* A clearance as a contact of the command (0: not finite). Unsigned
@@ -220,7 +212,7 @@ int px_urdf_avoid_step(struct px_urdf_robot *r,
 		       const double *qdot_nominal, int64_t period_ns,
 		       struct px_urdf_avoid_out *out)
 {
-	int i, n, ns, nk = 0, closest = -1, rc;
+	int i, n, ns, nk = 0, closest = -1, measured = 0, rc;
 	if (!out)
 		return PX_E_INVAL;
 	memset(&out->closest, 0, sizeof(out->closest));
@@ -233,11 +225,15 @@ int px_urdf_avoid_step(struct px_urdf_robot *r,
 		return PX_E_INVAL;
 	}
 	rc = px_urdf_robot_set_q(r, q, NULL, 0);
-	n = rc ? rc : px_urdf_robot_clearances(r, o, coherent, r->cl,
-						(size_t)r->cap_contacts, NULL);
-	ns = n < 0 ? n : px_urdf_robot_self_clearances(r, o, coherent, r->cl + n,
-							(size_t)(r->cap_contacts - n),
-							NULL);
+	/* pairs whose boxes lie beyond the influence distance cannot make
+	 * a contact: not measured */
+	n = rc ? rc : px__urdf_obstacle_pairs(r, o, coherent, p->influence_distance_m, r->cl,
+					      (size_t)r->cap_contacts, NULL, &measured);
+	ns = n < 0 ? n : self_pairs(r, o, coherent,
+				    p->self_influence_distance_m > 0
+					    ? p->self_influence_distance_m
+					    : p->influence_distance_m,
+				    r->cl + n, (size_t)(r->cap_contacts - n), NULL, &measured);
 	if (n < 0 || ns < 0) {
 		rc = n < 0 ? n : ns;
 		/* the command's own checks zero it; the error wins */
@@ -247,7 +243,7 @@ int px_urdf_avoid_step(struct px_urdf_robot *r,
 		out->cmd.scale = 0;
 		return rc;
 	}
-	out->pairs = n + ns;
+	out->pairs = measured;
 	for (i = 0; i < n + ns; i++) {
 		const struct px_urdf_clearance *c = &r->cl[i];
 		double reach = c->other_body >= 0 && p->self_influence_distance_m > 0

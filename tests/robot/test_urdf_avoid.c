@@ -345,7 +345,7 @@ static void test_step_is_the_command(void)
 	a = px_alloc_region_begin();
 	PX_CHECK_INT_EQ(px_urdf_avoid_step(r, &p, NULL, 0, q, qn, 1000000, &out), PX_OK);
 	PX_CHECK_INT_EQ(px_alloc_region_end(a), 0);
-	PX_CHECK_INT_EQ(out.pairs, BODIES + 15);
+	PX_CHECK(out.pairs > 0 && out.pairs < BODIES + 15); /* far pairs skipped */
 	n = px_urdf_robot_clearances(r, NULL, 0, cl, BODIES, NULL);
 	n += px_urdf_robot_self_clearances(r, NULL, 0, cl + n, 15, NULL);
 	for (k = 0; k < n; k++) {
