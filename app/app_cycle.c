@@ -57,6 +57,7 @@ int app_phase_read(struct px_loop *l, const struct px_loop_cycle *c,
 			px_loop_trip(l);
 		}
 	}
+	app_sensor_read(a, l, c->read_ns);
 	for (i = 0; i < a->n_dev; i++) {
 		int rc;
 		if (!(px_dev_caps(a->dev[i]) & PX_DEV_CAP_POSE))

@@ -90,49 +90,60 @@ static int check_indices(struct px_app *a, int dof)
 	return bad;
 }
 
-/* The scene's models are the obstacles; the self pairs skip the
- * allowed list. */
-static int robot_pairs(struct px_app *a, struct px_urdf_robot *r)
+/* The scene's models, and extra (may be NULL) after them, are the
+ * robot's obstacles. */
+int app_robot_obstacles(struct px_app *a, struct px_model *extra)
 {
-	const struct px_control_urdf_config *u = &a->ctl.urdf;
 	struct px_model **ob;
-	const char **al;
-	struct px_urdf_error err;
 	size_t n = a->scene ? px_scene_count(a->scene) : 0, i;
 	int rc;
-	ob = calloc(n + 1, sizeof(*ob));
-	al = calloc(2 * u->n_allowed + 1, sizeof(*al));
-	if (!ob || !al) {
-		free(ob);
-		free(al);
+	ob = calloc(n + 2, sizeof(*ob));
+	if (!ob) {
 		app_note(a, "%s: URDF robot: out of memory\n", app_name(a));
 		return 1;
 	}
 	for (i = 0; i < n; i++)
 		ob[i] = px_scene_model(a->scene, i);
-	rc = px_urdf_robot_set_obstacles(r, ob, (int)n);
+	if (extra)
+		ob[n] = extra;
+	a->n_scene_obstacles = (int)n;
+	rc = px_urdf_robot_set_obstacles(a->robot, ob, (int)n + (extra != NULL));
+	free(ob);
+	if (rc) {
+		app_note(a, "%s: URDF robot: obstacles: %s\n", app_name(a), px_strerror(rc));
+		return 1;
+	}
+	return 0;
+}
+
+/* The scene's models are the obstacles; the self pairs skip the
+ * allowed list. */
+static int robot_pairs(struct px_app *a, struct px_urdf_robot *r)
+{
+	const struct px_control_urdf_config *u = &a->ctl.urdf;
+	const char **al;
+	struct px_urdf_error err;
+	size_t i;
+	int rc = app_robot_obstacles(a, NULL);
+	if (rc || !u->self_clearance)
+		return rc;
+	al = calloc(2 * u->n_allowed + 1, sizeof(*al));
+	if (!al) {
+		app_note(a, "%s: URDF robot: out of memory\n", app_name(a));
+		return 1;
+	}
 	for (i = 0; i < u->n_allowed; i++) {
 		al[2 * i] = u->allowed[i].a;
 		al[2 * i + 1] = u->allowed[i].b;
 	}
-	if (rc == PX_OK && u->self_clearance) {
-		rc = px_urdf_robot_set_self(r, al, (int)u->n_allowed, &err);
-		if (rc == PX_E_NOTFOUND)
-			app_check_error(a, avoid_node(a, "allowed_collisions"),
-					"control.avoidance.allowed_collisions", "%s",
-					err.msg);
-		else if (rc < 0)
-			app_note(a, "%s: URDF robot: self pairs: %s\n", app_name(a),
-				 px_strerror(rc));
-		rc = rc < 0;
-	} else if (rc) {
-		app_note(a, "%s: URDF robot: obstacles: %s\n", app_name(a),
-			 px_strerror(rc));
-		rc = 1;
-	}
-	free(ob);
+	rc = px_urdf_robot_set_self(r, al, (int)u->n_allowed, &err);
+	if (rc == PX_E_NOTFOUND)
+		app_check_error(a, avoid_node(a, "allowed_collisions"),
+				"control.avoidance.allowed_collisions", "%s", err.msg);
+	else if (rc < 0)
+		app_note(a, "%s: URDF robot: self pairs: %s\n", app_name(a), px_strerror(rc));
 	free(al);
-	return rc;
+	return rc < 0;
 }
 
 int app_robot_setup(struct px_app *a)
