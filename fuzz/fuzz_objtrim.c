@@ -1,7 +1,8 @@
 /*
  * libFuzzer target for the trimmed OBJ reader: px_obj_load_mem() with
  * curv2, trim, hole, scrv and sp, then px_brep_from_obj() (composed
- * edges, trimmed domains) and queries on the B-rep model. Any input
+ * and curve-on-surface edges, several trim loops per surface, trimmed
+ * domains) and queries on the B-rep model. Any input
  * must load and answer finite distances whose closest point lies at
  * that distance, or fail with a placed message and one of the
  * documented codes; never crash, leak, hang or read out of bounds.

@@ -19,8 +19,10 @@
  * constant u, v. The pieces join C0 (interior knots of multiplicity
  * D) and keep c's parameter: the edge at t is the face at c(t).
  *
- * Refused with a message: a degree above PX_NURBS_MAX_DEGREE (a cubic
- * trim on a bicubic patch would need 18), more than CMP_MAX_PIECES
+ * An image above PX_NURBS_MAX_DEGREE (a cubic trim on a bicubic patch:
+ * 18) is no NURBS curve of the kernel: its Bezier pieces become a
+ * curve-on-surface edge (brep_cos.c) up to BREP_COS_MAX_DEGREE.
+ * Refused with a message: a degree above that, more than CMP_MAX_PIECES
  * pieces, a crossing search over its budget, weights that stay not
  * positive after CMP_MAX_HALVE halvings. Setup only (allocates).
  */
@@ -39,6 +41,7 @@
 #define CMP_MAX_HALVE 8
 #define CMP_MAX_DEPTH 52
 #define MAXD PX_NURBS_MAX_DEGREE
+#define CMAXD BREP_COS_MAX_DEGREE /* of the image's pieces */
 
 struct cmp {
 	const struct px_nurbs_surf *s;
@@ -220,10 +223,10 @@ static int piece_span(struct cmp *x, int dir, double ta, double tb)
  * for a = 0..deg, with s = (X - k0 W) / (k1 - k0) on the piece (X the
  * coordinate's homogeneous values, W the weights); out[a] has MAXD + 1. */
 static void basis_polys(const double *X, const double *W, int d, int deg,
-			double k0, double k1, double out[][MAXD + 1])
+			double k0, double k1, double out[][CMAXD + 1])
 {
-	double s[MAXD + 1], t[MAXD + 1], sp[MAXD + 1][MAXD + 1],
-		tp[MAXD + 1][MAXD + 1];
+	double s[MAXD + 1], t[MAXD + 1], sp[MAXD + 1][CMAXD + 1],
+		tp[MAXD + 1][CMAXD + 1];
 	int k, a;
 
 	for (k = 0; k <= d; k++) {
@@ -244,7 +247,7 @@ static void basis_polys(const double *X, const double *W, int d, int deg,
 
 /* The same for a constant coordinate: the Bernstein values (degree 0). */
 static void basis_const(double val, int deg, double k0, double k1,
-			double out[][MAXD + 1])
+			double out[][CMAXD + 1])
 {
 	double s = (val - k0) / (k1 - k0);
 	int a;
@@ -289,8 +292,8 @@ static int compose_range(struct cmp *x, double ta, double tb, int i, int j,
 			 int halvings)
 {
 	const double *Ku = x->s->knots[0], *Kv = x->s->knots[1];
-	double X[MAXD + 1], Y[MAXD + 1], W[MAXD + 1], N[4 * (MAXD + 1)];
-	double bu[MAXD + 1][MAXD + 1], bv[MAXD + 1][MAXD + 1], prod[MAXD + 1];
+	double X[MAXD + 1], Y[MAXD + 1], W[MAXD + 1], N[4 * (CMAXD + 1)];
+	double bu[MAXD + 1][CMAXD + 1], bv[MAXD + 1][CMAXD + 1], prod[CMAXD + 1];
 	struct px_nurbs_curve pc;
 	int p = x->p, q = x->q, du = x->eu * p * x->d, dv = x->ev * q * x->d;
 	int k, a, b, rc, ok = 1;
@@ -384,6 +387,63 @@ static int compose_span(struct cmp *x, double ta, double tb)
 	return PX_OK;
 }
 
+/* The Bezier pieces of S(c(t)) into x (x->pw, x->brk, x->n_pc of
+ * degree x->D; free both): PX_OK, 1 for a point, or a refusal. */
+static int compose_pieces(struct cmp *x, const struct px_nurbs_surf *s,
+			  const struct px_nurbs_curve *c, int max_deg)
+{
+	double t0, t1;
+	int i, rc;
+
+	x->s = s;
+	x->c = c;
+	x->pi = x->pj = -1;
+	x->d = c->degree;
+	x->p = s->degree[0];
+	x->q = s->degree[1];
+	x->eu = !constant_coord(c, 0, &x->uc);
+	x->ev = !constant_coord(c, 1, &x->vc);
+	x->D = x->d * (x->p * x->eu + x->q * x->ev);
+	if (x->D == 0)
+		return 1; /* a point of the parameter plane */
+	if (x->D > max_deg)
+		return cmp_fail(x, PX_E_NOSPC,
+				"its image on the surface has degree %d "
+				"(curve %d times (%d + %d)), above %d",
+				x->D, x->d, x->eu ? x->p : 0, x->ev ? x->q : 0,
+				max_deg);
+	x->cwlen = PX_NURBS_CURVE_WORK_LEN(c->degree, c->n_ctrl);
+	x->swlen = PX_NURBS_SURF_WORK_LEN(x->p, x->q, s->n_ctrl[0], s->n_ctrl[1]);
+	x->cwork = malloc(x->cwlen * sizeof(double));
+	x->swork = malloc(x->swlen * sizeof(double));
+	x->brk = malloc(17 * sizeof(double));
+	x->cap = 0;
+	/* a knot line is crossed at most d times by a piece (a few more
+	 * side changes where rounding blurs a tangency) */
+	x->sp_cap = (s->n_knots[0] + s->n_knots[1]) * (x->d + 4) + 16;
+	x->sp = malloc((size_t)x->sp_cap * sizeof(double));
+	rc = x->cwork && x->swork && x->brk && x->sp ? PX_OK : PX_E_NOMEM;
+	px_nurbs_curve_domain(c, &t0, &t1);
+	if (!rc)
+		x->brk[0] = t0;
+	for (i = c->degree; !rc && i < c->n_ctrl; i++) {
+		double a = fmax(c->knots[i], t0), b = fmin(c->knots[i + 1], t1);
+		if (b > a)
+			rc = compose_span(x, a, b);
+	}
+	free(x->cwork);
+	free(x->swork);
+	free(x->sp);
+	if (!rc && x->n_pc < 1)
+		rc = cmp_fail(x, PX_E_STATE, "no piece");
+	if (rc) {
+		free(x->pw);
+		free(x->brk);
+		x->pw = x->brk = NULL;
+	}
+	return rc;
+}
+
 int px__brep_compose_curve(const struct px_nurbs_surf *s,
 			   const struct px_nurbs_curve *c, double **mem,
 			   struct px_nurbs_curve *out, char *why, size_t why_cap)
@@ -394,53 +454,12 @@ int px__brep_compose_curve(const struct px_nurbs_surf *s,
 
 	*mem = NULL;
 	memset(&x, 0, sizeof(x));
-	x.s = s;
-	x.c = c;
 	x.why = why;
 	x.why_cap = why_cap;
-	x.pi = x.pj = -1;
-	x.d = c->degree;
-	x.p = s->degree[0];
-	x.q = s->degree[1];
-	x.eu = !constant_coord(c, 0, &x.uc);
-	x.ev = !constant_coord(c, 1, &x.vc);
-	x.D = x.d * (x.p * x.eu + x.q * x.ev);
-	if (x.D == 0)
-		return 1; /* a point of the parameter plane */
-	if (x.D > MAXD)
-		return cmp_fail(&x, PX_E_NOSPC,
-				"its image on the surface has degree %d "
-				"(curve %d times (%d + %d)), above %d",
-				x.D, x.d, x.eu ? x.p : 0, x.ev ? x.q : 0, MAXD);
-	x.cwlen = PX_NURBS_CURVE_WORK_LEN(c->degree, c->n_ctrl);
-	x.swlen = PX_NURBS_SURF_WORK_LEN(x.p, x.q, s->n_ctrl[0], s->n_ctrl[1]);
-	x.cwork = malloc(x.cwlen * sizeof(double));
-	x.swork = malloc(x.swlen * sizeof(double));
-	x.brk = malloc(17 * sizeof(double));
-	x.cap = 0;
-	/* a knot line is crossed at most d times by a piece (a few more
-	 * side changes where rounding blurs a tangency) */
-	x.sp_cap = (s->n_knots[0] + s->n_knots[1]) * (x.d + 4) + 16;
-	x.sp = malloc((size_t)x.sp_cap * sizeof(double));
-	rc = x.cwork && x.swork && x.brk && x.sp ? PX_OK : PX_E_NOMEM;
-	px_nurbs_curve_domain(c, &t0, &t1);
-	if (!rc)
-		x.brk[0] = t0;
-	for (i = c->degree; !rc && i < c->n_ctrl; i++) {
-		double a = fmax(c->knots[i], t0), b = fmin(c->knots[i + 1], t1);
-		if (b > a)
-			rc = compose_span(&x, a, b);
-	}
-	free(x.cwork);
-	free(x.swork);
-	free(x.sp);
-	if (!rc && x.n_pc < 1)
-		rc = cmp_fail(&x, PX_E_STATE, "no piece");
-	if (rc) {
-		free(x.pw);
-		free(x.brk);
+	rc = compose_pieces(&x, s, c, MAXD);
+	if (rc)
 		return rc;
-	}
+	px_nurbs_curve_domain(c, &t0, &t1);
 	n_ctrl = x.n_pc * x.D + 1;
 	nk = n_ctrl + x.D + 1;
 	*mem = malloc(((size_t)nk + 4 * (size_t)n_ctrl) * sizeof(double));
@@ -483,6 +502,23 @@ int px__brep_compose_curve(const struct px_nurbs_surf *s,
 	return PX_OK;
 }
 
+int px__brep_compose_bezier(const struct px_nurbs_surf *s,
+			    const struct px_nurbs_curve *c, int *deg, int *n_pc,
+			    double **pw, double **brk, char *why, size_t why_cap)
+{
+	struct cmp x;
+	int rc;
+	memset(&x, 0, sizeof(x));
+	x.why = why;
+	x.why_cap = why_cap;
+	rc = compose_pieces(&x, s, c, CMAXD);
+	*deg = x.D;
+	*n_pc = rc ? 0 : x.n_pc;
+	*pw = rc ? NULL : x.pw;
+	*brk = rc ? NULL : x.brk;
+	return rc;
+}
+
 /* ---- the description with the composed edges ------------------------------ */
 
 void px__brep_aug_free(struct brep_aug *g)
@@ -495,6 +531,7 @@ void px__brep_aug_free(struct brep_aug *g)
 	free(g->edges);
 	free(g->co);
 	free(g->cop);
+	px__brep_cos_free(g->cos);
 	memset(g, 0, sizeof(*g));
 }
 
@@ -525,10 +562,79 @@ static int count_missing(const struct px_brep_desc *d, int *n_co, int *n_lp)
 	return n;
 }
 
-/* Compose loop curve (f, l, k) into edge slot g->edges[*ne] when the
- * surface and the curve are valid and the image is no point. */
+/* The refusal of loop curve (f, l, k)'s image into err. */
+static int compose_refused(const struct px_brep_face_desc *fd, int f, int l,
+			   int k, int rc, const char *why, struct px_brep_error *err)
+{
+	if (err) {
+		err->code = rc;
+		err->face = f;
+		err->loop = l;
+		err->curve = k;
+		err->id = fd->id;
+		if (fd->id)
+			snprintf(err->msg, sizeof(err->msg),
+				 "face %d (id %ld): loop %d curve %d has no "
+				 "3D edge and its exact image cannot be made: %s",
+				 f, fd->id, l, k, why[0] ? why : px_strerror(rc));
+		else
+			snprintf(err->msg, sizeof(err->msg),
+				 "face %d: loop %d curve %d has no 3D edge "
+				 "and its exact image cannot be made: %s",
+				 f, l, k, why[0] ? why : px_strerror(rc));
+	}
+	return rc;
+}
+
+/* 1 when the n homogeneous points pw lie within tol of the first. */
+static int one_point(const double *pw, int n, double tol)
+{
+	px_vec3 p0 = px_v3(pw[0] / pw[3], pw[1] / pw[3], pw[2] / pw[3]);
+	int i;
+	for (i = 1; i < n; i++)
+		if (px_v3_dist(px_v3(pw[4 * i] / pw[4 * i + 3],
+				     pw[4 * i + 1] / pw[4 * i + 3],
+				     pw[4 * i + 2] / pw[4 * i + 3]),
+			       p0) > tol)
+			return 0;
+	return 1;
+}
+
+/* Loop curve (f, l, k), coedge co, as a curve-on-surface edge of g->cos
+ * (its image's degree is above the kernel's; *edge stays -1). */
+static int compose_cos(struct brep_aug *g, const struct px_brep_desc *d, int f,
+		       int l, int k, int co, const struct px_nurbs_surf *sv,
+		       const struct px_nurbs_curve *cv, double tol,
+		       struct px_brep_error *err)
+{
+	double *pw = NULL, *brk = NULL;
+	char why[200];
+	int deg, n_pc, rc;
+
+	why[0] = '\0';
+	rc = px__brep_compose_bezier(sv, cv, &deg, &n_pc, &pw, &brk, why, sizeof(why));
+	if (rc == 1)
+		return PX_OK;
+	if (rc)
+		return compose_refused(&d->faces[f], f, l, k, rc, why, err);
+	if (!one_point(pw, n_pc * deg + 1, tol)) {
+		if (!g->cos)
+			g->cos = calloc(1, sizeof(*g->cos));
+		rc = g->cos ? px__brep_cos_add(g->cos, f, co, deg, n_pc, pw, brk,
+					       d->scale)
+			    : PX_E_NOMEM;
+	}
+	free(pw);
+	free(brk);
+	return rc;
+}
+
+/* Compose loop curve (f, l, k) (coedge co) into edge slot g->edges[*ne]
+ * when the surface and the curve are valid and the image is no point;
+ * an image of too high a degree for the kernel becomes a curve-on-
+ * surface edge instead. */
 static int compose_one(struct brep_aug *g, const struct px_brep_desc *d, int f,
-		       int l, int k, int *edge, struct px_brep_error *err)
+		       int l, int k, int co, int *edge, struct px_brep_error *err)
 {
 	const struct px_brep_face_desc *fd = &d->faces[f];
 	const struct px_nurbs_curve *c = &fd->loops[l].curves[k];
@@ -548,35 +654,21 @@ static int compose_one(struct brep_aug *g, const struct px_brep_desc *d, int f,
 	    px_nurbs_curve_view(&cv, c->degree, c->n_ctrl, c->knots, c->n_knots,
 				c->pw, NULL))
 		return PX_OK; /* the checks report it */
-	why[0] = '\0';
-	rc = px__brep_compose_curve(&sv, &cv, &mem, &out, why, sizeof(why));
-	if (rc == 1)
-		return PX_OK;
-	if (rc) {
-		if (err) {
-			err->code = rc;
-			err->face = f;
-			err->loop = l;
-			err->curve = k;
-			err->id = fd->id;
-			if (fd->id)
-				snprintf(err->msg, sizeof(err->msg),
-					 "face %d (id %ld): loop %d curve %d has no "
-					 "3D edge and its exact image cannot be made: %s",
-					 f, fd->id, l, k, why[0] ? why : px_strerror(rc));
-			else
-				snprintf(err->msg, sizeof(err->msg),
-					 "face %d: loop %d curve %d has no 3D edge "
-					 "and its exact image cannot be made: %s",
-					 f, l, k, why[0] ? why : px_strerror(rc));
-		}
-		return rc;
-	}
-	g->mem[g->n_mem++] = mem;
 	/* an image within the tolerance of one point stays a collapsed
 	 * curve (px_brep_create()'s own test, in these units) */
 	hb = px_nurbs_surf_aabb(&sv);
 	tol = 1e-9 * (1.0 / d->scale + px_aabb_diagonal(&hb));
+	why[0] = '\0';
+	rc = px__brep_force_cos ? PX_E_NOSPC
+				: px__brep_compose_curve(&sv, &cv, &mem, &out, why,
+							 sizeof(why));
+	if (rc == 1)
+		return PX_OK;
+	if (rc == PX_E_NOSPC)
+		return compose_cos(g, d, f, l, k, co, &sv, &cv, tol, err);
+	if (rc)
+		return compose_refused(fd, f, l, k, rc, why, err);
+	g->mem[g->n_mem++] = mem;
 	{
 		px_vec3 p0 = px_nurbs_curve_ctrl(&out, 0, NULL);
 		for (i = 1; i < out.n_ctrl && point; i++)
@@ -629,7 +721,7 @@ int px__brep_compose(const struct px_brep_desc *d, struct brep_aug *g,
 						? fd->coedges[l][k].edge
 						: -1;
 				if (e == -1) {
-					rc = compose_one(g, d, f, l, k, &e, err);
+					rc = compose_one(g, d, f, l, k, at, &e, err);
 					if (rc) {
 						px__brep_aug_free(g);
 						return rc;

@@ -143,6 +143,10 @@ const char *px__trim_loop_name(int k, char *buf, size_t len);
  * then the index into pts). */
 #define BREP_POINT 2
 
+/* Kind of a curve-on-surface edge's answer (entity: its index among
+ * them, u the loop curve's parameter). */
+#define BREP_COS 3
+
 /* Query workspaces of one B-rep (threads borrow one without waiting). */
 #define BREP_WS 4
 /* (edge parameter, loop curve parameter) pairs per coedge: the start of
@@ -195,6 +199,7 @@ struct px_brep {
 	int *shell_closed;
 	struct px__dist_trim *dtrim;     /* per face, for the distance core */
 	struct px_dist_model *dm;
+	struct brep_cos_set *cos;  /* curve-on-surface edges, or NULL */
 	struct px_dist_ws *ws[BREP_WS];
 	atomic_flag busy[BREP_WS];
 	double *mem;               /* the copied arrays */
@@ -229,11 +234,19 @@ px_vec3 px__brep_face_normal(const struct px_brep *b, int f, double u,
 			     double v);
 
 /* Unsigned global answer of the B-rep (distance core + point
- * candidates) with workspace slot k. @note RT-safe. */
+ * candidates + curve-on-surface edges) with workspace slot k.
+ * @note RT-safe. */
 int px__brep_closest(const struct px_brep *b, int k, px_vec3 p,
 		     struct px_dist_result *d);
 
+/* The same with the caller's workspace of b's core. @note RT-safe. */
+int px__brep_closest_ws(const struct px_brep *b, struct px_dist_ws *ws, px_vec3 p,
+			struct px_dist_result *d);
+
 /* ---- composed edges (brep_compose.c) ----------------------------------------- */
+
+/* Highest degree of a curve-on-surface edge's pieces (brep_cos.c). */
+#define BREP_COS_MAX_DEGREE 24
 
 /* The exact image S(c(t)) of the (u, v) curve c on s, parametrised by
  * c's t, as a NURBS curve viewing *mem (free() it). Returns PX_OK, 1
@@ -242,6 +255,73 @@ int px__brep_closest(const struct px_brep *b, int k, px_vec3 p,
 int px__brep_compose_curve(const struct px_nurbs_surf *s,
 			   const struct px_nurbs_curve *c, double **mem,
 			   struct px_nurbs_curve *out, char *why, size_t why_cap);
+
+/* The image S(c(t)) as rational Bezier pieces of degree *deg (up to
+ * BREP_COS_MAX_DEGREE): *n_pc pieces, (*n_pc * *deg + 1) homogeneous
+ * points in *pw (consecutive pieces share their end point), the piece
+ * ends in c's parameter in *brk (*n_pc + 1); free() both. Returns as
+ * px__brep_compose_curve(). Setup only. */
+int px__brep_compose_bezier(const struct px_nurbs_surf *s,
+			    const struct px_nurbs_curve *c, int *deg, int *n_pc,
+			    double **pw, double **brk, char *why, size_t why_cap);
+
+/* ---- curve-on-surface edges (brep_cos.c) ------------------------------------ */
+
+/* One piece of a curve-on-surface edge: loop-curve parameters [t0, t1],
+ * degree, the degree of its critical-point polynomial, its box (of the
+ * control points), its edge and its coefficients at off in coef. */
+struct brep_cos_piece {
+	px_aabb box;
+	double t0, t1;
+	int deg, gdeg, wconst;
+	int cos;
+	size_t off;
+};
+
+/* An edge: the coedge it runs along (index into px_brep.co), its face,
+ * its pieces first .. first + n - 1 and its parameter range. */
+struct brep_cos {
+	int face, co;
+	int first, n;
+	double t0, t1;
+};
+
+/* The curve-on-surface edges of a B-rep, fixed after setup. */
+struct brep_cos_set {
+	int n_cos, n_pc;
+	struct brep_cos *cos;
+	struct brep_cos_piece *pc;
+	double *coef;
+	int cap_cos, cap_pc;
+	size_t n_coef, cap_coef;
+};
+
+/* Add the edge of coedge co (face face) from the pieces of
+ * px__brep_compose_bezier(), coordinates times scale. Setup only:
+ * PX_OK, PX_E_NOMEM or PX_E_RANGE. */
+int px__brep_cos_add(struct brep_cos_set *s, int face, int co, int deg,
+		     int n_pc, const double *pw, const double *brk, double scale);
+void px__brep_cos_free(struct brep_cos_set *s);
+
+/* 1 when one of s's edges is nearer to q than d->dist (then d is that
+ * answer: kind BREP_COS, and when it is no farther than d's proof's
+ * lower bound (dist - gap) that proof is settled), else 0; d->certified
+ * and gap take the edges' proof too, *edge_gap (may be NULL) their own
+ * gap (-1: certified). s may be NULL. @note RT-safe. */
+int px__brep_cos_closest(const struct brep_cos_set *s, px_vec3 q,
+			 struct px_dist_result *d, double *edge_gap);
+
+/* Tests: 1 makes every composed loop curve a curve-on-surface edge (to
+ * compare both on curves the kernel's degree allows). */
+PX__TEST_SWITCH(int, px__brep_force_cos, 0);
+
+/* A squared distance from q that a point of s's edges beats (their
+ * pieces' end points, widened by rounding): the bound of the core's
+ * query. @note RT-safe. */
+double px__brep_cos_bound2(const struct brep_cos_set *s, px_vec3 q);
+
+/* 1 when coedge co runs along a curve-on-surface edge. */
+int px__brep_cos_on(const struct brep_cos_set *s, int co);
 
 /* A description with an own composed edge for every loop curve that has
  * none (and no single-point image): d is a copy of the caller's with
@@ -254,6 +334,7 @@ struct brep_aug {
 	const struct px_brep_coedge **cop;
 	double **mem;
 	int n_mem;
+	struct brep_cos_set *cos; /* loop curves of too high an image degree */
 };
 
 /* Fill g from d (g->d.faces NULL: nothing to add, use d itself).

@@ -11,14 +11,26 @@
 #include "brep_internal.h"
 #include "px_model.h"
 
-int px__brep_closest(const struct px_brep *b, int k, px_vec3 p,
-		     struct px_dist_result *d)
+/* The core's answer, the point candidates, the curve-on-surface edges
+ * (px__brep_closest() and px__brep_closest_ws(), one body). */
+static inline __attribute__((always_inline)) int
+closest(const struct px_brep *b, struct px_dist_ws *ws, px_vec3 p,
+	struct px_dist_result *d)
 {
-	double best;
+	double best, edge_gap;
 	int i, bi = -1, rc;
 
-	rc = px_dist_query_ws(b->dm, b->ws[k], p, d);
-	if (rc != PX_OK)
+	if (b->cos) {
+		/* a point of the curve-on-surface edges bounds the core's
+		 * query (its faces may give no sample of their own) */
+		rc = px__dist_query_below(b->dm, ws, p, px__brep_cos_bound2(b->cos, p), d);
+		if (rc == 1) {
+			d->kind = BREP_COS;
+			d->entity = -1;
+		}
+	} else
+		rc = px_dist_query_ws(b->dm, ws, p, d);
+	if (rc < 0)
 		return rc;
 	best = d->dist * d->dist;
 	for (i = 0; i < b->n_pts; i++) {
@@ -38,7 +50,35 @@ int px__brep_closest(const struct px_brep *b, int k, px_vec3 p,
 		d->piece = -1;
 		d->dir = d->dist > 0.0 ? px_v3_scale(v, 1.0 / d->dist) : px_v3(0, 0, 0);
 	}
+	if (b->cos && px__brep_cos_closest(b->cos, p, d, &edge_gap) && !d->certified) {
+		/* the core's proof stopped short above the edge: once more
+		 * below the edge's distance, which prunes what it could not
+		 * settle (as a composed edge of the core would) */
+		struct px_dist_result e;
+		rc = px__dist_query_below(b->dm, ws, p,
+					  d->dist * d->dist * (1.0 + 1e-12) + 1e-300, &e);
+		if (rc < 0)
+			return rc;
+		if (rc == PX_OK)
+			*d = e;
+		else
+			d->gap = e.certified ? 0.0 : fmax(e.gap - (e.dist - d->dist), 0.0);
+		d->certified = e.certified && edge_gap < 0.0;
+		d->gap = fmax(d->gap, edge_gap);
+	}
 	return PX_OK;
+}
+
+int px__brep_closest(const struct px_brep *b, int k, px_vec3 p,
+		     struct px_dist_result *d)
+{
+	return closest(b, b->ws[k], p, d);
+}
+
+int px__brep_closest_ws(const struct px_brep *b, struct px_dist_ws *ws, px_vec3 p,
+			struct px_dist_result *d)
+{
+	return closest(b, ws, p, d);
 }
 
 static int ws_take(struct px_brep *b)
@@ -78,6 +118,11 @@ static void answer_feature(const struct px_brep *b,
 			r->feature = PX_FEATURE_VERTEX;
 			r->index = e->v1;
 		}
+	} else if (d->kind == BREP_COS) {
+		/* curve-on-surface edges are numbered after the edges */
+		r->feature = PX_FEATURE_CURVE;
+		r->index = b->n_edges + d->entity;
+		r->v = 0.0;
 	} else {
 		r->feature = PX_FEATURE_VERTEX;
 		r->index = b->pts[d->entity].vertex;
@@ -234,7 +279,7 @@ int px_brep_get_info(const struct px_brep *b, struct px_brep_info *info)
 		return PX_E_INVAL;
 	memset(info, 0, sizeof(*info));
 	info->n_faces = b->n_faces;
-	info->n_edges = b->n_edges;
+	info->n_edges = b->n_edges + (b->cos ? b->cos->n_cos : 0);
 	info->n_vertices = b->n_vertices;
 	info->n_shells = b->n_shells;
 	info->n_solids = b->n_solids;

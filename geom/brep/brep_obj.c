@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "brep_internal.h"
 #include "px_brep_obj.h"
 #include "px_file.h"
 #include "px_model.h"
@@ -68,32 +69,48 @@ struct build {
 	struct px_brep_edge_desc *edges;
 	int *face_ent, *edge_ent;
 	int n_faces, n_edges;
+	/* per file loop: the 'trim' loop a hole belongs to (-1: the domain
+	 * boundary), and for 'trim' loops of surfaces with several, the loop
+	 * alone as a domain and its area */
+	int *owner;
+	struct px_trim **region;
+	double *region_area;
 };
 
 static void build_free(struct build *b)
 {
+	int i;
 	px_arena_fini(&b->arena);
 	free(b->faces);
 	free(b->fl);
 	free(b->edges);
 	free(b->face_ent);
 	free(b->edge_ent);
+	free(b->owner);
+	if (b->region)
+		for (i = 0; i < b->m->n_loops; i++)
+			px_trim_free(b->region[i]);
+	free(b->region);
+	free(b->region_area);
 }
 
-/* Arena bytes: the sub-curves of the loops and the boundary lines. */
+/* Arena bytes: the sub-curves of the loops (twice: a 'trim' loop of a
+ * surface with several is made once more to sort the holes) and the
+ * boundary lines. */
 static size_t arena_need(const struct px_obj_model *m)
 {
 	size_t n = 4096;
 	int i;
 	for (i = 0; i < m->n_trim_curves; i++)
-		n += px_nurbs_curve_extract_bytes(&m->curv2[m->trim_curves[i].curv2].curve) +
-		     2 * PX_ARENA_ALIGN;
+		n += 2 * (px_nurbs_curve_extract_bytes(&m->curv2[m->trim_curves[i].curv2].curve) +
+			  2 * PX_ARENA_ALIGN);
 	for (i = 0; i < m->n_entities; i++)
 		n += 4 * (px_nurbs_curve_bytes(1, 2) + 2 * PX_ARENA_ALIGN) +
 		     4 * sizeof(struct px_nurbs_curve) + PX_ARENA_ALIGN;
-	n += (size_t)(m->n_entities + m->n_loops + 1) *
-	     (sizeof(struct px_trim_loop) + 2 * sizeof(int) + PX_ARENA_ALIGN) +
-	     (size_t)m->n_trim_curves * (sizeof(struct px_nurbs_curve) + 1 + PX_ARENA_ALIGN);
+	n += (size_t)(m->n_entities + 2 * m->n_loops + 1) *
+		     (sizeof(struct px_trim_loop) + 2 * sizeof(int) + 3 * PX_ARENA_ALIGN) +
+	     2 * (size_t)m->n_trim_curves *
+		     (sizeof(struct px_nurbs_curve) + 1 + 2 * PX_ARENA_ALIGN);
 	return n;
 }
 
@@ -136,63 +153,140 @@ static int domain_loop(struct build *b, const struct px_nurbs_surf *s,
 	return rc;
 }
 
-/* The loops of surface entity ent: outer first, then the holes. */
-static int face_loops(struct build *b, int ent, struct face_loops *fl,
+/* One loop of the file (index i of m->loops) into l, its place into
+ * fl at slot at. */
+static int file_loop(struct build *b, int i, struct face_loops *fl, int at)
+{
+	const struct px_obj_loop *ol = &b->m->loops[i];
+	struct px_nurbs_curve *cv;
+	unsigned char *rev;
+	int k, rc;
+	cv = px_arena_alloc(&b->arena, (size_t)ol->n * sizeof(*cv), 8);
+	rev = px_arena_alloc(&b->arena, (size_t)ol->n, 1);
+	if (!cv || !rev)
+		return PX_E_NOMEM;
+	for (k = 0; k < ol->n; k++) {
+		rc = loop_curve(b, &b->m->trim_curves[ol->first + k], &cv[k], &rev[k]);
+		if (rc)
+			return rc;
+	}
+	fl->loops[at].curves = cv;
+	fl->loops[at].n_curves = ol->n;
+	fl->loops[at].reversed = rev;
+	fl->line[at] = ol->line;
+	fl->col[at] = ol->column;
+	return PX_OK;
+}
+
+/* The loops of one face of surface entity ent: the outer loop (the
+ * file's loop outer, or the domain boundary when outer < 0), then the
+ * holes whose owner is outer. */
+static int face_loops(struct build *b, int ent, int outer, struct face_loops *fl,
 		      const struct px_nurbs_surf *s)
 {
 	const struct px_obj_model *m = b->m;
-	int i, n = 0, outer = -1, k, rc, pass;
+	int i, n = 1, rc;
 
 	for (i = 0; i < m->n_loops; i++)
-		if (m->loops[i].entity == ent) {
-			n++;
-			if (!m->loops[i].hole)
-				outer = i;
-		}
+		n += m->loops[i].entity == ent && m->loops[i].hole &&
+		     b->owner[i] == outer;
 	memset(fl, 0, sizeof(*fl));
-	if (n == 0)
-		return PX_OK;
-	if (outer < 0)
-		n++;
 	fl->loops = px_arena_alloc(&b->arena, (size_t)n * sizeof(*fl->loops), 8);
 	fl->line = px_arena_alloc(&b->arena, (size_t)n * sizeof(int), 8);
 	fl->col = px_arena_alloc(&b->arena, (size_t)n * sizeof(int), 8);
 	if (!fl->loops || !fl->line || !fl->col)
 		return PX_E_NOMEM;
-	if (outer < 0) {
-		rc = domain_loop(b, s, &fl->loops[0]);
-		if (rc)
-			return rc;
+	rc = outer < 0 ? domain_loop(b, s, &fl->loops[0]) : file_loop(b, outer, fl, 0);
+	if (rc)
+		return rc;
+	if (outer < 0)
 		fl->line[0] = fl->col[0] = 0;
-		fl->n = 1;
-	}
-	for (pass = 0; pass < 2; pass++)
-		for (i = 0; i < m->n_loops; i++) {
-			const struct px_obj_loop *ol = &m->loops[i];
-			struct px_trim_loop *l;
-			struct px_nurbs_curve *cv;
-			unsigned char *rev;
-			int at;
-			if (ol->entity != ent || ol->hole != pass)
-				continue;
-			at = fl->n++;
-			l = &fl->loops[at];
-			cv = px_arena_alloc(&b->arena, (size_t)ol->n * sizeof(*cv), 8);
-			rev = px_arena_alloc(&b->arena, (size_t)ol->n, 1);
-			if (!cv || !rev)
-				return PX_E_NOMEM;
-			for (k = 0; k < ol->n; k++) {
-				rc = loop_curve(b, &m->trim_curves[ol->first + k], &cv[k],
-						&rev[k]);
-				if (rc)
-					return rc;
-			}
-			l->curves = cv;
-			l->n_curves = ol->n;
-			l->reversed = rev;
-			fl->line[at] = ol->line;
-			fl->col[at] = ol->column;
+	fl->n = 1;
+	for (i = 0; i < m->n_loops; i++)
+		if (m->loops[i].entity == ent && m->loops[i].hole &&
+		    b->owner[i] == outer) {
+			rc = file_loop(b, i, fl, fl->n++);
+			if (rc)
+				return rc;
 		}
+	return PX_OK;
+}
+
+/* Where a point of loop i lies against the domain t (px_trim_contains):
+ * the first of its sample points that is not on t's boundary decides. */
+static int loop_where(struct build *b, int i, const struct px_trim *t)
+{
+	const struct px_obj_loop *ol = &b->m->loops[i];
+	int k, j, w = PX_TRIM_BOUNDARY;
+	for (k = 0; k < ol->n && w == PX_TRIM_BOUNDARY; k++) {
+		const struct px_obj_trim_curve *tc = &b->m->trim_curves[ol->first + k];
+		const struct px_nurbs_curve *c = &b->m->curv2[tc->curv2].curve;
+		for (j = 0; j < 8 && w == PX_TRIM_BOUNDARY; j++) {
+			px_vec3 q = px_nurbs_curve_point(c, tc->t0 + (tc->t1 - tc->t0) *
+								     (2 * j + 1) / 16.0);
+			w = px_trim_contains(t, q.x, q.y, NULL);
+		}
+	}
+	return w;
+}
+
+/* Surface entity ent with several 'trim' loops: every one is a face
+ * region, every hole belongs to the smallest of them that holds it
+ * (owner[hole] = that loop's index). A hole in none is refused. */
+static int assign_holes(struct build *b, int ent, struct px_obj_error *err)
+{
+	const struct px_obj_model *m = b->m;
+	struct px_trim_opts to;
+	int i, k, rc = PX_OK;
+
+	px_trim_opts_default(&to);
+	for (i = 0; i < m->n_loops; i++) {
+		const struct px_obj_loop *ol = &m->loops[i];
+		struct face_loops fl;
+		struct px_trim_loop tl;
+		int line, col;
+		if (ol->entity != ent || ol->hole)
+			continue;
+		memset(&fl, 0, sizeof(fl));
+		fl.loops = &tl;
+		fl.line = &line;
+		fl.col = &col;
+		rc = file_loop(b, i, &fl, 0);
+		if (!rc) {
+			struct px_trim_error te;
+			memset(&te, 0, sizeof(te));
+			rc = px_trim_create(&tl, 1, &to, &te, &b->region[i]);
+			if (rc)
+				return oerr(err, rc, ol->line, ol->column,
+					    "'trim' of the surface of line %d: %s",
+					    m->entities[ent].line, te.msg);
+			b->region_area[i] = fabs(px__trim_loop_area(b->region[i], 0));
+		}
+		if (rc)
+			return oerr(err, rc, ol->line, ol->column,
+				    "'trim' of the surface of line %d: cannot "
+				    "build it: %s",
+				    m->entities[ent].line, px_strerror(rc));
+	}
+	for (i = 0; i < m->n_loops; i++) {
+		const struct px_obj_loop *ol = &m->loops[i];
+		double best = INFINITY;
+		if (ol->entity != ent || !ol->hole)
+			continue;
+		b->owner[i] = -2;
+		for (k = 0; k < m->n_loops; k++)
+			if (b->region[k] && m->loops[k].entity == ent &&
+			    b->region_area[k] < best &&
+			    loop_where(b, i, b->region[k]) == PX_TRIM_INSIDE) {
+				best = b->region_area[k];
+				b->owner[i] = k;
+			}
+		if (b->owner[i] == -2)
+			return oerr(err, PX_E_INVAL, ol->line, ol->column,
+				    "'hole' of the surface of line %d lies in none "
+				    "of its 'trim' loops",
+				    m->entities[ent].line);
+	}
 	return PX_OK;
 }
 
@@ -249,6 +343,59 @@ static int place_error(const struct build *b, const struct px_brep_error *be,
 	return oerr(err, be->code, line, col, "%s", be->msg);
 }
 
+/* One face of surface entity ent: outer loop outer (-1: the domain
+ * boundary) and the holes it owns. */
+static int add_face(struct build *b, int ent, int outer, struct px_obj_error *err)
+{
+	const struct px_obj_entity *e = &b->m->entities[ent];
+	struct px_brep_face_desc *f = &b->faces[b->n_faces];
+	struct face_loops *fl = &b->fl[b->n_faces];
+	int rc = face_loops(b, ent, outer, fl, &e->surf);
+	if (rc)
+		return oerr(err, rc, e->line, 1,
+			    "surface of line %d: cannot build its loops: %s",
+			    e->line, px_strerror(rc));
+	memset(f, 0, sizeof(*f));
+	f->surf = e->surf;
+	f->loops = fl->n > 1 || outer >= 0 ? fl->loops : NULL;
+	f->n_loops = fl->n > 1 || outer >= 0 ? fl->n : 0;
+	f->shell = 0;
+	f->id = e->line;
+	b->face_ent[b->n_faces++] = ent;
+	return PX_OK;
+}
+
+/* The faces of surface entity ent: one per 'trim' loop (the whole
+ * domain when it has none), the holes with the loop that holds them. */
+static int surf_faces(struct build *b, int ent, struct px_obj_error *err)
+{
+	const struct px_obj_model *m = b->m;
+	int i, n_outer = 0, last = -1, rc;
+
+	for (i = 0; i < m->n_loops; i++)
+		if (m->loops[i].entity == ent && !m->loops[i].hole) {
+			n_outer++;
+			last = i;
+		}
+	if (n_outer > 1) {
+		rc = assign_holes(b, ent, err);
+		if (rc)
+			return rc;
+	} else
+		for (i = 0; i < m->n_loops; i++)
+			if (m->loops[i].entity == ent)
+				b->owner[i] = last;
+	if (n_outer == 0)
+		return add_face(b, ent, -1, err);
+	for (i = 0; i < m->n_loops; i++)
+		if (m->loops[i].entity == ent && !m->loops[i].hole) {
+			rc = add_face(b, ent, i, err);
+			if (rc)
+				return rc;
+		}
+	return PX_OK;
+}
+
 static int describe(struct build *b, double scale, struct px_brep **out,
 		    struct px_obj_error *err)
 {
@@ -262,21 +409,9 @@ static int describe(struct build *b, double scale, struct px_brep **out,
 	for (i = 0; i < m->n_entities; i++) {
 		const struct px_obj_entity *e = &m->entities[i];
 		if (e->kind == PX_OBJ_SURF) {
-			struct px_brep_face_desc *f = &b->faces[b->n_faces];
-			struct face_loops *fl = &b->fl[b->n_faces];
-			rc = face_loops(b, i, fl, &e->surf);
+			rc = surf_faces(b, i, err);
 			if (rc)
-				return oerr(err, rc, e->line, 1,
-					    "surface of line %d: cannot build its "
-					    "loops: %s",
-					    e->line, px_strerror(rc));
-			memset(f, 0, sizeof(*f));
-			f->surf = e->surf;
-			f->loops = fl->loops;
-			f->n_loops = fl->n;
-			f->shell = 0;
-			f->id = e->line;
-			b->face_ent[b->n_faces++] = i;
+				return rc;
 		} else {
 			struct px_brep_edge_desc *ed = &b->edges[b->n_edges];
 			ed->curve = e->curve;
@@ -322,13 +457,17 @@ int px_brep_from_obj(const struct px_obj_model *m, double scale,
 			    "surfaces in a trimmed file are not supported");
 	memset(&b, 0, sizeof(b));
 	b.m = m;
-	n = (size_t)m->n_entities + 1;
+	n = (size_t)m->n_entities + (size_t)m->n_loops + 1;
 	b.faces = calloc(n, sizeof(*b.faces));
 	b.fl = calloc(n, sizeof(*b.fl));
 	b.edges = calloc(n, sizeof(*b.edges));
 	b.face_ent = calloc(n, sizeof(int));
 	b.edge_ent = calloc(n, sizeof(int));
-	rc = b.faces && b.fl && b.edges && b.face_ent && b.edge_ent
+	b.owner = calloc(n, sizeof(int));
+	b.region = calloc(n, sizeof(*b.region));
+	b.region_area = calloc(n, sizeof(double));
+	rc = b.faces && b.fl && b.edges && b.face_ent && b.edge_ent && b.owner &&
+	     b.region && b.region_area
 		     ? px_arena_init_alloc(&b.arena, arena_need(m))
 		     : PX_E_NOMEM;
 	if (rc)

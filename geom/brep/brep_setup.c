@@ -444,6 +444,8 @@ static int link_topology(struct px_brep *b, const struct px_brep_desc *d,
 	b->bytes += ((size_t)b->n_co + b->n_vertices + 1) * sizeof(*b->pts);
 	for (i = 0; i < b->n_co; i++) {
 		struct brep_coedge *c = &b->co[i];
+		if (c->edge < 0 && px__brep_cos_on(b->cos, i))
+			continue; /* answered by its curve-on-surface edge */
 		if (c->edge < 0) {
 			rc = collapsed_curve(b, d, c, err);
 			if (rc) {
@@ -544,6 +546,7 @@ void px_brep_free(struct px_brep *b)
 	for (i = 0; i < BREP_WS; i++)
 		px_dist_ws_free(b->ws[i]);
 	px_dist_model_free(b->dm);
+	px__brep_cos_free(b->cos);
 	for (i = 0; b->faces && i < b->n_faces; i++)
 		px_trim_free(b->faces[i].trim);
 	free(b->faces);
@@ -645,8 +648,21 @@ int px_brep_create(const struct px_brep_desc *d, const struct px_brep_opts *opts
 	/* loop curves without edges get their exact images (brep_compose.c) */
 	memset(&aug, 0, sizeof(aug));
 	rc = o.compose_edges ? px__brep_compose(d, &aug, err) : PX_OK;
+	b->cos = aug.cos;
+	aug.cos = NULL;
 	if (!rc)
 		rc = create_steps(b, aug.d.faces ? &aug.d : d, &o, err);
+	if (!rc && b->cos) {
+		/* signs need every edge as a curve of the core */
+		b->closed = 0;
+		snprintf(b->why, sizeof(b->why),
+			 "%d loop curves are curve-on-surface edges (no signed "
+			 "distance over them)",
+			 b->cos->n_cos);
+		b->bytes += sizeof(*b->cos) + b->cos->n_coef * sizeof(double) +
+			    (size_t)b->cos->n_pc * sizeof(*b->cos->pc) +
+			    (size_t)b->cos->n_cos * sizeof(*b->cos->cos);
+	}
 	px__brep_aug_free(&aug);
 	if (rc) {
 		if (err && !err->msg[0])

@@ -7,8 +7,10 @@
  * face is such a point, or on a trimming edge, or at a vertex). Its
  * global query, where the tracked set cannot prove an answer, is the
  * distance core over the trimmed faces, as the model's own. The point
- * candidates (free vertices, loops collapsed to a point) are checked
- * directly every answer. Answers go through the model's own signing
+ * candidates (free vertices, loops collapsed to a point) and the
+ * curve-on-surface edges (brep_cos.c, not tracked) are checked directly
+ * every answer; when those edges alone bound the faces (the faces give
+ * the core no sample of their own), every answer is the global query's. Answers go through the model's own signing
  * (px__brep_answer()), so they are the global query's, sign included.
  *
  * Closed-form faces (planes, cylinders, cones, spheres, tori that the
@@ -54,7 +56,11 @@
 
 struct brep_stream {
 	struct px_strack *st;
-	int last;       /* last answer: -1 the tracker's, else a point candidate */
+	int last;       /* last answer: -1 the tracker's, >= 0 a point
+			 * candidate, -2 - k curve-on-surface edge k */
+	/* the faces give the core no sample of their own: every answer is
+	 * px__brep_closest_ws()'s in ws */
+	int cos_global;
 	int feature, index; /* the last answer's (feature -1: none yet) */
 	uint64_t tracked, global, cold, jumps, hot;
 	/* closed-form faces: per face its recognised shape (NULL: none)
@@ -204,7 +210,17 @@ int px__brep_stream_create(const void *impl, const struct px_model_stream_opts *
 		return PX_E_NOMEM;
 	s->last = -1;
 	s->feature = -1;
+	s->cf = -1;
 	s->verify_every = o->verify_every;
+	if (b->cos) {
+		struct px_dist_info di;
+		px_dist_model_info(b->dm, &di);
+		if (di.n_samples == 0) {
+			s->cos_global = 1;
+			rc = px_dist_ws_create(b->dm, &s->ws);
+			goto out;
+		}
+	}
 	rc = cf_setup(s, b, &all);
 	if (rc == PX_OK && ((all && o->cold_switch) || (s->box && o->verify_every > 0)))
 		rc = px_dist_ws_create(b->dm, &s->ws);
@@ -501,7 +517,14 @@ int px__brep_stream_query(const void *impl, void *state,
 	int rc, pi;
 
 	memset(&d, 0, sizeof(d));
-	if (s->cf >= 0 && cf_update(s, b, q->p, &d)) {
+	if (s->cos_global) {
+		rc = px__brep_closest_ws(b, s->ws, q->p, &d);
+		if (rc != PX_OK)
+			return rc;
+		note->source = PX_TRACK_GLOBAL;
+		note->n_crit = -1;
+		note->jumped = s->last != -1 || moved_far(s, q->p, d.point);
+	} else if (s->cf >= 0 && cf_update(s, b, q->p, &d)) {
 		note->source = PX_TRACK_TRACKED;
 		note->n_crit = 1;
 		note->jumped = s->last >= 0 || s->feature != PX_FEATURE_SURFACE ||
@@ -535,11 +558,19 @@ int px__brep_stream_query(const void *impl, void *state,
 		note->jumped = s->last != pi;
 		s->cf = -1;
 	}
+	if (!s->cos_global) {
+		d.piece = -1;
+		d.certified = 1;
+	}
+	/* curve-on-surface edges are not tracked: solved every answer */
+	if (b->cos && px__brep_cos_closest(b->cos, q->p, &d, NULL)) {
+		pi = -2 - d.entity;
+		note->jumped = s->last != pi;
+		s->cf = -1;
+	}
 	s->lq = q->p;
 	s->lpt = d.point;
 	s->last = pi;
-	d.piece = -1;
-	d.certified = 1;
 	rc = px__brep_answer(b, q, &d, r);
 	/* a face, an edge and its end vertex are features of their own
 	 * (the tracker's curve answer may run into an edge's end) */

@@ -120,8 +120,11 @@ struct px_brep_opts {
 	/* 1: a loop curve without a 3D edge (coedge edge -1) whose image is
 	 * not a single point gets its exact image on the surface as an own
 	 * edge (degree d (p + q) for a degree-d curve on a (p, q) surface,
-	 * d p or d q when u or v is constant along it; refused above
-	 * PX_NURBS_MAX_DEGREE); 0 (default): such a curve is refused. */
+	 * d p or d q when u or v is constant along it): a NURBS curve up to
+	 * PX_NURBS_MAX_DEGREE, above it a curve-on-surface edge (exact,
+	 * numbered after the edges in answers and px_brep_info, not
+	 * signed: a B-rep with one is open) up to degree 24, refused
+	 * beyond; 0 (default): such a curve is refused. */
 	int compose_edges;
 };
 

@@ -2,21 +2,26 @@
  * px_brep_obj.h - trimmed Wavefront OBJ free-form files (px_obj.h:
  * curv2, trim, hole) as B-rep models.
  *
- * Every surf of the file becomes one face of one free shell (an open
+ * Every surf of the file becomes one face per 'trim' loop (the
+ * surface's whole domain when it has none) of one free shell (an open
  * sheet: distances are unsigned; faces are not matched into a closed
- * solid): its trim loop is the outer loop (the surface's whole domain
- * when it has holes but no trim), its hole loops the holes, each loop
- * curve the curv2 restricted to the statement's range (run backwards
- * when u0 > u1). Loop curves have no 3D edges in OBJ, so every one gets
- * its exact image on the surface as an own edge (px_brep_opts
- * compose_edges; edges are not shared between faces). curv entities are
- * free edges; polygon faces (f) in a trimmed file are refused.
+ * solid): the trim loop is the face's outer loop, its holes the hole
+ * loops that lie inside it (with several trim loops, a hole belongs to
+ * the smallest one around it: an island in a hole of another region is
+ * a face of its own), each loop curve the curv2 restricted to the
+ * statement's range (run backwards when u0 > u1). Loop curves have no
+ * 3D edges in OBJ, so every one gets its exact image on the surface as
+ * an own edge (px_brep_opts compose_edges; edges are not shared between
+ * faces): a NURBS curve of the kernel when its degree allows, else
+ * (a cubic trim on a bicubic surface: degree 18) a curve-on-surface
+ * edge solved as exactly (up to degree 24). curv entities are free
+ * edges; polygon faces (f) in a trimmed file are refused.
  *
  * Errors carry the place in the file: px_obj_error line and column of
  * the trim or hole statement whose loop is refused (open, crossing,
- * zero area, outside the surface's domain, an image of too high a
- * degree), or of the surf or curv statement, and a message that says
- * what is wrong.
+ * zero area, outside the surface's domain, a hole in none of several
+ * trim loops, an image of too high a degree), or of the surf or curv
+ * statement, and a message that says what is wrong.
  *
  * Memory: setup only (allocates); the B-rep owns its copies.
  */

@@ -699,6 +699,7 @@ static int model_alloc(const struct px_dist_model *hdr, const struct builder *bl
 	m->n_sp = ly->n_sp;
 	m->n_samples = (int)bl->n_samples;
 	m->ws.n_pieces = bl->n;
+	m->ws.bound2 = INFINITY;
 	m->ws.n_ent = n_ent;
 	*spmem = NULL;
 	*shmem = NULL;

@@ -81,6 +81,15 @@ int px__dist_model_create_trimmed(const struct px_nurbs_curve *curves,
 				  const struct px_dist_opts *opts,
 				  struct px_dist_model **out);
 
+/* px_dist_query_ws() below an upper bound bound2 on the squared
+ * distance (the caller's own candidate): PX_OK with the answer, 1 when
+ * nothing of the model is nearer than the bound (r->dist its root,
+ * r->piece -1; certified and gap still describe the proof), or the
+ * same errors. A model whose pieces give no sample (trimmed faces that
+ * only crossed patches reach) still answers. @note RT-safe. */
+int px__dist_query_below(const struct px_dist_model *m, struct px_dist_ws *ws,
+			 px_vec3 p, double bound2, struct px_dist_result *r);
+
 /* ---- the prepared model ------------------------------------------------- */
 
 struct cand {
@@ -104,6 +113,7 @@ struct px_dist_ws {
 	struct cand *cand;
 	int n_pieces, n_ent;
 	int owned; /* allocated by px_dist_ws_create() */
+	double bound2; /* INFINITY but inside px__dist_query_below() */
 };
 
 /* One entry of the grid's index space: a curve piece or a patch. */

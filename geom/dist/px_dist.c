@@ -319,6 +319,7 @@ int px_dist_ws_create(const struct px_dist_model *m, struct px_dist_ws **out)
 	ws->n_pieces = m->n_pieces;
 	ws->n_ent = m->n_ent;
 	ws->owned = 1;
+	ws->bound2 = INFINITY;
 	*out = ws;
 	return PX_OK;
 }
@@ -606,7 +607,8 @@ int px_dist_query_ws(const struct px_dist_model *m, struct px_dist_ws *ws,
 	}
 	memset(r, 0, sizeof(*r));
 	r->certified = 1;
-	q.best = INFINITY;
+	/* INFINITY but inside px__dist_query_below() */
+	q.best = ws->bound2;
 	q.best_piece = -1;
 	q.best_sample = 0;
 	q.n_cand = 0;
@@ -619,7 +621,7 @@ int px_dist_query_ws(const struct px_dist_model *m, struct px_dist_ws *ws,
 		wave(m, ws, p, &q);
 	r->cells_visited = q.cells;
 	r->pieces_solved = q.shapes;
-	if (q.best_piece < 0)
+	if (q.best_piece < 0 && q.best == INFINITY)
 		/* The wave meets every piece, so only overflowing squared
 		 * distances (a model spanning more than about 1e154) leave
 		 * no best sample. */
@@ -630,7 +632,9 @@ int px_dist_query_ws(const struct px_dist_model *m, struct px_dist_ws *ws,
 	sv.best = q.best;
 	sv.gap = 0.0;
 	r->piece = q.best_piece;
-	if (q.best_sample >= 0) {
+	if (q.best_piece < 0) {
+		/* below a bound: only a solve can answer */
+	} else if (q.best_sample >= 0) {
 		r->point = m->samples[q.best_sample];
 		sample_params(m, q.best_piece, q.best_sample, &r->u, &r->v);
 	} else {
@@ -654,6 +658,8 @@ int px_dist_query_ws(const struct px_dist_model *m, struct px_dist_ws *ws,
 	if (!isfinite(r->dist))
 		return PX_E_RANGE; /* overflow: see PX__MAX_QUERY_REACH */
 	r->gap = sv.gap;
+	if (r->piece < 0)
+		return 1;
 	r->entity = m->pieces[r->piece].ent;
 	r->kind = m->ent[r->entity].kind;
 	{
@@ -662,6 +668,18 @@ int px_dist_query_ws(const struct px_dist_model *m, struct px_dist_ws *ws,
 				       : px_v3(0, 0, 0);
 	}
 	return PX_OK;
+}
+
+int px__dist_query_below(const struct px_dist_model *m, struct px_dist_ws *ws,
+			 px_vec3 p, double bound2, struct px_dist_result *r)
+{
+	int rc;
+	if (!ws)
+		return PX_E_INVAL;
+	ws->bound2 = bound2;
+	rc = px_dist_query_ws(m, ws, p, r);
+	ws->bound2 = INFINITY;
+	return rc;
 }
 
 int px_dist_query_batch(struct px_dist_model *m, const px_vec3 *p, size_t n,

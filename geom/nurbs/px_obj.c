@@ -157,7 +157,6 @@ static int lex(struct lexer *lx, struct tok *t)
 
 struct ent_rec {
 	int kind, line, col, rat, deg[2];
-	int n_outer;       /* 'trim' loops of a surface */
 	int deg_line, deg_col;
 	double range[4];
 	size_t ctrl_off, ctrl_count; /* into xyz/w pools (and ref places) */
@@ -756,11 +755,6 @@ static int st_loop(struct ctx *c, const struct tok *tk, size_t n, int kind)
 		return fail(c, &tk[0], PX_E_PARSE,
 			    "'%s' takes triples u0 u1 curv2 (got %zu values)",
 			    kw[kind], n - 1);
-	if (kind == 0 && e->n_outer)
-		return fail(c, &tk[0], PX_E_UNSUPPORTED,
-			    "second 'trim' loop of the surface of line %d (one "
-			    "outer loop per surface)",
-			    e->line);
 	lr.ent = (size_t)(c->in_body - 1);
 	lr.hole = kind == 1;
 	lr.line = tk[0].line;
@@ -793,8 +787,6 @@ static int st_loop(struct ctx *c, const struct tok *tk, size_t n, int kind)
 	}
 	if (kind == 2)
 		return PX_OK;
-	e = cur_ent(c);
-	e->n_outer += kind == 0;
 	return vec_push(&c->loops, &lr) ? nomem(c) : PX_OK;
 }
 

@@ -28,9 +28,9 @@
  *    out); "curv2 vp1 vp2 ..." with the current cstype and deg, its
  *    "parm u" and "end" (a 2D curve (u, v, 0) over the whole knot domain,
  *    w its weight when rational; in px_obj_model.curv2, not among the
- *    entities); inside a surf body "trim u0 u1 c ..." (the outer loop, at
- *    most one per surface) and "hole u0 u1 c ..." (holes): loops of
- *    curv2 curves c (1-based or negative, defined before) on [u0, u1]
+ *    entities); inside a surf body "trim u0 u1 c ..." (outer loops, each
+ *    bounding one region of the surface) and "hole u0 u1 c ..." (holes):
+ *    loops of curv2 curves c (1-based or negative, defined before) on [u0, u1]
  *    within their domains, in px_obj_model.loops and trim_curves (the
  *    B-rep is built by px_brep_obj.h). "scrv" (same form) and "sp vp ..."
  *    (in a curve or surface body) are checked (references, ranges) and
@@ -43,7 +43,7 @@
  * malformed statements (PX_E_PARSE) and valid OBJ this loader does not
  * handle (PX_E_UNSUPPORTED): Bezier, Cardinal, Taylor and basis-matrix
  * types, bmat, step, con, points (p) and lines (l), the superseded 2.11
- * patch statements, a second trim loop of one surface, trim, hole and
+ * patch statements, trim, hole and
  * scrv outside a surf body, sp outside a body, curv2 before any cstype;
  * unknown statements.
  * NURBS data errors (knot order, multiplicity, weights...) come from

@@ -8,11 +8,13 @@
  * built with compose_edges and refused without it.
  */
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "brep_internal.h"
+#include "px_alloc_count.h"
 #include "px_brep.h"
 #include "px_test.h"
 
@@ -300,20 +302,173 @@ static void test_brep(void)
 	PX_CHECK_INT_EQ(info.n_faces, 1);
 	PX_CHECK_INT_EQ(info.closed, 0);
 	px_brep_free(b);
-	/* a cubic hole curve on the bicubic sheet: degree 18 */
+	/* a cubic hole curve on the bicubic sheet: its image has degree
+	 * 18, above the kernel's, so it is a curve-on-surface edge */
 	{
 		double uvw[12] = {0.6, -0.3, 1, 1.0, 0.5, 1, 1.4, -0.5, 1, 0.6, -0.3, 1};
 		make_curve(&hole[0], 3, 4, uvw);
 		hc[0] = hole[0].c;
 		loops[1].n_curves = 1;
+		PX_CHECK_MSG(px_brep_create(&d, &o, &err, &b) == PX_OK, "%s", err.msg);
+		PX_CHECK_INT_EQ(px_brep_get_info(b, &info), PX_OK);
+		PX_CHECK_INT_EQ(info.n_edges, 5);
+		PX_CHECK(strstr(info.why, "curve-on-surface") != NULL);
+		px_brep_free(b);
+		b = NULL;
+	}
+	/* a quintic one: degree 30, above the curve-on-surface edges' 24 */
+	{
+		double uvw[18] = {0.6, -0.3, 1, 0.8, 0.4, 1, 1.0, 0.5, 1,
+				  1.2, 0.1, 1, 1.4, -0.5, 1, 0.6, -0.3, 1};
+		make_curve(&hole[0], 5, 6, uvw);
+		hc[0] = hole[0].c;
 		PX_CHECK_INT_EQ(px_brep_create(&d, &o, &err, &b), PX_E_NOSPC);
-		PX_CHECK_MSG(strstr(err.msg, "face 0 (id 7): loop 1 curve 0") != NULL,
+		PX_CHECK_MSG(strstr(err.msg, "face 0 (id 7): loop 1 curve 0") != NULL &&
+				     strstr(err.msg, "degree 30") != NULL,
 			     "%s", err.msg);
 		PX_CHECK(b == NULL);
 	}
 }
 
+
+/* Cubic curves on bicubic surfaces (polynomial and rational): the
+ * degree-18 Bezier pieces of px__brep_compose_bezier() reproduce
+ * S(c(t)) to 1e-12 of the size, and the curve-on-surface solver
+ * (brep_cos.c) finds the distance to them as dense sampling of S(c(t))
+ * polished by golden-section steps does, certified and without heap
+ * calls. */
+static void test_cos_solver(void)
+{
+	int it, worst_q = 0;
+	double worst = 0.0;
+	for (it = 0; it < 8; it++) {
+		struct surf_buf sb;
+		struct curve_buf cb;
+		struct brep_cos_set set;
+		double uvw[3 * 6], *pw = NULL, *brk = NULL, t0, t1, size, ew = 0.0;
+		char why[200];
+		int deg, n_pc, i, k, q;
+		px_aabb hb;
+		make_surf(&sb, 3, 3, 5 + it % 3, 4 + it % 2, it & 1);
+		for (i = 0; i < 6; i++) {
+			uvw[3 * i] = px_rand_range(0.05, 1.95);
+			uvw[3 * i + 1] = px_rand_range(-0.95, 0.95);
+			uvw[3 * i + 2] = it & 2 ? px_rand_range(0.7, 1.4) : 1.0;
+		}
+		make_curve(&cb, 3, 6, uvw);
+		hb = px_nurbs_surf_aabb(&sb.s);
+		size = px_aabb_diagonal(&hb);
+		PX_CHECK_INT_EQ(px__brep_compose_bezier(&sb.s, &cb.c, &deg, &n_pc, &pw, &brk,
+							why, sizeof(why)),
+				PX_OK);
+		PX_CHECK_INT_EQ(deg, 18);
+		if (!pw)
+			continue;
+		memset(&set, 0, sizeof(set));
+		PX_CHECK_INT_EQ(px__brep_cos_add(&set, 0, 0, deg, n_pc, pw, brk, 1.0), PX_OK);
+		/* the pieces against the surface at the curve */
+		for (k = 0; k < n_pc; k++)
+			for (i = 0; i <= 50; i++) {
+				double s = i / 50.0, t = brk[k] + (brk[k + 1] - brk[k]) * s;
+				px_vec3 c = px_nurbs_curve_point(&cb.c, t), a;
+				struct px_dist_result d;
+				memset(&d, 0, sizeof(d));
+				a = px_nurbs_surf_point(&sb.s, c.x, c.y);
+				/* the piece's own point at s (de Casteljau) */
+				{
+					double h[19][4];
+					int r, j, c4;
+					for (j = 0; j <= deg; j++)
+						for (c4 = 0; c4 < 4; c4++)
+							h[j][c4] = pw[4 * (k * deg + j) + c4];
+					for (r = 1; r <= deg; r++)
+						for (j = 0; j <= deg - r; j++)
+							for (c4 = 0; c4 < 4; c4++)
+								h[j][c4] = (1 - s) * h[j][c4] +
+									   s * h[j + 1][c4];
+					ew = fmax(ew, px_v3_dist(a, px_v3(h[0][0] / h[0][3],
+									h[0][1] / h[0][3],
+									h[0][2] / h[0][3])));
+				}
+				/* and the solver's answer at a query on it */
+				d.dist = INFINITY;
+				d.certified = 1;
+				px__brep_cos_closest(&set, a, &d, NULL);
+				ew = fmax(ew, d.dist);
+			}
+		PX_CHECK_MSG(ew <= 1e-12 * size, "pieces off the surface by %g", ew);
+		px_nurbs_curve_domain(&cb.c, &t0, &t1);
+		for (q = 0; q < 300; q++) {
+			px_vec3 p = px_v3(px_rand_range(-1.0, 4.0), px_rand_range(-2.0, 3.0),
+					  px_rand_range(-1.5, 1.5));
+			struct px_dist_result d;
+			double ref = INFINITY, step = (t1 - t0) / 3000.0, lo, hi, ds[3001];
+			uint64_t a0;
+			if (q % 2) {
+				/* near the curve */
+				px_vec3 c = px_nurbs_curve_point(&cb.c, px_rand_range(t0, t1));
+				p = px_v3_add(px_nurbs_surf_point(&sb.s, c.x, c.y),
+					      px_v3(px_rand_range(-1e-3, 1e-3),
+						    px_rand_range(-1e-3, 1e-3),
+						    px_rand_range(-1e-3, 1e-3)));
+			}
+			/* every local minimum of the samples, golden-section
+			 * polished between its neighbours */
+			for (i = 0; i <= 3000; i++) {
+				px_vec3 c = px_nurbs_curve_point(&cb.c, t0 + step * i);
+				ds[i] = px_v3_dist(px_nurbs_surf_point(&sb.s, c.x, c.y), p);
+				ref = fmin(ref, ds[i]);
+			}
+			for (k = 0; k <= 3000; k++) {
+				if ((k > 0 && ds[k - 1] < ds[k]) || (k < 3000 && ds[k + 1] < ds[k]))
+					continue;
+				lo = fmax(t0, t0 + step * (k - 1));
+				hi = fmin(t1, t0 + step * (k + 1));
+				for (i = 0; i < 100; i++) {
+					double m1 = lo + 0.381966 * (hi - lo), m2 = hi - 0.381966 * (hi - lo);
+					px_vec3 c1 = px_nurbs_curve_point(&cb.c, m1);
+					px_vec3 c2 = px_nurbs_curve_point(&cb.c, m2);
+					double d1 = px_v3_dist(px_nurbs_surf_point(&sb.s, c1.x, c1.y), p);
+					double d2 = px_v3_dist(px_nurbs_surf_point(&sb.s, c2.x, c2.y), p);
+					ref = fmin(ref, fmin(d1, d2));
+					if (d1 < d2)
+						hi = m2;
+					else
+						lo = m1;
+				}
+			}
+			memset(&d, 0, sizeof(d));
+			d.dist = INFINITY;
+			d.certified = 1;
+			a0 = px_alloc_region_begin();
+			PX_CHECK_INT_EQ(px__brep_cos_closest(&set, p, &d, NULL), 1);
+			PX_CHECK_INT_EQ((int)px_alloc_region_end(a0), 0);
+			PX_CHECK(d.certified);
+			if (fabs(d.dist - ref) > worst) {
+				worst = fabs(d.dist - ref);
+				worst_q = q;
+			}
+			{
+				px_vec3 c = px_nurbs_curve_point(&cb.c, d.u);
+				px_vec3 sp = px_nurbs_surf_point(&sb.s, c.x, c.y);
+				PX_CHECK_MSG(fabs(d.dist - ref) <= 1e-9 * size,
+					     "case %d query %d: %.17g, reference %.17g; at u %.17g "
+					     "the curve is %g from the answer, %.17g from p",
+					     it, q, d.dist, ref, d.u, px_v3_dist(sp, d.point),
+					     px_v3_dist(sp, p));
+			}
+		}
+		free(pw);
+		free(brk);
+		free(set.cos);
+		free(set.pc);
+		free(set.coef);
+	}
+	(void)worst_q;
+}
+
 static const struct px_test tests[] = {
 	PX_T(test_lines), PX_T(test_curves), PX_T(test_circle),
-	PX_T(test_iso_and_tangent), PX_T(test_degree_cap), PX_T(test_brep)};
+	PX_T(test_iso_and_tangent), PX_T(test_degree_cap), PX_T(test_brep),
+	PX_T(test_cos_solver)};
 PX_TEST_MAIN(tests)

@@ -9,11 +9,15 @@
  * trimmed .obj as a B-rep and leaves untrimmed ones to the mesh loader.
  */
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
+#include "brep_internal.h"
+#include "px_alloc_count.h"
 #include "px_brep_obj.h"
 #include "px_features.h"
 #include "px_load.h"
@@ -203,19 +207,32 @@ static void freeform_text(char *buf, size_t cap, double *ctrl)
  * images, the best of each polished by projected Newton steps. */
 struct ffref {
 	const struct px_nurbs_surf *s;
-	const struct px_trim *t;
-	const struct px_nurbs_curve *c[4];
+	const struct px_trim *t[8]; /* the face regions */
+	int nt;
+	const struct px_nurbs_curve *c[8];
 	int nc;
 	double *su, *sv;
 	px_vec3 *sp;
 	int ns;
 };
 
+/* (u, v) in one of the regions (on its boundary counts). */
+static int ff_in(const struct ffref *f, double u, double v, int strict)
+{
+	int k;
+	for (k = 0; k < f->nt; k++) {
+		int w = px_trim_contains(f->t[k], u, v, NULL);
+		if (w == PX_TRIM_INSIDE || (!strict && w != PX_TRIM_OUTSIDE))
+			return 1;
+	}
+	return 0;
+}
+
 static double ff_polish_surf(const struct ffref *f, px_vec3 p, double u, double v)
 {
 	double best = px_v3_dist(px_nurbs_surf_point(f->s, u, v), p);
 	int it;
-	for (it = 0; it < 40; it++) {
+	for (it = 0; it < 400; it++) {
 		struct px_nurbs_surf_derivs d;
 		px_vec3 r;
 		double a, b, c, g0, g1, det, du, dv, nd, lam = 1.0;
@@ -233,8 +250,7 @@ static double ff_polish_surf(const struct ffref *f, px_vec3 p, double u, double 
 		dv = -(a * g1 - b * g0) / det;
 		for (; lam > 1e-6; lam *= 0.5) {
 			double un = u + lam * du, vn = v + lam * dv;
-			if (un < 0 || un > 1 || vn < 0 || vn > 1 ||
-			    px_trim_contains(f->t, un, vn, NULL) == PX_TRIM_OUTSIDE)
+			if (un < 0 || un > 1 || vn < 0 || vn > 1 || !ff_in(f, un, vn, 0))
 				continue;
 			nd = px_v3_dist(px_nurbs_surf_point(f->s, un, vn), p);
 			if (nd < best) {
@@ -288,19 +304,44 @@ static double ff_reference(const struct ffref *f, px_vec3 p)
 		}
 	}
 	best = ff_polish_surf(f, p, f->su[bi], f->sv[bi]);
+	/* and the next best samples away from it (other basins) */
+	{
+		int picked[6], np = 1, j;
+		picked[0] = bi;
+		while (np < 6) {
+			double bd = INFINITY;
+			int bj = -1;
+			for (i = 0; i < f->ns; i++) {
+				double d = px_v3_dist2(f->sp[i], p);
+				int far = d < bd;
+				for (j = 0; j < np && far; j++)
+					far = fabs(f->su[i] - f->su[picked[j]]) +
+						      fabs(f->sv[i] - f->sv[picked[j]]) >
+					      0.08;
+				if (far) {
+					bd = d;
+					bj = i;
+				}
+			}
+			if (bj < 0)
+				break;
+			picked[np++] = bj;
+			best = fmin(best, ff_polish_surf(f, p, f->su[bj], f->sv[bj]));
+		}
+	}
 	for (k = 0; k < f->nc; k++) {
-		double t0, t1, bd = INFINITY, bt = 0;
+		/* every local minimum of the samples, polished */
+		double t0, t1, ds[401];
 		px_nurbs_curve_domain(f->c[k], &t0, &t1);
 		for (i = 0; i <= 400; i++) {
-			double t = t0 + (t1 - t0) * i / 400.0, d;
-			px_vec3 q = px_nurbs_curve_point(f->c[k], t);
-			d = px_v3_dist(px_nurbs_surf_point(f->s, q.x, q.y), p);
-			if (d < bd) {
-				bd = d;
-				bt = t;
-			}
+			px_vec3 q = px_nurbs_curve_point(f->c[k], t0 + (t1 - t0) * i / 400.0);
+			ds[i] = px_v3_dist(px_nurbs_surf_point(f->s, q.x, q.y), p);
 		}
-		best = fmin(best, ff_polish_curve(f, f->c[k], p, bt, (t1 - t0) / 400.0));
+		for (i = 0; i <= 400; i++)
+			if (!((i > 0 && ds[i - 1] < ds[i]) || (i < 400 && ds[i + 1] < ds[i])))
+				best = fmin(best, ff_polish_curve(f, f->c[k], p,
+								  t0 + (t1 - t0) * i / 400.0,
+								  (t1 - t0) / 400.0));
 	}
 	return best;
 }
@@ -350,7 +391,8 @@ static void test_freeform(void)
 	PX_CHECK_INT_EQ(px_trim_create(loops, 2, NULL, NULL, &t), PX_OK);
 	memset(&f, 0, sizeof(f));
 	f.s = &om->entities[0].surf;
-	f.t = t;
+	f.t[0] = t;
+	f.nt = 1;
 	for (i = 0; i < 4; i++)
 		f.c[i] = &om->curv2[i].curve;
 	f.nc = 4;
@@ -397,6 +439,380 @@ static void test_freeform(void)
 	px_obj_free(om);
 }
 
+
+/* ---- cubic trims, several regions ------------------------------------------ */
+
+/* A closed loop of the sheets below: a wobbly circle of 8 control points
+ * (the ninth closes it) around (cx, cy), its face region, hole or not. */
+struct loop_spec {
+	double cx, cy, r;
+	int hole, region;
+};
+
+/* A wavy n x n sheet of degree p over [0, 1]^2 (x up to 3, y up to
+ * 2.5) with the loops as degree-dt curv2 curves, trim or hole, in the
+ * given order. */
+static void sheet_text(char *buf, size_t cap, int p, int n, int dt,
+		       const struct loop_spec *L, int nl)
+{
+	int at = 0, i, j, k;
+	for (j = 0; j < n; j++)
+		for (i = 0; i < n; i++)
+			at += snprintf(buf + at, cap - (size_t)at, "v %.17g %.17g %.17g\n",
+				       3.0 * i / (n - 1), 2.5 * j / (n - 1),
+				       0.4 * sin(1.7 * i * 5.0 / (n - 1) + 0.3) *
+					       cos(1.3 * j * 4.0 / (n - 1)));
+	for (k = 0; k < nl; k++)
+		for (i = 0; i < 9; i++) {
+			double th = 2.0 * M_PI * (i % 8) / 8.0;
+			double r = L[k].r * (1.0 + 0.12 * sin(3.0 * th + 7.0 * L[k].cx));
+			at += snprintf(buf + at, cap - (size_t)at, "vp %.17g %.17g\n",
+				       L[k].cx + r * cos(th), L[k].cy + r * sin(th));
+		}
+	at += snprintf(buf + at, cap - (size_t)at, "cstype bspline\ndeg %d\n", dt);
+	for (k = 0; k < nl; k++) {
+		at += snprintf(buf + at, cap - (size_t)at, "curv2");
+		for (i = 0; i < 9; i++)
+			at += snprintf(buf + at, cap - (size_t)at, " %d", 9 * k + i + 1);
+		at += snprintf(buf + at, cap - (size_t)at, "\nparm u");
+		for (i = 0; i < 9 + dt + 1; i++)
+			at += snprintf(buf + at, cap - (size_t)at, " %.17g",
+				       i <= dt ? 0.0 : (i >= 9 ? 1.0 : (double)(i - dt) / (9 - dt)));
+		at += snprintf(buf + at, cap - (size_t)at, "\nend\n");
+	}
+	at += snprintf(buf + at, cap - (size_t)at, "deg %d %d\nsurf 0 1 0 1", p, p);
+	for (i = 1; i <= n * n; i++)
+		at += snprintf(buf + at, cap - (size_t)at, " %d", i);
+	for (k = 0; k < 2; k++) {
+		at += snprintf(buf + at, cap - (size_t)at, "\nparm %c", k ? 'v' : 'u');
+		for (i = 0; i < n + p + 1; i++)
+			at += snprintf(buf + at, cap - (size_t)at, " %.17g",
+				       i <= p ? 0.0 : (i >= n ? 1.0 : (double)(i - p) / (n - p)));
+	}
+	at += snprintf(buf + at, cap - (size_t)at, "\n");
+	for (k = 0; k < nl; k++)
+		at += snprintf(buf + at, cap - (size_t)at, "%s 0 1 %d\n",
+			       L[k].hole ? "hole" : "trim", k + 1);
+	snprintf(buf + at, cap - (size_t)at, "end\n");
+}
+
+/* The reference of a sheet: one domain per region (its trim loop and
+ * its holes), every loop curve, the surface sampled inside. */
+static int sheet_ref(struct ffref *f, const struct px_obj_model *om,
+		     const struct loop_spec *L, int nl)
+{
+	struct px_trim *tr[8];
+	int r, k, i, j, nr = 0;
+	memset(f, 0, sizeof(*f));
+	f->s = &om->entities[0].surf;
+	for (k = 0; k < nl; k++) {
+		f->c[f->nc++] = &om->curv2[k].curve;
+		nr = L[k].region + 1 > nr ? L[k].region + 1 : nr;
+	}
+	for (r = 0; r < nr; r++) {
+		struct px_trim_loop loops[8];
+		int n = 0;
+		for (k = 0; k < nl; k++)
+			if (L[k].region == r && !L[k].hole) {
+				loops[n].curves = &om->curv2[k].curve;
+				loops[n].n_curves = 1;
+				loops[n++].reversed = NULL;
+			}
+		for (k = 0; k < nl; k++)
+			if (L[k].region == r && L[k].hole) {
+				loops[n].curves = &om->curv2[k].curve;
+				loops[n].n_curves = 1;
+				loops[n++].reversed = NULL;
+			}
+		if (px_trim_create(loops, n, NULL, NULL, &tr[r]) != PX_OK)
+			return -1;
+		f->t[f->nt++] = tr[r];
+	}
+	f->su = malloc(201 * 201 * sizeof(double));
+	f->sv = malloc(201 * 201 * sizeof(double));
+	f->sp = malloc(201 * 201 * sizeof(px_vec3));
+	for (i = 0; i <= 200; i++)
+		for (j = 0; j <= 200; j++) {
+			double u = i / 200.0, v = j / 200.0;
+			if (!ff_in(f, u, v, 1))
+				continue;
+			f->su[f->ns] = u;
+			f->sv[f->ns] = v;
+			f->sp[f->ns++] = px_nurbs_surf_point(f->s, u, v);
+		}
+	return PX_OK;
+}
+
+static void sheet_ref_free(struct ffref *f)
+{
+	int k;
+	for (k = 0; k < f->nt; k++)
+		px_trim_free((struct px_trim *)(uintptr_t)f->t[k]);
+	free(f->su);
+	free(f->sv);
+	free(f->sp);
+}
+
+/* Query points: far, near the trimmed sheet (both sides) and near the
+ * loops' images (offsets from 1e-7 to 0.1). */
+static px_vec3 sheet_point(const struct ffref *f, int i)
+{
+	px_vec3 dir = px_v3(px_rand_range(-1, 1), px_rand_range(-1, 1),
+			    px_rand_range(-1, 1));
+	double off = pow(10.0, px_rand_range(-7.0, -1.0));
+	dir = px_v3_scale(dir, 1.0 / fmax(px_v3_norm(dir), 1e-3));
+	if (i % 3 == 0)
+		return px_v3(px_rand_range(-2.0, 5.0), px_rand_range(-2.0, 4.5),
+			     px_rand_range(-2.0, 2.0));
+	if (i % 3 == 1) {
+		int k = rand() % f->ns;
+		return px_v3_add(f->sp[k], px_v3_scale(dir, off));
+	} else {
+		const struct px_nurbs_curve *c = f->c[rand() % f->nc];
+		px_vec3 q = px_nurbs_curve_point(c, px_rand_range(0.0, 1.0));
+		return px_v3_add(px_nurbs_surf_point(f->s, q.x, q.y), px_v3_scale(dir, off));
+	}
+}
+
+static double now_s(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Load text with the composed edges or, force, every loop curve as a
+ * curve-on-surface edge. */
+static struct px_model *load_forced(const char *text, int force, struct px_obj_error *e,
+				    int *rc)
+{
+	struct px_model *m;
+	px__brep_force_cos = force;
+	m = load_text(text, e, rc);
+	px__brep_force_cos = 0;
+	return m;
+}
+
+/* Every answer of m on n points against the reference: never above it,
+ * never below (the reference reaches the minimum on these sheets), the
+ * point on the model at that distance, certified or with a gap that
+ * reaches the minimum, no heap call. */
+static void sheet_check(const char *name, struct px_model *m, const struct ffref *f, int n)
+{
+	double size = 3.5;
+	int i, wrong = 0, below = 0, uncert = 0;
+	uint64_t allocs = 0;
+	for (i = 0; i < n; i++) {
+		struct px_model_result r;
+		px_vec3 p = sheet_point(f, i);
+		double want = ff_reference(f, p);
+		uint64_t a0 = px_alloc_region_begin();
+		int rc = px_model_query(m, p, &r);
+		allocs += px_alloc_region_end(a0);
+		PX_CHECK_INT_EQ(rc, 1);
+		if (!(r.distance <= want + 1e-9 * size) && wrong++ < 5)
+			PX_CHECK_MSG(0, "%s (%.17g, %.17g, %.17g): %.15g, reference %.15g "
+				     "(feature %d index %d)",
+				     name, p.x, p.y, p.z, r.distance, want, r.feature, r.index);
+		if (!(r.distance >= want - 1e-9 * size) && below++ < 5)
+			PX_CHECK_MSG(0, "%s (%.17g, %.17g, %.17g): %.15g below the reference "
+				     "%.15g (feature %d index %d)",
+				     name, p.x, p.y, p.z, r.distance, want, r.feature, r.index);
+		if (r.feature == PX_FEATURE_SURFACE &&
+		    (!ff_in(f, r.u, r.v, 0) ||
+		     px_v3_dist(px_nurbs_surf_point(f->s, r.u, r.v), r.point) > 1e-9 * size) &&
+		    wrong++ < 5)
+			PX_CHECK_MSG(0, "%s: a surface point outside the domain", name);
+		if (!(fabs(px_v3_dist(p, r.point) - r.distance) <= 1e-9 * size) && wrong++ < 5)
+			PX_CHECK_MSG(0, "%s: point not at the distance", name);
+		/* an unproved answer's gap reaches the true minimum */
+		if (!r.certified && !(r.gap > 0.0 && r.distance - r.gap <= want + 1e-9 * size))
+			uncert++;
+	}
+	PX_CHECK_INT_EQ(wrong, 0);
+	PX_CHECK_INT_EQ(below, 0);
+	PX_CHECK_INT_EQ(uncert, 0);
+	PX_CHECK_INT_EQ((int)allocs, 0);
+}
+
+/* The sheet of degree p with degree-dt loops L: loaded, its faces and
+ * edges counted, n points against the reference. */
+static void sheet_case(const char *name, int p, int dt, const struct loop_spec *L, int nl,
+		       int n_faces, int n_points)
+{
+	static char text[65536];
+	struct px_obj_model *om = NULL;
+	struct px_obj_error e;
+	struct px_brep_info info;
+	struct ffref f;
+	struct px_model *m;
+	int rc;
+
+	sheet_text(text, sizeof(text), p, 7, dt, L, nl);
+	PX_CHECK_INT_EQ(px_obj_load_mem("s.obj", text, strlen(text), &om, &e), PX_OK);
+	m = load_text(text, &e, &rc);
+	PX_CHECK_MSG(rc == PX_OK, "%s %d:%d %s", name, e.line, e.column, e.msg);
+	if (!m || !om) {
+		px_model_free(m);
+		px_obj_free(om);
+		return;
+	}
+	px_brep_get_info(px_model_brep(m), &info);
+	PX_CHECK_INT_EQ(info.n_faces, n_faces);
+	PX_CHECK_INT_EQ(info.n_edges, nl);
+	PX_CHECK_INT_EQ(info.closed, 0);
+	/* images above degree 10 are curve-on-surface edges */
+	PX_CHECK((strstr(info.why, "curve-on-surface") != NULL) == (dt * 2 * p > 10));
+	PX_CHECK_INT_EQ(sheet_ref(&f, om, L, nl), PX_OK);
+	sheet_check(name, m, &f, n_points);
+	sheet_ref_free(&f);
+	px_model_free(m);
+	px_obj_free(om);
+}
+
+/* A bicubic sheet trimmed by a cubic loop with a cubic hole (Rhino's
+ * usual export): the images (degree 18) are curve-on-surface edges. */
+static void test_cubic_trim(void)
+{
+	static const struct loop_spec L[2] = {{0.5, 0.5, 0.38, 0, 0}, {0.45, 0.5, 0.12, 1, 0}};
+	sheet_case("cubic", 3, 3, L, 2, 1, 900);
+}
+
+/* Several trim loops: two disjoint regions with a hole each, and an
+ * island in one hole (the hole belongs to the smallest loop around
+ * it); biquadratic with quadratic loops (composed edges) and bicubic
+ * with cubic ones (curve-on-surface edges). */
+static void test_regions(void)
+{
+	static const struct loop_spec L[5] = {{0.3, 0.5, 0.24, 0, 0},
+					      {0.76, 0.5, 0.07, 1, 2},
+					      {0.3, 0.5, 0.06, 0, 1},
+					      {0.76, 0.5, 0.18, 0, 2},
+					      {0.3, 0.5, 0.13, 1, 0}};
+	sheet_case("regions 2", 2, 2, L, 5, 3, 600);
+	sheet_case("regions 3", 3, 3, L, 5, 3, 600);
+}
+
+/* Quadratic loops on a biquadratic sheet, both ways: the composed edges
+ * (degree 8 curves of the core) and curve-on-surface edges answer the
+ * same; the time of both is printed. */
+static void test_cos_vs_composed(void)
+{
+	static const struct loop_spec L[2] = {{0.5, 0.5, 0.38, 0, 0}, {0.45, 0.5, 0.12, 1, 0}};
+	static char text[32768];
+	struct px_obj_error e;
+	struct px_model *mc, *ms;
+	px_vec3 *pts;
+	struct ffref f;
+	struct px_obj_model *om = NULL;
+	double worst = 0.0, sec[2] = {0, 0};
+	int rc, rc2, i, k, n = 3000;
+
+	sheet_text(text, sizeof(text), 2, 7, 2, L, 2);
+	PX_CHECK_INT_EQ(px_obj_load_mem("q.obj", text, strlen(text), &om, &e), PX_OK);
+	mc = load_forced(text, 0, &e, &rc);
+	ms = load_forced(text, 1, &e, &rc2);
+	PX_CHECK_INT_EQ(rc, PX_OK);
+	PX_CHECK_INT_EQ(rc2, PX_OK);
+	if (!mc || !ms || !om || sheet_ref(&f, om, L, 2)) {
+		px_model_free(mc);
+		px_model_free(ms);
+		px_obj_free(om);
+		return;
+	}
+	pts = malloc((size_t)n * sizeof(*pts));
+	for (i = 0; i < n; i++)
+		pts[i] = sheet_point(&f, i);
+	for (k = 0; k < 2; k++) {
+		struct px_model *m = k ? ms : mc;
+		struct px_model_result r;
+		double t0 = now_s();
+		for (i = 0; i < n; i++)
+			px_model_query(m, pts[i], &r);
+		sec[k] = now_s() - t0;
+	}
+	for (i = 0; i < n; i++) {
+		struct px_model_result a, b;
+		PX_CHECK_INT_EQ(px_model_query(mc, pts[i], &a), 1);
+		PX_CHECK_INT_EQ(px_model_query(ms, pts[i], &b), 1);
+		worst = fmax(worst, fabs(a.distance - b.distance));
+		/* as proved as the composed edges' answer (the core's
+		 * crossed-patch proofs stop short on the same far points) */
+		PX_CHECK_MSG(b.certified >= a.certified,
+			     "(%.17g, %.17g, %.17g): %.17g uncertified (gap %g), composed %.17g "
+			     "certified",
+			     pts[i].x, pts[i].y, pts[i].z, b.distance, b.gap, a.distance);
+	}
+	PX_CHECK_MSG(worst <= 1e-9 * 3.5, "composed and curve-on-surface differ by %g", worst);
+	printf("  quadratic trims, %d points: composed edges %.2f us/query, "
+	       "curve-on-surface %.2f us/query\n",
+	       n, 1e6 * sec[0] / n, 1e6 * sec[1] / n);
+	sheet_check("forced", ms, &f, 300);
+	free(pts);
+	sheet_ref_free(&f);
+	px_model_free(mc);
+	px_model_free(ms);
+	px_obj_free(om);
+}
+
+/* A tracked stream on text along a path that slides over the faces,
+ * crosses the trimming edges and the holes: every answer the global
+ * query's, jumps flagged, no heap call. */
+static void track_sheet(const char *name, const char *text)
+{
+	struct px_obj_error e;
+	struct px_model *m;
+	struct px_model_stream *st = NULL;
+	int rc, i, n = 2000, pf = -1, pi = -1;
+	uint64_t a0;
+
+	m = load_text(text, &e, &rc);
+	PX_CHECK_MSG(rc == PX_OK, "%s %d:%d %s", name, e.line, e.column, e.msg);
+	if (!m)
+		return;
+	PX_CHECK_INT_EQ(px_model_stream_create(m, NULL, &st), PX_OK);
+	a0 = px_alloc_region_begin();
+	for (i = 0; st && i <= n; i++) {
+		double s = (double)i / n;
+		px_vec3 p = px_v3(-0.3 + 3.6 * s, 1.25 + 0.6 * sin(6.0 * s),
+				  0.15 * cos(9.0 * s));
+		struct px_model_result a, c;
+		struct px_model_stream_note note;
+		PX_CHECK_INT_EQ(px_model_stream_query(st, p, INFINITY, 0, &a, &note), 1);
+		PX_CHECK_INT_EQ(px_model_query(m, p, &c), 1);
+		PX_CHECK_MSG(fabs(a.distance - c.distance) <= 1e-11 * 3.5,
+			     "%s step %d: tracked %.17g (feature %d index %d), global %.17g "
+			     "(feature %d index %d)",
+			     name, i, a.distance, a.feature, a.index, c.distance, c.feature,
+			     c.index);
+		PX_CHECK(a.certified);
+		if (i > 0 && (a.feature != pf || a.index != pi))
+			PX_CHECK_MSG(note.jumped, "%s step %d: feature %d/%d -> %d/%d, not jumped",
+				     name, i, pf, pi, a.feature, a.index);
+		pf = a.feature;
+		pi = a.index;
+	}
+	PX_CHECK_INT_EQ(px_alloc_region_end(a0), 0);
+	px_model_stream_free(st);
+	px_model_free(m);
+}
+
+/* Tracked streams over the cubic-trim sheet and the cubic regions. */
+static void test_cubic_tracked(void)
+{
+	static const struct loop_spec L[2] = {{0.5, 0.5, 0.38, 0, 0}, {0.45, 0.5, 0.12, 1, 0}};
+	static const struct loop_spec R[5] = {{0.3, 0.5, 0.24, 0, 0},
+					      {0.76, 0.5, 0.07, 1, 2},
+					      {0.3, 0.5, 0.06, 0, 1},
+					      {0.76, 0.5, 0.18, 0, 2},
+					      {0.3, 0.5, 0.13, 1, 0}};
+	static char text[65536];
+	sheet_text(text, sizeof(text), 3, 7, 3, L, 2);
+	track_sheet("cubic", text);
+	sheet_text(text, sizeof(text), 3, 7, 3, R, 5);
+	track_sheet("regions", text);
+}
+
 /* ---- refusals ---------------------------------------------------------------- */
 
 struct bad {
@@ -436,14 +852,19 @@ static const struct bad bad_files[] = {
 	{"vp 1.5 0.3\ndeg 1\ncurv2 1 4 3 1\nparm u 0 0 1 2 3 3\nend\n" SURF
 	 "trim 0 3 1\nend\n",
 	 PX_E_INVAL, 18, "outside the surface's domain"},
-	/* a second outer loop */
-	{TRI SURF "trim 0 1 1 0 1 2 0 1 3\ntrim 0 1 1 0 1 2 0 1 3\nend\n",
-	 PX_E_UNSUPPORTED, 24, "second 'trim'"},
-	/* limits: a cubic curv2 on a bicubic surface (degree 18) */
-	{"vp 0.4 0.6\ndeg 3\ncurv2 1 2 4 1\nparm u 0 0 0 0 1 1 1 1\nend\ndeg 3 3\n"
+	/* two outer loops and a hole in neither (lines 23, 24 the loops) */
+	{"vp 0.1 0.1\nvp 0.2 0.1\nvp 0.15 0.2\n" TRI
+	 "curv2 4 5\nparm u 0 0 1 1\nend\ncurv2 5 6\nparm u 0 0 1 1\nend\n"
+	 "curv2 6 4\nparm u 0 0 1 1\nend\n" SURF
+	 "trim 0 1 1 0 1 2 0 1 3\ntrim 0 1 4 0 1 5 0 1 6\n"
+	 "hole 0 1 4 0 1 5 0 1 6\nend\n",
+	 PX_E_INVAL, 37, "lies in none of its 'trim' loops"},
+	/* limits: a quintic curv2 on a bicubic surface (degree 30) */
+	{"vp 0.4 0.6\nvp 0.5 0.5\nvp 0.6 0.4\ndeg 5\ncurv2 1 2 4 5 6 1\n"
+	 "parm u 0 0 0 0 0 0 1 1 1 1 1 1\nend\ndeg 3 3\n"
 	 "surf 0 1 0 1 1 2 3 4 1 2 3 4 1 2 3 4 1 2 3 4\n"
 	 "parm u 0 0 0 0 1 1 1 1\nparm v 0 0 0 0 1 1 1 1\nhole 0 1 1\nend\n",
-	 PX_E_NOSPC, 18, "degree 18"},
+	 PX_E_NOSPC, 20, "degree 30"},
 	/* a trim outside a surf body */
 	{TRI "hole 0 1 1 0 1 2 0 1 3\n", PX_E_UNSUPPORTED, 19, "inside a surf body"},
 	/* a polygon face in a trimmed file */
@@ -519,6 +940,7 @@ static void test_model_load(void)
 }
 
 static const struct px_test tests[] = {
-	PX_T(test_plane_hole), PX_T(test_freeform), PX_T(test_refusals),
-	PX_T(test_model_load)};
+	PX_T(test_plane_hole), PX_T(test_freeform), PX_T(test_cubic_trim),
+	PX_T(test_regions), PX_T(test_cos_vs_composed), PX_T(test_cubic_tracked),
+	PX_T(test_refusals), PX_T(test_model_load)};
 PX_TEST_MAIN(tests)
