@@ -386,7 +386,7 @@ static void solve_piece(const struct brep_cos_set *s, const struct brep_cos_piec
 	/* after kb, W, bd, ibf and ibg (see piece_doubles()) */
 	const double *gbin = h + piece_doubles(n, G, p->wconst) - (G + 1);
 	double F[CF + 1], g[CG + 1], Fr[CF + 1], Wr[CF + 1], gr[CG + 1];
-	double sa[COS_MAX_DEPTH + 2], sb[COS_MAX_DEPTH + 2];
+	double sa[COS_MAX_DEPTH + 2], sb[COS_MAX_DEPTH + 2], slack, eps_g;
 	int sd[COS_MAX_DEPTH + 2];
 
 	take(s, p, q, 0.0, b);
@@ -394,6 +394,19 @@ static void solve_piece(const struct brep_cos_set *s, const struct brep_cos_piec
 	for (k = 1; k < 4; k++)
 		take(s, p, q, 0.25 * k, b);
 	forms(s, p, q, F, g);
+	/* Rounding in F is about 1e-16 of the squared reach of the piece
+	 * from q: a bound within a thousand times that of the best can
+	 * only improve it by noise (a circle seen from its centre would
+	 * else split to the depth bound); values of g within 1e-13 of its
+	 * largest coefficient count as zero. */
+	{
+		px_vec3 c = px_v3_scale(px_v3_add(p->box.min, p->box.max), 0.5);
+		double r = px_v3_dist(c, q) + px_aabb_diagonal(&p->box), gmax = 0.0;
+		slack = 1e-13 * r * r;
+		for (k = 0; k <= G; k++)
+			gmax = fabs(g[k]) > gmax ? fabs(g[k]) : gmax;
+		eps_g = 1e-13 * gmax;
+	}
 	sa[0] = 0.0;
 	sb[0] = 1.0;
 	sd[0] = 0;
@@ -412,9 +425,19 @@ static void solve_piece(const struct brep_cos_set *s, const struct brep_cos_piec
 			double r = W ? Fr[i] / Wr[i] : Fr[i];
 			lb = r < lb ? r : lb;
 		}
-		if (lb >= b->d2)
+		if (lb >= b->d2 - slack)
 			continue;
 		restrict_to(g, G, a, e, gr);
+		/* a root at an end (to rounding) is invisible to the count:
+		 * the end is the candidate */
+		if (fabs(gr[0]) <= eps_g) {
+			take(s, p, q, a, b);
+			gr[0] = 0.0;
+		}
+		if (fabs(gr[G]) <= eps_g) {
+			take(s, p, q, e, b);
+			gr[G] = 0.0;
+		}
 		sc = sign_changes(gr, G, &first, &last);
 		if (sc == 0 || (sc == 1 && first > 0)) {
 			/* the minimum on [a, e] is at an end */
@@ -434,7 +457,7 @@ static void solve_piece(const struct brep_cos_set *s, const struct brep_cos_piec
 			take(s, p, q, a, b);
 			take(s, p, q, e, b);
 			take(s, p, q, 0.5 * (a + e), b);
-			if (lb < b->d2) {
+			if (lb < b->d2 - slack) {
 				b->certified = 0;
 				b->gap2 = fmax(b->gap2, b->d2 - lb);
 			}
