@@ -236,11 +236,19 @@ static double ff_polish_surf(const struct ffref *f, px_vec3 p, double u, double 
 		struct px_nurbs_surf_derivs d;
 		px_vec3 r;
 		double a, b, c, g0, g1, det, du, dv, nd, lam = 1.0;
-		px_nurbs_surf_eval(f->s, u, v, 1, &d);
+		/* Newton on |S - p|^2 / 2 (the residual's curvature terms
+		 * keep it quadratic far from the sheet), Gauss-Newton where
+		 * that Hessian is not positive */
+		px_nurbs_surf_eval(f->s, u, v, 2, &d);
 		r = px_v3_sub(d.s, p);
-		a = px_v3_dot(d.su, d.su);
-		b = px_v3_dot(d.su, d.sv);
-		c = px_v3_dot(d.sv, d.sv);
+		a = px_v3_dot(d.su, d.su) + px_v3_dot(r, d.suu);
+		b = px_v3_dot(d.su, d.sv) + px_v3_dot(r, d.suv);
+		c = px_v3_dot(d.sv, d.sv) + px_v3_dot(r, d.svv);
+		if (!(a > 0.0 && a * c - b * b > 0.0)) {
+			a = px_v3_dot(d.su, d.su);
+			b = px_v3_dot(d.su, d.sv);
+			c = px_v3_dot(d.sv, d.sv);
+		}
 		g0 = px_v3_dot(r, d.su);
 		g1 = px_v3_dot(r, d.sv);
 		det = a * c - b * b;
