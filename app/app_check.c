@@ -185,6 +185,9 @@ static const struct px_config_key sim_keys[] = {
 	{.name = "spawn_arm", .type = PX_CONFIG_T_STRING,
 	 .offset = offsetof(struct raw_sim, spawn_arm),
 	 .flags = PX_CONFIG_NONEMPTY},
+	{.name = "depth_sensor", .type = PX_CONFIG_T_SUB,
+	 .offset = offsetof(struct raw_sim, depth), .sub = &app_depth_schema,
+	 .flags = PX_CONFIG_PRESENT, .present_offset = offsetof(struct raw_sim, has_depth)},
 };
 static const struct px_config_schema sim_schema = {
 	"sim", sim_keys, sizeof(sim_keys) / sizeof(sim_keys[0]), sim_check};
@@ -476,6 +479,8 @@ int app_validate(struct px_app *a)
 			    "%zu devices; a run takes at most %d",
 			    cfg->n_devices, MAX_DEVS);
 	app_check_control(a);
+	if (!a->n_check_errors && !app_robot_setup(a))
+		app_sensor_setup(a);
 	app_check_memory(a);
 	if (a->ctl.mode == PX_CONTROL_MODE_HAPTIC) {
 		rc = px_control_haptic_init(&a->haptic, &a->ctl.haptic,

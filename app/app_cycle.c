@@ -57,6 +57,7 @@ int app_phase_read(struct px_loop *l, const struct px_loop_cycle *c,
 			px_loop_trip(l);
 		}
 	}
+	app_sensor_read(a, l, c->read_ns);
 	for (i = 0; i < a->n_dev; i++) {
 		int rc;
 		if (!(px_dev_caps(a->dev[i]) & PX_DEV_CAP_POSE))
@@ -130,8 +131,11 @@ static void avoid_compute(struct px_app *a, const struct px_loop_cycle *c)
 					   cos(2 * M_PI * nm->frequency_hz * t +
 					       nm->phase_rad);
 	}
-	rc = px_control_avoid_step(&a->ctl.chain, &a->ctl.avoid, &a->query, a->q,
-				   qnom, c->period_ns, &a->aout);
+	if (a->robot)
+		rc = app_robot_step(a, qnom, c->period_ns);
+	else
+		rc = px_control_avoid_step(&a->ctl.chain, &a->ctl.avoid, &a->query,
+					   a->q, qnom, c->period_ns, &a->aout);
 	if (rc < 0) {
 		a->query_errors++;
 		a->last_query_err = rc;
@@ -198,6 +202,19 @@ int app_phase_compute(struct px_loop *l, const struct px_loop_cycle *c,
 	return PX_OK;
 }
 
+/* The closest pair of an avoidance cycle in the record's point
+ * columns: the link point as the device's, the obstacle's as the
+ * proxy's. */
+static void record_pair(struct px_app_record *r, px_vec3 pa, px_vec3 pb)
+{
+	r->dev_m[0] = pa.x;
+	r->dev_m[1] = pa.y;
+	r->dev_m[2] = pa.z;
+	r->proxy_m[0] = pb.x;
+	r->proxy_m[1] = pb.y;
+	r->proxy_m[2] = pb.z;
+}
+
 /* The telemetry record of this cycle (every decimation-th), pushed to
  * the ring (dropped and counted when it is full). f: the force sent. */
 static void push_record(struct px_app *a, const struct px_loop_cycle *c,
@@ -239,15 +256,13 @@ static void push_record(struct px_app *a, const struct px_loop_cycle *c,
 		r.penetration_m = 0;
 		r.queries = a->aout.point_queries;
 		r.valid = 1;
-		if (k >= 0) {
-			px_vec3 pa = a->aout.caps[k].point_m;
-			px_vec3 pb = a->aout.caps[k].obstacle_m;
-			r.dev_m[0] = pa.x;
-			r.dev_m[1] = pa.y;
-			r.dev_m[2] = pa.z;
-			r.proxy_m[0] = pb.x;
-			r.proxy_m[1] = pb.y;
-			r.proxy_m[2] = pb.z;
+		if (a->robot_models && a->uout.closest.body >= 0) {
+			record_pair(&r, a->uout.closest.point_robot,
+				    a->uout.closest.point_obstacle);
+			r.queries = a->uout.pairs;
+		} else if (k >= 0) {
+			record_pair(&r, a->aout.caps[k].point_m,
+				    a->aout.caps[k].obstacle_m);
 		}
 	}
 	r.contact = a->out.contact;

@@ -28,8 +28,11 @@
 #include "px_arena.h"
 #include "px_can.h"
 #include "px_canopen.h"
+#include "px_cloud.h"
+#include "px_cloud_feed.h"
 #include "px_config.h"
 #include "px_control.h"
+#include "px_depth_sim.h"
 #include "px_dev.h"
 #include "px_devcfg.h"
 #include "px_gpio.h"
@@ -38,6 +41,7 @@
 #include "px_sim.h"
 #include "px_stats.h"
 #include "px_scene.h"
+#include "px_urdf.h"
 
 #define APP_WHY_MAX 2560
 
@@ -70,12 +74,30 @@ struct raw_nominal {
 	double amplitude_rad_per_s, frequency_hz, phase_rad;
 };
 
+/* sim.depth_sensor: a simulated depth camera (app_sensor.c) */
+struct raw_depth_pose {
+	double xyz_m[3], rpy_rad[3];
+};
+
+struct raw_depth {
+	int kind;
+	struct raw_depth_pose camera;
+	int64_t width, height, seed, slots;
+	double fov_x_rad, max_range_m, noise_m, rate_hz;
+	double size_m[3], from_m[3], to_m[3];
+	double start_s, period_s;
+	int64_t lookahead_ns, stale_timeout_ns;
+};
+extern const struct px_config_schema app_depth_schema;
+
 struct raw_sim {
 	struct raw_fault *faults;
 	size_t n_faults;
 	struct raw_nominal *nominal;
 	size_t n_nominal;
 	const char *spawn_arm; /* a socketcan device on transport unix */
+	struct raw_depth depth;
+	bool has_depth;
 	const struct px_config *cfg_; /* not a key: context for the check */
 };
 
@@ -187,6 +209,21 @@ struct px_app {
 	int have_q, enabled;
 	int64_t last_feedback_ns;
 	struct px_control_avoid_out aout;
+	/* control.avoidance.urdf: the robot, its link models measured
+	 * (clearance: models), config joint i = chain joint joint_perm[i] */
+	struct px_urdf_robot *robot;
+	int robot_models;
+	int joint_perm[PX_CONTROL_MAX_JOINTS];
+	struct px_urdf_avoid_out uout;
+	int n_scene_obstacles;
+	/* sim.depth_sensor: the camera, its feed, the robot's obstacle it
+	 * fills (a far point until the first frame), the loop input its
+	 * stamps feed, frames taken and swapped in */
+	struct px_depth_sim *depth;
+	struct px_cloud_feed *feed;
+	struct px_model *cloud_none;
+	int cloud_obstacle, cloud_input;
+	uint64_t cloud_taken, cloud_swaps;
 	double min_clearance_m, min_scale;
 	uint64_t stop_cycles;   /* cycles with the nominal motion stopped */
 	/* fault campaign */
@@ -269,6 +306,14 @@ void app_note_shutdown(struct px_app *a);
 void app_teardown(struct px_app *a);
 void app_safe_shutdown(struct px_app *a, const char *reason);
 int app_avoid_joints(const struct px_app *a);
+int app_robot_setup(struct px_app *a);
+void app_robot_free(struct px_app *a);
+int app_robot_step(struct px_app *a, const double *qnom, int64_t period_ns);
+int app_robot_obstacles(struct px_app *a, struct px_model *extra);
+int app_sensor_setup(struct px_app *a);
+int app_sensor_start(struct px_app *a);
+void app_sensor_free(struct px_app *a);
+void app_sensor_read(struct px_app *a, struct px_loop *l, int64_t now_ns);
 void app_drain(struct px_app *a,
 	       void (*record)(void *user, const struct px_app_record *r),
 	       void *user);

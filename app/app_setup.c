@@ -607,6 +607,8 @@ int app_setup(struct px_app *a)
 			return 1;
 		}
 	}
+	if (app_sensor_start(a))
+		return 1;
 	if (ring_cap < 16)
 		ring_cap = 16;
 	rc = px_arena_init_alloc(&a->arena, px_ring_size(ring_cap, sizeof(struct px_app_record)) +
@@ -715,6 +717,8 @@ void app_teardown(struct px_app *a)
 		px_devcfg_free(a->dcfg[i]); /* devices, master, buses */
 	px_can_sim_free(a->fault_bus); /* after its endpoints */
 	px_scene_tracking_free(a->tracking); /* before its scene */
+	app_sensor_free(a); /* its thread first */
+	app_robot_free(a); /* its pairs point at the scene's models */
 	px_scene_free(a->scene);
 	px_arena_fini(&a->arena);
 	free(a->lfaults);

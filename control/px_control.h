@@ -379,6 +379,15 @@ struct px_control_avoid_params {
 	double max_margin_fraction;
 	int segment_point_queries;    /* budget per capsule, 2..64 */
 	double segment_tol_m;         /* bisection stops at this gap */
+	/* true: the speed scaling looks only at the contacts that the
+	 * nominal motion closes (moving away, or along an obstacle, keeps
+	 * full speed); false: at the smallest clearance whatever the
+	 * motion. Repulsion and the discrete-time guard act either way. */
+	bool approach_only;
+	/* Self-clearance of robot links (px_urdf_avoid_step): their own
+	 * ramp, as the two distances above; 0 <= protective < influence,
+	 * or both 0: self contacts take the distances above. */
+	double self_influence_distance_m, self_protective_distance_m;
 };
 
 /* Clearance of one capsule. */
@@ -401,7 +410,9 @@ struct px_control_avoid_out {
 };
 
 /* Defaults: influence 0.3 m, protective 0.05 m, repulsion 0.1 m/s, joint
- * limit 1 rad/s, margin fraction 0.5, 24 queries, 1e-4 m. */
+ * limit 1 rad/s, margin fraction 0.5, 24 queries, 1e-4 m, scaling on
+ * every contact (approach_only false), self-clearance 0.05 m influence
+ * and 0.01 m protective. */
 PX_API void px_control_avoid_params_default(struct px_control_avoid_params *p);
 
 /* Check params. Returns PX_OK, PX_E_INVAL (NULL) or PX_E_RANGE. */
@@ -442,6 +453,52 @@ PX_API int px_control_avoid_step(const struct px_control_chain *c,
 				 int64_t period_ns,
 				 struct px_control_avoid_out *out);
 
+/*
+ * A clearance measured elsewhere (robot link models against obstacles
+ * or against each other, px_urdf.h): the point on link frame `link`
+ * closest to the other side, the other side's point (a fixed obstacle,
+ * or on link frame other_link for self-clearance), the unit normal from
+ * the other side toward the link point (the direction that opens the
+ * clearance; its opposite points at the obstacle), and the clearance,
+ * a certified lower bound where one is known, negative (-depth) when
+ * the two overlap.
+ */
+struct px_control_contact {
+	int link;           /* 0 (base) .. n_joints */
+	int other_link;     /* -1: a fixed obstacle; else 0 .. n_joints */
+	double clearance_m;
+	px_vec3 point_m;    /* on the link, world */
+	px_vec3 other_m;    /* on the other side, world */
+	px_vec3 normal;
+	/* this contact's own ramp (self-clearance, whose links come close
+	 * by design): influence_distance_m > protective_distance_m >= 0;
+	 * influence_distance_m 0: the params' distances */
+	double influence_distance_m, protective_distance_m;
+};
+
+/*
+ * The avoidance command of px_control_avoid_step() from n given
+ * contacts instead of capsule queries: speed scaling by the smallest
+ * ramp (1 at the contact's influence distance, 0 at its protective
+ * distance) over the contacts (p->approach_only: over those the nominal
+ * motion closes, rate -(J^T n) . qdot_nominal > 0), repulsion along J^T n
+ * for every contact inside the influence distance (self-contacts: the
+ * relative Jacobian J_link^T n - J_other^T n), the joint velocity limit
+ * and the discrete-time guard, exactly as there. out->caps and
+ * out->point_queries are left zero, out->closest_capsule -1; *closest
+ * (may be NULL) gets the index of the smallest contact, -1 when none
+ * lies within the influence distance. Returns PX_OK, PX_E_INVAL,
+ * PX_E_RANGE (a link index out of the chain, bad params), PX_E_NAN.
+ * @note RT-safe.
+ */
+PX_API int px_control_avoid_command(const struct px_control_chain *c,
+				    const struct px_control_avoid_params *p,
+				    const double *q, const double *qdot_nominal,
+				    int64_t period_ns,
+				    const struct px_control_contact *contacts,
+				    int n, struct px_control_avoid_out *out,
+				    int *closest);
+
 /* ------------------------------------------------------------------ */
 /* Configuration (setup time)                                          */
 /* ------------------------------------------------------------------ */
@@ -456,12 +513,50 @@ enum px_control_mode {
 	PX_CONTROL_MODE_AVOIDANCE = 2
 };
 
+enum px_control_clearance_kind {
+	PX_CONTROL_CLEARANCE_AUTO = 0,     /* models with a URDF, else capsules */
+	PX_CONTROL_CLEARANCE_CAPSULES = 1, /* capsules against the scene */
+	PX_CONTROL_CLEARANCE_MODELS = 2    /* URDF collision shapes as models */
+};
+
+#define PX_CONTROL_MAX_PACKAGE_PATHS 16
+#define PX_CONTROL_MAX_ALLOWED 4096
+
+/* Two link names (an allowed-collision entry). */
+struct px_control_link_pair {
+	const char *a, *b;
+};
+
+/*
+ * control.avoidance with a URDF (path NULL: the chain is the typed
+ * joints). The control module only reads the keys; the runner loads the
+ * file (robot/px_urdf.h). Strings point into the config document.
+ */
+struct px_control_urdf_config {
+	const char *path;        /* as written: relative to the config file */
+	const char *base_link;   /* NULL: the URDF's root */
+	const char *tip_link;
+	const char **package_paths;
+	size_t n_package_paths;
+	/* joint i of the drives (canopen drives' joint: i) is the URDF
+	 * joint joints[i]; n_joints 0: the chain's own order */
+	const char **joints;
+	size_t n_joints;
+	int clearance;           /* enum px_control_clearance_kind, never AUTO */
+	bool self_clearance;     /* non-adjacent links against each other */
+	/* link pairs never measured against each other (MoveIt's allowed
+	 * collision matrix) */
+	const struct px_control_link_pair *allowed;
+	size_t n_allowed;
+};
+
 struct px_control_config {
 	int mode;                              /* enum px_control_mode */
 	const char *device;                    /* device the output goes to */
 	struct px_control_haptic_params haptic;
 	struct px_control_avoid_params avoid;
 	struct px_control_chain chain;
+	struct px_control_urdf_config urdf;
 	/* Haptic stability at the config's loop period (mode haptic). */
 	bool stable;
 	double stiffness_limit_n_per_m;

@@ -191,6 +191,9 @@ void px_control_avoid_params_default(struct px_control_avoid_params *p)
 	p->max_margin_fraction = 0.5;
 	p->segment_point_queries = 24;
 	p->segment_tol_m = 1e-4;
+	p->approach_only = false;
+	p->self_influence_distance_m = 0.05;
+	p->self_protective_distance_m = 0.01;
 }
 
 int px_control_avoid_params_check(const struct px_control_avoid_params *p)
@@ -205,7 +208,11 @@ int px_control_avoid_params_check(const struct px_control_avoid_params *p)
 	    !(p->max_margin_fraction > 0 && p->max_margin_fraction <= 1) ||
 	    p->segment_point_queries < 2 ||
 	    p->segment_point_queries > PX__CTL_SEG_MAX ||
-	    !(p->segment_tol_m >= 0 && p->segment_tol_m < 1))
+	    !(p->segment_tol_m >= 0 && p->segment_tol_m < 1) ||
+	    !((p->self_influence_distance_m == 0 && p->self_protective_distance_m == 0) ||
+	      (p->self_protective_distance_m >= 0 &&
+	       p->self_influence_distance_m > p->self_protective_distance_m &&
+	       p->self_influence_distance_m < 1e6)))
 		return PX_E_RANGE;
 	return PX_OK;
 }
@@ -286,6 +293,14 @@ static int check_caps(const struct px_control_chain *c)
 	return PX_OK;
 }
 
+/* The params and the capsules' links (PX_E_RANGE). */
+static int check_setup(const struct px_control_chain *c,
+		       const struct px_control_avoid_params *p)
+{
+	int rc = px_control_avoid_params_check(p);
+	return rc ? rc : check_caps(c);
+}
+
 int px_control_chain_clearances(const struct px_control_chain *c,
 				const struct px_control_avoid_params *p,
 				const struct px_control_query *qry,
@@ -303,10 +318,7 @@ int px_control_chain_clearances(const struct px_control_chain *c,
 		return PX_E_INVAL;
 	if (!(max_distance_m > 0))
 		return PX_E_RANGE;
-	rc = px_control_avoid_params_check(p);
-	if (rc)
-		return rc;
-	rc = check_caps(c);
+	rc = check_setup(c, p);
 	if (rc)
 		return rc;
 	rc = fk_full(c, q, frames, NULL, NULL);
@@ -328,81 +340,97 @@ static double ramp(double c, double lo, double hi)
 	return (c - lo) / (hi - lo);
 }
 
-int px_control_avoid_step(const struct px_control_chain *c,
-			  const struct px_control_avoid_params *p,
-			  const struct px_control_query *qry, const double *q,
-			  const double *qdot_nominal, int64_t period_ns,
-			  struct px_control_avoid_out *out)
+/* Jacobian row of a contact: g = J^T n at the contact point, minus the
+ * other link's when the other side moves too (self-clearance); the
+ * clearance grows at g . qdot. */
+static double contact_grad(const struct px_control_chain *c, const px_vec3 *ax,
+			   const px_vec3 *org, const struct px_control_contact *k,
+			   double *g)
 {
-	px_pose frames[PX_CONTROL_MAX_JOINTS + 1];
-	px_vec3 ax[PX_CONTROL_MAX_JOINTS], org[PX_CONTROL_MAX_JOINTS];
 	px_vec3 jac[PX_CONTROL_MAX_JOINTS];
-	double qd[PX_CONTROL_MAX_JOINTS];
-	double s, sigma = 1.0, vmax = 0, T;
-	struct counting k;
-	struct px_control_query cq;
-	int i, j, n, rc;
-	if (!out)
-		return PX_E_INVAL;
-	memset(out->qdot, 0, sizeof(out->qdot));
-	out->scale = 0;
-	out->min_clearance_m = 0;
-	out->closest_capsule = -1;
-	out->point_queries = 0;
-	if (!chain_valid(c) || !p || !qry || !qry->point ||
-	    (c->n_joints > 0 && !q) || period_ns <= 0)
-		return PX_E_INVAL;
-	rc = px_control_avoid_params_check(p);
-	if (rc)
-		return rc;
-	rc = check_caps(c);
-	if (rc)
-		return rc;
-	n = c->n_joints;
-	T = (double)period_ns * 1e-9;
-	for (i = 0; i < n; i++) {
-		qd[i] = qdot_nominal ? qdot_nominal[i] : 0.0;
-		if (!isfinite(qd[i]))
-			return PX_E_NAN;
+	double g2 = 0;
+	int j;
+	jac_from(c, ax, org, k->link, k->point_m, jac);
+	for (j = 0; j < c->n_joints; j++)
+		g[j] = px_v3_dot(jac[j], k->normal);
+	if (k->other_link >= 0) {
+		jac_from(c, ax, org, k->other_link, k->other_m, jac);
+		for (j = 0; j < c->n_joints; j++)
+			g[j] -= px_v3_dot(jac[j], k->normal);
 	}
-	rc = fk_full(c, q, frames, ax, org);
-	if (rc)
-		return rc;
-	counting_wrap(&k, qry, &cq);
-	rc = clearances(c, p, &cq, frames, p->influence_distance_m, out->caps);
-	out->point_queries = k.n;
-	if (rc < 0)
-		return rc;
+	for (j = 0; j < c->n_joints; j++)
+		g2 += g[j] * g[j];
+	return g2;
+}
 
-	/* Speed and separation monitoring on the smallest certified
-	 * clearance. */
+/* A contact's own distances, else the params'. */
+static double k_infl(const struct px_control_avoid_params *p,
+		     const struct px_control_contact *k)
+{
+	return k->influence_distance_m > 0 ? k->influence_distance_m
+					   : p->influence_distance_m;
+}
+
+static double k_prot(const struct px_control_avoid_params *p,
+		     const struct px_control_contact *k)
+{
+	return k->influence_distance_m > 0 ? k->protective_distance_m
+					   : p->protective_distance_m;
+}
+
+/* The command from the contacts (their clearances certified lower
+ * bounds): see px_control_avoid_command(). qd is the nominal velocity;
+ * out->qdot, scale, min_clearance_m and *closest (contact index, -1)
+ * are set. The scale is the smallest ramp over the contacts, which for
+ * contacts sharing the params' distances is the ramp of the smallest
+ * clearance (the ramp is monotone). */
+static void command(const struct px_control_chain *c,
+		    const struct px_control_avoid_params *p, const px_vec3 *ax,
+		    const px_vec3 *org, const double *qd, double T,
+		    const struct px_control_contact *ks, int nk,
+		    struct px_control_avoid_out *out, int *closest)
+{
+	double s = 1.0, sigma = 1.0, vmax = 0;
+	int i, j, n = c->n_joints;
+
+	/* Speed and separation monitoring on the certified clearances
+	 * (approach_only: of the contacts the nominal motion closes). */
 	out->min_clearance_m = p->influence_distance_m;
-	for (i = 0; i < c->n_capsules; i++) {
-		if (out->caps[i].valid &&
-		    out->caps[i].lower_bound_m < out->min_clearance_m) {
-			out->min_clearance_m = out->caps[i].lower_bound_m;
-			out->closest_capsule = i;
+	*closest = -1;
+	for (i = 0; i < nk; i++) {
+		double lo = k_prot(p, &ks[i]), hi = k_infl(p, &ks[i]);
+		if (ks[i].clearance_m < out->min_clearance_m) {
+			out->min_clearance_m = ks[i].clearance_m;
+			*closest = i;
 		}
+		if (ks[i].clearance_m >= hi)
+			continue;
+		if (p->approach_only) {
+			double g[PX_CONTROL_MAX_JOINTS], rate = 0;
+			double g2 = contact_grad(c, ax, org, &ks[i], g);
+			for (j = 0; j < n; j++)
+				rate -= g[j] * qd[j];
+			/* closing faster than a nanometre per second, or no
+			 * direction (touching unsigned models, a singular
+			 * point): approaching */
+			if (!(rate > 1e-9 || g2 < 1e-12))
+				continue;
+		}
+		s = fmin(s, ramp(ks[i].clearance_m, lo, hi));
 	}
-	s = ramp(out->min_clearance_m, p->protective_distance_m,
-		 p->influence_distance_m);
 	for (i = 0; i < n; i++)
 		out->qdot[i] = s * qd[i];
 
-	/* Repulsion: minimum-norm joint velocity moving capsule i's closest
-	 * point along its normal at w_i * v_rep (direction J^T n). */
-	for (i = 0; i < c->n_capsules; i++) {
-		const struct px_control_clearance *ci = &out->caps[i];
-		double w, g2 = 0, g[PX_CONTROL_MAX_JOINTS];
-		if (!ci->valid || ci->lower_bound_m >= p->influence_distance_m)
+	/* Repulsion: minimum-norm joint velocity moving contact i's point
+	 * along its normal at w_i * v_rep (direction J^T n). */
+	for (i = 0; i < nk; i++) {
+		const struct px_control_contact *ci = &ks[i];
+		double w, g2, g[PX_CONTROL_MAX_JOINTS];
+		double lo = k_prot(p, ci), hi = k_infl(p, ci);
+		if (ci->clearance_m >= hi)
 			continue;
-		w = 1.0 - ramp(ci->lower_bound_m, p->protective_distance_m,
-			       p->influence_distance_m);
-		jac_from(c, ax, org, c->capsules[i].link, ci->point_m, jac);
-		for (j = 0; j < n; j++) {
-			g[j] = px_v3_dot(jac[j], ci->normal);
-			g2 += g[j] * g[j];
-		}
+		w = 1.0 - ramp(ci->clearance_m, lo, hi);
+		g2 = contact_grad(c, ax, org, ci, g);
 		if (g2 < 1e-12)
 			continue; /* no joint can move this point away */
 		for (j = 0; j < n; j++)
@@ -415,21 +443,19 @@ int px_control_avoid_step(const struct px_control_chain *c,
 		for (j = 0; j < n; j++)
 			out->qdot[j] *= p->max_joint_velocity / vmax;
 
-	/* Discrete-time guard: no capsule may close more than the given
+	/* Discrete-time guard: no contact may close more than the given
 	 * fraction of its margin to the protective distance in one period
 	 * (first order; with the fraction below 1 the curvature of the
 	 * motion within one period is covered). */
-	for (i = 0; i < c->n_capsules; i++) {
-		const struct px_control_clearance *ci = &out->caps[i];
-		double rate = 0, margin;
-		if (!ci->valid)
-			continue;
-		jac_from(c, ax, org, c->capsules[i].link, ci->point_m, jac);
+	for (i = 0; i < nk; i++) {
+		const struct px_control_contact *ci = &ks[i];
+		double rate = 0, margin, g[PX_CONTROL_MAX_JOINTS];
+		contact_grad(c, ax, org, ci, g);
 		for (j = 0; j < n; j++)
-			rate -= px_v3_dot(jac[j], ci->normal) * out->qdot[j];
+			rate -= g[j] * out->qdot[j];
 		if (rate <= 0)
 			continue;
-		margin = ci->lower_bound_m - p->protective_distance_m;
+		margin = ci->clearance_m - k_prot(p, ci);
 		if (margin <= 0)
 			sigma = 0;
 		else
@@ -440,5 +466,118 @@ int px_control_avoid_step(const struct px_control_chain *c,
 		for (j = 0; j < n; j++)
 			out->qdot[j] *= sigma;
 	out->scale = s * sigma;
+}
+
+/* Common checks and the nominal velocity of both commands. */
+static int command_begin(const struct px_control_chain *c,
+			 const struct px_control_avoid_params *p, const double *q,
+			 const double *qdot_nominal, int64_t period_ns,
+			 int bad_input, struct px_control_avoid_out *out,
+			 double *qd)
+{
+	int i, rc;
+	if (!out)
+		return PX_E_INVAL;
+	memset(out->qdot, 0, sizeof(out->qdot));
+	out->scale = 0;
+	out->min_clearance_m = 0;
+	out->closest_capsule = -1;
+	out->point_queries = 0;
+	if (bad_input || !chain_valid(c) || !p || (c->n_joints > 0 && !q) ||
+	    period_ns <= 0)
+		return PX_E_INVAL;
+	rc = check_setup(c, p);
+	if (rc)
+		return rc;
+	for (i = 0; i < c->n_joints; i++) {
+		qd[i] = qdot_nominal ? qdot_nominal[i] : 0.0;
+		if (!isfinite(qd[i]))
+			return PX_E_NAN;
+	}
+	return PX_OK;
+}
+
+int px_control_avoid_step(const struct px_control_chain *c,
+			  const struct px_control_avoid_params *p,
+			  const struct px_control_query *qry, const double *q,
+			  const double *qdot_nominal, int64_t period_ns,
+			  struct px_control_avoid_out *out)
+{
+	px_pose frames[PX_CONTROL_MAX_JOINTS + 1];
+	px_vec3 ax[PX_CONTROL_MAX_JOINTS], org[PX_CONTROL_MAX_JOINTS];
+	double qd[PX_CONTROL_MAX_JOINTS];
+	struct px_control_contact ks[PX_CONTROL_MAX_CAPSULES];
+	int cap_of[PX_CONTROL_MAX_CAPSULES];
+	struct counting k;
+	struct px_control_query cq;
+	int i, nk = 0, closest, rc;
+	rc = command_begin(c, p, q, qdot_nominal, period_ns, !qry || !qry->point,
+			   out, qd);
+	if (rc)
+		return rc;
+	rc = fk_full(c, q, frames, ax, org);
+	if (rc)
+		return rc;
+	counting_wrap(&k, qry, &cq);
+	rc = clearances(c, p, &cq, frames, p->influence_distance_m, out->caps);
+	out->point_queries = k.n;
+	if (rc < 0)
+		return rc;
+	for (i = 0; i < c->n_capsules; i++) {
+		const struct px_control_clearance *ci = &out->caps[i];
+		if (!ci->valid)
+			continue;
+		ks[nk].link = c->capsules[i].link;
+		ks[nk].other_link = -1;
+		ks[nk].clearance_m = ci->lower_bound_m;
+		ks[nk].point_m = ci->point_m;
+		ks[nk].other_m = ci->obstacle_m;
+		ks[nk].normal = ci->normal;
+		ks[nk].influence_distance_m = 0;
+		ks[nk].protective_distance_m = 0;
+		cap_of[nk++] = i;
+	}
+	command(c, p, ax, org, qd, (double)period_ns * 1e-9, ks, nk, out, &closest);
+	out->closest_capsule = closest >= 0 ? cap_of[closest] : -1;
+	return PX_OK;
+}
+
+int px_control_avoid_command(const struct px_control_chain *c,
+			     const struct px_control_avoid_params *p,
+			     const double *q, const double *qdot_nominal,
+			     int64_t period_ns,
+			     const struct px_control_contact *contacts, int n,
+			     struct px_control_avoid_out *out, int *closest)
+{
+	px_pose frames[PX_CONTROL_MAX_JOINTS + 1];
+	px_vec3 ax[PX_CONTROL_MAX_JOINTS], org[PX_CONTROL_MAX_JOINTS];
+	double qd[PX_CONTROL_MAX_JOINTS];
+	int i, k, rc;
+	if (closest)
+		*closest = -1;
+	rc = command_begin(c, p, q, qdot_nominal, period_ns,
+			   n < 0 || (n > 0 && !contacts), out, qd);
+	if (rc)
+		return rc;
+	for (i = 0; i < n; i++) {
+		const struct px_control_contact *ci = &contacts[i];
+		if (ci->link < 0 || ci->link > c->n_joints ||
+		    ci->other_link < -1 || ci->other_link > c->n_joints)
+			return PX_E_RANGE;
+		if (!(ci->influence_distance_m >= 0) ||
+		    (ci->influence_distance_m > 0 &&
+		     !(ci->protective_distance_m >= 0 &&
+		       ci->protective_distance_m < ci->influence_distance_m)))
+			return PX_E_RANGE;
+		if (!isfinite(ci->clearance_m) || !px_v3_isfinite(ci->point_m) ||
+		    !px_v3_isfinite(ci->other_m) || !px_v3_isfinite(ci->normal))
+			return PX_E_NAN;
+	}
+	rc = fk_full(c, q, frames, ax, org);
+	if (rc)
+		return rc;
+	command(c, p, ax, org, qd, (double)period_ns * 1e-9, contacts, n, out, &k);
+	if (closest)
+		*closest = k;
 	return PX_OK;
 }

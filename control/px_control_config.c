@@ -17,6 +17,7 @@
 static const char *const mode_names[] = {"none", "haptic", "avoidance", NULL};
 static const char *const renderer_names[] = {"penalty", "proxy", NULL};
 static const char *const joint_type_names[] = {"revolute", "prismatic", NULL};
+static const char *const clearance_names[] = {"auto", "capsules", "models", NULL};
 
 /* ---- raw structs filled by the reader ---------------------------- */
 
@@ -55,7 +56,17 @@ struct raw_haptic {
 };
 
 struct raw_avoid {
+	const char *urdf, *base_link, *tip_link;
+	const char **package_paths;
+	size_t n_package_paths;
+	const char **urdf_joints;
+	size_t n_urdf_joints;
+	int clearance;
+	bool approach_only, self_clearance;
+	struct px_control_link_pair *allowed;
+	size_t n_allowed;
 	double influence_distance_m, protective_distance_m;
+	double self_influence_distance_m, self_protective_distance_m;
 	double repulsive_speed_m_per_s, max_joint_velocity_rad_per_s;
 	double max_margin_fraction;
 	int64_t segment_point_queries;
@@ -143,6 +154,12 @@ static const struct px_config_key capsule_keys[] = {
 };
 SCHEMA(capsule_schema, "capsule", capsule_keys, NULL);
 
+static const struct px_config_key link_pair_keys[] = {
+	K_STR(struct px_control_link_pair, a, "a", PX_CONFIG_REQUIRED),
+	K_STR(struct px_control_link_pair, b, "b", PX_CONFIG_REQUIRED),
+};
+SCHEMA(link_pair_schema, "link pair", link_pair_keys, NULL);
+
 static const struct px_config_key haptic_keys[] = {
 	K_ENUM(struct raw_haptic, renderer, "renderer", 0, renderer_names,
 	       PX_CONTROL_PROXY),
@@ -188,6 +205,46 @@ static void haptic_check(struct px_config_reader *r,
 }
 SCHEMA(haptic_schema, "haptic", haptic_keys, haptic_check);
 
+/* control.avoidance with a URDF: the chain comes from the file (loaded
+ * by the runner, which names the file's own line on a refusal), so the
+ * typed chain keys are out, and the names must be usable. */
+static void urdf_check(struct px_config_reader *r,
+		       const struct px_config_node *map, const struct raw_avoid *a)
+{
+	size_t i, k;
+	char p[48];
+	if (a->n_joints)
+		px_config_reader_error(r, px_config_node_get(map, "joints"), "joints",
+				       "give either urdf or joints, not both (the "
+				       "URDF's joints between base_link and "
+				       "tip_link are the chain)");
+	if (!a->tip_link)
+		px_config_reader_error(r, map, "tip_link",
+				       "missing required key (urdf is given)");
+	if (a->clearance == PX_CONTROL_CLEARANCE_CAPSULES && !a->n_capsules)
+		px_config_reader_error(r, px_config_node_get(map, "clearance"),
+				       "clearance",
+				       "'capsules' needs the capsules list");
+	if (a->clearance != PX_CONTROL_CLEARANCE_CAPSULES && a->n_capsules)
+		px_config_reader_error(r, px_config_node_get(map, "capsules"),
+				       "capsules",
+				       "used only with clearance: capsules (the "
+				       "URDF's collision shapes are measured)");
+	for (i = 0; i < a->n_urdf_joints; i++)
+		for (k = 0; k < i; k++)
+			if (!strcmp(a->urdf_joints[i], a->urdf_joints[k])) {
+				const struct px_config_node *s =
+					px_config_node_get(map, "urdf_joints");
+				snprintf(p, sizeof(p), "urdf_joints[%zu]", i);
+				px_config_reader_error(
+					r,
+					s && s->kind == PX_CONFIG_NODE_SEQ && i < s->len
+						? s->items[i]
+						: map,
+					p, "'%s' is listed twice", a->urdf_joints[i]);
+			}
+}
+
 static void avoid_check(struct px_config_reader *r,
 			const struct px_config_node *map, void *obj)
 {
@@ -202,7 +259,17 @@ static void avoid_check(struct px_config_reader *r,
 				       "influence_distance_m %g",
 				       a->protective_distance_m,
 				       a->influence_distance_m);
-	for (i = 0; i < a->n_capsules; i++) {
+	if (a->self_protective_distance_m >= a->self_influence_distance_m)
+		px_config_reader_error(r,
+				       px_config_node_get(map, "self_protective_distance_m"),
+				       "self_protective_distance_m",
+				       "%g must be smaller than "
+				       "self_influence_distance_m %g",
+				       a->self_protective_distance_m,
+				       a->self_influence_distance_m);
+	if (a->urdf)
+		urdf_check(r, map, a);
+	for (i = 0; !a->urdf && i < a->n_capsules; i++) {
 		const struct px_config_node *caps = px_config_node_get(map, "capsules");
 		const struct px_config_node *c =
 			caps && caps->kind == PX_CONFIG_NODE_SEQ && i < caps->len
@@ -222,6 +289,32 @@ static void avoid_check(struct px_config_reader *r,
 }
 
 static const struct px_config_key avoid_keys[] = {
+	K_STR(struct raw_avoid, urdf, "urdf", 0),
+	K_STR(struct raw_avoid, base_link, "base_link", 0),
+	K_STR(struct raw_avoid, tip_link, "tip_link", 0),
+	{.name = "package_paths", .type = PX_CONFIG_T_SEQ,
+	 .offset = offsetof(struct raw_avoid, package_paths),
+	 .flags = PX_CONFIG_NONEMPTY, .elem = PX_CONFIG_T_STRING,
+	 .elem_size = sizeof(const char *),
+	 .count_offset = offsetof(struct raw_avoid, n_package_paths),
+	 .max_count = PX_CONTROL_MAX_PACKAGE_PATHS},
+	{.name = "urdf_joints", .type = PX_CONFIG_T_SEQ,
+	 .offset = offsetof(struct raw_avoid, urdf_joints),
+	 .flags = PX_CONFIG_NONEMPTY, .elem = PX_CONFIG_T_STRING,
+	 .elem_size = sizeof(const char *),
+	 .count_offset = offsetof(struct raw_avoid, n_urdf_joints),
+	 .min_count = 1, .max_count = PX_CONTROL_MAX_JOINTS},
+	K_ENUM(struct raw_avoid, clearance, "clearance", 0, clearance_names,
+	       PX_CONTROL_CLEARANCE_AUTO),
+	K_BOOL(struct raw_avoid, approach_only, "approach_only", 0),
+	K_DBL(struct raw_avoid, self_influence_distance_m, "self_influence_distance_m",
+	      PX_CONFIG_MIN_EXCL, 0, 100, 0.05),
+	K_DBL(struct raw_avoid, self_protective_distance_m, "self_protective_distance_m",
+	      0, 0, 100, 0.01),
+	K_BOOL(struct raw_avoid, self_clearance, "self_clearance", 1),
+	K_SEQ(struct raw_avoid, allowed, n_allowed, "allowed_collisions", 0,
+	      link_pair_schema, struct px_control_link_pair, 0,
+	      PX_CONTROL_MAX_ALLOWED),
 	K_DBL(struct raw_avoid, influence_distance_m, "influence_distance_m",
 	      PX_CONFIG_MIN_EXCL, 0, 100, 0.3),
 	K_DBL(struct raw_avoid, protective_distance_m, "protective_distance_m", 0,
@@ -333,6 +426,28 @@ static void control_check(struct px_config_reader *r,
 	out->avoid.max_margin_fraction = c->avoid.max_margin_fraction;
 	out->avoid.segment_point_queries = (int)c->avoid.segment_point_queries;
 	out->avoid.segment_tol_m = c->avoid.segment_tol_m;
+	out->avoid.approach_only = c->avoid.approach_only;
+	out->avoid.self_influence_distance_m = c->avoid.self_influence_distance_m;
+	out->avoid.self_protective_distance_m = c->avoid.self_protective_distance_m;
+	out->urdf.path = c->avoid.urdf;
+	out->urdf.base_link = c->avoid.base_link;
+	out->urdf.tip_link = c->avoid.tip_link;
+	out->urdf.package_paths = c->avoid.package_paths;
+	out->urdf.n_package_paths = c->avoid.n_package_paths;
+	out->urdf.joints = c->avoid.urdf_joints;
+	out->urdf.n_joints = c->avoid.n_urdf_joints;
+	out->urdf.clearance = c->avoid.clearance == PX_CONTROL_CLEARANCE_AUTO
+				      ? (c->avoid.urdf ? PX_CONTROL_CLEARANCE_MODELS
+						       : PX_CONTROL_CLEARANCE_CAPSULES)
+				      : c->avoid.clearance;
+	out->urdf.self_clearance = c->avoid.self_clearance;
+	out->urdf.allowed = c->avoid.allowed;
+	out->urdf.n_allowed = c->avoid.n_allowed;
+	if (!c->avoid.urdf && c->avoid.clearance == PX_CONTROL_CLEARANCE_MODELS)
+		px_config_reader_error(r, path_node(map, "avoidance", "clearance"),
+				       "avoidance.clearance",
+				       "'models' needs urdf (the link models "
+				       "come from its collision shapes)");
 	px_control_chain_init(&out->chain,
 			      px_control_pose_from_xyz_rpy(
 				      v3a(c->avoid.base.xyz_m),
@@ -359,7 +474,7 @@ static void control_check(struct px_config_reader *r,
 					     v3a(cp->a_m), v3a(cp->b_m),
 					     cp->radius_m);
 	}
-	if (c->mode == PX_CONTROL_MODE_AVOIDANCE) {
+	if (c->mode == PX_CONTROL_MODE_AVOIDANCE && !c->avoid.urdf) {
 		if (c->avoid.n_joints == 0)
 			px_config_reader_error(r, path_node(map, "avoidance", NULL),
 					       "avoidance.joints",
@@ -370,24 +485,31 @@ static void control_check(struct px_config_reader *r,
 					       "avoidance.capsules",
 					       "mode avoidance needs at least "
 					       "one capsule");
-		/* Joint positions come from the device's drives. */
-		if (dev && dev->backend == PX_CONFIG_BACKEND_SOCKETCAN &&
+	}
+	if (c->mode == PX_CONTROL_MODE_AVOIDANCE) {
+		/* Joint positions come from the device's drives (with a URDF
+		 * and no urdf_joints the count is known once it is read: the
+		 * runner checks then). */
+		size_t nj = c->avoid.urdf ? c->avoid.n_urdf_joints : c->avoid.n_joints;
+		if (dev && (!c->avoid.urdf || nj) &&
+		    dev->backend == PX_CONFIG_BACKEND_SOCKETCAN &&
 		    dev->socketcan.canopen.present) {
 			for (i = 0; i < dev->socketcan.canopen.n_drives; i++)
 				if (dev->socketcan.canopen.drives[i].joint >=
-				    (int64_t)c->avoid.n_joints)
+				    (int64_t)nj)
 					px_config_reader_error(
 						r, px_config_node_get(map, "device"),
 						"device",
 						"drive with node_id %lld of device "
 						"'%s' feeds joint %lld, but "
-						"avoidance.joints has %zu joints",
+						"avoidance.%s has %zu joints",
 						(long long)dev->socketcan.canopen
 							.drives[i].node_id,
 						c->device,
 						(long long)dev->socketcan.canopen
 							.drives[i].joint,
-						c->avoid.n_joints);
+						c->avoid.urdf ? "urdf_joints" : "joints",
+						nj);
 		}
 	}
 

@@ -227,6 +227,9 @@ struct px_urdf_clearance {
 	px_vec3 normal;         /* unit, from the obstacle towards the body */
 	int intersecting;
 	int local_only;         /* may be only a local minimum */
+	/* self-clearance (px_urdf_robot_self_clearances): the other body,
+	 * whose point is point_obstacle (obstacle is then -1); else -1 */
+	int other_body;
 };
 
 /*
@@ -242,6 +245,78 @@ PX_API int px_urdf_robot_clearances(struct px_urdf_robot *r,
 				    const struct px_pair_opts *o, int coherent,
 				    struct px_urdf_clearance *out, size_t cap,
 				    struct px_urdf_clearance *min);
+
+/*
+ * Replace obstacle k by model m (same kind of use as set_obstacles:
+ * the caller keeps m) between two calls of px_urdf_robot_clearances(),
+ * e.g. a point cloud rebuilt outside the cycle and handed over
+ * (px_cloud_feed.h). The pairs of every body with obstacle k forget
+ * their last answer, so the next call measures them cold. Returns
+ * PX_OK, PX_E_INVAL. @note RT-safe (no heap: bodies steps).
+ */
+PX_API int px_urdf_robot_replace_obstacle(struct px_urdf_robot *r, int k,
+					  struct px_model *m);
+
+/* ---- self-clearance ----------------------------------------------------- */
+
+/*
+ * Measure the robot's bodies against each other: every pair of bodies
+ * on different chain frames except bodies on consecutive frames (links
+ * joined by one movable joint: adjacent, they touch by design) and
+ * except the link pairs in allowed (2 n_allowed names: allowed[2i] and
+ * allowed[2i+1], MoveIt's allowed-collision matrix; both orders). Bodies
+ * on the same frame (one link, or links joined by fixed joints) never
+ * move against each other and are never measured. Replaces any previous
+ * set. Returns the number of body pairs, or PX_E_INVAL, PX_E_NOTFOUND
+ * (a name that is no link of the robot: err names it), PX_E_NOMEM.
+ * err may be NULL. Setup.
+ */
+PX_API int px_urdf_robot_set_self(struct px_urdf_robot *r,
+				  const char *const *allowed, int n_allowed,
+				  struct px_urdf_error *err);
+
+/*
+ * The self pairs at the pose last set, as px_urdf_robot_clearances()
+ * (body is the pair's second body, other_body the first, obstacle -1;
+ * normal from the first toward the second). Returns the number of
+ * pairs or an error. @note RT-safe.
+ */
+PX_API int px_urdf_robot_self_clearances(struct px_urdf_robot *r,
+					 const struct px_pair_opts *o,
+					 int coherent,
+					 struct px_urdf_clearance *out, size_t cap,
+					 struct px_urdf_clearance *min);
+
+/* ---- avoidance ---------------------------------------------------------- */
+
+struct px_urdf_avoid_out {
+	/* the command (qdot, scale, min_clearance_m; caps unused,
+	 * closest_capsule -1) */
+	struct px_control_avoid_out cmd;
+	/* the smallest clearance within the influence distance (body -1
+	 * when none) */
+	struct px_urdf_clearance closest;
+	int pairs;          /* pairs measured this cycle */
+	int local_only;     /* of them, answered without a global proof */
+};
+
+/*
+ * One avoidance cycle on the robot's own link models: pose the bodies
+ * at q (px_urdf_robot_set_q), measure every body against every obstacle
+ * and, after px_urdf_robot_set_self(), the self pairs (o: pair options,
+ * NULL defaults; coherent: start from last cycle's pairs), and turn
+ * every clearance below p->influence_distance_m into a contact of
+ * px_control_avoid_command(): speed scaling (p->approach_only: only for
+ * the contacts the nominal motion closes), repulsion along J^T n with n
+ * the pair's separating direction at its witness point, the velocity
+ * limit and the discrete-time guard. On an error the command is zero
+ * and the error is returned. @note RT-safe.
+ */
+PX_API int px_urdf_avoid_step(struct px_urdf_robot *r,
+			      const struct px_control_avoid_params *p,
+			      const struct px_pair_opts *o, int coherent,
+			      const double *q, const double *qdot_nominal,
+			      int64_t period_ns, struct px_urdf_avoid_out *out);
 
 #ifdef __cplusplus
 }

@@ -11,24 +11,6 @@
 #include "px_prim.h"
 #include "robot_internal.h"
 
-#define NAME_LEN 64
-
-struct px_urdf_robot {
-	struct px_control_chain chain;
-	int dof;
-	char names[PX_CONTROL_MAX_JOINTS][NAME_LEN];
-	double lower[PX_CONTROL_MAX_JOINTS], upper[PX_CONTROL_MAX_JOINTS];
-	double velocity[PX_CONTROL_MAX_JOINTS];
-	int n_bodies;
-	struct px_urdf_body *bodies;
-	char (*body_link)[NAME_LEN];
-	px_pose frames[PX_CONTROL_MAX_JOINTS + 1];
-	/* clearances: obstacles and the last answer of each pair */
-	int n_obstacles;
-	struct px_model **obstacles;
-	struct px_pair_result *pairs;
-};
-
 void px_urdf_robot_free(struct px_urdf_robot *r)
 {
 	int i;
@@ -40,6 +22,7 @@ void px_urdf_robot_free(struct px_urdf_robot *r)
 	free(r->body_link);
 	free(r->obstacles);
 	free(r->pairs);
+	px__urdf_avoid_free(r);
 	free(r);
 }
 
@@ -172,7 +155,7 @@ static int build_chain(struct px_urdf_robot *r, const struct px_urdf *u, int bas
 			if (rc)
 				return px__urdf_fail(err, rc, u->file, j->line, "",
 						     "joint '%.60s': %s", j->name, px_strerror(rc));
-			snprintf(r->names[r->dof], NAME_LEN, "%s", j->name);
+			snprintf(r->names[r->dof], URDF_NAME_LEN, "%s", j->name);
 			r->lower[r->dof] = j->lower;
 			r->upper[r->dof] = j->upper;
 			r->velocity[r->dof] = j->velocity;
@@ -228,7 +211,7 @@ static int make_bodies(struct px_urdf_robot *r, const struct px_urdf *u,
 			b->offset = px_pose_compose(offset[l], lk->shapes[i].origin);
 			b->link = l;
 			b->shape = i;
-			snprintf(r->body_link[r->n_bodies], NAME_LEN, "%s", lk->name);
+			snprintf(r->body_link[r->n_bodies], URDF_NAME_LEN, "%s", lk->name);
 			r->n_bodies++;
 		}
 	}
@@ -381,12 +364,83 @@ int px_urdf_robot_set_obstacles(struct px_urdf_robot *r,
 	r->obstacles = ob;
 	r->pairs = pr;
 	r->n_obstacles = n;
-	return PX_OK;
+	return px__urdf_avoid_size(r);
 }
 
-int px_urdf_robot_clearances(struct px_urdf_robot *r, const struct px_pair_opts *o,
-			     int coherent, struct px_urdf_clearance *out, size_t cap,
-			     struct px_urdf_clearance *min)
+struct px_urdf_clearance px__urdf_clearance(const struct px_pair_result *p, int body,
+					    int obstacle, int other_body)
+{
+	struct px_urdf_clearance c;
+	c.body = body;
+	c.obstacle = obstacle;
+	c.other_body = other_body;
+	c.distance_m = p->distance;
+	c.point_robot = p->point_b;
+	c.point_obstacle = p->point_a;
+	c.normal = p->normal;
+	c.intersecting = p->intersecting;
+	c.local_only = p->local_only;
+	return c;
+}
+
+/* Gap between two models' world boxes: a lower bound of their
+ * distance (0 when the boxes meet or one is unbounded). */
+static double box_gap(const struct px_model *a, const struct px_model *b)
+{
+	px_aabb x = px_model_world_aabb(a), y = px_model_world_aabb(b);
+	px_vec3 d = px_v3(fmax(0, fmax(x.min.x - y.max.x, y.min.x - x.max.x)),
+			  fmax(0, fmax(x.min.y - y.max.y, y.min.y - x.max.y)),
+			  fmax(0, fmax(x.min.z - y.max.z, y.min.z - x.max.z)));
+	double g = px_v3_norm(d);
+	return isfinite(g) ? g : 0.0;
+}
+
+int px__urdf_pair(const struct px_model *a, const struct px_model *b,
+		  const struct px_pair_opts *po, int coherent, double reach,
+		  struct px_pair_result *p, int body, int obstacle, int other_body,
+		  struct px_urdf_clearance *c)
+{
+	double gap = reach < INFINITY ? box_gap(a, b) : 0.0;
+	int rc;
+	if (gap >= reach) {
+		/* farther than anyone asks: the boxes' gap stands for it */
+		memset(c, 0, sizeof(*c));
+		c->body = body;
+		c->obstacle = obstacle;
+		c->other_body = other_body;
+		c->distance_m = gap;
+		return 0;
+	}
+	if (!coherent)
+		p->valid = 0;
+	rc = px_pair_distance(a, b, po, p);
+	if (rc)
+		return rc;
+	*c = px__urdf_clearance(p, body, obstacle, other_body);
+	return 1;
+}
+
+void px__urdf_pair_opts(const struct px_pair_opts *o, int coherent, struct px_pair_opts *po)
+{
+	if (o)
+		*po = *o;
+	else
+		memset(po, 0, sizeof(*po));
+	po->coherent = coherent ? 1 : 0;
+}
+
+void px__urdf_min_init(struct px_urdf_clearance *min)
+{
+	if (!min)
+		return;
+	memset(min, 0, sizeof(*min));
+	min->body = min->obstacle = min->other_body = -1;
+	min->distance_m = INFINITY;
+}
+
+int px__urdf_obstacle_pairs(struct px_urdf_robot *r, const struct px_pair_opts *o,
+			    int coherent, double reach, struct px_urdf_clearance *out,
+			    size_t cap, struct px_urdf_clearance *min, int *measured)
 {
 	struct px_pair_opts po;
 	int b, k, n = 0, rc;
@@ -394,37 +448,28 @@ int px_urdf_robot_clearances(struct px_urdf_robot *r, const struct px_pair_opts 
 		return PX_E_INVAL;
 	if (out && cap < (size_t)r->n_bodies * (size_t)r->n_obstacles)
 		return PX_E_NOSPC;
-	if (o)
-		po = *o;
-	else
-		memset(&po, 0, sizeof(po));
-	po.coherent = coherent ? 1 : 0;
-	if (min) {
-		memset(min, 0, sizeof(*min));
-		min->body = min->obstacle = -1;
-		min->distance_m = INFINITY;
-	}
+	px__urdf_pair_opts(o, coherent, &po);
+	px__urdf_min_init(min);
 	for (b = 0; b < r->n_bodies; b++)
 		for (k = 0; k < r->n_obstacles; k++, n++) {
-			struct px_pair_result *p = &r->pairs[n];
 			struct px_urdf_clearance c;
-			if (!coherent)
-				p->valid = 0;
-			rc = px_pair_distance(r->obstacles[k], r->bodies[b].model, &po, p);
-			if (rc)
+			rc = px__urdf_pair(r->obstacles[k], r->bodies[b].model, &po, coherent,
+					   reach, &r->pairs[n], b, k, -1, &c);
+			if (rc < 0)
 				return rc;
-			c.body = b;
-			c.obstacle = k;
-			c.distance_m = p->distance;
-			c.point_robot = p->point_b;
-			c.point_obstacle = p->point_a;
-			c.normal = p->normal;
-			c.intersecting = p->intersecting;
-			c.local_only = p->local_only;
+			if (measured)
+				*measured += rc;
 			if (out)
 				out[n] = c;
 			if (min && c.distance_m < min->distance_m)
 				*min = c;
 		}
 	return n;
+}
+
+int px_urdf_robot_clearances(struct px_urdf_robot *r, const struct px_pair_opts *o,
+			     int coherent, struct px_urdf_clearance *out, size_t cap,
+			     struct px_urdf_clearance *min)
+{
+	return px__urdf_obstacle_pairs(r, o, coherent, INFINITY, out, cap, min, NULL);
 }

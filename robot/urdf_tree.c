@@ -30,8 +30,10 @@ int px__urdf_fail(struct px_urdf_error *err, int code, const char *file,
 	else if (line > 0)
 		snprintf(err->msg, sizeof(err->msg), "%.160s:%ld: %.320s", err->file,
 			 line, what);
-	else
+	else if (err->file[0])
 		snprintf(err->msg, sizeof(err->msg), "%.160s: %.340s", err->file, what);
+	else
+		snprintf(err->msg, sizeof(err->msg), "%.380s", what);
 	return code;
 }
 

@@ -15,9 +15,9 @@
 #include "px_config.h"
 #include "px_sim.h"
 #include "px_test.h"
+#include "px_test_app.h"
 
 #define HAPTIC_SIM "config/examples/haptic_sim.yaml"
-#define MAX_RECS 4096
 
 /* The shipped configs that run without hardware, in this process
  * (can_sim's arm is another program, proxima-simarm: test_proxima_run). */
@@ -26,30 +26,6 @@ static const char *const sim_configs[] = {
 	"config/examples/haptic_faults.yaml",
 	"config/examples/can_avoid_sim.yaml",
 };
-
-static char notes[16384];
-
-static void on_note(void *user, const char *text)
-{
-	size_t n = strlen(notes);
-	(void)user;
-	snprintf(notes + n, sizeof(notes) - n, "%s", text);
-}
-
-struct recs {
-	struct px_app_record r[MAX_RECS];
-	size_t n;
-};
-
-static void on_record(void *user, const struct px_app_record *r)
-{
-	struct recs *rs = user;
-	if (rs->n < MAX_RECS) {
-		rs->r[rs->n] = *r;
-		rs->r[rs->n].compute_ns = 0; /* wall clock: not compared */
-		rs->n++;
-	}
-}
 
 static struct px_config *load(const char *path)
 {
@@ -66,7 +42,7 @@ static void options(struct px_app_options *o, const char *path, double dur_s)
 	o->config = path;
 	o->virtual_time = 1;
 	o->duration_s = dur_s;
-	o->note = on_note;
+	o->note = px_test_app_note;
 }
 
 static struct px_app *create(const struct px_config *cfg,
@@ -75,10 +51,10 @@ static struct px_app *create(const struct px_config *cfg,
 	struct px_app *app = NULL;
 	char msg[256];
 	int rc;
-	notes[0] = '\0';
+	px_test_app_notes[0] = '\0';
 	rc = px_app_create(cfg, o, &app, msg, sizeof(msg));
 	PX_CHECK_MSG(rc == PX_OK, "%s: %s: %s (%s)", o->config, px_strerror(rc),
-		     msg, notes);
+		     msg, px_test_app_notes);
 	return app;
 }
 
@@ -107,18 +83,18 @@ static void test_create_free_every_sim_config(void)
  * give the same telemetry. */
 static void test_own_loop_matches_the_apps_run(void)
 {
-	static struct recs a, b;
+	static struct px_test_recs a, b;
 	struct px_config *cfg = load(HAPTIC_SIM);
 	struct px_app_options o;
 	struct px_app *app;
 	int k;
 	options(&o, HAPTIC_SIM, 0.5);
-	o.record = on_record;
+	o.record = px_test_app_record;
 	o.user = &a;
 	a.n = b.n = 0;
 	app = create(cfg, &o);
 	PX_CHECK_INT_EQ(px_app_run(app), PX_OK);
-	px_app_drain(app, on_record, &a);
+	px_app_drain(app, px_test_app_record, &a);
 	px_app_free(app);
 
 	o.record = NULL;
@@ -127,9 +103,9 @@ static void test_own_loop_matches_the_apps_run(void)
 	for (k = 0; k < 500; k++) {
 		PX_CHECK_INT_EQ(px_app_step(app), PX_OK);
 		if (k % 100 == 99)
-			px_app_drain(app, on_record, &b);
+			px_app_drain(app, px_test_app_record, &b);
 	}
-	px_app_drain(app, on_record, &b);
+	px_app_drain(app, px_test_app_record, &b);
 	px_app_free(app);
 	px_config_free(cfg);
 	PX_CHECK_INT_EQ((long long)a.n, 500);
@@ -143,7 +119,7 @@ static void test_own_loop_matches_the_apps_run(void)
  * no phase after it. */
 static void test_own_phases_match_the_apps_run(void)
 {
-	static struct recs a, b;
+	static struct px_test_recs a, b;
 	struct px_config *cfg = load(HAPTIC_SIM);
 	struct px_app_options o;
 	struct px_app_summary sa, sb;
@@ -155,14 +131,14 @@ static void test_own_phases_match_the_apps_run(void)
 	int64_t t0, now;
 	int k, pushed = 0;
 	options(&o, HAPTIC_SIM, 3.0);
-	o.record = on_record;
+	o.record = px_test_app_record;
 	o.user = &a;
 	a.n = b.n = 0;
 	app = create(cfg, &o);
 	PX_CHECK_INT_EQ(px_app_run(app), PX_OK);
-	px_app_drain(app, on_record, &a);
+	px_app_drain(app, px_test_app_record, &a);
 	PX_CHECK_INT_EQ(px_app_shutdown(app, "end of run"), PX_OK);
-	px_app_drain(app, on_record, &a);
+	px_app_drain(app, px_test_app_record, &a);
 	PX_CHECK_INT_EQ(px_app_summary(app, &sa), PX_OK);
 	px_app_free(app);
 
@@ -186,12 +162,12 @@ static void test_own_phases_match_the_apps_run(void)
 		pushed |= hs.enable && (hs.force_n[0] != 0 ||
 					hs.force_n[1] != 0 || hs.force_n[2] != 0);
 		if (k % 100 == 99)
-			px_app_drain(app, on_record, &b);
+			px_app_drain(app, px_test_app_record, &b);
 	}
 	PX_CHECK_MSG(heap == 0, "%llu heap calls in 3000 phase-driven cycles",
 		     (unsigned long long)heap);
 	PX_CHECK_MSG(pushed, "no force in 3000 cycles");
-	px_app_drain(app, on_record, &b);
+	px_app_drain(app, px_test_app_record, &b);
 	/* shut down in the middle of a cycle: safe, and the rest refused */
 	PX_CHECK_INT_EQ(px_app_read(app, now + ls.period_ns), PX_OK);
 	PX_CHECK_INT_EQ(px_app_shutdown(app, "end of run"), PX_OK);
@@ -203,7 +179,7 @@ static void test_own_phases_match_the_apps_run(void)
 	PX_CHECK_INT_EQ(px_app_read(app, now + 2 * ls.period_ns), PX_E_STATE);
 	PX_CHECK_INT_EQ(px_sim_haptic_state(dev, &hs), PX_OK);
 	PX_CHECK_INT_EQ(hs.enable, 0);
-	px_app_drain(app, on_record, &b);
+	px_app_drain(app, px_test_app_record, &b);
 	PX_CHECK_INT_EQ(px_app_summary(app, &sb), PX_OK);
 	PX_CHECK(sb.shutdown_done && sb.shutdown_safe);
 	PX_CHECK_INT_EQ(sb.force_zeroed, 1);
@@ -401,7 +377,7 @@ static void test_bad_options_refused(void)
 	options(&o, HAPTIC_SIM, 1);
 	o.faults[0] = "melt,haptic,0,1";
 	o.n_faults = 1;
-	notes[0] = '\0';
+	px_test_app_notes[0] = '\0';
 	PX_CHECK_INT_EQ(px_app_create(cfg, &o, &app, msg, sizeof(msg)), PX_E_INVAL);
 	PX_CHECK_MSG(strstr(msg, "unknown kind 'melt'") != NULL, "%s", msg);
 	/* messages start with opt.name (default px_app) */
@@ -409,7 +385,7 @@ static void test_bad_options_refused(void)
 	o.name = "mytool";
 	PX_CHECK_INT_EQ(px_app_create(cfg, &o, &app, msg, sizeof(msg)), PX_E_INVAL);
 	PX_CHECK_MSG(strncmp(msg, "mytool: --fault melt", 20) == 0, "%s", msg);
-	PX_CHECK(strstr(notes, "unknown kind 'melt'") != NULL);
+	PX_CHECK(strstr(px_test_app_notes, "unknown kind 'melt'") != NULL);
 	o.faults[0] = "drop,nosuchdevice,0,1";
 	PX_CHECK_INT_EQ(px_app_create(cfg, &o, &app, msg, sizeof(msg)), PX_E_INVAL);
 	PX_CHECK(msg[0]);

@@ -1842,6 +1842,73 @@ static void test_config_docs_and_examples(void)
 	px_config_free(cfg);
 }
 
+/* control.avoidance with a URDF: the keys read as written (clearance
+ * auto turns to models), and every misuse refused at its key. */
+static void test_config_avoid_urdf(void)
+{
+	static struct px_config_diag diag;
+	static struct px_control_config c;
+	PX_NEEDS(YAML);
+	PX_CHECK_INT_EQ(load_control("control:\n"                  /* 15 */
+				     "  mode: avoidance\n"
+				     "  device: arm\n"
+				     "  avoidance:\n"
+				     "    urdf: robots/arm6/arm6.urdf\n"
+				     "    base_link: base_link\n"    /* 20 */
+				     "    tip_link: tool0\n"
+				     "    package_paths: [robots, /opt/ros]\n"
+				     "    urdf_joints: [shoulder_pan, shoulder_lift]\n"
+				     "    approach_only: true\n"
+				     "    self_influence_distance_m: 0.04\n" /* 25 */
+				     "    allowed_collisions:\n"
+				     "      - {a: wrist1_link, b: wrist3_link}\n",
+				     &c, &diag),
+			PX_OK);
+	PX_CHECK(c.urdf.path && !strcmp(c.urdf.path, "robots/arm6/arm6.urdf"));
+	PX_CHECK(!strcmp(c.urdf.base_link, "base_link") && !strcmp(c.urdf.tip_link, "tool0"));
+	PX_CHECK_INT_EQ(c.urdf.n_package_paths, 2);
+	PX_CHECK(!strcmp(c.urdf.package_paths[1], "/opt/ros"));
+	PX_CHECK_INT_EQ(c.urdf.n_joints, 2);
+	PX_CHECK(!strcmp(c.urdf.joints[1], "shoulder_lift"));
+	PX_CHECK_INT_EQ(c.urdf.clearance, PX_CONTROL_CLEARANCE_MODELS);
+	PX_CHECK(c.urdf.self_clearance);
+	PX_CHECK(c.avoid.approach_only);
+	PX_CHECK_NEAR(c.avoid.self_influence_distance_m, 0.04, 0);
+	PX_CHECK_NEAR(c.avoid.self_protective_distance_m, 0.01, 0);
+	PX_CHECK_INT_EQ(c.urdf.n_allowed, 1);
+	PX_CHECK(!strcmp(c.urdf.allowed[0].b, "wrist3_link"));
+	PX_CHECK_INT_EQ(px_control_avoid_params_check(&c.avoid), PX_OK);
+	/* without a URDF: capsules, as before */
+	PX_CHECK_INT_EQ(load_control("control:\n"
+				     "  mode: none\n", &c, &diag),
+			PX_OK);
+	PX_CHECK(c.urdf.path == NULL);
+	PX_CHECK_INT_EQ(c.urdf.clearance, PX_CONTROL_CLEARANCE_CAPSULES);
+	/* lines 15..20: control, mode, device, avoidance, urdf, tip_link */
+#define URDF_HEAD "control:\n  mode: avoidance\n  device: arm\n  avoidance:\n" \
+		  "    urdf: a.urdf\n    tip_link: tool0\n"
+	expect_control_error(URDF_HEAD "    joints:\n      - {dh: {a_m: 0.1}}\n",
+			     "control.avoidance.joints", 22, "either urdf or joints");
+	expect_control_error("control:\n  mode: avoidance\n  device: arm\n  avoidance:\n"
+			     "    urdf: a.urdf\n",
+			     "control.avoidance.tip_link", 19, "missing required key");
+	expect_control_error("control:\n  mode: avoidance\n  device: arm\n  avoidance:\n"
+			     "    clearance: models\n",
+			     "control.avoidance.clearance", 19, "needs urdf");
+	expect_control_error(URDF_HEAD "    clearance: capsules\n",
+			     "control.avoidance.clearance", 21, "needs the capsules list");
+	expect_control_error(URDF_HEAD "    urdf_joints: [a, b, a]\n",
+			     "control.avoidance.urdf_joints[2]", 21, "listed twice");
+	/* drive joint 1 of the head's arm beyond a one-joint mapping */
+	expect_control_error(URDF_HEAD "    urdf_joints: [a]\n",
+			     "control.device", 17, "avoidance.urdf_joints has 1 joints");
+	expect_control_error(URDF_HEAD "    self_influence_distance_m: 0.01\n"
+			     "    self_protective_distance_m: 0.02\n",
+			     "control.avoidance.self_protective_distance_m", 22,
+			     "smaller than");
+#undef URDF_HEAD
+}
+
 static const struct px_test tests[] = {
 	PX_T(test_segment_search_bounds),
 	PX_T(test_force_limit),
@@ -1866,6 +1933,7 @@ static const struct px_test tests[] = {
 	PX_T(test_config_haptic_section),
 	PX_T(test_config_errors),
 	PX_T(test_config_chain_matches_code),
+	PX_T(test_config_avoid_urdf),
 	PX_T(test_config_docs_and_examples),
 };
 PX_TEST_MAIN(tests)

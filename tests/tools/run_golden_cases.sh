@@ -7,7 +7,8 @@
 #   help                   --help
 #   usage                  a refused --duration-s
 #   check_<config>         --check on every config/examples/*.yaml but
-#                          those with STEP/IGES parts (kind cad): the
+#                          those with STEP/IGES parts (kind cad) or a
+#                          URDF robot (control.avoidance.urdf): the
 #                          golden runner predates them and cannot read
 #                          them (tests/tools/test_proxima_run.sh runs them)
 #   run_<config>           every config in virtual time for 0.2 s with
@@ -54,6 +55,7 @@ golden_cases() {
 	echo "usage||config/examples/haptic_sim.yaml --duration-s 0"
 	for f in config/examples/*.yaml; do
 		grep -q 'kind: cad' "$f" && continue
+		grep -qE '^ +urdf: ' "$f" && continue
 		n=$(basename "$f" .yaml)
 		echo "check_$n||--check $f"
 		echo "run_$n||$f --virtual-time --duration-s $GOLDEN_DURATION --telemetry @OUT@/run_$n.csv --summary-json @OUT@/run_$n.json"
