@@ -75,7 +75,7 @@ SRC_ASSIMP    := px_import.c
 SRC_YAML      := px_config_yaml.c
 SRC_OCCT      := cad_occt.cpp
 SRC_XML       := urdf_xml.c
-SRC_DDS       := px_bridge_dds.c
+SRC_DDS       := px_bridge_dds.c px_bridge_dev.c
 # Tests name the parts they need by these tags (PX_TEST_NEEDS, tests/run.sh).
 TAG_HIDAPI    := hidapi
 TAG_LIBUSB    := libusb
@@ -116,7 +116,7 @@ OPT_ON   := $(foreach p,$(OPT_PARTS),$(if $(filter 1,$(WITH_$(p))),$(p)))
 PKGS     := $(foreach p,$(OPT_ON),$(PKG_$(p)))
 # The file of each part that this build leaves out.
 OPT_OUT_SRC := $(foreach p,$(OPT_PARTS),$(if $(filter 1,$(WITH_$(p))),\
-                 $(basename $(SRC_$(p)))_none.c,$(SRC_$(p))))
+                 $(addsuffix _none.c,$(basename $(SRC_$(p)))),$(SRC_$(p))))
 # Asked when a recipe runs, not when this file is read.
 PKG_CFLAGS = $(if $(PKGS),$(shell pkg-config --cflags $(PKGS)))
 PKG_LIBS   = $(if $(PKGS),$(shell pkg-config --libs $(PKGS)))
@@ -579,7 +579,7 @@ FUZZ_BIN     := $(patsubst %,$(BUILD)/fuzz/fuzz_%,$(FUZZ_NAMES))
 # C++ parts and the DDS bridge are built with their C stand-ins there
 # (the fuzz targets reach neither C++ nor DDS, whose generated types are
 # not in the fuzz build).
-FUZZ_LIB_SRC := $(patsubst %/$(SRC_DDS),%/$(SRC_DDS:.c=_none.c),$(LIB_SRC))
+FUZZ_LIB_SRC := $(foreach f,$(LIB_SRC),$(if $(filter $(addprefix %/,$(SRC_DDS)),$(f)),$(f:.c=_none.c),$(f)))
 FUZZ_LIB_OBJ := $(patsubst %.c,$(BUILD)/fuzz/obj/%.o,$(FUZZ_LIB_SRC) $(LIB_CXX_SRC:.cpp=_none.c))
 FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=undefined
 FUZZ_FLAGS   := -std=c11 -D_GNU_SOURCE $(WARN) $(INCS) -g -O1 \

@@ -18,6 +18,16 @@
  * in batches of up to 1000 cycles on the virtual one. */
 #define PX_BRIDGE_QUEUE 256
 
+/* DDS side (px_bridge_dds.c), shared with the device back end: join the
+ * domain of c with the configuration of px_bridge_dds_config() (*domain
+ * 0 when it existed before), and the QoS of a stream (best-effort) or of
+ * the status (reliable), keep-last-1, volatile: a dds_qos_t to delete
+ * with dds_delete_qos(), NULL without memory. Entities are Cyclone's
+ * dds_entity_t (int32_t). */
+int px__bridge_join(const struct px_bridge_config *c, int32_t *domain,
+		    int32_t *dp, char *msg, size_t cap);
+void *px__bridge_qos(int reliable);
+
 /* 1 for the loopback interface ("lo", 127.x.x.x, ::1, localhost). */
 int px_bridge_is_loopback(const char *iface);
 

@@ -23,6 +23,9 @@
  * the bridge thread's publishing may allocate inside Cyclone DDS. Nothing
  * here is real-time safe; the loop's thread never calls it.
  *
+ * Devices: px_bridge_dev_create() is the "dds" back end of px_dev.h, a
+ * pose stream in and a force command out (below).
+ *
  * Build: an optional part (PX_HAVE_DDS in px_features.h). Without Cyclone
  * DDS the config functions work and px_bridge_create() returns
  * PX_E_UNSUPPORTED, saying "built without Cyclone DDS".
@@ -36,6 +39,7 @@
 
 #include "px_base.h"
 #include "px_config.h"
+#include "px_dev.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -205,6 +209,34 @@ PX_API void px_bridge_counts(struct px_bridge *b, struct px_bridge_counts *out);
 
 /* Stop the thread, leave the domain. NULL is a no-op. */
 PX_API void px_bridge_free(struct px_bridge *b);
+
+/* ---- the "dds" device back end -------------------------------------- */
+
+/* A device on DDS topics rt/<namespace>/<topic> (bridge's namespace and
+ * network), best-effort keep-last-1 as the bridge's streams. */
+struct px_bridge_dev_config {
+	const struct px_bridge_config *bridge; /* domain, namespace, network */
+	/* geometry_msgs/PoseStamped in: the device's pose input (NULL none) */
+	const char *pose_topic;
+	/* geometry_msgs/WrenchStamped out: its force command (NULL none) */
+	const char *command_topic;
+};
+
+/*
+ * A device (px_dev.h) whose pose comes from pose_topic and whose force
+ * commands go to command_topic. Its own thread takes each pose as it
+ * arrives, stamped with the loop clock at receipt, so a silent peer
+ * makes the samples stale after dc->stale_timeout_ns and the loop's
+ * watchdog trips; a command written in the cycle only crosses a
+ * wait-free slot and goes out within about a millisecond. In safe state
+ * the loop zeroes the command (px_dev_force_attach) and px_dev_safe()
+ * sends a zero wrench at once. Start it with px_dev_start(). Returns
+ * PX_OK, PX_E_INVAL (msg says why), PX_E_IO (Cyclone DDS refused),
+ * PX_E_NOMEM or PX_E_UNSUPPORTED (built without Cyclone DDS).
+ */
+PX_API int px_bridge_dev_create(const struct px_dev_config *dc,
+				const struct px_bridge_dev_config *bc,
+				struct px_dev **out, char *msg, size_t cap);
 
 #ifdef __cplusplus
 }

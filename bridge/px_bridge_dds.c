@@ -263,12 +263,12 @@ static void set_msg(char *msg, size_t cap, const char *what, dds_return_t rc)
 
 /* The QoS of ROS 2's profiles: sensor data (best-effort) for streams,
  * default (reliable) for the status; keep-last-1, volatile. */
-static dds_qos_t *topic_qos(enum px_bridge_topic t)
+void *px__bridge_qos(int reliable)
 {
 	dds_qos_t *q = dds_create_qos();
 	if (!q)
 		return NULL;
-	if (px_bridge_topic_reliable(t))
+	if (reliable)
 		dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE,
 				     DDS_MSECS(100));
 	else
@@ -278,13 +278,14 @@ static dds_qos_t *topic_qos(enum px_bridge_topic t)
 	return q;
 }
 
-static int make_entities(struct px_bridge *b, char *msg, size_t cap)
+int px__bridge_join(const struct px_bridge_config *c, int32_t *domain,
+		    int32_t *dp, char *msg, size_t cap)
 {
-	char xml[PX_BRIDGE_DDS_CONFIG_MAX], name[PX_BRIDGE_TOPIC_MAX];
-	dds_domainid_t dom = (dds_domainid_t)b->c.domain_id;
+	char xml[PX_BRIDGE_DDS_CONFIG_MAX];
+	dds_domainid_t dom = (dds_domainid_t)c->domain_id;
 	dds_entity_t e;
-	int t;
-	if (px_bridge_dds_config(&b->c, xml, sizeof(xml)) != PX_OK) {
+	*domain = *dp = 0;
+	if (px_bridge_dds_config(c, xml, sizeof(xml)) != PX_OK) {
 		snprintf(msg, cap, "bridge: the DDS configuration is too long");
 		return PX_E_INVAL;
 	}
@@ -293,15 +294,24 @@ static int make_entities(struct px_bridge *b, char *msg, size_t cap)
 		set_msg(msg, cap, "cannot configure the DDS domain", e);
 		return PX_E_IO;
 	}
-	b->domain = e > 0 ? e : 0; /* existing: its configuration stays */
-	b->dp = dds_create_participant(dom, NULL, NULL);
-	if (b->dp < 0) {
-		set_msg(msg, cap, "cannot join the DDS domain", b->dp);
-		b->dp = 0;
+	*domain = e > 0 ? e : 0; /* existing: its configuration stays */
+	e = dds_create_participant(dom, NULL, NULL);
+	if (e < 0) {
+		set_msg(msg, cap, "cannot join the DDS domain", e);
 		return PX_E_IO;
 	}
+	*dp = e;
+	return PX_OK;
+}
+
+static int make_entities(struct px_bridge *b, char *msg, size_t cap)
+{
+	char name[PX_BRIDGE_TOPIC_MAX];
+	int t, rc = px__bridge_join(&b->c, &b->domain, &b->dp, msg, cap);
+	if (rc != PX_OK)
+		return rc;
 	for (t = 0; t < PX_BRIDGE_TOPIC__COUNT; t++) {
-		dds_qos_t *q = topic_qos((enum px_bridge_topic)t);
+		dds_qos_t *q = px__bridge_qos(px_bridge_topic_reliable(t));
 		if (!q)
 			return PX_E_NOMEM;
 		px_bridge_topic_name(b->ns, px_bridge_topic_short_name(t), name,

@@ -244,6 +244,25 @@ static void test_create_unsupported_or_refused(void)
 	PX_CHECK_INT_EQ(px_bridge_create(&c, NULL, msg, sizeof(msg)),
 			PX_HAVE_DDS ? PX_E_INVAL : PX_E_UNSUPPORTED);
 	px_bridge_free(NULL);
+	{
+		struct px_dev_config dc;
+		struct px_bridge_dev_config bc = {&c, "tool_pose", NULL};
+		struct px_dev *d = (struct px_dev *)&c;
+		px_dev_config_default(&dc);
+		dc.name = "remote";
+		PX_CHECK_INT_EQ(px_bridge_dev_create(&dc, &bc, &d, msg,
+						     sizeof(msg)),
+				PX_HAVE_DDS ? PX_E_INVAL : PX_E_UNSUPPORTED);
+		PX_CHECK(d == NULL);
+		PX_CHECK(strstr(msg, PX_HAVE_DDS ? "namespace"
+						 : "built without Cyclone DDS"));
+		bc.pose_topic = NULL;
+		c.ns = "proxima";
+		if (PX_HAVE_DDS)
+			PX_CHECK_INT_EQ(px_bridge_dev_create(&dc, &bc, &d, msg,
+							     sizeof(msg)),
+					PX_E_INVAL);
+	}
 }
 
 /* ---- two processes on loopback (Cyclone DDS) ----------------------- */
@@ -691,6 +710,114 @@ static void test_round_trip_two_processes(void)
 	PX_CHECK_INT_EQ(strict_matched, 0);
 }
 
+static int take_wrench(dds_entity_t r, double w[6])
+{
+	void *buf[1] = {NULL};
+	dds_sample_info_t info[1];
+	int n = dds_take(r, buf, info, 1, 1), got = 0;
+	if (n > 0 && info[0].valid_data) {
+		const geometry_msgs_msg_dds__WrenchStamped_ *m = buf[0];
+		w[0] = m->wrench.force.x, w[1] = m->wrench.force.y;
+		w[2] = m->wrench.force.z, w[3] = m->wrench.torque.x;
+		w[4] = m->wrench.torque.y, w[5] = m->wrench.torque.z;
+		got = 1;
+	}
+	if (n > 0)
+		dds_return_loan(r, buf, n);
+	return got;
+}
+
+/* The "dds" device: the bridge's tool pose as its pose input (stale once
+ * the stream stops), its force command on a wrench topic, zero after
+ * px_dev_safe(). */
+static void test_dds_device(void)
+{
+	struct px_bridge_config c;
+	struct px_bridge_dev_config bc;
+	struct px_dev_config dc;
+	struct px_bridge_sample s;
+	struct px_pose_sample p;
+	struct px_force_cmd cmd = {{1.5, -2.0, 0.25}, {0.0, 0.5, 0.0}, 1};
+	struct px_dev_status st;
+	struct px_bridge *b = NULL;
+	struct px_dev *d = NULL;
+	dds_entity_t dom = 0, dp, rd;
+	char ns[64], msg[256];
+	double w[6] = {0}, zero_seen = 0;
+	int fresh = 0, got = 0, stale, rc_safe;
+	int64_t end;
+	PX_NEEDS(DDS);
+	snprintf(ns, sizeof(ns), "pxdev_%d", (int)getpid());
+	role_config(&c, test_domain() + 1, ns);
+	c.tool_pose_rate_hz = 500;
+	PX_CHECK_MSG(px_bridge_create(&c, &b, msg, sizeof(msg)) == PX_OK, "%s",
+		     msg);
+	px_dev_config_default(&dc);
+	dc.name = "remote";
+	dc.stale_timeout_ns = 50000000;
+	bc.bridge = &c;
+	bc.pose_topic = "tool_pose";
+	bc.command_topic = "command_wrench";
+	PX_CHECK_MSG(px_bridge_dev_create(&dc, &bc, &d, msg, sizeof(msg)) ==
+			     PX_OK,
+		     "%s", msg);
+	PX_CHECK_INT_EQ(px_dev_caps(d), PX_DEV_CAP_POSE | PX_DEV_CAP_FORCE);
+	PX_CHECK_INT_EQ(px_dev_start(d), PX_OK);
+	dp = join((int)c.domain_id, &dom);
+	rd = reader(dp, px_bridge_topic_descriptor(PX_BRIDGE_WRENCH), ns,
+		    "command_wrench", 0);
+	known_sample(&s);
+	end = mono_ns() + 10000000000LL;
+	while (!fresh && mono_ns() < end) {
+		px_bridge_offer(b, &s);
+		s.stamp_ns += 2000000;
+		dds_sleepfor(DDS_MSECS(2));
+		if (px_dev_pose_read(d, px_dev_mono_ns(), &p) >= 0 && p.valid &&
+		    !p.stale)
+			fresh = 1;
+	}
+	/* the stream stops: stale after the device's timeout */
+	dds_sleepfor(DDS_MSECS(150));
+	px_dev_pose_read(d, px_dev_mono_ns(), &p);
+	stale = p.stale;
+	while (!got && mono_ns() < end) {
+		px_dev_force_write(d, &cmd, px_dev_mono_ns());
+		dds_sleepfor(DDS_MSECS(2));
+		got = take_wrench(rd, w);
+	}
+	rc_safe = px_dev_safe(d, px_dev_mono_ns());
+	end = mono_ns() + 5000000000LL;
+	while (!zero_seen && mono_ns() < end) {
+		double z[6];
+		if (take_wrench(rd, z) && !z[0] && !z[1] && !z[2] && !z[3] &&
+		    !z[4] && !z[5])
+			zero_seen = 1;
+		dds_sleepfor(DDS_MSECS(2));
+	}
+	px_dev_status(d, &st);
+	px_dev_free(d);
+	px_bridge_free(b);
+	dds_delete(dp);
+	if (dom > 0)
+		dds_delete(dom);
+	PX_CHECK_MSG(fresh, "no fresh pose from the stream");
+	PX_CHECK_NEAR(p.pos_m.x, s.tool_m[0], 0);
+	PX_CHECK_NEAR(p.pos_m.y, s.tool_m[1], 0);
+	PX_CHECK_NEAR(p.pos_m.z, s.tool_m[2], 0);
+	/* q (w x y z) and -q are the same rotation */
+	PX_CHECK_NEAR(fabs(p.q.w * s.tool_quat_xyzw[3] + p.q.x * s.tool_quat_xyzw[0] +
+			   p.q.y * s.tool_quat_xyzw[1] + p.q.z * s.tool_quat_xyzw[2]),
+		      1.0, 1e-12);
+	PX_CHECK_MSG(stale, "the pose stayed fresh 150 ms after the stream stopped");
+	PX_CHECK_MSG(got, "the command never arrived");
+	PX_CHECK(w[0] == 1.5 && w[1] == -2.0 && w[2] == 0.25 && w[3] == 0 &&
+		 w[4] == 0.5 && w[5] == 0);
+	PX_CHECK_INT_EQ(rc_safe, PX_OK);
+	PX_CHECK_MSG(zero_seen, "no zero wrench after px_dev_safe");
+	PX_CHECK(st.safe_writes >= 1 && st.outputs_safe == 1);
+	PX_CHECK(!strcmp(st.backend, "dds"));
+}
+
 /* For test_bridge_run.sh: exit 0 once proxima-run's tool pose, wrench and
  * status arrived, 1 after SECONDS without. */
 static int role_listen(const char *role)
@@ -744,6 +871,11 @@ static void test_round_trip_two_processes(void)
 	PX_NEEDS(DDS);
 }
 
+static void test_dds_device(void)
+{
+	PX_NEEDS(DDS);
+}
+
 #endif
 
 static const struct px_test tests[] = {
@@ -754,6 +886,7 @@ static const struct px_test tests[] = {
 	PX_T(test_dds_config),
 	PX_T(test_create_unsupported_or_refused),
 	PX_T(test_round_trip_two_processes),
+	PX_T(test_dds_device),
 };
 
 int main(int argc, char **argv)
