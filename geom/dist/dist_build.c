@@ -653,6 +653,7 @@ static size_t model_bytes(const struct px_dist_model *hdr,
 	return ALIGNED(sizeof(*hdr)) +
 	       ALIGNED(n_ent * sizeof(struct px_dist_entity_info)) +
 	       ALIGNED(n_ent * sizeof(struct px_recog_shape)) +
+	       ALIGNED(n_ent * sizeof(struct px__shape_fast)) +
 	       (ly->trimmed ? ALIGNED(n_ent * sizeof(struct px__dist_trim)) : 0) +
 	       ALIGNED(ly->shape_doubles * sizeof(double)) +
 	       ALIGNED(n_ent * sizeof(uint32_t)) +
@@ -714,12 +715,45 @@ static int model_alloc(const struct px_dist_model *hdr, const struct builder *bl
 	    !TAKE(m->cell_slot, m->n_cells * m->cap) ||
 	    !TAKE(m->spill, m->n_spill + 1) || !TAKE(m->ws.stamp, bl->n) ||
 	    !TAKE(m->ws.cand, bl->n) || !TAKE(m->shape, n_ent) ||
+	    !TAKE(m->sfast, n_ent) ||
 	    !TAKE(m->ws.ent_stamp, n_ent) ||
 	    (ly->shape_doubles && !TAKE(*shmem, ly->shape_doubles)) ||
 	    (ly->trimmed && !TAKE(m->trim, n_ent)))
 		return PX_E_NOMEM; /* the sizing above is wrong: a bug */
 #undef TAKE
 	return PX_OK;
+}
+
+/* The wedge of a turn of the given sweep into w (px__shape_fast). */
+static void wedge(double sweep, double w[3])
+{
+	w[0] = cos(0.5 * sweep);
+	w[1] = sin(0.5 * sweep);
+	w[2] = sweep >= 2.0 * M_PI ? -2.0 : cos(0.5 * sweep);
+}
+
+static px_vec3 arc_end(const struct px_recog_arc *a, double f)
+{
+	return px_v3_add(a->center, px_v3_add(px_v3_scale(a->e0, a->radius * cos(f)),
+					      px_v3_scale(a->e1, a->radius * sin(f))));
+}
+
+/* Every shape's px__shape_fast. */
+static void fill_fast(struct px_dist_model *m)
+{
+	int e;
+	for (e = 0; e < m->n_ent; e++) {
+		const struct px_recog_shape *sh = &m->shape[e];
+		struct px__shape_fast *f = &m->sfast[e];
+		const struct px_recog_arc *a = sh->kind == PX_RECOG_ARC ? &sh->arc
+									: &sh->rev.parc;
+		wedge(sh->kind == PX_RECOG_ARC ? sh->arc.sweep : sh->rev.sweep, f->wedge);
+		f->end[0] = cos(sh->rev.sweep);
+		f->end[1] = sin(sh->rev.sweep);
+		wedge(sh->rev.parc.sweep, f->pwedge);
+		f->a0 = arc_end(a, 0.0);
+		f->a1 = arc_end(a, a->sweep);
+	}
 }
 
 /* The shapes view the entity's arrays (for parameter inversion): point
@@ -1013,6 +1047,7 @@ int px__dist_model_create_trimmed(const struct px_nurbs_curve *curves,
 	m->n_shape_items = hdr_shape_items;
 	memcpy(m->ent, ent, (size_t)ly.n_ent * sizeof(*ent));
 	memcpy(m->shape, shapes, (size_t)ly.n_ent * sizeof(*shapes));
+	fill_fast(m);
 	copy_shape_arrays(m, curves, n_curves, surfs, shmem);
 	if (trims) {
 		int e;

@@ -97,6 +97,21 @@ struct cand {
 	int piece;
 };
 
+/*
+ * What the wave's bound on a closed-form shape's distance reads besides
+ * the shape (dist_build.c fills it at setup), so that the bound needs no
+ * angle function: for the turn of an arc or a surface of revolution
+ * (about its axis) the unit direction of its middle and the cosine of
+ * half its sweep (below -1 for a full turn), which decide whether a
+ * query's angle lies in the sweep by one comparison; the direction of
+ * the sweep's end; the same wedge for a profile arc; the end points of
+ * the arc (a curve) or of the profile arc (meridian coordinates).
+ */
+struct px__shape_fast {
+	double wedge[3], end[2], pwedge[3];
+	px_vec3 a0, a1;
+};
+
 /* PK_SHAPE: a whole closed-form entity in the grid (trimmed models). */
 enum { PK_CURVE = 0, PK_PATCH = 1, PK_SHAPE = 2 };
 /* PIECE_SHAPE: a piece of an entity the grid holds as one PK_SHAPE item
@@ -148,6 +163,7 @@ struct px_dist_model {
 	/* Knowledge step: entities that are exactly a primitive (with the
 	 * arrays their parameter inversion reads, copied here). */
 	struct px_recog_shape *shape;
+	struct px__shape_fast *sfast; /* per entity, beside shape */
 	/* Per entity: the trimmed domain (inside NULL: untrimmed), or NULL
 	 * for a model without trimmed surfaces. */
 	struct px__dist_trim *trim;

@@ -106,6 +106,84 @@ static inline int on_domain_edge(const struct px_recog_shape *sh, double u,
 	       v <= sh->dom[2] + ev || v >= sh->dom[3] - ev;
 }
 
+/* 1 when the direction (x, y) of length r lies in the wedge w of a turn
+ * (struct px__shape_fast): its angle from the middle is at most half
+ * the sweep. */
+static inline int in_wedge(double x, double y, double r, const double w[3])
+{
+	return x * w[0] + y * w[1] >= r * w[2];
+}
+
+/* Squared distance from p to the arc a of wedge w and end points e0, e1
+ * (the arc_closest() of px_recog.c without its angles). */
+static inline double arc_d2(const struct px_recog_arc *a, const double w[3],
+			    px_vec3 e0, px_vec3 e1, px_vec3 p)
+{
+	px_vec3 d = px_v3_sub(p, a->center);
+	double h = px_v3_dot(a->normal, d), x = px_v3_dot(a->e0, d),
+	       y = px_v3_dot(a->e1, d), r = sqrt(x * x + y * y), d0, d1;
+	if (in_wedge(x, y, r, w))
+		return h * h + (r - a->radius) * (r - a->radius);
+	/* Outside the sweep the nearer end point answers. */
+	d0 = px_v3_dist2(p, e0);
+	d1 = px_v3_dist2(p, e1);
+	return d0 < d1 ? d0 : d1;
+}
+
+/*
+ * The squared distance from p to a closed-form shape to rounding,
+ * without angle functions (px__shape_fast), or for a parallelogram the
+ * squared distance to its plane: a bound the wave prunes with, far
+ * cheaper than px_recog_closest(). A surface of revolution: p's
+ * meridian coordinates (h, rho), or where p's angle is outside the
+ * sweep, those of its projection on the nearer end meridian plus the
+ * squared distance to that plane; then the profile's nearest point.
+ */
+static inline double shape_lb2(const struct px_recog_shape *sh,
+			       const struct px__shape_fast *f, px_vec3 p)
+{
+	const struct px_recog_rev *rv = &sh->rev;
+	px_vec3 w;
+	double a, b, c, x, y, r, extra = 0.0;
+
+	switch (sh->kind) {
+	case PX_RECOG_ARC:
+		return arc_d2(&sh->arc, f->wedge, f->a0, f->a1, p);
+	case PX_RECOG_PARALLELOGRAM:
+		a = px_v3_dot(sh->quad.normal, px_v3_sub(p, sh->quad.origin));
+		return a * a / px_v3_dot(sh->quad.normal, sh->quad.normal);
+	case PX_RECOG_CYLINDER:
+	case PX_RECOG_CONE:
+	case PX_RECOG_ANNULUS:
+	case PX_RECOG_SPHERE:
+	case PX_RECOG_TORUS:
+		w = px_v3_sub(p, rv->origin);
+		a = px_v3_dot(rv->axis, w);
+		x = px_v3_dot(rv->e0, w);
+		y = px_v3_dot(rv->e1, w);
+		r = sqrt(x * x + y * y);
+		b = r;
+		if (!in_wedge(x, y, r, f->wedge)) {
+			double b1 = x * f->end[0] + y * f->end[1];
+			b = x > b1 ? x : b1;
+			extra = r * r - b * b;
+			extra = extra > 0.0 ? extra : 0.0;
+		}
+		if (rv->profile_is_arc)
+			return extra + arc_d2(&rv->parc, f->pwedge, f->a0, f->a1,
+					      px_v3(a, b, 0.0));
+		a -= rv->pseg.p0.x;
+		b -= rv->pseg.p0.y;
+		c = a * rv->pseg.dir.x + b * rv->pseg.dir.y;
+		c = c < 0.0 ? 0.0 : (c > rv->pseg.len ? rv->pseg.len : c);
+		a -= c * rv->pseg.dir.x;
+		b -= c * rv->pseg.dir.y;
+		return extra + a * a + b * b;
+	default:
+		return 0.0;
+	}
+}
+
 /*
  * A PK_SHAPE item (trimmed models, dist_build.c: add_shape_items()):
  * its entity in closed form, once per query. The answer is exact, so it
@@ -121,28 +199,28 @@ visit_shape(const struct px_dist_model *m, struct px_dist_ws *ws, px_vec3 p,
 	const struct px__dist_trim *tr = m->trim ? &m->trim[pc->ent] : NULL;
 	struct px_recog_hit h;
 	double d2;
+	int trimmed;
 
 	if (ws->ent_stamp[pc->ent] == ws->epoch)
 		return;
 	/* Rounding margin: the bound only skips what is clearly farther. */
-	if (px__dist_shape_lb2(&m->shape[pc->ent], p) * (1.0 - 1e-9) >= q->best)
+	if (shape_lb2(&m->shape[pc->ent], &m->sfast[pc->ent], p) * (1.0 - 1e-9) >=
+	    q->best)
 		return; /* q->best only falls: no other item of it can win */
 	ws->ent_stamp[pc->ent] = ws->epoch;
 	q->shapes++;
-	/* The point first: the parameters (dearer) only where they decide. */
-	if (px_recog_closest(&m->shape[pc->ent], p, 0, &h) != PX_OK)
+	/* The parameters only where the domain asks for them. */
+	trimmed = tr && tr->inside;
+	if (px_recog_closest(&m->shape[pc->ent], p, trimmed ? PX_RECOG_WANT_PARAMS : 0,
+			     &h) != PX_OK)
 		return; /* only an unrecognised kind refuses: never made an item */
 	d2 = h.dist * h.dist;
 	if (d2 >= q->best)
 		return;
-	q->best_params = 0;
-	if (tr && tr->inside) {
-		px_recog_closest(&m->shape[pc->ent], p, PX_RECOG_WANT_PARAMS, &h);
-		if (on_domain_edge(&m->shape[pc->ent], h.u, h.v) ||
-		    !tr->inside(tr->ctx, h.u, h.v))
-			return;
-		q->best_params = 1;
-	}
+	if (trimmed && (on_domain_edge(&m->shape[pc->ent], h.u, h.v) ||
+			!tr->inside(tr->ctx, h.u, h.v)))
+		return;
+	q->best_params = trimmed;
 	q->best = d2;
 	q->best_sample = -1;
 	q->best_piece = pc->idx;
