@@ -4,6 +4,7 @@
  * samples, the knowledge step's closed-form shapes, and the grid that
  * the query's wave walks, all in one arena block.
  */
+#include <float.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -566,6 +567,11 @@ static void count_pieces(const struct builder *bl, struct layout *ly)
  * in closed form (on CAD parts 8 beat both 2 and 32 under callgrind). */
 #define SHAPE_ITEM_WEIGHT 8
 
+/* Up to this many PK_SHAPE items are scanned by their boxes before the
+ * wave instead of being binned (px_dist.c: scan_shapes()): on CAD parts
+ * of a few dozen faces the scan costs a fraction of the wave's shells. */
+#define SCAN_ITEMS 40
+
 /* Grid geometry (paper section 6) into hdr: bounds, cell size from the
  * finest entity's piece count along the longest extent, cell counts. */
 static void grid_geometry(struct px_dist_model *hdr, const struct builder *bl,
@@ -581,7 +587,7 @@ static void grid_geometry(struct px_dist_model *hdr, const struct builder *bl,
 	for (i = 0; i < bl->n; i++) {
 		hdr->bounds = px_aabb_union(&hdr->bounds, &bl->tp[i].pc.box);
 		if (bl->tp[i].pc.kind == PK_SHAPE)
-			cell_budget += SHAPE_ITEM_WEIGHT;
+			cell_budget += bl->tp[i].pc.trim != PIECE_SHAPE ? SHAPE_ITEM_WEIGHT : 0;
 		else
 			cell_budget += bl->tp[i].pc.trim != PIECE_SHAPE;
 	}
@@ -654,6 +660,7 @@ static size_t model_bytes(const struct px_dist_model *hdr,
 	       ALIGNED(n_ent * sizeof(struct px_dist_entity_info)) +
 	       ALIGNED(n_ent * sizeof(struct px_recog_shape)) +
 	       ALIGNED(n_ent * sizeof(struct px__shape_fast)) +
+	       ALIGNED(n * sizeof(struct px__dist_sbox)) +
 	       (ly->trimmed ? ALIGNED(n_ent * sizeof(struct px__dist_trim)) : 0) +
 	       ALIGNED(ly->shape_doubles * sizeof(double)) +
 	       ALIGNED(n_ent * sizeof(uint32_t)) +
@@ -724,6 +731,20 @@ static int model_alloc(const struct px_dist_model *hdr, const struct builder *bl
 	return PX_OK;
 }
 
+/* Box b as centre and half extents, the extents widened by a few ulp
+ * of the coordinates (so |x - c| - e never exceeds the gap to b). */
+static void sbox(const px_aabb *b, struct px__dist_sbox *o)
+{
+	const double lo[3] = {b->min.x, b->min.y, b->min.z};
+	const double hi[3] = {b->max.x, b->max.y, b->max.z};
+	int d;
+	for (d = 0; d < 3; d++) {
+		o->c[d] = 0.5 * (lo[d] + hi[d]);
+		o->e[d] = 0.5 * (hi[d] - lo[d]) +
+			  4.0 * DBL_EPSILON * (fabs(lo[d]) + fabs(hi[d]));
+	}
+}
+
 /* The wedge of a turn of the given sweep into w (px__shape_fast). */
 static void wedge(double sweep, double w[3])
 {
@@ -753,6 +774,16 @@ static void fill_fast(struct px_dist_model *m)
 		wedge(sh->rev.parc.sweep, f->pwedge);
 		f->a0 = arc_end(a, 0.0);
 		f->a1 = arc_end(a, a->sweep);
+		if (sh->kind == PX_RECOG_PARALLELOGRAM) {
+			const struct px_recog_quad *qd = &sh->quad;
+			double l1 = px_v3_dot(qd->e1, qd->e1), l2 = px_v3_dot(qd->e2, qd->e2);
+			/* Square to rounding: the bound's error stays far below
+			 * the pruning margin (1e-9). */
+			if (fabs(px_v3_dot(qd->e1, qd->e2)) <= 1e-14 * sqrt(l1 * l2)) {
+				f->side2[0] = l1;
+				f->side2[1] = l2;
+			}
+		}
 	}
 }
 
@@ -993,7 +1024,7 @@ int px__dist_model_create_trimmed(const struct px_nurbs_curve *curves,
 	struct layout ly;
 	long *refs = NULL;
 	double *spmem, *shmem;
-	int rc, hdr_shape_items = 0;
+	int rc, i, hdr_shape_items = 0;
 
 	if (!out)
 		return PX_E_INVAL;
@@ -1031,6 +1062,9 @@ int px__dist_model_create_trimmed(const struct px_nurbs_curve *curves,
 		if (rc)
 			goto fail;
 		hdr_shape_items = bl.n - n0;
+		if (hdr_shape_items <= SCAN_ITEMS)
+			for (i = n0; i < bl.n; i++)
+				bl.tp[i].pc.trim = PIECE_SHAPE; /* scanned, not binned */
 	}
 	count_pieces(&bl, &ly);
 	memset(&hdr, 0, sizeof(hdr));
@@ -1045,6 +1079,18 @@ int px__dist_model_create_trimmed(const struct px_nurbs_curve *curves,
 	if (rc)
 		goto fail;
 	m->n_shape_items = hdr_shape_items;
+	for (i = 0; i < bl.n; i++)
+		m->wave_pieces += binned(&bl.tp[i].pc);
+	if (hdr_shape_items && hdr_shape_items <= SCAN_ITEMS) {
+		m->shape_box = px_arena_calloc(&m->arena, (size_t)hdr_shape_items,
+					       sizeof(*m->shape_box), 64);
+		if (!m->shape_box) {
+			rc = PX_E_NOMEM; /* the sizing is wrong: a bug */
+			goto fail;
+		}
+		for (i = 0; i < hdr_shape_items; i++)
+			sbox(&bl.tp[bl.n - hdr_shape_items + i].pc.box, &m->shape_box[i]);
+	}
 	memcpy(m->ent, ent, (size_t)ly.n_ent * sizeof(*ent));
 	memcpy(m->shape, shapes, (size_t)ly.n_ent * sizeof(*shapes));
 	fill_fast(m);

@@ -105,11 +105,21 @@ struct cand {
  * half its sweep (below -1 for a full turn), which decide whether a
  * query's angle lies in the sweep by one comparison; the direction of
  * the sweep's end; the same wedge for a profile arc; the end points of
- * the arc (a curve) or of the profile arc (meridian coordinates).
+ * the arc (a curve) or of the profile arc (meridian coordinates); for a
+ * parallelogram whose sides are square to each other, their squared
+ * lengths (else zero).
  */
 struct px__shape_fast {
 	double wedge[3], end[2], pwedge[3];
 	px_vec3 a0, a1;
+	double side2[2];
+};
+
+/* A scanned item's box as centre and half extents (its bound is then a
+ * few branch-free operations per axis; the extents are rounded up so
+ * that the bound never exceeds the box's). */
+struct px__dist_sbox {
+	double c[3], e[3];
 };
 
 /* PK_SHAPE: a whole closed-form entity in the grid (trimmed models). */
@@ -163,7 +173,6 @@ struct px_dist_model {
 	/* Knowledge step: entities that are exactly a primitive (with the
 	 * arrays their parameter inversion reads, copied here). */
 	struct px_recog_shape *shape;
-	struct px__shape_fast *sfast; /* per entity, beside shape */
 	/* Per entity: the trimmed domain (inside NULL: untrimmed), or NULL
 	 * for a model without trimmed surfaces. */
 	struct px__dist_trim *trim;
@@ -193,6 +202,13 @@ struct px_dist_model {
 	int *spill;
 	/* the workspace of px_dist_query() */
 	struct px_dist_ws ws;
+	/* Per entity, beside shape (trimmed models' closed forms). */
+	struct px__shape_fast *sfast;
+	/* Models with few PK_SHAPE items: their boxes in one array (else
+	 * NULL), scanned before the wave; wave_pieces: the grid's other
+	 * pieces (0: no wave). */
+	struct px__dist_sbox *shape_box;
+	int wave_pieces;
 };
 
 /*

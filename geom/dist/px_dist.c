@@ -132,12 +132,13 @@ static inline double arc_d2(const struct px_recog_arc *a, const double w[3],
 
 /*
  * The squared distance from p to a closed-form shape to rounding,
- * without angle functions (px__shape_fast), or for a parallelogram the
- * squared distance to its plane: a bound the wave prunes with, far
- * cheaper than px_recog_closest(). A surface of revolution: p's
- * meridian coordinates (h, rho), or where p's angle is outside the
- * sweep, those of its projection on the nearer end meridian plus the
- * squared distance to that plane; then the profile's nearest point.
+ * without angle functions (px__shape_fast), or for a parallelogram
+ * whose sides are not square the squared distance to its plane: a bound
+ * the wave prunes with, far cheaper than px_recog_closest(). A surface
+ * of revolution: p's meridian coordinates (h, rho), or where p's angle
+ * is outside the sweep, those of its projection on the nearer end
+ * meridian plus the squared distance to that plane; then the profile's
+ * nearest point.
  */
 static inline double shape_lb2(const struct px_recog_shape *sh,
 			       const struct px__shape_fast *f, px_vec3 p)
@@ -149,9 +150,23 @@ static inline double shape_lb2(const struct px_recog_shape *sh,
 	switch (sh->kind) {
 	case PX_RECOG_ARC:
 		return arc_d2(&sh->arc, f->wedge, f->a0, f->a1, p);
+	case PX_RECOG_SEGMENT:
+		w = px_v3_sub(p, sh->seg.p0);
+		c = px_v3_dot(w, sh->seg.dir);
+		c = c < 0.0 ? 0.0 : (c > sh->seg.len ? sh->seg.len : c);
+		return px_v3_dist2(w, px_v3_scale(sh->seg.dir, c));
 	case PX_RECOG_PARALLELOGRAM:
-		a = px_v3_dot(sh->quad.normal, px_v3_sub(p, sh->quad.origin));
-		return a * a / px_v3_dot(sh->quad.normal, sh->quad.normal);
+		w = px_v3_sub(p, sh->quad.origin);
+		a = px_v3_dot(sh->quad.normal, w);
+		a = a * a / px_v3_dot(sh->quad.normal, sh->quad.normal);
+		/* Square sides: the in-plane excess beyond the sides adds. */
+		x = px_v3_dot(sh->quad.f1, w);
+		y = px_v3_dot(sh->quad.f2, w);
+		b = gap1(x, sh->quad.x0 < sh->quad.x1 ? sh->quad.x0 : sh->quad.x1,
+			 sh->quad.x0 < sh->quad.x1 ? sh->quad.x1 : sh->quad.x0);
+		c = gap1(y, sh->quad.y0 < sh->quad.y1 ? sh->quad.y0 : sh->quad.y1,
+			 sh->quad.y0 < sh->quad.y1 ? sh->quad.y1 : sh->quad.y0);
+		return a + b * b * f->side2[0] + c * c * f->side2[1];
 	case PX_RECOG_CYLINDER:
 	case PX_RECOG_CONE:
 	case PX_RECOG_ANNULUS:
@@ -203,10 +218,6 @@ visit_shape(const struct px_dist_model *m, struct px_dist_ws *ws, px_vec3 p,
 
 	if (ws->ent_stamp[pc->ent] == ws->epoch)
 		return;
-	/* Rounding margin: the bound only skips what is clearly farther. */
-	if (shape_lb2(&m->shape[pc->ent], &m->sfast[pc->ent], p) * (1.0 - 1e-9) >=
-	    q->best)
-		return; /* q->best only falls: no other item of it can win */
 	ws->ent_stamp[pc->ent] = ws->epoch;
 	q->shapes++;
 	/* The parameters only where the domain asks for them. */
@@ -229,6 +240,74 @@ visit_shape(const struct px_dist_model *m, struct px_dist_ws *ws, px_vec3 p,
 	q->best_v = h.v;
 }
 
+/* A PK_SHAPE item met: solved when its closed form's bound (with a
+ * rounding margin, so that it only skips what is clearly farther) can
+ * still beat the best. q->best only falls, so an item skipped once can
+ * never win. */
+static __attribute__((noinline)) void
+meet_shape(const struct px_dist_model *m, struct px_dist_ws *ws, px_vec3 p,
+	   const struct piece *pc, struct qstate *q)
+{
+	if (ws->ent_stamp[pc->ent] != ws->epoch &&
+	    shape_lb2(&m->shape[pc->ent], &m->sfast[pc->ent], p) * (1.0 - 1e-9) <
+		    q->best)
+		visit_shape(m, ws, p, pc, q);
+}
+
+/*
+ * Models with few PK_SHAPE items (dist_build.c: SCAN_ITEMS): all of
+ * them by their boxes' bounds, the nearest box's item first, then the
+ * items whose bound beats its answer, nearest first, until the bound
+ * reaches the best. A big face's box spans many cells, so the wave
+ * would meet it from many of them and far from its nearest point; a
+ * scan of a few dozen boxes costs less than the wave's shells. These
+ * items are not in the grid, which holds the model's other pieces. The
+ * bounds sit at the far end of the candidate list, which has room for
+ * every piece.
+ */
+static __attribute__((noinline)) void
+scan_shapes(const struct px_dist_model *m, struct px_dist_ws *ws, px_vec3 p,
+	    struct qstate *q)
+{
+	int n = m->n_shape_items, first = m->n_pieces - n, i, k = 0, near = 0;
+	struct cand *h = ws->cand + first;
+	double near_lb = INFINITY;
+	for (i = 0; i < n; i++) {
+		const struct px__dist_sbox *b = &m->shape_box[i];
+		double dx = fabs(p.x - b->c[0]) - b->e[0];
+		double dy = fabs(p.y - b->c[1]) - b->e[1];
+		double dz = fabs(p.z - b->c[2]) - b->e[2];
+		double lb;
+		int nearer;
+		dx = dx > 0.0 ? dx : 0.0;
+		dy = dy > 0.0 ? dy : 0.0;
+		dz = dz > 0.0 ? dz : 0.0;
+		lb = dx * dx + dy * dy + dz * dz;
+		nearer = lb < near_lb;
+		h[i].lb = lb;
+		near_lb = nearer ? lb : near_lb;
+		near = nearer ? i : near;
+	}
+	/* The nearest box's item first: its answer leaves few to order. */
+	meet_shape(m, ws, p, &m->pieces[first + near], q);
+	for (i = 0; i < n; i++)
+		if (h[i].lb < q->best && i != near) {
+			h[k].lb = h[i].lb;
+			h[k++].piece = first + i;
+		}
+	/* Nearest first by selection: usually one or two are taken. */
+	while (k > 0) {
+		int lo = 0, id;
+		for (i = 1; i < k; i++)
+			lo = h[i].lb < h[lo].lb ? i : lo;
+		if (h[lo].lb >= q->best)
+			break;
+		id = h[lo].piece;
+		h[lo] = h[--k];
+		meet_shape(m, ws, p, &m->pieces[id], q);
+	}
+}
+
 /* Inline: called for every piece of every visited cell. shapes: the
  * model has PK_SHAPE items (a constant in each specialised wave). */
 static inline __attribute__((always_inline)) void
@@ -246,7 +325,7 @@ visit_piece(const struct px_dist_model *m, struct px_dist_ws *ws, px_vec3 p,
 	if (lb >= q->best)
 		return;
 	if (shapes && pc->kind == PK_SHAPE) {
-		visit_shape(m, ws, p, pc, q);
+		meet_shape(m, ws, p, pc, q);
 		return;
 	}
 	/* Branch-free scan (conditional moves): which sample of a random
@@ -469,10 +548,18 @@ static void wave(const struct px_dist_model *m, struct px_dist_ws *ws,
 	wave_k(m, ws, p, q, 0);
 }
 
-static void wave_shapes(const struct px_dist_model *m, struct px_dist_ws *ws,
-			px_vec3 p, struct qstate *q)
+static __attribute__((noinline)) void
+wave_shapes(const struct px_dist_model *m, struct px_dist_ws *ws, px_vec3 p,
+	    struct qstate *q)
 {
-	wave_k(m, ws, p, q, 1);
+	if (!m->shape_box) {
+		wave_k(m, ws, p, q, 1);
+		return;
+	}
+	/* The scanned items are not in the grid. */
+	scan_shapes(m, ws, p, q);
+	if (m->wave_pieces)
+		wave_k(m, ws, p, q, 0);
 }
 
 /* What the solves of one query carry from candidate to candidate. */
