@@ -211,6 +211,21 @@ struct px_dist_model {
 	int wave_pieces;
 };
 
+/* Squared distance from (a, b) to a profile segment in meridian
+ * coordinates (struct px_recog_rev). */
+static inline double px__dist_pseg_d2(const struct px_recog_seg *s, double a,
+				      double b)
+{
+	double c;
+	a -= s->p0.x;
+	b -= s->p0.y;
+	c = a * s->dir.x + b * s->dir.y;
+	c = c < 0.0 ? 0.0 : (c > s->len ? s->len : c);
+	a -= c * s->dir.x;
+	b -= c * s->dir.y;
+	return a * a + b * b;
+}
+
 /*
  * A lower bound on the squared distance from p to a closed-form shape,
  * far cheaper than its closest point (no angles): the whole circle of
@@ -252,13 +267,7 @@ static inline double px__dist_shape_lb2(const struct px_recog_shape *sh, px_vec3
 			l = sqrt(a * a + b * b) - rv->parc.radius;
 			return l * l;
 		}
-		a -= rv->pseg.p0.x;
-		b -= rv->pseg.p0.y;
-		c = a * rv->pseg.dir.x + b * rv->pseg.dir.y;
-		c = c < 0.0 ? 0.0 : (c > rv->pseg.len ? rv->pseg.len : c);
-		a -= c * rv->pseg.dir.x;
-		b -= c * rv->pseg.dir.y;
-		return a * a + b * b;
+		return px__dist_pseg_d2(&rv->pseg, a, b);
 	default:
 		return 0.0;
 	}

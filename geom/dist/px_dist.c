@@ -187,13 +187,7 @@ static inline double shape_lb2(const struct px_recog_shape *sh,
 		if (rv->profile_is_arc)
 			return extra + arc_d2(&rv->parc, f->pwedge, f->a0, f->a1,
 					      px_v3(a, b, 0.0));
-		a -= rv->pseg.p0.x;
-		b -= rv->pseg.p0.y;
-		c = a * rv->pseg.dir.x + b * rv->pseg.dir.y;
-		c = c < 0.0 ? 0.0 : (c > rv->pseg.len ? rv->pseg.len : c);
-		a -= c * rv->pseg.dir.x;
-		b -= c * rv->pseg.dir.y;
-		return extra + a * a + b * b;
+		return extra + px__dist_pseg_d2(&rv->pseg, a, b);
 	default:
 		return 0.0;
 	}
