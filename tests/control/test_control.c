@@ -1578,20 +1578,22 @@ static const char cfg_head[] =
 	"          - {node_id: 1, mode: csv, joint: 0}\n"       /* 13 */
 	"          - {node_id: 2, mode: csv, joint: 1}\n";
 
-/* Load cfg_head + body and read its control section. */
+/* Load cfg_head + body and read its control section. The strings out
+ * points to (device, URDF names) live in the config, which is kept until
+ * the next call. */
 static int load_control(const char *body, struct px_control_config *out,
 			struct px_config_diag *diag)
 {
 	static char buf[8192];
-	struct px_config *cfg = NULL;
+	static struct px_config *cfg;
 	int rc;
+	px_config_free(cfg);
+	cfg = NULL;
 	snprintf(buf, sizeof(buf), "%s%s", cfg_head, body);
 	rc = px_config_load_mem("t.yaml", buf, strlen(buf), &cfg, diag);
 	PX_CHECK_MSG(rc == PX_OK, "base config failed: %s",
 		     diag->count ? diag->errors[0].msg : px_strerror(rc));
-	rc = px_control_config_read(cfg, out, diag);
-	px_config_free(cfg); /* out keeps no pointer used below but device */
-	return rc;
+	return px_control_config_read(cfg, out, diag);
 }
 
 static void expect_control_error(const char *body, const char *path, int line,
