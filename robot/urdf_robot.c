@@ -26,47 +26,15 @@ void px_urdf_robot_free(struct px_urdf_robot *r)
 	free(r);
 }
 
-/* A mesh file scaled by s (a negative product mirrors it: the triangles
- * turn round so that outside stays outside). */
+/* A mesh file scaled by s (a negative product mirrors it: the loader
+ * turns the triangles round so that outside stays outside). */
 static int mesh_model(const char *path, const double *s, struct px_model **out,
 		      char *why, size_t cap)
 {
 	struct px_mesh_report rep;
-	struct px_model *m = NULL;
-	double *xyz;
-	uint32_t *tri;
-	size_t n, i;
-	int rc = px_mesh_load(path, NULL, &rep, &m), flip = s[0] * s[1] * s[2] < 0;
-	if (rc) {
-		snprintf(why, cap, "%s", rep.message[0] ? rep.message : px_strerror(rc));
-		return rc;
-	}
-	if (s[0] == 1.0 && s[1] == 1.0 && s[2] == 1.0) {
-		*out = m;
-		return PX_OK;
-	}
-	n = px_mesh_triangle_count(m);
-	xyz = malloc(9 * n * sizeof(*xyz) + 1);
-	tri = malloc(3 * n * sizeof(*tri) + 1);
-	rc = xyz && tri ? PX_OK : PX_E_NOMEM;
-	for (i = 0; rc == PX_OK && i < n; i++) {
-		px_vec3 v[3];
-		int k;
-		rc = px_mesh_triangle(m, i, v);
-		for (k = 0; k < 3; k++) {
-			xyz[9 * i + 3 * k] = v[k].x * s[0];
-			xyz[9 * i + 3 * k + 1] = v[k].y * s[1];
-			xyz[9 * i + 3 * k + 2] = v[k].z * s[2];
-			tri[3 * i + (size_t)(flip && k ? 3 - k : k)] = (uint32_t)(3 * i + (size_t)k);
-		}
-	}
-	px_model_free(m);
-	if (rc == PX_OK)
-		rc = px_mesh_model(xyz, 3 * n, tri, n, NULL, &rep, out);
+	int rc = px_mesh_load_scaled(path, s, NULL, &rep, out);
 	if (rc)
 		snprintf(why, cap, "%s", rep.message[0] ? rep.message : px_strerror(rc));
-	free(xyz);
-	free(tri);
 	return rc;
 }
 

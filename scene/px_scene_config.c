@@ -322,54 +322,20 @@ static void resolve(char *out, size_t cap, const char *cfg_path,
 			 file);
 }
 
+/* kind nurbs: an OBJ's curves and surfaces (a B-rep when trimmed). */
 static int load_nurbs(const char *path, struct px_model **out, char *msg,
 		      size_t cap)
 {
-	struct px_obj_model *obj = NULL;
-	struct px_obj_error err;
-	struct px_nurbs_curve *curves = NULL;
-	struct px_nurbs_surf *surfs = NULL;
-	int nc = 0, ns = 0, i, rc, trimmed = 0;
-	/* trim or hole loops: a B-rep of trimmed faces (px_brep_obj.h) */
-	rc = px_model_load_obj_brep(path, 1.0, &trimmed, out, msg, cap);
-	if (trimmed)
-		return rc;
-	msg[0] = '\0';
-	memset(&err, 0, sizeof(err));
-	rc = px_obj_load_file(path, &obj, &err);
-	if (rc != PX_OK) {
-		px_obj_error_text(&err, path, rc, msg, cap);
-		return rc;
-	}
-	curves = calloc((size_t)obj->n_entities + 1, sizeof(*curves));
-	surfs = calloc((size_t)obj->n_entities + 1, sizeof(*surfs));
-	if (!curves || !surfs) {
-		rc = PX_E_NOMEM;
-		snprintf(msg, cap, "%.256s: out of memory", path);
-		goto done;
-	}
-	for (i = 0; i < obj->n_entities; i++) {
-		if (obj->entities[i].kind == PX_OBJ_CURVE)
-			curves[nc++] = obj->entities[i].curve;
-		else
-			surfs[ns++] = obj->entities[i].surf;
-	}
-	if (nc + ns == 0) {
-		rc = PX_E_PARSE;
+	int rc = px_model_load_obj(path, out, msg, cap);
+	if (rc == PX_OK && px_model_kind(*out) == PX_MODEL_MESH) {
+		px_model_free(*out);
+		*out = NULL;
 		snprintf(msg, cap,
 			 "%.256s: no curves or surfaces in the file (polygon "
 			 "faces: use kind 'mesh')",
 			 path);
-		goto done;
+		return PX_E_PARSE;
 	}
-	rc = px_nurbs_model_create(curves, nc, surfs, ns, NULL, out);
-	if (rc != PX_OK)
-		snprintf(msg, cap, "%.256s: cannot build the NURBS model: %s", path,
-			 px_strerror(rc));
-done:
-	free(curves);
-	free(surfs);
-	px_obj_free(obj);
 	return rc;
 }
 

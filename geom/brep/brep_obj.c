@@ -478,13 +478,41 @@ int px_brep_from_obj(const struct px_obj_model *m, double scale,
 	return rc;
 }
 
+int px_model_from_obj_brep(const struct px_obj_model *m, const char *path,
+			   double scale, struct px_model **out, char *msg,
+			   size_t msg_cap)
+{
+	struct px_obj_error e;
+	struct px_brep *b = NULL;
+	struct px_brep_info info;
+	int rc;
+
+	if (msg && msg_cap)
+		msg[0] = '\0';
+	if (!m || !path || !out)
+		return PX_E_INVAL;
+	*out = NULL;
+	memset(&e, 0, sizeof(e));
+	snprintf(e.file, sizeof(e.file), "%s", path);
+	rc = px_brep_from_obj(m, scale, &b, &e);
+	if (!rc)
+		rc = px_model_from_brep(b, out);
+	if (rc) {
+		px_obj_error_text(&e, path, rc, msg, msg_cap);
+		return rc;
+	}
+	px_brep_get_info(px_model_brep(*out), &info);
+	if (!info.closed && msg && msg_cap)
+		snprintf(msg, msg_cap, "%s: open B-rep, distances are unsigned (%s)",
+			 path, info.why);
+	return PX_OK;
+}
+
 int px_model_load_obj_brep(const char *path, double scale, int *trimmed,
 			   struct px_model **out, char *msg, size_t msg_cap)
 {
 	struct px_obj_model *m = NULL;
 	struct px_obj_error e;
-	struct px_brep *b = NULL;
-	struct px_brep_info info;
 	char *buf = NULL;
 	size_t len = 0;
 	int rc;
@@ -508,18 +536,11 @@ int px_model_load_obj_brep(const char *path, double scale, int *trimmed,
 	memset(&e, 0, sizeof(e));
 	rc = px_obj_load_mem(path, buf, len, &m, &e);
 	free(buf);
-	if (!rc)
-		rc = px_brep_from_obj(m, scale, &b, &e);
-	px_obj_free(m);
-	if (!rc)
-		rc = px_model_from_brep(b, out);
 	if (rc) {
 		px_obj_error_text(&e, path, rc, msg, msg_cap);
 		return rc;
 	}
-	px_brep_get_info(px_model_brep(*out), &info);
-	if (!info.closed && msg && msg_cap)
-		snprintf(msg, msg_cap, "%s: open B-rep, distances are unsigned (%s)",
-			 path, info.why);
-	return PX_OK;
+	rc = px_model_from_obj_brep(m, path, scale, out, msg, msg_cap);
+	px_obj_free(m);
+	return rc;
 }

@@ -56,6 +56,16 @@ PX_API int px_brep_from_obj(const struct px_obj_model *m, double scale,
 			    struct px_brep **out, struct px_obj_error *err);
 
 /*
+ * The model of a loaded OBJ with trim or hole loops (px_obj_trimmed()):
+ * px_brep_from_obj() then px_model_from_brep(). path names the file in
+ * msg, as px_model_load_obj_brep() says it. Setup only.
+ */
+PX_API int px_model_from_obj_brep(const struct px_obj_model *m,
+				  const char *path, double scale,
+				  struct px_model **out, char *msg,
+				  size_t msg_cap);
+
+/*
  * Load the OBJ file at path as a model: a file with trim or hole
  * statements as a B-rep (kind PX_MODEL_BREP, coordinates times scale)
  * with *trimmed = 1; any other file is left alone (*trimmed = 0,

@@ -846,8 +846,28 @@ int px_mesh_model(const double *xyz, size_t nv, const uint32_t *tri,
 
 /* ---- files ------------------------------------------------------------------ */
 
-int px_mesh_load(const char *path, const struct px_mesh_opts *opt,
-		 struct px_mesh_report *rep, struct px_model **out)
+/* The imported vertices times scale; a mirroring scale (negative
+ * product) turns every triangle round so that outside stays outside. */
+static void scale_mesh(double *xyz, size_t nv, uint32_t *tri, size_t nt,
+		       const double scale[3])
+{
+	size_t i;
+	for (i = 0; i < nv; i++) {
+		xyz[3 * i] *= scale[0];
+		xyz[3 * i + 1] *= scale[1];
+		xyz[3 * i + 2] *= scale[2];
+	}
+	if (scale[0] * scale[1] * scale[2] < 0.0)
+		for (i = 0; i < nt; i++) {
+			uint32_t t = tri[3 * i + 1];
+			tri[3 * i + 1] = tri[3 * i + 2];
+			tri[3 * i + 2] = t;
+		}
+}
+
+int px__mesh_load_data(const char *path, char *data, size_t len,
+		       const double scale[3], const struct px_mesh_opts *opt,
+		       struct px_mesh_report *rep, struct px_model **out)
 {
 	struct px_mesh_report lrep;
 	double *xyz = NULL;
@@ -857,16 +877,18 @@ int px_mesh_load(const char *path, const struct px_mesh_opts *opt,
 	int rc;
 
 	rep = report_init(rep ? rep : &lrep, out);
-	if (!out || !path) {
+	if (!out || !path || !data) {
 		rep_msg(rep, "invalid arguments");
 		return PX_E_INVAL;
 	}
-	rc = px__import_file(path, 1, &xyz, &nv, &tri, &nt, &skipped, msg,
-			     sizeof(msg));
+	rc = px__import_data(path, data, len, 1, &xyz, &nv, &tri, &nt, &skipped,
+			     msg, sizeof(msg));
 	if (rc != PX_OK) {
 		snprintf(rep->message, sizeof(rep->message), "%s", msg);
 		return rc;
 	}
+	if (scale)
+		scale_mesh(xyz, nv, tri, nt, scale);
 	rc = px_mesh_model(xyz, nv, tri, nt, opt, rep, out);
 	if (rep->message[0]) {
 		px__prefix_path(rep->message, sizeof(rep->message), path);
@@ -874,4 +896,38 @@ int px_mesh_load(const char *path, const struct px_mesh_opts *opt,
 	free(xyz);
 	free(tri);
 	return rc;
+}
+
+int px_mesh_load_scaled(const char *path, const double scale[3],
+			const struct px_mesh_opts *opt,
+			struct px_mesh_report *rep, struct px_model **out)
+{
+	struct px_mesh_report lrep;
+	char *data = NULL;
+	size_t len = 0;
+	int rc, k;
+
+	rep = report_init(rep ? rep : &lrep, out);
+	if (!out || !path) {
+		rep_msg(rep, "invalid arguments");
+		return PX_E_INVAL;
+	}
+	for (k = 0; scale && k < 3; k++)
+		if (!isfinite(scale[k]) || scale[k] == 0.0) {
+			snprintf(rep->message, sizeof(rep->message),
+				 "%s: scale %d must be finite and not zero", path, k);
+			return PX_E_RANGE;
+		}
+	rc = px__import_read(path, &data, &len, rep->message, sizeof(rep->message));
+	if (rc != PX_OK)
+		return rc;
+	rc = px__mesh_load_data(path, data, len, scale, opt, rep, out);
+	free(data);
+	return rc;
+}
+
+int px_mesh_load(const char *path, const struct px_mesh_opts *opt,
+		 struct px_mesh_report *rep, struct px_model **out)
+{
+	return px_mesh_load_scaled(path, NULL, opt, rep, out);
 }

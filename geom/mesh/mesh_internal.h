@@ -715,6 +715,16 @@ int px__mesh_vs_model(const struct px_model *m, const struct px_model *o,
 int px__import_file(const char *path, int want_tri, double **xyz,
 		    size_t *nv, uint32_t **tri, size_t *nt, size_t *n_skipped,
 		    char *msg, size_t msg_cap);
+/* The same for bytes already read (px__import_read()); data stays the
+ * caller's. */
+int px__import_data(const char *path, char *data, size_t len, int want_tri,
+		    double **xyz, size_t *nv, uint32_t **tri, size_t *nt,
+		    size_t *n_skipped, char *msg, size_t msg_cap);
+
+/* px_mesh_load_scaled() of bytes already read; scale may be NULL. */
+int px__mesh_load_data(const char *path, char *data, size_t len,
+		       const double scale[3], const struct px_mesh_opts *opt,
+		       struct px_mesh_report *rep, struct px_model **out);
 
 /* ---- mesh_ply.c: the importer's parts that need no importer library
  * (so that PLY point clouds load in a build without assimp). Setup only. */

@@ -41,6 +41,38 @@ int px__import_read(const char *path, char **data, size_t *len, char *msg, size_
 	return PX_OK;
 }
 
+/* Both importers (with and without assimp) read the same way. */
+int px__import_file(const char *path, int want_tri, double **xyz,
+		    size_t *nv, uint32_t **tri, size_t *nt, size_t *n_skipped,
+		    char *msg, size_t msg_cap)
+{
+	char *data = NULL;
+	size_t len = 0;
+	int rc;
+	if (msg_cap)
+		msg[0] = '\0';
+	if (!path || !xyz || !nv || (want_tri && (!tri || !nt))) {
+		snprintf(msg, msg_cap, "invalid arguments");
+		return PX_E_INVAL;
+	}
+	rc = px__import_read(path, &data, &len, msg, msg_cap);
+	if (rc != PX_OK) {
+		*xyz = NULL;
+		*nv = 0;
+		if (tri)
+			*tri = NULL;
+		if (nt)
+			*nt = 0;
+		if (n_skipped)
+			*n_skipped = 0;
+		return rc;
+	}
+	rc = px__import_data(path, data, len, want_tri, xyz, nv, tri, nt,
+			     n_skipped, msg, msg_cap);
+	free(data);
+	return rc;
+}
+
 /* fmemopen wants at least one byte; an empty file never gets that far. */
 FILE *px__mem_stream(const char *path, char *data, size_t len, char *msg, size_t msg_cap)
 {

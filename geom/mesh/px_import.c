@@ -506,21 +506,21 @@ static int import_scene(const char *path, const char *data, size_t len, const ch
 	return PX_OK;
 }
 
-int px__import_file(const char *path, int want_tri, double **xyz,
-		    size_t *nv, uint32_t **tri, size_t *nt, size_t *n_skipped,
-		    char *msg, size_t msg_cap)
+int px__import_data(const char *path, char *data, size_t len, int want_tri,
+		    double **xyz, size_t *nv, uint32_t **tri, size_t *nt,
+		    size_t *n_skipped, char *msg, size_t msg_cap)
 {
 	struct acc A;
-	char *data = NULL, hint[16] = "";
+	char hint[16] = "";
 	double *pv = NULL;
-	size_t len = 0, pn = 0;
+	size_t pn = 0;
 	int rc;
 
 	memset(&A, 0, sizeof(A));
 	A.want_tri = want_tri;
 	if (msg_cap)
 		msg[0] = '\0';
-	if (!path || !xyz || !nv || (want_tri && (!tri || !nt))) {
+	if (!path || !data || !xyz || !nv || (want_tri && (!tri || !nt))) {
 		snprintf(msg, msg_cap, "invalid arguments");
 		return PX_E_INVAL;
 	}
@@ -530,13 +530,9 @@ int px__import_file(const char *path, int want_tri, double **xyz,
 		*tri = NULL;
 	if (nt)
 		*nt = 0;
-	rc = px__import_read(path, &data, &len, msg, msg_cap);
-	if (rc != PX_OK)
-		return rc;
 	rc = check_file(path, data, len, want_tri, hint, &pv, &pn, msg, msg_cap);
 	if (rc == PX_OK && pv) {
 		/* points: the file's own values, doubles kept exact */
-		free(data);
 		*xyz = pv;
 		*nv = pn;
 		if (n_skipped)
@@ -545,7 +541,6 @@ int px__import_file(const char *path, int want_tri, double **xyz,
 	}
 	if (rc == PX_OK)
 		rc = import_scene(path, data, len, hint, &A, msg, msg_cap);
-	free(data);
 	if (rc != PX_OK) {
 		free(A.xyz);
 		free(A.tri);

@@ -9,13 +9,11 @@
 
 #include "mesh_internal.h"
 
-int px__import_file(const char *path, int want_tri, double **xyz,
-		    size_t *nv, uint32_t **tri, size_t *nt, size_t *n_skipped,
-		    char *msg, size_t msg_cap)
+int px__import_data(const char *path, char *data, size_t len, int want_tri,
+		    double **xyz, size_t *nv, uint32_t **tri, size_t *nt,
+		    size_t *n_skipped, char *msg, size_t msg_cap)
 {
-	char *data = NULL;
-	size_t len = 0;
-	int rc, ply;
+	int rc = PX_OK, ply;
 	if (msg_cap)
 		msg[0] = '\0';
 	if (tri)
@@ -24,19 +22,15 @@ int px__import_file(const char *path, int want_tri, double **xyz,
 		*nt = 0;
 	if (n_skipped)
 		*n_skipped = 0;
-	if (!path || !xyz || !nv || (want_tri && (!tri || !nt))) {
+	if (!path || !data || !xyz || !nv || (want_tri && (!tri || !nt))) {
 		snprintf(msg, msg_cap, "invalid arguments");
 		return PX_E_INVAL;
 	}
 	*xyz = NULL;
 	*nv = 0;
-	rc = px__import_read(path, &data, &len, msg, msg_cap);
-	if (rc != PX_OK)
-		return rc;
 	ply = px__ply_file(path, data, len);
 	if (ply)
 		rc = px__ply_read(path, data, len, want_tri, xyz, nv, msg, msg_cap);
-	free(data);
 	if (ply && (rc != PX_OK || !want_tri))
 		return rc;
 	free(*xyz);

@@ -6,10 +6,11 @@
  * By name: .stl and .obj are meshes; .xyz, .csv, .txt and .pts are point
  * clouds; .ply is a mesh when it has faces and a point cloud when it has
  * only vertices; .step, .stp, .iges and .igs are CAD parts. Other names
- * are tried as meshes (the importer knows many formats). Free-form OBJ
- * (NURBS curves and surfaces) belongs to the NURBS loader, not here,
- * except an OBJ with trim or hole statements: it is read as a B-rep
- * (px_model_load_obj_brep(), px_brep_obj.h; unsigned, an open sheet).
+ * are tried as meshes (the importer knows many formats). An OBJ with
+ * free-form statements (NURBS curves and surfaces) is read by
+ * px_model_load_obj(): trim or hole loops make a B-rep (px_brep_obj.h),
+ * untrimmed curves and surfaces one NURBS model; a polygon OBJ goes to
+ * the mesh importer as other meshes do. Each file is read once.
  *
  * CAD parts (px_model_load_cad()) are read with px_cad_load() and built
  * with px_brep_create() into one model of kind PX_MODEL_BREP: the whole
@@ -51,6 +52,19 @@ extern "C" {
  */
 PX_API int px_model_load(const char *path, double cloud_radius_m,
 			 struct px_model **out, char *msg, size_t msg_cap);
+
+/*
+ * Load the OBJ file at path (px_obj.h reads it, coordinates as written,
+ * in metres) as one model: trim or hole loops make a B-rep
+ * (PX_MODEL_BREP, px_model_from_obj_brep()); free-form curves and
+ * surfaces one NURBS model (px_nurbs_model_create()); polygon faces a
+ * mesh (px_mesh_model(), exact doubles). A file with both free-form
+ * entities and faces is PX_E_UNSUPPORTED (load them as two files); one
+ * with neither PX_E_NOTFOUND. msg as for px_model_load(); errors name
+ * the file (and line and column for syntax). Setup only.
+ */
+PX_API int px_model_load_obj(const char *path, struct px_model **out,
+			     char *msg, size_t msg_cap);
 
 /*
  * Load the STEP or IGES file path (the format from its name, else from

@@ -177,6 +177,18 @@ PX_API int px_mesh_load(const char *path, const struct px_mesh_opts *opt,
 			struct px_mesh_report *rep, struct px_model **out);
 
 /*
+ * px_mesh_load() with the file's coordinates multiplied by scale[0..2]
+ * (x, y, z; each finite and not zero, else PX_E_RANGE) before the model
+ * is built, as a URDF <mesh scale> asks. A mirroring scale (an odd
+ * number of negative factors) turns every triangle round, so the
+ * outside stays outside. scale NULL is px_mesh_load(). Setup only.
+ */
+PX_API int px_mesh_load_scaled(const char *path, const double scale[3],
+			       const struct px_mesh_opts *opt,
+			       struct px_mesh_report *rep,
+			       struct px_model **out);
+
+/*
  * Exact closest point of triangle (a, b, c) to p: returns the squared
  * distance, writes the point q, its feature (PX_FEATURE_FACE, _EDGE,
  * _VERTEX), sub (edge 0: ab, 1: bc, 2: ca, or vertex 0..2) and the

@@ -53,82 +53,6 @@ static int ends_with(const char *s, const char *ext)
 
 /* ---- models ------------------------------------------------------------ */
 
-/* An OBJ file as proxima-query reads it: its free-form curves and
- * surfaces as one NURBS model, or its faces as a mesh. */
-static int load_obj(const char *path, struct px_model **out, char *msg,
-		    size_t cap)
-{
-	struct px_obj_error oe;
-	struct px_obj_model *obj = NULL;
-	struct px_nurbs_curve *cv = NULL;
-	struct px_nurbs_surf *sf = NULL;
-	size_t ne;
-	int i, nc = 0, ns = 0, trimmed = 0, rc;
-	/* trim or hole loops: one B-rep of trimmed faces (px_brep_obj.h) */
-	rc = px_model_load_obj_brep(path, 1.0, &trimmed, out, msg, cap);
-	if (trimmed)
-		return rc;
-	if (msg && cap)
-		msg[0] = '\0';
-	rc = px_obj_load_file(path, &obj, &oe);
-	if (rc) {
-		px_obj_error_text(&oe, path, rc, msg, cap);
-		return rc;
-	}
-	if (obj->n_entities > 0 && obj->n_triangles > 0) {
-		px_obj_free(obj);
-		return say(msg, cap, PX_E_UNSUPPORTED,
-			   "%s: the file has both free-form entities and faces; "
-			   "load them as two models (one file each)", path);
-	}
-	if (obj->n_triangles > 0) {
-		struct px_mesh_report rep;
-		uint32_t *tri = malloc(3 * (size_t)obj->n_triangles * sizeof(*tri));
-		if (!tri) {
-			px_obj_free(obj);
-			return say(msg, cap, PX_E_NOMEM, "%s: out of memory", path);
-		}
-		for (i = 0; i < 3 * obj->n_triangles; i++)
-			tri[i] = (uint32_t)obj->triangles[i];
-		rc = px_mesh_model(obj->vertices, (size_t)obj->n_vertices, tri,
-				   (size_t)obj->n_triangles, NULL, &rep, out);
-		free(tri);
-		px_obj_free(obj);
-		if (rc)
-			return say(msg, cap, rc, "%s: faces: %s", path,
-				   rep.message[0] ? rep.message : px_strerror(rc));
-		return PX_OK;
-	}
-	if (obj->n_entities == 0) {
-		px_obj_free(obj);
-		return say(msg, cap, PX_E_NOTFOUND,
-			   "%s: no free-form curve or surface and no face in the file",
-			   path);
-	}
-	ne = obj->n_entities > 0 ? (size_t)obj->n_entities : 1;
-	cv = calloc(ne, sizeof(*cv));
-	sf = calloc(ne, sizeof(*sf));
-	if (!cv || !sf) {
-		rc = say(msg, cap, PX_E_NOMEM, "%s: out of memory", path);
-	} else {
-		for (i = 0; i < obj->n_entities; i++) {
-			if (obj->entities[i].kind == PX_OBJ_CURVE)
-				cv[nc++] = obj->entities[i].curve;
-			else
-				sf[ns++] = obj->entities[i].surf;
-		}
-		rc = px_nurbs_model_create(nc ? cv : NULL, nc, ns ? sf : NULL, ns,
-					   NULL, out);
-		if (rc)
-			say(msg, cap, rc, "%s: cannot prepare the model: %s", path,
-			    px_strerror(rc));
-	}
-	free(cv);
-	free(sf);
-	px_obj_free(obj);
-	return rc;
-}
-
 int pxpy_load(const char *path, double cloud_radius_m, double scale,
 	      struct px_model **out, char *msg, size_t msg_cap)
 {
@@ -137,7 +61,7 @@ int pxpy_load(const char *path, double cloud_radius_m, double scale,
 	if (msg && msg_cap)
 		msg[0] = '\0';
 	if (ends_with(path, ".obj"))
-		return load_obj(path, out, msg, msg_cap);
+		return px_model_load_obj(path, out, msg, msg_cap);
 	if (px_model_is_cad_name(path))
 		rc = px_model_load_cad(path, scale, out, msg, msg_cap);
 	else

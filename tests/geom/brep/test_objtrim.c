@@ -936,13 +936,41 @@ static void test_model_load(void)
 	PX_CHECK(m == NULL);
 	snprintf(msg2, sizeof(msg2), "%s:16:1: ", path);
 	PX_CHECK_MSG(strncmp(msg, msg2, strlen(msg2)) == 0, "%s", msg);
-	/* untrimmed: the mesh loader's answer, as before */
+	/* untrimmed: one NURBS model, the same as px_model_load_obj()'s */
 	plane_text(text, sizeof(text), 0.0, 0, 1, 1, 1);
 	fp = fopen(path, "w");
 	fputs(text, fp);
 	fclose(fp);
 	rc = px_model_load(path, 0.0, &m, msg, sizeof(msg));
-	PX_CHECK(rc != PX_OK || px_model_kind(m) == PX_MODEL_MESH);
+	PX_CHECK_MSG(rc == PX_OK, "%s", msg);
+	PX_CHECK(m && px_model_kind(m) == PX_MODEL_NURBS);
+	if (m) {
+		struct px_model *m2 = NULL;
+		px_vec3 p = {0.3, 0.4, 0.7};
+		struct px_model_result r1, r2;
+		PX_CHECK_INT_EQ(px_model_load_obj(path, &m2, msg, sizeof(msg)), PX_OK);
+		PX_CHECK(m2 && px_model_kind(m2) == PX_MODEL_NURBS);
+		if (m2) {
+			PX_CHECK_INT_EQ(px_model_query(m, p, &r1), 1);
+			PX_CHECK_INT_EQ(px_model_query(m2, p, &r2), 1);
+			PX_CHECK(r1.distance == r2.distance);
+		}
+		px_model_free(m2);
+	}
+	px_model_free(m);
+	/* both free-form entities and faces: refused, named */
+	fp = fopen(path, "a");
+	fputs("f 1 2 3\n", fp);
+	fclose(fp);
+	m = NULL;
+	PX_CHECK_INT_EQ(px_model_load_obj(path, &m, msg, sizeof(msg)), PX_E_UNSUPPORTED);
+	PX_CHECK(m == NULL && strstr(msg, path) && strstr(msg, "both"));
+	/* faces only: a mesh with the file's own coordinates */
+	fp = fopen(path, "w");
+	fputs("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", fp);
+	fclose(fp);
+	PX_CHECK_INT_EQ(px_model_load_obj(path, &m, msg, sizeof(msg)), PX_OK);
+	PX_CHECK(m && px_model_kind(m) == PX_MODEL_MESH);
 	px_model_free(m);
 	unlink(path);
 }

@@ -832,6 +832,36 @@ static void test_load_files(void)
 		}
 		px_model_free(m);
 	}
+	{
+		/* scaled (a URDF <mesh scale>): mirrored keeps outside outside */
+		const double sc[2][3] = {{2.0, 0.5, 3.0}, {-2.0, 0.5, 3.0}};
+		const double zero[3] = {1.0, 0.0, 1.0};
+		int s;
+		for (s = 0; s < 2; s++) {
+			int rc = px_mesh_load_scaled(tpath("box.obj"), sc[s], NULL, &rp, &m);
+			PX_CHECK_MSG(rc == PX_OK, "%s", rp.message);
+			if (rc)
+				continue;
+			PX_CHECK_MSG(rp.closed && !rp.flipped, "scale %d: %s", s, rp.message);
+			PX_CHECK_NEAR(rp.volume, 8 * h[0] * h[1] * h[2] * 3.0, 1e-12);
+			for (i = 0; i < 50; i++) {
+				struct px_model_result a, b;
+				px_vec3 p = rand_v(1.2), q;
+				q.x = p.x / sc[s][0];
+				q.y = p.y / sc[s][1];
+				q.z = p.z / sc[s][2];
+				px_model_query(m, p, &a);
+				px_model_query(ref, q, &b);
+				/* the sign of a point is the sign of its preimage */
+				PX_CHECK((a.distance < 0) == (b.distance < 0));
+			}
+			px_model_free(m);
+		}
+		m = (struct px_model *)1;
+		PX_CHECK_INT_EQ(px_mesh_load_scaled(tpath("box.obj"), zero, NULL, &rp, &m),
+				PX_E_RANGE);
+		PX_CHECK(m == NULL && strstr(rp.message, "box.obj") != NULL);
+	}
 	m = (struct px_model *)1;
 	PX_CHECK_INT_EQ(px_mesh_load(tpath("missing.stl"), NULL, &rp, &m), PX_E_NOTFOUND);
 	PX_CHECK(m == NULL);
