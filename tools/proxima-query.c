@@ -286,6 +286,29 @@ static int load_obj_faces(struct query *q)
 	return 0;
 }
 
+/* trim or hole loops: one B-rep of trimmed faces (px_brep_obj.h),
+ * answered by global queries. 0 or the exit status. */
+static int load_trimmed(struct query *q)
+{
+	char msg[512];
+	int rc = px_model_from_obj_brep(q->obj, q->model_path, 1.0, &q->mesh,
+					msg, sizeof(msg));
+	if (rc) {
+		fprintf(stderr, "%s: %s\n", prog, msg);
+		return 1;
+	}
+	if (q->track) {
+		fprintf(stderr, "%s: %s: --track: trimmed surfaces are "
+				"answered by global queries only; run "
+				"without --track\n",
+			prog, q->model_path);
+		return 2;
+	}
+	if (msg[0] && q->stats)
+		fprintf(stderr, "%s: %s\n", prog, msg);
+	return 0;
+}
+
 /* An OBJ: its free-form entities as a global model or a tracker, its
  * faces as a mesh. 0 or the exit status. */
 static int load_obj(struct query *q)
@@ -300,6 +323,8 @@ static int load_obj(struct query *q)
 		return 1;
 	}
 	obj = q->obj;
+	if (px_obj_trimmed(obj))
+		return load_trimmed(q);
 	q->curves = calloc((size_t)obj->n_entities + 1, sizeof(*q->curves));
 	q->surfs = calloc((size_t)obj->n_entities + 1, sizeof(*q->surfs));
 	if (!q->curves || !q->surfs) {
@@ -353,29 +378,8 @@ static int load_model(struct query *q)
 			prog, q->model_path);
 		return 2;
 	}
-	if (ieq(ext, "obj")) {
-		/* trim or hole loops: one B-rep of trimmed faces
-		 * (px_brep_obj.h), answered by global queries */
-		int trimmed = 0;
-		rc = px_model_load_obj_brep(q->model_path, 1.0, &trimmed, &q->mesh,
-					    msg, sizeof(msg));
-		if (!trimmed)
-			return load_obj(q);
-		if (rc) {
-			fprintf(stderr, "%s: %s\n", prog, msg);
-			return 1;
-		}
-		if (q->track) {
-			fprintf(stderr, "%s: %s: --track: trimmed surfaces are "
-					"answered by global queries only; run "
-					"without --track\n",
-				prog, q->model_path);
-			return 2;
-		}
-		if (msg[0] && q->stats)
-			fprintf(stderr, "%s: %s\n", prog, msg);
-		return 0;
-	}
+	if (ieq(ext, "obj"))
+		return load_obj(q);
 	/* meshes and point clouds */
 	rc = px_model_load(q->model_path, 0.0, &q->mesh, msg, sizeof(msg));
 	if (rc) {
