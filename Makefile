@@ -26,11 +26,12 @@ SOMAJOR := $(firstword $(subst ., ,$(VERSION)))
 # Library folders are found, not listed: every folder under a top-level
 # folder that is not one of NON_LIB_DIRS or a build directory and holds .c
 # or .h files (geom/nurbs, devices/backends, app, ...) is a module folder:
-# its sources go into the library and it is on the include path.
+# its sources go into the library and it is on the include path (npm's
+# node_modules are not searched).
 NON_LIB_DIRS := tests tools bench fuzz examples docs python
 LIB_TOP := $(filter-out $(NON_LIB_DIRS) build% $(firstword $(subst /, ,$(BUILD))),\
              $(patsubst %/,%,$(wildcard */)))
-MODULE_DIRS := $(sort $(patsubst %/,%,$(dir $(shell find $(LIB_TOP) -type f -name '*.[ch]'))))
+MODULE_DIRS := $(sort $(patsubst %/,%,$(dir $(shell find $(LIB_TOP) -name node_modules -prune -o -type f -name '*.[ch]' -print))))
 WARN    := -Wall -Wextra -Wshadow -Wstrict-prototypes -Werror
 INCS    := $(addprefix -I,$(MODULE_DIRS))
 BASE_CFLAGS := -std=c11 -D_GNU_SOURCE $(WARN) $(INCS) -fvisibility=hidden -MMD -MP
@@ -300,6 +301,37 @@ endif
 $(PY_STAMP): $(PY_SRC) $(SHARED_LIB) $(PUB_HDRS)
 	$(call PY_BUILD,$(BUILD)/python,$(abspath $(BUILD)/lib))
 
+# ---- the view page (view/web/) ---------------------------------------------
+# The browser side of the view (docs/view-page.md): npm packages in
+# view/web/node_modules (three.js, uPlot; esbuild bundles, playwright-core
+# and ws serve the browser tests), installed by `make deps` or `make
+# view-web`; view/web/build.mjs bundles the page into $(BUILD)/view/web.
+# `all` builds it when the packages are installed, fetching nothing; the
+# browser tests (tests/view/) skip without them or chromium.
+NODE ?= node
+NPM  ?= npm
+VIEW_WEB      := view/web
+VIEW_WEB_OUT  := $(BUILD)/view/web
+VIEW_WEB_MODS := $(VIEW_WEB)/node_modules/.package-lock.json
+VIEW_WEB_SRC  := $(wildcard $(VIEW_WEB)/src/*) $(VIEW_WEB)/build.mjs
+DEB_PACKAGES += nodejs chromium chromium-driver
+
+.PHONY: view-web
+view-web: $(VIEW_WEB_MODS)
+	@$(MAKE) --no-print-directory $(VIEW_WEB_OUT)/index.html
+ifneq ($(wildcard $(VIEW_WEB_MODS)),)
+all: $(VIEW_WEB_OUT)/index.html
+endif
+
+# npm ci installs exactly the lock file's versions.
+$(VIEW_WEB_MODS): $(VIEW_WEB)/package.json $(wildcard $(VIEW_WEB)/package-lock.json)
+	cd $(VIEW_WEB) && if [ -f package-lock.json ]; then $(NPM) ci --no-audit --no-fund; \
+	  else $(NPM) install --no-audit --no-fund; fi
+	@touch $@
+
+$(VIEW_WEB_OUT)/index.html: $(VIEW_WEB_SRC) $(VIEW_WEB_MODS)
+	$(NODE) $(VIEW_WEB)/build.mjs --out $(VIEW_WEB_OUT)
+
 # ---- rules ---------------------------------------------------------------
 $(BUILD)/obj/%.o: %.c | $(FEATURES_H)
 	@mkdir -p $(dir $@)
@@ -488,6 +520,10 @@ run: deps
 
 deps:
 	@sh tools/install-deps.sh $(DEB_PACKAGES)
+	@# Debian's npm only where node came without one.
+	@command -v $(NPM) >/dev/null 2>&1 || sh tools/install-deps.sh npm
+	@$(MAKE) --no-print-directory $(VIEW_WEB_MODS) >/dev/null || \
+	  echo "make deps: the view page's npm packages are not installed: its browser tests skip" >&2
 
 install: lib tools $(FEATURES_H)
 	install -d $(DESTDIR)$(LIBDIR)/pkgconfig $(DESTDIR)$(INCLUDEDIR)/$(NAME) $(DESTDIR)$(BINDIR)
@@ -531,6 +567,7 @@ help:
 	@echo '  install    library, headers, tools and proxima.pc under DESTDIR/PREFIX'
 	@echo '  uninstall  remove what install put there'
 	@echo '  deps       install the Debian packages building and testing need'
+	@echo '  view-web   install the npm packages of the view page, build it into $(BUILD)/view/web'
 	@echo '  clean      remove the build directory'
 	@echo '  help       this text'
 	@echo 'Variables (make VAR=value):'
