@@ -39,7 +39,11 @@ export function checker(name) {
 export async function openPage(browser, url) {
   const page = await browser.newPage({ viewport: { width: 960, height: 540 } });
   const errors = [];
-  page.on("console", (m) => { if (m.type() === "error") errors.push(m.text()); });
+  // The browser's own line for a refused WebSocket is expected while a
+  // server is down (the page retries every second); any other is an error.
+  page.on("console", (m) => {
+    if (m.type() === "error" && !/^WebSocket connection to .* failed: .*ERR_CONNECTION_REFUSED/.test(m.text())) errors.push(m.text());
+  });
   page.on("pageerror", (e) => errors.push(String(e)));
   await page.goto(url);
   return { page, errors };
@@ -83,3 +87,65 @@ export async function shot(page, file) {
 
 export const near = (a, b, tol = 1e-9) =>
   Array.isArray(a) && Array.isArray(b) && a.length === b.length && a.every((v, i) => Math.abs(v - b[i]) <= tol);
+
+// The report tool's substitution: the marker replaced by the JSON object,
+// "</" written as "<\/" so no string can close the script element.
+export function fillReport(template, data) {
+  const parts = template.split("/*PX_VIEW_DATA*/null");
+  if (parts.length !== 2) throw new Error("report template: marker not found exactly once");
+  return parts[0] + JSON.stringify(data).replace(/<\//g, "<\\/") + parts[1];
+}
+
+// Replay and report: the run is loaded, the slider shows the frame at its
+// time, play moves the tool, pause holds it, 4x plays four times as fast.
+// frames: the run's frames when the test knows them (checked exactly).
+export async function checkPlayer(t, page, label, frames) {
+  let s = await state(page);
+  const n = frames ? frames.length : s.replay && s.replay.frames;
+  t.ok(s.replay && n > 1 && s.replay.frames === n && s.plotPoints > 1, `${label}: the whole run is loaded`,
+    [s.replay, s.plotPoints]);
+  const speeds = await page.$$eval("#speed option", (o) => o.map((x) => Number(x.value)));
+  t.ok(speeds[0] === 0.25 && speeds[speeds.length - 1] === 4, `${label}: speeds 0.25x to 4x`, speeds);
+  await page.$eval("#scrub", (el) => { el.value = "500"; el.dispatchEvent(new Event("input")); });
+  s = await state(page);
+  const f = s.lastFrame;
+  const at = frames && frames.filter((x) => x.t_s <= s.replay.t_s).pop();
+  t.ok(f && f.t_s <= s.replay.t_s && near(s.toolDrawn, f.tool) && (!at || f.cycle === at.cycle),
+    `${label}: the slider shows the frame at its time`, [s.replay.t_s, f && f.t_s, at && at.t_s]);
+  // From the start (a short run must not end under the test's feet).
+  await page.$eval("#scrub", (el) => { el.value = "0"; el.dispatchEvent(new Event("input")); });
+  s = await state(page);
+  await page.selectOption("#speed", "1");
+  await page.click("#play");
+  t.ok(await until(page, (x) => window.pxView.replay.t_s > x + 0.1, s.replay.t_s, 3000), `${label}: play advances the time`);
+  await page.click("#play");
+  const s2 = await state(page);
+  await page.waitForTimeout(150);
+  const s3 = await state(page);
+  t.ok(!s3.replay.playing && s3.replay.t_s === s2.replay.t_s && near(s3.toolDrawn, s2.toolDrawn),
+    `${label}: pause holds the time and the tool`, [s2.replay, s3.replay]);
+  t.ok(!near(s2.toolDrawn, s.toolDrawn, 1e-7), `${label}: play moved the tool`, [s.toolDrawn, s2.toolDrawn]);
+  // 4x: the play time runs four times the clock of the animation frames
+  // (the player steps by their time stamps), sampled over frames after
+  // the first one of the play.
+  await page.$eval("#scrub", (el) => { el.value = "0"; el.dispatchEvent(new Event("input")); });
+  await page.selectOption("#speed", "4");
+  const r = await page.evaluate(async () => {
+    const v = window.pxView.replay;
+    const frame = () => new Promise((ok) => requestAnimationFrame(ok));
+    document.getElementById("play").click();
+    const w = [], ts = [];
+    await frame();
+    for (let i = 0; i < 30 && v.playing; i++) {
+      w.push(await frame());
+      ts.push(v.t_s);
+      if (w.length >= 3 && w[w.length - 1] - w[0] > 300) break;
+    }
+    if (v.playing) document.getElementById("play").click();
+    const n = w.length - 1;
+    return { ratio: n > 0 ? (ts[n] - ts[0]) / ((w[n] - w[0]) / 1000) : null, speed: v.speed, samples: w.length };
+  });
+  t.ok(r.speed === 4 && r.ratio > 3.6 && r.ratio < 4.4, `${label}: 4x plays four times as fast`, r);
+  const px = await drawnShare(page);
+  t.ok(px.share > 0.01, `${label}: the WebGL canvas shows the scene`, px);
+}

@@ -5,7 +5,7 @@ import { readFileSync, writeFileSync, mkdirSync } from "node:fs";
 import { join } from "node:path";
 import { pathToFileURL } from "node:url";
 import { startFixture, fixtureScene, fixtureTrack } from "./fixture.mjs";
-import { launch, checker, openPage, until, state, drawnShare, shot, near, WEB, SHOTS } from "./harness.mjs";
+import { launch, checker, openPage, until, state, drawnShare, shot, near, checkPlayer, fillReport, WEB, SHOTS } from "./harness.mjs";
 
 const t = checker("test_view_page");
 // A hung browser must not hold the suite: fail after a minute.
@@ -35,6 +35,18 @@ async function live() {
   t.ok(b.p > a.p && a.p > 0, "live: the plots receive data", [a.p, b.p]);
   t.ok(b.r > a.r, "live: the view keeps rendering", [a.r, b.r]);
 
+  // Follow the tool: the camera's target moves with the tool.
+  await page.check("#follow");
+  const rel = () => page.evaluate(() => window.pxView.cameraTarget.map((v, i) => v - window.pxView.toolDrawn[i]));
+  await page.waitForTimeout(100);
+  const r0 = await rel();
+  const n1 = (await state(page)).framesReceived;
+  await until(page, (n) => window.pxView.framesReceived > n + 5, n1);
+  await page.waitForTimeout(100);
+  const r1 = await rel();
+  t.ok(near(r0, r1, 1e-6), "live: follow tool keeps the camera on the tool", [r0, r1]);
+  await page.uncheck("#follow");
+
   // The server goes away and comes back on the same port.
   const port = fx.port;
   await fx.close();
@@ -60,60 +72,17 @@ async function live() {
   await fx.close();
 }
 
-async function checkPlayer(page, label) {
-  let s = await state(page);
-  t.ok(s.replay && s.replay.frames === 120 && s.plotPoints === 120, `${label}: the whole run is loaded`, s.replay);
-  const frames = fixtureTrack().frames;
-  // Scrub to the middle: the tool is the frame at that time.
-  await page.$eval("#scrub", (el) => { el.value = "500"; el.dispatchEvent(new Event("input")); });
-  s = await state(page);
-  const mid = frames.filter((f) => f.t_s <= s.replay.t_s).pop();
-  t.ok(near(s.toolDrawn, mid.tool) && s.lastFrame.cycle === mid.cycle, `${label}: scrub shows the frame at that time`,
-    [s.replay.t_s, s.toolDrawn, mid.tool]);
-  // Play, then pause: the time moves, then holds.
-  await page.click("#play");
-  t.ok(await until(page, (x) => window.pxView.replay.t_s > x + 0.1, s.replay.t_s, 3000), `${label}: play advances the time`);
-  await page.click("#play");
-  const s2 = await state(page);
-  await page.waitForTimeout(150);
-  const s3 = await state(page);
-  t.ok(!s3.replay.playing && s3.replay.t_s === s2.replay.t_s && near(s3.toolDrawn, s2.toolDrawn),
-    `${label}: pause holds the time and the tool`, [s2.replay, s3.replay]);
-  t.ok(!near(s2.toolDrawn, s.toolDrawn, 1e-6), `${label}: play moved the tool`, [s.toolDrawn, s2.toolDrawn]);
-  // From the start at 4x: the whole run (4 s) plays in about 1 s.
-  await page.$eval("#scrub", (el) => { el.value = "0"; el.dispatchEvent(new Event("input")); });
-  await page.selectOption("#speed", "4");
-  const w0 = Date.now();
-  await page.click("#play");
-  t.ok(await until(page, () => !window.pxView.replay.playing, null, 3000), `${label}: 4x plays to the end`);
-  const ms = Date.now() - w0;
-  const s4 = await state(page);
-  t.ok(s4.replay.speed === 4 && ms < 2500 && near(s4.toolDrawn, frames[frames.length - 1].tool),
-    `${label}: at 4x the 4 s run took ${ms} ms and ends on its last frame`, s4.replay);
-  const px = await drawnShare(page);
-  t.ok(px.share > 0.01, `${label}: the WebGL canvas shows the scene`, px);
-}
-
 async function replay() {
   const fx = await startFixture({ root: WEB, mode: "replay" });
   const { page, errors } = await openPage(browser, fx.url);
   t.ok(await until(page, () => window.pxView.replay && window.pxView.mode === "replay"), "replay: track loaded, mode replay");
   t.ok(await page.isVisible("#replay"), "replay: the play bar is shown");
-  await checkPlayer(page, "replay");
+  await checkPlayer(t, page, "replay", fixtureTrack().frames);
   await shot(page, "replay.png");
   t.ok((await state(page)).errors.length === 0, "replay: no page errors");
   allErrors.push(...errors);
   await page.close();
   await fx.close();
-}
-
-// The report tool's substitution: the marker replaced by the JSON object,
-// "</" written as "<\/" so no string can close the script element.
-export function fillReport(template, data) {
-  const marker = "/*PX_VIEW_DATA*/null";
-  const parts = template.split(marker);
-  if (parts.length !== 2) throw new Error("report template: marker not found exactly once");
-  return parts[0] + JSON.stringify(data).replace(/<\//g, "<\\/") + parts[1];
 }
 
 async function report() {
@@ -133,7 +102,7 @@ async function report() {
   const rows = await page.$$eval("#summary-table tr", (r) => r.map((x) => x.textContent));
   t.ok(!(await page.isHidden("#summary")) && rows.some((r) => r.includes("latency_us.p99") && r.includes("16")),
     "report: the summary table", rows);
-  await checkPlayer(page, "report");
+  await checkPlayer(t, page, "report", fixtureTrack().frames);
   await shot(page, "report.png");
   const s = await state(page);
   t.ok(s.errors.length === 0 && !s.connected, "report: no page errors, never connected", s.errors);

@@ -175,6 +175,11 @@ export class View {
     this.dirty = true;
   }
 
+  noteTarget() {
+    const c = this.controls.target;
+    pxView.cameraTarget = [c.x, c.y, c.z];
+  }
+
   // One frame of telemetry (a "frame" message or a track entry).
   setFrame(f) {
     const t = f.tool;
@@ -188,6 +193,7 @@ export class View {
         this.controls.target.add(d);
         this.camera.position.add(d);
         this.controls.update();
+        this.noteTarget();
       }
     }
     this.toolMat.color.setHex(f.safe ? COLORS.toolSafe : f.contact ? COLORS.toolContact : COLORS.tool);
@@ -279,6 +285,7 @@ export class View {
   render() {
     if (!this.dirty) return;
     this.dirty = false;
+    this.noteTarget();
     this.renderer.render(this.scene, this.camera);
     pxView.renders++;
   }

@@ -13,6 +13,7 @@ export const pxView = {
   reconnects: 0,
   ended: false,          // live: the server said the run finished
   replay: null,          // replay/report: {playing, t_s, speed, frames}
+  cameraTarget: [0, 0, 0], // the point the camera orbits (follows the tool when asked)
 };
 
 export function reportError(what) {
