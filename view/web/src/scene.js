@@ -79,7 +79,7 @@ export class View {
 
   setMarkerRadius(radius) {
     // The tool is drawn at its radius, never smaller than a visible dot.
-    const r = Math.max(radius, this.size * 0.008);
+    const r = Math.max(radius, this.size * 0.01);
     this.tool.scale.setScalar(r);
     this.proxy.scale.setScalar(r * 1.15);
     this.closest.scale.setScalar(r * 0.6);
@@ -119,7 +119,7 @@ export class View {
       } else {
         obj = new THREE.Mesh(triGeometry(m.positions, m.indices), new THREE.MeshStandardMaterial({
           color: COLORS.model, roughness: 0.75, metalness: 0.05, side: THREE.DoubleSide,
-          transparent: true, opacity: 0.85, polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1,
+          transparent: true, opacity: 0.7, polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1,
         }));
       }
       obj.name = m.name || "model " + m.id;
@@ -235,8 +235,8 @@ export class View {
       this.force.visible = false;
       return;
     }
-    // 1 N is 5% of the scene; long forces are drawn no longer than 40%.
-    const len = Math.min(n * this.size * 0.05, this.size * 0.4);
+    // 1 N is 2% of the scene; long forces are drawn no longer than 25%.
+    const len = Math.min(n * this.size * 0.02, this.size * 0.25);
     this.force.position.set(at[0], at[1], at[2]);
     this.force.setDirection(v.divideScalar(n));
     this.force.setLength(len, len * 0.2, len * 0.1);
