@@ -760,4 +760,36 @@ int px__ends_with_ci(const char *s, const char *ext);
 struct px_model;
 long px__cloud_grid_hint(const struct px_model *m, px_vec3 p, px_vec3 *centre);
 
+/* A point cloud's hierarchy, read only, for the pair traversals: the
+ * four-wide tree (root node 0; a leaf range indexes pt), the points in
+ * leaf order with their input indices (orig) and back (leaf_of), the
+ * points' box in the cloud's frame, the largest |coordinate| and the
+ * point radius. */
+struct px__cloud_view {
+	const struct node4 *n4;
+	const px_vec3 *pt;
+	const uint32_t *orig, *leaf_of;
+	size_t n;
+	px_aabb box;
+	double absmax, radius;
+};
+
+/* Fills *v and returns 1 when m is a point cloud, else 0. RT-safe. */
+int px__cloud_view(const struct px_model *m, struct px__cloud_view *v);
+
+/*
+ * Exact distance between the surface of mesh model a and the points of
+ * cloud model c (their centres: the point radius is the caller's) at
+ * their poses, by a simultaneous depth-first traversal of both
+ * hierarchies as px__mesh_pair's (box pairs bounded below in both
+ * frames and along the line of centres; a mesh leaf against a cloud
+ * leaf by exact point-triangle distances). hint_tri, hint_pt: last
+ * cycle's triangle and point (input order; -1: none), the first bound.
+ * out: tri_a the triangle, tri_b the point. Unsigned: inside a closed
+ * mesh is the caller's (px__cloud_min_model). RT-safe: no allocation,
+ * a fixed stack.
+ */
+int px__mesh_cloud_pair(const struct px_model *a, const struct px_model *c, int hint_tri,
+			int hint_pt, struct px__mesh_pair *out);
+
 #endif

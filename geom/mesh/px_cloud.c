@@ -804,6 +804,22 @@ static const struct cloud *as_cloud(const struct px_model *m)
 	return px_model_impl(m);
 }
 
+int px__cloud_view(const struct px_model *m, struct px__cloud_view *v)
+{
+	const struct cloud *C = as_cloud(m);
+	if (!C)
+		return 0;
+	v->n4 = C->n4;
+	v->pt = C->pt;
+	v->orig = C->orig;
+	v->leaf_of = C->leaf_of;
+	v->n = C->n;
+	v->box = C->box;
+	v->absmax = C->absmax;
+	v->radius = C->radius;
+	return 1;
+}
+
 size_t px_cloud_point_count(const struct px_model *m)
 {
 	const struct cloud *C = as_cloud(m);

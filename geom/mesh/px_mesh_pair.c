@@ -265,8 +265,16 @@ struct mp_ent {
 	double lb2;
 };
 
+/* One side's hierarchy: a mesh's or a cloud's (the same layout). */
+struct tree {
+	const struct node4 *n4;
+	px_aabb box;
+};
+
 struct mp_ctx {
-	const struct mesh *A, *B;
+	const struct mesh *A, *B; /* B: NULL against a cloud */
+	struct tree ta, tb;
+	const px_vec3 *cpt;       /* the cloud's points (leaf order) */
 	double R[3][3], Ra[3][3]; /* B frame -> A frame: p_A = R p_B + t */
 	px_vec3 t;
 	double slack;
@@ -283,7 +291,7 @@ static const struct mesh *mesh_of(const struct px_model *m)
 	return px_mesh_triangle_count(m) > 0 ? px_model_impl(m) : NULL;
 }
 
-static void ref_get(const struct mesh *M, uint32_t node, int slot, px_vec3 *c,
+static void ref_get(const struct tree *M, uint32_t node, int slot, px_vec3 *c,
 		    px_vec3 *h, uint32_t *idx, uint32_t *cnt)
 {
 	if (slot == ROOT_SLOT) {
@@ -563,55 +571,218 @@ static void leaf_pair(struct mp_ctx *X, uint32_t ia, uint32_t na, uint32_t ib,
 	}
 }
 
+/* Lower bound of the squared distance from p (A's frame) to leaf
+ * triangle li of A from its float plane and edge data (struct tlb: the
+ * plane distance and the largest edge-line excess, exact in the face
+ * and edge regions), in double; slack covers the float data's rounding
+ * (16 * 2^-24 of the coordinates, doubled, as the point query's). */
+static inline double tlb_d2(const struct mesh *A, uint32_t li, px_vec3 p, double slack)
+{
+	const struct tlb *L = &A->lb[li];
+	double v[4], h, e;
+	int j;
+	for (j = 0; j < 4; j++)
+		v[j] = (double)L->c[0][j] * p.x + (double)L->c[1][j] * p.y +
+		       (double)L->c[2][j] * p.z - (double)L->c[3][j];
+	h = gap_pos(fabs(v[0]) - slack);
+	e = gap_pos(mx3(v[1], v[2], v[3]) - slack);
+	return h * h + e * e;
+}
+
+/* A leaf of A against a leaf of cloud points: every point not bounded
+ * out by A's leaf box, against every triangle not bounded out by its
+ * plane and edges, exactly. */
+static void leaf_points(struct mp_ctx *X, uint32_t ia, uint32_t na, uint32_t ib,
+			uint32_t nb, px_vec3 ca, px_vec3 ha)
+{
+	double alo[LEAF_MAX][3], ahi[LEAF_MAX][3];
+	uint32_t i, j;
+	int k, have = 0;
+
+	na = na > LEAF_MAX ? LEAF_MAX : na; /* leaves hold at most 16 */
+	for (j = 0; j < nb; j++) {
+		px_vec3 p = to_a(X, X->cpt[ib + j]);
+		double g2 = 0.0, slack;
+		for (k = 0; k < 3; k++) {
+			double g = gap_pos(fabs(px_v3_comp(p, k) - px_v3_comp(ca, k)) -
+					   px_v3_comp(ha, k) - X->slack);
+			g2 += g * g;
+		}
+		if (g2 > X->best2)
+			continue;
+		if (!have) {
+			/* the triangles' boxes, once per leaf pair */
+			for (i = 0; i < na; i++) {
+				const struct mtri3 t = px__tri3_get(X->A, ia + i);
+				for (k = 0; k < 3; k++) {
+					double a = px_v3_comp(t.a, k), b = px_v3_comp(t.b, k),
+					       c = px_v3_comp(t.c, k);
+					alo[i][k] = mn3(a, b, c);
+					ahi[i][k] = mx3(a, b, c);
+				}
+			}
+			have = 1;
+		}
+		slack = 0x1p-19 * (X->A->absmax + px__amax3(p));
+		for (i = 0; i < na; i++) {
+			struct mtri3 t;
+			px_vec3 q;
+			double d2;
+			/* the triangle's box (tight beyond its corners), then
+			 * its plane and edges (tight beside its face) */
+			g2 = 0.0;
+			for (k = 0; k < 3; k++) {
+				double x = px_v3_comp(p, k), lo = alo[i][k] - x, hi = x - ahi[i][k];
+				double g = gap_pos((lo > hi ? lo : hi) - X->slack);
+				g2 += g * g;
+			}
+			if (g2 > X->best2 || (g2 == X->best2 && X->la >= 0))
+				continue;
+			g2 = tlb_d2(X->A, ia + i, p, slack);
+			if (g2 > X->best2 || (g2 == X->best2 && X->la >= 0))
+				continue;
+			t = px__tri3_get(X->A, ia + i);
+			X->tests++;
+			d2 = px_tri_closest(p, t.a, t.b, t.c, &q, NULL, NULL, NULL, NULL);
+			if (d2 < X->best2 || X->la < 0) {
+				X->best2 = d2;
+				X->la = (long)(ia + i);
+				X->lb = (long)(ib + j);
+				X->pa = q;
+				X->pb = p;
+				X->crossing = 0;
+				if (d2 == 0.0)
+					return;
+			}
+		}
+	}
+}
+
 static void mat_of(px_quat q, double R[3][3])
 {
 	px_mat3 m = px_quat_to_mat3(q);
 	memcpy(R, m.m, sizeof(m.m));
 }
 
-int px__mesh_pair(const struct px_model *a, const struct px_model *b,
-		  int hint_a, int hint_b, struct px__mesh_pair *out)
+/* The context of a traversal of A (mesh model a) against model b:
+ * b's frame seen from a's, nothing found yet. */
+static void mp_setup(struct mp_ctx *X, const struct px_model *a, const struct px_model *b,
+		     double absmax)
 {
-	const struct mesh *A = mesh_of(a), *B = mesh_of(b);
-	struct mp_ent st[MP_STACK];
-	struct mp_ctx X;
-	px_pose Pa, Pb;
+	px_pose Pa = px_model_pose(a), Pb = px_model_pose(b);
 	double RA[3][3], RB[3][3];
-	int sp = 0, i, j, k, certified = 1;
+	int i, j, k;
 
-	if (!A || !B || !out)
-		return PX_E_INVAL;
-	Pa = px_model_pose(a);
-	Pb = px_model_pose(b);
 	mat_of(Pa.q, RA);
 	mat_of(Pb.q, RB);
-	memset(&X, 0, sizeof(X));
-	X.A = A;
-	X.B = B;
+	memset(X, 0, sizeof(*X));
 	/* R = RA^T RB, t = RA^T (tB - tA) */
 	for (i = 0; i < 3; i++)
 		for (j = 0; j < 3; j++) {
 			double s = 0.0;
 			for (k = 0; k < 3; k++)
 				s += RA[k][i] * RB[k][j];
-			X.R[i][j] = s;
-			X.Ra[i][j] = fabs(s);
+			X->R[i][j] = s;
+			X->Ra[i][j] = fabs(s);
 		}
-	X.t = px_pose_inverse_transform_vector(Pa, px_v3_sub(Pb.t, Pa.t));
-	X.slack = 1e-14 * (A->absmax + B->absmax + px_v3_norm(X.t));
-	X.best2 = INFINITY;
-	X.la = X.lb = -1;
+	X->t = px_pose_inverse_transform_vector(Pa, px_v3_sub(Pb.t, Pa.t));
+	X->slack = 1e-14 * (absmax + px_v3_norm(X->t));
+	X->best2 = INFINITY;
+	X->la = X->lb = -1;
+}
+
+/* The traversal itself; returns 0 only if the fixed stack ran out. */
+static int mp_descend(struct mp_ctx *X);
+
+/* Run the traversal and fill out (A's frame is pose Pa; B's elements
+ * numbered back to input order by orig_b). */
+static int mp_finish(struct mp_ctx *X, px_pose Pa, const uint32_t *orig_b,
+		     struct px__mesh_pair *out)
+{
+	int certified = mp_descend(X);
+	if (X->la < 0)
+		return PX_E_DEGENERATE; /* cannot happen: both have elements */
+	out->distance = sqrt(X->best2);
+	out->point_a = px_pose_transform_point(Pa, X->pa);
+	out->point_b = px_pose_transform_point(Pa, X->pb);
+	out->tri_a = (int)X->A->orig[X->la];
+	out->tri_b = (int)orig_b[X->lb];
+	out->intersecting = X->best2 == 0.0;
+	out->nodes = X->nodes;
+	out->tri_tests = X->tests;
+	out->certified = certified;
+	return PX_OK;
+}
+
+int px__mesh_pair(const struct px_model *a, const struct px_model *b,
+		  int hint_a, int hint_b, struct px__mesh_pair *out)
+{
+	const struct mesh *A = mesh_of(a), *B = mesh_of(b);
+	struct mp_ctx X;
+	px_pose Pa;
+
+	if (!A || !B || !out)
+		return PX_E_INVAL;
+	Pa = px_model_pose(a);
+	mp_setup(&X, a, b, A->absmax + B->absmax);
+	X.A = A;
+	X.B = B;
+	X.ta.n4 = A->n4;
+	X.ta.box = A->box;
+	X.tb.n4 = B->n4;
+	X.tb.box = B->box;
 	if (hint_a >= 0 && (size_t)hint_a < A->nt && hint_b >= 0 && (size_t)hint_b < B->nt) {
 		uint32_t la = A->leaf_of[hint_a], lb = B->leaf_of[hint_b];
 		const struct mtri3 tb_ = px__tri3_get(B, lb), *tb = &tb_;
 		px_vec3 V[3] = {to_a(&X, tb->a), to_a(&X, tb->b), to_a(&X, tb->c)};
 		pair_test(&X, la, V, lb);
 	}
+	return mp_finish(&X, Pa, B->orig, out);
+}
+
+int px__mesh_cloud_pair(const struct px_model *a, const struct px_model *c, int hint_tri,
+			int hint_pt, struct px__mesh_pair *out)
+{
+	const struct mesh *A = mesh_of(a);
+	struct px__cloud_view V;
+	struct mp_ctx X;
+	px_pose Pa;
+
+	if (!A || !out || !px__cloud_view(c, &V))
+		return PX_E_INVAL;
+	Pa = px_model_pose(a);
+	mp_setup(&X, a, c, A->absmax + V.absmax);
+	X.A = A;
+	X.ta.n4 = A->n4;
+	X.ta.box = A->box;
+	X.tb.n4 = V.n4;
+	X.tb.box = V.box;
+	X.cpt = V.pt;
+	if (hint_tri >= 0 && (size_t)hint_tri < A->nt && hint_pt >= 0 && (size_t)hint_pt < V.n) {
+		/* last cycle's pair: a tight first bound, so the traversal
+		 * prunes almost everything else */
+		uint32_t la = A->leaf_of[hint_tri], lb = V.leaf_of[hint_pt];
+		const struct mtri3 t = px__tri3_get(A, la);
+		px_vec3 p = to_a(&X, V.pt[lb]), q;
+		X.best2 = px_tri_closest(p, t.a, t.b, t.c, &q, NULL, NULL, NULL, NULL);
+		X.la = (long)la;
+		X.lb = (long)lb;
+		X.pa = q;
+		X.pb = p;
+	}
+	return mp_finish(&X, Pa, V.orig, out);
+}
+
+static int mp_descend(struct mp_ctx *X)
+{
+	struct mp_ent st[MP_STACK];
+	int sp = 0, j, k, certified = 1;
+
 	st[0].na = st[0].nb = 0;
 	st[0].sa = st[0].sb = ROOT_SLOT;
 	st[0].lb2 = 0.0;
 	sp = 1;
-	while (sp > 0 && X.best2 > 0.0) {
+	while (sp > 0 && X->best2 > 0.0) {
 		struct mp_ent e = st[--sp];
 		px_vec3 ca, ha, cb, hb;
 		uint32_t ia, na, ib, nb;
@@ -620,23 +791,26 @@ int px__mesh_pair(const struct px_model *a, const struct px_model *b,
 		struct bx fixed;
 		int nk = 0, da;
 
-		if (e.lb2 > X.best2 || (e.lb2 == X.best2 && X.la >= 0))
+		if (e.lb2 > X->best2 || (e.lb2 == X->best2 && X->la >= 0))
 			continue;
-		ref_get(A, e.na, e.sa, &ca, &ha, &ia, &na);
-		ref_get(B, e.nb, e.sb, &cb, &hb, &ib, &nb);
-		X.nodes++;
+		ref_get(&X->ta, e.na, e.sa, &ca, &ha, &ia, &na);
+		ref_get(&X->tb, e.nb, e.sb, &cb, &hb, &ib, &nb);
+		X->nodes++;
 		if (na > 0 && nb > 0) {
-			leaf_pair(&X, ia, na, ib, nb, ca, ha, cb, hb);
+			if (X->cpt)
+				leaf_points(X, ia, na, ib, nb, ca, ha);
+			else
+				leaf_pair(X, ia, na, ib, nb, ca, ha, cb, hb);
 			continue;
 		}
 		/* split the inner node with the larger box (a leaf cannot be
 		 * split) */
 		da = na == 0 && (nb > 0 || px_v3_norm2(ha) >= px_v3_norm2(hb));
-		nd = da ? &A->n4[ia] : &B->n4[ib];
+		nd = da ? &X->ta.n4[ia] : &X->tb.n4[ib];
 		if (da)
-			bx_of_b(&X, cb, hb, &fixed);
+			bx_of_b(X, cb, hb, &fixed);
 		else
-			bx_of_a(&X, ca, ha, &fixed);
+			bx_of_a(X, ca, ha, &fixed);
 		for (j = 0; j < 4; j++) {
 			px_vec3 cc, hc;
 			uint32_t ic, nc;
@@ -645,23 +819,23 @@ int px__mesh_pair(const struct px_model *a, const struct px_model *b,
 			if (nd->idx[j] == EMPTY)
 				continue;
 			if (da) {
-				ref_get(A, ia, j, &cc, &hc, &ic, &nc);
-				bx_of_a(&X, cc, hc, &kb);
-				c.lb2 = box_lb2(&X, &kb, &fixed);
+				ref_get(&X->ta, ia, j, &cc, &hc, &ic, &nc);
+				bx_of_a(X, cc, hc, &kb);
+				c.lb2 = box_lb2(X, &kb, &fixed);
 				c.na = ia;
 				c.sa = (uint8_t)j;
 				c.nb = e.nb;
 				c.sb = e.sb;
 			} else {
-				ref_get(B, ib, j, &cc, &hc, &ic, &nc);
-				bx_of_b(&X, cc, hc, &kb);
-				c.lb2 = box_lb2(&X, &fixed, &kb);
+				ref_get(&X->tb, ib, j, &cc, &hc, &ic, &nc);
+				bx_of_b(X, cc, hc, &kb);
+				c.lb2 = box_lb2(X, &fixed, &kb);
 				c.na = e.na;
 				c.sa = e.sa;
 				c.nb = ib;
 				c.sb = (uint8_t)j;
 			}
-			if (c.lb2 > X.best2)
+			if (c.lb2 > X->best2)
 				continue;
 			/* insertion by bound, farthest first */
 			for (k = nk; k > 0 && kid[k - 1].lb2 < c.lb2; k--)
@@ -677,18 +851,7 @@ int px__mesh_pair(const struct px_model *a, const struct px_model *b,
 			st[sp++] = kid[k];
 		}
 	}
-	if (X.la < 0)
-		return PX_E_DEGENERATE; /* cannot happen: meshes have triangles */
-	out->distance = sqrt(X.best2);
-	out->point_a = px_pose_transform_point(Pa, X.pa);
-	out->point_b = px_pose_transform_point(Pa, X.pb);
-	out->tri_a = (int)A->orig[X.la];
-	out->tri_b = (int)B->orig[X.lb];
-	out->intersecting = X.best2 == 0.0;
-	out->nodes = X.nodes;
-	out->tri_tests = X.tests;
-	out->certified = certified;
-	return PX_OK;
+	return certified;
 }
 
 /* ---- mesh against any model ------------------------------------------------ */
@@ -709,11 +872,14 @@ int px__mesh_vs_model(const struct px_model *m, const struct px_model *o,
 {
 	const struct mesh *M = mesh_of(m);
 	struct mv_ent st[MV_STACK];
+	struct tree T;
 	px_pose P;
 	int sp, exact = 1, rc, j, k;
 
 	if (!M || !o || !tri || !best || !best_tri || !queries)
 		return PX_E_INVAL;
+	T.n4 = M->n4;
+	T.box = M->box;
 	P = px_model_pose(m);
 	st[0].node = 0;
 	st[0].slot = ROOT_SLOT;
@@ -730,7 +896,7 @@ int px__mesh_vs_model(const struct px_model *m, const struct px_model *o,
 		 * rounding, and a tie cannot improve the answer */
 		if (e.lb >= *best * (1.0 - 1e-12))
 			continue;
-		ref_get(M, e.node, e.slot, &c, &h, &idx, &cnt);
+		ref_get(&T, e.node, e.slot, &c, &h, &idx, &cnt);
 		if (cnt > 0) {
 			uint32_t i;
 			for (i = idx; i < idx + cnt; i++) {
@@ -760,7 +926,7 @@ int px__mesh_vs_model(const struct px_model *m, const struct px_model *o,
 				continue;
 			if (*queries >= max_queries)
 				return 0;
-			ref_get(M, idx, j, &cc, &hc, &ic, &nc);
+			ref_get(&T, idx, j, &cc, &hc, &ic, &nc);
 			rc = px_model_query_ex(o, px_pose_transform_point(P, cc), INFINITY, -1,
 					       0, &q);
 			(*queries)++;

@@ -2,8 +2,9 @@
  * pair_internal.h - the methods px_pair_distance (px_pair.c) chooses
  * from: closed-form pairs (capsule against capsule or box:
  * px_pair_prim.c), GJK and EPA for convex models (pair_gjk.c), the exact
- * mesh paths (pair_mesh.c) and the general search by alternating
- * projections (pair_search.c). Not part of the public API.
+ * mesh paths (pair_mesh.c), a cloud against a mesh or a primitive
+ * (pair_cloud.c) and the general search by alternating projections
+ * (pair_search.c). Not part of the public API.
  *
  * Memory and real-time rules: no allocation, fixed stacks and buffers,
  * bounded steps; RT-safe.
@@ -191,13 +192,46 @@ int px__pair_contained(const struct px_model *a, const struct px_model *b,
 int px__pair_mesh_convex(const struct px_model *m, const struct px_model *o, int hint,
 			 struct pair_run *best, int *total);
 
+/* ---- a point cloud against a model (pair_cloud.c) -------------------------- */
+
+/* The least distance of a model over a cloud's points (centres). */
+struct px__cloud_min {
+	double s;        /* the least distance found (the limit if none) */
+	px_vec3 p, q;    /* the cloud point, its closest point on the model */
+	int pi, oi;      /* the point (input order), the model's feature */
+	int found;       /* a point at or below the limit was found */
+	int certified;   /* every query was exact and the stack sufficed */
+	int queries;     /* point queries of the model made */
+};
+
 /*
- * Mesh m against point cloud c (radius 0, with the cache operations):
- * best (m's side first when m_first, else c's) certified or improved
- * exactly, triangle by triangle. Returns 1 when proven global, 0 when
- * not (budget out, or c without the cache operations), or an error.
+ * The least distance s_o(p) of model o (signed when o has an inside)
+ * over the points p of cloud c, where it is at most limit (INFINITY:
+ * the minimum itself): the cloud's hierarchy bounded below by one query
+ * of o per node (its box centre's distance minus the half diagonal; the
+ * distance is 1-Lipschitz). inside_only: only points inside o (s < 0)
+ * count, and nodes whose box misses o's box are skipped unqueried.
+ * Fills out (found = 0 when no point qualifies); returns PX_OK or an
+ * error (c not a cloud: PX_E_INVAL). RT-safe: no allocation, a fixed
+ * stack; work bounded by the cloud's node count.
  */
-int px__pair_mesh_cloud(const struct px_model *m, const struct px_model *c, int m_first,
-			struct pair_run *best, int *total);
+int px__cloud_min_model(const struct px_model *c, const struct px_model *o, double limit,
+			int inside_only, struct px__cloud_min *out);
+
+/*
+ * A point cloud against a mesh or a primitive, exactly: the least
+ * distance of the other model over the cloud's points minus the point
+ * radius, negative (with its depth) where a point lies inside a closed
+ * model. A mesh by both hierarchies at once (px__mesh_cloud_pair; with
+ * coherent, res's last triangle and point are the first bound), then
+ * for a closed mesh its points inside (px__cloud_min_model); a
+ * primitive by its point queries over the cloud's hierarchy. Fills res
+ * as px_pair_distance() does (local_only only if a query was not exact)
+ * and returns 1 (the normal from the points is the caller's), 2 (with
+ * its normal: an overlap with depth), 0 when the pair is not one of
+ * these, or an error. RT-safe.
+ */
+int px__pair_cloud(const struct px_model *a, const struct px_model *b, int coherent,
+		   struct px_pair_result *res);
 
 #endif

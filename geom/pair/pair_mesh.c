@@ -1,9 +1,8 @@
 /*
  * pair_mesh.c - exact pairs with a mesh: a mesh against a convex model
  * (the mesh hierarchy bounded by the other's point queries, GJK or a
- * closed form per triangle) and a mesh against a point cloud, and the
- * containment test of a closed model holding the other whole
- * (pair_internal.h).
+ * closed form per triangle), and the containment test of a closed model
+ * holding the other whole (pair_internal.h).
  */
 #include <math.h>
 #include <string.h>
@@ -108,136 +107,6 @@ static int tri_vs_convex(void *ctx, const px_vec3 v[3], int index, double *d)
 	return 0;
 }
 
-/*
- * Mesh against a point cloud (radius 0, with the cache operations),
- * exact per triangle: a piece S of the triangle (centroid g, radius r)
- * is at least d(g) - r from the cloud, d(g) being the cloud's exact
- * nearest-point distance; pieces not bounded out collect the cloud
- * points within best + r of g (every point closer than best to S is
- * among them) and measure them exactly against the whole triangle.
- * When there are too many such points the piece is split in four
- * (midpoint subdivision, up to TP_DEPTH levels): near the answer g's
- * nearest point is about best away, so the ball holds only the points
- * of a thin shell, and few.
- */
-#define TP_CAP 64
-#define TP_DEPTH 5
-
-struct tp_ctx {
-	const struct px_model *c;
-	double best;
-	px_vec3 pt, pc; /* on the triangle, the cloud point */
-	int tri, pidx;
-	int iters, budget;
-	int idx[TP_CAP];
-};
-
-static void tp_take(struct tp_ctx *c, const px_vec3 v[3], int index, px_vec3 x,
-		    int pidx, double *found)
-{
-	px_vec3 qt;
-	double dd = sqrt(px_tri_closest(x, v[0], v[1], v[2], &qt, NULL, NULL, NULL, NULL));
-	if (dd < *found)
-		*found = dd;
-	if (dd < c->best) {
-		c->best = dd;
-		c->pt = qt;
-		c->pc = x;
-		c->tri = index;
-		c->pidx = pidx;
-	}
-}
-
-static int tri_vs_points(void *ctx, const px_vec3 v[3], int index, double *d)
-{
-	struct tp_ctx *c = ctx;
-	const struct px_model_ops *o = px_model_get_ops(c->c);
-	const void *impl = px_model_impl(c->c);
-	px_pose P = px_model_pose(c->c);
-	struct {
-		px_vec3 v[3];
-		int depth;
-	} st[3 * TP_DEPTH + 2];
-	double found = INFINITY;
-	int sp = 1, unsure = 0, k, rc;
-
-	st[0].v[0] = v[0];
-	st[0].v[1] = v[1];
-	st[0].v[2] = v[2];
-	st[0].depth = 0;
-	while (sp > 0) {
-		const px_vec3 *S;
-		px_vec3 g, gl;
-		struct px_model_result nr;
-		struct px_model_query q;
-		double r;
-		int n, dep;
-		sp--;
-		S = st[sp].v;
-		dep = st[sp].depth;
-		g = px_v3_scale(px_v3_add(S[0], px_v3_add(S[1], S[2])), 1.0 / 3.0);
-		r = fmax(px_v3_dist(g, S[0]), fmax(px_v3_dist(g, S[1]), px_v3_dist(g, S[2])));
-		if (c->iters >= c->budget) {
-			unsure = 1;
-			break;
-		}
-		gl = px_pose_inverse_transform_point(P, g);
-		q.p = gl;
-		q.max_dist = INFINITY;
-		q.hint = -1;
-		q.flags = PX_QUERY_UNSIGNED;
-		if ((rc = o->closest(impl, &q, &nr)) < 0)
-			return rc;
-		c->iters++;
-		if (rc == 0)
-			continue;
-		/* the nearest point is itself a candidate pair */
-		tp_take(c, v, index, px_pose_transform_point(P, nr.point), nr.index, &found);
-		if (nr.distance - r >= c->best * (1.0 - 1e-12))
-			continue;
-		n = o->collect(impl, gl, (c->best + r) * (1.0 + 1e-12), c->idx, TP_CAP);
-		if (n == PX_E_NOSPC) {
-			if (dep >= TP_DEPTH || sp + 4 > (int)(sizeof(st) / sizeof(st[0]))) {
-				unsure = 1;
-				continue;
-			}
-			{
-				px_vec3 a = S[0], b = S[1], cc = S[2];
-				px_vec3 ab = px_v3_scale(px_v3_add(a, b), 0.5);
-				px_vec3 bc = px_v3_scale(px_v3_add(b, cc), 0.5);
-				px_vec3 ca = px_v3_scale(px_v3_add(cc, a), 0.5);
-				px_vec3 T4[4][3] = {{a, ab, ca}, {ab, b, bc}, {ca, bc, cc}, {ab, bc, ca}};
-				int j;
-				for (j = 0; j < 4; j++) {
-					st[sp].v[0] = T4[j][0];
-					st[sp].v[1] = T4[j][1];
-					st[sp].v[2] = T4[j][2];
-					st[sp].depth = dep + 1;
-					sp++;
-				}
-			}
-			continue;
-		}
-		if (n < 0)
-			return n;
-		for (k = 0; k < n; k++) {
-			struct px_model_result pr;
-			rc = o->closest_among(impl, &q, &c->idx[k], 1, &pr);
-			if (rc < 0)
-				return rc;
-			if (rc > 0)
-				tp_take(c, v, index, px_pose_transform_point(P, pr.point), pr.index,
-					&found);
-		}
-	}
-	/* the triangle is at least c->best away unless something closer
-	 * was measured */
-	*d = unsure ? INFINITY : fmin(found, c->best);
-	return 0;
-}
-
-#define MESH_CLOUD_QUERIES 1024
-
 #define MESH_CONVEX_QUERIES 4096
 
 int px__pair_mesh_convex(const struct px_model *m, const struct px_model *o, int hint,
@@ -304,34 +173,4 @@ int px__pair_mesh_convex(const struct px_model *m, const struct px_model *o, int
 		best->d = px_v3_dist(pt, q.point);
 	}
 	return exact;
-}
-
-int px__pair_mesh_cloud(const struct px_model *m, const struct px_model *c, int m_first,
-			struct pair_run *best, int *total)
-{
-	const struct px_model_ops *co = px_model_get_ops(c);
-	struct tp_ctx tc;
-	double bd = best->d;
-	int bt = -1, queries = 0, ex;
-
-	if (!co->collect || !co->closest_among)
-		return 0;
-	memset(&tc, 0, sizeof(tc));
-	tc.c = c;
-	tc.best = best->d;
-	tc.tri = -1;
-	tc.budget = MESH_CLOUD_QUERIES;
-	ex = px__mesh_vs_model(m, c, tri_vs_points, &tc, MESH_CLOUD_QUERIES, &bd, &bt, &queries);
-	if (ex < 0)
-		return ex;
-	*total += queries + tc.iters;
-	if (tc.tri >= 0 && tc.best < best->d) {
-		best->d = tc.best;
-		best->pa = m_first ? tc.pt : tc.pc;
-		best->pb = m_first ? tc.pc : tc.pt;
-		best->ia = m_first ? tc.tri : tc.pidx;
-		best->ib = m_first ? tc.pidx : tc.tri;
-		best->intersecting = best->d == 0.0;
-	}
-	return ex;
 }

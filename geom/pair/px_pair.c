@@ -3,9 +3,10 @@
  * a pair, and the answer's final form. The methods: one point query of a
  * sphere's centre, the closed forms (px_pair_prim.c), GJK and EPA for
  * two convex models (pair_gjk.c), the exact mesh paths (two meshes:
- * px_mesh_pair.c; a mesh against a convex model or a cloud:
- * pair_mesh.c), and the general search by alternating projections with
- * the deepest-point search for overlaps (pair_search.c).
+ * px_mesh_pair.c; a mesh against a convex model: pair_mesh.c), a cloud
+ * against a mesh or a primitive (pair_cloud.c), and the general search
+ * by alternating projections with the deepest-point search for overlaps
+ * (pair_search.c).
  */
 #include <math.h>
 #include <string.h>
@@ -23,12 +24,12 @@ struct pair_cfg {
 };
 
 /* The general search's state: the best pair so far, the work spent
- * (point queries and the like), the starts made, whether the answer is
- * proven global, and the contact triangles' corners (nxs per side) that
- * seed the depth search when the models overlap. */
+ * (point queries and the like), the starts made, and the contact
+ * triangles' corners (nxs per side) that seed the depth search when the
+ * models overlap. */
 struct pair_state {
 	struct pair_run best;
-	int total, n, have, cert, nxs;
+	int total, n, have, nxs;
 	px_vec3 xs[2][3];
 };
 
@@ -387,24 +388,6 @@ static int pair_projections(const struct px_model *a, const struct px_model *b,
 	return pair_refine(a, b, cfg, st);
 }
 
-/* A mesh against a point cloud: the search's answer certified (or
- * improved) exactly, triangle by triangle (pair_mesh.c). */
-static int pair_mesh_cloud(const struct px_model *a, const struct px_model *b,
-			   struct pair_state *st)
-{
-	int ma = px_mesh_triangle_count(a) > 0;
-	int ex;
-	if (st->best.intersecting || !(st->best.d > 0.0) ||
-	    !((ma && px_model_kind(b) == PX_MODEL_CLOUD) ||
-	      (px_mesh_triangle_count(b) > 0 && px_model_kind(a) == PX_MODEL_CLOUD)))
-		return 0;
-	ex = px__pair_mesh_cloud(ma ? a : b, ma ? b : a, ma, &st->best, &st->total);
-	if (ex < 0)
-		return ex;
-	st->cert = ex == 1;
-	return 0;
-}
-
 /* Penetration: the deepest point of either model in the other, from the
  * overlap found (and the contact triangles' corners) and from every
  * seed; fills the depth, points and normal when one was found. */
@@ -474,8 +457,7 @@ static int pair_general(const struct px_model *a, const struct px_model *b,
 		if (rc < 0 || rc == STEP_DONE)
 			return rc;
 	}
-	if (rc == STEP_NONE && ((rc = pair_projections(a, b, cfg, res, &st)) < 0 ||
-				(rc = pair_mesh_cloud(a, b, &st)) < 0))
+	if (rc == STEP_NONE && (rc = pair_projections(a, b, cfg, res, &st)) < 0)
 		return rc;
 	res->distance = st.best.d;
 	res->point_a = st.best.pa;
@@ -488,7 +470,7 @@ static int pair_general(const struct px_model *a, const struct px_model *b,
 	res->starts = st.n;
 	res->converged = st.best.converged;
 	res->intersecting = st.best.intersecting;
-	res->local_only = !(st.best.intersecting || st.cert ||
+	res->local_only = !(st.best.intersecting ||
 			    (st.best.converged &&
 			     (px_model_caps(a) & PX_MODEL_CAP_CONVEX) &&
 			     (px_model_caps(b) & PX_MODEL_CAP_CONVEX)));
@@ -522,6 +504,9 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 	    (px_model_caps(b) & PX_MODEL_CAP_CONVEX) && px_model_get_ops(a)->support &&
 	    px_model_get_ops(b)->support)
 		rc = pair_convex(a, b, res);
+	/* a cloud against a mesh or a primitive: exact (pair_cloud.c) */
+	if (rc == STEP_NONE)
+		rc = px__pair_cloud(a, b, cfg.coherent, res);
 	if (rc == STEP_NONE)
 		rc = pair_general(a, b, &cfg, res);
 	if (rc < 0)

@@ -52,27 +52,36 @@
  *   its budget of 4096 point queries runs out (very fine meshes close
  *   to a large primitive) the best pair found joins the projections
  *   below and the flag stays.
+ * - a point cloud against a mesh (closed or open): the least distance
+ *   over the cloud's points, by both hierarchies at once (box pairs
+ *   bounded below as for two meshes, each remaining point against the
+ *   triangles its plane and edge bounds leave, exactly;
+ *   geom/mesh/px_mesh_pair.c); against a closed mesh a point inside is
+ *   at minus its distance to the surface, so the pair's distance is the
+ *   least signed distance over the points (the deepest point's, with
+ *   its depth, when one is inside: found by the cloud's hierarchy
+ *   bounded by the mesh's signed queries, pair_cloud.c), the same in
+ *   cold and coherent calls. In coherent mode last cycle's triangle and
+ *   point are the starting bound. index_a/index_b: the triangle (the
+ *   mesh's feature for a point inside) and the point; a cloud radius
+ *   is subtracted;
+ * - a point cloud against any primitive: the least of the primitive's
+ *   exact (signed) point queries over the points, by the cloud's
+ *   hierarchy bounded by one query per node (the distance is
+ *   1-Lipschitz: a node's centre minus its half diagonal).
  * Surfaces apart but one closed model holding the other whole (its
  * signed distance at the other's closest point is negative) counts as
  * intersecting.
  *
- * Everything else runs the projections. Then:
- * - a mesh against a point cloud without radius is certified by the
- *   mesh hierarchy bounded by the cloud's exact point queries; triangles
- *   not bounded out are measured exactly against the cloud points near
- *   them (collected within the best distance plus the piece's radius,
- *   pieces split up to five times when more than 64 points are near),
- *   which may also improve the answer. It stays flagged only when the
- *   budget of 1024 cloud queries runs out or a piece still holds too
- *   many near points after the splits;
- * - two convex models that converged are certified (projections onto
- *   convex sets converge to the global minimum).
+ * Everything else runs the projections. Then two convex models that
+ * converged are certified (projections onto convex sets converge to the
+ * global minimum).
  * local_only = 1 remains exactly for: NURBS models against anything
- * but a sphere; clouds against anything but a sphere or a mesh (and
- * clouds with a radius against meshes); the torus primitive against
- * anything but a sphere; the half-space against anything not convex
- * (meshes that are not convex, clouds, NURBS, the torus); convex pairs
- * whose projections did not converge; and the budget cases above.
+ * but a sphere; clouds against NURBS, B-rep parts and other clouds; the
+ * torus primitive against anything but a sphere or a cloud; the
+ * half-space against anything not convex but a cloud (meshes that are
+ * not convex, NURBS, the torus); convex pairs whose projections did not
+ * converge; and the budget case above.
  *
  * Coherent mode: the previous result's points (kept in the result, in
  * each model's own frame, so they follow the models' new poses) are the
@@ -108,9 +117,11 @@
  * mesh pairs (in practice the node pairs near the closest pair: about a
  * thousand for two 4k-triangle meshes 4 cm apart, half a millisecond,
  * and coherent mode saves little: the proof, not the search, is the
- * cost), by the query budgets above for the mesh/convex and mesh/cloud
- * paths (bench_models: a 4k-triangle torus against a box about 0.1 ms,
- * against a 2k-point cloud about 0.5 ms with the certification),
+ * cost), by the query budget above for the mesh/convex path
+ * (bench_models: a 4k-triangle torus against a box about 0.1 ms), by
+ * the node pairs of both hierarchies and, against a closed mesh, the
+ * cloud nodes within the mesh's box for the mesh/cloud path
+ * (bench_arm), by the cloud's nodes for cloud/primitive pairs,
  * plus for overlapping non-convex pairs 2 (starts + 4) (2 + 80) queries
  * of the depth search (points deep inside a mesh are its slowest
  * queries: budget for it, or lower starts), each RT-safe. @note RT-safe.

@@ -226,11 +226,19 @@ static void test_clearances_reference(void)
 					PX_CHECK_MSG(-cl[k].distance_m <= -deep + 1e-9,
 						     "body %d cloud: depth %.12g, deepest point %.12g",
 						     cl[k].body, -cl[k].distance_m, -deep);
+					/* the deepest point's depth itself, certified */
+					PX_CHECK_MSG(fabs(cl[k].distance_m - deep) <= 1e-9,
+						     "body %d cloud: %.12g, deepest point %.12g",
+						     cl[k].body, cl[k].distance_m, deep);
+					PX_CHECK(!cl[k].local_only);
 					inside++;
 				} else {
 					PX_CHECK_MSG(fabs(cl[k].distance_m - ref) <= 1e-9,
 						     "body %d cloud (a point inside): %.12g vs %.12g",
 						     cl[k].body, cl[k].distance_m, ref);
+					/* only a point on the surface: touching */
+					PX_CHECK_MSG(deep > -1e-9, "body %d cloud: a point %.12g deep missed",
+						     cl[k].body, deep);
 					inside++;
 				}
 				touching += ref < 0.01;
@@ -265,7 +273,7 @@ static void test_coherent_equals_cold(void)
 	struct px_model *obs[1], *cloud;
 	struct px_urdf_clearance a[BODIES + 16], b[BODIES + 16];
 	double pts[3 * 200], q[6], v[6];
-	int path, step, k, n, j, compared = 0, skipped = 0;
+	int path, step, k, n, j, compared = 0, skipped = 0, cloud_inside = 0;
 	PX_NEEDS(XML);
 	PX_NEEDS(ASSIMP);
 	r = arm();
@@ -294,9 +302,18 @@ static void test_coherent_equals_cold(void)
 			n = px_urdf_robot_clearances(r, NULL, 0, b, BODIES, NULL);
 			n += px_urdf_robot_self_clearances(r, NULL, 0, b + n, 16, NULL);
 			for (k = 0; k < n; k++) {
-				/* a cloud point inside a link: the mesh/cloud path
-				 * may see the overlap from one start and not from
-				 * another (px_pair.h); apart pairs must agree */
+				if (k < nb) {
+					/* link against cloud: exact and signed, also
+					 * with a point inside (px_pair.h) */
+					PX_CHECK(!a[k].local_only && !b[k].local_only);
+					PX_CHECK_MSG(a[k].distance_m == b[k].distance_m,
+						     "path %d step %d cloud pair %d: coherent %.17g cold "
+						     "%.17g", path, step, k, a[k].distance_m,
+						     b[k].distance_m);
+					cloud_inside += a[k].distance_m < 0.0;
+				}
+				/* self pairs overlapping: the depth search is
+				 * local (px_pair.h); apart pairs must agree */
 				if (a[k].local_only || b[k].local_only || a[k].intersecting ||
 				    b[k].intersecting) {
 					skipped++;
@@ -310,6 +327,7 @@ static void test_coherent_equals_cold(void)
 		}
 	}
 	PX_CHECK_MSG(compared > 20 * skipped, "%d pairs compared, %d skipped", compared, skipped);
+	printf("    %d cloud pairs with a point inside a link, coherent = cold\n", cloud_inside);
 	px_model_free(cloud);
 	px_urdf_robot_free(r);
 }

