@@ -1,13 +1,17 @@
 /*
  * bench_util.h - what the benchmarks share: a fixed-seed random stream
- * (so every run times the same inputs), a monotonic clock in ns, and an
- * int64 comparison for qsort of timings. Benchmarks only; one include
+ * (so every run times the same inputs), a monotonic clock in ns, an
+ * int64 comparison for qsort of timings, and where the FCL reference
+ * program is. Benchmarks only; one include
  * per program (the stream's state is per file).
  */
 #ifndef PX_BENCH_UTIL_H
 #define PX_BENCH_UTIL_H
 
+#include <libgen.h>
 #include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <time.h>
 
 static uint64_t rng = 0x9e3779b97f4a7c15ull;
@@ -32,6 +36,20 @@ static inline int cmp_i64(const void *a, const void *b)
 {
 	int64_t x = *(const int64_t *)a, y = *(const int64_t *)b;
 	return (x > y) - (x < y);
+}
+
+/* Path of the FCL reference program (bench/fcl_models.cpp):
+ * $PX_BENCH_MODELS_FCL, else fcl_models next to the benchmark argv0. */
+static inline void fcl_path(const char *argv0, char *path, size_t n)
+{
+	const char *env = getenv("PX_BENCH_MODELS_FCL");
+	char dir[4096];
+	if (env && *env) {
+		snprintf(path, n, "%s", env);
+	} else {
+		snprintf(dir, sizeof(dir), "%s", argv0);
+		snprintf(path, n, "%s/fcl_models", dirname(dir));
+	}
 }
 
 #endif

@@ -27,6 +27,7 @@ trap 'rm -f "$tmp" "$body" "$log"' EXIT INT TERM HUP
 # What each benchmark compares (by binary name).
 describe() {
 	case "$1" in
+	bench_arm) echo "Every link-obstacle clearance of the 6-joint URDF arm (\`config/examples/robots/arm6\`, 7 link meshes) per 1 ms cycle along a joint path, as exact model pairs: against a 100,000-point cloud (cold, coherent, and the first cycle after the cloud is replaced by a new frame), and against 20 mesh obstacles next to FCL 0.7's \`distance()\` (OBBRSS) on the same pairs at the same poses, with the ratio and the distances compared. Thread CPU time per cycle: median, p99, max." ;;
 	bench_control) echo "Time per cycle and scene queries per cycle of the haptic proxy and penalty renderers and of the avoidance step (6 joints, 6 capsules) against a small analytic scene (sphere, thin plate, floor), so the figures are the control code's own cost." ;;
 	bench_dist) echo "The global distance query (\`px_dist_query\`) on representative NURBS curves and patches: time per query (median, p99, max) for random points in the model's box enlarged by 25 % per side, root iterations, pieces solved per query and model memory." ;;
 	bench_dist_occt) echo "The same models and points next to OpenCASCADE in one process, each query interleaved with OCCT's (so the figures here are cold-cache times): OCCT's correct set-up (surface projection plus boundary curves and corners) and its fastest (Extrema tree search, minimum only), with the ratios and how often either answer is on a wrong branch." ;;

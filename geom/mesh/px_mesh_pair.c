@@ -275,6 +275,11 @@ struct mp_ctx {
 	const struct mesh *A, *B; /* B: NULL against a cloud */
 	struct tree ta, tb;
 	const px_vec3 *cpt;       /* the cloud's points (leaf order) */
+	/* a small A's vertices (its support function, which bounds any
+	 * part of it) and its box centre; n_sv 0: none */
+	const px_vec3 *sv;
+	size_t n_sv;
+	px_vec3 sc;
 	double R[3][3], Ra[3][3]; /* B frame -> A frame: p_A = R p_B + t */
 	px_vec3 t;
 	double slack;
@@ -589,6 +594,35 @@ static inline double tlb_d2(const struct mesh *A, uint32_t li, px_vec3 p, double
 	return h * h + e * e;
 }
 
+/* Lower bound of the squared distance between a box of B (centre c,
+ * half extents h, B's frame) and a part of A with vertices sv (A's
+ * frame), along the unit vector u from sc towards the box: the gap
+ * between the box's projection and the part's support along u (the
+ * largest projection of its vertices). Tight for a far box, where the
+ * two boxes' own bound loses what A's box sticks out beyond A. */
+static double support_lb2(const struct mp_ctx *X, const px_vec3 *sv, size_t n_sv, px_vec3 sc,
+			  px_vec3 c, px_vec3 h)
+{
+	px_vec3 cA = to_a(X, c), u = px_v3_sub(cA, sc);
+	double n = px_v3_norm(u), top = -INFINITY, r = 0.0, g;
+	size_t i;
+	int k;
+	if (!(n > 0.0))
+		return 0.0;
+	u = px_v3_scale(u, 1.0 / n);
+	for (i = 0; i < n_sv; i++) {
+		double v = px_v3_dot(u, sv[i]);
+		top = v > top ? v : top;
+	}
+	/* the box's projection radius: u in B's frame against h */
+	for (k = 0; k < 3; k++)
+		r += fabs(X->R[0][k] * u.x + X->R[1][k] * u.y + X->R[2][k] * u.z) *
+		     px_v3_comp(h, k);
+	g = px_v3_dot(u, cA) - r - top - X->slack -
+	    1e-14 * (fabs(top) + fabs(px_v3_dot(u, cA)) + r);
+	return g > 0.0 ? g * g : 0.0;
+}
+
 /* A leaf of A against a leaf of cloud points: every point not bounded
  * out by A's leaf box, against every triangle not bounded out by its
  * plane and edges, exactly. */
@@ -691,6 +725,17 @@ static void mp_setup(struct mp_ctx *X, const struct px_model *a, const struct px
 	X->la = X->lb = -1;
 }
 
+/* A small A (a robot link, say) bounds B's boxes by its support too
+ * (support_lb2): worth its vertices' dot products up to 64 of them. */
+static void mp_support(struct mp_ctx *X, const struct mesh *A)
+{
+	if (A->n_vx <= 64) {
+		X->sv = A->vx;
+		X->n_sv = A->n_vx;
+		X->sc = px_aabb_center(&A->box);
+	}
+}
+
 /* The traversal itself; returns 0 only if the fixed stack ran out. */
 static int mp_descend(struct mp_ctx *X);
 
@@ -731,6 +776,7 @@ int px__mesh_pair(const struct px_model *a, const struct px_model *b,
 	X.ta.box = A->box;
 	X.tb.n4 = B->n4;
 	X.tb.box = B->box;
+	mp_support(&X, A);
 	if (hint_a >= 0 && (size_t)hint_a < A->nt && hint_b >= 0 && (size_t)hint_b < B->nt) {
 		uint32_t la = A->leaf_of[hint_a], lb = B->leaf_of[hint_b];
 		const struct mtri3 tb_ = px__tri3_get(B, lb), *tb = &tb_;
@@ -758,6 +804,7 @@ int px__mesh_cloud_pair(const struct px_model *a, const struct px_model *c, int 
 	X.tb.n4 = V.n4;
 	X.tb.box = V.box;
 	X.cpt = V.pt;
+	mp_support(&X, A);
 	if (hint_tri >= 0 && (size_t)hint_tri < A->nt && hint_pt >= 0 && (size_t)hint_pt < V.n) {
 		/* last cycle's pair: a tight first bound, so the traversal
 		 * prunes almost everything else */
@@ -789,6 +836,8 @@ static int mp_descend(struct mp_ctx *X)
 		const struct node4 *nd;
 		struct mp_ent kid[4];
 		struct bx fixed;
+		px_vec3 lv[3 * LEAF_MAX];
+		size_t nlv = 0;
 		int nk = 0, da;
 
 		if (e.lb2 > X->best2 || (e.lb2 == X->best2 && X->la >= 0))
@@ -830,6 +879,23 @@ static int mp_descend(struct mp_ctx *X)
 				ref_get(&X->tb, ib, j, &cc, &hc, &ic, &nc);
 				bx_of_b(X, cc, hc, &kb);
 				c.lb2 = box_lb2(X, &fixed, &kb);
+				if (X->n_sv && !(c.lb2 > X->best2)) {
+					double ls;
+					if (na > 0 && !nlv) {
+						/* A is a leaf: its own vertices,
+						 * once per expansion */
+						uint32_t t;
+						for (t = 0; t < na && t < LEAF_MAX; t++) {
+							const struct mtri3 v = px__tri3_get(X->A, ia + t);
+							lv[nlv++] = v.a;
+							lv[nlv++] = v.b;
+							lv[nlv++] = v.c;
+						}
+					}
+					ls = na > 0 ? support_lb2(X, lv, nlv, ca, cc, hc)
+						    : support_lb2(X, X->sv, X->n_sv, X->sc, cc, hc);
+					c.lb2 = ls > c.lb2 ? ls : c.lb2;
+				}
 				c.na = e.na;
 				c.sa = e.sa;
 				c.nb = ib;
