@@ -381,6 +381,7 @@ int px_app_summary(const struct px_app *a, struct px_app_summary *s)
 	s->ended_by_time = a->ended_by_time;
 	s->min_speed_scale = a->min_scale;
 	s->stop_cycles = a->stop_cycles;
+	s->cloud_swaps = a->cloud_swaps;
 	s->last_query_error = a->last_query_err;
 	memcpy(s->faults_by_cause, a->faults_by_cause, sizeof(s->faults_by_cause));
 	s->faults_injected = a->sim.n_faults;

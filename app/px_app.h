@@ -254,6 +254,7 @@ struct px_app_summary {
 	int64_t phase_error_ns;       /* deadlines' span minus the cycles' */
 	double min_speed_scale;
 	uint64_t stop_cycles;         /* avoidance: nominal motion stopped */
+	uint64_t cloud_swaps;         /* sim.depth_sensor: frames swapped in */
 	int last_query_error;
 	uint64_t faults_by_cause[PX_FAULT__COUNT];
 	size_t faults_injected;

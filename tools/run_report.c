@@ -156,6 +156,9 @@ void run_print_summary(const struct run_result *r)
 		       S->protective_distance_m * 1e3,
 		       S->influence_distance_m * 1e3, S->min_speed_scale,
 		       (unsigned long long)S->stop_cycles);
+	if (S->avoiding && S->cloud_swaps)
+		printf("  obstacle cloud    %llu frames swapped in\n",
+		       (unsigned long long)S->cloud_swaps);
 	else if (S->distance_reported)
 		printf("  distance          min %+.3f mm, max penetration %.3f mm, "
 		       "proxy min clearance %+.3f mm\n",
