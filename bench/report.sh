@@ -93,7 +93,8 @@ if [ "${BENCH_SECTIONS:-0}" = 1 ]; then
 		echo "bench/report.sh: $out not written" >&2
 		exit 1
 	fi
-	# and their rows of the header's table
+	# and their rows of the header's table (a new benchmark's row after
+	# the last one)
 	for b in "$@"; do
 		n=$(basename "$b" .sh)
 		echo "| [\`$n\`](#$n) | $(describe "$n") |"
@@ -109,8 +110,9 @@ if [ "${BENCH_SECTIONS:-0}" = 1 ]; then
 				k = l; sub(/^\| \[`/, "", k); sub(/`.*/, "", k); row[k] = l
 			}
 		}
-		/^\| \[`/ { k = $0; sub(/^\| \[`/, "", k); sub(/`.*/, "", k)
-			     if (k in row) { print row[k]; next } }
+		/^\| \[`/ { k = $0; sub(/^\| \[`/, "", k); sub(/`.*/, "", k); intable = 1
+			     if (k in row) { print row[k]; had[k] = 1; next } }
+		intable && !/^\|/ { for (k in row) if (!(k in had)) print row[k]; intable = 0 }
 		/^## / { if (skip) print ""
 			 name = substr($0, 4); skip = (name in sec)
 			 if (skip) { printf "%s", sec[name]; done[name] = 1 } }
