@@ -480,6 +480,11 @@ bench: all
 	@$(MAKE) --no-print-directory fcl-bench || echo "make bench: FCL reference not built"
 	@$(MAKE) --no-print-directory run-benches
 
+# Teleoperation on loopback: the two example processes linked by DDS.
+.PHONY: teleop
+teleop: all
+	@sh tools/teleop.sh --duration-s $(or $(TELEOP_S),10) $(BUILD)
+
 # Runs every benchmark and writes docs/benchmarks.md from their output.
 run-benches:
 	@BUILD=$(BUILD) PYTHON=$(PYTHON) sh bench/report.sh $(BENCH_BIN) $(CXX_BENCH_BIN) \
@@ -558,6 +563,7 @@ help:
 	@echo '  test       install missing packages, build, run the whole test suite'
 	@echo '  bench      build and run the benchmarks'
 	@echo '  bench-section BENCH=name  run one benchmark, replace its section of docs/benchmarks.md'
+	@echo '  teleop     the teleoperation examples, master and follower on loopback (TELEOP_S=10)'
 	@echo '  sanitize   the test suite built with AddressSanitizer + UBSan'
 	@echo '  run        build, then run proxima-run on RUN_CONFIG for RUN_SECONDS (default config, 10 s)'
 	@echo '  fuzz       build fuzz/fuzz_*.c with libFuzzer, run each FUZZ_SECONDS=$(FUZZ_SECONDS) s'

@@ -265,6 +265,9 @@ unsigned app_config_caps(const struct px_config_device *d, int *canopen)
 					      : 0;
 	case PX_CONFIG_BACKEND_GPIOD:
 		return PX_DEV_CAP_DIO;
+	case PX_CONFIG_BACKEND_DDS:
+		return (d->dds.pose_topic ? PX_DEV_CAP_POSE : 0u) |
+		       (d->dds.command_topic ? PX_DEV_CAP_FORCE : 0u);
 	default:
 		return 0;
 	}
@@ -479,6 +482,7 @@ int app_validate(struct px_app *a)
 			    "%zu devices; a run takes at most %d",
 			    cfg->n_devices, MAX_DEVS);
 	app_check_control(a);
+	app_teleop_check(a);
 	if (!a->n_check_errors && !app_robot_setup(a))
 		app_sensor_setup(a);
 	app_check_memory(a);
@@ -539,6 +543,8 @@ int app_check_device(struct px_app *a, int k)
 	struct px_devcfg *h = NULL;
 	char msg[512] = "";
 	int rc;
+	if (d->backend == PX_CONFIG_BACKEND_DDS)
+		return 0; /* its keys were checked with the config's */
 	memset(&opt, 0, sizeof(opt));
 	opt.check_only = 1;
 	rc = px_devcfg_open(a->cfg, d, &opt, &h, msg, sizeof(msg));

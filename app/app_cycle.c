@@ -65,6 +65,8 @@ int app_phase_read(struct px_loop *l, const struct px_loop_cycle *c,
 		rc = px_dev_pose_read(a->dev[i], c->read_ns, &a->sample[i]);
 		(void)rc; /* staleness reaches the watchdog through the stamp */
 	}
+	if (a->tele.n_dds)
+		app_teleop_read_phase(a, l, c->read_ns);
 	{
 		/* e-stop lines: a pressed (or unreadable) one trips the loop
 		 * inside px_dev_estop_read (px_dev_attach), every cycle it is
@@ -124,7 +126,9 @@ static void avoid_compute(struct px_app *a, const struct px_loop_cycle *c)
 		memcpy(a->qcmd, a->q, sizeof(a->qcmd));
 		a->started = 1;
 	}
-	for (k = 0; k < a->sim.n_nominal; k++) {
+	/* the task: a remote pose to follow, else the demo's sinusoids */
+	for (k = app_teleop_follow(a, qnom) ? a->sim.n_nominal : 0;
+	     k < a->sim.n_nominal; k++) {
 		const struct raw_nominal *nm = &a->sim.nominal[k];
 		if (nm->joint < a->ctl.chain.n_joints)
 			qnom[nm->joint] += nm->amplitude_rad_per_s *
@@ -182,6 +186,8 @@ int app_phase_compute(struct px_loop *l, const struct px_loop_cycle *c,
 		}
 		a->have_out = 1;
 	}
+	if (a->tele.n_dds)
+		app_teleop_compute(a);
 	for (i = 0; i < a->n_ov; i++)
 		if (c->deadline_ns >= a->ov_start[i] && c->deadline_ns < a->ov_end[i]) {
 			/* injected overrun: this compute takes ov_ns */
@@ -231,6 +237,12 @@ static void push_record(struct px_app *a, const struct px_loop_cycle *c,
 		r.dev_m[1] = s->pos_m.y;
 		r.dev_m[2] = s->pos_m.z;
 		r.valid = s->valid;
+		r.dev_quat_xyzw[0] = (float)s->q.x;
+		r.dev_quat_xyzw[1] = (float)s->q.y;
+		r.dev_quat_xyzw[2] = (float)s->q.z;
+		r.dev_quat_xyzw[3] = (float)s->q.w;
+	} else {
+		r.dev_quat_xyzw[3] = 1;
 	}
 	r.proxy_m[0] = a->out.proxy_m.x;
 	r.proxy_m[1] = a->out.proxy_m.y;
@@ -252,6 +264,8 @@ static void push_record(struct px_app *a, const struct px_loop_cycle *c,
 		r.scale = c->safe ? 0.0 : a->aout.scale;
 		for (j = 0; j < TELE_JOINTS && j < a->ctl.chain.n_joints; j++)
 			r.qdot[j] = c->safe ? 0.0 : a->aout.qdot[j];
+		for (j = 0; j < TELE_JOINTS && j < a->ctl.chain.n_joints; j++)
+			r.q[j] = (float)a->q[j];
 		r.distance_m = a->aout.min_clearance_m;
 		r.penetration_m = 0;
 		r.queries = a->aout.point_queries;
@@ -278,6 +292,8 @@ int app_phase_write(struct px_loop *l, const struct px_loop_cycle *c,
 	struct px_app *a = user;
 	double f;
 	(void)l;
+	if (a->tele.n_dds)
+		app_teleop_write(a, c);
 	if (a->rendering && a->ctl_dev >= 0) {
 		/* In safe state the loop has zeroed cmd and cleared enable. */
 		if (px_dev_force_write(a->dev[a->ctl_dev], &a->cmd, c->write_ns) !=

@@ -26,6 +26,7 @@
 
 #include "px_app.h"
 #include "px_arena.h"
+#include "px_bridge.h"
 #include "px_can.h"
 #include "px_canopen.h"
 #include "px_cloud.h"
@@ -101,6 +102,40 @@ struct raw_sim {
 	const struct px_config *cfg_; /* not a key: context for the check */
 };
 
+
+/* The teleop section (app_teleop.c). */
+struct raw_teleop {
+	const char *follow_device, *feedback_device, *force_device;
+	double follow_scale, follow_gain_per_s, follow_max_speed_m_per_s;
+	double feedback_max_force_n;
+};
+
+/* Remote devices and teleoperation; device indices into px_app.dev,
+ * -1 none. */
+struct app_teleop {
+	struct raw_teleop c;
+	struct px_bridge_config bridge; /* domain, network of dds devices */
+	struct {
+		int dev;
+		int64_t tmo_ns;
+		int pose_out;
+	} dds[64];
+	int n_dds;
+	int follow, feedback, force;
+	int force_input;        /* loop input of the remote force */
+	/* follower: offset caught at engagement, the last tracking error */
+	int engaged;
+	double offset_m[3], error_m[3];
+	uint64_t follow_cycles;
+	double follow_err_max_m, follow_err_sq_sum;
+	struct px_force_cmd fb_cmd; /* force from the clearances */
+	/* master: the newest remote force and its receipt (loop clock) */
+	double remote_force_n[3];
+	int64_t force_t_ns;
+	/* a live remote input went silent: latched safe state */
+	int link_lost, link_lost_dev;
+	int64_t link_lost_ns, link_silent_ns;
+};
 
 /* Bound of each of the shutdown's waits (devices, then each CANopen
  * master's drives): an unplugged device gets its safe output as soon as
@@ -260,6 +295,7 @@ struct px_app {
 	struct px_sim_fault linef[PX_SIM_MAX_FAULTS];
 	struct px_sim_fault devf[PX_SIM_MAX_FAULTS];
 	char cli_devs[PX_APP_MAX_CLI_FAULTS][64];
+	struct app_teleop tele;
 	char *msg;              /* px_app_create's msg buffer (first line) */
 	size_t msg_cap;
 };
@@ -319,5 +355,15 @@ void app_drain(struct px_app *a,
 	       void *user);
 int app_run(struct px_app *a);
 int app_add_cli_faults(struct px_app *a);
+const struct px_config_schema *app_teleop_schema(void);
+int app_teleop_read(struct px_app *a);
+void app_teleop_check(struct px_app *a);
+int app_make_dds(struct px_app *a, int k);
+int app_teleop_attach(struct px_app *a);
+void app_teleop_read_phase(struct px_app *a, struct px_loop *l, int64_t now_ns);
+int app_teleop_follow(struct px_app *a, double *qnom);
+void app_teleop_compute(struct px_app *a);
+void app_teleop_write(struct px_app *a, const struct px_loop_cycle *c);
+void app_teleop_summary(const struct px_app *a, struct px_app_summary *s);
 
 #endif

@@ -285,6 +285,8 @@ int app_make_device(struct px_app *a, int k)
 	char msg[256] = "";
 	size_t i;
 	int rc;
+	if (d->backend == PX_CONFIG_BACKEND_DDS)
+		return app_make_dds(a, k);
 	if (d->backend != PX_CONFIG_BACKEND_SIM || s->kind == PX_CONFIG_SIM_GPIO)
 		return app_make_devcfg(a, k);
 	px_dev_config_default(&dc);
@@ -581,7 +583,10 @@ int app_setup(struct px_app *a)
 	}
 	for (i = 0; i < a->n_dev; i++) {
 		rc = px_dev_start(a->dev[i]);
-		if (rc == PX_OK)
+		/* a dds device may be a pure output or remote force: nothing
+		 * for the watchdog to stamp */
+		if (rc == PX_OK &&
+		    (px_dev_caps(a->dev[i]) & (PX_DEV_CAP_POSE | PX_DEV_CAP_DIO)))
 			rc = px_dev_attach(a->dev[i], a->loop);
 		if (rc >= 0 && a->rendering && i == a->ctl_dev)
 			rc = px_dev_force_attach(a->dev[i], a->loop, &a->cmd);
@@ -607,6 +612,8 @@ int app_setup(struct px_app *a)
 			return 1;
 		}
 	}
+	if (app_teleop_attach(a))
+		return 1;
 	if (app_sensor_start(a))
 		return 1;
 	if (ring_cap < 16)

@@ -146,6 +146,12 @@ int px_app_create(const struct px_config *cfg, const struct px_app_options *opt,
 		rc = 1;
 		goto fail;
 	}
+	rc = app_teleop_read(a);
+	if (rc != PX_OK) {
+		app_report_config(a, rc, &a->diag);
+		rc = 1;
+		goto fail;
+	}
 	if (a->ctl.warning[0])
 		app_note(a, "%s\n", a->ctl.warning);
 	rc = app_add_cli_faults(a);
@@ -402,6 +408,7 @@ int px_app_summary(const struct px_app *a, struct px_app_summary *s)
 	s->drives_device = a->co ? a->co_name : NULL;
 	s->drives_enabled_cycles = a->enabled_cycles;
 	s->drive_problem_cycles = a->drive_problem_cycles;
+	app_teleop_summary(a, s);
 	s->tracking_enabled = a->tracking != NULL;
 	s->tracking_streams = px_scene_tracking_stats(a->tracking, &s->tracking);
 	for (i = 0; i < a->sim.n_faults && i < PX_APP_MAX_CAMPAIGN; i++)

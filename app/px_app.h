@@ -68,6 +68,11 @@ struct px_app_record {
 	int32_t contact, safe, queries, valid;
 	/* avoidance: speed scale and commanded joint velocities */
 	double scale, qdot[PX_APP_RECORD_JOINTS];
+	/* avoidance: the drives' joint positions (rad or m; single
+	 * precision keeps the record small: 1e-7 of a turn) */
+	float q[PX_APP_RECORD_JOINTS];
+	/* the device's orientation (identity for a point device) */
+	float dev_quat_xyzw[4];
 };
 
 struct px_app_options {
@@ -269,6 +274,19 @@ struct px_app_summary {
 	uint64_t drives_enabled_cycles, drive_problem_cycles;
 	int tracking_enabled, tracking_streams;
 	struct px_model_stream_stats tracking;
+	/* remote (dds) devices and teleoperation: the link (samples in and
+	 * out of every dds device, best-effort samples known lost), a live
+	 * remote input that went silent (latched safe state: the device,
+	 * loop time), a follower's tool against its target (outside safe
+	 * state, after engagement) */
+	int dds_devices;
+	uint64_t remote_in, remote_out, remote_lost;
+	int link_lost;
+	char link_lost_device[32];
+	double link_lost_t_s;
+	int64_t link_silent_ns;       /* its last sample's age then */
+	uint64_t follow_cycles;
+	double follow_error_max_m, follow_error_rms_m;
 };
 
 PX_API int px_app_summary(const struct px_app *app, struct px_app_summary *out);

@@ -56,35 +56,11 @@ void px_bridge_config_default(struct px_bridge_config *c)
 	c->status_rate_hz = 10;
 }
 
-/* ROS 2 name rules for the namespace: tokens of [A-Za-z0-9_] split by
- * single '/', none starting with a digit, no leading or trailing '/'. */
+/* ROS 2 name rules for the namespace (the config's, for the dds
+ * device's topics too). */
 static const char *ns_problem(const char *ns)
 {
-	const char *p;
-	int start = 1;
-	if (!ns || !*ns)
-		return "must not be empty";
-	if (strlen(ns) >= PX_BRIDGE_NAME_MAX)
-		return "is too long";
-	for (p = ns; *p; p++) {
-		char ch = *p;
-		if (ch == '/') {
-			if (start)
-				return "has an empty token (a leading or "
-				       "doubled '/')";
-			start = 1;
-			continue;
-		}
-		if (!((ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') ||
-		      (ch >= '0' && ch <= '9') || ch == '_'))
-			return "may hold only letters, digits, '_' and '/' "
-			       "(ROS 2 name rules)";
-		if (start && ch >= '0' && ch <= '9')
-			return "has a token starting with a digit (ROS 2 "
-			       "name rules)";
-		start = 0;
-	}
-	return start ? "ends with '/'" : NULL;
+	return px__ros_name_problem(ns, PX_BRIDGE_NAME_MAX);
 }
 
 /* Interface names and addresses go into the XML as they are: only

@@ -220,23 +220,58 @@ struct px_bridge_dev_config {
 	const char *pose_topic;
 	/* geometry_msgs/WrenchStamped out: its force command (NULL none) */
 	const char *command_topic;
+	/* geometry_msgs/WrenchStamped in: a remote force, read with
+	 * px_bridge_dev_wrench() (NULL none) */
+	const char *wrench_topic;
+	/* geometry_msgs/PoseStamped out: a pose written in the cycle with
+	 * px_bridge_dev_pose_write() (NULL none) */
+	const char *pose_out_topic;
+	/* px_dev_start() waits at most this long until every topic above
+	 * has a peer (0: no wait) */
+	int64_t connect_timeout_ns;
 };
 
 /*
- * A device (px_dev.h) whose pose comes from pose_topic and whose force
- * commands go to command_topic. Its own thread takes each pose as it
- * arrives, stamped with the loop clock at receipt, so a silent peer
- * makes the samples stale after dc->stale_timeout_ns and the loop's
- * watchdog trips; a command written in the cycle only crosses a
- * wait-free slot and goes out within about a millisecond. In safe state
- * the loop zeroes the command (px_dev_force_attach) and px_dev_safe()
- * sends a zero wrench at once. Start it with px_dev_start(). Returns
- * PX_OK, PX_E_INVAL (msg says why), PX_E_IO (Cyclone DDS refused),
- * PX_E_NOMEM or PX_E_UNSUPPORTED (built without Cyclone DDS).
+ * A device (px_dev.h) on the topics above: caps PX_DEV_CAP_POSE with a
+ * pose_topic, PX_DEV_CAP_FORCE with a command_topic. Its own thread
+ * takes each pose as it arrives, stamped with the loop clock at
+ * receipt, so a silent peer makes the samples stale after
+ * dc->stale_timeout_ns and the loop's watchdog trips; a command or pose
+ * written in the cycle only crosses a wait-free slot and goes out within
+ * a fraction of a millisecond. In safe state the loop zeroes the command
+ * (px_dev_force_attach) and px_dev_safe() sends a zero wrench at once.
+ * px_dev_start() starts the thread after the peers matched (or
+ * PX_E_TIMEOUT naming the topic without one). Returns PX_OK, PX_E_INVAL
+ * (msg says why), PX_E_IO (Cyclone DDS refused), PX_E_NOMEM or
+ * PX_E_UNSUPPORTED (built without Cyclone DDS).
  */
 PX_API int px_bridge_dev_create(const struct px_dev_config *dc,
 				const struct px_bridge_dev_config *bc,
 				struct px_dev **out, char *msg, size_t cap);
+
+/* The newest remote force of the wrench_topic and its receipt time on
+ * the loop clock (*t_ns). Returns 1, 0 (none yet) or PX_E_INVAL (not a
+ * dds device with a wrench_topic). Loop thread. @note RT-safe. */
+PX_API int px_bridge_dev_wrench(struct px_dev *d, struct px_force_cmd *out,
+				int64_t *t_ns);
+
+/* A pose for the pose_out_topic (sent by the device's thread, stamped
+ * with CLOCK_REALTIME then). PX_OK or PX_E_INVAL. Loop thread.
+ * @note RT-safe. */
+PX_API int px_bridge_dev_pose_write(struct px_dev *d, const px_vec3 *pos_m,
+				    const px_quat *q);
+
+/* What a dds device's thread did. */
+struct px_bridge_dev_counts {
+	uint64_t poses_in, wrenches_in, commands_out, poses_out;
+	/* best-effort samples the readers know were lost (DDS's sample
+	 * lost status, sequence gaps) */
+	uint64_t lost;
+};
+
+/* PX_OK or PX_E_INVAL (not a dds device). Any thread. */
+PX_API int px_bridge_dev_counts(struct px_dev *d,
+				struct px_bridge_dev_counts *out);
 
 #ifdef __cplusplus
 }

@@ -1,9 +1,10 @@
 /* The "dds" device back end (px_bridge_dev_create): a pose stream from
  * the network as a device's pose input, a force command as a wrench
- * stream to the network. One thread of the device's own takes the poses
- * (fed to the device with the loop clock's receipt time, so the
- * watchdog sees a silent peer as stale) and sends the newest command;
- * the cycle only swaps a command into a seqlock slot. */
+ * stream to the network, and for teleoperation a remote force in and a
+ * pose out. One thread of the device's own takes the poses and forces
+ * (fed with the loop clock's receipt time, so the watchdog sees a silent
+ * peer as stale) and sends the newest command and pose; the cycle only
+ * swaps values through seqlock slots. */
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -15,19 +16,65 @@
 #include "bridge_internal.h"
 #include "geometry_msgs.h"
 
+/* A value handed between the cycle and the device's thread: seq is odd
+ * while the writer copies; a reader retries a torn copy. */
+struct slot {
+	atomic_uint_fast64_t seq;
+	union {
+		struct px_force_cmd cmd;
+		struct {
+			double pos[3], quat_xyzw[4];
+		} pose;
+		struct {
+			struct px_force_cmd w;
+			int64_t t_ns;
+		} wrench;
+	} v;
+};
+
 struct dds_dev {
 	struct px_dev *d;
 	char frame[PX_BRIDGE_NAME_MAX];
+	char topics[4][PX_BRIDGE_TOPIC_MAX]; /* for the connect message */
 	dds_entity_t domain, dp, reader, writer, ws;
+	dds_entity_t wreader, pwriter; /* wrench in, pose out */
+	int64_t connect_timeout_ns;
 	pthread_t th;
 	int started;
 	atomic_int stop;
-	/* the newest command: written by the cycle (seq odd while it
-	 * writes), read by the thread, which retries a torn copy */
-	atomic_uint_fast64_t seq;
-	struct px_force_cmd cmd;
-	uint64_t sent_seq;
+	struct slot cmd, pose_out, wrench;
+	uint64_t sent_seq, pose_sent_seq;
+	_Atomic uint64_t n_pose, n_wrench, n_cmd, n_pose_out, n_lost;
 };
+
+static void slot_put(struct slot *s, const void *v, size_t n)
+{
+	uint64_t q = atomic_load_explicit(&s->seq, memory_order_relaxed);
+	atomic_store_explicit(&s->seq, q + 1, memory_order_relaxed);
+	atomic_thread_fence(memory_order_release);
+	memcpy(&s->v, v, n);
+	atomic_store_explicit(&s->seq, q + 2, memory_order_release);
+}
+
+/* The slot's value when its sequence differs from *last (then *last is
+ * updated): 1, else 0. Bounded: a writer that keeps writing makes the
+ * reader give up after a few tries (0, next call again). */
+static int slot_get(struct slot *s, void *v, size_t n, uint64_t *last)
+{
+	int tries;
+	for (tries = 0; tries < 16; tries++) {
+		uint64_t s0 = atomic_load_explicit(&s->seq, memory_order_acquire);
+		if (s0 == *last || (s0 & 1))
+			return 0;
+		memcpy(v, &s->v, n);
+		atomic_thread_fence(memory_order_acquire);
+		if (atomic_load_explicit(&s->seq, memory_order_relaxed) == s0) {
+			*last = s0;
+			return 1;
+		}
+	}
+	return 0;
+}
 
 /* A unit quaternion as a rotation vector (rad), the device's axes. */
 static void rotvec(const geometry_msgs_msg_dds__Quaternion_ *q, double r[3])
@@ -59,8 +106,49 @@ static void take_poses(struct dds_dev *x)
 			/* non-finite values are refused and recorded there */
 			px_dev_feed_axes(x->d, a, (1u << PX_AXIS__COUNT) - 1, 0,
 					 0, px_dev_mono_ns());
+			atomic_fetch_add(&x->n_pose, 1);
 		}
 		dds_return_loan(x->reader, buf, n);
+	}
+}
+
+/* Remote forces as they arrive: non-finite ones are dropped (recorded),
+ * the others go to the slot with their receipt time. */
+static void take_wrenches(struct dds_dev *x)
+{
+	for (;;) {
+		void *buf[1] = {NULL};
+		dds_sample_info_t info[1];
+		int n = dds_take(x->wreader, buf, info, 1, 1);
+		if (n <= 0)
+			return;
+		if (info[0].valid_data) {
+			const geometry_msgs_msg_dds__WrenchStamped_ *m = buf[0];
+			struct {
+				struct px_force_cmd w;
+				int64_t t_ns;
+			} v;
+			memset(&v, 0, sizeof(v));
+			v.w.force_n[0] = m->wrench.force.x;
+			v.w.force_n[1] = m->wrench.force.y;
+			v.w.force_n[2] = m->wrench.force.z;
+			v.w.torque_n_m[0] = m->wrench.torque.x;
+			v.w.torque_n_m[1] = m->wrench.torque.y;
+			v.w.torque_n_m[2] = m->wrench.torque.z;
+			v.w.enable = 1;
+			v.t_ns = px_dev_mono_ns();
+			if (isfinite(v.w.force_n[0] + v.w.force_n[1] +
+				     v.w.force_n[2] + v.w.torque_n_m[0] +
+				     v.w.torque_n_m[1] + v.w.torque_n_m[2])) {
+				slot_put(&x->wrench, &v, sizeof(v));
+				atomic_fetch_add(&x->n_wrench, 1);
+			} else {
+				px_dev_record(x->d, PX_DEV_ERR_NONFINITE, PX_E_NAN, 0,
+					      -1, NULL, "a non-finite wrench",
+					      v.t_ns);
+			}
+		}
+		dds_return_loan(x->wreader, buf, n);
 	}
 }
 
@@ -83,6 +171,7 @@ static int send_wrench(struct dds_dev *x, const struct px_force_cmd *c)
 	m.wrench.torque.z = on ? c->torque_n_m[2] : 0;
 	rc = dds_write(x->writer, &m);
 	px_dev_count_write(x->d, rc == DDS_RETCODE_OK);
+	atomic_fetch_add(&x->n_cmd, rc == DDS_RETCODE_OK);
 	if (rc != DDS_RETCODE_OK) {
 		px_dev_record(x->d, PX_DEV_ERR_IO, PX_E_IO, 0, -1, NULL,
 			      "dds_write of the command", px_dev_mono_ns());
@@ -95,40 +184,117 @@ static int send_wrench(struct dds_dev *x, const struct px_force_cmd *c)
 static void send_newest(struct dds_dev *x)
 {
 	struct px_force_cmd c;
-	uint64_t s0, s1;
-	do {
-		s0 = atomic_load_explicit(&x->seq, memory_order_acquire);
-		if (s0 == x->sent_seq || (s0 & 1))
-			return;
-		memcpy(&c, &x->cmd, sizeof(c));
-		atomic_thread_fence(memory_order_acquire);
-		s1 = atomic_load_explicit(&x->seq, memory_order_relaxed);
-	} while (s0 != s1);
-	x->sent_seq = s0;
-	send_wrench(x, &c);
+	if (slot_get(&x->cmd, &c, sizeof(c), &x->sent_seq))
+		send_wrench(x, &c);
 }
 
-/* Poses as they arrive; commands within a millisecond of the cycle's
- * write. */
+static void send_pose(struct dds_dev *x)
+{
+	geometry_msgs_msg_dds__PoseStamped_ m;
+	struct {
+		double pos[3], quat_xyzw[4];
+	} v;
+	struct timespec ts;
+	if (!slot_get(&x->pose_out, &v, sizeof(v), &x->pose_sent_seq))
+		return;
+	clock_gettime(CLOCK_REALTIME, &ts);
+	memset(&m, 0, sizeof(m));
+	m.header.stamp.sec = (int32_t)ts.tv_sec;
+	m.header.stamp.nanosec = (uint32_t)ts.tv_nsec;
+	m.header.frame_id = x->frame;
+	m.pose.position.x = v.pos[0];
+	m.pose.position.y = v.pos[1];
+	m.pose.position.z = v.pos[2];
+	m.pose.orientation.x = v.quat_xyzw[0];
+	m.pose.orientation.y = v.quat_xyzw[1];
+	m.pose.orientation.z = v.quat_xyzw[2];
+	m.pose.orientation.w = v.quat_xyzw[3];
+	if (dds_write(x->pwriter, &m) == DDS_RETCODE_OK)
+		atomic_fetch_add(&x->n_pose_out, 1);
+	else
+		px_dev_record(x->d, PX_DEV_ERR_IO, PX_E_IO, 0, -1, NULL,
+			      "dds_write of the pose", px_dev_mono_ns());
+}
+
+static void count_lost(struct dds_dev *x, dds_entity_t reader)
+{
+	dds_sample_lost_status_t st;
+	if (reader > 0 && dds_get_sample_lost_status(reader, &st) == DDS_RETCODE_OK)
+		atomic_fetch_add(&x->n_lost, (uint64_t)st.total_count_change);
+}
+
+/* Inputs as they arrive; outputs within a tenth of a millisecond of the
+ * cycle's write (the wait's timeout: the cycle signals nothing, it only
+ * swaps a slot). */
 static void *dev_thread(void *arg)
 {
 	struct dds_dev *x = arg;
+	int outputs = x->writer > 0 || x->pwriter > 0;
+	dds_duration_t poll = outputs ? DDS_USECS(100) : DDS_MSECS(1);
 	while (!atomic_load(&x->stop)) {
 		if (x->ws > 0)
-			dds_waitset_wait(x->ws, NULL, 0, DDS_MSECS(1));
+			dds_waitset_wait(x->ws, NULL, 0, poll);
 		else
-			dds_sleepfor(DDS_MSECS(1));
+			dds_sleepfor(poll);
 		if (x->reader > 0)
 			take_poses(x);
+		if (x->wreader > 0)
+			take_wrenches(x);
 		if (x->writer > 0)
 			send_newest(x);
+		if (x->pwriter > 0)
+			send_pose(x);
+		count_lost(x, x->reader);
+		count_lost(x, x->wreader);
 	}
 	return NULL;
+}
+
+/* Until each endpoint has a peer (readers: a matched writer; writers: a
+ * matched reader), at most connect_timeout_ns. PX_OK or PX_E_TIMEOUT
+ * (recorded, naming the topic). */
+static int wait_peers(struct dds_dev *x)
+{
+	const dds_entity_t e[4] = {x->reader, x->wreader, x->writer, x->pwriter};
+	int64_t end = px_dev_mono_ns() + x->connect_timeout_ns;
+	int i;
+	if (x->connect_timeout_ns <= 0)
+		return PX_OK;
+	for (i = 0; i < 4; i++) {
+		while (e[i] > 0) {
+			uint32_t n = 0;
+			if (i < 2) {
+				dds_subscription_matched_status_t st;
+				if (dds_get_subscription_matched_status(e[i], &st) == 0)
+					n = st.current_count;
+			} else {
+				dds_publication_matched_status_t st;
+				if (dds_get_publication_matched_status(e[i], &st) == 0)
+					n = st.current_count;
+			}
+			if (n > 0)
+				break;
+			if (px_dev_mono_ns() >= end) {
+				char why[PX_BRIDGE_TOPIC_MAX + 64];
+				snprintf(why, sizeof(why),
+					 "no peer on %s within the connect timeout",
+					 x->topics[i]);
+				px_dev_record(x->d, PX_DEV_ERR_IO, PX_E_TIMEOUT, 0,
+					      -1, NULL, why, px_dev_mono_ns());
+				return PX_E_TIMEOUT;
+			}
+			dds_sleepfor(DDS_MSECS(5));
+		}
+	}
+	return PX_OK;
 }
 
 static int dev_start(struct px_dev *d)
 {
 	struct dds_dev *x = px_dev_impl(d);
+	int rc = wait_peers(x);
+	if (rc != PX_OK)
+		return rc;
 	atomic_store(&x->stop, 0);
 	if (pthread_create(&x->th, NULL, dev_thread, x) != 0)
 		return PX_E_NOMEM;
@@ -152,12 +318,8 @@ static int dev_force(struct px_dev *d, const struct px_force_cmd *c,
 		     int64_t now_ns)
 {
 	struct dds_dev *x = px_dev_impl(d);
-	uint64_t s = atomic_load_explicit(&x->seq, memory_order_relaxed);
 	(void)now_ns;
-	atomic_store_explicit(&x->seq, s + 1, memory_order_relaxed);
-	atomic_thread_fence(memory_order_release);
-	x->cmd = *c;
-	atomic_store_explicit(&x->seq, s + 2, memory_order_release);
+	slot_put(&x->cmd, c, sizeof(*c));
 	return PX_OK;
 }
 
@@ -168,6 +330,8 @@ static int dev_safe(struct px_dev *d, int64_t now_ns)
 	struct dds_dev *x = px_dev_impl(d);
 	struct px_force_cmd zero;
 	memset(&zero, 0, sizeof(zero));
+	if (x->writer <= 0)
+		return PX_OK;
 	dev_force(d, &zero, now_ns);
 	return send_wrench(x, &zero);
 }
@@ -181,17 +345,72 @@ static void dev_destroy(struct px_dev *d)
 		dds_delete(x->domain);
 }
 
-static const struct px_dev_ops pose_ops = {
-	.backend = "dds", .caps = PX_DEV_CAP_POSE, .start = dev_start,
-	.stop = dev_stop, .destroy = dev_destroy};
-static const struct px_dev_ops force_ops = {
-	.backend = "dds", .caps = PX_DEV_CAP_FORCE, .start = dev_start,
-	.stop = dev_stop, .force = dev_force, .safe = dev_safe,
-	.destroy = dev_destroy};
-static const struct px_dev_ops both_ops = {
-	.backend = "dds", .caps = PX_DEV_CAP_POSE | PX_DEV_CAP_FORCE,
-	.start = dev_start, .stop = dev_stop, .force = dev_force,
-	.safe = dev_safe, .destroy = dev_destroy};
+/* One table per caps combination (index: bit 0 pose, bit 1 force). */
+#define DDS_OPS(caps_, force_)                                              \
+	{.backend = "dds", .caps = (caps_), .start = dev_start,             \
+	 .stop = dev_stop, .force = (force_) ? dev_force : NULL,            \
+	 .safe = dev_safe, .destroy = dev_destroy}
+static const struct px_dev_ops dds_ops[4] = {
+	DDS_OPS(0, 0), DDS_OPS(PX_DEV_CAP_POSE, 0), DDS_OPS(PX_DEV_CAP_FORCE, 1),
+	DDS_OPS(PX_DEV_CAP_POSE | PX_DEV_CAP_FORCE, 1)};
+
+static struct dds_dev *dds_of(struct px_dev *d)
+{
+	const struct px_dev_ops *o = d ? px_dev_ops(d) : NULL;
+	return o >= dds_ops && o < dds_ops + 4 ? px_dev_impl(d) : NULL;
+}
+
+int px_bridge_dev_wrench(struct px_dev *d, struct px_force_cmd *out,
+			 int64_t *t_ns)
+{
+	struct dds_dev *x = dds_of(d);
+	struct {
+		struct px_force_cmd w;
+		int64_t t_ns;
+	} v;
+	uint64_t none = 0;
+	if (!x || x->wreader <= 0 || !out || !t_ns)
+		return PX_E_INVAL;
+	/* seq 0 is "never written": a copy against 0 is any value */
+	if (!slot_get(&x->wrench, &v, sizeof(v), &none))
+		return 0;
+	*out = v.w;
+	*t_ns = v.t_ns;
+	return 1;
+}
+
+int px_bridge_dev_pose_write(struct px_dev *d, const px_vec3 *pos_m,
+			     const px_quat *q)
+{
+	struct dds_dev *x = dds_of(d);
+	struct {
+		double pos[3], quat_xyzw[4];
+	} v;
+	if (!x || x->pwriter <= 0 || !pos_m)
+		return PX_E_INVAL;
+	v.pos[0] = pos_m->x;
+	v.pos[1] = pos_m->y;
+	v.pos[2] = pos_m->z;
+	v.quat_xyzw[0] = q ? q->x : 0;
+	v.quat_xyzw[1] = q ? q->y : 0;
+	v.quat_xyzw[2] = q ? q->z : 0;
+	v.quat_xyzw[3] = q ? q->w : 1;
+	slot_put(&x->pose_out, &v, sizeof(v));
+	return PX_OK;
+}
+
+int px_bridge_dev_counts(struct px_dev *d, struct px_bridge_dev_counts *out)
+{
+	struct dds_dev *x = dds_of(d);
+	if (!x || !out)
+		return PX_E_INVAL;
+	out->poses_in = atomic_load(&x->n_pose);
+	out->wrenches_in = atomic_load(&x->n_wrench);
+	out->commands_out = atomic_load(&x->n_cmd);
+	out->poses_out = atomic_load(&x->n_pose_out);
+	out->lost = atomic_load(&x->n_lost);
+	return PX_OK;
+}
 
 static dds_entity_t endpoint(struct dds_dev *x, const char *ns,
 			     const char *name, const dds_topic_descriptor_t *t,
@@ -214,37 +433,52 @@ static dds_entity_t endpoint(struct dds_dev *x, const char *ns,
 	return e;
 }
 
+/* A reader whose data wakes the device's thread. */
+static dds_entity_t watched_reader(struct dds_dev *x, const char *ns,
+				   const char *name,
+				   const dds_topic_descriptor_t *t)
+{
+	dds_entity_t r = endpoint(x, ns, name, t, 1), cond;
+	if (r < 0)
+		return r;
+	if (x->ws <= 0) {
+		x->ws = dds_create_waitset(x->dp);
+		if (x->ws < 0)
+			return x->ws;
+	}
+	cond = dds_create_readcondition(r, DDS_ANY_STATE);
+	if (cond < 0)
+		return cond;
+	return dds_waitset_attach(x->ws, cond, 0) < 0 ? DDS_RETCODE_ERROR : r;
+}
+
 static int open_dds(struct dds_dev *x, const struct px_bridge_dev_config *bc,
 		    char *msg, size_t cap)
 {
 	const struct px_bridge_config *c = bc->bridge;
-	int rc = px__bridge_join(c, &x->domain, &x->dp, msg, cap);
+	const char *const names[4] = {bc->pose_topic, bc->wrench_topic,
+				      bc->command_topic, bc->pose_out_topic};
+	dds_entity_t *const ents[4] = {&x->reader, &x->wreader, &x->writer,
+				       &x->pwriter};
+	const dds_topic_descriptor_t *const types[4] = {
+		&geometry_msgs_msg_dds__PoseStamped__desc,
+		&geometry_msgs_msg_dds__WrenchStamped__desc,
+		&geometry_msgs_msg_dds__WrenchStamped__desc,
+		&geometry_msgs_msg_dds__PoseStamped__desc};
+	int i, rc = px__bridge_join(c, &x->domain, &x->dp, msg, cap);
 	if (rc != PX_OK)
 		return rc;
-	if (bc->pose_topic) {
-		x->reader = endpoint(x, c->ns, bc->pose_topic,
-				     &geometry_msgs_msg_dds__PoseStamped__desc, 1);
-		x->ws = x->reader > 0 ? dds_create_waitset(x->dp) : x->reader;
-		if (x->ws > 0) {
-			dds_entity_t cond = dds_create_readcondition(
-				x->reader, DDS_ANY_STATE);
-			if (cond < 0 || dds_waitset_attach(x->ws, cond, 0) < 0)
-				x->ws = cond < 0 ? cond : DDS_RETCODE_ERROR;
-		}
-		if (x->reader < 0 || x->ws < 0) {
-			snprintf(msg, cap, "dds device: cannot read %s: %s",
-				 bc->pose_topic,
-				 dds_strretcode(x->reader < 0 ? x->reader : x->ws));
-			return PX_E_IO;
-		}
-	}
-	if (bc->command_topic) {
-		x->writer = endpoint(x, c->ns, bc->command_topic,
-				     &geometry_msgs_msg_dds__WrenchStamped__desc,
-				     0);
-		if (x->writer < 0) {
-			snprintf(msg, cap, "dds device: cannot publish %s: %s",
-				 bc->command_topic, dds_strretcode(x->writer));
+	for (i = 0; i < 4; i++) {
+		if (!names[i])
+			continue;
+		px_bridge_topic_name(c->ns, names[i], x->topics[i],
+				     sizeof(x->topics[i]));
+		*ents[i] = i < 2 ? watched_reader(x, c->ns, names[i], types[i])
+				 : endpoint(x, c->ns, names[i], types[i], 0);
+		if (*ents[i] < 0) {
+			snprintf(msg, cap, "dds device: cannot %s %s: %s",
+				 i < 2 ? "read" : "publish", names[i],
+				 dds_strretcode(*ents[i]));
 			return PX_E_IO;
 		}
 	}
@@ -264,23 +498,26 @@ int px_bridge_dev_create(const struct px_dev_config *dc,
 	if (!out)
 		return PX_E_INVAL;
 	*out = NULL;
-	if (!dc || !bc || !bc->bridge || (!bc->pose_topic && !bc->command_topic)) {
-		snprintf(msg, cap, "dds device: a pose or a command topic needed");
+	if (!dc || !bc || !bc->bridge ||
+	    (!bc->pose_topic && !bc->command_topic && !bc->wrench_topic &&
+	     !bc->pose_out_topic) ||
+	    bc->connect_timeout_ns < 0) {
+		snprintf(msg, cap, "dds device: a pose, wrench, command or "
+				   "pose_out topic needed");
 		return PX_E_INVAL;
 	}
 	if (px_bridge_config_check(bc->bridge, why, sizeof(why)) != PX_OK) {
 		snprintf(msg, cap, "dds device: %s", why);
 		return PX_E_INVAL;
 	}
-	ops = !bc->command_topic ? &pose_ops
-	      : !bc->pose_topic  ? &force_ops
-				 : &both_ops;
+	ops = &dds_ops[(bc->pose_topic ? 1 : 0) | (bc->command_topic ? 2 : 0)];
 	rc = px_dev_create(ops, dc, sizeof(*x), out);
 	if (rc != PX_OK)
 		return rc;
 	x = px_dev_impl(*out);
 	x->d = *out;
 	snprintf(x->frame, sizeof(x->frame), "%s", bc->bridge->frame_id);
+	x->connect_timeout_ns = bc->connect_timeout_ns;
 	rc = open_dds(x, bc, msg, cap);
 	if (rc != PX_OK) {
 		px_dev_free(*out);

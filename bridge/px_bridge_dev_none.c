@@ -16,3 +16,23 @@ int px_bridge_dev_create(const struct px_dev_config *dc,
 				   "(built without Cyclone DDS)");
 	return PX_E_UNSUPPORTED;
 }
+
+int px_bridge_dev_wrench(struct px_dev *d, struct px_force_cmd *out,
+			 int64_t *t_ns)
+{
+	(void)d, (void)out, (void)t_ns;
+	return PX_E_INVAL;
+}
+
+int px_bridge_dev_pose_write(struct px_dev *d, const px_vec3 *pos_m,
+			     const px_quat *q)
+{
+	(void)d, (void)pos_m, (void)q;
+	return PX_E_INVAL;
+}
+
+int px_bridge_dev_counts(struct px_dev *d, struct px_bridge_dev_counts *out)
+{
+	(void)d, (void)out;
+	return PX_E_INVAL;
+}

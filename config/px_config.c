@@ -11,8 +11,8 @@
 
 /* ---- enum names (order = the C enums in px_config.h) ------------- */
 
-static const char *const backend_names[] = {"sim",       "hidapi", "libusb",
-					    "socketcan", "gpiod",  NULL};
+static const char *const backend_names[] = {
+	"sim", "hidapi", "libusb", "socketcan", "gpiod", "dds", NULL};
 static const char *const overrun_names[] = {"skip", "catch_up", NULL};
 static const char *const byte_order_names[] = {"little", "big", NULL};
 static const char *const axis_names[] = {"x", "y", "z", "rx", "ry", "rz", NULL};
@@ -106,6 +106,35 @@ static bool valid_name(const char *s)
 		      *s == '.'))
 			return false;
 	return true;
+}
+
+const char *px__ros_name_problem(const char *s, size_t max)
+{
+	const char *p;
+	int start = 1;
+	if (!s || !*s)
+		return "must not be empty";
+	if (strlen(s) >= max)
+		return "is too long";
+	for (p = s; *p; p++) {
+		char ch = *p;
+		if (ch == '/') {
+			if (start)
+				return "has an empty token (a leading or "
+				       "doubled '/')";
+			start = 1;
+			continue;
+		}
+		if (!((ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') ||
+		      (ch >= '0' && ch <= '9') || ch == '_'))
+			return "may hold only letters, digits, '_' and '/' "
+			       "(ROS 2 name rules)";
+		if (start && ch >= '0' && ch <= '9')
+			return "has a token starting with a digit (ROS 2 "
+			       "name rules)";
+		start = 0;
+	}
+	return start ? "ends with '/'" : NULL;
 }
 
 /* ---- codec (hidapi, libusb, sim) --------------------------------- */
@@ -821,6 +850,54 @@ static const struct px_config_key sim_keys[] = {
 };
 SCHEMA(sim_schema, "sim", sim_keys, sim_check);
 
+/* ---- dds --------------------------------------------------------- */
+
+/* Longest namespace or topic: rt/<namespace>/<topic> fits the bridge's
+ * 192-byte topic names. */
+#define DDS_NAME_MAX 90
+
+static void dds_check(struct px_config_reader *r,
+		      const struct px_config_node *map, void *obj)
+{
+	const struct px_config_dds *d = obj;
+	const char *const names[] = {"namespace", "pose_topic", "wrench_topic",
+				     "command_topic", "pose_out_topic"};
+	const char *const vals[] = {d->ns, d->pose_topic, d->wrench_topic,
+				    d->command_topic, d->pose_out_topic};
+	size_t i;
+	if (!map)
+		return;
+	for (i = 0; i < sizeof(vals) / sizeof(vals[0]); i++) {
+		const char *p =
+			vals[i] ? px__ros_name_problem(vals[i], DDS_NAME_MAX) : NULL;
+		if (p)
+			px_config_reader_error(r, px_config_node_get(map, names[i]),
+					       names[i], "'%s' %s", EX(vals[i]), p);
+	}
+	if (!d->pose_topic && !d->wrench_topic && !d->command_topic &&
+	    !d->pose_out_topic)
+		px_config_reader_error(r, map, "pose_topic",
+				       "a dds device needs at least one of "
+				       "pose_topic, wrench_topic, command_topic "
+				       "and pose_out_topic");
+}
+
+static const struct px_config_key dds_keys[] = {
+	{.name = "namespace", .type = PX_CONFIG_T_STRING,
+	 .offset = offsetof(struct px_config_dds, ns),
+	 .flags = PX_CONFIG_NONEMPTY},
+	K_STR(struct px_config_dds, pose_topic, "pose_topic", PX_CONFIG_NONEMPTY),
+	K_STR(struct px_config_dds, wrench_topic, "wrench_topic",
+	      PX_CONFIG_NONEMPTY),
+	K_STR(struct px_config_dds, command_topic, "command_topic",
+	      PX_CONFIG_NONEMPTY),
+	K_STR(struct px_config_dds, pose_out_topic, "pose_out_topic",
+	      PX_CONFIG_NONEMPTY),
+	K_DUR(struct px_config_dds, connect_timeout_ns, "connect_timeout_ns", 0,
+	      0, 60 * NS_PER_S, 10 * NS_PER_S),
+};
+SCHEMA(dds_schema, "dds", dds_keys, dds_check);
+
 /* ---- devices ----------------------------------------------------- */
 
 static void device_check(struct px_config_reader *r,
@@ -828,7 +905,7 @@ static void device_check(struct px_config_reader *r,
 {
 	struct px_config_device *d = obj;
 	const bool has[] = {d->has_sim, d->has_hidapi, d->has_libusb,
-			    d->has_socketcan, d->has_gpiod};
+			    d->has_socketcan, d->has_gpiod, d->has_dds};
 	int b;
 	d->node_ = map;
 	if (!map || map->kind != PX_CONFIG_NODE_MAP)
@@ -869,6 +946,7 @@ static const struct px_config_key device_keys[] = {
 	K_SUBP(struct px_config_device, socketcan, "socketcan", socketcan_schema,
 	       has_socketcan),
 	K_SUBP(struct px_config_device, gpiod, "gpiod", gpiod_schema, has_gpiod),
+	K_SUBP(struct px_config_device, dds, "dds", dds_schema, has_dds),
 	K_INT(struct px_config_device, stuck_limit, "stuck_limit", 0, 0, 1000000,
 	      0),
 	K_DUR(struct px_config_device, min_report_interval_ns,
@@ -1073,6 +1151,7 @@ static const struct px_config_key root_keys[] = {
 	K_MAP(struct px_config, control, "control"),
 	K_MAP(struct px_config, sim, "sim"),
 	K_MAP(struct px_config, bridge, "bridge"),
+	K_MAP(struct px_config, teleop, "teleop"),
 };
 SCHEMA(root_schema, "config", root_keys, root_check);
 

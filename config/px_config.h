@@ -368,7 +368,8 @@ enum px_config_backend {
 	PX_CONFIG_BACKEND_HIDAPI,
 	PX_CONFIG_BACKEND_LIBUSB,
 	PX_CONFIG_BACKEND_SOCKETCAN,
-	PX_CONFIG_BACKEND_GPIOD
+	PX_CONFIG_BACKEND_GPIOD,
+	PX_CONFIG_BACKEND_DDS
 };
 
 enum px_config_byte_order {
@@ -634,6 +635,19 @@ struct px_config_gpiod {
 	size_t n_lines;
 };
 
+/* A device on DDS topics (bridge/px_bridge.h, px_bridge_dev_create):
+ * domain, interface and discovery are the bridge section's. Topic names
+ * are ROS 2 names below the namespace (rt/<namespace>/<topic>); NULL:
+ * not used. */
+struct px_config_dds {
+	const char *ns;              /* key "namespace"; NULL: the bridge's */
+	const char *pose_topic;      /* PoseStamped in: a watched pose input */
+	const char *wrench_topic;    /* WrenchStamped in: a remote force */
+	const char *command_topic;   /* WrenchStamped out: zero in safe state */
+	const char *pose_out_topic;  /* PoseStamped out: control.device's pose */
+	int64_t connect_timeout_ns;  /* setup waits this long for the peers */
+};
+
 enum px_config_sim_kind {
 	PX_CONFIG_SIM_HAPTIC = 0, /* mass-spring-damper arm + hand trajectory */
 	PX_CONFIG_SIM_POSE,       /* pose source following the trajectory */
@@ -683,12 +697,13 @@ struct px_config_device {
 	const char *name;
 	int backend;                 /* enum px_config_backend */
 	int64_t stale_timeout_ns;    /* 0 = safety.watchdog.device_timeout_ns */
-	bool has_sim, has_hidapi, has_libusb, has_socketcan, has_gpiod;
+	bool has_sim, has_hidapi, has_libusb, has_socketcan, has_gpiod, has_dds;
 	struct px_config_sim sim;
 	struct px_config_hidapi hidapi;
 	struct px_config_libusb libusb;
 	struct px_config_socketcan socketcan;
 	struct px_config_gpiod gpiod;
+	struct px_config_dds dds;
 	const struct px_config_node *node_; /* the device's mapping */
 	/* Pose inputs: identical samples this many times in a row mark the
 	 * device stuck (0 = off), and an identical report/frame sooner than
@@ -710,6 +725,7 @@ struct px_config {
 	const struct px_config_node *control;
 	const struct px_config_node *sim;
 	const struct px_config_node *bridge; /* read by bridge/px_bridge.h */
+	const struct px_config_node *teleop; /* read by app/px_app.h */
 	struct px_config_doc *doc; /* owns every string and array above */
 };
 

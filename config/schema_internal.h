@@ -82,4 +82,9 @@
 	static const struct px_config_schema var = {                        \
 		nm, keys, sizeof(keys) / sizeof(keys[0]), chk}
 
+/* What breaks ROS 2's name rules in s (tokens of [A-Za-z0-9_] split by
+ * single '/', none starting with a digit, no leading or trailing '/',
+ * shorter than max bytes), or NULL: for namespaces and topic names. */
+const char *px__ros_name_problem(const char *s, size_t max);
+
 #endif

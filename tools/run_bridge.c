@@ -16,6 +16,7 @@ static struct {
 	struct px_bridge *b;
 	struct px_app *app;
 	int avoiding;
+	int joints; /* joint states published (avoidance: the arm's) */
 	double offer_every_s, last_offer_t_s;
 	int64_t stamp0_ns; /* CLOCK_REALTIME of loop time 0; -1 unknown */
 	int64_t status_every_ns, last_status_ns;
@@ -59,6 +60,11 @@ int run_bridge_start(struct px_app *app, int avoiding)
 	}
 	B.app = app;
 	B.avoiding = avoiding;
+	if (avoiding) {
+		static struct px_app_summary sum;
+		px_app_summary(app, &sum);
+		B.joints = sum.record_joints;
+	}
 	for (i = 0; i < sizeof(rates) / sizeof(rates[0]); i++)
 		if (rates[i] > max_rate)
 			max_rate = rates[i];
@@ -123,6 +129,7 @@ static void distance_of(const struct px_app_record *r,
 void run_bridge_record(const struct px_app_record *r)
 {
 	struct px_bridge_sample s;
+	int k;
 	if (!B.b || r->t_s - B.last_offer_t_s < B.offer_every_s)
 		return;
 	B.last_offer_t_s = r->t_s;
@@ -131,11 +138,26 @@ void run_bridge_record(const struct px_app_record *r)
 	memset(&s, 0, sizeof(s));
 	s.stamp_ns = B.stamp0_ns + (int64_t)(r->t_s * 1e9);
 	memcpy(s.tool_m, r->dev_m, sizeof(s.tool_m));
-	s.tool_quat_xyzw[3] = 1; /* a point tool: identity */
+	/* the device's orientation; a record without one (all zero):
+	 * identity */
+	for (k = 0; k < 4; k++)
+		s.tool_quat_xyzw[k] = r->dev_quat_xyzw[k];
+	if (!(r->dev_quat_xyzw[0] || r->dev_quat_xyzw[1] ||
+	      r->dev_quat_xyzw[2] || r->dev_quat_xyzw[3]))
+		s.tool_quat_xyzw[3] = 1;
 	memcpy(s.proxy_m, r->proxy_m, sizeof(s.proxy_m));
 	memcpy(s.force_n, r->force_n, sizeof(s.force_n));
 	distance_of(r, &s);
 	px_bridge_offer(B.b, &s);
+	if (B.joints > 0) {
+		double q[PX_APP_RECORD_JOINTS], qd[PX_APP_RECORD_JOINTS];
+		for (k = 0; k < B.joints; k++) {
+			q[k] = r->q[k];
+			qd[k] = r->qdot[k];
+		}
+		px_bridge_publish_joint_state(B.b, s.stamp_ns, (size_t)B.joints,
+					      NULL, q, qd, NULL);
+	}
 }
 
 void run_bridge_tick(void)
@@ -172,6 +194,7 @@ void run_bridge_stop(void)
 {
 	struct px_bridge_counts n;
 	uint64_t total = 0;
+	char js[48] = "";
 	int t;
 	if (!B.b)
 		return;
@@ -180,13 +203,17 @@ void run_bridge_stop(void)
 	B.b = NULL;
 	for (t = 0; t < PX_BRIDGE_TOPIC__COUNT; t++)
 		total += n.published[t];
+	if (B.joints)
+		snprintf(js, sizeof(js), ", joint_states %llu",
+			 (unsigned long long)n.published[PX_BRIDGE_JOINT_STATES]);
 	fprintf(stderr,
 		"proxima-run: bridge: %llu messages on %s (tool_pose %llu, "
-		"wrench %llu, distance %llu, status %llu), %llu write errors\n",
+		"wrench %llu, distance %llu, status %llu%s), %llu write errors\n",
 		(unsigned long long)total, B.topic0,
 		(unsigned long long)n.published[PX_BRIDGE_TOOL_POSE],
 		(unsigned long long)n.published[PX_BRIDGE_WRENCH],
 		(unsigned long long)n.published[PX_BRIDGE_DISTANCE],
 		(unsigned long long)n.published[PX_BRIDGE_STATUS],
+		js,
 		(unsigned long long)n.write_errors);
 }

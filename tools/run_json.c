@@ -101,6 +101,25 @@ static void json_figures(FILE *f, const struct run_result *r)
 		(unsigned long long)ts.reinits,
 		(unsigned long long)ts.verifications,
 		(unsigned long long)ts.disagreements);
+	if (S->dds_devices) {
+		fprintf(f,
+			"  \"remote\": {\"dds_devices\": %d, \"samples_in\": %llu, "
+			"\"samples_out\": %llu, \"lost\": %llu, "
+			"\"link_lost\": %s, \"link_lost_device\": ",
+			S->dds_devices, (unsigned long long)S->remote_in,
+			(unsigned long long)S->remote_out,
+			(unsigned long long)S->remote_lost,
+			S->link_lost ? "true" : "false");
+		json_string(f, S->link_lost_device);
+		fprintf(f,
+			", \"link_lost_t_s\": %.6f, \"link_silent_ns\": %lld, "
+			"\"follow_cycles\": %llu, "
+			"\"follow_error_max_m\": %.9g, "
+			"\"follow_error_rms_m\": %.9g},\n",
+			S->link_lost_t_s, (long long)S->link_silent_ns,
+			(unsigned long long)S->follow_cycles,
+			S->follow_error_max_m, S->follow_error_rms_m);
+	}
 	fprintf(f,
 		"  \"max_force_n\": %.9g,\n  \"force_clamp_n\": %.9g,\n"
 		"  \"min_distance_m\": %.9g,\n  \"max_penetration_m\": %.9g,\n"

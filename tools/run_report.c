@@ -165,6 +165,26 @@ void run_print_summary(const struct run_result *r)
 		       run_finite(S->min_distance_m) * 1e3,
 		       S->max_penetration_m * 1e3,
 		       run_finite(S->min_proxy_distance_m) * 1e3);
+	if (S->dds_devices) {
+		printf("  remote            %d dds device%s: %llu samples in, %llu "
+		       "out, %llu known lost",
+		       S->dds_devices, S->dds_devices == 1 ? "" : "s",
+		       (unsigned long long)S->remote_in,
+		       (unsigned long long)S->remote_out,
+		       (unsigned long long)S->remote_lost);
+		if (S->link_lost)
+			printf("; link lost ('%s' silent %.1f ms at %.3f s: safe "
+			       "state latched)",
+			       S->link_lost_device, (double)S->link_silent_ns * 1e-6,
+			       S->link_lost_t_s);
+		printf("\n");
+		if (S->follow_cycles)
+			printf("  following         tool to target: max %.1f mm, "
+			       "rms %.1f mm over %llu cycles\n",
+			       S->follow_error_max_m * 1e3,
+			       S->follow_error_rms_m * 1e3,
+			       (unsigned long long)S->follow_cycles);
+	}
 	print_safety(r);
 	if (!r->counted)
 		printf("\n  allocations       not counted (no heap counter: "

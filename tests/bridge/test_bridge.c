@@ -246,7 +246,7 @@ static void test_create_unsupported_or_refused(void)
 	px_bridge_free(NULL);
 	{
 		struct px_dev_config dc;
-		struct px_bridge_dev_config bc = {&c, "tool_pose", NULL};
+		struct px_bridge_dev_config bc = {.bridge = &c, .pose_topic = "tool_pose"};
 		struct px_dev *d = (struct px_dev *)&c;
 		px_dev_config_default(&dc);
 		dc.name = "remote";
@@ -755,6 +755,7 @@ static void test_dds_device(void)
 	px_dev_config_default(&dc);
 	dc.name = "remote";
 	dc.stale_timeout_ns = 50000000;
+	memset(&bc, 0, sizeof(bc));
 	bc.bridge = &c;
 	bc.pose_topic = "tool_pose";
 	bc.command_topic = "command_wrench";

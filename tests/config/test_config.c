@@ -78,7 +78,7 @@ static void test_message_format(void)
 		     "  - name: b\n"
 		     "    backend: hidraw2\n",
 		     "t.yaml:5:14: devices[1].backend: unknown value 'hidraw2' "
-		     "(expected one of: sim, hidapi, libusb, socketcan, gpiod)");
+		     "(expected one of: sim, hidapi, libusb, socketcan, gpiod, dds)");
 	/* Every error carries the place and the path in this shape. */
 	PX_CHECK_INT_EQ(g_diag.errors[0].line, 5);
 	PX_CHECK_INT_EQ(g_diag.errors[0].column, 14);
@@ -251,7 +251,7 @@ static void test_value_errors(void)
 	expect_error("robot: {}\n",
 		     "t.yaml:1:1: robot: unknown key (expected one of: version, "
 		     "loop, safety, telemetry, devices, scene, control, sim, "
-		     "bridge)");
+		     "bridge, teleop)");
 	expect_error("version: 2\n",
 		     "t.yaml:1:10: version: 2 is out of range [1, 1]");
 	/* UTF-8 text is shown as text; line separators and C1 controls are

@@ -7,10 +7,11 @@
 #   help                   --help
 #   usage                  a refused --duration-s
 #   check_<config>         --check on every config/examples/*.yaml but
-#                          those with STEP/IGES parts (kind cad) or a
-#                          URDF robot (control.avoidance.urdf): the
-#                          golden runner predates them and cannot read
-#                          them (tests/tools/test_proxima_run.sh runs them)
+#                          those with STEP/IGES parts (kind cad), a
+#                          URDF robot (control.avoidance.urdf) or a dds
+#                          device: the golden runner predates them and
+#                          cannot read them (tests/tools/test_proxima_run.sh
+#                          and tests/bridge/test_teleop.sh run them)
 #   run_<config>           every config in virtual time for 0.2 s with
 #                          --telemetry and --summary-json: the CSV, the
 #                          JSON and both SVG plots (configs with hardware
@@ -56,6 +57,7 @@ golden_cases() {
 	for f in config/examples/*.yaml; do
 		grep -q 'kind: cad' "$f" && continue
 		grep -qE '^ +urdf: ' "$f" && continue
+		grep -q 'backend: dds' "$f" && continue
 		n=$(basename "$f" .yaml)
 		echo "check_$n||--check $f"
 		echo "run_$n||$f --virtual-time --duration-s $GOLDEN_DURATION --telemetry @OUT@/run_$n.csv --summary-json @OUT@/run_$n.json"

@@ -107,7 +107,7 @@ has "unknown key with suggestion" "$tmp/err" \
 has "wrong type" "$tmp/err" \
 	"$tmp/bad.yaml:4:13: loop.priority: expected an integer, got 'high'"
 has "unknown enum value" "$tmp/err" \
-	"$tmp/bad.yaml:7:14: devices[0].backend: unknown value 'hidraw2' (expected one of: sim, hidapi, libusb, socketcan, gpiod)"
+	"$tmp/bad.yaml:7:14: devices[0].backend: unknown value 'hidraw2' (expected one of: sim, hidapi, libusb, socketcan, gpiod, dds)"
 has "error count" "$tmp/err" "$tmp/bad.yaml: invalid configuration (4 errors)"
 if [ -s "$tmp/out" ]; then echo "    stdout not empty"; bad "nothing on stdout for a bad config"; else ok "nothing on stdout for a bad config"; fi
 
@@ -195,6 +195,13 @@ for f in config/examples/*.yaml; do
 			sed 's/^/    /' "$tmp/err" | head -n 5
 			bad "$f: absent hardware named with its reason (exit $rc)"
 		fi
+		continue
+	fi
+	if grep -q 'backend: dds' "$f"; then
+		# a peer process over DDS: the real clock only, and its peer
+		# (tests/bridge/test_teleop.sh runs the two teleop configs)
+		expect "$f: no virtual time with a dds device" 2 "$bin" "$f" --virtual-time --duration-s 1
+		expect "$f: --check" 0 "$bin" --check "$f"
 		continue
 	fi
 	if grep -qE 'transport: unix' "$f"; then
