@@ -349,8 +349,8 @@ $(BUILD)/obj/gen-bridge/%.o: $(DDS_GEN)/%.c $(DDS_GEN_H)
 
 # What includes the generated headers (the bridge, its tests) sees them.
 ifeq ($(WITH_DDS),1)
-$(BUILD)/obj/bridge/%.o $(BUILD)/obj-hooks/bridge/%.o $(BUILD)/obj/tests/bridge/%.o: ALL_CFLAGS += -I$(DDS_GEN)
-$(patsubst %.c,$(BUILD)/obj/%.o,$(wildcard bridge/*.c tests/bridge/*.c)): | $(DDS_GEN_H)
+$(BUILD)/obj/bridge/%.o $(BUILD)/obj-hooks/bridge/%.o $(BUILD)/obj/tests/bridge/%.o $(BUILD)/obj/bench/bench_teleop.o: ALL_CFLAGS += -I$(DDS_GEN)
+$(patsubst %.c,$(BUILD)/obj/%.o,$(wildcard bridge/*.c tests/bridge/*.c) bench/bench_teleop.c): | $(DDS_GEN_H)
 endif
 
 $(BUILD)/obj/%.o: %.cpp | $(FEATURES_H)

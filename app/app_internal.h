@@ -108,6 +108,9 @@ struct raw_teleop {
 	const char *follow_device, *feedback_device, *force_device;
 	double follow_scale, follow_gain_per_s, follow_max_speed_m_per_s;
 	double feedback_max_force_n;
+	const char *params_device;
+	struct px_bridge_params params_min, params_max;
+	bool has_params_max;
 };
 
 /* Remote devices and teleoperation; device indices into px_app.dev,
@@ -117,11 +120,14 @@ struct app_teleop {
 	struct px_bridge_config bridge; /* domain, network of dds devices */
 	struct {
 		int dev;
-		int64_t tmo_ns;
+		int64_t tmo_ns, connect_ns;
 		int pose_out;
-	} dds[64];
+		int input; /* its loop input (pose devices), -1 none */
+	} dds[64]; /* MAX_DEVS */
 	int n_dds;
-	int follow, feedback, force;
+	int follow, feedback, force, params;
+	double speed_scale;     /* remote parameter on the follow task */
+	uint64_t params_applied;
 	int force_input;        /* loop input of the remote force */
 	/* follower: offset caught at engagement, the last tracking error */
 	int engaged;
@@ -156,6 +162,7 @@ struct shutdown_report {
 /* ---- the application ----------------------------------------------- */
 
 #define MAX_DEVS 64
+_Static_assert(MAX_DEVS == 64, "app_teleop.dds holds MAX_DEVS entries");
 #define TELE_JOINTS PX_APP_RECORD_JOINTS
 #define PLOT_MAX ((size_t)1 << 20)
 
@@ -359,7 +366,11 @@ const struct px_config_schema *app_teleop_schema(void);
 int app_teleop_read(struct px_app *a);
 void app_teleop_check(struct px_app *a);
 int app_make_dds(struct px_app *a, int k);
+/* SCHED_FIFO priority `below` the loop's for the DDS link's threads
+ * (0: the loop has none to spare). */
+int app_link_priority(const struct px_config *cfg, int below);
 int app_teleop_attach(struct px_app *a);
+void app_teleop_input(struct px_app *a, int dev, int input);
 void app_teleop_read_phase(struct px_app *a, struct px_loop *l, int64_t now_ns);
 int app_teleop_follow(struct px_app *a, double *qnom);
 void app_teleop_compute(struct px_app *a);

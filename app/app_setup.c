@@ -586,8 +586,11 @@ int app_setup(struct px_app *a)
 		/* a dds device may be a pure output or remote force: nothing
 		 * for the watchdog to stamp */
 		if (rc == PX_OK &&
-		    (px_dev_caps(a->dev[i]) & (PX_DEV_CAP_POSE | PX_DEV_CAP_DIO)))
+		    (px_dev_caps(a->dev[i]) & (PX_DEV_CAP_POSE | PX_DEV_CAP_DIO))) {
 			rc = px_dev_attach(a->dev[i], a->loop);
+			if (rc >= 0 && a->tele.n_dds)
+				app_teleop_input(a, i, rc);
+		}
 		if (rc >= 0 && a->rendering && i == a->ctl_dev)
 			rc = px_dev_force_attach(a->dev[i], a->loop, &a->cmd);
 		if (rc < 0) {

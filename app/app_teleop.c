@@ -11,6 +11,17 @@
 
 /* ---- the teleop section ---------------------------------------------- */
 
+static const struct px_config_key params_keys[] = {
+	K_DBL(struct px_bridge_params, stiffness_n_per_m, "stiffness_n_per_m", 0,
+	      0, 1e7, 0),
+	K_DBL(struct px_bridge_params, damping_n_s_per_m, "damping_n_s_per_m", 0,
+	      0, 1e6, 0),
+	K_DBL(struct px_bridge_params, max_force_n, "max_force_n", 0, 0, 10000,
+	      0),
+	K_DBL(struct px_bridge_params, speed_scale, "speed_scale", 0, 0, 1, 0),
+};
+SCHEMA(params_schema, "params", params_keys, NULL);
+
 static const struct px_config_key teleop_keys[] = {
 	K_STR(struct raw_teleop, follow_device, "follow_device",
 	      PX_CONFIG_NONEMPTY),
@@ -26,6 +37,11 @@ static const struct px_config_key teleop_keys[] = {
 	      0, 0, 1000, 2.0),
 	K_STR(struct raw_teleop, force_device, "force_device",
 	      PX_CONFIG_NONEMPTY),
+	K_STR(struct raw_teleop, params_device, "params_device",
+	      PX_CONFIG_NONEMPTY),
+	K_SUB(struct raw_teleop, params_min, "params_min", params_schema),
+	K_SUBP(struct raw_teleop, params_max, "params_max", params_schema,
+	       has_params_max),
 };
 SCHEMA(teleop_schema, "teleop", teleop_keys, NULL);
 
@@ -38,12 +54,22 @@ int app_teleop_read(struct px_app *a)
 {
 	struct app_teleop *t = &a->tele;
 	int rc;
-	t->follow = t->feedback = t->force = -1;
+	t->follow = t->feedback = t->force = t->params = -1;
 	t->force_input = -1;
+	t->speed_scale = 1.0;
 	rc = px_config_read(a->cfg->doc, a->cfg->teleop, "teleop",
 			    &teleop_schema, &t->c, &a->diag);
 	if (rc == PX_OK)
 		rc = px_bridge_config_read(a->cfg, &t->bridge, &a->diag);
+	t->bridge.thread_priority = app_link_priority(a->cfg, 2);
+	/* without params_max: the config's own values, speed 1 (remote
+	 * updates may only lower them) */
+	if (rc == PX_OK && !t->c.has_params_max) {
+		t->c.params_max.stiffness_n_per_m = a->ctl.haptic.stiffness_n_per_m;
+		t->c.params_max.damping_n_s_per_m = a->ctl.haptic.damping_n_s_per_m;
+		t->c.params_max.max_force_n = a->ctl.haptic.max_force_n;
+		t->c.params_max.speed_scale = 1.0;
+	}
 	return rc;
 }
 
@@ -81,6 +107,18 @@ void app_teleop_check(struct px_app *a)
 		 offsetof(struct px_config_dds, command_topic), "command_topic",
 		 PX_CONTROL_MODE_AVOIDANCE,
 		 "forces from clearances need control mode 'avoidance' (an arm)");
+	need_dds(a, "params_device", c->params_device,
+		 offsetof(struct px_config_dds, params_topic), "params_topic",
+		 a->ctl.mode, "");
+	if (c->params_device &&
+	    (c->params_min.stiffness_n_per_m > c->params_max.stiffness_n_per_m ||
+	     c->params_min.damping_n_s_per_m > c->params_max.damping_n_s_per_m ||
+	     c->params_min.max_force_n > c->params_max.max_force_n ||
+	     c->params_min.speed_scale > c->params_max.speed_scale))
+		app_check_error(a, app_cfg_node(a, "teleop", "params_min"),
+				"teleop.params_min",
+				"a minimum above its maximum (params_max, or "
+				"the config's own value when absent)");
 	need_dds(a, "force_device", c->force_device,
 		 offsetof(struct px_config_dds, wrench_topic), "wrench_topic",
 		 PX_CONTROL_MODE_HAPTIC,
@@ -89,6 +127,12 @@ void app_teleop_check(struct px_app *a)
 }
 
 /* ---- dds devices ------------------------------------------------------ */
+
+int app_link_priority(const struct px_config *cfg, int below)
+{
+	int64_t p = cfg->loop.priority - below;
+	return p >= 1 ? (int)p : 0;
+}
 
 int app_make_dds(struct px_app *a, int k)
 {
@@ -117,6 +161,15 @@ int app_make_dds(struct px_app *a, int k)
 	bc.wrench_topic = d->dds.wrench_topic;
 	bc.pose_out_topic = d->dds.pose_out_topic;
 	bc.connect_timeout_ns = d->dds.connect_timeout_ns;
+	/* the link's thread just below the loop: it carries the loop's
+	 * inputs and outputs */
+	bc.thread_priority = app_link_priority(a->cfg, 1);
+	/* parameters only from the device teleop.params_device names */
+	if (t->c.params_device && !strcmp(t->c.params_device, d->name)) {
+		bc.params_topic = d->dds.params_topic;
+		bc.params_min = t->c.params_min;
+		bc.params_max = t->c.params_max;
+	}
 	rc = px_bridge_dev_create(&dc, &bc, &a->dev[i], msg, sizeof(msg));
 	if (rc != PX_OK) {
 		app_note(a, "%s: device '%s' (dds): %s\n", app_name(a), d->name,
@@ -128,6 +181,8 @@ int app_make_dds(struct px_app *a, int k)
 	t->dds[t->n_dds].dev = i;
 	t->dds[t->n_dds].tmo_ns = dc.stale_timeout_ns;
 	t->dds[t->n_dds].pose_out = d->dds.pose_out_topic != NULL;
+	t->dds[t->n_dds].connect_ns = d->dds.connect_timeout_ns;
+	t->dds[t->n_dds].input = -1;
 	t->n_dds++;
 	if (t->c.follow_device && !strcmp(t->c.follow_device, d->name))
 		t->follow = i;
@@ -135,9 +190,20 @@ int app_make_dds(struct px_app *a, int k)
 		t->feedback = i;
 	if (t->c.force_device && !strcmp(t->c.force_device, d->name))
 		t->force = i;
+	if (bc.params_topic)
+		t->params = i;
 	if (a->ctl.device && !strcmp(a->ctl.device, d->name) && d->dds.pose_topic)
 		a->ctl_dev = i;
 	return 0;
+}
+
+/* Device dev (index in px_app.dev) is the loop's input `input`. */
+void app_teleop_input(struct px_app *a, int dev, int input)
+{
+	int i;
+	for (i = 0; i < a->tele.n_dds; i++)
+		if (a->tele.dds[i].dev == dev)
+			a->tele.dds[i].input = input;
 }
 
 /* After the loop exists: the remote force is a watched input, the
@@ -182,6 +248,29 @@ void app_teleop_read_phase(struct px_app *a, struct px_loop *l, int64_t now_ns)
 			t->force_t_ns = at;
 			px_loop_input_stamp(l, t->force_input, at);
 		}
+	}
+	if (t->params >= 0) {
+		struct px_bridge_params p;
+		if (px_bridge_dev_params(a->dev[t->params], &p) == 1) {
+			/* checked against the configured ranges on receipt */
+			a->haptic.p.stiffness_n_per_m = p.stiffness_n_per_m;
+			a->haptic.p.damping_n_s_per_m = p.damping_n_s_per_m;
+			a->haptic.p.max_force_n = p.max_force_n;
+			t->speed_scale = p.speed_scale;
+			t->params_applied++;
+		}
+	}
+	/* the peer's loop may start a little after this one: until its
+	 * first sample (at most connect_timeout_ns after the start) a remote
+	 * input is not yet live, and not stale either */
+	for (i = 0; i < t->n_dds; i++) {
+		int k = t->dds[i].dev;
+		if (now_ns - a->t0_ns >= t->dds[i].connect_ns)
+			continue;
+		if (t->dds[i].input >= 0 && a->sample[k].seq == 0)
+			px_loop_input_stamp(l, t->dds[i].input, now_ns);
+		if (k == t->force && !t->force_t_ns)
+			px_loop_input_stamp(l, t->force_input, now_ns);
 	}
 	for (i = 0; i < t->n_dds && !t->link_lost; i++) {
 		int k = t->dds[i].dev, silent = 0;
@@ -283,6 +372,8 @@ int app_teleop_follow(struct px_app *a, double *qnom)
 	if (sp > t->c.follow_max_speed_m_per_s)
 		for (i = 0; i < 3; i++)
 			v[i] *= t->c.follow_max_speed_m_per_s / sp;
+	for (i = 0; i < 3; i++)
+		v[i] *= t->speed_scale;
 	dls(jac, n, v, qd);
 	for (i = 0; i < n; i++)
 		qnom[i] = qd[a->robot ? a->joint_perm[i] : i];
@@ -326,7 +417,7 @@ void app_teleop_compute(struct px_app *a)
 		t->fb_cmd.enable = 1;
 	}
 	if (t->force >= 0 && a->rendering) {
-		double f[3], m, lim = a->ctl.haptic.max_force_n;
+		double f[3], m, lim = a->haptic.p.max_force_n;
 		for (i = 0; i < 3; i++)
 			f[i] = a->cmd.force_n[i] + t->remote_force_n[i];
 		m = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
@@ -376,6 +467,8 @@ void app_teleop_summary(const struct px_app *a, struct px_app_summary *s)
 		s->remote_in += n.poses_in + n.wrenches_in;
 		s->remote_out += n.commands_out + n.poses_out;
 		s->remote_lost += n.lost;
+		s->params_accepted += n.params_accepted;
+		s->params_refused += n.params_refused;
 	}
 	s->link_lost = t->link_lost;
 	if (t->link_lost) {
@@ -384,6 +477,7 @@ void app_teleop_summary(const struct px_app *a, struct px_app_summary *s)
 		s->link_lost_t_s = (double)(t->link_lost_ns - a->t0_ns) * 1e-9;
 		s->link_silent_ns = t->link_silent_ns;
 	}
+	s->params_applied = t->params_applied;
 	s->follow_cycles = t->follow_cycles;
 	s->follow_error_max_m = t->follow_err_max_m;
 	s->follow_error_rms_m =

@@ -281,6 +281,9 @@ struct px_app_summary {
 	 * state, after engagement) */
 	int dds_devices;
 	uint64_t remote_in, remote_out, remote_lost;
+	/* remote parameter sets: accepted (within the configured ranges),
+	 * refused (non-finite or out of range), applied by the cycle */
+	uint64_t params_accepted, params_refused, params_applied;
 	int link_lost;
 	char link_lost_device[32];
 	double link_lost_t_s;

@@ -47,22 +47,6 @@ static void hist_init(struct hist *h)
 	h->max_ns = INT64_MIN;
 }
 
-static long env_long(const char *name, long def, long lo, long hi)
-{
-	const char *s = getenv(name);
-	char *end;
-	long v;
-	if (!s || !*s)
-		return def;
-	v = strtol(s, &end, 10);
-	if (*end || v < lo || v > hi) {
-		fprintf(stderr, "bench_rt: ignoring %s=%s (want %ld..%ld)\n",
-			name, s, lo, hi);
-		return def;
-	}
-	return v;
-}
-
 /* ---- cyclictest ---------------------------------------------------------- */
 
 static int find_cyclictest(char *path, size_t n)
@@ -217,8 +201,10 @@ static void latency_bench(void)
 	static struct hist ours, theirs;
 	struct px_loop_status st;
 	char prog[256];
-	long secs = env_long("PX_BENCH_RT_SECONDS", 10, 1, 86400);
-	int prio = (int)env_long("PX_BENCH_RT_PRIO", 80, 1, 99);
+	long secs = bench_env_long("bench_rt", "PX_BENCH_RT_SECONDS", 10, 1,
+				   86400);
+	int prio = (int)bench_env_long("bench_rt", "PX_BENCH_RT_PRIO", 80, 1,
+				       99);
 	long chunks = secs, c, done = 0; /* 1 s chunks: both see the same load */
 	int have_ct = find_cyclictest(prog, sizeof(prog)), ct_ok = have_ct;
 	int64_t qo[4], qt[4];

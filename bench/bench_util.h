@@ -1,8 +1,9 @@
 /*
  * bench_util.h - what the benchmarks share: a fixed-seed random stream
  * (so every run times the same inputs), a monotonic clock in ns, an
- * int64 comparison for qsort of timings, and where the FCL reference
- * program is. Benchmarks only; one include
+ * int64 comparison for qsort of timings, where the FCL reference
+ * program is, and a bounded integer from the environment. Benchmarks
+ * only; one include
  * per program (the stream's state is per file).
  */
 #ifndef PX_BENCH_UTIL_H
@@ -50,6 +51,25 @@ static inline void fcl_path(const char *argv0, char *path, size_t n)
 		snprintf(dir, sizeof(dir), "%s", argv0);
 		snprintf(path, n, "%s/fcl_models", dirname(dir));
 	}
+}
+
+/* The integer in environment variable name, def when unset or outside
+ * lo..hi (then said on stderr, prefixed by the program's name). */
+static inline long bench_env_long(const char *prog, const char *name,
+				  long def, long lo, long hi)
+{
+	const char *s = getenv(name);
+	char *end;
+	long v;
+	if (!s || !*s)
+		return def;
+	v = strtol(s, &end, 10);
+	if (*end || v < lo || v > hi) {
+		fprintf(stderr, "%s: ignoring %s=%s (want %ld..%ld)\n", prog,
+			name, s, lo, hi);
+		return def;
+	}
+	return v;
 }
 
 #endif

@@ -91,6 +91,21 @@ static const char *discovery_problem(int discovery, const char *iface)
 	return NULL;
 }
 
+/* The file goes into a comma-separated list of Cyclone configuration
+ * sources: no comma, no XML. */
+static const char *security_problem(const char *s)
+{
+	if (!s)
+		return NULL;
+	if (!*s)
+		return "must not be empty";
+	if (strlen(s) >= 512)
+		return "is too long";
+	if (strpbrk(s, ",<>\"'"))
+		return "may not hold ',', '<', '>' or quotes (a file path)";
+	return NULL;
+}
+
 static const char *frame_problem(const char *s)
 {
 	if (!s)
@@ -131,6 +146,10 @@ int px_bridge_config_check(const struct px_bridge_config *c, char *why,
 		snprintf(why, cap, "frame_id %s", p);
 		return PX_E_INVAL;
 	}
+	if ((p = security_problem(c->security_file))) {
+		snprintf(why, cap, "security_file %s", p);
+		return PX_E_INVAL;
+	}
 	if (c->discovery < 0 || c->discovery > PX_BRIDGE_DISCOVERY_MULTICAST) {
 		snprintf(why, cap, "unknown discovery %d", c->discovery);
 		return PX_E_INVAL;
@@ -164,6 +183,9 @@ static void bridge_check(struct px_config_reader *r,
 	if ((p = frame_problem(c->frame_id)))
 		px_config_reader_error(r, px_config_node_get(map, "frame_id"),
 				       "frame_id", "%s", p);
+	if ((p = security_problem(c->security_file)))
+		px_config_reader_error(r, px_config_node_get(map, "security_file"),
+				       "security_file", "%s", p);
 	if (!iface_problem(c->interface) &&
 	    (p = discovery_problem(c->discovery, c->interface)))
 		px_config_reader_error(r, px_config_node_get(map, "discovery"),
@@ -187,6 +209,8 @@ static const struct px_config_key bridge_keys[] = {
 	{.name = "frame_id", .type = PX_CONFIG_T_STRING,
 	 .offset = offsetof(struct px_bridge_config, frame_id),
 	 .flags = PX_CONFIG_NONEMPTY, .sdef = "world"},
+	{.name = "security_file", .type = PX_CONFIG_T_STRING,
+	 .offset = offsetof(struct px_bridge_config, security_file)},
 	RATE_KEY(tool_pose_rate_hz, "tool_pose_rate_hz", 100),
 	RATE_KEY(proxy_pose_rate_hz, "proxy_pose_rate_hz", 100),
 	RATE_KEY(wrench_rate_hz, "wrench_rate_hz", 100),
@@ -247,13 +271,26 @@ int px_bridge_is_loopback(const char *iface)
 int px_bridge_dds_config(const struct px_bridge_config *c, char *buf,
 			 size_t cap)
 {
-	char why[160];
+	char why[160], thr[640] = "";
 	int n, unicast;
 	if (!buf || !cap)
 		return PX_E_INVAL;
 	buf[0] = '\0';
 	if (px_bridge_config_check(c, why, sizeof(why)) != PX_OK)
 		return PX_E_INVAL;
+	if (c->thread_priority > 0 && c->thread_priority < 100) {
+		static const char *const names[] = {"recv", "dq.user", "tev"};
+		size_t i, k = 0;
+		k += (size_t)snprintf(thr + k, sizeof(thr) - k, "<Threads>");
+		for (i = 0; i < 3; i++)
+			k += (size_t)snprintf(
+				thr + k, sizeof(thr) - k,
+				"<Thread name=\"%s\"><Scheduling><Class>realtime"
+				"</Class><Priority>%d</Priority></Scheduling>"
+				"</Thread>",
+				names[i], c->thread_priority);
+		snprintf(thr + k, sizeof(thr) - k, "</Threads>");
+	}
 	unicast = c->discovery == PX_BRIDGE_DISCOVERY_UNICAST ||
 		  (c->discovery == PX_BRIDGE_DISCOVERY_AUTO &&
 		   px_bridge_is_loopback(c->interface));
@@ -263,7 +300,7 @@ int px_bridge_dds_config(const struct px_bridge_config *c, char *buf,
 		     "<AllowMulticast>%s</AllowMulticast></General>"
 		     "<Discovery><ParticipantIndex>auto</ParticipantIndex>"
 		     "<MaxAutoParticipantIndex>%d</MaxAutoParticipantIndex>"
-		     "%s</Discovery></Domain></CycloneDDS>",
+		     "%s</Discovery>%s</Domain></CycloneDDS>",
 		     is_address(c->interface) ? "address" : "name",
 		     c->interface,
 		     !unicast && px_bridge_is_loopback(c->interface)
@@ -271,6 +308,10 @@ int px_bridge_dds_config(const struct px_bridge_config *c, char *buf,
 			     : "",
 		     unicast ? "false" : "true", PX_BRIDGE_MAX_PARTICIPANTS,
 		     unicast ? "<Peers><Peer address=\"127.0.0.1\"/></Peers>"
-			     : "");
+			     : "",
+		     thr);
+	if (n > 0 && (size_t)n < cap && c->security_file)
+		n += snprintf(buf + n, cap - (size_t)n, ",file://%s",
+			      c->security_file);
 	return n > 0 && (size_t)n < cap ? PX_OK : PX_E_RANGE;
 }

@@ -69,7 +69,7 @@ enum px_bridge_discovery {
 
 #define PX_BRIDGE_NAME_MAX 128 /* namespace, interface, frame id */
 #define PX_BRIDGE_TOPIC_MAX 192 /* "rt/<namespace>/<name>" */
-#define PX_BRIDGE_DDS_CONFIG_MAX 1024 /* the generated Cyclone XML */
+#define PX_BRIDGE_DDS_CONFIG_MAX 2048 /* the generated Cyclone XML */
 
 /* The section "bridge" of a config (docs/config.md). Rates in Hz; 0
  * leaves that stream unpublished. Strings point into the config's
@@ -81,6 +81,13 @@ struct px_bridge_config {
 	const char *interface;   /* network interface name or IPv4 address */
 	int discovery;           /* enum px_bridge_discovery */
 	const char *frame_id;    /* header.frame_id of every message */
+	/* key "security_file": a Cyclone DDS XML file (its DDS Security
+	 * section) added to the generated configuration; NULL none */
+	const char *security_file;
+	/* not a key: SCHED_FIFO priority of Cyclone's receive, delivery
+	 * and timed-event threads (1..99; 0: normal scheduling), so a
+	 * loaded machine does not starve a real-time loop's link */
+	int thread_priority;
 	double tool_pose_rate_hz;
 	double proxy_pose_rate_hz;
 	double wrench_rate_hz;
@@ -129,7 +136,9 @@ PX_API const void *px_bridge_topic_descriptor(enum px_bridge_topic t);
 /*
  * The Cyclone DDS configuration the bridge runs with (XML, the content a
  * CYCLONEDDS_URI could hold): the interface, multicast off and the
- * localhost peers for unicast discovery. PX_OK or PX_E_RANGE / PX_E_INVAL.
+ * localhost peers for unicast discovery, then ",file://<security_file>"
+ * when one is given (Cyclone reads the list in order). PX_OK or
+ * PX_E_RANGE / PX_E_INVAL.
  */
 PX_API int px_bridge_dds_config(const struct px_bridge_config *c, char *buf,
 				size_t cap);
@@ -212,8 +221,15 @@ PX_API void px_bridge_free(struct px_bridge *b);
 
 /* ---- the "dds" device back end -------------------------------------- */
 
+/* Remote parameters (proxima_msgs/Params): the haptic renderer's
+ * stiffness, damping and force clamp, and a speed scale on the task. */
+struct px_bridge_params {
+	double stiffness_n_per_m, damping_n_s_per_m, max_force_n, speed_scale;
+};
+
 /* A device on DDS topics rt/<namespace>/<topic> (bridge's namespace and
- * network), best-effort keep-last-1 as the bridge's streams. */
+ * network), best-effort keep-last-1 as the bridge's streams (the
+ * parameters reliable). */
 struct px_bridge_dev_config {
 	const struct px_bridge_config *bridge; /* domain, namespace, network */
 	/* geometry_msgs/PoseStamped in: the device's pose input (NULL none) */
@@ -226,9 +242,18 @@ struct px_bridge_dev_config {
 	/* geometry_msgs/PoseStamped out: a pose written in the cycle with
 	 * px_bridge_dev_pose_write() (NULL none) */
 	const char *pose_out_topic;
+	/* proxima_msgs/Params in (reliable; NULL none): a message whose
+	 * every value is finite and within [params_min, params_max] is
+	 * handed to the cycle (px_bridge_dev_params()), any other is
+	 * refused and counted. Not waited for by px_dev_start(). */
+	const char *params_topic;
+	struct px_bridge_params params_min, params_max;
 	/* px_dev_start() waits at most this long until every topic above
-	 * has a peer (0: no wait) */
+	 * but the parameters has a peer (0: no wait) */
 	int64_t connect_timeout_ns;
+	/* SCHED_FIFO priority of the device's thread (1..99; 0: normal
+	 * scheduling; refused without the privilege: normal) */
+	int thread_priority;
 };
 
 /*
@@ -261,9 +286,16 @@ PX_API int px_bridge_dev_wrench(struct px_dev *d, struct px_force_cmd *out,
 PX_API int px_bridge_dev_pose_write(struct px_dev *d, const px_vec3 *pos_m,
 				    const px_quat *q);
 
+/* The newest accepted parameter set, when one arrived since this
+ * thread's last call: 1 and *out, else 0; PX_E_INVAL (not a dds device
+ * with a params_topic). Through a px_param triple buffer: never torn.
+ * Loop thread. @note RT-safe. */
+PX_API int px_bridge_dev_params(struct px_dev *d, struct px_bridge_params *out);
+
 /* What a dds device's thread did. */
 struct px_bridge_dev_counts {
 	uint64_t poses_in, wrenches_in, commands_out, poses_out;
+	uint64_t params_accepted, params_refused;
 	/* best-effort samples the readers know were lost (DDS's sample
 	 * lost status, sequence gaps) */
 	uint64_t lost;

@@ -7,6 +7,7 @@
  * swaps values through seqlock slots. */
 #include <math.h>
 #include <pthread.h>
+#include <sched.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <string.h>
@@ -15,6 +16,12 @@
 
 #include "bridge_internal.h"
 #include "geometry_msgs.h"
+#include "proxima_msgs.h"
+#include "px_arena.h"
+#include "px_param.h"
+
+/* Parameter sets a reader holds until the device's thread takes them. */
+#define PARAMS_DEPTH 64
 
 /* A value handed between the cycle and the device's thread: seq is odd
  * while the writer copies; a reader retries a torn copy. */
@@ -38,13 +45,19 @@ struct dds_dev {
 	char topics[4][PX_BRIDGE_TOPIC_MAX]; /* for the connect message */
 	dds_entity_t domain, dp, reader, writer, ws;
 	dds_entity_t wreader, pwriter; /* wrench in, pose out */
+	dds_entity_t preader;          /* parameters in */
+	struct px_bridge_params pmin, pmax;
+	struct px_arena arena;         /* the parameters' triple buffer */
+	struct px_param *params;
 	int64_t connect_timeout_ns;
+	int priority;
 	pthread_t th;
 	int started;
 	atomic_int stop;
 	struct slot cmd, pose_out, wrench;
 	uint64_t sent_seq, pose_sent_seq;
 	_Atomic uint64_t n_pose, n_wrench, n_cmd, n_pose_out, n_lost;
+	_Atomic uint64_t n_accepted, n_refused;
 };
 
 static void slot_put(struct slot *s, const void *v, size_t n)
@@ -180,6 +193,47 @@ static int send_wrench(struct dds_dev *x, const struct px_force_cmd *c)
 	return PX_OK;
 }
 
+/* v within [lo, hi] and finite (NaN fails both comparisons). */
+static int in_range(double v, double lo, double hi)
+{
+	return v >= lo && v <= hi && isfinite(v);
+}
+
+/* Parameter sets as they arrive: each value checked against the
+ * configured range, the set applied whole or refused whole. */
+static void take_params(struct dds_dev *x)
+{
+	for (;;) {
+		void *buf[1] = {NULL};
+		dds_sample_info_t info[1];
+		int n = dds_take(x->preader, buf, info, 1, 1);
+		if (n <= 0)
+			return;
+		if (info[0].valid_data) {
+			const proxima_msgs_msg_dds__Params_ *m = buf[0];
+			struct px_bridge_params p;
+			p.stiffness_n_per_m = m->stiffness_n_per_m;
+			p.damping_n_s_per_m = m->damping_n_s_per_m;
+			p.max_force_n = m->max_force_n;
+			p.speed_scale = m->speed_scale;
+			if (in_range(p.stiffness_n_per_m, x->pmin.stiffness_n_per_m,
+				     x->pmax.stiffness_n_per_m) &&
+			    in_range(p.damping_n_s_per_m, x->pmin.damping_n_s_per_m,
+				     x->pmax.damping_n_s_per_m) &&
+			    in_range(p.max_force_n, x->pmin.max_force_n,
+				     x->pmax.max_force_n) &&
+			    in_range(p.speed_scale, x->pmin.speed_scale,
+				     x->pmax.speed_scale)) {
+				px_param_write(x->params, &p);
+				atomic_fetch_add(&x->n_accepted, 1);
+			} else {
+				atomic_fetch_add(&x->n_refused, 1);
+			}
+		}
+		dds_return_loan(x->preader, buf, n);
+	}
+}
+
 /* The newest command, when the cycle wrote one since the last send. */
 static void send_newest(struct dds_dev *x)
 {
@@ -230,6 +284,14 @@ static void *dev_thread(void *arg)
 {
 	struct dds_dev *x = arg;
 	int outputs = x->writer > 0 || x->pwriter > 0;
+	if (x->priority > 0) {
+		/* beside the loop, below it; refused (no privilege): the
+		 * thread runs at normal priority, as without */
+		struct sched_param sp;
+		memset(&sp, 0, sizeof(sp));
+		sp.sched_priority = x->priority;
+		pthread_setschedparam(pthread_self(), SCHED_FIFO, &sp);
+	}
 	dds_duration_t poll = outputs ? DDS_USECS(100) : DDS_MSECS(1);
 	while (!atomic_load(&x->stop)) {
 		if (x->ws > 0)
@@ -240,6 +302,8 @@ static void *dev_thread(void *arg)
 			take_poses(x);
 		if (x->wreader > 0)
 			take_wrenches(x);
+		if (x->preader > 0)
+			take_params(x);
 		if (x->writer > 0)
 			send_newest(x);
 		if (x->pwriter > 0)
@@ -343,6 +407,7 @@ static void dev_destroy(struct px_dev *d)
 		dds_delete(x->dp);
 	if (x->domain > 0)
 		dds_delete(x->domain);
+	px_arena_fini(&x->arena);
 }
 
 /* One table per caps combination (index: bit 0 pose, bit 1 force). */
@@ -399,6 +464,20 @@ int px_bridge_dev_pose_write(struct px_dev *d, const px_vec3 *pos_m,
 	return PX_OK;
 }
 
+int px_bridge_dev_params(struct px_dev *d, struct px_bridge_params *out)
+{
+	struct dds_dev *x = dds_of(d);
+	const struct px_bridge_params *p;
+	int fresh = 0;
+	if (!x || !x->params || !out)
+		return PX_E_INVAL;
+	p = px_param_read(x->params, &fresh);
+	if (!fresh)
+		return 0;
+	*out = *p;
+	return 1;
+}
+
 int px_bridge_dev_counts(struct px_dev *d, struct px_bridge_dev_counts *out)
 {
 	struct dds_dev *x = dds_of(d);
@@ -409,6 +488,8 @@ int px_bridge_dev_counts(struct px_dev *d, struct px_bridge_dev_counts *out)
 	out->commands_out = atomic_load(&x->n_cmd);
 	out->poses_out = atomic_load(&x->n_pose_out);
 	out->lost = atomic_load(&x->n_lost);
+	out->params_accepted = atomic_load(&x->n_accepted);
+	out->params_refused = atomic_load(&x->n_refused);
 	return PX_OK;
 }
 
@@ -417,10 +498,15 @@ static dds_entity_t endpoint(struct dds_dev *x, const char *ns,
 			     int reader)
 {
 	char topic[PX_BRIDGE_TOPIC_MAX];
-	dds_qos_t *q = px__bridge_qos(0); /* a stream, as the bridge's */
+	/* a stream, as the bridge's; the parameters reliable, and kept
+	 * until the thread takes them (a burst is not cut to its last) */
+	int params = t == &proxima_msgs_msg_dds__Params__desc;
+	dds_qos_t *q = px__bridge_qos(params);
 	dds_entity_t tp, e;
 	if (!q)
 		return DDS_RETCODE_OUT_OF_RESOURCES;
+	if (params && reader)
+		dds_qset_history(q, DDS_HISTORY_KEEP_LAST, PARAMS_DEPTH);
 	if (px_bridge_topic_name(ns, name, topic, sizeof(topic)) != PX_OK) {
 		dds_delete_qos(q);
 		return DDS_RETCODE_BAD_PARAMETER;
@@ -482,6 +568,26 @@ static int open_dds(struct dds_dev *x, const struct px_bridge_dev_config *bc,
 			return PX_E_IO;
 		}
 	}
+	if (bc->params_topic) {
+		struct px_bridge_params zero;
+		memset(&zero, 0, sizeof(zero));
+		x->pmin = bc->params_min;
+		x->pmax = bc->params_max;
+		rc = px_arena_init_alloc(&x->arena,
+					 px_param_size(sizeof(zero)) + 256);
+		if (rc == PX_OK)
+			rc = px_param_create(&x->arena, sizeof(zero), &zero,
+					     &x->params);
+		if (rc != PX_OK)
+			return rc;
+		x->preader = watched_reader(x, c->ns, bc->params_topic,
+					    &proxima_msgs_msg_dds__Params__desc);
+		if (x->preader < 0) {
+			snprintf(msg, cap, "dds device: cannot read %s: %s",
+				 bc->params_topic, dds_strretcode(x->preader));
+			return PX_E_IO;
+		}
+	}
 	return PX_OK;
 }
 
@@ -500,7 +606,7 @@ int px_bridge_dev_create(const struct px_dev_config *dc,
 	*out = NULL;
 	if (!dc || !bc || !bc->bridge ||
 	    (!bc->pose_topic && !bc->command_topic && !bc->wrench_topic &&
-	     !bc->pose_out_topic) ||
+	     !bc->pose_out_topic && !bc->params_topic) ||
 	    bc->connect_timeout_ns < 0) {
 		snprintf(msg, cap, "dds device: a pose, wrench, command or "
 				   "pose_out topic needed");
@@ -518,6 +624,7 @@ int px_bridge_dev_create(const struct px_dev_config *dc,
 	x->d = *out;
 	snprintf(x->frame, sizeof(x->frame), "%s", bc->bridge->frame_id);
 	x->connect_timeout_ns = bc->connect_timeout_ns;
+	x->priority = bc->thread_priority;
 	rc = open_dds(x, bc, msg, cap);
 	if (rc != PX_OK) {
 		px_dev_free(*out);

@@ -36,3 +36,9 @@ int px_bridge_dev_counts(struct px_dev *d, struct px_bridge_dev_counts *out)
 	(void)d, (void)out;
 	return PX_E_INVAL;
 }
+
+int px_bridge_dev_params(struct px_dev *d, struct px_bridge_params *out)
+{
+	(void)d, (void)out;
+	return PX_E_INVAL;
+}

@@ -645,6 +645,7 @@ struct px_config_dds {
 	const char *wrench_topic;    /* WrenchStamped in: a remote force */
 	const char *command_topic;   /* WrenchStamped out: zero in safe state */
 	const char *pose_out_topic;  /* PoseStamped out: control.device's pose */
+	const char *params_topic;    /* proxima_msgs Params in (teleop) */
 	int64_t connect_timeout_ns;  /* setup waits this long for the peers */
 };
 

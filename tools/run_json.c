@@ -105,10 +105,15 @@ static void json_figures(FILE *f, const struct run_result *r)
 		fprintf(f,
 			"  \"remote\": {\"dds_devices\": %d, \"samples_in\": %llu, "
 			"\"samples_out\": %llu, \"lost\": %llu, "
+			"\"params_accepted\": %llu, \"params_refused\": %llu, "
+			"\"params_applied\": %llu, "
 			"\"link_lost\": %s, \"link_lost_device\": ",
 			S->dds_devices, (unsigned long long)S->remote_in,
 			(unsigned long long)S->remote_out,
 			(unsigned long long)S->remote_lost,
+			(unsigned long long)S->params_accepted,
+			(unsigned long long)S->params_refused,
+			(unsigned long long)S->params_applied,
 			S->link_lost ? "true" : "false");
 		json_string(f, S->link_lost_device);
 		fprintf(f,

@@ -172,6 +172,10 @@ void run_print_summary(const struct run_result *r)
 		       (unsigned long long)S->remote_in,
 		       (unsigned long long)S->remote_out,
 		       (unsigned long long)S->remote_lost);
+		if (S->params_accepted || S->params_refused)
+			printf("; parameters %llu accepted, %llu refused",
+			       (unsigned long long)S->params_accepted,
+			       (unsigned long long)S->params_refused);
 		if (S->link_lost)
 			printf("; link lost ('%s' silent %.1f ms at %.3f s: safe "
 			       "state latched)",

@@ -11,6 +11,9 @@
  * tests/bridge/test_bridge_run.sh:
  *   PX_BRIDGE_TEST_ROLE=publish:DOMAIN:NAMESPACE:SECONDS
  *   PX_BRIDGE_TEST_ROLE=listen:DOMAIN:NAMESPACE:SECONDS
+ *   PX_BRIDGE_TEST_ROLE=params:DOMAIN:NAMESPACE/TOPIC:COUNT (COUNT bad
+ *     parameter sets, 2 ms apart: non-finite or absurd values; COUNT 0:
+ *     one set of modest values)
  * (listen exits 0 once a tool pose, a wrench and a status arrived.)
  * Every wait is bounded; discovery is retried until its deadline.
  */
@@ -219,6 +222,13 @@ static void test_dds_config(void)
 	PX_CHECK(strstr(xml, "<NetworkInterface name=\"eth0\"/>"));
 	PX_CHECK(!strstr(xml, "<Peer ") && !strstr(xml, "multicast=\""));
 	PX_CHECK_INT_EQ(px_bridge_dds_config(&c, xml, 40), PX_E_RANGE);
+	/* a security configuration passed through as a second source */
+	c.security_file = "/etc/proxima/dds_security.xml";
+	PX_CHECK_INT_EQ(px_bridge_dds_config(&c, xml, sizeof(xml)), PX_OK);
+	PX_CHECK(strstr(xml, "</CycloneDDS>,file:///etc/proxima/dds_security.xml"));
+	c.security_file = "a,b.xml";
+	PX_CHECK_INT_EQ(px_bridge_dds_config(&c, xml, sizeof(xml)), PX_E_INVAL);
+	c.security_file = NULL;
 	c.interface = "lo\"/><x";
 	PX_CHECK_INT_EQ(px_bridge_dds_config(&c, xml, sizeof(xml)), PX_E_INVAL);
 	PX_CHECK_INT_EQ(px_bridge_config_check(&c, why, sizeof(why)),
@@ -865,6 +875,66 @@ static int role_listen(const char *role)
 	return n == 3 ? 0 : 1;
 }
 
+/* A peer that sends parameter sets (proxima_msgs/Params, reliable) to
+ * rt/NAMESPACE/TOPIC once a reader matched (at most 10 s): COUNT sets
+ * each with one value non-finite or far out of any range, or with COUNT
+ * 0 one set of modest values. Exit 0 when all were written. */
+static int role_params(const char *role)
+{
+	char ns[128], *slash;
+	double count;
+	int domain, i, n, fails = 0;
+	dds_entity_t dom = 0, dp, t, w;
+	dds_qos_t *q;
+	dds_publication_matched_status_t st;
+	int64_t end = mono_ns() + 10000000000LL;
+	char topic[PX_BRIDGE_TOPIC_MAX];
+	if (parse_role(role, "params", &domain, ns, sizeof(ns), &count) ||
+	    !(slash = strrchr(ns, '/')))
+		return 2;
+	*slash = '\0';
+	dp = join(domain, &dom);
+	px_bridge_topic_name(ns, slash + 1, topic, sizeof(topic));
+	q = dds_create_qos();
+	dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
+	dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 1);
+	t = dds_create_topic(dp, &proxima_msgs_msg_dds__Params__desc, topic, q,
+			     NULL);
+	w = t < 0 ? t : dds_create_writer(dp, t, q, NULL);
+	dds_delete_qos(q);
+	if (w < 0)
+		return 1;
+	do
+		dds_sleepfor(DDS_MSECS(5));
+	while (dds_get_publication_matched_status(w, &st) == 0 &&
+	       !st.current_count && mono_ns() < end);
+	n = count > 0 ? (int)count : 1;
+	for (i = 0; i < n; i++) {
+		proxima_msgs_msg_dds__Params_ m;
+		memset(&m, 0, sizeof(m));
+		m.header.frame_id = "world";
+		m.stiffness_n_per_m = 100;
+		m.damping_n_s_per_m = 0.1;
+		m.max_force_n = 1;
+		m.speed_scale = 0.5;
+		switch (count > 0 ? i % 5 : -1) {
+		case 0: m.stiffness_n_per_m = NAN; break;
+		case 1: m.stiffness_n_per_m = 1e12; break;
+		case 2: m.damping_n_s_per_m = -1; break;
+		case 3: m.max_force_n = INFINITY; break;
+		case 4: m.speed_scale = 7; break;
+		default: break;
+		}
+		fails += dds_write(w, &m) != DDS_RETCODE_OK;
+		dds_sleepfor(DDS_MSECS(2));
+	}
+	dds_sleepfor(DDS_MSECS(100)); /* reliable: let the last arrive */
+	dds_delete(dp);
+	if (dom > 0)
+		dds_delete(dom);
+	return fails ? 1 : 0;
+}
+
 #else
 
 static void test_round_trip_two_processes(void)
@@ -899,6 +969,8 @@ int main(int argc, char **argv)
 			return role_publish(role);
 		if (!strncmp(role, "listen:", 7))
 			return role_listen(role);
+		if (!strncmp(role, "params:", 7))
+			return role_params(role);
 #endif
 		fprintf(stderr, "unknown or unsupported role '%s'\n", role);
 		return 2;

@@ -7,7 +7,9 @@
 #     displacement within 50 mm (rms within 30 mm; the stated error of
 #     docs/bridge.md), forces come back, both loops' threads make no heap
 #     call after setup with the link running (the tests' allocation
-#     counter, preloaded), the master never enters safe state;
+#     counter, preloaded), the master never enters safe state; a flood of
+#     200 non-finite or out-of-range parameter sets is refused and
+#     counted, a valid one after it applied;
 #  2. the master killed (SIGKILL) mid-run: the follower latches safe state
 #     with its input silent for its 100 ms timeout (plus a cycle), and
 #     stays there after the run;
@@ -63,10 +65,15 @@ run() {
 	pids="$pids $last"
 }
 
-# 1. both sides, the master ending first
+# 1. both sides, the master ending first; meanwhile a flood of bad
+# parameter sets, then one good one, at the master
 rm -f "$tmp"/*.json
 run follower 3.5; fp=$last
 run master 2.5; mp=$last
+PX_BRIDGE_TEST_ROLE="params:$domain:$ns/master/params:200" "$b/tests/test_bridge" >"$tmp/flood.out" 2>&1
+floodrc=$?
+PX_BRIDGE_TEST_ROLE="params:$domain:$ns/master/params:0" "$b/tests/test_bridge" >"$tmp/good.out" 2>&1
+goodrc=$?
 wait "$mp"; mrc=$?
 wait "$fp"; frc=$?
 pids=
@@ -81,6 +88,11 @@ if [ -s "$tmp/follower.json" ] && [ -s "$tmp/master.json" ]; then
 	check "the master read the follower's forces ($(num "$mj" samples_in))" "$(num "$mj" samples_in) > 1500"
 	check "a force came back (max $(num "$mj" max_force_n) N)" "$(num "$mj" max_force_n) > 0.1"
 	check "the master never entered safe state" "$(num "$mj" safe_state_trips) == 0"
+	check "200 bad parameter sets sent, one good one (exit $floodrc, $goodrc)" "$floodrc == 0 && $goodrc == 0"
+	check "bad parameter sets refused and counted ($(num "$mj" params_refused) of 200)" \
+		"$(num "$mj" params_refused) >= 100 && $(num "$mj" params_refused) <= 200"
+	check "only the good set accepted and applied ($(num "$mj" params_accepted), $(num "$mj" params_applied))" \
+		"$(num "$mj" params_accepted) == 1 && $(num "$mj" params_applied) == 1"
 	check "no reliable-topic loss, best-effort loss counted ($(num "$fj" lost), $(num "$mj" lost))" \
 		"$(num "$fj" lost) >= 0 && $(num "$mj" lost) >= 0"
 	for j in "$mj" "$fj"; do
