@@ -35,6 +35,9 @@ async function live() {
   t.ok(b.p > a.p && a.p > 0, "live: the plots receive data", [a.p, b.p]);
   t.ok(b.r > a.r, "live: the view keeps rendering", [a.r, b.r]);
 
+  // The fixture swaps its cloud every 60 frames (2 s).
+  t.ok(await until(page, () => window.pxView.cloudsSwapped >= 1, null, 4000), "live: a swapped cloud replaces the model's points");
+
   // Follow the tool: the camera's target moves with the tool.
   await page.check("#follow");
   const rel = () => page.evaluate(() => window.pxView.cameraTarget.map((v, i) => v - window.pxView.toolDrawn[i]));

@@ -279,6 +279,7 @@ export class View {
     obj.geometry.dispose();
     obj.geometry = new THREE.BufferGeometry();
     obj.geometry.setAttribute("position", new THREE.Float32BufferAttribute(positions || [], 3));
+    pxView.cloudsSwapped++;
     this.dirty = true;
   }
 

@@ -14,6 +14,7 @@ export const pxView = {
   ended: false,          // live: the server said the run finished
   replay: null,          // replay/report: {playing, t_s, speed, frames}
   cameraTarget: [0, 0, 0], // the point the camera orbits (follows the tool when asked)
+  cloudsSwapped: 0,      // "cloud" messages applied to a model of the scene
 };
 
 export function reportError(what) {
