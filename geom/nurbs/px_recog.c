@@ -241,6 +241,10 @@ static void qarc_table(const struct px_nurbs_curve *c,
 		q->a[n] = acc;
 		q->lam[n] = sqrt(w0 / w2);
 		q->half[n] = half;
+		q->mid[n][0] = cos(acc + half);
+		q->mid[n][1] = sin(acc + half);
+		q->chalf[n] = wn;
+		q->tquart[n] = tan(0.5 * half);
 		acc += turn;
 		n++;
 		q->u[n] = c->knots[k + 1];
@@ -248,6 +252,16 @@ static void qarc_table(const struct px_nurbs_curve *c,
 	q->a[n] = acc;
 	if (n > 0 && fabs(acc - ar->sweep) <= 1e-9)
 		q->n = n;
+}
+
+/* struct px_recog_arc's trig of a sweep. */
+static void sweep_trig(double sweep, double t[5])
+{
+	t[0] = cos(0.5 * sweep);
+	t[1] = sin(0.5 * sweep);
+	t[2] = sweep >= TWO_PI ? -2.0 : t[0];
+	t[3] = cos(sweep);
+	t[4] = sin(sweep);
 }
 
 static int rec_arc(const struct px_nurbs_curve *c, double tol, double margin,
@@ -392,6 +406,7 @@ static int rec_arc(const struct px_nurbs_curve *c, double tol, double margin,
 	if (!(sweep > 0) || sweep > TWO_PI + 1e-9)
 		return 0;
 	ar.sweep = sweep > TWO_PI ? TWO_PI : sweep;
+	sweep_trig(ar.sweep, ar.trig);
 	r->kind = PX_RECOG_ARC;
 	r->arc = ar;
 	r->linear = 0;
@@ -685,6 +700,7 @@ static void rev_fill(int d, double hd, double size, double tol,
 	out->rev.e0 = rr->arc.e0;
 	out->rev.e1 = rr->arc.e1;
 	out->rev.sweep = rr->arc.sweep;
+	memcpy(out->rev.trig, rr->arc.trig, sizeof(out->rev.trig));
 	out->rev.profile_is_arc = pr->kind == PX_RECOG_ARC;
 	out->rev.pseg = pr->seg;
 	out->rev.parc = pr->arc;
@@ -943,11 +959,28 @@ static px_vec3 seg_closest(const struct px_recog_seg *sg, px_vec3 p, double *t)
 	return px_v3_madd(sg->p0, sg->dir, s);
 }
 
-static px_vec3 arc_point(const struct px_recog_arc *ar, double f)
+/* The direction of a closest point on an arc or about an axis: the unit
+ * vector (c, s) in the (e0, e1) frame, and end 0 inside the sweep, 1 at
+ * its start, 2 at its end (the angle is only computed when a parameter
+ * inversion needs it: dir_angle()). */
+struct adir {
+	double c, s;
+	int end;
+};
+
+static px_vec3 arc_at(const struct px_recog_arc *ar, double c, double s)
 {
 	return px_v3_add(ar->center,
-			 px_v3_add(px_v3_scale(ar->e0, ar->radius * cos(f)),
-				   px_v3_scale(ar->e1, ar->radius * sin(f))));
+			 px_v3_add(px_v3_scale(ar->e0, ar->radius * c),
+				   px_v3_scale(ar->e1, ar->radius * s)));
+}
+
+/* 1 when the direction (x, y) of length r lies in the sweep of trig
+ * (struct px_recog_arc): its angle from the middle is at most half the
+ * sweep. */
+static int in_sweep(double x, double y, double r, const double *trig)
+{
+	return x * trig[0] + y * trig[1] >= r * trig[2];
 }
 
 /* Angle of (x, y) in [mid - pi, mid + pi). */
@@ -961,77 +994,83 @@ static double angle_near(double y, double x, double mid)
 	return f;
 }
 
-static px_vec3 arc_closest(const struct px_recog_arc *ar, px_vec3 p, double *f,
+static double dir_angle(const struct adir *d, double sweep)
+{
+	return d->end == 1 ? 0.0 : d->end == 2 ? sweep : angle_near(d->s, d->c, 0.5 * sweep);
+}
+
+static px_vec3 arc_closest(const struct px_recog_arc *ar, px_vec3 p, struct adir *d,
 			   int *tie)
 {
 	px_vec3 w = px_v3_sub(p, ar->center);
-	double x = px_v3_dot(ar->e0, w), y = px_v3_dot(ar->e1, w), phi;
+	double x = px_v3_dot(ar->e0, w), y = px_v3_dot(ar->e1, w);
+	double r = sqrt(x * x + y * y);
 	px_vec3 q0, q1;
 	double d0, d1;
 
 	/* On the axis every circle point is equally near. */
-	if (hypot(x, y) <= 1e-12 * ar->radius)
+	if (r <= 1e-12 * ar->radius)
 		*tie = 1;
 	if (x == 0 && y == 0) {
-		*f = 0;
-		return arc_point(ar, 0);
+		d->c = 1, d->s = 0, d->end = 1;
+		return arc_at(ar, 1, 0);
 	}
-	phi = angle_near(y, x, 0.5 * ar->sweep);
-	if (phi >= 0 && phi <= ar->sweep) {
-		*f = phi;
-		return arc_point(ar, phi);
+	if (in_sweep(x, y, r, ar->trig)) {
+		d->c = x / r, d->s = y / r, d->end = 0;
+		return arc_at(ar, d->c, d->s);
 	}
 	/* Outside the arc the distance grows with the angular distance, so
 	 * one end point is the answer. */
-	q0 = arc_point(ar, 0);
-	q1 = arc_point(ar, ar->sweep);
+	q0 = arc_at(ar, 1, 0);
+	q1 = arc_at(ar, ar->trig[3], ar->trig[4]);
 	d0 = px_v3_dist2(p, q0);
 	d1 = px_v3_dist2(p, q1);
 	if (fabs(d0 - d1) <= 1e-14 * (d0 + d1))
 		*tie = 1;
 	if (d0 <= d1) {
-		*f = 0;
+		d->c = 1, d->s = 0, d->end = 1;
 		return q0;
 	}
-	*f = ar->sweep;
+	d->c = ar->trig[3], d->s = ar->trig[4], d->end = 2;
 	return q1;
 }
 
-static px_vec3 rev_closest(const struct px_recog_rev *rv, px_vec3 p, double *theta,
-			   double *prof_t, int *tie)
+static px_vec3 rev_closest(const struct px_recog_rev *rv, px_vec3 p, struct adir *da,
+			   struct adir *dp, double *prof_t, int *tie)
 {
 	px_vec3 w = px_v3_sub(p, rv->origin), q2, m;
 	double hq = px_v3_dot(rv->axis, w), x = px_v3_dot(rv->e0, w),
-	       y = px_v3_dot(rv->e1, w), rq = hypot(x, y), th, dth = 0;
+	       y = px_v3_dot(rv->e1, w), rq = sqrt(x * x + y * y);
 
 	if (rq <= 1e-12 * px_v3_norm(w))
 		*tie = 1;
+	da->c = 1, da->s = 0, da->end = 1;
 	if (rq == 0) {
-		th = 0;
+		q2 = px_v3(hq, 0, 0);
+	} else if (in_sweep(x, y, rq, rv->trig)) {
+		da->c = x / rq, da->s = y / rq, da->end = 0;
+		q2 = px_v3(hq, rq, 0);
 	} else {
-		th = angle_near(y, x, 0.5 * rv->sweep);
-		if (th < 0 || th > rv->sweep) {
-			/* Nearer end meridian: the same for every profile
-			 * point since rho >= 0. */
-			double a0 = fabs(remainder(th, TWO_PI));
-			double a1 = fabs(remainder(th - rv->sweep, TWO_PI));
-			if (fabs(a0 - a1) <= 1e-14)
-				*tie = 1;
-			if (a0 <= a1)
-				th = 0, dth = a0;
-			else
-				th = rv->sweep, dth = a1;
+		/* Nearer end meridian (the same for every profile point since
+		 * rho >= 0): the larger projection on the end directions. */
+		double b1 = x * rv->trig[3] + y * rv->trig[4];
+		if (fabs(x - b1) <= 1e-14 * rq)
+			*tie = 1;
+		if (x >= b1) {
+			q2 = px_v3(hq, x, 0);
+		} else {
+			da->c = rv->trig[3], da->s = rv->trig[4], da->end = 2;
+			q2 = px_v3(hq, b1, 0);
 		}
 	}
-	q2 = px_v3(hq, rq * cos(dth), 0);
+	dp->c = 1, dp->s = 0, dp->end = 1;
 	if (rv->profile_is_arc)
-		m = arc_closest(&rv->parc, q2, prof_t, tie);
+		m = arc_closest(&rv->parc, q2, dp, tie);
 	else
 		m = seg_closest(&rv->pseg, q2, prof_t);
-	*theta = th;
 	return px_v3_add(px_v3_madd(rv->origin, rv->axis, m.x),
-			 px_v3_scale(px_v3_add(px_v3_scale(rv->e0, cos(th)),
-					       px_v3_scale(rv->e1, sin(th))),
+			 px_v3_scale(px_v3_add(px_v3_scale(rv->e0, da->c),
+					       px_v3_scale(rv->e1, da->s)),
 				     m.y));
 }
 
@@ -1204,17 +1243,30 @@ static double inv_solve(const struct px_recog_shape *pr, int which, double lo,
 	return s;
 }
 
-/* Closed-form parameter of angle f on a degree-2 arc table. */
-static double qarc_param(const struct px_recog_qarc *q, double f)
+/* Closed-form parameter of the direction d on a degree-2 arc table:
+ * its span is the one whose bisector is nearest in angle (the one
+ * holding it), its angle from that bisector psi by its sine and cosine,
+ * tan(psi / 2) = sin psi / (1 + cos psi) (|psi| <= half < pi / 2). */
+static double qarc_param(const struct px_recog_qarc *q, const struct adir *d)
 {
-	int k = 0;
-	double psi, sp, s, t, h;
-	while (k < q->n - 1 && f > q->a[k + 1])
-		k++;
-	h = q->half[k];
-	psi = f - q->a[k] - h;
-	psi = psi < -h ? -h : (psi > h ? h : psi);
-	sp = tan(0.5 * psi) / tan(0.5 * h);
+	int k, best = 0;
+	double bv = -INFINITY, cp, sp, s, t;
+	if (d->end)
+		return d->end == 1 ? q->u[0] : q->u[q->n];
+	for (k = 0; k < q->n; k++) {
+		double v = d->c * q->mid[k][0] + d->s * q->mid[k][1] - q->chalf[k];
+		if (v > bv)
+			bv = v, best = k;
+		if (v >= 0)
+			break;
+	}
+	k = best;
+	cp = d->c * q->mid[k][0] + d->s * q->mid[k][1];
+	sp = q->mid[k][0] * d->s - q->mid[k][1] * d->c;
+	if (cp < q->chalf[k])
+		sp = sp < 0 ? -1 : 1;
+	else
+		sp = sp / ((1 + cp) * q->tquart[k]);
 	sp = sp < -1 ? -1 : (sp > 1 ? 1 : sp);
 	s = 0.5 * (sp + 1);
 	t = q->lam[k] * s / ((1 - s) + q->lam[k] * s);
@@ -1257,14 +1309,14 @@ int px_recog_closest(const struct px_recog_shape *pr, px_vec3 p, int flags,
 		break;
 	}
 	case PX_RECOG_ARC: {
-		double f;
-		x = arc_closest(&pr->arc, p, &f, &hit->tie);
+		struct adir d;
+		x = arc_closest(&pr->arc, p, &d, &hit->tie);
 		if (want && pr->qarc[0].n) {
-			hit->u = qarc_param(&pr->qarc[0], f);
+			hit->u = qarc_param(&pr->qarc[0], &d);
 			hit->param = PX_RECOG_PARAM_EXACT;
 		} else if (want) {
 			hit->u = inv_solve(pr, INV_CURVE, pr->dom[0], pr->dom[1], 0,
-					   pr->arc.sweep, f, 1);
+					   pr->arc.sweep, dir_angle(&d, pr->arc.sweep), 1);
 			hit->param = PX_RECOG_PARAM_SOLVED;
 		}
 		break;
@@ -1275,24 +1327,26 @@ int px_recog_closest(const struct px_recog_shape *pr, px_vec3 p, int flags,
 	case PX_RECOG_SPHERE:
 	case PX_RECOG_TORUS: {
 		const struct px_recog_rev *rv = &pr->rev;
-		double th, pt, pa, pp;
+		double pt = 0, pa, pp;
+		struct adir dang, dprof;
 		int da = rv->dir_angle;
-		x = rev_closest(rv, p, &th, &pt, &hit->tie);
+		x = rev_closest(rv, p, &dang, &dprof, &pt, &hit->tie);
 		if (want) {
 			int exact = 1;
 			double lo = pr->dom[2 - 2 * da], hi = pr->dom[3 - 2 * da];
 			if (pr->qarc[0].n) {
-				pa = qarc_param(&pr->qarc[0], th);
+				pa = qarc_param(&pr->qarc[0], &dang);
 			} else {
 				pa = inv_solve(pr, INV_REV_ANG, pr->dom[2 * da],
-					       pr->dom[2 * da + 1], 0, rv->sweep, th, 1);
+					       pr->dom[2 * da + 1], 0, rv->sweep,
+					       dir_angle(&dang, rv->sweep), 1);
 				exact = 0;
 			}
 			if (rv->profile_is_arc && pr->qarc[1].n) {
-				pp = qarc_param(&pr->qarc[1], pt);
+				pp = qarc_param(&pr->qarc[1], &dprof);
 			} else if (rv->profile_is_arc) {
-				pp = inv_solve(pr, INV_REV_PROF, lo, hi, 0,
-					       rv->parc.sweep, pt, 1);
+				pp = inv_solve(pr, INV_REV_PROF, lo, hi, 0, rv->parc.sweep,
+					       dir_angle(&dprof, rv->parc.sweep), 1);
 				exact = 0;
 			} else if (pr->linear & (1 << (1 - da))) {
 				pp = lin_param(lo, hi, 0, rv->pseg.len, pt);

@@ -114,10 +114,14 @@ struct px_recog_seg {
 };
 
 /* Arc center + r (cos f e0 + sin f e1), f in [0, sweep], sweep in
- * (0, 2 pi]; e1 = normal x e0; f grows with the parameter. */
+ * (0, 2 pi]; e1 = normal x e0; f grows with the parameter. trig: the
+ * sweep's middle direction (cos, sin of sweep / 2), the cosine of half
+ * the sweep (-2 for a full turn) and the end direction (cos, sin of
+ * sweep), so closest points need no angle functions. */
 struct px_recog_arc {
 	px_vec3 center, normal, e0, e1;
 	double radius, sweep;
+	double trig[5];
 };
 
 /*
@@ -130,7 +134,7 @@ struct px_recog_arc {
  */
 struct px_recog_rev {
 	px_vec3 origin, axis, e0, e1;
-	double sweep;
+	double sweep, trig[5]; /* trig as in struct px_recog_arc */
 	int profile_is_arc;
 	struct px_recog_seg pseg;
 	struct px_recog_arc parc;
@@ -146,13 +150,17 @@ struct px_recog_rev {
  * turn. On the standard form (end weights equal, reached by the Moebius
  * map t = lam s / (1 - s + lam s)) the angle from the span's bisector is
  * f = 2 atan(tan(half / 2) (2 s - 1)), so parameters invert in closed
- * form.
+ * form; with the bisector's direction mid (angle a[k] + half), cos(half)
+ * and tan(half / 2) kept, from the point's direction without angle
+ * functions.
  */
 #define PX_RECOG_QSPANS 16
 struct px_recog_qarc {
 	int n;
 	double u[PX_RECOG_QSPANS + 1], a[PX_RECOG_QSPANS + 1];
 	double lam[PX_RECOG_QSPANS], half[PX_RECOG_QSPANS];
+	double mid[PX_RECOG_QSPANS][2], chalf[PX_RECOG_QSPANS],
+		tquart[PX_RECOG_QSPANS];
 };
 
 /* Parallelogram origin + x e1 + y e2, x in [x0, x1], y in [y0, y1]
