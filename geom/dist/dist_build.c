@@ -567,10 +567,9 @@ static void count_pieces(const struct builder *bl, struct layout *ly)
  * in closed form (on CAD parts 8 beat both 2 and 32 under callgrind). */
 #define SHAPE_ITEM_WEIGHT 8
 
-/* Up to this many PK_SHAPE items are scanned by their boxes before the
- * wave instead of being binned (px_dist.c: scan_shapes()): on CAD parts
- * of a few dozen faces the scan costs a fraction of the wave's shells. */
-#define SCAN_ITEMS 40
+/* On CAD parts of a few dozen faces the scan of PX__DIST_SCAN_ITEMS
+ * boxes costs a fraction of the wave's shells. */
+#define SCAN_ITEMS PX__DIST_SCAN_ITEMS
 
 /* Grid geometry (paper section 6) into hdr: bounds, cell size from the
  * finest entity's piece count along the longest extent, cell counts. */
@@ -733,15 +732,16 @@ static int model_alloc(const struct px_dist_model *hdr, const struct builder *bl
 
 /* Box b as centre and half extents, the extents widened by a few ulp
  * of the coordinates (so |x - c| - e never exceeds the gap to b). */
-static void sbox(const px_aabb *b, struct px__dist_sbox *o)
+/* Item i's lane of the scanned boxes o (struct px__dist_sbox); b NULL
+ * for the padding lane. */
+static void sbox(const px_aabb *b, struct px__dist_sbox *o, int i)
 {
-	const double lo[3] = {b->min.x, b->min.y, b->min.z};
-	const double hi[3] = {b->max.x, b->max.y, b->max.z};
-	int d;
+	int d, l = i & 1;
+	o += i / 2;
 	for (d = 0; d < 3; d++) {
-		o->c[d] = 0.5 * (lo[d] + hi[d]);
-		o->e[d] = 0.5 * (hi[d] - lo[d]) +
-			  4.0 * DBL_EPSILON * (fabs(lo[d]) + fabs(hi[d]));
+		const double lo = b ? (&b->min.x)[d] : 0.0, hi = b ? (&b->max.x)[d] : 0.0;
+		o->c[d][l] = b ? 0.5 * (lo + hi) : INFINITY;
+		o->e[d][l] = 0.5 * (hi - lo) + 4.0 * DBL_EPSILON * (fabs(lo) + fabs(hi));
 	}
 }
 
@@ -1082,14 +1082,16 @@ int px__dist_model_create_trimmed(const struct px_nurbs_curve *curves,
 	for (i = 0; i < bl.n; i++)
 		m->wave_pieces += binned(&bl.tp[i].pc);
 	if (hdr_shape_items && hdr_shape_items <= SCAN_ITEMS) {
-		m->shape_box = px_arena_calloc(&m->arena, (size_t)hdr_shape_items,
+		m->shape_box = px_arena_calloc(&m->arena, (size_t)(hdr_shape_items + 1) / 2,
 					       sizeof(*m->shape_box), 64);
 		if (!m->shape_box) {
 			rc = PX_E_NOMEM; /* the sizing is wrong: a bug */
 			goto fail;
 		}
 		for (i = 0; i < hdr_shape_items; i++)
-			sbox(&bl.tp[bl.n - hdr_shape_items + i].pc.box, &m->shape_box[i]);
+			sbox(&bl.tp[bl.n - hdr_shape_items + i].pc.box, m->shape_box, i);
+		if (hdr_shape_items & 1)
+			sbox(NULL, m->shape_box, hdr_shape_items);
 	}
 	memcpy(m->ent, ent, (size_t)ly.n_ent * sizeof(*ent));
 	memcpy(m->shape, shapes, (size_t)ly.n_ent * sizeof(*shapes));

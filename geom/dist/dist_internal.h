@@ -115,11 +115,17 @@ struct px__shape_fast {
 	double side2[2];
 };
 
-/* A scanned item's box as centre and half extents (its bound is then a
- * few branch-free operations per axis; the extents are rounded up so
- * that the bound never exceeds the box's). */
+/* Up to this many PK_SHAPE items are scanned by their boxes before the
+ * wave instead of being binned (px_dist.c: scan_shapes()). */
+#define PX__DIST_SCAN_ITEMS 40
+
+/* The boxes of scanned items 2 j and 2 j + 1, lane by lane (axis d of
+ * item i in c[d][i & 1]), as centres and half extents, so that two
+ * bounds are a few vector operations per axis; the extents are rounded
+ * up so that a bound never exceeds the box's. An odd count's last lane
+ * is infinitely far. */
 struct px__dist_sbox {
-	double c[3], e[3];
+	double c[3][2], e[3][2];
 };
 
 /* PK_SHAPE: a whole closed-form entity in the grid (trimmed models). */

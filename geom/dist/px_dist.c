@@ -259,34 +259,50 @@ meet_shape(const struct px_dist_model *m, struct px_dist_ws *ws, px_vec3 p,
  * bounds sit at the far end of the candidate list, which has room for
  * every piece.
  */
+typedef double sb_v2 __attribute__((vector_size(16)));
+typedef long long sb_i2 __attribute__((vector_size(16)));
+
 static __attribute__((noinline)) void
 scan_shapes(const struct px_dist_model *m, struct px_dist_ws *ws, px_vec3 p,
 	    struct qstate *q)
 {
 	int n = m->n_shape_items, first = m->n_pieces - n, i, k = 0, near = 0;
 	struct cand *h = ws->cand + first;
-	double near_lb = INFINITY;
-	for (i = 0; i < n; i++) {
+	double near_lb, lbs[PX__DIST_SCAN_ITEMS + 1];
+	const sb_v2 px = {p.x, p.x}, py = {p.y, p.y}, pz = {p.z, p.z}, zero = {0.0, 0.0};
+	sb_v2 least = {INFINITY, INFINITY};
+	const sb_i2 mag = {INT64_MAX, INT64_MAX};
+	/* Two boxes at a time: lane by lane the scalar bound's operations
+	 * (|p - c| - e clamped at 0, squares summed in the same order), so
+	 * the same values bit for bit. */
+	for (i = 0; 2 * i < n; i++) {
 		const struct px__dist_sbox *b = &m->shape_box[i];
-		double dx = fabs(p.x - b->c[0]) - b->e[0];
-		double dy = fabs(p.y - b->c[1]) - b->e[1];
-		double dz = fabs(p.z - b->c[2]) - b->e[2];
-		double lb;
-		int nearer;
-		dx = dx > 0.0 ? dx : 0.0;
-		dy = dy > 0.0 ? dy : 0.0;
-		dz = dz > 0.0 ? dz : 0.0;
+		sb_v2 c, e, dx, dy, dz, lb;
+		memcpy(&c, b->c[0], sizeof(c));
+		memcpy(&e, b->e[0], sizeof(e));
+		dx = (sb_v2)((sb_i2)(px - c) & mag) - e;
+		memcpy(&c, b->c[1], sizeof(c));
+		memcpy(&e, b->e[1], sizeof(e));
+		dy = (sb_v2)((sb_i2)(py - c) & mag) - e;
+		memcpy(&c, b->c[2], sizeof(c));
+		memcpy(&e, b->e[2], sizeof(e));
+		dz = (sb_v2)((sb_i2)(pz - c) & mag) - e;
+		dx = (sb_v2)((sb_i2)dx & (dx > zero));
+		dy = (sb_v2)((sb_i2)dy & (dy > zero));
+		dz = (sb_v2)((sb_i2)dz & (dz > zero));
 		lb = dx * dx + dy * dy + dz * dz;
-		nearer = lb < near_lb;
-		h[i].lb = lb;
-		near_lb = nearer ? lb : near_lb;
-		near = nearer ? i : near;
+		memcpy(lbs + 2 * i, &lb, sizeof(lb));
+		least = (sb_v2)(((sb_i2)lb & (lb < least)) | ((sb_i2)least & ~(lb < least)));
 	}
+	/* The first of the nearest boxes. */
+	near_lb = least[0] < least[1] ? least[0] : least[1];
+	while (near < n - 1 && lbs[near] != near_lb)
+		near++;
 	/* The nearest box's item first: its answer leaves few to order. */
 	meet_shape(m, ws, p, &m->pieces[first + near], q);
 	for (i = 0; i < n; i++)
-		if (h[i].lb < q->best && i != near) {
-			h[k].lb = h[i].lb;
+		if (lbs[i] < q->best && i != near) {
+			h[k].lb = lbs[i];
 			h[k++].piece = first + i;
 		}
 	/* Nearest first by selection: usually one or two are taken. */
