@@ -58,7 +58,7 @@ ALL_LDFLAGS := $(SANFLAGS) $(LDFLAGS)
 # hidapi comes as two builds with the same symbols: HIDAPI=hidraw
 # (default, /dev/hidraw*) or HIDAPI=libusb.
 HIDAPI   ?= hidraw
-OPT_PARTS := HIDAPI LIBUSB SOCKETCAN GPIOD ASSIMP YAML OCCT XML DDS
+OPT_PARTS := HIDAPI LIBUSB SOCKETCAN GPIOD ASSIMP YAML OCCT XML DDS VIEW
 OPT_DEVICE_PARTS := HIDAPI LIBUSB SOCKETCAN GPIOD
 PKG_HIDAPI    := hidapi-$(HIDAPI)
 PKG_LIBUSB    := libusb-1.0
@@ -68,6 +68,7 @@ PKG_ASSIMP    := assimp
 PKG_YAML      := yaml-0.1
 PKG_XML       := libxml-2.0
 PKG_DDS       := CycloneDDS
+PKG_VIEW      := libwebsockets
 SRC_HIDAPI    := px_hidapi.c
 SRC_LIBUSB    := px_usb.c
 SRC_SOCKETCAN := px_socketcan.c
@@ -77,6 +78,7 @@ SRC_YAML      := px_config_yaml.c
 SRC_OCCT      := cad_occt.cpp
 SRC_XML       := urdf_xml.c
 SRC_DDS       := px_bridge_dds.c px_bridge_dev.c
+SRC_VIEW      := view_lws.c
 # Tests name the parts they need by these tags (PX_TEST_NEEDS, tests/run.sh).
 TAG_HIDAPI    := hidapi
 TAG_LIBUSB    := libusb
@@ -87,6 +89,7 @@ TAG_YAML      := libyaml
 TAG_OCCT      := occt
 TAG_XML       := libxml2
 TAG_DDS       := cyclonedds
+TAG_VIEW      := libwebsockets
 DESC_HIDAPI    := HID devices (hidapi-$(HIDAPI))
 DESC_LIBUSB    := USB devices (libusb-1.0)
 DESC_SOCKETCAN := CAN interface state and bitrate (libsocketcan)
@@ -96,6 +99,7 @@ DESC_YAML      := YAML configs (libyaml)
 DESC_OCCT      := STEP and IGES parts (OpenCASCADE)
 DESC_XML       := URDF robots (libxml2)
 DESC_DDS       := ROS 2 compatible DDS bridge (Cyclone DDS and its idlc)
+DESC_VIEW      := the browser view server (libwebsockets)
 WITH_DEVICES ?= 1
 pc_have = $(shell pkg-config --exists $(1) 2>/dev/null && echo 1 || echo 0)
 # OpenCASCADE: its headers, the toolkits the importer links (C++, so the
@@ -232,6 +236,8 @@ DEB_PACKAGES += libhidapi-dev libusb-1.0-0-dev libsocketcan-dev libgpiod-dev
 DEB_PACKAGES += libudev-dev
 # bridge/: the DDS bridge (Cyclone DDS and its IDL compiler).
 DEB_PACKAGES += cyclonedds-dev cyclonedds-tools
+# view/: the browser view's server (HTTP and WebSocket).
+DEB_PACKAGES += libwebsockets-dev
 # Debian packages the benchmarks compare against (installed by `make bench`;
 # a benchmark whose reference is missing says so and still runs).
 BENCH_DEB_PACKAGES := rt-tests g++ libocct-modeling-algorithms-dev
@@ -516,12 +522,15 @@ sanitize:
 RUN_CONFIG  ?= config/examples/haptic_sim.yaml
 RUN_SECONDS ?= 10
 RUN_ARGS    ?=
+# The live view's port ([ADDR:]PORT; empty: no view). A port taken is
+# said and the run goes on without the view.
+RUN_VIEW    ?= 8765
 .PHONY: run
 # The run counts its heap calls after setup with the tests' counter.
 run: deps
 	@$(MAKE) --no-print-directory all $(if $(filter 1,$(SAN)),,$(ALLOC_SO))
 	$(if $(filter 1,$(SAN)),,LD_PRELOAD=$(abspath $(ALLOC_SO))) $(BUILD)/bin/proxima-run $(RUN_CONFIG) --duration-s $(RUN_SECONDS) \
-	  --summary-json $(BUILD)/run-summary.json $(RUN_ARGS)
+	  --summary-json $(BUILD)/run-summary.json $(if $(RUN_VIEW),--view $(RUN_VIEW)) $(RUN_ARGS)
 
 deps:
 	@sh tools/install-deps.sh $(DEB_PACKAGES)
@@ -565,7 +574,8 @@ help:
 	@echo '  bench-section BENCH=name  run one benchmark, replace its section of docs/benchmarks.md'
 	@echo '  teleop     the teleoperation examples, master and follower on loopback (TELEOP_S=10)'
 	@echo '  sanitize   the test suite built with AddressSanitizer + UBSan'
-	@echo '  run        build, then run proxima-run on RUN_CONFIG for RUN_SECONDS (default config, 10 s)'
+	@echo '  run        build, then run proxima-run on RUN_CONFIG for RUN_SECONDS (default config, 10 s),'
+	@echo '             the live view on RUN_VIEW=$(RUN_VIEW)'
 	@echo '  fuzz       build fuzz/fuzz_*.c with libFuzzer, run each FUZZ_SECONDS=$(FUZZ_SECONDS) s'
 	@echo '  soak       SOAK_CYCLES=$(SOAK_CYCLES) loop cycles with faults in virtual time'
 	@echo '  memcheck   the tools under valgrind memcheck on sample inputs'

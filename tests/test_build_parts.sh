@@ -146,6 +146,11 @@ for part in $parts; do
 	YAML)
 		check "WITH_$part=0: proxima-run --check says built without libyaml" \
 			fails_saying "built without libyaml" "$b/bin/proxima-run" --check config/examples/haptic_sim.yaml ;;
+	VIEW)
+		check "WITH_$part=0: proxima-run --view says built without libwebsockets and runs" \
+			runs_saying "built without libwebsockets" "$b/bin/proxima-run" \
+			config/examples/haptic_sim.yaml --virtual-time --duration-s 0.1 \
+			--telemetry "$tmp/view.csv" --view 1 ;;
 	esac
 	rm -rf "$b"
 done

@@ -2,7 +2,7 @@
  * proxima-run - run a proxima application from its YAML config.
  *
  *   proxima-run CONFIG [--duration-s N] [--virtual-time] [--summary-json FILE]
- *                      [--telemetry FILE]
+ *                      [--telemetry FILE] [--view [ADDR:]PORT [--view-root DIR]]
  *   proxima-run --check CONFIG
  *
  * A main over the app module (app/px_app.h), which owns the setup from the
@@ -76,6 +76,9 @@ static const char usage_text[] =
 	"  --help             this text\n"
 	"Exit status: 0 ok, 1 invalid config or setup failure (e.g. a device\n"
 	"absent), 2 usage error or --virtual-time with hardware devices.\n";
+
+/* --view [ADDR:]PORT and --view-root DIR (NULL: none) */
+static const char *view_spec, *view_root;
 
 static int usage_error(const char *fmt, const char *arg)
 {
@@ -156,6 +159,18 @@ static int parse_args(int argc, char **argv, struct px_app_options *o)
 			if (!v || !*v)
 				return usage_error("%s needs a file name", a);
 			o->telemetry = v;
+		} else if (!rest && matches(a, "--view-root")) {
+			const char *v = opt_value(argc, argv, &i, "--view-root");
+			if (!v || !*v)
+				return usage_error("%s needs a folder", a);
+			view_root = v;
+		} else if (!rest && matches(a, "--view")) {
+			const char *v = opt_value(argc, argv, &i, "--view");
+			char addr[64];
+			int port;
+			if (!v || run_view_parse(v, addr, sizeof(addr), &port))
+				return usage_error("%s needs [ADDR:]PORT", a);
+			view_spec = v;
 		} else if (!rest && a[0] == '-' && a[1] != '\0') {
 			return usage_error("unknown option '%s'", a);
 		} else if (!o->config) {
@@ -345,6 +360,7 @@ static void on_record(void *user, const struct px_app_record *r)
 {
 	(void)user;
 	run_bridge_record(r);
+	run_view_record(r);
 	/* the plots keep the first PLOT_MAX records (about 17 min at
 	 * 1 kHz); the CSV gets everything */
 	if (T.n_recs < PLOT_MAX) {
@@ -385,6 +401,7 @@ static void on_record(void *user, const struct px_app_record *r)
 static void finish(void)
 {
 	run_bridge_stop();
+	run_view_stop();
 	tool_out_discard(&T.csv_out); /* an unfinished CSV: never in place */
 	px_app_free(A);
 	A = NULL;
@@ -569,6 +586,7 @@ int main(int argc, char **argv)
 		finish();
 		return 1;
 	}
+	run_view_start(A, O.config, view_spec, view_root, CFG->loop.period_ns);
 	T.setup_heap_calls = heap_count();
 	px_app_warnings(A);
 	announce();

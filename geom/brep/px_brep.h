@@ -215,6 +215,15 @@ PX_API int px_model_from_brep(struct px_brep *b, struct px_model **out);
  * @note RT-safe. */
 PX_API const struct px_brep *px_model_brep(const struct px_model *m);
 
+/* Face i of b (0 <= i < n_faces of px_brep_get_info()): its surface in
+ * metres (*surf, the B-rep's scaled copy) and its trimmed domain (*trim,
+ * NULL: the whole surface), both valid while b lives; *reversed 1 when
+ * the face's outside is against Su x Sv. For display (px_tess.h).
+ * Returns PX_OK or PX_E_INVAL. @note RT-safe. */
+PX_API int px_brep_face(const struct px_brep *b, int i,
+			const struct px_nurbs_surf **surf,
+			const struct px_trim **trim, int *reversed);
+
 #ifdef __cplusplus
 }
 #endif

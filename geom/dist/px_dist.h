@@ -227,6 +227,13 @@ struct px_nurbs_sign_info {
 PX_API int px_nurbs_model_sign_info(const struct px_model *m,
 				    struct px_nurbs_sign_info *info);
 
+/* The surfaces of a model from px_nurbs_model_create() (its own copy, in
+ * the model's frame; valid while the model lives): their count and, in
+ * *surfs, the array; PX_E_INVAL for NULL or another kind of model (for
+ * display, px_tess.h). @note RT-safe. */
+PX_API int px_nurbs_model_surfaces(const struct px_model *m,
+				   const struct px_nurbs_surf **surfs);
+
 /* n queries; stops at the first error and returns it. @note RT-safe. */
 PX_API int px_dist_query_batch(struct px_dist_model *m, const px_vec3 *p,
 			       size_t n, struct px_dist_result *r);

@@ -905,3 +905,14 @@ int px_nurbs_model_sign_info(const struct px_model *m,
 	memcpy(info->why, n->why, sizeof(info->why));
 	return PX_OK;
 }
+
+int px_nurbs_model_surfaces(const struct px_model *m,
+			    const struct px_nurbs_surf **surfs)
+{
+	const struct nurbs_impl *n;
+	if (!m || !surfs || px_model_get_ops(m) != &nurbs_ops)
+		return PX_E_INVAL;
+	n = px_model_impl(m);
+	*surfs = n->ks;
+	return n->n_ks;
+}

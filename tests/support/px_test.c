@@ -152,7 +152,7 @@ const char *px_test_part_lib_(const char *part)
 		{"SOCKETCAN", "libsocketcan"}, {"GPIOD", "libgpiod"},
 		{"ASSIMP", "assimp"},	  {"YAML", "libyaml"},
 		{"OCCT", "OpenCASCADE"},   {"XML", "libxml2"},
-		{"DDS", "cyclonedds"},
+		{"DDS", "cyclonedds"},     {"VIEW", "libwebsockets"},
 	};
 	for (size_t i = 0; i < sizeof names / sizeof names[0]; i++)
 		if (!strcmp(part, names[i][0]))

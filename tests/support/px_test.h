@@ -46,7 +46,7 @@ _Noreturn void px_test_skip_(const char *fmt, ...)
 	__attribute__((format(printf, 1, 2)));
 /* Skip the test when the build left out an optional part it needs
  * (PART as in px_features.h: HIDAPI, LIBUSB, SOCKETCAN, GPIOD, ASSIMP,
- * YAML, OCCT, XML, DDS), saying which: "skipped: built without libyaml". */
+ * YAML, OCCT, XML, DDS, VIEW), saying which: "skipped: built without libyaml". */
 #define PX_NEEDS(PART)                                                      \
 	do {                                                                \
 		if (!PX_HAVE_##PART)                                        \

@@ -1,0 +1,469 @@
+/* The browser view's server (view/px_view.h) with a WebSocket client
+ * written here on a plain socket: the messages of a connection, the
+ * frames against the records fed, malformed requests, and a loop that
+ * runs the same with clients that never read or vanish.
+ * PX_TEST_NEEDS: libwebsockets */
+#include <arpa/inet.h>
+#include <errno.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "px_alloc_count.h"
+#include "px_app.h"
+#include "px_config.h"
+#include "px_prim.h"
+#include "px_scene.h"
+#include "px_test.h"
+#include "px_test_app.h"
+#include "px_view.h"
+
+#define HAPTIC_SIM "config/examples/haptic_sim.yaml"
+
+static char root[64];
+
+/* A folder with a page, once. */
+static const char *web_root(void)
+{
+	FILE *f;
+	char path[96];
+	if (root[0])
+		return root;
+	snprintf(root, sizeof(root), "/tmp/px-view-test-%d", (int)getpid());
+	mkdir(root, 0700);
+	snprintf(path, sizeof(path), "%s/index.html", root);
+	f = fopen(path, "w");
+	PX_CHECK(f != NULL);
+	fputs("<html><body>view</body></html>\n", f);
+	fclose(f);
+	return root;
+}
+
+/* A port free now (bound to 0 and let go). */
+static int free_port(void)
+{
+	struct sockaddr_in a;
+	socklen_t n = sizeof(a);
+	int fd = socket(AF_INET, SOCK_STREAM, 0), port;
+	memset(&a, 0, sizeof(a));
+	a.sin_family = AF_INET;
+	a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+	PX_CHECK(bind(fd, (struct sockaddr *)&a, sizeof(a)) == 0);
+	PX_CHECK(getsockname(fd, (struct sockaddr *)&a, &n) == 0);
+	port = ntohs(a.sin_port);
+	close(fd);
+	return port;
+}
+
+static int connect_to(int port)
+{
+	struct sockaddr_in a;
+	int fd = socket(AF_INET, SOCK_STREAM, 0);
+	memset(&a, 0, sizeof(a));
+	a.sin_family = AF_INET;
+	a.sin_port = htons((uint16_t)port);
+	a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+	PX_CHECK(connect(fd, (struct sockaddr *)&a, sizeof(a)) == 0);
+	return fd;
+}
+
+/* Read exactly n bytes within timeout_ms; 0 ok, -1 not. */
+static int read_n(int fd, unsigned char *buf, size_t n, int timeout_ms)
+{
+	size_t got = 0;
+	while (got < n) {
+		struct pollfd p = {fd, POLLIN, 0};
+		ssize_t k;
+		if (poll(&p, 1, timeout_ms) <= 0)
+			return -1;
+		k = read(fd, buf + got, n - got);
+		if (k <= 0)
+			return -1;
+		got += (size_t)k;
+	}
+	return 0;
+}
+
+/* An HTTP request; the status line's code, or -1 when the server closed
+ * without one. */
+static int http_status(int port, const char *request)
+{
+	char buf[512];
+	size_t got = 0;
+	int fd = connect_to(port), code = -1;
+	PX_CHECK(write(fd, request, strlen(request)) == (ssize_t)strlen(request));
+	while (got < sizeof(buf) - 1) {
+		struct pollfd p = {fd, POLLIN, 0};
+		ssize_t k;
+		if (poll(&p, 1, 2000) <= 0)
+			break;
+		k = read(fd, buf + got, sizeof(buf) - 1 - got);
+		if (k <= 0)
+			break;
+		got += (size_t)k;
+		buf[got] = '\0';
+		if (strstr(buf, "\r\n"))
+			break;
+	}
+	buf[got] = '\0';
+	if (!strncmp(buf, "HTTP/1.", 7))
+		code = atoi(buf + 9);
+	close(fd);
+	return code;
+}
+
+/* The WebSocket handshake on /ws; the socket, the response checked. */
+static int ws_open(int port, const char *path)
+{
+	char req[512], resp[1024] = "";
+	size_t got = 0;
+	int fd = connect_to(port);
+	snprintf(req, sizeof(req),
+		 "GET %s HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nUpgrade: websocket\r\n"
+		 "Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
+		 "Sec-WebSocket-Version: 13\r\nSec-WebSocket-Protocol: %s\r\n\r\n",
+		 path, port, PX_VIEW_PROTOCOL);
+	PX_CHECK(write(fd, req, strlen(req)) == (ssize_t)strlen(req));
+	while (got < sizeof(resp) - 1 && !strstr(resp, "\r\n\r\n")) {
+		if (read_n(fd, (unsigned char *)resp + got, 1, 2000))
+			break;
+		resp[++got] = '\0';
+	}
+	resp[got] = '\0';
+	if (strncmp(resp, "HTTP/1.1 101", 12) != 0) {
+		if (getenv("PX_VIEW_TEST_DEBUG"))
+			fprintf(stderr, "handshake: %s\n", resp);
+		close(fd);
+		return -1;
+	}
+	PX_CHECK(strstr(resp, "s3pPLMBiTxaQ9kYGzzhZRbK+xOo=") != NULL);
+	return fd;
+}
+
+/* One whole text message (fragments joined), malloc'd; NULL on close or
+ * timeout. */
+static char *ws_read(int fd, int timeout_ms)
+{
+	char *msg = NULL;
+	size_t n = 0;
+	for (;;) {
+		unsigned char h[2], ext[8];
+		uint64_t len;
+		int fin, op, i;
+		char *p;
+		if (read_n(fd, h, 2, timeout_ms))
+			break;
+		fin = h[0] & 0x80;
+		op = h[0] & 0x0f;
+		len = h[1] & 0x7f;
+		PX_CHECK(!(h[1] & 0x80)); /* a server never masks */
+		if (len == 126) {
+			if (read_n(fd, ext, 2, timeout_ms))
+				break;
+			len = (uint64_t)ext[0] << 8 | ext[1];
+		} else if (len == 127) {
+			if (read_n(fd, ext, 8, timeout_ms))
+				break;
+			for (len = 0, i = 0; i < 8; i++)
+				len = len << 8 | ext[i];
+		}
+		PX_CHECK(len < 64u << 20);
+		p = realloc(msg, n + len + 1);
+		PX_CHECK(p != NULL);
+		msg = p;
+		if (len && read_n(fd, (unsigned char *)msg + n, len, timeout_ms))
+			break;
+		if (op == 8)
+			break; /* close */
+		n += len;
+		msg[n] = '\0';
+		if (fin)
+			return msg;
+	}
+	free(msg);
+	return NULL;
+}
+
+static double num_after(const char *s, const char *key)
+{
+	const char *p = strstr(s, key);
+	PX_CHECK_MSG(p != NULL, "no %s in %.200s", key, s);
+	return strtod(p + strlen(key), NULL);
+}
+
+static struct px_view *make_view(int port, const struct px_scene *sc)
+{
+	struct px_view_options o;
+	struct px_view *v = NULL;
+	char msg[256], *scene;
+	size_t len;
+	px_view_options_default(&o);
+	o.port = port;
+	o.web_root = web_root();
+	o.name = "test";
+	o.stall_ms = 300;
+	PX_CHECK_MSG(px_view_create(&o, &v, msg, sizeof(msg)) == PX_OK, "%s", msg);
+	PX_CHECK_INT_EQ(px_view_scene_json(sc, NULL, &scene, &len), PX_OK);
+	PX_CHECK_INT_EQ(px_view_set_scene(v, scene, len), PX_OK);
+	free(scene);
+	PX_CHECK_INT_EQ(px_view_start(v), PX_OK);
+	return v;
+}
+
+static void sleep_ms(int ms)
+{
+	struct timespec ts = {ms / 1000, (long)(ms % 1000) * 1000000};
+	nanosleep(&ts, NULL);
+}
+
+/* hello, scene (the sphere), the frames fed (positions as fed), end. */
+static void test_messages_of_a_connection(void)
+{
+	struct px_scene *sc;
+	struct px_model *m;
+	struct px_prim p = {PX_PRIM_SPHERE, 0.05, 0, 0};
+	struct px_view *v;
+	int port = free_port(), fd, i;
+	char *s;
+	PX_NEEDS(VIEW);
+	PX_CHECK_INT_EQ(px_scene_create(4, &sc), PX_OK);
+	PX_CHECK_INT_EQ(px_prim_model(&p, &m), PX_OK);
+	PX_CHECK(px_scene_add(sc, m, "ball") >= 0);
+	v = make_view(port, sc);
+	PX_CHECK_INT_EQ(http_status(port, "GET / HTTP/1.1\r\nHost: x\r\n\r\n"), 200);
+	fd = ws_open(port, "/ws");
+	PX_CHECK(fd >= 0);
+	s = ws_read(fd, 2000);
+	PX_CHECK(s && strstr(s, "\"type\":\"hello\"") && strstr(s, "\"mode\":\"live\""));
+	free(s);
+	s = ws_read(fd, 2000);
+	PX_CHECK(s && strstr(s, "\"type\":\"scene\"") && strstr(s, "\"name\":\"ball\"") &&
+		 strstr(s, "\"kind\":\"prim\""));
+	PX_CHECK_NEAR(num_after(s, "\"bounds\":["), -0.05, 1e-3);
+	free(s);
+	for (i = 0; i < 5; i++) {
+		struct px_app_record r;
+		memset(&r, 0, sizeof(r));
+		r.t_s = 0.1 * i;
+		r.cycle = (uint64_t)(100 * i);
+		r.dev_m[0] = 0.01 * i;
+		r.dev_m[1] = -0.02;
+		r.dev_m[2] = 0.5;
+		r.distance_m = i == 2 ? NAN : 0.1;
+		PX_CHECK_INT_EQ(px_view_feed_record(v, &r), 1);
+		/* within 1/rate: decimated away */
+		r.t_s += 0.001;
+		PX_CHECK_INT_EQ(px_view_feed_record(v, &r), 0);
+		s = ws_read(fd, 2000);
+		PX_CHECK(s && strstr(s, "\"type\":\"frame\""));
+		PX_CHECK_NEAR(num_after(s, "\"tool\":["), 0.01 * i, 1e-12);
+		PX_CHECK_INT_EQ((long long)num_after(s, "\"cycle\":"), 100 * i);
+		if (i == 2)
+			PX_CHECK(strstr(s, "\"distance_m\":null") != NULL);
+		free(s);
+	}
+	px_view_end(v);
+	s = ws_read(fd, 2000);
+	PX_CHECK(s && !strcmp(s, "{\"type\":\"end\"}"));
+	free(s);
+	close(fd);
+	px_view_free(v);
+	px_scene_free(sc);
+}
+
+/* Malformed and refused requests get an error; the server goes on. */
+static void test_bad_requests_answered(void)
+{
+	struct px_view *v;
+	int port = free_port(), fd;
+	char *s;
+	PX_NEEDS(VIEW);
+	v = make_view(port, NULL);
+	PX_CHECK_INT_EQ(http_status(port, "GET /nothing.js HTTP/1.1\r\nHost: x\r\n\r\n"), 404);
+	PX_CHECK_INT_EQ(http_status(port, "POST / HTTP/1.1\r\nHost: x\r\nContent-Length: 0\r\n\r\n"), 405);
+	PX_CHECK(http_status(port, "GARBAGE\r\n\r\n") != 200);
+	PX_CHECK(http_status(port, "GET /../../etc/passwd HTTP/1.1\r\nHost: x\r\n\r\n") != 200);
+	PX_CHECK(ws_open(port, "/other") < 0); /* the WebSocket is on /ws only */
+	PX_CHECK_INT_EQ(http_status(port, "GET / HTTP/1.1\r\nHost: x\r\n\r\n"), 200);
+	fd = ws_open(port, "/ws");
+	PX_CHECK(fd >= 0);
+	s = ws_read(fd, 2000);
+	PX_CHECK(s && strstr(s, "\"type\":\"hello\""));
+	free(s);
+	close(fd);
+	px_view_free(v);
+}
+
+/* A client that never reads falls behind: frames dropped, then closed;
+ * the feed never waits. */
+static void test_slow_client_dropped_and_closed(void)
+{
+	struct px_view *v;
+	struct px_view_stats st;
+	int port = free_port(), fd, i;
+	char *big = malloc(PX_VIEW_FRAME_MAX);
+	PX_NEEDS(VIEW);
+	PX_CHECK(big != NULL);
+	v = make_view(port, NULL);
+	fd = ws_open(port, "/ws");
+	PX_CHECK(fd >= 0);
+	{
+		/* a small receive buffer so that it fills soon */
+		int sz = 4096;
+		setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &sz, sizeof(sz));
+	}
+	memset(big, ' ', PX_VIEW_FRAME_MAX);
+	big[0] = '{';
+	big[PX_VIEW_FRAME_MAX - 1] = '}';
+	for (i = 0; i < 20000; i++) {
+		int64_t t0;
+		struct timespec a, b;
+		clock_gettime(CLOCK_MONOTONIC, &a);
+		PX_CHECK_INT_EQ(px_view_feed_json(v, big, PX_VIEW_FRAME_MAX), PX_OK);
+		clock_gettime(CLOCK_MONOTONIC, &b);
+		t0 = (b.tv_sec - a.tv_sec) * 1000000000LL + (b.tv_nsec - a.tv_nsec);
+		PX_CHECK_MSG(t0 < 50000000, "a feed took %lld ns", (long long)t0);
+		if (i % 100 == 0)
+			sleep_ms(20);
+		px_view_stats(v, &st);
+		if (st.clients_closed)
+			break;
+	}
+	px_view_stats(v, &st);
+	if (getenv("PX_VIEW_TEST_DEBUG"))
+		fprintf(stderr, "i %d fed %llu sent %llu dropped %llu closed %llu\n", i,
+			(unsigned long long)st.frames_fed, (unsigned long long)st.frames_sent,
+			(unsigned long long)st.frames_dropped, (unsigned long long)st.clients_closed);
+	PX_CHECK(st.frames_dropped > 0);
+	PX_CHECK_INT_EQ((long long)st.clients_closed, 1);
+	close(fd);
+	free(big);
+	px_view_free(v);
+}
+
+/* The record hook of a run with a view: feeds it. */
+static void feed(void *user, const struct px_app_record *r)
+{
+	px_view_feed_record(user, r);
+}
+
+struct run {
+	uint64_t cycles, allocs, overruns;
+	double max_force_n, min_distance_m;
+};
+
+static struct run run_app(int virtual_time, double dur_s, struct px_view *v)
+{
+	struct px_config *cfg = NULL;
+	static struct px_config_diag diag;
+	struct px_app_options o;
+	struct px_app *app = NULL;
+	struct px_app_summary s;
+	struct run out;
+	char msg[256];
+	PX_CHECK_INT_EQ(px_config_load_file(HAPTIC_SIM, &cfg, &diag), PX_OK);
+	px_app_options_default(&o);
+	o.config = HAPTIC_SIM;
+	o.virtual_time = virtual_time;
+	o.duration_s = dur_s;
+	o.note = px_test_app_note;
+	o.heap_count = px_alloc_count_thread;
+	o.telemetry = "build/tests/view-telemetry.csv";
+	if (v) {
+		o.record = feed;
+		o.user = v;
+	}
+	PX_CHECK_MSG(px_app_create(cfg, &o, &app, msg, sizeof(msg)) == PX_OK, "%s", msg);
+	PX_CHECK_INT_EQ(px_app_run(app), PX_OK);
+	PX_CHECK_INT_EQ(px_app_shutdown(app, "end of run"), PX_OK);
+	px_app_drain(app, v ? feed : NULL, v);
+	PX_CHECK_INT_EQ(px_app_summary(app, &s), PX_OK);
+	out.cycles = s.cycles;
+	out.allocs = s.allocations_after_setup;
+	out.overruns = s.overruns;
+	out.max_force_n = s.max_force_n;
+	out.min_distance_m = s.min_distance_m;
+	px_app_free(app);
+	px_config_free(cfg);
+	return out;
+}
+
+/* The same run with and without a view and clients (one reading, one
+ * never reading, one gone): the same cycles and figures, no heap call
+ * after setup, on the virtual clock and on the real one. */
+static void test_loop_unaffected_by_clients(void)
+{
+	struct px_view *v;
+	struct px_view_stats st;
+	struct run a, b;
+	int port = free_port(), reader, idle, gone, k;
+	PX_NEEDS(VIEW);
+	if (!strcmp(px_alloc_count_mode(), "none"))
+		PX_SKIP("no allocation counter in this build");
+	a = run_app(1, 2.0, NULL);
+	v = make_view(port, NULL);
+	reader = ws_open(port, "/ws");
+	idle = ws_open(port, "/ws");
+	gone = ws_open(port, "/ws");
+	PX_CHECK(reader >= 0 && idle >= 0 && gone >= 0);
+	close(gone);
+	PX_CHECK(http_status(port, "BAD\r\n\r\n") != 200);
+	b = run_app(1, 2.0, v);
+	PX_CHECK_INT_EQ((long long)b.cycles, (long long)a.cycles);
+	PX_CHECK_INT_EQ((long long)a.allocs, 0);
+	PX_CHECK_INT_EQ((long long)b.allocs, 0);
+	PX_CHECK_NEAR(b.max_force_n, a.max_force_n, 0);
+	PX_CHECK_NEAR(b.min_distance_m, a.min_distance_m, 0);
+	/* the reading client got frames */
+	for (k = 0; k < 5; k++) {
+		char *s = ws_read(reader, 2000);
+		PX_CHECK(s != NULL);
+		free(s);
+	}
+	px_view_stats(v, &st);
+	PX_CHECK(st.frames_fed >= 59 && st.frames_fed <= 61);
+	/* the real clock: 0.3 s each way, no heap call after setup */
+	a = run_app(0, 0.3, NULL);
+	b = run_app(0, 0.3, v);
+	PX_CHECK_INT_EQ((long long)a.allocs, 0);
+	PX_CHECK_INT_EQ((long long)b.allocs, 0);
+	PX_CHECK(b.cycles >= 280 && a.cycles >= 280);
+	close(reader);
+	close(idle);
+	px_view_free(v);
+}
+
+/* A port taken: create fails saying so. */
+static void test_port_taken(void)
+{
+	struct px_view_options o;
+	struct px_view *v = NULL, *w = NULL;
+	char msg[256];
+	int port = free_port();
+	PX_NEEDS(VIEW);
+	v = make_view(port, NULL);
+	px_view_options_default(&o);
+	o.port = port;
+	o.web_root = web_root();
+	PX_CHECK_INT_EQ(px_view_create(&o, &w, msg, sizeof(msg)), PX_E_IO);
+	PX_CHECK(w == NULL && strstr(msg, "cannot listen"));
+	o.web_root = "/nonexistent-folder";
+	PX_CHECK_INT_EQ(px_view_create(&o, &w, msg, sizeof(msg)), PX_E_NOTFOUND);
+	px_view_free(v);
+}
+
+static const struct px_test tests[] = {
+	PX_T(test_messages_of_a_connection),
+	PX_T(test_bad_requests_answered),
+	PX_T(test_slow_client_dropped_and_closed),
+	PX_T(test_loop_unaffected_by_clients),
+	PX_T(test_port_taken),
+};
+
+PX_TEST_MAIN(tests)

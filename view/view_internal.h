@@ -1,0 +1,29 @@
+/*
+ * view_internal.h - the view's text buffer (view_json.c), shared by the
+ * JSON writers and the server (view_lws.c).
+ */
+#ifndef VIEW_INTERNAL_H
+#define VIEW_INTERNAL_H
+
+#include <stdarg.h>
+#include <stddef.h>
+
+/* Text that grows (growable) or stays in the caller's array; the first
+ * failure sticks (err: PX_E_NOMEM or PX_E_NOSPC). */
+struct view_buf {
+	char *p;
+	size_t n, cap;
+	int growable, err;
+};
+
+void view_buf_fixed(struct view_buf *b, char *p, size_t cap);
+void view_buf_put(struct view_buf *b, const char *s, size_t n);
+void view_buf_puts(struct view_buf *b, const char *s);
+void view_buf_printf(struct view_buf *b, const char *fmt, ...)
+	__attribute__((format(printf, 2, 3)));
+/* A JSON number (%.*g), null when not finite. */
+void view_buf_num(struct view_buf *b, double v, int digits);
+/* A JSON string, escaped. */
+void view_buf_str(struct view_buf *b, const char *s);
+
+#endif

@@ -1,0 +1,567 @@
+/* The view's server on libwebsockets (px_view.h): static files from the
+ * web root, the WebSocket of PX_VIEW_PROTOCOL on /ws, one service thread.
+ *
+ * Frames go through a ring of queue_frames + 1 fixed slots: the feeding
+ * thread writes slot head % n under the lock and wakes the service thread
+ * (lws_cancel_service); each connection keeps the sequence number of the
+ * next frame it sends and copies one slot out under the lock when its
+ * socket can take more. A connection more than queue_frames behind jumps
+ * to the newest frame (the skipped ones are counted as dropped). */
+#include <errno.h>
+#include <limits.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <libwebsockets.h>
+
+#include "px_view.h"
+#include "view_internal.h"
+
+/* Big messages (scene, track) go out in fragments of this size. */
+#define CHUNK 32768
+
+struct slot {
+	uint64_t seq;
+	size_t len;
+	char text[PX_VIEW_FRAME_MAX];
+};
+
+struct msg {
+	char *p;
+	size_t n;
+};
+
+enum stage { ST_HELLO, ST_SCENE, ST_TRACK, ST_FRAMES, ST_DONE };
+
+struct sess {
+	struct px_view *v;
+	struct lws *wsi;
+	enum stage stage;
+	size_t off;             /* sent of the current big message */
+	uint64_t next;          /* next frame's sequence number */
+	int64_t progress_ns;    /* last write, or the connection's start */
+	int killed;
+	unsigned char *buf;     /* LWS_PRE + CHUNK (>= a frame) */
+};
+
+struct px_view {
+	struct px_view_options o;
+	char addr[64], root[PATH_MAX], name[128], mode[8];
+	struct lws_context *ctx;
+	struct lws_protocols protos[3];
+	struct lws_http_mount mount;
+	pthread_t th;
+	int started;
+	atomic_int stop, ended;
+	struct msg hello, scene, track;
+	/* the ring (lock: mu) */
+	pthread_mutex_t mu;
+	struct slot *ring;
+	int ring_n;
+	uint64_t head;          /* sequence number of the next frame fed */
+	/* the feeding thread's */
+	double last_t_s;
+	char fbuf[PX_VIEW_FRAME_MAX];
+	/* the service thread's */
+	struct sess **sess;
+	int n_sess;
+	atomic_int clients, ends_pending;
+	atomic_ullong connections, fed, sent, dropped, closed, refused;
+};
+
+static int64_t now_ns(void)
+{
+	struct timespec ts;
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
+}
+
+/* libwebsockets' own log: its last error line, kept for create's msg. */
+static char lws_last[200];
+
+static void lws_emit(int level, const char *line)
+{
+	size_t n;
+	if (!(level & LLL_ERR))
+		return;
+	snprintf(lws_last, sizeof(lws_last), "%s", line);
+	n = strlen(lws_last);
+	while (n && (lws_last[n - 1] == '\n' || lws_last[n - 1] == '\r'))
+		lws_last[--n] = '\0';
+}
+
+static void sess_remove(struct px_view *v, struct sess *s)
+{
+	int i;
+	for (i = 0; i < v->n_sess; i++)
+		if (v->sess[i] == s) {
+			v->sess[i] = v->sess[--v->n_sess];
+			break;
+		}
+}
+
+/* The big message of stage st (NULL: none for this stage). */
+static const struct msg *stage_msg(struct px_view *v, enum stage st)
+{
+	if (st == ST_HELLO)
+		return &v->hello;
+	if (st == ST_SCENE)
+		return &v->scene;
+	if (st == ST_TRACK)
+		return v->track.p ? &v->track : NULL;
+	return NULL;
+}
+
+/* Send the next fragment of a big message; 1 when more remain. */
+static int send_big(struct sess *s, const struct msg *m)
+{
+	size_t n = m->n - s->off;
+	int start = s->off == 0, end;
+	if (n > CHUNK)
+		n = CHUNK;
+	end = s->off + n == m->n;
+	memcpy(s->buf + LWS_PRE, m->p + s->off, n);
+	if (lws_write(s->wsi, s->buf + LWS_PRE, n,
+		      (enum lws_write_protocol)lws_write_ws_flags(LWS_WRITE_TEXT, start,
+								  end)) < (int)n)
+		return -1;
+	s->off += n;
+	return !end;
+}
+
+static int send_text(struct sess *s, const char *t, size_t n)
+{
+	memcpy(s->buf + LWS_PRE, t, n);
+	return lws_write(s->wsi, s->buf + LWS_PRE, n, LWS_WRITE_TEXT) < (int)n ? -1
+									       : 0;
+}
+
+/* The connection can take more: the next message. 0 ok, -1 close. */
+static int writable(struct px_view *v, struct sess *s)
+{
+	const struct msg *m;
+	uint64_t head;
+	size_t len = 0;
+	int rc;
+	s->progress_ns = now_ns();
+	while (s->stage < ST_FRAMES && !(m = stage_msg(v, s->stage))) {
+		s->stage++;
+		s->off = 0;
+	}
+	if (s->stage < ST_FRAMES) {
+		rc = send_big(s, m);
+		if (rc < 0)
+			return -1;
+		if (rc == 0) {
+			s->stage++;
+			s->off = 0;
+		}
+		lws_callback_on_writable(s->wsi);
+		return 0;
+	}
+	if (s->stage == ST_DONE)
+		return 0;
+	pthread_mutex_lock(&v->mu);
+	head = v->head;
+	if (s->next < head) {
+		const struct slot *sl;
+		if (head - s->next > (uint64_t)v->o.queue_frames) {
+			/* behind: the newest frame wins */
+			atomic_fetch_add(&v->dropped, head - 1 - s->next);
+			s->next = head - 1;
+		}
+		sl = &v->ring[s->next % (uint64_t)v->ring_n];
+		len = sl->len;
+		memcpy(s->buf + LWS_PRE, sl->text, len);
+		s->next++;
+	}
+	pthread_mutex_unlock(&v->mu);
+	if (len) {
+		if (lws_write(s->wsi, s->buf + LWS_PRE, len, LWS_WRITE_TEXT) < (int)len)
+			return -1;
+		atomic_fetch_add(&v->sent, 1);
+		if (s->next < head)
+			lws_callback_on_writable(s->wsi);
+		else if (atomic_load(&v->ended))
+			lws_callback_on_writable(s->wsi); /* the end next */
+		return 0;
+	}
+	if (atomic_load(&v->ended)) {
+		static const char end[] = "{\"type\":\"end\"}";
+		if (send_text(s, end, sizeof(end) - 1))
+			return -1;
+		s->stage = ST_DONE;
+		atomic_fetch_sub(&v->ends_pending, 1);
+	}
+	return 0;
+}
+
+/* Woken by a feed, an end or a stop: every connection gets a writable
+ * callback; one that took nothing for stall_ms while frames wait is
+ * closed. */
+static void wake(struct px_view *v)
+{
+	int64_t t = now_ns();
+	uint64_t head;
+	int i;
+	pthread_mutex_lock(&v->mu);
+	head = v->head;
+	pthread_mutex_unlock(&v->mu);
+	for (i = 0; i < v->n_sess; i++) {
+		struct sess *s = v->sess[i];
+		if (s->killed)
+			continue;
+		if ((s->next < head || s->stage < ST_FRAMES) &&
+		    t - s->progress_ns > (int64_t)v->o.stall_ms * 1000000) {
+			s->killed = 1;
+			atomic_fetch_add(&v->closed, 1);
+			lws_set_timeout(s->wsi, PENDING_TIMEOUT_USER_OK,
+					LWS_TO_KILL_ASYNC);
+			continue;
+		}
+		lws_callback_on_writable(s->wsi);
+	}
+}
+
+static int cb_view(struct lws *wsi, enum lws_callback_reasons reason,
+		   void *user, void *in, size_t len)
+{
+	struct px_view *v = lws_context_user(lws_get_context(wsi));
+	struct sess *s = user;
+	char uri[64];
+	(void)in;
+	switch (reason) {
+	case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:
+		if (lws_hdr_copy(wsi, uri, sizeof(uri), WSI_TOKEN_GET_URI) <= 0 ||
+		    strcmp(uri, "/ws") != 0 || v->n_sess >= v->o.max_clients ||
+		    atomic_load(&v->stop)) {
+			atomic_fetch_add(&v->refused, 1);
+			return 1;
+		}
+		return 0;
+	case LWS_CALLBACK_ESTABLISHED:
+		memset(s, 0, sizeof(*s));
+		s->v = v;
+		s->wsi = wsi;
+		s->buf = malloc(LWS_PRE + CHUNK);
+		if (!s->buf)
+			return -1;
+		pthread_mutex_lock(&v->mu);
+		s->next = v->head; /* frames from now on */
+		pthread_mutex_unlock(&v->mu);
+		s->progress_ns = now_ns();
+		v->sess[v->n_sess++] = s;
+		atomic_fetch_add(&v->clients, 1);
+		atomic_fetch_add(&v->ends_pending, 1);
+		atomic_fetch_add(&v->connections, 1);
+		lws_callback_on_writable(wsi);
+		return 0;
+	case LWS_CALLBACK_SERVER_WRITEABLE:
+		if (!s->buf || s->killed)
+			return -1;
+		return writable(v, s);
+	case LWS_CALLBACK_RECEIVE:
+		return 0; /* read-only: nothing a page sends is acted on */
+	case LWS_CALLBACK_CLOSED:
+		if (s->buf) {
+			sess_remove(v, s);
+			if (s->stage != ST_DONE)
+				atomic_fetch_sub(&v->ends_pending, 1);
+			atomic_fetch_sub(&v->clients, 1);
+			free(s->buf);
+			s->buf = NULL;
+		}
+		return 0;
+	case LWS_CALLBACK_EVENT_WAIT_CANCELLED:
+		wake(v);
+		return 0;
+	default:
+		return 0;
+	}
+	(void)len;
+}
+
+/* HTTP: GET only (lws answers 404 for what the web root lacks and 4xx
+ * for what it cannot parse); the rest as libwebsockets' own. */
+static int cb_http(struct lws *wsi, enum lws_callback_reasons reason,
+		   void *user, void *in, size_t len)
+{
+	if (reason == LWS_CALLBACK_FILTER_HTTP_CONNECTION &&
+	    lws_hdr_total_length(wsi, WSI_TOKEN_GET_URI) <= 0) {
+		lws_return_http_status(wsi, HTTP_STATUS_METHOD_NOT_ALLOWED, NULL);
+		return -1;
+	}
+	return lws_callback_http_dummy(wsi, reason, user, in, len);
+}
+
+static void *service(void *arg)
+{
+	struct px_view *v = arg;
+	while (!atomic_load(&v->stop))
+		if (lws_service(v->ctx, 0) < 0)
+			break;
+	return NULL;
+}
+
+static int fail(char *msg, size_t cap, int rc, const char *fmt, ...)
+	__attribute__((format(printf, 4, 5)));
+static int fail(char *msg, size_t cap, int rc, const char *fmt, ...)
+{
+	va_list ap;
+	if (msg && cap) {
+		va_start(ap, fmt);
+		vsnprintf(msg, cap, fmt, ap);
+		va_end(ap);
+	}
+	return rc;
+}
+
+static int make_hello(struct px_view *v)
+{
+	struct view_buf b;
+	memset(&b, 0, sizeof(b));
+	b.growable = 1;
+	view_buf_printf(&b, "{\"type\":\"hello\",\"version\":1,\"mode\":");
+	view_buf_str(&b, v->mode);
+	view_buf_puts(&b, ",\"name\":");
+	view_buf_str(&b, v->name);
+	view_buf_printf(&b, ",\"period_ns\":%lld,\"rate_hz\":",
+			(long long)v->o.period_ns);
+	view_buf_num(&b, v->o.rate_hz, 6);
+	view_buf_puts(&b, "}");
+	if (b.err) {
+		free(b.p);
+		return b.err;
+	}
+	v->hello.p = b.p;
+	v->hello.n = b.n;
+	return PX_OK;
+}
+
+int px_view_create(const struct px_view_options *o, struct px_view **out,
+		   char *msg, size_t cap)
+{
+	struct lws_context_creation_info info;
+	struct px_view *v;
+	char index[PATH_MAX + 16];
+	int rc;
+	if (!o || !out)
+		return fail(msg, cap, PX_E_INVAL, "view: no options");
+	*out = NULL;
+	if (o->port < 1 || o->port > 65535)
+		return fail(msg, cap, PX_E_INVAL, "view: port %d is not 1..65535",
+			    o->port);
+	if (!o->web_root || !*o->web_root)
+		return fail(msg, cap, PX_E_INVAL, "view: no web root folder");
+	if (!(o->rate_hz > 0 && o->rate_hz <= 1000) || o->max_clients < 1 ||
+	    o->queue_frames < 1 || o->stall_ms < 1 ||
+	    (o->mode && strcmp(o->mode, "live") && strcmp(o->mode, "replay")))
+		return fail(msg, cap, PX_E_INVAL, "view: invalid options");
+	v = calloc(1, sizeof(*v));
+	if (!v)
+		return fail(msg, cap, PX_E_NOMEM, "view: out of memory");
+	v->o = *o;
+	snprintf(v->addr, sizeof(v->addr), "%s", o->addr ? o->addr : "127.0.0.1");
+	snprintf(v->name, sizeof(v->name), "%s", o->name ? o->name : "");
+	snprintf(v->mode, sizeof(v->mode), "%s", o->mode ? o->mode : "live");
+	if (!realpath(o->web_root, v->root)) {
+		free(v);
+		return fail(msg, cap, PX_E_NOTFOUND, "view: web root %s: %s",
+			    o->web_root, strerror(errno));
+	}
+	snprintf(index, sizeof(index), "%s/index.html", v->root);
+	if (access(index, R_OK) != 0) {
+		free(v);
+		return fail(msg, cap, PX_E_NOTFOUND,
+			    "view: no index.html in %s (make view-web builds the page)",
+			    o->web_root);
+	}
+	pthread_mutex_init(&v->mu, NULL);
+	v->ring_n = o->queue_frames + 1;
+	v->ring = calloc((size_t)v->ring_n, sizeof(*v->ring));
+	v->sess = calloc((size_t)o->max_clients, sizeof(*v->sess));
+	v->last_t_s = -1e300;
+	if (!v->ring || !v->sess || make_hello(v) != PX_OK) {
+		px_view_free(v);
+		return fail(msg, cap, PX_E_NOMEM, "view: out of memory");
+	}
+	v->protos[0].name = "http";
+	v->protos[0].callback = cb_http;
+	v->protos[1].name = PX_VIEW_PROTOCOL;
+	v->protos[1].callback = cb_view;
+	v->protos[1].per_session_data_size = sizeof(struct sess);
+	v->protos[1].rx_buffer_size = 1024;
+	v->mount.mountpoint = "/";
+	v->mount.mountpoint_len = 1;
+	v->mount.origin = v->root;
+	v->mount.def = "index.html";
+	v->mount.origin_protocol = LWSMPRO_FILE;
+	memset(&info, 0, sizeof(info));
+	info.port = o->port;
+	info.iface = v->addr;
+	info.protocols = v->protos;
+	info.mounts = &v->mount;
+	info.user = v;
+	info.options = LWS_SERVER_OPTION_VALIDATE_UTF8;
+	if (!strchr(v->addr, ':'))
+		info.options |= LWS_SERVER_OPTION_DISABLE_IPV6;
+	lws_last[0] = '\0';
+	lws_set_log_level(LLL_ERR, lws_emit);
+	v->ctx = lws_create_context(&info);
+	if (!v->ctx) {
+		rc = fail(msg, cap, PX_E_IO, "view: cannot listen on %s:%d%s%s",
+			  v->addr, o->port, lws_last[0] ? ": " : "", lws_last);
+		px_view_free(v);
+		return rc;
+	}
+	*out = v;
+	return PX_OK;
+}
+
+int px_view_port(const struct px_view *v)
+{
+	return v ? v->o.port : PX_E_INVAL;
+}
+
+static int set_msg(struct px_view *v, struct msg *m, const char *json,
+		   size_t len)
+{
+	char *p;
+	if (!v || !json || v->started)
+		return PX_E_INVAL;
+	p = malloc(len + 1);
+	if (!p)
+		return PX_E_NOMEM;
+	memcpy(p, json, len);
+	p[len] = '\0';
+	free(m->p);
+	m->p = p;
+	m->n = len;
+	return PX_OK;
+}
+
+int px_view_set_scene(struct px_view *v, const char *json, size_t len)
+{
+	return v ? set_msg(v, &v->scene, json, len) : PX_E_INVAL;
+}
+
+int px_view_set_track(struct px_view *v, const char *json, size_t len)
+{
+	return v ? set_msg(v, &v->track, json, len) : PX_E_INVAL;
+}
+
+int px_view_start(struct px_view *v)
+{
+	if (!v)
+		return PX_E_INVAL;
+	if (v->started)
+		return PX_E_STATE;
+	if (!v->scene.p) {
+		static const char none[] =
+			"{\"type\":\"scene\",\"models\":[],\"tool\":{\"radius_m\":0},"
+			"\"robot\":null,\"bounds\":[-0.1,-0.1,-0.1,0.1,0.1,0.1]}";
+		int rc = set_msg(v, &v->scene, none, sizeof(none) - 1);
+		if (rc)
+			return rc;
+	}
+	if (pthread_create(&v->th, NULL, service, v) != 0)
+		return PX_E_NOMEM;
+	v->started = 1;
+	return PX_OK;
+}
+
+int px_view_feed_json(struct px_view *v, const char *json, size_t len)
+{
+	struct slot *sl;
+	if (!v || !json || len == 0 || len > PX_VIEW_FRAME_MAX)
+		return PX_E_INVAL;
+	pthread_mutex_lock(&v->mu);
+	sl = &v->ring[v->head % (uint64_t)v->ring_n];
+	memcpy(sl->text, json, len);
+	sl->len = len;
+	sl->seq = v->head++;
+	pthread_mutex_unlock(&v->mu);
+	atomic_fetch_add(&v->fed, 1);
+	if (v->started)
+		lws_cancel_service(v->ctx);
+	return PX_OK;
+}
+
+int px_view_feed_record(struct px_view *v, const struct px_app_record *r)
+{
+	int n;
+	if (!v || !r)
+		return 0;
+	/* decimated by loop time; a clock that went back (a new run)
+	 * starts again */
+	if (r->t_s >= v->last_t_s && r->t_s - v->last_t_s < 0.999 / v->o.rate_hz)
+		return 0;
+	v->last_t_s = r->t_s;
+	n = px_view_frame_json(r, 1, v->fbuf, sizeof(v->fbuf));
+	if (n <= 0)
+		return 0;
+	return px_view_feed_json(v, v->fbuf, (size_t)n) == PX_OK;
+}
+
+void px_view_end(struct px_view *v)
+{
+	if (!v)
+		return;
+	atomic_store(&v->ended, 1);
+	if (v->started)
+		lws_cancel_service(v->ctx);
+}
+
+void px_view_stats(struct px_view *v, struct px_view_stats *s)
+{
+	if (!s)
+		return;
+	memset(s, 0, sizeof(*s));
+	if (!v)
+		return;
+	s->clients = atomic_load(&v->clients);
+	s->connections = atomic_load(&v->connections);
+	s->frames_fed = atomic_load(&v->fed);
+	s->frames_sent = atomic_load(&v->sent);
+	s->frames_dropped = atomic_load(&v->dropped);
+	s->clients_closed = atomic_load(&v->closed);
+	s->refused = atomic_load(&v->refused);
+}
+
+void px_view_stop(struct px_view *v, int wait_ms)
+{
+	int64_t until;
+	if (!v || !v->started)
+		return;
+	px_view_end(v);
+	until = now_ns() + (int64_t)wait_ms * 1000000;
+	while (atomic_load(&v->ends_pending) > 0 && now_ns() < until) {
+		struct timespec ts = {0, 5000000};
+		nanosleep(&ts, NULL);
+	}
+	atomic_store(&v->stop, 1);
+	lws_cancel_service(v->ctx);
+	pthread_join(v->th, NULL);
+	v->started = 0;
+}
+
+void px_view_free(struct px_view *v)
+{
+	if (!v)
+		return;
+	px_view_stop(v, 0);
+	if (v->ctx)
+		lws_context_destroy(v->ctx); /* closes what is still open */
+	pthread_mutex_destroy(&v->mu);
+	free(v->ring);
+	free(v->sess);
+	free(v->hello.p);
+	free(v->scene.p);
+	free(v->track.p);
+	free(v);
+}
