@@ -237,6 +237,13 @@ PX_API int px_scene_config_load(const struct px_config *cfg,
 				struct px_scene **out,
 				struct px_config_diag *diag);
 
+/* A config's model with a scale other than 1 is the file's model seen
+ * at that scale about its origin: *inner gets the file's model and the
+ * scale is returned; any other model is its own inner at scale 1 (for
+ * drawing it, px_tess.h). @note RT-safe. */
+PX_API double px_scene_model_scale(const struct px_model *m,
+				   const struct px_model **inner);
+
 /* Schema of the scene section (tools, the docs check). */
 PX_API const struct px_config_schema *px_scene_config_schema(void);
 

@@ -309,6 +309,21 @@ static int scale_model(struct px_model **m, double s)
 			       px_model_caps(w->inner), m);
 }
 
+double px_scene_model_scale(const struct px_model *m,
+			    const struct px_model **inner)
+{
+	const struct px_model_ops *o = px_model_get_ops(m);
+	const struct scaled *w;
+	if (!o || o < scaled_ops ||
+	    o >= scaled_ops + sizeof(scaled_ops) / sizeof(scaled_ops[0])) {
+		*inner = m;
+		return 1.0;
+	}
+	w = px_model_impl(m);
+	*inner = w->inner;
+	return w->s;
+}
+
 /* ---- loading ------------------------------------------------------ */
 
 static void resolve(char *out, size_t cap, const char *cfg_path,

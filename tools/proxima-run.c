@@ -53,6 +53,7 @@
 #include "run_internal.h"
 #include "tool_out.h"
 #include "tool_svg.h"
+#include "tool_view.h"
 
 static const char usage_text[] =
 	"usage: proxima-run CONFIG [--duration-s N] [--virtual-time] "
@@ -168,7 +169,7 @@ static int parse_args(int argc, char **argv, struct px_app_options *o)
 			const char *v = opt_value(argc, argv, &i, "--view");
 			char addr[64];
 			int port;
-			if (!v || run_view_parse(v, addr, sizeof(addr), &port))
+			if (!v || tool_view_parse(v, addr, sizeof(addr), &port))
 				return usage_error("%s needs [ADDR:]PORT", a);
 			view_spec = v;
 		} else if (!rest && a[0] == '-' && a[1] != '\0') {

@@ -77,12 +77,10 @@ void run_bridge_record(const struct px_app_record *r);
 void run_bridge_tick(void);
 void run_bridge_stop(void);
 
-/* The browser view (run_view.c), on the draining thread too: parse
- * [ADDR:]PORT (0, or -1), start the server for --view SPEC (NULL: none)
+/* The browser view (run_view.c), on the draining thread too: start the server for --view SPEC (NULL: none)
  * with the page of root (NULL: the built one beside the program), saying
  * its URL on stderr, or why not and going on without it; feed it each
  * drained record; stop sends "end" and says what it sent. */
-int run_view_parse(const char *spec, char *addr, size_t cap, int *port);
 void run_view_start(struct px_app *app, const char *name, const char *spec,
 		    const char *root, int64_t period_ns);
 void run_view_record(const struct px_app_record *r);

@@ -3,7 +3,6 @@
  * draining thread, never the loop's), ended and stopped after the run.
  * A view that cannot start (no page built, the port taken) is said on
  * stderr and the run goes on without it. */
-#include <errno.h>
 #include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -12,71 +11,28 @@
 
 #include "px_view.h"
 #include "run_internal.h"
+#include "tool_view.h"
 
 static struct px_view *V;
-
-int run_view_parse(const char *spec, char *addr, size_t cap, int *port)
-{
-	const char *colon = strrchr(spec, ':'), *p = colon ? colon + 1 : spec;
-	char *end;
-	long n;
-	addr[0] = '\0';
-	if (colon) {
-		size_t len = (size_t)(colon - spec);
-		if (len == 0 || len >= cap)
-			return -1;
-		memcpy(addr, spec, len);
-		addr[len] = '\0';
-		/* [::1]:PORT */
-		if (addr[0] == '[' && addr[len - 1] == ']') {
-			memmove(addr, addr + 1, len - 2);
-			addr[len - 2] = '\0';
-		}
-	}
-	errno = 0;
-	n = strtol(p, &end, 10);
-	if (end == p || *end || errno || n < 1 || n > 65535)
-		return -1;
-	*port = (int)n;
-	return 0;
-}
-
-/* build/view/web beside build/bin, else share/proxima/view beside bin. */
-static void default_root(char *buf, size_t cap)
-{
-	char exe[PATH_MAX], *slash;
-	ssize_t n = readlink("/proc/self/exe", exe, sizeof(exe) - 1);
-	buf[0] = '\0';
-	if (n <= 0)
-		return;
-	exe[n] = '\0';
-	slash = strrchr(exe, '/');
-	if (!slash)
-		return;
-	*slash = '\0';
-	snprintf(buf, cap, "%s/../view/web", exe);
-	if (access(buf, R_OK) != 0)
-		snprintf(buf, cap, "%s/../share/proxima/view", exe);
-}
 
 void run_view_start(struct px_app *app, const char *name, const char *spec,
 		    const char *root, int64_t period_ns)
 {
 	struct px_view_options o;
 	struct px_view_scene_info info;
-	char addr[64], dflt[PATH_MAX + 32], msg[320];
+	char addr[64], dflt[PATH_MAX + 32], msg[320], url[128];
 	char *scene = NULL;
 	size_t len = 0;
 	int port, rc;
 	if (!spec)
 		return;
-	if (run_view_parse(spec, addr, sizeof(addr), &port)) {
+	if (tool_view_parse(spec, addr, sizeof(addr), &port)) {
 		fprintf(stderr, "proxima-run: view: '%s' is not [ADDR:]PORT; "
 				"running without the view\n", spec);
 		return;
 	}
 	if (!root) {
-		default_root(dflt, sizeof(dflt));
+		tool_view_root(dflt, sizeof(dflt));
 		root = dflt;
 	}
 	px_view_options_default(&o);
@@ -105,10 +61,8 @@ void run_view_start(struct px_app *app, const char *name, const char *spec,
 		V = NULL;
 		return;
 	}
-	fprintf(stderr, "proxima-run: view: http://%s%s%s:%d/\n",
-		strchr(addr[0] ? addr : "", ':') ? "[" : "",
-		addr[0] ? addr : "127.0.0.1",
-		strchr(addr[0] ? addr : "", ':') ? "]" : "", port);
+	tool_view_url(addr, port, url, sizeof(url));
+	fprintf(stderr, "proxima-run: view: %s\n", url);
 }
 
 void run_view_record(const struct px_app_record *r)

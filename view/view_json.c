@@ -171,12 +171,13 @@ static const char *kind_name(enum px_model_kind k)
 static int model_json(struct view_buf *b, const struct px_scene *s, size_t i,
 		      double *bounds)
 {
-	const struct px_model *m = px_scene_model(s, i);
+	const struct px_model *m = px_scene_model(s, i), *inner;
 	struct px_tess t;
 	px_pose P = px_model_pose(m);
 	const char *name = px_scene_name(s, i);
+	double sc = px_scene_model_scale(m, &inner);
 	size_t k;
-	int rc = px_model_tessellate(m, NULL, &t);
+	int rc = px_model_tessellate(inner, NULL, &t);
 	if (rc != PX_OK && rc != PX_E_UNSUPPORTED) {
 		px_tess_free(&t);
 		return rc;
@@ -194,7 +195,8 @@ static int model_json(struct view_buf *b, const struct px_scene *s, size_t i,
 	}
 	view_buf_puts(b, "],\"positions\":[");
 	for (k = 0; k < t.n_vertices; k++) {
-		px_vec3 l = {t.xyz[3 * k], t.xyz[3 * k + 1], t.xyz[3 * k + 2]};
+		px_vec3 l = {sc * t.xyz[3 * k], sc * t.xyz[3 * k + 1],
+			     sc * t.xyz[3 * k + 2]};
 		px_vec3 w = px_pose_transform_point(P, l);
 		const double wv[3] = {w.x, w.y, w.z};
 		int d;
