@@ -1,6 +1,7 @@
 #!/bin/sh
 # The library with every optional part left out (WITH_DEVICES=0
-# WITH_ASSIMP=0 WITH_YAML=0 WITH_OCCT=0 WITH_XML=0 WITH_DDS=0), built
+# WITH_ASSIMP=0 WITH_YAML=0 WITH_OCCT=0 WITH_XML=0 WITH_DDS=0
+# WITH_VIEW=0), built
 # into its own directory and installed into a scratch DESTDIR: it needs
 # libc, libm and pthread alone, its proxima.pc requires nothing,
 # px_features.h says so, the examples link with only -lproxima -lm
@@ -28,7 +29,7 @@ check() { # description, command...
 full=${BUILD:-build}
 min="$tmp/build"
 root="$tmp/root"
-off="WITH_DEVICES=0 WITH_ASSIMP=0 WITH_YAML=0 WITH_OCCT=0 WITH_XML=0 WITH_DDS=0"
+off="WITH_DEVICES=0 WITH_ASSIMP=0 WITH_YAML=0 WITH_OCCT=0 WITH_XML=0 WITH_DDS=0 WITH_VIEW=0"
 # The full build's objects are the same code: starting from them, only
 # the parts' *_none.c files compile here.
 mkdir -p "$min"
@@ -79,6 +80,7 @@ cat >"$tmp/parts.c" <<'C'
 #include <proxima/px_cad.h>
 #include <proxima/px_urdf.h>
 #include <proxima/px_bridge.h>
+#include <proxima/px_view.h>
 #include <stdio.h>
 #include <string.h>
 static int says(const char *what, int rc, const char *msg, const char *lib)
@@ -133,8 +135,17 @@ int main(int argc, char **argv)
 		rc = px_bridge_create(&bc, &b, msg, sizeof msg);
 		bad |= says("bridge", rc, msg, "Cyclone DDS") || b != NULL;
 	}
+	{
+		struct px_view_options vo;
+		struct px_view *v = NULL;
+		px_view_options_default(&vo);
+		vo.port = 1;
+		vo.web_root = ".";
+		rc = px_view_create(&vo, &v, msg, sizeof msg);
+		bad |= says("view", rc, msg, "libwebsockets") || v != NULL;
+	}
 	return bad || PX_HAVE_YAML || PX_HAVE_HIDAPI || PX_HAVE_OCCT || PX_HAVE_XML ||
-	       PX_HAVE_DDS;
+	       PX_HAVE_DDS || PX_HAVE_VIEW;
 }
 C
 check "a program using the left-out parts links" \

@@ -44,7 +44,7 @@ struct sess {
 	enum stage stage;
 	size_t off;             /* sent of the current big message */
 	uint64_t next;          /* next frame's sequence number */
-	int64_t progress_ns;    /* last write, or the connection's start */
+	int64_t waiting_ns;     /* asked to write since then (0: not asked) */
 	int killed;
 	unsigned char *buf;     /* LWS_PRE + CHUNK (>= a frame) */
 };
@@ -148,7 +148,7 @@ static int writable(struct px_view *v, struct sess *s)
 	uint64_t head;
 	size_t len = 0;
 	int rc;
-	s->progress_ns = now_ns();
+	s->waiting_ns = 0;
 	while (s->stage < ST_FRAMES && !(m = stage_msg(v, s->stage))) {
 		s->stage++;
 		s->off = 0;
@@ -201,9 +201,10 @@ static int writable(struct px_view *v, struct sess *s)
 	return 0;
 }
 
-/* Woken by a feed, an end or a stop: every connection gets a writable
- * callback; one that took nothing for stall_ms while frames wait is
- * closed. */
+/* Woken by a feed, an end or a stop: every connection is asked for a
+ * writable callback; one asked stall_ms ago whose socket has not taken
+ * anything since is closed (measured from the ask, not from its last
+ * write, so that a server thread kept off the CPU closes nobody). */
 static void wake(struct px_view *v)
 {
 	int64_t t = now_ns();
@@ -216,14 +217,16 @@ static void wake(struct px_view *v)
 		struct sess *s = v->sess[i];
 		if (s->killed)
 			continue;
-		if ((s->next < head || s->stage < ST_FRAMES) &&
-		    t - s->progress_ns > (int64_t)v->o.stall_ms * 1000000) {
+		if (s->waiting_ns &&
+		    t - s->waiting_ns > (int64_t)v->o.stall_ms * 1000000) {
 			s->killed = 1;
 			atomic_fetch_add(&v->closed, 1);
 			lws_set_timeout(s->wsi, PENDING_TIMEOUT_USER_OK,
 					LWS_TO_KILL_ASYNC);
 			continue;
 		}
+		if (!s->waiting_ns && (s->next < head || s->stage < ST_FRAMES))
+			s->waiting_ns = t;
 		lws_callback_on_writable(s->wsi);
 	}
 }
@@ -254,7 +257,6 @@ static int cb_view(struct lws *wsi, enum lws_callback_reasons reason,
 		pthread_mutex_lock(&v->mu);
 		s->next = v->head; /* frames from now on */
 		pthread_mutex_unlock(&v->mu);
-		s->progress_ns = now_ns();
 		v->sess[v->n_sess++] = s;
 		atomic_fetch_add(&v->clients, 1);
 		atomic_fetch_add(&v->ends_pending, 1);
