@@ -310,19 +310,6 @@ static void *service(void *arg)
 	return NULL;
 }
 
-static int fail(char *msg, size_t cap, int rc, const char *fmt, ...)
-	__attribute__((format(printf, 4, 5)));
-static int fail(char *msg, size_t cap, int rc, const char *fmt, ...)
-{
-	va_list ap;
-	if (msg && cap) {
-		va_start(ap, fmt);
-		vsnprintf(msg, cap, fmt, ap);
-		va_end(ap);
-	}
-	return rc;
-}
-
 static int make_hello(struct px_view *v)
 {
 	struct view_buf b;
@@ -345,41 +332,44 @@ static int make_hello(struct px_view *v)
 	return PX_OK;
 }
 
-int px_view_create(const struct px_view_options *o, struct px_view **out,
-		   char *msg, size_t cap)
+/* px_view_create() with its message always in why (WHY_MAX bytes). */
+#define WHY_MAX 320
+#define FAIL(rc, ...) (snprintf(why, WHY_MAX, __VA_ARGS__), (rc))
+static int create(const struct px_view_options *o, struct px_view **out,
+		  char *why)
 {
 	struct lws_context_creation_info info;
 	struct px_view *v;
 	char index[PATH_MAX + 16];
 	int rc;
 	if (!o || !out)
-		return fail(msg, cap, PX_E_INVAL, "view: no options");
+		return FAIL(PX_E_INVAL, "view: no options");
 	*out = NULL;
 	if (o->port < 1 || o->port > 65535)
-		return fail(msg, cap, PX_E_INVAL, "view: port %d is not 1..65535",
+		return FAIL(PX_E_INVAL, "view: port %d is not 1..65535",
 			    o->port);
 	if (!o->web_root || !*o->web_root)
-		return fail(msg, cap, PX_E_INVAL, "view: no web root folder");
+		return FAIL(PX_E_INVAL, "view: no web root folder");
 	if (!(o->rate_hz > 0 && o->rate_hz <= 1000) || o->max_clients < 1 ||
 	    o->queue_frames < 1 || o->stall_ms < 1 ||
 	    (o->mode && strcmp(o->mode, "live") && strcmp(o->mode, "replay")))
-		return fail(msg, cap, PX_E_INVAL, "view: invalid options");
+		return FAIL(PX_E_INVAL, "view: invalid options");
 	v = calloc(1, sizeof(*v));
 	if (!v)
-		return fail(msg, cap, PX_E_NOMEM, "view: out of memory");
+		return FAIL(PX_E_NOMEM, "view: out of memory");
 	v->o = *o;
 	snprintf(v->addr, sizeof(v->addr), "%s", o->addr ? o->addr : "127.0.0.1");
 	snprintf(v->name, sizeof(v->name), "%s", o->name ? o->name : "");
 	snprintf(v->mode, sizeof(v->mode), "%s", o->mode ? o->mode : "live");
 	if (!realpath(o->web_root, v->root)) {
 		free(v);
-		return fail(msg, cap, PX_E_NOTFOUND, "view: web root %s: %s",
+		return FAIL(PX_E_NOTFOUND, "view: web root %s: %s",
 			    o->web_root, strerror(errno));
 	}
 	snprintf(index, sizeof(index), "%s/index.html", v->root);
 	if (access(index, R_OK) != 0) {
 		free(v);
-		return fail(msg, cap, PX_E_NOTFOUND,
+		return FAIL(PX_E_NOTFOUND,
 			    "view: no index.html in %s (make view-web builds the page)",
 			    o->web_root);
 	}
@@ -390,7 +380,7 @@ int px_view_create(const struct px_view_options *o, struct px_view **out,
 	v->last_t_s = -1e300;
 	if (!v->ring || !v->sess || make_hello(v) != PX_OK) {
 		px_view_free(v);
-		return fail(msg, cap, PX_E_NOMEM, "view: out of memory");
+		return FAIL(PX_E_NOMEM, "view: out of memory");
 	}
 	v->protos[0].name = "http";
 	v->protos[0].callback = cb_http;
@@ -416,13 +406,26 @@ int px_view_create(const struct px_view_options *o, struct px_view **out,
 	lws_set_log_level(LLL_ERR, lws_emit);
 	v->ctx = lws_create_context(&info);
 	if (!v->ctx) {
-		rc = fail(msg, cap, PX_E_IO, "view: cannot listen on %s:%d (the port taken, or the address not this machine's)%s%s",
+		rc = FAIL(PX_E_IO, "view: cannot listen on %s:%d (the port taken, or "
+			  "the address not this machine's)%s%s",
 			  v->addr, o->port, lws_last[0] ? ": " : "", lws_last);
 		px_view_free(v);
 		return rc;
 	}
 	*out = v;
 	return PX_OK;
+}
+
+#undef FAIL
+
+int px_view_create(const struct px_view_options *o, struct px_view **out,
+		   char *msg, size_t cap)
+{
+	char why[WHY_MAX] = "";
+	int rc = create(o, out, why);
+	if (msg && cap)
+		snprintf(msg, cap, "%s", why);
+	return rc;
 }
 
 int px_view_port(const struct px_view *v)
