@@ -47,7 +47,7 @@ kinds="drop delay duplicate corrupt stuck nan unplug bus_off estop overrun"
 scenarios=""
 for f in config/examples/*.yaml; do
 	# the scenarios that run in virtual time (no hardware, no second process)
-	grep -qE 'backend: (hidapi|libusb|gpiod)|transport: (kernel|unix)' "$f" && continue
+	grep -qE 'backend: (hidapi|libusb|gpiod|dds)|transport: (kernel|unix)' "$f" && continue
 	scenarios="$scenarios $f"
 done
 printf '%-16s %-9s %-7s %6s %7s %5s %7s %7s %9s %s\n' scenario kind device trips faults \
