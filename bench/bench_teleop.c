@@ -242,6 +242,7 @@ int main(void)
 	px_bridge_config_default(&c);
 	c.domain_id = getpid() % 200 + 1;
 	c.ns = ns;
+	c.thread_priority = prio > 2 ? prio - 2 : 0; /* as proxima-run's */
 	printf("teleoperation link over loopback DDS, two processes at 1 kHz, "
 	       "%ld s (SCHED_FIFO %d)\n", seconds, prio);
 	fflush(stdout);
