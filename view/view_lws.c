@@ -406,8 +406,8 @@ static int create(const struct px_view_options *o, struct px_view **out,
 	lws_set_log_level(LLL_ERR, lws_emit);
 	v->ctx = lws_create_context(&info);
 	if (!v->ctx) {
-		rc = FAIL(PX_E_IO, "view: cannot listen on %s:%d (the port taken, or "
-			  "the address not this machine's)%s%s",
+		rc = FAIL(PX_E_IO, "view: cannot listen on %.63s:%d (the port taken, or "
+			  "the address not this machine's)%s%.160s",
 			  v->addr, o->port, lws_last[0] ? ": " : "", lws_last);
 		px_view_free(v);
 		return rc;
