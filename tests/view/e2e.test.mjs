@@ -7,7 +7,7 @@ import { createServer } from "node:net";
 import { mkdirSync, existsSync, rmSync } from "node:fs";
 import { join, resolve } from "node:path";
 import { pathToFileURL } from "node:url";
-import { launch, checker, openPage, until, state, drawnShare, shot, near, checkPlayer, WEB, SHOTS } from "./harness.mjs";
+import { launch, checker, openPage, until, state, drawnShare, shot, near, checkPlayer, runSteps, WEB, SHOTS } from "./harness.mjs";
 
 const t = checker("test_view_e2e");
 setTimeout(() => { t.ok(false, "finished within 90 s"); t.done(); process.exit(1); }, 90000).unref();
@@ -133,16 +133,6 @@ async function report() {
   await page.close();
 }
 
-const timed = async (f) => { const t0 = Date.now(); await f(); console.log(`   (${f.name}: ${Date.now() - t0} ms)`); };
-try {
-  await timed(live);
-  await timed(replay);
-  await timed(report);
-  t.ok(allErrors.length === 0, "no console errors on any page", allErrors);
-} catch (e) {
-  t.ok(false, "the browser test ran to its end", String((e && e.stack) || e));
-} finally {
+await runSteps(t, browser, [live, replay, report], allErrors, () => {
   for (const p of procs) if (p.exitCode === null) p.kill("SIGKILL");
-  await browser.close();
-}
-process.exit(t.done() ? 0 : 1);
+});

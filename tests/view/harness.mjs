@@ -149,3 +149,23 @@ export async function checkPlayer(t, page, label, frames) {
   const px = await drawnShare(page);
   t.ok(px.share > 0.01, `${label}: the WebGL canvas shows the scene`, px);
 }
+
+/* Run the test's steps in order, each timed, then check that no page
+ * logged an error; the browser always closes (after cleanup). Exits the
+ * process with the checker's verdict. */
+export async function runSteps(t, browser, steps, allErrors, cleanup = () => {}) {
+  try {
+    for (const f of steps) {
+      const t0 = Date.now();
+      await f();
+      console.log(`   (${f.name}: ${Date.now() - t0} ms)`);
+    }
+    t.ok(allErrors.length === 0, "no console errors on any page", allErrors);
+  } catch (e) {
+    t.ok(false, "the browser test ran to its end", String((e && e.stack) || e));
+  } finally {
+    cleanup();
+    await browser.close();
+  }
+  process.exit(t.done() ? 0 : 1);
+}

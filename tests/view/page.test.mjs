@@ -5,7 +5,7 @@ import { readFileSync, writeFileSync, mkdirSync } from "node:fs";
 import { join } from "node:path";
 import { pathToFileURL } from "node:url";
 import { startFixture, fixtureScene, fixtureTrack } from "./fixture.mjs";
-import { launch, checker, openPage, until, state, drawnShare, shot, near, checkPlayer, fillReport, WEB, SHOTS } from "./harness.mjs";
+import { launch, checker, openPage, until, state, drawnShare, shot, near, checkPlayer, fillReport, runSteps, WEB, SHOTS } from "./harness.mjs";
 
 const t = checker("test_view_page");
 // A hung browser must not hold the suite: fail after a minute.
@@ -113,15 +113,4 @@ async function report() {
   await page.close();
 }
 
-const timed = async (f) => { const t0 = Date.now(); await f(); console.log(`   (${f.name}: ${Date.now() - t0} ms)`); };
-try {
-  await timed(live);
-  await timed(replay);
-  await timed(report);
-  t.ok(allErrors.length === 0, "no console errors on any page", allErrors);
-} catch (e) {
-  t.ok(false, "the browser test ran to its end", String(e && e.stack || e));
-} finally {
-  await browser.close();
-}
-process.exit(t.done() ? 0 : 1);
+await runSteps(t, browser, [live, replay, report], allErrors);
