@@ -15,8 +15,6 @@
 #include "px_dist.h"
 #include "px_load.h"
 #include "px_mesh.h"
-#include "px_brep_obj.h"
-#include "px_obj.h"
 #include "px_prim.h"
 #include "px_scene.h"
 #include "schema_internal.h"

@@ -10,14 +10,12 @@
 #include <string.h>
 
 #include "px_base.h"
-#include "px_brep_obj.h"
 #include "px_cloud.h"
 #include "px_dist.h"
 #include "px_load.h"
 #include "px_mesh.h"
 #include "px_model.h"
 #include "px_nurbs.h"
-#include "px_obj.h"
 #include "px_pair.h"
 #include "px_prim.h"
 #include "px_scene.h"
