@@ -14,7 +14,9 @@
  * tree (reads the URDF).
  *
  * Environment: PX_BENCH_MODELS_FCL (path of bench/fcl_models.cpp's
- * program; default fcl_models next to this binary).
+ * program; default fcl_models next to this binary); PX_BENCH_ARM_PARTS
+ * (the parts to run, default "abc": "b" alone profiles the mesh pairs);
+ * PX_BENCH_ARM_MESH_CYCLES (cycles of part (b), default 400).
  */
 #include <math.h>
 #include <stdint.h>
@@ -34,7 +36,7 @@
 #define ARM "config/examples/robots/arm6/arm6.urdf"
 #define NCYC 5000   /* cycles of the cloud runs */
 #define NMESH 20
-#define MCYC 400    /* cycles of the mesh runs (FCL's too) */
+#define MCYC 400    /* cycles of the mesh runs (FCL's too), at most NCYC */
 #define NPTS 100000
 #define SWAP_EVERY 33
 #define MAXB 16
@@ -69,15 +71,11 @@ static void path_q(int k, double q[6])
 		q[j] = mid[j] + amp[j] * sin(2.0 * M_PI * hz[j] * t + j);
 }
 
-/* The cloud scene: a table top below the reach, a box (a person's
- * torso) beside it, a ball above it; 1 mm Gaussian noise. */
-static struct px_model *scene_cloud(void)
+/* The cloud scene's points: a table top below the reach, a box (a
+ * person's torso) beside it, a ball above it; 1 mm Gaussian noise. */
+static void scene_points(double *x)
 {
-	double *x = malloc(3 * (size_t)NPTS * sizeof(double));
-	struct px_model *m = NULL;
 	int i;
-	if (!x)
-		return NULL;
 	for (i = 0; i < NPTS; i++) {
 		double *p = x + 3 * (size_t)i, u = urand(), v = urand();
 		if (i < 40000) { /* table: z = -0.1 over x 0.35..1.2, y -0.7..0.7 */
@@ -100,7 +98,19 @@ static struct px_model *scene_cloud(void)
 		p[1] += 0.001 * gauss();
 		p[2] += 0.001 * gauss();
 	}
-	if (px_cloud_model(x, NPTS, 0.0, NULL, &m) != PX_OK)
+}
+
+/* The cloud scene as a model; build 0: the points only (the random
+ * numbers drawn, so the mesh obstacles land where they do after the
+ * cloud runs). */
+static struct px_model *scene_cloud(int build)
+{
+	double *x = malloc(3 * (size_t)NPTS * sizeof(double));
+	struct px_model *m = NULL;
+	if (!x)
+		return NULL;
+	scene_points(x);
+	if (build && px_cloud_model(x, NPTS, 0.0, NULL, &m) != PX_OK)
 		m = NULL;
 	free(x);
 	return m;
@@ -167,8 +177,8 @@ static void cloud_runs(struct px_urdf_robot *r, int nb)
 	struct px_model *c[2];
 	double sum = 0.0, mn = INFINITY;
 	int k, local = 0, n = 0, coherent, over = 0;
-	c[0] = scene_cloud();
-	c[1] = scene_cloud();
+	c[0] = scene_cloud(1);
+	c[1] = scene_cloud(1);
 	if (!c[0] || !c[1] || px_urdf_robot_set_obstacles(r, c, 1) != PX_OK) {
 		fprintf(stderr, "bench_arm: cloud setup failed\n");
 		exit(1);
@@ -251,7 +261,7 @@ static void write_pose(FILE *f, px_pose P)
 		P.q.y, P.q.z);
 }
 
-static void mesh_runs(struct px_urdf_robot *r, int nb, const char *argv0)
+static void mesh_runs(struct px_urdf_robot *r, int nb, const char *argv0, int mcyc)
 {
 	struct px_model *obs[NMESH];
 	struct gen_mesh g[NMESH];
@@ -282,29 +292,29 @@ static void mesh_runs(struct px_urdf_robot *r, int nb, const char *argv0)
 		exit(1);
 	}
 	printf("(b) %d bodies against %d mesh obstacles (%d pairs), %d cycles:\n", nb, NMESH,
-	       nb * NMESH, MCYC);
+	       nb * NMESH, mcyc);
 	for (coherent = 0; coherent < 2; coherent++) {
-		for (k = 0; k < MCYC; k++) {
+		for (k = 0; k < mcyc; k++) {
 			t_ns[k] = cycle(r, 10 * k, coherent && k > 0, nb * NMESH, &sum[coherent], &local);
 			for (i = 0; i < nb * NMESH && !coherent; i++)
 				over += cl[i].distance_m <= 0.0;
 		}
-		report(coherent ? "coherent (last cycle's pairs)" : "cold", MCYC);
-		med[coherent] = t_ns[MCYC / 2];
+		report(coherent ? "coherent (last cycle's pairs)" : "cold", mcyc);
+		med[coherent] = t_ns[mcyc / 2];
 	}
 	fd = mkstemp(file);
 	f = fd >= 0 ? fdopen(fd, "w") : NULL;
 	if (!f) {
 		printf("  FCL: cannot write the workload\n");
 	} else {
-		fprintf(f, "%d %d %d\n", nb, NMESH, MCYC);
+		fprintf(f, "%d %d %d\n", nb, NMESH, mcyc);
 		for (i = 0; i < nb; i++)
 			write_model(f, px_urdf_robot_body(r, i)->model);
 		for (i = 0; i < NMESH; i++)
 			write_model(f, obs[i]);
 		for (i = 0; i < NMESH; i++)
 			write_pose(f, px_model_pose(obs[i]));
-		for (k = 0; k < MCYC; k++) {
+		for (k = 0; k < mcyc; k++) {
 			double q[6];
 			path_q(10 * k, q);
 			px_urdf_robot_set_q(r, q, NULL, 0);
@@ -338,7 +348,8 @@ int main(int argc, char **argv)
 	struct px_urdf_error e;
 	struct px_urdf *u = NULL;
 	struct px_urdf_robot *r = NULL;
-	int nb;
+	const char *parts = getenv("PX_BENCH_ARM_PARTS"), *mc = getenv("PX_BENCH_ARM_MESH_CYCLES");
+	int nb, mcyc = mc ? atoi(mc) : MCYC;
 	(void)argc;
 	memset(&o, 0, sizeof(o));
 	o.package_paths = pk;
@@ -354,8 +365,18 @@ int main(int argc, char **argv)
 	nb = px_urdf_robot_body_count(r);
 	if (nb > MAXB)
 		return 1;
-	cloud_runs(r, nb);
-	mesh_runs(r, nb, argv[0]);
+	if (!parts)
+		parts = "abc";
+	if (mcyc < 1 || mcyc > NCYC)
+		mcyc = MCYC;
+	if (strchr(parts, 'a') || strchr(parts, 'c')) {
+		cloud_runs(r, nb);
+	} else {
+		scene_cloud(0);
+		scene_cloud(0);
+	}
+	if (strchr(parts, 'b'))
+		mesh_runs(r, nb, argv[0], mcyc);
 	px_urdf_robot_free(r);
 	return 0;
 }

@@ -12,10 +12,17 @@
  * into A's frame and enclosed by an axis-aligned box, against A's box;
  * and the same from B's side. Each encloses the true box, so each gap is
  * at most the true box distance, and the box distance is at most the
- * distance of any two triangles inside. Triangle pairs are measured
- * exactly (px__tri_tri). So the answer is the minimum over all triangle
- * pairs, up to rounding (a gap is reduced by a slack of 1e-14 of the
- * coordinate scale before it prunes).
+ * distance of any two triangles inside. Once a pair is found, its own
+ * direction is a separating axis too (box pairs, and each leaf's
+ * triangles exactly): near a contact where both models are locally
+ * convex every other pair projects farther apart than the best along
+ * it, so a good first pair (last cycle's, in coherent use) ends the
+ * search after few triangle tests. Triangle pairs are measured exactly
+ * (px__tri_tri). So the answer is the minimum over all triangle pairs,
+ * up to rounding (a gap is reduced by a slack of 1e-14 of the
+ * coordinate scale before it prunes; along the best pair's direction a
+ * pair within twice that slack of the best is a tie and is not
+ * measured).
  *
  * Memory and real-time rules: no allocation; a fixed stack of MP_STACK
  * entries on the call stack. Every node pair is expanded at most once,
@@ -284,6 +291,10 @@ struct mp_ctx {
 	px_vec3 t;
 	double slack;
 	double best2;
+	/* the best pair's unit direction pb - pa in A's frame (wu) and in
+	 * B's (wub), with wu . t, as of best2 == wbest2 (wok: one exists) */
+	double wu[3], wub[3], wut, wbest2;
+	int wok;
 	long la, lb;
 	px_vec3 pa, pb; /* A frame */
 	int crossing;
@@ -382,6 +393,21 @@ static double box_lb2(const struct mp_ctx *X, const struct bx *a, const struct b
 		ext += fabs(w) * a->eA[k] + fabs(wb) * b->eB[k];
 	}
 	s1 = s1 > s2 ? s1 : s2;
+	if (X->wok) {
+		/* the best pair's direction: A's box projects exactly in
+		 * A's frame, B's in B's; the slack, doubled, covers the sums
+		 * of up to six products of a unit vector */
+		double pa = 0.0, ra = 0.0, pb = X->wut, rb = 0.0, g;
+		for (k = 0; k < 3; k++) {
+			pa += X->wu[k] * a->cA[k];
+			ra += fabs(X->wu[k]) * a->eA[k];
+			pb += X->wub[k] * b->cB[k];
+			rb += fabs(X->wub[k]) * b->eB[k];
+		}
+		g = fabs(pb - pa) - ra - rb - 2.0 * X->slack;
+		if (g > 0.0 && g * g > s1)
+			s1 = g * g;
+	}
 	/* (|w|^2 - ext) / |w| is the gap; the slack, scaled by |w|_1 >=
 	 * |w|, keeps it a lower bound under rounding */
 	ext += X->slack * w1;
@@ -413,6 +439,32 @@ static inline double mx3(double a, double b, double c)
 	return m > c ? m : c;
 }
 
+/* Lower bound of a triangle pair along any direction u (not unit): the
+ * gap between the triangles' projections onto it, at most their
+ * distance. Returns 1 when that gap alone exceeds the best distance. */
+static inline int axis_apart(const struct mp_ctx *X, px_vec3 u, const px_vec3 T[3],
+			     const px_vec3 V[3])
+{
+	double uu = px_v3_norm2(u);
+	double t0 = px_v3_dot(u, T[0]), t1 = px_v3_dot(u, T[1]), t2 = px_v3_dot(u, T[2]);
+	double v0 = px_v3_dot(u, V[0]), v1 = px_v3_dot(u, V[1]), v2 = px_v3_dot(u, V[2]);
+	double g = mn3(v0, v1, v2) - mx3(t0, t1, t2), g2 = mn3(t0, t1, t2) - mx3(v0, v1, v2);
+	g = g > g2 ? g : g2;
+	if (!(g > 0.0) || !(uu > 0.0))
+		return 0;
+	g = g / sqrt(uu) - X->slack;
+	return g > 0.0 && g * g > X->best2;
+}
+
+/* The same along the triangles' line of centres. */
+static inline int centres_apart(const struct mp_ctx *X, const px_vec3 T[3],
+				const px_vec3 V[3])
+{
+	px_vec3 ct = px_v3_add(T[0], px_v3_add(T[1], T[2]));
+	px_vec3 cv = px_v3_add(V[0], px_v3_add(V[1], V[2]));
+	return axis_apart(X, px_v3_sub(cv, ct), T, V);
+}
+
 static void pair_test(struct mp_ctx *X, uint32_t ia, const px_vec3 V[3], uint32_t ib)
 {
 	const struct mtri ta_ = px__mtri_get(X->A, ia), *ta = &ta_;
@@ -437,6 +489,10 @@ static void pair_test(struct mp_ctx *X, uint32_t ia, const px_vec3 V[3], uint32_
 			if (m > 0.0 && m * m > X->best2)
 				return;
 		}
+		/* and the same from B's side: A's triangle against B's
+		 * plane */
+		if (axis_apart(X, px_v3_cross(px_v3_sub(V[1], V[0]), px_v3_sub(V[2], V[0])), T, V))
+			return;
 	}
 	X->tests++;
 	d2 = px__tri_tri(T, V, &pa, &pb, &cr);
@@ -450,39 +506,67 @@ static void pair_test(struct mp_ctx *X, uint32_t ia, const px_vec3 V[3], uint32_
 	}
 }
 
-/* Lower bound of a triangle pair from its line of centres: the gap
- * between the triangles' projections onto it (at most their distance).
- * Returns 1 when that gap alone exceeds the best distance. */
-static inline int centres_apart(const struct mp_ctx *X, const px_vec3 T[3],
-				const px_vec3 V[3])
-{
-	px_vec3 ct = px_v3_add(T[0], px_v3_add(T[1], T[2]));
-	px_vec3 cv = px_v3_add(V[0], px_v3_add(V[1], V[2]));
-	px_vec3 u = px_v3_sub(cv, ct);
-	double uu = px_v3_norm2(u);
-	double g = mn3(px_v3_dot(u, V[0]), px_v3_dot(u, V[1]), px_v3_dot(u, V[2])) -
-		   mx3(px_v3_dot(u, T[0]), px_v3_dot(u, T[1]), px_v3_dot(u, T[2]));
-	if (!(g > 0.0) || !(uu > 0.0))
-		return 0;
-	g = g / sqrt(uu) - X->slack;
-	return g > 0.0 && g * g > X->best2;
-}
-
 /* A leaf of A with its triangles' boxes (A frame), set up once per
  * leaf pair. */
 #define LEAF_MAX 16
+
+/*
+ * The best pair's own direction u = pb - pa as a separating axis: the
+ * gap between a triangle pair's projections onto u is at most its
+ * distance, and near a contact where both models are locally convex it
+ * exceeds the best distance for every triangle pair but those touching
+ * the two supporting planes: the bound that ends a search whose best is
+ * already the answer (a coherent start, a far pair whose nearest
+ * features are found early). Per leaf pair: each triangle's extreme
+ * projection, remade whenever the best changes.
+ */
+struct wax {
+	double best2, inv;
+	double amax[LEAF_MAX], bmin[LEAF_MAX];
+};
+
+static void wax_update(const struct mp_ctx *X, struct wax *W, uint32_t ia, uint32_t na,
+		       const px_vec3 (*VB)[3], uint32_t nb)
+{
+	px_vec3 u = px_v3_sub(X->pb, X->pa);
+	double uu = px_v3_norm2(u);
+	uint32_t i;
+	W->best2 = X->best2;
+	W->inv = uu > 0.0 ? 1.0 / sqrt(uu) : 0.0;
+	for (i = 0; i < na; i++) {
+		const struct mtri3 t = px__tri3_get(X->A, ia + i);
+		W->amax[i] = mx3(px_v3_dot(u, t.a), px_v3_dot(u, t.b), px_v3_dot(u, t.c));
+	}
+	for (i = 0; i < nb; i++)
+		W->bmin[i] = mn3(px_v3_dot(u, VB[i][0]), px_v3_dot(u, VB[i][1]),
+				 px_v3_dot(u, VB[i][2]));
+}
+
+/* Does the best pair's axis rule out a part of A whose projections
+ * reach up to amax against a part of B whose projections start at bmin?
+ * A pair whose bound comes within twice the slack of the best is a tie:
+ * it cannot lower the answer by more than rounding. */
+static inline int wax_prunes(const struct mp_ctx *X, const struct wax *W, double amax,
+			     double bmin)
+{
+	double g = (bmin - amax) * W->inv + X->slack;
+	return g > 0.0 && g * g >= X->best2;
+}
 
 static void leaf_pair(struct mp_ctx *X, uint32_t ia, uint32_t na, uint32_t ib,
 		      uint32_t nb, px_vec3 ca, px_vec3 ha, px_vec3 cb, px_vec3 hb)
 {
 	double alo[LEAF_MAX][3], ahi[LEAF_MAX][3];
 	px_vec3 VB[LEAF_MAX][3], ga = px_v3(0, 0, 0), gb = px_v3(0, 0, 0), u;
+	struct wax W;
 	uint8_t near_b[LEAF_MAX];
 	px_vec3 cbA = to_a(X, cb);
-	double eb[3], uu, mxa = -INFINITY, mnb = INFINITY;
+	double eb[3], uu, mxa = -INFINITY, mnb = INFINITY, wa = 0.0, wb = 0.0;
 	uint32_t j, i;
 	int k, any = 0;
 
+	W.best2 = -1.0; /* no axis yet */
+	W.inv = 0.0;
 	na = na > LEAF_MAX ? LEAF_MAX : na; /* leaves hold at most 16 */
 	nb = nb > LEAF_MAX ? LEAF_MAX : nb;
 	for (j = 0; j < nb; j++) {
@@ -491,6 +575,19 @@ static void leaf_pair(struct mp_ctx *X, uint32_t ia, uint32_t na, uint32_t ib,
 		VB[j][1] = to_a(X, tb->b);
 		VB[j][2] = to_a(X, tb->c);
 		gb = px_v3_add(gb, px_v3_add(VB[j][0], px_v3_add(VB[j][1], VB[j][2])));
+	}
+	if (X->best2 < INFINITY && X->la >= 0) {
+		/* the best pair's axis against the leaves' triangles: wa, wb
+		 * the largest of A's and the least of B's projections */
+		wax_update(X, &W, ia, na, (const px_vec3(*)[3])VB, nb);
+		wa = W.amax[0];
+		wb = W.bmin[0];
+		for (i = 1; i < na; i++)
+			wa = W.amax[i] > wa ? W.amax[i] : wa;
+		for (j = 1; j < nb; j++)
+			wb = W.bmin[j] < wb ? W.bmin[j] : wb;
+		if (wax_prunes(X, &W, wa, wb))
+			return;
 	}
 	for (i = 0; i < na; i++) {
 		const struct mtri3 ta_ = px__tri3_get(X->A, ia + i), *ta = &ta_;
@@ -564,6 +661,12 @@ static void leaf_pair(struct mp_ctx *X, uint32_t ia, uint32_t na, uint32_t ib,
 			}
 			if (g2 > X->best2)
 				continue;
+			if (X->best2 < INFINITY) {
+				if (W.best2 != X->best2)
+					wax_update(X, &W, ia, na, (const px_vec3(*)[3])VB, nb);
+				if (wax_prunes(X, &W, W.amax[i], W.bmin[j]))
+					continue;
+			}
 			T[0] = ta->a;
 			T[1] = ta->b;
 			T[2] = ta->c;
@@ -820,6 +923,23 @@ int px__mesh_cloud_pair(const struct px_model *a, const struct px_model *c, int 
 	return mp_finish(&X, Pa, V.orig, out);
 }
 
+/* The best pair's direction for box_lb2, remade when the best moved. */
+static void mp_axis(struct mp_ctx *X)
+{
+	px_vec3 u = px_v3_sub(X->pb, X->pa);
+	double n = px_v3_norm(u);
+	int k;
+	X->wbest2 = X->best2;
+	X->wok = n > 0.0 && X->la >= 0;
+	if (!X->wok)
+		return;
+	u = px_v3_scale(u, 1.0 / n);
+	X->wu[0] = u.x, X->wu[1] = u.y, X->wu[2] = u.z;
+	X->wut = px_v3_dot(u, X->t);
+	for (k = 0; k < 3; k++)
+		X->wub[k] = X->R[0][k] * u.x + X->R[1][k] * u.y + X->R[2][k] * u.z;
+}
+
 static int mp_descend(struct mp_ctx *X)
 {
 	struct mp_ent st[MP_STACK];
@@ -842,6 +962,8 @@ static int mp_descend(struct mp_ctx *X)
 
 		if (e.lb2 > X->best2 || (e.lb2 == X->best2 && X->la >= 0))
 			continue;
+		if (X->best2 != X->wbest2)
+			mp_axis(X);
 		ref_get(&X->ta, e.na, e.sa, &ca, &ha, &ia, &na);
 		ref_get(&X->tb, e.nb, e.sb, &cb, &hb, &ib, &nb);
 		X->nodes++;

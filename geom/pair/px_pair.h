@@ -39,9 +39,10 @@
  * - two triangle meshes (any, closed or open, convex or not): the exact
  *   minimum over all triangle pairs, by a simultaneous traversal of both
  *   hierarchies (geom/mesh/px_mesh_pair.c: box pairs bounded below in both
- *   frames and along the line of centres, exact triangle-triangle
- *   distances with a crossing test); index_a/index_b are the triangles.
- *   In coherent mode last cycle's triangle pair is the starting bound;
+ *   frames, along the line of centres and along the best pair's own
+ *   direction, exact triangle-triangle distances with a crossing test);
+ *   index_a/index_b are the triangles. In coherent mode last cycle's
+ *   triangle pair is the starting bound;
  * - a mesh against a convex model with a support function (box,
  *   capsule, cylinder, cone): the mesh hierarchy bounded below by the
  *   other model's point queries (distance of a node box's centre minus
@@ -114,10 +115,8 @@
  * simplex and polytope in fixed arrays on the stack, about 14 kB; the
  * mesh traversals a fixed stack of about 4 kB); work bounded by starts *
  * max_iters point queries, by the node pairs of the two hierarchies for
- * mesh pairs (in practice the node pairs near the closest pair: about a
- * thousand for two 4k-triangle meshes 4 cm apart, half a millisecond,
- * and coherent mode saves little: the proof, not the search, is the
- * cost), by the query budget above for the mesh/convex path
+ * mesh pairs (in practice the node pairs near the closest pair, fewer
+ * from a good first pair such as coherent mode's), by the query budget above for the mesh/convex path
  * (bench_models: a 4k-triangle torus against a box about 0.1 ms), by
  * the node pairs of both hierarchies and, against a closed mesh, the
  * cloud nodes within the mesh's box for the mesh/cloud path
@@ -148,9 +147,9 @@ struct px_pair_opts {
 	int coherent;     /* start from the previous result's pair */
 	double rel_tol;
 	/* With coherent = 1 and a valid previous result: 1 lets a pair of
-	 * meshes skip the exact traversal (whose proof costs about a
-	 * thousand node pairs per call even with a perfect first bound) and
-	 * run the projections from last cycle's pair instead, answering
+	 * meshes skip the exact traversal (whose proof still visits the
+	 * node pairs near the closest pair) and run the projections from
+	 * last cycle's pair instead, answering
 	 * with local_only = 1 (also when one mesh is convex, which would
 	 * otherwise take the mesh/convex path; two convex meshes keep GJK,
 	 * which is exact and cheap). Use with starts = 1 for a cheap tracking

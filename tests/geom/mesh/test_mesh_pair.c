@@ -677,9 +677,114 @@ static void test_pair_coherent_local_ok(void)
 	px_model_free(b);
 }
 
+/* A generated obstacle (torus, L-prism, sphere or box) against a small
+ * link-like mesh (a long box or a coarse sphere), as the arm's pairs:
+ * the link moves along a random line through the obstacle, far apart to
+ * deep overlap; at every step the cold answer and the coherent one (last
+ * step's triangles as the start) equal brute force and each other, and
+ * the link moved onto the obstacle by the found gap (touching) gives 0. */
+static struct px_model *gen_shape(int kind, struct gen_mesh *g)
+{
+	static const double hb[3] = {0.08, 0.05, 0.12}, hl[3] = {0.03, 0.035, 0.16};
+	struct px_model *m = NULL;
+	int rc;
+	memset(g, 0, sizeof(*g));
+	switch (kind) {
+	case 0:
+		rc = gen_torus(0.1, 0.03, 32, 16, g);
+		break;
+	case 1:
+		rc = gen_lprism(0.12, 0.08, g);
+		break;
+	case 2:
+		rc = gen_sphere(0.09, 8, 12, g);
+		break;
+	case 3:
+		rc = gen_box(hb, 2, g);
+		break;
+	default:
+		rc = gen_box(hl, 1, g);
+		break;
+	}
+	PX_CHECK_INT_EQ(rc, 0);
+	PX_CHECK_INT_EQ(px_mesh_model(g->xyz, g->nv, g->tri, g->nt, NULL, NULL, &m), PX_OK);
+	return m;
+}
+
+static void test_mesh_pair_paths_coherent_vs_brute(void)
+{
+	int path, n = 0, apart = 0, over = 0, touch = 0;
+	for (path = 0; path < 8; path++) {
+		struct gen_mesh ga, gb;
+		struct px_model *a = gen_shape(path % 4, &ga);
+		struct px_model *b = gen_shape(path % 3 == 2 ? 2 : 4, &gb);
+		px_vec3 d0 = rand_pt(1), p0, p1;
+		px_pose Pb = rand_pose(px_v3(0, 0, 0));
+		px_vec3 ax = rand_pt(1);
+		struct px__mesh_pair prev;
+		int i, have = 0;
+		d0 = px_v3_scale(d0, 1.0 / px_v3_norm(d0));
+		p0 = px_v3_scale(d0, 0.6);
+		p1 = px_v3_add(px_v3_scale(d0, -0.05), rand_pt(0.05));
+		px_model_set_pose(a, rand_pose(rand_pt(0.1)));
+		for (i = 0; i <= 24; i++) {
+			struct px__mesh_pair r0, r1;
+			double ref, t = i / 24.0;
+			px_quat dq;
+			PX_CHECK_INT_EQ(px_quat_from_axis_angle(ax, 0.05 * i, &dq), PX_OK);
+			Pb.t = px_v3_add(px_v3_scale(p0, 1.0 - t), px_v3_scale(p1, t));
+			Pb.q = px_quat_mul(dq, rand_pose(p0).q);
+			Pb.q = px_quat_mul(dq, Pb.q);
+			px_model_set_pose(b, Pb);
+			PX_CHECK_INT_EQ(px__mesh_pair(a, b, -1, -1, &r0), PX_OK);
+			PX_CHECK_INT_EQ(px__mesh_pair(a, b, have ? prev.tri_a : -1,
+						      have ? prev.tri_b : -1, &r1), PX_OK);
+			ref = brute(a, b);
+			PX_CHECK_MSG(fabs(r0.distance - ref) <= 1e-9 * ref + 1e-12,
+				     "path %d step %d: cold %.17g vs brute force %.17g", path, i,
+				     r0.distance, ref);
+			PX_CHECK_MSG(fabs(r1.distance - r0.distance) <= 1e-12 * r0.distance + 1e-15,
+				     "path %d step %d: coherent %.17g vs cold %.17g", path, i,
+				     r1.distance, r0.distance);
+			PX_CHECK(r0.certified && r1.certified);
+			PX_CHECK_NEAR(px_v3_dist(r1.point_a, r1.point_b), r1.distance, 1e-12);
+			check_on_triangle(a, r1.tri_a, r1.point_a);
+			check_on_triangle(b, r1.tri_b, r1.point_b);
+			n++;
+			apart += ref > 0.0;
+			over += ref == 0.0;
+			if (ref > 1e-6) {
+				/* moved by the gap onto the obstacle: touching */
+				px_pose Pt = Pb;
+				struct px__mesh_pair rt;
+				Pt.t = px_v3_add(Pb.t, px_v3_sub(r0.point_a, r0.point_b));
+				px_model_set_pose(b, Pt);
+				PX_CHECK_INT_EQ(px__mesh_pair(a, b, r0.tri_a, r0.tri_b, &rt), PX_OK);
+				ref = brute(a, b);
+				PX_CHECK_MSG(fabs(rt.distance - ref) <= 1e-9 * ref + 1e-12 &&
+						     ref < 1e-12,
+					     "path %d step %d touching: %.17g vs brute force %.17g",
+					     path, i, rt.distance, ref);
+				px_model_set_pose(b, Pb);
+				touch++;
+			}
+			prev = r1;
+			have = 1;
+		}
+		px_model_free(a);
+		px_model_free(b);
+		gen_free(&ga);
+		gen_free(&gb);
+	}
+	PX_CHECK(apart > 0 && over > 0 && touch > 0);
+	printf("    %d poses along 8 paths: %d apart, %d overlapping, %d touching; coherent == cold "
+	       "== brute force\n", n, apart, over, touch);
+}
+
 static const struct px_test tests[] = {
 	PX_T(test_tri_tri_vs_references), PX_T(test_mesh_pair_vs_brute),
 	PX_T(test_mesh_pair_parallel_faces), PX_T(test_mesh_pair_errors_and_alloc),
 	PX_T(test_pair_mesh_vs_convex_primitives), PX_T(test_pair_mesh_in_mesh),
-	PX_T(test_pair_exact_paths_alloc), PX_T(test_pair_coherent_local_ok)};
+	PX_T(test_pair_exact_paths_alloc), PX_T(test_pair_coherent_local_ok),
+	PX_T(test_mesh_pair_paths_coherent_vs_brute)};
 PX_TEST_MAIN(tests)
