@@ -379,9 +379,28 @@ static void bx_of_b(const struct mp_ctx *X, px_vec3 c, px_vec3 h, struct bx *o)
  */
 static double box_lb2(const struct mp_ctx *X, const struct bx *a, const struct bx *b)
 {
-	double s1 = 0.0, s2 = 0.0, ww = 0.0, ext = 0.0, w1 = 0.0;
+	double s1 = 0.0, s2 = 0.0, ww = 0.0, ext = 0.0, w1 = 0.0, sw = 0.0;
 	int k;
 
+	if (X->wok) {
+		/* the best pair's direction first (alone it prunes most box
+		 * pairs): A's box projects exactly in A's frame, B's in B's;
+		 * the slack, doubled, covers the sums of up to six products
+		 * of a unit vector */
+		double pa = 0.0, ra = 0.0, pb = X->wut, rb = 0.0, g;
+		for (k = 0; k < 3; k++) {
+			pa += X->wu[k] * a->cA[k];
+			ra += fabs(X->wu[k]) * a->eA[k];
+			pb += X->wub[k] * b->cB[k];
+			rb += fabs(X->wub[k]) * b->eB[k];
+		}
+		g = fabs(pb - pa) - ra - rb - 2.0 * X->slack;
+		if (g > 0.0) {
+			sw = g * g;
+			if (sw > X->best2)
+				return sw;
+		}
+	}
 	for (k = 0; k < 3; k++) {
 		double w = b->cA[k] - a->cA[k], wb = b->cB[k] - a->cB[k];
 		double g1 = gap_pos(fabs(w) - a->eA[k] - b->eA[k] - X->slack);
@@ -393,21 +412,7 @@ static double box_lb2(const struct mp_ctx *X, const struct bx *a, const struct b
 		ext += fabs(w) * a->eA[k] + fabs(wb) * b->eB[k];
 	}
 	s1 = s1 > s2 ? s1 : s2;
-	if (X->wok) {
-		/* the best pair's direction: A's box projects exactly in
-		 * A's frame, B's in B's; the slack, doubled, covers the sums
-		 * of up to six products of a unit vector */
-		double pa = 0.0, ra = 0.0, pb = X->wut, rb = 0.0, g;
-		for (k = 0; k < 3; k++) {
-			pa += X->wu[k] * a->cA[k];
-			ra += fabs(X->wu[k]) * a->eA[k];
-			pb += X->wub[k] * b->cB[k];
-			rb += fabs(X->wub[k]) * b->eB[k];
-		}
-		g = fabs(pb - pa) - ra - rb - 2.0 * X->slack;
-		if (g > 0.0 && g * g > s1)
-			s1 = g * g;
-	}
+	s1 = s1 > sw ? s1 : sw;
 	/* (|w|^2 - ext) / |w| is the gap; the slack, scaled by |w|_1 >=
 	 * |w|, keeps it a lower bound under rounding */
 	ext += X->slack * w1;
@@ -510,6 +515,23 @@ static void pair_test(struct mp_ctx *X, uint32_t ia, const px_vec3 V[3], uint32_
  * leaf pair. */
 #define LEAF_MAX 16
 
+/* The best pair's direction for box_lb2, remade when the best moved. */
+static void mp_axis(struct mp_ctx *X)
+{
+	px_vec3 u = px_v3_sub(X->pb, X->pa);
+	double n = px_v3_norm(u);
+	int k;
+	X->wbest2 = X->best2;
+	X->wok = n > 0.0 && X->la >= 0;
+	if (!X->wok)
+		return;
+	u = px_v3_scale(u, 1.0 / n);
+	X->wu[0] = u.x, X->wu[1] = u.y, X->wu[2] = u.z;
+	X->wut = px_v3_dot(u, X->t);
+	for (k = 0; k < 3; k++)
+		X->wub[k] = X->R[0][k] * u.x + X->R[1][k] * u.y + X->R[2][k] * u.z;
+}
+
 /*
  * The best pair's own direction u = pb - pa as a separating axis: the
  * gap between a triangle pair's projections onto u is at most its
@@ -521,25 +543,31 @@ static void pair_test(struct mp_ctx *X, uint32_t ia, const px_vec3 V[3], uint32_
  * projection, remade whenever the best changes.
  */
 struct wax {
-	double best2, inv;
+	double best2;
 	double amax[LEAF_MAX], bmin[LEAF_MAX];
 };
 
-static void wax_update(const struct mp_ctx *X, struct wax *W, uint32_t ia, uint32_t na,
-		       const px_vec3 (*VB)[3], uint32_t nb)
+/* B's projections from its own frame (u . (R p + t) = (R^T u) . p + u .
+ * t): no triangle of B need be moved into A's frame for the test. */
+static void wax_update(struct mp_ctx *X, struct wax *W, uint32_t ia, uint32_t na, uint32_t ib,
+		       uint32_t nb)
 {
-	px_vec3 u = px_v3_sub(X->pb, X->pa);
-	double uu = px_v3_norm2(u);
+	px_vec3 u, ub;
 	uint32_t i;
+	if (X->best2 != X->wbest2)
+		mp_axis(X);
+	u = px_v3(X->wu[0], X->wu[1], X->wu[2]);
+	ub = px_v3(X->wub[0], X->wub[1], X->wub[2]);
 	W->best2 = X->best2;
-	W->inv = uu > 0.0 ? 1.0 / sqrt(uu) : 0.0;
 	for (i = 0; i < na; i++) {
 		const struct mtri3 t = px__tri3_get(X->A, ia + i);
 		W->amax[i] = mx3(px_v3_dot(u, t.a), px_v3_dot(u, t.b), px_v3_dot(u, t.c));
 	}
-	for (i = 0; i < nb; i++)
-		W->bmin[i] = mn3(px_v3_dot(u, VB[i][0]), px_v3_dot(u, VB[i][1]),
-				 px_v3_dot(u, VB[i][2]));
+	for (i = 0; i < nb; i++) {
+		const struct mtri3 t = px__tri3_get(X->B, ib + i);
+		W->bmin[i] = mn3(px_v3_dot(ub, t.a), px_v3_dot(ub, t.b), px_v3_dot(ub, t.c)) +
+			     X->wut;
+	}
 }
 
 /* Does the best pair's axis rule out a part of A whose projections
@@ -549,7 +577,8 @@ static void wax_update(const struct mp_ctx *X, struct wax *W, uint32_t ia, uint3
 static inline int wax_prunes(const struct mp_ctx *X, const struct wax *W, double amax,
 			     double bmin)
 {
-	double g = (bmin - amax) * W->inv + X->slack;
+	double g = bmin - amax + X->slack;
+	(void)W;
 	return g > 0.0 && g * g >= X->best2;
 }
 
@@ -566,28 +595,27 @@ static void leaf_pair(struct mp_ctx *X, uint32_t ia, uint32_t na, uint32_t ib,
 	int k, any = 0;
 
 	W.best2 = -1.0; /* no axis yet */
-	W.inv = 0.0;
 	na = na > LEAF_MAX ? LEAF_MAX : na; /* leaves hold at most 16 */
 	nb = nb > LEAF_MAX ? LEAF_MAX : nb;
-	for (j = 0; j < nb; j++) {
-		const struct mtri3 tb_ = px__tri3_get(X->B, ib + j), *tb = &tb_;
-		VB[j][0] = to_a(X, tb->a);
-		VB[j][1] = to_a(X, tb->b);
-		VB[j][2] = to_a(X, tb->c);
-		gb = px_v3_add(gb, px_v3_add(VB[j][0], px_v3_add(VB[j][1], VB[j][2])));
-	}
 	if (X->best2 < INFINITY && X->la >= 0) {
 		/* the best pair's axis against the leaves' triangles: wa, wb
 		 * the largest of A's and the least of B's projections */
-		wax_update(X, &W, ia, na, (const px_vec3(*)[3])VB, nb);
+		wax_update(X, &W, ia, na, ib, nb);
 		wa = W.amax[0];
 		wb = W.bmin[0];
 		for (i = 1; i < na; i++)
 			wa = W.amax[i] > wa ? W.amax[i] : wa;
 		for (j = 1; j < nb; j++)
 			wb = W.bmin[j] < wb ? W.bmin[j] : wb;
-		if (wax_prunes(X, &W, wa, wb))
+		if (X->wok && wax_prunes(X, &W, wa, wb))
 			return;
+	}
+	for (j = 0; j < nb; j++) {
+		const struct mtri3 tb_ = px__tri3_get(X->B, ib + j), *tb = &tb_;
+		VB[j][0] = to_a(X, tb->a);
+		VB[j][1] = to_a(X, tb->b);
+		VB[j][2] = to_a(X, tb->c);
+		gb = px_v3_add(gb, px_v3_add(VB[j][0], px_v3_add(VB[j][1], VB[j][2])));
 	}
 	for (i = 0; i < na; i++) {
 		const struct mtri3 ta_ = px__tri3_get(X->A, ia + i), *ta = &ta_;
@@ -663,8 +691,8 @@ static void leaf_pair(struct mp_ctx *X, uint32_t ia, uint32_t na, uint32_t ib,
 				continue;
 			if (X->best2 < INFINITY) {
 				if (W.best2 != X->best2)
-					wax_update(X, &W, ia, na, (const px_vec3(*)[3])VB, nb);
-				if (wax_prunes(X, &W, W.amax[i], W.bmin[j]))
+					wax_update(X, &W, ia, na, ib, nb);
+				if (X->wok && wax_prunes(X, &W, W.amax[i], W.bmin[j]))
 					continue;
 			}
 			T[0] = ta->a;
@@ -921,23 +949,6 @@ int px__mesh_cloud_pair(const struct px_model *a, const struct px_model *c, int 
 		X.pb = p;
 	}
 	return mp_finish(&X, Pa, V.orig, out);
-}
-
-/* The best pair's direction for box_lb2, remade when the best moved. */
-static void mp_axis(struct mp_ctx *X)
-{
-	px_vec3 u = px_v3_sub(X->pb, X->pa);
-	double n = px_v3_norm(u);
-	int k;
-	X->wbest2 = X->best2;
-	X->wok = n > 0.0 && X->la >= 0;
-	if (!X->wok)
-		return;
-	u = px_v3_scale(u, 1.0 / n);
-	X->wu[0] = u.x, X->wu[1] = u.y, X->wu[2] = u.z;
-	X->wut = px_v3_dot(u, X->t);
-	for (k = 0; k < 3; k++)
-		X->wub[k] = X->R[0][k] * u.x + X->R[1][k] * u.y + X->R[2][k] * u.z;
 }
 
 static int mp_descend(struct mp_ctx *X)

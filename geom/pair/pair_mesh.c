@@ -22,6 +22,22 @@ void px__tri_world(const struct px_model *m, int t, px_vec3 v[3])
 		v[k] = px_pose_transform_point(px_model_pose(m), v[k]);
 }
 
+/* Is p (world) clearly outside model x's box, where x holds nothing?
+ * The margin, a millionth of the box and the coordinates, covers the
+ * rounding of the move into x's frame. */
+static int outside_box(const struct px_model *x, px_vec3 p)
+{
+	px_aabb b = px_model_local_aabb(x);
+	px_vec3 l;
+	double m;
+	if (!px__finite_box(&b))
+		return 0;
+	l = px_pose_inverse_transform_point(px_model_pose(x), p);
+	m = 1e-6 * (px_aabb_diagonal(&b) + px_v3_norm(l) + px_v3_norm(px_model_pose(x).t));
+	return l.x < b.min.x - m || l.x > b.max.x + m || l.y < b.min.y - m ||
+	       l.y > b.max.y + m || l.z < b.min.z - m || l.z > b.max.z + m;
+}
+
 int px__pair_contained(const struct px_model *a, const struct px_model *b,
 		       struct pair_run *best, int *total)
 {
@@ -30,7 +46,7 @@ int px__pair_contained(const struct px_model *a, const struct px_model *b,
 		const struct px_model *x = side ? b : a;
 		px_vec3 p = side ? best->pa : best->pb; /* a point of the other */
 		struct px_model_result q;
-		if (!(px_model_caps(x) & PX_MODEL_CAP_SIGNED))
+		if (!(px_model_caps(x) & PX_MODEL_CAP_SIGNED) || outside_box(x, p))
 			continue;
 		if ((rc = px_model_query(x, p, &q)) < 0)
 			return rc;
