@@ -16,7 +16,8 @@
  * Environment: PX_BENCH_MODELS_FCL (path of bench/fcl_models.cpp's
  * program; default fcl_models next to this binary); PX_BENCH_ARM_PARTS
  * (the parts to run, default "abc": "b" alone profiles the mesh pairs);
- * PX_BENCH_ARM_MESH_CYCLES (cycles of part (b), default 400).
+ * PX_BENCH_ARM_MESH_CYCLES (cycles of part (b), default 400);
+ * PX_BENCH_ARM_CLOUD_CYCLES (of parts (a) and (c), default 5000).
  */
 #include <math.h>
 #include <stdint.h>
@@ -172,7 +173,7 @@ static int64_t cycle(struct px_urdf_robot *r, int k, int coherent, int npairs, d
 	return t0;
 }
 
-static void cloud_runs(struct px_urdf_robot *r, int nb)
+static void cloud_runs(struct px_urdf_robot *r, int nb, int ncyc)
 {
 	struct px_model *c[2];
 	double sum = 0.0, mn = INFINITY;
@@ -183,9 +184,9 @@ static void cloud_runs(struct px_urdf_robot *r, int nb)
 		fprintf(stderr, "bench_arm: cloud setup failed\n");
 		exit(1);
 	}
-	printf("(a) %d bodies against a %d-point cloud, %d cycles along the path:\n", nb, NPTS, NCYC);
+	printf("(a) %d bodies against a %d-point cloud, %d cycles along the path:\n", nb, NPTS, ncyc);
 	for (coherent = 0; coherent < 2; coherent++) {
-		for (k = 0; k < NCYC; k++) {
+		for (k = 0; k < ncyc; k++) {
 			int i;
 			t_ns[k] = cycle(r, k, coherent && k > 0, nb, &sum, &local);
 			for (i = 0; i < nb; i++) {
@@ -193,12 +194,12 @@ static void cloud_runs(struct px_urdf_robot *r, int nb)
 				over += cl[i].distance_m < 0.0;
 			}
 		}
-		report(coherent ? "coherent (last cycle's pairs)" : "cold", NCYC);
+		report(coherent ? "coherent (last cycle's pairs)" : "cold", ncyc);
 	}
 	printf("  pairs flagged local_only: %d; least clearance %.4f m; pairs with a point inside a "
-	       "link: %d of %d\n", local, mn, over, 2 * NCYC * nb);
+	       "link: %d of %d\n", local, mn, over, 2 * ncyc * nb);
 	printf("(c) the cloud replaced every %d cycles by a new frame (other noise):\n", SWAP_EVERY);
-	for (k = 0; k < NCYC; k++) {
+	for (k = 0; k < ncyc; k++) {
 		int64_t t;
 		if (k % SWAP_EVERY == 0)
 			px_urdf_robot_replace_obstacle(r, 0, c[(k / SWAP_EVERY) % 2]);
@@ -349,7 +350,8 @@ int main(int argc, char **argv)
 	struct px_urdf *u = NULL;
 	struct px_urdf_robot *r = NULL;
 	const char *parts = getenv("PX_BENCH_ARM_PARTS"), *mc = getenv("PX_BENCH_ARM_MESH_CYCLES");
-	int nb, mcyc = mc ? atoi(mc) : MCYC;
+	const char *cc = getenv("PX_BENCH_ARM_CLOUD_CYCLES");
+	int nb, mcyc = mc ? atoi(mc) : MCYC, ccyc = cc ? atoi(cc) : NCYC;
 	(void)argc;
 	memset(&o, 0, sizeof(o));
 	o.package_paths = pk;
@@ -369,8 +371,10 @@ int main(int argc, char **argv)
 		parts = "abc";
 	if (mcyc < 1 || mcyc > NCYC)
 		mcyc = MCYC;
+	if (ccyc < 1 || ccyc > NCYC)
+		ccyc = NCYC;
 	if (strchr(parts, 'a') || strchr(parts, 'c')) {
-		cloud_runs(r, nb);
+		cloud_runs(r, nb, ccyc);
 	} else {
 		scene_cloud(0);
 		scene_cloud(0);
