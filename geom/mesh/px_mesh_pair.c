@@ -272,6 +272,16 @@ struct mp_ent {
 	double lb2;
 };
 
+/* Projections of leaves onto the best pair's direction (a leaf meets
+ * several leaves of the other side): direct mapped by the leaf's first
+ * element, valid while the direction is the one of stamp. */
+#define WC_SLOTS 32
+
+struct wcache {
+	uint32_t key[WC_SLOTS]; /* first element + 1; 0: empty */
+	double stamp[WC_SLOTS], val[WC_SLOTS];
+};
+
 /* One side's hierarchy: a mesh's or a cloud's (the same layout). */
 struct tree {
 	const struct node4 *n4;
@@ -295,6 +305,7 @@ struct mp_ctx {
 	 * B's (wub), with wu . t, as of best2 == wbest2 (wok: one exists) */
 	double wu[3], wub[3], wut, wbest2;
 	int wok;
+	struct wcache wca, wcb; /* leaf projections on it, A's and B's */
 	long la, lb;
 	px_vec3 pa, pb; /* A frame */
 	int crossing;
@@ -369,38 +380,41 @@ static void bx_of_b(const struct mp_ctx *X, px_vec3 c, px_vec3 h, struct bx *o)
 	}
 }
 
+/* A box (centre c, half extents h) of A (side 0) or of B (side 1), in
+ * its own model's frame, projected exactly onto the best pair's
+ * direction: centre *p and radius *r, on A's frame's line. */
+static inline void wax_box(const struct mp_ctx *X, int side, px_vec3 c, px_vec3 h, double *p,
+			   double *r)
+{
+	const double *u = side ? X->wub : X->wu;
+	*p = u[0] * c.x + u[1] * c.y + u[2] * c.z + (side ? X->wut : 0.0);
+	*r = fabs(u[0]) * h.x + fabs(u[1]) * h.y + fabs(u[2]) * h.z;
+}
+
+/* The squared gap of two boxes so projected (0 without a direction);
+ * the slack, doubled, covers the sums of up to six products of a unit
+ * vector. */
+static inline double wax_gap2(const struct mp_ctx *X, double p1, double r1, double p2, double r2)
+{
+	double g = fabs(p1 - p2) - r1 - r2 - 2.0 * X->slack;
+	return X->wok && g > 0.0 ? g * g : 0.0;
+}
+
 /*
  * Lower bound of the squared distance between box a of A and box b of
  * B (see the top of the file): the axis-aligned gaps in A's frame and in
  * B's frame, and the gap along the line of centres w, where the boxes
  * project to intervals of half lengths sum |w_k| h_k (each box in its
  * own frame) around centres |w| apart; that one is tight when the boxes
- * face each other diagonally, where the axis-aligned gaps lose most.
+ * face each other diagonally, where the axis-aligned gaps lose most. sw:
+ * the gap along the best pair's direction (wax_gap2), the first and
+ * cheapest bound, which the caller has tried alone.
  */
-static double box_lb2(const struct mp_ctx *X, const struct bx *a, const struct bx *b)
+static double box_lb2(const struct mp_ctx *X, const struct bx *a, const struct bx *b, double sw)
 {
-	double s1 = 0.0, s2 = 0.0, ww = 0.0, ext = 0.0, w1 = 0.0, sw = 0.0;
+	double s1 = 0.0, s2 = 0.0, ww = 0.0, ext = 0.0, w1 = 0.0;
 	int k;
 
-	if (X->wok) {
-		/* the best pair's direction first (alone it prunes most box
-		 * pairs): A's box projects exactly in A's frame, B's in B's;
-		 * the slack, doubled, covers the sums of up to six products
-		 * of a unit vector */
-		double pa = 0.0, ra = 0.0, pb = X->wut, rb = 0.0, g;
-		for (k = 0; k < 3; k++) {
-			pa += X->wu[k] * a->cA[k];
-			ra += fabs(X->wu[k]) * a->eA[k];
-			pb += X->wub[k] * b->cB[k];
-			rb += fabs(X->wub[k]) * b->eB[k];
-		}
-		g = fabs(pb - pa) - ra - rb - 2.0 * X->slack;
-		if (g > 0.0) {
-			sw = g * g;
-			if (sw > X->best2)
-				return sw;
-		}
-	}
 	for (k = 0; k < 3; k++) {
 		double w = b->cA[k] - a->cA[k], wb = b->cB[k] - a->cB[k];
 		double g1 = gap_pos(fabs(w) - a->eA[k] - b->eA[k] - X->slack);
@@ -522,7 +536,8 @@ static void mp_axis(struct mp_ctx *X)
 	double n = px_v3_norm(u);
 	int k;
 	X->wbest2 = X->best2;
-	X->wok = n > 0.0 && X->la >= 0;
+	/* not against a cloud: its nodes' own bounds prune as well there */
+	X->wok = n > 0.0 && X->la >= 0 && !X->cpt;
 	if (!X->wok)
 		return;
 	u = px_v3_scale(u, 1.0 / n);
@@ -574,12 +589,35 @@ static void wax_update(struct mp_ctx *X, struct wax *W, uint32_t ia, uint32_t na
  * reach up to amax against a part of B whose projections start at bmin?
  * A pair whose bound comes within twice the slack of the best is a tie:
  * it cannot lower the answer by more than rounding. */
-static inline int wax_prunes(const struct mp_ctx *X, const struct wax *W, double amax,
-			     double bmin)
+static inline int wax_prunes(const struct mp_ctx *X, double amax, double bmin)
 {
 	double g = bmin - amax + X->slack;
-	(void)W;
 	return g > 0.0 && g * g >= X->best2;
+}
+
+/* The largest projection of A's leaf [i0, i0 + n) onto the best pair's
+ * direction (side 0), or the least of B's (side 1), cached. */
+static double leaf_proj(struct mp_ctx *X, int side, uint32_t i0, uint32_t n)
+{
+	struct wcache *C = side ? &X->wcb : &X->wca;
+	uint32_t s = (i0 * 2654435761u) >> 27, i; /* 32 slots */
+	px_vec3 u = side ? px_v3(X->wub[0], X->wub[1], X->wub[2])
+			 : px_v3(X->wu[0], X->wu[1], X->wu[2]);
+	double v = 0.0;
+	if (C->key[s] == i0 + 1 && C->stamp[s] == X->wbest2)
+		return C->val[s];
+	for (i = 0; i < n; i++) {
+		const struct mtri3 t = px__tri3_get(side ? X->B : X->A, i0 + i);
+		double a = px_v3_dot(u, t.a), b = px_v3_dot(u, t.b), c = px_v3_dot(u, t.c);
+		double x = side ? mn3(a, b, c) : mx3(a, b, c);
+		v = i == 0 || (side ? x < v : x > v) ? x : v;
+	}
+	if (side)
+		v += X->wut;
+	C->key[s] = i0 + 1;
+	C->stamp[s] = X->wbest2;
+	C->val[s] = v;
+	return v;
 }
 
 static void leaf_pair(struct mp_ctx *X, uint32_t ia, uint32_t na, uint32_t ib,
@@ -590,7 +628,7 @@ static void leaf_pair(struct mp_ctx *X, uint32_t ia, uint32_t na, uint32_t ib,
 	struct wax W;
 	uint8_t near_b[LEAF_MAX];
 	px_vec3 cbA = to_a(X, cb);
-	double eb[3], uu, mxa = -INFINITY, mnb = INFINITY, wa = 0.0, wb = 0.0;
+	double eb[3], uu, mxa = -INFINITY, mnb = INFINITY;
 	uint32_t j, i;
 	int k, any = 0;
 
@@ -598,17 +636,13 @@ static void leaf_pair(struct mp_ctx *X, uint32_t ia, uint32_t na, uint32_t ib,
 	na = na > LEAF_MAX ? LEAF_MAX : na; /* leaves hold at most 16 */
 	nb = nb > LEAF_MAX ? LEAF_MAX : nb;
 	if (X->best2 < INFINITY && X->la >= 0) {
-		/* the best pair's axis against the leaves' triangles: wa, wb
-		 * the largest of A's and the least of B's projections */
-		wax_update(X, &W, ia, na, ib, nb);
-		wa = W.amax[0];
-		wb = W.bmin[0];
-		for (i = 1; i < na; i++)
-			wa = W.amax[i] > wa ? W.amax[i] : wa;
-		for (j = 1; j < nb; j++)
-			wb = W.bmin[j] < wb ? W.bmin[j] : wb;
-		if (X->wok && wax_prunes(X, &W, wa, wb))
+		/* the best pair's axis against the leaves' triangles, then
+		 * each triangle's projection for the pairs below */
+		if (X->best2 != X->wbest2)
+			mp_axis(X);
+		if (X->wok && wax_prunes(X, leaf_proj(X, 0, ia, na), leaf_proj(X, 1, ib, nb)))
 			return;
+		wax_update(X, &W, ia, na, ib, nb);
 	}
 	for (j = 0; j < nb; j++) {
 		const struct mtri3 tb_ = px__tri3_get(X->B, ib + j), *tb = &tb_;
@@ -692,7 +726,7 @@ static void leaf_pair(struct mp_ctx *X, uint32_t ia, uint32_t na, uint32_t ib,
 			if (X->best2 < INFINITY) {
 				if (W.best2 != X->best2)
 					wax_update(X, &W, ia, na, ib, nb);
-				if (X->wok && wax_prunes(X, &W, W.amax[i], W.bmin[j]))
+				if (X->wok && wax_prunes(X, W.amax[i], W.bmin[j]))
 					continue;
 			}
 			T[0] = ta->a;
@@ -969,6 +1003,7 @@ static int mp_descend(struct mp_ctx *X)
 		struct bx fixed;
 		px_vec3 lv[3 * LEAF_MAX];
 		size_t nlv = 0;
+		double fp = 0.0, fr = 0.0;
 		int nk = 0, da;
 
 		if (e.lb2 > X->best2 || (e.lb2 == X->best2 && X->la >= 0))
@@ -993,25 +1028,45 @@ static int mp_descend(struct mp_ctx *X)
 			bx_of_b(X, cb, hb, &fixed);
 		else
 			bx_of_a(X, ca, ha, &fixed);
+		if (X->wok)
+			wax_box(X, da, da ? cb : ca, da ? hb : ha, &fp, &fr);
 		for (j = 0; j < 4; j++) {
 			px_vec3 cc, hc;
 			uint32_t ic, nc;
 			struct mp_ent c;
 			struct bx kb;
+			double sw = 0.0;
 			if (nd->idx[j] == EMPTY)
 				continue;
+			ref_get(da ? &X->ta : &X->tb, da ? ia : ib, j, &cc, &hc, &ic, &nc);
+			if (X->wok) {
+				/* the child on the best pair's direction alone */
+				double cp, cr;
+				wax_box(X, !da, cc, hc, &cp, &cr);
+				sw = wax_gap2(X, fp, fr, cp, cr);
+				if (sw > X->best2)
+					continue;
+				if (nc > 0) {
+					/* a leaf: its triangles' own extreme
+					 * projection, tighter than its box (B lies
+					 * beyond A along the direction) */
+					double g = da ? fp - fr - leaf_proj(X, 0, ic, nc)
+						      : leaf_proj(X, 1, ic, nc) - fp - fr;
+					g -= 2.0 * X->slack;
+					if (g > 0.0 && g * g > X->best2)
+						continue;
+				}
+			}
 			if (da) {
-				ref_get(&X->ta, ia, j, &cc, &hc, &ic, &nc);
 				bx_of_a(X, cc, hc, &kb);
-				c.lb2 = box_lb2(X, &kb, &fixed);
+				c.lb2 = box_lb2(X, &kb, &fixed, sw);
 				c.na = ia;
 				c.sa = (uint8_t)j;
 				c.nb = e.nb;
 				c.sb = e.sb;
 			} else {
-				ref_get(&X->tb, ib, j, &cc, &hc, &ic, &nc);
 				bx_of_b(X, cc, hc, &kb);
-				c.lb2 = box_lb2(X, &fixed, &kb);
+				c.lb2 = box_lb2(X, &fixed, &kb, sw);
 				if (X->n_sv && !(c.lb2 > X->best2)) {
 					double ls;
 					if (na > 0 && !nlv) {
