@@ -985,6 +985,28 @@ int px__mesh_cloud_pair(const struct px_model *a, const struct px_model *c, int 
 	return mp_finish(&X, Pa, V.orig, out);
 }
 
+/* The best pair's direction with B beyond A: does it rule out child
+ * (c, h, its elements ic, nc: a leaf when nc > 0) of A (da) or of B,
+ * against the fixed side's extreme fx (B's least projection when da,
+ * else A's largest; exact when fexact)? A leaf's extreme is its
+ * triangles' own, tighter than its box; two exact sides take the tie
+ * rule of the triangles. */
+static int wax_directed(struct mp_ctx *X, int da, px_vec3 c, px_vec3 h, uint32_t ic,
+			uint32_t nc, double fx, int fexact)
+{
+	double x, p, r, g;
+	if (nc > 0) {
+		x = leaf_proj(X, !da, ic, nc);
+		if (fexact)
+			return da ? wax_prunes(X, x, fx) : wax_prunes(X, fx, x);
+	} else {
+		wax_box(X, !da, c, h, &p, &r);
+		x = da ? p + r : p - r;
+	}
+	g = (da ? fx - x : x - fx) - 2.0 * X->slack;
+	return g > 0.0 && g * g > X->best2;
+}
+
 static int mp_descend(struct mp_ctx *X)
 {
 	struct mp_ent st[MP_STACK];
@@ -1003,7 +1025,8 @@ static int mp_descend(struct mp_ctx *X)
 		struct bx fixed;
 		px_vec3 lv[3 * LEAF_MAX];
 		size_t nlv = 0;
-		double fp = 0.0, fr = 0.0;
+		double fp = 0.0, fr = 0.0, fx = 0.0;
+		uint32_t fn = 0;
 		int nk = 0, da;
 
 		if (e.lb2 > X->best2 || (e.lb2 == X->best2 && X->la >= 0))
@@ -1028,8 +1051,14 @@ static int mp_descend(struct mp_ctx *X)
 			bx_of_b(X, cb, hb, &fixed);
 		else
 			bx_of_a(X, ca, ha, &fixed);
-		if (X->wok)
+		if (X->wok) {
+			/* the fixed side's extreme towards the other: its
+			 * triangles' own when it is a leaf */
+			uint32_t fi = da ? ib : ia;
+			fn = da ? nb : na;
 			wax_box(X, da, da ? cb : ca, da ? hb : ha, &fp, &fr);
+			fx = fn > 0 ? leaf_proj(X, da, fi, fn) : (da ? fp - fr : fp + fr);
+		}
 		for (j = 0; j < 4; j++) {
 			px_vec3 cc, hc;
 			uint32_t ic, nc;
@@ -1046,16 +1075,8 @@ static int mp_descend(struct mp_ctx *X)
 				sw = wax_gap2(X, fp, fr, cp, cr);
 				if (sw > X->best2)
 					continue;
-				if (nc > 0) {
-					/* a leaf: its triangles' own extreme
-					 * projection, tighter than its box (B lies
-					 * beyond A along the direction) */
-					double g = da ? fp - fr - leaf_proj(X, 0, ic, nc)
-						      : leaf_proj(X, 1, ic, nc) - fp - fr;
-					g -= 2.0 * X->slack;
-					if (g > 0.0 && g * g > X->best2)
-						continue;
-				}
+				if (wax_directed(X, da, cc, hc, ic, nc, fx, fn > 0))
+					continue;
 			}
 			if (da) {
 				bx_of_a(X, cc, hc, &kb);
