@@ -439,6 +439,7 @@ int app_validate(struct px_app *a)
 	int i, rc, status = 0;
 
 	a->ctl_dev = -1;
+	a->cloud_input = -1;
 	a->estop_first_ns = -1;
 	a->safe_first_after_estop_ns = -1;
 	a->clock0_ns = a->o.virtual_time || a->o.check ? 0 : app_mono_ns();

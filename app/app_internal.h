@@ -111,6 +111,15 @@ struct raw_teleop {
 	const char *params_device;
 	struct px_bridge_params params_min, params_max;
 	bool has_params_max;
+	/* scene updates (app_teleop.c): the one source, the models it may
+	 * pose, the box its points and positions must keep to, the largest
+	 * cloud */
+	const char *scene_device;
+	const char **scene_models;
+	size_t n_scene_models;
+	double workspace_min_m[3], workspace_max_m[3];
+	bool has_ws_min, has_ws_max;
+	int64_t cloud_max_points;
 };
 
 /* Remote devices and teleoperation; device indices into px_app.dev,
@@ -126,6 +135,13 @@ struct app_teleop {
 	} dds[64]; /* MAX_DEVS */
 	int n_dds;
 	int follow, feedback, force, params;
+	/* scene updates: teleop.scene_device (index in px_app.dev, -1
+	 * none), its dds entry, the scene index of each scene model, the
+	 * sequence of each model's pose last applied, poses applied */
+	int scene, scene_dds, scene_cloud;
+	int scene_model[PX_BRIDGE_SCENE_MODELS];
+	uint64_t scene_seq[PX_BRIDGE_SCENE_MODELS];
+	uint64_t scene_poses_applied;
 	double speed_scale;     /* remote parameter on the follow task */
 	uint64_t params_applied;
 	int force_input;        /* loop input of the remote force */
@@ -376,5 +392,6 @@ int app_teleop_follow(struct px_app *a, double *qnom);
 void app_teleop_compute(struct px_app *a);
 void app_teleop_write(struct px_app *a, const struct px_loop_cycle *c);
 void app_teleop_summary(const struct px_app *a, struct px_app_summary *s);
+int app_teleop_cloud_source(const struct px_app *a);
 
 #endif

@@ -1,7 +1,9 @@
-/* The app's simulated depth camera (sim.depth_sensor): its keys, the
- * camera and its cloud feed at setup (the cloud is one more obstacle of
- * the URDF robot), and in the cycle (real-time rules) the newest frame
- * swapped in and its stamp given to the watchdog. */
+/* The app's obstacle cloud: a simulated depth camera (sim.depth_sensor:
+ * its keys, the camera) or a remote cloud (teleop.scene_device's
+ * cloud_topic, filled by the dds device's thread). At setup the cloud
+ * feed (the cloud is one more obstacle of the URDF robot), in the cycle
+ * (real-time rules) the newest frame swapped in and its stamp given to
+ * the watchdog. */
 #include "app_internal.h"
 #include "schema_internal.h"
 
@@ -52,23 +54,69 @@ const struct px_config_schema app_depth_schema = {
 
 /* ---- setup --------------------------------------------------------------- */
 
+/* Not an obstacle without a URDF robot's clearance models. */
+static int needs_robot(struct px_app *a, const struct px_config_node *at,
+		       const char *key, const char *what)
+{
+	if (a->robot_models)
+		return 0;
+	app_check_error(a, at, key,
+			"%s is an obstacle of a URDF robot: it needs control.mode "
+			"avoidance with control.avoidance.urdf and clearance models",
+			what);
+	return 1;
+}
+
+/* The feed and the far point that stands for an empty view, the
+ * robot's last obstacle until the first frame (what: the source, for
+ * the error). */
+static int feed_setup(struct px_app *a, const struct px_config_node *at,
+		      const char *key, const char *what, int slots,
+		      size_t max_points)
+{
+	static const double far[3] = {0, 0, PX_CLOUD_FEED_FAR_M};
+	int rc = px_cloud_feed_create(slots, max_points, 0.0, &a->feed);
+	if (rc == PX_OK)
+		rc = px_cloud_model(far, 1, 0.0, NULL, &a->cloud_none);
+	if (rc != PX_OK) {
+		app_check_error(a, at, key, "%s: %s", what, px_strerror(rc));
+		return 1;
+	}
+	rc = app_robot_obstacles(a, a->cloud_none);
+	a->cloud_obstacle = a->n_scene_obstacles;
+	return rc;
+}
+
+/* A remote cloud (teleop.scene_device with a cloud_topic): the feed its
+ * device's thread fills, made before the devices. */
+static int remote_cloud_setup(struct px_app *a)
+{
+	const struct px_config_node *at = app_cfg_node(a, "teleop", "scene_device");
+	if (a->sim.has_depth) {
+		app_check_error(a, at, "teleop.scene_device",
+				"one obstacle cloud per run: sim.depth_sensor or a "
+				"remote cloud, not both");
+		return 1;
+	}
+	if (needs_robot(a, at, "teleop.scene_device", "a remote cloud"))
+		return 1;
+	return feed_setup(a, at, "teleop.scene_device", "the cloud feed", 4,
+			  (size_t)a->tele.c.cloud_max_points);
+}
+
 int app_sensor_setup(struct px_app *a)
 {
 	const struct raw_depth *d = &a->sim.depth;
 	const struct px_config_node *at =
 		px_config_node_get(app_cfg_node(a, "sim", NULL), "depth_sensor");
 	struct px_depth_sim_params p;
-	static const double far[3] = {0, 0, PX_CLOUD_FEED_FAR_M};
 	int rc;
+	if (app_teleop_cloud_source(a))
+		return remote_cloud_setup(a);
 	if (!a->sim.has_depth)
 		return 0;
-	if (!a->robot_models) {
-		app_check_error(a, at, "sim.depth_sensor",
-				"the camera's cloud is an obstacle of a URDF robot: it needs "
-				"control.mode avoidance with control.avoidance.urdf and "
-				"clearance models");
+	if (needs_robot(a, at, "sim.depth_sensor", "the camera's cloud"))
 		return 1;
-	}
 	px_depth_sim_params_default(&p);
 	p.kind = d->kind;
 	p.camera = px_control_pose_from_xyz_rpy(px_v3(d->camera.xyz_m[0], d->camera.xyz_m[1],
@@ -88,28 +136,32 @@ int app_sensor_setup(struct px_app *a)
 	p.period_s = d->period_s;
 	p.seed = (uint64_t)d->seed;
 	rc = px_depth_sim_create(&p, &a->depth);
-	if (rc == PX_OK)
-		rc = px_cloud_feed_create((int)d->slots, px_depth_sim_max_points(a->depth), 0.0,
-					  &a->feed);
-	if (rc == PX_OK)
-		rc = px_cloud_model(far, 1, 0.0, NULL, &a->cloud_none);
 	if (rc != PX_OK) {
 		app_check_error(a, at, "sim.depth_sensor", "the simulated camera: %s",
 				px_strerror(rc));
 		return 1;
 	}
-	/* the cloud is the robot's last obstacle, nothing in view until the
-	 * first frame */
-	rc = app_robot_obstacles(a, a->cloud_none);
-	a->cloud_obstacle = a->n_scene_obstacles;
-	return rc;
+	return feed_setup(a, at, "sim.depth_sensor", "the simulated camera",
+			  (int)d->slots, px_depth_sim_max_points(a->depth));
 }
 
-/* After the loop exists: the camera's frames are a watched input, and
- * its thread starts. */
+/* After the loop exists: the cloud's frames are a watched input (a
+ * remote one with its device's stale timeout), and the camera's thread
+ * starts. */
 int app_sensor_start(struct px_app *a)
 {
 	int rc;
+	if (a->feed && !a->depth && a->tele.scene >= 0) {
+		struct px_dev *d = a->dev[a->tele.scene];
+		a->cloud_input = px_loop_input_add(a->loop, px_dev_name(d),
+						   px_dev_stale_timeout_ns(d));
+		if (a->cloud_input < 0) {
+			app_note(a, "%s: remote cloud watchdog: %s\n", app_name(a),
+				 px_strerror(a->cloud_input));
+			return 1;
+		}
+		return 0;
+	}
 	if (!a->depth)
 		return 0;
 	a->cloud_input = px_loop_input_add(a->loop, "depth_sensor", a->sim.depth.stale_timeout_ns);
@@ -160,10 +212,11 @@ static void wait_due_frame(struct px_app *a, int64_t now_ns)
 void app_sensor_read(struct px_app *a, struct px_loop *l, int64_t now_ns)
 {
 	struct px_cloud_feed_stats st;
-	if (!a->depth)
+	if (!a->feed || a->cloud_input < 0)
 		return;
-	px_depth_sim_clock(a->depth, now_ns);
-	if (a->o.virtual_time)
+	if (a->depth)
+		px_depth_sim_clock(a->depth, now_ns);
+	if (a->depth && a->o.virtual_time)
 		wait_due_frame(a, now_ns);
 	else
 		px_cloud_feed_take(a->feed, now_ns, NULL, NULL);

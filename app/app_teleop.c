@@ -42,6 +42,19 @@ static const struct px_config_key teleop_keys[] = {
 	K_SUB(struct raw_teleop, params_min, "params_min", params_schema),
 	K_SUBP(struct raw_teleop, params_max, "params_max", params_schema,
 	       has_params_max),
+	K_STR(struct raw_teleop, scene_device, "scene_device", PX_CONFIG_NONEMPTY),
+	{.name = "scene_models", .type = PX_CONFIG_T_SEQ,
+	 .offset = offsetof(struct raw_teleop, scene_models),
+	 .flags = PX_CONFIG_NONEMPTY, .elem = PX_CONFIG_T_STRING,
+	 .elem_size = sizeof(const char *),
+	 .count_offset = offsetof(struct raw_teleop, n_scene_models),
+	 .min_count = 1, .max_count = PX_BRIDGE_SCENE_MODELS},
+	K_VECPD(struct raw_teleop, workspace_min_m, "workspace_min_m", 0, -1e6,
+		1e6, -2.0, has_ws_min),
+	K_VECPD(struct raw_teleop, workspace_max_m, "workspace_max_m", 0, -1e6,
+		1e6, 2.0, has_ws_max),
+	K_INT(struct raw_teleop, cloud_max_points, "cloud_max_points", 0, 1,
+	      PX_BRIDGE_CLOUD_MAX_POINTS, 20000),
 };
 SCHEMA(teleop_schema, "teleop", teleop_keys, NULL);
 
@@ -55,6 +68,7 @@ int app_teleop_read(struct px_app *a)
 	struct app_teleop *t = &a->tele;
 	int rc;
 	t->follow = t->feedback = t->force = t->params = -1;
+	t->scene = t->scene_dds = -1;
 	t->force_input = -1;
 	t->speed_scale = 1.0;
 	rc = px_config_read(a->cfg->doc, a->cfg->teleop, "teleop",
@@ -96,6 +110,73 @@ static void need_dds(struct px_app *a, const char *key, const char *name,
 		app_check_error(a, at, k, "%s", why);
 }
 
+/* The scene updates' keys: a dds device with a cloud or scene topic,
+ * scene_models exactly with a scene topic, each the name of a scene
+ * model (and a ROS 2 name token: it is part of a topic name), a box
+ * that is one. The cloud's place among the obstacles is app_sensor.c's
+ * to check. */
+static void scene_check(struct px_app *a)
+{
+	const struct raw_teleop *c = &a->tele.c;
+	const struct px_config_node *at = app_cfg_node(a, "teleop", "scene_device");
+	const struct px_config_device *d;
+	size_t i, j, n = a->scene ? px_scene_count(a->scene) : 0;
+	if (!c->scene_device) {
+		if (c->n_scene_models)
+			app_check_error(a, app_cfg_node(a, "teleop", "scene_models"),
+					"teleop.scene_models",
+					"scene models without a teleop.scene_device");
+		return;
+	}
+	d = px_config_device_find(a->cfg, c->scene_device);
+	if (!d || d->backend != PX_CONFIG_BACKEND_DDS) {
+		app_check_error(a, at, "teleop.scene_device",
+				"'%s' is not a dds device in devices", c->scene_device);
+		return;
+	}
+	if (!d->dds.cloud_topic && !d->dds.scene_topic)
+		app_check_error(a, at, "teleop.scene_device",
+				"dds device '%s' has neither cloud_topic nor scene_topic",
+				c->scene_device);
+	if (!d->dds.scene_topic != !c->n_scene_models)
+		app_check_error(a, app_cfg_node(a, "teleop", "scene_models"),
+				"teleop.scene_models",
+				d->dds.scene_topic
+					? "dds device '%s' has a scene_topic: name the "
+					  "models it may pose"
+					: "dds device '%s' has no scene_topic for them",
+				c->scene_device);
+	for (i = 0; i < c->n_scene_models; i++) {
+		const char *m = c->scene_models[i];
+		for (j = 0; j < n && strcmp(px_scene_name(a->scene, j), m); j++)
+			;
+		if (j == n || px__ros_name_problem(m, 64) || strchr(m, '/'))
+			app_check_error(a, app_cfg_node(a, "teleop", "scene_models"),
+					"teleop.scene_models",
+					j == n ? "'%s' is not a model of the scene"
+					       : "'%s' is not a ROS 2 name token "
+						 "(letters, digits, '_')",
+					m);
+		else
+			a->tele.scene_model[i] = (int)j;
+	}
+	for (i = 0; i < 3; i++)
+		if (!(c->workspace_min_m[i] < c->workspace_max_m[i]))
+			app_check_error(a, app_cfg_node(a, "teleop", "workspace_max_m"),
+					"teleop.workspace_max_m",
+					"each coordinate must be above workspace_min_m's");
+}
+
+/* 1 when teleop.scene_device reads obstacle clouds. */
+int app_teleop_cloud_source(const struct px_app *a)
+{
+	const struct px_config_device *d;
+	if (!a->tele.c.scene_device)
+		return 0;
+	d = px_config_device_find(a->cfg, a->tele.c.scene_device);
+	return d && d->backend == PX_CONFIG_BACKEND_DDS && d->dds.cloud_topic;
+}
+
 void app_teleop_check(struct px_app *a)
 {
 	const struct raw_teleop *c = &a->tele.c;
@@ -119,6 +200,7 @@ void app_teleop_check(struct px_app *a)
 				"teleop.params_min",
 				"a minimum above its maximum (params_max, or "
 				"the config's own value when absent)");
+	scene_check(a);
 	need_dds(a, "force_device", c->force_device,
 		 offsetof(struct px_config_dds, wrench_topic), "wrench_topic",
 		 PX_CONTROL_MODE_HAPTIC,
@@ -170,6 +252,19 @@ int app_make_dds(struct px_app *a, int k)
 		bc.params_min = t->c.params_min;
 		bc.params_max = t->c.params_max;
 	}
+	/* scene updates only from the device teleop.scene_device names */
+	if (t->c.scene_device && !strcmp(t->c.scene_device, d->name)) {
+		bc.cloud_topic = d->dds.cloud_topic;
+		bc.cloud_feed = a->feed;
+		bc.cloud_max_points = (size_t)t->c.cloud_max_points;
+		bc.scene_topic = d->dds.scene_topic;
+		bc.scene_models = t->c.scene_models;
+		bc.n_scene_models = t->c.n_scene_models;
+		memcpy(bc.workspace_min_m, t->c.workspace_min_m,
+		       sizeof(bc.workspace_min_m));
+		memcpy(bc.workspace_max_m, t->c.workspace_max_m,
+		       sizeof(bc.workspace_max_m));
+	}
 	rc = px_bridge_dev_create(&dc, &bc, &a->dev[i], msg, sizeof(msg));
 	if (rc != PX_OK) {
 		app_note(a, "%s: device '%s' (dds): %s\n", app_name(a), d->name,
@@ -192,6 +287,11 @@ int app_make_dds(struct px_app *a, int k)
 		t->force = i;
 	if (bc.params_topic)
 		t->params = i;
+	if (bc.cloud_topic || bc.scene_topic) {
+		t->scene = i;
+		t->scene_dds = t->n_dds - 1;
+		t->scene_cloud = bc.cloud_topic != NULL;
+	}
 	if (a->ctl.device && !strcmp(a->ctl.device, d->name) && d->dds.pose_topic)
 		a->ctl_dev = i;
 	return 0;
@@ -235,11 +335,43 @@ int app_teleop_attach(struct px_app *a)
 
 /* ---- the cycle (real-time rules) --------------------------------------- */
 
-/* Read phase, after the devices: the remote force, the link rule. */
+/* The remote model poses accepted since the last cycle, each set on
+ * its scene model (seen by the next query; the robot measures the same
+ * models). */
+static void scene_poses(struct px_app *a)
+{
+	struct app_teleop *t = &a->tele;
+	struct px_bridge_scene_poses p;
+	size_t i;
+	if (px_bridge_dev_scene_poses(a->dev[t->scene], &p) != 1)
+		return;
+	for (i = 0; i < t->c.n_scene_models; i++)
+		if (p.seq[i] != t->scene_seq[i]) {
+			t->scene_seq[i] = p.seq[i];
+			if (px_scene_set_pose(a->scene, (size_t)t->scene_model[i],
+					      p.pose[i]) == PX_OK)
+				t->scene_poses_applied++;
+		}
+}
+
+/* The remote cloud's newest frame (taken by app_sensor_read): its
+ * receipt time, 0 before the first. */
+static int64_t cloud_stamp(const struct px_app *a)
+{
+	struct px_cloud_feed_stats st;
+	px_cloud_feed_stats(a->feed, &st);
+	return st.taken ? st.stamp_ns : 0;
+}
+
+/* Read phase, after the devices: the remote force, the scene updates,
+ * the link rule. */
 void app_teleop_read_phase(struct px_app *a, struct px_loop *l, int64_t now_ns)
 {
 	struct app_teleop *t = &a->tele;
+	int64_t cloud_at = t->scene_cloud ? cloud_stamp(a) : 0;
 	int i;
+	if (t->scene >= 0 && t->c.n_scene_models)
+		scene_poses(a);
 	if (t->force >= 0) {
 		struct px_force_cmd w;
 		int64_t at = 0;
@@ -271,6 +403,8 @@ void app_teleop_read_phase(struct px_app *a, struct px_loop *l, int64_t now_ns)
 			px_loop_input_stamp(l, t->dds[i].input, now_ns);
 		if (k == t->force && !t->force_t_ns)
 			px_loop_input_stamp(l, t->force_input, now_ns);
+		if (k == t->scene && t->scene_cloud && !cloud_at)
+			px_loop_input_stamp(l, a->cloud_input, now_ns);
 	}
 	for (i = 0; i < t->n_dds && !t->link_lost; i++) {
 		int k = t->dds[i].dev, silent = 0;
@@ -284,6 +418,10 @@ void app_teleop_read_phase(struct px_app *a, struct px_loop *l, int64_t now_ns)
 		    now_ns - t->force_t_ns > t->dds[i].tmo_ns) {
 			silent = 1;
 			age = now_ns - t->force_t_ns;
+		}
+		if (k == t->scene && cloud_at && now_ns - cloud_at > t->dds[i].tmo_ns) {
+			silent = 1;
+			age = now_ns - cloud_at;
 		}
 		if (silent) {
 			t->link_lost = 1;
@@ -469,7 +607,13 @@ void app_teleop_summary(const struct px_app *a, struct px_app_summary *s)
 		s->remote_lost += n.lost;
 		s->params_accepted += n.params_accepted;
 		s->params_refused += n.params_refused;
+		s->clouds_accepted += n.clouds_accepted;
+		s->clouds_refused += n.clouds_refused;
+		s->clouds_dropped += n.clouds_dropped;
+		s->scene_poses_accepted += n.scene_poses_accepted;
+		s->scene_poses_refused += n.scene_poses_refused;
 	}
+	s->scene_poses_applied = t->scene_poses_applied;
 	s->link_lost = t->link_lost;
 	if (t->link_lost) {
 		snprintf(s->link_lost_device, sizeof(s->link_lost_device), "%s",

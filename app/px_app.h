@@ -284,6 +284,11 @@ struct px_app_summary {
 	/* remote parameter sets: accepted (within the configured ranges),
 	 * refused (non-finite or out of range), applied by the cycle */
 	uint64_t params_accepted, params_refused, params_applied;
+	/* remote scene updates (teleop.scene_device): clouds built into the
+	 * feed, refused (frame, fields, sizes, points, workspace), dropped
+	 * (the feed full); model poses accepted, refused, applied */
+	uint64_t clouds_accepted, clouds_refused, clouds_dropped;
+	uint64_t scene_poses_accepted, scene_poses_refused, scene_poses_applied;
 	int link_lost;
 	char link_lost_device[32];
 	double link_lost_t_s;

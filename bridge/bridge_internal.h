@@ -28,6 +28,43 @@ int px__bridge_join(const struct px_bridge_config *c, int32_t *domain,
 		    int32_t *dp, char *msg, size_t cap);
 void *px__bridge_qos(int reliable);
 
+/* A best-effort keep-last-1 reader of rt/<ns>/<name> (type: a
+ * dds_topic_descriptor_t) on participant dp whose data wakes the
+ * waitset *ws (made on first use). Cyclone's entity or its error. */
+int32_t px__bridge_watched_reader(int32_t dp, int32_t *ws, const char *ns,
+				  const char *name, const void *type);
+
+/* A dds device's scene updates (px_bridge_scene.c): made by
+ * px__bridge_scene_open() (*out NULL when bc asks for none; on an error
+ * *out may hold what was made, for px__bridge_scene_free()), taken by
+ * the device's thread (px__bridge_scene_take), the model poses read by
+ * the cycle (px__bridge_scene_poses, RT-safe). The two checks say why a
+ * message is refused ("frame", "fields", "points", "sizes",
+ * "workspace", "orientation") or return NULL with its content. */
+struct bridge_scene;
+int px__bridge_scene_open(struct bridge_scene **out, int32_t dp, int32_t *ws,
+			  const struct px_bridge_dev_config *bc, char *msg,
+			  size_t cap);
+void px__bridge_scene_take(struct bridge_scene *s);
+int px__bridge_scene_poses(struct bridge_scene *s,
+			   struct px_bridge_scene_poses *out);
+void px__bridge_scene_counts(const struct bridge_scene *s,
+			     struct px_bridge_dev_counts *out);
+int32_t px__bridge_scene_cloud_reader(const struct bridge_scene *s);
+void px__bridge_scene_free(struct bridge_scene *s);
+struct px__bridge_limits {
+	const char *frame;   /* the header's frame_id must be this */
+	double lo_m[3], hi_m[3];
+	size_t max_points;   /* of a cloud */
+};
+/* msg: a sensor_msgs_msg_dds__PointCloud2_ (its points into xyz, room
+ * for max_points) or a geometry_msgs_msg_dds__PoseStamped_. */
+const char *px__bridge_cloud_points(const void *msg,
+				    const struct px__bridge_limits *s,
+				    double *xyz, size_t *n);
+const char *px__bridge_scene_pose(const void *msg,
+				  const struct px__bridge_limits *s, px_pose *out);
+
 /* 1 for the loopback interface ("lo", 127.x.x.x, ::1, localhost). */
 int px_bridge_is_loopback(const char *iface);
 

@@ -24,7 +24,9 @@
  * here is real-time safe; the loop's thread never calls it.
  *
  * Devices: px_bridge_dev_create() is the "dds" back end of px_dev.h, a
- * pose stream in and a force command out (below).
+ * pose stream in and a force command out, and scene updates in
+ * (obstacle clouds, model poses) checked against configured limits
+ * (below).
  *
  * Build: an optional part (PX_HAVE_DDS in px_features.h). Without Cyclone
  * DDS the config functions work and px_bridge_create() returns
@@ -227,6 +229,12 @@ struct px_bridge_params {
 	double stiffness_n_per_m, damping_n_s_per_m, max_force_n, speed_scale;
 };
 
+/* Models whose poses one dds device may set; points of a remote cloud. */
+#define PX_BRIDGE_SCENE_MODELS 16
+#define PX_BRIDGE_CLOUD_MAX_POINTS (1 << 20)
+
+struct px_cloud_feed;
+
 /* A device on DDS topics rt/<namespace>/<topic> (bridge's namespace and
  * network), best-effort keep-last-1 as the bridge's streams (the
  * parameters reliable). */
@@ -248,8 +256,28 @@ struct px_bridge_dev_config {
 	 * refused and counted. Not waited for by px_dev_start(). */
 	const char *params_topic;
 	struct px_bridge_params params_min, params_max;
+	/* Scene updates in (docs/bridge.md, "Scene updates"). cloud_topic:
+	 * sensor_msgs/PointCloud2 obstacle clouds, each accepted one built
+	 * into cloud_feed (px_cloud_feed.h) by the device's thread, stamped
+	 * with the loop clock at receipt. scene_topic: one
+	 * geometry_msgs/PoseStamped topic per name of scene_models,
+	 * <scene_topic>/<name>/pose, read by px_bridge_dev_scene_poses().
+	 * A message is accepted whole or refused and counted: its frame_id
+	 * must be the bridge's frame_id and every point or the position
+	 * finite and inside [workspace_min_m, workspace_max_m]; a cloud has
+	 * float32 fields x, y, z inside its point_step, consistent sizes
+	 * and at most cloud_max_points (1 .. PX_BRIDGE_CLOUD_MAX_POINTS,
+	 * at most the feed's) points; a pose a unit quaternion (within
+	 * 1e-3). NULL topics: none. */
+	const char *cloud_topic;
+	struct px_cloud_feed *cloud_feed;
+	size_t cloud_max_points;
+	const char *scene_topic;
+	const char *const *scene_models; /* ROS 2 name tokens */
+	size_t n_scene_models;           /* 1 .. PX_BRIDGE_SCENE_MODELS */
+	double workspace_min_m[3], workspace_max_m[3];
 	/* px_dev_start() waits at most this long until every topic above
-	 * but the parameters has a peer (0: no wait) */
+	 * but the parameters and the scene poses has a peer (0: no wait) */
 	int64_t connect_timeout_ns;
 	/* SCHED_FIFO priority of the device's thread (1..99; 0: normal
 	 * scheduling; refused without the privilege: normal) */
@@ -292,10 +320,28 @@ PX_API int px_bridge_dev_pose_write(struct px_dev *d, const px_vec3 *pos_m,
  * Loop thread. @note RT-safe. */
 PX_API int px_bridge_dev_params(struct px_dev *d, struct px_bridge_params *out);
 
+/* The remote poses of the scene_models (index as there): seq[i]
+ * counts model i's accepted poses (0: none yet), pose[i] the newest. */
+struct px_bridge_scene_poses {
+	uint64_t seq[PX_BRIDGE_SCENE_MODELS];
+	px_pose pose[PX_BRIDGE_SCENE_MODELS];
+};
+
+/* The newest scene poses, when a pose was accepted since this thread's
+ * last call: 1 and *out, else 0; PX_E_INVAL (not a dds device with a
+ * scene_topic). Through a px_param triple buffer: never torn. Loop
+ * thread. @note RT-safe. */
+PX_API int px_bridge_dev_scene_poses(struct px_dev *d,
+				     struct px_bridge_scene_poses *out);
+
 /* What a dds device's thread did. */
 struct px_bridge_dev_counts {
 	uint64_t poses_in, wrenches_in, commands_out, poses_out;
 	uint64_t params_accepted, params_refused;
+	/* scene updates: clouds built into the feed, refused, dropped (the
+	 * feed had no free slot); model poses accepted, refused */
+	uint64_t clouds_accepted, clouds_refused, clouds_dropped;
+	uint64_t scene_poses_accepted, scene_poses_refused;
 	/* best-effort samples the readers know were lost (DDS's sample
 	 * lost status, sequence gaps) */
 	uint64_t lost;

@@ -42,10 +42,12 @@ struct slot {
 struct dds_dev {
 	struct px_dev *d;
 	char frame[PX_BRIDGE_NAME_MAX];
-	char topics[4][PX_BRIDGE_TOPIC_MAX]; /* for the connect message */
+	/* for the connect message: pose, wrench, cloud, command, pose out */
+	char topics[5][PX_BRIDGE_TOPIC_MAX];
 	dds_entity_t domain, dp, reader, writer, ws;
 	dds_entity_t wreader, pwriter; /* wrench in, pose out */
 	dds_entity_t preader;          /* parameters in */
+	struct bridge_scene *scene;    /* scene updates in, NULL none */
 	struct px_bridge_params pmin, pmax;
 	struct px_arena arena;         /* the parameters' triple buffer */
 	struct px_param *params;
@@ -304,6 +306,7 @@ static void *dev_thread(void *arg)
 			take_wrenches(x);
 		if (x->preader > 0)
 			take_params(x);
+		px__bridge_scene_take(x->scene);
 		if (x->writer > 0)
 			send_newest(x);
 		if (x->pwriter > 0)
@@ -319,15 +322,17 @@ static void *dev_thread(void *arg)
  * (recorded, naming the topic). */
 static int wait_peers(struct dds_dev *x)
 {
-	const dds_entity_t e[4] = {x->reader, x->wreader, x->writer, x->pwriter};
+	const dds_entity_t e[5] = {x->reader, x->wreader,
+				   px__bridge_scene_cloud_reader(x->scene),
+				   x->writer, x->pwriter};
 	int64_t end = px_dev_mono_ns() + x->connect_timeout_ns;
 	int i;
 	if (x->connect_timeout_ns <= 0)
 		return PX_OK;
-	for (i = 0; i < 4; i++) {
+	for (i = 0; i < 5; i++) {
 		while (e[i] > 0) {
 			uint32_t n = 0;
-			if (i < 2) {
+			if (i < 3) {
 				dds_subscription_matched_status_t st;
 				if (dds_get_subscription_matched_status(e[i], &st) == 0)
 					n = st.current_count;
@@ -407,6 +412,7 @@ static void dev_destroy(struct px_dev *d)
 		dds_delete(x->dp);
 	if (x->domain > 0)
 		dds_delete(x->domain);
+	px__bridge_scene_free(x->scene);
 	px_arena_fini(&x->arena);
 }
 
@@ -478,6 +484,13 @@ int px_bridge_dev_params(struct px_dev *d, struct px_bridge_params *out)
 	return 1;
 }
 
+int px_bridge_dev_scene_poses(struct px_dev *d,
+			      struct px_bridge_scene_poses *out)
+{
+	struct dds_dev *x = dds_of(d);
+	return x ? px__bridge_scene_poses(x->scene, out) : PX_E_INVAL;
+}
+
 int px_bridge_dev_counts(struct px_dev *d, struct px_bridge_dev_counts *out)
 {
 	struct dds_dev *x = dds_of(d);
@@ -490,10 +503,13 @@ int px_bridge_dev_counts(struct px_dev *d, struct px_bridge_dev_counts *out)
 	out->lost = atomic_load(&x->n_lost);
 	out->params_accepted = atomic_load(&x->n_accepted);
 	out->params_refused = atomic_load(&x->n_refused);
+	out->clouds_accepted = out->clouds_refused = out->clouds_dropped = 0;
+	out->scene_poses_accepted = out->scene_poses_refused = 0;
+	px__bridge_scene_counts(x->scene, out);
 	return PX_OK;
 }
 
-static dds_entity_t endpoint(struct dds_dev *x, const char *ns,
+static dds_entity_t endpoint(dds_entity_t dp, const char *ns,
 			     const char *name, const dds_topic_descriptor_t *t,
 			     int reader)
 {
@@ -511,56 +527,60 @@ static dds_entity_t endpoint(struct dds_dev *x, const char *ns,
 		dds_delete_qos(q);
 		return DDS_RETCODE_BAD_PARAMETER;
 	}
-	tp = dds_create_topic(x->dp, t, topic, q, NULL);
+	tp = dds_create_topic(dp, t, topic, q, NULL);
 	e = tp < 0 ? tp
-	    : reader ? dds_create_reader(x->dp, tp, q, NULL)
-		     : dds_create_writer(x->dp, tp, q, NULL);
+	    : reader ? dds_create_reader(dp, tp, q, NULL)
+		     : dds_create_writer(dp, tp, q, NULL);
 	dds_delete_qos(q);
 	return e;
 }
 
 /* A reader whose data wakes the device's thread. */
-static dds_entity_t watched_reader(struct dds_dev *x, const char *ns,
-				   const char *name,
-				   const dds_topic_descriptor_t *t)
+int32_t px__bridge_watched_reader(int32_t dp, int32_t *ws, const char *ns,
+				  const char *name, const void *type)
 {
-	dds_entity_t r = endpoint(x, ns, name, t, 1), cond;
+	dds_entity_t r = endpoint(dp, ns, name, type, 1), cond;
 	if (r < 0)
 		return r;
-	if (x->ws <= 0) {
-		x->ws = dds_create_waitset(x->dp);
-		if (x->ws < 0)
-			return x->ws;
+	if (*ws <= 0) {
+		*ws = dds_create_waitset(dp);
+		if (*ws < 0)
+			return *ws;
 	}
 	cond = dds_create_readcondition(r, DDS_ANY_STATE);
 	if (cond < 0)
 		return cond;
-	return dds_waitset_attach(x->ws, cond, 0) < 0 ? DDS_RETCODE_ERROR : r;
+	return dds_waitset_attach(*ws, cond, 0) < 0 ? DDS_RETCODE_ERROR : r;
 }
 
 static int open_dds(struct dds_dev *x, const struct px_bridge_dev_config *bc,
 		    char *msg, size_t cap)
 {
 	const struct px_bridge_config *c = bc->bridge;
-	const char *const names[4] = {bc->pose_topic, bc->wrench_topic,
+	/* in wait_peers' order; the cloud reader is the scene's */
+	const char *const names[5] = {bc->pose_topic, bc->wrench_topic, NULL,
 				      bc->command_topic, bc->pose_out_topic};
-	dds_entity_t *const ents[4] = {&x->reader, &x->wreader, &x->writer,
-				       &x->pwriter};
-	const dds_topic_descriptor_t *const types[4] = {
+	dds_entity_t *const ents[5] = {&x->reader, &x->wreader, NULL,
+				       &x->writer, &x->pwriter};
+	const dds_topic_descriptor_t *const types[5] = {
 		&geometry_msgs_msg_dds__PoseStamped__desc,
-		&geometry_msgs_msg_dds__WrenchStamped__desc,
+		&geometry_msgs_msg_dds__WrenchStamped__desc, NULL,
 		&geometry_msgs_msg_dds__WrenchStamped__desc,
 		&geometry_msgs_msg_dds__PoseStamped__desc};
 	int i, rc = px__bridge_join(c, &x->domain, &x->dp, msg, cap);
 	if (rc != PX_OK)
 		return rc;
-	for (i = 0; i < 4; i++) {
+	if (bc->cloud_topic)
+		px_bridge_topic_name(c->ns, bc->cloud_topic, x->topics[2],
+				     sizeof(x->topics[2]));
+	for (i = 0; i < 5; i++) {
 		if (!names[i])
 			continue;
 		px_bridge_topic_name(c->ns, names[i], x->topics[i],
 				     sizeof(x->topics[i]));
-		*ents[i] = i < 2 ? watched_reader(x, c->ns, names[i], types[i])
-				 : endpoint(x, c->ns, names[i], types[i], 0);
+		*ents[i] = i < 2 ? px__bridge_watched_reader(x->dp, &x->ws, c->ns,
+							      names[i], types[i])
+				 : endpoint(x->dp, c->ns, names[i], types[i], 0);
 		if (*ents[i] < 0) {
 			snprintf(msg, cap, "dds device: cannot %s %s: %s",
 				 i < 2 ? "read" : "publish", names[i],
@@ -580,15 +600,16 @@ static int open_dds(struct dds_dev *x, const struct px_bridge_dev_config *bc,
 					     &x->params);
 		if (rc != PX_OK)
 			return rc;
-		x->preader = watched_reader(x, c->ns, bc->params_topic,
-					    &proxima_msgs_msg_dds__Params__desc);
+		x->preader = px__bridge_watched_reader(
+			x->dp, &x->ws, c->ns, bc->params_topic,
+			&proxima_msgs_msg_dds__Params__desc);
 		if (x->preader < 0) {
 			snprintf(msg, cap, "dds device: cannot read %s: %s",
 				 bc->params_topic, dds_strretcode(x->preader));
 			return PX_E_IO;
 		}
 	}
-	return PX_OK;
+	return px__bridge_scene_open(&x->scene, x->dp, &x->ws, bc, msg, cap);
 }
 
 int px_bridge_dev_create(const struct px_dev_config *dc,
@@ -606,10 +627,11 @@ int px_bridge_dev_create(const struct px_dev_config *dc,
 	*out = NULL;
 	if (!dc || !bc || !bc->bridge ||
 	    (!bc->pose_topic && !bc->command_topic && !bc->wrench_topic &&
-	     !bc->pose_out_topic && !bc->params_topic) ||
+	     !bc->pose_out_topic && !bc->params_topic && !bc->cloud_topic &&
+	     !bc->scene_topic) ||
 	    bc->connect_timeout_ns < 0) {
-		snprintf(msg, cap, "dds device: a pose, wrench, command or "
-				   "pose_out topic needed");
+		snprintf(msg, cap, "dds device: a pose, wrench, command, "
+				   "pose_out, params, cloud or scene topic needed");
 		return PX_E_INVAL;
 	}
 	if (px_bridge_config_check(bc->bridge, why, sizeof(why)) != PX_OK) {

@@ -42,3 +42,10 @@ int px_bridge_dev_params(struct px_dev *d, struct px_bridge_params *out)
 	(void)d, (void)out;
 	return PX_E_INVAL;
 }
+
+int px_bridge_dev_scene_poses(struct px_dev *d,
+			      struct px_bridge_scene_poses *out)
+{
+	(void)d, (void)out;
+	return PX_E_INVAL;
+}

@@ -862,10 +862,12 @@ static void dds_check(struct px_config_reader *r,
 	const struct px_config_dds *d = obj;
 	const char *const names[] = {"namespace",     "pose_topic",
 				     "wrench_topic",  "command_topic",
-				     "pose_out_topic", "params_topic"};
+				     "pose_out_topic", "params_topic",
+				     "cloud_topic",   "scene_topic"};
 	const char *const vals[] = {d->ns,		d->pose_topic,
 				    d->wrench_topic,	d->command_topic,
-				    d->pose_out_topic, d->params_topic};
+				    d->pose_out_topic, d->params_topic,
+				    d->cloud_topic,	d->scene_topic};
 	size_t i;
 	if (!map)
 		return;
@@ -877,11 +879,13 @@ static void dds_check(struct px_config_reader *r,
 					       names[i], "'%s' %s", EX(vals[i]), p);
 	}
 	if (!d->pose_topic && !d->wrench_topic && !d->command_topic &&
-	    !d->pose_out_topic && !d->params_topic)
+	    !d->pose_out_topic && !d->params_topic && !d->cloud_topic &&
+	    !d->scene_topic)
 		px_config_reader_error(r, map, "pose_topic",
 				       "a dds device needs at least one of "
 				       "pose_topic, wrench_topic, command_topic, "
-				       "pose_out_topic and params_topic");
+				       "pose_out_topic, params_topic, cloud_topic "
+				       "and scene_topic");
 }
 
 static const struct px_config_key dds_keys[] = {
@@ -896,6 +900,10 @@ static const struct px_config_key dds_keys[] = {
 	K_STR(struct px_config_dds, pose_out_topic, "pose_out_topic",
 	      PX_CONFIG_NONEMPTY),
 	K_STR(struct px_config_dds, params_topic, "params_topic",
+	      PX_CONFIG_NONEMPTY),
+	K_STR(struct px_config_dds, cloud_topic, "cloud_topic",
+	      PX_CONFIG_NONEMPTY),
+	K_STR(struct px_config_dds, scene_topic, "scene_topic",
 	      PX_CONFIG_NONEMPTY),
 	K_DUR(struct px_config_dds, connect_timeout_ns, "connect_timeout_ns", 0,
 	      0, 60 * NS_PER_S, 10 * NS_PER_S),

@@ -646,6 +646,8 @@ struct px_config_dds {
 	const char *command_topic;   /* WrenchStamped out: zero in safe state */
 	const char *pose_out_topic;  /* PoseStamped out: control.device's pose */
 	const char *params_topic;    /* proxima_msgs Params in (teleop) */
+	const char *cloud_topic;     /* PointCloud2 in: obstacles (teleop) */
+	const char *scene_topic;     /* <scene_topic>/<model>/pose in (teleop) */
 	int64_t connect_timeout_ns;  /* setup waits this long for the peers */
 };
 

@@ -107,6 +107,11 @@ static void json_figures(FILE *f, const struct run_result *r)
 			"\"samples_out\": %llu, \"lost\": %llu, "
 			"\"params_accepted\": %llu, \"params_refused\": %llu, "
 			"\"params_applied\": %llu, "
+			"\"clouds_accepted\": %llu, \"clouds_refused\": %llu, "
+			"\"clouds_dropped\": %llu, \"cloud_swaps\": %llu, "
+			"\"scene_poses_accepted\": %llu, "
+			"\"scene_poses_refused\": %llu, "
+			"\"scene_poses_applied\": %llu, "
 			"\"link_lost\": %s, \"link_lost_device\": ",
 			S->dds_devices, (unsigned long long)S->remote_in,
 			(unsigned long long)S->remote_out,
@@ -114,6 +119,13 @@ static void json_figures(FILE *f, const struct run_result *r)
 			(unsigned long long)S->params_accepted,
 			(unsigned long long)S->params_refused,
 			(unsigned long long)S->params_applied,
+			(unsigned long long)S->clouds_accepted,
+			(unsigned long long)S->clouds_refused,
+			(unsigned long long)S->clouds_dropped,
+			(unsigned long long)S->cloud_swaps,
+			(unsigned long long)S->scene_poses_accepted,
+			(unsigned long long)S->scene_poses_refused,
+			(unsigned long long)S->scene_poses_applied,
 			S->link_lost ? "true" : "false");
 		json_string(f, S->link_lost_device);
 		fprintf(f,

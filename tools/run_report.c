@@ -176,6 +176,17 @@ void run_print_summary(const struct run_result *r)
 			printf("; parameters %llu accepted, %llu refused",
 			       (unsigned long long)S->params_accepted,
 			       (unsigned long long)S->params_refused);
+		if (S->clouds_accepted || S->clouds_refused || S->clouds_dropped)
+			printf("; clouds %llu accepted, %llu refused, %llu dropped",
+			       (unsigned long long)S->clouds_accepted,
+			       (unsigned long long)S->clouds_refused,
+			       (unsigned long long)S->clouds_dropped);
+		if (S->scene_poses_accepted || S->scene_poses_refused)
+			printf("; model poses %llu accepted, %llu refused, %llu "
+			       "applied",
+			       (unsigned long long)S->scene_poses_accepted,
+			       (unsigned long long)S->scene_poses_refused,
+			       (unsigned long long)S->scene_poses_applied);
 		if (S->link_lost)
 			printf("; link lost ('%s' silent %.1f ms at %.3f s: safe "
 			       "state latched)",

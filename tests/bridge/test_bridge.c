@@ -35,6 +35,7 @@
 #if PX_HAVE_DDS
 #include <dds/dds.h>
 
+#include "bridge_test.h"
 #include "proxima_msgs.h"
 #include "sensor_msgs.h"
 #endif
@@ -279,13 +280,6 @@ static void test_create_unsupported_or_refused(void)
 
 #if PX_HAVE_DDS
 
-static int64_t mono_ns(void)
-{
-	struct timespec ts;
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
-}
-
 /* What the publisher sends: fixed values, exact in binary. */
 static const int64_t STAMP_NS = 1700000000123456789LL;
 
@@ -386,20 +380,6 @@ static int role_publish(const char *role)
 	}
 	px_bridge_free(b);
 	return 0;
-}
-
-/* A participant of this process on the same domain, configured as the
- * bridge configures its own. */
-static dds_entity_t join(int domain, dds_entity_t *dom)
-{
-	struct px_bridge_config c;
-	char xml[PX_BRIDGE_DDS_CONFIG_MAX];
-	px_bridge_config_default(&c);
-	c.domain_id = domain;
-	if (px_bridge_dds_config(&c, xml, sizeof(xml)) != PX_OK)
-		return -1;
-	*dom = dds_create_domain((dds_domainid_t)domain, xml);
-	return dds_create_participant((dds_domainid_t)domain, NULL, NULL);
 }
 
 static dds_entity_t reader(dds_entity_t dp, const dds_topic_descriptor_t *d,
@@ -610,27 +590,7 @@ static int take_check(dds_entity_t r, int t)
 /* The second process: this binary as publisher. */
 static pid_t spawn(const char *role)
 {
-	pid_t pid = fork();
-	if (pid == 0) {
-		char self[4096];
-		ssize_t n = readlink("/proc/self/exe", self, sizeof(self) - 1);
-		if (n > 0) {
-			self[n] = '\0';
-			setenv("PX_BRIDGE_TEST_ROLE", role, 1);
-			execl(self, self, (char *)NULL);
-		}
-		_exit(127);
-	}
-	return pid;
-}
-
-static void stop_child(pid_t pid)
-{
-	int st;
-	if (pid <= 0)
-		return;
-	kill(pid, SIGTERM);
-	waitpid(pid, &st, 0);
+	return spawn_role("PX_BRIDGE_TEST_ROLE", role);
 }
 
 static int test_domain(void)

@@ -23,22 +23,11 @@ bin="$b/bin/proxima-run"
 tmp=$(mktemp -d)
 pids=
 trap 'for p in $pids; do kill "$p" 2>/dev/null; done; rm -rf "$tmp"' EXIT
-pass=0 fail=0 skip=0
-ok() { echo "ok   $1"; pass=$((pass + 1)); }
-bad() { echo "FAIL $1"; for f in "$tmp"/*.out; do echo "    -- $f"; sed 's/^/    /' "$f" | tail -n 25; done; fail=$((fail + 1)); }
-check() { if awk "BEGIN { exit !($2) }"; then ok "$1"; else echo "    false: $2"; bad "$1"; fi; }
-num() { sed -n "s/.*\"$2\": *\\([-0-9.eE+]*\\).*/\\1/p" "$1" | head -n 1; }
-str() { sed -n "s/.*\"$2\": *\\([a-z]*\\).*/\\1/p" "$1" | head -n 1; }
+. tests/bridge/common.sh
 if [ ! -x "$bin" ]; then
 	echo "skip: $bin not built"
 	echo "$name: 0 passed, 0 failed, 1 skipped"
 	exit 0
-fi
-counter_so="$b/lib/libproxima-alloc-count.so"
-preload=${LD_PRELOAD:-}
-if [ "${SAN:-}" != 1 ] && [ -f "$counter_so" ]; then
-	counter_so="$(cd "$(dirname "$counter_so")" && pwd)/$(basename "$counter_so")"
-	preload="$counter_so${LD_PRELOAD:+:$LD_PRELOAD}"
 fi
 
 domain=$(( $$ % 200 + 20 ))
