@@ -175,7 +175,7 @@ endif
 # a second time with -DPX_TEST_HOOKS into TEST_LIB, which the tests and
 # benches link; the shipped library has none (geom/math/math_internal.h).
 TEST_HOOK_SRC := $(filter geom/track/%.c geom/dist/spiece_solve.c geom/brep/brep_cos.c \
-                           geom/brep/brep_compose.c,$(LIB_SRC))
+                           geom/brep/brep_compose.c geom/pair/pair_nurbs.c,$(LIB_SRC))
 TEST_HOOK_OBJ := $(patsubst %.c,$(BUILD)/obj-hooks/%.o,$(TEST_HOOK_SRC))
 TEST_LIB := $(BUILD)/lib/lib$(NAME)-test.a
 

@@ -63,6 +63,7 @@
 #include "px_load.h"
 #include "px_model.h"
 #include "px_nurbs.h"
+#include "sheet_gen.h"
 #include "px_strack.h"
 #include "px_test_paths.h"
 #include "px_track.h"
@@ -628,22 +629,7 @@ static void run(const char *name, const struct px_nurbs_curve *cs, int nc)
 static int wavy_net(struct px_nurbs_surf *s, int n, int rational)
 {
 	double U[16], xyz[3 * 49], w[49];
-	int i, j, p = 3;
-	for (i = 0; i <= p; i++) {
-		U[i] = 0.0;
-		U[n + i] = 1.0;
-	}
-	for (i = p + 1; i < n; i++)
-		U[i] = (double)(i - p) / (n - p);
-	for (j = 0; j < n; j++)
-		for (i = 0; i < n; i++) {
-			double x = -1 + 2.0 * i / (n - 1), y = -1 + 2.0 * j / (n - 1);
-			double *q = &xyz[3 * (j * n + i)];
-			q[0] = x;
-			q[1] = y + 0.1 * sin(3 * x);
-			q[2] = 0.35 * sin(2.2 * x + 0.3) * cos(2.7 * y - 0.2);
-			w[j * n + i] = 0.6 + 0.9 * ((i * 7 + j * 3) % 5) / 4.0;
-		}
+	sheet_net(n, 1.0, 0.35, U, xyz, w);
 	return px_nurbs_surf_init(s, &arena, 3, 3, n, n, U, n + 4, U, n + 4, xyz,
 				  rational ? w : NULL, NULL);
 }

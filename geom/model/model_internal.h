@@ -57,4 +57,11 @@ static inline size_t px__median_split(uint32_t *perm, size_t n, const double *ke
  * fit. Setup only. */
 void px__prefix_path(char *msg, size_t cap, const char *path);
 
+/* The distance core's model behind a model from px_nurbs_model_create()
+ * (read only: its pieces' control nets, for model-to-model descents,
+ * geom/pair/pair_nurbs.c); NULL for any other model. @note RT-safe. */
+struct px_model;
+struct px_dist_model;
+const struct px_dist_model *px__nurbs_model_dist(const struct px_model *m);
+
 #endif

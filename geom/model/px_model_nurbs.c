@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "px_dist.h"
+#include "model_internal.h"
 #include "px_model.h"
 #include "px_strack.h"
 #include "px_track.h"
@@ -915,4 +916,11 @@ int px_nurbs_model_surfaces(const struct px_model *m,
 	n = px_model_impl(m);
 	*surfs = n->ks;
 	return n->n_ks;
+}
+
+const struct px_dist_model *px__nurbs_model_dist(const struct px_model *m)
+{
+	if (!m || px_model_get_ops(m) != &nurbs_ops)
+		return NULL;
+	return ((const struct nurbs_impl *)px_model_impl(m))->dm;
 }

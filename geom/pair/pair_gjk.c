@@ -159,6 +159,19 @@ static int gjk_reduce(struct gjk_vert *S, int *n, px_vec3 *v, px_vec3 *pa,
 
 static int shp_support(const struct shp *s, px_vec3 d, px_vec3 *out)
 {
+	if (s->v && s->nv > 3) {
+		double hb = px_v3_dot(s->v[0], d);
+		int k, kb = 0;
+		for (k = 1; k < s->nv; k++) {
+			double h = px_v3_dot(s->v[k], d);
+			if (h > hb) {
+				hb = h;
+				kb = k;
+			}
+		}
+		*out = s->v[kb];
+		return PX_OK;
+	}
 	if (s->v) {
 		double h0 = px_v3_dot(s->v[0], d), h1 = px_v3_dot(s->v[1], d),
 		       h2 = px_v3_dot(s->v[2], d);
@@ -171,6 +184,13 @@ static int shp_support(const struct shp *s, px_vec3 d, px_vec3 *out)
 
 static px_vec3 shp_centre(const struct shp *s)
 {
+	if (s->v && s->nv > 3) {
+		px_vec3 c = s->v[0];
+		int k;
+		for (k = 1; k < s->nv; k++)
+			c = px_v3_add(c, s->v[k]);
+		return px_v3_scale(c, 1.0 / s->nv);
+	}
 	if (s->v)
 		return px_v3_scale(px_v3_add(s->v[0], px_v3_add(s->v[1], s->v[2])), 1.0 / 3.0);
 	return px_model_pose(s->m).t;

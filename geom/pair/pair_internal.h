@@ -12,6 +12,7 @@
 #ifndef PX_PAIR_INTERNAL_H
 #define PX_PAIR_INTERNAL_H
 
+#include "math_internal.h"
 #include "px_math.h"
 #include "px_model.h"
 #include "px_pair.h"
@@ -75,11 +76,13 @@ struct gjk_vert {
 	px_vec3 w, a, b; /* w = a - b */
 };
 
-/* A convex shape for GJK: a model with a support function, or a
- * triangle (world-frame vertices) of a mesh. */
+/* A convex shape for GJK: a model with a support function, a
+ * triangle (world-frame vertices) of a mesh, or the convex hull of a
+ * point set (a Bezier patch's control net). */
 struct shp {
 	const struct px_model *m;
 	const px_vec3 *v; /* 3 vertices, or NULL for m */
+	int nv;           /* points at v (their convex hull); 0 means 3 */
 };
 
 /*
@@ -233,5 +236,26 @@ int px__cloud_min_model(const struct px_model *c, const struct px_model *o, doub
  */
 int px__pair_cloud(const struct px_model *a, const struct px_model *b, int coherent,
 		   struct px_pair_result *res);
+
+/* ---- NURBS surface models (pair_nurbs.c) ---------------------------------- */
+
+/*
+ * A NURBS surface model against a mesh, another NURBS surface model or a
+ * convex primitive with a support function, certified: both models'
+ * hierarchies descended at once (sub-patches bounded by their control
+ * nets' hulls, GJK per node pair), the answer a real pair of surface
+ * points within 1e-6 of the NURBS box diagonal of the global minimum.
+ * With coherent, res's last pair (not intersecting) is the first bound.
+ * Fills res as px_pair_distance() does (local_only = 1 only when the
+ * descent's budget ran out) and returns 1; returns 0 when the pair is
+ * not one of these or overlaps (the general search then answers, with
+ * its depth), or an error. RT-safe.
+ */
+int px__pair_nurbs(const struct px_model *a, const struct px_model *b, int coherent,
+		   struct px_pair_result *res);
+
+/* Test switch (math_internal.h): 1 sends every NURBS pair to the general
+ * search, the peer the benchmark times the descent against. */
+PX__TEST_SWITCH(int, px__pair_nurbs_off, 0);
 
 #endif

@@ -81,7 +81,7 @@ struct tv_ctx {
 static int tri_vs_convex(void *ctx, const px_vec3 v[3], int index, double *d)
 {
 	struct tv_ctx *c = ctx;
-	struct shp T = {NULL, v}, O = {c->o, NULL};
+	struct shp T = {NULL, v, 3}, O = {c->o, NULL, 0};
 	struct gjk_vert S[4];
 	double dist = 0.0;
 	px_vec3 pt = v[0], po = v[0];

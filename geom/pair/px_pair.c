@@ -172,7 +172,7 @@ static int pair_convex(const struct px_model *a, const struct px_model *b,
 	double d = 0.0, lower = 0.0;
 	px_vec3 pa, pb, gv;
 	struct gjk_vert S[4];
-	struct shp sa = {a, NULL}, sb = {b, NULL};
+	struct shp sa = {a, NULL, 0}, sb = {b, NULL, 0};
 	int its = 0, ns = 0, g = px__gjk(&sa, &sb, &d, &pa, &pb, &its, S, &ns, &gv, &lower);
 
 	if (g > 0) {
@@ -507,6 +507,10 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 	/* a cloud against a mesh or a primitive: exact (pair_cloud.c) */
 	if (rc == STEP_NONE)
 		rc = px__pair_cloud(a, b, cfg.coherent, res);
+	/* NURBS surfaces against a mesh, NURBS or a convex primitive:
+	 * certified by both hierarchies (pair_nurbs.c) */
+	if (rc == STEP_NONE)
+		rc = px__pair_nurbs(a, b, cfg.coherent, res);
 	if (rc == STEP_NONE)
 		rc = pair_general(a, b, &cfg, res);
 	if (rc < 0)

@@ -69,7 +69,17 @@
  * - a point cloud against any primitive: the least of the primitive's
  *   exact (signed) point queries over the points, by the cloud's
  *   hierarchy bounded by one query per node (the distance is
- *   1-Lipschitz: a node's centre minus its half diagonal).
+ *   1-Lipschitz: a node's centre minus its half diagonal);
+ * - a NURBS model of untrimmed surfaces against a mesh, another such
+ *   model or a convex primitive with a support function: both models
+ *   descended at once (geom/pair/pair_nurbs.c: the distance core's
+ *   Bezier patches and their sub-patches, bounded below by their
+ *   control nets' hulls, GJK per node pair; the mesh hierarchy; Newton
+ *   on the best pair's parameters for the upper bound), the answer a
+ *   real pair of surface points at most 1e-6 of the NURBS model's box
+ *   diagonal (the smaller of two) above the global minimum; in coherent
+ *   mode last cycle's pair is the starting bound. Overlapping pairs go
+ *   on to the projections and the depth search below.
  * Surfaces apart but one closed model holding the other whole (its
  * signed distance at the other's closest point is negative) counts as
  * intersecting.
@@ -77,8 +87,11 @@
  * Everything else runs the projections. Then two convex models that
  * converged are certified (projections onto convex sets converge to the
  * global minimum).
- * local_only = 1 remains exactly for: NURBS models against anything
- * but a sphere; clouds against NURBS, B-rep parts and other clouds; the
+ * local_only = 1 remains exactly for: NURBS models with curves or
+ * trimmed faces (B-rep parts), or with more than 256 patches or a
+ * degree above 5, against anything but a sphere; NURBS surfaces against
+ * clouds and non-convex primitives; a NURBS descent that ran out of its
+ * budget (20,000 node pairs); clouds against NURBS, B-rep parts and other clouds; the
  * torus primitive against anything but a sphere or a cloud; the
  * half-space against anything not convex but a cloud (meshes that are
  * not convex, NURBS, the torus); convex pairs whose projections did not
@@ -113,7 +126,8 @@
  *
  * Memory and real-time rules: no allocation (GJK and EPA keep their
  * simplex and polytope in fixed arrays on the stack, about 14 kB; the
- * mesh traversals a fixed stack of about 4 kB); work bounded by starts *
+ * mesh traversals a fixed stack of about 4 kB; the NURBS descent about
+ * 150 kB, its work bounded by its 20,000 node pairs); work bounded by starts *
  * max_iters point queries, by the node pairs of the two hierarchies for
  * mesh pairs (in practice the node pairs near the closest pair, fewer
  * from a good first pair such as coherent mode's), by the query budget above for the mesh/convex path
