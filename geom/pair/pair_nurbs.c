@@ -704,12 +704,14 @@ static int expand(struct np_ctx *X, const struct np_ent *e, struct np_ent *stk, 
 		c.b = split_b ? kid[k] : e->b;
 		c.sa = split_b ? e->sa : (float)px_aabb_diagonal(&gk.box);
 		c.sb = split_b ? (float)px_aabb_diagonal(&gk.box) : e->sb;
+		c.lb = split_b ? pair_lb(X, &gs, &gk) : pair_lb(X, &gk, &gs);
+		if (!(c.lb < X->best - X->eps))
+			continue; /* pruned: its corners cannot beat the best */
 		if (split_b ? gk.n > 0 : gs.n != 0) {
 			rc = split_b ? pair_ub(X, &gs, &gk) : pair_ub(X, &gk, &gs);
 			if (rc < 0)
 				return rc;
 		}
-		c.lb = split_b ? pair_lb(X, &gs, &gk) : pair_lb(X, &gk, &gs);
 		if (c.lb < X->best - X->eps)
 			ce[m++] = c;
 	}
