@@ -194,6 +194,23 @@ const struct px_scene *px_app_scene(const struct px_app *a)
 	return a ? a->scene : NULL;
 }
 
+int px_app_arm(struct px_app *a, struct px_app_arm *out)
+{
+	/* (a config checked only is not avoiding yet: its mode says) */
+	if (!a || !out || a->ctl.mode != PX_CONTROL_MODE_AVOIDANCE ||
+	    a->ctl.chain.n_joints < 1)
+		return 0;
+	memset(out, 0, sizeof(*out));
+	out->chain = &a->ctl.chain;
+	out->robot = a->robot;
+	out->joint_perm = a->robot ? a->joint_perm : NULL;
+	out->record_joints = app_avoid_joints(a);
+	out->protective_distance_m = a->ctl.avoid.protective_distance_m;
+	out->influence_distance_m = a->ctl.avoid.influence_distance_m;
+	out->cloud_feed = a->feed;
+	return 1;
+}
+
 int px_app_last_record(const struct px_app *a, struct px_app_record *out)
 {
 	if (!a->have_last)

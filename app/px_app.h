@@ -40,9 +40,12 @@
 #include "px_config.h"
 #include "px_dev.h"
 #include "px_canopen.h"
+#include "px_cloud_feed.h"
+#include "px_control.h"
 #include "px_loop.h"
 #include "px_stats.h"
 #include "px_scene.h"
+#include "px_urdf.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -135,6 +138,24 @@ PX_API struct px_canopen *px_app_canopen(struct px_app *app);
  * non-real-time thread beside the loop (as px_app_drain() makes); the
  * app owns it. */
 PX_API const struct px_scene *px_app_scene(const struct px_app *app);
+
+/* The arm of an avoidance run, for drawing it beside the loop (a view):
+ * what setup made, never changed while the loop runs. */
+struct px_app_arm {
+	const struct px_control_chain *chain; /* joints; capsules unless robot */
+	const struct px_urdf_robot *robot;    /* URDF link models, or NULL */
+	const int *joint_perm; /* record joint i is chain joint joint_perm[i];
+				* NULL: the same */
+	int record_joints;     /* joints a record's q carries */
+	double protective_distance_m, influence_distance_m;
+	/* sim.depth_sensor: its feed of clouds (NULL: none); a reader
+	 * pins the frame it copies (px_cloud_feed_pin()) */
+	struct px_cloud_feed *cloud_feed;
+};
+
+/* 1 and *out for an app in avoidance mode (also one made to check its
+ * config), else 0. */
+PX_API int px_app_arm(struct px_app *app, struct px_app_arm *out);
 
 /* The newest drained record: 1 and *out, or 0 before any. */
 PX_API int px_app_last_record(const struct px_app *app,

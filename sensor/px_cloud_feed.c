@@ -3,7 +3,10 @@
  * and the cycle (px_cloud_feed.h). Frame s lives in slot s % n; head
  * counts frames published, used is 1 + the frame the consumer holds
  * (0: none). Frame s may be built once frame s - n (its slot's last) is
- * older than the held one: s - n < used - 1.
+ * older than the held one, s - n < used - 1, and not pinned by the
+ * reader beside the consumer: pinned != s - n + 1. The pin protocol
+ * needs one order of the stores and loads of used and pinned across
+ * the three threads, hence sequentially consistent atomics on them.
  */
 #include <stdatomic.h>
 #include <stdlib.h>
@@ -31,6 +34,8 @@ struct px_cloud_feed {
 	/* consumer */
 	_Atomic uint64_t used;  /* 1 + frame held, 0 none */
 	_Atomic uint64_t taken;
+	/* the reader beside the consumer: 1 + frame pinned, 0 none */
+	_Atomic uint64_t pinned;
 };
 
 int px_cloud_feed_create(int slots, size_t max_points, double radius_m,
@@ -54,6 +59,7 @@ int px_cloud_feed_create(int slots, size_t max_points, double radius_m,
 	atomic_init(&f->refused, 0);
 	atomic_init(&f->used, 0);
 	atomic_init(&f->taken, 0);
+	atomic_init(&f->pinned, 0);
 	*out = f;
 	return PX_OK;
 }
@@ -68,21 +74,24 @@ void px_cloud_feed_free(struct px_cloud_feed *f)
 	free(f);
 }
 
-/* Frame s's slot is free: its last frame (s - n) is older than the
- * held one, or it never held one. */
-static int slot_free(const struct px_cloud_feed *f, uint64_t s, uint64_t used)
+/* Frame s's slot is free: it never held a frame, or its last frame
+ * (s - n) is older than the held one and not pinned. */
+static int slot_free(const struct px_cloud_feed *f, uint64_t s, uint64_t used,
+		     uint64_t pinned)
 {
-	return s < (uint64_t)f->n || s + 2 <= used + (uint64_t)f->n;
+	uint64_t n = (uint64_t)f->n;
+	return s < n || (s + 2 <= used + n && pinned != s - n + 1);
 }
 
 int px_cloud_feed_space(const struct px_cloud_feed *f)
 {
-	uint64_t used, s;
+	uint64_t used, pinned, s;
 	int k = 0;
 	if (!f)
 		return 0;
-	used = atomic_load_explicit(&f->used, memory_order_acquire);
-	for (s = f->next; k < f->n && slot_free(f, s, used); s++)
+	used = atomic_load_explicit(&f->used, memory_order_seq_cst);
+	pinned = atomic_load_explicit(&f->pinned, memory_order_seq_cst);
+	for (s = f->next; k < f->n && slot_free(f, s, used, pinned); s++)
 		k++;
 	return k;
 }
@@ -93,14 +102,15 @@ int px_cloud_feed_publish(struct px_cloud_feed *f, const double *xyz, size_t n,
 	static const double far[3] = {0, 0, PX_CLOUD_FEED_FAR_M};
 	struct slot *sl;
 	struct px_model *m = NULL;
-	uint64_t used;
+	uint64_t used, pinned;
 	int rc;
 	if (!f || (n > 0 && !xyz))
 		return PX_E_INVAL;
 	if (n > f->max_points || stamp_ns < f->last_stamp)
 		return PX_E_RANGE;
-	used = atomic_load_explicit(&f->used, memory_order_acquire);
-	if (!slot_free(f, f->next, used)) {
+	used = atomic_load(&f->used);
+	pinned = atomic_load(&f->pinned);
+	if (!slot_free(f, f->next, used, pinned)) {
 		atomic_fetch_add_explicit(&f->refused, 1, memory_order_relaxed);
 		return PX_E_AGAIN;
 	}
@@ -136,7 +146,7 @@ int px_cloud_feed_take(struct px_cloud_feed *f, int64_t now_ns,
 		const struct slot *sl = &f->slots[(k - 1) % (uint64_t)f->n];
 		if (sl->stamp_ns > now_ns)
 			continue;
-		atomic_store_explicit(&f->used, k, memory_order_release);
+		atomic_store(&f->used, k); /* seq_cst: see the pin */
 		atomic_fetch_add_explicit(&f->taken, 1, memory_order_relaxed);
 		if (model)
 			*model = sl->model;
@@ -176,4 +186,40 @@ void px_cloud_feed_stats(const struct px_cloud_feed *f, struct px_cloud_feed_sta
 		out->stamp_ns = f->slots[(used - 1) % (uint64_t)f->n].stamp_ns;
 		out->points = f->slots[(used - 1) % (uint64_t)f->n].points;
 	}
+}
+
+struct px_model *px_cloud_feed_pin(struct px_cloud_feed *f, uint64_t *frame)
+{
+	uint64_t u = 0;
+	int k;
+	if (frame)
+		*frame = 0;
+	if (!f)
+		return NULL;
+	/* the held frame pinned and then seen still held: a producer can
+	 * rebuild its slot only after a newer take, whose store of used
+	 * comes after this load in the one order, so it sees the pin. A
+	 * consumer taking frames faster than this loop turns is not waited
+	 * for: the reader gets nothing this time. */
+	for (k = 0; k < 64; k++) {
+		u = atomic_load(&f->used);
+		if (!u)
+			return NULL;
+		atomic_store(&f->pinned, u);
+		if (atomic_load(&f->used) == u)
+			break;
+	}
+	if (k == 64) {
+		atomic_store(&f->pinned, 0);
+		return NULL;
+	}
+	if (frame)
+		*frame = u;
+	return f->slots[(u - 1) % (uint64_t)f->n].model;
+}
+
+void px_cloud_feed_unpin(struct px_cloud_feed *f)
+{
+	if (f)
+		atomic_store(&f->pinned, 0);
 }

@@ -23,10 +23,16 @@
  * PX_CLOUD_FEED_FAR_M away from the origin along z: a model the pairs
  * can measure, farther than any influence distance.
  *
+ * A third party (one non-real-time thread, e.g. a view drawing the
+ * cloud) may read the frame the consumer holds: px_cloud_feed_pin()
+ * keeps its slot from being rebuilt until px_cloud_feed_unpin(), even
+ * after the consumer has taken newer frames (the producer then waits
+ * for space as for a held frame).
+ *
  * Memory and real-time rules: create, free and publish allocate
  * (producer side and setup); take and the accessors are RT-safe
- * (atomics, at most PX_CLOUD_FEED_MAX_SLOTS steps). One producer thread
- * and one consumer thread at a time.
+ * (atomics, at most PX_CLOUD_FEED_MAX_SLOTS steps). One producer thread,
+ * one consumer thread and one pinning thread at a time.
  */
 #ifndef PX_CLOUD_FEED_H
 #define PX_CLOUD_FEED_H
@@ -94,6 +100,18 @@ struct px_cloud_feed_stats {
 PX_API struct px_model *px_cloud_feed_model(const struct px_cloud_feed *f);
 PX_API void px_cloud_feed_stats(const struct px_cloud_feed *f,
 				struct px_cloud_feed_stats *out);
+
+/* ---- a reader beside the consumer (one thread, not real time) ----------- */
+
+/*
+ * Pin the frame the consumer holds: its model (NULL when none is held)
+ * stays valid, and is not rebuilt by the producer, until
+ * px_cloud_feed_unpin(); *frame (may be NULL) gets its number (1 for
+ * the first frame published, growing with every newer frame taken; 0:
+ * none), which tells a reader whether it has seen it. One pin at a time.
+ */
+PX_API struct px_model *px_cloud_feed_pin(struct px_cloud_feed *f, uint64_t *frame);
+PX_API void px_cloud_feed_unpin(struct px_cloud_feed *f);
 
 #ifdef __cplusplus
 }

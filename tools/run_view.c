@@ -14,12 +14,36 @@
 #include "tool_view.h"
 
 static struct px_view *V;
+static struct px_view_arm *ARM;
+
+/* The arm of an avoidance run and its depth sensor's clouds (none
+ * when the run has no arm or the arm cannot be drawn: said). */
+static void arm_sources(struct px_app *app, struct px_view_scene_info *info,
+			struct px_view_sources *src)
+{
+	struct px_app_arm arm;
+	int rc;
+	if (!px_app_arm(app, &arm))
+		return;
+	rc = px_view_arm_create(&arm, &ARM);
+	if (rc != PX_OK)
+		fprintf(stderr, "proxima-run: view: the arm is not drawn: %s\n",
+			px_strerror(rc));
+	info->arm = ARM;
+	src->arm = ARM;
+	if (arm.cloud_feed) {
+		info->cloud_name = "depth sensor";
+		src->cloud_feed = arm.cloud_feed;
+		src->cloud_id = (int)(px_app_scene(app) ? px_scene_count(px_app_scene(app)) : 0);
+	}
+}
 
 void run_view_start(struct px_app *app, const char *name, const char *spec,
 		    const char *root, int64_t period_ns)
 {
 	struct px_view_options o;
 	struct px_view_scene_info info;
+	struct px_view_sources src;
 	char addr[64], dflt[PATH_MAX + 32], msg[320], url[128];
 	char *scene = NULL;
 	size_t len = 0;
@@ -47,11 +71,16 @@ void run_view_start(struct px_app *app, const char *name, const char *spec,
 		return;
 	}
 	memset(&info, 0, sizeof(info));
+	memset(&src, 0, sizeof(src));
 	info.tool_radius_m = 0.002;
+	src.scene = px_app_scene(app);
+	arm_sources(app, &info, &src);
 	rc = px_view_scene_json(px_app_scene(app), &info, &scene, &len);
 	if (rc == PX_OK)
 		rc = px_view_set_scene(V, scene, len);
 	free(scene);
+	if (rc == PX_OK)
+		rc = px_view_set_sources(V, &src);
 	if (rc == PX_OK)
 		rc = px_view_start(V);
 	if (rc != PX_OK) {
@@ -59,6 +88,8 @@ void run_view_start(struct px_app *app, const char *name, const char *spec,
 			px_strerror(rc));
 		px_view_free(V);
 		V = NULL;
+		px_view_arm_free(ARM);
+		ARM = NULL;
 		return;
 	}
 	tool_view_url(addr, port, url, sizeof(url));
@@ -87,4 +118,6 @@ void run_view_stop(void)
 		(unsigned long long)st.frames_dropped);
 	px_view_free(V);
 	V = NULL;
+	px_view_arm_free(ARM);
+	ARM = NULL;
 }

@@ -37,6 +37,7 @@
 
 #include "px_app.h"
 #include "px_base.h"
+#include "px_cloud_feed.h"
 #include "px_scene.h"
 
 #ifdef __cplusplus
@@ -47,7 +48,12 @@ struct px_view;
 
 /* The WebSocket subprotocol and the largest frame message. */
 #define PX_VIEW_PROTOCOL "proxima-view.v1"
-#define PX_VIEW_FRAME_MAX 8192
+#define PX_VIEW_FRAME_MAX 16384
+/* At most this many arm links and moved models in one frame, and
+ * points in one cloud message (a larger cloud is decimated). */
+#define PX_VIEW_MAX_LINKS 48
+#define PX_VIEW_MAX_MOVED 16
+#define PX_VIEW_CLOUD_MAX 20000
 
 struct px_view_options {
 	const char *addr;      /* numeric IPv4/IPv6 address; NULL: 127.0.0.1 */
@@ -92,11 +98,36 @@ PX_API int px_view_port(const struct px_view *v);
 PX_API int px_view_set_scene(struct px_view *v, const char *json, size_t len);
 PX_API int px_view_set_track(struct px_view *v, const char *json, size_t len);
 
+struct px_view_arm;
+
+/* Where the feed finds what a frame shows beside its record; each may
+ * be NULL. Read on the feeding thread only: */
+struct px_view_sources {
+	/* the closest point of a haptic run (the scene's point nearest the
+	 * tool) and the models whose pose changed since set (frame.models):
+	 * nothing may move the scene's models while the feed reads them */
+	const struct px_scene *scene;
+	/* the arm: frame.links from the record's joint positions and
+	 * frame.clearances from its closest pair (px_view_arm_create()) */
+	const struct px_view_arm *arm;
+	/* a point cloud obstacle: when the consumer has taken a newer
+	 * frame, it is pinned, copied (decimated to PX_VIEW_CLOUD_MAX) and
+	 * sent as a "cloud" message of model cloud_id */
+	struct px_cloud_feed *cloud_feed;
+	int cloud_id;
+};
+
+/* The sources (kept by the caller until px_view_free()), before
+ * px_view_start(). PX_OK, PX_E_INVAL, PX_E_STATE, PX_E_NOMEM. */
+PX_API int px_view_set_sources(struct px_view *v,
+			       const struct px_view_sources *src);
+
 /* The server thread. PX_OK, PX_E_STATE (started), PX_E_NOMEM. */
 PX_API int px_view_start(struct px_view *v);
 
 /* One telemetry record: fed when rate_hz allows (by r->t_s), dropped
- * otherwise. Returns 1 fed, 0 decimated away. No allocation. */
+ * otherwise, with what the sources add to it. Returns 1 fed, 0
+ * decimated away. No allocation but a cloud message's (a newer cloud). */
 PX_API int px_view_feed_record(struct px_view *v,
 			       const struct px_app_record *r);
 
@@ -121,9 +152,54 @@ PX_API void px_view_free(struct px_view *v);
 /* What the scene message shows beside the models. */
 struct px_view_scene_info {
 	double tool_radius_m;           /* 0: none */
-	double protective_distance_m;   /* robot only */
+	double protective_distance_m;   /* unused: scene.robot has the arm's */
 	double influence_distance_m;
+	const struct px_view_arm *arm;  /* scene.robot; NULL: null */
+	/* a point cloud obstacle outside the scene (a depth sensor): one
+	 * more model of kind cloud, id px_scene_count(), no points until a
+	 * "cloud" message; NULL: none */
+	const char *cloud_name;
 };
+
+/*
+ * The arm of an avoidance run drawn: every link model of arm->robot
+ * (or every capsule of arm->chain without one) tessellated once, and
+ * the chain copied, for scene.robot and the links' poses from a
+ * record's joint positions. Setup only (allocates). PX_OK, PX_E_INVAL,
+ * PX_E_RANGE (more than PX_VIEW_MAX_LINKS links), PX_E_NOMEM.
+ */
+PX_API int px_view_arm_create(const struct px_app_arm *arm,
+			      struct px_view_arm **out);
+PX_API void px_view_arm_free(struct px_view_arm *a);
+PX_API int px_view_arm_link_count(const struct px_view_arm *a);
+
+/* The links' poses (world, [x,y,z,qw,qx,qy,qz], order of scene.robot)
+ * at the joint positions r->q: the chain's forward kinematics. Returns
+ * the number of links (0 when the record carries fewer joints than the
+ * chain has, or they are not finite), PX_E_INVAL, PX_E_NOSPC (cap).
+ * No allocation. */
+PX_API int px_view_arm_links(const struct px_view_arm *a,
+			     const struct px_app_record *r, double (*poses)[7],
+			     int cap);
+
+/* What a frame shows beside its record (px_view_frame_fill()). */
+struct px_view_frame_extra {
+	int has_closest;
+	double closest_m[3];
+	int n_links;
+	double links[PX_VIEW_MAX_LINKS][7];
+	int n_clearances;                 /* [ax,ay,az,bx,by,bz,d_m] */
+	double clearances[1][7];
+	int n_models;                     /* [id,x,y,z,qw,qx,qy,qz] */
+	double models[PX_VIEW_MAX_MOVED][8];
+};
+
+/* x from record r and src (scene and arm; the cloud and moved models
+ * are the server's): the closest point of a haptic run, the links and
+ * the closest pair of an arm. No allocation. */
+PX_API void px_view_frame_fill(const struct px_view_sources *src,
+			       const struct px_app_record *r,
+			       struct px_view_frame_extra *x);
 
 /*
  * The scene message of s (may be NULL: no models): every model
@@ -138,6 +214,16 @@ PX_API int px_view_scene_json(const struct px_scene *s,
  * track). Returns the length, or PX_E_NOSPC. No allocation. */
 PX_API int px_view_frame_json(const struct px_app_record *r, int with_type,
 			      char *buf, size_t cap);
+/* The same with x's fields (x NULL: none). */
+PX_API int px_view_frame_json_extra(const struct px_app_record *r,
+				    const struct px_view_frame_extra *x,
+				    int with_type, char *buf, size_t cap);
+
+/* The "cloud" message of n points (xyz, 3 per point; every
+ * ceil(n / PX_VIEW_CLOUD_MAX)-th kept) of model id at t_s: *json
+ * malloc'd. PX_OK, PX_E_INVAL, PX_E_NOMEM. */
+PX_API int px_view_cloud_json(int id, double t_s, const float *xyz, size_t n,
+			      char **json, size_t *len);
 
 #ifdef __cplusplus
 }

@@ -109,6 +109,28 @@ void view_buf_str(struct view_buf *b, const char *s)
 	view_buf_put(b, "\"", 1);
 }
 
+void view_buf_floats(struct view_buf *b, const double *v, size_t n,
+		     double scale, int digits)
+{
+	size_t k;
+	view_buf_put(b, "[", 1);
+	for (k = 0; k < n; k++) {
+		if (k)
+			view_buf_put(b, ",", 1);
+		view_buf_num(b, scale * v[k], digits);
+	}
+	view_buf_put(b, "]", 1);
+}
+
+void view_tess_indices(struct view_buf *b, const struct px_tess *t)
+{
+	size_t k;
+	view_buf_puts(b, "\"indices\":[");
+	for (k = 0; k < 3 * t->n_triangles; k++)
+		view_buf_printf(b, k ? ",%u" : "%u", (unsigned)t->tri[k]);
+	view_buf_puts(b, "]}");
+}
+
 static void vec3(struct view_buf *b, const double *v, int digits)
 {
 	view_buf_put(b, "[", 1);
@@ -120,8 +142,32 @@ static void vec3(struct view_buf *b, const double *v, int digits)
 	view_buf_put(b, "]", 1);
 }
 
+/* The rows of a frame's array field: ,"key":[[...],...] (none: left out). */
+static void rows(struct view_buf *b, const char *key, const double *v, int n,
+		 int width, int digits)
+{
+	int i;
+	if (n <= 0)
+		return;
+	view_buf_printf(b, ",\"%s\":[", key);
+	for (i = 0; i < n; i++) {
+		if (i)
+			view_buf_put(b, ",", 1);
+		view_buf_floats(b, v + (size_t)i * (size_t)width, (size_t)width, 1.0,
+				digits);
+	}
+	view_buf_put(b, "]", 1);
+}
+
 int px_view_frame_json(const struct px_app_record *r, int with_type, char *buf,
 		       size_t cap)
+{
+	return px_view_frame_json_extra(r, NULL, with_type, buf, cap);
+}
+
+int px_view_frame_json_extra(const struct px_app_record *r,
+			     const struct px_view_frame_extra *x, int with_type,
+			     char *buf, size_t cap)
 {
 	struct view_buf b;
 	if (!r || !buf)
@@ -134,7 +180,12 @@ int px_view_frame_json(const struct px_app_record *r, int with_type, char *buf,
 	vec3(&b, r->dev_m, 9);
 	view_buf_puts(&b, ",\"proxy\":");
 	vec3(&b, r->proxy_m, 9);
-	view_buf_puts(&b, ",\"closest\":null,\"distance_m\":");
+	view_buf_puts(&b, ",\"closest\":");
+	if (x && x->has_closest)
+		vec3(&b, x->closest_m, 9);
+	else
+		view_buf_puts(&b, "null");
+	view_buf_puts(&b, ",\"distance_m\":");
 	view_buf_num(&b, r->distance_m, 9);
 	view_buf_puts(&b, ",\"force_n\":");
 	vec3(&b, r->force_n, 6);
@@ -147,6 +198,12 @@ int px_view_frame_json(const struct px_app_record *r, int with_type, char *buf,
 	view_buf_num(&b, (double)r->compute_ns / 1e3, 6);
 	view_buf_puts(&b, ",\"scale\":");
 	view_buf_num(&b, r->scale, 6);
+	if (x) {
+		/* ids are small integers: exact at any digits */
+		rows(&b, "models", &x->models[0][0], x->n_models, 8, 9);
+		rows(&b, "links", &x->links[0][0], x->n_links, 7, 7);
+		rows(&b, "clearances", &x->clearances[0][0], x->n_clearances, 7, 9);
+	}
 	view_buf_puts(&b, "}");
 	return b.err ? b.err : (int)b.n;
 }
@@ -215,10 +272,8 @@ static int model_json(struct view_buf *b, const struct px_scene *s, size_t i,
 					bounds[3 + d] = wv[d];
 			}
 	}
-	view_buf_puts(b, "],\"indices\":[");
-	for (k = 0; k < 3 * t.n_triangles; k++)
-		view_buf_printf(b, k ? ",%u" : "%u", (unsigned)t.tri[k]);
-	view_buf_puts(b, "]}");
+	view_buf_puts(b, "],");
+	view_tess_indices(b, &t);
 	px_tess_free(&t);
 	return b->err;
 }
@@ -239,9 +294,24 @@ int px_view_scene_json(const struct px_scene *s,
 	view_buf_puts(&b, "{\"type\":\"scene\",\"models\":[");
 	for (i = 0; i < n && rc == PX_OK; i++)
 		rc = model_json(&b, s, i, bounds);
+	if (rc == PX_OK && info && info->cloud_name) {
+		/* the cloud obstacle: points from "cloud" messages */
+		view_buf_printf(&b, "%s{\"id\":%zu,\"name\":", n ? "," : "", n);
+		view_buf_str(&b, info->cloud_name);
+		view_buf_puts(&b, ",\"kind\":\"cloud\",\"pose\":[0,0,0,1,0,0,0],"
+				  "\"positions\":[],\"indices\":[]}");
+	}
 	view_buf_puts(&b, "],\"tool\":{\"radius_m\":");
 	view_buf_num(&b, info ? info->tool_radius_m : 0.0, 9);
-	view_buf_puts(&b, "},\"robot\":null,\"bounds\":[");
+	view_buf_puts(&b, "},\"robot\":");
+	if (info && info->arm) {
+		size_t alen;
+		const char *aj = view_arm_json(info->arm, &alen);
+		view_buf_put(&b, aj, alen);
+	} else {
+		view_buf_puts(&b, "null");
+	}
+	view_buf_puts(&b, ",\"bounds\":[");
 	if (!(bounds[0] <= bounds[3]))
 		for (d = 0; d < 3; d++) {
 			bounds[d] = -0.1;
@@ -258,6 +328,38 @@ int px_view_scene_json(const struct px_scene *s,
 	if (rc != PX_OK) {
 		free(b.p);
 		return rc;
+	}
+	*json = b.p;
+	*len = b.n;
+	return PX_OK;
+}
+
+int px_view_cloud_json(int id, double t_s, const float *xyz, size_t n,
+		       char **json, size_t *len)
+{
+	struct view_buf b;
+	size_t step = n > PX_VIEW_CLOUD_MAX
+		? (n + PX_VIEW_CLOUD_MAX - 1) / PX_VIEW_CLOUD_MAX : 1, i;
+	if (!json || !len || (n && !xyz) || id < 0)
+		return PX_E_INVAL;
+	memset(&b, 0, sizeof(b));
+	b.growable = 1;
+	view_buf_printf(&b, "{\"type\":\"cloud\",\"id\":%d,\"t_s\":", id);
+	view_buf_num(&b, t_s, 9);
+	view_buf_puts(&b, ",\"positions\":[");
+	for (i = 0; i < n; i += step) {
+		if (i)
+			view_buf_put(&b, ",", 1);
+		view_buf_num(&b, xyz[3 * i], 6);
+		view_buf_put(&b, ",", 1);
+		view_buf_num(&b, xyz[3 * i + 1], 6);
+		view_buf_put(&b, ",", 1);
+		view_buf_num(&b, xyz[3 * i + 2], 6);
+	}
+	view_buf_puts(&b, "]}");
+	if (b.err) {
+		free(b.p);
+		return b.err;
 	}
 	*json = b.p;
 	*len = b.n;

@@ -6,9 +6,15 @@
  * (lws_cancel_service); each connection keeps the sequence number of the
  * next frame it sends and copies one slot out under the lock when its
  * socket can take more. A connection more than queue_frames behind jumps
- * to the newest frame (the skipped ones are counted as dropped). */
+ * to the newest frame (the skipped ones are counted as dropped).
+ *
+ * A swapped point cloud is one message that stays: the newest "cloud"
+ * is kept (shared, counted references under the lock) and every
+ * connection sends it before its next frame when it has not sent that
+ * one, so a page that connects later gets the cloud as it is. */
 #include <errno.h>
 #include <limits.h>
+#include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdio.h>
@@ -19,6 +25,7 @@
 
 #include <libwebsockets.h>
 
+#include "px_cloud.h"
 #include "px_view.h"
 #include "view_internal.h"
 
@@ -36,6 +43,13 @@ struct msg {
 	size_t n;
 };
 
+/* A message several connections send at once (lock: mu). */
+struct shared {
+	int refs;
+	uint64_t seq;
+	struct msg m;
+};
+
 enum stage { ST_HELLO, ST_SCENE, ST_TRACK, ST_FRAMES, ST_DONE };
 
 struct sess {
@@ -47,6 +61,8 @@ struct sess {
 	int64_t waiting_ns;     /* asked to write since then (0: not asked) */
 	int killed;
 	unsigned char *buf;     /* LWS_PRE + CHUNK (>= a frame) */
+	struct shared *cloud;   /* being sent (off), or NULL */
+	uint64_t cloud_seq;     /* the last cloud sent */
 };
 
 struct px_view {
@@ -64,9 +80,16 @@ struct px_view {
 	struct slot *ring;
 	int ring_n;
 	uint64_t head;          /* sequence number of the next frame fed */
+	struct shared *cloud;   /* the newest cloud message, or NULL */
 	/* the feeding thread's */
 	double last_t_s;
 	char fbuf[PX_VIEW_FRAME_MAX];
+	struct px_view_sources src;
+	struct px_view_frame_extra extra;
+	px_pose *ref_pose;      /* the scene's poses when set, ref_n of them */
+	size_t ref_n;
+	float *cloud_xyz;       /* PX_VIEW_CLOUD_MAX points */
+	uint64_t cloud_frame, cloud_seq;
 	/* the service thread's */
 	struct sess **sess;
 	int n_sess;
@@ -141,6 +164,45 @@ static int send_text(struct sess *s, const char *t, size_t n)
 									       : 0;
 }
 
+static void shared_release(struct shared *sh)
+{
+	if (sh && --sh->refs == 0) {
+		free(sh->m.p);
+		free(sh);
+	}
+}
+
+/* The newest cloud when this connection has not sent it: 1 while its
+ * fragments go out (nothing else may go between them), 0 none, -1
+ * close. */
+static int send_cloud(struct px_view *v, struct sess *s)
+{
+	int rc;
+	if (!s->cloud) {
+		pthread_mutex_lock(&v->mu);
+		if (v->cloud && v->cloud->seq != s->cloud_seq) {
+			s->cloud = v->cloud;
+			s->cloud->refs++;
+			s->off = 0;
+		}
+		pthread_mutex_unlock(&v->mu);
+		if (!s->cloud)
+			return 0;
+	}
+	rc = send_big(s, &s->cloud->m);
+	if (rc == 0) {
+		s->cloud_seq = s->cloud->seq;
+		pthread_mutex_lock(&v->mu);
+		shared_release(s->cloud);
+		pthread_mutex_unlock(&v->mu);
+		s->cloud = NULL;
+		s->off = 0;
+	}
+	if (rc >= 0)
+		lws_callback_on_writable(s->wsi);
+	return rc < 0 ? -1 : 1;
+}
+
 /* The connection can take more: the next message. 0 ok, -1 close. */
 static int writable(struct px_view *v, struct sess *s)
 {
@@ -166,6 +228,9 @@ static int writable(struct px_view *v, struct sess *s)
 	}
 	if (s->stage == ST_DONE)
 		return 0;
+	rc = send_cloud(v, s);
+	if (rc)
+		return rc < 0 ? -1 : 0;
 	pthread_mutex_lock(&v->mu);
 	head = v->head;
 	if (s->next < head) {
@@ -225,7 +290,8 @@ static void wake(struct px_view *v)
 					LWS_TO_KILL_ASYNC);
 			continue;
 		}
-		if (!s->waiting_ns && (s->next < head || s->stage < ST_FRAMES))
+		if (!s->waiting_ns && (s->next < head || s->stage < ST_FRAMES ||
+				       s->cloud))
 			s->waiting_ns = t;
 		lws_callback_on_writable(s->wsi);
 	}
@@ -270,6 +336,12 @@ static int cb_view(struct lws *wsi, enum lws_callback_reasons reason,
 	case LWS_CALLBACK_RECEIVE:
 		return 0; /* read-only: nothing a page sends is acted on */
 	case LWS_CALLBACK_CLOSED:
+		if (s->cloud) {
+			pthread_mutex_lock(&v->mu);
+			shared_release(s->cloud);
+			pthread_mutex_unlock(&v->mu);
+			s->cloud = NULL;
+		}
 		if (s->buf) {
 			sess_remove(v, s);
 			if (s->stage != ST_DONE)
@@ -460,6 +532,39 @@ int px_view_set_track(struct px_view *v, const char *json, size_t len)
 	return v ? set_msg(v, &v->track, json, len) : PX_E_INVAL;
 }
 
+int px_view_set_sources(struct px_view *v, const struct px_view_sources *src)
+{
+	size_t i, n;
+	if (!v || !src)
+		return PX_E_INVAL;
+	if (v->started)
+		return PX_E_STATE;
+	free(v->ref_pose);
+	free(v->cloud_xyz);
+	v->ref_pose = NULL;
+	v->cloud_xyz = NULL;
+	v->ref_n = 0;
+	v->src = *src;
+	/* the scene's poses now: a model away from its pose is "moved" */
+	n = src->scene ? px_scene_count(src->scene) : 0;
+	if (n > 1024)
+		n = 1024; /* the first ones are watched */
+	if (n) {
+		v->ref_pose = malloc(n * sizeof(*v->ref_pose));
+		if (!v->ref_pose)
+			return PX_E_NOMEM;
+		for (i = 0; i < n; i++)
+			v->ref_pose[i] = px_model_pose(px_scene_model(src->scene, i));
+		v->ref_n = n;
+	}
+	if (src->cloud_feed) {
+		v->cloud_xyz = malloc(3 * sizeof(float) * PX_VIEW_CLOUD_MAX);
+		if (!v->cloud_xyz)
+			return PX_E_NOMEM;
+	}
+	return PX_OK;
+}
+
 int px_view_start(struct px_view *v)
 {
 	if (!v)
@@ -497,6 +602,74 @@ int px_view_feed_json(struct px_view *v, const char *json, size_t len)
 	return PX_OK;
 }
 
+/* The models away from their pose when the sources were set. */
+static void moved_models(struct px_view *v, struct px_view_frame_extra *x)
+{
+	size_t i;
+	for (i = 0; i < v->ref_n && x->n_models < PX_VIEW_MAX_MOVED; i++) {
+		px_pose P = px_model_pose(px_scene_model(v->src.scene, i));
+		double *m = x->models[x->n_models];
+		if (!memcmp(&P, &v->ref_pose[i], sizeof(P)))
+			continue;
+		m[0] = (double)i;
+		m[1] = P.t.x, m[2] = P.t.y, m[3] = P.t.z;
+		m[4] = P.q.w, m[5] = P.q.x, m[6] = P.q.y, m[7] = P.q.z;
+		x->n_models++;
+	}
+}
+
+/* A newer cloud than the last sent: pinned while copied (the producer
+ * cannot rebuild it meanwhile), then the message every connection
+ * sends next. The far point of an empty frame is no point. */
+static void feed_cloud(struct px_view *v, double t_s)
+{
+	struct px_cloud_feed_stats st;
+	struct shared *sh, *old;
+	struct px_model *m;
+	uint64_t frame;
+	size_t n, step, i, k = 0;
+	char *json;
+	size_t len;
+	px_cloud_feed_stats(v->src.cloud_feed, &st);
+	if (!st.taken)
+		return;
+	m = px_cloud_feed_pin(v->src.cloud_feed, &frame);
+	if (!m || frame == v->cloud_frame) {
+		px_cloud_feed_unpin(v->src.cloud_feed);
+		return;
+	}
+	n = px_cloud_point_count(m);
+	step = n > PX_VIEW_CLOUD_MAX ? (n + PX_VIEW_CLOUD_MAX - 1) / PX_VIEW_CLOUD_MAX : 1;
+	for (i = 0; i < n && k < PX_VIEW_CLOUD_MAX; i += step) {
+		px_vec3 p;
+		if (px_cloud_point(m, i, &p) != PX_OK ||
+		    fabs(p.z) >= 0.5 * PX_CLOUD_FEED_FAR_M)
+			continue;
+		v->cloud_xyz[3 * k] = (float)p.x;
+		v->cloud_xyz[3 * k + 1] = (float)p.y;
+		v->cloud_xyz[3 * k + 2] = (float)p.z;
+		k++;
+	}
+	px_cloud_feed_unpin(v->src.cloud_feed);
+	v->cloud_frame = frame;
+	if (px_view_cloud_json(v->src.cloud_id, t_s, v->cloud_xyz, k, &json, &len))
+		return;
+	sh = malloc(sizeof(*sh));
+	if (!sh) {
+		free(json);
+		return;
+	}
+	sh->refs = 1;
+	sh->seq = ++v->cloud_seq;
+	sh->m.p = json;
+	sh->m.n = len;
+	pthread_mutex_lock(&v->mu);
+	old = v->cloud;
+	v->cloud = sh;
+	shared_release(old);
+	pthread_mutex_unlock(&v->mu);
+}
+
 int px_view_feed_record(struct px_view *v, const struct px_app_record *r)
 {
 	int n;
@@ -507,7 +680,11 @@ int px_view_feed_record(struct px_view *v, const struct px_app_record *r)
 	if (r->t_s >= v->last_t_s && r->t_s - v->last_t_s < 0.999 / v->o.rate_hz)
 		return 0;
 	v->last_t_s = r->t_s;
-	n = px_view_frame_json(r, 1, v->fbuf, sizeof(v->fbuf));
+	px_view_frame_fill(&v->src, r, &v->extra);
+	moved_models(v, &v->extra);
+	if (v->src.cloud_feed)
+		feed_cloud(v, r->t_s); /* before the frame: the page has both */
+	n = px_view_frame_json_extra(r, &v->extra, 1, v->fbuf, sizeof(v->fbuf));
 	if (n <= 0)
 		return 0;
 	return px_view_feed_json(v, v->fbuf, (size_t)n) == PX_OK;
@@ -568,5 +745,8 @@ void px_view_free(struct px_view *v)
 	free(v->hello.p);
 	free(v->scene.p);
 	free(v->track.p);
+	shared_release(v->cloud);
+	free(v->ref_pose);
+	free(v->cloud_xyz);
 	free(v);
 }

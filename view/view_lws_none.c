@@ -34,6 +34,12 @@ int px_view_set_track(struct px_view *v, const char *json, size_t len)
 	return PX_E_UNSUPPORTED;
 }
 
+int px_view_set_sources(struct px_view *v, const struct px_view_sources *src)
+{
+	(void)v, (void)src;
+	return PX_E_UNSUPPORTED;
+}
+
 int px_view_start(struct px_view *v)
 {
 	(void)v;

@@ -16,6 +16,8 @@
 #include <unistd.h>
 
 #include "px_alloc_count.h"
+#include "px_cloud_feed.h"
+#include "px_control.h"
 #include "px_app.h"
 #include "px_config.h"
 #include "px_prim.h"
@@ -25,6 +27,7 @@
 #include "px_view.h"
 
 #define HAPTIC_SIM "config/examples/haptic_sim.yaml"
+#define AVOID_URDF "config/examples/can_avoid_urdf.yaml"
 
 static char root[64];
 
@@ -458,12 +461,338 @@ static void test_port_taken(void)
 	px_view_free(v);
 }
 
+/* A chain of two revolute joints with a capsule on each link, as an
+ * arm the view draws (no URDF: the capsules are the links). */
+static void two_link_chain(struct px_control_chain *c)
+{
+	px_control_chain_init(c, px_pose_identity());
+	PX_CHECK_INT_EQ(px_control_chain_add_dh(c, PX_CONTROL_REVOLUTE, 0.4, 0, 0.1, 0), PX_OK);
+	PX_CHECK_INT_EQ(px_control_chain_add_dh(c, PX_CONTROL_REVOLUTE, 0.3, 0, 0, 0), PX_OK);
+	PX_CHECK_INT_EQ(px_control_chain_add_capsule(c, 1, px_v3(-0.4, 0, 0), px_v3(0, 0, 0), 0.03),
+			PX_OK);
+	PX_CHECK_INT_EQ(px_control_chain_add_capsule(c, 2, px_v3(-0.3, 0, 0), px_v3(0, 0, 0), 0.02),
+			PX_OK);
+}
+
+/* scene.robot: a link per capsule, tessellated, with the distances;
+ * frame.links: the capsules' poses by forward kinematics of the
+ * record's joint positions; frame.clearances: the record's closest
+ * pair inside the influence distance only. */
+static void test_arm_links_and_clearances(void)
+{
+	struct px_control_chain c;
+	struct px_app_arm in;
+	struct px_view_arm *arm;
+	struct px_view_scene_info info;
+	struct px_view_sources src;
+	struct px_view_frame_extra x;
+	struct px_app_record r;
+	px_pose frames[3];
+	double q[2] = {0.7, -0.4}, poses[PX_VIEW_MAX_LINKS][7], before[7];
+	char *json, buf[PX_VIEW_FRAME_MAX];
+	size_t len;
+	int n, k;
+	two_link_chain(&c);
+	memset(&in, 0, sizeof(in));
+	in.chain = &c;
+	in.record_joints = 2;
+	in.protective_distance_m = 0.05;
+	in.influence_distance_m = 0.2;
+	PX_CHECK_INT_EQ(px_view_arm_create(&in, &arm), PX_OK);
+	PX_CHECK_INT_EQ(px_view_arm_link_count(arm), 2);
+	memset(&info, 0, sizeof(info));
+	info.arm = arm;
+	PX_CHECK_INT_EQ(px_view_scene_json(NULL, &info, &json, &len), PX_OK);
+	PX_CHECK(strstr(json, "\"robot\":{\"links\":[{\"name\":\"capsule 0 (link 1)\",\"positions\":[") &&
+		 strstr(json, "\"name\":\"capsule 1 (link 2)\""));
+	PX_CHECK_NEAR(num_after(json, "\"protective_distance_m\":"), 0.05, 1e-12);
+	PX_CHECK_NEAR(num_after(json, "\"influence_distance_m\":"), 0.2, 1e-12);
+	PX_CHECK(strstr(json, "\"indices\":[]") == NULL);
+	free(json);
+	/* the links at q: each capsule's middle where the chain puts it */
+	memset(&r, 0, sizeof(r));
+	r.q[0] = (float)q[0];
+	r.q[1] = (float)q[1];
+	r.valid = 1;
+	q[0] = r.q[0];
+	q[1] = r.q[1];
+	PX_CHECK_INT_EQ(px_control_chain_fk(&c, q, frames, 3), PX_OK);
+	n = px_view_arm_links(arm, &r, poses, PX_VIEW_MAX_LINKS);
+	PX_CHECK_INT_EQ(n, 2);
+	for (k = 0; k < 2; k++) {
+		px_vec3 mid = px_pose_transform_point(frames[k + 1],
+						      px_v3(k ? -0.15 : -0.2, 0, 0));
+		PX_CHECK_NEAR(poses[k][0], mid.x, 1e-7);
+		PX_CHECK_NEAR(poses[k][1], mid.y, 1e-7);
+		PX_CHECK_NEAR(poses[k][2], mid.z, 1e-7);
+	}
+	memcpy(before, poses[1], sizeof(before));
+	r.q[1] = 0.3f;
+	PX_CHECK_INT_EQ(px_view_arm_links(arm, &r, poses, PX_VIEW_MAX_LINKS), 2);
+	PX_CHECK(fabs(poses[1][0] - before[0]) + fabs(poses[1][1] - before[1]) > 1e-3);
+	PX_CHECK_INT_EQ(px_view_arm_links(arm, &r, poses, 1), PX_E_NOSPC);
+	/* the frame: links, and the pair within the influence distance */
+	memset(&src, 0, sizeof(src));
+	src.arm = arm;
+	r.dev_m[0] = 0.5, r.proxy_m[0] = 0.6;
+	r.distance_m = 0.1;
+	px_view_frame_fill(&src, &r, &x);
+	PX_CHECK_INT_EQ(x.n_links, 2);
+	PX_CHECK_INT_EQ(x.n_clearances, 1);
+	PX_CHECK(!x.has_closest);
+	n = px_view_frame_json_extra(&r, &x, 1, buf, sizeof(buf));
+	PX_CHECK(n > 0 && strstr(buf, "\"links\":[[") && strstr(buf, "\"closest\":null"));
+	PX_CHECK_NEAR(num_after(buf, "\"clearances\":[["), 0.5, 1e-12);
+	PX_CHECK_NEAR(num_after(buf, "0.6,0,0,"), 0.1, 1e-12);
+	r.distance_m = 0.2; /* nothing within the influence distance */
+	px_view_frame_fill(&src, &r, &x);
+	PX_CHECK_INT_EQ(x.n_clearances, 0);
+	PX_CHECK(px_view_frame_json_extra(&r, &x, 1, buf, sizeof(buf)) > 0 &&
+		 !strstr(buf, "clearances"));
+	/* a chain with more joints than the record carries: no links */
+	in.record_joints = 1;
+	px_view_arm_free(arm);
+	PX_CHECK_INT_EQ(px_view_arm_create(&in, &arm), PX_OK);
+	PX_CHECK_INT_EQ(px_view_arm_links(arm, &r, poses, PX_VIEW_MAX_LINKS), 0);
+	px_view_arm_free(arm);
+}
+
+/* A haptic run's frame: the scene's point nearest the tool. */
+static void test_closest_point(void)
+{
+	struct px_scene *sc;
+	struct px_model *m;
+	struct px_prim p = {PX_PRIM_SPHERE, 0.1, 0, 0};
+	struct px_view_sources src;
+	struct px_view_frame_extra x;
+	struct px_app_record r;
+	char buf[PX_VIEW_FRAME_MAX];
+	PX_CHECK_INT_EQ(px_scene_create(4, &sc), PX_OK);
+	PX_CHECK_INT_EQ(px_prim_model(&p, &m), PX_OK);
+	PX_CHECK(px_scene_add(sc, m, "ball") >= 0);
+	memset(&src, 0, sizeof(src));
+	memset(&r, 0, sizeof(r));
+	src.scene = sc;
+	r.dev_m[0] = 0.3;
+	px_view_frame_fill(&src, &r, &x);
+	PX_CHECK(x.has_closest);
+	PX_CHECK(px_view_frame_json_extra(&r, &x, 0, buf, sizeof(buf)) > 0);
+	PX_CHECK_NEAR(num_after(buf, "\"closest\":["), 0.1, 1e-9);
+	PX_CHECK(!strstr(buf, "\"links\"") && !strstr(buf, "\"type\""));
+	px_scene_free(sc);
+	/* no scene: null */
+	src.scene = NULL;
+	px_view_frame_fill(&src, &r, &x);
+	PX_CHECK(px_view_frame_json_extra(&r, &x, 1, buf, sizeof(buf)) > 0 &&
+		 strstr(buf, "\"closest\":null"));
+}
+
+/* A cloud message keeps at most PX_VIEW_CLOUD_MAX points. */
+static void test_cloud_message(void)
+{
+	size_t n = 50000, i, len, commas = 0;
+	float *xyz = malloc(3 * n * sizeof(float));
+	char *json, *p;
+	PX_CHECK(xyz != NULL);
+	for (i = 0; i < 3 * n; i++)
+		xyz[i] = (float)(i % 7) * 0.25f;
+	PX_CHECK_INT_EQ(px_view_cloud_json(3, 1.5, xyz, n, &json, &len), PX_OK);
+	PX_CHECK(strstr(json, "{\"type\":\"cloud\",\"id\":3,\"t_s\":1.5,\"positions\":[") == json);
+	for (p = strstr(json, "\"positions\":["); *p; p++)
+		commas += *p == ',';
+	PX_CHECK((commas + 1) % 3 == 0);
+	PX_CHECK((commas + 1) / 3 <= PX_VIEW_CLOUD_MAX && (commas + 1) / 3 >= PX_VIEW_CLOUD_MAX / 2);
+	free(json);
+	PX_CHECK_INT_EQ(px_view_cloud_json(3, 0, xyz, 0, &json, &len), PX_OK);
+	PX_CHECK(strstr(json, "\"positions\":[]}") != NULL);
+	free(json);
+	free(xyz);
+}
+
+struct arm_run {
+	uint64_t cycles, allocs;
+	double min_clearance_m;
+};
+
+/* The view the arm run feeds once it exists (the app is made first:
+ * the view's sources are the app's). */
+static struct px_view *arm_view;
+
+static void feed_arm(void *user, const struct px_app_record *r)
+{
+	(void)user;
+	if (arm_view)
+		px_view_feed_record(arm_view, r);
+}
+
+/* A view of app's arm and cloud as proxima-run makes it; *fd a page
+ * connected before the run. */
+static struct px_view *arm_view_make(struct px_app *app, int port,
+				     struct px_view_arm **va, int *fd)
+{
+	struct px_app_arm arm;
+	struct px_view_options vo;
+	struct px_view_scene_info info;
+	struct px_view_sources src;
+	struct px_view *v = NULL;
+	char msg[256], *scene;
+	size_t len;
+	PX_CHECK_INT_EQ(px_app_arm(app, &arm), 1);
+	PX_CHECK(arm.robot != NULL && arm.cloud_feed != NULL && arm.record_joints == 6);
+	PX_CHECK_INT_EQ(px_view_arm_create(&arm, va), PX_OK);
+	px_view_options_default(&vo);
+	vo.port = port;
+	vo.web_root = web_root();
+	vo.queue_frames = 400; /* the virtual clock feeds fast: keep them all */
+	PX_CHECK_MSG(px_view_create(&vo, &v, msg, sizeof(msg)) == PX_OK, "%s", msg);
+	memset(&info, 0, sizeof(info));
+	memset(&src, 0, sizeof(src));
+	info.arm = *va;
+	info.cloud_name = "depth sensor";
+	src.scene = px_app_scene(app);
+	src.arm = *va;
+	src.cloud_feed = arm.cloud_feed;
+	src.cloud_id = (int)px_scene_count(px_app_scene(app));
+	PX_CHECK_INT_EQ(px_view_scene_json(px_app_scene(app), &info, &scene, &len), PX_OK);
+	PX_CHECK_INT_EQ(px_view_set_scene(v, scene, len), PX_OK);
+	free(scene);
+	PX_CHECK_INT_EQ(px_view_set_sources(v, &src), PX_OK);
+	PX_CHECK_INT_EQ(px_view_start(v), PX_OK);
+	*fd = ws_open(port, "/ws");
+	PX_CHECK(*fd >= 0);
+	sleep_ms(100); /* connected before the first frame */
+	return v;
+}
+
+/* The URDF arm with its depth sensor, 6 s on the virtual clock (the box
+ * is in reach from 3 s); with a
+ * view (port > 0) fed as proxima-run feeds it, *fd its page. */
+static struct arm_run run_arm(int port, int *fd)
+{
+	struct px_config *cfg = NULL;
+	static struct px_config_diag diag;
+	struct px_app_options o;
+	struct px_app *app = NULL;
+	struct px_app_summary s;
+	struct px_view_arm *va = NULL;
+	struct arm_run out;
+	char msg[256];
+	PX_CHECK_INT_EQ(px_config_load_file(AVOID_URDF, &cfg, &diag), PX_OK);
+	px_app_options_default(&o);
+	o.config = AVOID_URDF;
+	o.virtual_time = 1;
+	o.duration_s = 6.0;
+	o.note = px_test_app_note;
+	o.heap_count = px_alloc_count_thread;
+	o.telemetry = "build/tests/view-arm-telemetry.csv";
+	o.record = feed_arm;
+	PX_CHECK_MSG(px_app_create(cfg, &o, &app, msg, sizeof(msg)) == PX_OK, "%s", msg);
+	arm_view = port > 0 ? arm_view_make(app, port, &va, fd) : NULL;
+	PX_CHECK_INT_EQ(px_app_run(app), PX_OK);
+	PX_CHECK_INT_EQ(px_app_shutdown(app, "end of run"), PX_OK);
+	px_app_drain(app, feed_arm, NULL);
+	PX_CHECK_INT_EQ(px_app_summary(app, &s), PX_OK);
+	out.cycles = s.cycles;
+	out.allocs = s.allocations_after_setup;
+	out.min_clearance_m = s.min_clearance_m;
+	if (arm_view)
+		px_view_end(arm_view); /* the page reads to the end */
+	px_app_free(app);
+	px_config_free(cfg);
+	px_view_arm_free(va);
+	return out;
+}
+
+/* The top-level arrays of key's array in s ("links":[[...],...]). */
+static int rows_of(const char *s, const char *key)
+{
+	const char *p = strstr(s, key);
+	int depth = 0, n = 0;
+	if (!p)
+		return 0;
+	for (p += strlen(key); *p; p++) {
+		if (*p == '[' && ++depth == 2)
+			n++;
+		if (*p == ']' && depth-- == 1)
+			break;
+	}
+	return n;
+}
+
+/* An arm run with a page attached: scene.robot's links, frames with the
+ * links moving and the closest pair, the depth sensor's swapped clouds;
+ * the loop the same as without the view (cycles, clearance, no heap
+ * call after setup). */
+static void test_arm_run_with_view(void)
+{
+	struct arm_run a, b;
+	char *s, first[512] = "";
+	int port = free_port(), fd = -1, frames = 0, moved = 0, clouds = 0,
+	    points = 0, pairs = 0;
+	PX_NEEDS(VIEW);
+	PX_NEEDS(XML);
+	if (!strcmp(px_alloc_count_mode(), "none"))
+		PX_SKIP("no allocation counter in this build");
+	a = run_arm(0, NULL);
+	b = run_arm(port, &fd);
+	PX_CHECK_INT_EQ((long long)b.cycles, (long long)a.cycles);
+	PX_CHECK_INT_EQ((long long)a.allocs, 0);
+	PX_CHECK_INT_EQ((long long)b.allocs, 0);
+	PX_CHECK_NEAR(b.min_clearance_m, a.min_clearance_m, 0);
+	s = ws_read(fd, 2000);
+	PX_CHECK(s && strstr(s, "\"type\":\"hello\""));
+	free(s);
+	s = ws_read(fd, 2000);
+	PX_CHECK(s && strstr(s, "\"type\":\"scene\""));
+	PX_CHECK(strstr(s, "{\"id\":1,\"name\":\"depth sensor\",\"kind\":\"cloud\"") != NULL);
+	PX_CHECK_INT_EQ(rows_of(s, "\"bounds\":"), 0);
+	PX_CHECK(strstr(s, "\"robot\":{\"links\":[{\"name\":\"base_link\"") &&
+		 strstr(s, "\"name\":\"forearm_link\"") && strstr(s, "\"name\":\"wrist3_link\""));
+	PX_CHECK_NEAR(num_after(s, "\"protective_distance_m\":"), 0.05, 1e-12);
+	free(s);
+	while ((s = ws_read(fd, 3000)) != NULL) {
+		if (strstr(s, "\"type\":\"end\"")) {
+			free(s);
+			break;
+		}
+		if (strstr(s, "\"type\":\"cloud\"")) {
+			clouds++;
+			PX_CHECK_INT_EQ((long long)num_after(s, "\"id\":"), 1);
+			if (!strstr(s, "\"positions\":[]"))
+				points++;
+		} else if (strstr(s, "\"type\":\"frame\"")) {
+			const char *l = strstr(s, "\"links\":[[");
+			frames++;
+			PX_CHECK_INT_EQ(rows_of(s, "\"links\":"), 7);
+			PX_CHECK(strstr(s, "\"closest\":null") != NULL);
+			pairs += strstr(s, "\"clearances\":[[") != NULL;
+			if (l && !first[0])
+				snprintf(first, sizeof(first), "%s", l);
+			else if (l && strncmp(first, l, strlen(first)))
+				moved++;
+		}
+		free(s);
+	}
+	/* (records every 10 ms, frames at most 30 a second: every 40 ms) */
+	PX_CHECK_MSG(frames >= 145 && frames <= 181, "%d frames", frames);
+	PX_CHECK_MSG(moved > 0 && pairs > 0, "links moved in %d frames, %d pairs", moved, pairs);
+	/* (the virtual clock drains once a loop second: a cloud each) */
+	PX_CHECK_MSG(clouds >= 4 && points >= 3, "%d clouds, %d with points", clouds, points);
+	close(fd);
+	px_view_free(arm_view);
+	arm_view = NULL;
+}
+
 static const struct px_test tests[] = {
 	PX_T(test_messages_of_a_connection),
 	PX_T(test_bad_requests_answered),
 	PX_T(test_slow_client_dropped_and_closed),
 	PX_T(test_loop_unaffected_by_clients),
 	PX_T(test_port_taken),
+	PX_T(test_arm_links_and_clearances),
+	PX_T(test_closest_point),
+	PX_T(test_cloud_message),
+	PX_T(test_arm_run_with_view),
 };
 
 PX_TEST_MAIN(tests)

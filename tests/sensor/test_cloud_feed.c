@@ -105,6 +105,45 @@ static void test_feed_rules(void)
 	px_cloud_feed_free(f);
 }
 
+/* A reader beside the consumer pins the held frame: its slot is not
+ * rebuilt while pinned, even after the consumer moved on. */
+static void test_pin(void)
+{
+	struct px_cloud_feed *f;
+	struct px_model *m, *held;
+	double xyz[30];
+	uint64_t frame = 99;
+	int i;
+	PX_CHECK_INT_EQ(px_cloud_feed_create(4, 10, 0, &f), PX_OK);
+	PX_CHECK(px_cloud_feed_pin(f, &frame) == NULL); /* nothing held */
+	PX_CHECK_INT_EQ(frame, 0);
+	px_cloud_feed_unpin(f);
+	for (i = 0; i < 4; i++) {
+		cloud_at(xyz, 10, i);
+		PX_CHECK_INT_EQ(px_cloud_feed_publish(f, xyz, 10, 10 * (i + 1)), PX_OK);
+	}
+	PX_CHECK_INT_EQ(px_cloud_feed_take(f, 15, &held, NULL), 1); /* frame 0 */
+	m = px_cloud_feed_pin(f, &frame);
+	PX_CHECK(m == held);
+	PX_CHECK_INT_EQ(frame, 1);
+	/* the consumer moves on to frame 3: frames 4..6 could reuse the
+	 * slots of 0..2, but frame 0's is pinned */
+	PX_CHECK_INT_EQ(px_cloud_feed_take(f, 1000, &held, NULL), 1);
+	PX_CHECK(held != m);
+	PX_CHECK_INT_EQ(px_cloud_feed_space(f), 0);
+	PX_CHECK_INT_EQ(px_cloud_feed_publish(f, xyz, 10, 50), PX_E_AGAIN);
+	PX_CHECK_INT_EQ(px_cloud_point_count(m), 10);
+	PX_CHECK_NEAR(first_x(m), 0.0, 0);
+	px_cloud_feed_unpin(f);
+	PX_CHECK_INT_EQ(px_cloud_feed_space(f), 3);
+	PX_CHECK_INT_EQ(px_cloud_feed_publish(f, xyz, 10, 50), PX_OK);
+	/* the newest held frame pinned: its number grew */
+	m = px_cloud_feed_pin(f, &frame);
+	PX_CHECK(m == held && frame == 4);
+	px_cloud_feed_unpin(f);
+	px_cloud_feed_free(f);
+}
+
 /* Distance from p to the surface of the box [lo, hi]. */
 static double box_surface(px_vec3 p, px_vec3 lo, px_vec3 hi)
 {
@@ -392,6 +431,7 @@ static void test_depth_thread(void)
 
 static const struct px_test tests[] = {
 	PX_T(test_feed_rules),
+	PX_T(test_pin),
 	PX_T(test_depth_box),
 	PX_T(test_depth_arm),
 	PX_T(test_swap_while_running),

@@ -106,6 +106,8 @@ export class View {
     this.links = [];
     this.robot = null;
     pxView.sceneModels = 0;
+    pxView.linksDrawn = 0;
+    pxView.linkPositions = [];
   }
 
   setScene(scene) {
@@ -138,6 +140,7 @@ export class View {
         this.world.add(obj);
       }
     }
+    pxView.linksDrawn = this.links.length;
     this.fitBounds(scene.bounds);
     this.setMarkerRadius((scene.tool && scene.tool.radius_m) || 0);
     this.dirty = true;
@@ -219,6 +222,7 @@ export class View {
     }
     if (Array.isArray(f.links)) {
       f.links.forEach((p, i) => { if (this.links[i]) setPose(this.links[i], p); });
+      pxView.linkPositions = this.links.map((o) => [o.position.x, o.position.y, o.position.z]);
     }
     this.setClearances(f.clearances);
     this.dirty = true;
@@ -246,6 +250,7 @@ export class View {
   setClearances(list) {
     if (!Array.isArray(list) || list.length === 0) {
       this.clearances.visible = false;
+      pxView.clearancesDrawn = 0;
       return;
     }
     if (list.length > this.clearCap) {
@@ -270,6 +275,7 @@ export class View {
     pos.needsUpdate = col.needsUpdate = true;
     this.clearGeo.setDrawRange(0, list.length * 2);
     this.clearances.visible = true;
+    pxView.clearancesDrawn = list.length;
   }
 
   // A swapped point cloud replaces the model's points.
@@ -280,6 +286,7 @@ export class View {
     obj.geometry = new THREE.BufferGeometry();
     obj.geometry.setAttribute("position", new THREE.Float32BufferAttribute(positions || [], 3));
     pxView.cloudsSwapped++;
+    pxView.cloudPoints = obj.geometry.attributes.position.count;
     this.dirty = true;
   }
 

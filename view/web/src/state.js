@@ -15,6 +15,10 @@ export const pxView = {
   replay: null,          // replay/report: {playing, t_s, speed, frames}
   cameraTarget: [0, 0, 0], // the point the camera orbits (follows the tool when asked)
   cloudsSwapped: 0,      // "cloud" messages applied to a model of the scene
+  cloudPoints: 0,        // points of the last cloud applied
+  linksDrawn: 0,         // arm links of the scene drawn (scene.robot.links)
+  linkPositions: [],     // each link mesh's world position as drawn [[x,y,z],...]
+  clearancesDrawn: 0,    // witness segments drawn in the last frame
 };
 
 export function reportError(what) {
