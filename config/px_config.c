@@ -1022,6 +1022,7 @@ static const struct px_config_key telemetry_keys[] = {
 	      1000000, 1),
 	K_INT(struct px_config_telemetry, ring_records, "ring_records", 0, 16,
 	      1 << 24, 8192),
+	K_BOOL(struct px_config_telemetry, joint_positions, "joint_positions", 0),
 };
 SCHEMA(telemetry_schema, "telemetry", telemetry_keys, NULL);
 

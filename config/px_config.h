@@ -361,6 +361,7 @@ struct px_config_telemetry {
 	const char *file;     /* CSV path; NULL or "" = no telemetry file */
 	int64_t decimation;   /* record every Nth cycle */
 	int64_t ring_records; /* capacity of the RT-to-writer ring */
+	bool joint_positions; /* avoidance: the joints' positions too */
 };
 
 enum px_config_backend {

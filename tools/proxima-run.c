@@ -74,6 +74,9 @@ static const char usage_text[] =
 	"                     inject fault kind K into device DEV (as an entry "
 	"of\n"
 	"                     sim.faults; DEV 'loop' for overrun); repeatable\n"
+	"  --view [ADDR:]PORT serve the live view of the run to a browser on PORT\n"
+	"                     (ADDR default 127.0.0.1; [::1]:PORT for IPv6)\n"
+	"  --view-root DIR    the view's built page (default: build/view/web)\n"
 	"  --help             this text\n"
 	"Exit status: 0 ok, 1 invalid config or setup failure (e.g. a device\n"
 	"absent), 2 usage error or --virtual-time with hardware devices.\n";
@@ -392,6 +395,9 @@ static void on_record(void *user, const struct px_app_record *r)
 			fprintf(T.csv_f, ",%.6g", r->scale);
 			for (j = 0; j < S.record_joints; j++)
 				fprintf(T.csv_f, ",%.6g", r->qdot[j]);
+			if (CFG->telemetry.joint_positions)
+				for (j = 0; j < S.record_joints; j++)
+					fprintf(T.csv_f, ",%.9g", (double)r->q[j]);
 		}
 		fputc('\n', T.csv_f);
 	}
@@ -463,6 +469,11 @@ static int open_csv(void)
 		fprintf(T.csv_f, ",speed_scale");
 		for (j = 0; j < S.record_joints; j++)
 			fprintf(T.csv_f, ",qdot%d_rad_per_s", j);
+		/* telemetry.joint_positions: where the arm is (the view
+		 * draws its links from them) */
+		if (CFG->telemetry.joint_positions)
+			for (j = 0; j < S.record_joints; j++)
+				fprintf(T.csv_f, ",q%d_rad", j);
 	}
 	fputc('\n', T.csv_f);
 	return 0;

@@ -2,15 +2,19 @@
  * proxima-view - replay a run in the browser, or write it as one page.
  *
  *   proxima-view [--port [ADDR:]PORT] [--config CFG] [--web-root DIR]
- *                [--summary FILE] TELEMETRY.csv
+ *                [--summary FILE] [--rate HZ] TELEMETRY.csv
  *   proxima-view --html OUT.html [--config CFG] [--template FILE]
- *                [--summary FILE] TELEMETRY.csv
+ *                [--summary FILE] [--rate HZ] TELEMETRY.csv
  *
  * Serves the view's page (view/px_view.h) in replay mode: "hello", the
  * scene of CFG's scene section tessellated (px_view_scene_json()), and
  * the whole run as one "track" message from the telemetry CSV with the
  * run's summary JSON (--summary, else run-summary.json beside the CSV
- * when there is one); the page plays it. Until Ctrl-C. With --html it
+ * when there is one); the page plays it. The track holds a frame at most
+ * every 1/HZ s of loop time (60; 0: every row) and at every change of
+ * contact or safe state, with the closest point on the scene; for an arm (CFG in
+ * avoidance mode, its robot made as for a config check) the links where
+ * the CSV has the joint positions (telemetry.joint_positions). Until Ctrl-C. With --html it
  * writes one self-contained page instead: the report template (the
  * built page's report-template.html) with {"scene":...,"track":...} put
  * where it says PX_VIEW_DATA, written through tools/tool_out.h.
@@ -28,6 +32,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "px_app.h"
 #include "px_config.h"
 #include "px_scene.h"
 #include "px_view.h"
@@ -37,9 +42,9 @@
 
 static const char usage_text[] =
 	"usage: proxima-view [--port [ADDR:]PORT] [--config CFG] [--web-root DIR]\n"
-	"                    [--summary FILE] TELEMETRY.csv\n"
+	"                    [--summary FILE] [--rate HZ] TELEMETRY.csv\n"
 	"       proxima-view --html OUT.html [--config CFG] [--template FILE]\n"
-	"                    [--summary FILE] TELEMETRY.csv\n"
+	"                    [--summary FILE] [--rate HZ] TELEMETRY.csv\n"
 	"\n"
 	"  --port [ADDR:]PORT  serve the replay there (default 127.0.0.1:8765)\n"
 	"  --config CFG        the run's config: its scene is shown\n"
@@ -49,15 +54,21 @@ static const char usage_text[] =
 	"  --html OUT.html     write one self-contained report page and exit\n"
 	"  --template FILE     the report template (default: report-template.html\n"
 	"                      of the built page)\n"
+	"  --rate HZ           track frames a second of loop time at most, and at\n"
+	"                      every change of contact or safe state (default 60;\n"
+	"                      0: every row)\n"
 	"  --help              this text\n"
 	"Exit status: 0 ok, 1 an input or output failed, 2 usage error.\n";
+
+/* Frames a second of loop time in the track at most (--rate). */
+#define TRACK_RATE_HZ 60.0
 
 /* The report template's limit and the marker the data replaces. */
 #define TEMPLATE_MAX (64u << 20)
 static const char marker[] = "/*PX_VIEW_DATA*/null";
 
 static struct {
-	const char *port, *config, *root, *summary, *html, *templ, *csv;
+	const char *port, *config, *root, *summary, *html, *templ, *csv, *rate;
 } A;
 
 static volatile sig_atomic_t stop;
@@ -82,7 +93,8 @@ static int parse_args(int argc, char **argv)
 		const char **value;
 	} flags[] = {{"--port", &A.port},       {"--config", &A.config},
 		     {"--web-root", &A.root},   {"--summary", &A.summary},
-		     {"--html", &A.html},       {"--template", &A.templ}};
+		     {"--html", &A.html},       {"--template", &A.templ},
+		     {"--rate", &A.rate}};
 	int i;
 	size_t k;
 	for (i = 1; i < argc; i++) {
@@ -117,36 +129,72 @@ static int parse_args(int argc, char **argv)
 		return usage_error("no TELEMETRY.csv given", NULL);
 	if (A.html && A.port)
 		return usage_error("--html writes a file; --port serves", NULL);
+	if (A.rate) {
+		char *end;
+		double hz = strtod(A.rate, &end);
+		if (*end || !(hz >= 0 && hz <= 1e6))
+			return usage_error("--rate needs a number 0 .. 1000000, not", A.rate);
+	}
 	return 0;
 }
 
-/* The scene message of --config (none: an empty scene). 0 or 1. */
-static int scene_json(char **json, size_t *len)
+/* What --config gives: its scene and, in avoidance mode, its arm. */
+static struct {
+	struct px_config *cfg;
+	struct px_scene *scene;
+	struct px_view_arm *arm;
+} C;
+
+/* The arm of C.cfg's robot as a config check makes it (none when the
+ * config is not in avoidance mode or its robot cannot be made). */
+static void load_arm(void)
+{
+	struct px_app_options o;
+	struct px_app *app = NULL;
+	struct px_app_arm arm;
+	char msg[256];
+	px_app_options_default(&o);
+	o.name = "proxima-view";
+	o.config = A.config;
+	o.check = 1;
+	if (px_app_create(C.cfg, &o, &app, msg, sizeof(msg)) != PX_OK)
+		return;
+	if (px_app_arm(app, &arm) && px_view_arm_create(&arm, &C.arm) != PX_OK)
+		fprintf(stderr, "proxima-view: %s: the arm is not drawn\n", A.config);
+	px_app_free(app);
+}
+
+/* The scene and arm of --config (none: no models). 0 or 1. */
+static int load_config(void)
 {
 	static struct px_config_diag diag;
-	struct px_config *cfg = NULL;
-	struct px_scene *sc = NULL;
+	int rc;
+	if (!A.config)
+		return 0;
+	rc = px_config_load_file(A.config, &C.cfg, &diag);
+	if (rc == PX_OK) {
+		px_config_diag_init(&diag);
+		rc = px_scene_config_load(C.cfg, &C.scene, &diag);
+	}
+	if (rc != PX_OK) {
+		px_config_diag_print(&diag, stderr);
+		fprintf(stderr, "proxima-view: %s: %s\n", A.config, px_strerror(rc));
+		return 1;
+	}
+	load_arm();
+	return 0;
+}
+
+/* The scene message: the config's models, the arm when the track has
+ * its links. 0 or 1. */
+static int scene_json(int links, char **json, size_t *len)
+{
 	struct px_view_scene_info info;
 	int rc;
 	memset(&info, 0, sizeof(info));
 	info.tool_radius_m = 0.002;
-	if (A.config) {
-		rc = px_config_load_file(A.config, &cfg, &diag);
-		if (rc == PX_OK) {
-			px_config_diag_init(&diag);
-			rc = px_scene_config_load(cfg, &sc, &diag);
-		}
-		if (rc != PX_OK) {
-			px_config_diag_print(&diag, stderr);
-			fprintf(stderr, "proxima-view: %s: %s\n", A.config,
-				px_strerror(rc));
-			px_config_free(cfg);
-			return 1;
-		}
-	}
-	rc = px_view_scene_json(sc, &info, json, len);
-	px_scene_free(sc);
-	px_config_free(cfg);
+	info.arm = links ? C.arm : NULL;
+	rc = px_view_scene_json(C.scene, &info, json, len);
 	if (rc != PX_OK) {
 		fprintf(stderr, "proxima-view: the scene: %s\n", px_strerror(rc));
 		return 1;
@@ -301,14 +349,21 @@ int main(int argc, char **argv)
 	char *scene = NULL, *summary = NULL, *track = NULL;
 	char why[PATH_MAX + 128];
 	size_t scene_len = 0, track_len = 0, rows = 0;
+	struct view_track_opts to;
+	struct view_track_info ti;
 	int rc = parse_args(argc, argv);
 	if (rc)
 		return rc == 1 ? 0 : rc;
-	if (scene_json(&scene, &scene_len) || summary_json(&summary))
+	memset(&to, 0, sizeof(to));
+	to.rate_hz = A.rate ? strtod(A.rate, NULL) : TRACK_RATE_HZ;
+	if (load_config() || summary_json(&summary)) {
 		rc = 1;
-	else if (view_track_json(A.csv, summary, &track, &track_len, &rows, why,
-				 sizeof(why))) {
+	} else if (to.summary = summary, to.scene = C.scene, to.arm = C.arm,
+		   view_track_json(A.csv, &to, &track, &track_len, &ti, why,
+				   sizeof(why))) {
 		fprintf(stderr, "proxima-view: %s\n", why);
+		rc = 1;
+	} else if (rows = ti.frames, scene_json(ti.links, &scene, &scene_len)) {
 		rc = 1;
 	} else if (A.html) {
 		rc = write_html(scene, scene_len, track, track_len, rows);
@@ -318,5 +373,8 @@ int main(int argc, char **argv)
 	free(scene);
 	free(summary);
 	free(track);
+	px_view_arm_free(C.arm);
+	px_scene_free(C.scene);
+	px_config_free(C.cfg);
 	return rc;
 }

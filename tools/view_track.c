@@ -13,12 +13,15 @@
 /* The CSV columns a frame reads, by header name. */
 enum col {
 	C_T, C_CYCLE, C_X, C_Y, C_Z, C_PX, C_PY, C_PZ, C_FX, C_FY, C_FZ,
-	C_DIST, C_PEN, C_CONTACT, C_SAFE, C_LAT, C_COMP, C_SCALE, C__N
+	C_DIST, C_PEN, C_CONTACT, C_SAFE, C_LAT, C_COMP, C_SCALE, C_Q0, C_Q1,
+	C_Q2, C_Q3, C_Q4, C_Q5, C__N
 };
 static const char *const col_names[C__N] = {
 	"t_s", "cycle", "x_m", "y_m", "z_m", "proxy_x_m", "proxy_y_m",
 	"proxy_z_m", "fx_n", "fy_n", "fz_n", "distance_m", "penetration_m",
-	"contact", "safe", "wakeup_latency_ns", "compute_ns", "speed_scale"};
+	"contact", "safe", "wakeup_latency_ns", "compute_ns", "speed_scale",
+	"q0_rad", "q1_rad", "q2_rad", "q3_rad", "q4_rad", "q5_rad"};
+_Static_assert(C__N - C_Q0 == PX_APP_RECORD_JOINTS, "a q column per record joint");
 #define REQUIRED 5 /* the first five */
 #define MAX_COLS 64
 
@@ -117,19 +120,57 @@ static int row_record(char **f, int nf, const int *idx,
 	r->latency_ns = (int64_t)v[C_LAT];
 	r->compute_ns = (int64_t)v[C_COMP];
 	r->scale = v[C_SCALE];
+	for (c = C_Q0; c < C__N; c++)
+		r->q[c - C_Q0] = (float)v[c];
+	r->valid = 1;
 	return 0;
 }
 
-int view_track_json(const char *path, const char *summary, char **json,
-		    size_t *len, size_t *rows, char *why, size_t cap)
+/* Whether row r starts a frame of the track: the first, one at most
+ * every 1 / rate_hz of loop time (a clock that goes back starts again),
+ * and every change of contact or safe state. */
+static int keep_row(const struct px_app_record *r, const struct px_app_record *kept,
+		    size_t rows, double rate_hz)
+{
+	return rows == 0 || !(rate_hz > 0) || r->t_s < kept->t_s ||
+	       r->t_s - kept->t_s >= 0.999 / rate_hz ||
+	       r->contact != kept->contact || r->safe != kept->safe;
+}
+
+/* One frame of the track, after n others. -1: too long. */
+static int frame_put(struct obuf *o, const struct px_view_sources *src,
+		     const struct px_app_record *r, size_t n, char *buf,
+		     size_t cap)
+{
+	struct px_view_frame_extra x;
+	int k;
+	px_view_frame_fill(src, r, &x);
+	k = px_view_frame_json_extra(r, &x, 0, buf, cap);
+	if (k < 0)
+		return -1;
+	if (n)
+		put(o, ",", 1);
+	put(o, buf, (size_t)k);
+	return 0;
+}
+
+int view_track_json(const char *path, const struct view_track_opts *opt,
+		    char **json, size_t *len, struct view_track_info *info,
+		    char *why, size_t cap)
 {
 	FILE *f = fopen(path, "r");
 	char *line = malloc(VIEW_CSV_LINE_MAX + 2), *fields[MAX_COLS];
 	char frame[PX_VIEW_FRAME_MAX];
 	struct obuf o = {NULL, 0, 0, 0};
-	size_t lineno = 0;
-	int idx[C__N], nf, c, rc = -1, got;
-	*rows = 0;
+	struct px_app_record kept, last;
+	struct px_view_sources src;
+	size_t lineno = 0, *rows = &info->frames;
+	int idx[C__N], nf, c, rc = -1, got, last_kept = 1;
+	memset(info, 0, sizeof(*info));
+	memset(&src, 0, sizeof(src));
+	memset(&kept, 0, sizeof(kept));
+	memset(&last, 0, sizeof(last));
+	src.scene = opt->scene;
 	if (!f || !line) {
 		snprintf(why, cap, "%s: %s", path, f ? "out of memory" : strerror(errno));
 		goto done;
@@ -153,11 +194,21 @@ int view_track_json(const char *path, const char *summary, char **json,
 			goto done;
 		}
 	}
+	/* the arm's links where the CSV has every joint position it needs */
+	if (opt->arm && idx[C_Q0] >= 0) {
+		struct px_view_frame_extra probe;
+		memset(&last, 0, sizeof(last));
+		for (c = C_Q0; c < C__N; c++)
+			if (idx[c] < 0)
+				last.q[c - C_Q0] = NAN;
+		if (px_view_arm_links(opt->arm, &last, probe.links, PX_VIEW_MAX_LINKS) > 0)
+			src.arm = opt->arm;
+	}
+	info->links = src.arm != NULL;
 	put(&o, "{\"type\":\"track\",\"frames\":[", 26);
 	while ((got = get_line(f, line, VIEW_CSV_LINE_MAX + 2)) != 0) {
 		struct px_app_record r;
 		const char *bad = NULL;
-		int k;
 		lineno++;
 		if (got < 0) {
 			snprintf(why, cap, "%s:%zu: line longer than %d bytes", path,
@@ -178,19 +229,29 @@ int view_track_json(const char *path, const char *summary, char **json,
 				 bad ? bad : "", "");
 			goto done;
 		}
-		k = px_view_frame_json(&r, 0, frame, sizeof(frame));
-		if (k < 0) {
+		info->rows++;
+		last = r;
+		last_kept = keep_row(&r, &kept, *rows, opt->rate_hz);
+		if (!last_kept)
+			continue;
+		if (frame_put(&o, &src, &r, *rows, frame, sizeof(frame)) < 0) {
 			snprintf(why, cap, "%s:%zu: frame too long", path, lineno);
 			goto done;
 		}
-		if (*rows)
-			put(&o, ",", 1);
-		put(&o, frame, (size_t)k);
+		kept = r;
+		++*rows;
+	}
+	/* the run's last row ends the track */
+	if (!last_kept) {
+		if (frame_put(&o, &src, &last, *rows, frame, sizeof(frame)) < 0) {
+			snprintf(why, cap, "%s:%zu: frame too long", path, lineno);
+			goto done;
+		}
 		++*rows;
 	}
 	put(&o, "],\"summary\":", 12);
-	if (summary)
-		put(&o, summary, strlen(summary));
+	if (opt->summary)
+		put(&o, opt->summary, strlen(opt->summary));
 	else
 		put(&o, "null", 4);
 	put(&o, "}", 1);
