@@ -24,7 +24,8 @@
  * Threads: create, set_*, start, stop and free from one control thread;
  * feed and end from one feeding thread (proxima-run's draining thread),
  * never from the loop's cycle. Memory: create allocates the ring; the
- * feed allocates nothing; the server thread allocates per connection.
+ * feed allocates nothing but a swapped cloud's message; the server
+ * thread allocates per connection.
  *
  * Builds without libwebsockets (PX_HAVE_VIEW 0) keep the JSON side;
  * px_view_create() returns PX_E_UNSUPPORTED saying so.

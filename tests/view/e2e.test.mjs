@@ -2,16 +2,14 @@
 // proxima-run --view on the real clock, stopped and started again (the
 // page reconnects), then the run's telemetry replayed by proxima-view
 // and written as its HTML report. Run by test_view_e2e.sh.
-import { spawn } from "node:child_process";
-import { createServer } from "node:net";
 import { mkdirSync, existsSync, rmSync } from "node:fs";
-import { join, resolve } from "node:path";
+import { join } from "node:path";
 import { pathToFileURL } from "node:url";
-import { launch, checker, openPage, until, state, drawnShare, shot, near, checkPlayer, runSteps, WEB, SHOTS } from "./harness.mjs";
+import { launch, checker, openPage, until, state, drawnShare, shot, near, checkPlayer, runSteps, freePort, run, served,
+  WEB, SHOTS } from "./harness.mjs";
 
 const t = checker("test_view_e2e");
 setTimeout(() => { t.ok(false, "finished within 90 s"); t.done(); process.exit(1); }, 90000).unref();
-const BIN = resolve(process.env.PX_VIEW_BIN || join(process.env.BUILD || "build", "bin"));
 const CONFIG = "config/examples/haptic_sim.yaml";
 const OUT = join(SHOTS, "e2e");
 rmSync(OUT, { recursive: true, force: true });
@@ -20,37 +18,6 @@ mkdirSync(OUT, { recursive: true });
 const CSV = join(OUT, "telemetry.csv");
 const SUMMARY = join(OUT, "run-summary.json");
 const CSV2 = join(OUT, "telemetry-2.csv");
-
-function freePort() {
-  return new Promise((ok, fail) => {
-    const s = createServer();
-    s.once("error", fail);
-    s.listen(0, "127.0.0.1", () => { const p = s.address().port; s.close(() => ok(p)); });
-  });
-}
-
-// A tool of the project, its output kept for the failure report.
-function run(tool, args) {
-  const p = spawn(join(BIN, tool), args, { stdio: ["ignore", "pipe", "pipe"] });
-  p.out = "";
-  p.stdout.on("data", (d) => { p.out += d; });
-  p.stderr.on("data", (d) => { p.out += d; });
-  p.done = new Promise((ok) => p.on("exit", (code, sig) => ok(code === null ? sig : code)));
-  return p;
-}
-
-// Until the server answers GET / (or the process ended).
-async function served(url, proc, ms = 10000) {
-  const end = Date.now() + ms;
-  while (Date.now() < end && proc.exitCode === null) {
-    try {
-      const r = await fetch(url);
-      if (r.ok) return true;
-    } catch (e) { /* not listening yet */ }
-    await new Promise((ok) => setTimeout(ok, 100));
-  }
-  return false;
-}
 
 const runArgs = (port, csv, summary) => [CONFIG, "--duration-s", "60", "--view", `127.0.0.1:${port}`,
   "--view-root", WEB, "--telemetry", csv, ...(summary ? ["--summary-json", summary] : [])];

@@ -2,6 +2,8 @@
 // playwright-core (from view/web/node_modules), checks counted and
 // printed in the suite's format ("name: N passed, N failed, N skipped"),
 // screenshots kept in build/tests/view/.
+import { spawn } from "node:child_process";
+import { createServer } from "node:net";
 import { mkdirSync } from "node:fs";
 import { join, resolve } from "node:path";
 import { need } from "./fixture.mjs";
@@ -10,6 +12,8 @@ const { chromium } = need("playwright-core");
 export const CHROMIUM = process.env.PX_CHROMIUM || "/usr/bin/chromium";
 export const SHOTS = resolve(process.env.BUILD || "build", "tests/view");
 export const WEB = resolve(process.env.BUILD || "build", "view/web");
+// The project's tools the tests run against the page.
+export const BIN = resolve(process.env.PX_VIEW_BIN || join(process.env.BUILD || "build", "bin"));
 
 export async function launch() {
   // WebGL without a GPU: ANGLE on SwiftShader, software rendering.
@@ -168,4 +172,35 @@ export async function runSteps(t, browser, steps, allErrors, cleanup = () => {})
     await browser.close();
   }
   process.exit(t.done() ? 0 : 1);
+}
+
+export function freePort() {
+  return new Promise((ok, fail) => {
+    const s = createServer();
+    s.once("error", fail);
+    s.listen(0, "127.0.0.1", () => { const p = s.address().port; s.close(() => ok(p)); });
+  });
+}
+
+// A tool of the project, its output kept for the failure report.
+export function run(tool, args) {
+  const p = spawn(join(BIN, tool), args, { stdio: ["ignore", "pipe", "pipe"] });
+  p.out = "";
+  p.stdout.on("data", (d) => { p.out += d; });
+  p.stderr.on("data", (d) => { p.out += d; });
+  p.done = new Promise((ok) => p.on("exit", (code, sig) => ok(code === null ? sig : code)));
+  return p;
+}
+
+// Until the server answers GET / (or the process ended).
+export async function served(url, proc, ms = 10000) {
+  const end = Date.now() + ms;
+  while (Date.now() < end && proc.exitCode === null) {
+    try {
+      const r = await fetch(url);
+      if (r.ok) return true;
+    } catch (e) { /* not listening yet */ }
+    await new Promise((ok) => setTimeout(ok, 100));
+  }
+  return false;
 }
