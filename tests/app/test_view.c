@@ -200,7 +200,10 @@ static double num_after(const char *s, const char *key)
 	return strtod(p + strlen(key), NULL);
 }
 
-static struct px_view *make_view(int port, const struct px_scene *sc)
+/* A started view of scene sc (may be NULL) whose frames take src (may
+ * be NULL: none). */
+static struct px_view *make_view_src(int port, const struct px_scene *sc,
+				     const struct px_view_sources *src)
 {
 	struct px_view_options o;
 	struct px_view *v = NULL;
@@ -215,8 +218,17 @@ static struct px_view *make_view(int port, const struct px_scene *sc)
 	PX_CHECK_INT_EQ(px_view_scene_json(sc, NULL, &scene, &len), PX_OK);
 	PX_CHECK_INT_EQ(px_view_set_scene(v, scene, len), PX_OK);
 	free(scene);
+	if (src)
+		PX_CHECK_INT_EQ(px_view_set_sources(v, src), PX_OK);
 	PX_CHECK_INT_EQ(px_view_start(v), PX_OK);
+	if (src)
+		PX_CHECK_INT_EQ(px_view_set_sources(v, src), PX_E_STATE);
 	return v;
+}
+
+static struct px_view *make_view(int port, const struct px_scene *sc)
+{
+	return make_view_src(port, sc, NULL);
 }
 
 static void sleep_ms(int ms)
@@ -587,6 +599,52 @@ static void test_closest_point(void)
 		 strstr(buf, "\"closest\":null"));
 }
 
+/* A model posed anew after the sources were set: its pose in every
+ * frame (frame.models), the others not; the closest point follows it. */
+static void test_moved_models(void)
+{
+	struct px_scene *sc;
+	struct px_model *m;
+	struct px_prim p = {PX_PRIM_SPHERE, 0.05, 0, 0};
+	struct px_view_sources src;
+	struct px_app_record r;
+	struct px_view *v;
+	px_pose P = px_pose_identity();
+	int port = free_port(), fd, i;
+	char *s;
+	PX_NEEDS(VIEW);
+	PX_CHECK_INT_EQ(px_scene_create(4, &sc), PX_OK);
+	for (i = 0; i < 2; i++) {
+		PX_CHECK_INT_EQ(px_prim_model(&p, &m), PX_OK);
+		PX_CHECK(px_scene_add(sc, m, i ? "still" : "moving") >= 0);
+	}
+	memset(&src, 0, sizeof(src));
+	src.scene = sc;
+	v = make_view_src(port, sc, &src);
+	fd = ws_open(port, "/ws");
+	PX_CHECK(fd >= 0);
+	for (i = 0; i < 2; i++)
+		free(ws_read(fd, 2000)); /* hello, scene */
+	memset(&r, 0, sizeof(r));
+	r.dev_m[0] = 0.5;
+	PX_CHECK_INT_EQ(px_view_feed_record(v, &r), 1);
+	s = ws_read(fd, 2000);
+	PX_CHECK(s && !strstr(s, "\"models\"") && strstr(s, "\"closest\":["));
+	PX_CHECK_NEAR(num_after(s, "\"closest\":["), 0.05, 1e-9);
+	free(s);
+	P.t = px_v3(0.2, 0, 0);
+	PX_CHECK_INT_EQ(px_scene_set_pose(sc, 0, P), PX_OK);
+	r.t_s = 1;
+	PX_CHECK_INT_EQ(px_view_feed_record(v, &r), 1);
+	s = ws_read(fd, 2000);
+	PX_CHECK(s && strstr(s, "\"models\":[[0,0.2,0,0,1,0,0,0]]"));
+	PX_CHECK_NEAR(num_after(s, "\"closest\":["), 0.25, 1e-9);
+	free(s);
+	close(fd);
+	px_view_free(v);
+	px_scene_free(sc);
+}
+
 /* A cloud message keeps at most PX_VIEW_CLOUD_MAX points. */
 static void test_cloud_message(void)
 {
@@ -791,6 +849,7 @@ static const struct px_test tests[] = {
 	PX_T(test_port_taken),
 	PX_T(test_arm_links_and_clearances),
 	PX_T(test_closest_point),
+	PX_T(test_moved_models),
 	PX_T(test_cloud_message),
 	PX_T(test_arm_run_with_view),
 };

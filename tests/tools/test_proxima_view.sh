@@ -119,12 +119,16 @@ check "the data at the marker is valid JSON with every row" "$py" "$tmp/report.p
 "$run" "$cfg" --virtual-time --duration-s 2 --telemetry "$tmp/long.csv" >/dev/null 2>&1
 check "--html thins the track" "$view" --html "$tmp/thin.html" --config "$cfg" \
 	--template "$tmp/tpl.html" "$tmp/long.csv"
-cat >"$tmp/thin.py" <<'PY'
+# the report's data (the template above), the CSV's rows, the frames
+cat >"$tmp/page.py" <<'PY'
 import csv, json, sys
 s = open(sys.argv[1]).read()
 d = json.loads(s[s.index("const D = ") + 10:s.rindex(";</script>")])
 rows = list(csv.DictReader(open(sys.argv[2])))
 fr = d["track"]["frames"]
+PY
+cat >"$tmp/thin.py" <<'PY'
+from page import d, rows, fr
 assert len(rows) == 2000 and 110 <= len(fr) < 400, (len(rows), len(fr))
 assert fr[0]["cycle"] == int(rows[0]["cycle"]) and fr[-1]["cycle"] == int(rows[-1]["cycle"])
 ts = [f["t_s"] for f in fr]
@@ -150,11 +154,7 @@ if "$run" "$acfg" --check >/dev/null 2>&1; then
 	check "--html of an arm run" "$view" --html "$tmp/arm.html" --config "$acfg" \
 		--template "$tmp/tpl.html" "$tmp/arm.csv"
 	cat >"$tmp/arm.py" <<'PY'
-import csv, json, sys
-s = open(sys.argv[1]).read()
-d = json.loads(s[s.index("const D = ") + 10:s.rindex(";</script>")])
-rows = list(csv.DictReader(open(sys.argv[2])))
-fr = d["track"]["frames"]
+from page import d, rows, fr
 robot = d["scene"]["robot"]
 n = len(robot["links"])
 assert n == 7 and all(len(l["positions"]) and len(l["indices"]) for l in robot["links"]), n

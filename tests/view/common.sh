@@ -16,3 +16,16 @@ view_ready() {
 	echo "$1: 0 passed, 0 failed, 1 skipped"
 	return 1
 }
+
+# view_tools NAME: the same for the project's tools the end-to-end tests
+# run (proxima-run, proxima-view).
+view_tools() {
+	for tool in proxima-run proxima-view; do
+		if [ ! -x "${PX_VIEW_BIN:-${BUILD:-build}/bin}/$tool" ]; then
+			echo "skip: $tool not built"
+			echo "$1: 0 passed, 0 failed, 1 skipped"
+			return 1
+		fi
+	done
+	return 0
+}

@@ -7,13 +7,7 @@
 set -u
 . tests/view/common.sh
 view_ready test_view_arm || exit 0
-for tool in proxima-run proxima-view; do
-	if [ ! -x "${PX_VIEW_BIN:-${BUILD:-build}/bin}/$tool" ]; then
-		echo "skip: $tool not built"
-		echo "test_view_arm: 0 passed, 0 failed, 1 skipped"
-		exit 0
-	fi
-done
+view_tools test_view_arm || exit 0
 if ! "${PX_VIEW_BIN:-${BUILD:-build}/bin}/proxima-run" --check config/examples/can_avoid_urdf.yaml >/dev/null 2>&1; then
 	echo "skip: config/examples/can_avoid_urdf.yaml does not check here (a build without libxml2)"
 	echo "test_view_arm: 0 passed, 0 failed, 1 skipped"
