@@ -16,7 +16,7 @@
 static struct px_view *V;
 static struct px_view_arm *ARM;
 
-/* The arm of an avoidance run and its depth sensor's clouds (none
+/* The arm of an avoidance run and its obstacle clouds (none
  * when the run has no arm or the arm cannot be drawn: said). */
 static void arm_sources(struct px_app *app, struct px_view_scene_info *info,
 			struct px_view_sources *src)
@@ -32,7 +32,7 @@ static void arm_sources(struct px_app *app, struct px_view_scene_info *info,
 	info->arm = ARM;
 	src->arm = ARM;
 	if (arm.cloud_feed) {
-		info->cloud_name = "depth sensor";
+		info->cloud_name = "obstacle cloud";
 		src->cloud_feed = arm.cloud_feed;
 		src->cloud_id = (int)(px_app_scene(app) ? px_scene_count(px_app_scene(app)) : 0);
 	}
