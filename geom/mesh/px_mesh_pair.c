@@ -16,8 +16,9 @@
  * direction is a separating axis too (box pairs, and each leaf's
  * triangles exactly): near a contact where both models are locally
  * convex every other pair projects farther apart than the best along
- * it, so a good first pair (last cycle's, in coherent use) ends the
- * search after few triangle tests. Triangle pairs are measured exactly
+ * it, so a good first pair (last cycle's in coherent use, else a greedy
+ * guess down both hierarchies) ends the search after few triangle
+ * tests. Triangle pairs are measured exactly
  * (px__tri_tri). So the answer is the minimum over all triangle pairs,
  * up to rounding (a gap is reduced by a slack of 1e-14 of the
  * coordinate scale before it prunes; along the best pair's direction a
@@ -924,6 +925,58 @@ static int mp_finish(struct mp_ctx *X, px_pose Pa, const uint32_t *orig_b,
 	return PX_OK;
 }
 
+/* A triangle of M (leaf order) near p (M's frame), cheaply: down the
+ * hierarchy by the child box nearest p, then the leaf's triangle whose
+ * centroid is nearest. Only a guess. */
+static uint32_t greedy_tri(const struct tree *T, const struct mesh *M, px_vec3 p)
+{
+	uint32_t node = 0, idx = 0, cnt = 0, i, best = 0;
+	int depth, j;
+	double bd = INFINITY;
+	for (depth = 0; depth < 64 && cnt == 0; depth++) {
+		const struct node4 *nd = &T->n4[node];
+		int pick = -1;
+		for (j = 0; j < 4; j++) {
+			double d2 = 0.0;
+			int k;
+			if (nd->idx[j] == EMPTY)
+				continue;
+			for (k = 0; k < 3; k++) {
+				double x = px_v3_comp(p, k), g = nd->lo[k][j] - x;
+				g = g > x - nd->hi[k][j] ? g : x - nd->hi[k][j];
+				d2 += g > 0.0 ? g * g : 0.0;
+			}
+			if (pick < 0 || d2 < bd) {
+				bd = d2;
+				pick = j;
+			}
+		}
+		if (pick < 0)
+			return 0;
+		idx = nd->idx[pick];
+		cnt = nd->cnt[pick];
+		node = idx;
+		bd = INFINITY;
+	}
+	for (i = 0; i < cnt && i < LEAF_MAX; i++) {
+		const struct mtri3 t = px__tri3_get(M, idx + i);
+		double d2 = px_v3_dist2(px_v3_scale(px_v3_add(t.a, px_v3_add(t.b, t.c)), 1.0 / 3.0), p);
+		if (i == 0 || d2 < bd) {
+			bd = d2;
+			best = idx + i;
+		}
+	}
+	return cnt > 0 ? best : 0;
+}
+
+/* Triangles la of A and lb of B (leaf order) as the first pair. */
+static void mp_first(struct mp_ctx *X, uint32_t la, uint32_t lb)
+{
+	const struct mtri3 tb = px__tri3_get(X->B, lb);
+	px_vec3 V[3] = {to_a(X, tb.a), to_a(X, tb.b), to_a(X, tb.c)};
+	pair_test(X, la, V, lb);
+}
+
 int px__mesh_pair(const struct px_model *a, const struct px_model *b,
 		  int hint_a, int hint_b, struct px__mesh_pair *out)
 {
@@ -943,10 +996,17 @@ int px__mesh_pair(const struct px_model *a, const struct px_model *b,
 	X.tb.box = B->box;
 	mp_support(&X, A);
 	if (hint_a >= 0 && (size_t)hint_a < A->nt && hint_b >= 0 && (size_t)hint_b < B->nt) {
-		uint32_t la = A->leaf_of[hint_a], lb = B->leaf_of[hint_b];
-		const struct mtri3 tb_ = px__tri3_get(B, lb), *tb = &tb_;
-		px_vec3 V[3] = {to_a(&X, tb->a), to_a(&X, tb->b), to_a(&X, tb->c)};
-		pair_test(&X, la, V, lb);
+		mp_first(&X, A->leaf_of[hint_a], B->leaf_of[hint_b]);
+	} else {
+		/* cold: a greedy guess as the first bound, A's triangle
+		 * nearest B's centre and B's nearest that one */
+		uint32_t la = greedy_tri(&X.ta, A, to_a(&X, px_aabb_center(&B->box)));
+		const struct mtri3 t = px__tri3_get(A, la);
+		px_vec3 d = px_v3_sub(px_v3_scale(px_v3_add(t.a, px_v3_add(t.b, t.c)), 1.0 / 3.0), X.t);
+		d = px_v3(X.R[0][0] * d.x + X.R[1][0] * d.y + X.R[2][0] * d.z,
+			  X.R[0][1] * d.x + X.R[1][1] * d.y + X.R[2][1] * d.z,
+			  X.R[0][2] * d.x + X.R[1][2] * d.y + X.R[2][2] * d.z);
+		mp_first(&X, la, greedy_tri(&X.tb, B, d));
 	}
 	return mp_finish(&X, Pa, B->orig, out);
 }
