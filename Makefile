@@ -77,7 +77,7 @@ SRC_ASSIMP    := px_import.c
 SRC_YAML      := px_config_yaml.c
 SRC_OCCT      := cad_occt.cpp
 SRC_XML       := urdf_xml.c
-SRC_DDS       := px_bridge_dds.c px_bridge_dev.c px_bridge_scene.c
+SRC_DDS       := px_bridge_dds.c px_bridge_dev.c px_bridge_joint.c px_bridge_scene.c
 SRC_VIEW      := view_lws.c
 # Tests name the parts they need by these tags (PX_TEST_NEEDS, tests/run.sh).
 TAG_HIDAPI    := hidapi

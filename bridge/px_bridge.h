@@ -232,6 +232,7 @@ struct px_bridge_params {
 /* Models whose poses one dds device may set; points of a remote cloud. */
 #define PX_BRIDGE_SCENE_MODELS 16
 #define PX_BRIDGE_CLOUD_MAX_POINTS (1 << 20)
+#define PX_BRIDGE_MAX_JOINTS 16
 
 struct px_cloud_feed;
 
@@ -276,6 +277,20 @@ struct px_bridge_dev_config {
 	const char *const *scene_models; /* ROS 2 name tokens */
 	size_t n_scene_models;           /* 1 .. PX_BRIDGE_SCENE_MODELS */
 	double workspace_min_m[3], workspace_max_m[3];
+	/* A remote arm (docs/bridge.md, "Remote joints"): joint_state_topic,
+	 * sensor_msgs/JointState in, the positions (and velocities, when
+	 * given) of joint_names by name, in any order among others, read
+	 * with px_bridge_dev_joint_state(); a message without one of the
+	 * names, with lengths that differ (velocity may be empty) or a
+	 * non-finite value is refused and counted. joint_command_topic,
+	 * sensor_msgs/JointState out: joint_names with the position target
+	 * and velocity the cycle writes (px_bridge_dev_joint_command());
+	 * px_bridge_dev_joint_hold() sends velocity 0 at the newest
+	 * received position. NULL topics: none. */
+	const char *joint_state_topic;
+	const char *joint_command_topic;
+	const char *const *joint_names; /* 1 .. PX_BRIDGE_MAX_JOINTS */
+	size_t n_joints;
 	/* px_dev_start() waits at most this long until every topic above
 	 * but the parameters and the scene poses has a peer (0: no wait) */
 	int64_t connect_timeout_ns;
@@ -334,6 +349,36 @@ struct px_bridge_scene_poses {
 PX_API int px_bridge_dev_scene_poses(struct px_dev *d,
 				     struct px_bridge_scene_poses *out);
 
+/* A remote arm's newest joint state (joint_names' order), its receipt
+ * on the loop clock. */
+struct px_bridge_joint_state {
+	double position_rad[PX_BRIDGE_MAX_JOINTS];
+	double velocity_rad_per_s[PX_BRIDGE_MAX_JOINTS]; /* 0: none given */
+	int64_t t_ns;
+};
+
+/* The newest accepted joint state: 1 and *out, 0 (none yet) or
+ * PX_E_INVAL (not a dds device with a joint_state_topic). Loop thread.
+ * @note RT-safe. */
+PX_API int px_bridge_dev_joint_state(struct px_dev *d,
+				     struct px_bridge_joint_state *out);
+
+/* A joint command (n_joints values each; velocity may be NULL: zeros)
+ * for the joint_command_topic, sent by the device's thread. PX_OK or
+ * PX_E_INVAL. Loop thread. @note RT-safe. */
+PX_API int px_bridge_dev_joint_command(struct px_dev *d,
+				       const double *position_rad,
+				       const double *velocity_rad_per_s);
+
+/* Hold the remote arm now: velocity 0 at the newest received position
+ * (before any: the last commanded one), sent from the calling thread
+ * and kept as the newest command until the cycle writes another; a
+ * write DDS accepted is the confirmation (px_dev_safe() covers force
+ * and I/O devices only; a shutdown calls this for a remote arm). PX_OK,
+ * PX_E_IO, PX_E_INVAL (not a dds device with a joint_command_topic).
+ * Not RT-safe (a DDS write). */
+PX_API int px_bridge_dev_joint_hold(struct px_dev *d);
+
 /* What a dds device's thread did. */
 struct px_bridge_dev_counts {
 	uint64_t poses_in, wrenches_in, commands_out, poses_out;
@@ -342,6 +387,8 @@ struct px_bridge_dev_counts {
 	 * feed had no free slot); model poses accepted, refused */
 	uint64_t clouds_accepted, clouds_refused, clouds_dropped;
 	uint64_t scene_poses_accepted, scene_poses_refused;
+	/* remote joints: states accepted, refused; commands sent */
+	uint64_t joint_states_in, joint_states_refused, joint_commands_out;
 	/* best-effort samples the readers know were lost (DDS's sample
 	 * lost status, sequence gaps) */
 	uint64_t lost;

@@ -1,7 +1,8 @@
 /* The "dds" device back end (px_bridge_dev_create): a pose stream from
  * the network as a device's pose input, a force command as a wrench
  * stream to the network, and for teleoperation a remote force in and a
- * pose out. One thread of the device's own takes the poses and forces
+ * pose out (scene updates: px_bridge_scene.c; a remote arm's joints:
+ * px_bridge_joint.c). One thread of the device's own takes the poses and forces
  * (fed with the loop clock's receipt time, so the watchdog sees a silent
  * peer as stale) and sends the newest command and pose; the cycle only
  * swaps values through seqlock slots. */
@@ -23,31 +24,25 @@
 /* Parameter sets a reader holds until the device's thread takes them. */
 #define PARAMS_DEPTH 64
 
-/* A value handed between the cycle and the device's thread: seq is odd
- * while the writer copies; a reader retries a torn copy. */
-struct slot {
-	atomic_uint_fast64_t seq;
-	union {
-		struct px_force_cmd cmd;
-		struct {
-			double pos[3], quat_xyzw[4];
-		} pose;
-		struct {
-			struct px_force_cmd w;
-			int64_t t_ns;
-		} wrench;
-	} v;
+/* Values of the slots (px__slot) between the cycle and the thread. */
+struct pose_val {
+	double pos[3], quat_xyzw[4];
+};
+struct wrench_val {
+	struct px_force_cmd w;
+	int64_t t_ns;
 };
 
 struct dds_dev {
 	struct px_dev *d;
 	char frame[PX_BRIDGE_NAME_MAX];
-	/* for the connect message: pose, wrench, cloud, command, pose out */
-	char topics[5][PX_BRIDGE_TOPIC_MAX];
+	/* for the connect message, in wait_peers' order */
+	char topics[7][PX_BRIDGE_TOPIC_MAX];
 	dds_entity_t domain, dp, reader, writer, ws;
 	dds_entity_t wreader, pwriter; /* wrench in, pose out */
 	dds_entity_t preader;          /* parameters in */
 	struct bridge_scene *scene;    /* scene updates in, NULL none */
+	struct bridge_joints *joints;  /* a remote arm, NULL none */
 	struct px_bridge_params pmin, pmax;
 	struct px_arena arena;         /* the parameters' triple buffer */
 	struct px_param *params;
@@ -56,40 +51,11 @@ struct dds_dev {
 	pthread_t th;
 	int started;
 	atomic_int stop;
-	struct slot cmd, pose_out, wrench;
+	struct px__slot cmd, pose_out, wrench;
 	uint64_t sent_seq, pose_sent_seq;
 	_Atomic uint64_t n_pose, n_wrench, n_cmd, n_pose_out, n_lost;
 	_Atomic uint64_t n_accepted, n_refused;
 };
-
-static void slot_put(struct slot *s, const void *v, size_t n)
-{
-	uint64_t q = atomic_load_explicit(&s->seq, memory_order_relaxed);
-	atomic_store_explicit(&s->seq, q + 1, memory_order_relaxed);
-	atomic_thread_fence(memory_order_release);
-	memcpy(&s->v, v, n);
-	atomic_store_explicit(&s->seq, q + 2, memory_order_release);
-}
-
-/* The slot's value when its sequence differs from *last (then *last is
- * updated): 1, else 0. Bounded: a writer that keeps writing makes the
- * reader give up after a few tries (0, next call again). */
-static int slot_get(struct slot *s, void *v, size_t n, uint64_t *last)
-{
-	int tries;
-	for (tries = 0; tries < 16; tries++) {
-		uint64_t s0 = atomic_load_explicit(&s->seq, memory_order_acquire);
-		if (s0 == *last || (s0 & 1))
-			return 0;
-		memcpy(v, &s->v, n);
-		atomic_thread_fence(memory_order_acquire);
-		if (atomic_load_explicit(&s->seq, memory_order_relaxed) == s0) {
-			*last = s0;
-			return 1;
-		}
-	}
-	return 0;
-}
 
 /* A unit quaternion as a rotation vector (rad), the device's axes. */
 static void rotvec(const geometry_msgs_msg_dds__Quaternion_ *q, double r[3])
@@ -139,10 +105,7 @@ static void take_wrenches(struct dds_dev *x)
 			return;
 		if (info[0].valid_data) {
 			const geometry_msgs_msg_dds__WrenchStamped_ *m = buf[0];
-			struct {
-				struct px_force_cmd w;
-				int64_t t_ns;
-			} v;
+			struct wrench_val v;
 			memset(&v, 0, sizeof(v));
 			v.w.force_n[0] = m->wrench.force.x;
 			v.w.force_n[1] = m->wrench.force.y;
@@ -155,7 +118,7 @@ static void take_wrenches(struct dds_dev *x)
 			if (isfinite(v.w.force_n[0] + v.w.force_n[1] +
 				     v.w.force_n[2] + v.w.torque_n_m[0] +
 				     v.w.torque_n_m[1] + v.w.torque_n_m[2])) {
-				slot_put(&x->wrench, &v, sizeof(v));
+				px__slot_put(&x->wrench, &v, sizeof(v));
 				atomic_fetch_add(&x->n_wrench, 1);
 			} else {
 				px_dev_record(x->d, PX_DEV_ERR_NONFINITE, PX_E_NAN, 0,
@@ -167,17 +130,23 @@ static void take_wrenches(struct dds_dev *x)
 	}
 }
 
+void px__bridge_header_now(void *header, char *frame)
+{
+	std_msgs_msg_dds__Header_ *h = header;
+	struct timespec ts;
+	clock_gettime(CLOCK_REALTIME, &ts);
+	h->stamp.sec = (int32_t)ts.tv_sec;
+	h->stamp.nanosec = (uint32_t)ts.tv_nsec;
+	h->frame_id = frame; /* written, never freed */
+}
+
 static int send_wrench(struct dds_dev *x, const struct px_force_cmd *c)
 {
 	geometry_msgs_msg_dds__WrenchStamped_ m;
-	struct timespec ts;
 	int on = c->enable != 0;
 	dds_return_t rc;
-	clock_gettime(CLOCK_REALTIME, &ts);
 	memset(&m, 0, sizeof(m));
-	m.header.stamp.sec = (int32_t)ts.tv_sec;
-	m.header.stamp.nanosec = (uint32_t)ts.tv_nsec;
-	m.header.frame_id = x->frame;
+	px__bridge_header_now(&m.header, x->frame);
 	m.wrench.force.x = on ? c->force_n[0] : 0;
 	m.wrench.force.y = on ? c->force_n[1] : 0;
 	m.wrench.force.z = on ? c->force_n[2] : 0;
@@ -240,24 +209,18 @@ static void take_params(struct dds_dev *x)
 static void send_newest(struct dds_dev *x)
 {
 	struct px_force_cmd c;
-	if (slot_get(&x->cmd, &c, sizeof(c), &x->sent_seq))
+	if (px__slot_get(&x->cmd, &c, sizeof(c), &x->sent_seq))
 		send_wrench(x, &c);
 }
 
 static void send_pose(struct dds_dev *x)
 {
 	geometry_msgs_msg_dds__PoseStamped_ m;
-	struct {
-		double pos[3], quat_xyzw[4];
-	} v;
-	struct timespec ts;
-	if (!slot_get(&x->pose_out, &v, sizeof(v), &x->pose_sent_seq))
+	struct pose_val v;
+	if (!px__slot_get(&x->pose_out, &v, sizeof(v), &x->pose_sent_seq))
 		return;
-	clock_gettime(CLOCK_REALTIME, &ts);
 	memset(&m, 0, sizeof(m));
-	m.header.stamp.sec = (int32_t)ts.tv_sec;
-	m.header.stamp.nanosec = (uint32_t)ts.tv_nsec;
-	m.header.frame_id = x->frame;
+	px__bridge_header_now(&m.header, x->frame);
 	m.pose.position.x = v.pos[0];
 	m.pose.position.y = v.pos[1];
 	m.pose.position.z = v.pos[2];
@@ -285,7 +248,8 @@ static void count_lost(struct dds_dev *x, dds_entity_t reader)
 static void *dev_thread(void *arg)
 {
 	struct dds_dev *x = arg;
-	int outputs = x->writer > 0 || x->pwriter > 0;
+	int outputs = x->writer > 0 || x->pwriter > 0 ||
+		      px__bridge_joints_endpoint(x->joints, 1) > 0;
 	if (x->priority > 0) {
 		/* beside the loop, below it; refused (no privilege): the
 		 * thread runs at normal priority, as without */
@@ -307,6 +271,7 @@ static void *dev_thread(void *arg)
 		if (x->preader > 0)
 			take_params(x);
 		px__bridge_scene_take(x->scene);
+		px__bridge_joints_take(x->joints);
 		if (x->writer > 0)
 			send_newest(x);
 		if (x->pwriter > 0)
@@ -322,17 +287,19 @@ static void *dev_thread(void *arg)
  * (recorded, naming the topic). */
 static int wait_peers(struct dds_dev *x)
 {
-	const dds_entity_t e[5] = {x->reader, x->wreader,
+	const dds_entity_t e[7] = {x->reader, x->wreader,
 				   px__bridge_scene_cloud_reader(x->scene),
-				   x->writer, x->pwriter};
+				   px__bridge_joints_endpoint(x->joints, 0),
+				   x->writer, x->pwriter,
+				   px__bridge_joints_endpoint(x->joints, 1)};
 	int64_t end = px_dev_mono_ns() + x->connect_timeout_ns;
 	int i;
 	if (x->connect_timeout_ns <= 0)
 		return PX_OK;
-	for (i = 0; i < 5; i++) {
+	for (i = 0; i < 7; i++) {
 		while (e[i] > 0) {
 			uint32_t n = 0;
-			if (i < 3) {
+			if (i < 4) {
 				dds_subscription_matched_status_t st;
 				if (dds_get_subscription_matched_status(e[i], &st) == 0)
 					n = st.current_count;
@@ -388,7 +355,7 @@ static int dev_force(struct px_dev *d, const struct px_force_cmd *c,
 {
 	struct dds_dev *x = px_dev_impl(d);
 	(void)now_ns;
-	slot_put(&x->cmd, c, sizeof(*c));
+	px__slot_put(&x->cmd, c, sizeof(*c));
 	return PX_OK;
 }
 
@@ -413,6 +380,7 @@ static void dev_destroy(struct px_dev *d)
 	if (x->domain > 0)
 		dds_delete(x->domain);
 	px__bridge_scene_free(x->scene);
+	px__bridge_joints_free(x->joints);
 	px_arena_fini(&x->arena);
 }
 
@@ -435,15 +403,12 @@ int px_bridge_dev_wrench(struct px_dev *d, struct px_force_cmd *out,
 			 int64_t *t_ns)
 {
 	struct dds_dev *x = dds_of(d);
-	struct {
-		struct px_force_cmd w;
-		int64_t t_ns;
-	} v;
+	struct wrench_val v;
 	uint64_t none = 0;
 	if (!x || x->wreader <= 0 || !out || !t_ns)
 		return PX_E_INVAL;
 	/* seq 0 is "never written": a copy against 0 is any value */
-	if (!slot_get(&x->wrench, &v, sizeof(v), &none))
+	if (!px__slot_get(&x->wrench, &v, sizeof(v), &none))
 		return 0;
 	*out = v.w;
 	*t_ns = v.t_ns;
@@ -454,9 +419,7 @@ int px_bridge_dev_pose_write(struct px_dev *d, const px_vec3 *pos_m,
 			     const px_quat *q)
 {
 	struct dds_dev *x = dds_of(d);
-	struct {
-		double pos[3], quat_xyzw[4];
-	} v;
+	struct pose_val v;
 	if (!x || x->pwriter <= 0 || !pos_m)
 		return PX_E_INVAL;
 	v.pos[0] = pos_m->x;
@@ -466,7 +429,7 @@ int px_bridge_dev_pose_write(struct px_dev *d, const px_vec3 *pos_m,
 	v.quat_xyzw[1] = q ? q->y : 0;
 	v.quat_xyzw[2] = q ? q->z : 0;
 	v.quat_xyzw[3] = q ? q->w : 1;
-	slot_put(&x->pose_out, &v, sizeof(v));
+	px__slot_put(&x->pose_out, &v, sizeof(v));
 	return PX_OK;
 }
 
@@ -491,6 +454,30 @@ int px_bridge_dev_scene_poses(struct px_dev *d,
 	return x ? px__bridge_scene_poses(x->scene, out) : PX_E_INVAL;
 }
 
+int px_bridge_dev_joint_state(struct px_dev *d,
+			      struct px_bridge_joint_state *out)
+{
+	struct dds_dev *x = dds_of(d);
+	return x ? px__bridge_joints_state(x->joints, out) : PX_E_INVAL;
+}
+
+int px_bridge_dev_joint_command(struct px_dev *d, const double *position_rad,
+				const double *velocity_rad_per_s)
+{
+	struct dds_dev *x = dds_of(d);
+	return x ? px__bridge_joints_command(x->joints, position_rad,
+					     velocity_rad_per_s)
+		 : PX_E_INVAL;
+}
+
+int px_bridge_dev_joint_hold(struct px_dev *d)
+{
+	struct dds_dev *x = dds_of(d);
+	if (!x || px__bridge_joints_endpoint(x->joints, 1) <= 0)
+		return PX_E_INVAL;
+	return px__bridge_joints_hold(x->joints);
+}
+
 int px_bridge_dev_counts(struct px_dev *d, struct px_bridge_dev_counts *out)
 {
 	struct dds_dev *x = dds_of(d);
@@ -505,7 +492,10 @@ int px_bridge_dev_counts(struct px_dev *d, struct px_bridge_dev_counts *out)
 	out->params_refused = atomic_load(&x->n_refused);
 	out->clouds_accepted = out->clouds_refused = out->clouds_dropped = 0;
 	out->scene_poses_accepted = out->scene_poses_refused = 0;
+	out->joint_states_in = out->joint_states_refused = 0;
+	out->joint_commands_out = 0;
 	px__bridge_scene_counts(x->scene, out);
+	px__bridge_joints_counts(x->joints, out);
 	return PX_OK;
 }
 
@@ -535,6 +525,12 @@ static dds_entity_t endpoint(dds_entity_t dp, const char *ns,
 	return e;
 }
 
+int32_t px__bridge_writer(int32_t dp, const char *ns, const char *name,
+			  const void *type)
+{
+	return endpoint(dp, ns, name, type, 0);
+}
+
 /* A reader whose data wakes the device's thread. */
 int32_t px__bridge_watched_reader(int32_t dp, int32_t *ws, const char *ns,
 				  const char *name, const void *type)
@@ -557,27 +553,31 @@ static int open_dds(struct dds_dev *x, const struct px_bridge_dev_config *bc,
 		    char *msg, size_t cap)
 {
 	const struct px_bridge_config *c = bc->bridge;
-	/* in wait_peers' order; the cloud reader is the scene's */
-	const char *const names[5] = {bc->pose_topic, bc->wrench_topic, NULL,
+	/* in wait_peers' order; the cloud and joint endpoints are made
+	 * by their own files (only their names here) */
+	const char *const all[7] = {bc->pose_topic, bc->wrench_topic,
+				    bc->cloud_topic, bc->joint_state_topic,
+				    bc->command_topic, bc->pose_out_topic,
+				    bc->joint_command_topic};
+	const char *const names[4] = {bc->pose_topic, bc->wrench_topic,
 				      bc->command_topic, bc->pose_out_topic};
-	dds_entity_t *const ents[5] = {&x->reader, &x->wreader, NULL,
-				       &x->writer, &x->pwriter};
-	const dds_topic_descriptor_t *const types[5] = {
+	dds_entity_t *const ents[4] = {&x->reader, &x->wreader, &x->writer,
+				       &x->pwriter};
+	const dds_topic_descriptor_t *const types[4] = {
 		&geometry_msgs_msg_dds__PoseStamped__desc,
-		&geometry_msgs_msg_dds__WrenchStamped__desc, NULL,
+		&geometry_msgs_msg_dds__WrenchStamped__desc,
 		&geometry_msgs_msg_dds__WrenchStamped__desc,
 		&geometry_msgs_msg_dds__PoseStamped__desc};
 	int i, rc = px__bridge_join(c, &x->domain, &x->dp, msg, cap);
 	if (rc != PX_OK)
 		return rc;
-	if (bc->cloud_topic)
-		px_bridge_topic_name(c->ns, bc->cloud_topic, x->topics[2],
-				     sizeof(x->topics[2]));
-	for (i = 0; i < 5; i++) {
+	for (i = 0; i < 7; i++)
+		if (all[i])
+			px_bridge_topic_name(c->ns, all[i], x->topics[i],
+					     sizeof(x->topics[i]));
+	for (i = 0; i < 4; i++) {
 		if (!names[i])
 			continue;
-		px_bridge_topic_name(c->ns, names[i], x->topics[i],
-				     sizeof(x->topics[i]));
 		*ents[i] = i < 2 ? px__bridge_watched_reader(x->dp, &x->ws, c->ns,
 							      names[i], types[i])
 				 : endpoint(x->dp, c->ns, names[i], types[i], 0);
@@ -609,7 +609,10 @@ static int open_dds(struct dds_dev *x, const struct px_bridge_dev_config *bc,
 			return PX_E_IO;
 		}
 	}
-	return px__bridge_scene_open(&x->scene, x->dp, &x->ws, bc, msg, cap);
+	rc = px__bridge_scene_open(&x->scene, x->dp, &x->ws, bc, msg, cap);
+	return rc != PX_OK ? rc
+			   : px__bridge_joints_open(&x->joints, x->dp, &x->ws, bc,
+						    msg, cap);
 }
 
 int px_bridge_dev_create(const struct px_dev_config *dc,
@@ -628,10 +631,12 @@ int px_bridge_dev_create(const struct px_dev_config *dc,
 	if (!dc || !bc || !bc->bridge ||
 	    (!bc->pose_topic && !bc->command_topic && !bc->wrench_topic &&
 	     !bc->pose_out_topic && !bc->params_topic && !bc->cloud_topic &&
-	     !bc->scene_topic) ||
+	     !bc->scene_topic && !bc->joint_state_topic &&
+	     !bc->joint_command_topic) ||
 	    bc->connect_timeout_ns < 0) {
 		snprintf(msg, cap, "dds device: a pose, wrench, command, "
-				   "pose_out, params, cloud or scene topic needed");
+				   "pose_out, params, cloud, scene or joint topic "
+				   "needed");
 		return PX_E_INVAL;
 	}
 	if (px_bridge_config_check(bc->bridge, why, sizeof(why)) != PX_OK) {

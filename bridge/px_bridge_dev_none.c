@@ -49,3 +49,23 @@ int px_bridge_dev_scene_poses(struct px_dev *d,
 	(void)d, (void)out;
 	return PX_E_INVAL;
 }
+
+int px_bridge_dev_joint_state(struct px_dev *d,
+			      struct px_bridge_joint_state *out)
+{
+	(void)d, (void)out;
+	return PX_E_INVAL;
+}
+
+int px_bridge_dev_joint_command(struct px_dev *d, const double *position_rad,
+				const double *velocity_rad_per_s)
+{
+	(void)d, (void)position_rad, (void)velocity_rad_per_s;
+	return PX_E_INVAL;
+}
+
+int px_bridge_dev_joint_hold(struct px_dev *d)
+{
+	(void)d;
+	return PX_E_INVAL;
+}
