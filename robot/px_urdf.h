@@ -211,7 +211,10 @@ PX_API int px_urdf_robot_set_q(struct px_urdf_robot *r, const double *q,
 /*
  * Obstacles the robot's bodies are measured against (models the caller
  * keeps, posed by the caller; at most 1024). Sets up one model pair per
- * body and obstacle and keeps each pair's last answer for coherence.
+ * body and obstacle and keeps each pair's last answer for coherence;
+ * for each obstacle that is a point cloud, also a cut cache per body
+ * (px_pair_distance_cached(), about 15 kB each), which clouds swapped
+ * into that slot later (px_urdf_robot_replace_obstacle) use as well.
  * Returns PX_OK, PX_E_INVAL, PX_E_RANGE (too many), PX_E_NOMEM. Setup.
  */
 #define PX_URDF_MAX_OBSTACLES 1024

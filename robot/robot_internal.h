@@ -52,6 +52,9 @@ struct px_urdf_robot {
 	int n_obstacles;
 	struct px_model **obstacles;
 	struct px_pair_result *pairs;
+	/* per pair: the cut cache of a link against a cloud obstacle (NULL
+	 * for obstacles that were not clouds when set) */
+	struct px_pair_cache **caches;
 	/* self-clearance: body pairs measured and their last answers */
 	int n_self;
 	int (*self)[2];
@@ -68,13 +71,14 @@ struct px_urdf_robot {
 struct px_urdf_clearance px__urdf_clearance(const struct px_pair_result *p, int body,
 					    int obstacle, int other_body);
 
-/* One pair (a's answer, b the body): measured into c (returns 1) unless
- * the models' world boxes are reach or more apart (returns 0: c holds
- * the boxes' gap, a lower bound), or an error. */
+/* One pair (a's answer, b the body; cache: its cut cache, may be NULL):
+ * measured into c (returns 1) unless the models' world boxes are reach
+ * or more apart (returns 0: c holds the boxes' gap, a lower bound), or
+ * an error. */
 int px__urdf_pair(const struct px_model *a, const struct px_model *b,
 		  const struct px_pair_opts *po, int coherent, double reach,
-		  struct px_pair_result *p, int body, int obstacle, int other_body,
-		  struct px_urdf_clearance *c);
+		  struct px_pair_result *p, struct px_pair_cache *cache, int body, int obstacle,
+		  int other_body, struct px_urdf_clearance *c);
 void px__urdf_pair_opts(const struct px_pair_opts *o, int coherent,
 			struct px_pair_opts *po);
 void px__urdf_min_init(struct px_urdf_clearance *min);

@@ -159,7 +159,7 @@ static int self_pairs(struct px_urdf_robot *r, const struct px_pair_opts *o,
 		struct px_urdf_clearance c;
 		int a = r->self[i][0], b = r->self[i][1];
 		rc = px__urdf_pair(r->bodies[a].model, r->bodies[b].model, &po, coherent, reach,
-				   &r->self_pairs[i], b, -1, a, &c);
+				   &r->self_pairs[i], NULL, b, -1, a, &c);
 		if (rc < 0)
 			return rc;
 		if (measured)

@@ -22,6 +22,7 @@ void px_urdf_robot_free(struct px_urdf_robot *r)
 	free(r->body_link);
 	free(r->obstacles);
 	free(r->pairs);
+	free(r->caches);
 	px__urdf_avoid_free(r);
 	free(r);
 }
@@ -310,6 +311,9 @@ int px_urdf_robot_set_obstacles(struct px_urdf_robot *r,
 {
 	struct px_model **ob;
 	struct px_pair_result *pr;
+	struct px_pair_cache **pc;
+	size_t nc = 0, np = (size_t)n * (size_t)r->n_bodies;
+	char *cmem;
 	int i;
 	if (!r || n < 0 || (n > 0 && !obstacles))
 		return PX_E_INVAL;
@@ -318,19 +322,38 @@ int px_urdf_robot_set_obstacles(struct px_urdf_robot *r,
 	for (i = 0; i < n; i++)
 		if (!obstacles[i])
 			return PX_E_INVAL;
+	/* a cut cache per link against each cloud (urdf_robot.c's pairs) */
+	for (i = 0; i < n; i++)
+		nc += px_model_kind(obstacles[i]) == PX_MODEL_CLOUD ? (size_t)r->n_bodies : 0;
 	ob = calloc((size_t)n + 1, sizeof(*ob));
-	pr = calloc((size_t)n * (size_t)r->n_bodies + 1, sizeof(*pr));
-	if (!ob || !pr) {
+	pr = calloc(np + 1, sizeof(*pr));
+	/* one block: the pointers per pair, then the caches */
+	cmem = calloc(1, (np + 1) * sizeof(*pc) + nc * sizeof(struct px_pair_cache));
+	if (!ob || !pr || !cmem) {
 		free(ob);
 		free(pr);
+		free(cmem);
 		return PX_E_NOMEM;
+	}
+	pc = (struct px_pair_cache **)(void *)cmem;
+	nc = 0;
+	for (i = 0; i < n; i++) {
+		int b;
+		if (px_model_kind(obstacles[i]) != PX_MODEL_CLOUD)
+			continue;
+		for (b = 0; b < r->n_bodies; b++)
+			pc[(size_t)b * (size_t)n + (size_t)i] =
+				(struct px_pair_cache *)(void *)(cmem + (np + 1) * sizeof(*pc)) +
+				nc++;
 	}
 	if (n)
 		memcpy(ob, obstacles, (size_t)n * sizeof(*ob));
 	free(r->obstacles);
 	free(r->pairs);
+	free(r->caches);
 	r->obstacles = ob;
 	r->pairs = pr;
+	r->caches = pc;
 	r->n_obstacles = n;
 	return px__urdf_avoid_size(r);
 }
@@ -365,8 +388,8 @@ static double box_gap(const struct px_model *a, const struct px_model *b)
 
 int px__urdf_pair(const struct px_model *a, const struct px_model *b,
 		  const struct px_pair_opts *po, int coherent, double reach,
-		  struct px_pair_result *p, int body, int obstacle, int other_body,
-		  struct px_urdf_clearance *c)
+		  struct px_pair_result *p, struct px_pair_cache *cache, int body, int obstacle,
+		  int other_body, struct px_urdf_clearance *c)
 {
 	double gap = reach < INFINITY ? box_gap(a, b) : 0.0;
 	int rc;
@@ -381,7 +404,7 @@ int px__urdf_pair(const struct px_model *a, const struct px_model *b,
 	}
 	if (!coherent)
 		p->valid = 0;
-	rc = px_pair_distance(a, b, po, p);
+	rc = px_pair_distance_cached(a, b, po, cache, p);
 	if (rc)
 		return rc;
 	*c = px__urdf_clearance(p, body, obstacle, other_body);
@@ -422,7 +445,7 @@ int px__urdf_obstacle_pairs(struct px_urdf_robot *r, const struct px_pair_opts *
 		for (k = 0; k < r->n_obstacles; k++, n++) {
 			struct px_urdf_clearance c;
 			rc = px__urdf_pair(r->obstacles[k], r->bodies[b].model, &po, coherent,
-					   reach, &r->pairs[n], b, k, -1, &c);
+					   reach, &r->pairs[n], r->caches[n], b, k, -1, &c);
 			if (rc < 0)
 				return rc;
 			if (measured)

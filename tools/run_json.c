@@ -143,6 +143,7 @@ static void json_figures(FILE *f, const struct run_result *r)
 		"  \"min_proxy_distance_m\": %.9g,\n"
 		"  \"min_clearance_m\": %.9g,\n  \"protective_distance_m\": %.9g,\n"
 		"  \"min_speed_scale\": %.9g,\n"
+		"  \"cloud_swaps\": %llu,\n"
 		"  \"contact_cycles\": %llu,\n  \"safe_state_trips\": %llu,\n"
 		"  \"faults\": {",
 		S->max_force_n, S->rendering ? S->force_clamp_n : 0.0,
@@ -151,6 +152,7 @@ static void json_figures(FILE *f, const struct run_result *r)
 		S->avoiding ? run_finite(S->min_clearance_m) : 0.0,
 		S->avoiding ? S->protective_distance_m : 0.0,
 		S->avoiding ? S->min_speed_scale : 1.0,
+		(unsigned long long)S->cloud_swaps,
 		(unsigned long long)S->contact_cycles,
 		(unsigned long long)r->st.safe_entries);
 	for (k = 1; k < PX_FAULT__COUNT; k++)

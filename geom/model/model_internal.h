@@ -12,6 +12,12 @@
 
 #include "px_math.h"
 
+/* A number no other model created in this process has (counted from
+ * 1 at creation): tells a model from one allocated later at the same
+ * address, for state kept across calls. 0 for NULL. RT-safe. */
+struct px_model;
+unsigned long px__model_serial(const struct px_model *m);
+
 /*
  * Quickselect for the hierarchies (mesh, cloud, scene): reorder the index
  * array a[0..n) so that a[k] holds the element whose key[3 * a[k] + axis]

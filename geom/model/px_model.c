@@ -16,7 +16,10 @@ struct px_model {
 	unsigned caps;
 	px_pose pose;
 	px_aabb local_box; /* cached at creation: geometry never changes */
+	unsigned long serial; /* unique per model created (model_internal.h) */
 };
+
+static _Atomic unsigned long model_serial;
 
 int px_model_create(const struct px_model_ops *ops, void *impl,
 		    unsigned caps, struct px_model **out)
@@ -41,8 +44,14 @@ int px_model_create(const struct px_model_ops *ops, void *impl,
 	m->caps = caps;
 	m->pose = px_pose_identity();
 	m->local_box = ops->aabb(impl);
+	m->serial = ++model_serial;
 	*out = m;
 	return PX_OK;
+}
+
+unsigned long px__model_serial(const struct px_model *m)
+{
+	return m ? m->serial : 0;
 }
 
 void px_model_free(struct px_model *m)

@@ -218,7 +218,7 @@ static int cloud_answer(struct px_pair_result *res, double s, px_vec3 po, px_vec
 }
 
 int px__pair_cloud(const struct px_model *a, const struct px_model *b, int coherent,
-		   struct px_pair_result *res)
+		   struct px_pair_cache *cache, struct px_pair_result *res)
 {
 	int ca = px_model_kind(a) == PX_MODEL_CLOUD, cb = !ca && px_model_kind(b) == PX_MODEL_CLOUD;
 	const struct px_model *c = ca ? a : b, *o = ca ? b : a;
@@ -230,6 +230,21 @@ int px__pair_cloud(const struct px_model *a, const struct px_model *b, int coher
 	if ((!ca && !cb) || px_model_kind(o) == PX_MODEL_CLOUD)
 		return 0;
 	radius = px_cloud_radius(c);
+	if (cache && px_mesh_triangle_count(o) > 0 &&
+	    px_mesh_triangle_count(o) <= PX_PAIR_PLANES_MAX_TRIS) {
+		/* a small mesh through a cache: the cloud's hierarchy alone,
+		 * bounded by the mesh's planes, signed over the points for a
+		 * closed mesh (inside: minus the depth), unsigned for an
+		 * open one */
+		if ((rc = px__cloud_mesh_min(c, o, cache, coherent,
+					     coherent ? (ca ? res->index_a : res->index_b) : -1,
+					     &cm)) < 0)
+			return rc;
+		if (!cm.found)
+			return PX_E_DEGENERATE;
+		return cloud_answer(res, cm.s, cm.q, cm.p, radius, cm.oi, cm.pi, cb, cm.certified,
+				    cm.nodes + cm.queries);
+	}
 	if (px_mesh_triangle_count(o) > 0) {
 		struct px__mesh_pair mp;
 		int ht = -1, hp = -1;

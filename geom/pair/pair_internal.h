@@ -205,6 +205,7 @@ struct px__cloud_min {
 	int found;       /* a point at or below the limit was found */
 	int certified;   /* every query was exact and the stack sufficed */
 	int queries;     /* point queries of the model made */
+	int nodes;       /* cloud nodes expanded (px__cloud_mesh_min) */
 };
 
 /*
@@ -222,6 +223,20 @@ int px__cloud_min_model(const struct px_model *c, const struct px_model *o, doub
 			int inside_only, struct px__cloud_min *out);
 
 /*
+ * The least distance of mesh o (signed when closed) over the points of
+ * cloud c, exactly, by the cloud's hierarchy bounded by o's box
+ * (pair_cloud_mesh.c); hint: a point (input order) measured first as
+ * the first bound (-1: none). C (may be NULL) lends its bounding planes
+ * of o (made for o when missing); with coherent and its cut valid for
+ * the pair, only the part of the cloud the motion since may have
+ * brought within reach is walked, and a full coherent walk records its
+ * cut into C. Fills out
+ * (found = 1 unless an error); returns PX_OK or an error. RT-safe.
+ */
+int px__cloud_mesh_min(const struct px_model *c, const struct px_model *o, struct px_pair_cache *C,
+		       int coherent, int hint, struct px__cloud_min *out);
+
+/*
  * A point cloud against a mesh or a primitive, exactly: the least
  * distance of the other model over the cloud's points minus the point
  * radius, negative (with its depth) where a point lies inside a closed
@@ -235,7 +250,7 @@ int px__cloud_min_model(const struct px_model *c, const struct px_model *o, doub
  * these, or an error. RT-safe.
  */
 int px__pair_cloud(const struct px_model *a, const struct px_model *b, int coherent,
-		   struct px_pair_result *res);
+		   struct px_pair_cache *cache, struct px_pair_result *res);
 
 /* ---- NURBS surface models (pair_nurbs.c) ---------------------------------- */
 

@@ -480,6 +480,36 @@ static int pair_general(const struct px_model *a, const struct px_model *b,
 int px_pair_distance(const struct px_model *a, const struct px_model *b,
 		     const struct px_pair_opts *opt, struct px_pair_result *res)
 {
+	return px_pair_distance_cached(a, b, opt, NULL, res);
+}
+
+void px_pair_cache_init(struct px_pair_cache *c)
+{
+	if (c) {
+		c->valid_ = 0;
+		c->n_ = 0;
+		c->cloud_ = c->model_ = NULL;
+		c->planes_.model_ = NULL;
+		c->planes_.serial_ = 0;
+		c->planes_.n_ = 0;
+		c->made_ = c->reused_ = 0;
+	}
+}
+
+unsigned long px_pair_cache_full(const struct px_pair_cache *c)
+{
+	return c ? c->made_ : 0;
+}
+
+unsigned long px_pair_cache_reused(const struct px_pair_cache *c)
+{
+	return c ? c->reused_ : 0;
+}
+
+int px_pair_distance_cached(const struct px_model *a, const struct px_model *b,
+			    const struct px_pair_opts *opt, struct px_pair_cache *cache,
+			    struct px_pair_result *res)
+{
 	struct pair_cfg cfg;
 	int rc;
 
@@ -506,7 +536,7 @@ int px_pair_distance(const struct px_model *a, const struct px_model *b,
 		rc = pair_convex(a, b, res);
 	/* a cloud against a mesh or a primitive: exact (pair_cloud.c) */
 	if (rc == STEP_NONE)
-		rc = px__pair_cloud(a, b, cfg.coherent, res);
+		rc = px__pair_cloud(a, b, cfg.coherent, cache, res);
 	/* NURBS surfaces against a mesh, NURBS or a convex primitive:
 	 * certified by both hierarchies (pair_nurbs.c) */
 	if (rc == STEP_NONE)

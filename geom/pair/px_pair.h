@@ -63,9 +63,12 @@
  *   its depth, when one is inside: found by the cloud's hierarchy
  *   bounded by the mesh's signed queries, pair_cloud.c), the same in
  *   cold and coherent calls. In coherent mode last cycle's triangle and
- *   point are the starting bound. index_a/index_b: the triangle (the
- *   mesh's feature for a point inside) and the point; a cloud radius
- *   is subtracted;
+ *   point are the starting bound. Through px_pair_distance_cached() a
+ *   mesh of at most PX_PAIR_PLANES_MAX_TRIS triangles (a robot link)
+ *   takes the cloud's hierarchy alone, bounded by the mesh's planes, and
+ *   coherent calls keep a cut of it (see there). index_a/index_b: the
+ *   triangle (the mesh's feature for a point inside) and the point; a
+ *   cloud radius is subtracted;
  * - a point cloud against any primitive: the least of the primitive's
  *   exact (signed) point queries over the points, by the cloud's
  *   hierarchy bounded by one query per node (the distance is
@@ -142,6 +145,8 @@
 #ifndef PX_PAIR_H
 #define PX_PAIR_H
 
+#include <stdint.h>
+
 #include "px_base.h"
 #include "px_math.h"
 #include "px_model.h"
@@ -217,6 +222,81 @@ struct px_pair_result {
 PX_API int px_pair_distance(const struct px_model *a, const struct px_model *b,
 			    const struct px_pair_opts *opt,
 			    struct px_pair_result *res);
+
+/* ---- coherent cut of a mesh against a point cloud -------------------------
+ *
+ * A mesh (a robot link) against a large cloud, cycle after cycle, can
+ * skip most of the cloud: a full call records the cut of the cloud's
+ * hierarchy its walk made (every subtree it pruned and every leaf it
+ * measured, with its lower bound: at most PX_PAIR_CACHE_CAP of them);
+ * later calls bound how far the mesh has moved relative to the cloud
+ * since (its box centre's displacement and its rotation's change times
+ * its box radius), walk again only the entries whose bound that motion
+ * may have brought below the best point (last cycle's, measured first),
+ * and are as exact as the full call. A cut that leaves more than an
+ * eighth of its entries to walk again is made anew at the next call;
+ * another model, a cloud replaced (even at the same address), or what
+ * the cut could not hold coming within reach also make it anew. The
+ * cache also keeps bounding planes of the mesh (up to
+ * PX_PAIR_CACHE_PLANES of its face normals, each at the mesh's support
+ * along it: valid for any mesh, tight for convex ones) and the radius
+ * of the mesh about its box's core (the box shrunk by its least half
+ * extent: the axis of a long link), which bound the cloud's boxes and
+ * points far more tightly than the mesh's box; cold calls through a
+ * cache use them too.
+ */
+#define PX_PAIR_CACHE_CAP 1024
+#define PX_PAIR_CACHE_PLANES 64
+#define PX_PAIR_CACHE_CELLS (6 * 8 * 8)
+#define PX_PAIR_PLANES_MAX_TRIS 256
+
+struct px_pair_cache_ent {
+	uint32_t idx, cnt; /* a node (cnt 0) or a leaf range of the cloud */
+	float lb;          /* lower bound of the distance over it when made */
+};
+
+/* The bounding planes of a mesh (below); members private. */
+struct px_pair_planes {
+	const struct px_model *model_;
+	unsigned long serial_;
+	int n_;
+	double rho_;
+	double plane_[PX_PAIR_CACHE_PLANES][4];
+	uint8_t cell_[PX_PAIR_CACHE_CELLS];
+};
+
+/* Caller-owned state of one mesh/cloud pair; plain struct, members
+ * private (zeroed, or px_pair_cache_init(), before the first use). */
+struct px_pair_cache {
+	const struct px_model *cloud_, *model_;
+	unsigned long serial_;
+	int valid_, n_;
+	uint32_t witness_;
+	double far_;
+	px_mat3 rot_;
+	px_vec3 centre_;
+	unsigned long made_, reused_;
+	struct px_pair_cache_ent ent_[PX_PAIR_CACHE_CAP];
+	struct px_pair_planes planes_;
+};
+
+/* Empty the cache (the next call is a full one). @note RT-safe. */
+PX_API void px_pair_cache_init(struct px_pair_cache *c);
+
+/*
+ * px_pair_distance() through cache c (may be NULL: then exactly
+ * px_pair_distance()). A mesh against a point cloud with opt->coherent
+ * set uses and keeps the cut; every other pair ignores c. Answers are
+ * those of px_pair_distance() (among equidistant points another may be
+ * reported). @note RT-safe.
+ */
+PX_API int px_pair_distance_cached(const struct px_model *a, const struct px_model *b,
+				   const struct px_pair_opts *opt, struct px_pair_cache *c,
+				   struct px_pair_result *res);
+
+/* Full calls made and cuts reused through c. @note RT-safe. */
+PX_API unsigned long px_pair_cache_full(const struct px_pair_cache *c);
+PX_API unsigned long px_pair_cache_reused(const struct px_pair_cache *c);
 
 #ifdef __cplusplus
 }

@@ -5,7 +5,9 @@
  * the sign from the closed mesh's own point query; every point's
  * primitive query), on random poses with clouds apart, touching and
  * reaching inside; coherent calls equal cold ones along random paths;
- * no heap call in the calls.
+ * through a cut cache (px_pair_distance_cached) the same, also along
+ * paths with the cloud replaced (a new model, maybe at the old one's
+ * address); no heap call in the calls.
  */
 #include <math.h>
 #include <stdint.h>
@@ -232,6 +234,102 @@ static void test_cloud_primitives(void)
 	PX_CHECK_MSG(inside >= 10, "only %d clouds reaching inside", inside);
 }
 
+/* Through a cache, cold and coherent: brute force's distance on random
+ * poses with clouds apart, touching and reaching inside (convex and
+ * non-convex meshes: the cache's planes bound both). */
+static void test_cached_reference(void)
+{
+	static px_vec3 w[NP];
+	static double xyz[3 * NP];
+	static struct px_pair_cache pc;
+	struct px_pair_opts co = {1, 0, 0, 1, 0, 0};
+	int trial, apart = 0, inside = 0;
+	for (trial = 0; trial < 60; trial++) {
+		double rm, ref;
+		struct px_model *m = px_test_mesh_shape(trial % 4, 1, &rm), *c;
+		struct px_pair_result r, rs;
+		int mode = trial % 3;
+		double off = mode == 0 ? rm + px_rand_range(0.35, 1.0) : px_rand_range(0.0, rm);
+		px_vec3 cen = px_v3_scale(rand_dir(), off);
+		px_model_set_pose(m, px_test_rand_pose(0.5));
+		cen = px_pose_transform_point(px_model_pose(m), cen);
+		make_points(m, cen, px_rand_range(0.1, 0.3), mode == 2, w, xyz);
+		PX_CHECK_INT_EQ(px_cloud_model(xyz, NP, 0.0, NULL, &c), PX_OK);
+		ref = brute_mesh(m, w, NP);
+		px_pair_cache_init(&pc);
+		memset(&r, 0, sizeof(r));
+		memset(&rs, 0, sizeof(rs));
+		PX_CHECK_INT_EQ(px_pair_distance_cached(c, m, NULL, &pc, &r), PX_OK);
+		PX_CHECK_INT_EQ(px_pair_distance_cached(m, c, &co, &pc, &rs), PX_OK);
+		PX_CHECK_MSG(fabs(r.distance - ref) <= 1e-9 * (1 + fabs(ref)) &&
+				     fabs(rs.distance - ref) <= 1e-9 * (1 + fabs(ref)),
+			     "trial %d: %.17g, %.17g vs brute force %.17g", trial, r.distance,
+			     rs.distance, ref);
+		check_result(&r);
+		check_result(&rs);
+		apart += ref > 1e-9;
+		inside += ref < -1e-9;
+		px_model_free(m);
+		px_model_free(c);
+	}
+	PX_CHECK_MSG(apart >= 15 && inside >= 10, "%d apart, %d inside", apart, inside);
+}
+
+/* Coherent calls through a cache along random paths of the mesh
+ * through and around the cloud, the cloud replaced every 16 steps by a
+ * new one (freed first, so the new one may take its address): brute
+ * force's distance at every step, the cut reused most steps, no heap
+ * call in the calls. */
+static void test_cached_paths(void)
+{
+	static px_vec3 w[NP];
+	static double xyz[3 * NP];
+	static struct px_pair_cache pc;
+	struct px_pair_opts co = {1, 0, 0, 1, 0, 0};
+	int path, k, neg = 0;
+	uint64_t allocs = 0;
+	for (path = 0; path < 8; path++) {
+		double rm;
+		struct px_model *m = px_test_mesh_shape(path % 4, 1, &rm), *c = NULL;
+		struct px_pair_result rc;
+		px_pose P0 = px_test_rand_pose(0.0), P1 = px_test_rand_pose(0.0);
+		px_vec3 a = px_v3_scale(rand_dir(), rm + 0.5), b = px_v3_scale(a, -0.2);
+		px_pair_cache_init(&pc);
+		memset(&rc, 0, sizeof(rc));
+		for (k = 0; k <= 160; k++) {
+			double s = k / 160.0, ref;
+			px_pose P;
+			uint64_t al;
+			if (k % 16 == 0) {
+				px_model_free(c);
+				make_points(m, px_v3(0, 0, 0), 0.25, 0, w, xyz);
+				PX_CHECK_INT_EQ(px_cloud_model(xyz, NP, 0.0, NULL, &c), PX_OK);
+			}
+			/* small steps: the cut stays valid over several */
+			P.q = px_quat_slerp(P0.q, P1.q, 0.3 * s);
+			P.t = px_v3_lerp(a, b, s);
+			px_model_set_pose(m, P);
+			al = px_alloc_region_begin();
+			PX_CHECK_INT_EQ(px_pair_distance_cached(m, c, &co, &pc, &rc), PX_OK);
+			allocs += px_alloc_region_end(al);
+			ref = brute_mesh(m, w, NP);
+			PX_CHECK_MSG(fabs(rc.distance - ref) <= 1e-9 * (1 + fabs(ref)),
+				     "path %d step %d: %.17g vs brute force %.17g", path, k,
+				     rc.distance, ref);
+			PX_CHECK(!rc.local_only);
+			neg += rc.distance < 0.0;
+		}
+		PX_CHECK_MSG(px_pair_cache_reused(&pc) > px_pair_cache_full(&pc),
+			     "path %d: cut reused %lu times, made %lu", path,
+			     px_pair_cache_reused(&pc), px_pair_cache_full(&pc));
+		px_model_free(m);
+		px_model_free(c);
+	}
+	PX_CHECK_INT_EQ(allocs, 0);
+	PX_CHECK_MSG(neg >= 20, "only %d steps with points inside", neg);
+}
+
 static const struct px_test tests[] = {PX_T(test_mesh_cloud_reference), PX_T(test_open_mesh_cloud),
-				       PX_T(test_coherent_equals_cold), PX_T(test_cloud_primitives)};
+				       PX_T(test_coherent_equals_cold), PX_T(test_cloud_primitives),
+				       PX_T(test_cached_reference), PX_T(test_cached_paths)};
 PX_TEST_MAIN(tests)
