@@ -337,11 +337,6 @@ static int beats(const struct px__cloud_min *m, double v)
 	return m->found ? v < m->s : v <= m->s;
 }
 
-/* Must a subtree or point of bound lb be opened? */
-static int opens(const struct cl_ctx *X, double lb)
-{
-	return beats(X->out, lb);
-}
 
 /* Lower bound of the signed distance of o at cloud point p (cloud
  * frame): its distance to o's box, or minus its depth in the box. */
@@ -384,7 +379,7 @@ static double cl_leaf(struct cl_ctx *X, uint32_t i0, uint32_t n, int *rc)
 	 * measured first lowers the best for the rest */
 	for (i = 0; i < n && i < LEAF_PTS; i++) {
 		double lb = point_lb(X, X->V.pt[i0 + i]);
-		if (!opens(X, lb)) {
+		if (!beats(X->out, lb)) {
 			least = lb < least ? lb : least;
 			continue;
 		}
@@ -401,7 +396,7 @@ static double cl_leaf(struct cl_ctx *X, uint32_t i0, uint32_t n, int *rc)
 		double lb = lbs[j], reach;
 		struct px_model_result q;
 		int r;
-		if (!opens(X, lb)) {
+		if (!beats(X->out, lb)) {
 			least = lb < least ? lb : least;
 			continue;
 		}
@@ -462,7 +457,7 @@ static int cl_walk(struct cl_ctx *X, struct cl_ent *st, int sp)
 		struct cl_ent e = st[--sp], kid[4];
 		const struct node4 *nd;
 		int nk = 0;
-		if (!opens(X, e.lb)) {
+		if (!beats(X->out, e.lb)) {
 			cut_add(X, e.idx, e.cnt, e.lb);
 			continue;
 		}
@@ -486,7 +481,7 @@ static int cl_walk(struct cl_ctx *X, struct cl_ent *st, int sp)
 				       px_v3_scale(px_v3_sub(hi, lo), 0.5));
 			ch.idx = nd->idx[j];
 			ch.cnt = nd->cnt[j];
-			if (!opens(X, ch.lb)) {
+			if (!beats(X->out, ch.lb)) {
 				cut_add(X, ch.idx, ch.cnt, ch.lb);
 				continue;
 			}

@@ -89,23 +89,34 @@ static void make_points(const struct px_model *m, px_vec3 c, double rr, int touc
 	}
 }
 
+/* Trial k of the reference tests: a posed mesh (returned) and a cloud
+ * *c of NP points (w, xyz) apart from it (k % 3 == 0), through its
+ * surface (1) or touching it (2); *ref the brute-force distance. */
+static struct px_model *reference_case(int k, px_vec3 *w, double *xyz, struct px_model **c,
+				       double *ref)
+{
+	double rm;
+	struct px_model *m = px_test_mesh_shape(k % 4, 1, &rm);
+	int mode = k % 3;
+	double off = mode == 0 ? rm + px_rand_range(0.35, 1.0) : px_rand_range(0.0, rm);
+	px_vec3 cen = px_v3_scale(rand_dir(), off);
+	px_model_set_pose(m, px_test_rand_pose(0.5));
+	cen = px_pose_transform_point(px_model_pose(m), cen);
+	make_points(m, cen, px_rand_range(0.1, 0.3), mode == 2, w, xyz);
+	PX_CHECK_INT_EQ(px_cloud_model(xyz, NP, 0.0, NULL, c), PX_OK);
+	*ref = brute_mesh(m, w, NP);
+	return m;
+}
+
 static void test_mesh_cloud_reference(void)
 {
 	static px_vec3 w[NP];
 	static double xyz[3 * NP];
 	int trial, apart = 0, inside = 0, touching = 0;
 	for (trial = 0; trial < 80; trial++) {
-		double rm, ref;
-		struct px_model *m = px_test_mesh_shape(trial % 4, 1, &rm), *c;
+		double ref;
+		struct px_model *c, *m = reference_case(trial, w, xyz, &c, &ref);
 		struct px_pair_result r, rs;
-		int mode = trial % 3; /* 0 apart, 1 through the surface, 2 touching */
-		double off = mode == 0 ? rm + px_rand_range(0.35, 1.0) : px_rand_range(0.0, rm);
-		px_vec3 cen = px_v3_scale(rand_dir(), off);
-		px_model_set_pose(m, px_test_rand_pose(0.5));
-		cen = px_pose_transform_point(px_model_pose(m), cen);
-		make_points(m, cen, px_rand_range(0.1, 0.3), mode == 2, w, xyz);
-		PX_CHECK_INT_EQ(px_cloud_model(xyz, NP, 0.0, NULL, &c), PX_OK);
-		ref = brute_mesh(m, w, NP);
 		memset(&r, 0, sizeof(r));
 		memset(&rs, 0, sizeof(rs));
 		PX_CHECK_INT_EQ(px_pair_distance(m, c, NULL, &r), PX_OK);
@@ -245,17 +256,9 @@ static void test_cached_reference(void)
 	struct px_pair_opts co = {1, 0, 0, 1, 0, 0};
 	int trial, apart = 0, inside = 0;
 	for (trial = 0; trial < 60; trial++) {
-		double rm, ref;
-		struct px_model *m = px_test_mesh_shape(trial % 4, 1, &rm), *c;
+		double ref;
+		struct px_model *c, *m = reference_case(trial, w, xyz, &c, &ref);
 		struct px_pair_result r, rs;
-		int mode = trial % 3;
-		double off = mode == 0 ? rm + px_rand_range(0.35, 1.0) : px_rand_range(0.0, rm);
-		px_vec3 cen = px_v3_scale(rand_dir(), off);
-		px_model_set_pose(m, px_test_rand_pose(0.5));
-		cen = px_pose_transform_point(px_model_pose(m), cen);
-		make_points(m, cen, px_rand_range(0.1, 0.3), mode == 2, w, xyz);
-		PX_CHECK_INT_EQ(px_cloud_model(xyz, NP, 0.0, NULL, &c), PX_OK);
-		ref = brute_mesh(m, w, NP);
 		px_pair_cache_init(&pc);
 		memset(&r, 0, sizeof(r));
 		memset(&rs, 0, sizeof(rs));
