@@ -218,7 +218,7 @@ static int cloud_answer(struct px_pair_result *res, double s, px_vec3 po, px_vec
 }
 
 int px__pair_cloud(const struct px_model *a, const struct px_model *b, int coherent,
-		   struct px_pair_cache *cache, struct px_pair_result *res)
+		   struct px_pair_cache *cache, int keep_cut, struct px_pair_result *res)
 {
 	int ca = px_model_kind(a) == PX_MODEL_CLOUD, cb = !ca && px_model_kind(b) == PX_MODEL_CLOUD;
 	const struct px_model *c = ca ? a : b, *o = ca ? b : a;
@@ -236,7 +236,7 @@ int px__pair_cloud(const struct px_model *a, const struct px_model *b, int coher
 		 * bounded by the mesh's planes, signed over the points for a
 		 * closed mesh (inside: minus the depth), unsigned for an
 		 * open one */
-		if ((rc = px__cloud_mesh_min(c, o, cache, coherent,
+		if ((rc = px__cloud_mesh_min(c, o, cache, keep_cut,
 					     coherent ? (ca ? res->index_a : res->index_b) : -1,
 					     &cm)) < 0)
 			return rc;

@@ -243,14 +243,17 @@ int px__cloud_mesh_min(const struct px_model *c, const struct px_model *o, struc
  * model. A mesh by both hierarchies at once (px__mesh_cloud_pair; with
  * coherent, res's last triangle and point are the first bound), then
  * for a closed mesh its points inside (px__cloud_min_model); a
- * primitive by its point queries over the cloud's hierarchy. Fills res
+ * primitive by its point queries over the cloud's hierarchy. cache (may
+ * be NULL): a small mesh takes px__cloud_mesh_min() instead, keeping
+ * the cut when keep_cut (the caller asked for coherence, even where
+ * res holds no valid last answer: a cloud just swapped in). Fills res
  * as px_pair_distance() does (local_only only if a query was not exact)
  * and returns 1 (the normal from the points is the caller's), 2 (with
  * its normal: an overlap with depth), 0 when the pair is not one of
  * these, or an error. RT-safe.
  */
 int px__pair_cloud(const struct px_model *a, const struct px_model *b, int coherent,
-		   struct px_pair_cache *cache, struct px_pair_result *res);
+		   struct px_pair_cache *cache, int keep_cut, struct px_pair_result *res);
 
 /* ---- NURBS surface models (pair_nurbs.c) ---------------------------------- */
 

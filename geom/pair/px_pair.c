@@ -536,7 +536,7 @@ int px_pair_distance_cached(const struct px_model *a, const struct px_model *b,
 		rc = pair_convex(a, b, res);
 	/* a cloud against a mesh or a primitive: exact (pair_cloud.c) */
 	if (rc == STEP_NONE)
-		rc = px__pair_cloud(a, b, cfg.coherent, cache, res);
+		rc = px__pair_cloud(a, b, cfg.coherent, cache, opt && opt->coherent, res);
 	/* NURBS surfaces against a mesh, NURBS or a convex primitive:
 	 * certified by both hierarchies (pair_nurbs.c) */
 	if (rc == STEP_NONE)
