@@ -341,10 +341,14 @@ int px_urdf_robot_set_obstacles(struct px_urdf_robot *r,
 		int b;
 		if (px_model_kind(obstacles[i]) != PX_MODEL_CLOUD)
 			continue;
-		for (b = 0; b < r->n_bodies; b++)
-			pc[(size_t)b * (size_t)n + (size_t)i] =
+		for (b = 0; b < r->n_bodies; b++) {
+			struct px_pair_cache *c =
 				(struct px_pair_cache *)(void *)(cmem + (np + 1) * sizeof(*pc)) +
 				nc++;
+			/* the link's planes now, not in its first cycle */
+			px_pair_cache_prepare(c, r->bodies[b].model);
+			pc[(size_t)b * (size_t)n + (size_t)i] = c;
+		}
 	}
 	if (n)
 		memcpy(ob, obstacles, (size_t)n * sizeof(*ob));

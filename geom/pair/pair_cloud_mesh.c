@@ -533,6 +533,12 @@ static int full_walk(struct cl_ctx *X, struct px_pair_cache *C)
 	return rc;
 }
 
+void px_pair_cache_prepare(struct px_pair_cache *c, const struct px_model *mesh)
+{
+	if (c && mesh && px_model_kind(mesh) == PX_MODEL_MESH)
+		planes_make(&c->planes_, mesh);
+}
+
 int px__cloud_mesh_min(const struct px_model *c, const struct px_model *o, struct px_pair_cache *C,
 		       int coherent, int hint, struct px__cloud_min *out)
 {

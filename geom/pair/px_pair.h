@@ -283,6 +283,12 @@ struct px_pair_cache {
 /* Empty the cache (the next call is a full one). @note RT-safe. */
 PX_API void px_pair_cache_init(struct px_pair_cache *c);
 
+/* Make mesh's bounding planes in c now (setup time), so that the first
+ * px_pair_distance_cached() of mesh against a cloud does not (up to a
+ * millisecond for PX_PAIR_PLANES_MAX_TRIS triangles). Nothing for other
+ * models. After px_pair_cache_init(), which empties c. */
+PX_API void px_pair_cache_prepare(struct px_pair_cache *c, const struct px_model *mesh);
+
 /*
  * px_pair_distance() through cache c (may be NULL: then exactly
  * px_pair_distance()). A mesh against a point cloud with opt->coherent

@@ -298,6 +298,9 @@ static void test_cached_paths(void)
 		px_pose P0 = px_test_rand_pose(0.0), P1 = px_test_rand_pose(0.0);
 		px_vec3 a = px_v3_scale(rand_dir(), rm + 0.5), b = px_v3_scale(a, -0.2);
 		px_pair_cache_init(&pc);
+		/* half the paths with the planes made at setup */
+		if (path % 2)
+			px_pair_cache_prepare(&pc, m);
 		memset(&rc, 0, sizeof(rc));
 		for (k = 0; k <= 160; k++) {
 			double s = k / 160.0, ref;
