@@ -631,8 +631,9 @@ FUZZ_RUN     := $(if $(FUZZ_TARGETS),$(subst $(comma), ,$(FUZZ_TARGETS)),$(FUZZ_
 FUZZ_BIN     := $(patsubst %,$(BUILD)/fuzz/fuzz_%,$(FUZZ_NAMES))
 # C++ parts and the DDS bridge are built with their C stand-ins there
 # (the fuzz targets reach neither C++ nor DDS, whose generated types are
-# not in the fuzz build).
-FUZZ_LIB_SRC := $(foreach f,$(LIB_SRC),$(if $(filter $(addprefix %/,$(SRC_DDS)),$(f)),$(f:.c=_none.c),$(f)))
+# not in the fuzz build); a DDS file without a _none.c of its own has its
+# stand-ins in another's (as in a build without DDS).
+FUZZ_LIB_SRC := $(foreach f,$(LIB_SRC),$(if $(filter $(addprefix %/,$(SRC_DDS)),$(f)),$(wildcard $(f:.c=_none.c)),$(f)))
 FUZZ_LIB_OBJ := $(patsubst %.c,$(BUILD)/fuzz/obj/%.o,$(FUZZ_LIB_SRC) $(LIB_CXX_SRC:.cpp=_none.c))
 FUZZ_SAN     := -fsanitize=address,undefined -fno-sanitize-recover=undefined
 FUZZ_FLAGS   := -std=c11 -D_GNU_SOURCE $(WARN) $(INCS) -g -O1 \
